@@ -1,0 +1,1 @@
+// daemon: eicald internals. See daemon/*/ for the parts.

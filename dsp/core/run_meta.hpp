@@ -1,0 +1,94 @@
+#pragma once
+// Metadata of a recorded run (eical-run/1, shared/spec/run-format.md) as plain data.
+// Parsing and writing live in drivers/run_io; dsp only reads these values.
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace eical::dsp {
+
+struct Acquisition {
+  double fs_hz = 10000.0;
+  int adc_bits = 24;
+  double adc_lsb_volt = 1.1920929e-6;  // 20 V span / 2^24
+  std::int64_t adc_offset_counts = 0;
+  double daq_group_delay_samples = 38.8;  // nominal (data sheet)
+};
+
+struct Site {
+  double latitude_deg = 51.3;
+  double heading_deg = 0.0;  // azimuth of machine +X, clockwise from north
+  double g_mps2 = 9.8113;
+};
+
+// Which machine axes are moved by the table and which by the head ("x", "y", "z").
+struct MachineLayout {
+  std::string name = "sim-maho";
+  std::vector<std::string> table_axes = {"x", "y"};
+  std::vector<std::string> head_axes = {"z"};
+};
+
+// Data-sheet (nominal) sensor values as in [sensors.table] / [sensors.head].
+struct SensorSpec {
+  std::string model = "SF3000L";
+  Eigen::Matrix3d to_machine = Eigen::Matrix3d::Identity();  // rows machine X,Y,Z; cols sensor axes
+  Eigen::Vector3d k1_v_per_g{1.235, 1.228, 1.234};
+  Eigen::Vector3d k2_g_per_g2{-7.05e-4, -8.56e-4, -1.57e-3};
+  Eigen::Vector3d k3_g_per_g3{6.45e-4, 1.06e-3, -1.49e-3};
+  Eigen::Vector3d bias_g{0.044, 0.010, -0.012};
+  double tc_k1_ppm_per_c = 70.0;
+  double tc_bias_ug_per_c = 100.0;
+  double f0_hz = 1000.0;
+  double zeta = 0.707;
+  double noise_ug_per_rthz = 0.4;
+  double temp_ref_c = 20.0;
+};
+
+struct PsdSpec {
+  std::string measures = "x";      // relative-position axis it measures
+  double center_mm[2] = {0.0, 0.0};  // (x, y) of the strip centre, relative coordinates
+  double length_mm = 10.0;
+  double width_mm = 0.5;
+  double lockin_tau_s = 2.0e-5;
+};
+
+// [program]: which keys are meaningful depends on kind (see run-format.md).
+struct Program {
+  std::string kind = "circle";  // step | positioning | rectangle | circle | freeform
+  std::string plane = "xy";
+  double center_mm[2] = {0.0, 0.0};
+  double radius_mm = 10.0;
+  double feed_mm_min = 2500.0;
+  std::string direction = "ccw";  // cw | ccw
+  int repeats = 1;
+  std::string axis = "x";          // step / positioning
+  std::vector<double> targets_mm;  // step / positioning
+  int runs = 1;                    // step / positioning
+  double dwell_s = 0.0;
+  double corner_mm[2] = {0.0, 0.0};  // rectangle
+  double size_mm[2] = {0.0, 0.0};    // rectangle
+  std::string gcode;                 // NC source that produced the run, if any
+};
+
+struct Reference {
+  std::string kind;
+  std::vector<std::string> axes;
+};
+
+struct RunMeta {
+  std::string format = "eical-run/1";
+  std::string id;
+  std::string created;  // RFC 3339 text as written in run.toml
+  Acquisition acquisition;
+  Site site;
+  MachineLayout machine;
+  SensorSpec sensors[2];  // index by Sensor: table, head
+  std::vector<PsdSpec> psd;
+  Program program;
+  std::optional<Reference> reference;
+};
+
+}  // namespace eical::dsp

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Install the Debian 12 packages eical needs, only those missing; quiet when none is.
+# Usage: scripts/deps.sh [build|test]   (test adds what only the test suite needs)
+set -euo pipefail
+build_pkgs=(g++ cmake ninja-build pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev
+  nlohmann-json3-dev zlib1g-dev libsystemd-dev libusb-1.0-0-dev libgpiod-dev
+  cyclonedds-dev cyclonedds-tools libgtest-dev libbenchmark-dev libboost-dev)
+test_pkgs=(systemd)
+want=("${build_pkgs[@]}")
+[[ "${1:-build}" == test ]] && want+=("${test_pkgs[@]}")
+
+missing=()
+for p in "${want[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+((${#missing[@]} == 0)) && exit 0
+
+echo "eical: installing missing Debian packages: ${missing[*]}" >&2
+sudo_cmd=()
+if [[ $(id -u) -ne 0 ]]; then
+  command -v sudo >/dev/null || { echo "eical: need root or sudo to install: ${missing[*]}" >&2; exit 1; }
+  sudo_cmd=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -qq
+"${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

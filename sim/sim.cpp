@@ -1,0 +1,1 @@
+// sim: physics of the machine and the measurement chain. See sim/*/ for the parts.

@@ -1,0 +1,12 @@
+#include "tools/commands.hpp"
+
+#include <cstdio>
+
+namespace eical::tools {
+
+void register_version(CLI::App& app) {
+  auto* cmd = app.add_subcommand("version", "Print the eical version and the formats it speaks");
+  cmd->callback([] { std::printf("eical 0.1.0 (eical-run/1, eical-result/1, eical-explain/1)\n"); });
+}
+
+}  // namespace eical::tools

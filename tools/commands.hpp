@@ -1,0 +1,16 @@
+#pragma once
+// Every `eical` subcommand is one file tools/cmd_<name>.cpp exposing one register function.
+// A command reports failure by throwing (message printed as "eical: <what>", exit 1) or
+// CLI::RuntimeError(code) for a specific exit code.
+#include <CLI/CLI.hpp>
+
+namespace eical::tools {
+
+void register_version(CLI::App& app);
+
+// The list main() registers, in the order `eical --help` shows them.
+inline void register_all(CLI::App& app) {
+  register_version(app);
+}
+
+}  // namespace eical::tools
