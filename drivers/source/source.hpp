@@ -1,0 +1,45 @@
+#pragma once
+// One interface for every origin of frames: hardware DAQ, simulator, recorded run.
+// The acquisition thread calls read() in a loop and pushes into the SPSC ring.
+#include "dsp/core/frame.hpp"
+#include "dsp/core/run_meta.hpp"
+
+#include <cstddef>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace eical::drivers {
+
+// A source that cannot start (absent device, unreadable file) says why with this type.
+class SourceError : public std::runtime_error {
+ public:
+  explicit SourceError(const std::string& what) : std::runtime_error(what) {}
+};
+
+// How the pump treats a full ring. Live hardware must never block (the DAQ keeps
+// sampling): the newest frame is dropped and counted. A source without a real-time
+// clock (free-running replay or simulation) has nothing to lose by waiting.
+enum class Backpressure { drop_newest, wait };
+
+class Source {
+ public:
+  Source() = default;
+  Source(const Source&) = delete;
+  Source& operator=(const Source&) = delete;
+  virtual ~Source() = default;
+
+  // Starts acquisition; throws SourceError naming the cause when the device is absent.
+  virtual void open() = 0;
+  // Acquisition metadata (fs, ADC, sensors, site, PSD geometry) this source delivers.
+  [[nodiscard]] virtual const dsp::RunMeta& meta() const = 0;
+  // Fills `out` with the next frames; may block until they are due (paced sources).
+  // Returns the number written; 0 together with at_end() means the source is finished.
+  virtual std::size_t read(std::span<dsp::Frame> out) = 0;
+  [[nodiscard]] virtual bool at_end() const = 0;
+  [[nodiscard]] virtual std::string_view name() const = 0;
+  [[nodiscard]] virtual Backpressure backpressure() const = 0;
+};
+
+}  // namespace eical::drivers
