@@ -1,1 +1,0 @@
-// daemon: eicald internals. See daemon/*/ for the parts.

@@ -1,0 +1,62 @@
+#pragma once
+// Strict reading of TOML configuration files (daemon config, simulation scenarios):
+// every key must be known and of the right type; anything else is an error that names
+// the file, the line and the key. Unknown keys are caught by finish(), so a typo such as
+// `fs_hz` → `fs_Hz` never silently falls back to a default.
+#include <toml++/toml.h>
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace eical::drivers {
+
+class StrictTable {
+ public:
+  // `file` names the source in messages; `section` is the dotted table path ("" = root).
+  StrictTable(const toml::table& table, std::string file, std::string section);
+
+  // Parses a whole file; syntax errors become InputError "file:line:col: message".
+  static toml::table parse_file(const std::string& path);
+
+  [[nodiscard]] bool has(std::string_view key) const;
+
+  double number(std::string_view key);  // required; integers are accepted as numbers
+  double number(std::string_view key, double fallback);
+  std::int64_t integer(std::string_view key);
+  std::int64_t integer(std::string_view key, std::int64_t fallback);
+  std::string string(std::string_view key);
+  std::string string(std::string_view key, std::string fallback);
+  // A string that must be one of `allowed`.
+  std::string choice(std::string_view key, const std::vector<std::string>& allowed, std::string fallback);
+  bool boolean(std::string_view key, bool fallback);
+  std::vector<double> numbers(std::string_view key, std::optional<std::size_t> exact_size = std::nullopt);
+  std::vector<std::string> strings(std::string_view key);
+
+  // Sub-table (required or optional) and arrays of tables ([[psd]]).
+  StrictTable table(std::string_view key);
+  std::optional<StrictTable> optional_table(std::string_view key);
+  std::vector<StrictTable> tables(std::string_view key);
+
+  // Throws InputError for the first key that was never asked for.
+  void finish() const;
+
+  [[nodiscard]] const std::string& file() const { return file_; }
+  [[nodiscard]] std::string where(std::string_view key) const;  // "file:line: [section] key"
+
+  // Error for a value that has the right type but is out of range.
+  [[noreturn]] void fail(std::string_view key, const std::string& reason) const;
+
+ private:
+  const toml::node* get(std::string_view key, bool required);
+  const toml::table* table_;
+  std::string file_;
+  std::string section_;
+  std::set<std::string, std::less<>> used_;
+};
+
+}  // namespace eical::drivers
