@@ -1,0 +1,278 @@
+#include "sim/gcode/parser.hpp"
+
+#include "dsp/core/error.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <optional>
+#include <string>
+
+namespace eical::sim::gcode {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct Word {
+  char letter;
+  double value;
+  int column;  // 1-based
+};
+
+// Axis index pairs (u, v) of each plane and the normal axis; ccw is positive about the normal.
+struct PlaneAxes {
+  int u, v, normal;
+};
+constexpr PlaneAxes axes_of(Plane p) {
+  switch (p) {
+    case Plane::xy: return {0, 1, 2};
+    case Plane::zx: return {2, 0, 1};
+    case Plane::yz: return {1, 2, 0};
+  }
+  return {0, 1, 2};
+}
+
+class LineParser {
+ public:
+  LineParser(std::string_view name, int line) : name_(name), line_(line) {}
+
+  [[noreturn]] void fail(int column, const std::string& what) const {
+    throw dsp::InputError(std::string(name_) + ":" + std::to_string(line_) + ":" + std::to_string(column) + ": " + what);
+  }
+
+  // Splits one line into words, dropping comments, block delete and '%'.
+  std::vector<Word> words(std::string_view text) const {
+    std::vector<Word> out;
+    std::size_t i = 0;
+    const auto skip_space = [&] {
+      while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i]))) ++i;
+    };
+    while (true) {
+      skip_space();
+      if (i >= text.size()) break;
+      const char c = text[i];
+      if (c == ';') break;
+      if (c == '%' && out.empty()) break;
+      if (c == '(') {
+        const auto close = text.find(')', i);
+        if (close == std::string_view::npos) fail(static_cast<int>(i) + 1, "comment '(' is not closed on this line");
+        i = close + 1;
+        continue;
+      }
+      if (!std::isalpha(static_cast<unsigned char>(c)))
+        fail(static_cast<int>(i) + 1, std::string("expected a word letter, got '") + c + "'");
+      const int column = static_cast<int>(i) + 1;
+      const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+      ++i;
+      skip_space();
+      std::size_t start = i;
+      if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+      while (i < text.size() && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.')) ++i;
+      std::string number(text.substr(start, i - start));
+      if (!number.empty() && number.front() == '+') number.erase(0, 1);
+      // from_chars does not take ".5" or "5." forms everywhere; normalise them.
+      if (!number.empty() && (number.front() == '.' || (number.size() > 1 && number[0] == '-' && number[1] == '.')))
+        number.insert(number.front() == '-' ? 1u : 0u, "0");
+      double v = 0.0;
+      const auto* first = number.data();
+      const auto* last = number.data() + number.size();
+      auto [ptr, ec] = std::from_chars(first, last, v);
+      if (number.empty() || ec != std::errc() || ptr != last)
+        fail(column, std::string("word '") + letter + "' needs a number");
+      out.push_back({letter, v, column});
+    }
+    return out;
+  }
+
+ private:
+  std::string_view name_;
+  int line_;
+};
+
+bool is_code(double value, double code) { return std::abs(value - code) < 1e-9; }
+
+}  // namespace
+
+Program parse(std::string_view text, std::string_view name, const ParseOptions& options) {
+  Program program;
+  Eigen::Vector3d pos = options.start_mm;
+  Plane plane = Plane::xy;
+  bool absolute = true;       // G90
+  bool arc_absolute = false;  // G90.1 / G91.1 (LinuxCNC default: incremental I/J/K)
+  double unit_mm = 1.0;       // G21; 25.4 after G20
+  int motion = -1;            // modal motion G0..G3, -1 = none yet
+  double feed_mm_min = 0.0;
+
+  int line_no = 0;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(begin, end - begin);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    ++line_no;
+    begin = end + 1;
+    LineParser lp(name, line_no);
+    const std::vector<Word> words = lp.words(line);
+    if (words.empty()) {
+      if (end == text.size()) break;
+      continue;
+    }
+
+    std::array<std::optional<Word>, 26> value{};  // non-G/M words by letter
+    std::vector<Word> gcodes, mcodes;
+    for (const Word& w : words) {
+      switch (w.letter) {
+        case 'G': gcodes.push_back(w); break;
+        case 'M': mcodes.push_back(w); break;
+        case 'N': break;  // line number
+        case 'X': case 'Y': case 'Z': case 'I': case 'J': case 'K': case 'R': case 'F': case 'P': case 'Q': {
+          auto& slot = value[static_cast<std::size_t>(w.letter - 'A')];
+          if (slot) lp.fail(w.column, std::string("word '") + w.letter + "' appears twice in one block");
+          slot = w;
+          break;
+        }
+        default: lp.fail(w.column, std::string("unsupported word '") + w.letter + "'");
+      }
+    }
+    const auto word = [&](char l) -> const std::optional<Word>& { return value[static_cast<std::size_t>(l - 'A')]; };
+
+    bool dwell = false;
+    int block_motion = -1;
+    for (const Word& g : gcodes) {
+      const double c = g.value;
+      if (is_code(c, 0) || is_code(c, 1) || is_code(c, 2) || is_code(c, 3)) {
+        if (block_motion >= 0) lp.fail(g.column, "two motion G-codes in one block");
+        block_motion = static_cast<int>(std::lround(c));
+      } else if (is_code(c, 4)) dwell = true;
+      else if (is_code(c, 17)) plane = Plane::xy;
+      else if (is_code(c, 18)) plane = Plane::zx;
+      else if (is_code(c, 19)) plane = Plane::yz;
+      else if (is_code(c, 20)) unit_mm = 25.4;
+      else if (is_code(c, 21)) unit_mm = 1.0;
+      else if (is_code(c, 61) || is_code(c, 61.1)) program.exact_stop = true;
+      else if (is_code(c, 64)) program.exact_stop = false;
+      else if (is_code(c, 90)) absolute = true;
+      else if (is_code(c, 91)) absolute = false;
+      else if (is_code(c, 90.1)) arc_absolute = true;
+      else if (is_code(c, 91.1)) arc_absolute = false;
+      else if (is_code(c, 94)) {  // units per minute feed: the only feed mode supported
+      } else {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "G%g", c);
+        lp.fail(g.column, std::string("unsupported G-code ") + buf);
+      }
+    }
+    if (const auto& f = word('F')) {
+      if (!(f->value > 0.0)) lp.fail(f->column, "feed F must be positive");
+      feed_mm_min = f->value * unit_mm;
+    }
+
+    // Execution order within a block follows LinuxCNC: user M-codes, dwell, then motion.
+    for (const Word& m : mcodes) {
+      const int code = static_cast<int>(std::lround(m.value));
+      if (!is_code(m.value, code)) lp.fail(m.column, "M-code must be an integer");
+      if (code >= 100 && code <= 199) {
+        program.blocks.emplace_back(Trigger{code, word('P') ? word('P')->value : kNaN, word('Q') ? word('Q')->value : kNaN});
+        program.source.push_back({line_no});
+      } else if (std::find(options.ignored_m.begin(), options.ignored_m.end(), code) == options.ignored_m.end()) {
+        lp.fail(m.column, "unsupported M-code M" + std::to_string(code));
+      }
+    }
+    const bool trigger_in_block = std::any_of(mcodes.begin(), mcodes.end(), [](const Word& m) {
+      return m.value >= 100 && m.value < 200;
+    });
+    if (dwell) {
+      const auto& p = word('P');
+      if (!p) lp.fail(gcodes.front().column, "G4 needs P<seconds>");
+      if (p->value < 0.0) lp.fail(p->column, "dwell P must not be negative");
+      program.blocks.emplace_back(Dwell{p->value});
+      program.source.push_back({line_no});
+    } else if (word('P') && !trigger_in_block) {
+      lp.fail(word('P')->column, "word 'P' without G4 or a user M-code");
+    }
+    if (word('Q') && !trigger_in_block) lp.fail(word('Q')->column, "word 'Q' without a user M-code");
+
+    if (block_motion >= 0) motion = block_motion;
+    const bool has_axis = word('X') || word('Y') || word('Z');
+    const bool has_arc_words = word('I') || word('J') || word('K') || word('R');
+    if (!has_axis && !has_arc_words) continue;
+    if (dwell) lp.fail(word('X') ? word('X')->column : 1, "G4 and a motion in one block");
+    if (motion < 0) lp.fail(words.front().column, "axis words without a motion mode (G0/G1/G2/G3)");
+
+    Eigen::Vector3d target = pos;
+    for (int a = 0; a < 3; ++a) {
+      if (const auto& w = word(static_cast<char>('X' + a))) target[a] = absolute ? w->value * unit_mm : pos[a] + w->value * unit_mm;
+    }
+    if (motion == 0 || motion == 1) {
+      if (has_arc_words) {
+        const auto& w = word('I') ? word('I') : word('J') ? word('J') : word('K') ? word('K') : word('R');
+        lp.fail(w->column, "arc words I/J/K/R need G2 or G3");
+      }
+      if (motion == 1 && feed_mm_min <= 0.0) lp.fail(words.front().column, "G1 without a feed rate F");
+      program.blocks.emplace_back(Linear{pos, target, feed_mm_min, motion == 0});
+      program.source.push_back({line_no});
+      pos = target;
+      continue;
+    }
+
+    // Arcs (G2 clockwise, G3 counter-clockwise about the plane normal).
+    if (feed_mm_min <= 0.0) lp.fail(words.front().column, "arc without a feed rate F");
+    const PlaneAxes ax = axes_of(plane);
+    const bool cw = motion == 2;
+    const Eigen::Vector2d s(pos[ax.u], pos[ax.v]);
+    const Eigen::Vector2d e(target[ax.u], target[ax.v]);
+    Eigen::Vector2d c;
+    if (const auto& r = word('R')) {
+      if (word('I') || word('J') || word('K')) lp.fail(r->column, "arc with both R and I/J/K");
+      const double radius = std::abs(r->value) * unit_mm;
+      const Eigen::Vector2d chord = e - s;
+      const double d = chord.norm();
+      if (d < 1e-12) lp.fail(r->column, "R-form arc needs distinct start and end points");
+      if (d / 2.0 > radius + options.arc_radius_tolerance_mm) lp.fail(r->column, "arc radius R is smaller than half the chord");
+      const double h = std::sqrt(std::max(0.0, radius * radius - d * d / 4.0));
+      const Eigen::Vector2d left(-chord.y() / d, chord.x() / d);  // unit normal to the left of the chord
+      // Short arc (R > 0): centre left of the chord for ccw, right for cw; R < 0 flips.
+      const double side = (cw ? -1.0 : 1.0) * (r->value < 0.0 ? -1.0 : 1.0);
+      c = (s + e) / 2.0 + side * h * left;
+    } else {
+      const std::array<char, 3> offset_letter{'I', 'J', 'K'};
+      double off[3] = {0.0, 0.0, 0.0};
+      for (int a = 0; a < 3; ++a)
+        if (const auto& w = word(offset_letter[static_cast<std::size_t>(a)])) {
+          if (a == ax.normal) lp.fail(w->column, std::string("offset ") + w->letter + " is normal to the arc plane");
+          off[a] = w->value * unit_mm;
+        }
+      c = arc_absolute ? Eigen::Vector2d(off[ax.u], off[ax.v]) : s + Eigen::Vector2d(off[ax.u], off[ax.v]);
+      const double r_start = (s - c).norm(), r_end = (e - c).norm();
+      if (std::abs(r_start - r_end) > options.arc_radius_tolerance_mm)
+        lp.fail(words.front().column, "arc end point is not on the circle (radius " + std::to_string(r_start) + " vs " +
+                                          std::to_string(r_end) + " mm)");
+      if (r_start < 1e-9) lp.fail(words.front().column, "arc radius is zero");
+    }
+    const double a0 = std::atan2(s.y() - c.y(), s.x() - c.x());
+    const double a1 = std::atan2(e.y() - c.y(), e.x() - c.x());
+    double sweep = a1 - a0;
+    if (cw) {
+      while (sweep >= -1e-12) sweep -= 2.0 * kPi;  // same point → full clockwise turn
+      if (sweep < -2.0 * kPi - 1e-12) sweep += 2.0 * kPi;
+    } else {
+      while (sweep <= 1e-12) sweep += 2.0 * kPi;
+      if (sweep > 2.0 * kPi + 1e-12) sweep -= 2.0 * kPi;
+    }
+    Eigen::Vector3d centre = pos;
+    centre[ax.u] = c.x();
+    centre[ax.v] = c.y();
+    program.blocks.emplace_back(Arc{pos, target, centre, plane, cw, sweep, feed_mm_min});
+    program.source.push_back({line_no});
+    pos = target;
+  }
+  return program;
+}
+
+}  // namespace eical::sim::gcode
