@@ -150,6 +150,25 @@ std::vector<std::string> StrictTable::strings(std::string_view key) {
   return out;
 }
 
+std::vector<std::vector<double>> StrictTable::matrix(std::string_view key, std::size_t rows, std::size_t cols) {
+  const toml::node* n = get(key, true);
+  const toml::array* arr = n->as_array();
+  const std::string shape = std::to_string(rows) + "x" + std::to_string(cols);
+  if (!arr || arr->size() != rows) fail(key, "expected a " + shape + " matrix (array of " + std::to_string(rows) + " rows)");
+  std::vector<std::vector<double>> out;
+  for (const toml::node& row : *arr) {
+    const toml::array* r = row.as_array();
+    if (!r || r->size() != cols) fail(key, "row " + std::to_string(out.size()) + " is not " + std::to_string(cols) + " numbers");
+    auto& dst = out.emplace_back();
+    for (const toml::node& e : *r) {
+      if (auto i = e.value_exact<std::int64_t>()) dst.push_back(static_cast<double>(*i));
+      else if (auto f = e.value_exact<double>(); f && std::isfinite(*f)) dst.push_back(*f);
+      else fail(key, "row " + std::to_string(out.size() - 1) + " holds a value that is not a finite number");
+    }
+  }
+  return out;
+}
+
 StrictTable StrictTable::table(std::string_view key) {
   const toml::node* n = get(key, true);
   const toml::table* t = n->as_table();

@@ -36,6 +36,8 @@ class StrictTable {
   bool boolean(std::string_view key, bool fallback);
   std::vector<double> numbers(std::string_view key, std::optional<std::size_t> exact_size = std::nullopt);
   std::vector<std::string> strings(std::string_view key);
+  // An array of `rows` arrays of `cols` numbers, e.g. a 3x3 mounting matrix.
+  std::vector<std::vector<double>> matrix(std::string_view key, std::size_t rows, std::size_t cols);
 
   // Sub-table (required or optional) and arrays of tables ([[psd]]).
   StrictTable table(std::string_view key);

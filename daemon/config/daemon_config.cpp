@@ -1,0 +1,129 @@
+#include "daemon/config/daemon_config.hpp"
+
+#include "drivers/config/meta_sections.hpp"
+#include "drivers/config/strict_toml.hpp"
+
+
+namespace eical::daemon {
+namespace {
+
+using drivers::StrictTable;
+
+void read_source(StrictTable t, SourceConfig& s) {
+  s.kind = t.choice("kind", {"sim", "replay", "usb_daq"}, s.kind);
+  s.pacing = t.choice("pacing", {"realtime", "free_running"}, s.pacing);
+  s.replay_run = t.string("replay_run", s.replay_run.string());
+  if (s.kind == "replay" && s.replay_run.empty()) t.fail("replay_run", "required when kind = \"replay\"");
+  s.usb_id = t.string("usb_id", s.usb_id);
+  if (auto sim = t.optional_table("sim")) {
+    s.sim_program = sim->choice("program", {"circle", "step"}, s.sim_program);
+    s.sim_radius_mm = sim->number("radius_mm", s.sim_radius_mm);
+    if (s.sim_radius_mm <= 0.0) sim->fail("radius_mm", "must be positive");
+    s.sim_feed_mm_min = sim->number("feed_mm_min", s.sim_feed_mm_min);
+    if (s.sim_feed_mm_min <= 0.0) sim->fail("feed_mm_min", "must be positive");
+    s.sim_repeats = static_cast<int>(sim->integer("repeats", s.sim_repeats));
+    if (s.sim_repeats < 1) sim->fail("repeats", "must be at least 1");
+    const auto seed = sim->integer("seed", static_cast<std::int64_t>(s.sim_seed));
+    if (seed < 0) sim->fail("seed", "must not be negative");
+    s.sim_seed = static_cast<std::uint64_t>(seed);
+    s.sim_idle_s = sim->number("idle_s", s.sim_idle_s);
+    if (s.sim_idle_s < 0.0) sim->fail("idle_s", "must not be negative");
+    s.sim_repeat_program = sim->boolean("repeat_program", s.sim_repeat_program);
+    sim->finish();
+  }
+  t.finish();
+}
+
+void read_triggers(StrictTable t, TriggerConfig& c) {
+  if (t.has("inputs")) c.inputs = t.strings("inputs");
+  for (const auto& in : c.inputs)
+    if (in != "frame" && in != "dds" && in != "gpio" && in != "can")
+      t.fail("inputs", "'" + in + "' is not one of: frame, dds, gpio, can");
+  c.gpio_chip = t.string("gpio_chip", c.gpio_chip);
+  if (t.has("gpio_lines")) {
+    const auto lines = t.numbers("gpio_lines", 3);
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (lines[i] < 0 || lines[i] != static_cast<double>(static_cast<int>(lines[i])))
+        t.fail("gpio_lines", "line offsets must be non-negative integers");
+      c.gpio_lines[i] = static_cast<int>(lines[i]);
+    }
+  }
+  c.can_interface = t.string("can_interface", c.can_interface);
+  const auto id = t.integer("can_id", c.can_id);
+  if (id < 0 || id > 0x7FF) t.fail("can_id", "must be a standard 11-bit CAN id (0..0x7FF)");
+  c.can_id = static_cast<std::uint32_t>(id);
+  t.finish();
+}
+
+void read_dds(StrictTable t, DdsConfig& d) {
+  d.domain_id = static_cast<int>(t.integer("domain_id", d.domain_id));
+  if (d.domain_id < 0 || d.domain_id > 232) t.fail("domain_id", "must be within 0..232");
+  d.config_uri = t.string("config_uri", d.config_uri);
+  d.live_rate_hz = t.number("live_rate_hz", d.live_rate_hz);
+  if (d.live_rate_hz < 1.0 || d.live_rate_hz > 1000.0) t.fail("live_rate_hz", "must be within 1..1000");
+  d.status_rate_hz = t.number("status_rate_hz", d.status_rate_hz);
+  if (d.status_rate_hz <= 0.0 || d.status_rate_hz > 50.0) t.fail("status_rate_hz", "must be within (0, 50]");
+  t.finish();
+}
+
+void read_recording(StrictTable t, RecordingConfig& r) {
+  r.dir = t.string("dir", r.dir.string());
+  if (r.dir.empty()) t.fail("dir", "must not be empty");
+  r.gzip = t.boolean("gzip", r.gzip);
+  t.finish();
+}
+
+void read_limits(StrictTable t, Limits& l) {
+  const auto cap = t.integer("ring_capacity_frames", static_cast<std::int64_t>(l.ring_capacity_frames));
+  if (cap < 1024 || (cap & (cap - 1)) != 0) t.fail("ring_capacity_frames", "must be a power of two >= 1024");
+  l.ring_capacity_frames = static_cast<std::size_t>(cap);
+  l.max_measurement_s = t.number("max_measurement_s", l.max_measurement_s);
+  if (l.max_measurement_s <= 0.0 || l.max_measurement_s > 3600.0) t.fail("max_measurement_s", "must be within (0, 3600]");
+  l.temp_min_c = t.number("temp_min_c", l.temp_min_c);
+  l.temp_max_c = t.number("temp_max_c", l.temp_max_c);
+  if (l.temp_max_c <= l.temp_min_c) t.fail("temp_max_c", "must be above temp_min_c");
+  const auto lost = t.integer("max_lost_frames", static_cast<std::int64_t>(l.max_lost_frames));
+  if (lost < 0) t.fail("max_lost_frames", "must not be negative");
+  l.max_lost_frames = static_cast<std::uint64_t>(lost);
+  t.finish();
+}
+
+void read_realtime(StrictTable t, RealtimeConfig& r) {
+  r.sched_fifo_priority = static_cast<int>(t.integer("sched_fifo_priority", r.sched_fifo_priority));
+  if (r.sched_fifo_priority < 0 || r.sched_fifo_priority > 99) t.fail("sched_fifo_priority", "must be within 0..99");
+  r.mlockall = t.boolean("mlockall", r.mlockall);
+  t.finish();
+}
+
+}  // namespace
+
+DaemonConfig load_daemon_config(const std::filesystem::path& file) {
+  const toml::table root = StrictTable::parse_file(file.string());
+  StrictTable t(root, file.string(), "");
+  DaemonConfig c;
+  c.file = file.string();
+  if (auto s = t.optional_table("source")) read_source(*s, c.source);
+  if (auto s = t.optional_table("triggers")) read_triggers(*s, c.triggers);
+  if (auto s = t.optional_table("dds")) read_dds(*s, c.dds);
+  if (auto s = t.optional_table("recording")) read_recording(*s, c.recording);
+  if (auto s = t.optional_table("limits")) read_limits(*s, c.limits);
+  if (auto s = t.optional_table("realtime")) read_realtime(*s, c.realtime);
+  if (auto s = t.optional_table("acquisition")) c.acquisition = drivers::read_acquisition(*s);
+  if (auto s = t.optional_table("site")) c.site = drivers::read_site(*s);
+  if (auto s = t.optional_table("machine")) c.machine = drivers::read_machine(*s);
+  if (auto s = t.optional_table("sensors")) {
+    if (auto table = s->optional_table("table")) c.sensors[0] = drivers::read_sensor(*table);
+    if (auto head = s->optional_table("head")) c.sensors[1] = drivers::read_sensor(*head);
+    s->finish();
+  }
+  if (auto s = t.optional_table("calibration")) {
+    c.calibration_file = s->string("file", "");
+    s->finish();
+  }
+  for (auto& p : t.tables("psd")) c.psd.push_back(drivers::read_psd(p));
+  if (c.triggers.inputs.empty()) t.fail("triggers", "no trigger input configured: the NC could not start a measurement");
+  t.finish();
+  return c;
+}
+
+}  // namespace eical::daemon

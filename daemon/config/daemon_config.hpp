@@ -1,0 +1,84 @@
+#pragma once
+// eicald's configuration (config/eicald.toml documents every key). Read strictly: unknown
+// or mistyped keys are errors naming file, line and key, so a typo never silently falls
+// back to a default on a machine tool.
+#include "dsp/core/run_meta.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace eical::daemon {
+
+struct SourceConfig {
+  std::string kind = "sim";           // sim | replay | usb_daq
+  std::string pacing = "realtime";    // realtime | free_running (sim, replay)
+  std::filesystem::path replay_run;   // replay: an eical-run/1 directory
+  // sim: the calibration program the simulated NC runs; its M101/102/103 reach the
+  // daemon on the DAQ trigger channel, as a PLC wired to the DAQ's trigger input would.
+  std::string sim_program = "circle";  // circle | step
+  double sim_radius_mm = 10.0;
+  double sim_feed_mm_min = 2500.0;
+  int sim_repeats = 5;
+  std::uint64_t sim_seed = 1;
+  double sim_idle_s = 2.0;             // rest between repetitions of the program
+  bool sim_repeat_program = true;      // run the program again after each idle time
+  std::string usb_id = "1d50:6161";    // usb_daq: vendor:product
+};
+
+struct TriggerConfig {
+  // Which inputs may deliver M101/M102/M103: "frame" (DAQ trigger channel), "dds"
+  // (Command topic, used by `eical trigger`), "gpio", "can".
+  std::vector<std::string> inputs = {"frame", "dds"};
+  std::string gpio_chip = "gpiochip0";
+  std::vector<int> gpio_lines = {17, 27, 22};  // lines for M101, M102, M103 (rising edge)
+  std::string can_interface = "can0";
+  std::uint32_t can_id = 0x1E0;  // NC trigger frame id
+};
+
+struct DdsConfig {
+  int domain_id = 0;
+  std::string config_uri;  // Cyclone DDS XML; empty = CYCLONEDDS_URI / built-in default
+  double live_rate_hz = 100.0;
+  double status_rate_hz = 1.0;
+};
+
+struct RecordingConfig {
+  std::filesystem::path dir = "/var/lib/eical/runs";
+  bool gzip = true;
+};
+
+struct Limits {
+  std::size_t ring_capacity_frames = 65536;  // 6.5 s at 10 kHz: rides out a stalled DSP thread
+  double max_measurement_s = 600.0;          // recorder capacity, pre-allocated at start
+  double temp_min_c = 5.0;
+  double temp_max_c = 45.0;
+  std::uint64_t max_lost_frames = 0;  // more lost frames than this → result flagged degraded
+};
+
+struct RealtimeConfig {
+  int sched_fifo_priority = 80;  // 0 = normal scheduling
+  bool mlockall = true;
+};
+
+struct DaemonConfig {
+  std::string file;  // where it was read from (for messages)
+  SourceConfig source;
+  TriggerConfig triggers;
+  DdsConfig dds;
+  RecordingConfig recording;
+  Limits limits;
+  RealtimeConfig realtime;
+  dsp::Acquisition acquisition;
+  dsp::Site site;
+  dsp::MachineLayout machine;
+  dsp::SensorSpec sensors[2];            // data-sheet values, table and head
+  std::filesystem::path calibration_file;  // identified calibration (optional, overrides)
+  std::vector<dsp::PsdSpec> psd;
+};
+
+// Throws dsp::InputError "file:line: section.key: reason" on any problem.
+DaemonConfig load_daemon_config(const std::filesystem::path& file);
+
+}  // namespace eical::daemon

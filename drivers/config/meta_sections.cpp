@@ -1,0 +1,105 @@
+#include "drivers/config/meta_sections.hpp"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+
+namespace eical::drivers {
+namespace {
+
+Eigen::Vector3d vec3(StrictTable& t, std::string_view key, const Eigen::Vector3d& fallback) {
+  if (!t.has(key)) return fallback;  // finish() only rejects keys that are present
+  const auto v = t.numbers(key, 3);
+  return {v[0], v[1], v[2]};
+}
+
+bool valid_axis(const std::string& a) { return a == "x" || a == "y" || a == "z"; }
+
+}  // namespace
+
+dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults) {
+  dsp::Acquisition a = defaults;
+  a.fs_hz = t.number("fs_hz", a.fs_hz);
+  if (a.fs_hz <= 0.0) t.fail("fs_hz", "must be positive");
+  a.adc_bits = static_cast<int>(t.integer("adc_bits", a.adc_bits));
+  if (a.adc_bits < 8 || a.adc_bits > 32) t.fail("adc_bits", "must be between 8 and 32");
+  a.adc_lsb_volt = t.number("adc_lsb_volt", a.adc_lsb_volt);
+  if (a.adc_lsb_volt <= 0.0) t.fail("adc_lsb_volt", "must be positive");
+  a.adc_offset_counts = t.integer("adc_offset_counts", a.adc_offset_counts);
+  a.daq_group_delay_samples = t.number("daq_group_delay_samples", a.daq_group_delay_samples);
+  if (a.daq_group_delay_samples < 0.0) t.fail("daq_group_delay_samples", "must not be negative");
+  t.finish();
+  return a;
+}
+
+dsp::Site read_site(StrictTable t, const dsp::Site& defaults) {
+  dsp::Site s = defaults;
+  s.latitude_deg = t.number("latitude_deg", s.latitude_deg);
+  if (s.latitude_deg < -90.0 || s.latitude_deg > 90.0) t.fail("latitude_deg", "must be within [-90, 90]");
+  s.heading_deg = t.number("heading_deg", s.heading_deg);
+  s.g_mps2 = t.number("g_mps2", s.g_mps2);
+  if (s.g_mps2 < 9.7 || s.g_mps2 > 9.9) t.fail("g_mps2", "local gravity must be within [9.7, 9.9] m/s^2");
+  t.finish();
+  return s;
+}
+
+dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults) {
+  dsp::MachineLayout m = defaults;
+  m.name = t.string("name", m.name);
+  if (t.has("table_axes")) m.table_axes = t.strings("table_axes");
+  if (t.has("head_axes")) m.head_axes = t.strings("head_axes");
+  for (const auto* list : {&m.table_axes, &m.head_axes})
+    for (const auto& a : *list)
+      if (!valid_axis(a)) t.fail(list == &m.table_axes ? "table_axes" : "head_axes", "axis '" + a + "' is not x, y or z");
+  for (const auto& a : m.table_axes)
+    if (std::find(m.head_axes.begin(), m.head_axes.end(), a) != m.head_axes.end())
+      t.fail("head_axes", "axis '" + a + "' is moved by both table and head");
+  t.finish();
+  return m;
+}
+
+dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults) {
+  dsp::SensorSpec s = defaults;
+  s.model = t.string("model", s.model);
+  if (t.has("to_machine")) {
+    const auto rows = t.matrix("to_machine", 3, 3);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) s.to_machine(r, c) = rows[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)];
+    // A mounting matrix is a rotation (plus small misalignment): reject typos such as a zero row.
+    if (std::abs(s.to_machine.determinant()) < 0.5) t.fail("to_machine", "matrix is singular or far from a rotation");
+  }
+  s.k1_v_per_g = vec3(t, "k1_v_per_g", s.k1_v_per_g);
+  for (int i = 0; i < 3; ++i)
+    if (!(s.k1_v_per_g[i] > 0.0)) t.fail("k1_v_per_g", "scale factors must be positive");
+  s.k2_g_per_g2 = vec3(t, "k2_g_per_g2", s.k2_g_per_g2);
+  s.k3_g_per_g3 = vec3(t, "k3_g_per_g3", s.k3_g_per_g3);
+  s.bias_g = vec3(t, "bias_g", s.bias_g);
+  s.tc_k1_ppm_per_c = t.number("tc_k1_ppm_per_c", s.tc_k1_ppm_per_c);
+  s.tc_bias_ug_per_c = t.number("tc_bias_ug_per_c", s.tc_bias_ug_per_c);
+  s.f0_hz = t.number("f0_hz", s.f0_hz);
+  if (s.f0_hz <= 0.0) t.fail("f0_hz", "must be positive");
+  s.zeta = t.number("zeta", s.zeta);
+  if (s.zeta <= 0.0 || s.zeta > 5.0) t.fail("zeta", "must be within (0, 5]");
+  s.noise_ug_per_rthz = t.number("noise_ug_per_rthz", s.noise_ug_per_rthz);
+  if (s.noise_ug_per_rthz < 0.0) t.fail("noise_ug_per_rthz", "must not be negative");
+  s.temp_ref_c = t.number("temp_ref_c", s.temp_ref_c);
+  t.finish();
+  return s;
+}
+
+dsp::PsdSpec read_psd(StrictTable t) {
+  dsp::PsdSpec p;
+  p.measures = t.choice("measures", {"x", "y", "z"}, p.measures);
+  const auto c = t.numbers("center_mm", 2);
+  p.center_mm[0] = c[0];
+  p.center_mm[1] = c[1];
+  p.length_mm = t.number("length_mm", p.length_mm);
+  if (p.length_mm <= 0.0) t.fail("length_mm", "must be positive");
+  p.width_mm = t.number("width_mm", p.width_mm);
+  p.lockin_tau_s = t.number("lockin_tau_s", p.lockin_tau_s);
+  t.finish();
+  return p;
+}
+
+}  // namespace eical::drivers

@@ -1,0 +1,18 @@
+#pragma once
+// The metadata sections shared by run.toml, the daemon config and simulation scenarios
+// ([acquisition], [site], [machine], [sensors.*], [[psd]]), read strictly: same key names
+// and units as shared/spec/run-format.md, so a value can be copied between the files.
+#include "drivers/config/strict_toml.hpp"
+#include "dsp/core/run_meta.hpp"
+
+namespace eical::drivers {
+
+// Each reader starts from `defaults`, overrides the keys present, checks ranges and
+// calls finish() on the table (unknown keys are errors).
+dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults = {});
+dsp::Site read_site(StrictTable t, const dsp::Site& defaults = {});
+dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults = {});
+dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults = {});
+dsp::PsdSpec read_psd(StrictTable t);
+
+}  // namespace eical::drivers
