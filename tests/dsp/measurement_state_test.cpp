@@ -1,8 +1,8 @@
-#include "daemon/state/measurement_state.hpp"
+#include "dsp/session/measurement_state.hpp"
 
 #include <gtest/gtest.h>
 
-namespace eical::daemon {
+namespace eical::dsp {
 
 TEST(MeasurementState, NormalProgramRunsThroughAllStates) {
   MeasurementState m;
@@ -74,4 +74,4 @@ TEST(MeasurementState, RestartedProgramStartsOver) {
   EXPECT_FALSE(t.message.empty());
 }
 
-}  // namespace eical::daemon
+}  // namespace eical::dsp

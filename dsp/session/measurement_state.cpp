@@ -1,6 +1,6 @@
-#include "daemon/state/measurement_state.hpp"
+#include "dsp/session/measurement_state.hpp"
 
-namespace eical::daemon {
+namespace eical::dsp {
 
 std::string_view to_string(State s) {
   switch (s) {
@@ -88,4 +88,4 @@ Transition MeasurementState::handle(Event e, std::string_view reason) {
   return refuse();
 }
 
-}  // namespace eical::daemon
+}  // namespace eical::dsp

@@ -3,12 +3,13 @@
 //   IDLE → ARMED → MEASURING → EVALUATING → DONE, and FAULT (with a reason) from anywhere.
 // Events come from NC triggers (M101 start/tare, M102 segment, M103 end — seed 003:
 // M-functions tare, start and stop recording), HMI commands and the service itself.
-// Pure logic: no clocks, no I/O; the service feeds it events and acts on the transitions.
+// Pure logic: no clocks, no I/O. It lives in dsp/ (not daemon/) so that eicald and the
+// offline tools (`eical demo`, replay) run the identical measurement logic.
 #include <cstdint>
 #include <string>
 #include <string_view>
 
-namespace eical::daemon {
+namespace eical::dsp {
 
 enum class State { idle, armed, measuring, evaluating, done, fault };
 
@@ -52,4 +53,4 @@ class MeasurementState {
   std::uint32_t segments_ = 0;
 };
 
-}  // namespace eical::daemon
+}  // namespace eical::dsp
