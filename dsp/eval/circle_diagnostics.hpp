@@ -1,0 +1,67 @@
+#pragma once
+// Ballbar-class diagnostics of a circular test (ISO 230-4 context), from the 2-D relative
+// path that eical measures. A ballbar sees only the radius; eical sees both axes, so the
+// machine errors are fitted per axis against the commanded path:
+//
+//   e_a(t) = P_a,pass(t) + k_a·(a_cmd − c_a) − [a = x only] α·(y_cmd − c_y) − τ_a·v_a
+//            − (b_a/2)·sgn(v_a) + (l_a/2)·sgn(v_b) + C_a·sin(2π a_cmd/p) + S_a·cos(2π a_cmd/p)
+//            + w_b·((b_cmd − c_b)/R)²
+//
+// with a, b the two axes of the plane, e = measured − commanded, P a quadratic in time per
+// pass (integration start offset and the slow drift that double integration leaves), k
+// the scale error, α the squareness, τ the servo lag, b the backlash (lost motion), l the
+// lateral play, C/S the cyclic (pitch p) error and w the bow of axis b's travel seen on
+// axis a (straightness of axis b). One direction alone cannot separate τ_x from α (both
+// follow sin θ); the fit then assumes equal lags and says so. Linear least squares
+// over every pass (both directions) at once, spikes excluded in a second pass; reversal
+// spikes are then measured per axis on the residual after each reversal, so that one
+// axis' spikes are not hidden in the other's signal (thesis (8-8) fits a reference sine
+// per axis for the same reason). Conventions follow ballbar practice (results.md):
+// squareness positive when the angle between +X and +Y exceeds 90°; scale mismatch =
+// X scale − Y scale; servo mismatch positive when X lags Y.
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace eical::dsp::eval {
+
+// One direction of the circular test: steady revolutions only (no ramp-in/out).
+struct CirclePass {
+  int direction = +1;  // +1 counter-clockwise, −1 clockwise (seen from +normal)
+  double fs_hz = 10000.0;
+  std::vector<Eigen::Vector2d> cmd_mm;   // commanded relative position, plane axes (u, v)
+  std::vector<Eigen::Vector2d> meas_mm;  // measured relative position, same samples
+};
+
+struct DiagnosticsOptions {
+  Eigen::Vector2d centre_mm = Eigen::Vector2d::Zero();
+  double radius_mm = 10.0;
+  // Ball-screw pitch for the cyclic error; empty = search 1..25 mm and keep the best.
+  std::optional<double> cyclic_pitch_mm;
+  double spike_window_s = 0.06;  // residual window after each reversal searched for spikes
+};
+
+struct CircleDiagnostics {
+  double backlash_x_um = 0, backlash_y_um = 0;
+  double reversal_spike_x_um = 0, reversal_spike_y_um = 0;
+  double lateral_play_x_um = 0, lateral_play_y_um = 0;
+  double cyclic_error_x_um = 0, cyclic_error_y_um = 0;  // amplitude
+  double cyclic_pitch_mm = 0;
+  double servo_mismatch_ms = 0;
+  double squareness_urad = 0;
+  double scale_mismatch_ppm = 0;
+  double straightness_x_um = 0, straightness_y_um = 0;  // bow of the axis' path
+  double stick_slip_um = 0;   // tangential jerk steps: RMS of the fast tangential residual
+  double vibration_um = 0;    // radial residual RMS above the model (fast components)
+  double lag_x_ms = 0, lag_y_ms = 0;  // each axis' lag behind the set-point (common servo lag)
+  double residual_rms_um = 0;         // what the model leaves
+  bool servo_and_squareness_separated = false;  // needs both directions
+  std::vector<std::string> notes;
+};
+
+// Throws InputError when the passes are empty, mismatched or do not go round.
+CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& options);
+
+}  // namespace eical::dsp::eval
