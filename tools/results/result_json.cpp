@@ -1,0 +1,70 @@
+#include "tools/results/result_json.hpp"
+
+#include <cmath>
+
+namespace eical::tools {
+
+nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d) {
+  nlohmann::json j = {
+      {"backlash_x_um", number_or_null(d.backlash_x_um)},
+      {"backlash_y_um", number_or_null(d.backlash_y_um)},
+      {"reversal_spike_x_um", number_or_null(d.reversal_spike_x_um)},
+      {"reversal_spike_y_um", number_or_null(d.reversal_spike_y_um)},
+      {"lateral_play_x_um", number_or_null(d.lateral_play_x_um)},
+      {"lateral_play_y_um", number_or_null(d.lateral_play_y_um)},
+      {"cyclic_error_x_um", number_or_null(d.cyclic_error_x_um)},
+      {"cyclic_error_y_um", number_or_null(d.cyclic_error_y_um)},
+      {"cyclic_pitch_mm", number_or_null(d.cyclic_pitch_mm)},
+      {"servo_mismatch_ms", d.servo_and_squareness_separated ? number_or_null(d.servo_mismatch_ms) : nullptr},
+      {"squareness_urad", number_or_null(d.squareness_urad)},
+      {"scale_mismatch_ppm", number_or_null(d.scale_mismatch_ppm)},
+      {"straightness_x_um", number_or_null(d.straightness_x_um)},
+      {"straightness_y_um", number_or_null(d.straightness_y_um)},
+      {"stick_slip_um", number_or_null(d.stick_slip_um)},
+      {"vibration_um", number_or_null(d.vibration_um)},
+      {"servo_lag_x_ms", number_or_null(d.lag_x_ms)},
+      {"servo_lag_y_ms", number_or_null(d.lag_y_ms)},
+      {"model_residual_rms_um", number_or_null(d.residual_rms_um)},
+      {"notes", d.notes},
+  };
+  return j;
+}
+
+nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r) {
+  nlohmann::json moves = nlohmann::json::array();
+  for (const auto& m : r.moves)
+    moves.push_back({{"from_mm", m.from_mm},
+                     {"to_mm", m.to_mm},
+                     {"step_measured_um", m.step_measured_um},
+                     {"end_error_um", m.end_error_um},
+                     {"overshoot_um", m.overshoot_um},
+                     {"settling_s", m.settled ? nlohmann::json(m.settling_s) : nlohmann::json(nullptr)},
+                     {"resolved", m.resolved}});
+  return {{"axis", axis},
+          {"end_position_error_um", number_or_null(r.end_position_error_um)},
+          {"scatter_um", number_or_null(r.scatter_um)},
+          {"overshoot_um", number_or_null(r.overshoot_um)},
+          {"settling_s", number_or_null(r.settling_s)},
+          {"noise_um", number_or_null(r.noise_um)},
+          {"smallest_step_resolved_um", number_or_null(r.smallest_step_resolved_um)},
+          {"moves", moves}};
+}
+
+nlohmann::json rectangle_json(const dsp::eval::RectangleResult& r) {
+  nlohmann::json corners = nlohmann::json::array(), errors = nlohmann::json::array(), sides = nlohmann::json::array();
+  for (const auto& c : r.corners_mm) corners.push_back({c.x(), c.y()});
+  for (const auto& e : r.corner_errors_um) errors.push_back({e.x(), e.y()});
+  for (const auto& s : r.sides)
+    sides.push_back({{"from_mm", {s.from_mm.x(), s.from_mm.y()}},
+                     {"to_mm", {s.to_mm.x(), s.to_mm.y()}},
+                     {"straightness_um", s.straightness_um},
+                     {"direction_error_urad", s.direction_error_urad}});
+  return {{"corners_mm", corners},
+          {"corner_errors_um", errors},
+          {"sides", sides},
+          {"corner_angle_error_urad", r.corner_angle_error_urad}};
+}
+
+}  // namespace eical::tools

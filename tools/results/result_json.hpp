@@ -1,0 +1,22 @@
+#pragma once
+// eical-result/1 (shared/spec/results.md): JSON objects for each evaluation. Keys are
+// fixed by the spec; extra keys are allowed and used for figures the spec does not name.
+// A figure that could not be determined is null with a reason in quality.flags.
+#include "dsp/eval/circle_diagnostics.hpp"
+#include "dsp/eval/rectangle.hpp"
+#include "dsp/eval/step_response.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace eical::tools {
+
+nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d);
+nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r);
+nlohmann::json rectangle_json(const dsp::eval::RectangleResult& r);
+
+// A finite number, or null (callers add the reason to quality.flags).
+nlohmann::json number_or_null(double v);
+
+}  // namespace eical::tools
