@@ -1,0 +1,177 @@
+#include "sim/gcode/generate.hpp"
+
+#include "dsp/core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+namespace eical::sim::gcode {
+namespace {
+
+struct PlaneAxes {
+  const char* g;       // G17 / G18 / G19
+  char a, b;           // the two plane axes, counter-clockwise order seen from +normal
+  char ia, ib;         // their centre-offset words
+};
+
+PlaneAxes plane_axes(const std::string& plane) {
+  if (plane == "xy") return {"G17", 'X', 'Y', 'I', 'J'};
+  if (plane == "zx") return {"G18", 'Z', 'X', 'K', 'I'};
+  if (plane == "yz") return {"G19", 'Y', 'Z', 'J', 'K'};
+  throw dsp::InputError("program plane '" + plane + "' is not xy, zx or yz");
+}
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+std::string num(double v) { return fmt("%.4f", std::abs(v) < 5e-5 ? 0.0 : v); }
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw dsp::InputError("program: " + what);
+}
+
+std::string header(const char* mode_comment, const std::string& plane_g, bool exact) {
+  return std::string("G90 G21 ") + plane_g + (exact ? " G61" : " G64") + " (" + mode_comment + ")\n";
+}
+
+std::string start(const RestTimes& r) {
+  return "G4 P" + fmt("%.3g", r.before_start_s) + "\nM101\nG4 P" + fmt("%.3g", r.after_start_s) + "\n";
+}
+std::string finish(const RestTimes& r) {
+  return "G4 P" + fmt("%.3g", r.before_end_s) + "\nM103\nG4 P" + fmt("%.3g", r.after_end_s) + "\n";
+}
+
+char axis_letter(const std::string& axis) {
+  require(axis == "x" || axis == "y" || axis == "z", "axis '" + axis + "' is not x, y or z");
+  return static_cast<char>(std::toupper(axis[0]));
+}
+
+}  // namespace
+
+std::string circle_program(const dsp::Program& p, const RestTimes& rest) {
+  require(p.radius_mm > 0.0, "radius_mm must be positive");
+  require(p.feed_mm_min > 0.0, "feed_mm_min must be positive");
+  require(p.repeats >= 1, "repeats must be at least 1");
+  require(p.direction == "ccw" || p.direction == "cw", "direction must be cw or ccw");
+  const PlaneAxes ax = plane_axes(p.plane);
+  const bool ccw = p.direction == "ccw";
+  const double r = p.radius_mm, c0 = p.center_mm[0], c1 = p.center_mm[1];
+  // Start at 45°; the ramp-in quarter ends at 135° (ccw) or −45° (cw): the revolutions
+  // then start and end there, so every one of them runs at full feed.
+  const double a0 = std::numbers::pi / 4, step = ccw ? std::numbers::pi / 2 : -std::numbers::pi / 2;
+  auto pt = [&](double ang) { return std::pair{c0 + r * std::cos(ang), c1 + r * std::sin(ang)}; };
+  auto arc = [&](double from, double to, const char* comment, bool with_feed) {
+    const auto [fa, fb] = pt(from);
+    const auto [ta, tb] = pt(to);
+    std::string line = std::string(ccw ? "G3 " : "G2 ") + ax.a + num(ta) + " " + ax.b + num(tb) + " " + ax.ia +
+                       num(c0 - fa) + " " + ax.ib + num(c1 - fb);
+    if (with_feed) line += " F" + fmt("%.0f", p.feed_mm_min);
+    if (comment[0]) line += std::string(" (") + comment + ")";
+    return line + "\n";
+  };
+  std::string g = header("continuous path: the arcs are one blended move", ax.g, false);
+  const auto [sa, sb] = pt(a0);
+  g += std::string("G0 ") + ax.a + num(sa) + " " + ax.b + num(sb) + "\n";
+  g += start(rest);
+  const double rev_start = a0 + step;
+  g += arc(a0, rev_start, "ramp-in", true);
+  for (int k = 0; k < p.repeats; ++k) {
+    g += "M102\n";
+    // A full circle as one G2/G3 with end = start.
+    g += arc(rev_start, rev_start, "", false);
+  }
+  g += "M102\n";
+  g += arc(rev_start, rev_start + step, "ramp-out", false);
+  g += finish(rest);
+  return g;
+}
+
+std::string positioning_program(const dsp::Program& p, double overrun_mm, const RestTimes& rest) {
+  require(p.targets_mm.size() >= 2, "positioning needs at least 2 targets");
+  require(std::is_sorted(p.targets_mm.begin(), p.targets_mm.end()), "targets_mm must be ascending");
+  require(p.runs >= 1, "runs must be at least 1");
+  require(p.feed_mm_min > 0.0, "feed_mm_min must be positive");
+  require(overrun_mm >= 0.0, "overrun must not be negative");
+  const char a = axis_letter(p.axis);
+  const std::string f = " F" + fmt("%.0f", p.feed_mm_min);
+  const std::string dwell = "G4 P" + fmt("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.5) + "\n";
+  std::string g = header("ISO 230-2 linear cycle, exact stop", "G17", true);
+  g += std::string("G0 ") + a + num(p.targets_mm.front() - overrun_mm) + "\n";
+  g += start(rest);
+  for (int run = 0; run < p.runs; ++run) {
+    for (double t : p.targets_mm) g += std::string("G1 ") + a + num(t) + f + "\nM102\n" + dwell;
+    g += std::string("G1 ") + a + num(p.targets_mm.back() + overrun_mm) + f + " (overrun, reversal)\n";
+    for (auto it = p.targets_mm.rbegin(); it != p.targets_mm.rend(); ++it)
+      g += std::string("G1 ") + a + num(*it) + f + "\nM102\n" + dwell;
+    g += std::string("G1 ") + a + num(p.targets_mm.front() - overrun_mm) + f + " (overrun, reversal)\n";
+  }
+  g += finish(rest);
+  return g;
+}
+
+std::string step_program(const dsp::Program& p, const RestTimes& rest) {
+  require(p.targets_mm.size() == 2, "step needs targets_mm = [a, b]");
+  require(p.runs >= 1, "runs must be at least 1");
+  require(p.feed_mm_min > 0.0, "feed_mm_min must be positive");
+  const char a = axis_letter(p.axis);
+  const std::string f = " F" + fmt("%.0f", p.feed_mm_min);
+  const std::string dwell = "G4 P" + fmt("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.5) + "\n";
+  // Starts where the machine stands (at targets_mm[0]), as the recorded step runs do.
+  std::string g = header("absolute, mm, XY plane, exact stop", "G17", true);
+  g += start(rest);
+  for (int run = 0; run < p.runs; ++run) {
+    g += std::string("G1 ") + a + num(p.targets_mm[1]) + f + "\nM102\n" + dwell;
+    g += std::string("G1 ") + a + num(p.targets_mm[0]) + f + "\nM102\n" + dwell;
+  }
+  g += finish(rest);
+  return g;
+}
+
+std::string rectangle_program(const dsp::Program& p, const RestTimes& rest) {
+  require(p.size_mm[0] > 0.0 && p.size_mm[1] > 0.0, "size_mm must be positive");
+  require(p.feed_mm_min > 0.0, "feed_mm_min must be positive");
+  require(p.repeats >= 1, "repeats must be at least 1");
+  const PlaneAxes ax = plane_axes(p.plane);
+  const double x0 = p.corner_mm[0], y0 = p.corner_mm[1], x1 = x0 + p.size_mm[0], y1 = y0 + p.size_mm[1];
+  const std::string f = " F" + fmt("%.0f", p.feed_mm_min);
+  const std::string dwell = "G4 P" + fmt("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.2) + "\n";
+  auto go = [&](double a, double b) { return std::string("G1 ") + ax.a + num(a) + " " + ax.b + num(b) + f + "\nM102\n" + dwell; };
+  std::string g = header("rectangle, exact stop at the corners", ax.g, true);
+  g += std::string("G0 ") + ax.a + num(x0) + " " + ax.b + num(y0) + "\n";
+  g += start(rest);
+  for (int k = 0; k < p.repeats; ++k) g += go(x1, y0) + go(x1, y1) + go(x0, y1) + go(x0, y0);
+  g += finish(rest);
+  return g;
+}
+
+std::string identify_program(const dsp::Program& p, const RestTimes& rest) {
+  require(!p.targets_mm.empty(), "identify needs targets_mm = [psd_centre]");
+  const char a = axis_letter(p.axis);
+  const double c = p.targets_mm[0];
+  const double half = p.size_mm[0] > 0 ? p.size_mm[0] / 2 : 20.0;  // swing ± half around the strip
+  std::string g = header("on-site identification: swings across the PSD at rising feeds", "G17", true);
+  g += std::string("G0 ") + a + num(c - half) + "\n";
+  g += start(rest);
+  for (double feed : {500.0, 1500.0, 3000.0, 6000.0}) {
+    const std::string f = " F" + fmt("%.0f", feed);
+    g += std::string("G1 ") + a + num(c + half) + f + "\nM102\nG4 P0.3\n";
+    g += std::string("G1 ") + a + num(c - half) + f + "\nM102\nG4 P0.3\n";
+  }
+  g += finish(rest);
+  return g;
+}
+
+std::string program_gcode(const dsp::Program& p) {
+  if (p.kind == "circle") return circle_program(p);
+  if (p.kind == "positioning") return positioning_program(p);
+  if (p.kind == "step") return step_program(p);
+  if (p.kind == "rectangle") return rectangle_program(p);
+  if (p.kind == "identify") return identify_program(p);
+  throw dsp::InputError("program kind '" + p.kind + "' has no generator (circle, positioning, step, rectangle, identify)");
+}
+
+}  // namespace eical::sim::gcode

@@ -1,0 +1,47 @@
+#pragma once
+// Calibration NC programs as ISO G-code with the measurement M-functions in place:
+//   M101  program start: the machine rests; tare (bias reference) and start recording
+//   M102  segment mark: a repeat starts, a corner or a target is reached
+//   M103  program end: the machine rests again; stop recording and evaluate
+// Every program begins and ends with a rest long enough for the bias and ZUPT windows.
+// The text is what `eical gen-nc` prints and what the simulator runs.
+#include "dsp/core/run_meta.hpp"
+
+#include <string>
+
+namespace eical::sim::gcode {
+
+struct RestTimes {
+  double before_start_s = 0.4;  // G4 before M101 (the sample runs' convention)
+  double after_start_s = 0.1;   // G4 between M101 and the first move
+  double before_end_s = 0.4;    // G4 after the last move, before M103
+  double after_end_s = 0.1;     // G4 after M103
+};
+
+// Circle (ISO 230-4): start at 45° on the circle, a quarter-arc ramp-in, `repeats` full
+// revolutions each preceded by M102, a M102 after the last one, a quarter-arc ramp-out;
+// G64 so that the arcs blend into one move at constant feed. Planes xy, zx, yz.
+std::string circle_program(const dsp::Program& p, const RestTimes& rest = {});
+
+// ISO 230-2 linear positioning cycle: `runs` bidirectional runs over `targets_mm`
+// (ascending), each target approached in both directions, with an overrun of
+// `overrun_mm` beyond the end targets so that every approach of a direction is made the
+// same way; dwell `dwell_s` and M102 at every target. G61 exact stop.
+std::string positioning_program(const dsp::Program& p, double overrun_mm = 2.0, const RestTimes& rest = {});
+
+// Step test: back and forth between the targets `runs` times, M102 at every arrival.
+std::string step_program(const dsp::Program& p, const RestTimes& rest = {});
+
+// Rectangle: corner_mm, size_mm in the program plane, counter-clockwise, M102 at every
+// corner, `repeats` times. G61.
+std::string rectangle_program(const dsp::Program& p, const RestTimes& rest = {});
+
+// On-site identification (ch. 8.2 without a KGM): moves along `axis` across its PSD
+// strip centred at `targets_mm[0]`, at rising feeds (accelerations), both directions,
+// each move followed by a dwell (ZUPT) and M102.
+std::string identify_program(const dsp::Program& p, const RestTimes& rest = {});
+
+// Dispatches on p.kind; throws InputError for an unknown or incomplete program.
+std::string program_gcode(const dsp::Program& p);
+
+}  // namespace eical::sim::gcode
