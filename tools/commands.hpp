@@ -7,10 +7,12 @@
 namespace eical::tools {
 
 void register_version(CLI::App& app);
+void register_gen_nc(CLI::App& app);
 
 // The list main() registers, in the order `eical --help` shows them.
 inline void register_all(CLI::App& app) {
   register_version(app);
+  register_gen_nc(app);
 }
 
 }  // namespace eical::tools

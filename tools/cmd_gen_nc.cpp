@@ -1,0 +1,158 @@
+// eical gen-nc {circle,positioning,step,rectangle,identify}: ISO G-code with the M101/
+// M102/M103 measurement triggers, plus the [program] metadata a recorded run carries.
+// On a real control the M-codes are user M-functions (LinuxCNC: executables M101..M103 in
+// the PROGRAM_PREFIX directory, which call `eical trigger`; Siemens/Heidenhain: a PLC
+// output wired to the trigger input, or a CAN frame) — see README "NC triggers".
+#include "sim/gcode/generate.hpp"
+#include "tools/commands.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+
+namespace eical::tools {
+namespace {
+
+struct GenOptions {
+  dsp::Program program;
+  std::vector<double> center{0.0, 0.0};
+  std::vector<double> corner{0.0, 0.0};
+  std::vector<double> size{20.0, 10.0};
+  double overrun_mm = 2.0;
+  std::string out;
+  std::string meta_out;
+};
+
+std::string toml_list(const std::vector<double>& v) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + std::to_string(v[i]);
+  return s + "]";
+}
+
+// The [program] table of run.toml (shared/spec/run-format.md) for this program.
+std::string program_toml(const dsp::Program& p, const std::string& gcode) {
+  std::string t = "[program]\nkind = \"" + p.kind + "\"\nplane = \"" + p.plane + "\"\n";
+  t += "feed_mm_min = " + std::to_string(p.feed_mm_min) + "\n";
+  if (p.kind == "circle") {
+    t += "center_mm = " + toml_list({p.center_mm[0], p.center_mm[1]}) + "\nradius_mm = " + std::to_string(p.radius_mm) +
+         "\ndirection = \"" + p.direction + "\"\nrepeats = " + std::to_string(p.repeats) + "\n";
+  } else if (p.kind == "rectangle") {
+    t += "corner_mm = " + toml_list({p.corner_mm[0], p.corner_mm[1]}) + "\nsize_mm = " +
+         toml_list({p.size_mm[0], p.size_mm[1]}) + "\ndwell_s = " + std::to_string(p.dwell_s) +
+         "\nrepeats = " + std::to_string(p.repeats) + "\n";
+  } else {
+    t += "axis = \"" + p.axis + "\"\ntargets_mm = " + toml_list(p.targets_mm) + "\nruns = " + std::to_string(p.runs) +
+         "\ndwell_s = " + std::to_string(p.dwell_s) + "\n";
+  }
+  return t + "gcode = \"\"\"\n" + gcode + "\"\"\"\n";
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") {
+    std::fputs(text.c_str(), stdout);
+    return;
+  }
+  std::ofstream os(path, std::ios::trunc);
+  if (!os) throw std::runtime_error(path + ": cannot write");
+  os << text;
+  if (!os.flush()) throw std::runtime_error(path + ": write failed");
+}
+
+void add_output(CLI::App* cmd, GenOptions& o) {
+  cmd->add_option("-o,--out", o.out, "G-code file (default: standard output)");
+  cmd->add_option("--meta", o.meta_out, "also write the run's [program] table (TOML) here");
+}
+
+void emit(GenOptions& o) {
+  dsp::Program& p = o.program;
+  p.center_mm[0] = o.center.at(0), p.center_mm[1] = o.center.at(1);
+  p.corner_mm[0] = o.corner.at(0), p.corner_mm[1] = o.corner.at(1);
+  p.size_mm[0] = o.size.at(0), p.size_mm[1] = o.size.at(1);
+  const std::string g = p.kind == "positioning" ? sim::gcode::positioning_program(p, o.overrun_mm)
+                                                : sim::gcode::program_gcode(p);
+  p.gcode = g;
+  write_text(o.out, g);
+  if (!o.meta_out.empty()) write_text(o.meta_out, program_toml(p, g));
+}
+
+// One option set per program kind: CLI11 writes defaults into the bound variables when
+// the options are declared, so kinds must not share them.
+void add_circle(CLI::App* gen) {
+  auto o = std::make_shared<GenOptions>();
+  dsp::Program& p = o->program;
+  auto* c = gen->add_subcommand("circle", "ISO 230-4 circular test");
+  c->add_option("--radius", p.radius_mm, "radius in mm")->default_val(10.0);
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2500.0);
+  c->add_option("--repeats", p.repeats, "full revolutions")->default_val(5);
+  c->add_option("--direction", p.direction, "ccw or cw")->default_val("ccw")->check(CLI::IsMember({"ccw", "cw"}));
+  c->add_option("--plane", p.plane, "xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
+  c->add_option("--center", o->center, "centre in the plane, mm")->expected(2)->delimiter(',');
+  add_output(c, *o);
+  c->callback([o] { o->program.kind = "circle"; emit(*o); });
+}
+
+void add_positioning(CLI::App* gen) {
+  auto o = std::make_shared<GenOptions>();
+  dsp::Program& p = o->program;
+  auto* c = gen->add_subcommand("positioning", "ISO 230-2 bidirectional positioning cycle");
+  c->add_option("--axis", p.axis, "x, y or z")->default_val("x")->check(CLI::IsMember({"x", "y", "z"}));
+  c->add_option("--targets", p.targets_mm, "targets in mm, ascending (comma separated)")->required()->delimiter(',');
+  c->add_option("--runs", p.runs, "bidirectional runs")->default_val(5);
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2000.0);
+  c->add_option("--dwell", p.dwell_s, "dwell at each target in s")->default_val(0.5);
+  c->add_option("--overrun", o->overrun_mm, "overrun beyond the end targets in mm")->default_val(2.0);
+  add_output(c, *o);
+  c->callback([o] { o->program.kind = "positioning"; emit(*o); });
+}
+
+void add_step(CLI::App* gen) {
+  auto o = std::make_shared<GenOptions>();
+  dsp::Program& p = o->program;
+  auto* c = gen->add_subcommand("step", "step response: back and forth between two targets");
+  c->add_option("--axis", p.axis, "x, y or z")->default_val("x")->check(CLI::IsMember({"x", "y", "z"}));
+  c->add_option("--targets", p.targets_mm, "a,b in mm")->required()->expected(2)->delimiter(',');
+  c->add_option("--runs", p.runs, "there-and-back pairs")->default_val(2);
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(3250.0);
+  c->add_option("--dwell", p.dwell_s, "dwell at each end in s")->default_val(0.5);
+  add_output(c, *o);
+  c->callback([o] { o->program.kind = "step"; emit(*o); });
+}
+
+void add_rectangle(CLI::App* gen) {
+  auto o = std::make_shared<GenOptions>();
+  dsp::Program& p = o->program;
+  auto* c = gen->add_subcommand("rectangle", "rectangle with exact stop at the corners");
+  c->add_option("--corner", o->corner, "start corner in the plane, mm")->expected(2)->delimiter(',');
+  c->add_option("--size", o->size, "side lengths, mm")->expected(2)->delimiter(',');
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(1000.0);
+  c->add_option("--dwell", p.dwell_s, "dwell at each corner in s")->default_val(0.2);
+  c->add_option("--repeats", p.repeats, "laps")->default_val(1);
+  c->add_option("--plane", p.plane, "xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
+  add_output(c, *o);
+  c->callback([o] { o->program.kind = "rectangle"; emit(*o); });
+}
+
+void add_identify(CLI::App* gen) {
+  auto o = std::make_shared<GenOptions>();
+  dsp::Program& p = o->program;
+  auto* c = gen->add_subcommand("identify", "on-site sensor identification across a PSD strip");
+  c->add_option("--axis", p.axis, "x, y or z")->default_val("x")->check(CLI::IsMember({"x", "y", "z"}));
+  c->add_option("--psd-center", p.targets_mm, "position of the PSD strip centre on the axis, mm")->required()->expected(1);
+  add_output(c, *o);
+  c->callback([o] { o->program.kind = "identify"; emit(*o); });
+}
+
+}  // namespace
+
+void register_gen_nc(CLI::App& app) {
+  auto* gen = app.add_subcommand("gen-nc", "Write a calibration NC program (ISO G-code with M101/M102/M103)");
+  gen->require_subcommand(1);
+  add_circle(gen);
+  add_positioning(gen);
+  add_step(gen);
+  add_rectangle(gen);
+  add_identify(gen);
+}
+
+}  // namespace eical::tools
