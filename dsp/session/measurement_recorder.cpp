@@ -1,0 +1,67 @@
+#include "dsp/session/measurement_recorder.hpp"
+
+#include <algorithm>
+#include <utility>
+
+namespace eical::dsp {
+
+MeasurementRecorder::MeasurementRecorder(std::size_t capacity_frames, std::size_t pretrigger_frames)
+    : capacity_(capacity_frames + pretrigger_frames), pre_(std::max<std::size_t>(1, pretrigger_frames)) {
+  buffer_.reserve(capacity_);
+  if (pretrigger_frames == 0) pre_.clear();
+}
+
+void MeasurementRecorder::push(const Frame& f) noexcept {
+  if (complete_) {
+    // A finished recording waits to be taken; frames meanwhile keep the pre-trigger
+    // ring warm for the next measurement.
+  } else if (recording_) {
+    if (buffer_.size() < capacity_) buffer_.push_back(f);  // within reserve: no allocation
+    else ++overflow_;
+    if (stopping_ && post_left_-- == 0) {
+      recording_ = false;
+      complete_ = true;
+    }
+    return;
+  }
+  if (pre_.empty()) return;
+  pre_[pre_head_] = f;
+  pre_head_ = (pre_head_ + 1) % pre_.size();
+  pre_count_ = std::min(pre_count_ + 1, pre_.size());
+}
+
+void MeasurementRecorder::start() noexcept {
+  if (complete_) return;  // the previous recording was not taken yet: the caller faults
+  buffer_.clear();
+  const std::size_t n = pre_.size();
+  for (std::size_t k = 0; k < pre_count_; ++k) buffer_.push_back(pre_[(pre_head_ + n - pre_count_ + k) % n]);
+  pre_count_ = 0;
+  recording_ = true;
+  stopping_ = false;
+}
+
+void MeasurementRecorder::stop_after(std::size_t posttrigger_frames) noexcept {
+  if (!recording_) return;
+  if (posttrigger_frames == 0) {
+    recording_ = false;
+    complete_ = true;
+    return;
+  }
+  stopping_ = true;
+  post_left_ = posttrigger_frames - 1;
+}
+
+void MeasurementRecorder::discard() noexcept {
+  buffer_.clear();
+  recording_ = complete_ = stopping_ = false;
+}
+
+bool MeasurementRecorder::take(std::vector<Frame>& spare) noexcept {
+  if (!complete_ || spare.capacity() < capacity_) return false;
+  spare.clear();
+  std::swap(buffer_, spare);
+  complete_ = false;
+  return true;
+}
+
+}  // namespace eical::dsp
