@@ -1,0 +1,188 @@
+#include "sim/nc/trajectory.hpp"
+
+#include "dsp/core/error.hpp"
+#include "sim/gcode/parser.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <variant>
+
+namespace eical::sim::nc {
+
+Eigen::Vector3d PathElement::position(double s) const {
+  if (!is_arc) return length_mm > 0 ? from_mm + (to_mm - from_mm) * (s / length_mm) : from_mm;
+  const double u = length_mm > 0 ? s / length_mm : 0.0;
+  const double th = start_rad + sweep_rad * u;
+  Eigen::Vector3d p;
+  p[axis_a] = center_mm[axis_a] + radius_mm * std::cos(th);
+  p[axis_b] = center_mm[axis_b] + radius_mm * std::sin(th);
+  p[axis_n] = from_mm[axis_n] + (to_mm[axis_n] - from_mm[axis_n]) * u;  // helical part
+  return p;
+}
+
+Eigen::Vector3d PathElement::tangent(double s) const {
+  if (!is_arc) return length_mm > 0 ? Eigen::Vector3d((to_mm - from_mm) / length_mm) : Eigen::Vector3d::Zero();
+  const double th = start_rad + sweep_rad * (s / length_mm);
+  const double dth = sweep_rad / length_mm;
+  Eigen::Vector3d t;
+  t[axis_a] = -radius_mm * std::sin(th) * dth;
+  t[axis_b] = radius_mm * std::cos(th) * dth;
+  t[axis_n] = (to_mm[axis_n] - from_mm[axis_n]) / length_mm;
+  return t;
+}
+
+Eigen::Vector3d PathElement::curvature(double s) const {
+  if (!is_arc) return Eigen::Vector3d::Zero();
+  const double th = start_rad + sweep_rad * (s / length_mm);
+  const double dth = sweep_rad / length_mm;
+  Eigen::Vector3d k = Eigen::Vector3d::Zero();
+  k[axis_a] = -radius_mm * std::cos(th) * dth * dth;
+  k[axis_b] = -radius_mm * std::sin(th) * dth * dth;
+  return k;
+}
+
+Trajectory::Trajectory(std::vector<Move> moves, std::vector<TimedTrigger> triggers, Eigen::Vector3d start_mm, double duration_s)
+    : moves_(std::move(moves)), triggers_(std::move(triggers)), start_mm_(start_mm), duration_(duration_s) {}
+
+MotionState Trajectory::at(double t) const {
+  MotionState st;
+  // The last move that started at or before t.
+  auto it = std::upper_bound(moves_.begin(), moves_.end(), t, [](double v, const Move& m) { return v < m.t0_s; });
+  if (it == moves_.begin()) {
+    st.pos_mm = start_mm_;
+    return st;
+  }
+  const Move& m = *(it - 1);
+  const PathState ps = m.profile.at(t - m.t0_s);
+  const auto k = static_cast<std::size_t>(
+      std::upper_bound(m.s_start_mm.begin(), m.s_start_mm.end(), ps.s) - m.s_start_mm.begin() - 1);
+  const PathElement& e = m.elements[std::min(k, m.elements.size() - 1)];
+  const double s = ps.s - m.s_start_mm[std::min(k, m.elements.size() - 1)];
+  st.pos_mm = e.position(s);
+  const Eigen::Vector3d tan = e.tangent(s);
+  st.vel_mm_s = tan * ps.v;
+  st.acc_mm_s2 = tan * ps.a + e.curvature(s) * ps.v * ps.v;
+  return st;
+}
+
+namespace {
+
+int axis_index_normal(gcode::Plane p) { return p == gcode::Plane::xy ? 2 : (p == gcode::Plane::zx ? 1 : 0); }
+
+PathElement element_of(const gcode::Linear& l) {
+  PathElement e;
+  e.from_mm = l.from_mm;
+  e.to_mm = l.to_mm;
+  e.length_mm = (l.to_mm - l.from_mm).norm();
+  return e;
+}
+
+PathElement element_of(const gcode::Arc& a) {
+  PathElement e;
+  e.is_arc = true;
+  e.from_mm = a.from_mm;
+  e.to_mm = a.to_mm;
+  e.center_mm = a.center_mm;
+  // Counter-clockwise order of the plane axes seen from the positive normal.
+  switch (a.plane) {
+    case gcode::Plane::xy: e.axis_a = 0, e.axis_b = 1; break;
+    case gcode::Plane::zx: e.axis_a = 2, e.axis_b = 0; break;
+    case gcode::Plane::yz: e.axis_a = 1, e.axis_b = 2; break;
+  }
+  e.axis_n = axis_index_normal(a.plane);
+  const Eigen::Vector3d r0 = a.from_mm - a.center_mm;
+  e.radius_mm = std::hypot(r0[e.axis_a], r0[e.axis_b]);
+  e.start_rad = std::atan2(r0[e.axis_b], r0[e.axis_a]);
+  e.sweep_rad = a.sweep_rad;
+  e.length_mm = std::hypot(e.radius_mm * a.sweep_rad, a.to_mm[e.axis_n] - a.from_mm[e.axis_n]);
+  return e;
+}
+
+}  // namespace
+
+Trajectory interpolate(const gcode::Program& program, const Eigen::Vector3d& start_mm, const MachineLimits& lim) {
+  std::vector<Move> moves;
+  std::vector<TimedTrigger> triggers;
+  double t = 0.0;
+
+  // The open chain of blended elements and the triggers waiting for their path position.
+  std::vector<PathElement> chain;
+  double chain_feed = 0.0;  // mm/s, the lowest feed and arc speed limit in the chain
+  std::vector<std::pair<double, int>> chain_triggers;  // (path position, code)
+  double chain_len = 0.0;
+
+  auto flush = [&] {
+    if (chain.empty()) return;
+    Move m;
+    m.t0_s = t;
+    double s = 0.0;
+    for (const auto& e : chain) {
+      m.s_start_mm.push_back(s);
+      s += e.length_mm;
+    }
+    m.elements = chain;
+    m.profile = SCurve(s, chain_feed, lim.a_max_mm_s2, lim.j_max_mm_s3);
+    for (const auto& [pos, code] : chain_triggers) triggers.push_back({t + m.profile.time_at(pos), code});
+    t += m.profile.duration_s();
+    moves.push_back(std::move(m));
+    chain.clear();
+    chain_triggers.clear();
+    chain_len = 0.0;
+  };
+
+  for (std::size_t i = 0; i < program.blocks.size(); ++i) {
+    const auto& block = program.blocks[i];
+    if (const auto* d = std::get_if<gcode::Dwell>(&block)) {
+      flush();
+      t += d->duration_s;
+      continue;
+    }
+    if (const auto* tr = std::get_if<gcode::Trigger>(&block)) {
+      if (chain.empty()) triggers.push_back({t, tr->code});
+      else chain_triggers.emplace_back(chain_len, tr->code);
+      continue;
+    }
+    PathElement e;
+    double feed_mm_s = 0.0;
+    if (const auto* l = std::get_if<gcode::Linear>(&block)) {
+      e = element_of(*l);
+      feed_mm_s = (l->rapid ? lim.rapid_mm_min : l->feed_mm_min) / 60.0;
+    } else {
+      const auto& a = std::get<gcode::Arc>(block);
+      e = element_of(a);
+      // Centripetal acceleration v²/r must stay within the machine's limit.
+      feed_mm_s = std::min(a.feed_mm_min / 60.0, std::sqrt(lim.a_max_mm_s2 * e.radius_mm));
+    }
+    if (!(feed_mm_s > 0.0)) throw dsp::InputError("interpolator: a move without feed (F word missing) at block " + std::to_string(i + 1));
+    if (e.length_mm <= 1e-12) continue;  // e.g. the G0 to where the machine already is
+    // Blend into the open chain only in G64 and where the path is tangent-continuous.
+    if (!chain.empty()) {
+      const Eigen::Vector3d t_end = chain.back().tangent(chain.back().length_mm).normalized();
+      const Eigen::Vector3d t_start = e.tangent(0.0).normalized();
+      const bool tangent = t_end.dot(t_start) > std::cos(1e-3);
+      if (program.exact_stop || !tangent || std::abs(chain_feed - feed_mm_s) > 1e-9) flush();
+    }
+    if (chain.empty()) chain_feed = feed_mm_s;
+    chain.push_back(e);
+    chain_len += e.length_mm;
+    if (program.exact_stop) flush();
+  }
+  flush();
+  std::stable_sort(triggers.begin(), triggers.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  return Trajectory(std::move(moves), std::move(triggers), start_mm, t);
+}
+
+Trajectory interpolate_gcode(std::string_view text, std::string_view name, const MachineLimits& limits) {
+  gcode::ParseOptions opt;
+  const gcode::Program first = gcode::parse(text, name, opt);
+  for (const auto& b : first.blocks) {
+    if (const auto* l = std::get_if<gcode::Linear>(&b)) {
+      if (l->rapid) opt.start_mm = l->to_mm;
+      break;
+    }
+    if (std::holds_alternative<gcode::Arc>(b)) break;
+  }
+  return interpolate(gcode::parse(text, name, opt), opt.start_mm, limits);
+}
+
+}  // namespace eical::sim::nc

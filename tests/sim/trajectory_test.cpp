@@ -1,0 +1,89 @@
+// The interpolator against the sample runs' truth (their NC timing is known to 1e-9 s)
+// and against its own limits.
+#include "sim/gcode/generate.hpp"
+#include "sim/gcode/parser.hpp"
+#include "sim/nc/trajectory.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace eical::sim::nc {
+namespace {
+
+Trajectory circle_trajectory(int repeats = 5) {
+  dsp::Program p;
+  p.kind = "circle";
+  p.repeats = repeats;
+  return interpolate_gcode(gcode::circle_program(p), "circle", MachineLimits{});
+}
+
+TEST(Trajectory, CircleTimingMatchesTheSampleRunsTruth) {
+  const Trajectory tr = circle_trajectory();
+  // truth.toml of baseline-0011: moves_s = [[0.5, 8.851539632]], triggers 101 at 0.4, 102 at
+  // 0.9058586319, 2.413823106, ..., 8.445681001, 103 at 9.251539632. The generator of those
+  // runs moved on the exact R = 10 mm circle; the G-code text rounds the start point to
+  // 0.1 µm (7.0711), so the NC's radius is 10.0000455 mm and each revolution is 0.29 µm
+  // (6.9 µs) longer: allow 6 revolutions of that.
+  const double tol = 5e-5;
+  ASSERT_EQ(tr.moves().size(), 1u);
+  EXPECT_NEAR(tr.moves()[0].t0_s, 0.5, 1e-12);
+  EXPECT_NEAR(tr.moves()[0].t0_s + tr.moves()[0].profile.duration_s(), 8.851539632, tol);
+  const std::vector<double> t102 = {0.9058586319, 2.413823106, 3.921787579, 5.429752053, 6.937716527, 8.445681001};
+  std::vector<double> got;
+  for (const auto& t : tr.triggers())
+    if (t.code == 102) got.push_back(t.t_s);
+  ASSERT_EQ(got.size(), t102.size());
+  for (std::size_t k = 0; k < got.size(); ++k) EXPECT_NEAR(got[k], t102[k], tol);
+  EXPECT_NEAR(tr.triggers().front().t_s, 0.4, 1e-12);
+  EXPECT_NEAR(tr.triggers().back().t_s, 9.251539632, tol);
+  EXPECT_NEAR(tr.duration_s(), 9.351539632, tol);
+}
+
+TEST(Trajectory, CircleRunsOnTheRadiusAtFeedWithinTheLimits) {
+  const Trajectory tr = circle_trajectory(2);
+  const double feed = 2500.0 / 60.0;
+  double max_acc = 0.0, max_jerk = 0.0;
+  MotionState prev = tr.at(0.0);
+  const double h = 1e-4;
+  for (double t = h; t < tr.duration_s(); t += h) {
+    const MotionState s = tr.at(t);
+    ASSERT_NEAR(std::hypot(s.pos_mm.x(), s.pos_mm.y()), std::hypot(7.0711, 7.0711), 1e-9) << t;
+    // Velocity and acceleration are the derivatives of position (central differences).
+    const MotionState a = tr.at(t - h / 2), b = tr.at(t + h / 2);
+    ASSERT_LT((s.vel_mm_s - (b.pos_mm - a.pos_mm) / h).norm(), 1e-3) << t;
+    ASSERT_LT((s.acc_mm_s2 - (b.vel_mm_s - a.vel_mm_s) / h).norm(), 50000.0 * h) << t;  // jerk steps: j·h
+    // Path (tangential) acceleration within a_max; jerk of the path speed within j_max.
+    const double tangential = s.acc_mm_s2.dot(s.vel_mm_s.normalized());
+    if (s.vel_mm_s.norm() > 1e-9) max_acc = std::max(max_acc, std::abs(tangential));
+    max_jerk = std::max(max_jerk, std::abs(s.vel_mm_s.norm() - prev.vel_mm_s.norm()) / h);
+    prev = s;
+  }
+  EXPECT_LE(max_acc, 2000.0 * (1 + 1e-9));
+  EXPECT_NEAR(tr.at(3.0).vel_mm_s.norm(), feed, 1e-9);
+  EXPECT_EQ(tr.at(0.45).vel_mm_s.norm(), 0.0);                 // at rest before the move
+  EXPECT_EQ(tr.at(tr.duration_s() - 0.05).vel_mm_s.norm(), 0.0);  // and after
+}
+
+TEST(Trajectory, ExactStopStepsReachTheirTargetsAndRest) {
+  dsp::Program p;
+  p.kind = "step";
+  p.targets_mm = {0.0, 50.0};
+  p.feed_mm_min = 3250.0;
+  p.runs = 2;
+  p.dwell_s = 0.5;
+  const Trajectory tr = interpolate(gcode::parse(gcode::step_program(p)), Eigen::Vector3d::Zero(), MachineLimits{});
+  ASSERT_EQ(tr.moves().size(), 4u);
+  int arrivals = 0;
+  for (const auto& trig : tr.triggers()) {
+    if (trig.code != 102) continue;
+    const MotionState s = tr.at(trig.t_s + 0.25);  // mid-dwell
+    EXPECT_EQ(s.vel_mm_s.norm(), 0.0);
+    EXPECT_NEAR(s.pos_mm.x(), arrivals % 2 == 0 ? 50.0 : 0.0, 1e-12);
+    ++arrivals;
+  }
+  EXPECT_EQ(arrivals, 4);
+}
+
+}  // namespace
+}  // namespace eical::sim::nc
