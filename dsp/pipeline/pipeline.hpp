@@ -1,0 +1,123 @@
+#pragma once
+// The DSP pipeline v1: frames → relative position head − table in machine axes.
+// Causal per-sample step() (live, in eicald's DSP thread) and an offline finish() that
+// adds what needs the whole measurement (ZUPT at the rest after the motion). The same
+// code runs live and offline.
+//
+//   1 static compensation per sensor (StaticComp)
+//   2 bias from the rest window M101 → first set-point motion (per sensor: it removes
+//     gravity, the data-sheet bias error and the machine's tilt in one go)
+//   3 trapezoid integration of each sensor's velocity; relative velocity and position
+//     integrated from the start of the motion, starting at the set-point there
+//   4 two-stage dynamic compensation (6-38) with the DAQ delay, per sensor at the
+//     position level: X_kor = X + Σ ±(c1·V_s + c2·A_s)
+//   5 finish(): ZUPT — the velocity left at the rest after the motion is attributed to a
+//     constant acceleration bias error and removed (ramp in velocity, parabola in position)
+#include "dsp/core/frame.hpp"
+#include "dsp/core/run_meta.hpp"
+#include "dsp/pipeline/dynamic_comp.hpp"
+#include "dsp/pipeline/static_comp.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace eical::dsp {
+
+struct PipelineConfig {
+  Acquisition acquisition;
+  Site site;
+  SensorSpec sensors[2];
+  std::size_t capacity_samples = 0;  // longest measurement the trace can hold
+  DynamicComp dynamic = DynamicComp::two_stage;
+  double zupt_settle_s = 0.05;       // after the set-point stops (plus the DAQ delay)
+  bool zupt = true;
+};
+
+PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples);
+
+// Why a result is degraded (bit set) — named in Measurement::flags.
+namespace quality_flag {
+inline constexpr std::uint32_t accel_missing = 1u << 0;
+inline constexpr std::uint32_t accel_saturated = 1u << 1;
+inline constexpr std::uint32_t frames_lost = 1u << 2;
+inline constexpr std::uint32_t not_finite = 1u << 3;
+inline constexpr std::uint32_t no_start_trigger = 1u << 4;
+inline constexpr std::uint32_t no_motion = 1u << 5;
+inline constexpr std::uint32_t short_rest_window = 1u << 6;
+inline constexpr std::uint32_t no_zupt_window = 1u << 7;
+inline constexpr std::uint32_t capacity_exceeded = 1u << 8;
+inline constexpr std::uint32_t no_end_trigger = 1u << 9;
+}  // namespace quality_flag
+
+std::vector<std::string> quality_flag_names(std::uint32_t bits);
+
+struct LiveEstimate {
+  std::int64_t sample_index = -1;
+  bool integrating = false;
+  Eigen::Vector3d pos_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d vel_mm_s = Eigen::Vector3d::Zero();
+};
+
+struct TriggerMark {
+  std::int64_t sample_index;
+  int code;
+};
+
+struct Measurement {
+  double fs_hz = 0.0;
+  std::vector<std::int64_t> sample_index;  // from the start of the motion to the end
+  std::vector<Eigen::Vector3d> pos_mm, vel_mm_s, cmd_mm, ref_mm;
+  std::vector<TriggerMark> triggers;       // all triggers seen, on the DAQ clock
+  std::int64_t start_index = -1;           // first sample of the motion (integration start)
+  std::int64_t motion_end_index = -1;      // last sample where the set-point moved
+  bool degraded = false;
+  std::vector<std::string> flags;
+  Eigen::Vector3d rest_bias_rel_mps2 = Eigen::Vector3d::Zero();  // head − table, incl. gravity
+  Eigen::Vector3d zupt_velocity_error_mm_s = Eigen::Vector3d::Zero();
+  std::size_t rest_window_samples = 0, zupt_window_samples = 0;
+};
+
+class Pipeline {
+ public:
+  explicit Pipeline(const PipelineConfig& config);
+
+  void step(const Frame& frame) noexcept;
+  [[nodiscard]] const LiveEstimate& live() const noexcept { return live_; }
+  [[nodiscard]] std::uint32_t quality_bits() const noexcept { return quality_; }
+  // Offline completion (allocates; not for the DSP thread's per-sample path). Call once.
+  Measurement finish();
+
+ private:
+  enum class Phase { wait_start, rest, moving };
+  void store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept;
+
+  PipelineConfig config_;
+  StaticComp comp_[2];
+  DynamicCoefficients dyn_[2];
+  double dt_s_;
+  Phase phase_ = Phase::wait_start;
+  std::uint32_t quality_ = 0;
+  bool saw_start_ = false, saw_end_ = false;
+  std::int64_t prev_index_ = -1;
+  Eigen::Vector3d prev_cmd_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Vector3d last_valid_a_[2];
+  // Rest window sums.
+  Eigen::Vector3d bias_sum_[2];
+  std::size_t bias_n_ = 0;
+  Eigen::Vector3d bias_[2];
+  // Integrator state (m, m/s, m/s²), per sensor and relative.
+  Eigen::Vector3d a_prev_[2], v_[2];
+  Eigen::Vector3d v_rel_prev_ = Eigen::Vector3d::Zero(), x_rel_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d start_pos_mm_ = Eigen::Vector3d::Zero();
+  std::int64_t start_index_ = -1, motion_end_index_ = -1;
+  LiveEstimate live_;
+  Measurement m_;  // trace storage, reserved in the constructor
+  std::size_t trigger_capacity_ = 4096;
+};
+
+}  // namespace eical::dsp
