@@ -18,7 +18,7 @@ bool valid_axis(const std::string& a) { return a == "x" || a == "y" || a == "z";
 
 }  // namespace
 
-dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults) {
+dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults, Unknown u) {
   dsp::Acquisition a = defaults;
   a.fs_hz = t.number("fs_hz", a.fs_hz);
   if (a.fs_hz <= 0.0) t.fail("fs_hz", "must be positive");
@@ -29,22 +29,22 @@ dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& default
   a.adc_offset_counts = t.integer("adc_offset_counts", a.adc_offset_counts);
   a.daq_group_delay_samples = t.number("daq_group_delay_samples", a.daq_group_delay_samples);
   if (a.daq_group_delay_samples < 0.0) t.fail("daq_group_delay_samples", "must not be negative");
-  t.finish();
+  if (u == Unknown::reject) t.finish();
   return a;
 }
 
-dsp::Site read_site(StrictTable t, const dsp::Site& defaults) {
+dsp::Site read_site(StrictTable t, const dsp::Site& defaults, Unknown u) {
   dsp::Site s = defaults;
   s.latitude_deg = t.number("latitude_deg", s.latitude_deg);
   if (s.latitude_deg < -90.0 || s.latitude_deg > 90.0) t.fail("latitude_deg", "must be within [-90, 90]");
   s.heading_deg = t.number("heading_deg", s.heading_deg);
   s.g_mps2 = t.number("g_mps2", s.g_mps2);
   if (s.g_mps2 < 9.7 || s.g_mps2 > 9.9) t.fail("g_mps2", "local gravity must be within [9.7, 9.9] m/s^2");
-  t.finish();
+  if (u == Unknown::reject) t.finish();
   return s;
 }
 
-dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults) {
+dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults, Unknown u) {
   dsp::MachineLayout m = defaults;
   m.name = t.string("name", m.name);
   if (t.has("table_axes")) m.table_axes = t.strings("table_axes");
@@ -55,11 +55,11 @@ dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& default
   for (const auto& a : m.table_axes)
     if (std::find(m.head_axes.begin(), m.head_axes.end(), a) != m.head_axes.end())
       t.fail("head_axes", "axis '" + a + "' is moved by both table and head");
-  t.finish();
+  if (u == Unknown::reject) t.finish();
   return m;
 }
 
-dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults) {
+dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults, Unknown u) {
   dsp::SensorSpec s = defaults;
   s.model = t.string("model", s.model);
   if (t.has("to_machine")) {
@@ -84,11 +84,11 @@ dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults) {
   s.noise_ug_per_rthz = t.number("noise_ug_per_rthz", s.noise_ug_per_rthz);
   if (s.noise_ug_per_rthz < 0.0) t.fail("noise_ug_per_rthz", "must not be negative");
   s.temp_ref_c = t.number("temp_ref_c", s.temp_ref_c);
-  t.finish();
+  if (u == Unknown::reject) t.finish();
   return s;
 }
 
-dsp::PsdSpec read_psd(StrictTable t) {
+dsp::PsdSpec read_psd(StrictTable t, Unknown u) {
   dsp::PsdSpec p;
   p.measures = t.choice("measures", {"x", "y", "z"}, p.measures);
   const auto c = t.numbers("center_mm", 2);
@@ -98,7 +98,42 @@ dsp::PsdSpec read_psd(StrictTable t) {
   if (p.length_mm <= 0.0) t.fail("length_mm", "must be positive");
   p.width_mm = t.number("width_mm", p.width_mm);
   p.lockin_tau_s = t.number("lockin_tau_s", p.lockin_tau_s);
-  t.finish();
+  if (u == Unknown::reject) t.finish();
+  return p;
+}
+
+dsp::Program read_program(StrictTable t, Unknown u) {
+  dsp::Program p;
+  p.kind = t.string("kind");
+  (void)t.choice("kind", {"step", "positioning", "rectangle", "circle", "freeform", "identify"}, p.kind);
+  p.plane = t.choice("plane", {"xy", "zx", "yz"}, p.plane);
+  if (t.has("center_mm")) {
+    const auto c = t.numbers("center_mm", 2);
+    p.center_mm[0] = c[0], p.center_mm[1] = c[1];
+  }
+  p.radius_mm = t.number("radius_mm", p.radius_mm);
+  if (p.radius_mm <= 0.0) t.fail("radius_mm", "must be positive");
+  p.feed_mm_min = t.number("feed_mm_min", p.feed_mm_min);
+  if (p.feed_mm_min <= 0.0) t.fail("feed_mm_min", "must be positive");
+  p.direction = t.choice("direction", {"cw", "ccw"}, p.direction);
+  p.repeats = static_cast<int>(t.integer("repeats", p.repeats));
+  if (p.repeats < 1) t.fail("repeats", "must be at least 1");
+  p.axis = t.choice("axis", {"x", "y", "z"}, p.axis);
+  if (t.has("targets_mm")) p.targets_mm = t.numbers("targets_mm");
+  p.runs = static_cast<int>(t.integer("runs", p.runs));
+  if (p.runs < 1) t.fail("runs", "must be at least 1");
+  p.dwell_s = t.number("dwell_s", p.dwell_s);
+  if (p.dwell_s < 0.0) t.fail("dwell_s", "must not be negative");
+  if (t.has("corner_mm")) {
+    const auto c = t.numbers("corner_mm", 2);
+    p.corner_mm[0] = c[0], p.corner_mm[1] = c[1];
+  }
+  if (t.has("size_mm")) {
+    const auto c = t.numbers("size_mm", 2);
+    p.size_mm[0] = c[0], p.size_mm[1] = c[1];
+  }
+  p.gcode = t.string("gcode", "");
+  if (u == Unknown::reject) t.finish();
   return p;
 }
 

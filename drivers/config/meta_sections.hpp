@@ -7,12 +7,15 @@
 
 namespace eical::drivers {
 
-// Each reader starts from `defaults`, overrides the keys present, checks ranges and
-// calls finish() on the table (unknown keys are errors).
-dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults = {});
-dsp::Site read_site(StrictTable t, const dsp::Site& defaults = {});
-dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults = {});
-dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults = {});
-dsp::PsdSpec read_psd(StrictTable t);
+// Each reader starts from `defaults`, overrides the keys present and checks types and
+// ranges. Configs are strict (unknown keys are errors); recorded runs may carry keys
+// added by others (spec), so run.toml is read with Unknown::accept.
+enum class Unknown { reject, accept };
+dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults = {}, Unknown u = Unknown::reject);
+dsp::Site read_site(StrictTable t, const dsp::Site& defaults = {}, Unknown u = Unknown::reject);
+dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults = {}, Unknown u = Unknown::reject);
+dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults = {}, Unknown u = Unknown::reject);
+dsp::PsdSpec read_psd(StrictTable t, Unknown u = Unknown::reject);
+dsp::Program read_program(StrictTable t, Unknown u = Unknown::reject);
 
 }  // namespace eical::drivers

@@ -1,0 +1,231 @@
+#include "drivers/run_io/run_reader.hpp"
+
+#include "drivers/config/meta_sections.hpp"
+#include "drivers/config/strict_toml.hpp"
+#include "drivers/run_io/line_source.hpp"
+#include "dsp/core/error.hpp"
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+
+namespace eical::drivers {
+namespace fs = std::filesystem;
+namespace {
+
+using Unknown = drivers::Unknown;
+
+enum Col : int {
+  c_t, c_tax, c_tay, c_taz, c_hax, c_hay, c_haz, c_ttemp, c_htemp, c_cx, c_cy, c_cz, c_rx, c_ry, c_rz, c_trig,
+  c_psd0,  // psd k i1 = c_psd0 + 2k, i2 = c_psd0 + 2k + 1
+  c_count = c_psd0 + 2 * dsp::kMaxPsd
+};
+
+const char* const kNames[] = {"t", "table_ax", "table_ay", "table_az", "head_ax", "head_ay", "head_az", "table_temp",
+                              "head_temp", "cmd_x", "cmd_y", "cmd_z", "ref_x", "ref_y", "ref_z", "trigger"};
+
+std::string column_name(int c) {
+  if (c < c_psd0) return kNames[c];
+  const int k = (c - c_psd0) / 2;
+  return "psd" + std::to_string(k) + ((c - c_psd0) % 2 == 0 ? "_i1" : "_i2");
+}
+
+[[noreturn]] void fail_at(const LineSource& src, int col, const std::string& what) {
+  throw dsp::InputError(src.name() + ":" + std::to_string(src.line_number()) + ": column '" + column_name(col) + "': " + what);
+}
+
+std::optional<double> parse_double(const LineSource& src, int col, std::string_view f) {
+  if (f.empty()) return std::nullopt;
+  double v = 0.0;
+  const auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
+  if (ec != std::errc() || p != f.data() + f.size()) fail_at(src, col, "expected a number, got '" + std::string(f) + "'");
+  if (!std::isfinite(v)) fail_at(src, col, "NaN or Inf in a sample ('" + std::string(f) + "')");
+  return v;
+}
+
+std::optional<std::int64_t> parse_int(const LineSource& src, int col, std::string_view f, const char* what) {
+  if (f.empty()) return std::nullopt;
+  std::int64_t v = 0;
+  const auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
+  if (ec == std::errc::result_out_of_range) fail_at(src, col, std::string(what) + " out of range: '" + std::string(f) + "'");
+  if (ec != std::errc() || p != f.data() + f.size()) fail_at(src, col, std::string("expected ") + what + ", got '" + std::string(f) + "'");
+  return v;
+}
+
+fs::path samples_file(const fs::path& dir) {
+  const fs::path plain = dir / "samples.csv", gz = dir / "samples.csv.gz";
+  const bool has_plain = fs::exists(plain), has_gz = fs::exists(gz);
+  if (has_plain && has_gz) throw dsp::InputError(dir.string() + ": both samples.csv and samples.csv.gz exist; keep one");
+  if (!has_plain && !has_gz) throw dsp::InputError(dir.string() + ": no samples.csv or samples.csv.gz");
+  return has_plain ? plain : gz;
+}
+
+void read_samples(const fs::path& file, dsp::Run& run) {
+  LineSource src(file);
+  std::string_view line;
+  if (!src.next(line)) throw dsp::InputError(file.string() + ": empty file (no header line)");
+  std::array<int, c_count> where;
+  where.fill(-1);
+  int n_fields = 0;
+  {
+    std::size_t pos = 0;
+    for (;;) {
+      const auto comma = line.find(',', pos);
+      const std::string_view name = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
+      for (int c = 0; c < c_count; ++c)
+        if (column_name(c) == name) {
+          if (where[c] >= 0) throw dsp::InputError(file.string() + ":1: column '" + std::string(name) + "' appears twice");
+          where[c] = n_fields;
+        }
+      ++n_fields;
+      if (comma == std::string_view::npos) break;
+      pos = comma + 1;
+    }
+  }
+  for (int c : {c_t, c_tax, c_tay, c_taz, c_hax, c_hay, c_haz, c_ttemp, c_htemp, c_cx, c_cy, c_cz, c_trig})
+    if (where[c] < 0) throw dsp::InputError(file.string() + ":1: required column '" + column_name(c) + "' is missing");
+  const int n_psd = static_cast<int>(run.meta.psd.size());
+  if (n_psd > dsp::kMaxPsd) throw dsp::InputError(file.string() + ": more than " + std::to_string(dsp::kMaxPsd) + " [[psd]] strips");
+  for (int k = 0; k < dsp::kMaxPsd; ++k)
+    for (int e = 0; e < 2; ++e) {
+      const int c = c_psd0 + 2 * k + e;
+      if (k < n_psd && where[c] < 0)
+        throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' is missing (run.toml has " + std::to_string(n_psd) + " [[psd]])");
+      if (k >= n_psd && where[c] >= 0)
+        throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' has no [[psd]] table in run.toml");
+    }
+  for (int a = 0; a < 3; ++a) run.channels.ref[a] = where[c_rx + a] >= 0;
+  run.channels.psd_count = n_psd;
+
+  const double fs = run.meta.acquisition.fs_hz;
+  const double lsb = run.meta.acquisition.adc_lsb_volt;
+  const auto offset = static_cast<double>(run.meta.acquisition.adc_offset_counts);
+  std::vector<std::string_view> fields(static_cast<std::size_t>(n_fields));
+  std::int64_t prev_index = -1;
+  while (src.next(line)) {
+    // Split into exactly n_fields fields.
+    std::size_t k = 0, pos = 0;
+    for (;;) {
+      const auto comma = line.find(',', pos);
+      if (k < fields.size()) fields[k] = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
+      ++k;
+      if (comma == std::string_view::npos) break;
+      pos = comma + 1;
+    }
+    if (k != fields.size()) {
+      const std::string why = !src.last_line_had_newline() ? "truncated file: the last line is incomplete" : "wrong number of fields";
+      throw dsp::InputError(file.string() + ":" + std::to_string(src.line_number()) + ": " + why + " (" + std::to_string(k) +
+                            " fields, header has " + std::to_string(n_fields) + ")");
+    }
+    auto field = [&](int c) { return fields[static_cast<std::size_t>(where[c])]; };
+    dsp::Frame f;
+    const auto t = parse_double(src, c_t, field(c_t));
+    if (!t) fail_at(src, c_t, "empty time");
+    const double idx_real = *t * fs;
+    const auto idx = static_cast<std::int64_t>(std::llround(idx_real));
+    // 1e-3 sample, plus what printing t with 10 significant digits can cost on long runs.
+    if (std::abs(idx_real - static_cast<double>(idx)) > 1e-3 + 1e-9 * std::abs(idx_real))
+      fail_at(src, c_t, "time " + std::string(field(c_t)) + " s is not on the sample grid of fs = " + std::to_string(fs) + " Hz");
+    if (prev_index >= 0 && idx <= prev_index) fail_at(src, c_t, "time does not increase");
+    if (prev_index >= 0 && idx > prev_index + 1) f.flags |= dsp::frame_flag::gap_before;
+    prev_index = idx;
+    f.sample_index = idx;
+    for (int c = c_tax; c <= c_haz; ++c) {
+      const auto v = parse_int(src, c, field(c), "integer ADC counts");
+      if (!v) {
+        f.flags |= dsp::frame_flag::accel_missing;
+        continue;
+      }
+      if (*v > INT32_MAX || *v < INT32_MIN) fail_at(src, c, "ADC counts out of the 32-bit range");
+      f.accel_counts[c - c_tax] = static_cast<std::int32_t>(*v);
+      const double full = std::ldexp(1.0, run.meta.acquisition.adc_bits - 1);
+      if (static_cast<double>(*v) >= full - 1 || static_cast<double>(*v) <= -full) f.flags |= dsp::frame_flag::accel_saturated;
+    }
+    for (int s = 0; s < 2; ++s) {
+      const auto v = parse_double(src, c_ttemp + s, field(c_ttemp + s));
+      if (v) f.temp_c[s] = static_cast<float>(*v);
+      else f.flags |= dsp::frame_flag::temp_missing;
+    }
+    for (int a = 0; a < 3; ++a) {
+      const auto v = parse_double(src, c_cx + a, field(c_cx + a));
+      if (v) f.cmd_mm[a] = *v;
+      else f.flags |= dsp::frame_flag::cmd_missing;
+      if (where[c_rx + a] >= 0) {
+        const auto r = parse_double(src, c_rx + a, field(c_rx + a));
+        if (r) f.ref_mm[a] = *r;
+      }
+    }
+    for (int c = c_psd0; c < c_psd0 + 2 * n_psd; ++c) {
+      const auto v = parse_double(src, c, field(c));
+      if (!v) {
+        f.flags |= dsp::frame_flag::psd_missing;
+        continue;
+      }
+      f.psd_counts[c - c_psd0] = static_cast<std::int32_t>(std::llround(*v / lsb + offset));
+    }
+    const auto trig = parse_int(src, c_trig, field(c_trig), "an integer trigger code");
+    if (!trig) fail_at(src, c_trig, "empty trigger (0 means none)");
+    f.trigger = static_cast<std::int32_t>(*trig);
+    run.frames.push_back(f);
+  }
+  if (run.frames.empty()) throw dsp::InputError(file.string() + ": no samples after the header");
+}
+
+}  // namespace
+
+dsp::RunMeta read_run_meta(const fs::path& file) {
+  if (!fs::exists(file)) throw dsp::InputError(file.string() + ": no such file");
+  const toml::table root = StrictTable::parse_file(file.string());
+  StrictTable t(root, file.string(), "");
+  dsp::RunMeta m;
+  m.format = t.string("format");
+  if (m.format != "eical-run/1") t.fail("format", "expected \"eical-run/1\", got \"" + m.format + "\"");
+  m.id = t.string("id");
+  if (t.has("created")) {
+    const toml::node* n = root.get("created");
+    if (auto dt = n->value<toml::date_time>()) {
+      std::ostringstream os;
+      os << *dt;
+      m.created = os.str();
+    } else if (auto s = n->value<std::string>()) {
+      m.created = *s;
+    } else {
+      t.fail("created", "expected an RFC 3339 date-time");
+    }
+  }
+  m.acquisition = read_acquisition(t.table("acquisition"), {}, Unknown::accept);
+  if (auto s = t.optional_table("site")) m.site = read_site(*s, {}, Unknown::accept);
+  if (auto s = t.optional_table("machine")) m.machine = read_machine(*s, {}, Unknown::accept);
+  StrictTable sensors = t.table("sensors");
+  m.sensors[0] = read_sensor(sensors.table("table"), {}, Unknown::accept);
+  m.sensors[1] = read_sensor(sensors.table("head"), {}, Unknown::accept);
+  for (auto& p : t.tables("psd")) m.psd.push_back(read_psd(p, Unknown::accept));
+  m.program = read_program(t.table("program"), Unknown::accept);
+  if (auto r = t.optional_table("reference")) {
+    dsp::Reference ref;
+    ref.kind = r->string("kind");
+    ref.axes = r->strings("axes");
+    m.reference = ref;
+  }
+  return m;
+}
+
+dsp::Run read_run(const fs::path& dir) {
+  if (!fs::is_directory(dir)) throw dsp::InputError(dir.string() + ": not a run directory");
+  dsp::Run run;
+  run.meta = read_run_meta(dir / "run.toml");
+  read_samples(samples_file(dir), run);
+  const fs::path truth = dir / "truth.toml";
+  if (fs::exists(truth)) {
+    (void)StrictTable::parse_file(truth.string());  // must at least be valid TOML
+    std::ifstream is(truth, std::ios::binary);
+    run.truth_toml = std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>());
+  }
+  return run;
+}
+
+}  // namespace eical::drivers

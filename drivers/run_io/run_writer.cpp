@@ -1,0 +1,272 @@
+#include "drivers/run_io/run_writer.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+namespace eical::drivers {
+namespace fs = std::filesystem;
+namespace {
+
+[[noreturn]] void sys_fail(const fs::path& p, const char* what, int err) {
+  throw std::runtime_error(p.string() + ": " + what + ": " + std::strerror(err));
+}
+
+// Shortest text that reads back to the same double; fixed notation (as people and
+// spreadsheets expect: 0.0001, not 1e-04) unless the value is tiny or huge.
+void put_double(std::string& out, double v) {
+  char buf[64];
+  const double a = std::abs(v);
+  const auto fmt = (a == 0.0 || (a >= 1e-9 && a < 1e15)) ? std::chars_format::fixed : std::chars_format::scientific;
+  const auto r = std::to_chars(buf, buf + sizeof buf, v, fmt);
+  out.append(buf, r.ptr);
+}
+
+std::string toml_double(double v) {
+  std::string s;
+  put_double(s, v);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+std::string toml_str(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') {
+      o += "\\n";
+      continue;
+    }
+    o += c;
+  }
+  return o + "\"";
+}
+
+std::string vec(const double* v, int n) {
+  std::string s = "[";
+  for (int i = 0; i < n; ++i) s += (i ? ", " : "") + toml_double(v[i]);
+  return s + "]";
+}
+
+std::string strs(const std::vector<std::string>& v) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? ", " : "") + toml_str(v[i]);
+  return s + "]";
+}
+
+void write_sensor(std::string& o, const char* name, const dsp::SensorSpec& s) {
+  o += std::string("\n[sensors.") + name + "]\nmodel = " + toml_str(s.model) + "\nto_machine = [";
+  for (int r = 0; r < 3; ++r) {
+    const double row[3] = {s.to_machine(r, 0), s.to_machine(r, 1), s.to_machine(r, 2)};
+    o += (r ? ", " : "") + vec(row, 3);
+  }
+  o += "]\nk1_v_per_g = " + vec(s.k1_v_per_g.data(), 3) + "\nk2_g_per_g2 = " + vec(s.k2_g_per_g2.data(), 3) +
+       "\nk3_g_per_g3 = " + vec(s.k3_g_per_g3.data(), 3) + "\nbias_g = " + vec(s.bias_g.data(), 3) +
+       "\ntc_k1_ppm_per_c = " + toml_double(s.tc_k1_ppm_per_c) + "\ntc_bias_ug_per_c = " + toml_double(s.tc_bias_ug_per_c) +
+       "\nf0_hz = " + toml_double(s.f0_hz) + "\nzeta = " + toml_double(s.zeta) + "\nnoise_ug_per_rthz = " +
+       toml_double(s.noise_ug_per_rthz) + "\ntemp_ref_c = " + toml_double(s.temp_ref_c) + "\n";
+}
+
+class FileOut {
+ public:
+  FileOut(const fs::path& p, bool gzip) : path_(p), gzip_(gzip) {
+    fd_ = ::open(p.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd_ < 0) sys_fail(p, "cannot create", errno);
+    if (gzip_) {
+      const int dup = ::dup(fd_);
+      gz_ = gzdopen(dup, "wb6");
+      if (!gz_) sys_fail(p, "cannot start gzip", errno);
+    }
+    buf_.reserve(1 << 20);
+  }
+  ~FileOut() {
+    if (gz_) gzclose(gz_);
+    if (fd_ >= 0) ::close(fd_);
+  }
+  std::string& buffer() { return buf_; }
+  void flush_if_full() {
+    if (buf_.size() > (1 << 20) - 4096) flush();
+  }
+  void flush() {
+    if (buf_.empty()) return;
+    if (gzip_) {
+      if (gzwrite(gz_, buf_.data(), static_cast<unsigned>(buf_.size())) != static_cast<int>(buf_.size())) {
+        int code = 0;
+        const char* msg = gzerror(gz_, &code);
+        throw std::runtime_error(path_.string() + ": write failed: " + (code == Z_ERRNO ? std::strerror(errno) : msg));
+      }
+    } else {
+      std::size_t done = 0;
+      while (done < buf_.size()) {
+        const ssize_t n = ::write(fd_, buf_.data() + done, buf_.size() - done);
+        if (n < 0) {
+          if (errno == EINTR) continue;
+          sys_fail(path_, "write failed", errno);
+        }
+        done += static_cast<std::size_t>(n);
+      }
+    }
+    buf_.clear();
+  }
+  void close_and_sync() {
+    flush();
+    if (gz_) {
+      const int rc = gzclose(gz_);
+      gz_ = nullptr;
+      if (rc != Z_OK) sys_fail(path_, "gzip close failed", errno);
+    }
+    if (::fsync(fd_) != 0) sys_fail(path_, "fsync failed", errno);
+    if (::close(fd_) != 0) sys_fail(path_, "close failed", errno);
+    fd_ = -1;
+  }
+
+ private:
+  fs::path path_;
+  bool gzip_;
+  int fd_ = -1;
+  gzFile gz_ = nullptr;
+  std::string buf_;
+};
+
+void write_text(const fs::path& p, const std::string& text) {
+  FileOut f(p, false);
+  f.buffer() = text;
+  f.close_and_sync();
+}
+
+void sync_dir(const fs::path& d) {
+  const int fd = ::open(d.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) sys_fail(d, "cannot open directory to sync", errno);
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  if (rc != 0) sys_fail(d, "fsync of the directory failed", err);
+}
+
+void write_samples(const dsp::Run& run, const fs::path& file, bool gzip) {
+  FileOut out(file, gzip);
+  std::string& b = out.buffer();
+  const int n_psd = run.channels.psd_count;
+  b = "t,table_ax,table_ay,table_az,head_ax,head_ay,head_az,table_temp,head_temp";
+  for (int k = 0; k < n_psd; ++k) b += ",psd" + std::to_string(k) + "_i1,psd" + std::to_string(k) + "_i2";
+  b += ",cmd_x,cmd_y,cmd_z";
+  const char* ref_names[3] = {",ref_x", ",ref_y", ",ref_z"};
+  for (int a = 0; a < 3; ++a)
+    if (run.channels.ref[a]) b += ref_names[a];
+  b += ",trigger\n";
+  const double fs = run.meta.acquisition.fs_hz;
+  const double lsb = run.meta.acquisition.adc_lsb_volt;
+  const auto offset = run.meta.acquisition.adc_offset_counts;
+  char num[32];
+  auto put_int = [&](std::int64_t v) {
+    const auto r = std::to_chars(num, num + sizeof num, v);
+    b.append(num, r.ptr);
+  };
+  for (const auto& f : run.frames) {
+    put_double(b, static_cast<double>(f.sample_index) / fs);
+    for (int c = 0; c < 6; ++c) {
+      b += ',';
+      if (!(f.flags & dsp::frame_flag::accel_missing)) put_int(f.accel_counts[c]);
+    }
+    for (int s = 0; s < 2; ++s) {
+      b += ',';
+      if (!(f.flags & dsp::frame_flag::temp_missing)) put_double(b, static_cast<double>(f.temp_c[s]));
+    }
+    for (int c = 0; c < 2 * n_psd; ++c) {
+      b += ',';
+      if (!(f.flags & dsp::frame_flag::psd_missing)) put_double(b, static_cast<double>(f.psd_counts[c] - offset) * lsb);
+    }
+    for (int a = 0; a < 3; ++a) {
+      b += ',';
+      if (!(f.flags & dsp::frame_flag::cmd_missing)) put_double(b, f.cmd_mm[a]);
+    }
+    for (int a = 0; a < 3; ++a) {
+      if (!run.channels.ref[a]) continue;
+      b += ',';
+      if (std::isfinite(f.ref_mm[a])) put_double(b, f.ref_mm[a]);
+    }
+    b += ',';
+    put_int(f.trigger);
+    b += '\n';
+    out.flush_if_full();
+  }
+  out.close_and_sync();
+}
+
+}  // namespace
+
+std::string run_toml_text(const dsp::RunMeta& m) {
+  std::string o;
+  o += "format = \"eical-run/1\"\nid = " + toml_str(m.id) + "\n";
+  if (!m.created.empty()) o += "created = " + m.created + "\n";
+  const auto& a = m.acquisition;
+  o += "\n[acquisition]\nfs_hz = " + toml_double(a.fs_hz) + "\nadc_bits = " + std::to_string(a.adc_bits) +
+       "\nadc_lsb_volt = " + toml_double(a.adc_lsb_volt) + "\nadc_offset_counts = " + std::to_string(a.adc_offset_counts) +
+       "\ndaq_group_delay_samples = " + toml_double(a.daq_group_delay_samples) + "\n";
+  o += "\n[site]\nlatitude_deg = " + toml_double(m.site.latitude_deg) + "\nheading_deg = " + toml_double(m.site.heading_deg) +
+       "\ng_mps2 = " + toml_double(m.site.g_mps2) + "\n";
+  o += "\n[machine]\nname = " + toml_str(m.machine.name) + "\ntable_axes = " + strs(m.machine.table_axes) +
+       "\nhead_axes = " + strs(m.machine.head_axes) + "\n";
+  write_sensor(o, "table", m.sensors[0]);
+  write_sensor(o, "head", m.sensors[1]);
+  const auto& p = m.program;
+  o += "\n[program]\nkind = " + toml_str(p.kind) + "\nplane = " + toml_str(p.plane) + "\ncenter_mm = " + vec(p.center_mm, 2) +
+       "\nradius_mm = " + toml_double(p.radius_mm) + "\nfeed_mm_min = " + toml_double(p.feed_mm_min) +
+       "\ndirection = " + toml_str(p.direction) + "\nrepeats = " + std::to_string(p.repeats) + "\naxis = " + toml_str(p.axis) +
+       "\ntargets_mm = " + vec(p.targets_mm.data(), static_cast<int>(p.targets_mm.size())) + "\nruns = " + std::to_string(p.runs) +
+       "\ndwell_s = " + toml_double(p.dwell_s) + "\ncorner_mm = " + vec(p.corner_mm, 2) + "\nsize_mm = " + vec(p.size_mm, 2) + "\n";
+  if (!p.gcode.empty()) o += "gcode = \"\"\"\n" + p.gcode + "\"\"\"\n";
+  for (const auto& s : m.psd) {
+    o += "\n[[psd]]\nmeasures = " + toml_str(s.measures) + "\ncenter_mm = " + vec(s.center_mm, 2) + "\nlength_mm = " +
+         toml_double(s.length_mm) + "\nwidth_mm = " + toml_double(s.width_mm) + "\nlockin_tau_s = " + toml_double(s.lockin_tau_s) + "\n";
+  }
+  if (m.reference) o += "\n[reference]\nkind = " + toml_str(m.reference->kind) + "\naxes = " + strs(m.reference->axes) + "\n";
+  return o;
+}
+
+void write_run(const dsp::Run& run, const fs::path& dir_in, const WriteOptions& opt) {
+  const fs::path dir = dir_in.has_filename() ? dir_in : dir_in.parent_path();
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !opt.overwrite)
+    throw std::runtime_error(dir.string() + ": a run already exists here (not overwritten)");
+  const fs::path parent = dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
+  if (!fs::is_directory(parent, ec)) throw std::runtime_error(parent.string() + ": no such directory");
+  std::random_device rd;
+  const fs::path tmp = parent / ("." + dir.filename().string() + ".tmp-" + std::to_string(rd()));
+  if (::mkdir(tmp.c_str(), 0755) != 0) sys_fail(tmp, "cannot create", errno);
+  try {
+    write_text(tmp / "run.toml", run_toml_text(run.meta));
+    write_samples(run, tmp / (opt.gzip ? "samples.csv.gz" : "samples.csv"), opt.gzip);
+    if (run.truth_toml) write_text(tmp / "truth.toml", *run.truth_toml);
+    sync_dir(tmp);
+    if (fs::exists(dir)) {
+      // Replace atomically: old run aside, new in, old removed.
+      const fs::path old = parent / ("." + dir.filename().string() + ".old-" + std::to_string(rd()));
+      if (::rename(dir.c_str(), old.c_str()) != 0) sys_fail(dir, "cannot move the old run aside", errno);
+      if (::rename(tmp.c_str(), dir.c_str()) != 0) {
+        const int err = errno;
+        (void)::rename(old.c_str(), dir.c_str());
+        sys_fail(dir, "cannot rename the new run into place", err);
+      }
+      fs::remove_all(old, ec);
+    } else if (::rename(tmp.c_str(), dir.c_str()) != 0) {
+      sys_fail(dir, "cannot rename the new run into place", errno);
+    }
+    sync_dir(parent);
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+}
+
+}  // namespace eical::drivers

@@ -1,0 +1,23 @@
+#pragma once
+// Writes an eical-run/1 directory atomically: everything goes into a temporary sibling
+// directory, every file and the directory are fsynced, then it is renamed into place.
+// A reader never sees half a run, and a failed write (disk full, unwritable path) never
+// touches an earlier run of the same name.
+#include "dsp/core/run.hpp"
+
+#include <filesystem>
+
+namespace eical::drivers {
+
+struct WriteOptions {
+  bool gzip = false;       // samples.csv.gz instead of samples.csv
+  bool overwrite = false;  // replace an existing run (atomically) instead of failing
+};
+
+// Throws std::runtime_error naming the path and the system's reason.
+void write_run(const dsp::Run& run, const std::filesystem::path& dir, const WriteOptions& options = {});
+
+// run.toml text for `meta` (used by the writer; exposed for tests and `eical gen-nc`).
+std::string run_toml_text(const dsp::RunMeta& meta);
+
+}  // namespace eical::drivers
