@@ -216,19 +216,27 @@ TEST(RunIoBadInput, PsdColumnsMustMatchPsdTables) {
 
 TEST(RunIoWriter, UnwritablePlaceFailsWithThePathAndLeavesNothing) {
   TempDir tmp;
-  const fs::path ro = tmp.path / "ro";
-  fs::create_directories(ro);
-  fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+  // A parent that is a regular file cannot hold a run, not even for root.
+  const fs::path file = tmp.path / "not-a-dir";
+  std::ofstream(file) << "x";
   try {
-    write_run(small_run(), ro / "run");
-    if (::geteuid() != 0) FAIL() << "wrote into a read-only directory";
+    write_run(small_run(), file / "run");
+    FAIL() << "wrote below a regular file";
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find(ro.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
   }
-  fs::permissions(ro, fs::perms::owner_all);
-  if (::geteuid() == 0) GTEST_SKIP() << "running as root: permissions do not stop writes";
-  EXPECT_TRUE(fs::is_empty(ro));
   EXPECT_THROW(write_run(small_run(), tmp.path / "no" / "such" / "dir"), std::runtime_error);
+  if (::geteuid() != 0) {  // permissions bind everyone but root
+    const fs::path ro = tmp.path / "ro";
+    fs::create_directories(ro);
+    fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+    EXPECT_THROW(write_run(small_run(), ro / "run"), std::runtime_error);
+    fs::permissions(ro, fs::perms::owner_all);
+    EXPECT_TRUE(fs::is_empty(ro)) << "a temporary directory was left behind";
+  }
+  int entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(tmp.path)) ++entries;
+  EXPECT_EQ(entries, ::geteuid() != 0 ? 2 : 1);
 }
 
 TEST(RunIoWriter, ExistingRunIsNeverCorrupted) {
