@@ -8,11 +8,19 @@ namespace eical::tools {
 
 void register_version(CLI::App& app);
 void register_gen_nc(CLI::App& app);
+void register_simulate(CLI::App& app);
+void register_analyze(CLI::App& app);
+void register_report(CLI::App& app);
+void register_demo(CLI::App& app);
 
 // The list main() registers, in the order `eical --help` shows them.
 inline void register_all(CLI::App& app) {
-  register_version(app);
+  register_demo(app);
+  register_simulate(app);
+  register_analyze(app);
+  register_report(app);
   register_gen_nc(app);
+  register_version(app);
 }
 
 }  // namespace eical::tools

@@ -1,10 +1,67 @@
 #include "tools/results/result_json.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace eical::tools {
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult& c) {
+  nlohmann::json j = {{"plane", p.plane},
+                      {"radius_nominal_mm", p.radius_mm},
+                      {"feed_mm_min", p.feed_mm_min},
+                      {"direction", c.direction},
+                      {"revolutions", c.revolutions},
+                      {"radius_mean_deviation_um", number_or_null(c.radius_mean_deviation_um)},
+                      {"circular_deviation_G_um", number_or_null(c.circular_deviation_G_um)},
+                      {"circular_hysteresis_H_um", c.circular_hysteresis_H_um ? nlohmann::json(*c.circular_hysteresis_H_um) : nlohmann::json(nullptr)},
+                      {"radial_deviation_F_max_um", number_or_null(c.radial_deviation_F_max_um)},
+                      {"radial_deviation_F_min_um", number_or_null(c.radial_deviation_F_min_um)}};
+  nlohmann::json centers = nlohmann::json::array();
+  for (const auto& ctr : c.centers_mm) centers.push_back({ctr.x(), ctr.y()});
+  j["revolution_centers_mm"] = centers;
+  j["revolution_radii_mm"] = c.radii_mm;
+  // The trace thinned to at most ~3600 points per revolution set: the plots need no more.
+  const std::size_t n = c.trace.angle_deg.size();
+  const std::size_t step = std::max<std::size_t>(1, n / 3600);
+  nlohmann::json ang = nlohmann::json::array(), dev = nlohmann::json::array(), dir = nlohmann::json::array();
+  for (std::size_t i = 0; i < n; i += step) {
+    ang.push_back(std::round(c.trace.angle_deg[i] * 1000.0) / 1000.0);
+    dev.push_back(std::round(c.trace.radius_deviation_um[i] * 1000.0) / 1000.0);
+    dir.push_back(c.trace.direction[i]);
+  }
+  j["trace"] = {{"angle_deg", ang}, {"radius_deviation_um", dev}, {"direction", dir}};
+  return j;
+}
+
+nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
+  nlohmann::json j;
+  j["format"] = "eical-result/1";
+  j["run_id"] = run.meta.id;
+  j["program"] = run.meta.program.kind;
+  j["quality"] = {{"degraded", a.degraded}, {"flags", a.flags}};
+  j["sensor_model"] = {{"identified", false}, {"source", "datasheet"}};
+  if (a.circle) {
+    j["circle"] = circle_json(run.meta.program, *a.circle);
+  } else if (run.meta.program.kind == "circle") {
+    j["circle"] = nullptr;
+  }
+  if (a.diagnostics) j["diagnostics"] = diagnostics_json(*a.diagnostics);
+  if (a.step) j["step"] = step_json(a.step_axis, *a.step);
+  if (a.circle_accuracy_rms_um) {
+    j["reference_comparison"] = {{"reference", run.meta.reference ? run.meta.reference->kind : "ref"},
+                                 {"radius_deviation_error_rms_um", *a.circle_accuracy_rms_um},
+                                 {"reference_circular_deviation_G_um", a.circle_reference->circular_deviation_G_um},
+                                 {"reference_radius_mean_deviation_um", a.circle_reference->radius_mean_deviation_um}};
+  }
+  const auto& m = a.measurement;
+  j["pipeline"] = {{"rest_window_samples", m.rest_window_samples},
+                   {"zupt_window_samples", m.zupt_window_samples},
+                   {"zupt_velocity_error_mm_s", {m.zupt_velocity_error_mm_s.x(), m.zupt_velocity_error_mm_s.y(), m.zupt_velocity_error_mm_s.z()}},
+                   {"dynamic_compensation", "two-stage (6-38) with DAQ delay"}};
+  return j;
+}
 
 nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d) {
   nlohmann::json j = {

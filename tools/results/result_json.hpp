@@ -2,6 +2,9 @@
 // eical-result/1 (shared/spec/results.md): JSON objects for each evaluation. Keys are
 // fixed by the spec; extra keys are allowed and used for figures the spec does not name.
 // A figure that could not be determined is null with a reason in quality.flags.
+#include "dsp/analysis/analyze_run.hpp"
+#include "dsp/core/run.hpp"
+#include "dsp/eval/circle.hpp"
 #include "dsp/eval/circle_diagnostics.hpp"
 #include "dsp/eval/rectangle.hpp"
 #include "dsp/eval/step_response.hpp"
@@ -12,6 +15,10 @@
 
 namespace eical::tools {
 
+// The whole eical-result/1 document of an analysed run.
+nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis);
+
+nlohmann::json circle_json(const dsp::Program& program, const dsp::eval::CircleResult& c);
 nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d);
 nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r);
 nlohmann::json rectangle_json(const dsp::eval::RectangleResult& r);

@@ -1,0 +1,35 @@
+// eical analyze RUN [--json]: the pipeline and the program's evaluation on a recorded run.
+#include "drivers/run_io/run_reader.hpp"
+#include "dsp/analysis/analyze_run.hpp"
+#include "tools/commands.hpp"
+#include "tools/results/result_json.hpp"
+#include "tools/run_files.hpp"
+
+#include <cstdio>
+#include <memory>
+
+namespace eical::tools {
+
+void register_analyze(CLI::App& app) {
+  struct Opt {
+    std::string run, dynamic = "two-stage";
+    bool json = false, no_zupt = false;
+  };
+  auto o = std::make_shared<Opt>();
+  auto* cmd = app.add_subcommand("analyze", "Evaluate a recorded run (circle: ISO 230-4 + diagnostics; step)");
+  cmd->add_option("run", o->run, "run directory (eical-run/1)")->required();
+  cmd->add_flag("--json", o->json, "print the eical-result/1 document");
+  cmd->add_option("--dynamic", o->dynamic, "dynamic compensation: two-stage or none")->default_val("two-stage")->check(CLI::IsMember({"two-stage", "none"}));
+  cmd->add_flag("--no-zupt", o->no_zupt, "skip the zero-velocity update after the motion");
+  cmd->callback([o] {
+    const dsp::Run run = drivers::read_run(o->run);
+    dsp::AnalysisOptions opt;
+    opt.dynamic = o->dynamic == "none" ? dsp::DynamicComp::none : dsp::DynamicComp::two_stage;
+    opt.zupt = !o->no_zupt;
+    const dsp::Analysis a = dsp::analyze_run(run, opt);
+    if (o->json) std::printf("%s\n", result_json(run, a).dump(2).c_str());
+    else std::fputs(summary_text(run, a).c_str(), stdout);
+  });
+}
+
+}  // namespace eical::tools

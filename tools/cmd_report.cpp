@@ -1,0 +1,32 @@
+// eical report RUN [--out DIR]: HTML report with SVG plots and CSV traces.
+#include "drivers/run_io/run_reader.hpp"
+#include "dsp/analysis/analyze_run.hpp"
+#include "tools/commands.hpp"
+#include "tools/report/run_report.hpp"
+#include "tools/results/result_json.hpp"
+#include "tools/run_files.hpp"
+
+#include <cstdio>
+#include <memory>
+
+namespace eical::tools {
+
+void register_report(CLI::App& app) {
+  struct Opt {
+    std::string run, out;
+  };
+  auto o = std::make_shared<Opt>();
+  auto* cmd = app.add_subcommand("report", "Render the HTML report of a recorded run");
+  cmd->add_option("run", o->run, "run directory (eical-run/1)")->required();
+  cmd->add_option("-o,--out", o->out, "report folder (default: RUN/report)");
+  cmd->callback([o] {
+    const dsp::Run run = drivers::read_run(o->run);
+    const dsp::Analysis a = dsp::analyze_run(run);
+    const std::filesystem::path dir = o->out.empty() ? std::filesystem::path(o->run) / "report" : std::filesystem::path(o->out);
+    const auto file = report::write_run_report(run, a, dir);
+    write_file_atomic(dir / "result.json", result_json(run, a).dump(2) + "\n");
+    std::printf("report: %s\n", file.c_str());
+  });
+}
+
+}  // namespace eical::tools
