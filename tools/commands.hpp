@@ -12,6 +12,7 @@ void register_simulate(CLI::App& app);
 void register_analyze(CLI::App& app);
 void register_report(CLI::App& app);
 void register_demo(CLI::App& app);
+void register_lincomp(CLI::App& app);
 
 // The list main() registers, in the order `eical --help` shows them.
 inline void register_all(CLI::App& app) {
@@ -20,6 +21,7 @@ inline void register_all(CLI::App& app) {
   register_analyze(app);
   register_report(app);
   register_gen_nc(app);
+  register_lincomp(app);
   register_version(app);
 }
 

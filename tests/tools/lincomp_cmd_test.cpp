@@ -1,0 +1,70 @@
+// `eical lincomp` in-process: exports written on success, nothing written on bad input.
+#include "dsp/core/error.hpp"
+#include "tools/commands.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <array>
+#include <random>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Tmp {
+  fs::path dir = fs::temp_directory_path() / ("eical-lincomp-" + std::to_string(std::random_device{}()));
+  Tmp() { fs::create_directories(dir); }
+  ~Tmp() { fs::remove_all(dir); }
+};
+
+void run(std::vector<std::string> args) {
+  CLI::App app;
+  eical::tools::register_all(app);
+  args.insert(args.begin(), "eical");
+  std::vector<const char*> argv;
+  for (const auto& a : args) argv.push_back(a.c_str());
+  app.parse(static_cast<int>(argv.size()), argv.data());
+}
+
+TEST(LinCompCmd, WritesLinuxCncAndCsvTables) {
+  Tmp t;
+  {
+    std::ofstream os(t.dir / "c.csv");
+    os << "pos_mm,error_um\n";
+    for (int i = 0; i <= 200; ++i) os << i << "," << 0.02 * i << "\n";  // 20 µm/m
+  }
+  run({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "50", "--linuxcnc", (t.dir / "x.comp").string(), "--csv",
+       (t.dir / "x.csv").string()});
+  std::ifstream is(t.dir / "x.comp");
+  std::string header, line;
+  std::getline(is, header);
+  std::vector<std::array<double, 3>> rows;
+  double n, f, r;
+  while (is >> n >> f >> r) rows.push_back({n, f, r});
+  ASSERT_EQ(rows.size(), 5u);  // 0, 50, 100, 150, 200
+  // At 200 mm the axis goes 4 µm too far: command 4 µm less to arrive at nominal.
+  EXPECT_NEAR(rows[4][0], 200.0, 1e-9);
+  EXPECT_NEAR(rows[4][1], 200.0 - 0.004, 1e-9);
+  EXPECT_NEAR(rows[4][2], 200.0 - 0.004, 1e-9);
+  EXPECT_TRUE(fs::exists(t.dir / "x.csv"));
+}
+
+TEST(LinCompCmd, BadCurveWritesNothing) {
+  Tmp t;
+  std::ofstream(t.dir / "bad.csv") << "pos_mm,error_um\n0,1\n10,2\n10,3\n20,4\n";
+  EXPECT_THROW(run({"lincomp", "--curve", (t.dir / "bad.csv").string(), "--spacing-mm", "5", "--linuxcnc", (t.dir / "x.comp").string()}),
+               eical::dsp::InputError);
+  EXPECT_FALSE(fs::exists(t.dir / "x.comp"));
+  std::ofstream(t.dir / "nan.csv") << "pos_mm,error_um\n0,1\n10,nan\n20,4\n";
+  try {
+    run({"lincomp", "--curve", (t.dir / "nan.csv").string(), "--spacing-mm", "5"});
+    FAIL();
+  } catch (const eical::dsp::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("nan.csv:3: column 'error_um'"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace

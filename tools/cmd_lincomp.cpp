@@ -1,0 +1,133 @@
+// eical lincomp: piecewise-linear axis compensation table from an error curve (seed 002),
+// with the worst residual over grid shifts, and exports for the control.
+#include "dsp/comp/lincomp.hpp"
+#include "dsp/core/error.hpp"
+#include "tools/commands.hpp"
+#include "tools/io/csv_table.hpp"
+#include "tools/run_files.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <memory>
+
+namespace eical::tools {
+namespace {
+
+struct Curves {
+  dsp::comp::ErrorCurve mean, up, down;  // up/down only from a positioning result
+};
+
+Curves read_curve_csv(const std::string& file) {
+  const CsvTable t(file, {"pos_mm", "error_um"});
+  Curves c;
+  for (std::size_t r = 0; r < t.rows(); ++r) {
+    c.mean.pos_mm.push_back(t.number(r, "pos_mm"));
+    c.mean.error_um.push_back(t.number(r, "error_um"));
+  }
+  c.up = c.down = c.mean;
+  return c;
+}
+
+// The positioning object of an eical-result/1 document: mean deviation per target and
+// direction over the runs (ISO 230-2 x̄i↑, x̄i↓) and their bidirectional mean.
+Curves read_positioning_json(const std::string& file) {
+  std::ifstream is(file);
+  if (!is) throw dsp::InputError(file + ": cannot open");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(is);
+  } catch (const nlohmann::json::exception& e) {
+    throw dsp::InputError(file + ": not JSON: " + e.what());
+  }
+  if (!j.contains("positioning") || !j["positioning"].is_object()) throw dsp::InputError(file + ": no 'positioning' object");
+  const auto& p = j["positioning"];
+  const auto targets = p.at("targets_mm").get<std::vector<double>>();
+  Curves c;
+  for (const char* dir : {"up", "down"}) {
+    const auto runs = p.at("deviation_um").at(dir).get<std::vector<std::vector<double>>>();
+    auto& curve = std::string(dir) == "up" ? c.up : c.down;
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      double sum = 0.0;
+      for (const auto& run : runs) {
+        if (run.size() != targets.size()) throw dsp::InputError(file + ": positioning.deviation_um." + dir + ": a run has the wrong number of targets");
+        sum += run[i];
+      }
+      if (runs.empty()) throw dsp::InputError(file + ": positioning.deviation_um." + dir + " is empty");
+      curve.pos_mm.push_back(targets[i]);
+      curve.error_um.push_back(sum / static_cast<double>(runs.size()));
+    }
+  }
+  c.mean = c.up;
+  for (std::size_t i = 0; i < c.mean.error_um.size(); ++i) c.mean.error_um[i] = 0.5 * (c.up.error_um[i] + c.down.error_um[i]);
+  return c;
+}
+
+}  // namespace
+
+void register_lincomp(CLI::App& app) {
+  struct Opt {
+    std::string curve, positioning, linuxcnc, csv;
+    double spacing = 50.0, shift_step = 1.0, u = 0.0;
+    bool json = false;
+  };
+  auto o = std::make_shared<Opt>();
+  auto* cmd = app.add_subcommand("lincomp", "Piecewise-linear axis compensation table with its worst residual over grid shifts");
+  auto* in_curve = cmd->add_option("--curve", o->curve, "error curve CSV: pos_mm,error_um (error = actual - nominal)");
+  auto* in_pos = cmd->add_option("--positioning", o->positioning,
+                                 "eical-result/1 JSON with a 'positioning' object: mean deviation per target is the curve");
+  in_curve->excludes(in_pos);
+  cmd->add_option("--spacing-mm", o->spacing, "correction point spacing A")->required()->check(CLI::PositiveNumber);
+  cmd->add_option("--shift-step-mm", o->shift_step, "grid shift step")->default_val(1.0)->check(CLI::PositiveNumber);
+  cmd->add_option("--period-error-um", o->u, "position error within one signal period u (magnitude)")->default_val(0.0)->check(CLI::NonNegativeNumber);
+  cmd->add_option("--linuxcnc", o->linuxcnc, "write a LinuxCNC compensation file (COMP_FILE_TYPE = 0)");
+  cmd->add_option("--csv", o->csv, "write the table as CSV (pos_mm,correction_um)");
+  cmd->add_flag("--json", o->json, "print the result as JSON");
+  cmd->callback([o] {
+    if (o->curve.empty() && o->positioning.empty()) throw dsp::InputError("lincomp: give --curve or --positioning");
+    const Curves c = o->curve.empty() ? read_positioning_json(o->positioning) : read_curve_csv(o->curve);
+    const dsp::comp::LinCompOptions opt{o->spacing, o->shift_step, o->u};
+    const auto r = dsp::comp::piecewise_linear(c.mean, opt);  // validates before anything is written
+    const auto up = dsp::comp::correction_table(c.up, c.up.pos_mm.front(), o->spacing);
+    const auto down = dsp::comp::correction_table(c.down, c.down.pos_mm.front(), o->spacing);
+    if (!o->linuxcnc.empty()) {
+      // LinuxCNC [JOINT_n] COMP_FILE_TYPE = 0: "nominal forward reverse" per line, machine
+      // units (mm), ascending nominal. forward/reverse are the positions to command so
+      // that the axis arrives at nominal: nominal − deviation (deviation = actual − nominal).
+      std::string text = "# eical lincomp: spacing " + std::to_string(o->spacing) + " mm; COMP_FILE_TYPE = 0 (nominal forward reverse, mm)\n";
+      for (std::size_t i = 0; i < up.pos_mm.size(); ++i) {
+        char line[128];
+        std::snprintf(line, sizeof line, "%.4f %.6f %.6f\n", up.pos_mm[i], up.pos_mm[i] - up.correction_um[i] / 1000.0,
+                      down.pos_mm[i] - down.correction_um[i] / 1000.0);
+        text += line;
+      }
+      write_file_atomic(o->linuxcnc, text);
+    }
+    if (!o->csv.empty()) {
+      std::string text = "pos_mm,correction_um,correction_up_um,correction_down_um\n";
+      for (std::size_t i = 0; i < r.table.pos_mm.size(); ++i) {
+        char line[160];
+        std::snprintf(line, sizeof line, "%.4f,%.4f,%.4f,%.4f\n", r.table.pos_mm[i], r.table.correction_um[i], up.correction_um[i],
+                      down.correction_um[i]);
+        text += line;
+      }
+      write_file_atomic(o->csv, text);
+    }
+    if (o->json) {
+      nlohmann::json table = nlohmann::json::array();
+      for (std::size_t i = 0; i < r.table.pos_mm.size(); ++i)
+        table.push_back({{"pos_mm", r.table.pos_mm[i]}, {"correction_um", r.table.correction_um[i]}});
+      const nlohmann::json j = {{"spacing_mm", r.spacing_mm},           {"max_residual_um", r.max_residual_um},
+                                {"worst_shift_mm", r.worst_shift_mm},   {"total_um", r.total_um},
+                                {"period_error_um", o->u},              {"residual_unshifted_um", r.residual_unshifted_um},
+                                {"shift_step_mm", o->shift_step},       {"table", table}};
+      std::printf("%s\n", j.dump(2).c_str());
+    } else {
+      std::printf("spacing %.3f mm: F_rest %.3f um (worst grid shift %.1f mm), F_total = F_rest + u = %.3f um, %zu correction points\n",
+                  r.spacing_mm, r.max_residual_um, r.worst_shift_mm, r.total_um, r.table.pos_mm.size());
+    }
+  });
+}
+
+}  // namespace eical::tools
