@@ -13,6 +13,7 @@ void register_analyze(CLI::App& app);
 void register_report(CLI::App& app);
 void register_demo(CLI::App& app);
 void register_lincomp(CLI::App& app);
+void register_fourier(CLI::App& app);
 
 // The list main() registers, in the order `eical --help` shows them.
 inline void register_all(CLI::App& app) {
@@ -22,6 +23,7 @@ inline void register_all(CLI::App& app) {
   register_report(app);
   register_gen_nc(app);
   register_lincomp(app);
+  register_fourier(app);
   register_version(app);
 }
 
