@@ -14,6 +14,7 @@ void register_report(CLI::App& app);
 void register_demo(CLI::App& app);
 void register_lincomp(CLI::App& app);
 void register_fourier(CLI::App& app);
+void register_volumetric(CLI::App& app);
 
 // The list main() registers, in the order `eical --help` shows them.
 inline void register_all(CLI::App& app) {
@@ -24,6 +25,7 @@ inline void register_all(CLI::App& app) {
   register_gen_nc(app);
   register_lincomp(app);
   register_fourier(app);
+  register_volumetric(app);
   register_version(app);
 }
 
