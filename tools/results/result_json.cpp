@@ -63,6 +63,27 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   return j;
 }
 
+nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp::eval::PositioningResult& r, bool vdi) {
+  nlohmann::json targets = nlohmann::json::array();
+  for (const auto& t : r.targets)
+    targets.push_back({{"target_mm", t.target_mm}, {"mean_up_um", t.mean_up_um}, {"mean_down_um", t.mean_down_um},
+                       {"mean_um", t.mean_um}, {"s_up_um", t.s_up_um}, {"s_down_um", t.s_down_um},
+                       {"band_up_um", {t.mean_up_um - 2 * t.s_up_um, t.mean_up_um + 2 * t.s_up_um}},
+                       {"band_down_um", {t.mean_down_um - 2 * t.s_down_um, t.mean_down_um + 2 * t.s_down_um}},
+                       {"B_um", t.B_um}, {"R_up_um", t.R_up_um}, {"R_down_um", t.R_down_um}, {"R_um", t.R_um}});
+  nlohmann::json j = {{"axis", r.axis},           {"targets_mm", in.targets_mm},
+                      {"runs", r.runs},           {"A_um", r.A_um},
+                      {"A_up_um", r.A_up_um},     {"A_down_um", r.A_down_um},
+                      {"E_um", r.E_um},           {"E_up_um", r.E_up_um},
+                      {"E_down_um", r.E_down_um}, {"M_um", r.M_um},
+                      {"R_um", r.R_um},           {"R_up_um", r.R_up_um},
+                      {"R_down_um", r.R_down_um}, {"B_um", r.B_um},
+                      {"B_mean_um", r.B_mean_um}, {"deviation_um", {{"up", in.up_um}, {"down", in.down_um}}},
+                      {"per_target", targets},    {"standard", "ISO 230-2:2014"}};
+  if (vdi) j["vdi3441"] = {{"P_um", r.vdi.P_um}, {"Pa_um", r.vdi.Pa_um}, {"U_um", r.vdi.U_um}, {"Ps_um", r.vdi.Ps_um}};
+  return j;
+}
+
 nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d) {
   nlohmann::json j = {
       {"backlash_x_um", number_or_null(d.backlash_x_um)},

@@ -6,6 +6,7 @@
 #include "dsp/core/run.hpp"
 #include "dsp/eval/circle.hpp"
 #include "dsp/eval/circle_diagnostics.hpp"
+#include "dsp/eval/positioning.hpp"
 #include "dsp/eval/rectangle.hpp"
 #include "dsp/eval/step_response.hpp"
 
@@ -19,6 +20,8 @@ namespace eical::tools {
 nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis);
 
 nlohmann::json circle_json(const dsp::Program& program, const dsp::eval::CircleResult& c);
+// The positioning object of results.md; deviation_um.up/down are [run][target].
+nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp::eval::PositioningResult& r, bool vdi3441);
 nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d);
 nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r);
 nlohmann::json rectangle_json(const dsp::eval::RectangleResult& r);

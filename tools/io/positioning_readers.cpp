@@ -1,0 +1,95 @@
+#include "tools/io/positioning_readers.hpp"
+
+#include "dsp/core/error.hpp"
+#include "tools/io/csv_table.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <tuple>
+
+namespace eical::tools {
+
+dsp::eval::PositioningInput read_deviation_csv(const std::string& file) {
+  const CsvTable t(file, {"target_mm", "run", "direction", "deviation_um"});
+  std::map<long long, double> target_of;  // key: target in nm
+  std::map<std::tuple<long long, long long, int>, double> value;
+  long long max_run = 0;
+  for (std::size_t r = 0; r < t.rows(); ++r) {
+    const double target = t.number(r, "target_mm");
+    const long long run = t.integer(r, "run");
+    if (run < 1) throw dsp::InputError(t.where(r, "run") + ": runs are numbered from 1");
+    const std::string& d = t.text(r, "direction");
+    if (d != "up" && d != "down") throw dsp::InputError(t.where(r, "direction") + ": expected up or down, got '" + d + "'");
+    const double dev = t.number(r, "deviation_um");
+    const long long key = std::llround(target * 1e6);
+    target_of[key] = target;
+    if (!value.emplace(std::tuple{key, run, d == "up" ? 0 : 1}, dev).second)
+      throw dsp::InputError(t.where(r, "run") + ": target " + std::to_string(target) + " mm, run " + std::to_string(run) + ", " + d + " appears twice");
+    max_run = std::max(max_run, run);
+  }
+  dsp::eval::PositioningInput in;
+  for (const auto& [k, v] : target_of) in.targets_mm.push_back(v);
+  in.up_um.assign(static_cast<std::size_t>(max_run), {});
+  in.down_um.assign(static_cast<std::size_t>(max_run), {});
+  for (long long run = 1; run <= max_run; ++run)
+    for (const auto& [k, v] : target_of)
+      for (int dir = 0; dir < 2; ++dir) {
+        const auto it = value.find({k, run, dir});
+        if (it == value.end())
+          throw dsp::InputError(file + ": no deviation for target " + std::to_string(v) + " mm, run " + std::to_string(run) + ", " + (dir ? "down" : "up"));
+        (dir ? in.down_um : in.up_um)[static_cast<std::size_t>(run - 1)].push_back(it->second);
+      }
+  return in;
+}
+
+dsp::eval::PositioningInput read_ecmc_dat(const std::string& file) {
+  std::ifstream is(file);
+  if (!is) throw dsp::InputError(file + ": cannot open");
+  static const std::regex tgt(R"(^\s*TGT_DATA\[(\d+)\]\s*=\s*(\S+)\s*$)");
+  static const std::regex ref(R"(^\s*REF_DATA_(FWD|BWD)\[(\d+),(\d+)\]\s*=\s*(\S+)\s*$)");
+  std::map<int, double> targets;
+  std::map<std::tuple<int, int, int>, double> refs;  // (dir, target, cycle)
+  std::string line;
+  int no = 0;
+  auto number = [&](const std::string& s) {
+    double v = 0.0;
+    const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || p != s.data() + s.size() || !std::isfinite(v))
+      throw dsp::InputError(file + ":" + std::to_string(no) + ": '" + s + "' is not a number");
+    return v;
+  };
+  while (std::getline(is, line)) {
+    ++no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos || line[0] == '#') continue;
+    std::smatch m;
+    if (std::regex_match(line, m, tgt)) {
+      targets[std::stoi(m[1])] = number(m[2]);
+    } else if (std::regex_match(line, m, ref)) {
+      refs[{m[1] == "FWD" ? 0 : 1, std::stoi(m[2]), std::stoi(m[3])}] = number(m[4]);
+    } else {
+      throw dsp::InputError(file + ":" + std::to_string(no) + ": not a TGT_DATA or REF_DATA line: '" + line + "'");
+    }
+  }
+  if (targets.empty()) throw dsp::InputError(file + ": no TGT_DATA lines");
+  int cycles = 0;
+  for (const auto& [k, v] : refs) cycles = std::max(cycles, std::get<2>(k));
+  dsp::eval::PositioningInput in;
+  for (const auto& [i, t] : targets) in.targets_mm.push_back(t);
+  in.up_um.assign(static_cast<std::size_t>(cycles), {});
+  in.down_um.assign(static_cast<std::size_t>(cycles), {});
+  for (int j = 1; j <= cycles; ++j)
+    for (const auto& [i, t] : targets)
+      for (int dir = 0; dir < 2; ++dir) {
+        const auto it = refs.find({dir, i, j});
+        if (it == refs.end())
+          throw dsp::InputError(file + ": REF_DATA_" + (dir ? "BWD" : "FWD") + "[" + std::to_string(i) + "," + std::to_string(j) + "] is missing");
+        (dir ? in.down_um : in.up_um)[static_cast<std::size_t>(j - 1)].push_back((it->second - t) * 1000.0);  // REF − TGT, µm
+      }
+  return in;
+}
+
+}  // namespace eical::tools
