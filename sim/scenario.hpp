@@ -37,4 +37,7 @@ Scenario circle_scenario(double radius_mm = 10.0, double feed_mm_min = 2500.0, i
 Scenario step_scenario(double from_mm = 0.0, double to_mm = 50.0, double feed_mm_min = 3250.0, int runs = 2,
                        std::uint64_t seed = 1);
 
+// ISO 230-2 linear cycle on x over `targets_mm` (ascending), `runs` bidirectional runs.
+Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs = 5, double feed_mm_min = 2000.0, std::uint64_t seed = 1);
+
 }  // namespace eical::sim

@@ -60,6 +60,24 @@ Scenario step_scenario(double from_mm, double to_mm, double feed_mm_min, int run
   return sc;
 }
 
+Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs, double feed_mm_min, std::uint64_t seed) {
+  Scenario sc;
+  sc.name = "positioning";
+  sc.seed = seed;
+  sc.description = "ISO 230-2 linear cycle on x, ideal machine";
+  auto& p = sc.meta.program;
+  p.kind = "positioning";
+  p.axis = "x";
+  p.targets_mm = targets_mm;
+  p.runs = runs;
+  p.feed_mm_min = feed_mm_min;
+  p.dwell_s = 0.5;
+  sc.meta.id = "sim-positioning-s" + std::to_string(seed);
+  sc.meta.reference = dsp::Reference{"ideal", {"x", "y", "z"}};
+  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s];
+  return sc;
+}
+
 dsp::Run simulate(const Scenario& sc) {
   const dsp::Acquisition& acq = sc.meta.acquisition;
   if (!(acq.fs_hz > 0.0)) throw dsp::InputError("simulate: fs_hz must be positive");

@@ -2,6 +2,7 @@
 
 #include "dsp/core/error.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace eical::dsp {
@@ -96,7 +97,71 @@ void evaluate_step_program(const Run& run, Analysis& a) {
   }
 }
 
+void evaluate_positioning_program(const Run& run, Analysis& a) {
+  try {
+    a.positioning_input = positioning_deviations(a.measurement, run.meta.program);
+    a.positioning = eval::evaluate_positioning(*a.positioning_input);
+  } catch (const InputError& e) {
+    a.flags.push_back(std::string("positioning: ") + e.what());
+    a.degraded = true;
+  }
+}
+
 }  // namespace
+
+eval::PositioningInput positioning_deviations(const Measurement& m, const Program& program) {
+  const int ax = axis_index(program.axis);
+  eval::PositioningInput in;
+  in.axis = program.axis;
+  in.targets_mm = program.targets_mm;
+  std::sort(in.targets_mm.begin(), in.targets_mm.end());
+  if (in.targets_mm.size() < 2) throw InputError("positioning program without targets_mm");
+  // Index of each sample in the trace.
+  auto at = [&](std::int64_t idx) -> std::ptrdiff_t {
+    const auto it = std::lower_bound(m.sample_index.begin(), m.sample_index.end(), idx);
+    return it == m.sample_index.end() ? -1 : it - m.sample_index.begin();
+  };
+  std::vector<double> up_run(in.targets_mm.size(), NAN), down_run(in.targets_mm.size(), NAN);
+  auto flush_if_complete = [&] {
+    const auto full = [](const std::vector<double>& v) {
+      return std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); });
+    };
+    if (full(up_run) && full(down_run)) {
+      in.up_um.push_back(up_run);
+      in.down_um.push_back(down_run);
+      std::fill(up_run.begin(), up_run.end(), NAN);
+      std::fill(down_run.begin(), down_run.end(), NAN);
+    }
+  };
+  for (const auto& t : m.triggers) {
+    if (t.code != 102) continue;
+    const auto k = at(t.sample_index);
+    if (k < 1) continue;
+    const auto ku = static_cast<std::size_t>(k);
+    // The dwell lasts until the set-point moves again (1 nm: the trigger sample may sit a
+    // fraction of a sample before the exact arrival).
+    const double target_here = m.cmd_mm[ku][ax];
+    std::size_t end = ku;
+    while (end + 1 < m.cmd_mm.size() && std::abs(m.cmd_mm[end + 1][ax] - target_here) < 1e-6) ++end;
+    const std::size_t from = ku + (end - ku) / 2;
+    if (end <= from) continue;
+    double dev = 0.0;
+    for (std::size_t i = from; i <= end; ++i) dev += m.pos_mm[i][ax] - m.cmd_mm[i][ax];
+    dev = dev / static_cast<double>(end - from + 1) * 1000.0;
+    // Approach direction: where the set-point came from.
+    std::size_t before = ku;
+    while (before > 0 && std::abs(m.cmd_mm[before][ax] - target_here) < 1e-6) --before;
+    const bool up = m.cmd_mm[ku][ax] > m.cmd_mm[before][ax];
+    const double target = m.cmd_mm[ku][ax];
+    std::size_t ti = in.targets_mm.size();
+    for (std::size_t i = 0; i < in.targets_mm.size(); ++i)
+      if (std::abs(in.targets_mm[i] - target) < 1e-6) ti = i;
+    if (ti == in.targets_mm.size()) continue;  // a mark that is not at a target
+    (up ? up_run : down_run)[ti] = dev;
+    flush_if_complete();
+  }
+  return in;
+}
 
 Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   if (run.frames.empty()) throw InputError("run '" + run.meta.id + "' holds no frames");
@@ -113,7 +178,8 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   if (a.measurement.sample_index.empty()) return a;  // no motion: nothing to evaluate
   const std::string& kind = run.meta.program.kind;
   if (kind == "circle") evaluate_circle_program(run, a);
-  else if (kind == "step" || kind == "positioning") evaluate_step_program(run, a);
+  else if (kind == "step") evaluate_step_program(run, a);
+  else if (kind == "positioning") evaluate_positioning_program(run, a);
   else a.flags.push_back("program kind '" + kind + "': no evaluation in this version");
   return a;
 }

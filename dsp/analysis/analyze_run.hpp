@@ -7,6 +7,7 @@
 #include "dsp/core/run.hpp"
 #include "dsp/eval/circle.hpp"
 #include "dsp/eval/circle_diagnostics.hpp"
+#include "dsp/eval/positioning.hpp"
 #include "dsp/eval/step_response.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 
@@ -28,6 +29,8 @@ struct Analysis {
   std::optional<double> circle_accuracy_rms_um;        // RMS of (measured − reference) radius deviation
   std::optional<eval::CircleDiagnostics> diagnostics;
   std::optional<eval::StepResult> step;
+  std::optional<eval::PositioningInput> positioning_input;  // deviations per run/target/direction
+  std::optional<eval::PositioningResult> positioning;
   std::string step_axis;
   bool degraded = false;
   std::vector<std::string> flags;  // pipeline quality flags and evaluation failures
@@ -35,6 +38,11 @@ struct Analysis {
 
 // Throws InputError only when the run itself is unusable (no frames, fs ≤ 0).
 Analysis analyze_run(const Run& run, const AnalysisOptions& options = {});
+
+// Deviations at the targets of a positioning program: at each M102 (target reached) the
+// mean of measured − set-point over the second half of the dwell, grouped by target and
+// approach direction; a run is one pass up and one pass down (ISO 230-2 linear cycle).
+eval::PositioningInput positioning_deviations(const Measurement& m, const Program& program);
 
 // Plane axes of a program ("xy" → 0, 1; "zx" → 2, 0; "yz" → 1, 2).
 std::pair<int, int> plane_axes(const std::string& plane);

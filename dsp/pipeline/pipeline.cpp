@@ -144,6 +144,69 @@ void Pipeline::step(const Frame& f) noexcept {
   }
 }
 
+void Pipeline::apply_zupt(Measurement& m) {
+  // (ch. 3.4.2 / 8.3.1) Zero-velocity updates at every standstill of the set-point: the
+  // integrated velocity should be zero there, and what is left is the integral of the
+  // acceleration error since the start. Between two standstills the error is taken as
+  // linear in time (a constant acceleration error per segment — each partial move its
+  // own offset, ch. 8.3.2); after the last one it is held. The correction is removed from
+  // the velocity and, integrated, from the position.
+  const double fs = config_.acquisition.fs_hz;
+  const auto n = m.sample_index.size();
+  const auto settle = static_cast<std::size_t>(std::ceil(config_.acquisition.daq_group_delay_samples + config_.zupt_settle_s * fs));
+  const auto min_window = static_cast<std::size_t>(0.05 * fs);
+  struct Knot {
+    double t_s;
+    Eigen::Vector3d dv;
+  };
+  std::vector<Knot> knots{{0.0, Eigen::Vector3d::Zero()}};  // integration starts at rest
+  std::size_t i = 0;
+  while (i < n) {
+    // A stationary stretch of the set-point.
+    std::size_t j = i;
+    while (j + 1 < n && (m.cmd_mm[j + 1] - m.cmd_mm[i]).cwiseAbs().maxCoeff() < 1e-9 &&
+           m.sample_index[j + 1] == m.sample_index[j] + 1)
+      ++j;
+    if (i > 0 && j - i + 1 >= settle + min_window) {
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      double t = 0.0;
+      for (std::size_t k = i + settle; k <= j; ++k) {
+        v += m.vel_mm_s[k];
+        t += static_cast<double>(m.sample_index[k] - start_index_) / fs;
+      }
+      const double cnt = static_cast<double>(j - i - settle + 1);
+      knots.push_back({t / cnt, v / cnt});
+      m.zupt_window_samples += j - i - settle + 1;
+      m.zupt_velocity_error_mm_s = v / cnt;
+    }
+    i = j + 1;
+  }
+  if (knots.size() < 2) {
+    quality_ |= quality_flag::no_zupt_window;
+    return;
+  }
+  std::size_t seg = 0;
+  Eigen::Vector3d pos_corr = Eigen::Vector3d::Zero(), prev_v = Eigen::Vector3d::Zero();
+  double prev_t = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double t = static_cast<double>(m.sample_index[k] - start_index_) / fs;
+    while (seg + 1 < knots.size() && t > knots[seg + 1].t_s) ++seg;
+    Eigen::Vector3d vc;
+    if (seg + 1 < knots.size()) {
+      const auto& a = knots[seg];
+      const auto& b = knots[seg + 1];
+      vc = a.dv + (b.dv - a.dv) * ((t - a.t_s) / (b.t_s - a.t_s));
+    } else {
+      vc = knots.back().dv;
+    }
+    if (k > 0) pos_corr += 0.5 * (vc + prev_v) * (t - prev_t);
+    prev_v = vc;
+    prev_t = t;
+    m.vel_mm_s[k] -= vc;
+    m.pos_mm[k] -= pos_corr;
+  }
+}
+
 Measurement Pipeline::finish() {
   Measurement m = std::move(m_);
   m_ = Measurement{};
@@ -153,38 +216,7 @@ Measurement Pipeline::finish() {
   m.motion_end_index = motion_end_index_;
   if (phase_ != Phase::moving) quality_ |= quality_flag::no_motion;
 
-  if (config_.zupt && phase_ == Phase::moving && !m.sample_index.empty()) {
-    // ZUPT window: from the end of the motion + DAQ delay + settling to the end (M103
-    // and the post-trigger frames are all at rest).
-    const double fs = config_.acquisition.fs_hz;
-    const auto from = motion_end_index_ +
-                      static_cast<std::int64_t>(std::ceil(config_.acquisition.daq_group_delay_samples + config_.zupt_settle_s * fs));
-    Eigen::Vector3d v_sum = Eigen::Vector3d::Zero();
-    double t_sum = 0.0;
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
-      if (m.sample_index[i] < from) continue;
-      v_sum += m.vel_mm_s[i];
-      t_sum += static_cast<double>(m.sample_index[i] - start_index_) / fs;
-      ++n;
-    }
-    m.zupt_window_samples = n;
-    if (n >= static_cast<std::size_t>(0.05 * fs)) {
-      // (ch. 3.4.2) a constant acceleration error b since the start makes the velocity
-      // grow as b·t: the mean velocity over the window at its mean time t_z gives b.
-      const Eigen::Vector3d dv = v_sum / static_cast<double>(n);
-      const double tz = t_sum / static_cast<double>(n);
-      const Eigen::Vector3d b = dv / tz;  // mm/s²
-      m.zupt_velocity_error_mm_s = dv;
-      for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
-        const double t = static_cast<double>(m.sample_index[i] - start_index_) / fs;
-        m.vel_mm_s[i] -= b * t;
-        m.pos_mm[i] -= b * (t * t / 2.0);
-      }
-    } else {
-      quality_ |= quality_flag::no_zupt_window;
-    }
-  }
+  if (config_.zupt && phase_ == Phase::moving && !m.sample_index.empty()) apply_zupt(m);
   m.flags = quality_flag_names(quality_);
   m.degraded = quality_ != 0;
   return m;

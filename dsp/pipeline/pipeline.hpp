@@ -11,8 +11,8 @@
 //     integrated from the start of the motion, starting at the set-point there
 //   4 two-stage dynamic compensation (6-38) with the DAQ delay, per sensor at the
 //     position level: X_kor = X + Σ ±(c1·V_s + c2·A_s)
-//   5 finish(): ZUPT — the velocity left at the rest after the motion is attributed to a
-//     constant acceleration bias error and removed (ramp in velocity, parabola in position)
+//   5 finish(): ZUPT at every standstill of the set-point — the velocity left there is
+//     the integrated acceleration error; it is removed piecewise linearly in time
 #include "dsp/core/frame.hpp"
 #include "dsp/core/run_meta.hpp"
 #include "dsp/pipeline/dynamic_comp.hpp"
@@ -94,6 +94,7 @@ class Pipeline {
 
  private:
   enum class Phase { wait_start, rest, moving };
+  void apply_zupt(Measurement& m);
   void store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept;
 
   PipelineConfig config_;
