@@ -13,12 +13,14 @@ void register_simulate(CLI::App& app) {
     std::string program = "circle", direction = "ccw", out;
     double radius_mm = 10.0, feed_mm_min = 2500.0, noise_ug = 0.4, from_mm = 0.0, to_mm = 50.0;
     int repeats = 5, runs = 2;
+    std::vector<double> targets{0.0, 10.0, 20.0, 30.0, 40.0};
     std::uint64_t seed = 1;
     bool gzip = false, overwrite = false;
   };
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand("simulate", "Simulate a machine and its sensors; write a recorded run (eical-run/1)");
-  cmd->add_option("--program", o->program, "circle or step")->default_val("circle")->check(CLI::IsMember({"circle", "step"}));
+  cmd->add_option("--program", o->program, "circle, step or positioning")->default_val("circle")->check(CLI::IsMember({"circle", "step", "positioning"}));
+  cmd->add_option("--targets", o->targets, "positioning: targets on x, mm (comma separated)")->delimiter(',');
   cmd->add_option("--radius", o->radius_mm, "circle radius, mm")->default_val(10.0)->check(CLI::PositiveNumber);
   cmd->add_option("--feed", o->feed_mm_min, "feed, mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
   cmd->add_option("--repeats", o->repeats, "circle revolutions")->default_val(5)->check(CLI::Range(1, 1000));
@@ -33,7 +35,8 @@ void register_simulate(CLI::App& app) {
   cmd->add_flag("--overwrite", o->overwrite, "replace an existing run");
   cmd->callback([o] {
     sim::Scenario sc = o->program == "circle" ? sim::circle_scenario(o->radius_mm, o->feed_mm_min, o->repeats, o->direction, o->seed)
-                                              : sim::step_scenario(o->from_mm, o->to_mm, o->feed_mm_min, o->runs, o->seed);
+                       : o->program == "step" ? sim::step_scenario(o->from_mm, o->to_mm, o->feed_mm_min, o->runs, o->seed)
+                                              : sim::positioning_scenario(o->targets, o->runs, o->feed_mm_min, o->seed);
     for (auto& t : sc.truth) t.spec.noise_ug_per_rthz = o->noise_ug;
     for (auto& s : sc.meta.sensors) s.noise_ug_per_rthz = o->noise_ug;
     const dsp::Run run = sim::simulate(sc);

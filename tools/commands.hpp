@@ -16,6 +16,7 @@ void register_lincomp(CLI::App& app);
 void register_fourier(CLI::App& app);
 void register_volumetric(CLI::App& app);
 void register_iso230_2(CLI::App& app);
+void register_comp(CLI::App& app);
 
 // The list main() registers, in the order `eical --help` shows them.
 inline void register_all(CLI::App& app) {
@@ -25,6 +26,7 @@ inline void register_all(CLI::App& app) {
   register_report(app);
   register_iso230_2(app);
   register_gen_nc(app);
+  register_comp(app);
   register_lincomp(app);
   register_fourier(app);
   register_volumetric(app);

@@ -49,6 +49,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   }
   if (a.diagnostics) j["diagnostics"] = diagnostics_json(*a.diagnostics);
   if (a.step) j["step"] = step_json(a.step_axis, *a.step);
+  if (a.positioning && a.positioning_input) j["positioning"] = positioning_json(*a.positioning_input, *a.positioning, true);
   if (a.circle_accuracy_rms_um) {
     j["reference_comparison"] = {{"reference", run.meta.reference ? run.meta.reference->kind : "ref"},
                                  {"radius_deviation_error_rms_um", *a.circle_accuracy_rms_um},
