@@ -240,7 +240,8 @@ void write_run(const dsp::Run& run, const fs::path& dir_in, const WriteOptions& 
   if (fs::exists(dir, ec) && !opt.overwrite)
     throw std::runtime_error(dir.string() + ": a run already exists here (not overwritten)");
   const fs::path parent = dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
-  if (!fs::is_directory(parent, ec)) throw std::runtime_error(parent.string() + ": no such directory");
+  if (!fs::exists(parent, ec)) fs::create_directories(parent, ec);  // like mkdir -p; errors surface below
+  if (!fs::is_directory(parent, ec)) throw std::runtime_error(parent.string() + ": not a directory or cannot be created");
   std::random_device rd;
   const fs::path tmp = parent / ("." + dir.filename().string() + ".tmp-" + std::to_string(rd()));
   if (::mkdir(tmp.c_str(), 0755) != 0) sys_fail(tmp, "cannot create", errno);

@@ -1,0 +1,86 @@
+// Bad input at the command line: one line on stderr naming the cause, exit status 1,
+// never a crash (a signal would give a different status).
+#include "drivers/run_io/run_writer.hpp"
+#include "sim/simulate.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int exit_code;
+  std::string output;
+};
+
+Outcome eical(const std::string& args) {
+  const std::string cmd = std::string(EICAL_CLI) + " " + args + " 2>&1 >/dev/null";
+  FILE* p = ::popen(cmd.c_str(), "r");
+  std::string out;
+  char buf[512];
+  while (p && std::fgets(buf, sizeof buf, p)) out += buf;
+  const int status = p ? ::pclose(p) : -1;
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), out};
+}
+
+void expect_one_line_error(const Outcome& o, const std::string& cause) {
+  EXPECT_EQ(o.exit_code, 1) << o.output;
+  EXPECT_EQ(std::count(o.output.begin(), o.output.end(), '\n'), 1) << o.output;
+  EXPECT_EQ(o.output.rfind("eical: ", 0), 0u) << o.output;
+  EXPECT_NE(o.output.find(cause), std::string::npos) << o.output;
+}
+
+class CliErrors : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("cli-" + std::to_string(std::random_device{}()));
+    eical::drivers::write_run(eical::sim::simulate(eical::sim::circle_scenario(10, 2500, 1)), dir_ / "run");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  void edit(const char* file, const std::string& from, const std::string& to) {
+    const fs::path p = dir_ / "run" / file;
+    std::ifstream is(p);
+    std::string s{std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
+    const auto at = s.find(from);
+    ASSERT_NE(at, std::string::npos);
+    s.replace(at, from.size(), to);
+    std::ofstream(p, std::ios::trunc) << s;
+  }
+  std::string run() const { return (dir_ / "run").string(); }
+  fs::path dir_;
+};
+
+TEST_F(CliErrors, GoodRunAnalyzesWithExitZero) { EXPECT_EQ(eical("analyze " + run()).exit_code, 0); }
+
+TEST_F(CliErrors, MissingRun) { expect_one_line_error(eical("analyze " + (dir_ / "nope").string()), "not a run directory"); }
+
+TEST_F(CliErrors, MissingColumn) {
+  edit("samples.csv", "head_az", "head_azz");
+  expect_one_line_error(eical("analyze " + run()), "'head_az' is missing");
+}
+
+TEST_F(CliErrors, NaNInASample) {
+  edit("samples.csv", "\n0.0001,", "\nnan,");
+  expect_one_line_error(eical("analyze " + run()), "samples.csv:3: column 't'");
+}
+
+TEST_F(CliErrors, TruncatedRun) {
+  const fs::path p = dir_ / "run" / "samples.csv";
+  fs::resize_file(p, fs::file_size(p) - 7);
+  expect_one_line_error(eical("report " + run()), "truncated");
+}
+
+TEST_F(CliErrors, WrongTypeInRunToml) {
+  edit("run.toml", "adc_bits = 24", "adc_bits = \"24\"");
+  expect_one_line_error(eical("analyze " + run()), "acquisition.adc_bits: expected an integer, got string");
+}
+
+}  // namespace
