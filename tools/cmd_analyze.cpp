@@ -2,7 +2,7 @@
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "tools/commands.hpp"
-#include "tools/results/result_json.hpp"
+#include "drivers/results/result_json.hpp"
 #include "tools/run_files.hpp"
 
 #include <cstdio>
@@ -27,7 +27,7 @@ void register_analyze(CLI::App& app) {
     opt.dynamic = o->dynamic == "none" ? dsp::DynamicComp::none : dsp::DynamicComp::two_stage;
     opt.zupt = !o->no_zupt;
     const dsp::Analysis a = dsp::analyze_run(run, opt);
-    if (o->json) std::printf("%s\n", result_json(run, a).dump(2).c_str());
+    if (o->json) std::printf("%s\n", drivers::result_json(run, a).dump(2).c_str());
     else std::fputs(summary_text(run, a).c_str(), stdout);
   });
 }

@@ -11,7 +11,7 @@
 #include "dsp/session/measurement_session.hpp"
 #include "tools/commands.hpp"
 #include "tools/report/run_report.hpp"
-#include "tools/results/result_json.hpp"
+#include "drivers/results/result_json.hpp"
 #include "tools/run_files.hpp"
 
 #include <atomic>
@@ -73,7 +73,7 @@ void register_demo(CLI::App& app) {
     drivers::write_run(run, out / "run", {.gzip = false, .overwrite = true});
     const dsp::Analysis a = dsp::analyze_run(run);
     session.evaluation_done();
-    write_file_atomic(out / "result.json", result_json(run, a).dump(2) + "\n");
+    write_file_atomic(out / "result.json", drivers::result_json(run, a).dump(2) + "\n");
     const auto report = report::write_run_report(run, a, out / "report");
     const auto t1 = std::chrono::steady_clock::now();
 

@@ -2,7 +2,7 @@
 #include "dsp/eval/positioning.hpp"
 #include "tools/commands.hpp"
 #include "tools/io/positioning_readers.hpp"
-#include "tools/results/result_json.hpp"
+#include "drivers/results/result_json.hpp"
 
 #include <cstdio>
 #include <memory>
@@ -28,7 +28,7 @@ void register_iso230_2(CLI::App& app) {
     in.axis = o->axis;
     const auto r = dsp::eval::evaluate_positioning(in);
     if (o->json) {
-      std::printf("%s\n", positioning_json(in, r, o->vdi).dump(2).c_str());
+      std::printf("%s\n", drivers::positioning_json(in, r, o->vdi).dump(2).c_str());
       return;
     }
     std::printf("ISO 230-2, axis %s: %zu targets x %d bidirectional runs\n", r.axis.c_str(), r.targets.size(), r.runs);

@@ -3,7 +3,7 @@
 #include "dsp/analysis/analyze_run.hpp"
 #include "tools/commands.hpp"
 #include "tools/report/run_report.hpp"
-#include "tools/results/result_json.hpp"
+#include "drivers/results/result_json.hpp"
 #include "tools/run_files.hpp"
 
 #include <cstdio>
@@ -24,7 +24,7 @@ void register_report(CLI::App& app) {
     const dsp::Analysis a = dsp::analyze_run(run);
     const std::filesystem::path dir = o->out.empty() ? std::filesystem::path(o->run) / "report" : std::filesystem::path(o->out);
     const auto file = report::write_run_report(run, a, dir);
-    write_file_atomic(dir / "result.json", result_json(run, a).dump(2) + "\n");
+    write_file_atomic(dir / "result.json", drivers::result_json(run, a).dump(2) + "\n");
     std::printf("report: %s\n", file.c_str());
   });
 }

@@ -51,6 +51,23 @@ Pipeline::Pipeline(const PipelineConfig& c) : config_(c), dt_s_(1.0 / c.acquisit
   m_.triggers.reserve(trigger_capacity_);
 }
 
+void Pipeline::reset() noexcept {
+  phase_ = Phase::wait_start;
+  quality_ = 0;
+  saw_start_ = saw_end_ = false;
+  prev_index_ = -1;
+  prev_cmd_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  bias_n_ = 0;
+  for (int s = 0; s < 2; ++s) last_valid_a_[s] = bias_sum_[s] = bias_[s] = a_prev_[s] = v_[s] = Eigen::Vector3d::Zero();
+  v_rel_prev_.setZero();
+  x_rel_.setZero();
+  start_index_ = motion_end_index_ = -1;
+  live_ = LiveEstimate{};
+  m_.sample_index.clear();
+  for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->clear();
+  m_.triggers.clear();
+}
+
 void Pipeline::store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept {
   if (m_.sample_index.size() >= config_.capacity_samples) {
     quality_ |= quality_flag::capacity_exceeded;

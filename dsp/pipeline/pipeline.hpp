@@ -91,6 +91,9 @@ class Pipeline {
   [[nodiscard]] std::uint32_t quality_bits() const noexcept { return quality_; }
   // Offline completion (allocates; not for the DSP thread's per-sample path). Call once.
   Measurement finish();
+  // Back to waiting for M101, keeping the reserved trace storage (for the live path,
+  // which discards its causal estimate at the end of each measurement).
+  void reset() noexcept;
 
  private:
   enum class Phase { wait_start, rest, moving };

@@ -12,9 +12,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <string>
 
-namespace eical::tools {
+namespace eical::drivers {
 
 // The whole eical-result/1 document of an analysed run.
 nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis);
@@ -26,7 +27,10 @@ nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d);
 nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r);
 nlohmann::json rectangle_json(const dsp::eval::RectangleResult& r);
 
+// Writes the document to `file` atomically (temporary + rename).
+void write_result(const dsp::Run& run, const dsp::Analysis& analysis, const std::filesystem::path& file);
+
 // A finite number, or null (callers add the reason to quality.flags).
 nlohmann::json number_or_null(double v);
 
-}  // namespace eical::tools
+}  // namespace eical::drivers
