@@ -1,0 +1,48 @@
+#pragma once
+// Plain C++ forms of the DDS topics (drivers/dds/eical.idl): the rest of eical never
+// touches generated C types or dds_* calls.
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+namespace eical::drivers::dds {
+
+struct StatusMsg {
+  std::string daemon, state, fault;
+  std::uint64_t frames = 0, overruns = 0, frames_lost = 0, measurements = 0, results = 0;
+  float temp_table_c = NAN, temp_head_c = NAN;
+  std::int64_t time_ns = 0;
+};
+
+struct LiveMsg {
+  std::string daemon;
+  std::int64_t sample_index = 0;
+  std::array<double, 3> pos_mm{}, vel_mm_s{};
+  bool integrating = false;
+};
+
+struct ResultMsg {
+  std::string program_id, program;
+  bool degraded = false;
+  double circular_deviation_G_um = NAN, radius_mean_deviation_um = NAN;
+  std::string json;
+};
+
+struct CommandMsg {
+  std::string sender;
+  std::uint32_t request_id = 0;
+  std::string action;  // trigger | arm | abort | reset
+  std::int32_t code = 0;
+  double p = NAN, q = NAN;
+  std::int64_t time_ns = 0;
+};
+
+struct ReplyMsg {
+  std::string sender;
+  std::uint32_t request_id = 0;
+  bool ok = false;
+  std::string message, state;
+};
+
+}  // namespace eical::drivers::dds
