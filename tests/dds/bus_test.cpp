@@ -130,6 +130,7 @@ TEST(DdsBus, WakeEndsAWaitingTakePromptly) {
 }
 
 TEST(DdsBus, MalformedConfigIsAClearErrorNotACrash) {
+  const int d = domain() + 1;  // initialises the loopback URI first, so it can be replaced below
   const std::string bad = "/tmp/eical-bad-dds-" + std::to_string(::getpid()) + ".xml";
   FILE* f = std::fopen(bad.c_str(), "w");
   ASSERT_NE(f, nullptr);
@@ -139,7 +140,7 @@ TEST(DdsBus, MalformedConfigIsAClearErrorNotACrash) {
   const std::string saved = old ? old : "";
   ::setenv("CYCLONEDDS_URI", ("file://" + bad).c_str(), 1);
   try {
-    Bus b(domain() + 1, Role::hmi);
+    Bus b(d, Role::hmi);
     ADD_FAILURE() << "a malformed configuration was accepted";
   } catch (const BusError& e) {
     EXPECT_NE(std::string(e.what()).find("CYCLONEDDS_URI"), std::string::npos) << e.what();
