@@ -17,12 +17,14 @@ void register_fourier(CLI::App& app);
 void register_volumetric(CLI::App& app);
 void register_iso230_2(CLI::App& app);
 void register_comp(CLI::App& app);
+void register_hmi(CLI::App& app);
 
 // The list main() registers, in the order `eical --help` shows them.
 inline void register_all(CLI::App& app) {
   register_demo(app);
   register_simulate(app);
   register_analyze(app);
+  register_hmi(app);
   register_report(app);
   register_iso230_2(app);
   register_gen_nc(app);

@@ -1,5 +1,6 @@
 #include "daemon/service/service.hpp"
 
+#include "daemon/service/hmi_link.hpp"
 #include "daemon/system/log.hpp"
 #include "daemon/system/realtime.hpp"
 #include "drivers/acquisition/pump.hpp"
@@ -13,6 +14,7 @@
 #include "sim/scenario.hpp"
 #include "drivers/results/result_json.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <ctime>
@@ -80,6 +82,21 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   dsp::MeasurementSession session(scfg);
   dsp::Pipeline live(dsp::pipeline_config(meta, session.recorder_capacity()));
 
+  // The HMI bus; without it the service still measures and records (and says so).
+  std::unique_ptr<HmiLink> hmi;
+  try {
+    hmi = std::make_unique<HmiLink>(config_.dds, "eicald@" + config_.machine.name);
+    log(LogLevel::info, "dds: publishing on domain %d", config_.dds.domain_id);
+  } catch (const std::exception& e) {
+    log(LogLevel::warning, "dds unavailable, running without the HMI bus: %s", e.what());
+  }
+  const bool dds_triggers = std::find(config_.triggers.inputs.begin(), config_.triggers.inputs.end(), "dds") != config_.triggers.inputs.end();
+  // DAQ clock ↔ CLOCK_MONOTONIC: the DSP thread notes (sample index, time) as frames
+  // arrive; a trigger's time maps onto the sample that was due then.
+  std::int64_t clock_index = 0, clock_ns = 0;
+  const double fs = meta.acquisition.fs_hz;
+  const auto live_every = static_cast<std::uint64_t>(std::max(1.0, fs / config_.dds.live_rate_hz));
+
   // Evaluation thread: takes finished recordings, writes them and their result.
   std::mutex mu;
   std::condition_variable cv;
@@ -110,6 +127,15 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
         drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false});
         const dsp::Analysis a = dsp::analyze_run(run);
         drivers::write_result(run, a, dir / "result.json");
+        if (hmi) {
+          drivers::dds::ResultMsg r;
+          r.program_id = run.meta.id;
+          r.program = run.meta.program.kind;
+          r.degraded = a.degraded;
+          if (a.circle) r.circular_deviation_G_um = a.circle->circular_deviation_G_um, r.radius_mean_deviation_um = a.circle->radius_mean_deviation_um;
+          r.json = drivers::result_json(run, a).dump();
+          hmi->publish_result(r);
+        }
         log(LogLevel::notice, "measurement %s written (%zu frames)%s", run.meta.id.c_str(), run.frames.size(), a.degraded ? ", result degraded" : "");
       } catch (const std::exception& e) {
         error = e.what();
@@ -139,9 +165,28 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   auto last_status = std::chrono::steady_clock::now();
   std::uint64_t frames = 0;
   const auto stats = drivers::pump(*source, ring, [&](const dsp::Frame& f) {
+    if ((frames & 63) == 0) {
+      timespec ts{};
+      clock_gettime(CLOCK_MONOTONIC, &ts);
+      clock_index = f.sample_index;
+      clock_ns = static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+    }
+    if (hmi && dds_triggers) {
+      TriggerRequest t;
+      while (hmi->pop_trigger(t)) {
+        const std::int64_t idx = t.time_ns > 0 ? clock_index + static_cast<std::int64_t>(static_cast<double>(t.time_ns - clock_ns) * 1e-9 * fs)
+                                               : f.sample_index;
+        (void)session.queue_trigger(std::max(idx, f.sample_index), t.code);
+      }
+    }
     session.on_frame(f);
     if (session.state().state() == dsp::State::measuring || f.trigger == 103) live.step(f);
     ++frames;
+    if (hmi && frames % live_every == 0) {
+      const auto& l = live.live();
+      LiveSample s{l.sample_index, {l.pos_mm.x(), l.pos_mm.y(), l.pos_mm.z()}, {l.vel_mm_s.x(), l.vel_mm_s.y(), l.vel_mm_s.z()}, l.integrating};
+      hmi->push_live(s);
+    }
     if (session.measurement_ready()) {
       std::unique_lock lk(mu, std::try_to_lock);  // never wait on the evaluator
       if (lk.owns_lock() && spare_ready && !have_pending && session.take(spare)) {
@@ -169,6 +214,14 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
         s.frames_lost = session.counters().frames_lost;
         s.measurements = session.counters().measurements_completed;
         on_status(s);
+        if (hmi) {
+          drivers::dds::StatusMsg m;
+          m.state = s.state, m.fault = s.fault, m.frames = s.frames, m.overruns = s.overruns, m.frames_lost = s.frames_lost;
+          m.measurements = s.measurements, m.results = s.results_written;
+          m.temp_table_c = f.temp_c[0], m.temp_head_c = f.temp_c[1];
+          hmi->set_status(m);
+          hmi->set_state(s.state);
+        }
       }
     }
   }, stop);

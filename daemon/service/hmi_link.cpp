@@ -1,0 +1,106 @@
+#include "daemon/service/hmi_link.hpp"
+
+#include "daemon/system/log.hpp"
+
+#include <chrono>
+#include <cstdlib>
+#include <ctime>
+
+namespace eical::daemon {
+namespace {
+
+std::int64_t now_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+}
+
+}  // namespace
+
+HmiLink::HmiLink(const DdsConfig& config, std::string daemon_name) : config_(config), name_(std::move(daemon_name)) {
+  status_.state = "STARTING";
+  if (!config_.config_uri.empty()) ::setenv("CYCLONEDDS_URI", config_.config_uri.c_str(), 1);
+  bus_ = std::make_unique<drivers::dds::Bus>(config_.domain_id, drivers::dds::Role::daemon);
+  publisher_ = std::thread([this] { publisher(); });
+  commander_ = std::thread([this] { commander(); });
+}
+
+HmiLink::~HmiLink() {
+  stop_.store(true);
+  bus_->wake();
+  commander_.join();
+  publisher_.join();
+}
+
+void HmiLink::set_status(const drivers::dds::StatusMsg& s) {
+  std::lock_guard lk(mu_);
+  status_ = s;
+}
+
+void HmiLink::set_state(const std::string& state) {
+  std::lock_guard lk(mu_);
+  state_ = state;
+}
+
+void HmiLink::publish_result(const drivers::dds::ResultMsg& r) {
+  if (!bus_->publish(r)) log(LogLevel::warning, "dds: result %s not published", r.program_id.c_str());
+}
+
+void HmiLink::publisher() {
+  using clock = std::chrono::steady_clock;
+  const auto status_period = std::chrono::duration<double>(1.0 / config_.status_rate_hz);
+  const auto live_period = std::chrono::duration<double>(1.0 / config_.live_rate_hz);
+  auto next_status = clock::now();
+  while (!stop_.load()) {
+    // Live: the newest sample of what the DSP thread handed over since the last tick.
+    LiveSample s{}, latest{};
+    bool any = false;
+    while (live_.try_pop(s)) latest = s, any = true;
+    if (any) {
+      drivers::dds::LiveMsg m;
+      m.daemon = name_;
+      m.sample_index = latest.sample_index;
+      for (int i = 0; i < 3; ++i) m.pos_mm[static_cast<std::size_t>(i)] = latest.pos_mm[i], m.vel_mm_s[static_cast<std::size_t>(i)] = latest.vel_mm_s[i];
+      m.integrating = latest.integrating;
+      (void)bus_->publish(m);
+    }
+    if (clock::now() >= next_status) {
+      drivers::dds::StatusMsg st;
+      {
+        std::lock_guard lk(mu_);
+        st = status_;
+      }
+      st.daemon = name_;
+      st.time_ns = now_ns();
+      (void)bus_->publish(st);
+      next_status += std::chrono::duration_cast<clock::duration>(status_period);
+    }
+    std::this_thread::sleep_for(live_period);  // the Live rate; the loop does nothing else
+  }
+}
+
+void HmiLink::commander() {
+  while (!stop_.load()) {
+    const auto cmd = bus_->take_command(std::chrono::milliseconds(500));
+    if (!cmd) continue;
+    ++commands_;
+    drivers::dds::ReplyMsg reply;
+    reply.sender = cmd->sender;
+    reply.request_id = cmd->request_id;
+    if (cmd->action == "trigger" && (cmd->code == 101 || cmd->code == 102 || cmd->code == 103)) {
+      reply.ok = triggers_.try_push({cmd->time_ns, cmd->code});
+      reply.message = reply.ok ? "M" + std::to_string(cmd->code) + " queued for the DAQ clock" : "trigger queue full";
+    } else {
+      reply.ok = false;
+      reply.message = "unknown command '" + cmd->action + "' (code " + std::to_string(cmd->code) + "); use trigger 101|102|103";
+    }
+    {
+      std::lock_guard lk(mu_);
+      reply.state = state_;
+    }
+    (void)bus_->publish(reply);
+    log(LogLevel::info, "command from %s: %s %d -> %s", cmd->sender.c_str(), cmd->action.c_str(), cmd->code, reply.message.c_str());
+  }
+}
+
+}  // namespace eical::daemon

@@ -1,0 +1,108 @@
+// eical hmi / eical trigger: the reference HMI on the DDS bus. `hmi` prints eicald's
+// Status and every Result it receives (a late HMI still gets the last Result per program:
+// transient-local); `trigger` sends an M-code (101 tare + start, 102 segment, 103 stop)
+// as an NC user M-function would, and waits for the daemon's Reply.
+#include "tools/commands.hpp"
+
+#if EICAL_HAVE_DDS
+#include "drivers/dds/bus.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <memory>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace eical::tools {
+namespace {
+
+void use_uri(const std::string& uri) {
+  if (!uri.empty()) ::setenv("CYCLONEDDS_URI", uri.c_str(), 1);
+}
+
+}  // namespace
+
+void register_hmi(CLI::App& app) {
+  struct Opt {
+    int domain = 0, results = 0;
+    double timeout_s = 0.0;
+    std::string uri;
+    int code = 0;
+    double p = NAN, q = NAN;
+  };
+  auto o = std::make_shared<Opt>();
+  auto* hmi = app.add_subcommand("hmi", "Reference HMI: print eicald's status and results from the DDS bus");
+  hmi->add_option("--domain", o->domain, "DDS domain id")->default_val(0);
+  hmi->add_option("--dds-config", o->uri, "Cyclone DDS XML (file://...); default $CYCLONEDDS_URI");
+  hmi->add_option("--results", o->results, "exit after this many results (0 = run until the timeout)")->default_val(0);
+  hmi->add_option("--timeout", o->timeout_s, "exit after this many seconds (0 = never)")->default_val(0.0);
+  hmi->callback([o] {
+    use_uri(o->uri);
+    drivers::dds::Bus bus(o->domain, drivers::dds::Role::hmi);
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                             std::chrono::duration<double>(o->timeout_s > 0 ? o->timeout_s : 1e9));
+    int results = 0;
+    while (std::chrono::steady_clock::now() < end) {
+      if (auto s = bus.take_status(std::chrono::milliseconds(100)))
+        std::printf("status %s: %s, %llu frames, %llu overruns, %llu lost, %llu results%s%s\n", s->daemon.c_str(), s->state.c_str(),
+                    static_cast<unsigned long long>(s->frames), static_cast<unsigned long long>(s->overruns),
+                    static_cast<unsigned long long>(s->frames_lost), static_cast<unsigned long long>(s->results),
+                    s->fault.empty() ? "" : " — ", s->fault.c_str());
+      if (auto r = bus.take_result(std::chrono::milliseconds(10))) {
+        std::printf("result %s (%s)%s: G %.2f um, mean radius deviation %.2f um\n", r->program_id.c_str(), r->program.c_str(),
+                    r->degraded ? " DEGRADED" : "", r->circular_deviation_G_um, r->radius_mean_deviation_um);
+        std::fflush(stdout);
+        if (o->results > 0 && ++results >= o->results) return;
+      }
+      std::fflush(stdout);
+    }
+    if (o->results > 0) throw std::runtime_error("hmi: " + std::to_string(results) + " of " + std::to_string(o->results) + " results before the timeout");
+  });
+
+  auto* trig = app.add_subcommand("trigger", "Send an NC trigger (M101/M102/M103) to eicald over DDS");
+  trig->add_option("code", o->code, "101 (tare + start), 102 (segment), 103 (stop + evaluate)")->required()->check(CLI::IsMember({101, 102, 103}));
+  trig->add_option("-P", o->p, "the M-code's P word");
+  trig->add_option("-Q", o->q, "the M-code's Q word");
+  trig->add_option("--domain", o->domain, "DDS domain id")->default_val(0);
+  trig->add_option("--dds-config", o->uri, "Cyclone DDS XML (file://...); default $CYCLONEDDS_URI");
+  trig->add_option("--timeout", o->timeout_s, "seconds to wait for eicald's reply")->default_val(3.0);
+  trig->callback([o] {
+    use_uri(o->uri);
+    timespec ts{};
+    clock_gettime(CLOCK_MONOTONIC, &ts);  // the M-code's moment, before any DDS latency
+    drivers::dds::Bus bus(o->domain, drivers::dds::Role::hmi);
+    drivers::dds::CommandMsg c;
+    c.sender = "eical-trigger-" + std::to_string(::getpid());
+    c.request_id = 1;
+    c.action = "trigger";
+    c.code = o->code;
+    c.p = o->p;
+    c.q = o->q;
+    c.time_ns = static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                             std::chrono::duration<double>(o->timeout_s));
+    // Volatile command topic: resend until the daemon's reader has matched and replied.
+    while (std::chrono::steady_clock::now() < end) {
+      bus.send(c);
+      if (auto r = bus.take_reply(std::chrono::milliseconds(100)); r && r->sender == c.sender && r->request_id == c.request_id) {
+        std::printf("M%d: %s (state %s)\n", o->code, r->message.c_str(), r->state.c_str());
+        if (!r->ok) throw std::runtime_error("trigger refused: " + r->message);
+        return;
+      }
+    }
+    throw std::runtime_error("trigger: no eicald answered on DDS domain " + std::to_string(o->domain) + " within " + std::to_string(o->timeout_s) + " s");
+  });
+}
+
+}  // namespace eical::tools
+#else
+namespace eical::tools {
+void register_hmi(CLI::App& app) {
+  auto* hmi = app.add_subcommand("hmi", "Reference HMI (this build has no DDS)");
+  hmi->callback([] { throw std::runtime_error("eical was built without Cyclone DDS (EICAL_BUILD_DAEMON=OFF): no hmi/trigger"); });
+}
+}  // namespace eical::tools
+#endif
