@@ -7,7 +7,6 @@
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <tuple>
 
 namespace eical::tools {
@@ -48,8 +47,6 @@ dsp::eval::PositioningInput read_deviation_csv(const std::string& file) {
 dsp::eval::PositioningInput read_ecmc_dat(const std::string& file) {
   std::ifstream is(file);
   if (!is) throw dsp::InputError(file + ": cannot open");
-  static const std::regex tgt(R"(^\s*TGT_DATA\[(\d+)\]\s*=\s*(\S+)\s*$)");
-  static const std::regex ref(R"(^\s*REF_DATA_(FWD|BWD)\[(\d+),(\d+)\]\s*=\s*(\S+)\s*$)");
   std::map<int, double> targets;
   std::map<std::tuple<int, int, int>, double> refs;  // (dir, target, cycle)
   std::string line;
@@ -65,13 +62,29 @@ dsp::eval::PositioningInput read_ecmc_dat(const std::string& file) {
     ++no;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.find_first_not_of(" \t") == std::string::npos || line[0] == '#') continue;
-    std::smatch m;
-    if (std::regex_match(line, m, tgt)) {
-      targets[std::stoi(m[1])] = number(m[2]);
-    } else if (std::regex_match(line, m, ref)) {
-      refs[{m[1] == "FWD" ? 0 : 1, std::stoi(m[2]), std::stoi(m[3])}] = number(m[4]);
-    } else {
+    // NAME[i] = value or NAME[i,j] = value (no regex: plain parsing keeps it strict and fast).
+    std::string t;
+    for (char ch : line)
+      if (ch != ' ' && ch != '\t') t += ch;
+    const auto open = t.find('['), close = t.find(']'), eq = t.find('=');
+    if (open == std::string::npos || close == std::string::npos || eq == std::string::npos || !(open < close && close < eq))
       throw dsp::InputError(file + ":" + std::to_string(no) + ": not a TGT_DATA or REF_DATA line: '" + line + "'");
+    const std::string name = t.substr(0, open), index = t.substr(open + 1, close - open - 1), value = t.substr(eq + 1);
+    auto int_of = [&](const std::string& s) {
+      int v = 0;
+      const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+      if (s.empty() || ec != std::errc() || p != s.data() + s.size() || v < 1)
+        throw dsp::InputError(file + ":" + std::to_string(no) + ": index '" + s + "' is not a positive integer");
+      return v;
+    };
+    if (name == "TGT_DATA") {
+      targets[int_of(index)] = number(value);
+    } else if (name == "REF_DATA_FWD" || name == "REF_DATA_BWD") {
+      const auto comma = index.find(',');
+      if (comma == std::string::npos) throw dsp::InputError(file + ":" + std::to_string(no) + ": " + name + " needs [target,cycle]");
+      refs[{name == "REF_DATA_FWD" ? 0 : 1, int_of(index.substr(0, comma)), int_of(index.substr(comma + 1))}] = number(value);
+    } else {
+      throw dsp::InputError(file + ":" + std::to_string(no) + ": unknown name '" + name + "' (TGT_DATA, REF_DATA_FWD, REF_DATA_BWD)");
     }
   }
   if (targets.empty()) throw dsp::InputError(file + ": no TGT_DATA lines");
