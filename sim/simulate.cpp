@@ -19,16 +19,41 @@ bool contains(const std::vector<std::string>& axes, int axis) {
   return std::find(axes.begin(), axes.end(), name) != axes.end();
 }
 
+
+// The common part of the built-in scenarios: data-sheet sensors that are also the truth,
+// an ideal reference instrument on all axes.
+Scenario base_scenario(const std::string& kind, std::uint64_t seed, std::string description) {
+  Scenario sc;
+  sc.name = kind;
+  sc.seed = seed;
+  sc.description = std::move(description);
+  sc.meta.program.kind = kind;
+  sc.meta.id = "sim-" + kind + "-s" + std::to_string(seed);
+  sc.meta.reference = dsp::Reference{"ideal", {"x", "y", "z"}};
+  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s];
+  return sc;
+}
+
+// Single-axis programs on x with a 0.5 s dwell (step and positioning).
+Scenario axis_scenario(const std::string& kind, std::vector<double> targets_mm, double feed_mm_min, int runs, std::uint64_t seed,
+                       std::string description) {
+  Scenario sc = base_scenario(kind, seed, std::move(description));
+  auto& p = sc.meta.program;
+  p.axis = "x";
+  p.targets_mm = std::move(targets_mm);
+  p.feed_mm_min = feed_mm_min;
+  p.runs = runs;
+  p.dwell_s = 0.5;
+  return sc;
+}
+
 }  // namespace
 
 Scenario circle_scenario(double radius_mm, double feed_mm_min, int repeats, const std::string& direction, std::uint64_t seed) {
-  Scenario sc;
-  sc.name = "circle";
-  sc.seed = seed;
-  sc.description = "R" + std::to_string(radius_mm) + " circle F" + std::to_string(feed_mm_min) + " x" + std::to_string(repeats) +
-                   " " + direction + ", ideal machine, data-sheet sensors";
+  Scenario sc = base_scenario("circle", seed,
+                              "R" + std::to_string(radius_mm) + " circle F" + std::to_string(feed_mm_min) + " x" + std::to_string(repeats) +
+                                  " " + direction + ", ideal machine, data-sheet sensors");
   auto& p = sc.meta.program;
-  p.kind = "circle";
   p.plane = "xy";
   p.radius_mm = radius_mm;
   p.feed_mm_min = feed_mm_min;
@@ -36,46 +61,17 @@ Scenario circle_scenario(double radius_mm, double feed_mm_min, int repeats, cons
   p.direction = direction;
   sc.meta.id = "sim-circle-r" + std::to_string(static_cast<int>(radius_mm)) + "-f" + std::to_string(static_cast<int>(feed_mm_min)) +
                "-s" + std::to_string(seed);
-  sc.meta.reference = dsp::Reference{"ideal", {"x", "y", "z"}};
-  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s];
   sc.truth[1].temp_c = 20.5;
   return sc;
 }
 
 Scenario step_scenario(double from_mm, double to_mm, double feed_mm_min, int runs, std::uint64_t seed) {
-  Scenario sc;
-  sc.name = "step";
-  sc.seed = seed;
-  sc.description = "x step " + std::to_string(from_mm) + " -> " + std::to_string(to_mm) + " mm, ideal machine";
-  auto& p = sc.meta.program;
-  p.kind = "step";
-  p.axis = "x";
-  p.targets_mm = {from_mm, to_mm};
-  p.feed_mm_min = feed_mm_min;
-  p.runs = runs;
-  p.dwell_s = 0.5;
-  sc.meta.id = "sim-step-s" + std::to_string(seed);
-  sc.meta.reference = dsp::Reference{"ideal", {"x", "y", "z"}};
-  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s];
-  return sc;
+  return axis_scenario("step", {from_mm, to_mm}, feed_mm_min, runs, seed,
+                       "x step " + std::to_string(from_mm) + " -> " + std::to_string(to_mm) + " mm, ideal machine");
 }
 
 Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs, double feed_mm_min, std::uint64_t seed) {
-  Scenario sc;
-  sc.name = "positioning";
-  sc.seed = seed;
-  sc.description = "ISO 230-2 linear cycle on x, ideal machine";
-  auto& p = sc.meta.program;
-  p.kind = "positioning";
-  p.axis = "x";
-  p.targets_mm = targets_mm;
-  p.runs = runs;
-  p.feed_mm_min = feed_mm_min;
-  p.dwell_s = 0.5;
-  sc.meta.id = "sim-positioning-s" + std::to_string(seed);
-  sc.meta.reference = dsp::Reference{"ideal", {"x", "y", "z"}};
-  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s];
-  return sc;
+  return axis_scenario("positioning", targets_mm, feed_mm_min, runs, seed, "ISO 230-2 linear cycle on x, ideal machine");
 }
 
 dsp::Run simulate(const Scenario& sc) {

@@ -24,21 +24,13 @@
 namespace eical::daemon {
 namespace {
 
-std::string timestamp_id() {
+// UTC now in a strftime format: "%Y%m%dT%H%M%SZ" for run ids, RFC 3339 for run.toml.
+std::string utc_now(const char* format) {
   const std::time_t t = std::time(nullptr);
   std::tm tm{};
   gmtime_r(&t, &tm);
   char b[32];
-  std::strftime(b, sizeof b, "%Y%m%dT%H%M%SZ", &tm);
-  return b;
-}
-
-std::string rfc3339() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  std::strftime(b, sizeof b, format, &tm);
   return b;
 }
 
@@ -117,8 +109,8 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
       }
       dsp::Run run;
       run.meta = meta;
-      run.meta.id = "eicald-" + timestamp_id() + "-" + std::to_string(frames.empty() ? 0 : frames.front().sample_index);
-      run.meta.created = rfc3339();
+      run.meta.id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(frames.empty() ? 0 : frames.front().sample_index);
+      run.meta.created = utc_now("%Y-%m-%dT%H:%M:%SZ");
       run.channels.psd_count = 0;
       run.frames = std::move(frames);
       const auto dir = config_.recording.dir / run.meta.id;

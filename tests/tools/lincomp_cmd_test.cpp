@@ -1,6 +1,6 @@
 // `eical lincomp` in-process: exports written on success, nothing written on bad input.
 #include "dsp/core/error.hpp"
-#include "tools/commands.hpp"
+#include "tests/tools/cli_runner.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,14 +20,8 @@ struct Tmp {
   ~Tmp() { fs::remove_all(dir); }
 };
 
-void run(std::vector<std::string> args) {
-  CLI::App app;
-  eical::tools::register_all(app);
-  args.insert(args.begin(), "eical");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  app.parse(static_cast<int>(argv.size()), argv.data());
-}
+using eical::tools::testing::run_cli;
+
 
 TEST(LinCompCmd, WritesLinuxCncAndCsvTables) {
   Tmp t;
@@ -36,7 +30,7 @@ TEST(LinCompCmd, WritesLinuxCncAndCsvTables) {
     os << "pos_mm,error_um\n";
     for (int i = 0; i <= 200; ++i) os << i << "," << 0.02 * i << "\n";  // 20 µm/m
   }
-  run({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "50", "--linuxcnc", (t.dir / "x.comp").string(), "--csv",
+  run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "50", "--linuxcnc", (t.dir / "x.comp").string(), "--csv",
        (t.dir / "x.csv").string()});
   std::ifstream is(t.dir / "x.comp");
   std::string header, line;
@@ -55,12 +49,12 @@ TEST(LinCompCmd, WritesLinuxCncAndCsvTables) {
 TEST(LinCompCmd, BadCurveWritesNothing) {
   Tmp t;
   std::ofstream(t.dir / "bad.csv") << "pos_mm,error_um\n0,1\n10,2\n10,3\n20,4\n";
-  EXPECT_THROW(run({"lincomp", "--curve", (t.dir / "bad.csv").string(), "--spacing-mm", "5", "--linuxcnc", (t.dir / "x.comp").string()}),
+  EXPECT_THROW(run_cli({"lincomp", "--curve", (t.dir / "bad.csv").string(), "--spacing-mm", "5", "--linuxcnc", (t.dir / "x.comp").string()}),
                eical::dsp::InputError);
   EXPECT_FALSE(fs::exists(t.dir / "x.comp"));
   std::ofstream(t.dir / "nan.csv") << "pos_mm,error_um\n0,1\n10,nan\n20,4\n";
   try {
-    run({"lincomp", "--curve", (t.dir / "nan.csv").string(), "--spacing-mm", "5"});
+    run_cli({"lincomp", "--curve", (t.dir / "nan.csv").string(), "--spacing-mm", "5"});
     FAIL();
   } catch (const eical::dsp::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("nan.csv:3: column 'error_um'"), std::string::npos) << e.what();

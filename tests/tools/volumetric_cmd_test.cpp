@@ -1,6 +1,6 @@
 // `eical volumetric` in-process with the example model: results and refusals.
 #include "dsp/core/error.hpp"
-#include "tools/commands.hpp"
+#include "tests/tools/cli_runner.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,14 +13,8 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kModel = fs::path(EICAL_SOURCE_DIR) / "config" / "examples" / "volumetric-example.toml";
 
-void run(std::vector<std::string> args) {
-  CLI::App app;
-  eical::tools::register_all(app);
-  args.insert(args.begin(), "eical");
-  std::vector<const char*> argv;
-  for (const auto& a : args) argv.push_back(a.c_str());
-  app.parse(static_cast<int>(argv.size()), argv.data());
-}
+using eical::tools::testing::run_cli;
+
 
 std::string slurp(const fs::path& p) {
   std::ifstream is(p);
@@ -31,7 +25,7 @@ TEST(VolumetricCmd, ExampleModelGivesDeviationsAndFlagsRanges) {
   const fs::path dir = fs::temp_directory_path() / ("vol-" + std::to_string(std::random_device{}()));
   fs::create_directories(dir);
   std::ofstream(dir / "p.csv") << "x,y,z,xp,yp,zp\n0,0,0,0,0,0\n400,250,200,0,0,100\n-1,0,0,0,0,0\n0,0,401,0,0,0\n";
-  run({"volumetric", "--model", kModel.string(), "--points", (dir / "p.csv").string(), "--out", (dir / "o.csv").string()});
+  run_cli({"volumetric", "--model", kModel.string(), "--points", (dir / "p.csv").string(), "--out", (dir / "o.csv").string()});
   const std::string out = slurp(dir / "o.csv");
   EXPECT_NE(out.find(",ok\n"), std::string::npos) << out;
   EXPECT_NE(out.find("out_of_range:x"), std::string::npos) << out;
@@ -45,7 +39,7 @@ TEST(VolumetricCmd, ExampleModelGivesDeviationsAndFlagsRanges) {
   std::ofstream(dir / "bad.toml") << model;
   fs::remove(dir / "o.csv");
   try {
-    run({"volumetric", "--model", (dir / "bad.toml").string(), "--points", (dir / "p.csv").string(), "--out", (dir / "o.csv").string()});
+    run_cli({"volumetric", "--model", (dir / "bad.toml").string(), "--points", (dir / "p.csv").string(), "--out", (dir / "o.csv").string()});
     FAIL() << "accepted an unknown component";
   } catch (const eical::dsp::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("yrq"), std::string::npos) << e.what();
