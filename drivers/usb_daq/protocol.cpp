@@ -1,0 +1,149 @@
+#include "drivers/usb_daq/protocol.hpp"
+
+#include <cmath>
+#include <cstring>
+
+namespace eical::drivers::usb_daq {
+namespace {
+
+std::uint32_t u32(const std::uint8_t* p) {
+  return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 | static_cast<std::uint32_t>(p[2]) << 16 |
+         static_cast<std::uint32_t>(p[3]) << 24;
+}
+
+std::int32_t s24(const std::uint8_t* p) {
+  const std::uint32_t v = static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 | static_cast<std::uint32_t>(p[2]) << 16;
+  return static_cast<std::int32_t>(v << 8) >> 8;  // sign-extend 24 → 32 bits
+}
+
+std::array<std::uint16_t, 256> crc_table() {
+  std::array<std::uint16_t, 256> t{};
+  for (unsigned i = 0; i < 256; ++i) {
+    std::uint16_t c = static_cast<std::uint16_t>(i << 8);
+    for (int k = 0; k < 8; ++k) c = static_cast<std::uint16_t>((c & 0x8000) ? (c << 1) ^ 0x1021 : c << 1);
+    t[i] = c;
+  }
+  return t;
+}
+
+void put_crc(std::vector<std::uint8_t>& p) {
+  const std::uint16_t crc = crc16_ccitt(std::span<const std::uint8_t>(p).subspan(2));
+  p.push_back(static_cast<std::uint8_t>(crc & 0xFF));
+  p.push_back(static_cast<std::uint8_t>(crc >> 8));
+}
+
+}  // namespace
+
+std::uint16_t crc16_ccitt(std::span<const std::uint8_t> bytes, std::uint16_t crc) {
+  static const auto table = crc_table();
+  for (std::uint8_t b : bytes) crc = static_cast<std::uint16_t>((crc << 8) ^ table[((crc >> 8) ^ b) & 0xFF]);
+  return crc;
+}
+
+Decoder::Decoder(int psd_count) : psd_count_(psd_count) {}
+
+void Decoder::drop(std::size_t n) {
+  std::memmove(buf_.data(), buf_.data() + n, fill_ - n);
+  fill_ -= n;
+}
+
+void Decoder::parse(const std::function<void(const dsp::Frame&)>& emit) {
+  for (;;) {
+    // Find the sync word.
+    std::size_t i = 0;
+    while (i + 1 < fill_ && !(buf_[i] == kSync0 && buf_[i + 1] == kSync1)) ++i;
+    if (i > 0) {
+      stats_.resync_bytes += i;
+      drop(i);
+    }
+    if (fill_ < kHeader) return;
+    const std::uint8_t version = buf_[2], type = buf_[3], channels = buf_[4], samples = buf_[5];
+    const std::size_t payload = type == kTypeSamples ? static_cast<std::size_t>(samples) * (1 + 3 * static_cast<std::size_t>(channels))
+                                                     : type == kTypeSlow ? 5 : 0;
+    if (version != kVersion || payload == 0 || samples > 64 || channels > 6 + 2 * dsp::kMaxPsd) {
+      ++stats_.unknown_packets;
+      drop(2);  // not a packet we understand: look for the next sync
+      continue;
+    }
+    const std::size_t total = kHeader + payload + kCrc;
+    if (fill_ < total) return;
+    const std::uint16_t crc = static_cast<std::uint16_t>(buf_[total - 2] | buf_[total - 1] << 8);
+    if (crc16_ccitt(std::span<const std::uint8_t>(buf_.data() + 2, total - 4)) != crc) {
+      ++stats_.crc_errors;
+      drop(2);  // the sync was data or the packet is damaged: search on
+      continue;
+    }
+    ++stats_.packets;
+    const std::uint32_t seq = u32(&buf_[6]);
+    const std::uint8_t* p = &buf_[kHeader];
+    if (type == kTypeSlow) {
+      temp_c_[0] = static_cast<float>(static_cast<std::int16_t>(p[0] | p[1] << 8)) / 100.0f;
+      temp_c_[1] = static_cast<float>(static_cast<std::int16_t>(p[2] | p[3] << 8)) / 100.0f;
+      if (p[4] != 0) pending_trigger_ = p[4];
+      drop(total);
+      continue;
+    }
+    // Sequence numbers wrap at 2^32; the sample index is unwrapped from the last one.
+    bool gap = false;
+    std::int64_t first;
+    if (!have_seq_) {
+      first = seq;
+      have_seq_ = true;
+    } else {
+      const std::uint32_t missing = seq - next_seq_;  // mod 2^32: a forward jump
+      gap = missing != 0;
+      stats_.lost_samples += missing;
+      first = next_index_ + missing;
+    }
+    const int n_psd_ch = static_cast<int>(channels) - 6;
+    for (int k = 0; k < samples; ++k) {
+      dsp::Frame f;
+      const std::uint8_t status = *p++;
+      f.sample_index = first + k;
+      for (int c = 0; c < 6 && c < channels; ++c, p += 3) f.accel_counts[c] = s24(p);
+      for (int c = 0; c < n_psd_ch; ++c, p += 3) f.psd_counts[c] = s24(p);
+      if (channels < 6) f.flags |= dsp::frame_flag::accel_missing;
+      if (n_psd_ch < 2 * psd_count_) f.flags |= dsp::frame_flag::psd_missing;
+      if (status & 1) f.flags |= dsp::frame_flag::accel_saturated;
+      if (k == 0 && gap) f.flags |= dsp::frame_flag::gap_before;
+      f.temp_c[0] = temp_c_[0], f.temp_c[1] = temp_c_[1];
+      f.flags |= dsp::frame_flag::cmd_missing;  // the NC set-point comes from another source
+      for (double& v : f.cmd_mm) v = std::nan("");
+      if (k == 0 && pending_trigger_) f.trigger = pending_trigger_, pending_trigger_ = 0;
+      ++stats_.frames;
+      emit(f);
+    }
+    next_seq_ = seq + samples;
+    next_index_ = first + samples;
+    drop(total);
+  }
+}
+
+std::vector<std::uint8_t> encode_samples(std::uint32_t seq, const std::vector<std::array<std::int32_t, 14>>& samples, int channels,
+                                         std::uint8_t status) {
+  std::vector<std::uint8_t> p = {kSync0, kSync1, kVersion, kTypeSamples, static_cast<std::uint8_t>(channels),
+                                 static_cast<std::uint8_t>(samples.size())};
+  for (int b = 0; b < 4; ++b) p.push_back(static_cast<std::uint8_t>(seq >> (8 * b)));
+  for (const auto& s : samples) {
+    p.push_back(status);
+    for (int c = 0; c < channels; ++c)
+      for (int b = 0; b < 3; ++b) p.push_back(static_cast<std::uint8_t>(static_cast<std::uint32_t>(s[static_cast<std::size_t>(c)]) >> (8 * b)));
+  }
+  put_crc(p);
+  return p;
+}
+
+std::vector<std::uint8_t> encode_slow(std::uint32_t seq, float t0, float t1, int trigger) {
+  std::vector<std::uint8_t> p = {kSync0, kSync1, kVersion, kTypeSlow, 0, 1};
+  for (int b = 0; b < 4; ++b) p.push_back(static_cast<std::uint8_t>(seq >> (8 * b)));
+  for (float t : {t0, t1}) {
+    const auto v = static_cast<std::int16_t>(std::lround(t * 100.0f));
+    p.push_back(static_cast<std::uint8_t>(v & 0xFF));
+    p.push_back(static_cast<std::uint8_t>((static_cast<std::uint16_t>(v) >> 8) & 0xFF));
+  }
+  p.push_back(static_cast<std::uint8_t>(trigger));
+  put_crc(p);
+  return p;
+}
+
+}  // namespace eical::drivers::usb_daq
