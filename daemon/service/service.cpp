@@ -8,6 +8,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/source/replay_source.hpp"
 #include "drivers/source/sim_source.hpp"
+#include "drivers/usb_daq/usb_daq_source.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 #include "dsp/session/measurement_session.hpp"
@@ -45,8 +46,17 @@ std::unique_ptr<drivers::Source> Service::make_source(const DaemonConfig& c) {
     auto run = std::make_shared<const dsp::Run>(drivers::read_run(c.source.replay_run));
     return std::make_unique<drivers::ReplaySource>(run, pacing, "replay");
   }
-  if (c.source.kind == "usb_daq")
-    throw drivers::SourceError("usb_daq: the USB DAQ backend is not part of this build yet (configure source.kind = \"sim\" or \"replay\")");
+  if (c.source.kind == "usb_daq") {
+    dsp::RunMeta meta;
+    meta.acquisition = c.acquisition;
+    meta.site = c.site;
+    meta.machine = c.machine;
+    meta.sensors[0] = c.sensors[0];
+    meta.sensors[1] = c.sensors[1];
+    meta.psd = c.psd;
+    meta.program.kind = "freeform";
+    return std::make_unique<drivers::UsbDaqSource>(meta, drivers::parse_usb_id(c.source.usb_id));
+  }
   sim::Scenario sc = c.source.sim_program == "circle"
                          ? sim::circle_scenario(c.source.sim_radius_mm, c.source.sim_feed_mm_min, c.source.sim_repeats, "ccw", c.source.sim_seed)
                          : sim::step_scenario(0.0, 50.0, c.source.sim_feed_mm_min, c.source.sim_repeats, c.source.sim_seed);

@@ -1,0 +1,76 @@
+#include "drivers/can/can_trigger.hpp"
+
+#include <linux/can/raw.h>
+#include <net/if.h>
+#include <poll.h>
+#include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <stdexcept>
+
+namespace eical::drivers {
+
+std::optional<CanTrigger> parse_can_trigger(const can_frame& f, std::uint32_t id) {
+  if ((f.can_id & CAN_EFF_FLAG) || (f.can_id & CAN_RTR_FLAG) || (f.can_id & CAN_SFF_MASK) != id || f.len != 8) return std::nullopt;
+  if (f.data[0] < 1 || f.data[0] > 3) return std::nullopt;
+  const auto raw = static_cast<std::int32_t>(static_cast<std::uint32_t>(f.data[2]) | static_cast<std::uint32_t>(f.data[3]) << 8 |
+                                             static_cast<std::uint32_t>(f.data[4]) << 16 | static_cast<std::uint32_t>(f.data[5]) << 24);
+  const double p = raw == INT32_MIN ? std::nan("") : raw / 1000.0;
+  return CanTrigger{100 + f.data[0], p, f.data[1]};
+}
+
+can_frame make_can_trigger(std::uint32_t id, int code, std::uint8_t sequence, double p) {
+  can_frame f{};
+  f.can_id = id & CAN_SFF_MASK;
+  f.len = 8;
+  f.data[0] = static_cast<std::uint8_t>(code - 100);
+  f.data[1] = sequence;
+  const std::int32_t raw = std::isnan(p) ? INT32_MIN : static_cast<std::int32_t>(std::lround(p * 1000.0));
+  for (int b = 0; b < 4; ++b) f.data[2 + b] = static_cast<std::uint8_t>(static_cast<std::uint32_t>(raw) >> (8 * b));
+  return f;
+}
+
+CanTriggerInput::CanTriggerInput(const std::string& interface, std::uint32_t id) : id_(id) {
+  fd_ = ::socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
+  if (fd_ < 0) throw std::runtime_error(std::string("can: SocketCAN is not available in this kernel (socket(PF_CAN): ") + std::strerror(errno) + ")");
+  const unsigned idx = ::if_nametoindex(interface.c_str());
+  if (idx == 0) {
+    const int err = errno;
+    ::close(fd_);
+    throw std::runtime_error("can: no CAN interface '" + interface + "' (" + std::strerror(err) + ")");
+  }
+  can_filter filter{id & CAN_SFF_MASK, CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG};
+  ::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, &filter, sizeof filter);
+  sockaddr_can addr{};
+  addr.can_family = AF_CAN;
+  addr.can_ifindex = static_cast<int>(idx);
+  if (::bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+    const int err = errno;
+    ::close(fd_);
+    throw std::runtime_error("can: cannot bind to '" + interface + "': " + std::strerror(err));
+  }
+}
+
+CanTriggerInput::~CanTriggerInput() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+std::optional<std::pair<CanTrigger, std::int64_t>> CanTriggerInput::next(int timeout_ms) {
+  pollfd p{fd_, POLLIN, 0};
+  if (::poll(&p, 1, timeout_ms) <= 0) return std::nullopt;
+  can_frame f{};
+  if (::read(fd_, &f, sizeof f) != static_cast<ssize_t>(sizeof f)) return std::nullopt;
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  auto t = parse_can_trigger(f, id_);
+  if (!t || t->sequence == last_seq_) return std::nullopt;  // not ours, or a retransmission
+  last_seq_ = t->sequence;
+  return std::pair{*t, static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec};
+}
+
+}  // namespace eical::drivers

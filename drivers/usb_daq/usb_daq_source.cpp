@@ -1,0 +1,65 @@
+#include "drivers/usb_daq/usb_daq_source.hpp"
+
+#include <libusb.h>
+
+#include <charconv>
+#include <cstdio>
+#include <vector>
+
+namespace eical::drivers {
+
+UsbDaqOptions parse_usb_id(const std::string& id) {
+  UsbDaqOptions o;
+  const auto colon = id.find(':');
+  unsigned v = 0, p = 0;
+  const bool ok = colon == 4 && id.size() == 9 &&
+                  std::from_chars(id.data(), id.data() + 4, v, 16).ec == std::errc() &&
+                  std::from_chars(id.data() + 5, id.data() + 9, p, 16).ec == std::errc();
+  if (!ok) throw SourceError("usb_daq: USB id '" + id + "' is not vendor:product in hex (e.g. 1d50:6161)");
+  o.vendor_id = static_cast<std::uint16_t>(v);
+  o.product_id = static_cast<std::uint16_t>(p);
+  return o;
+}
+
+UsbDaqSource::UsbDaqSource(dsp::RunMeta meta, UsbDaqOptions options)
+    : meta_(std::move(meta)), options_(options), decoder_(static_cast<int>(meta_.psd.size())) {}
+
+UsbDaqSource::~UsbDaqSource() {
+  if (handle_) {
+    libusb_release_interface(handle_, 0);
+    libusb_close(handle_);
+  }
+  if (ctx_) libusb_exit(ctx_);
+}
+
+void UsbDaqSource::open() {
+  if (const int rc = libusb_init(&ctx_); rc != 0) throw SourceError(std::string("usb_daq: libusb_init failed: ") + libusb_error_name(rc));
+  libusb_device** list = nullptr;
+  const ssize_t n = libusb_get_device_list(ctx_, &list);
+  if (n >= 0) libusb_free_device_list(list, 1);
+  handle_ = libusb_open_device_with_vid_pid(ctx_, options_.vendor_id, options_.product_id);
+  if (!handle_) {
+    char id[16];
+    std::snprintf(id, sizeof id, "%04x:%04x", options_.vendor_id, options_.product_id);
+    throw SourceError(std::string("usb_daq: no DAQ with USB id ") + id + " found (" + std::to_string(n < 0 ? 0 : n) +
+                      " USB devices visible)");
+  }
+  if (const int rc = libusb_claim_interface(handle_, 0); rc != 0)
+    throw SourceError(std::string("usb_daq: cannot claim the DAQ's interface: ") + libusb_error_name(rc));
+}
+
+std::size_t UsbDaqSource::read(std::span<dsp::Frame> out) {
+  while (pending_.size() < out.size()) {
+    unsigned char buf[16384];
+    int got = 0;
+    const int rc = libusb_bulk_transfer(handle_, options_.endpoint, buf, sizeof buf, &got, options_.timeout_ms);
+    if (rc == LIBUSB_ERROR_TIMEOUT) break;
+    if (rc != 0) throw SourceError(std::string("usb_daq: bulk transfer failed: ") + libusb_error_name(rc));
+    decoder_.feed(std::span<const std::uint8_t>(buf, static_cast<std::size_t>(got)), [&](const dsp::Frame& f) { pending_.push_back(f); });
+  }
+  std::size_t n = 0;
+  while (n < out.size() && !pending_.empty()) out[n++] = pending_.front(), pending_.pop_front();
+  return n;
+}
+
+}  // namespace eical::drivers

@@ -1,0 +1,47 @@
+#pragma once
+// The 24-bit multichannel DAQ on USB (libusb-1.0, bulk IN), decoded by usb_daq::Decoder.
+// open() finds the device by vendor:product; an absent device is a SourceError that says
+// so (with the number of USB devices visible), never a crash.
+#include "drivers/source/source.hpp"
+#include "drivers/usb_daq/protocol.hpp"
+
+#include <cstdint>
+#include <deque>
+#include <string>
+
+struct libusb_context;
+struct libusb_device_handle;
+
+namespace eical::drivers {
+
+struct UsbDaqOptions {
+  std::uint16_t vendor_id = 0x1d50, product_id = 0x6161;
+  unsigned char endpoint = 0x81;
+  int timeout_ms = 200;
+};
+
+// "1d50:6161" → ids; throws SourceError on a malformed id.
+UsbDaqOptions parse_usb_id(const std::string& id);
+
+class UsbDaqSource final : public Source {
+ public:
+  UsbDaqSource(dsp::RunMeta meta, UsbDaqOptions options);
+  ~UsbDaqSource() override;
+
+  void open() override;
+  [[nodiscard]] const dsp::RunMeta& meta() const override { return meta_; }
+  std::size_t read(std::span<dsp::Frame> out) override;
+  [[nodiscard]] bool at_end() const override { return false; }  // a DAQ streams until stopped
+  [[nodiscard]] std::string_view name() const override { return "usb_daq"; }
+  [[nodiscard]] Backpressure backpressure() const override { return Backpressure::drop_newest; }
+
+ private:
+  dsp::RunMeta meta_;
+  UsbDaqOptions options_;
+  usb_daq::Decoder decoder_;
+  libusb_context* ctx_ = nullptr;
+  libusb_device_handle* handle_ = nullptr;
+  std::deque<dsp::Frame> pending_;
+};
+
+}  // namespace eical::drivers
