@@ -2,17 +2,130 @@
 // Everything one simulated run depends on. Nominal values (what eical is told: data sheet,
 // program) live in `meta`; the true values the data are generated with live beside them,
 // so a scenario can make reality differ from the data sheet (and truth.toml says how).
+// Every effect of shared/spec/run-format.md maps onto fields here; all default to "off"
+// (an ideal machine that follows the set-point, data-sheet sensors, a nominal DAQ).
 #include "dsp/core/run_meta.hpp"
 #include "sim/nc/trajectory.hpp"
 
+#include <Eigen/Core>
+
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace eical::sim {
 
+// Slowly warming sensor case: T(t) = t0 + rise·(1 − exp(−t/tau)).
+struct CaseTemperature {
+  double t0_c = 20.0;
+  double rise_c = 0.0;
+  double tau_s = 600.0;
+  [[nodiscard]] double at(double t_s) const;
+};
+
+// True sensor: the data-sheet keys (spec) plus what the data sheet does not list.
 struct SensorTruth {
-  dsp::SensorSpec spec;  // true k1, k2, k3, bias, f0, zeta, noise, mounting
-  double temp_c = 20.0;  // constant case temperature (v1)
+  dsp::SensorSpec spec;  // true k1, k2, k3, bias, tc, f0, zeta, noise, mounting
+  // (6-4) cross terms in g: row = sensor axis responding, column = axis across it.
+  Eigen::Matrix3d k_cross_g_per_g = Eigen::Matrix3d::Zero();    // k_x a_y, k_y a_x, ...
+  Eigen::Matrix3d k_cross2_g_per_g2 = Eigen::Matrix3d::Zero();  // k_zy a_z a_y, ...: (i,j) = a_i·a_j on axis row
+  double zeta_per_g = 0.0;          // squeeze-film damping: ζ = ζ0 (1 + zeta_per_g |a|/g) (ch. 8.3.1)
+  double bias_rw_ug_per_rts = 0.0;  // bias random walk (6-5, 6-6)
+  double bias_step_ug = 0.0;        // bias jump at the start of every move (ch. 8.3.2), alternating sign
+  double bias_drift_ug_per_s = 0.0;  // linear bias drift
+  CaseTemperature temperature;
+};
+
+// Position loop of one axis: v = ff·v_cmd + Kv·(cmd − x), optionally through a first-order
+// velocity loop (time constant) which makes the loop second order. kv_per_s = 0: ideal.
+struct AxisServo {
+  double kv_per_s = 0.0;
+  double feedforward = 0.0;
+  double velocity_tau_s = 0.0;
+};
+
+struct ReversalSpike {
+  double amp_um = 0.0;  // peak lag after a reversal
+  double tau_ms = 15.0;  // time to the peak; decays over a few tau
+};
+
+struct CyclicError {
+  double amp_um = 0.0;
+  double pitch_mm = 10.0;
+  double phase_deg = 0.0;
+};
+
+// Axis bends sideways: deviation along `direction` = bow·(1 − u²), u = −1..1 over the span.
+struct Straightness {
+  int direction = -1;  // 0, 1, 2 = x, y, z; −1 = none
+  double bow_um = 0.0;
+  double span_mm[2] = {-10.0, 10.0};
+};
+
+// Below `below_mm_min` the axis sticks until the lag reaches amp, then slips in `slip_ms`.
+struct StickSlip {
+  double amp_um = 0.0;
+  double below_mm_min = 100.0;
+  double slip_ms = 2.0;
+};
+
+struct MachineErrors {
+  AxisServo servo[3];
+  double backlash_um[3] = {0, 0, 0};
+  ReversalSpike spike[3];
+  double squareness_urad[3] = {0, 0, 0};  // xy, yz, zx: positive = angle between axes > 90°
+  double scale_ppm[3] = {0, 0, 0};
+  CyclicError cyclic[3];
+  Straightness straightness[3];  // of axis x, y, z
+  StickSlip stick_slip[3];
+};
+
+struct Tone {
+  double freq_hz = 100.0;
+  Eigen::Vector3d amp_mg = Eigen::Vector3d::Zero();  // peak, machine axes
+  double phase_deg = 0.0;
+};
+
+// A structural mode driven by the axes' commanded acceleration:
+// m'' + 2ζω m' + ω² m = gain·a_cmd (per machine axis).
+struct DriveMode {
+  double freq_hz = 9.0;
+  double zeta = 0.03;
+  Eigen::Vector3d gain = Eigen::Vector3d::Zero();  // dimensionless
+};
+
+// Head and table vibrate together (absolute motion, no relative motion).
+struct CommonVibration {
+  std::vector<Tone> tones;
+  Eigen::Vector3d broadband_rms_mg = Eigen::Vector3d::Zero();
+  double band_hz[2] = {20.0, 800.0};
+  DriveMode mode;  // the machine rocking on its foundation
+  [[nodiscard]] bool on() const;
+};
+
+struct DaqTruth {
+  double group_delay_samples = 38.8;
+  double skew_head_samples = 0.0;       // head channels later than table
+  std::int64_t offset_counts[6] = {0, 0, 0, 0, 0, 0};
+  double noise_nv_per_rthz = 0.0;       // electronic noise at the ADC input, two-sided
+};
+
+// The laser spot on a 1-D PSD strip: what the data sheet of run.toml [[psd]] does not say.
+struct PsdTruth {
+  double spot_mm = 0.03;
+  double full_scale_v = 2.0;      // i1 + i2 with the whole spot on the strip
+  double nonlinearity = 0.0;      // u_meas = u (1 + nl (2u/L)²)
+  double noise_v_per_rthz = 6e-7;
+};
+
+// Reference instrument (cross-grid encoder): scale error and interpolation error within a
+// signal period, 1 nm resolution.
+struct ReferenceTruth {
+  double scale_ppm[3] = {0, 0, 0};
+  double interp_nm[3][2] = {{0, 0}, {0, 0}, {0, 0}};         // 1st and 2nd harmonic per axis
+  double interp_phase_deg[3][2] = {{0, 0}, {0, 0}, {0, 0}};
+  double signal_period_um = 4.0;
+  double resolution_nm = 1.0;
 };
 
 struct Scenario {
@@ -21,11 +134,22 @@ struct Scenario {
   std::uint64_t seed = 1;
   dsp::RunMeta meta;           // nominal metadata written to run.toml; program.gcode may be empty
   SensorTruth truth[2];        // table, head
-  double daq_delay_samples_true = 38.8;
+  DaqTruth daq;
+  MachineErrors machine;
+  CommonVibration common_vibration;
+  DriveMode differential_vibration;  // head against table: real relative motion
+  bool coriolis = false;             // Earth rate from [site] latitude and heading
+  std::vector<PsdTruth> psd;         // one per meta.psd strip (defaults when shorter)
+  ReferenceTruth reference;
   nc::MachineLimits limits;
   int oversample = 10;         // internal rate = oversample · fs (≥ 100 kHz at 10 kHz)
   bool noise = true;           // white sensor noise (quantisation is always on: for a
                                // near-ideal ADC use adc_bits = 32 and a tiny adc_lsb_volt)
+  // Effects the scenario injected on purpose (names of run-format.md) and those present
+  // only at tolerance level; truth.toml lists both. Empty `present`: derived from the
+  // parameters that differ from nominal.
+  std::vector<std::string> effects_present;
+  std::vector<std::string> effects_background;
 };
 
 // The issue-2 demo circle: R = 10 mm, F = 2500 mm/min, 5 repeats ccw in XY, both sensors
@@ -39,5 +163,11 @@ Scenario step_scenario(double from_mm = 0.0, double to_mm = 50.0, double feed_mm
 
 // ISO 230-2 linear cycle on x over `targets_mm` (ascending), `runs` bidirectional runs.
 Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs = 5, double feed_mm_min = 2000.0, std::uint64_t seed = 1);
+
+// Rectangle in XY from `corner_mm`, sides `size_mm`, `repeats` times.
+Scenario rectangle_scenario(double size_mm = 50.0, double feed_mm_min = 6500.0, int repeats = 1, std::uint64_t seed = 1);
+
+// A scenario running the given G-code (a free-form program or any generated one).
+Scenario gcode_scenario(const std::string& gcode, const std::string& kind = "freeform", std::uint64_t seed = 1);
 
 }  // namespace eical::sim

@@ -1,23 +1,45 @@
 #pragma once
-// A synthetic recorded run from a scenario: NC interpolator → machine (v1: ideal, the
-// relative motion is the set-point; table axes move the table by −p, head axes the head
-// by +p) → per sensor specific force (gravity, mounting) → PT2 at the internal rate →
-// DAQ group delay → static model (6-4) with noise → 24-bit ADC.
+// A synthetic recorded run from a scenario, physics in this order, on an internal grid
+// at oversample·fs (≥ 100 kHz):
+//   NC interpolator (set-point) → machine: per-axis position loop and axis errors
+//   (sim/machine/axis_motion), errors between axes (sim/machine/geometry), the head's
+//   mode against the table (real relative motion) → absolute acceleration of table and
+//   head (set-point acceleration plus the second difference of their deviations, so the
+//   double integral of what the sensors see is exactly the relative position the
+//   reference reads) + common vibration + Earth-rate Coriolis → specific force with
+//   gravity in each sensor's true mounting → PT2 and the fast static model per sensing
+//   element (sim/sensor/sensing_element) → DAQ decimation filter with the true group
+//   delay (head channels skewed) → slow static terms (bias, drift, random walk,
+//   temperature of k1 and bias), white sensor and electronic noise → ADC with offsets.
+//   PSD strips see the relative position through their lock-in and the same DAQ filter;
+//   the reference reads the relative position undelayed with its own small errors.
 //
 // Conventions the DSP pipeline relies on:
 //  * specific force f = a − g_vec with g_vec = (0, 0, −g): a sensor at rest, z up, reads +1 g;
 //  * sensor axes = to_machine⁻¹ · f (to_machine maps sensor axes to machine axes);
-//  * U = k1 (a_g + bias + k2 a_g² + k3 a_g³ + n), counts = round(U / lsb) + offset;
+//  * U = k1 (a_g + bias + k2 a_g² + k3 a_g³ + cross terms + n), counts = round(U / lsb) + offset;
 //  * output sample n holds the analog signal at n/fs − d/fs (d = DAQ group delay in
-//    samples); cmd_mm and ref_mm at sample n are the set-point and true relative position
+//    samples); cmd_mm and ref_mm at sample n are the set-point and the reference reading
 //    at n/fs (not delayed); triggers sit on the sample nearest their time.
-// Deterministic for a given seed: std::mt19937_64 and std::normal_distribution of
-// libstdc++ (the same build always gives the same frames).
+// Deterministic for a given seed; each random process (sensor noise per channel, bias
+// walk, broadband vibration, PSD noise) has its own stream, so switching one effect on
+// does not change the noise of the others.
 #include "dsp/core/run.hpp"
 #include "sim/scenario.hpp"
+
+#include <Eigen/Core>
+
+#include <vector>
 
 namespace eical::sim {
 
 dsp::Run simulate(const Scenario& scenario);
+
+// The same, also returning the true relative position at every frame (mm) — what an
+// ideal reference would read — for validation and tests.
+dsp::Run simulate(const Scenario& scenario, std::vector<Eigen::Vector3d>* true_rel_mm);
+
+// An independent random stream per purpose, derived from the scenario's seed.
+std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t purpose) noexcept;
 
 }  // namespace eical::sim

@@ -1,5 +1,10 @@
 #include "sim/truth.hpp"
 
+#include "sim/effects.hpp"
+#include "sim/sensor/earth_rate.hpp"
+
+#include <Eigen/LU>
+
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -11,82 +16,219 @@ std::string num(double v) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.10g", v);
   std::string s = buf;
+  if (s == "inf" || s == "-inf" || s == "nan") return s;
   // TOML floats need a decimal point or exponent.
-  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  if (s.find_first_of(".eE") == std::string::npos) s += ".0";
   return s;
 }
 
 std::string vec3(const Eigen::Vector3d& v) { return "[" + num(v[0]) + ", " + num(v[1]) + ", " + num(v[2]) + "]"; }
-
+std::string arr(const double* v, int n) {
+  std::string s = "[";
+  for (int i = 0; i < n; ++i) s += (i ? ", " : "") + num(v[i]);
+  return s + "]";
+}
 std::string mat3(const Eigen::Matrix3d& m) {
   std::string s = "[";
   for (int r = 0; r < 3; ++r) s += (r ? ", " : "") + vec3(m.row(r).transpose());
   return s + "]";
 }
+std::string str(const std::string& s) { return "\"" + s + "\""; }
+std::string list(const std::vector<std::string>& v) {
+  std::string s = "[";
+  for (std::size_t k = 0; k < v.size(); ++k) s += (k ? ", " : "") + str(v[k]);
+  return s + "]";
+}
 
-bool differs(double a, double b) { return std::abs(a - b) > 1e-12 * std::max(1.0, std::abs(b)); }
-bool differs(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return (a - b).norm() > 1e-12; }
+const char* kAxis[3] = {"x", "y", "z"};
+const char* kPair[3] = {"xy", "yz", "zx"};
+const char* kSensor[2] = {"table", "head"};
+
+// Small rotation (mrad) about the sensor axes between nominal and true mounting.
+Eigen::Vector3d misalignment_mrad(const Eigen::Matrix3d& nominal, const Eigen::Matrix3d& truth) {
+  const Eigen::Matrix3d r = nominal.inverse() * truth;
+  return 1e3 * Eigen::Vector3d(0.5 * (r(2, 1) - r(1, 2)), 0.5 * (r(0, 2) - r(2, 0)), 0.5 * (r(1, 0) - r(0, 1)));
+}
+
+// Which sensors an effect shows in.
+std::string sensors_with(const Scenario& sc, bool (*pred)(const Scenario&, int)) {
+  const bool t = pred(sc, 0), h = pred(sc, 1);
+  return t && h ? "both" : (t ? "table" : (h ? "head" : "none"));
+}
+
+std::string effect_table(const Scenario& sc, const std::string& name) {
+  std::string o = "\n[effects.\"" + name + "\"]\n";
+  const MachineErrors& m = sc.machine;
+  auto per_axis = [&](auto pred, auto body) {
+    for (int i = 0; i < 3; ++i)
+      if (pred(i)) {
+        o += "axis = " + str(kAxis[i]) + "\n" + body(i);
+        return;
+      }
+  };
+  if (name.rfind("sensor.", 0) == 0) {
+    bool (*pred)(const Scenario&, int) = nullptr;
+    if (name == "sensor.scale") pred = [](const Scenario& s, int i) { return (s.truth[i].spec.k1_v_per_g - s.meta.sensors[i].k1_v_per_g).norm() > 1e-12; };
+    if (name == "sensor.bias_drift") pred = [](const Scenario& s, int i) { return s.truth[i].bias_rw_ug_per_rts != 0.0 || s.truth[i].bias_step_ug != 0.0 || s.truth[i].bias_drift_ug_per_s != 0.0; };
+    if (name == "sensor.nonlinearity") pred = [](const Scenario& s, int i) { return (s.truth[i].spec.k2_g_per_g2 - s.meta.sensors[i].k2_g_per_g2).norm() + (s.truth[i].spec.k3_g_per_g3 - s.meta.sensors[i].k3_g_per_g3).norm() > 1e-12; };
+    if (name == "sensor.cross_coupling") pred = [](const Scenario& s, int i) { return s.truth[i].k_cross_g_per_g.squaredNorm() + s.truth[i].k_cross2_g_per_g2.squaredNorm() > 0.0; };
+    if (name == "sensor.misalignment") pred = [](const Scenario& s, int i) { return (s.truth[i].spec.to_machine - s.meta.sensors[i].to_machine).norm() > 1e-12; };
+    if (name == "sensor.dynamics") pred = [](const Scenario& s, int i) { return std::abs(s.truth[i].spec.f0_hz - s.meta.sensors[i].f0_hz) + std::abs(s.truth[i].spec.zeta - s.meta.sensors[i].zeta) > 1e-12; };
+    if (name == "sensor.damping_amplitude") pred = [](const Scenario& s, int i) { return s.truth[i].zeta_per_g != 0.0; };
+    if (name == "sensor.scale_temperature") pred = [](const Scenario& s, int i) { return s.truth[i].temperature.rise_c != 0.0; };
+    const std::string which = pred ? sensors_with(sc, pred) : "none";
+    o += "sensor = " + str(which) + "\n";
+    const int s = which == "head" ? 1 : 0;
+    const SensorTruth& t = sc.truth[s];
+    if (name == "sensor.scale") o += "k1_v_per_g = " + vec3(t.spec.k1_v_per_g) + "\n";
+    if (name == "sensor.bias_drift")
+      o += "rw_ug_per_rts = " + num(t.bias_rw_ug_per_rts) + "\nstep_ug = " + num(t.bias_step_ug) + "\ndrift_ug_per_s = " + num(t.bias_drift_ug_per_s) + "\n";
+    if (name == "sensor.nonlinearity") o += "k2_g_per_g2 = " + vec3(t.spec.k2_g_per_g2) + "\nk3_g_per_g3 = " + vec3(t.spec.k3_g_per_g3) + "\n";
+    if (name == "sensor.cross_coupling") o += "k_cross_g_per_g = " + mat3(t.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(t.k_cross2_g_per_g2) + "\n";
+    if (name == "sensor.misalignment") o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
+    if (name == "sensor.dynamics") o += "f0_hz = " + num(t.spec.f0_hz) + "\nzeta = " + num(t.spec.zeta) + "\n";
+    if (name == "sensor.damping_amplitude") o += "zeta0 = " + num(t.spec.zeta) + "\nzeta_per_g = " + num(t.zeta_per_g) + "\n";
+    if (name == "sensor.scale_temperature")
+      o += "rise_c = " + num(t.temperature.rise_c) + "\ntau_s = " + num(t.temperature.tau_s) + "\ntc_k1_ppm_per_c = " + num(t.spec.tc_k1_ppm_per_c) +
+           "\ntc_bias_ug_per_c = " + num(t.spec.tc_bias_ug_per_c) + "\n";
+  } else if (name == "daq.group_delay") {
+    o += "group_delay_samples = " + num(sc.daq.group_delay_samples) + "\nskew_head_samples = " + num(sc.daq.skew_head_samples) + "\n";
+  } else if (name == "site.coriolis") {
+    o += "latitude_deg = " + num(sc.meta.site.latitude_deg) + "\nheading_deg = " + num(sc.meta.site.heading_deg) + "\n";
+  } else if (name == "machine.common_vibration") {
+    const CommonVibration& v = sc.common_vibration;
+    o += "broadband_rms_mg = " + vec3(v.broadband_rms_mg) + "\nband_hz = " + arr(v.band_hz, 2) + "\n";
+    for (const Tone& t : v.tones)
+      o += "\n[[effects.\"" + name + "\".tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) + "\nphase_deg = " + num(t.phase_deg) + "\n";
+    o += "\n[effects.\"" + name + "\".mode]\nfreq_hz = " + num(v.mode.freq_hz) + "\nzeta = " + num(v.mode.zeta) + "\ngain = " + vec3(v.mode.gain) + "\n";
+  } else if (name == "machine.differential_vibration") {
+    const DriveMode& d = sc.differential_vibration;
+    o += "freq_hz = " + num(d.freq_hz) + "\nzeta = " + num(d.zeta) + "\ngain = " + vec3(d.gain) + "\n";
+  } else if (name == "machine.backlash") {
+    per_axis([&](int i) { return m.backlash_um[i] != 0.0; }, [&](int i) { return "value_um = " + num(m.backlash_um[i]) + "\n"; });
+  } else if (name == "machine.reversal_spike") {
+    per_axis([&](int i) { return m.spike[i].amp_um != 0.0; },
+             [&](int i) { return "amp_um = " + num(m.spike[i].amp_um) + "\ntau_ms = " + num(m.spike[i].tau_ms) + "\n"; });
+  } else if (name == "machine.servo_mismatch") {
+    for (int i = 0; i < 3; ++i)
+      o += std::string("lag_") + kAxis[i] + "_ms = " +
+           num(m.servo[i].kv_per_s > 0 ? 1e3 * (1.0 - m.servo[i].feedforward) / m.servo[i].kv_per_s : 0.0) + "\n";
+  } else if (name == "machine.squareness") {
+    for (int i = 0; i < 3; ++i)
+      if (m.squareness_urad[i] != 0.0) o += std::string("plane = ") + str(kPair[i]) + "\nvalue_urad = " + num(m.squareness_urad[i]) + "\n";
+  } else if (name == "machine.scale_mismatch") {
+    for (int i = 0; i < 3; ++i) o += std::string(kAxis[i]) + "_ppm = " + num(m.scale_ppm[i]) + "\n";
+  } else if (name == "machine.cyclic_error") {
+    per_axis([&](int i) { return m.cyclic[i].amp_um != 0.0; }, [&](int i) {
+      return "amp_um = " + num(m.cyclic[i].amp_um) + "\npitch_mm = " + num(m.cyclic[i].pitch_mm) + "\nphase_deg = " + num(m.cyclic[i].phase_deg) + "\n";
+    });
+  } else if (name == "machine.straightness") {
+    per_axis([&](int i) { return m.straightness[i].direction >= 0 && m.straightness[i].bow_um != 0.0; }, [&](int i) {
+      return "direction = " + str(kAxis[m.straightness[i].direction]) + "\nbow_um = " + num(m.straightness[i].bow_um) +
+             "\nspan_mm = " + arr(m.straightness[i].span_mm, 2) + "\n";
+    });
+  } else if (name == "machine.stick_slip") {
+    per_axis([&](int i) { return m.stick_slip[i].amp_um != 0.0; }, [&](int i) {
+      return "amp_um = " + num(m.stick_slip[i].amp_um) + "\nbelow_mm_min = " + num(m.stick_slip[i].below_mm_min) + "\nslip_ms = " +
+             num(m.stick_slip[i].slip_ms) + "\n";
+    });
+  }
+  return o;
+}
 
 }  // namespace
 
 std::string truth_toml(const Scenario& sc, const nc::Trajectory& tr) {
-  std::vector<std::string> present;
-  for (int s = 0; s < 2; ++s) {
-    const auto& t = sc.truth[s].spec;
-    const auto& n = sc.meta.sensors[s];
-    auto add = [&](const char* e) {
-      for (const auto& p : present)
-        if (p == e) return;
-      present.emplace_back(e);
-    };
-    if (differs(t.k1_v_per_g, n.k1_v_per_g)) add("sensor.scale");
-    if (differs(t.k2_g_per_g2, n.k2_g_per_g2) || differs(t.k3_g_per_g3, n.k3_g_per_g3)) add("sensor.nonlinearity");
-    if (differs(t.f0_hz, n.f0_hz) || differs(t.zeta, n.zeta)) add("sensor.dynamics");
-    if ((t.to_machine - n.to_machine).norm() > 1e-12) add("sensor.misalignment");
-  }
-  if (differs(sc.daq_delay_samples_true, sc.meta.acquisition.daq_group_delay_samples)) present.emplace_back("daq.group_delay");
-
+  const EffectLists effects = effect_lists(sc);
   std::string o;
-  o += "# truth.toml -- synthetic run, true parameters (eical sim v1).\n";
-  o += "# Noise densities are two-sided (sample std = n sqrt(fs)). Machine: ideal (relative\n";
-  o += "# position = NC set-point); no PSD, no vibration, no temperature drift in v1.\n";
-  o += "generator = \"eical-sim 1\"\n";
-  o += "scenario = \"" + sc.name + "\"\n";
-  o += "seed = " + std::to_string(sc.seed) + "\n";
-  o += "description = \"" + sc.description + "\"\n\n[effects]\npresent = [";
-  for (std::size_t k = 0; k < present.size(); ++k) o += (k ? ", \"" : "\"") + present[k] + "\"";
-  o += "]\nbackground = []\n";
-  const char* names[2] = {"table", "head"};
+  o += "# truth.toml -- synthetic run, true parameters (eical sim 2).\n";
+  o += "# [effects] present: injected on purpose; background: also in the data, at tolerance level.\n";
+  o += "# Noise densities are two-sided (sample std = n sqrt(fs), sigma_x = n T^1.5/sqrt(3)).\n";
+  o += "# [sensors.*].to_machine is the true mounting; machine errors in relative-position sense.\n";
+  o += "generator = \"eical-sim 2\"\n";
+  o += "scenario = " + str(sc.name) + "\nseed = " + std::to_string(sc.seed) + "\ndescription = " + str(sc.description) + "\n";
+  o += "\n[effects]\npresent = " + list(effects.present) + "\nbackground = " + list(effects.background) + "\n";
+  for (const auto& e : effects.present) o += effect_table(sc, e);
+
   for (int s = 0; s < 2; ++s) {
-    const auto& t = sc.truth[s].spec;
-    o += std::string("\n[sensors.") + names[s] + "]\n";
-    o += "model = \"" + t.model + "\"\n";
-    o += "to_machine = " + mat3(t.to_machine) + "\n";
-    o += "k1_v_per_g = " + vec3(t.k1_v_per_g) + "\n";
-    o += "k2_g_per_g2 = " + vec3(t.k2_g_per_g2) + "\n";
-    o += "k3_g_per_g3 = " + vec3(t.k3_g_per_g3) + "\n";
-    o += "bias_g = " + vec3(t.bias_g) + "\n";
-    o += "tc_k1_ppm_per_c = " + num(t.tc_k1_ppm_per_c) + "\n";
-    o += "tc_bias_ug_per_c = " + num(t.tc_bias_ug_per_c) + "\n";
-    o += "f0_hz = " + num(t.f0_hz) + "\nzeta = " + num(t.zeta) + "\n";
-    o += "noise_ug_per_rthz = " + num(sc.noise ? t.noise_ug_per_rthz : 0.0) + "\n";
+    const SensorTruth& st = sc.truth[s];
+    const auto& t = st.spec;
+    o += std::string("\n[sensors.") + kSensor[s] + "]\n";
+    o += "model = " + str(t.model) + "\nto_machine = " + mat3(t.to_machine) + "\n";
+    o += "k1_v_per_g = " + vec3(t.k1_v_per_g) + "\nk2_g_per_g2 = " + vec3(t.k2_g_per_g2) + "\nk3_g_per_g3 = " + vec3(t.k3_g_per_g3) + "\n";
+    o += "bias_g = " + vec3(t.bias_g) + "\ntc_k1_ppm_per_c = " + num(t.tc_k1_ppm_per_c) + "\ntc_bias_ug_per_c = " + num(t.tc_bias_ug_per_c) + "\n";
+    o += "f0_hz = " + num(t.f0_hz) + "\nzeta = " + num(t.zeta) + "\nnoise_ug_per_rthz = " + num(sc.noise ? t.noise_ug_per_rthz : 0.0) + "\n";
     o += "temp_ref_c = " + num(t.temp_ref_c) + "\n";
-    o += std::string("\n[sensors.") + names[s] + ".temperature]\nstart_c = " + num(sc.truth[s].temp_c) +
-         "\nend_c = " + num(sc.truth[s].temp_c) + "\n";
+    o += "k_cross_g_per_g = " + mat3(st.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(st.k_cross2_g_per_g2) + "\n";
+    o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.to_machine)) + "\n";
+    o += "zeta_per_g = " + num(st.zeta_per_g) + "\nbias_rw_ug_per_rts = " + num(st.bias_rw_ug_per_rts) + "\nbias_step_ug = " + num(st.bias_step_ug) +
+         "\nbias_drift_ug_per_s = " + num(st.bias_drift_ug_per_s) + "\n";
+    o += std::string("\n[sensors.") + kSensor[s] + ".temperature]\nt0_c = " + num(st.temperature.t0_c) + "\nrise_c = " + num(st.temperature.rise_c) +
+         "\ntau_s = " + num(st.temperature.tau_s) + "\nstart_c = " + num(st.temperature.at(0.0)) + "\nend_c = " + num(st.temperature.at(tr.duration_s())) + "\n";
   }
-  o += "\n[daq]\ngroup_delay_samples = " + num(sc.daq_delay_samples_true) + "\nskew_samples = 0.0\n";
+
+  const MachineErrors& m = sc.machine;
+  auto axes3 = [&](const char* table, auto get) {
+    o += std::string("\n[machine_errors.") + table + "]\n";
+    for (int i = 0; i < 3; ++i) o += std::string(kAxis[i]) + " = " + num(get(i)) + "\n";
+  };
+  o += "\n[machine_errors]\n# relative-position sense; an axis' errors are carried by the part that moves it\n";
+  axes3("kv_per_s", [&](int i) { return m.servo[i].kv_per_s; });
+  axes3("feedforward", [&](int i) { return m.servo[i].feedforward; });
+  axes3("velocity_tau_ms", [&](int i) { return m.servo[i].velocity_tau_s * 1e3; });
+  axes3("servo_lag_ms", [&](int i) { return m.servo[i].kv_per_s > 0 ? 1e3 * (1.0 - m.servo[i].feedforward) / m.servo[i].kv_per_s : 0.0; });
+  axes3("backlash_um", [&](int i) { return m.backlash_um[i]; });
+  axes3("scale_ppm", [&](int i) { return m.scale_ppm[i]; });
+  o += "\n[machine_errors.squareness_urad]\n";
+  for (int i = 0; i < 3; ++i) o += std::string(kPair[i]) + " = " + num(m.squareness_urad[i]) + "\n";
+  for (int i = 0; i < 3; ++i) {
+    o += std::string("\n[machine_errors.reversal_spike.") + kAxis[i] + "]\namp_um = " + num(m.spike[i].amp_um) + "\ntau_ms = " + num(m.spike[i].tau_ms) + "\n";
+    o += std::string("\n[machine_errors.cyclic.") + kAxis[i] + "]\namp_um = " + num(m.cyclic[i].amp_um) + "\npitch_mm = " + num(m.cyclic[i].pitch_mm) +
+         "\nphase_deg = " + num(m.cyclic[i].phase_deg) + "\n";
+    if (m.straightness[i].direction >= 0)
+      o += std::string("\n[machine_errors.straightness.") + kAxis[i] + "]\ndirection = " + str(kAxis[m.straightness[i].direction]) +
+           "\nbow_um = " + num(m.straightness[i].bow_um) + "\nspan_mm = " + arr(m.straightness[i].span_mm, 2) + "\n";
+    o += std::string("\n[machine_errors.stick_slip.") + kAxis[i] + "]\namp_um = " + num(m.stick_slip[i].amp_um) + "\nbelow_mm_min = " +
+         num(m.stick_slip[i].below_mm_min) + "\nslip_ms = " + num(m.stick_slip[i].slip_ms) + "\n";
+  }
+
+  o += "\n[daq]\ngroup_delay_samples = " + num(sc.daq.group_delay_samples) + "\nskew_head_samples = " + num(sc.daq.skew_head_samples) + "\n";
+  o += "offset_counts = [";
+  for (int c = 0; c < 6; ++c) o += (c ? ", " : "") + std::to_string(sc.daq.offset_counts[c]);
+  o += "]\nnoise_nv_per_rthz = " + num(sc.daq.noise_nv_per_rthz) + "\noversample = " + std::to_string(sc.oversample) + "\n";
   o += "\n[site]\nlatitude_deg = " + num(sc.meta.site.latitude_deg) + "\nheading_deg = " + num(sc.meta.site.heading_deg) +
-       "\ng_mps2 = " + num(sc.meta.site.g_mps2) + "\n";
-  o += "\n[nc]\na_max_mps2 = " + num(sc.limits.a_max_mm_s2 / 1000.0) + "\njerk_mps3 = " + num(sc.limits.j_max_mm_s3 / 1000.0) +
-       "\nmoves_s = [";
+       "\ng_mps2 = " + num(sc.meta.site.g_mps2) + "\ncoriolis = " + (sc.coriolis ? "true" : "false") +
+       "\nomega_machine_radps = " + vec3(earth_rate_machine(sc.meta.site)) + "\n";
+  o += "\n[nc]\na_max_mps2 = " + num(sc.limits.a_max_mm_s2 / 1000.0) + "\njerk_mps3 = " + num(sc.limits.j_max_mm_s3 / 1000.0) + "\nmoves_s = [";
   for (std::size_t k = 0; k < tr.moves().size(); ++k) {
-    const auto& m = tr.moves()[k];
-    o += (k ? ", [" : "[") + num(m.t0_s) + ", " + num(m.t0_s + m.profile.duration_s()) + "]";
+    const auto& mv = tr.moves()[k];
+    o += (k ? ", [" : "[") + num(mv.t0_s) + ", " + num(mv.t0_s + mv.profile.duration_s()) + "]";
   }
   o += "]\ntriggers = [";
   for (std::size_t k = 0; k < tr.triggers().size(); ++k)
     o += (k ? ", [" : "[") + num(tr.triggers()[k].t_s) + ", " + std::to_string(tr.triggers()[k].code) + "]";
-  o += "]\n\n[machine_errors]\n# none: ideal machine\n";
+  o += "]\n";
+  const CommonVibration& v = sc.common_vibration;
+  o += "\n[vibration.common]\nbroadband_rms_mg = " + vec3(v.broadband_rms_mg) + "\nband_hz = " + arr(v.band_hz, 2) +
+       "\nmode_freq_hz = " + num(v.mode.freq_hz) + "\nmode_zeta = " + num(v.mode.zeta) + "\nmode_gain = " + vec3(v.mode.gain) + "\n";
+  for (const Tone& t : v.tones)
+    o += "\n[[vibration.common.tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) + "\nphase_deg = " + num(t.phase_deg) + "\n";
+  const DriveMode& d = sc.differential_vibration;
+  o += "\n[vibration.differential]\nfreq_hz = " + num(d.freq_hz) + "\nzeta = " + num(d.zeta) + "\ngain = " + vec3(d.gain) + "\n";
+  for (std::size_t k = 0; k < sc.meta.psd.size(); ++k) {
+    const auto& p = sc.meta.psd[k];
+    const PsdTruth pt = k < sc.psd.size() ? sc.psd[k] : PsdTruth{};
+    o += "\n[[psd]]\nmeasures = " + str(p.measures) + "\ncenter_mm = " + arr(p.center_mm, 2) + "\nlength_mm = " + num(p.length_mm) +
+         "\nwidth_mm = " + num(p.width_mm) + "\nlockin_tau_s = " + num(p.lockin_tau_s) + "\nspot_mm = " + num(pt.spot_mm) +
+         "\nfull_scale_v = " + num(pt.full_scale_v) + "\nnonlinearity = " + num(pt.nonlinearity) + "\nnoise_v_per_rthz = " + num(pt.noise_v_per_rthz) + "\n";
+  }
+  if (sc.meta.reference) {
+    const ReferenceTruth& r = sc.reference;
+    o += "\n[reference]\nkind = " + str(sc.meta.reference->kind) + "\naxes = " + list(sc.meta.reference->axes) + "\nscale_ppm = " + arr(r.scale_ppm, 3) +
+         "\ninterp_nm = [" + arr(r.interp_nm[0], 2) + ", " + arr(r.interp_nm[1], 2) + ", " + arr(r.interp_nm[2], 2) + "]" +
+         "\ninterp_phase_deg = [" + arr(r.interp_phase_deg[0], 2) + ", " + arr(r.interp_phase_deg[1], 2) + ", " + arr(r.interp_phase_deg[2], 2) + "]" +
+         "\nsignal_period_um = " + num(r.signal_period_um) + "\nresolution_nm = " + num(r.resolution_nm) + "\n";
+  }
   return o;
 }
 

@@ -1,4 +1,5 @@
 // eical simulate: a synthetic recorded run (eical-run/1 with truth.toml) from the simulator.
+#include "drivers/config/scenario_file.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "sim/simulate.hpp"
 #include "tools/commands.hpp"
@@ -10,7 +11,7 @@ namespace eical::tools {
 
 void register_simulate(CLI::App& app) {
   struct Opt {
-    std::string program = "circle", direction = "ccw", out;
+    std::string program = "circle", direction = "ccw", out, scenario;
     double radius_mm = 10.0, feed_mm_min = 2500.0, noise_ug = 0.4, from_mm = 0.0, to_mm = 50.0;
     int repeats = 5, runs = 2;
     std::vector<double> targets{0.0, 10.0, 20.0, 30.0, 40.0};
@@ -19,7 +20,12 @@ void register_simulate(CLI::App& app) {
   };
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand("simulate", "Simulate a machine and its sensors; write a recorded run (eical-run/1)");
-  cmd->add_option("--program", o->program, "circle, step or positioning")->default_val("circle")->check(CLI::IsMember({"circle", "step", "positioning"}));
+  auto* scenario = cmd->add_option("--scenario", o->scenario, "scenario file (eical-scenario/1, config/scenarios/README.md): machine errors, vibration, sensor truth, every effect")
+                       ->check(CLI::ExistingFile);
+  cmd->add_option("--program", o->program, "circle, step, positioning or rectangle")
+      ->default_val("circle")
+      ->check(CLI::IsMember({"circle", "step", "positioning", "rectangle"}))
+      ->excludes(scenario);
   cmd->add_option("--targets", o->targets, "positioning: targets on x, mm (comma separated)")->delimiter(',');
   cmd->add_option("--radius", o->radius_mm, "circle radius, mm")->default_val(10.0)->check(CLI::PositiveNumber);
   cmd->add_option("--feed", o->feed_mm_min, "feed, mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
@@ -34,11 +40,17 @@ void register_simulate(CLI::App& app) {
   cmd->add_flag("--gzip", o->gzip, "write samples.csv.gz");
   cmd->add_flag("--overwrite", o->overwrite, "replace an existing run");
   cmd->callback([o] {
-    sim::Scenario sc = o->program == "circle" ? sim::circle_scenario(o->radius_mm, o->feed_mm_min, o->repeats, o->direction, o->seed)
-                       : o->program == "step" ? sim::step_scenario(o->from_mm, o->to_mm, o->feed_mm_min, o->runs, o->seed)
-                                              : sim::positioning_scenario(o->targets, o->runs, o->feed_mm_min, o->seed);
-    for (auto& t : sc.truth) t.spec.noise_ug_per_rthz = o->noise_ug;
-    for (auto& s : sc.meta.sensors) s.noise_ug_per_rthz = o->noise_ug;
+    sim::Scenario sc;
+    if (!o->scenario.empty()) {
+      sc = drivers::read_scenario_file(o->scenario);
+    } else {
+      sc = o->program == "circle"        ? sim::circle_scenario(o->radius_mm, o->feed_mm_min, o->repeats, o->direction, o->seed)
+           : o->program == "step"        ? sim::step_scenario(o->from_mm, o->to_mm, o->feed_mm_min, o->runs, o->seed)
+           : o->program == "rectangle"   ? sim::rectangle_scenario(50.0, o->feed_mm_min, o->repeats, o->seed)
+                                         : sim::positioning_scenario(o->targets, o->runs, o->feed_mm_min, o->seed);
+      for (auto& t : sc.truth) t.spec.noise_ug_per_rthz = o->noise_ug;
+      for (auto& s : sc.meta.sensors) s.noise_ug_per_rthz = o->noise_ug;
+    }
     const dsp::Run run = sim::simulate(sc);
     drivers::write_run(run, o->out, {.gzip = o->gzip, .overwrite = o->overwrite});
     std::printf("wrote %s: %zu samples, %.2f s, program %s\n", o->out.c_str(), run.frames.size(),

@@ -2,6 +2,7 @@
 
 #include "dsp/core/error.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -192,6 +193,15 @@ std::vector<StrictTable> StrictTable::tables(std::string_view key) {
   if (!arr || !arr->is_array_of_tables()) fail(key, "expected an array of tables ([[" + std::string(key) + "]])");
   for (const toml::node& e : *arr)
     out.emplace_back(*e.as_table(), file_, join(section_, key) + "[" + std::to_string(out.size()) + "]");
+  return out;
+}
+
+std::vector<std::string> StrictTable::keys() const {
+  std::vector<std::pair<std::uint32_t, std::string>> found;
+  for (const auto& [k, v] : *table_) found.emplace_back(v.source().begin.line, std::string(k.str()));
+  std::stable_sort(found.begin(), found.end());
+  std::vector<std::string> out;
+  for (auto& [line, k] : found) out.push_back(std::move(k));
   return out;
 }
 

@@ -41,6 +41,28 @@ Eigen::Vector3d PathElement::curvature(double s) const {
   return k;
 }
 
+void PathElement::state(double s, double v, double a, Eigen::Vector3d& pos, Eigen::Vector3d& vel, Eigen::Vector3d& acc) const {
+  if (!is_arc) {
+    const Eigen::Vector3d t = length_mm > 0 ? Eigen::Vector3d((to_mm - from_mm) / length_mm) : Eigen::Vector3d::Zero();
+    pos = from_mm + t * s;
+    vel = t * v;
+    acc = t * a;
+    return;
+  }
+  const double u = length_mm > 0 ? s / length_mm : 0.0;
+  const double th = start_rad + sweep_rad * u, dth = length_mm > 0 ? sweep_rad / length_mm : 0.0;
+  const double c = std::cos(th), sn = std::sin(th);
+  const double dn = length_mm > 0 ? (to_mm[axis_n] - from_mm[axis_n]) / length_mm : 0.0;
+  pos[axis_a] = center_mm[axis_a] + radius_mm * c;
+  pos[axis_b] = center_mm[axis_b] + radius_mm * sn;
+  pos[axis_n] = from_mm[axis_n] + (to_mm[axis_n] - from_mm[axis_n]) * u;
+  // dp/ds and d²p/ds² as in tangent() and curvature().
+  const double ta = -radius_mm * sn * dth, tb = radius_mm * c * dth;
+  const double ka = -radius_mm * c * dth * dth, kb = -radius_mm * sn * dth * dth;
+  vel[axis_a] = ta * v, vel[axis_b] = tb * v, vel[axis_n] = dn * v;
+  acc[axis_a] = ta * a + ka * v * v, acc[axis_b] = tb * a + kb * v * v, acc[axis_n] = dn * a;
+}
+
 Trajectory::Trajectory(std::vector<Move> moves, std::vector<TimedTrigger> triggers, Eigen::Vector3d start_mm, double duration_s)
     : moves_(std::move(moves)), triggers_(std::move(triggers)), start_mm_(start_mm), duration_(duration_s) {}
 
@@ -58,10 +80,7 @@ MotionState Trajectory::at(double t) const {
       std::upper_bound(m.s_start_mm.begin(), m.s_start_mm.end(), ps.s) - m.s_start_mm.begin() - 1);
   const PathElement& e = m.elements[std::min(k, m.elements.size() - 1)];
   const double s = ps.s - m.s_start_mm[std::min(k, m.elements.size() - 1)];
-  st.pos_mm = e.position(s);
-  const Eigen::Vector3d tan = e.tangent(s);
-  st.vel_mm_s = tan * ps.v;
-  st.acc_mm_s2 = tan * ps.a + e.curvature(s) * ps.v * ps.v;
+  e.state(s, ps.v, ps.a, st.pos_mm, st.vel_mm_s, st.acc_mm_s2);
   return st;
 }
 

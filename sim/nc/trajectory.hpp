@@ -36,6 +36,9 @@ struct PathElement {
   [[nodiscard]] Eigen::Vector3d position(double s) const;
   [[nodiscard]] Eigen::Vector3d tangent(double s) const;    // dp/ds, unit
   [[nodiscard]] Eigen::Vector3d curvature(double s) const;  // d²p/ds²
+  // Position, velocity and acceleration at path position s for path speed v and path
+  // acceleration a — one sine and cosine for all three.
+  void state(double s, double v, double a, Eigen::Vector3d& pos, Eigen::Vector3d& vel, Eigen::Vector3d& acc) const;
 };
 
 // A blended move: elements driven by one feed profile (G64 tangent-continuous chain, or

@@ -18,7 +18,6 @@ double decode_g(const dsp::Run& run, std::size_t n, int channel) {
 TEST(Simulate, AtRestSensorsReadBiasPlusGravityWithTheRightNoise) {
   Scenario sc = circle_scenario(10.0, 2500.0, 1);
   const dsp::Run run = simulate(sc);
-  const auto& s = sc.truth[0].spec;
   // 0.0–0.45 s: at rest (the move starts at 0.5 s; the DAQ delay is 3.9 ms).
   const std::size_t n_rest = 4500;
   for (int ch : {0, 2, 5}) {
@@ -29,8 +28,13 @@ TEST(Simulate, AtRestSensorsReadBiasPlusGravityWithTheRightNoise) {
     }
     const double mean = sum / n_rest, sd = std::sqrt(sum2 / n_rest - mean * mean);
     const int ax = ch % 3;
+    const auto& s = sc.truth[ch / 3].spec;
     const double a = ax == 2 ? 1.0 : 0.0;
-    const double expected = a + s.bias_g[ax] + s.k2_g_per_g2[ax] * a * a + s.k3_g_per_g3[ax] * a * a * a;
+    // (6-16): scale and bias at the case temperature (the head's case is 0.5 °C above 20 °C).
+    const double dT = sc.truth[ch / 3].temperature.t0_c - s.temp_ref_c;
+    const double k1_ratio = 1.0 + s.tc_k1_ppm_per_c * 1e-6 * dT;
+    const double expected =
+        k1_ratio * (a + s.bias_g[ax] + s.tc_bias_ug_per_c * 1e-6 * dT + s.k2_g_per_g2[ax] * a * a + s.k3_g_per_g3[ax] * a * a * a);
     EXPECT_NEAR(mean, expected, 3e-6) << "channel " << ch;
     // Two-sided density n: per-sample std = n·√fs = 40 µg (quantisation adds 0.28 µg rms).
     EXPECT_NEAR(sd, 0.4e-6 * std::sqrt(10000.0), 0.05 * 40e-6) << "channel " << ch;
@@ -59,7 +63,7 @@ TEST(Simulate, DaqDelayShowsUpAsThatManySamples) {
   sc.meta.acquisition.adc_bits = 32;
   sc.meta.acquisition.adc_lsb_volt = 1e-9;  // near-ideal ADC
   for (auto& t : sc.truth) t.spec.f0_hz = 20000.0;  // sensor dynamics far above the signal
-  sc.daq_delay_samples_true = 38.8;
+  sc.daq.group_delay_samples = 38.8;
   const dsp::Run run = simulate(sc);
   // The table x channel reads −a_x(t − d/fs) (table moves against the relative motion).
   const nc::Trajectory tr = nc::interpolate_gcode(run.meta.program.gcode, "c", sc.limits);

@@ -1,0 +1,306 @@
+#include "drivers/config/scenario_file.hpp"
+
+#include "drivers/config/meta_sections.hpp"
+#include "drivers/config/strict_toml.hpp"
+#include "dsp/core/error.hpp"
+#include "dsp/core/frame.hpp"
+#include "sim/effects.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+namespace eical::drivers {
+namespace {
+
+int axis_of(StrictTable& t, std::string_view key) {
+  const std::string a = t.choice(key, {"x", "y", "z"}, "");
+  if (a.empty()) t.fail(key, "required: \"x\", \"y\" or \"z\"");
+  return a[0] - 'x';
+}
+
+Eigen::Vector3d vec3(StrictTable& t, std::string_view key, const Eigen::Vector3d& fallback) {
+  if (!t.has(key)) return fallback;  // absent keys need no marking: finish() checks present ones
+  const auto v = t.numbers(key, 3);
+  return {v[0], v[1], v[2]};
+}
+
+Eigen::Matrix3d mat3(StrictTable& t, std::string_view key) {
+  if (!t.has(key)) return Eigen::Matrix3d::Zero();
+  const auto m = t.matrix(key, 3, 3);
+  Eigen::Matrix3d r;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) r(i, j) = m[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)];
+  return r;
+}
+
+double positive(StrictTable& t, std::string_view key, double fallback) {
+  const double v = t.number(key, fallback);
+  if (!(v > 0.0)) t.fail(key, "must be positive");
+  return v;
+}
+
+// The sensors an effect applies to.
+std::vector<int> sensors_of(StrictTable& t) {
+  const std::string s = t.choice("sensor", {"table", "head", "both"}, "both");
+  if (s == "table") return {0};
+  if (s == "head") return {1};
+  return {0, 1};
+}
+
+void read_sensor_effect(const std::string& name, StrictTable& t, sim::Scenario& sc) {
+  for (int s : sensors_of(t)) {
+    sim::SensorTruth& st = sc.truth[s];
+    const dsp::SensorSpec& nominal = sc.meta.sensors[s];
+    if (name == "sensor.scale") {
+      if (t.has("scale_ppm")) {
+        const Eigen::Vector3d ppm = vec3(t, "scale_ppm", Eigen::Vector3d::Zero());
+        st.spec.k1_v_per_g = nominal.k1_v_per_g.cwiseProduct(Eigen::Vector3d::Ones() + ppm * 1e-6);
+        if (t.has("k1_v_per_g")) t.fail("k1_v_per_g", "give either scale_ppm or k1_v_per_g, not both");
+      } else {
+        st.spec.k1_v_per_g = vec3(t, "k1_v_per_g", nominal.k1_v_per_g);
+      }
+    } else if (name == "sensor.bias_drift") {
+      st.bias_rw_ug_per_rts = t.number("rw_ug_per_rts", 0.0);
+      st.bias_step_ug = t.number("step_ug", 0.0);
+      st.bias_drift_ug_per_s = t.number("drift_ug_per_s", 0.0);
+    } else if (name == "sensor.nonlinearity") {
+      st.spec.k2_g_per_g2 = vec3(t, "k2_g_per_g2", nominal.k2_g_per_g2);
+      st.spec.k3_g_per_g3 = vec3(t, "k3_g_per_g3", nominal.k3_g_per_g3);
+    } else if (name == "sensor.cross_coupling") {
+      st.k_cross_g_per_g = mat3(t, "k_cross_g_per_g");
+      st.k_cross2_g_per_g2 = mat3(t, "k_cross2_g_per_g2");
+    } else if (name == "sensor.misalignment") {
+      const Eigen::Vector3d r = vec3(t, "misalignment_mrad", Eigen::Vector3d::Zero()) * 1e-3;
+      // Rotation about the sensor axes, applied after the nominal mounting.
+      const Eigen::Matrix3d rot = (Eigen::AngleAxisd(r[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r[1], Eigen::Vector3d::UnitY()) *
+                                   Eigen::AngleAxisd(r[0], Eigen::Vector3d::UnitX()))
+                                      .toRotationMatrix();
+      st.spec.to_machine = nominal.to_machine * rot;
+    } else if (name == "sensor.dynamics") {
+      st.spec.f0_hz = positive(t, "f0_hz", nominal.f0_hz);
+      st.spec.zeta = positive(t, "zeta", nominal.zeta);
+    } else if (name == "sensor.damping_amplitude") {
+      st.spec.zeta = positive(t, "zeta0", st.spec.zeta);
+      st.zeta_per_g = t.number("zeta_per_g");
+    } else if (name == "sensor.scale_temperature") {
+      st.temperature.t0_c = t.number("t0_c", st.temperature.t0_c);
+      st.temperature.rise_c = t.number("rise_c");
+      st.temperature.tau_s = positive(t, "tau_s", st.temperature.tau_s);
+      st.spec.tc_k1_ppm_per_c = t.number("tc_k1_ppm_per_c", st.spec.tc_k1_ppm_per_c);
+      st.spec.tc_bias_ug_per_c = t.number("tc_bias_ug_per_c", st.spec.tc_bias_ug_per_c);
+    }
+  }
+}
+
+sim::DriveMode read_mode(StrictTable t, const std::string& gain_key = "gain") {
+  sim::DriveMode m;
+  m.freq_hz = positive(t, "freq_hz", m.freq_hz);
+  m.zeta = positive(t, "zeta", m.zeta);
+  m.gain = vec3(t, gain_key, Eigen::Vector3d::Zero());
+  t.finish();
+  return m;
+}
+
+void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario& sc) {
+  sim::MachineErrors& m = sc.machine;
+  if (name == "machine.common_vibration") {
+    sim::CommonVibration& v = sc.common_vibration;
+    v.broadband_rms_mg = vec3(t, "broadband_rms_mg", Eigen::Vector3d::Zero());
+    if (t.has("band_hz")) {
+      const auto b = t.numbers("band_hz", 2);
+      if (!(b[0] > 0.0 && b[1] > b[0])) t.fail("band_hz", "must be [low, high] with 0 < low < high");
+      v.band_hz[0] = b[0], v.band_hz[1] = b[1];
+    }
+    for (StrictTable tone : t.tables("tones")) {
+      sim::Tone x;
+      x.freq_hz = positive(tone, "freq_hz", x.freq_hz);
+      x.amp_mg = vec3(tone, "amp_mg", Eigen::Vector3d::Zero());
+      x.phase_deg = tone.number("phase_deg", 0.0);
+      tone.finish();
+      v.tones.push_back(x);
+    }
+    if (auto mode = t.optional_table("mode")) v.mode = read_mode(*mode);
+    if (!v.on()) t.fail("broadband_rms_mg", "common vibration needs tones, broadband_rms_mg or a mode with gain");
+  } else if (name == "machine.differential_vibration") {
+    sc.differential_vibration.freq_hz = positive(t, "freq_hz", 9.0);
+    sc.differential_vibration.zeta = positive(t, "zeta", 0.03);
+    sc.differential_vibration.gain = vec3(t, "gain", Eigen::Vector3d::Zero());
+  } else if (name == "machine.backlash") {
+    m.backlash_um[axis_of(t, "axis")] = t.number("value_um");
+  } else if (name == "machine.reversal_spike") {
+    const int a = axis_of(t, "axis");
+    m.spike[a].amp_um = t.number("amp_um");
+    m.spike[a].tau_ms = positive(t, "tau_ms", m.spike[a].tau_ms);
+  } else if (name == "machine.servo_mismatch") {
+    // Needs a position loop on every axis: without [servo.*] the axes get Kv 30/s and
+    // 90 % velocity feed-forward, then the named axis its own Kv.
+    for (auto& s : m.servo)
+      if (!(s.kv_per_s > 0.0)) s.kv_per_s = 30.0, s.feedforward = 0.9;
+    const int a = axis_of(t, "axis");
+    m.servo[a].kv_per_s = positive(t, "kv_per_s", m.servo[a].kv_per_s);
+    m.servo[a].feedforward = t.number("feedforward", m.servo[a].feedforward);
+  } else if (name == "machine.squareness") {
+    const std::string plane = t.choice("plane", {"xy", "yz", "zx"}, "xy");
+    m.squareness_urad[plane == "xy" ? 0 : (plane == "yz" ? 1 : 2)] = t.number("value_urad");
+  } else if (name == "machine.scale_mismatch") {
+    m.scale_ppm[axis_of(t, "axis")] = t.number("value_ppm");
+  } else if (name == "machine.cyclic_error") {
+    const int a = axis_of(t, "axis");
+    m.cyclic[a].amp_um = t.number("amp_um");
+    m.cyclic[a].pitch_mm = positive(t, "pitch_mm", m.cyclic[a].pitch_mm);
+    m.cyclic[a].phase_deg = t.number("phase_deg", 0.0);
+  } else if (name == "machine.straightness") {
+    const int a = axis_of(t, "axis");
+    const int d = axis_of(t, "direction");
+    if (d == a) t.fail("direction", "must differ from the axis");
+    m.straightness[a].direction = d;
+    m.straightness[a].bow_um = t.number("bow_um");
+    if (t.has("span_mm")) {
+      const auto s = t.numbers("span_mm", 2);
+      if (!(s[1] > s[0])) t.fail("span_mm", "must be [from, to] with from < to");
+      m.straightness[a].span_mm[0] = s[0], m.straightness[a].span_mm[1] = s[1];
+    }
+  } else if (name == "machine.stick_slip") {
+    const int a = axis_of(t, "axis");
+    m.stick_slip[a].amp_um = t.number("amp_um");
+    m.stick_slip[a].below_mm_min = positive(t, "below_mm_min", m.stick_slip[a].below_mm_min);
+    m.stick_slip[a].slip_ms = positive(t, "slip_ms", m.stick_slip[a].slip_ms);
+  }
+}
+
+void read_effect(const std::string& name, StrictTable t, sim::Scenario& sc) {
+  if (name.rfind("sensor.", 0) == 0) {
+    read_sensor_effect(name, t, sc);
+  } else if (name == "daq.group_delay") {
+    sc.daq.group_delay_samples = t.number("group_delay_samples", sc.meta.acquisition.daq_group_delay_samples);
+    sc.daq.skew_head_samples = t.number("skew_head_samples", 0.0);
+    if (sc.daq.group_delay_samples < 0.0) t.fail("group_delay_samples", "must not be negative");
+  } else if (name == "site.coriolis") {
+    sc.coriolis = t.boolean("on", true);
+  } else {
+    read_machine_effect(name, t, sc);
+  }
+  t.finish();
+}
+
+std::string read_text(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  if (!in) throw dsp::InputError(p.string() + ": cannot read the G-code file");
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+}  // namespace
+
+sim::Scenario read_scenario_file(const std::string& path) {
+  const toml::table doc = StrictTable::parse_file(path);
+  StrictTable root(doc, path, "");
+  if (root.string("format") != "eical-scenario/1") root.fail("format", "expected \"eical-scenario/1\"");
+  sim::Scenario sc;
+  sc.name = root.string("name", "scenario");
+  sc.description = root.string("description", "");
+  sc.seed = static_cast<std::uint64_t>(root.integer("seed", 1));
+  sc.oversample = static_cast<int>(root.integer("oversample", 10));
+  if (sc.oversample < 1 || sc.oversample > 100) root.fail("oversample", "must be 1..100");
+  sc.noise = root.boolean("noise", true);
+  sc.meta.id = root.string("id", "sim-" + sc.name + "-s" + std::to_string(sc.seed));
+  if (auto t = root.optional_table("acquisition")) sc.meta.acquisition = read_acquisition(*t);
+  if (auto t = root.optional_table("site")) sc.meta.site = read_site(*t);
+  if (auto t = root.optional_table("machine")) sc.meta.machine = read_machine(*t);
+  if (auto sensors = root.optional_table("sensors")) {
+    if (auto t = sensors->optional_table("table")) sc.meta.sensors[0] = read_sensor(*t);
+    if (auto t = sensors->optional_table("head")) sc.meta.sensors[1] = read_sensor(*t);
+    sensors->finish();
+  }
+  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s];
+  sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples;
+
+  StrictTable program = root.table("program");
+  const std::string gcode_file = program.string("gcode_file", "");
+  sc.meta.program = read_program(program);  // the copy knows gcode_file is used
+  if (!gcode_file.empty()) {
+    const std::filesystem::path p = std::filesystem::path(path).parent_path() / gcode_file;
+    sc.meta.program.gcode = read_text(p);
+  }
+
+  for (StrictTable p : root.tables("psd")) {
+    sim::PsdTruth pt;
+    pt.spot_mm = positive(p, "spot_mm", pt.spot_mm);
+    pt.full_scale_v = positive(p, "full_scale_v", pt.full_scale_v);
+    pt.nonlinearity = p.number("nonlinearity", pt.nonlinearity);
+    pt.noise_v_per_rthz = p.number("noise_v_per_rthz", pt.noise_v_per_rthz);
+    sc.meta.psd.push_back(read_psd(p));
+    sc.psd.push_back(pt);
+  }
+  if (sc.meta.psd.size() > static_cast<std::size_t>(dsp::kMaxPsd)) root.fail("psd", "at most " + std::to_string(dsp::kMaxPsd) + " strips");
+
+  sc.meta.reference.reset();
+  if (auto r = root.optional_table("reference")) {
+    sc.meta.reference = dsp::Reference{r->string("kind", "KGM182"), r->strings("axes")};
+    if (r->has("scale_ppm")) {
+      const auto v = r->numbers("scale_ppm", 3);
+      std::copy(v.begin(), v.end(), sc.reference.scale_ppm);
+    }
+    if (r->has("interp_nm")) {
+      const auto m = r->matrix("interp_nm", 3, 2);
+      for (int a = 0; a < 3; ++a)
+        for (int h = 0; h < 2; ++h) sc.reference.interp_nm[a][h] = m[static_cast<std::size_t>(a)][static_cast<std::size_t>(h)];
+    }
+    if (r->has("interp_phase_deg")) {
+      const auto m = r->matrix("interp_phase_deg", 3, 2);
+      for (int a = 0; a < 3; ++a)
+        for (int h = 0; h < 2; ++h) sc.reference.interp_phase_deg[a][h] = m[static_cast<std::size_t>(a)][static_cast<std::size_t>(h)];
+    }
+    sc.reference.signal_period_um = positive(*r, "signal_period_um", sc.reference.signal_period_um);
+    sc.reference.resolution_nm = r->number("resolution_nm", sc.reference.resolution_nm);
+    r->finish();
+  }
+
+  if (auto l = root.optional_table("limits")) {
+    sc.limits.a_max_mm_s2 = positive(*l, "a_max_mps2", sc.limits.a_max_mm_s2 / 1000.0) * 1000.0;
+    sc.limits.j_max_mm_s3 = positive(*l, "jerk_mps3", sc.limits.j_max_mm_s3 / 1000.0) * 1000.0;
+    sc.limits.rapid_mm_min = positive(*l, "rapid_mm_min", sc.limits.rapid_mm_min);
+    l->finish();
+  }
+  if (auto servo = root.optional_table("servo")) {
+    for (int a = 0; a < 3; ++a) {
+      const char name[2] = {static_cast<char>('x' + a), 0};
+      if (auto t = servo->optional_table(name)) {
+        sc.machine.servo[a].kv_per_s = positive(*t, "kv_per_s", 30.0);
+        sc.machine.servo[a].feedforward = t->number("feedforward", 0.0);
+        sc.machine.servo[a].velocity_tau_s = t->number("velocity_tau_ms", 0.0) * 1e-3;
+        t->finish();
+      }
+    }
+    servo->finish();
+  }
+
+  if (auto effects = root.optional_table("effects")) {
+    const auto& known = sim::effect_names();
+    for (const std::string& name : effects->keys()) {
+      if (std::find(known.begin(), known.end(), name) == known.end()) {
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        effects->fail(name, "unknown effect (known: " + list + ")");
+      }
+      read_effect(name, effects->table(name), sc);
+      sc.effects_present.push_back(name);
+    }
+    effects->finish();
+  }
+  // Effects listed under `background` are in the data at tolerance level, not injected.
+  if (root.has("background")) sc.effects_background = root.strings("background");
+  std::erase_if(sc.effects_present, [&](const std::string& e) {
+    return std::find(sc.effects_background.begin(), sc.effects_background.end(), e) != sc.effects_background.end();
+  });
+  root.finish();
+  return sc;
+}
+
+}  // namespace eical::drivers

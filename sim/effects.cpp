@@ -1,0 +1,83 @@
+#include "sim/effects.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace eical::sim {
+namespace {
+
+bool differs(double a, double b) { return std::abs(a - b) > 1e-12 * std::max(1.0, std::abs(b)); }
+bool differs(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return (a - b).norm() > 1e-12; }
+
+}  // namespace
+
+const std::vector<std::string>& effect_names() {
+  static const std::vector<std::string> names = {
+      "sensor.scale", "sensor.bias_drift", "sensor.nonlinearity", "sensor.cross_coupling", "sensor.misalignment",
+      "sensor.dynamics", "sensor.damping_amplitude", "sensor.scale_temperature", "daq.group_delay", "site.coriolis",
+      "machine.common_vibration", "machine.differential_vibration", "machine.backlash", "machine.reversal_spike",
+      "machine.servo_mismatch", "machine.squareness", "machine.scale_mismatch", "machine.cyclic_error",
+      "machine.straightness", "machine.stick_slip"};
+  return names;
+}
+
+std::vector<std::string> effects_in(const Scenario& sc) {
+  std::vector<std::string> on;
+  auto add = [&](const char* e, bool cond) {
+    if (cond && std::find(on.begin(), on.end(), e) == on.end()) on.emplace_back(e);
+  };
+  for (int s = 0; s < 2; ++s) {
+    const SensorTruth& t = sc.truth[s];
+    const dsp::SensorSpec& n = sc.meta.sensors[s];
+    add("sensor.scale", differs(t.spec.k1_v_per_g, n.k1_v_per_g));
+    add("sensor.bias_drift", t.bias_rw_ug_per_rts != 0.0 || t.bias_step_ug != 0.0 || t.bias_drift_ug_per_s != 0.0);
+    add("sensor.nonlinearity", differs(t.spec.k2_g_per_g2, n.k2_g_per_g2) || differs(t.spec.k3_g_per_g3, n.k3_g_per_g3));
+    add("sensor.cross_coupling", t.k_cross_g_per_g.squaredNorm() > 0.0 || t.k_cross2_g_per_g2.squaredNorm() > 0.0);
+    add("sensor.misalignment", (t.spec.to_machine - n.to_machine).norm() > 1e-12);
+    add("sensor.dynamics", differs(t.spec.f0_hz, n.f0_hz) || differs(t.spec.zeta, n.zeta));
+    add("sensor.damping_amplitude", t.zeta_per_g != 0.0);
+    add("sensor.scale_temperature", t.temperature.rise_c != 0.0 &&
+                                        (t.spec.tc_k1_ppm_per_c != 0.0 || t.spec.tc_bias_ug_per_c != 0.0));
+  }
+  add("daq.group_delay", differs(sc.daq.group_delay_samples, sc.meta.acquisition.daq_group_delay_samples) ||
+                             sc.daq.skew_head_samples != 0.0);
+  add("site.coriolis", sc.coriolis);
+  add("machine.common_vibration", sc.common_vibration.on());
+  add("machine.differential_vibration", sc.differential_vibration.gain.squaredNorm() > 0.0);
+  const MachineErrors& m = sc.machine;
+  for (int i = 0; i < 3; ++i) {
+    add("machine.backlash", m.backlash_um[i] != 0.0);
+    add("machine.reversal_spike", m.spike[i].amp_um != 0.0);
+    add("machine.squareness", m.squareness_urad[i] != 0.0);
+    add("machine.scale_mismatch", m.scale_ppm[i] != 0.0);
+    add("machine.cyclic_error", m.cyclic[i].amp_um != 0.0);
+    add("machine.straightness", m.straightness[i].direction >= 0 && m.straightness[i].bow_um != 0.0);
+    add("machine.stick_slip", m.stick_slip[i].amp_um != 0.0);
+  }
+  // Servo mismatch: the lags (1 − ff)/Kv of the axes differ.
+  double lag_min = INFINITY, lag_max = -INFINITY;
+  for (int i = 0; i < 3; ++i) {
+    const double lag = m.servo[i].kv_per_s > 0.0 ? (1.0 - m.servo[i].feedforward) / m.servo[i].kv_per_s : 0.0;
+    lag_min = std::min(lag_min, lag), lag_max = std::max(lag_max, lag);
+  }
+  add("machine.servo_mismatch", lag_max - lag_min > 1e-9);
+  std::vector<std::string> ordered;  // in the table's order
+  for (const auto& name : effect_names())
+    if (std::find(on.begin(), on.end(), name) != on.end()) ordered.push_back(name);
+  return ordered;
+}
+
+EffectLists effect_lists(const Scenario& sc) {
+  EffectLists l;
+  const std::vector<std::string> found = effects_in(sc);
+  if (sc.effects_present.empty() && sc.effects_background.empty()) {
+    l.present = found;
+    return l;
+  }
+  l.present = sc.effects_present;
+  for (const auto& e : found)
+    if (std::find(l.present.begin(), l.present.end(), e) == l.present.end()) l.background.push_back(e);
+  return l;
+}
+
+}  // namespace eical::sim

@@ -1,0 +1,115 @@
+#include "sim/machine/axis_motion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace eical::sim {
+namespace {
+
+// Smooth 0 → 1 over u = 0..1 with zero slope at both ends (no acceleration impulse).
+double smoothstep(double u) {
+  u = std::clamp(u, 0.0, 1.0);
+  return u * u * (3.0 - 2.0 * u);
+}
+
+}  // namespace
+
+AxisMotion::AxisMotion(const MachineErrors& e, int axis, double step_s, double start_mm)
+    : servo_(e.servo[axis]),
+      backlash_mm_(e.backlash_um[axis] * 1e-3),
+      spike_mm_(e.spike[axis].amp_um * 1e-3),
+      spike_tau_s_(e.spike[axis].tau_ms * 1e-3),
+      cyclic_(e.cyclic[axis]),
+      scale_(e.scale_ppm[axis] * 1e-6),
+      ss_(e.stick_slip[axis]),
+      h_(step_s),
+      x_mm_(start_mm),
+      vx_mm_s_(0.0),
+      prev_cmd_mm_(start_mm),
+      prev_vel_mm_s_(0.0),
+      // The play starts taken up in + (the last approach was in the positive direction).
+      slide_mm_(start_mm - backlash_mm_ / 2.0) {
+  active_ = servo_.kv_per_s > 0.0 || backlash_mm_ != 0.0 || spike_mm_ != 0.0 || cyclic_.amp_um != 0.0 || scale_ != 0.0 ||
+            ss_.amp_um != 0.0;
+  if (servo_.kv_per_s > 0.0) exp_kv_h_ = std::exp(-servo_.kv_per_s * h_);
+}
+
+double AxisMotion::servo(double cmd, double vel) noexcept {
+  if (!(servo_.kv_per_s > 0.0)) return cmd;
+  const double kv = servo_.kv_per_s, ff = servo_.feedforward;
+  if (servo_.velocity_tau_s <= 0.0) {
+    // e = cmd − x obeys e' = (1 − ff) v − Kv e: exact over the step with v at mid-step.
+    const double v_mid = 0.5 * (vel + prev_vel_mm_s_);
+    const double e = (prev_cmd_mm_ - x_mm_) * exp_kv_h_ + (1.0 - ff) * v_mid * (1.0 - exp_kv_h_) / kv;
+    x_mm_ = cmd - e;
+  } else {
+    // Second-order loop: x' = vx, vx' = (ff v + Kv (cmd − x) − vx)/T; RK4 with the set-point
+    // interpolated linearly over the step.
+    const double T = servo_.velocity_tau_s;
+    auto f = [&](double frac, double x, double vx, double& dx, double& dvx) {
+      const double c = prev_cmd_mm_ + frac * (cmd - prev_cmd_mm_);
+      const double v = prev_vel_mm_s_ + frac * (vel - prev_vel_mm_s_);
+      dx = vx;
+      dvx = (ff * v + kv * (c - x) - vx) / T;
+    };
+    double k1x, k1v, k2x, k2v, k3x, k3v, k4x, k4v;
+    f(0.0, x_mm_, vx_mm_s_, k1x, k1v);
+    f(0.5, x_mm_ + 0.5 * h_ * k1x, vx_mm_s_ + 0.5 * h_ * k1v, k2x, k2v);
+    f(0.5, x_mm_ + 0.5 * h_ * k2x, vx_mm_s_ + 0.5 * h_ * k2v, k3x, k3v);
+    f(1.0, x_mm_ + h_ * k3x, vx_mm_s_ + h_ * k3v, k4x, k4v);
+    x_mm_ += h_ / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x);
+    vx_mm_s_ += h_ / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
+  }
+  return x_mm_;
+}
+
+double AxisMotion::stick_slip(double vel) noexcept {
+  const double amp = ss_.amp_um * 1e-3;
+  const double speed = std::abs(vel);
+  const bool creeping = speed > 1e-9 && speed * 60.0 < ss_.below_mm_min;
+  if (ss_slipping_) {
+    ss_slip_t_s_ += h_;
+    ss_lag_mm_ = ss_slip_from_mm_ * (1.0 - smoothstep(ss_slip_t_s_ / (ss_.slip_ms * 1e-3)));
+    if (ss_slip_t_s_ >= ss_.slip_ms * 1e-3) ss_slipping_ = false, ss_lag_mm_ = 0.0;
+  } else if (creeping) {
+    // Static friction holds the slide while the set-point creeps on.
+    ss_dir_ = vel > 0 ? 1 : -1;
+    ss_lag_mm_ += speed * h_;
+    if (ss_lag_mm_ >= amp) ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_t_s_ = 0.0;
+  } else if (ss_lag_mm_ > 0.0) {
+    ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_t_s_ = 0.0;  // breaks free
+  }
+  return -ss_dir_ * ss_lag_mm_;
+}
+
+double AxisMotion::step(double cmd, double vel) noexcept {
+  if (!active_) return 0.0;
+  const double motor = servo(cmd, vel);
+  prev_cmd_mm_ = cmd, prev_vel_mm_s_ = vel;
+  double dev = motor - cmd;
+  if (backlash_mm_ != 0.0) {
+    // Play operator: the motor drags the slide only at the ends of the play.
+    slide_mm_ = std::clamp(slide_mm_, motor - backlash_mm_ / 2.0, motor + backlash_mm_ / 2.0);
+    dev += slide_mm_ - motor + backlash_mm_ / 2.0;  // zero while moving in + after the start
+  }
+  if (spike_mm_ != 0.0) {
+    const int d = vel > 1e-9 ? 1 : (vel < -1e-9 ? -1 : 0);
+    if (d != 0 && dir_ != 0 && d != dir_) since_reversal_s_ = 0.0;
+    if (d != 0) dir_ = d;
+    since_reversal_s_ += h_;
+    if (since_reversal_s_ < 12.0 * spike_tau_s_) {
+      // Friction holds the slide as the set-point reverses: the lag grows from zero like
+      // t² (continuous position and velocity), peaks at tau and decays.
+      const double u = since_reversal_s_ / spike_tau_s_;
+      dev -= dir_ * spike_mm_ * u * u * std::exp(2.0 * (1.0 - u));
+    }
+  }
+  if (ss_.amp_um != 0.0) dev += stick_slip(vel);
+  if (scale_ != 0.0) dev += scale_ * cmd;
+  if (cyclic_.amp_um != 0.0)
+    dev += cyclic_.amp_um * 1e-3 * std::sin(2.0 * std::numbers::pi * cmd / cyclic_.pitch_mm + cyclic_.phase_deg * std::numbers::pi / 180.0);
+  return dev;
+}
+
+}  // namespace eical::sim

@@ -1,0 +1,49 @@
+#include "sim/psd/psd_strip.hpp"
+
+#include "dsp/core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace eical::sim {
+namespace {
+
+// Fraction of a Gaussian (σ) centred at 0 that falls within [lo, hi]; exact 0/1 far away.
+double covered(double lo, double hi, double sigma) {
+  const double k = 1.0 / (sigma * std::numbers::sqrt2);
+  auto cdf = [&](double x) { return x < -8.0 * sigma ? 0.0 : (x > 8.0 * sigma ? 1.0 : 0.5 * std::erfc(-x * k)); };
+  return cdf(hi) - cdf(lo);
+}
+
+}  // namespace
+
+PsdStrip::PsdStrip(const dsp::PsdSpec& spec, const PsdTruth& truth, double h) : spec_(spec), truth_(truth) {
+  if (spec.measures == "x") along_ = 0, across_ = 1;
+  else if (spec.measures == "y") along_ = 1, across_ = 0;
+  else throw dsp::InputError("psd: measures must be \"x\" or \"y\", got \"" + spec.measures + "\"");
+  if (!(spec.length_mm > 0.0) || !(spec.width_mm > 0.0)) throw dsp::InputError("psd: length_mm and width_mm must be positive");
+  sigma_mm_ = std::max(truth.spot_mm, 1e-6) / 4.0;  // 1/e² diameter = 4σ
+  alpha_ = spec.lockin_tau_s > 0.0 ? 1.0 - std::exp(-h / spec.lockin_tau_s) : 1.0;
+}
+
+void PsdStrip::step(const Eigen::Vector3d& p, double& i1_v, double& i2_v) noexcept {
+  const double u = p[along_] - spec_.center_mm[along_];
+  const double w = p[across_] - spec_.center_mm[across_];
+  const double half_l = spec_.length_mm / 2.0, half_w = spec_.width_mm / 2.0;
+  double target1 = 0.0, target2 = 0.0;
+  // Most of the time the spot is far from the strip: the cross direction decides first.
+  const double across = covered(-half_w - w, half_w - w, sigma_mm_);
+  const double light = across > 0.0 ? across * covered(-half_l - u, half_l - u, sigma_mm_) : 0.0;
+  if (light > 0.0) {
+    const double uc = std::clamp(u, -half_l, half_l);
+    const double r = 2.0 * uc / spec_.length_mm;
+    const double um = uc * (1.0 + truth_.nonlinearity * r * r);
+    target1 = light * truth_.full_scale_v * (0.5 - um / spec_.length_mm);
+    target2 = light * truth_.full_scale_v * (0.5 + um / spec_.length_mm);
+  }
+  i1_ += alpha_ * (target1 - i1_);
+  i2_ += alpha_ * (target2 - i2_);
+  i1_v = i1_, i2_v = i2_;
+}
+
+}  // namespace eical::sim

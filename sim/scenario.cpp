@@ -1,0 +1,89 @@
+#include "sim/scenario.hpp"
+
+#include <cmath>
+
+namespace eical::sim {
+
+double CaseTemperature::at(double t_s) const {
+  return rise_c == 0.0 ? t0_c : t0_c + rise_c * (1.0 - std::exp(-t_s / tau_s));
+}
+
+bool CommonVibration::on() const {
+  return !tones.empty() || broadband_rms_mg.squaredNorm() > 0.0 || mode.gain.squaredNorm() > 0.0;
+}
+
+namespace {
+
+// The common part of the built-in scenarios: data-sheet sensors that are also the truth,
+// an ideal reference instrument on all axes.
+Scenario base_scenario(const std::string& kind, std::uint64_t seed, std::string description) {
+  Scenario sc;
+  sc.name = kind;
+  sc.seed = seed;
+  sc.description = std::move(description);
+  sc.meta.program.kind = kind;
+  sc.meta.id = "sim-" + kind + "-s" + std::to_string(seed);
+  sc.meta.reference = dsp::Reference{"ideal", {"x", "y", "z"}};
+  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s];
+  return sc;
+}
+
+// Single-axis programs on x with a 0.5 s dwell (step and positioning).
+Scenario axis_scenario(const std::string& kind, std::vector<double> targets_mm, double feed_mm_min, int runs, std::uint64_t seed,
+                       std::string description) {
+  Scenario sc = base_scenario(kind, seed, std::move(description));
+  auto& p = sc.meta.program;
+  p.axis = "x";
+  p.targets_mm = std::move(targets_mm);
+  p.feed_mm_min = feed_mm_min;
+  p.runs = runs;
+  p.dwell_s = 0.5;
+  return sc;
+}
+
+}  // namespace
+
+Scenario circle_scenario(double radius_mm, double feed_mm_min, int repeats, const std::string& direction, std::uint64_t seed) {
+  Scenario sc = base_scenario("circle", seed,
+                              "R" + std::to_string(radius_mm) + " circle F" + std::to_string(feed_mm_min) + " x" + std::to_string(repeats) +
+                                  " " + direction + ", ideal machine, data-sheet sensors");
+  auto& p = sc.meta.program;
+  p.plane = "xy";
+  p.radius_mm = radius_mm;
+  p.feed_mm_min = feed_mm_min;
+  p.repeats = repeats;
+  p.direction = direction;
+  sc.meta.id = "sim-circle-r" + std::to_string(static_cast<int>(radius_mm)) + "-f" + std::to_string(static_cast<int>(feed_mm_min)) +
+               "-s" + std::to_string(seed);
+  sc.truth[1].temperature.t0_c = 20.5;
+  return sc;
+}
+
+Scenario step_scenario(double from_mm, double to_mm, double feed_mm_min, int runs, std::uint64_t seed) {
+  return axis_scenario("step", {from_mm, to_mm}, feed_mm_min, runs, seed,
+                       "x step " + std::to_string(from_mm) + " -> " + std::to_string(to_mm) + " mm, ideal machine");
+}
+
+Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs, double feed_mm_min, std::uint64_t seed) {
+  return axis_scenario("positioning", targets_mm, feed_mm_min, runs, seed, "ISO 230-2 linear cycle on x, ideal machine");
+}
+
+Scenario rectangle_scenario(double size_mm, double feed_mm_min, int repeats, std::uint64_t seed) {
+  Scenario sc = base_scenario("rectangle", seed, "rectangle " + std::to_string(size_mm) + " mm, ideal machine");
+  auto& p = sc.meta.program;
+  p.plane = "xy";
+  p.corner_mm[0] = p.corner_mm[1] = 0.0;
+  p.size_mm[0] = p.size_mm[1] = size_mm;
+  p.feed_mm_min = feed_mm_min;
+  p.repeats = repeats;
+  p.dwell_s = 0.3;
+  return sc;
+}
+
+Scenario gcode_scenario(const std::string& gcode, const std::string& kind, std::uint64_t seed) {
+  Scenario sc = base_scenario(kind, seed, "G-code program, ideal machine");
+  sc.meta.program.gcode = gcode;
+  return sc;
+}
+
+}  // namespace eical::sim
