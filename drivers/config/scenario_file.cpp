@@ -266,6 +266,17 @@ sim::Scenario read_scenario_file(const std::string& path) {
     sc.limits.a_max_mm_s2 = positive(*l, "a_max_mps2", sc.limits.a_max_mm_s2 / 1000.0) * 1000.0;
     sc.limits.j_max_mm_s3 = positive(*l, "jerk_mps3", sc.limits.j_max_mm_s3 / 1000.0) * 1000.0;
     sc.limits.rapid_mm_min = positive(*l, "rapid_mm_min", sc.limits.rapid_mm_min);
+    auto per_axis = [&](const char* key, double (&dst)[3], double unit) {
+      if (!l->has(key)) return;
+      const auto v = l->numbers(key, 3);
+      for (int i = 0; i < 3; ++i) {
+        if (v[static_cast<std::size_t>(i)] < 0.0) l->fail(key, "limits must not be negative (0 = none)");
+        dst[i] = v[static_cast<std::size_t>(i)] * unit;
+      }
+    };
+    per_axis("axis_v_mm_min", sc.limits.axis_v_mm_min, 1.0);
+    per_axis("axis_a_mps2", sc.limits.axis_a_mm_s2, 1000.0);
+    per_axis("axis_jerk_mps3", sc.limits.axis_j_mm_s3, 1000.0);
     l->finish();
   }
   if (auto servo = root.optional_table("servo")) {

@@ -140,7 +140,17 @@ Trajectory interpolate(const gcode::Program& program, const Eigen::Vector3d& sta
       s += e.length_mm;
     }
     m.elements = chain;
-    m.profile = SCurve(s, chain_feed, lim.a_max_mm_s2, lim.j_max_mm_s3);
+    // Per-axis limits: the largest share of the path speed any axis takes in this chain.
+    double v_lim = chain_feed, a_lim = lim.a_max_mm_s2, j_lim = lim.j_max_mm_s3;
+    for (const auto& e : chain)
+      for (int i = 0; i < 3; ++i) {
+        const double share = e.is_arc && (i == e.axis_a || i == e.axis_b) ? 1.0 : std::abs(e.tangent(0.0)[i]);
+        if (share <= 1e-12) continue;
+        if (lim.axis_v_mm_min[i] > 0) v_lim = std::min(v_lim, lim.axis_v_mm_min[i] / 60.0 / share);
+        if (lim.axis_a_mm_s2[i] > 0) a_lim = std::min(a_lim, lim.axis_a_mm_s2[i] / share);
+        if (lim.axis_j_mm_s3[i] > 0) j_lim = std::min(j_lim, lim.axis_j_mm_s3[i] / share);
+      }
+    m.profile = SCurve(s, v_lim, a_lim, j_lim);
     for (const auto& [pos, code] : chain_triggers) triggers.push_back({t + m.profile.time_at(pos), code});
     t += m.profile.duration_s();
     moves.push_back(std::move(m));

@@ -70,6 +70,12 @@ struct MachineLimits {
   double a_max_mm_s2 = 2000.0;   // path acceleration (the sample runs: 2 m/s²)
   double j_max_mm_s3 = 50000.0;  // path jerk (50 m/s³)
   double rapid_mm_min = 10000.0;
+  // Per-axis limits (0 = none). A move's path limits are lowered until no axis exceeds
+  // its own: for a path direction t, v_path ≤ v_i / |t_i| (arcs: the in-plane axes see
+  // the full path value somewhere on the arc).
+  double axis_v_mm_min[3] = {0, 0, 0};
+  double axis_a_mm_s2[3] = {0, 0, 0};
+  double axis_j_mm_s3[3] = {0, 0, 0};
 };
 
 // Interpolates a parsed program. The machine rests at `start_mm` at t = 0 (the program

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 namespace eical::sim::nc {
 namespace {
@@ -83,6 +84,31 @@ TEST(Trajectory, ExactStopStepsReachTheirTargetsAndRest) {
     ++arrivals;
   }
   EXPECT_EQ(arrivals, 4);
+}
+
+TEST(Trajectory, PerAxisLimitsHoldOnADiagonalMove) {
+  // A 30° move: x takes cos 30° of the path speed. x may do 1500 mm/min, 0.5 m/s² and
+  // 10 m/s³ — below the path limits — so the whole move is slowed for x's sake.
+  MachineLimits lim;
+  lim.axis_v_mm_min[0] = 1500.0;
+  lim.axis_a_mm_s2[0] = 500.0;
+  lim.axis_j_mm_s3[0] = 10000.0;
+  const Trajectory tr = interpolate_gcode("G90 G21 G17 G61\nG0 X0 Y0\nG4 P0.1\nG1 X43.3013 Y25 F6000\nG4 P0.1\n", "diag", lim);
+  double vx = 0.0, ax = 0.0, jx = 0.0, vy = 0.0;
+  const double h = 1e-4;
+  for (double t = h; t < tr.duration_s(); t += h) {
+    const MotionState s = tr.at(t), p = tr.at(t - h);
+    vx = std::max(vx, std::abs(s.vel_mm_s.x()) * 60.0);
+    vy = std::max(vy, std::abs(s.vel_mm_s.y()) * 60.0);
+    ax = std::max(ax, std::abs(s.acc_mm_s2.x()));
+    jx = std::max(jx, std::abs(s.acc_mm_s2.x() - p.acc_mm_s2.x()) / h);
+  }
+  EXPECT_LE(vx, 1500.0 * (1 + 1e-6));
+  EXPECT_GT(vx, 1500.0 * 0.999);  // the limit is reached, not undercut
+  EXPECT_NEAR(vy, 1500.0 * std::tan(std::numbers::pi / 6), 1.0);  // y follows the path direction
+  EXPECT_LE(ax, 500.0 * (1 + 1e-6));
+  EXPECT_LE(jx, 10000.0 * 1.01);
+  EXPECT_NEAR(tr.at(tr.duration_s()).pos_mm.x(), 43.3013, 1e-9);
 }
 
 }  // namespace
