@@ -1,6 +1,7 @@
 #include "daemon/service/hmi_link.hpp"
 
 #include "daemon/system/log.hpp"
+#include "daemon/system/realtime.hpp"
 
 #include <chrono>
 #include <cstdlib>
@@ -21,7 +22,8 @@ std::int64_t now_ns() {
 
 }  // namespace
 
-HmiLink::HmiLink(const DdsConfig& config, std::string daemon_name) : config_(config), name_(std::move(daemon_name)) {
+HmiLink::HmiLink(const DdsConfig& config, std::string daemon_name, int publisher_priority)
+    : config_(config), name_(std::move(daemon_name)), publisher_priority_(publisher_priority) {
   status_.state = "STARTING";
   if (!config_.config_uri.empty()) ::setenv("CYCLONEDDS_URI", config_.config_uri.c_str(), 1);
   bus_ = std::make_unique<drivers::dds::Bus>(config_.domain_id, drivers::dds::Role::daemon);
@@ -66,6 +68,10 @@ void HmiLink::publish_result(const drivers::dds::ResultMsg& r) {
 }
 
 void HmiLink::publisher() {
+  if (publisher_priority_ > 0) {
+    const auto rt = make_this_thread_realtime(publisher_priority_, "eicald-pub");
+    log(rt.ok ? LogLevel::info : LogLevel::warning, "%s", rt.message.c_str());
+  }
   using clock = std::chrono::steady_clock;
   const auto status_period = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(1.0 / config_.status_rate_hz));
   auto next_status = clock::now();

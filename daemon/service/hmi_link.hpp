@@ -32,7 +32,10 @@ struct TriggerRequest {
 class HmiLink {
  public:
   // Throws dds::BusError when the bus cannot start (bad CYCLONEDDS_URI, no network).
-  HmiLink(const DdsConfig& config, std::string daemon_name);
+  // publisher_priority: SCHED_FIFO of the Live/Status publisher (0 = normal), below the
+  // DSP thread's so that it never delays the sample path but is not queued behind
+  // ordinary work on a loaded control PC.
+  HmiLink(const DdsConfig& config, std::string daemon_name, int publisher_priority = 0);
   ~HmiLink();
 
   // DSP thread.
@@ -62,6 +65,7 @@ class HmiLink {
   std::string state_ = "IDLE";
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> commands_{0};
+  int publisher_priority_ = 0;
   int wake_fd_ = -1;  // eventfd: DSP thread → publisher
   std::thread publisher_, commander_;
 };

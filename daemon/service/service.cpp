@@ -111,7 +111,8 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   // The HMI bus; without it the service still measures and records (and says so).
   std::unique_ptr<HmiLink> hmi;
   try {
-    hmi = std::make_unique<HmiLink>(config_.dds, "eicald@" + config_.machine.name);
+    const int rt = config_.realtime.sched_fifo_priority;
+    hmi = std::make_unique<HmiLink>(config_.dds, "eicald@" + config_.machine.name, rt > 10 ? rt - 10 : 0);
     log(LogLevel::info, "dds: publishing on domain %d", config_.dds.domain_id);
   } catch (const std::exception& e) {
     log(LogLevel::warning, "dds unavailable, running without the HMI bus: %s", e.what());
