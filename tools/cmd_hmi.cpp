@@ -1,6 +1,6 @@
 // eical hmi / eical trigger: the reference HMI on the DDS bus. `hmi` prints eicald's
-// Status and every Result it receives (a late HMI still gets the last Result per program:
-// transient-local); `trigger` sends an M-code (101 tare + start, 102 segment, 103 stop)
+// Status and every Result and Trace it receives (a late HMI still gets the last Result and
+// Trace per program: transient-local) and can save the traces as CSV; `trigger` sends an M-code (101 tare + start, 102 segment, 103 stop)
 // as an NC user M-function would, and waits for the daemon's Reply.
 #include "tools/commands.hpp"
 
@@ -9,8 +9,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <ctime>
 #include <memory>
 #include <stdexcept>
@@ -23,11 +26,33 @@ void use_uri(const std::string& uri) {
   if (!uri.empty()) ::setenv("CYCLONEDDS_URI", uri.c_str(), 1);
 }
 
+// DIR/<program id>.trace.csv with the trace's own column names; written whole, then renamed.
+void save_trace(const std::filesystem::path& dir, const drivers::dds::TraceMsg& t) {
+  std::filesystem::create_directories(dir);
+  const auto file = dir / (t.program_id + ".trace.csv");
+  const auto tmp = dir / (t.program_id + ".trace.csv.tmp");
+  {
+    std::ofstream os(tmp, std::ios::trunc);
+    if (!os) throw std::runtime_error(tmp.string() + ": cannot write");
+    os << t.x_name << ',' << t.y_name << ",series" << (t.cw.empty() ? "" : ",direction") << '\n';
+    char line[96];
+    for (std::size_t i = 0; i < t.x.size() && i < t.y.size(); ++i) {
+      std::snprintf(line, sizeof line, "%.9g,%.9g,%d", t.x[i], t.y[i], i < t.series.size() ? t.series[i] : 0);
+      os << line;
+      if (!t.cw.empty()) os << (i < t.cw.size() && t.cw[i] ? ",cw" : ",ccw");
+      os << '\n';
+    }
+    if (!os.flush()) throw std::runtime_error(tmp.string() + ": write failed");
+  }
+  std::filesystem::rename(tmp, file);
+}
+
 }  // namespace
 
 void register_hmi(CLI::App& app) {
   struct Opt {
-    int domain = 0, results = 0;
+    int domain = 0, results = 0, traces = 0;
+    std::string save_traces;
     double timeout_s = 0.0;
     std::string uri;
     int code = 0;
@@ -38,13 +63,16 @@ void register_hmi(CLI::App& app) {
   hmi->add_option("--domain", o->domain, "DDS domain id")->default_val(0);
   hmi->add_option("--dds-config", o->uri, "Cyclone DDS XML (file://...); default $CYCLONEDDS_URI");
   hmi->add_option("--results", o->results, "exit after this many results (0 = run until the timeout)")->default_val(0);
+  hmi->add_option("--traces", o->traces, "also wait for this many traces before exiting with --results")->default_val(0);
+  hmi->add_option("--save-traces", o->save_traces, "write every trace received to DIR/<program id>.trace.csv");
   hmi->add_option("--timeout", o->timeout_s, "exit after this many seconds (0 = never)")->default_val(0.0);
   hmi->callback([o] {
     use_uri(o->uri);
     drivers::dds::Bus bus(o->domain, drivers::dds::Role::hmi);
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                              std::chrono::duration<double>(o->timeout_s > 0 ? o->timeout_s : 1e9));
-    int results = 0;
+    int results = 0, traces = 0;
+    const auto done = [&] { return o->results > 0 && results >= o->results && traces >= o->traces; };
     while (std::chrono::steady_clock::now() < end) {
       if (auto s = bus.take_status(std::chrono::milliseconds(100)))
         std::printf("status %s: %s, %llu frames, %llu overruns, %llu lost, %llu results%s%s\n", s->daemon.c_str(), s->state.c_str(),
@@ -54,12 +82,22 @@ void register_hmi(CLI::App& app) {
       if (auto r = bus.take_result(std::chrono::milliseconds(10))) {
         std::printf("result %s (%s)%s: G %.2f um, mean radius deviation %.2f um\n", r->program_id.c_str(), r->program.c_str(),
                     r->degraded ? " DEGRADED" : "", r->circular_deviation_G_um, r->radius_mean_deviation_um);
-        std::fflush(stdout);
-        if (o->results > 0 && ++results >= o->results) return;
+        ++results;
+      }
+      if (auto t = bus.take_trace(std::chrono::milliseconds(10))) {
+        const auto [lo, hi] = std::minmax_element(t->y.begin(), t->y.end());
+        std::printf("trace %s (%s): %zu points, %s -> %s, %s %.3f .. %.3f (every %u. point)\n", t->program_id.c_str(), t->program.c_str(),
+                    t->x.size(), t->x_name.c_str(), t->y_name.c_str(), t->y_name.c_str(), t->y.empty() ? std::nan("") : *lo,
+                    t->y.empty() ? std::nan("") : *hi, t->decimation);
+        if (!o->save_traces.empty()) save_trace(o->save_traces, *t);
+        ++traces;
       }
       std::fflush(stdout);
+      if (done()) return;
     }
-    if (o->results > 0) throw std::runtime_error("hmi: " + std::to_string(results) + " of " + std::to_string(o->results) + " results before the timeout");
+    if (o->results > 0)
+      throw std::runtime_error("hmi: " + std::to_string(results) + " of " + std::to_string(o->results) + " results and " + std::to_string(traces) +
+                               " of " + std::to_string(o->traces) + " traces before the timeout");
   });
 
   auto* trig = app.add_subcommand("trigger", "Send an NC trigger (M101/M102/M103) to eicald over DDS");

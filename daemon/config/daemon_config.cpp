@@ -29,7 +29,35 @@ void read_source(StrictTable t, SourceConfig& s) {
     s.sim_idle_s = sim->number("idle_s", s.sim_idle_s);
     if (s.sim_idle_s < 0.0) sim->fail("idle_s", "must not be negative");
     s.sim_repeat_program = sim->boolean("repeat_program", s.sim_repeat_program);
+    s.sim_program_file = sim->string("program_file", s.sim_program_file.string());
+    if (!s.sim_program_file.empty()) {
+      // Errors inside the program file name that file and line.
+      const toml::table root = StrictTable::parse_file(s.sim_program_file.string());
+      StrictTable file(root, s.sim_program_file.string(), "");
+      auto program = file.optional_table("program");
+      if (!program) sim->fail("program_file", s.sim_program_file.string() + " has no [program] table (write it with eical gen-nc --meta)");
+      s.sim_program_loaded = drivers::read_program(*program);
+      if (s.sim_program_loaded->gcode.empty()) sim->fail("program_file", s.sim_program_file.string() + ": [program] has no gcode");
+      file.finish();
+    }
     sim->finish();
+  }
+  s.retry_s = t.number("retry_s", s.retry_s);
+  if (s.retry_s < 0.1 || s.retry_s > 3600.0) t.fail("retry_s", "must be within 0.1..3600");
+  if (auto f = t.optional_table("fault")) {
+    auto& p = s.fault;
+    p.fail_at_s = f->number("fail_at_s", p.fail_at_s);
+    p.gap_at_s = f->number("gap_at_s", p.gap_at_s);
+    const auto gap = f->integer("gap_frames", p.gap_frames);
+    if (gap < 0) f->fail("gap_frames", "must not be negative");
+    p.gap_frames = gap;
+    p.saturate_at_s = f->number("saturate_at_s", p.saturate_at_s);
+    p.saturate_s = f->number("saturate_s", p.saturate_s);
+    p.saturate_channel = static_cast<int>(f->integer("saturate_channel", p.saturate_channel));
+    if (p.saturate_channel < 0 || p.saturate_channel > 5) f->fail("saturate_channel", "must be within 0..5");
+    p.nan_at_s = f->number("nan_at_s", p.nan_at_s);
+    p.nan_s = f->number("nan_s", p.nan_s);
+    f->finish();
   }
   t.finish();
 }
@@ -63,6 +91,9 @@ void read_dds(StrictTable t, DdsConfig& d) {
   if (d.live_rate_hz < 1.0 || d.live_rate_hz > 1000.0) t.fail("live_rate_hz", "must be within 1..1000");
   d.status_rate_hz = t.number("status_rate_hz", d.status_rate_hz);
   if (d.status_rate_hz <= 0.0 || d.status_rate_hz > 50.0) t.fail("status_rate_hz", "must be within (0, 50]");
+  const auto points = t.integer("trace_max_points", static_cast<std::int64_t>(d.trace_max_points));
+  if (points < 100 || points > 1000000) t.fail("trace_max_points", "must be within 100..1000000");
+  d.trace_max_points = static_cast<std::size_t>(points);
   t.finish();
 }
 

@@ -2,10 +2,12 @@
 // eicald's configuration (config/eicald.toml documents every key). Read strictly: unknown
 // or mistyped keys are errors naming file, line and key, so a typo never silently falls
 // back to a default on a machine tool.
+#include "drivers/source/fault_source.hpp"
 #include "dsp/core/run_meta.hpp"
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,12 @@ struct SourceConfig {
   std::uint64_t sim_seed = 1;
   double sim_idle_s = 2.0;             // rest between repetitions of the program
   bool sim_repeat_program = true;      // run the program again after each idle time
+  // The [program] table written by `eical gen-nc ... --meta FILE` (kind, geometry and the
+  // G-code the simulated NC runs); replaces program/radius/feed/repeats when set.
+  std::filesystem::path sim_program_file;
+  std::optional<dsp::Program> sim_program_loaded;  // read from sim_program_file at load
+  double retry_s = 2.0;                // a source that failed mid-run is reopened after this
+  drivers::FaultPlan fault;            // [source.fault]: injected faults (tests, commissioning)
   std::string usb_id = "1d50:6161";    // usb_daq: vendor:product
 };
 
@@ -42,6 +50,7 @@ struct DdsConfig {
   std::string config_uri;  // Cyclone DDS XML; empty = CYCLONEDDS_URI / built-in default
   double live_rate_hz = 100.0;
   double status_rate_hz = 1.0;
+  std::size_t trace_max_points = 20000;  // Trace topic: longer traces are decimated
 };
 
 struct RecordingConfig {

@@ -1,10 +1,15 @@
 #include "daemon/service/hmi_link.hpp"
 
 #include "daemon/system/log.hpp"
+#include "daemon/system/realtime.hpp"
 
 #include <chrono>
 #include <cstdlib>
 #include <ctime>
+#include <poll.h>
+#include <stdexcept>
+#include <sys/eventfd.h>
+#include <unistd.h>
 
 namespace eical::daemon {
 namespace {
@@ -17,10 +22,13 @@ std::int64_t now_ns() {
 
 }  // namespace
 
-HmiLink::HmiLink(const DdsConfig& config, std::string daemon_name) : config_(config), name_(std::move(daemon_name)) {
+HmiLink::HmiLink(const DdsConfig& config, std::string daemon_name, int publisher_priority)
+    : config_(config), name_(std::move(daemon_name)), publisher_priority_(publisher_priority) {
   status_.state = "STARTING";
   if (!config_.config_uri.empty()) ::setenv("CYCLONEDDS_URI", config_.config_uri.c_str(), 1);
   bus_ = std::make_unique<drivers::dds::Bus>(config_.domain_id, drivers::dds::Role::daemon);
+  wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (wake_fd_ < 0) throw std::runtime_error("hmi: eventfd failed");
   publisher_ = std::thread([this] { publisher(); });
   commander_ = std::thread([this] { commander(); });
 }
@@ -28,8 +36,21 @@ HmiLink::HmiLink(const DdsConfig& config, std::string daemon_name) : config_(con
 HmiLink::~HmiLink() {
   stop_.store(true);
   bus_->wake();
+  const std::uint64_t one = 1;
+  (void)!::write(wake_fd_, &one, sizeof one);
   commander_.join();
   publisher_.join();
+  ::close(wake_fd_);
+}
+
+void HmiLink::push_live(const LiveSample& s) noexcept {
+  if (!live_.push_or_drop(s)) return;
+  const std::uint64_t one = 1;
+  (void)!::write(wake_fd_, &one, sizeof one);  // non-blocking; a full counter is still a wake-up
+}
+
+void HmiLink::publish_trace(const drivers::dds::TraceMsg& t) {
+  if (!bus_->publish(t)) log(LogLevel::warning, "dds: trace %s not published", t.program_id.c_str());
 }
 
 void HmiLink::set_status(const drivers::dds::StatusMsg& s) {
@@ -47,12 +68,23 @@ void HmiLink::publish_result(const drivers::dds::ResultMsg& r) {
 }
 
 void HmiLink::publisher() {
+  if (publisher_priority_ > 0) {
+    const auto rt = make_this_thread_realtime(publisher_priority_, "eicald-pub");
+    log(rt.ok ? LogLevel::info : LogLevel::warning, "%s", rt.message.c_str());
+  }
   using clock = std::chrono::steady_clock;
-  const auto status_period = std::chrono::duration<double>(1.0 / config_.status_rate_hz);
-  const auto live_period = std::chrono::duration<double>(1.0 / config_.live_rate_hz);
+  const auto status_period = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(1.0 / config_.status_rate_hz));
   auto next_status = clock::now();
   while (!stop_.load()) {
-    // Live: the newest sample of what the DSP thread handed over since the last tick.
+    // Sleep until a Live sample arrives or the next Status is due.
+    const auto wait_ms = std::chrono::ceil<std::chrono::milliseconds>(next_status - clock::now()).count();
+    pollfd p{wake_fd_, POLLIN, 0};
+    if (wait_ms > 0 && ::poll(&p, 1, static_cast<int>(wait_ms)) > 0) {
+      std::uint64_t n = 0;
+      (void)!::read(wake_fd_, &n, sizeof n);
+    }
+    if (stop_.load()) break;
+    // Live: the newest sample handed over since the last wake-up.
     LiveSample s{}, latest{};
     bool any = false;
     while (live_.try_pop(s)) latest = s, any = true;
@@ -62,6 +94,7 @@ void HmiLink::publisher() {
       m.sample_index = latest.sample_index;
       for (int i = 0; i < 3; ++i) m.pos_mm[static_cast<std::size_t>(i)] = latest.pos_mm[i], m.vel_mm_s[static_cast<std::size_t>(i)] = latest.vel_mm_s[i];
       m.integrating = latest.integrating;
+      m.acquired_ns = latest.acquired_ns;
       (void)bus_->publish(m);
     }
     if (clock::now() >= next_status) {
@@ -73,9 +106,9 @@ void HmiLink::publisher() {
       st.daemon = name_;
       st.time_ns = now_ns();
       (void)bus_->publish(st);
-      next_status += std::chrono::duration_cast<clock::duration>(status_period);
+      next_status += status_period;
+      if (next_status < clock::now()) next_status = clock::now() + status_period;  // after a stall: no burst
     }
-    std::this_thread::sleep_for(live_period);  // the Live rate; the loop does nothing else
   }
 }
 

@@ -1,6 +1,8 @@
 #include "daemon/service/service.hpp"
 
+#include "daemon/service/frame_guard.hpp"
 #include "daemon/service/hmi_link.hpp"
+#include "daemon/service/trace_builder.hpp"
 #include "daemon/system/log.hpp"
 #include "daemon/system/realtime.hpp"
 #include "drivers/acquisition/pump.hpp"
@@ -8,6 +10,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/source/replay_source.hpp"
 #include "drivers/source/sim_source.hpp"
+#include "drivers/source/stamped_source.hpp"
 #include "drivers/usb_daq/usb_daq_source.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/pipeline/pipeline.hpp"
@@ -35,12 +38,11 @@ std::string utc_now(const char* format) {
   return b;
 }
 
-}  // namespace
+bool has_input(const TriggerConfig& t, const char* input) {
+  return std::find(t.inputs.begin(), t.inputs.end(), input) != t.inputs.end();
+}
 
-Service::Service(DaemonConfig config) : config_(std::move(config)) {}
-Service::~Service() = default;
-
-std::unique_ptr<drivers::Source> Service::make_source(const DaemonConfig& c) {
+std::unique_ptr<drivers::Source> make_base_source(const DaemonConfig& c) {
   const drivers::Pacing pacing = c.source.pacing == "realtime" ? drivers::Pacing::realtime : drivers::Pacing::free_running;
   if (c.source.kind == "replay") {
     auto run = std::make_shared<const dsp::Run>(drivers::read_run(c.source.replay_run));
@@ -60,6 +62,8 @@ std::unique_ptr<drivers::Source> Service::make_source(const DaemonConfig& c) {
   sim::Scenario sc = c.source.sim_program == "circle"
                          ? sim::circle_scenario(c.source.sim_radius_mm, c.source.sim_feed_mm_min, c.source.sim_repeats, "ccw", c.source.sim_seed)
                          : sim::step_scenario(0.0, 50.0, c.source.sim_feed_mm_min, c.source.sim_repeats, c.source.sim_seed);
+  // A program file (eical gen-nc --meta): the simulated NC runs its G-code.
+  if (c.source.sim_program_loaded) sc.meta.program = *c.source.sim_program_loaded;
   // The daemon's configuration is what the service believes about its hardware.
   sc.meta.acquisition = c.acquisition;
   sc.meta.site = c.site;
@@ -71,11 +75,30 @@ std::unique_ptr<drivers::Source> Service::make_source(const DaemonConfig& c) {
       sc, drivers::SimSourceOptions{pacing, c.source.sim_repeat_program, c.source.sim_idle_s});
 }
 
+// A recording handed from the DSP thread to the evaluation thread, with what the DSP
+// thread knows about it that the frames do not say.
+struct Job {
+  std::vector<dsp::Frame> frames;
+  std::string cause;                  // empty, or why it ended without M103 (a quality flag)
+  std::uint64_t nonfinite_frames = 0; // frames whose NaN/Inf channels the guard replaced
+};
+
+}  // namespace
+
+Service::Service(DaemonConfig config) : config_(std::move(config)) {}
+Service::~Service() = default;
+
+std::unique_ptr<drivers::Source> Service::make_source(const DaemonConfig& c) {
+  auto base = make_base_source(c);
+  if (c.source.fault.any()) return std::make_unique<drivers::FaultSource>(std::move(base), c.source.fault);
+  return base;
+}
+
 void Service::run(const std::atomic<bool>& stop, const std::function<void(const ServiceStatus&)>& on_status) {
-  auto source = make_source(config_);
-  source->open();
-  const dsp::RunMeta meta = source->meta();
-  log(LogLevel::info, "source %.*s open: %.0f Hz", static_cast<int>(source->name().size()), source->name().data(), meta.acquisition.fs_hz);
+  drivers::StampedSource source(make_source(config_));
+  source.open();  // absent hardware: a clear error at start, not a retry loop
+  const dsp::RunMeta meta = source.meta();
+  log(LogLevel::info, "source %.*s open: %.0f Hz", static_cast<int>(source.name().size()), source.name().data(), meta.acquisition.fs_hz);
 
   drivers::FrameRing ring(config_.limits.ring_capacity_frames);
   dsp::SessionConfig scfg;
@@ -83,51 +106,67 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   scfg.max_measurement_s = config_.limits.max_measurement_s;
   dsp::MeasurementSession session(scfg);
   dsp::Pipeline live(dsp::pipeline_config(meta, session.recorder_capacity()));
+  FrameGuard guard(static_cast<float>(meta.sensors[0].temp_ref_c), static_cast<float>(meta.sensors[1].temp_ref_c));
 
   // The HMI bus; without it the service still measures and records (and says so).
   std::unique_ptr<HmiLink> hmi;
   try {
-    hmi = std::make_unique<HmiLink>(config_.dds, "eicald@" + config_.machine.name);
+    const int rt = config_.realtime.sched_fifo_priority;
+    hmi = std::make_unique<HmiLink>(config_.dds, "eicald@" + config_.machine.name, rt > 10 ? rt - 10 : 0);
     log(LogLevel::info, "dds: publishing on domain %d", config_.dds.domain_id);
   } catch (const std::exception& e) {
     log(LogLevel::warning, "dds unavailable, running without the HMI bus: %s", e.what());
   }
-  const bool dds_triggers = std::find(config_.triggers.inputs.begin(), config_.triggers.inputs.end(), "dds") != config_.triggers.inputs.end();
-  // DAQ clock ↔ CLOCK_MONOTONIC: the DSP thread notes (sample index, time) as frames
-  // arrive; a trigger's time maps onto the sample that was due then.
+  const bool dds_triggers = has_input(config_.triggers, "dds");
+  // Without the "frame" input the DAQ's trigger channel is ignored (the NC sends its
+  // M-codes another way; a floating trigger line must not start measurements).
+  const bool frame_triggers = has_input(config_.triggers, "frame");
+  // DAQ clock ↔ CLOCK_MONOTONIC from the acquisition stamps: a trigger's time maps onto
+  // the sample that was acquired then.
   std::int64_t clock_index = 0, clock_ns = 0;
   const double fs = meta.acquisition.fs_hz;
   const auto live_every = static_cast<std::uint64_t>(std::max(1.0, fs / config_.dds.live_rate_hz));
 
   // Evaluation thread: takes finished recordings, writes them and their result.
   std::mutex mu;
-  std::condition_variable cv;
+  std::condition_variable cv, cv_back;
   std::vector<dsp::Frame> pending, spare;
   spare.reserve(session.recorder_capacity());
+  std::string pending_cause;
+  std::uint64_t pending_nonfinite = 0;
   bool have_pending = false, spare_ready = true, quit = false;
   ServiceStatus status;
   std::mutex status_mu;
   std::thread evaluator([&] {
     for (;;) {
-      std::vector<dsp::Frame> frames;
+      Job job;
       {
         std::unique_lock lk(mu);
         cv.wait(lk, [&] { return have_pending || quit; });
         if (!have_pending) return;
-        frames.swap(pending);
+        job.frames.swap(pending);
+        job.cause.swap(pending_cause);
+        job.nonfinite_frames = pending_nonfinite;
         have_pending = false;
       }
       dsp::Run run;
       run.meta = meta;
-      run.meta.id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(frames.empty() ? 0 : frames.front().sample_index);
+      run.meta.id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
       run.meta.created = utc_now("%Y-%m-%dT%H:%M:%SZ");
       run.channels.psd_count = 0;
-      run.frames = std::move(frames);
+      run.frames = std::move(job.frames);
       const auto dir = config_.recording.dir / run.meta.id;
       std::string error;
       try {
+        // The run first: what was measured is durable before anything can fail.
         drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false});
-        const dsp::Analysis a = dsp::analyze_run(run);
+        dsp::Analysis a = dsp::analyze_run(run);
+        if (!job.cause.empty()) a.flags.push_back(job.cause), a.degraded = true;
+        if (job.nonfinite_frames > 0) {
+          a.flags.push_back("not_finite: " + std::to_string(job.nonfinite_frames) +
+                            " frames had NaN/Inf in a temperature or set-point channel (last finite value held)");
+          a.degraded = true;
+        }
         drivers::write_result(run, a, dir / "result.json");
         if (hmi) {
           drivers::dds::ResultMsg r;
@@ -137,6 +176,7 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
           if (a.circle) r.circular_deviation_G_um = a.circle->circular_deviation_G_um, r.radius_mean_deviation_um = a.circle->radius_mean_deviation_um;
           r.json = drivers::result_json(run, a).dump();
           hmi->publish_result(r);
+          if (auto t = make_trace(run, a, config_.dds.trace_max_points)) hmi->publish_trace(*t);
         }
         log(LogLevel::notice, "measurement %s written (%zu frames)%s", run.meta.id.c_str(), run.frames.size(), a.degraded ? ", result degraded" : "");
       } catch (const std::exception& e) {
@@ -146,16 +186,65 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
       {
         std::lock_guard lk(status_mu);
         if (error.empty()) ++status.results_written, status.last_result = (dir / "result.json").string();
-        else status.fault = error;
+        else status.fault = "recording: " + error;
       }
       // Hand the storage back to the DSP thread (its capacity is kept).
       run.frames.clear();
-      std::lock_guard lk(mu);
-      spare = std::move(run.frames);
-      if (spare.capacity() < session.recorder_capacity()) spare.reserve(session.recorder_capacity());
-      spare_ready = true;
+      {
+        std::lock_guard lk(mu);
+        spare = std::move(run.frames);
+        if (spare.capacity() < session.recorder_capacity()) spare.reserve(session.recorder_capacity());
+        spare_ready = true;
+      }
+      cv_back.notify_one();
     }
   });
+
+  // DSP thread → evaluation thread. Live: never waits (try_lock; the recording stays
+  // complete in the session until the next frame). At the end of the data it may wait.
+  std::uint64_t meas_nonfinite = 0;
+  auto hand_over = [&](bool may_wait, const std::string* cause) {
+    std::unique_lock lk(mu, std::defer_lock);
+    if (may_wait) {
+      lk.lock();
+      cv_back.wait(lk, [&] { return spare_ready && !have_pending; });
+    } else if (!lk.try_lock() || !spare_ready || have_pending) {
+      return;
+    }
+    if (!session.take(spare)) return;
+    pending.swap(spare);
+    if (cause) pending_cause = *cause;
+    pending_nonfinite = meas_nonfinite;
+    have_pending = true;
+    spare_ready = false;
+    lk.unlock();
+    cv.notify_one();
+    session.evaluation_done();
+    live.reset();  // ready for the next M101, storage kept
+  };
+
+  auto report = [&](const std::string& state) {
+    ServiceStatus s;
+    {
+      std::lock_guard lk(status_mu);
+      s = status;
+    }
+    s.state = state;
+    s.frames = session.counters().frames;
+    s.overruns = ring.overruns();
+    s.frames_lost = session.counters().frames_lost;
+    s.measurements = session.counters().measurements_completed;
+    s.sample_index = clock_index, s.sample_time_ns = clock_ns;
+    on_status(s);
+    if (hmi) {
+      drivers::dds::StatusMsg m;
+      m.state = s.state, m.fault = s.fault, m.frames = s.frames, m.overruns = s.overruns, m.frames_lost = s.frames_lost;
+      m.measurements = s.measurements, m.results = s.results_written;
+      m.sample_index = s.sample_index, m.sample_time_ns = s.sample_time_ns;
+      hmi->set_status(m);
+      hmi->set_state(s.state);
+    }
+  };
 
   if (config_.realtime.mlockall) {
     const auto r = lock_memory();
@@ -165,77 +254,100 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   log(rt.ok ? LogLevel::info : LogLevel::warning, "%s", rt.message.c_str());
 
   auto last_status = std::chrono::steady_clock::now();
-  std::uint64_t frames = 0;
-  const auto stats = drivers::pump(*source, ring, [&](const dsp::Frame& f) {
-    if ((frames & 63) == 0) {
-      timespec ts{};
-      clock_gettime(CLOCK_MONOTONIC, &ts);
-      clock_index = f.sample_index;
-      clock_ns = static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
-    }
+  std::uint64_t frames = 0, started_seen = 0;
+  // After a reopened source restarts its sample clock, the DAQ clock continues: indices
+  // are offset past the last one seen and the first new frame is flagged gap_before.
+  std::int64_t index_offset = 0, last_index = -1;
+  bool gap_after_reopen = false;
+  auto consume = [&](const dsp::Frame& in) {
+    const std::int64_t acquired_ns = source.acquired_ns(in.sample_index);
+    dsp::Frame f = in;
+    f.sample_index += index_offset;
+    if (gap_after_reopen) f.flags |= dsp::frame_flag::gap_before, gap_after_reopen = false;
+    last_index = f.sample_index;
+    if (!frame_triggers) f.trigger = 0;
+    const bool nonfinite = guard.apply(f);
+    if (acquired_ns != 0) clock_index = source.current_stamp().last_index + index_offset, clock_ns = acquired_ns;
     if (hmi && dds_triggers) {
       TriggerRequest t;
       while (hmi->pop_trigger(t)) {
-        const std::int64_t idx = t.time_ns > 0 ? clock_index + static_cast<std::int64_t>(static_cast<double>(t.time_ns - clock_ns) * 1e-9 * fs)
-                                               : f.sample_index;
+        const std::int64_t idx = t.time_ns > 0 && clock_ns > 0
+                                     ? clock_index + static_cast<std::int64_t>(static_cast<double>(t.time_ns - clock_ns) * 1e-9 * fs)
+                                     : f.sample_index;
         (void)session.queue_trigger(std::max(idx, f.sample_index), t.code);
       }
     }
     session.on_frame(f);
-    if (session.state().state() == dsp::State::measuring || f.trigger == 103) live.step(f);
+    if (session.counters().measurements_started != started_seen) started_seen = session.counters().measurements_started, meas_nonfinite = 0;
+    const bool measuring = session.state().state() == dsp::State::measuring;
+    if (nonfinite && measuring) ++meas_nonfinite;
+    if (measuring || f.trigger == 103) live.step(f);
     ++frames;
     if (hmi && frames % live_every == 0) {
       const auto& l = live.live();
-      LiveSample s{l.sample_index, {l.pos_mm.x(), l.pos_mm.y(), l.pos_mm.z()}, {l.vel_mm_s.x(), l.vel_mm_s.y(), l.vel_mm_s.z()}, l.integrating};
-      hmi->push_live(s);
+      hmi->push_live({f.sample_index, {l.pos_mm.x(), l.pos_mm.y(), l.pos_mm.z()}, {l.vel_mm_s.x(), l.vel_mm_s.y(), l.vel_mm_s.z()},
+                      l.integrating, acquired_ns});
     }
-    if (session.measurement_ready()) {
-      std::unique_lock lk(mu, std::try_to_lock);  // never wait on the evaluator
-      if (lk.owns_lock() && spare_ready && !have_pending && session.take(spare)) {
-        pending.swap(spare);
-        have_pending = true;
-        spare_ready = false;
-        lk.unlock();
-        cv.notify_one();
-        session.evaluation_done();
-        live.reset();  // ready for the next M101, storage kept
-      }
-    }
+    if (session.measurement_ready()) hand_over(false, nullptr);
     if ((frames & 1023) == 0) {
       const auto now = std::chrono::steady_clock::now();
       if (now - last_status >= std::chrono::seconds(1)) {
         last_status = now;
-        ServiceStatus s;
-        {
-          std::lock_guard lk(status_mu);
-          s = status;
-        }
-        s.state = std::string(dsp::to_string(session.state().state()));
-        s.frames = frames;
-        s.overruns = ring.overruns();
-        s.frames_lost = session.counters().frames_lost;
-        s.measurements = session.counters().measurements_completed;
-        on_status(s);
-        if (hmi) {
-          drivers::dds::StatusMsg m;
-          m.state = s.state, m.fault = s.fault, m.frames = s.frames, m.overruns = s.overruns, m.frames_lost = s.frames_lost;
-          m.measurements = s.measurements, m.results = s.results_written;
-          m.temp_table_c = f.temp_c[0], m.temp_head_c = f.temp_c[1];
-          hmi->set_status(m);
-          hmi->set_state(s.state);
-        }
+        report(std::string(dsp::to_string(session.state().state())));  // 1 Hz, off the per-sample path
       }
     }
-  }, stop);
+  };
+
+  drivers::PumpStats stats;
+  for (;;) {
+    stats = drivers::pump(source, ring, consume, stop);
+    // A measurement the data ended inside is kept: recorded, evaluated and flagged.
+    const std::string cause =
+        stats.stopped ? std::string("interrupted: the service was stopped during the measurement; frames up to the stop are kept")
+        : !stats.source_error.empty() ? "source_stopped: " + stats.source_error
+                                      : std::string("source_stopped: the source ended during the measurement");
+    if (session.close_now() || session.measurement_ready()) hand_over(true, &cause);
+    if (stats.stopped || stats.source_error.empty()) break;
+
+    // The source failed: FAULT with the reason (Status, journal) and reopen it every retry_s.
+    log(LogLevel::error, "source failed: %s; reopening every %.1f s", stats.source_error.c_str(), config_.source.retry_s);
+    (void)session.command(dsp::Event::fault, stats.source_error);
+    {
+      std::lock_guard lk(status_mu);
+      status.fault = "source: " + stats.source_error;
+    }
+    bool reopened = false;
+    while (!reopened && !stop.load()) {
+      report("FAULT");
+      // A retry timer, not a data poll: SIGTERM is noticed within one step.
+      const auto step = std::chrono::duration<double>(std::min(config_.source.retry_s, 1.0));
+      for (double waited = 0; waited < config_.source.retry_s && !stop.load(); waited += step.count()) std::this_thread::sleep_for(step);
+      if (stop.load()) break;
+      try {
+        source.open();
+        reopened = true;
+      } catch (const std::exception& e) {
+        std::lock_guard lk(status_mu);
+        status.fault = std::string("source: ") + e.what();
+      }
+    }
+    if (!reopened) break;
+    source.reset_lookup();
+    index_offset = last_index + 1;
+    gap_after_reopen = true;
+    live.reset();
+    (void)session.command(dsp::Event::reset);
+    log(LogLevel::notice, "source reopened; measuring resumes at the next M101");
+  }
   {
     std::lock_guard lk(mu);
     quit = true;
   }
   cv.notify_one();
   evaluator.join();
-  if (!stats.source_error.empty()) throw drivers::SourceError(stats.source_error);
-  log(LogLevel::info, "stopped: %llu frames, %llu overruns", static_cast<unsigned long long>(stats.frames_read),
-      static_cast<unsigned long long>(stats.overruns));
+  report(std::string(dsp::to_string(session.state().state())));  // the last word: results and errors included
+  log(LogLevel::info, "stopped: %llu frames, %llu overruns", static_cast<unsigned long long>(session.counters().frames),
+      static_cast<unsigned long long>(ring.overruns()));
 }
 
 }  // namespace eical::daemon

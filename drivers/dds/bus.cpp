@@ -45,7 +45,7 @@ struct Endpoint {
 
 struct Bus::Impl {
   dds_entity_t participant = 0, guard = 0;
-  Endpoint status, live, result, command, reply;
+  Endpoint status, live, result, trace, command, reply;
 
   void make(Endpoint& ep, const dds_topic_descriptor_t* desc, const char* name, const Qos& q, bool write, bool read) {
     ep.topic = checked(dds_create_topic(participant, desc, name, nullptr, nullptr), name);
@@ -87,6 +87,7 @@ Bus::Bus(int domain_id, Role role) : impl_(std::make_unique<Impl>()) {
   d.make(d.status, &eical_msg_Status_desc, "eical_Status", qos(true, false, 1), daemon, !daemon);
   d.make(d.live, &eical_msg_Live_desc, "eical_Live", qos(false, false, 8), daemon, !daemon);
   d.make(d.result, &eical_msg_Result_desc, "eical_Result", qos(true, true, 1), daemon, !daemon);
+  d.make(d.trace, &eical_msg_Trace_desc, "eical_Trace", qos(true, true, 1), daemon, !daemon);
   d.make(d.command, &eical_msg_Command_desc, "eical_Command", qos(true, false, 16), !daemon, daemon);
   d.make(d.reply, &eical_msg_Reply_desc, "eical_Reply", qos(true, false, 16), daemon, !daemon);
 }
@@ -100,6 +101,7 @@ bool Bus::publish(const StatusMsg& m) {
   s.daemon = cs(m.daemon), s.state = cs(m.state), s.fault = cs(m.fault);
   s.frames = m.frames, s.overruns = m.overruns, s.frames_lost = m.frames_lost, s.measurements = m.measurements, s.results = m.results;
   s.temp_table_c = m.temp_table_c, s.temp_head_c = m.temp_head_c, s.time_ns = m.time_ns;
+  s.sample_index = m.sample_index, s.sample_time_ns = m.sample_time_ns;
   const bool ok = impl_->status.writer > 0 && dds_write(impl_->status.writer, &s) >= 0;
   if (!ok) ++write_errors_;
   return ok;
@@ -111,6 +113,7 @@ bool Bus::publish(const LiveMsg& m) {
   s.sample_index = m.sample_index;
   for (int i = 0; i < 3; ++i) s.pos_mm[i] = m.pos_mm[static_cast<std::size_t>(i)], s.vel_mm_s[i] = m.vel_mm_s[static_cast<std::size_t>(i)];
   s.integrating = m.integrating;
+  s.acquired_ns = m.acquired_ns;
   const bool ok = impl_->live.writer > 0 && dds_write(impl_->live.writer, &s) >= 0;
   if (!ok) ++write_errors_;
   return ok;
@@ -122,6 +125,24 @@ bool Bus::publish(const ResultMsg& m) {
   s.degraded = m.degraded;
   s.circular_deviation_G_um = m.circular_deviation_G_um, s.radius_mean_deviation_um = m.radius_mean_deviation_um;
   const bool ok = impl_->result.writer > 0 && dds_write(impl_->result.writer, &s) >= 0;
+  if (!ok) ++write_errors_;
+  return ok;
+}
+
+bool Bus::publish(const TraceMsg& m) {
+  eical_msg_Trace s{};
+  s.program_id = cs(m.program_id), s.program = cs(m.program), s.x_name = cs(m.x_name), s.y_name = cs(m.y_name);
+  // The sequences borrow the vectors' storage for the write (dds_write only reads it);
+  // vector<bool> has no contiguous storage, so the directions are unpacked once.
+  std::unique_ptr<bool[]> cw(new bool[m.cw.size() + 1]);
+  for (std::size_t i = 0; i < m.cw.size(); ++i) cw[i] = m.cw[i];
+  s.x._length = s.x._maximum = static_cast<uint32_t>(m.x.size()), s.x._buffer = const_cast<double*>(m.x.data());
+  s.y._length = s.y._maximum = static_cast<uint32_t>(m.y.size()), s.y._buffer = const_cast<double*>(m.y.data());
+  s.series._length = s.series._maximum = static_cast<uint32_t>(m.series.size()),
+  s.series._buffer = const_cast<std::int32_t*>(m.series.data());
+  s.cw._length = s.cw._maximum = static_cast<uint32_t>(m.cw.size()), s.cw._buffer = cw.get();
+  s.decimation = m.decimation;
+  const bool ok = impl_->trace.writer > 0 && dds_write(impl_->trace.writer, &s) >= 0;
   if (!ok) ++write_errors_;
   return ok;
 }
@@ -149,7 +170,7 @@ std::optional<StatusMsg> Bus::take_status(std::chrono::milliseconds timeout) {
   StatusMsg out;
   const bool ok = impl_->take_one<eical_msg_Status>(impl_->status, timeout, [&](const eical_msg_Status& s) {
     out = {str(s.daemon), str(s.state), str(s.fault), s.frames, s.overruns, s.frames_lost, s.measurements, s.results,
-           s.temp_table_c, s.temp_head_c, s.time_ns};
+           s.temp_table_c, s.temp_head_c, s.time_ns, s.sample_index, s.sample_time_ns};
   });
   return ok ? std::optional(out) : std::nullopt;
 }
@@ -162,6 +183,7 @@ std::optional<LiveMsg> Bus::take_live(std::chrono::milliseconds timeout) {
     out.sample_index = s.sample_index;
     for (std::size_t i = 0; i < 3; ++i) out.pos_mm[i] = s.pos_mm[i], out.vel_mm_s[i] = s.vel_mm_s[i];
     out.integrating = s.integrating;
+    out.acquired_ns = s.acquired_ns;
   });
   return ok ? std::optional(out) : std::nullopt;
 }
@@ -171,6 +193,20 @@ std::optional<ResultMsg> Bus::take_result(std::chrono::milliseconds timeout) {
   ResultMsg out;
   const bool ok = impl_->take_one<eical_msg_Result>(impl_->result, timeout, [&](const eical_msg_Result& s) {
     out = {str(s.program_id), str(s.program), s.degraded, s.circular_deviation_G_um, s.radius_mean_deviation_um, str(s.json)};
+  });
+  return ok ? std::optional(out) : std::nullopt;
+}
+
+std::optional<TraceMsg> Bus::take_trace(std::chrono::milliseconds timeout) {
+  if (impl_->trace.reader <= 0) return std::nullopt;
+  TraceMsg out;
+  const bool ok = impl_->take_one<eical_msg_Trace>(impl_->trace, timeout, [&](const eical_msg_Trace& s) {
+    out.program_id = str(s.program_id), out.program = str(s.program), out.x_name = str(s.x_name), out.y_name = str(s.y_name);
+    out.x.assign(s.x._buffer, s.x._buffer + s.x._length);
+    out.y.assign(s.y._buffer, s.y._buffer + s.y._length);
+    out.series.assign(s.series._buffer, s.series._buffer + s.series._length);
+    out.cw.assign(s.cw._buffer, s.cw._buffer + s.cw._length);
+    out.decimation = s.decimation;
   });
   return ok ? std::optional(out) : std::nullopt;
 }

@@ -1,5 +1,5 @@
 #pragma once
-// A participant on one DDS domain with eical's five topics. Set-up errors throw
+// A participant on one DDS domain with eical's six topics. Set-up errors throw
 // BusError with Cyclone's reason; per-message calls return false and count, never throw.
 // take_* wait on a waitset (no polling sleeps); wake() interrupts a waiting take from
 // another thread (guard condition), for shutdown.
@@ -30,12 +30,14 @@ class Bus {
   bool publish(const StatusMsg& m);
   bool publish(const LiveMsg& m);
   bool publish(const ResultMsg& m);
+  bool publish(const TraceMsg& m);
   bool publish(const ReplyMsg& m);
   bool send(const CommandMsg& m);
 
   // Each waits up to `timeout` for one sample of its topic.
   std::optional<StatusMsg> take_status(std::chrono::milliseconds timeout);
   std::optional<ResultMsg> take_result(std::chrono::milliseconds timeout);
+  std::optional<TraceMsg> take_trace(std::chrono::milliseconds timeout);
   std::optional<CommandMsg> take_command(std::chrono::milliseconds timeout);
   std::optional<ReplyMsg> take_reply(std::chrono::milliseconds timeout);
   std::optional<LiveMsg> take_live(std::chrono::milliseconds timeout);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace eical::drivers::dds {
 
@@ -13,6 +14,7 @@ struct StatusMsg {
   std::uint64_t frames = 0, overruns = 0, frames_lost = 0, measurements = 0, results = 0;
   float temp_table_c = NAN, temp_head_c = NAN;
   std::int64_t time_ns = 0;
+  std::int64_t sample_index = 0, sample_time_ns = 0;  // DAQ clock ↔ CLOCK_MONOTONIC
 };
 
 struct LiveMsg {
@@ -20,6 +22,7 @@ struct LiveMsg {
   std::int64_t sample_index = 0;
   std::array<double, 3> pos_mm{}, vel_mm_s{};
   bool integrating = false;
+  std::int64_t acquired_ns = 0;  // CLOCK_MONOTONIC when the acquisition thread had the sample
 };
 
 struct ResultMsg {
@@ -27,6 +30,14 @@ struct ResultMsg {
   bool degraded = false;
   double circular_deviation_G_um = NAN, radius_mean_deviation_um = NAN;
   std::string json;
+};
+
+struct TraceMsg {
+  std::string program_id, program, x_name, y_name;
+  std::vector<double> x, y;
+  std::vector<std::int32_t> series;
+  std::vector<bool> cw;  // empty when the program has no direction per point
+  std::uint32_t decimation = 1;
 };
 
 struct CommandMsg {

@@ -85,6 +85,17 @@ void MeasurementSession::on_frame(const Frame& in) noexcept {
   }
 }
 
+bool MeasurementSession::close_now() noexcept {
+  if (state_.state() == State::measuring) {
+    if (!state_.handle(Event::program_end).accepted) return false;
+    ++counters_.measurements_completed;
+  } else if (!(state_.state() == State::evaluating && recorder_.recording())) {
+    return false;  // nothing recording (or already complete)
+  }
+  recorder_.stop_after(0);
+  return recorder_.complete();
+}
+
 Transition MeasurementSession::command(Event e, std::string_view reason) {
   const Transition t = state_.handle(e, reason);
   if (t.accepted && t.action == Action::discard) recorder_.discard();

@@ -49,6 +49,9 @@ class MeasurementSession {
   // See MeasurementRecorder::take; then evaluate and call evaluation_done().
   bool take(std::vector<Frame>& spare) noexcept { return recorder_.take(spare); }
   void evaluation_done() { (void)state_.handle(Event::evaluation_done); }
+  // The data ended inside a measurement (service stopped, source failed): the frames so
+  // far become a complete recording, as if M103 had come now. False when none was running.
+  bool close_now() noexcept;
 
   [[nodiscard]] const MeasurementState& state() const noexcept { return state_; }
   [[nodiscard]] const SessionCounters& counters() const noexcept { return counters_; }

@@ -8,7 +8,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
+#include <set>
+#include <sstream>
+#include <vector>
 #include <string>
 
 namespace {
@@ -21,12 +25,35 @@ std::string read_file(const fs::path& p) {
   return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
 }
 
+// Values of `key=` in the unit, in order (keys may repeat).
+std::vector<std::string> values_of(const std::string& unit, const std::string& key) {
+  std::vector<std::string> out;
+  std::istringstream is(unit);
+  for (std::string line; std::getline(is, line);)
+    if (line.rfind(key + "=", 0) == 0) out.push_back(line.substr(key.size() + 1));
+  return out;
+}
+
+std::set<std::string> words(const std::string& s) {
+  std::istringstream is(s);
+  return {std::istream_iterator<std::string>(is), std::istream_iterator<std::string>()};
+}
+
 TEST(SystemdUnit, DeclaresNotifyWatchdogRestartAndHardening) {
   const std::string unit = read_file(kUnit);
   ASSERT_FALSE(unit.empty());
-  for (const char* line : {"Type=notify", "WatchdogSec=", "Restart=on-failure", "ProtectSystem=strict",
-                           "NoNewPrivileges=yes", "CapabilityBoundingSet=CAP_SYS_NICE CAP_IPC_LOCK"})
-    EXPECT_NE(unit.find(line), std::string::npos) << line;
+  EXPECT_EQ(values_of(unit, "Type"), std::vector<std::string>{"notify"});
+  ASSERT_EQ(values_of(unit, "WatchdogSec").size(), 1u);
+  EXPECT_GT(std::stod(values_of(unit, "WatchdogSec")[0]), 0.0);
+  EXPECT_EQ(values_of(unit, "Restart"), std::vector<std::string>{"on-failure"});
+  EXPECT_EQ(values_of(unit, "ProtectSystem"), std::vector<std::string>{"strict"});
+  EXPECT_EQ(values_of(unit, "NoNewPrivileges"), std::vector<std::string>{"yes"});
+  // Exactly what SCHED_FIFO and mlockall need, nothing more, in both sets.
+  const std::set<std::string> rt = {"CAP_SYS_NICE", "CAP_IPC_LOCK"};
+  ASSERT_EQ(values_of(unit, "CapabilityBoundingSet").size(), 1u);
+  EXPECT_EQ(words(values_of(unit, "CapabilityBoundingSet")[0]), rt);
+  ASSERT_EQ(values_of(unit, "AmbientCapabilities").size(), 1u);
+  EXPECT_EQ(words(values_of(unit, "AmbientCapabilities")[0]), rt);
 }
 
 TEST(SystemdUnit, RecordingDefaultIsWritableUnderTheSandbox) {
