@@ -54,16 +54,22 @@ std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t purpose) noexcept {
   return z ^ (z >> 31);
 }
 
-dsp::Run simulate(const Scenario& sc) { return simulate(sc, nullptr); }
+dsp::Run simulate(const Scenario& sc) { return simulate(sc, static_cast<std::vector<Eigen::Vector3d>*>(nullptr)); }
 
 dsp::Run simulate(const Scenario& sc, std::vector<Eigen::Vector3d>* true_rel_mm) {
+  Scenario with_program = sc;
+  auto& p = with_program.meta.program;
+  if (p.gcode.empty()) p.gcode = gcode::program_gcode(p);
+  const nc::Trajectory tr = nc::interpolate_gcode(p.gcode, sc.meta.id + ".ngc", sc.limits);
+  return simulate(with_program, tr, true_rel_mm);
+}
+
+dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen::Vector3d>* true_rel_mm) {
   check(sc);
   const dsp::Acquisition& acq = sc.meta.acquisition;
   dsp::Run run;
   run.meta = sc.meta;
   run.meta.format = "eical-run/1";
-  if (run.meta.program.gcode.empty()) run.meta.program.gcode = gcode::program_gcode(run.meta.program);
-  const nc::Trajectory tr = nc::interpolate_gcode(run.meta.program.gcode, run.meta.id + ".ngc", sc.limits);
 
   const double fs = acq.fs_hz;
   const int ov = sc.oversample;
@@ -194,7 +200,7 @@ dsp::Run simulate(const Scenario& sc, std::vector<Eigen::Vector3d>* true_rel_mm)
     const DecimationFilter daq_filter(ov, sc.daq.group_delay_samples + (s == 1 ? sc.daq.skew_head_samples : 0.0));
     // Bias steps at the start of every move, alternating in sign (ch. 8.3.2).
     std::vector<std::size_t> move_starts;
-    for (const auto& m : tr.moves()) move_starts.push_back(static_cast<std::size_t>(std::llround(m.t0_s * fs)));
+    for (const auto& [from, to] : tr.move_spans_s()) move_starts.push_back(static_cast<std::size_t>(std::llround(from * fs)));
     for (int a = 0; a < 3; ++a) {
       daq_filter.apply(sensor_g[static_cast<std::size_t>(s)][static_cast<std::size_t>(a)], filtered.data(), n_frames);
       std::mt19937_64 noise_rng(stream_seed(sc.seed, sensor_noise + static_cast<std::uint64_t>(3 * s + a)));

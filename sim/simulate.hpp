@@ -25,6 +25,7 @@
 // walk, broadband vibration, PSD noise) has its own stream, so switching one effect on
 // does not change the noise of the others.
 #include "dsp/core/run.hpp"
+#include "sim/nc/set_point.hpp"
 #include "sim/scenario.hpp"
 
 #include <Eigen/Core>
@@ -38,6 +39,10 @@ dsp::Run simulate(const Scenario& scenario);
 // The same, also returning the true relative position at every frame (mm) — what an
 // ideal reference would read — for validation and tests.
 dsp::Run simulate(const Scenario& scenario, std::vector<Eigen::Vector3d>* true_rel_mm);
+
+// The same for a set-point from elsewhere (another NC's servo-rate positions); the
+// program in scenario.meta is written to run.toml as it is (its gcode is not run).
+dsp::Run simulate(const Scenario& scenario, const nc::SetPoint& set_point, std::vector<Eigen::Vector3d>* true_rel_mm = nullptr);
 
 // An independent random stream per purpose, derived from the scenario's seed.
 std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t purpose) noexcept;

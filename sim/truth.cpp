@@ -138,7 +138,7 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
 
 }  // namespace
 
-std::string truth_toml(const Scenario& sc, const nc::Trajectory& tr) {
+std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
   const EffectLists effects = effect_lists(sc);
   std::string o;
   o += "# truth.toml -- synthetic run, true parameters (eical sim 2).\n";
@@ -200,10 +200,8 @@ std::string truth_toml(const Scenario& sc, const nc::Trajectory& tr) {
        "\ng_mps2 = " + num(sc.meta.site.g_mps2) + "\ncoriolis = " + (sc.coriolis ? "true" : "false") +
        "\nomega_machine_radps = " + vec3(earth_rate_machine(sc.meta.site)) + "\n";
   o += "\n[nc]\na_max_mps2 = " + num(sc.limits.a_max_mm_s2 / 1000.0) + "\njerk_mps3 = " + num(sc.limits.j_max_mm_s3 / 1000.0) + "\nmoves_s = [";
-  for (std::size_t k = 0; k < tr.moves().size(); ++k) {
-    const auto& mv = tr.moves()[k];
-    o += (k ? ", [" : "[") + num(mv.t0_s) + ", " + num(mv.t0_s + mv.profile.duration_s()) + "]";
-  }
+  const auto spans = tr.move_spans_s();
+  for (std::size_t k = 0; k < spans.size(); ++k) o += (k ? ", [" : "[") + num(spans[k].first) + ", " + num(spans[k].second) + "]";
   o += "]\ntriggers = [";
   for (std::size_t k = 0; k < tr.triggers().size(); ++k)
     o += (k ? ", [" : "[") + num(tr.triggers()[k].t_s) + ", " + std::to_string(tr.triggers()[k].code) + "]";

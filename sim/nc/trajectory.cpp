@@ -66,6 +66,12 @@ void PathElement::state(double s, double v, double a, Eigen::Vector3d& pos, Eige
 Trajectory::Trajectory(std::vector<Move> moves, std::vector<TimedTrigger> triggers, Eigen::Vector3d start_mm, double duration_s)
     : moves_(std::move(moves)), triggers_(std::move(triggers)), start_mm_(start_mm), duration_(duration_s) {}
 
+std::vector<std::pair<double, double>> Trajectory::move_spans_s() const {
+  std::vector<std::pair<double, double>> spans;
+  for (const auto& m : moves_) spans.emplace_back(m.t0_s, m.t0_s + m.profile.duration_s());
+  return spans;
+}
+
 MotionState Trajectory::at(double t) const {
   MotionState st;
   // The last move that started at or before t.

@@ -4,6 +4,7 @@
 // sensor model can evaluate them at its internal rate and the DAQ clock at its own.
 #include "sim/gcode/program.hpp"
 #include "sim/nc/scurve.hpp"
+#include "sim/nc/set_point.hpp"
 
 #include <Eigen/Core>
 
@@ -11,17 +12,6 @@
 #include <vector>
 
 namespace eical::sim::nc {
-
-struct MotionState {
-  Eigen::Vector3d pos_mm = Eigen::Vector3d::Zero();
-  Eigen::Vector3d vel_mm_s = Eigen::Vector3d::Zero();
-  Eigen::Vector3d acc_mm_s2 = Eigen::Vector3d::Zero();
-};
-
-struct TimedTrigger {
-  double t_s;
-  int code;
-};
 
 // One geometric element of a path (line or arc), parameterised by arc length.
 struct PathElement {
@@ -50,14 +40,15 @@ struct Move {
   std::vector<double> s_start_mm;  // path position where each element begins
 };
 
-class Trajectory {
+class Trajectory final : public SetPoint {
  public:
   Trajectory(std::vector<Move> moves, std::vector<TimedTrigger> triggers, Eigen::Vector3d start_mm, double duration_s);
 
-  [[nodiscard]] MotionState at(double t_s) const;
-  [[nodiscard]] const std::vector<TimedTrigger>& triggers() const { return triggers_; }
+  [[nodiscard]] MotionState at(double t_s) const override;
+  [[nodiscard]] const std::vector<TimedTrigger>& triggers() const override { return triggers_; }
   [[nodiscard]] const std::vector<Move>& moves() const { return moves_; }
-  [[nodiscard]] double duration_s() const { return duration_; }
+  [[nodiscard]] double duration_s() const override { return duration_; }
+  [[nodiscard]] std::vector<std::pair<double, double>> move_spans_s() const override;
 
  private:
   std::vector<Move> moves_;

@@ -1,5 +1,6 @@
 #include "sim/sensor/sensing_element.hpp"
 
+#include "dsp/core/error.hpp"
 #include "sim/sensor/pt2.hpp"
 
 #include <cmath>
@@ -44,8 +45,9 @@ void pt2_constant(std::vector<double>& x, double f0_hz, double zeta, double h) {
 }  // namespace
 
 void sense(std::array<std::vector<double>, 3>& a, const SensorTruth& s, double h) {
+  if (a[1].size() != a[0].size() || a[2].size() != a[0].size() || a[0].empty())
+    throw dsp::InputError("sensor model: the three axes need the same, non-zero number of samples");
   for (auto& axis : a) {
-    if (axis.empty()) continue;
     if (s.zeta_per_g != 0.0) pt2_amplitude_damped(axis, s.spec.f0_hz, s.spec.zeta, s.zeta_per_g, h);
     else pt2_constant(axis, s.spec.f0_hz, s.spec.zeta, h);
   }

@@ -2,6 +2,7 @@
 // and against its own limits.
 #include "sim/gcode/generate.hpp"
 #include "sim/gcode/parser.hpp"
+#include "sim/nc/sampled_set_point.hpp"
 #include "sim/nc/trajectory.hpp"
 
 #include <gtest/gtest.h>
@@ -109,6 +110,28 @@ TEST(Trajectory, PerAxisLimitsHoldOnADiagonalMove) {
   EXPECT_LE(ax, 500.0 * (1 + 1e-6));
   EXPECT_LE(jx, 10000.0 * 1.01);
   EXPECT_NEAR(tr.at(tr.duration_s()).pos_mm.x(), 43.3013, 1e-9);
+}
+
+TEST(SampledSetPoint, SplineThroughServoSamplesRecoversMotion) {
+  // Another NC's 1 kHz samples of eical's own circle: the spline reproduces position,
+  // velocity and acceleration between the samples.
+  const Trajectory tr = circle_trajectory(1);
+  std::vector<Eigen::Vector3d> samples;
+  for (double t = 0.0; t <= tr.duration_s(); t += 1e-3) samples.push_back(tr.at(t).pos_mm);
+  const SampledSetPoint sp(samples, 1000.0, tr.triggers());
+  double pos = 0, vel = 0, acc = 0;
+  for (double t = 0.6; t < 2.0; t += 0.000737) {
+    const MotionState a = tr.at(t), b = sp.at(t);
+    pos = std::max(pos, (a.pos_mm - b.pos_mm).norm());
+    vel = std::max(vel, (a.vel_mm_s - b.vel_mm_s).norm());
+    acc = std::max(acc, (a.acc_mm_s2 - b.acc_mm_s2).norm());
+  }
+  EXPECT_LT(pos, 1e-6);   // mm
+  EXPECT_LT(vel, 1e-3);   // mm/s
+  EXPECT_LT(acc, 30.0);   // mm/s² (jerk 50 m/s³ over half a servo period)
+  ASSERT_EQ(sp.move_spans_s().size(), 1u);
+  EXPECT_NEAR(sp.move_spans_s()[0].first, tr.moves()[0].t0_s, 2e-3);
+  EXPECT_EQ(sp.triggers().size(), tr.triggers().size());
 }
 
 }  // namespace
