@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 
 namespace eical::sim {
@@ -53,18 +54,40 @@ void DecimationFilter::apply(const std::vector<double>& in, double* out, std::si
   if (in.empty()) throw dsp::InputError("DAQ filter: no input");
   const long m = static_cast<long>(taps_half_.size()) - 1;
   const long n_in = static_cast<long>(in.size());
-  // Padded, fractionally delayed copy: xr[k + pad] = x(k − frac) with held ends.
-  const long pad = m + shift_ + 2;
-  std::vector<double> xr(static_cast<std::size_t>(n_in + 2 * pad));
-  auto x_at = [&](long k) { return in[static_cast<std::size_t>(std::clamp(k, 0L, n_in - 1))]; };
-  for (long k = -pad; k < n_in + pad; ++k) xr[static_cast<std::size_t>(k + pad)] = (1.0 - frac_) * x_at(k) + frac_ * x_at(k - 1);
+  // The input as the filter sees it: x(k − frac) with the ends held. A whole-sample delay
+  // (the nominal 38.8 samples at 10x) is read in place; a fractional one is interpolated
+  // into a copy first.
+  std::vector<double> shifted;
+  if (frac_ != 0.0) {
+    shifted.resize(in.size());
+    shifted[0] = in[0];
+    for (std::size_t k = 1; k < in.size(); ++k) shifted[k] = (1.0 - frac_) * in[k] + frac_ * in[k - 1];
+  }
+  const std::vector<double>& x = frac_ != 0.0 ? shifted : in;
+  // Where the input is constant over all taps the output is that constant (DC gain 1): a PSD
+  // strip is dark most of the time, a sensor at rest without vibration is constant.
+  // changes[k] counts the value changes up to k.
+  std::vector<std::uint32_t> changes(x.size(), 0);
+  for (std::size_t k = 1; k < x.size(); ++k) changes[k] = changes[k - 1] + (x[k] != x[k - 1] ? 1u : 0u);
   // Symmetric taps folded: h[0]·x[c] + Σ h[j]·(x[c−j] + x[c+j]), as Eigen expressions,
   // which are explicitly vectorised (a plain loop is not, without -ffast-math).
   const Eigen::Map<const Eigen::VectorXd> h(taps_half_.data() + 1, m);
+  auto filter_at = [&](const double* centre) {
+    const Eigen::Map<const Eigen::VectorXd> before(centre - m, m), after(centre + 1, m);
+    return taps_half_[0] * centre[0] + h.dot(before.reverse() + after);
+  };
+  std::vector<double> edge(static_cast<std::size_t>(2 * m + 1));
   for (std::size_t n = 0; n < n_out; ++n) {
-    const long c = std::min(static_cast<long>(n) * ov_ - shift_, n_in + pad - m - 1) + pad;  // centre in xr
-    const Eigen::Map<const Eigen::VectorXd> before(xr.data() + c - m, m), after(xr.data() + c + 1, m);
-    out[n] = taps_half_[0] * xr[static_cast<std::size_t>(c)] + h.dot(before.reverse() + after);
+    const long c = static_cast<long>(n) * ov_ - shift_;
+    const long lo = std::clamp(c - m, 0L, n_in - 1), hi = std::clamp(c + m, 0L, n_in - 1);
+    if (changes[static_cast<std::size_t>(hi)] == changes[static_cast<std::size_t>(lo)]) {
+      out[n] = x[static_cast<std::size_t>(lo)];
+    } else if (c - m >= 0 && c + m < n_in) {
+      out[n] = filter_at(x.data() + c);
+    } else {  // near the ends: the held values in a small copy
+      for (long j = -m; j <= m; ++j) edge[static_cast<std::size_t>(j + m)] = x[static_cast<std::size_t>(std::clamp(c + j, 0L, n_in - 1))];
+      out[n] = filter_at(edge.data() + m);
+    }
   }
 }
 
