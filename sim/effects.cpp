@@ -43,7 +43,7 @@ std::vector<std::string> effects_in(const Scenario& sc) {
                              sc.daq.skew_head_samples != 0.0);
   add("site.coriolis", sc.coriolis);
   add("machine.common_vibration", sc.common_vibration.on());
-  add("machine.differential_vibration", sc.differential_vibration.gain.squaredNorm() > 0.0);
+  add("machine.differential_vibration", sc.differential_vibration.gain.squaredNorm() > 0.0 || !sc.differential_tones.empty());
   const MachineErrors& m = sc.machine;
   for (int i = 0; i < 3; ++i) {
     add("machine.backlash", m.backlash_um[i] != 0.0);

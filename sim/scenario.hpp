@@ -137,7 +137,9 @@ struct Scenario {
   DaqTruth daq;
   MachineErrors machine;
   CommonVibration common_vibration;
-  DriveMode differential_vibration;  // head against table: real relative motion
+  DriveMode differential_vibration;  // head against table: real relative motion (a mode)
+  std::vector<Tone> differential_tones;  // ... and forced tones (spindle, drive): amp_mg is the
+                                         // relative acceleration, the displacement amp/ω²
   bool coriolis = false;             // Earth rate from [site] latitude and heading
   std::vector<PsdTruth> psd;         // one per meta.psd strip (defaults when shorter)
   ReferenceTruth reference;

@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <random>
 
 namespace eical::sim {
@@ -129,7 +130,7 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
   Window w_prev{}, w_cur{}, w_next{};
   nc::MotionState ms_cur{};
   const double inv_h2_m = 1e-3 / (h * h);  // mm → m over h²
-  auto deviations = [&](const nc::MotionState& ms) {
+  auto deviations = [&](const nc::MotionState& ms, double t) {
     Window w{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     for (int i = 0; i < 3; ++i) {
       Eigen::Vector3d d = Eigen::Vector3d::Zero();
@@ -138,6 +139,10 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
       (head_mask[i] != 0.0 ? w.head : w.table) += d;
     }
     if (diff_mode.on()) w.head += diff_mode.step(ms.acc_mm_s2);
+    for (const Tone& tone : sc.differential_tones) {  // displacement whose acceleration is amp·sin(ωt + φ)
+      const double w_rad = 2.0 * std::numbers::pi * tone.freq_hz;
+      w.head -= tone.amp_mg * 1e-3 * g * 1e3 / (w_rad * w_rad) * std::sin(w_rad * t + tone.phase_deg * std::numbers::pi / 180.0);
+    }
     if (common_mode.on()) w.base = common_mode.step(ms.acc_mm_s2);
     return w;
   };
@@ -146,7 +151,7 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
     // Advance the window to sample k (k = n_int: one sample past the end, for the last
     // second difference).
     const nc::MotionState ms_next = tr.at(static_cast<double>(k) * h);
-    w_next = deviations(ms_next);
+    w_next = deviations(ms_next, static_cast<double>(k) * h);
     if (k == 0) {
       w_prev = w_cur = w_next;
       ms_cur = ms_next;

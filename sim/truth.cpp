@@ -104,6 +104,8 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
   } else if (name == "machine.differential_vibration") {
     const DriveMode& d = sc.differential_vibration;
     o += "freq_hz = " + num(d.freq_hz) + "\nzeta = " + num(d.zeta) + "\ngain = " + vec3(d.gain) + "\n";
+    for (const Tone& t : sc.differential_tones)
+      o += "\n[[effects.\"" + name + "\".tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) + "\nphase_deg = " + num(t.phase_deg) + "\n";
   } else if (name == "machine.backlash") {
     per_axis([&](int i) { return m.backlash_um[i] != 0.0; }, [&](int i) { return "value_um = " + num(m.backlash_um[i]) + "\n"; });
   } else if (name == "machine.reversal_spike") {
@@ -213,6 +215,8 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
     o += "\n[[vibration.common.tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) + "\nphase_deg = " + num(t.phase_deg) + "\n";
   const DriveMode& d = sc.differential_vibration;
   o += "\n[vibration.differential]\nfreq_hz = " + num(d.freq_hz) + "\nzeta = " + num(d.zeta) + "\ngain = " + vec3(d.gain) + "\n";
+  for (const Tone& t : sc.differential_tones)
+    o += "\n[[vibration.differential.tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) + "\nphase_deg = " + num(t.phase_deg) + "\n";
   for (std::size_t k = 0; k < sc.meta.psd.size(); ++k) {
     const auto& p = sc.meta.psd[k];
     const PsdTruth pt = k < sc.psd.size() ? sc.psd[k] : PsdTruth{};

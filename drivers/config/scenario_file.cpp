@@ -130,6 +130,16 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
     sc.differential_vibration.freq_hz = positive(t, "freq_hz", 9.0);
     sc.differential_vibration.zeta = positive(t, "zeta", 0.03);
     sc.differential_vibration.gain = vec3(t, "gain", Eigen::Vector3d::Zero());
+    for (StrictTable tone : t.tables("tones")) {
+      sim::Tone x;
+      x.freq_hz = positive(tone, "freq_hz", x.freq_hz);
+      x.amp_mg = vec3(tone, "amp_mg", Eigen::Vector3d::Zero());
+      x.phase_deg = tone.number("phase_deg", 0.0);
+      tone.finish();
+      sc.differential_tones.push_back(x);
+    }
+    if (sc.differential_vibration.gain.squaredNorm() == 0.0 && sc.differential_tones.empty())
+      t.fail("gain", "differential vibration needs a mode gain or tones");
   } else if (name == "machine.backlash") {
     m.backlash_um[axis_of(t, "axis")] = t.number("value_um");
   } else if (name == "machine.reversal_spike") {

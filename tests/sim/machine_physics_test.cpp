@@ -143,6 +143,17 @@ TEST(MachinePhysics, DifferentialModeIsRealRelativeMotionCommonModeIsNot) {
   EXPECT_LT(rel_change, 1e-6 * table_change);  // identical sensors: the same counts
 }
 
+TEST(MachinePhysics, DifferentialToneMovesTheHeadAgainstTheTable) {
+  Scenario sc = quiet(circle_scenario(10.0, 2500.0, 1));
+  sc.differential_tones.push_back({45.0, Eigen::Vector3d(10.0, 0.0, 0.0), 0.0});
+  std::vector<Eigen::Vector3d> truth;
+  const dsp::Run run = simulate(sc, &truth);
+  const auto dx = deviation_um(run, truth, 0);
+  const auto [lo, hi] = std::minmax_element(dx.begin(), dx.end());
+  const double w = 2 * std::numbers::pi * 45.0;
+  EXPECT_NEAR((*hi - *lo) / 2.0, 10e-3 * sc.meta.site.g_mps2 / (w * w) * 1e6, 0.01);  // 1.23 µm
+}
+
 TEST(MachinePhysics, SensorsSeeExactlyTheMachinesMotion) {
   // All machine errors at once; the pipeline's integrated relative acceleration must equal
   // what the reference reads (noise-free): the second differences the sensors get are
