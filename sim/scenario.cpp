@@ -68,12 +68,12 @@ Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs, d
   return axis_scenario("positioning", targets_mm, feed_mm_min, runs, seed, "ISO 230-2 linear cycle on x, ideal machine");
 }
 
-Scenario rectangle_scenario(double size_mm, double feed_mm_min, int repeats, std::uint64_t seed) {
-  Scenario sc = base_scenario("rectangle", seed, "rectangle " + std::to_string(size_mm) + " mm, ideal machine");
+Scenario rectangle_scenario(double size_a_mm, double size_b_mm, double feed_mm_min, const std::string& plane, int repeats, std::uint64_t seed) {
+  Scenario sc = base_scenario("rectangle", seed, "rectangle " + std::to_string(size_a_mm) + " x " + std::to_string(size_b_mm) + " mm, ideal machine");
   auto& p = sc.meta.program;
-  p.plane = "xy";
+  p.plane = plane;
   p.corner_mm[0] = p.corner_mm[1] = 0.0;
-  p.size_mm[0] = p.size_mm[1] = size_mm;
+  p.size_mm[0] = size_a_mm, p.size_mm[1] = size_b_mm;
   p.feed_mm_min = feed_mm_min;
   p.repeats = repeats;
   p.dwell_s = 0.3;

@@ -166,8 +166,9 @@ Scenario step_scenario(double from_mm = 0.0, double to_mm = 50.0, double feed_mm
 // ISO 230-2 linear cycle on x over `targets_mm` (ascending), `runs` bidirectional runs.
 Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs = 5, double feed_mm_min = 2000.0, std::uint64_t seed = 1);
 
-// Rectangle in XY from `corner_mm`, sides `size_mm`, `repeats` times.
-Scenario rectangle_scenario(double size_mm = 50.0, double feed_mm_min = 6500.0, int repeats = 1, std::uint64_t seed = 1);
+// Rectangle `size_a_mm` × `size_b_mm` from the origin in `plane`, exact stop at the corners.
+Scenario rectangle_scenario(double size_a_mm = 50.0, double size_b_mm = 50.0, double feed_mm_min = 6500.0, const std::string& plane = "xy",
+                            int repeats = 1, std::uint64_t seed = 1);
 
 // A scenario running the given G-code (a free-form program or any generated one).
 Scenario gcode_scenario(const std::string& gcode, const std::string& kind = "freeform", std::uint64_t seed = 1);

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 namespace eical::tools {
@@ -20,6 +21,7 @@ struct GenOptions {
   std::vector<double> corner{0.0, 0.0};
   std::vector<double> size{20.0, 10.0};
   double overrun_mm = 2.0;
+  std::optional<double> arc_start_deg;
   std::string out;
   std::string meta_out;
 };
@@ -36,7 +38,9 @@ std::string program_toml(const dsp::Program& p, const std::string& gcode) {
   t += "feed_mm_min = " + std::to_string(p.feed_mm_min) + "\n";
   if (p.kind == "circle") {
     t += "center_mm = " + toml_list({p.center_mm[0], p.center_mm[1]}) + "\nradius_mm = " + std::to_string(p.radius_mm) +
-         "\ndirection = \"" + p.direction + "\"\nrepeats = " + std::to_string(p.repeats) + "\n";
+         "\ndirection = \"" + p.direction + "\"\nrepeats = " + std::to_string(p.repeats) + "\narc_deg = " +
+         std::to_string(p.arc_deg) + "\n";
+    if (p.arc_deg < 360.0) t += "arc_start_deg = " + std::to_string(sim::gcode::partial_arc_start_deg(p)) + "\n";
   } else if (p.kind == "rectangle") {
     t += "corner_mm = " + toml_list({p.corner_mm[0], p.corner_mm[1]}) + "\nsize_mm = " +
          toml_list({p.size_mm[0], p.size_mm[1]}) + "\ndwell_s = " + std::to_string(p.dwell_s) +
@@ -85,11 +89,18 @@ void add_circle(CLI::App* gen) {
   c->add_option("--radius", p.radius_mm, "radius in mm")->default_val(10.0);
   c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2500.0);
   c->add_option("--repeats", p.repeats, "full revolutions")->default_val(5);
-  c->add_option("--direction", p.direction, "ccw or cw")->default_val("ccw")->check(CLI::IsMember({"ccw", "cw"}));
+  c->add_option("--direction", p.direction, "ccw, cw or both (ccw, then cw back)")->default_val("ccw")->check(CLI::IsMember({"ccw", "cw", "both"}));
   c->add_option("--plane", p.plane, "xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
   c->add_option("--center", o->center, "centre in the plane, mm")->expected(2)->delimiter(',');
+  c->add_option("--arc-deg", p.arc_deg, "evaluated arc in deg: 360 = full circle, up to 340 for a partial arc")
+      ->default_val(360.0)->check(CLI::Range(1.0, 360.0));
+  c->add_option("--arc-start-deg", o->arc_start_deg, "partial arc: where it begins, deg (default 90 - arc/2)");
   add_output(c, *o);
-  c->callback([o] { o->program.kind = "circle"; emit(*o); });
+  c->callback([o] {
+    o->program.kind = "circle";
+    if (o->arc_start_deg) o->program.arc_start_deg = *o->arc_start_deg;
+    emit(*o);
+  });
 }
 
 void add_positioning(CLI::App* gen) {

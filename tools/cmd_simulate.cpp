@@ -3,6 +3,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "sim/simulate.hpp"
 #include "tools/commands.hpp"
+#include "tools/sim_programs.hpp"
 
 #include <cstdio>
 #include <memory>
@@ -11,8 +12,8 @@ namespace eical::tools {
 
 void register_simulate(CLI::App& app) {
   struct Opt {
-    std::string program = "circle", direction = "ccw", out, scenario;
-    double radius_mm = 10.0, feed_mm_min = 2500.0, noise_ug = 0.4, from_mm = 0.0, to_mm = 50.0;
+    std::string program = "circle", direction = "ccw", plane = "xy", out, scenario;
+    double arc_deg = 360.0, radius_mm = 10.0, feed_mm_min = 2500.0, noise_ug = 0.4, from_mm = 0.0, to_mm = 50.0;
     int repeats = 5, runs = 2;
     std::vector<double> targets{0.0, 10.0, 20.0, 30.0, 40.0};
     std::uint64_t seed = 1;
@@ -22,15 +23,17 @@ void register_simulate(CLI::App& app) {
   auto* cmd = app.add_subcommand("simulate", "Simulate a machine and its sensors; write a recorded run (eical-run/1)");
   auto* scenario = cmd->add_option("--scenario", o->scenario, "scenario file (eical-scenario/1, config/scenarios/README.md): machine errors, vibration, sensor truth, every effect")
                        ->check(CLI::ExistingFile);
-  cmd->add_option("--program", o->program, "circle, step, positioning or rectangle")
+  cmd->add_option("--program", o->program, "circle, step, positioning, rectangle or freeform")
       ->default_val("circle")
-      ->check(CLI::IsMember({"circle", "step", "positioning", "rectangle"}))
+      ->check(CLI::IsMember({"circle", "step", "positioning", "rectangle", "freeform"}))
       ->excludes(scenario);
+  cmd->add_option("--plane", o->plane, "circle, rectangle: xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
+  cmd->add_option("--arc-deg", o->arc_deg, "circle: evaluated arc in deg (below 360: partial arc, up to 340)")->default_val(360.0)->check(CLI::Range(1.0, 360.0));
   cmd->add_option("--targets", o->targets, "positioning: targets on x, mm (comma separated)")->delimiter(',');
   cmd->add_option("--radius", o->radius_mm, "circle radius, mm")->default_val(10.0)->check(CLI::PositiveNumber);
   cmd->add_option("--feed", o->feed_mm_min, "feed, mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
   cmd->add_option("--repeats", o->repeats, "circle revolutions")->default_val(5)->check(CLI::Range(1, 1000));
-  cmd->add_option("--direction", o->direction, "ccw or cw")->default_val("ccw")->check(CLI::IsMember({"ccw", "cw"}));
+  cmd->add_option("--direction", o->direction, "ccw, cw or both")->default_val("ccw")->check(CLI::IsMember({"ccw", "cw", "both"}));
   cmd->add_option("--from", o->from_mm, "step: start position on x, mm")->default_val(0.0);
   cmd->add_option("--to", o->to_mm, "step: end position on x, mm")->default_val(50.0);
   cmd->add_option("--runs", o->runs, "step: there-and-back pairs")->default_val(2)->check(CLI::Range(1, 1000));
@@ -44,10 +47,15 @@ void register_simulate(CLI::App& app) {
     if (!o->scenario.empty()) {
       sc = drivers::read_scenario_file(o->scenario);
     } else {
-      sc = o->program == "circle"        ? sim::circle_scenario(o->radius_mm, o->feed_mm_min, o->repeats, o->direction, o->seed)
-           : o->program == "step"        ? sim::step_scenario(o->from_mm, o->to_mm, o->feed_mm_min, o->runs, o->seed)
-           : o->program == "rectangle"   ? sim::rectangle_scenario(50.0, o->feed_mm_min, o->repeats, o->seed)
-                                         : sim::positioning_scenario(o->targets, o->runs, o->feed_mm_min, o->seed);
+      sc = o->program == "circle"      ? sim::circle_scenario(o->radius_mm, o->feed_mm_min, o->repeats, o->direction, o->seed)
+           : o->program == "step"      ? sim::step_scenario(o->from_mm, o->to_mm, o->feed_mm_min, o->runs, o->seed)
+           : o->program == "rectangle" ? sim::rectangle_scenario(20.0, 10.0, o->feed_mm_min, o->plane, 1, o->seed)
+           : o->program == "freeform"  ? freeform_scenario(o->feed_mm_min, o->seed)
+                                       : sim::positioning_scenario(o->targets, o->runs, o->feed_mm_min, o->seed);
+      if (o->program == "circle") {
+        sc.meta.program.plane = o->plane;
+        sc.meta.program.arc_deg = o->arc_deg;
+      }
       for (auto& t : sc.truth) t.spec.noise_ug_per_rthz = o->noise_ug;
       for (auto& s : sc.meta.sensors) s.noise_ug_per_rthz = o->noise_ug;
     }

@@ -115,7 +115,10 @@ dsp::Program read_program(StrictTable t, Unknown u) {
   if (p.radius_mm <= 0.0) t.fail("radius_mm", "must be positive");
   p.feed_mm_min = t.number("feed_mm_min", p.feed_mm_min);
   if (p.feed_mm_min <= 0.0) t.fail("feed_mm_min", "must be positive");
-  p.direction = t.choice("direction", {"cw", "ccw"}, p.direction);
+  p.direction = t.choice("direction", {"cw", "ccw", "both"}, p.direction);
+  p.arc_deg = t.number("arc_deg", p.arc_deg);
+  if (!(p.arc_deg > 0.0 && p.arc_deg <= 360.0)) t.fail("arc_deg", "must be in (0, 360]");
+  if (t.has("arc_start_deg")) p.arc_start_deg = t.number("arc_start_deg");
   p.repeats = static_cast<int>(t.integer("repeats", p.repeats));
   if (p.repeats < 1) t.fail("repeats", "must be at least 1");
   p.axis = t.choice("axis", {"x", "y", "z"}, p.axis);

@@ -1,6 +1,8 @@
 #include "drivers/results/result_json.hpp"
 
 #include <algorithm>
+#include <initializer_list>
+#include <map>
 #include <fstream>
 #include <stdexcept>
 #include <cmath>
@@ -29,6 +31,8 @@ nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult&
                       {"feed_mm_min", p.feed_mm_min},
                       {"direction", c.direction},
                       {"revolutions", c.revolutions},
+                      {"arc_deg", c.arc_deg},
+                      {"centre_reference", c.arc_deg < 360.0 ? "programmed centre (partial arc)" : "least-squares centre per revolution"},
                       {"radius_mean_deviation_um", number_or_null(c.radius_mean_deviation_um)},
                       {"circular_deviation_G_um", number_or_null(c.circular_deviation_G_um)},
                       {"circular_hysteresis_H_um", c.circular_hysteresis_H_um ? nlohmann::json(*c.circular_hysteresis_H_um) : nlohmann::json(nullptr)},
@@ -48,24 +52,93 @@ nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult&
     dir.push_back(c.trace.direction[i]);
   }
   j["trace"] = {{"angle_deg", ang}, {"radius_deviation_um", dev}, {"direction", dir}};
+  if (c.arc_deg < 360.0) j["arc_start_deg"] = p.arc_start_deg ? nlohmann::json(*p.arc_start_deg) : nlohmann::json(90.0 - c.arc_deg / 2.0);
   return j;
 }
 
+namespace {
+
+// The spec's keys of each object, for the objects of a program whose evaluation failed:
+// every key is present and null (results.md), the reason is already in quality.flags.
+nlohmann::json all_null(std::initializer_list<const char*> keys) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const char* k : keys) j[k] = nullptr;
+  return j;
+}
+
+// Every null figure of a program object must have a reason in quality.flags; a null the
+// evaluation did not explain gets a generic one naming it (never silently null).
+void explain_nulls(nlohmann::json& doc) {
+  auto& flags = doc["quality"]["flags"];
+  for (const char* obj : {"circle", "diagnostics", "positioning", "step", "rectangle", "freeform"}) {
+    if (!doc.contains(obj) || !doc[obj].is_object()) continue;
+    for (const auto& [key, value] : doc[obj].items()) {
+      if (!value.is_null()) continue;
+      const std::string name = std::string(obj) + "." + key;
+      bool explained = false;
+      for (const auto& f : flags) {
+        const std::string text = f.get<std::string>();
+        explained |= text.rfind(name, 0) == 0 || text.rfind(std::string(obj) + ": null", 0) == 0;
+      }
+      if (!explained) flags.push_back(name + ": null, could not be determined from this run");
+    }
+  }
+}
+
+}  // namespace
+
 nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   nlohmann::json j;
+  const std::string& kind = run.meta.program.kind;
   j["format"] = "eical-result/1";
   j["run_id"] = run.meta.id;
-  j["program"] = run.meta.program.kind;
+  j["program"] = kind;
   j["quality"] = {{"degraded", a.degraded}, {"flags", a.flags}};
   j["sensor_model"] = {{"identified", false}, {"source", "datasheet"}};
   if (a.circle) {
     j["circle"] = circle_json(run.meta.program, *a.circle);
-  } else if (run.meta.program.kind == "circle") {
-    j["circle"] = nullptr;
+  } else if (kind == "circle") {
+    j["circle"] = all_null({"radius_mean_deviation_um", "circular_deviation_G_um", "circular_hysteresis_H_um",
+                            "radial_deviation_F_max_um", "radial_deviation_F_min_um"});
+    j["circle"]["plane"] = run.meta.program.plane;
+    j["circle"]["radius_nominal_mm"] = run.meta.program.radius_mm;
+    j["circle"]["feed_mm_min"] = run.meta.program.feed_mm_min;
+    j["circle"]["arc_deg"] = run.meta.program.arc_deg;
+    j["circle"]["trace"] = {{"angle_deg", nlohmann::json::array()}, {"radius_deviation_um", nlohmann::json::array()},
+                            {"direction", nlohmann::json::array()}};
   }
-  if (a.diagnostics) j["diagnostics"] = diagnostics_json(*a.diagnostics);
-  if (a.step) j["step"] = step_json(a.step_axis, *a.step);
-  if (a.positioning && a.positioning_input) j["positioning"] = positioning_json(*a.positioning_input, *a.positioning, true);
+  if (a.diagnostics) {
+    j["diagnostics"] = diagnostics_json(*a.diagnostics);
+  } else if (kind == "circle") {
+    j["diagnostics"] = all_null({"backlash_x_um", "backlash_y_um", "reversal_spike_x_um", "reversal_spike_y_um",
+                                 "lateral_play_x_um", "lateral_play_y_um", "cyclic_error_x_um", "cyclic_error_y_um",
+                                 "servo_mismatch_ms", "squareness_urad", "scale_mismatch_ppm", "straightness_x_um",
+                                 "straightness_y_um", "stick_slip_um", "vibration_um"});
+  }
+  if (a.step) {
+    j["step"] = step_json(a.step_axis, *a.step);
+  } else if (kind == "step") {
+    j["step"] = all_null({"end_position_error_um", "scatter_um", "overshoot_um", "settling_s"});
+    j["step"]["axis"] = run.meta.program.axis;
+  }
+  if (a.positioning && a.positioning_input) {
+    j["positioning"] = positioning_json(*a.positioning_input, *a.positioning, true);
+  } else if (kind == "positioning") {
+    j["positioning"] = all_null({"A_um", "A_up_um", "A_down_um", "E_um", "M_um", "R_um", "R_up_um", "R_down_um", "B_um",
+                                 "B_mean_um", "deviation_um"});
+    j["positioning"]["axis"] = run.meta.program.axis;
+    j["positioning"]["targets_mm"] = run.meta.program.targets_mm;
+    j["positioning"]["runs"] = run.meta.program.runs;
+  }
+  if (a.rectangle) {
+    j["rectangle"] = rectangle_json(*a.rectangle);
+  } else if (kind == "rectangle") {
+    j["rectangle"] = all_null({"corners_mm", "corner_errors_um"});
+  }
+  if (kind == "rectangle" && j["rectangle"].is_object())
+    j["rectangle"]["path_deviation"] = a.path ? path_json(*a.path) : nlohmann::json(nullptr);
+  if (kind == "freeform")
+    j["freeform"] = a.path ? path_json(*a.path) : all_null({"contour_error_max_um", "contour_error_rms_um", "tangential_rms_um"});
   if (a.circle_accuracy_rms_um) {
     j["reference_comparison"] = {{"reference", run.meta.reference ? run.meta.reference->kind : "ref"},
                                  {"radius_deviation_error_rms_um", *a.circle_accuracy_rms_um},
@@ -77,7 +150,24 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
                    {"zupt_window_samples", m.zupt_window_samples},
                    {"zupt_velocity_error_mm_s", {m.zupt_velocity_error_mm_s.x(), m.zupt_velocity_error_mm_s.y(), m.zupt_velocity_error_mm_s.z()}},
                    {"dynamic_compensation", "two-stage (6-38) with DAQ delay"}};
+  explain_nulls(j);
   return j;
+}
+
+nlohmann::json path_json(const dsp::eval::PathDeviation& d) {
+  // Thinned to at most ~5000 points: the plots need no more; the report's CSV has all.
+  const std::size_t n = d.sample.size(), step = std::max<std::size_t>(1, n / 5000);
+  nlohmann::json s = nlohmann::json::array(), nrm = nlohmann::json::array(), tan = nlohmann::json::array();
+  for (std::size_t i = 0; i < n; i += step) {
+    s.push_back(std::round(d.arc_length_mm[i] * 1e4) / 1e4);
+    nrm.push_back(std::round(d.normal_um[i] * 1e3) / 1e3);
+    tan.push_back(std::round(d.tangential_um[i] * 1e3) / 1e3);
+  }
+  return {{"contour_error_max_um", number_or_null(d.contour_error_max_um)},
+          {"contour_error_rms_um", number_or_null(d.contour_error_rms_um)},
+          {"tangential_rms_um", number_or_null(d.tangential_rms_um)},
+          {"path_length_mm", n ? number_or_null(d.arc_length_mm.back()) : nlohmann::json(nullptr)},
+          {"trace", {{"arc_length_mm", s}, {"normal_um", nrm}, {"tangential_um", tan}}}};
 }
 
 nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp::eval::PositioningResult& r, bool vdi) {
@@ -129,7 +219,11 @@ nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d) {
 
 nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r) {
   nlohmann::json moves = nlohmann::json::array();
-  for (const auto& m : r.moves)
+  bool any_settled = false;
+  std::map<std::pair<long long, int>, int> repeats;  // (target nm, direction) → moves: scatter needs a repeat
+  for (const auto& m : r.moves) {
+    any_settled |= m.settled;
+    ++repeats[{std::llround(m.to_mm * 1e6), m.to_mm > m.from_mm ? 1 : -1}];
     moves.push_back({{"from_mm", m.from_mm},
                      {"to_mm", m.to_mm},
                      {"step_measured_um", m.step_measured_um},
@@ -137,13 +231,15 @@ nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r
                      {"overshoot_um", m.overshoot_um},
                      {"settling_s", m.settled ? nlohmann::json(m.settling_s) : nlohmann::json(nullptr)},
                      {"resolved", m.resolved}});
+  }
+  const bool has_repeat = std::any_of(repeats.begin(), repeats.end(), [](const auto& kv) { return kv.second > 1; });
   return {{"axis", axis},
           {"end_position_error_um", number_or_null(r.end_position_error_um)},
-          {"scatter_um", number_or_null(r.scatter_um)},
+          {"scatter_um", has_repeat ? number_or_null(r.scatter_um) : nlohmann::json(nullptr)},
           {"overshoot_um", number_or_null(r.overshoot_um)},
-          {"settling_s", number_or_null(r.settling_s)},
+          {"settling_s", any_settled ? number_or_null(r.settling_s) : nlohmann::json(nullptr)},
           {"noise_um", number_or_null(r.noise_um)},
-          {"smallest_step_resolved_um", number_or_null(r.smallest_step_resolved_um)},
+          {"smallest_step_resolved_um", r.smallest_step_resolved_um > 0 ? number_or_null(r.smallest_step_resolved_um) : nlohmann::json(nullptr)},
           {"moves", moves}};
 }
 

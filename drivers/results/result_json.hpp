@@ -6,6 +6,7 @@
 #include "dsp/core/run.hpp"
 #include "dsp/eval/circle.hpp"
 #include "dsp/eval/circle_diagnostics.hpp"
+#include "dsp/eval/path_deviation.hpp"
 #include "dsp/eval/positioning.hpp"
 #include "dsp/eval/rectangle.hpp"
 #include "dsp/eval/step_response.hpp"
@@ -26,6 +27,8 @@ nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp
 nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d);
 nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r);
 nlohmann::json rectangle_json(const dsp::eval::RectangleResult& r);
+// Free-form deviation along the path (also the rectangle's contour between the corners).
+nlohmann::json path_json(const dsp::eval::PathDeviation& d);
 
 // Writes the document to `file` atomically (temporary + rename).
 void write_result(const dsp::Run& run, const dsp::Analysis& analysis, const std::filesystem::path& file);

@@ -225,6 +225,8 @@ std::string run_toml_text(const dsp::RunMeta& m) {
        "\ndirection = " + toml_str(p.direction) + "\nrepeats = " + std::to_string(p.repeats) + "\naxis = " + toml_str(p.axis) +
        "\ntargets_mm = " + vec(p.targets_mm.data(), static_cast<int>(p.targets_mm.size())) + "\nruns = " + std::to_string(p.runs) +
        "\ndwell_s = " + toml_double(p.dwell_s) + "\ncorner_mm = " + vec(p.corner_mm, 2) + "\nsize_mm = " + vec(p.size_mm, 2) + "\n";
+  if (p.arc_deg < 360.0) o += "arc_deg = " + toml_double(p.arc_deg) + "\n";
+  if (p.arc_start_deg) o += "arc_start_deg = " + toml_double(*p.arc_start_deg) + "\n";
   if (!p.gcode.empty()) o += "gcode = \"\"\"\n" + p.gcode + "\"\"\"\n";
   for (const auto& s : m.psd) {
     o += "\n[[psd]]\nmeasures = " + toml_str(s.measures) + "\ncenter_mm = " + vec(s.center_mm, 2) + "\nlength_mm = " +

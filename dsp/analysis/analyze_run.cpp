@@ -1,5 +1,7 @@
 #include "dsp/analysis/analyze_run.hpp"
 
+#include "dsp/analysis/program_evaluations.hpp"
+
 #include "dsp/core/error.hpp"
 
 #include <algorithm>
@@ -17,69 +19,6 @@ namespace {
 
 int axis_index(const std::string& axis) { return axis == "y" ? 1 : axis == "z" ? 2 : 0; }
 
-void evaluate_circle_program(const Run& run, Analysis& a) {
-  const Measurement& m = a.measurement;
-  const auto [ia, ib] = plane_axes(run.meta.program.plane);
-  eval::CircleInput in;
-  in.center_mm = {run.meta.program.center_mm[0], run.meta.program.center_mm[1]};
-  in.radius_mm = run.meta.program.radius_mm;
-  in.direction = run.meta.program.direction;
-  in.sample_index = m.sample_index;
-  for (const auto& t : m.triggers)
-    if (t.code == 102) in.segment_marks.push_back(t.sample_index);
-  for (const auto& p : m.pos_mm) in.pos_mm.emplace_back(p[ia], p[ib]);
-  try {
-    a.circle = eval::evaluate_circle(in);
-  } catch (const InputError& e) {
-    a.flags.push_back(std::string("circle: ") + e.what());
-    a.degraded = true;
-    return;
-  }
-  // The reference instrument (or the simulator's truth) through the same evaluation.
-  const bool has_ref = run.channels.ref[ia] && run.channels.ref[ib];
-  if (has_ref) {
-    eval::CircleInput ref = in;
-    ref.pos_mm.clear();
-    bool finite = true;
-    for (const auto& p : m.ref_mm) {
-      ref.pos_mm.emplace_back(p[ia], p[ib]);
-      finite &= std::isfinite(p[ia]) && std::isfinite(p[ib]);
-    }
-    if (finite) {
-      try {
-        a.circle_reference = eval::evaluate_circle(ref);
-        const auto& dm = a.circle->trace.radius_deviation_um;
-        const auto& dr = a.circle_reference->trace.radius_deviation_um;
-        if (dm.size() == dr.size() && !dm.empty()) {
-          double ss = 0.0;
-          for (std::size_t i = 0; i < dm.size(); ++i) ss += (dm[i] - dr[i]) * (dm[i] - dr[i]);
-          a.circle_accuracy_rms_um = std::sqrt(ss / static_cast<double>(dm.size()));
-        }
-      } catch (const InputError& e) {
-        a.flags.push_back(std::string("circle reference: ") + e.what());
-      }
-    }
-  }
-  // Diagnostics over the steady revolutions.
-  eval::CirclePass pass;
-  pass.direction = in.direction == "cw" ? -1 : +1;
-  pass.fs_hz = m.fs_hz;
-  const auto first = in.segment_marks.front(), last = in.segment_marks.back();
-  for (std::size_t i = 0; i < m.sample_index.size(); ++i)
-    if (m.sample_index[i] >= first && m.sample_index[i] < last) {
-      pass.cmd_mm.emplace_back(m.cmd_mm[i][ia], m.cmd_mm[i][ib]);
-      pass.meas_mm.emplace_back(m.pos_mm[i][ia], m.pos_mm[i][ib]);
-    }
-  eval::DiagnosticsOptions opt;
-  opt.centre_mm = in.center_mm;
-  opt.radius_mm = in.radius_mm;
-  try {
-    a.diagnostics = eval::diagnose_circle({pass}, opt);
-  } catch (const InputError& e) {
-    a.flags.push_back(std::string("diagnostics: ") + e.what());
-  }
-}
-
 void evaluate_step_program(const Run& run, Analysis& a) {
   const Measurement& m = a.measurement;
   const int ax = axis_index(run.meta.program.axis);
@@ -91,6 +30,17 @@ void evaluate_step_program(const Run& run, Analysis& a) {
   }
   try {
     a.step = eval::evaluate_steps(cmd, meas, m.fs_hz);
+    // Figures the moves cannot give are null in the result; say why here.
+    const auto& mv = a.step->moves;
+    if (std::none_of(mv.begin(), mv.end(), [](const eval::StepMove& s) { return s.settled; }))
+      a.flags.push_back("step.settling_s: null, no move settled into the band before its dwell ended");
+    if (a.step->smallest_step_resolved_um <= 0.0)
+      a.flags.push_back("step.smallest_step_resolved_um: null, not even the largest step was resolved");
+    bool repeat = false;
+    for (std::size_t i = 0; i < mv.size(); ++i)
+      for (std::size_t k = i + 1; k < mv.size(); ++k)
+        repeat |= std::abs(mv[i].to_mm - mv[k].to_mm) < 1e-6 && (mv[i].to_mm > mv[i].from_mm) == (mv[k].to_mm > mv[k].from_mm);
+    if (!repeat) a.flags.push_back("step.scatter_um: null, no target was approached twice from the same side");
   } catch (const InputError& e) {
     a.flags.push_back(std::string("step: ") + e.what());
     a.degraded = true;
@@ -177,9 +127,11 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   a.degraded = a.measurement.degraded;
   if (a.measurement.sample_index.empty()) return a;  // no motion: nothing to evaluate
   const std::string& kind = run.meta.program.kind;
-  if (kind == "circle") evaluate_circle_program(run, a);
+  if (kind == "circle") detail::evaluate_circle_program(run, a);
   else if (kind == "step") evaluate_step_program(run, a);
   else if (kind == "positioning") evaluate_positioning_program(run, a);
+  else if (kind == "rectangle") detail::evaluate_rectangle_program(run, a);
+  else if (kind == "freeform") detail::evaluate_freeform_program(run, a);
   else a.flags.push_back("program kind '" + kind + "': no evaluation in this version");
   return a;
 }

@@ -7,7 +7,9 @@
 #include "dsp/core/run.hpp"
 #include "dsp/eval/circle.hpp"
 #include "dsp/eval/circle_diagnostics.hpp"
+#include "dsp/eval/path_deviation.hpp"
 #include "dsp/eval/positioning.hpp"
+#include "dsp/eval/rectangle.hpp"
 #include "dsp/eval/step_response.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 
@@ -24,7 +26,7 @@ struct AnalysisOptions {
 
 struct Analysis {
   Measurement measurement;
-  std::optional<eval::CircleResult> circle;
+  std::optional<eval::CircleResult> circle;             // both directions combined when the run has both
   std::optional<eval::CircleResult> circle_reference;  // the same evaluation of the reference channel
   std::optional<double> circle_accuracy_rms_um;        // RMS of (measured − reference) radius deviation
   std::optional<eval::CircleDiagnostics> diagnostics;
@@ -32,6 +34,8 @@ struct Analysis {
   std::optional<eval::PositioningInput> positioning_input;  // deviations per run/target/direction
   std::optional<eval::PositioningResult> positioning;
   std::string step_axis;
+  std::optional<eval::RectangleResult> rectangle;
+  std::optional<eval::PathDeviation> path;  // free form (and the rectangle's contour)
   bool degraded = false;
   std::vector<std::string> flags;  // pipeline quality flags and evaluation failures
 };

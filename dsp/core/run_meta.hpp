@@ -62,8 +62,12 @@ struct Program {
   double center_mm[2] = {0.0, 0.0};
   double radius_mm = 10.0;
   double feed_mm_min = 2500.0;
-  std::string direction = "ccw";  // cw | ccw
+  std::string direction = "ccw";  // cw | ccw | both (ccw first, then cw back)
   int repeats = 1;
+  // Circle: the evaluated arc (ISO 230-4 partial arc when below 360°) and, for a partial
+  // arc, where it begins (plane angle from the plane's first axis, counter-clockwise).
+  double arc_deg = 360.0;
+  std::optional<double> arc_start_deg;
   std::string axis = "x";          // step / positioning
   std::vector<double> targets_mm;  // step / positioning
   int runs = 1;                    // step / positioning

@@ -49,11 +49,15 @@ CircleFit fit_circle(const std::vector<Eigen::Vector2d>& pts) {
 CircleResult evaluate_circle(const CircleInput& in) {
   if (in.pos_mm.size() != in.sample_index.size()) throw InputError("circle evaluation: positions and sample indices differ in length");
   if (!(in.radius_mm > 0.0)) throw InputError("circle evaluation: nominal radius must be positive");
-  std::vector<std::int64_t> marks;
-  for (auto m : in.segment_marks)
-    if (!in.sample_index.empty() && m >= in.sample_index.front() && m <= in.sample_index.back()) marks.push_back(m);
-  std::sort(marks.begin(), marks.end());
-  if (marks.size() < 2)
+  std::vector<std::pair<std::int64_t, std::int64_t>> ranges = in.segments;
+  if (ranges.empty()) {
+    std::vector<std::int64_t> marks;
+    for (auto m : in.segment_marks)
+      if (!in.sample_index.empty() && m >= in.sample_index.front() && m <= in.sample_index.back()) marks.push_back(m);
+    std::sort(marks.begin(), marks.end());
+    for (std::size_t k = 0; k + 1 < marks.size(); ++k) ranges.emplace_back(marks[k], marks[k + 1]);
+  }
+  if (ranges.empty())
     throw InputError("circle evaluation: fewer than two M102 marks inside the measurement (a circle program marks each revolution)");
 
   CircleResult r;
@@ -61,10 +65,10 @@ CircleResult evaluate_circle(const CircleInput& in) {
   double sum_dev = 0.0;
   std::size_t n_dev = 0;
   double dmax = -INFINITY, dmin = INFINITY;
-  for (std::size_t k = 0; k + 1 < marks.size(); ++k) {
+  for (std::size_t k = 0; k < ranges.size(); ++k) {
     std::vector<Eigen::Vector2d> pts;
     for (std::size_t i = 0; i < in.sample_index.size(); ++i)
-      if (in.sample_index[i] >= marks[k] && in.sample_index[i] < marks[k + 1]) {
+      if (in.sample_index[i] >= ranges[k].first && in.sample_index[i] < ranges[k].second) {
         if (!in.pos_mm[i].allFinite()) throw InputError("circle evaluation: non-finite position at sample " + std::to_string(in.sample_index[i]));
         pts.push_back(in.pos_mm[i]);
       }
@@ -87,7 +91,7 @@ CircleResult evaluate_circle(const CircleInput& in) {
       dmin = std::min(dmin, dev_um);
     }
   }
-  r.revolutions = static_cast<int>(marks.size() - 1);
+  r.revolutions = static_cast<int>(ranges.size());
   r.radius_mean_deviation_um = sum_dev / static_cast<double>(n_dev);
   r.radial_deviation_F_max_um = dmax;
   r.radial_deviation_F_min_um = dmin;

@@ -14,7 +14,9 @@
 // nominal radius). Hysteresis H needs both directions (combine()).
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -24,6 +26,10 @@ struct CircleInput {
   std::vector<Eigen::Vector2d> pos_mm;      // measured, in the plane (axis a, axis b)
   std::vector<std::int64_t> sample_index;   // same length
   std::vector<std::int64_t> segment_marks;  // sample indices of the M102 triggers
+  // Explicit [begin, end) sample-index ranges of the revolutions (circle_segments.hpp);
+  // when non-empty they replace the consecutive marks (a "both" program has a stretch
+  // between the directions that is no revolution).
+  std::vector<std::pair<std::int64_t, std::int64_t>> segments;
   Eigen::Vector2d center_mm = Eigen::Vector2d::Zero();  // nominal
   double radius_mm = 10.0;                  // nominal
   std::string direction = "ccw";
@@ -33,7 +39,7 @@ struct CircleTrace {
   std::vector<double> angle_deg;            // 0..360 about the revolution's centre
   std::vector<double> radius_deviation_um;
   std::vector<std::string> direction;       // per point, for combined traces
-  std::vector<int> revolution;
+  std::vector<int> revolution;             // revolution or arc index within its direction
 };
 
 struct CircleResult {
@@ -43,7 +49,8 @@ struct CircleResult {
   double circular_deviation_G_um = 0.0;
   std::optional<double> circular_hysteresis_H_um;  // only with both directions
   double radial_deviation_F_max_um = 0.0, radial_deviation_F_min_um = 0.0;
-  std::vector<Eigen::Vector2d> centers_mm;  // per revolution
+  double arc_deg = 360.0;                   // < 360: partial arc, evaluated about the programmed centre
+  std::vector<Eigen::Vector2d> centers_mm;  // per revolution (partial arc: the programmed centre)
   std::vector<double> radii_mm;
   CircleTrace trace;
 };
@@ -59,7 +66,7 @@ CircleFit fit_circle(const std::vector<Eigen::Vector2d>& points);
 // revolution has too few points.
 CircleResult evaluate_circle(const CircleInput& input);
 
-// Both directions: G and F over both, H = max over 1° angle bins of |mean dev ccw − mean dev cw|.
+// Both directions (ISO 230-4 H): G and F over both, H = max over 1° angle bins of |mean dev ccw − mean dev cw|.
 CircleResult combine(const CircleResult& a, const CircleResult& b);
 
 }  // namespace eical::dsp::eval

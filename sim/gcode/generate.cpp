@@ -52,19 +52,29 @@ char axis_letter(const std::string& axis) {
 
 }  // namespace
 
+double partial_arc_start_deg(const dsp::Program& p) {
+  // Default: the arc symmetric about the plane's +second axis (90°), as a ballbar's 220°
+  // arc in a vertical plane stays above the table: −20° … 200°.
+  return p.arc_start_deg ? *p.arc_start_deg : 90.0 - p.arc_deg / 2.0;
+}
+
+double partial_arc_ramp_deg(const dsp::Program& p) { return std::min(45.0, (360.0 - p.arc_deg) / 2.0); }
+
 std::string circle_program(const dsp::Program& p, const RestTimes& rest) {
   require(p.radius_mm > 0.0, "radius_mm must be positive");
   require(p.feed_mm_min > 0.0, "feed_mm_min must be positive");
   require(p.repeats >= 1, "repeats must be at least 1");
-  require(p.direction == "ccw" || p.direction == "cw", "direction must be cw or ccw");
+  require(p.direction == "ccw" || p.direction == "cw" || p.direction == "both", "direction must be cw, ccw or both");
+  require(p.arc_deg > 0.0 && p.arc_deg <= 360.0, "arc_deg must be in (0, 360]");
+  const bool partial = p.arc_deg < 360.0;
+  // A partial arc needs room for its ramp arcs outside the evaluated arc (feed constant
+  // over the whole evaluated arc).
+  require(!partial || partial_arc_ramp_deg(p) >= 10.0, "a partial arc must leave at least 20 deg for the ramps (arc_deg <= 340)");
   const PlaneAxes ax = plane_axes(p.plane);
-  const bool ccw = p.direction == "ccw";
   const double r = p.radius_mm, c0 = p.center_mm[0], c1 = p.center_mm[1];
-  // Start at 45°; the ramp-in quarter ends at 135° (ccw) or −45° (cw): the revolutions
-  // then start and end there, so every one of them runs at full feed.
-  const double a0 = std::numbers::pi / 4, step = ccw ? std::numbers::pi / 2 : -std::numbers::pi / 2;
+  constexpr double deg = std::numbers::pi / 180.0;
   auto pt = [&](double ang) { return std::pair{c0 + r * std::cos(ang), c1 + r * std::sin(ang)}; };
-  auto arc = [&](double from, double to, const char* comment, bool with_feed) {
+  auto arc = [&](bool ccw, double from, double to, const char* comment, bool with_feed) {
     const auto [fa, fb] = pt(from);
     const auto [ta, tb] = pt(to);
     std::string line = std::string(ccw ? "G3 " : "G2 ") + ax.a + num(ta) + " " + ax.b + num(tb) + " " + ax.ia +
@@ -73,21 +83,46 @@ std::string circle_program(const dsp::Program& p, const RestTimes& rest) {
     if (comment[0]) line += std::string(" (") + comment + ")";
     return line + "\n";
   };
+  const std::string reversal = "G4 P0.2 (reversal: rest before the opposite direction)\n";
   std::string g = header("continuous path: the arcs are one blended move", ax.g, false);
-  const auto [sa, sb] = pt(a0);
-  g += std::string("G0 ") + ax.a + num(sa) + " " + ax.b + num(sb) + "\n";
-  g += start(rest);
-  const double rev_start = a0 + step;
-  g += arc(a0, rev_start, "ramp-in", true);
-  for (int k = 0; k < p.repeats; ++k) {
-    g += "M102\n";
-    // A full circle as one G2/G3 with end = start.
-    g += arc(rev_start, rev_start, "", false);
+  if (!partial) {
+    // Start at 45°; the ramp-in quarter ends at 135° (ccw) or −45° (cw): the revolutions
+    // then start and end there, so every one of them runs at full feed. "both" runs the
+    // ccw revolutions, rests, and comes back clockwise over the same quarters.
+    const double a0 = std::numbers::pi / 4, q = std::numbers::pi / 2;
+    auto revolutions = [&](bool ccw, double from) {
+      const double step = ccw ? q : -q, rev_start = from + step;
+      std::string s = arc(ccw, from, rev_start, "ramp-in", true);
+      for (int k = 0; k < p.repeats; ++k) s += "M102\n" + arc(ccw, rev_start, rev_start, "", false);  // end = start
+      return s + "M102\n" + arc(ccw, rev_start, rev_start + step, "ramp-out", false);
+    };
+    const auto [sa, sb] = pt(a0);
+    g += std::string("G0 ") + ax.a + num(sa) + " " + ax.b + num(sb) + "\n" + start(rest);
+    if (p.direction == "both") g += revolutions(true, a0) + reversal + revolutions(false, a0 + 2 * q);
+    else g += revolutions(p.direction == "ccw", a0);
+    return g + finish(rest);
   }
-  g += "M102\n";
-  g += arc(rev_start, rev_start + step, "ramp-out", false);
-  g += finish(rest);
-  return g;
+  // Partial arc (ISO 230-4 allows arcs below 360°): ramp-in arc, M102, the evaluated arc,
+  // M102, ramp-out arc. Repeats of one direction come back over the arc without marks.
+  const double s0 = partial_arc_start_deg(p) * deg, s1 = s0 + p.arc_deg * deg, ramp = partial_arc_ramp_deg(p) * deg;
+  auto sweep_ccw = [&](bool feed) {
+    return arc(true, s0 - ramp, s0, "ramp-in", feed) + "M102\n" + arc(true, s0, s1, "evaluated arc", false) + "M102\n" +
+           arc(true, s1, s1 + ramp, "ramp-out", false);
+  };
+  auto sweep_cw = [&](bool feed) {
+    return arc(false, s1 + ramp, s1, "ramp-in", feed) + "M102\n" + arc(false, s1, s0, "evaluated arc", false) + "M102\n" +
+           arc(false, s0, s0 - ramp, "ramp-out", false);
+  };
+  const bool cw_first = p.direction == "cw";
+  const auto [sa, sb] = pt(cw_first ? s1 + ramp : s0 - ramp);
+  g += std::string("G0 ") + ax.a + num(sa) + " " + ax.b + num(sb) + "\n" + start(rest);
+  for (int k = 0; k < p.repeats; ++k) {
+    if (k > 0) g += reversal;
+    if (p.direction == "both") g += sweep_ccw(k == 0) + reversal + sweep_cw(false);
+    else if (cw_first) g += sweep_cw(k == 0) + (k + 1 < p.repeats ? reversal + arc(true, s0 - ramp, s1 + ramp, "back", false) : "");
+    else g += sweep_ccw(k == 0) + (k + 1 < p.repeats ? reversal + arc(false, s1 + ramp, s0 - ramp, "back", false) : "");
+  }
+  return g + finish(rest);
 }
 
 std::string positioning_program(const dsp::Program& p, double overrun_mm, const RestTimes& rest) {

@@ -21,7 +21,15 @@ struct RestTimes {
 // Circle (ISO 230-4): start at 45° on the circle, a quarter-arc ramp-in, `repeats` full
 // revolutions each preceded by M102, a M102 after the last one, a quarter-arc ramp-out;
 // G64 so that the arcs blend into one move at constant feed. Planes xy, zx, yz.
+// direction "both": the ccw revolutions, a rest, then the cw revolutions back.
+// Partial arc (arc_deg < 360, at most 340): ramp-in arc (min(45°, (360° − arc)/2)), M102,
+// the evaluated arc from arc_start_deg (default 90° − arc/2: symmetric about the plane's
+// second axis), M102, ramp-out arc; "both" comes back clockwise after a rest.
 std::string circle_program(const dsp::Program& p, const RestTimes& rest = {});
+
+// Where a partial arc begins (deg) and how long its ramps are (deg).
+double partial_arc_start_deg(const dsp::Program& p);
+double partial_arc_ramp_deg(const dsp::Program& p);
 
 // ISO 230-2 linear positioning cycle: `runs` bidirectional runs over `targets_mm`
 // (ascending), each target approached in both directions, with an overrun of

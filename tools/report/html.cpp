@@ -12,26 +12,48 @@
 namespace eical::tools::report {
 namespace {
 
+// Print-friendly, quiet typography: one sans-serif family, tabular figures in tables,
+// a dark header band with the run id and the program.
 constexpr const char* kStyle = R"(
-body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:2em auto;max-width:1100px;color:#1d2330;background:#fff}
-h1{font-size:1.6em;margin:0 0 .2em}
-.sub{color:#5a6478;margin-bottom:1.2em}
-.warn{background:#fff4e0;border-left:4px solid #e59400;padding:.5em .8em;margin:.4em 0}
-section{border-top:1px solid #d8dde6;padding-top:1em;margin-top:1.4em}
-h2{font-size:1.2em;margin:0 0 .6em}
-.row{display:flex;flex-wrap:wrap;gap:1.5em;align-items:flex-start}
-table{border-collapse:collapse;min-width:300px}
-td{padding:.25em .6em;border-bottom:1px solid #eef0f4}
-td.v{text-align:right;font-variant-numeric:tabular-nums;font-weight:600}
-td.n{color:#5a6478;font-size:.9em}
-.na{color:#a33}
-p.note{color:#3b4456;max-width:60em}
+*{box-sizing:border-box}
+body{font-family:"Inter","Segoe UI","Helvetica Neue","DejaVu Sans",Arial,sans-serif;margin:0;color:#1d2330;background:#f4f6f9;font-size:14px;line-height:1.45}
+header{background:#17233b;color:#fff;padding:22px 40px 18px}
+header .brand{font-size:12px;letter-spacing:.12em;text-transform:uppercase;color:#9fb3d9}
+header h1{font-size:24px;font-weight:600;margin:4px 0 6px}
+header .prog{font-size:15px;color:#dfe7f5}
+header .runid{font-family:"DejaVu Sans Mono",Consolas,monospace;font-size:13px;color:#fff;background:#2b3b5c;padding:2px 8px;border-radius:3px}
+dl.ctx{display:flex;flex-wrap:wrap;gap:4px 28px;margin:12px 0 0;font-size:12px;color:#b8c6e0}
+dl.ctx dt{display:inline;color:#8ea2c8}dl.ctx dd{display:inline;margin:0 0 0 6px;color:#e9eef8}
+main{max-width:1220px;margin:0 auto;padding:18px 40px 40px}
+.warn{background:#fff6e5;border-left:4px solid #e59400;padding:6px 12px;margin:6px 0;font-size:13px}
+section{background:#fff;border:1px solid #dde2ea;border-radius:6px;padding:18px 22px;margin:18px 0}
+h2{font-size:18px;font-weight:600;margin:0 0 2px}
+p.lead{color:#5a6478;margin:0 0 12px}
+.row{display:flex;flex-wrap:wrap;gap:22px;align-items:flex-start}
+.plots{display:flex;flex-direction:column;gap:10px}
+.tables{display:flex;flex-direction:column;gap:14px;flex:1;min-width:330px}
+table{border-collapse:collapse;width:100%;font-size:13px}
+caption{text-align:left;font-weight:600;font-size:12px;letter-spacing:.06em;text-transform:uppercase;color:#5a6478;padding:0 0 4px}
+th{text-align:right;font-weight:600;color:#5a6478;border-bottom:1px solid #c9d0db;padding:3px 8px}
+th:first-child{text-align:left}
+td{padding:3px 8px;border-bottom:1px solid #eef0f4}
+td.v{text-align:right;font-variant-numeric:tabular-nums;font-weight:600;white-space:nowrap}
+td.u{color:#5a6478;white-space:nowrap}
+td.n{color:#6b7385;font-size:12px}
+td.c{text-align:right;font-variant-numeric:tabular-nums}
+.na{color:#a33;font-weight:500}
+p.note{color:#3b4456;max-width:70em;font-size:13px;margin:10px 0 0}
+svg.plot{background:#fff;border:1px solid #e3e7ee;border-radius:4px}
+footer{color:#6b7385;font-size:12px;margin-top:10px}
+footer a{color:#1f5fbf}
 )";
 
 std::string format_value(const Figure& f) {
   if (!f.value || !std::isfinite(*f.value)) return "<span class=\"na\">n/a</span>";
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", f.decimals, *f.value);
+  // No "-0.00": a value that rounds to zero is shown as zero.
+  const double v = std::abs(*f.value) < 0.5 * std::pow(10.0, -f.decimals) ? 0.0 : *f.value;
+  std::snprintf(buf, sizeof buf, "%.*f", f.decimals, v);
   return buf;
 }
 
@@ -39,31 +61,63 @@ std::string format_value(const Figure& f) {
 
 std::string render_html(const Page& page) {
   std::string out;
-  out.reserve(64 * 1024);
-  out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>";
-  out += xml_escape(page.title);
-  out += "</title>\n<style>";
-  out += kStyle;
-  out += "</style></head><body>\n<h1>" + xml_escape(page.title) + "</h1>\n";
-  out += "<div class=\"sub\">" + xml_escape(page.subtitle) + "</div>\n";
+  out.reserve(256 * 1024);
+  out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" + xml_escape(page.title + " — " + page.run_id) +
+         "</title>\n<style>" + kStyle + "</style></head><body>\n<header>\n<div class=\"brand\">eical · inertial machine-tool calibration</div>\n";
+  out += "<h1>" + xml_escape(page.title) + "</h1>\n";
+  out += "<div class=\"prog\">Run <span class=\"runid\">" + xml_escape(page.run_id) + "</span> &nbsp;·&nbsp; " + xml_escape(page.program) + "</div>\n";
+  if (!page.context.empty()) {
+    out += "<dl class=\"ctx\">";
+    for (const auto& [k, v] : page.context) out += "<div><dt>" + xml_escape(k) + "</dt><dd>" + xml_escape(v) + "</dd></div>";
+    out += "</dl>\n";
+  }
+  out += "</header>\n<main>\n";
   for (const auto& w : page.warnings) out += "<div class=\"warn\">" + xml_escape(w) + "</div>\n";
   for (const auto& s : page.sections) {
-    out += "<section><h2>" + xml_escape(s.heading) + "</h2>\n<div class=\"row\">\n";
-    if (!s.figures.empty()) {
-      out += "<table>\n";
-      for (const auto& f : s.figures) {
-        out += "<tr><td>" + xml_escape(f.label) + "</td><td class=\"v\">" + format_value(f) +
-               "</td><td>" + xml_escape(f.unit) + "</td><td class=\"n\">" + xml_escape(f.note) +
-               "</td></tr>\n";
+    out += "<section><h2>" + xml_escape(s.heading) + "</h2>\n";
+    if (!s.lead.empty()) out += "<p class=\"lead\">" + xml_escape(s.lead) + "</p>\n";
+    out += "<div class=\"row\">\n";
+    if (!s.svgs.empty()) {
+      out += "<div class=\"plots\">";
+      for (const auto& svg : s.svgs) out += svg;
+      out += "</div>\n";
+    }
+    if (!s.tables.empty()) {
+      out += "<div class=\"tables\">";
+      for (const auto& t : s.tables) {
+        out += "<table>";
+        if (!t.caption.empty()) out += "<caption>" + xml_escape(t.caption) + "</caption>";
+        for (const auto& f : t.rows)
+          out += "<tr><td>" + xml_escape(f.label) + "</td><td class=\"v\">" + format_value(f) + "</td><td class=\"u\">" +
+                 xml_escape(f.unit) + "</td><td class=\"n\">" + xml_escape(f.note) + "</td></tr>\n";
+        out += "</table>\n";
+      }
+      out += "</div>\n";
+    }
+    out += "</div>\n";
+    for (const auto& g : s.grids) {
+      out += "<table style=\"margin-top:14px\">";
+      if (!g.caption.empty()) out += "<caption>" + xml_escape(g.caption) + "</caption>";
+      out += "<tr>";
+      for (const auto& h : g.header) out += "<th>" + xml_escape(h) + "</th>";
+      out += "</tr>\n";
+      for (const auto& r : g.rows) {
+        out += "<tr>";
+        for (std::size_t i = 0; i < r.size(); ++i) out += (i ? "<td class=\"c\">" : "<td>") + xml_escape(r[i]) + "</td>";
+        out += "</tr>\n";
       }
       out += "</table>\n";
     }
-    for (const auto& svg : s.svgs) out += "<div>" + svg + "</div>\n";
-    out += "</div>\n";
     for (const auto& n : s.notes) out += "<p class=\"note\">" + xml_escape(n) + "</p>\n";
     out += "</section>\n";
   }
-  out += "</body></html>\n";
+  if (!page.files.empty()) {
+    out += "<footer>Every trace behind the plots, as CSV: ";
+    for (std::size_t i = 0; i < page.files.size(); ++i)
+      out += std::string(i ? ", " : "") + "<a href=\"" + xml_escape(page.files[i]) + "\">" + xml_escape(page.files[i]) + "</a>";
+    out += ". Machine-readable figures: <a href=\"result.json\">result.json</a> (eical-result/1).</footer>\n";
+  }
+  out += "</main></body></html>\n";
   return out;
 }
 

@@ -1,8 +1,8 @@
 #pragma once
 // Self-contained HTML report pages: inline CSS, inline SVG, no scripts, no network.
-// A page is a title, a line of context and sections; each section shows a table of
-// figures (value + unit + optional note) beside its plots, the way ballbar software lays
-// out a diagnostics page.
+// A page is a header (title, run id, program, context), the quality flags, and sections;
+// each section shows its plots with the tables of figures beside them, the way ballbar
+// software lays out a diagnostics page, and notes on how the figures were obtained.
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -15,21 +15,38 @@ struct Figure {
   std::optional<double> value;  // nullopt = could not be determined (shown as "n/a")
   std::string unit;
   int decimals = 1;
-  std::string note;  // e.g. the reason a figure is missing or a tolerance
+  std::string note;  // e.g. the reason a figure is missing or a convention
+};
+
+struct Table {
+  std::string caption;
+  std::vector<Figure> rows;
+};
+
+// A table of text cells (e.g. per corner, per target) with a header row.
+struct Grid {
+  std::string caption;
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
 };
 
 struct Section {
   std::string heading;
-  std::vector<Figure> figures;
-  std::vector<std::string> svgs;  // complete <svg> elements from svg.hpp
+  std::string lead;                // one line under the heading: what the test is
+  std::vector<std::string> svgs;   // complete <svg> elements from svg.hpp (left)
+  std::vector<Table> tables;       // beside the plots (right)
+  std::vector<Grid> grids;         // below
   std::vector<std::string> notes;  // plain text paragraphs
 };
 
 struct Page {
   std::string title;
-  std::string subtitle;  // run id, program, date
-  std::vector<std::string> warnings;  // quality flags: shown at the top, never hidden
+  std::string run_id;
+  std::string program;                 // e.g. "circle R 10 mm, F 2500 mm/min, XY, both directions"
+  std::vector<std::pair<std::string, std::string>> context;  // label → value under the header
+  std::vector<std::string> warnings;   // quality flags: shown at the top, never hidden
   std::vector<Section> sections;
+  std::vector<std::string> files;      // CSV files next to the report (linked at the end)
 };
 
 std::string render_html(const Page& page);

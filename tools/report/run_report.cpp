@@ -1,6 +1,7 @@
 #include "tools/report/run_report.hpp"
 
 #include "tools/report/html.hpp"
+#include "tools/report/sections.hpp"
 #include "tools/report/svg.hpp"
 
 #include <cstdio>
@@ -9,7 +10,6 @@
 
 namespace eical::tools::report {
 namespace fs = std::filesystem;
-namespace {
 
 std::string fmt(const char* f, double v) {
   char b[64];
@@ -17,150 +17,109 @@ std::string fmt(const char* f, double v) {
   return b;
 }
 
-void write_csv(const fs::path& file, const std::string& header, const std::vector<std::vector<double>>& cols) {
+std::pair<std::string, std::string> plane_axis_names(const std::string& plane) {
+  if (plane == "zx") return {"Z", "X"};
+  if (plane == "yz") return {"Y", "Z"};
+  return {"X", "Y"};
+}
+
+void CsvFiles::write(const std::string& name, const std::vector<std::string>& header, const std::vector<std::vector<double>>& cols) {
+  const fs::path file = dir_ / name;
   std::ofstream os(file, std::ios::trunc);
   if (!os) throw std::runtime_error(file.string() + ": cannot write");
-  os << header << "\n";
+  for (std::size_t c = 0; c < header.size(); ++c) os << (c ? "," : "") << header[c];
+  os << "\n";
   const std::size_t n = cols.empty() ? 0 : cols[0].size();
+  char buf[32];
   for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t c = 0; c < cols.size(); ++c) os << (c ? "," : "") << fmt("%.6f", cols[c][i]);
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      std::snprintf(buf, sizeof buf, "%.6f", i < cols[c].size() ? cols[c][i] : 0.0);
+      os << (c ? "," : "") << buf;
+    }
     os << "\n";
   }
+  if (!os.flush()) throw std::runtime_error(file.string() + ": write failed");
+  names_.push_back(name);
 }
 
-// Thins a trace to about `max_points` for plotting (the CSV keeps every point).
-std::vector<std::size_t> thin(std::size_t n, std::size_t max_points) {
-  std::vector<std::size_t> idx;
-  const std::size_t step = std::max<std::size_t>(1, n / max_points);
-  for (std::size_t i = 0; i < n; i += step) idx.push_back(i);
-  return idx;
+namespace {
+
+// One line naming the program the way a calibration engineer would.
+std::string program_line(const dsp::Program& p) {
+  const auto [na, nb] = plane_axis_names(p.plane);
+  if (p.kind == "circle") {
+    std::string s = "circular test R " + fmt("%g", p.radius_mm) + " mm, F " + fmt("%g", p.feed_mm_min) + " mm/min, " + na + nb + " plane, ";
+    s += p.direction == "both" ? "both directions" : p.direction == "cw" ? "clockwise" : "counter-clockwise";
+    if (p.arc_deg < 360.0) s += ", " + fmt("%g", p.arc_deg) + "° partial arc";
+    return s;
+  }
+  if (p.kind == "positioning" || p.kind == "step") {
+    std::string s = (p.kind == "step" ? "step response, axis " : "ISO 230-2 positioning, axis ") + p.axis + ", targets";
+    for (std::size_t i = 0; i < p.targets_mm.size() && i < 12; ++i) s += (i ? ", " : " ") + fmt("%g", p.targets_mm[i]);
+    if (p.targets_mm.size() > 12) s += ", …";
+    return s + " mm, " + std::to_string(p.runs) + " runs, F " + fmt("%g", p.feed_mm_min) + " mm/min";
+  }
+  if (p.kind == "rectangle")
+    return "rectangle " + fmt("%g", p.size_mm[0]) + " × " + fmt("%g", p.size_mm[1]) + " mm in " + na + nb + ", F " + fmt("%g", p.feed_mm_min) + " mm/min";
+  if (p.kind == "freeform") return "free-form path (G-code of the run), F " + fmt("%g", p.feed_mm_min) + " mm/min";
+  return p.kind + " program";
 }
 
-void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, const fs::path& dir) {
-  const auto& c = *a.circle;
-  const auto& p = run.meta.program;
-  Section s;
-  s.heading = std::string("Circular test (ISO 230-4), ") + (c.direction == "ccw" ? "counter-clockwise (G3)" : c.direction == "cw" ? "clockwise (G2)" : "both directions");
-  s.figures = {{"Nominal radius", p.radius_mm, "mm", 3, ""},
-               {"Feed", p.feed_mm_min, "mm/min", 0, ""},
-               {"Revolutions evaluated", static_cast<double>(c.revolutions), "", 0, "between the M102 marks"},
-               {"Mean radius deviation", c.radius_mean_deviation_um, "µm", 2, "measured − nominal"},
-               {"Circular deviation G", c.circular_deviation_G_um, "µm", 2, "max − min about the LSQ centre"},
-               {"Radial deviation F max", c.radial_deviation_F_max_um, "µm", 2, ""},
-               {"Radial deviation F min", c.radial_deviation_F_min_um, "µm", 2, ""}};
-  if (c.circular_hysteresis_H_um) s.figures.push_back({"Circular hysteresis H", *c.circular_hysteresis_H_um, "µm", 2, ""});
-  std::vector<PolarTrace> polar;
-  const char* colors[] = {"#1f5fbf", "#c0392b", "#27ae60", "#8e44ad", "#d35400", "#16a085"};
-  for (int rev = 0; rev < c.revolutions; ++rev) {
-    PolarTrace t;
-    t.label = "revolution " + std::to_string(rev + 1);
-    t.color = colors[rev % 6];
-    for (std::size_t i = 0; i < c.trace.angle_deg.size(); ++i)
-      if (c.trace.revolution[i] == rev && i % 10 == 0) {
-        t.angle_deg.push_back(c.trace.angle_deg[i]);
-        t.deviation_um.push_back(c.trace.radius_deviation_um[i]);
-      }
-    polar.push_back(std::move(t));
-  }
-  s.svgs.push_back(polar_plot(polar, "Radius deviation (µm) — " + c.direction));
-  s.notes.push_back("Each revolution is evaluated about its own least-squares centre (the integration drift of an inertial "
-                    "measurement moves the centre slowly; a ballbar's pivot does the same job). Trace: trace_circle.csv.");
-  page.sections.push_back(std::move(s));
-  std::vector<double> rev(c.trace.revolution.begin(), c.trace.revolution.end());
-  write_csv(dir / "trace_circle.csv", "angle_deg,radius_deviation_um,revolution", {c.trace.angle_deg, c.trace.radius_deviation_um, rev});
-
-  if (a.diagnostics) {
-    const auto& d = *a.diagnostics;
-    Section ds;
-    ds.heading = "Diagnostics (ballbar class, per axis)";
-    ds.figures = {{"Backlash X", d.backlash_x_um, "µm", 2, ""},
-                  {"Backlash Y", d.backlash_y_um, "µm", 2, ""},
-                  {"Reversal spike X", d.reversal_spike_x_um, "µm", 2, ""},
-                  {"Reversal spike Y", d.reversal_spike_y_um, "µm", 2, ""},
-                  {"Lateral play X", d.lateral_play_x_um, "µm", 2, ""},
-                  {"Lateral play Y", d.lateral_play_y_um, "µm", 2, ""},
-                  {"Cyclic error X", d.cyclic_error_x_um, "µm", 2, "pitch " + fmt("%.1f mm", d.cyclic_pitch_mm)},
-                  {"Cyclic error Y", d.cyclic_error_y_um, "µm", 2, ""},
-                  {"Servo mismatch", d.servo_and_squareness_separated ? std::optional<double>(d.servo_mismatch_ms) : std::nullopt, "ms",
-                   3, d.servo_and_squareness_separated ? "X lag − Y lag" : "needs both directions"},
-                  {"Squareness", d.squareness_urad, "µrad", 1, "positive: angle X–Y above 90°"},
-                  {"Scale mismatch", d.scale_mismatch_ppm, "ppm", 1, "X − Y"},
-                  {"Straightness X", d.straightness_x_um, "µm", 2, ""},
-                  {"Straightness Y", d.straightness_y_um, "µm", 2, ""},
-                  {"Model residual (radial, RMS)", d.vibration_um, "µm", 2, "vibration and noise"},
-                  {"Model residual (tangential, RMS)", d.stick_slip_um, "µm", 2, "stick-slip and noise"}};
-    for (const auto& n : d.notes) ds.notes.push_back(n);
-    page.sections.push_back(std::move(ds));
-  }
-  if (a.circle_reference && a.circle_accuracy_rms_um) {
-    Section r;
-    r.heading = "Compared with the reference (" + (run.meta.reference ? run.meta.reference->kind : std::string("ref")) + ")";
-    r.figures = {{"Radius deviation error (RMS)", *a.circle_accuracy_rms_um, "µm", 2, "eical − reference, same evaluation"},
-                 {"Reference circular deviation G", a.circle_reference->circular_deviation_G_um, "µm", 2, ""},
-                 {"Reference mean radius deviation", a.circle_reference->radius_mean_deviation_um, "µm", 2, ""}};
-    LineSeries meas{"eical", "#1f5fbf", {}, {}}, ref{"reference", "#c0392b", {}, {}};
-    const auto& dm = c.trace;
-    const auto& dr = a.circle_reference->trace;
-    for (std::size_t i : thin(dm.angle_deg.size(), 2500)) {
-      const double x = static_cast<double>(i) / static_cast<double>(dm.angle_deg.size()) * c.revolutions * 360.0;
-      meas.x.push_back(x), meas.y.push_back(dm.radius_deviation_um[i]);
-      if (i < dr.radius_deviation_um.size()) ref.x.push_back(x), ref.y.push_back(dr.radius_deviation_um[i]);
-    }
-    r.svgs.push_back(line_plot({meas, ref}, "Radius deviation along the path", "path angle (deg, all revolutions)", "µm"));
-    page.sections.push_back(std::move(r));
-  }
+std::string title_for(const std::string& kind) {
+  if (kind == "circle") return "Circular test report";
+  if (kind == "positioning") return "Positioning test report";
+  if (kind == "step") return "Step response report";
+  if (kind == "rectangle") return "Rectangle test report";
+  if (kind == "freeform") return "Free-form contour report";
+  return "Measurement report";
 }
 
-void step_sections(const dsp::Analysis& a, Page& page, const fs::path& dir) {
-  const auto& st = *a.step;
-  Section s;
-  s.heading = "Step response (axis " + a.step_axis + ")";
-  s.figures = {{"End-position error (mean)", st.end_position_error_um, "µm", 2, ""},
-               {"Scatter over repeats", st.scatter_um, "µm", 2, "pooled std, same target and direction"},
-               {"Overshoot (max)", st.overshoot_um, "µm", 2, ""},
-               {"Settling time (max)", st.settling_s * 1000.0, "ms", 1, "into ±1 µm"},
-               {"Noise in the dwell", st.noise_um, "µm", 3, ""},
-               {"Smallest step resolved", st.smallest_step_resolved_um > 0 ? std::optional<double>(st.smallest_step_resolved_um) : std::nullopt,
-                "µm", 1, ""}};
+void measurement_section(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
   const auto& m = a.measurement;
-  const int ax = a.step_axis == "y" ? 1 : a.step_axis == "z" ? 2 : 0;
-  LineSeries err{"measured − set-point", "#1f5fbf", {}, {}};
-  std::vector<double> t, pos, cmd, e;
+  Section p;
+  p.heading = "Measurement";
+  p.lead = "How the relative path head − table was obtained from the two accelerometers.";
+  p.tables.push_back({"Supports", {{"Rest window before the motion", static_cast<double>(m.rest_window_samples) / m.fs_hz, "s", 3, "bias reference (M101 → motion)"},
+                                   {"ZUPT window after the motion", static_cast<double>(m.zupt_window_samples) / m.fs_hz, "s", 3, ""},
+                                   {"Velocity error removed by ZUPT, x", m.zupt_velocity_error_mm_s.x() * 1000.0, "µm/s", 2, ""},
+                                   {"Velocity error removed by ZUPT, y", m.zupt_velocity_error_mm_s.y() * 1000.0, "µm/s", 2, ""},
+                                   {"Velocity error removed by ZUPT, z", m.zupt_velocity_error_mm_s.z() * 1000.0, "µm/s", 2, ""}}});
+  p.notes.push_back("Pipeline: data-sheet static compensation, rest-window bias, trapezoid double integration, two-stage "
+                    "dynamic compensation (6-38) including the DAQ group delay, ZUPT at the standstills.");
+  page.sections.push_back(std::move(p));
+  std::vector<std::vector<double>> cols(7);
   for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
-    t.push_back(static_cast<double>(m.sample_index[i]) / m.fs_hz);
-    pos.push_back(m.pos_mm[i][ax]);
-    cmd.push_back(m.cmd_mm[i][ax]);
-    e.push_back((m.pos_mm[i][ax] - m.cmd_mm[i][ax]) * 1000.0);
+    cols[0].push_back(static_cast<double>(m.sample_index[i]) / m.fs_hz);
+    for (int k = 0; k < 3; ++k) cols[1 + static_cast<std::size_t>(k)].push_back(m.cmd_mm[i][k]), cols[4 + static_cast<std::size_t>(k)].push_back(m.pos_mm[i][k]);
   }
-  for (std::size_t i : thin(t.size(), 3000)) err.x.push_back(t[i]), err.y.push_back(e[i]);
-  s.svgs.push_back(line_plot({err}, "Following error", "time (s)", "µm"));
-  page.sections.push_back(std::move(s));
-  write_csv(dir / "trace_step.csv", "t_s,position_mm,setpoint_mm,error_um", {t, pos, cmd, e});
+  csv.write("trace_measurement.csv", {"t_s", "setpoint_x_mm", "setpoint_y_mm", "setpoint_z_mm", "measured_x_mm", "measured_y_mm", "measured_z_mm"}, cols);
 }
 
 }  // namespace
 
 fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs::path& dir) {
   fs::create_directories(dir);
+  CsvFiles csv(dir);
   Page page;
-  page.title = "eical — " + run.meta.program.kind + " test, run " + run.meta.id;
-  page.subtitle = "machine " + run.meta.machine.name + " · " + fmt("%.0f Hz", run.meta.acquisition.fs_hz) + " · " +
-                  std::to_string(run.frames.size()) + " samples" + (run.meta.created.empty() ? "" : " · " + run.meta.created);
+  const auto& p = run.meta.program;
+  page.title = title_for(p.kind);
+  page.run_id = run.meta.id;
+  page.program = program_line(p);
+  page.context = {{"machine", run.meta.machine.name},
+                  {"sampling", fmt("%.0f Hz", run.meta.acquisition.fs_hz)},
+                  {"samples", std::to_string(run.frames.size())},
+                  {"sensors", run.meta.sensors[0].model + " (table), " + run.meta.sensors[1].model + " (head)"}};
+  if (!run.meta.created.empty()) page.context.emplace_back("recorded", run.meta.created);
+  if (run.meta.reference) page.context.emplace_back("reference", run.meta.reference->kind);
   page.warnings = a.flags;
   if (a.degraded && page.warnings.empty()) page.warnings.push_back("result degraded");
-  if (a.circle) circle_sections(run, a, page, dir);
-  if (a.step) step_sections(a, page, dir);
-  const auto& m = a.measurement;
-  Section p;
-  p.heading = "Measurement";
-  p.figures = {{"Rest window before the motion", static_cast<double>(m.rest_window_samples) / m.fs_hz, "s", 3, "bias reference (M101 → first motion)"},
-               {"ZUPT window after the motion", static_cast<double>(m.zupt_window_samples) / m.fs_hz, "s", 3, ""},
-               {"Velocity error removed by ZUPT (x)", m.zupt_velocity_error_mm_s.x() * 1000.0, "µm/s", 2, ""},
-               {"Velocity error removed by ZUPT (y)", m.zupt_velocity_error_mm_s.y() * 1000.0, "µm/s", 2, ""},
-               {"Relative rest acceleration z", m.rest_bias_rel_mps2.z(), "m/s²", 5, "head − table incl. gravity and bias"}};
-  p.notes.push_back("Pipeline: data-sheet static compensation, rest-window bias, trapezoid double integration, "
-                    "two-stage dynamic compensation (6-38) including the DAQ group delay, ZUPT after the motion.");
-  page.sections.push_back(std::move(p));
+  circle_sections(run, a, page, csv);
+  positioning_sections(run, a, page, csv);
+  step_sections(a, page, csv);
+  if (p.kind == "rectangle") rectangle_sections(run, a, page, csv);
+  if (p.kind == "freeform") freeform_sections(run, a, page, csv);
+  measurement_section(a, page, csv);
+  page.files = csv.names();
   const fs::path file = dir / "report.html";
   write_html(page, file);
   return file;

@@ -18,22 +18,53 @@ std::string num(double v) {
 
 std::string tick_label(double v, double step) {
   char buf[32];
-  const int decimals = step >= 1.0 ? 0 : static_cast<int>(std::ceil(-std::log10(step)));
+  const int decimals = step >= 1.0 ? 0 : static_cast<int>(std::ceil(-std::log10(step) - 1e-9));
+  if (std::abs(v) < step * 1e-6) v = 0.0;  // no "-0"
   std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
   return buf;
 }
 
+std::string svg_open(double w, double h) {
+  return "<svg xmlns='http://www.w3.org/2000/svg' class='plot' viewBox='0 0 " + num(w) + " " + num(h) + "' width='" + num(w) +
+         "' height='" + num(h) + "' font-family='inherit' font-size='11' fill='#1d2330'>";
+}
+
+std::string text(double x, double y, const std::string& s, const std::string& extra = "") {
+  return "<text x='" + num(x) + "' y='" + num(y) + "'" + (extra.empty() ? "" : " " + extra) + ">" + xml_escape(s) + "</text>";
+}
+
+// Every `stride`-th point so that a trace has at most `max_points` (plots need no more).
+std::size_t stride_for(std::size_t n, std::size_t max_points) { return std::max<std::size_t>(1, n / max_points); }
+
+// The next step of the 1-2-5 sequence above `step`.
+double next_nice(double step) {
+  const double mag = std::pow(10.0, std::floor(std::log10(step)));
+  const double norm = step / mag;
+  return (norm < 1.5 ? 2.0 : norm < 3.5 ? 5.0 : 10.0) * mag;
+}
+
+// Tick positions k·step inside [lo, hi], counted (not accumulated) so that rounding can
+// neither skip the last tick nor loop forever.
+std::vector<double> ticks(double lo, double hi, double step) {
+  std::vector<double> t;
+  if (!(step > 0.0) || !std::isfinite(lo) || !std::isfinite(hi)) return t;
+  const double k0 = std::ceil(lo / step - 1e-9), k1 = std::floor(hi / step + 1e-9);
+  for (double k = k0; k <= k1 && t.size() < 200; k += 1.0) t.push_back(k * step);
+  return t;
+}
+
 }  // namespace
 
-std::string xml_escape(const std::string& text) {
+std::string xml_escape(const std::string& t) {
   std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
+  out.reserve(t.size());
+  for (char c : t) {
     switch (c) {
       case '&': out += "&amp;"; break;
       case '<': out += "&lt;"; break;
       case '>': out += "&gt;"; break;
       case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
       default: out += c;
     }
   }
@@ -49,120 +80,201 @@ double nice_step(double span, int target_ticks) {
   return nice * mag;
 }
 
-std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title,
-                       double scale_um_per_div) {
-  // Geometry: the reference circle (zero deviation) at r0; each division is `ring` px.
-  const double size = 420.0, c = size / 2.0, r0 = 120.0, ring = 30.0;
-  const int divisions = 2;  // rings inside and outside the reference circle
+std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title, const std::string& axis_a,
+                       const std::string& axis_b, double scale_um_per_div) {
+  // The reference circle (zero deviation) at r0 with `divisions` rings inside and outside,
+  // each `ring` px: the ballbar plot's fixed geometry with a µm-per-division scale.
+  const double w = 500, h = 540, c = w / 2.0, cy = 266, r0 = 122.0, ring = 28.0;
+  const int divisions = 3;
   double max_abs_um = 0.0;
   for (const auto& t : traces)
     for (double d : t.deviation_um)
       if (std::isfinite(d)) max_abs_um = std::max(max_abs_um, std::abs(d));
-  if (scale_um_per_div <= 0.0) scale_um_per_div = nice_step(std::max(max_abs_um, 0.1), divisions) ;
-  if (scale_um_per_div * divisions < max_abs_um)
-    scale_um_per_div = nice_step(max_abs_um * 1.01, divisions - 1);
+  if (scale_um_per_div <= 0.0) scale_um_per_div = nice_step(std::max(max_abs_um, 0.05) * 1.05, divisions);
+  while (scale_um_per_div * divisions < max_abs_um) scale_um_per_div = next_nice(scale_um_per_div);
   const double px_per_um = ring / scale_um_per_div;
 
-  std::string s;
-  s += "<svg xmlns='http://www.w3.org/2000/svg' viewBox='0 0 " + num(size) + " " + num(size + 40) +
-       "' width='" + num(size) + "' height='" + num(size + 40) + "' font-family='sans-serif' font-size='11'>";
-  s += "<text x='" + num(c) + "' y='16' text-anchor='middle' font-size='14' font-weight='bold'>" +
-       xml_escape(title) + "</text>";
-  s += "<g transform='translate(0,24)'>";
+  std::string s = svg_open(w, h);
+  s += text(c, 18, title, "text-anchor='middle' font-size='14' font-weight='600'");
   for (int k = -divisions; k <= divisions; ++k) {
     const double r = r0 + k * ring;
-    s += "<circle cx='" + num(c) + "' cy='" + num(c) + "' r='" + num(r) + "' fill='none' stroke='" +
-         (k == 0 ? "#444" : "#ccc") + "' stroke-width='" + (k == 0 ? "1.2" : "0.8") +
-         (k == 0 ? "'" : "' stroke-dasharray='3,3'") + "/>";
-    s += "<text x='" + num(c + 3) + "' y='" + num(c - r - 2) + "' fill='#777'>" +
-         tick_label(k * scale_um_per_div, scale_um_per_div) + " µm</text>";
+    s += "<circle cx='" + num(c) + "' cy='" + num(cy) + "' r='" + num(r) + "' fill='none' stroke='" + (k == 0 ? "#8a93a3" : "#d5d9e0") +
+         "' stroke-width='" + (k == 0 ? "1.1" : "0.8") + (k == 0 ? "'" : "' stroke-dasharray='3,3'") + "/>";
+    if (k != 0 && k % 1 == 0)
+      s += text(c + 3, cy - r - 2, (k > 0 ? "+" : "") + tick_label(k * scale_um_per_div, scale_um_per_div), "fill='#6b7385' font-size='9'");
   }
   for (int a = 0; a < 360; a += 30) {
     const double th = a * kPi / 180.0;
-    const double r1 = r0 - divisions * ring, r2 = r0 + divisions * ring + 6;
-    s += "<line x1='" + num(c + r1 * std::cos(th)) + "' y1='" + num(c - r1 * std::sin(th)) + "' x2='" +
-         num(c + r2 * std::cos(th)) + "' y2='" + num(c - r2 * std::sin(th)) + "' stroke='#e4e4e4'/>";
-    s += "<text x='" + num(c + (r2 + 10) * std::cos(th)) + "' y='" + num(c - (r2 + 10) * std::sin(th) + 4) +
-         "' text-anchor='middle' fill='#555'>" + std::to_string(a) + "°</text>";
+    const double r1 = r0 - divisions * ring, r2 = r0 + divisions * ring + 4;
+    s += "<line x1='" + num(c + r1 * std::cos(th)) + "' y1='" + num(cy - r1 * std::sin(th)) + "' x2='" + num(c + r2 * std::cos(th)) +
+         "' y2='" + num(cy - r2 * std::sin(th)) + "' stroke='#e6e9ee'/>";
+    std::string lab = std::to_string(a) + "°";
+    if (a == 0) lab = axis_a;
+    if (a == 90) lab = axis_b;
+    s += text(c + (r2 + 14) * std::cos(th), cy - (r2 + 14) * std::sin(th) + 4, lab,
+              "text-anchor='middle' fill='#4a5366'" + std::string(a % 90 == 0 ? " font-weight='600'" : ""));
   }
-  double legend_y = size - 8;
+  double legend_y = h - 36;
   for (const auto& t : traces) {
     std::string pts;
     const std::size_t n = std::min(t.angle_deg.size(), t.deviation_um.size());
-    // Thin out very long traces; the plot resolution is well below 2000 points.
-    const std::size_t stride = std::max<std::size_t>(1, n / 2000);
+    const std::size_t stride = stride_for(n, 2500);
+    double prev_ang = NAN;
     for (std::size_t i = 0; i < n; i += stride) {
       if (!std::isfinite(t.deviation_um[i]) || !std::isfinite(t.angle_deg[i])) continue;
+      // A jump in angle (next revolution or arc) starts a new polyline.
+      if (std::isfinite(prev_ang) && std::abs(t.angle_deg[i] - prev_ang) > 5.0 && std::abs(std::abs(t.angle_deg[i] - prev_ang) - 360.0) > 5.0) {
+        s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" + pts + "'/>";
+        pts.clear();
+      }
+      prev_ang = t.angle_deg[i];
       const double th = t.angle_deg[i] * kPi / 180.0;
       const double r = std::max(0.0, r0 + t.deviation_um[i] * px_per_um);
-      pts += num(c + r * std::cos(th)) + "," + num(c - r * std::sin(th)) + " ";
+      pts += num(c + r * std::cos(th)) + "," + num(cy - r * std::sin(th)) + " ";
     }
-    s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' points='" + pts + "'/>";
-    s += "<rect x='8' y='" + num(legend_y - 9) + "' width='12' height='3' fill='" + t.color + "'/>";
-    s += "<text x='24' y='" + num(legend_y - 5) + "'>" + xml_escape(t.label) + "</text>";
-    legend_y -= 14;
+    s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" + pts + "'/>";
+    if (t.label.empty()) continue;  // a further revolution of a trace already in the legend
+    s += "<rect x='10' y='" + num(legend_y - 5) + "' width='16' height='3' fill='" + t.color + "'/>";
+    s += text(32, legend_y, t.label);
+    legend_y += 15;
   }
-  s += "<text x='" + num(size - 8) + "' y='" + num(size - 8) + "' text-anchor='end' fill='#555'>" +
-       tick_label(scale_um_per_div, scale_um_per_div) + " µm / division</text>";
-  s += "</g></svg>";
-  return s;
+  s += text(w - 10, h - 21, tick_label(scale_um_per_div, scale_um_per_div) + " µm / division", "text-anchor='end' fill='#4a5366'");
+  s += text(w - 10, h - 5, "reference circle = 0 µm", "text-anchor='end' fill='#6b7385' font-size='10'");
+  return s + "</svg>";
 }
 
-std::string line_plot(const std::vector<LineSeries>& series, const std::string& title,
-                      const std::string& x_label, const std::string& y_label) {
-  const double w = 640, h = 300, left = 60, right = 16, top = 28, bottom = 42;
+std::string line_plot(const std::vector<LineSeries>& series, const std::string& title, const std::string& x_label,
+                      const std::string& y_label, double w, double h) {
+  const double left = 64, right = 18, top = 30, bottom = 44;
   double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
+  auto extend_y = [&](double y) {
+    if (std::isfinite(y)) ymin = std::min(ymin, y), ymax = std::max(ymax, y);
+  };
   for (const auto& s : series) {
     const std::size_t n = std::min(s.x.size(), s.y.size());
     for (std::size_t i = 0; i < n; ++i) {
       if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
       xmin = std::min(xmin, s.x[i]), xmax = std::max(xmax, s.x[i]);
-      ymin = std::min(ymin, s.y[i]), ymax = std::max(ymax, s.y[i]);
+      extend_y(s.y[i]);
+      if (i < s.y_lo.size()) extend_y(s.y_lo[i]);
+      if (i < s.y_hi.size()) extend_y(s.y_hi[i]);
     }
   }
   if (!std::isfinite(xmin)) xmin = 0, xmax = 1, ymin = 0, ymax = 1;
-  if (xmax <= xmin) xmax = xmin + 1;
+  if (xmax <= xmin) xmin -= 0.5, xmax += 0.5;
   if (ymax <= ymin) ymin -= 0.5, ymax += 0.5;
-  const double ypad = 0.05 * (ymax - ymin);
+  const double ypad = 0.06 * (ymax - ymin);
   ymin -= ypad, ymax += ypad;
   const auto X = [&](double x) { return left + (x - xmin) / (xmax - xmin) * (w - left - right); };
   const auto Y = [&](double y) { return top + (ymax - y) / (ymax - ymin) * (h - top - bottom); };
 
-  std::string s = "<svg xmlns='http://www.w3.org/2000/svg' viewBox='0 0 640 300' width='640' height='300' "
-                  "font-family='sans-serif' font-size='11'>";
-  s += "<text x='" + num(w / 2) + "' y='16' text-anchor='middle' font-size='13' font-weight='bold'>" +
-       xml_escape(title) + "</text>";
-  s += "<rect x='" + num(left) + "' y='" + num(top) + "' width='" + num(w - left - right) + "' height='" +
-       num(h - top - bottom) + "' fill='none' stroke='#888'/>";
+  std::string s = svg_open(w, h);
+  s += text(w / 2, 17, title, "text-anchor='middle' font-size='13' font-weight='600'");
   const double xs = nice_step(xmax - xmin, 8), ys = nice_step(ymax - ymin, 6);
-  for (double x = std::ceil(xmin / xs) * xs; x <= xmax + 1e-12; x += xs) {
-    s += "<line x1='" + num(X(x)) + "' y1='" + num(top) + "' x2='" + num(X(x)) + "' y2='" + num(h - bottom) +
-         "' stroke='#eee'/><text x='" + num(X(x)) + "' y='" + num(h - bottom + 14) + "' text-anchor='middle'>" +
-         tick_label(x, xs) + "</text>";
-  }
-  for (double y = std::ceil(ymin / ys) * ys; y <= ymax + 1e-12; y += ys) {
-    s += "<line x1='" + num(left) + "' y1='" + num(Y(y)) + "' x2='" + num(w - right) + "' y2='" + num(Y(y)) +
-         "' stroke='#eee'/><text x='" + num(left - 4) + "' y='" + num(Y(y) + 4) + "' text-anchor='end'>" +
-         tick_label(y, ys) + "</text>";
-  }
-  s += "<text x='" + num((left + w - right) / 2) + "' y='" + num(h - 6) + "' text-anchor='middle'>" +
-       xml_escape(x_label) + "</text>";
-  s += "<text transform='translate(14," + num((top + h - bottom) / 2) + ") rotate(-90)' text-anchor='middle'>" +
-       xml_escape(y_label) + "</text>";
-  double ly = top + 12;
+  for (double x : ticks(xmin, xmax, xs))
+    s += "<line x1='" + num(X(x)) + "' y1='" + num(top) + "' x2='" + num(X(x)) + "' y2='" + num(h - bottom) + "' stroke='#edf0f4'/>" +
+         text(X(x), h - bottom + 15, tick_label(x, xs), "text-anchor='middle' fill='#4a5366'");
+  for (double y : ticks(ymin, ymax, ys))
+    s += "<line x1='" + num(left) + "' y1='" + num(Y(y)) + "' x2='" + num(w - right) + "' y2='" + num(Y(y)) + "' stroke='" +
+         (std::abs(y) < ys * 1e-6 ? "#9aa3b2" : "#edf0f4") + "'/>" + text(left - 5, Y(y) + 4, tick_label(y, ys), "text-anchor='end' fill='#4a5366'");
+  s += "<rect x='" + num(left) + "' y='" + num(top) + "' width='" + num(w - left - right) + "' height='" + num(h - top - bottom) +
+       "' fill='none' stroke='#8a93a3'/>";
+  s += text((left + w - right) / 2, h - 8, x_label, "text-anchor='middle'");
+  s += "<text transform='translate(15," + num((top + h - bottom) / 2) + ") rotate(-90)' text-anchor='middle'>" + xml_escape(y_label) + "</text>";
+  // Bands first, so that lines stay on top.
   for (const auto& ser : series) {
+    const std::size_t n = std::min({ser.x.size(), ser.y_lo.size(), ser.y_hi.size()});
+    if (n < 2) continue;
     std::string pts;
+    for (std::size_t i = 0; i < n; ++i) pts += num(X(ser.x[i])) + "," + num(Y(ser.y_hi[i])) + " ";
+    for (std::size_t i = n; i-- > 0;) pts += num(X(ser.x[i])) + "," + num(Y(ser.y_lo[i])) + " ";
+    s += "<polygon points='" + pts + "' fill='" + ser.color + "' fill-opacity='0.13' stroke='" + ser.color +
+         "' stroke-opacity='0.35' stroke-width='0.7'/>";
+  }
+  double ly = top + 14;
+  for (const auto& ser : series) {
     const std::size_t n = std::min(ser.x.size(), ser.y.size());
-    const std::size_t stride = std::max<std::size_t>(1, n / 3000);
-    for (std::size_t i = 0; i < n; i += stride)
-      if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i])) pts += num(X(ser.x[i])) + "," + num(Y(ser.y[i])) + " ";
-    s += "<polyline fill='none' stroke='" + ser.color + "' stroke-width='1.2' points='" + pts + "'/>";
-    s += "<rect x='" + num(w - right - 150) + "' y='" + num(ly - 6) + "' width='12' height='3' fill='" + ser.color +
-         "'/><text x='" + num(w - right - 134) + "' y='" + num(ly - 2) + "'>" + xml_escape(ser.label) + "</text>";
+    const std::size_t stride = stride_for(n, 3000);
+    if (ser.markers) {
+      for (std::size_t i = 0; i < n; i += stride)
+        if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i]))
+          s += "<circle cx='" + num(X(ser.x[i])) + "' cy='" + num(Y(ser.y[i])) + "' r='2.2' fill='" + ser.color + "' fill-opacity='0.7'/>";
+    } else {
+      std::string pts;
+      for (std::size_t i = 0; i < n; i += stride)
+        if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i])) pts += num(X(ser.x[i])) + "," + num(Y(ser.y[i])) + " ";
+      s += "<polyline fill='none' stroke='" + ser.color + "' stroke-width='" + num(ser.width) + "' stroke-linejoin='round'" +
+           (ser.dashed ? " stroke-dasharray='5,3'" : "") + " points='" + pts + "'/>";
+    }
+    if (ser.label.empty()) continue;
+    s += ser.markers ? "<circle cx='" + num(w - right - 176) + "' cy='" + num(ly - 4) + "' r='2.5' fill='" + ser.color + "'/>"
+                     : "<rect x='" + num(w - right - 184) + "' y='" + num(ly - 5) + "' width='16' height='3' fill='" + ser.color + "'/>";
+    s += text(w - right - 162, ly, ser.label, "fill='#1d2330'");
     ly += 14;
   }
-  s += "</svg>";
-  return s;
+  return s + "</svg>";
+}
+
+std::string path_plot(const PathView& v, const std::string& title, const std::string& axis_a, const std::string& axis_b) {
+  const double w = 460, pad = 46, top = 28, max_plot_h = 400;
+  double amin = INFINITY, amax = -INFINITY, bmin = INFINITY, bmax = -INFINITY, dmax_um = 0.0;
+  for (std::size_t i = 0; i < v.cmd_a_mm.size(); ++i) {
+    amin = std::min(amin, v.cmd_a_mm[i]), amax = std::max(amax, v.cmd_a_mm[i]);
+    bmin = std::min(bmin, v.cmd_b_mm[i]), bmax = std::max(bmax, v.cmd_b_mm[i]);
+  }
+  for (std::size_t i = 0; i < v.dev_a_um.size(); ++i) dmax_um = std::max(dmax_um, std::hypot(v.dev_a_um[i], v.dev_b_um[i]));
+  for (std::size_t i = 0; i < v.arrow_da_um.size(); ++i) dmax_um = std::max(dmax_um, std::hypot(v.arrow_da_um[i], v.arrow_db_um[i]));
+  if (!std::isfinite(amin)) amin = bmin = 0, amax = bmax = 1;
+  const double span_mm = std::max({amax - amin, bmax - bmin, 1e-3});
+  // Magnify so that the largest deviation shows as about 8 % of the path's extent.
+  const double mag = dmax_um > 0 ? nice_step(0.08 * span_mm * 1000.0 / dmax_um, 1) : 1.0;
+  const double grow = 0.12 * span_mm;
+  amin -= grow, amax += grow, bmin -= grow, bmax += grow;
+  // Equal scales on both axes; the picture is as tall as the path needs.
+  const double px_per_mm = std::min((w - 2 * pad) / (amax - amin), max_plot_h / (bmax - bmin));
+  const double plot_h = (bmax - bmin) * px_per_mm, h = top + plot_h + pad + 22;
+  const double a0 = (amin + amax) / 2, b0 = (bmin + bmax) / 2, cx = w / 2, cy = top + plot_h / 2;
+  const auto X = [&](double a) { return cx + (a - a0) * px_per_mm; };
+  const auto Y = [&](double b) { return cy - (b - b0) * px_per_mm; };
+  std::string s = svg_open(w, h);
+  s += text(w / 2, 17, title, "text-anchor='middle' font-size='13' font-weight='600'");
+  const double step = nice_step(std::max(amax - amin, bmax - bmin), 6);
+  for (double a : ticks(amin, amax, step))
+    s += "<line x1='" + num(X(a)) + "' y1='" + num(Y(bmin)) + "' x2='" + num(X(a)) + "' y2='" + num(Y(bmax)) + "' stroke='#edf0f4'/>" +
+         text(X(a), Y(bmin) + 14, tick_label(a, step), "text-anchor='middle' fill='#4a5366'");
+  for (double b : ticks(bmin, bmax, step))
+    s += "<line x1='" + num(X(amin)) + "' y1='" + num(Y(b)) + "' x2='" + num(X(amax)) + "' y2='" + num(Y(b)) + "' stroke='#edf0f4'/>" +
+         text(X(amin) - 4, Y(b) + 4, tick_label(b, step), "text-anchor='end' fill='#4a5366'");
+  s += "<rect x='" + num(X(amin)) + "' y='" + num(Y(bmax)) + "' width='" + num((amax - amin) * px_per_mm) + "' height='" +
+       num((bmax - bmin) * px_per_mm) + "' fill='none' stroke='#8a93a3'/>";
+  s += text(cx, Y(bmin) + 30, axis_a + " (mm)", "text-anchor='middle'");
+  s += "<text transform='translate(" + num(X(amin) - 34) + "," + num(cy) + ") rotate(-90)' text-anchor='middle'>" + xml_escape(axis_b + " (mm)") + "</text>";
+  std::string cmd, meas;
+  const std::size_t n = v.cmd_a_mm.size(), stride = stride_for(n, 3000);
+  for (std::size_t i = 0; i < n; i += stride) cmd += num(X(v.cmd_a_mm[i])) + "," + num(Y(v.cmd_b_mm[i])) + " ";
+  const std::size_t nd = std::min(v.base_a_mm.size(), v.dev_a_um.size()), sd = stride_for(nd, 3000);
+  s += "<polyline fill='none' stroke='" + std::string(kGrey) + "' stroke-width='1' stroke-dasharray='4,3' points='" + cmd + "'/>";
+  for (std::size_t i = 0; i < nd; i += sd) {
+    // A gap in the evaluated samples (a stop, a corner) starts a new polyline.
+    if (i > 0 && std::hypot(v.base_a_mm[i] - v.base_a_mm[i - sd], v.base_b_mm[i] - v.base_b_mm[i - sd]) > 0.03 * span_mm) {
+      s += "<polyline fill='none' stroke='" + std::string(kBlue) + "' stroke-width='1.3' points='" + meas + "'/>";
+      meas.clear();
+    }
+    meas += num(X(v.base_a_mm[i] + mag * v.dev_a_um[i] * 1e-3)) + "," + num(Y(v.base_b_mm[i] + mag * v.dev_b_um[i] * 1e-3)) + " ";
+  }
+  if (!meas.empty()) s += "<polyline fill='none' stroke='" + std::string(kBlue) + "' stroke-width='1.3' points='" + meas + "'/>";
+  for (std::size_t i = 0; i < v.arrow_a_mm.size(); ++i) {
+    const double x1 = X(v.arrow_a_mm[i]), y1 = Y(v.arrow_b_mm[i]);
+    const double x2 = X(v.arrow_a_mm[i] + mag * v.arrow_da_um[i] * 1e-3), y2 = Y(v.arrow_b_mm[i] + mag * v.arrow_db_um[i] * 1e-3);
+    s += "<line x1='" + num(x1) + "' y1='" + num(y1) + "' x2='" + num(x2) + "' y2='" + num(y2) + "' stroke='" + kRed + "' stroke-width='2'/>";
+    s += "<circle cx='" + num(x2) + "' cy='" + num(y2) + "' r='3' fill='" + kRed + "'/><circle cx='" + num(x1) + "' cy='" + num(y1) +
+         "' r='2' fill='#333'/>";
+  }
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "deviation magnified ×%g (1 µm → %.3g mm)", mag, mag * 1e-3);
+  s += text(w - 10, h - 6, buf, "text-anchor='end' fill='#4a5366'");
+  s += "<rect x='10' y='" + num(h - 12) + "' width='16' height='3' fill='" + kBlue + "'/>" + text(30, h - 8, "measured (contour)", "");
+  return s + "</svg>";
 }
 
 }  // namespace eical::tools::report

@@ -1,0 +1,120 @@
+// Circular test of a run: find the evaluated revolutions/arcs per direction from the
+// set-point, evaluate each direction (full circle: LSQ centre per revolution; partial
+// arc: programmed centre), combine both directions for H, and run the diagnostics on
+// full circles.
+#include "dsp/analysis/program_evaluations.hpp"
+#include "dsp/core/error.hpp"
+#include "dsp/eval/circle_arc.hpp"
+#include "dsp/eval/circle_segments.hpp"
+
+#include <cmath>
+
+namespace eical::dsp::detail {
+namespace {
+
+using Ranges = std::vector<std::pair<std::int64_t, std::int64_t>>;
+
+// One evaluation of the channel `pos` (measured or reference) over the segments found.
+std::optional<eval::CircleResult> evaluate_channel(const Program& p, const std::vector<std::int64_t>& idx,
+                                                   const std::vector<Eigen::Vector2d>& pos, const Ranges& ccw,
+                                                   const Ranges& cw) {
+  std::optional<eval::CircleResult> out;
+  for (const auto* ranges : {&ccw, &cw}) {
+    if (ranges->empty()) continue;
+    eval::CircleInput in;
+    in.center_mm = {p.center_mm[0], p.center_mm[1]};
+    in.radius_mm = p.radius_mm;
+    in.direction = ranges == &ccw ? "ccw" : "cw";
+    in.sample_index = idx;
+    in.pos_mm = pos;
+    in.segments = *ranges;
+    eval::CircleResult r = p.arc_deg < 360.0 ? eval::evaluate_arc(in, p.arc_deg) : eval::evaluate_circle(in);
+    out = out ? eval::combine(*out, r) : r;
+  }
+  return out;
+}
+
+}  // namespace
+
+void evaluate_circle_program(const Run& run, Analysis& a) {
+  const Measurement& m = a.measurement;
+  const Program& p = run.meta.program;
+  const auto [ia, ib] = plane_axes(p.plane);
+  std::vector<Eigen::Vector2d> cmd, pos, ref;
+  bool ref_finite = run.channels.ref[ia] && run.channels.ref[ib];
+  for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
+    cmd.emplace_back(m.cmd_mm[i][ia], m.cmd_mm[i][ib]);
+    pos.emplace_back(m.pos_mm[i][ia], m.pos_mm[i][ib]);
+    if (ref_finite) {
+      ref.emplace_back(m.ref_mm[i][ia], m.ref_mm[i][ib]);
+      ref_finite = ref.back().allFinite();
+    }
+  }
+  std::vector<std::int64_t> marks;
+  for (const auto& t : m.triggers)
+    if (t.code == 102) marks.push_back(t.sample_index);
+  Ranges ccw, cw;
+  try {
+    for (const auto& s : eval::find_circle_segments(cmd, m.sample_index, marks, {p.center_mm[0], p.center_mm[1]}, p.arc_deg))
+      (s.direction == "ccw" ? ccw : cw).emplace_back(s.begin_index, s.end_index);
+    if (ccw.empty() && cw.empty())
+      throw InputError("no stretch between two M102 marks sweeps the programmed " + std::to_string(p.arc_deg) + " deg about the programmed centre");
+    a.circle = evaluate_channel(p, m.sample_index, pos, ccw, cw);
+  } catch (const InputError& e) {
+    a.flags.push_back(std::string("circle: ") + e.what());
+    a.degraded = true;
+    return;
+  }
+  if (p.direction == "both" && (ccw.empty() || cw.empty()))
+    a.flags.push_back(std::string("circle: the program runs both directions but only ") + (ccw.empty() ? "cw" : "ccw") + " was found");
+  if (!a.circle->circular_hysteresis_H_um)
+    a.flags.push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions (this run has " + a.circle->direction + " only)");
+
+  // The reference instrument (or the simulator's truth) through the same evaluation.
+  if (ref_finite && !ref.empty()) {
+    try {
+      a.circle_reference = evaluate_channel(p, m.sample_index, ref, ccw, cw);
+      const auto& dm = a.circle->trace.radius_deviation_um;
+      const auto& dr = a.circle_reference->trace.radius_deviation_um;
+      if (dm.size() == dr.size() && !dm.empty()) {
+        double ss = 0.0;
+        for (std::size_t i = 0; i < dm.size(); ++i) ss += (dm[i] - dr[i]) * (dm[i] - dr[i]);
+        a.circle_accuracy_rms_um = std::sqrt(ss / static_cast<double>(dm.size()));
+      }
+    } catch (const InputError& e) {
+      a.flags.push_back(std::string("circle reference: ") + e.what());
+    }
+  }
+
+  // Diagnostics: one pass per direction over its steady revolutions.
+  if (p.arc_deg < 360.0) {
+    a.flags.push_back("diagnostics: null, the ballbar-class diagnostics need full revolutions (this run is a " +
+                      std::to_string(static_cast<int>(std::lround(p.arc_deg))) + " deg partial arc)");
+    return;
+  }
+  std::vector<eval::CirclePass> passes;
+  for (const auto* ranges : {&ccw, &cw}) {
+    if (ranges->empty()) continue;
+    eval::CirclePass pass;
+    pass.direction = ranges == &ccw ? +1 : -1;
+    pass.fs_hz = m.fs_hz;
+    for (std::size_t i = 0; i < m.sample_index.size(); ++i)
+      if (m.sample_index[i] >= ranges->front().first && m.sample_index[i] < ranges->back().second) {
+        pass.cmd_mm.push_back(cmd[i]);
+        pass.meas_mm.push_back(pos[i]);
+      }
+    passes.push_back(std::move(pass));
+  }
+  eval::DiagnosticsOptions opt;
+  opt.centre_mm = {p.center_mm[0], p.center_mm[1]};
+  opt.radius_mm = p.radius_mm;
+  try {
+    a.diagnostics = eval::diagnose_circle(passes, opt);
+    if (!a.diagnostics->servo_and_squareness_separated)
+      a.flags.push_back("diagnostics.servo_mismatch_ms: null, one direction cannot separate servo mismatch from squareness (squareness assumes equal lags)");
+  } catch (const InputError& e) {
+    a.flags.push_back(std::string("diagnostics: null, ") + e.what());
+  }
+}
+
+}  // namespace eical::dsp::detail

@@ -1,0 +1,42 @@
+// Rectangle and free-form programs of a run: both compare the measured path with the
+// set-point; the rectangle in its plane at the corner stops, the free form along the
+// whole path in 3-D.
+#include "dsp/analysis/program_evaluations.hpp"
+#include "dsp/core/error.hpp"
+
+namespace eical::dsp::detail {
+
+void evaluate_rectangle_program(const Run& run, Analysis& a) {
+  const Measurement& m = a.measurement;
+  const auto [ia, ib] = plane_axes(run.meta.program.plane);
+  std::vector<Eigen::Vector2d> cmd, meas;
+  for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
+    cmd.emplace_back(m.cmd_mm[i][ia], m.cmd_mm[i][ib]);
+    meas.emplace_back(m.pos_mm[i][ia], m.pos_mm[i][ib]);
+  }
+  try {
+    a.rectangle = eval::evaluate_rectangle(cmd, meas, m.fs_hz);
+  } catch (const InputError& e) {
+    a.flags.push_back(std::string("rectangle: null, ") + e.what());
+    a.degraded = true;
+  }
+  // The contour between the corners as well: the rectangle is a free form too.
+  try {
+    a.path = eval::path_deviation(m.cmd_mm, m.pos_mm, m.fs_hz);
+  } catch (const InputError& e) {
+    a.flags.push_back(std::string("path deviation: ") + e.what());
+  }
+}
+
+void evaluate_freeform_program(const Run& run, Analysis& a) {
+  (void)run;
+  const Measurement& m = a.measurement;
+  try {
+    a.path = eval::path_deviation(m.cmd_mm, m.pos_mm, m.fs_hz);
+  } catch (const InputError& e) {
+    a.flags.push_back(std::string("freeform: null, ") + e.what());
+    a.degraded = true;
+  }
+}
+
+}  // namespace eical::dsp::detail
