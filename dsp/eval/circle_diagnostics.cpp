@@ -150,8 +150,9 @@ double reversal_spike_um(const std::vector<CirclePass>& passes, const std::vecto
         double peak = 0.0;
         for (std::size_t k = i; k < i + window; ++k)
           if (std::abs(fit.residual_mm[pi][k]) > std::abs(peak)) peak = fit.residual_mm[pi][k];
-        // Sign so that a spike in the direction of the new motion (overshoot) is positive.
-        sum += peak * s;
+        // Positive when the axis lags behind its new direction (friction holds it at the
+        // reversal, the usual reversal spike); an overshoot is negative.
+        sum -= peak * s;
         ++count;
       }
       if (s != 0) last = s;
@@ -186,9 +187,16 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
 
   std::array<bool, n_cols> use{};
   use.fill(true);
-  const std::vector<double> pitches =
-      opt.cyclic_pitch_mm ? std::vector<double>{*opt.cyclic_pitch_mm}
-                          : std::vector<double>{1.0, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0};
+  // A pitch is identifiable only with at least two periods over the diameter; longer ones
+  // are collinear with scale, offset and bow.
+  std::vector<double> pitches;
+  if (opt.cyclic_pitch_mm) {
+    pitches = {*opt.cyclic_pitch_mm};
+  } else {
+    for (double p : {1.0, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0})
+      if (p <= opt.radius_mm) pitches.push_back(p);
+    if (pitches.empty()) pitches = {opt.radius_mm};
+  }
 
   CircleDiagnostics d;
   // Y first: its lag is identifiable from one direction (v_y follows cos θ, squareness
@@ -226,9 +234,11 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
   d.servo_mismatch_ms = d.lag_x_ms - d.lag_y_ms;
   d.squareness_urad = cx(square) * 1e6;
   d.scale_mismatch_ppm = (cx(scale) - cy(scale)) * 1e6;
-  // Bow of X's travel is seen on y, and the other way round.
-  d.straightness_x_um = cy(bow) * kUmPerMm;
-  d.straightness_y_um = cx(bow) * kUmPerMm;
+  // Bow of X's travel is seen on y, and the other way round; reported as the deviation at
+  // mid-travel relative to the ends of the circle's span (the u² column is zero at mid-travel
+  // and one at the ends, hence the sign).
+  d.straightness_x_um = -cy(bow) * kUmPerMm;
+  d.straightness_y_um = -cx(bow) * kUmPerMm;
   d.reversal_spike_x_um = reversal_spike_um(passes, vel, fits[0], 0, window);
   d.reversal_spike_y_um = reversal_spike_um(passes, vel, fits[1], 1, window);
 
@@ -250,8 +260,13 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
       ++n;
     }
   if (n > 0) {
-    d.vibration_um = std::sqrt(ss_rad / static_cast<double>(n)) * kUmPerMm;
-    d.stick_slip_um = std::sqrt(ss_tan / static_cast<double>(n)) * kUmPerMm;
+    // Over full revolutions a vibration in any direction of the plane projects equally on
+    // the radial and the tangential direction; what the tangential residual holds beyond
+    // that is motion along the path: stick-slip, a sawtooth from 0 to the lag A whose RMS
+    // is A/(2√3).
+    const double rad2 = ss_rad / static_cast<double>(n), tan2 = ss_tan / static_cast<double>(n);
+    d.vibration_um = std::sqrt(rad2) * kUmPerMm;
+    d.stick_slip_um = 2.0 * std::sqrt(3.0) * std::sqrt(std::max(0.0, tan2 - rad2)) * kUmPerMm;
   }
   d.residual_rms_um = std::hypot(fits[0].rms_mm, fits[1].rms_mm) * kUmPerMm;
   return d;

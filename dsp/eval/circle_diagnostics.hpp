@@ -45,15 +45,15 @@ struct DiagnosticsOptions {
 
 struct CircleDiagnostics {
   double backlash_x_um = 0, backlash_y_um = 0;
-  double reversal_spike_x_um = 0, reversal_spike_y_um = 0;
+  double reversal_spike_x_um = 0, reversal_spike_y_um = 0;  // positive: the axis lags after reversing
   double lateral_play_x_um = 0, lateral_play_y_um = 0;
   double cyclic_error_x_um = 0, cyclic_error_y_um = 0;  // amplitude
   double cyclic_pitch_mm = 0;
   double servo_mismatch_ms = 0;
   double squareness_urad = 0;
   double scale_mismatch_ppm = 0;
-  double straightness_x_um = 0, straightness_y_um = 0;  // bow of the axis' path
-  double stick_slip_um = 0;   // tangential jerk steps: RMS of the fast tangential residual
+  double straightness_x_um = 0, straightness_y_um = 0;  // bow of the axis' path at mid-travel vs its ends
+  double stick_slip_um = 0;   // sawtooth lag along the path: 2√3·√(tangential² − radial²) of the residual RMS
   double vibration_um = 0;    // radial residual RMS above the model (fast components)
   double lag_x_ms = 0, lag_y_ms = 0;  // each axis' lag behind the set-point (common servo lag)
   double residual_rms_um = 0;         // what the model leaves

@@ -20,8 +20,8 @@ struct Injected {
   double lag_x_ms = 0, lag_y_ms = 0;
   double squareness_urad = 0;
   double scale_x_ppm = 0, scale_y_ppm = 0;
-  double straightness_x_um = 0;  // bow of X travel, seen on y
-  double spike_x_um = 0;         // decaying overshoot after each x reversal
+  double straightness_x_um = 0;  // bow of X travel at mid-travel vs the span's ends, seen on y
+  double spike_x_um = 0;         // decaying lag after each x reversal (friction holds the axis)
   double noise_um = 0.1;
 };
 
@@ -47,10 +47,10 @@ CirclePass make_pass(int direction, const Injected& in, std::uint64_t seed) {
     Eigen::Vector2d e;
     e.x() = in.scale_x_ppm * 1e-6 * c.x() - in.squareness_urad * 1e-6 * c.y() - in.lag_x_ms * 1e-3 * v.x() -
             in.backlash_x_um * 1e-3 / 2 * sx + in.lateral_x_um * 1e-3 / 2 * sy +
-            in.cyclic_x_um * 1e-3 * std::sin(2 * std::numbers::pi * c.x() / in.pitch_mm + 0.3) +
-            in.spike_x_um * 1e-3 * sx * std::exp(-since_rev_s / 0.008);
+            in.cyclic_x_um * 1e-3 * std::sin(2 * std::numbers::pi * c.x() / in.pitch_mm + 0.3)
+            - in.spike_x_um * 1e-3 * sx * std::exp(-since_rev_s / 0.008);
     e.y() = in.scale_y_ppm * 1e-6 * c.y() - in.lag_y_ms * 1e-3 * v.y() - in.backlash_y_um * 1e-3 / 2 * sy +
-            in.straightness_x_um * 1e-3 * (c.x() / kR) * (c.x() / kR);
+            in.straightness_x_um * 1e-3 * (1.0 - (c.x() / kR) * (c.x() / kR));
     // Integration drift: an offset and a slow quadratic per pass.
     e += Eigen::Vector2d(0.004 + 0.002 * t / 7.5, -0.003 + 0.003 * (t / 7.5) * (t / 7.5));
     e += Eigen::Vector2d(noise(rng), noise(rng));
