@@ -11,4 +11,14 @@ DynamicCoefficients dynamic_coefficients(const SensorSpec& spec, double d, Dynam
   return {d + 2.0 * zeta / w0, d * d / 2.0 + 2.0 * zeta * d / w0 + 1.0 / (w0 * w0)};  // (6-38) with the delay
 }
 
+const char* dynamic_comp_name(DynamicComp mode) noexcept {
+  switch (mode) {
+    case DynamicComp::none: return "none";
+    case DynamicComp::acceleration_level: return "acceleration level (6-33)";
+    case DynamicComp::velocity_level: return "velocity level (6-34)";
+    case DynamicComp::position_level: return "position level, two-stage (6-38)";
+  }
+  return "?";
+}
+
 }  // namespace eical::dsp

@@ -1,6 +1,9 @@
 #include "dsp/pipeline/pipeline.hpp"
 
+#include "dsp/core/error.hpp"
+
 #include <cmath>
+#include <string>
 
 namespace eical::dsp {
 namespace {
@@ -31,6 +34,7 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
       "no_zupt_window: no rest after the motion (velocity drift not removed)",
       "capacity_exceeded: the measurement is longer than the trace capacity (end cut off)",
       "no_end_trigger: no M103 (103) trigger; the measurement ends with the data",
+      "fixed_saturated: the fixed-point path clamped a value outside its Q-format range",
   };
   std::vector<std::string> out;
   for (std::uint32_t b = 0; b < std::size(names); ++b)
@@ -38,29 +42,42 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
   return out;
 }
 
-Pipeline::Pipeline(const PipelineConfig& c) : config_(c), dt_s_(1.0 / c.acquisition.fs_hz) {
+Pipeline::Pipeline(const PipelineConfig& c)
+    : config_(c), fixed_(c.arithmetic == Arithmetic::fixed_q), dt_s_(1.0 / c.acquisition.fs_hz) {
+  if (fixed_ && c.coriolis) throw InputError("pipeline: the fixed-point path has no Coriolis term; use double arithmetic");
+  if (fixed_ && c.dynamic != DynamicComp::none && c.dynamic != DynamicComp::position_level)
+    throw InputError(std::string("pipeline: the fixed-point path compensates the dynamics at the position level only, not ") +
+                     dynamic_comp_name(c.dynamic));
   const double delay_s = c.acquisition.daq_group_delay_samples / c.acquisition.fs_hz;
+  if (c.coriolis) coriolis_ = CoriolisComp(c.site);
   for (int s = 0; s < 2; ++s) {
-    comp_[s] = StaticComp(c.sensors[s], c.acquisition, c.site);
-    dyn_[s] = dynamic_coefficients(c.sensors[s], delay_s, c.dynamic);
-    last_valid_a_[s] = bias_sum_[s] = bias_[s] = a_prev_[s] = v_[s] = Eigen::Vector3d::Zero();
+    comp_[s] = StaticComp(c.sensors[s], c.acquisition, c.site, c.calibration[s], c.static_comp);
+    fcomp_[s] = FixedStaticComp(comp_[s]);
+    const DynamicCoefficients dyn = dynamic_coefficients(c.sensors[s], delay_s, c.dynamic);
+    integ_[s] = SensorIntegrator(c.dynamic, dyn, dt_s_);
+    finteg_[s] = FixedIntegrator(dt_s_, dyn);
+    temp_c_[s] = static_cast<float>(c.sensors[s].temp_ref_c);
   }
   m_.fs_hz = c.acquisition.fs_hz;
   for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->reserve(c.capacity_samples);
   m_.sample_index.reserve(c.capacity_samples);
   m_.triggers.reserve(trigger_capacity_);
+  reset();
 }
 
 void Pipeline::reset() noexcept {
   phase_ = Phase::wait_start;
   quality_ = 0;
+  saturation_ = {};
   saw_start_ = saw_end_ = false;
   prev_index_ = -1;
   prev_cmd_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   bias_n_ = 0;
-  for (int s = 0; s < 2; ++s) last_valid_a_[s] = bias_sum_[s] = bias_[s] = a_prev_[s] = v_[s] = Eigen::Vector3d::Zero();
-  v_rel_prev_.setZero();
-  x_rel_.setZero();
+  for (int s = 0; s < 2; ++s) {
+    a_[s] = last_valid_a_[s] = bias_sum_[s] = bias_[s] = Eigen::Vector3d::Zero();
+    for (auto& h : rest_hist_[s]) h.setZero();
+    for (int i = 0; i < 3; ++i) aq_[s][i] = last_valid_aq_[s][i] = fbias_[s][i] = 0, fbias_sum_[s][i] = 0;
+  }
   start_index_ = motion_end_index_ = -1;
   live_ = LiveEstimate{};
   m_.sample_index.clear();
@@ -80,22 +97,78 @@ void Pipeline::store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen:
   m_.ref_mm.emplace_back(f.ref_mm[0], f.ref_mm[1], f.ref_mm[2]);
 }
 
+// Static compensation of both sensors into a_ (double) or aq_ (fixed); bad accelerations
+// are replaced by the last valid ones, a missing temperature by the last valid one.
+void Pipeline::compensate(const Frame& f) noexcept {
+  for (int s = 0; s < 2; ++s)
+    if (!(f.flags & frame_flag::temp_missing) && std::isfinite(f.temp_c[s])) temp_c_[s] = f.temp_c[s];
+  const bool bad = (f.flags & kAccelBad) != 0;
+  for (int s = 0; s < 2; ++s) {
+    if (fixed_) {
+      if (!bad) fcomp_[s].apply(&f.accel_counts[3 * s], temp_q24_c(temp_c_[s]), last_valid_aq_[s], saturation_);
+      for (int i = 0; i < 3; ++i) aq_[s][i] = last_valid_aq_[s][i];
+    } else {
+      if (!bad) last_valid_a_[s] = comp_[s].apply(&f.accel_counts[3 * s], temp_c_[s]);
+      a_[s] = last_valid_a_[s];
+    }
+  }
+  if (saturation_.hit) quality_ |= quality_flag::fixed_saturated;
+}
+
+// First motion of the set-point: the sensors (delayed by d) still see the rest, so the
+// rest mean is the bias; integration starts here.
+void Pipeline::start_motion() noexcept {
+  for (int s = 0; s < 2; ++s) {
+    if (fixed_) {
+      std::int64_t as[3];
+      for (int i = 0; i < 3; ++i) {
+        fbias_[s][i] = bias_n_ > 0 ? fx::sat64(fx::div_round(fbias_sum_[s][i], static_cast<fx::i128>(bias_n_)), saturation_) : aq_[s][i];
+        as[i] = fx::sub_sat(aq_[s][i], fbias_[s][i], saturation_);
+        bias_[s][i] = fx::to_double(fbias_[s][i], fx::kAccelQ);
+      }
+      finteg_[s].start(as);
+    } else {
+      bias_[s] = bias_n_ > 0 ? Eigen::Vector3d(bias_sum_[s] / static_cast<double>(bias_n_)) : a_[s];
+      Eigen::Vector3d hist[3];
+      for (int k = 0; k < 3; ++k) hist[k] = k < static_cast<int>(bias_n_) ? Eigen::Vector3d(rest_hist_[s][k] - bias_[s]) : Eigen::Vector3d::Zero();
+      integ_[s].start(a_[s] - bias_[s], hist);
+    }
+  }
+}
+
+void Pipeline::integrate(std::int64_t k_samples, double dt, Eigen::Vector3d& pos_m, Eigen::Vector3d& vel_mps) noexcept {
+  if (fixed_) {
+    std::int64_t x_q40[2][3], v_q40[2][3];
+    for (int s = 0; s < 2; ++s) {
+      std::int64_t as[3];
+      for (int i = 0; i < 3; ++i) as[i] = fx::sub_sat(aq_[s][i], fbias_[s][i], saturation_);
+      finteg_[s].step(as, k_samples, saturation_);
+      for (int i = 0; i < 3; ++i) x_q40[s][i] = finteg_[s].x_q40_m(i, saturation_), v_q40[s][i] = finteg_[s].v_q40_mps(i, saturation_);
+    }
+    for (int i = 0; i < 3; ++i) {  // head − table (3-1)
+      pos_m[i] = fx::to_double(fx::sub_sat(x_q40[1][i], x_q40[0][i], saturation_), kOutQ);
+      vel_mps[i] = fx::to_double(fx::sub_sat(v_q40[1][i], v_q40[0][i], saturation_), kOutQ);
+    }
+    if (saturation_.hit) quality_ |= quality_flag::fixed_saturated;
+    return;
+  }
+  for (int s = 0; s < 2; ++s) {
+    Eigen::Vector3d as = a_[s] - bias_[s];
+    if (config_.coriolis) as = coriolis_.apply(as, integ_[s].v_mps);  // (3-6), velocity fed back
+    integ_[s].step(as, dt);
+  }
+  pos_m = integ_[1].x_out_m - integ_[0].x_out_m;  // head − table (3-1)
+  vel_mps = integ_[1].v_out_mps - integ_[0].v_out_mps;
+}
+
 void Pipeline::step(const Frame& f) noexcept {
-  // Quality of this frame; bad accelerations are replaced by the last valid ones.
   if (f.flags & frame_flag::accel_missing) quality_ |= quality_flag::accel_missing;
   if (f.flags & frame_flag::accel_saturated) quality_ |= quality_flag::accel_saturated;
   if (f.flags & frame_flag::not_finite) quality_ |= quality_flag::not_finite;
   if (f.flags & frame_flag::gap_before) quality_ |= quality_flag::frames_lost;
-  Eigen::Vector3d a[2];
-  for (int s = 0; s < 2; ++s) {
-    if (f.flags & kAccelBad) {
-      a[s] = last_valid_a_[s];
-    } else {
-      a[s] = comp_[s].apply(&f.accel_counts[3 * s]);
-      last_valid_a_[s] = a[s];
-    }
-  }
-  const double dt = prev_index_ >= 0 ? static_cast<double>(f.sample_index - prev_index_) * dt_s_ : dt_s_;
+  compensate(f);
+  const std::int64_t k_samples = prev_index_ >= 0 ? f.sample_index - prev_index_ : 1;
+  const double dt = static_cast<double>(k_samples) * dt_s_;
   prev_index_ = f.sample_index;
   if (f.trigger != 0 && m_.triggers.size() < trigger_capacity_) m_.triggers.push_back({f.sample_index, f.trigger});
   if (f.trigger == 101) saw_start_ = true;
@@ -114,45 +187,33 @@ void Pipeline::step(const Frame& f) noexcept {
       [[fallthrough]];
     case Phase::rest:
       if (!cmd_moved) {
-        for (int s = 0; s < 2; ++s) bias_sum_[s] += a[s];
+        for (int s = 0; s < 2; ++s) {
+          if (fixed_) {
+            for (int i = 0; i < 3; ++i) fbias_sum_[s][i] += aq_[s][i];
+          } else {
+            bias_sum_[s] += a_[s];
+            rest_hist_[s][2] = rest_hist_[s][1], rest_hist_[s][1] = rest_hist_[s][0], rest_hist_[s][0] = a_[s];
+          }
+        }
         ++bias_n_;
         return;
       }
-      // First motion of the set-point: the sensors (delayed by d) still see the rest,
-      // so the rest mean is the bias; integration starts here at the set-point.
-      for (int s = 0; s < 2; ++s) {
-        bias_[s] = bias_n_ > 0 ? Eigen::Vector3d(bias_sum_[s] / static_cast<double>(bias_n_)) : a[s];
-        a_prev_[s] = a[s] - bias_[s];
-        v_[s].setZero();
-      }
+      start_motion();
       if (bias_n_ < static_cast<std::size_t>(0.1 / dt_s_)) quality_ |= quality_flag::short_rest_window;
       m_.rest_bias_rel_mps2 = bias_[1] - bias_[0];
       m_.rest_window_samples = bias_n_;
       start_pos_mm_ = prev_cmd_;
       start_index_ = motion_end_index_ = f.sample_index;
-      v_rel_prev_.setZero();
-      x_rel_.setZero();
       phase_ = Phase::moving;
       live_.integrating = true;
       store(f, start_pos_mm_, Eigen::Vector3d::Zero());
       return;
     case Phase::moving: {
       if (cmd_moved) motion_end_index_ = f.sample_index;
-      Eigen::Vector3d x_kor = Eigen::Vector3d::Zero(), v_kor = Eigen::Vector3d::Zero();
-      for (int s = 0; s < 2; ++s) {
-        const Eigen::Vector3d as = a[s] - bias_[s];
-        v_[s] += 0.5 * (as + a_prev_[s]) * dt;  // trapezoid
-        // Head counts +, table − (relative motion head − table, 3-1); (6-38) per sensor.
-        const double sign = s == 1 ? 1.0 : -1.0;
-        x_kor += sign * (dyn_[s].c1_s * v_[s] + dyn_[s].c2_s2 * as);
-        v_kor += sign * dyn_[s].c1_s * as;
-        a_prev_[s] = as;
-      }
-      const Eigen::Vector3d v_rel = v_[1] - v_[0];
-      x_rel_ += 0.5 * (v_rel + v_rel_prev_) * dt;
-      v_rel_prev_ = v_rel;
-      const Eigen::Vector3d pos_mm = start_pos_mm_ + (x_rel_ + x_kor) * 1000.0;
-      const Eigen::Vector3d vel_mm_s = (v_rel + v_kor) * 1000.0;
+      Eigen::Vector3d pos_m, vel_mps;
+      integrate(k_samples, dt, pos_m, vel_mps);
+      const Eigen::Vector3d pos_mm = start_pos_mm_ + pos_m * 1000.0;
+      const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
       live_.pos_mm = pos_mm;
       live_.vel_mm_s = vel_mm_s;
       store(f, pos_mm, vel_mm_s);  // frames after M103 belong to the rest (ZUPT) window too

@@ -1,21 +1,26 @@
 #pragma once
-// The DSP pipeline v1: frames → relative position head − table in machine axes.
+// The DSP pipeline: frames → relative position head − table in machine axes.
 // Causal per-sample step() (live, in eicald's DSP thread) and an offline finish() that
 // adds what needs the whole measurement (ZUPT at the rest after the motion). The same
-// code runs live and offline.
+// code runs live and offline, in double or in Q-format integers (Arithmetic).
 //
-//   1 static compensation per sensor (StaticComp)
+//   1 static compensation per sensor (StaticComp / FixedStaticComp): (6-16) with the
+//     frames' case temperature, (6-17) and cross terms, (6-18) into machine axes
 //   2 bias from the rest window M101 → first set-point motion (per sensor: it removes
 //     gravity, the data-sheet bias error and the machine's tilt in one go)
-//   3 trapezoid integration of each sensor's velocity; relative velocity and position
-//     integrated from the start of the motion, starting at the set-point there
-//   4 two-stage dynamic compensation (6-38) with the DAQ delay, per sensor at the
-//     position level: X_kor = X + Σ ±(c1·V_s + c2·A_s)
+//   3 Coriolis (3-6) with each sensor's velocity fed back from its first integrator
+//   4 trapezoid integration of each sensor from the start of the motion with the dynamic
+//     compensation (PT2 + DAQ delay) at the chosen level (SensorIntegrator /
+//     FixedIntegrator); relative = head − table (3-1), starting at the set-point there
 //   5 finish(): ZUPT at every standstill of the set-point — the velocity left there is
 //     the integrated acceleration error; it is removed piecewise linearly in time
 #include "dsp/core/frame.hpp"
 #include "dsp/core/run_meta.hpp"
+#include "dsp/pipeline/coriolis.hpp"
 #include "dsp/pipeline/dynamic_comp.hpp"
+#include "dsp/pipeline/fixed_integrator.hpp"
+#include "dsp/pipeline/fixed_static_comp.hpp"
+#include "dsp/pipeline/sensor_integrator.hpp"
 #include "dsp/pipeline/static_comp.hpp"
 
 #include <Eigen/Core>
@@ -28,12 +33,23 @@
 
 namespace eical::dsp {
 
+// double: the reference path. fixed_q: static compensation, bias and integrators in
+// Q-format integers (fixed_point.hpp); supports DynamicComp none and position_level
+// (two_stage) and no Coriolis term (the constructor says so otherwise).
+enum class Arithmetic { double_precision, fixed_q };
+
 struct PipelineConfig {
   Acquisition acquisition;
   Site site;
   SensorSpec sensors[2];
+  StaticCalibration calibration[2];  // cross terms and mounting (6-4, 6-18); default: data sheet
   std::size_t capacity_samples = 0;  // longest measurement the trace can hold
   DynamicComp dynamic = DynamicComp::two_stage;
+  StaticCompOptions static_comp;     // temperature (6-16) and nonlinearity (6-17) on/off
+  // (3-6) Earth-rate Coriolis from [site]. Off by default: the simulator's built-in runs
+  // leave it out (sc.coriolis), and correcting a term that is absent adds it. Real runs: on.
+  bool coriolis = false;
+  Arithmetic arithmetic = Arithmetic::double_precision;
   double zupt_settle_s = 0.05;       // after the set-point stops (plus the DAQ delay)
   bool zupt = true;
 };
@@ -52,6 +68,7 @@ inline constexpr std::uint32_t short_rest_window = 1u << 6;
 inline constexpr std::uint32_t no_zupt_window = 1u << 7;
 inline constexpr std::uint32_t capacity_exceeded = 1u << 8;
 inline constexpr std::uint32_t no_end_trigger = 1u << 9;
+inline constexpr std::uint32_t fixed_saturated = 1u << 10;
 }  // namespace quality_flag
 
 std::vector<std::string> quality_flag_names(std::uint32_t bits);
@@ -99,11 +116,27 @@ class Pipeline {
   enum class Phase { wait_start, rest, moving };
   void apply_zupt(Measurement& m);
   void store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept;
+  void compensate(const Frame& f) noexcept;
+  void start_motion() noexcept;
+  void integrate(std::int64_t k_samples, double dt_s, Eigen::Vector3d& pos_m, Eigen::Vector3d& vel_mps) noexcept;
 
   PipelineConfig config_;
+  bool fixed_ = false;
   StaticComp comp_[2];
-  DynamicCoefficients dyn_[2];
+  FixedStaticComp fcomp_[2];
+  SensorIntegrator integ_[2];
+  FixedIntegrator finteg_[2];
+  CoriolisComp coriolis_;
+  fx::Saturation saturation_;
   double dt_s_;
+  float temp_c_[2] = {0.0F, 0.0F};  // last valid case temperature
+  // This frame's compensated acceleration (double path, m/s²; fixed path, Q40 m/s²).
+  Eigen::Vector3d a_[2];
+  std::int64_t aq_[2][3] = {};
+  std::int64_t last_valid_aq_[2][3] = {};
+  fx::i128 fbias_sum_[2][3] = {};
+  std::int64_t fbias_[2][3] = {};
+  Eigen::Vector3d rest_hist_[2][3];  // the last three rest samples (derivative history)
   Phase phase_ = Phase::wait_start;
   std::uint32_t quality_ = 0;
   bool saw_start_ = false, saw_end_ = false;
@@ -114,9 +147,6 @@ class Pipeline {
   Eigen::Vector3d bias_sum_[2];
   std::size_t bias_n_ = 0;
   Eigen::Vector3d bias_[2];
-  // Integrator state (m, m/s, m/s²), per sensor and relative.
-  Eigen::Vector3d a_prev_[2], v_[2];
-  Eigen::Vector3d v_rel_prev_ = Eigen::Vector3d::Zero(), x_rel_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d start_pos_mm_ = Eigen::Vector3d::Zero();
   std::int64_t start_index_ = -1, motion_end_index_ = -1;
   LiveEstimate live_;
