@@ -30,7 +30,7 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
       "not_finite: NaN or Inf in a sample (last valid value held)",
       "no_start_trigger: no M101 (101) trigger; rest window taken from the start of the data",
       "no_motion: the set-point never moved",
-      "short_rest_window: fewer than 0.1 s at rest before the motion (bias uncertain)",
+      "short_rest_window: fewer than 0.05 s at rest before the motion (bias uncertain)",
       "no_zupt_window: no rest after the motion (velocity drift not removed)",
       "capacity_exceeded: the measurement is longer than the trace capacity (end cut off)",
       "no_end_trigger: no M103 (103) trigger; the measurement ends with the data",
@@ -48,12 +48,17 @@ Pipeline::Pipeline(const PipelineConfig& c)
   if (fixed_ && c.dynamic != DynamicComp::none && c.dynamic != DynamicComp::position_level)
     throw InputError(std::string("pipeline: the fixed-point path compensates the dynamics at the position level only, not ") +
                      dynamic_comp_name(c.dynamic));
-  const double delay_s = c.acquisition.daq_group_delay_samples / c.acquisition.fs_hz;
+  // The DAQ delay is not inverted by the series of dynamic_comp.hpp: a pure delay is exact
+  // as a re-indexing of the trace (finish()), which also holds for the sharp transients of
+  // backlash engagement and stick-slip, where the second-order series errs by c2·A (tens of
+  // µm). The integrators compensate the sensor's PT2 only; the live estimate is predicted
+  // over the delay.
+  delay_samples_ = c.acquisition.daq_group_delay_samples;
   if (c.coriolis) coriolis_ = CoriolisComp(c.site);
   for (int s = 0; s < 2; ++s) {
     comp_[s] = StaticComp(c.sensors[s], c.acquisition, c.site, c.calibration[s], c.static_comp);
     fcomp_[s] = FixedStaticComp(comp_[s]);
-    const DynamicCoefficients dyn = dynamic_coefficients(c.sensors[s], delay_s, c.dynamic);
+    const DynamicCoefficients dyn = dynamic_coefficients(c.sensors[s], 0.0, c.dynamic);
     integ_[s] = SensorIntegrator(c.dynamic, dyn, dt_s_);
     finteg_[s] = FixedIntegrator(dt_s_, dyn);
     temp_c_[s] = static_cast<float>(c.sensors[s].temp_ref_c);
@@ -199,7 +204,9 @@ void Pipeline::step(const Frame& f) noexcept {
         return;
       }
       start_motion();
-      if (bias_n_ < static_cast<std::size_t>(0.1 / dt_s_)) quality_ |= quality_flag::short_rest_window;
+      // The programs dwell 0.1 s after M101; a trigger that reaches the DAQ clock a few
+      // samples late must not flag a good rest.
+      if (bias_n_ < static_cast<std::size_t>(0.05 / dt_s_)) quality_ |= quality_flag::short_rest_window;
       m_.rest_bias_rel_mps2 = bias_[1] - bias_[0];
       m_.rest_window_samples = bias_n_;
       start_pos_mm_ = prev_cmd_;
@@ -214,7 +221,8 @@ void Pipeline::step(const Frame& f) noexcept {
       integrate(k_samples, dt, pos_m, vel_mps);
       const Eigen::Vector3d pos_mm = start_pos_mm_ + pos_m * 1000.0;
       const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
-      live_.pos_mm = pos_mm;
+      // Predicted over the DAQ delay (what finish() re-indexes exactly).
+      live_.pos_mm = config_.dynamic == DynamicComp::none ? pos_mm : Eigen::Vector3d(pos_mm + vel_mm_s * (delay_samples_ * dt_s_));
       live_.vel_mm_s = vel_mm_s;
       store(f, pos_mm, vel_mm_s);  // frames after M103 belong to the rest (ZUPT) window too
       return;
@@ -285,6 +293,29 @@ void Pipeline::apply_zupt(Measurement& m) {
   }
 }
 
+void Pipeline::align_delay(Measurement& m) const {
+  // Sample k of the trace holds what the sensors saw at k − d (DAQ filter delay, 38.8
+  // samples nominal): move it back by d so that it lines up with the set-point and the
+  // reference, interpolating linearly between samples; the last d samples (at rest after
+  // the motion) hold the final value.
+  const std::size_t n = m.pos_mm.size();
+  const double d = delay_samples_;
+  if (!(d > 0.0) || n < 2) return;
+  for (auto* trace : {&m.pos_mm, &m.vel_mm_s}) {
+    auto& x = *trace;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double src = static_cast<double>(k) + d;
+      const auto i = static_cast<std::size_t>(src);
+      if (i + 1 >= n) {
+        x[k] = x[n - 1];
+        continue;
+      }
+      const double f = src - static_cast<double>(i);
+      x[k] = (1.0 - f) * x[i] + f * x[i + 1];  // i ≥ k: reads ahead of what it writes
+    }
+  }
+}
+
 Measurement Pipeline::finish() {
   Measurement m = std::move(m_);
   m_ = Measurement{};
@@ -294,6 +325,8 @@ Measurement Pipeline::finish() {
   m.motion_end_index = motion_end_index_;
   if (phase_ != Phase::moving) quality_ |= quality_flag::no_motion;
 
+  // DynamicComp::none leaves the DAQ delay in as well (the thesis' "uncompensated").
+  if (config_.dynamic != DynamicComp::none && phase_ == Phase::moving && !m.sample_index.empty()) align_delay(m);
   if (config_.zupt && phase_ == Phase::moving && !m.sample_index.empty()) apply_zupt(m);
   m.flags = quality_flag_names(quality_);
   m.degraded = quality_ != 0;

@@ -10,10 +10,12 @@
 //     gravity, the data-sheet bias error and the machine's tilt in one go)
 //   3 Coriolis (3-6) with each sensor's velocity fed back from its first integrator
 //   4 trapezoid integration of each sensor from the start of the motion with the dynamic
-//     compensation (PT2 + DAQ delay) at the chosen level (SensorIntegrator /
-//     FixedIntegrator); relative = head − table (3-1), starting at the set-point there
-//   5 finish(): ZUPT at every standstill of the set-point — the velocity left there is
-//     the integrated acceleration error; it is removed piecewise linearly in time
+//     compensation of the PT2 at the chosen level (SensorIntegrator / FixedIntegrator);
+//     relative = head − table (3-1), starting at the set-point there
+//   5 finish(): the DAQ delay removed by re-indexing the trace (exact for any signal; the
+//     live estimate is predicted over it instead), then ZUPT at every standstill of the
+//     set-point — the velocity left there is the integrated acceleration error; it is
+//     removed piecewise linearly in time
 #include "dsp/core/frame.hpp"
 #include "dsp/core/run_meta.hpp"
 #include "dsp/pipeline/coriolis.hpp"
@@ -115,6 +117,7 @@ class Pipeline {
  private:
   enum class Phase { wait_start, rest, moving };
   void apply_zupt(Measurement& m);
+  void align_delay(Measurement& m) const;
   void store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept;
   void compensate(const Frame& f) noexcept;
   void start_motion() noexcept;
@@ -129,6 +132,7 @@ class Pipeline {
   CoriolisComp coriolis_;
   fx::Saturation saturation_;
   double dt_s_;
+  double delay_samples_ = 0.0;  // DAQ group delay, removed by re-indexing in finish()
   float temp_c_[2] = {0.0F, 0.0F};  // last valid case temperature
   // This frame's compensated acceleration (double path, m/s²; fixed path, Q40 m/s²).
   Eigen::Vector3d a_[2];
