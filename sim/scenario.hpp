@@ -62,7 +62,10 @@ struct Straightness {
   double span_mm[2] = {-10.0, 10.0};
 };
 
-// Below `below_mm_min` the axis sticks until the lag reaches amp, then slips in `slip_ms`.
+// Below `below_mm_min` static friction holds the slide until its lag behind the set-point
+// reaches amp (it breaks free there), then it slips forward in `slip_ms` and sticks again.
+// The lag peaks a little above amp while the slide gathers speed. At standstill it stays
+// where it stuck (a positioning error); above the creep speed it breaks free.
 struct StickSlip {
   double amp_um = 0.0;
   double below_mm_min = 100.0;

@@ -108,6 +108,7 @@ void evaluate_circle_program(const Run& run, Analysis& a) {
   eval::DiagnosticsOptions opt;
   opt.centre_mm = {p.center_mm[0], p.center_mm[1]};
   opt.radius_mm = p.radius_mm;
+  opt.feed_mm_min = p.feed_mm_min;
   try {
     a.diagnostics = eval::diagnose_circle(passes, opt);
     if (!a.diagnostics->servo_and_squareness_separated)

@@ -58,7 +58,27 @@ struct Sample {
 // `skip` (reversal windows) are left out of the fit but get residuals.
 AxisFit fit_axis(const std::vector<CirclePass>& passes, const std::vector<std::vector<Eigen::Vector2d>>& vel,
                  const std::vector<std::vector<bool>>& skip, int a, const std::array<bool, n_cols>& use,
-                 const DiagnosticsOptions& opt, double pitch_mm, double fixed_lag_s) {
+                 const DiagnosticsOptions& opt, double pitch_mm, double fixed_lag_s, double play_mm = 0.0) {
+  // Backlash column: the lost motion as the slide sees it. With a play estimate it is the
+  // play operator's output (the slide waits until the motor has crossed the play, so the
+  // step after a reversal takes time); without one, the step −sgn(v)/2.
+  std::vector<std::vector<double>> lost;
+  for (std::size_t pi = 0; pi < passes.size(); ++pi) {
+    const auto& p = passes[pi];
+    auto& col = lost.emplace_back(p.cmd_mm.size(), 0.0);
+    if (!(play_mm > 0.0)) {
+      for (std::size_t i = 0; i < col.size(); ++i) col[i] = -0.5 * sgn(vel[pi][i][a], 1e-6);
+      continue;
+    }
+    int d0 = 0;
+    for (std::size_t i = 0; i < col.size() && d0 == 0; ++i) d0 = sgn(vel[pi][i][a], 1e-6);
+    double slide = p.cmd_mm[0][a] - 0.5 * play_mm * d0;  // play taken up in the first direction
+    for (std::size_t i = 0; i < col.size(); ++i) {
+      const double x = p.cmd_mm[i][a];
+      slide = std::clamp(slide, x - 0.5 * play_mm, x + 0.5 * play_mm);
+      col[i] = (slide - x) / play_mm;
+    }
+  }
   const int b = 1 - a;
   const double R = opt.radius_mm;
   const double eps = 1e-6;
@@ -84,7 +104,7 @@ AxisFit fit_axis(const std::vector<CirclePass>& passes, const std::vector<std::v
     put(scale, c[a] - opt.centre_mm[a]);
     put(square, a == 0 ? -(c[1] - opt.centre_mm[1]) : 0.0);
     put(lag, -v[a]);
-    put(backlash, -0.5 * sgn(v[a], eps));
+    put(backlash, lost[pi][i]);
     put(lateral, 0.5 * sgn(v[b], eps));
     put(cyc_sin, std::sin(2.0 * std::numbers::pi * c[a] / pitch_mm));
     put(cyc_cos, std::cos(2.0 * std::numbers::pi * c[a] / pitch_mm));
@@ -209,17 +229,23 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
                        fit_axis(passes, vel, skip[0], 0, use, opt, p, 0.0).rms_mm;
     if (rms < best_rms) best_rms = rms, best_pitch = p;
   }
-  fits[1] = fit_axis(passes, vel, skip[1], 1, use, opt, best_pitch, 0.0);
-  if (both_directions) {
-    fits[0] = fit_axis(passes, vel, skip[0], 0, use, opt, best_pitch, 0.0);
-    d.servo_and_squareness_separated = true;
-  } else {
-    auto use_x = use;
-    use_x[lag] = false;
-    fits[0] = fit_axis(passes, vel, skip[0], 0, use_x, opt, best_pitch, fits[1].coef(lag));
-    fits[0].coef(lag) = fits[1].coef(lag);
-    d.notes.push_back("one direction only: servo mismatch cannot be separated from squareness; equal lags assumed");
+  // Twice: first with a step for the backlash, then with the play operator of the play
+  // just found (a sharp step would leave the play's crossing time as a false reversal spike).
+  double play_mm[2] = {0.0, 0.0};
+  for (int round = 0; round < 2; ++round) {
+    fits[1] = fit_axis(passes, vel, skip[1], 1, use, opt, best_pitch, 0.0, play_mm[1]);
+    if (both_directions) {
+      fits[0] = fit_axis(passes, vel, skip[0], 0, use, opt, best_pitch, 0.0, play_mm[0]);
+    } else {
+      auto use_x = use;
+      use_x[lag] = false;
+      fits[0] = fit_axis(passes, vel, skip[0], 0, use_x, opt, best_pitch, fits[1].coef(lag), play_mm[0]);
+      fits[0].coef(lag) = fits[1].coef(lag);
+    }
+    for (int a = 0; a < 2; ++a) play_mm[a] = std::max(0.0, fits[static_cast<std::size_t>(a)].coef(backlash));
   }
+  if (both_directions) d.servo_and_squareness_separated = true;
+  else d.notes.push_back("one direction only: servo mismatch cannot be separated from squareness; equal lags assumed");
   const Eigen::VectorXd& cx = fits[0].coef;
   const Eigen::VectorXd& cy = fits[1].coef;
   d.backlash_x_um = cx(backlash) * kUmPerMm;
@@ -242,10 +268,9 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
   d.reversal_spike_x_um = reversal_spike_um(passes, vel, fits[0], 0, window);
   d.reversal_spike_y_um = reversal_spike_um(passes, vel, fits[1], 1, window);
 
-  // What the model leaves: radial part = vibration class, tangential part = stick-slip
-  // class (sawtooth along the path at low feed). Both RMS over the samples outside the
-  // reversal windows.
-  double ss_rad = 0.0, ss_tan = 0.0;
+  // What the model leaves (RMS over the samples outside the reversal windows): radially
+  // the vibration class, per axis the stick-slip class.
+  double ss_rad = 0.0, ss_axis[2] = {0.0, 0.0};
   std::size_t n = 0;
   for (std::size_t pi = 0; pi < passes.size(); ++pi)
     for (std::size_t i = 0; i < passes[pi].cmd_mm.size(); ++i) {
@@ -254,19 +279,21 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
       Eigen::Vector2d radial = passes[pi].cmd_mm[i] - opt.centre_mm;
       if (radial.norm() <= 0.0) continue;
       radial.normalize();
-      const Eigen::Vector2d tangent(-radial[1], radial[0]);
       ss_rad += std::pow(r.dot(radial), 2);
-      ss_tan += std::pow(r.dot(tangent), 2);
+      ss_axis[0] += r[0] * r[0], ss_axis[1] += r[1] * r[1];
       ++n;
     }
   if (n > 0) {
-    // Over full revolutions a vibration in any direction of the plane projects equally on
-    // the radial and the tangential direction; what the tangential residual holds beyond
-    // that is motion along the path: stick-slip, a sawtooth from 0 to the lag A whose RMS
-    // is A/(2√3).
-    const double rad2 = ss_rad / static_cast<double>(n), tan2 = ss_tan / static_cast<double>(n);
-    d.vibration_um = std::sqrt(rad2) * kUmPerMm;
-    d.stick_slip_um = 2.0 * std::sqrt(3.0) * std::sqrt(std::max(0.0, tan2 - rad2)) * kUmPerMm;
+    if (opt.feed_mm_min > 0.0 && opt.feed_mm_min <= opt.creep_feed_mm_min) {
+      // Creep feed: the fast residual of each axis is its slide sticking and slipping — a
+      // sawtooth (or triangle) between 0 and the lag A, whose RMS is A/(2√3). Its mean lag
+      // A/2 against the direction of motion reads as backlash A.
+      const double ax = std::sqrt(ss_axis[0] / static_cast<double>(n)), ay = std::sqrt(ss_axis[1] / static_cast<double>(n));
+      d.stick_slip_um = 2.0 * std::sqrt(3.0) * std::max(ax, ay) * kUmPerMm;
+      d.notes.push_back("creep feed: the fast residual is reported as stick-slip (its mean lag also reads as backlash)");
+    } else {
+      d.vibration_um = std::sqrt(ss_rad / static_cast<double>(n)) * kUmPerMm;
+    }
   }
   d.residual_rms_um = std::hypot(fits[0].rms_mm, fits[1].rms_mm) * kUmPerMm;
   return d;

@@ -41,6 +41,11 @@ struct DiagnosticsOptions {
   // Ball-screw pitch for the cyclic error; empty = search 1..25 mm and keep the best.
   std::optional<double> cyclic_pitch_mm;
   double spike_window_s = 0.06;  // residual window after each reversal searched for spikes
+  // Programmed feed; at or below the creep feed the fast residual is friction-driven
+  // stick-slip, above it vibration. One feed cannot tell a vibration along an axis from
+  // jerks of that axis (both are fast residuals on it); a second test at another feed can.
+  double feed_mm_min = 0.0;
+  double creep_feed_mm_min = 200.0;
 };
 
 struct CircleDiagnostics {
@@ -53,8 +58,8 @@ struct CircleDiagnostics {
   double squareness_urad = 0;
   double scale_mismatch_ppm = 0;
   double straightness_x_um = 0, straightness_y_um = 0;  // bow of the axis' path at mid-travel vs its ends
-  double stick_slip_um = 0;   // sawtooth lag along the path: 2√3·√(tangential² − radial²) of the residual RMS
-  double vibration_um = 0;    // radial residual RMS above the model (fast components)
+  double stick_slip_um = 0;   // creep feed only: peak-to-peak lag per axis, 2√3 × the fast residual RMS (sawtooth/triangle)
+  double vibration_um = 0;    // above the creep feed: radial residual RMS above the model (fast components)
   double lag_x_ms = 0, lag_y_ms = 0;  // each axis' lag behind the set-point (common servo lag)
   double residual_rms_um = 0;         // what the model leaves
   bool servo_and_squareness_separated = false;  // needs both directions

@@ -5,15 +5,6 @@
 #include <numbers>
 
 namespace eical::sim {
-namespace {
-
-// Smooth 0 → 1 over u = 0..1 with zero slope at both ends (no acceleration impulse).
-double smoothstep(double u) {
-  u = std::clamp(u, 0.0, 1.0);
-  return u * u * (3.0 - 2.0 * u);
-}
-
-}  // namespace
 
 AxisMotion::AxisMotion(const MachineErrors& e, int axis, double step_s, double start_mm)
     : servo_(e.servo[axis]),
@@ -65,22 +56,28 @@ double AxisMotion::servo(double cmd, double vel) noexcept {
 }
 
 double AxisMotion::stick_slip(double vel) noexcept {
+  // lag = set-point − slide (signed). Below the creep speed static friction holds the slide
+  // (the lag follows the set-point) until |lag| reaches amp; above it the slide breaks free.
   const double amp = ss_.amp_um * 1e-3;
-  const double speed = std::abs(vel);
-  const bool creeping = speed > 1e-9 && speed * 60.0 < ss_.below_mm_min;
+  const bool creeping = std::abs(vel) * 60.0 < ss_.below_mm_min;
   if (ss_slipping_) {
+    // The slide breaks free and stops again: its speed u = U (1 − cos 2πt/T)/2 rises and
+    // falls back to zero (no velocity step, so no acceleration impulse), covering the lag
+    // plus the set-point's progress over the slip, U = 2 (L0 + v T)/T.
+    const double T = ss_.slip_ms * 1e-3;
     ss_slip_t_s_ += h_;
-    ss_lag_mm_ = ss_slip_from_mm_ * (1.0 - smoothstep(ss_slip_t_s_ / (ss_.slip_ms * 1e-3)));
-    if (ss_slip_t_s_ >= ss_.slip_ms * 1e-3) ss_slipping_ = false, ss_lag_mm_ = 0.0;
+    const double t = std::min(ss_slip_t_s_, T);
+    const double U = 2.0 * (ss_slip_from_mm_ + ss_slip_v_mm_s_ * T) / T;
+    const double covered = U * (t / 2.0 - T * std::sin(2.0 * std::numbers::pi * t / T) / (4.0 * std::numbers::pi));
+    ss_lag_mm_ = ss_slip_from_mm_ + ss_slip_v_mm_s_ * t - covered;
+    if (ss_slip_t_s_ >= T) ss_slipping_ = false;
   } else if (creeping) {
-    // Static friction holds the slide while the set-point creeps on.
-    ss_dir_ = vel > 0 ? 1 : -1;
-    ss_lag_mm_ += speed * h_;
-    if (ss_lag_mm_ >= amp) ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_t_s_ = 0.0;
-  } else if (ss_lag_mm_ > 0.0) {
-    ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_t_s_ = 0.0;  // breaks free
+    ss_lag_mm_ += vel * h_;
+    if (std::abs(ss_lag_mm_) >= amp) ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_v_mm_s_ = vel, ss_slip_t_s_ = 0.0;
+  } else if (ss_lag_mm_ != 0.0) {
+    ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_v_mm_s_ = vel, ss_slip_t_s_ = 0.0;  // fast: breaks free
   }
-  return -ss_dir_ * ss_lag_mm_;
+  return -ss_lag_mm_;
 }
 
 double AxisMotion::step(double cmd, double vel) noexcept {

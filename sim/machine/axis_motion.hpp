@@ -35,10 +35,9 @@ class AxisMotion {
   // Reversal spike: last direction and time since the last reversal.
   int dir_ = 0;
   double since_reversal_s_ = 1e9;
-  // Stick-slip: current lag and whether the axis is slipping.
-  double ss_lag_mm_ = 0.0, ss_slip_from_mm_ = 0.0, ss_slip_t_s_ = 0.0;
+  // Stick-slip: signed lag (set-point − slide), and the slip in progress.
+  double ss_lag_mm_ = 0.0, ss_slip_from_mm_ = 0.0, ss_slip_v_mm_s_ = 0.0, ss_slip_t_s_ = 0.0;
   bool ss_slipping_ = false;
-  int ss_dir_ = 0;
 };
 
 }  // namespace eical::sim

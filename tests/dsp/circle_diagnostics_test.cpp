@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -36,6 +38,9 @@ CirclePass make_pass(int direction, const Injected& in, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, in.noise_um * 1e-3);
   double last_sx = 0.0, since_rev_s = 1e9;
+  // A positive backlash is a play between motor and slide (the slide waits at a reversal
+  // until the motor has crossed it); a negative one has no such mechanism and stays a step.
+  double slide_x = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t i = 0; i < n; ++i) {
     const double t = static_cast<double>(i) / kFs;
     const double th = std::numbers::pi / 4 + w * t;
@@ -45,8 +50,15 @@ CirclePass make_pass(int direction, const Injected& in, std::uint64_t seed) {
     if (last_sx != 0.0 && sx != last_sx) since_rev_s = 0.0;
     last_sx = sx;
     Eigen::Vector2d e;
-    e.x() = in.scale_x_ppm * 1e-6 * c.x() - in.squareness_urad * 1e-6 * c.y() - in.lag_x_ms * 1e-3 * v.x() -
-            in.backlash_x_um * 1e-3 / 2 * sx + in.lateral_x_um * 1e-3 / 2 * sy +
+    const double b = in.backlash_x_um * 1e-3;
+    double lost_x = -b / 2 * sx;
+    if (b > 0.0) {
+      if (std::isnan(slide_x)) slide_x = c.x() - b / 2 * sx;
+      slide_x = std::clamp(slide_x, c.x() - b / 2, c.x() + b / 2);
+      lost_x = slide_x - c.x();
+    }
+    e.x() = in.scale_x_ppm * 1e-6 * c.x() - in.squareness_urad * 1e-6 * c.y() - in.lag_x_ms * 1e-3 * v.x() + lost_x +
+            in.lateral_x_um * 1e-3 / 2 * sy +
             in.cyclic_x_um * 1e-3 * std::sin(2 * std::numbers::pi * c.x() / in.pitch_mm + 0.3)
             - in.spike_x_um * 1e-3 * sx * std::exp(-since_rev_s / 0.008);
     e.y() = in.scale_y_ppm * 1e-6 * c.y() - in.lag_y_ms * 1e-3 * v.y() - in.backlash_y_um * 1e-3 / 2 * sy +

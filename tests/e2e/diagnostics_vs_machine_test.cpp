@@ -24,7 +24,7 @@ sim::Scenario circle_both(double radius_mm = kRadius_mm, double feed_mm_min = kF
   sim::Scenario sc = sim::circle_scenario(radius_mm, feed_mm_min, 2, "both", 5);
   sc.noise = false;
   sc.meta.acquisition.adc_bits = 32;
-  sc.meta.acquisition.adc_lsb_volt = 1e-9;
+  sc.meta.acquisition.adc_lsb_volt = 4e-9;  // ±8.6 V: the range of the real DAQ, 3 ng resolution
   return sc;
 }
 
@@ -71,6 +71,14 @@ void expect_diagnostics(const sim::Scenario& sc, const std::map<std::string, dou
 
 TEST(DiagnosticsVsMachine, IdealMachineReportsNothing) { expect_diagnostics(circle_both(), {}); }
 
+TEST(DiagnosticsVsMachine, Backlash) {
+  for (int axis : {0, 1}) {
+    sim::Scenario sc = circle_both();
+    sc.machine.backlash_um[axis] = 4.0;
+    expect_diagnostics(sc, {{axis == 0 ? "backlash_x_um" : "backlash_y_um", 4.0}});
+  }
+}
+
 TEST(DiagnosticsVsMachine, ReversalSpikePerAxis) {
   // Spikes on y only: x must stay ≈ 0 (8-8: one axis' spikes not masked by the other).
   sim::Scenario sc = circle_both();
@@ -114,6 +122,16 @@ TEST(DiagnosticsVsMachine, Straightness) {
   sim::Scenario sc = circle_both();
   sc.machine.straightness[0] = {1, 3.0, {-kRadius_mm, kRadius_mm}};  // X's travel bows 3 µm towards +Y
   expect_diagnostics(sc, {{"straightness_x_um", 3.0}});
+}
+
+TEST(DiagnosticsVsMachine, StickSlipAtLowFeed) {
+  // Creep feed: a 1 mm circle at 60 mm/min; each slide sticks until it lags 2 µm, then slips
+  // forward in 1 ms (the lag peaks at 2 µm + v·T/4 = 2.25 µm as it gathers speed).
+  sim::Scenario sc = circle_both(1.0, 60.0);
+  sc.meta.program.repeats = 1;
+  for (int a : {0, 1}) sc.machine.stick_slip[a] = {2.0, 100.0, 1.0};
+  // The mean lag A/2 against each direction of motion is lost motion A at the reversals.
+  expect_diagnostics(sc, {{"stick_slip_um", 2.0}, {"backlash_x_um", 2.0}, {"backlash_y_um", 2.0}});
 }
 
 TEST(DiagnosticsVsMachine, DifferentialVibration) {

