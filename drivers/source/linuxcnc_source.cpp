@@ -37,7 +37,7 @@ void LinuxcncSource::stop_worker() {
 void LinuxcncSource::fail(const std::string& why) {
   {
     std::lock_guard lk(mu_);
-    if (error_.empty()) error_ = "linuxcnc: " + why;
+    if (error_.empty()) error_ = why;  // read() → pump names the source; open() adds the prefix
   }
   failed_.store(true, std::memory_order_release);
   cv_.notify_all();
@@ -83,7 +83,7 @@ void LinuxcncSource::open() {
   std::unique_lock lk(mu_);
   const bool got = cv_.wait_for(lk, std::chrono::duration<double>(options_.connect_timeout_s), [&] { return first_line_ || !error_.empty(); });
   if (!error_.empty() || !got) {
-    const std::string why = !error_.empty() ? error_
+    const std::string why = !error_.empty() ? "linuxcnc: " + error_
                                             : "no servo samples on " + path + " within " + std::to_string(options_.connect_timeout_s) +
                                                   " s: is LinuxCNC running with the eical kit (eical_sampler.hal loads eical-halsampler, "
                                                   "which writes this pipe)?";
@@ -124,11 +124,12 @@ void LinuxcncSource::work(int fd) {
   std::vector<char> buf(1 << 16);
   std::size_t used = 0;
   std::int64_t last_number = -1;
-  Eigen::Vector3d last_pos = Eigen::Vector3d::Zero();
+  Eigen::Vector3d last_pos = Eigen::Vector3d::Zero(), last_cmd = Eigen::Vector3d::Zero();
   bool drop_flag = false;
   LinuxcncStreamStats local;
   const int stall_ms = static_cast<int>(options_.stall_timeout_s * 1000.0);
-  const int connect_ms = static_cast<int>(options_.connect_timeout_s * 1000.0);
+  // Longer than open()'s wait, so open() reports the absent LinuxCNC in its own words.
+  const int connect_ms = static_cast<int>(options_.connect_timeout_s * 2000.0);
 
   auto emit = [&](bool flush) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -193,6 +194,7 @@ void LinuxcncSource::work(int fd) {
       std::string error;
       const auto parsed = parse_servo_line(line, error);
       if (!parsed) {
+        emit(true);  // the cycles before the bad line still become frames
         fail("malformed servo line " + std::to_string(local.lines + 1) + ": " + error + " in '" + std::string(line.substr(0, 120)) + "'");
         broken = true;
         break;
@@ -230,12 +232,13 @@ void LinuxcncSource::work(int fd) {
         // Lost cycles (HAL sampler overrun): linear fill, frames flagged cmd_missing.
         local.lost_cycles += lost;
         for (std::size_t k = 1; k <= lost; ++k) {
-          sim.push(last_pos + (pos - last_pos) * (static_cast<double>(k) / static_cast<double>(lost + 1)), true);
+          const double u = static_cast<double>(k) / static_cast<double>(lost + 1);
+          sim.push(last_pos + (pos - last_pos) * u, last_cmd + (cmd - last_cmd) * u, true);
           if (sim.block_ready()) emit(false);
         }
       }
-      last_number = s.number, last_pos = pos;
-      sim.push(pos);
+      last_number = s.number, last_pos = pos, last_cmd = cmd;
+      sim.push(pos, cmd);
       if (sim.block_ready()) {
         emit(false);
         publish_stats();

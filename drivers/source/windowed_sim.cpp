@@ -46,17 +46,19 @@ WindowedSim::WindowedSim(sim::Scenario scenario, WindowedSimOptions options) : s
                       std::to_string(options_.servo_rate_hz) + " Hz");
   ratio_ = static_cast<int>(std::lround(r));
   if (options_.block_cycles < 10) throw SourceError("linuxcnc: block must be at least 10 servo cycles");
-  if (options_.prefix_cycles < 4) throw SourceError("linuxcnc: the approach prefix needs at least 4 servo cycles");
+  if (options_.prefix_cycles < 12) throw SourceError("linuxcnc: the approach prefix needs at least 12 servo cycles");
   const std::string bad = stateful_effects(scenario_, static_cast<double>(options_.history_cycles) / options_.servo_rate_hz);
   if (!bad.empty())
     throw SourceError("linuxcnc: the block-wise simulation cannot continue these scenario effects across blocks: " + bad);
   hist_.reserve(options_.history_cycles + 2 * (options_.block_cycles + options_.lookahead_cycles));
   filled_.reserve(hist_.capacity());
+  cmd_.reserve(hist_.capacity());
   window_.reserve(options_.prefix_cycles + hist_.capacity());
 }
 
-void WindowedSim::push(const Eigen::Vector3d& pos_mm, bool filled) {
-  hist_.push_back(pos_mm);
+void WindowedSim::push(const Eigen::Vector3d& drive_mm, const Eigen::Vector3d& cmd_mm, bool filled) {
+  hist_.push_back(drive_mm);
+  cmd_.push_back(cmd_mm);
   filled_.push_back(filled ? 1 : 0);
   ++pending_;
 }
@@ -72,9 +74,9 @@ std::size_t WindowedSim::simulate_block(std::span<dsp::Frame> out, bool flush) {
   Eigen::Vector3d approach;
   for (int a = 0; a < 3; ++a) approach[a] = dir_[a] * (scenario_.machine.backlash_um[a] * 1e-3 + 1e-3);
   window_.clear();
-  const std::size_t np = options_.prefix_cycles, half = np / 2;
+  const std::size_t np = options_.prefix_cycles, hold = np / 6, ramp = np / 3;
   for (std::size_t k = 0; k < np; ++k) {
-    const double u = k < half ? 0.0 : static_cast<double>(k - half + 1) / static_cast<double>(np - half);
+    const double u = k < hold ? 0.0 : std::min(1.0, static_cast<double>(k - hold + 1) / static_cast<double>(ramp));
     const double s = u * u * (3.0 - 2.0 * u);
     window_.push_back(p0 - approach * (1.0 - s));
   }
@@ -99,6 +101,10 @@ std::size_t WindowedSim::simulate_block(std::span<dsp::Frame> out, bool flush) {
     f.sample_index = index + static_cast<std::int64_t>(n);
     const std::size_t cycle = (i + r - 1) / r - np;  // the cycle this frame leads up to
     if (cycle < filled_.size() && filled_[cycle]) f.flags |= dsp::frame_flag::cmd_missing;
+    const std::size_t c0 = i / r - np, frac = i % r;
+    Eigen::Vector3d cmd = cmd_[c0];
+    if (frac != 0) cmd += (cmd_[c0 + 1] - cmd_[c0]) * (static_cast<double>(frac) / static_cast<double>(r));
+    for (int a = 0; a < 3; ++a) f.cmd_mm[a] = cmd[a];
     out[n] = f;
   }
   emitted_cycles_ += static_cast<std::int64_t>(block);
@@ -116,6 +122,7 @@ std::size_t WindowedSim::simulate_block(std::span<dsp::Frame> out, bool flush) {
       }
     hist_.erase(hist_.begin(), hist_.begin() + static_cast<std::ptrdiff_t>(drop));
     filled_.erase(filled_.begin(), filled_.begin() + static_cast<std::ptrdiff_t>(drop));
+    cmd_.erase(cmd_.begin(), cmd_.begin() + static_cast<std::ptrdiff_t>(drop));
   }
   return n;
 }

@@ -5,7 +5,7 @@
 //   [prefix | history | block | lookahead]
 // * prefix: a short approach to the window's first position in the direction each axis
 //   last moved, so the backlash play is taken up on the right side (the one machine state
-//   that outlives any history);
+//   that outlives any history), then a rest so the first block of a stream starts settled;
 // * history: long enough for the position loops, sensor, DAQ filter and PSD lock-in to
 //   forget the window's start (checked against the scenario's Kv);
 // * lookahead: keeps the spline's free end out of the block.
@@ -29,7 +29,7 @@ struct WindowedSimOptions {
   std::size_t block_cycles = 200;
   std::size_t history_cycles = 300;
   std::size_t lookahead_cycles = 5;
-  std::size_t prefix_cycles = 40;
+  std::size_t prefix_cycles = 60;  // 10 hold, 20 approach, 30 settle (DAQ filter, PT2)
 };
 
 class WindowedSim {
@@ -38,9 +38,13 @@ class WindowedSim {
   // has an effect the windows cannot continue.
   WindowedSim(sim::Scenario scenario, WindowedSimOptions options);
 
-  // One servo cycle: the position that drives the simulated machine (mm) and whether it
-  // was filled in for a lost cycle (its frames are flagged cmd_missing).
-  void push(const Eigen::Vector3d& pos_mm, bool filled = false);
+  // One servo cycle: the position that drives the simulated machine (mm), the commanded
+  // position the frames carry as set-point, and whether the cycle was filled in for a lost
+  // one (its frames are flagged cmd_missing). Between cycles the frames' set-point is
+  // interpolated linearly, so at rest it is bit-for-bit constant (the pipeline detects
+  // motion by any change of the set-point).
+  void push(const Eigen::Vector3d& drive_mm, const Eigen::Vector3d& cmd_mm, bool filled = false);
+  void push(const Eigen::Vector3d& pos_mm, bool filled = false) { push(pos_mm, pos_mm, filled); }
   [[nodiscard]] bool block_ready() const { return pending_ >= options_.block_cycles + options_.lookahead_cycles; }
   // Frames one block yields (block_cycles · fs / servo rate).
   [[nodiscard]] std::size_t frames_per_block() const { return options_.block_cycles * ratio_; }
@@ -56,7 +60,8 @@ class WindowedSim {
   sim::Scenario scenario_;
   WindowedSimOptions options_;
   int ratio_ = 10;                        // DAQ frames per servo cycle
-  std::vector<Eigen::Vector3d> hist_;     // history + pending cycles
+  std::vector<Eigen::Vector3d> hist_;     // history + pending cycles (drive positions)
+  std::vector<Eigen::Vector3d> cmd_;      // the commanded positions of the same cycles
   std::vector<char> filled_;              // per entry of hist_
   std::size_t pending_ = 0;               // cycles of hist_ not yet emitted
   std::int64_t emitted_cycles_ = 0;       // servo cycles whose frames went out
