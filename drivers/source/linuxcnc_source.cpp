@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fcntl.h>
 #include <poll.h>
@@ -126,6 +127,7 @@ void LinuxcncSource::work(int fd) {
   std::int64_t last_number = -1;
   Eigen::Vector3d last_pos = Eigen::Vector3d::Zero(), last_cmd = Eigen::Vector3d::Zero();
   bool drop_flag = false;
+  std::uint32_t last_marker = 0;
   LinuxcncStreamStats local;
   const int stall_ms = static_cast<int>(options_.stall_timeout_s * 1000.0);
   // Longer than open()'s wait, so open() reports the absent LinuxCNC in its own words.
@@ -237,6 +239,11 @@ void LinuxcncSource::work(int fd) {
           if (sim.block_ready()) emit(false);
         }
       }
+      if (s.marker != last_marker && s.marker != 0)
+        // Diagnostic (EICAL_MARK=1 in the kit): when the M-code script ran, on the DAQ clock.
+        std::fprintf(stderr, "<6>linuxcnc: M-code marker %u at servo cycle %lld = sample %lld\n", s.marker,
+                     static_cast<long long>(s.number), static_cast<long long>((s.number - local.first_number) * ratio_));
+      last_marker = s.marker;
       last_number = s.number, last_pos = pos, last_cmd = cmd;
       sim.push(pos, cmd);
       if (sim.block_ready()) {
@@ -253,6 +260,14 @@ void LinuxcncSource::work(int fd) {
     }
   }
   publish_stats();
+  std::fprintf(stderr,
+               "<6>linuxcnc: %llu lines, %llu cycles lost, %llu overrun lines, %llu frames dropped, %llu blocks (longest %.1f ms); "
+               "servo clock: cycle 0 at %lld ns CLOCK_MONOTONIC, lines %.2f ms (mean) / %.2f ms (max) behind their cycle; "
+               "max |cmd - fb| %.4f mm\n",
+               static_cast<unsigned long long>(local.lines), static_cast<unsigned long long>(local.lost_cycles),
+               static_cast<unsigned long long>(local.overrun_lines), static_cast<unsigned long long>(local.dropped_frames),
+               static_cast<unsigned long long>(local.blocks), local.max_block_sim_ms, static_cast<long long>(local.clock_offset_ns),
+               local.mean_delay_ms, local.max_delay_ms, local.max_following_error_mm);
 }
 
 }  // namespace eical::drivers
