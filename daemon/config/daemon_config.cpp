@@ -40,6 +40,8 @@ void read_linuxcnc(StrictTable t, LinuxcncConfig& l) {
   if (l.connect_timeout_s < 0.1 || l.connect_timeout_s > 3600.0) t.fail("connect_timeout_s", "must be within 0.1..3600");
   l.stall_timeout_s = t.number("stall_timeout_s", l.stall_timeout_s);
   if (l.stall_timeout_s < 0.1 || l.stall_timeout_s > 3600.0) t.fail("stall_timeout_s", "must be within 0.1..3600");
+  l.hold_ms = t.number("hold_ms", l.hold_ms);
+  if (l.hold_ms < 0.0 || l.hold_ms > 10000.0) t.fail("hold_ms", "must be within 0..10000");
   const auto seed = t.integer("seed", static_cast<std::int64_t>(l.seed));
   if (seed < 0) t.fail("seed", "must not be negative");
   l.seed = static_cast<std::uint64_t>(seed);

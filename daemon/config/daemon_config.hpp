@@ -24,6 +24,7 @@ struct LinuxcncConfig {
   double block_ms = 200.0, history_ms = 300.0;    // simulation windows
   std::string drive = "command";                  // command | feedback: which positions move the machine
   double connect_timeout_s = 10.0, stall_timeout_s = 2.0;
+  double hold_ms = 1000.0;                        // frame latency: must exceed the M-code → DDS trigger time
   std::uint64_t seed = 1;
 };
 

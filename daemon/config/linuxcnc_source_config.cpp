@@ -29,6 +29,7 @@ std::unique_ptr<drivers::Source> make_linuxcnc_source(const DaemonConfig& c) {
   o.drive_from_feedback = l.drive == "feedback";
   o.connect_timeout_s = l.connect_timeout_s;
   o.stall_timeout_s = l.stall_timeout_s;
+  o.hold_s = l.hold_ms * 1e-3;
   return std::make_unique<drivers::LinuxcncSource>(std::move(sc), o);
 }
 

@@ -4,6 +4,7 @@
 #include "drivers/source/stamped_source.hpp"
 
 #include <cerrno>
+#include <deque>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -128,6 +129,7 @@ void LinuxcncSource::work(int fd) {
   Eigen::Vector3d last_pos = Eigen::Vector3d::Zero(), last_cmd = Eigen::Vector3d::Zero();
   bool drop_flag = false;
   std::uint32_t last_marker = 0;
+  std::deque<dsp::Frame> held;
   LinuxcncStreamStats local;
   const int stall_ms = static_cast<int>(options_.stall_timeout_s * 1000.0);
   // Longer than open()'s wait, so open() reports the absent LinuxCNC in its own words.
@@ -137,14 +139,25 @@ void LinuxcncSource::work(int fd) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t n = sim.simulate_block(frames, flush);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    for (std::size_t i = 0; i < n; ++i) {
-      if (drop_flag) frames[i].flags |= dsp::frame_flag::gap_before;
-      drop_flag = !ring_->push_or_drop(frames[i]);
-      if (drop_flag) ++local.dropped_frames;
-    }
-    if (n > 0) available_.release();
+    held.insert(held.end(), frames.begin(), frames.begin() + static_cast<std::ptrdiff_t>(n));
     local.blocks = sim.blocks();
     if (ms > local.max_block_sim_ms) local.max_block_sim_ms = ms;
+  };
+  // Frames wait until their servo cycle is hold_ms old: a DDS trigger (eical trigger
+  // starts a process and a participant first) must reach eicald before its frame does,
+  // or it is clamped onto a later frame. Released as servo lines arrive (every ~10 ms).
+  const auto hold_ns = static_cast<std::int64_t>(options_.hold_s * 1e9);
+  auto release = [&](bool all) {
+    std::size_t n = 0;
+    const std::int64_t now = monotonic_ns();
+    while (!held.empty() && (all || sample_time_ns(held.front().sample_index) + hold_ns <= now)) {
+      dsp::Frame& f = held.front();
+      if (drop_flag) f.flags |= dsp::frame_flag::gap_before;
+      drop_flag = !ring_->push_or_drop(f);
+      if (drop_flag) ++local.dropped_frames;
+      held.pop_front(), ++n;
+    }
+    if (n > 0) available_.release();
   };
   auto publish_stats = [&] {
     local.clock_offset_ns = clock_->offset_ns();
@@ -182,6 +195,7 @@ void LinuxcncSource::work(int fd) {
         break;
       }
       emit(true);  // what arrived before the end still becomes frames
+      release(true);
       publish_stats();
       fail("LinuxCNC closed the servo stream after cycle " + std::to_string(last_number) + " (LinuxCNC stopped or eical-halsampler exited)");
       break;
@@ -197,6 +211,7 @@ void LinuxcncSource::work(int fd) {
       const auto parsed = parse_servo_line(line, error);
       if (!parsed) {
         emit(true);  // the cycles before the bad line still become frames
+        release(true);
         fail("malformed servo line " + std::to_string(local.lines + 1) + ": " + error + " in '" + std::string(line.substr(0, 120)) + "'");
         broken = true;
         break;
@@ -251,6 +266,7 @@ void LinuxcncSource::work(int fd) {
         publish_stats();
       }
     }
+    release(false);
     if (broken) break;
     // Keep the partial line.
     if (start > 0) std::memmove(buf.data(), buf.data() + start, used - start), used -= start;

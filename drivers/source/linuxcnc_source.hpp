@@ -10,8 +10,10 @@
 // computation). eicald's acquisition thread only pops finished frames from an SPSC ring
 // in read(): allocation-free, waiting on a semaphore with a 100 ms bound so the pump
 // still sees its stop flag.
-// Latency of a frame behind its servo cycle: up to block + lookahead cycles plus the
-// block's simulation time plus halsampler's ~10 ms wake-up. sample_time_ns() gives the
+// Latency of a frame behind its servo cycle: hold_s (default 1 s), which must exceed both
+// the simulation latency (block + lookahead cycles, the block's simulation time,
+// halsampler's ~10 ms wake-up) and the time an M-code's `eical trigger` needs to reach
+// eicald (process start and DDS discovery: up to ~0.75 s measured on 2 loaded cores). sample_time_ns() gives the
 // servo cycle's own CLOCK_MONOTONIC time (ServoClock), so eicald maps trigger times onto
 // the right frame whatever that latency.
 #include "drivers/ring/spsc_ring.hpp"
@@ -36,6 +38,7 @@ struct LinuxcncSourceOptions {
   bool drive_from_feedback = false;   // feedback (LinuxCNC's plant) instead of the command drives the machine
   double connect_timeout_s = 10.0;    // open(): first servo line within this time, else "LinuxCNC absent"
   double stall_timeout_s = 2.0;       // no line for this long while streaming: the source fails
+  double hold_s = 1.0;                // frames are released this long after their servo cycle (DDS trigger latency)
   std::size_t max_fill_cycles = 1000; // lost cycles up to this many are interpolated; more fail the source
   std::size_t ring_frames = 1u << 16;
 };
