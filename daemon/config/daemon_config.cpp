@@ -9,8 +9,47 @@ namespace {
 
 using drivers::StrictTable;
 
+// The [program] table of a file written by `eical gen-nc ... --meta`; errors inside it
+// name that file and line.
+dsp::Program read_program_file(StrictTable& t, const std::filesystem::path& path) {
+  const toml::table root = StrictTable::parse_file(path.string());
+  StrictTable file(root, path.string(), "");
+  auto program = file.optional_table("program");
+  if (!program) t.fail("program_file", path.string() + " has no [program] table (write it with eical gen-nc --meta)");
+  dsp::Program p = drivers::read_program(*program);
+  if (p.gcode.empty()) t.fail("program_file", path.string() + ": [program] has no gcode");
+  file.finish();
+  return p;
+}
+
+void read_linuxcnc(StrictTable t, LinuxcncConfig& l) {
+  l.fifo = t.string("fifo", l.fifo.string());
+  if (l.fifo.empty()) t.fail("fifo", "must not be empty");
+  l.program_file = t.string("program_file", l.program_file.string());
+  if (l.program_file.empty()) t.fail("program_file", "required: the [program] table (eical gen-nc --meta) of what LinuxCNC runs");
+  l.program_loaded = read_program_file(t, l.program_file);
+  l.scenario_file = t.string("scenario_file", l.scenario_file.string());
+  l.servo_rate_hz = t.number("servo_rate_hz", l.servo_rate_hz);
+  if (l.servo_rate_hz < 100.0 || l.servo_rate_hz > 20000.0) t.fail("servo_rate_hz", "must be within 100..20000");
+  l.block_ms = t.number("block_ms", l.block_ms);
+  if (l.block_ms < 20.0 || l.block_ms > 5000.0) t.fail("block_ms", "must be within 20..5000");
+  l.history_ms = t.number("history_ms", l.history_ms);
+  if (l.history_ms < 10.0 || l.history_ms > 10000.0) t.fail("history_ms", "must be within 10..10000");
+  l.drive = t.choice("drive", {"command", "feedback"}, l.drive);
+  l.connect_timeout_s = t.number("connect_timeout_s", l.connect_timeout_s);
+  if (l.connect_timeout_s < 0.1 || l.connect_timeout_s > 3600.0) t.fail("connect_timeout_s", "must be within 0.1..3600");
+  l.stall_timeout_s = t.number("stall_timeout_s", l.stall_timeout_s);
+  if (l.stall_timeout_s < 0.1 || l.stall_timeout_s > 3600.0) t.fail("stall_timeout_s", "must be within 0.1..3600");
+  l.hold_ms = t.number("hold_ms", l.hold_ms);
+  if (l.hold_ms < 0.0 || l.hold_ms > 10000.0) t.fail("hold_ms", "must be within 0..10000");
+  const auto seed = t.integer("seed", static_cast<std::int64_t>(l.seed));
+  if (seed < 0) t.fail("seed", "must not be negative");
+  l.seed = static_cast<std::uint64_t>(seed);
+  t.finish();
+}
+
 void read_source(StrictTable t, SourceConfig& s) {
-  s.kind = t.choice("kind", {"sim", "replay", "usb_daq"}, s.kind);
+  s.kind = t.choice("kind", {"sim", "replay", "usb_daq", "linuxcnc"}, s.kind);
   s.pacing = t.choice("pacing", {"realtime", "free_running"}, s.pacing);
   s.replay_run = t.string("replay_run", s.replay_run.string());
   if (s.kind == "replay" && s.replay_run.empty()) t.fail("replay_run", "required when kind = \"replay\"");
@@ -30,18 +69,11 @@ void read_source(StrictTable t, SourceConfig& s) {
     if (s.sim_idle_s < 0.0) sim->fail("idle_s", "must not be negative");
     s.sim_repeat_program = sim->boolean("repeat_program", s.sim_repeat_program);
     s.sim_program_file = sim->string("program_file", s.sim_program_file.string());
-    if (!s.sim_program_file.empty()) {
-      // Errors inside the program file name that file and line.
-      const toml::table root = StrictTable::parse_file(s.sim_program_file.string());
-      StrictTable file(root, s.sim_program_file.string(), "");
-      auto program = file.optional_table("program");
-      if (!program) sim->fail("program_file", s.sim_program_file.string() + " has no [program] table (write it with eical gen-nc --meta)");
-      s.sim_program_loaded = drivers::read_program(*program);
-      if (s.sim_program_loaded->gcode.empty()) sim->fail("program_file", s.sim_program_file.string() + ": [program] has no gcode");
-      file.finish();
-    }
+    if (!s.sim_program_file.empty()) s.sim_program_loaded = read_program_file(*sim, s.sim_program_file);
     sim->finish();
   }
+  if (auto l = t.optional_table("linuxcnc")) read_linuxcnc(*l, s.linuxcnc);
+  if (s.kind == "linuxcnc" && !s.linuxcnc.program_loaded) t.fail("linuxcnc", "[source.linuxcnc] with program_file is required when kind = \"linuxcnc\"");
   s.retry_s = t.number("retry_s", s.retry_s);
   if (s.retry_s < 0.1 || s.retry_s > 3600.0) t.fail("retry_s", "must be within 0.1..3600");
   if (auto f = t.optional_table("fault")) {

@@ -13,8 +13,23 @@
 
 namespace eical::daemon {
 
+// [source.linuxcnc]: LinuxCNC's servo-rate positions drive the simulated machine and
+// sensors (integrations/linuxcnc streams them into `fifo`).
+struct LinuxcncConfig {
+  std::filesystem::path fifo = "/run/eical/linuxcnc-servo.fifo";
+  std::filesystem::path program_file;             // eical gen-nc --meta: what LinuxCNC runs (the evaluation)
+  std::optional<dsp::Program> program_loaded;
+  std::filesystem::path scenario_file;            // eical-scenario/1: the machine and sensor truth (optional)
+  double servo_rate_hz = 1000.0;                  // [EMCMOT]SERVO_PERIOD
+  double block_ms = 200.0, history_ms = 300.0;    // simulation windows
+  std::string drive = "command";                  // command | feedback: which positions move the machine
+  double connect_timeout_s = 10.0, stall_timeout_s = 2.0;
+  double hold_ms = 1000.0;                        // frame latency: must exceed the M-code → DDS trigger time
+  std::uint64_t seed = 1;
+};
+
 struct SourceConfig {
-  std::string kind = "sim";           // sim | replay | usb_daq
+  std::string kind = "sim";           // sim | replay | usb_daq | linuxcnc
   std::string pacing = "realtime";    // realtime | free_running (sim, replay)
   std::filesystem::path replay_run;   // replay: an eical-run/1 directory
   // sim: the calibration program the simulated NC runs; its M101/102/103 reach the
@@ -33,6 +48,7 @@ struct SourceConfig {
   double retry_s = 2.0;                // a source that failed mid-run is reopened after this
   drivers::FaultPlan fault;            // [source.fault]: injected faults (tests, commissioning)
   std::string usb_id = "1d50:6161";    // usb_daq: vendor:product
+  LinuxcncConfig linuxcnc;             // [source.linuxcnc]
 };
 
 struct TriggerConfig {

@@ -1,5 +1,7 @@
 #include "daemon/service/hmi_link.hpp"
 
+#include <algorithm>
+
 #include "daemon/system/log.hpp"
 #include "daemon/system/realtime.hpp"
 
@@ -120,8 +122,19 @@ void HmiLink::commander() {
     drivers::dds::ReplyMsg reply;
     reply.sender = cmd->sender;
     reply.request_id = cmd->request_id;
-    if (cmd->action == "trigger" && (cmd->code == 101 || cmd->code == 102 || cmd->code == 103)) {
+    // `eical trigger` resends until it sees a Reply: a resend of an accepted trigger is
+    // answered again but not queued twice (a doubled M102 would add a segment).
+    const std::pair<std::string, std::uint32_t> key{cmd->sender, cmd->request_id};
+    const bool resend = std::find(recent_triggers_.begin(), recent_triggers_.end(), key) != recent_triggers_.end();
+    if (cmd->action == "trigger" && resend) {
+      reply.ok = true;
+      reply.message = "M" + std::to_string(cmd->code) + " already queued (resend ignored)";
+    } else if (cmd->action == "trigger" && (cmd->code == 101 || cmd->code == 102 || cmd->code == 103)) {
       reply.ok = triggers_.try_push({cmd->time_ns, cmd->code});
+      if (reply.ok) {
+        recent_triggers_.push_back(key);
+        if (recent_triggers_.size() > 64) recent_triggers_.pop_front();
+      }
       reply.message = reply.ok ? "M" + std::to_string(cmd->code) + " queued for the DAQ clock" : "trigger queue full";
     } else {
       reply.ok = false;

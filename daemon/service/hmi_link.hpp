@@ -10,6 +10,7 @@
 #include "drivers/ring/spsc_ring.hpp"
 
 #include <atomic>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -68,6 +69,7 @@ class HmiLink {
   int publisher_priority_ = 0;
   int wake_fd_ = -1;  // eventfd: DSP thread → publisher
   std::thread publisher_, commander_;
+  std::deque<std::pair<std::string, std::uint32_t>> recent_triggers_;  // commander thread: (sender, request id)
 };
 
 }  // namespace eical::daemon

@@ -1,5 +1,6 @@
 #include "daemon/service/service.hpp"
 
+#include "daemon/config/linuxcnc_source_config.hpp"
 #include "daemon/service/frame_guard.hpp"
 #include "daemon/service/hmi_link.hpp"
 #include "daemon/service/trace_builder.hpp"
@@ -48,6 +49,7 @@ std::unique_ptr<drivers::Source> make_base_source(const DaemonConfig& c) {
     auto run = std::make_shared<const dsp::Run>(drivers::read_run(c.source.replay_run));
     return std::make_unique<drivers::ReplaySource>(run, pacing, "replay");
   }
+  if (c.source.kind == "linuxcnc") return make_linuxcnc_source(c);
   if (c.source.kind == "usb_daq") {
     dsp::RunMeta meta;
     meta.acquisition = c.acquisition;

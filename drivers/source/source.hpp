@@ -5,6 +5,7 @@
 #include "dsp/core/run_meta.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -40,6 +41,10 @@ class Source {
   [[nodiscard]] virtual bool at_end() const = 0;
   [[nodiscard]] virtual std::string_view name() const = 0;
   [[nodiscard]] virtual Backpressure backpressure() const = 0;
+  // CLOCK_MONOTONIC (ns) at which the sample was taken, when the source knows it better
+  // than "when read() returned it" (a source that delivers with latency, e.g. linuxcnc);
+  // 0 = unknown.
+  [[nodiscard]] virtual std::int64_t sample_time_ns(std::int64_t /*sample_index*/) const { return 0; }
 };
 
 }  // namespace eical::drivers

@@ -1,6 +1,7 @@
 #pragma once
 // When did the acquisition thread have a sample? Wraps a Source and, after each block
-// read, pushes (last sample index of the block, CLOCK_MONOTONIC now) into an SPSC ring of
+// read, pushes (last sample index of the block, CLOCK_MONOTONIC now — or the source's own
+// sample_time_ns when it knows better) into an SPSC ring of
 // stamps. The stamp is pushed before the pump hands the block's frames to the frame ring,
 // so the DSP thread always finds the stamp of a frame it holds. Allocation only in the
 // constructor; push and lookup are lock-free and never block.
@@ -32,7 +33,11 @@ class StampedSource final : public Source {
   [[nodiscard]] const dsp::RunMeta& meta() const override { return inner_->meta(); }
   std::size_t read(std::span<dsp::Frame> out) override {
     const std::size_t n = inner_->read(out);
-    if (n > 0) (void)stamps_.push_or_drop({out[n - 1].sample_index, monotonic_ns()});
+    if (n > 0) {
+      // A source that knows when its samples were taken says so; others: now.
+      const std::int64_t taken_ns = inner_->sample_time_ns(out[n - 1].sample_index);
+      (void)stamps_.push_or_drop({out[n - 1].sample_index, taken_ns != 0 ? taken_ns : monotonic_ns()});
+    }
     return n;
   }
   [[nodiscard]] bool at_end() const override { return inner_->at_end(); }

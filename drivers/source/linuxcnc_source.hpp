@@ -1,0 +1,95 @@
+#pragma once
+// LinuxCNC as the NC of the simulated machine: the servo-rate joint positions LinuxCNC
+// streams through the integration kit (integrations/linuxcnc: HAL sampler → eical-halsampler
+// → a named pipe) drive eical's machine, sensor and DAQ simulation (WindowedSim), so the
+// accelerations come from LinuxCNC's trajectory planner.
+//
+// Threads: a worker thread of this source (in the role of the DAQ card's processor) reads
+// the pipe with poll() — no polling sleeps —, parses the lines, keeps the servo clock, and
+// simulates a block every block_cycles; it allocates (sim::simulate is a batch
+// computation). eicald's acquisition thread only pops finished frames from an SPSC ring
+// in read(): allocation-free, waiting on a semaphore with a 100 ms bound so the pump
+// still sees its stop flag.
+// Latency of a frame behind its servo cycle: hold_s (default 1 s), which must exceed both
+// the simulation latency (block + lookahead cycles, the block's simulation time,
+// halsampler's ~10 ms wake-up) and the time an M-code's `eical trigger` needs to reach
+// eicald (process start and DDS discovery: up to ~0.75 s measured on 2 loaded cores). sample_time_ns() gives the
+// servo cycle's own CLOCK_MONOTONIC time (ServoClock), so eicald maps trigger times onto
+// the right frame whatever that latency.
+#include "drivers/ring/spsc_ring.hpp"
+#include "drivers/source/servo_clock.hpp"
+#include "drivers/source/source.hpp"
+#include "drivers/source/windowed_sim.hpp"
+
+#include <atomic>
+#include <condition_variable>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <semaphore>
+#include <string>
+#include <thread>
+
+namespace eical::drivers {
+
+struct LinuxcncSourceOptions {
+  std::filesystem::path fifo = "/run/eical/linuxcnc-servo.fifo";
+  WindowedSimOptions window;
+  bool drive_from_feedback = false;   // feedback (LinuxCNC's plant) instead of the command drives the machine
+  double connect_timeout_s = 10.0;    // open(): first servo line within this time, else "LinuxCNC absent"
+  double stall_timeout_s = 2.0;       // no line for this long while streaming: the source fails
+  double hold_s = 1.0;                // frames are released this long after their servo cycle (DDS trigger latency)
+  std::size_t max_fill_cycles = 1000; // lost cycles up to this many are interpolated; more fail the source
+  std::size_t ring_frames = 1u << 16;
+};
+
+// What the worker learned about the stream (for the log and tests).
+struct LinuxcncStreamStats {
+  std::uint64_t lines = 0, lost_cycles = 0, overrun_lines = 0, dropped_frames = 0, blocks = 0;
+  std::int64_t first_number = -1;
+  std::int64_t clock_offset_ns = 0;     // CLOCK_MONOTONIC of servo cycle 0 (ServoClock)
+  double mean_delay_ms = 0.0, max_delay_ms = 0.0;  // lines behind their cycle
+  double max_block_sim_ms = 0.0;        // longest simulation of one block
+  double max_following_error_mm = 0.0;  // |cmd − fb| largest seen
+};
+
+class LinuxcncSource final : public Source {
+ public:
+  LinuxcncSource(sim::Scenario scenario, LinuxcncSourceOptions options);
+  ~LinuxcncSource() override;
+
+  // Creates the named pipe if absent (mode 0666: LinuxCNC may run as another user), opens
+  // it and waits for the first servo line; SourceError naming the cause otherwise.
+  void open() override;
+  [[nodiscard]] const dsp::RunMeta& meta() const override { return scenario_.meta; }
+  std::size_t read(std::span<dsp::Frame> out) override;
+  [[nodiscard]] bool at_end() const override { return false; }
+  [[nodiscard]] std::string_view name() const override { return "linuxcnc"; }
+  [[nodiscard]] Backpressure backpressure() const override { return Backpressure::drop_newest; }
+  [[nodiscard]] std::int64_t sample_time_ns(std::int64_t sample_index) const override;
+
+  [[nodiscard]] LinuxcncStreamStats stats() const;
+
+ private:
+  void stop_worker();
+  void work(int fd);
+  void fail(const std::string& why);
+
+  sim::Scenario scenario_;
+  LinuxcncSourceOptions options_;
+  std::unique_ptr<SpscRing<dsp::Frame>> ring_;
+  std::counting_semaphore<> available_{0};
+  std::thread worker_;
+  int fd_ = -1, wake_fd_ = -1;
+  std::atomic<bool> failed_{false}, streaming_{false};
+  std::atomic<std::int64_t> first_number_{-1};
+  std::unique_ptr<ServoClock> clock_;
+  int ratio_ = 10;  // frames per servo cycle
+  mutable std::mutex mu_;  // error_, stats_, first line (worker writes, others read; not per sample)
+  std::condition_variable cv_;
+  bool first_line_ = false;
+  std::string error_;
+  LinuxcncStreamStats stats_;
+};
+
+}  // namespace eical::drivers
