@@ -13,7 +13,8 @@ namespace eical::tools {
 void register_analyze(CLI::App& app) {
   struct Opt {
     std::string run, dynamic = "two-stage";
-    bool json = false, no_zupt = false;
+    bool json = false, no_zupt = false, coriolis = false;
+    std::string nbs = "auto";
   };
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand("analyze", "Evaluate a recorded run (circle: ISO 230-4 + diagnostics; step)");
@@ -21,11 +22,17 @@ void register_analyze(CLI::App& app) {
   cmd->add_flag("--json", o->json, "print the eical-result/1 document");
   cmd->add_option("--dynamic", o->dynamic, "dynamic compensation: two-stage or none")->default_val("two-stage")->check(CLI::IsMember({"two-stage", "none"}));
   cmd->add_flag("--no-zupt", o->no_zupt, "skip the zero-velocity update after the motion");
+  cmd->add_option("--nbs", o->nbs, "hold axes whose set-point does not move (Bild 7-8): auto (rectangles), on, off")
+      ->default_val("auto")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
+  cmd->add_flag("--coriolis", o->coriolis, "correct the Earth-rate Coriolis acceleration (3-6) with [site] latitude and heading");
   cmd->callback([o] {
     const dsp::Run run = drivers::read_run(o->run);
     dsp::AnalysisOptions opt;
     opt.dynamic = o->dynamic == "none" ? dsp::DynamicComp::none : dsp::DynamicComp::two_stage;
     opt.zupt = !o->no_zupt;
+    if (o->nbs != "auto") opt.nbs = o->nbs == "on";
+    opt.coriolis = o->coriolis;
     const dsp::Analysis a = dsp::analyze_run(run, opt);
     if (o->json) std::printf("%s\n", drivers::result_json(run, a).dump(2).c_str());
     else std::fputs(summary_text(run, a).c_str(), stdout);

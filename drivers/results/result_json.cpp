@@ -149,7 +149,11 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   j["pipeline"] = {{"rest_window_samples", m.rest_window_samples},
                    {"zupt_window_samples", m.zupt_window_samples},
                    {"zupt_velocity_error_mm_s", {m.zupt_velocity_error_mm_s.x(), m.zupt_velocity_error_mm_s.y(), m.zupt_velocity_error_mm_s.z()}},
-                   {"dynamic_compensation", "two-stage (6-38) with DAQ delay"}};
+                   {"dynamic_compensation", a.dynamic == dsp::DynamicComp::none
+                                                ? std::string("none (PT2 and DAQ delay uncompensated)")
+                                                : std::string(dsp::dynamic_comp_name(a.dynamic)) + ", DAQ delay removed by re-indexing"},
+                   {"nbs", a.nbs},
+                   {"coriolis", a.coriolis}};
   explain_nulls(j);
   return j;
 }

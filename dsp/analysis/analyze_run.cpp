@@ -119,9 +119,12 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   PipelineConfig cfg = pipeline_config(run.meta, run.frames.size());
   cfg.dynamic = options.dynamic;
   cfg.zupt = options.zupt;
+  cfg.nbs = options.nbs.value_or(run.meta.program.kind == "rectangle");
+  cfg.coriolis = options.coriolis;
   Pipeline pipeline(cfg);
   for (const auto& f : run.frames) pipeline.step(f);
   Analysis a;
+  a.dynamic = cfg.dynamic, a.nbs = cfg.nbs, a.coriolis = cfg.coriolis;
   a.measurement = pipeline.finish();
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;

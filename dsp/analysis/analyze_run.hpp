@@ -22,10 +22,14 @@ namespace eical::dsp {
 struct AnalysisOptions {
   DynamicComp dynamic = DynamicComp::two_stage;
   bool zupt = true;
+  std::optional<bool> nbs;  // unset: on for rectangles (axis-parallel moves), off otherwise
+  bool coriolis = false;    // (3-6) Earth rate from [site]; real machines: on (simulated runs have it only when injected)
 };
 
 struct Analysis {
   Measurement measurement;
+  DynamicComp dynamic = DynamicComp::two_stage;  // what the pipeline did
+  bool nbs = false, coriolis = false;
   std::optional<eval::CircleResult> circle;             // both directions combined when the run has both
   std::optional<eval::CircleResult> circle_reference;  // the same evaluation of the reference channel
   std::optional<double> circle_accuracy_rms_um;        // RMS of (measured − reference) radius deviation

@@ -316,6 +316,49 @@ void Pipeline::align_delay(Measurement& m) const {
   }
 }
 
+void Pipeline::apply_nbs(Measurement& m) const {
+  // Moves are the stretches where the set-point changes. Within one (and the settling
+  // after it) every axis whose set-point stays put is held at its level from before the
+  // move with zero velocity; what it would have drifted is subtracted from it afterwards,
+  // so the later rests keep their level relative to it.
+  const std::size_t n = m.pos_mm.size();
+  const auto tail = static_cast<std::size_t>(std::ceil(config_.zupt_settle_s * config_.acquisition.fs_hz));
+  auto moved = [&](std::size_t j) { return (m.cmd_mm[j] - m.cmd_mm[j - 1]).cwiseAbs().maxCoeff() >= 1e-12; };
+  Eigen::Vector3d carried = Eigen::Vector3d::Zero();
+  std::size_t k = 1;
+  while (k < n) {
+    if (!moved(k)) {
+      m.pos_mm[k] -= carried;
+      ++k;
+      continue;
+    }
+    std::size_t e = k;
+    while (e < n && moved(e)) ++e;
+    std::size_t end = e;  // the sensors see the move d samples late and settle: hold a little longer
+    while (end < n && end < e + tail + static_cast<std::size_t>(delay_samples_) && !moved(end)) ++end;
+    bool still[3];
+    for (int a = 0; a < 3; ++a) {
+      still[a] = true;
+      for (std::size_t j = k; j < e && still[a]; ++j) still[a] = m.cmd_mm[j][a] == m.cmd_mm[k - 1][a];
+    }
+    const Eigen::Vector3d level = m.pos_mm[k - 1];  // corrected already
+    Eigen::Vector3d last_raw = level;
+    for (std::size_t j = k; j < end; ++j)
+      for (int a = 0; a < 3; ++a) {
+        if (still[a]) {
+          last_raw[a] = m.pos_mm[j][a];
+          m.pos_mm[j][a] = level[a];
+          m.vel_mm_s[j][a] = 0.0;
+        } else {
+          m.pos_mm[j][a] -= carried[a];
+        }
+      }
+    for (int a = 0; a < 3; ++a)
+      if (still[a]) carried[a] = last_raw[a] - level[a];
+    k = end;
+  }
+}
+
 Measurement Pipeline::finish() {
   Measurement m = std::move(m_);
   m_ = Measurement{};
@@ -328,6 +371,7 @@ Measurement Pipeline::finish() {
   // DynamicComp::none leaves the DAQ delay in as well (the thesis' "uncompensated").
   if (config_.dynamic != DynamicComp::none && phase_ == Phase::moving && !m.sample_index.empty()) align_delay(m);
   if (config_.zupt && phase_ == Phase::moving && !m.sample_index.empty()) apply_zupt(m);
+  if (config_.nbs && phase_ == Phase::moving && !m.sample_index.empty()) apply_nbs(m);
   m.flags = quality_flag_names(quality_);
   m.degraded = quality_ != 0;
   return m;

@@ -54,6 +54,10 @@ struct PipelineConfig {
   Arithmetic arithmetic = Arithmetic::double_precision;
   double zupt_settle_s = 0.05;       // after the set-point stops (plus the DAQ delay)
   bool zupt = true;
+  // NBS (Bild 7-8): an axis whose set-point does not move during a move is held still —
+  // its integrated drift there is removed (and so is any real motion of it: straightness of
+  // the moving axis is no longer seen). For rectangles and other axis-parallel programs.
+  bool nbs = false;
 };
 
 PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples);
@@ -117,6 +121,7 @@ class Pipeline {
  private:
   enum class Phase { wait_start, rest, moving };
   void apply_zupt(Measurement& m);
+  void apply_nbs(Measurement& m) const;
   void align_delay(Measurement& m) const;
   void store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept;
   void compensate(const Frame& f) noexcept;

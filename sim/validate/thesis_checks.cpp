@@ -24,7 +24,9 @@ Scenario deterministic(Scenario sc) {
 // pipeline without dynamic compensation (Bild 7-14, 7-5, 8-18 "uncompensated").
 double peak_dynamic_error_um(const Scenario& sc, std::initializer_list<int> axes, dsp::DynamicComp comp) {
   const dsp::Run run = simulate(sc);
-  const dsp::Analysis a = dsp::analyze_run(run, {.dynamic = comp, .zupt = true});
+  dsp::AnalysisOptions options;
+  options.dynamic = comp;
+  const dsp::Analysis a = dsp::analyze_run(run, options);
   const dsp::Measurement& m = a.measurement;
   double peak = 0.0;
   for (std::size_t i = 0; i < m.pos_mm.size(); ++i) {

@@ -171,7 +171,9 @@ TEST(MachinePhysics, SensorsSeeExactlyTheMachinesMotion) {
   const dsp::Run run = simulate(sc);
   // Without ZUPT: the machine still settles (servo lag, the head's 9 Hz mode) when the
   // set-point stops, which a ZUPT would wrongly call rest.
-  const dsp::Measurement m = dsp::analyze_run(run, {.dynamic = dsp::DynamicComp::two_stage, .zupt = false}).measurement;
+  dsp::AnalysisOptions no_zupt;
+  no_zupt.zupt = false;
+  const dsp::Measurement m = dsp::analyze_run(run, no_zupt).measurement;
   double ss = 0.0, moved = 0.0;
   // The pipeline starts at the set-point; the reference reads the machine's deviation
   // there too: compare from the same start.

@@ -22,7 +22,9 @@ struct Outcome {
 };
 
 Outcome eical(const std::string& args) {
-  const std::string cmd = std::string(EICAL_CLI) + " " + args + " 2>&1 >/dev/null";
+  // Appended piecewise: GCC 12 at -O2 warns falsely (-Warray-bounds) on the chained operator+.
+  std::string cmd = EICAL_CLI;
+  cmd.append(" ").append(args).append(" 2>&1 >/dev/null");
   FILE* p = ::popen(cmd.c_str(), "r");
   std::string out;
   char buf[512];
