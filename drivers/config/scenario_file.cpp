@@ -97,6 +97,20 @@ void read_sensor_effect(const std::string& name, StrictTable& t, sim::Scenario& 
   }
 }
 
+// [[…tones]]: freq_hz, amp_mg [3], phase_deg.
+std::vector<sim::Tone> read_tones(StrictTable& t) {
+  std::vector<sim::Tone> tones;
+  for (StrictTable tone : t.tables("tones")) {
+    sim::Tone x;
+    x.freq_hz = positive(tone, "freq_hz", x.freq_hz);
+    x.amp_mg = vec3(tone, "amp_mg", Eigen::Vector3d::Zero());
+    x.phase_deg = tone.number("phase_deg", 0.0);
+    tone.finish();
+    tones.push_back(x);
+  }
+  return tones;
+}
+
 sim::DriveMode read_mode(StrictTable t, const std::string& gain_key = "gain") {
   sim::DriveMode m;
   m.freq_hz = positive(t, "freq_hz", m.freq_hz);
@@ -116,28 +130,14 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
       if (!(b[0] > 0.0 && b[1] > b[0])) t.fail("band_hz", "must be [low, high] with 0 < low < high");
       v.band_hz[0] = b[0], v.band_hz[1] = b[1];
     }
-    for (StrictTable tone : t.tables("tones")) {
-      sim::Tone x;
-      x.freq_hz = positive(tone, "freq_hz", x.freq_hz);
-      x.amp_mg = vec3(tone, "amp_mg", Eigen::Vector3d::Zero());
-      x.phase_deg = tone.number("phase_deg", 0.0);
-      tone.finish();
-      v.tones.push_back(x);
-    }
+    v.tones = read_tones(t);
     if (auto mode = t.optional_table("mode")) v.mode = read_mode(*mode);
     if (!v.on()) t.fail("broadband_rms_mg", "common vibration needs tones, broadband_rms_mg or a mode with gain");
   } else if (name == "machine.differential_vibration") {
     sc.differential_vibration.freq_hz = positive(t, "freq_hz", 9.0);
     sc.differential_vibration.zeta = positive(t, "zeta", 0.03);
     sc.differential_vibration.gain = vec3(t, "gain", Eigen::Vector3d::Zero());
-    for (StrictTable tone : t.tables("tones")) {
-      sim::Tone x;
-      x.freq_hz = positive(tone, "freq_hz", x.freq_hz);
-      x.amp_mg = vec3(tone, "amp_mg", Eigen::Vector3d::Zero());
-      x.phase_deg = tone.number("phase_deg", 0.0);
-      tone.finish();
-      sc.differential_tones.push_back(x);
-    }
+    sc.differential_tones = read_tones(t);
     if (sc.differential_vibration.gain.squaredNorm() == 0.0 && sc.differential_tones.empty())
       t.fail("gain", "differential vibration needs a mode gain or tones");
   } else if (name == "machine.backlash") {
