@@ -64,8 +64,10 @@ std::string strs(const std::vector<std::string>& v) {
   return s + "]";
 }
 
-void write_sensor(std::string& o, const char* name, const dsp::SensorSpec& s) {
-  o += std::string("\n[sensors.") + name + "]\nmodel = " + toml_str(s.model) + "\nto_machine = [";
+}  // namespace
+
+std::string sensor_section_toml(const char* name, const dsp::SensorSpec& s) {
+  std::string o = std::string("\n[sensors.") + name + "]\nmodel = " + toml_str(s.model) + "\nto_machine = [";
   for (int r = 0; r < 3; ++r) {
     const double row[3] = {s.to_machine(r, 0), s.to_machine(r, 1), s.to_machine(r, 2)};
     o += (r ? ", " : "") + vec(row, 3);
@@ -75,7 +77,12 @@ void write_sensor(std::string& o, const char* name, const dsp::SensorSpec& s) {
        "\ntc_k1_ppm_per_c = " + toml_double(s.tc_k1_ppm_per_c) + "\ntc_bias_ug_per_c = " + toml_double(s.tc_bias_ug_per_c) +
        "\nf0_hz = " + toml_double(s.f0_hz) + "\nzeta = " + toml_double(s.zeta) + "\nnoise_ug_per_rthz = " +
        toml_double(s.noise_ug_per_rthz) + "\ntemp_ref_c = " + toml_double(s.temp_ref_c) + "\n";
+  return o;
 }
+
+std::string toml_number(double v) { return toml_double(v); }
+
+namespace {
 
 class FileOut {
  public:
@@ -217,8 +224,8 @@ std::string run_toml_text(const dsp::RunMeta& m) {
        "\ng_mps2 = " + toml_double(m.site.g_mps2) + "\n";
   o += "\n[machine]\nname = " + toml_str(m.machine.name) + "\ntable_axes = " + strs(m.machine.table_axes) +
        "\nhead_axes = " + strs(m.machine.head_axes) + "\n";
-  write_sensor(o, "table", m.sensors[0]);
-  write_sensor(o, "head", m.sensors[1]);
+  o += sensor_section_toml("table", m.sensors[0]);
+  o += sensor_section_toml("head", m.sensors[1]);
   const auto& p = m.program;
   o += "\n[program]\nkind = " + toml_str(p.kind) + "\nplane = " + toml_str(p.plane) + "\ncenter_mm = " + vec(p.center_mm, 2) +
        "\nradius_mm = " + toml_double(p.radius_mm) + "\nfeed_mm_min = " + toml_double(p.feed_mm_min) +

@@ -20,4 +20,9 @@ void write_run(const dsp::Run& run, const std::filesystem::path& dir, const Writ
 // run.toml text for `meta` (used by the writer; exposed for tests and `eical gen-nc`).
 std::string run_toml_text(const dsp::RunMeta& meta);
 
+// One [sensors.<name>] table with every key of run-format.md (run.toml, calibration files).
+std::string sensor_section_toml(const char* name, const dsp::SensorSpec& spec);
+// TOML text of a number that reads back to the same double.
+std::string toml_number(double v);
+
 }  // namespace eical::drivers

@@ -1,0 +1,102 @@
+#include "drivers/config/sensor_calibration.hpp"
+
+#include "drivers/config/meta_sections.hpp"
+#include "drivers/config/strict_toml.hpp"
+#include "drivers/run_io/run_writer.hpp"
+#include "dsp/core/error.hpp"
+
+#include <fstream>
+#include <stdexcept>
+
+namespace eical::drivers {
+namespace {
+
+constexpr const char* kFormat = "eical-sensor-cal/1";
+constexpr const char* kSensorNames[2] = {"table", "head"};
+
+Eigen::Matrix3d read_matrix(StrictTable& t, const char* key) {
+  const auto rows = t.matrix(key, 3, 3);
+  Eigen::Matrix3d m;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) m(r, c) = rows[static_cast<std::size_t>(r)][static_cast<std::size_t>(c)];
+  if (!m.allFinite()) t.fail(key, "not finite");
+  return m;
+}
+
+std::string matrix_toml(const Eigen::Matrix3d& m) {
+  std::string s = "[";
+  for (int r = 0; r < 3; ++r) {
+    s += r ? ", [" : "[";
+    for (int c = 0; c < 3; ++c) s += (c ? ", " : "") + toml_number(m(r, c));
+    s += "]";
+  }
+  return s + "]";
+}
+
+}  // namespace
+
+SensorCalibration read_sensor_calibration(const std::filesystem::path& file, const dsp::RunMeta& datasheet) {
+  const toml::table doc = StrictTable::parse_file(file.string());
+  StrictTable root(doc, file.string(), "");
+  const std::string format = root.string("format");
+  if (format != kFormat) root.fail("format", "expected \"" + std::string(kFormat) + "\", got \"" + format + "\"");
+  SensorCalibration cal;
+  cal.method = root.choice("method", {"psd", "ref", "explain"}, "psd");
+  cal.run_id = root.string("run", "");
+  if (auto acq = root.optional_table("acquisition")) {
+    if (acq->has("daq_group_delay_samples")) {
+      const double d = acq->number("daq_group_delay_samples");
+      if (!(d >= 0.0 && d < 10000.0)) acq->fail("daq_group_delay_samples", "must be within [0, 10000) samples");
+      cal.daq_group_delay_samples = d;
+    }
+    acq->finish();
+  }
+  for (int s = 0; s < 2; ++s) cal.sensors[s] = datasheet.sensors[s];
+  if (auto sensors = root.optional_table("sensors")) {
+    for (int s = 0; s < 2; ++s) {
+      auto t = sensors->optional_table(kSensorNames[s]);
+      if (!t) continue;
+      if (t->has("cross_g_per_g")) cal.static_cal[s].cross_g_per_g = read_matrix(*t, "cross_g_per_g");
+      // read_sensor checks the rest strictly (its copy knows cross_g_per_g was read).
+      cal.sensors[s] = read_sensor(*t, datasheet.sensors[s], Unknown::reject);
+    }
+    sensors->finish();
+  }
+  root.finish();
+  return cal;
+}
+
+void write_sensor_calibration(const SensorCalibration& cal, const std::filesystem::path& file) {
+  std::string o = "# Sensor calibration: eical-sensor-cal/1 (identified on site; see README).\n";
+  o += std::string("format = \"") + kFormat + "\"\nmethod = \"" + cal.method + "\"\nrun = \"" + cal.run_id + "\"\n";
+  if (cal.daq_group_delay_samples) o += "\n[acquisition]\ndaq_group_delay_samples = " + toml_number(*cal.daq_group_delay_samples) + "\n";
+  for (int s = 0; s < 2; ++s) {
+    o += sensor_section_toml(kSensorNames[s], cal.sensors[s]);
+    o += "cross_g_per_g = " + matrix_toml(cal.static_cal[s].cross_g_per_g) + "\n";
+  }
+  const std::filesystem::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+    if (!os) throw std::runtime_error(tmp.string() + ": cannot create");
+    os << o;
+    if (!os.flush()) throw std::runtime_error(tmp.string() + ": write failed (disk full?)");
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, file, ec);
+  if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
+}
+
+void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta) {
+  for (int s = 0; s < 2; ++s) meta.sensors[s] = cal.sensors[s];
+  if (cal.daq_group_delay_samples) meta.acquisition.daq_group_delay_samples = *cal.daq_group_delay_samples;
+}
+
+void apply_calibration(const SensorCalibration& cal, dsp::PipelineConfig& config) {
+  for (int s = 0; s < 2; ++s) {
+    config.sensors[s] = cal.sensors[s];
+    config.calibration[s].cross_g_per_g = cal.static_cal[s].cross_g_per_g;
+  }
+  if (cal.daq_group_delay_samples) config.acquisition.daq_group_delay_samples = *cal.daq_group_delay_samples;
+}
+
+}  // namespace eical::drivers
