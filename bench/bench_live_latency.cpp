@@ -8,6 +8,7 @@
 //   bench_live_latency [--duration 600] [--load 1] [--rt-priority 80] [--json]
 #include "daemon/service/service.hpp"
 #include "drivers/dds/bus.hpp"
+#include "drivers/dds/domain_claim.hpp"
 #include "daemon/system/realtime.hpp"
 #include "drivers/source/stamped_source.hpp"
 
@@ -36,7 +37,7 @@ int main(int argc, char** argv) {
   app.add_option("--domain", domain, "DDS domain (default: derived from the pid)");
   app.add_flag("--json", json, "print one JSON object");
   CLI11_PARSE(app, argc, argv);
-  if (domain == 0) domain = 1 + static_cast<int>((::getpid() * 5 + 3) % 200);
+  if (domain == 0) domain = eical::drivers::dds::claim_free_domain();
 
   const auto dir = std::filesystem::temp_directory_path() / ("eical-bench-latency-" + std::to_string(::getpid()));
   eical::daemon::DaemonConfig c;

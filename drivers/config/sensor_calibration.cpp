@@ -74,16 +74,7 @@ void write_sensor_calibration(const SensorCalibration& cal, const std::filesyste
     o += sensor_section_toml(kSensorNames[s], cal.sensors[s]);
     o += "cross_g_per_g = " + matrix_toml(cal.static_cal[s].cross_g_per_g) + "\n";
   }
-  const std::filesystem::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-    if (!os) throw std::runtime_error(tmp.string() + ": cannot create");
-    os << o;
-    if (!os.flush()) throw std::runtime_error(tmp.string() + ": write failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
+  write_text_atomic(file, o);
 }
 
 void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta) {

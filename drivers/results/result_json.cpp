@@ -1,5 +1,7 @@
 #include "drivers/results/result_json.hpp"
 
+#include "drivers/run_io/run_writer.hpp"
+
 #include <algorithm>
 #include <initializer_list>
 #include <map>
@@ -11,16 +13,7 @@ namespace eical::drivers {
 
 void write_result(const dsp::Run& run, const dsp::Analysis& analysis, const std::filesystem::path& file) {
   const std::string text = result_json(run, analysis).dump(2) + "\n";
-  const std::filesystem::path tmp = file.string() + ".tmp";
-  {
-    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-    if (!os) throw std::runtime_error(tmp.string() + ": cannot create");
-    os << text;
-    if (!os.flush()) throw std::runtime_error(tmp.string() + ": write failed (disk full?)");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, file, ec);
-  if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
+  write_text_atomic(file, text);
 }
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -81,6 +82,19 @@ std::string sensor_section_toml(const char* name, const dsp::SensorSpec& s) {
 }
 
 std::string toml_number(double v) { return toml_double(v); }
+
+void write_text_atomic(const fs::path& file, const std::string& text) {
+  const fs::path tmp = file.string() + ".tmp";
+  {
+    std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
+    if (!os) throw std::runtime_error(tmp.string() + ": cannot create");
+    os << text;
+    if (!os.flush()) throw std::runtime_error(tmp.string() + ": write failed (disk full?)");
+  }
+  std::error_code ec;
+  fs::rename(tmp, file, ec);
+  if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
+}
 
 namespace {
 

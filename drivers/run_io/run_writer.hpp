@@ -22,6 +22,9 @@ std::string run_toml_text(const dsp::RunMeta& meta);
 
 // One [sensors.<name>] table with every key of run-format.md (run.toml, calibration files).
 std::string sensor_section_toml(const char* name, const dsp::SensorSpec& spec);
+// A small text file written atomically (temporary sibling + rename): result.json,
+// calibration files. Throws std::runtime_error naming the path.
+void write_text_atomic(const std::filesystem::path& file, const std::string& text);
 // TOML text of a number that reads back to the same double.
 std::string toml_number(double v);
 

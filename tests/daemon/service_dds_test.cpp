@@ -2,6 +2,7 @@
 // simulated measurement and gets a Reply to a trigger command.
 #include "daemon/service/service.hpp"
 #include "drivers/dds/bus.hpp"
+#include "drivers/dds/domain_claim.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -18,7 +19,7 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
 TEST(ServiceDds, HmiReceivesResultAndCommandsAreAnswered) {
-  const int domain = 1 + static_cast<int>((::getpid() + 100) % 200);
+  const int domain = eical::drivers::dds::claim_free_domain();
   const fs::path dir = fs::temp_directory_path() / ("eicald-dds-" + std::to_string(std::random_device{}()));
   eical::daemon::DaemonConfig c;
   c.source.pacing = "free_running";

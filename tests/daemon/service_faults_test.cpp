@@ -3,6 +3,7 @@
 // unwritable. Each must end in a flagged result or a reported error, the service going on,
 // and every completed recording intact (readable, result.json unchanged).
 #include "daemon/service/service.hpp"
+#include "drivers/dds/domain_claim.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "sim/gcode/generate.hpp"
 #include "sim/nc/trajectory.hpp"
@@ -35,7 +36,7 @@ DaemonConfig base_config(const fs::path& dir) {
   c.source.sim_repeats = 2;
   c.source.sim_repeat_program = false;
   c.triggers.inputs = {"frame"};  // no HMI bus needed here
-  c.dds.domain_id = 1 + static_cast<int>((::getpid() * 3 + 11) % 200);
+  c.dds.domain_id = eical::drivers::dds::claim_free_domain();
   c.dds.config_uri = "file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml";
   c.recording.dir = dir;
   c.recording.gzip = false;

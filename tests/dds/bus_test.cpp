@@ -1,6 +1,7 @@
 // The DDS bus over loopback (config/cyclonedds-loopback.xml), two participants in one
 // process: every topic round-trips, Result reaches a late-joining HMI, wake() ends a wait.
 #include "drivers/dds/bus.hpp"
+#include "drivers/dds/domain_claim.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -19,7 +20,7 @@ using namespace std::chrono_literals;
 int domain() {
   static const int d = [] {
     ::setenv("CYCLONEDDS_URI", "file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml", 1);
-    return 1 + static_cast<int>(::getpid() % 200);
+    return eical::drivers::dds::claim_free_domain();
   }();
   return d;
 }

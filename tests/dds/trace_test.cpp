@@ -2,6 +2,7 @@
 // HMI that joins after the publication still gets the last trace per program id
 // (reliable, transient-local).
 #include "drivers/dds/bus.hpp"
+#include "drivers/dds/domain_claim.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -16,7 +17,7 @@ using namespace std::chrono_literals;
 
 int trace_domain() {
   ::setenv("CYCLONEDDS_URI", "file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml", 1);
-  return 1 + static_cast<int>((::getpid() + 37) % 200);
+  return eical::drivers::dds::claim_free_domain();
 }
 
 TraceMsg circle_trace(const std::string& id, std::size_t n) {

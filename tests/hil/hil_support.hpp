@@ -3,6 +3,7 @@
 // (sim backend, loopback DDS, triggers only over DDS), a DDS domain of the test's own,
 // and the NC's side of the bus (commands sent once after a handshake, replies awaited).
 #include "drivers/dds/bus.hpp"
+#include "drivers/dds/domain_claim.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -27,9 +28,9 @@ inline fs::path scratch_dir(const std::string& tag) {
   return d;
 }
 
-inline int hil_domain(int salt) {
+inline int hil_domain(int /*salt*/) {
   ::setenv("CYCLONEDDS_URI", "file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml", 1);
-  return 1 + static_cast<int>((::getpid() * 7 + salt) % 200);
+  return drivers::dds::claim_free_domain();  // no other test on this host hears it
 }
 
 struct HilConfig {
