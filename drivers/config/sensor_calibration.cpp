@@ -68,7 +68,14 @@ SensorCalibration read_sensor_calibration(const std::filesystem::path& file, con
 
 void write_sensor_calibration(const SensorCalibration& cal, const std::filesystem::path& file) {
   std::string o = "# Sensor calibration: eical-sensor-cal/1 (identified on site; see README).\n";
-  o += std::string("format = \"") + kFormat + "\"\nmethod = \"" + cal.method + "\"\nrun = \"" + cal.run_id + "\"\n";
+  // Appended piecewise: GCC 12 warns falsely (-Warray-bounds) on the long temporary chain.
+  o += "format = \"";
+  o += kFormat;
+  o += "\"\nmethod = \"";
+  o += cal.method;
+  o += "\"\nrun = \"";
+  o += cal.run_id;
+  o += "\"\n";
   if (cal.daq_group_delay_samples) o += "\n[acquisition]\ndaq_group_delay_samples = " + toml_number(*cal.daq_group_delay_samples) + "\n";
   for (int s = 0; s < 2; ++s) {
     o += sensor_section_toml(kSensorNames[s], cal.sensors[s]);

@@ -18,7 +18,10 @@ PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples
   c.site = meta.site;
   c.sensors[0] = meta.sensors[0];
   c.sensors[1] = meta.sensors[1];
+  c.psd = meta.psd;
   c.capacity_samples = capacity_samples;
+  // Relative noise density, µg/√Hz · g → µm/s²/√Hz (two-sided, run-format.md).
+  c.fusion.accel_noise_um_s2_rthz = std::hypot(meta.sensors[0].noise_ug_per_rthz, meta.sensors[1].noise_ug_per_rthz) * meta.site.g_mps2;
   return c;
 }
 
@@ -35,6 +38,7 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
       "capacity_exceeded: the measurement is longer than the trace capacity (end cut off)",
       "no_end_trigger: no M103 (103) trigger; the measurement ends with the data",
       "fixed_saturated: the fixed-point path clamped a value outside its Q-format range",
+      "supports_diverged: the support fusion met values it cannot take (trace left as integrated, no ZUPT/NBS/CUPT)",
   };
   std::vector<std::string> out;
   for (std::uint32_t b = 0; b < std::size(names); ++b)
@@ -63,6 +67,12 @@ Pipeline::Pipeline(const PipelineConfig& c)
     finteg_[s] = FixedIntegrator(dt_s_, dyn);
     temp_c_[s] = static_cast<float>(c.sensors[s].temp_ref_c);
   }
+  SupportConfig sc;
+  sc.zupt = c.zupt, sc.nbs = c.nbs, sc.cupt = c.cupt, sc.smooth = c.smooth;
+  sc.model = c.fusion;
+  sc.standstill = c.standstill;
+  const double noise_mps2 = c.fusion.accel_noise_um_s2_rthz * 1e-6;
+  supports_ = SupportStage(sc, c.acquisition, c.psd, noise_mps2 * noise_mps2 * c.acquisition.fs_hz, c.capacity_samples);
   m_.fs_hz = c.acquisition.fs_hz;
   for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->reserve(c.capacity_samples);
   m_.sample_index.reserve(c.capacity_samples);
@@ -88,6 +98,7 @@ void Pipeline::reset() noexcept {
   m_.sample_index.clear();
   for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->clear();
   m_.triggers.clear();
+  supports_.reset();
 }
 
 void Pipeline::store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept {
@@ -141,6 +152,14 @@ void Pipeline::start_motion() noexcept {
   }
 }
 
+// This frame's acceleration of one sensor less its rest-window bias, m/s², machine axes.
+Eigen::Vector3d Pipeline::bias_free(int s) const noexcept {
+  if (!fixed_) return a_[s] - bias_[s];
+  Eigen::Vector3d a;
+  for (int i = 0; i < 3; ++i) a[i] = fx::to_double(aq_[s][i], fx::kAccelQ) - bias_[s][i];
+  return a;
+}
+
 void Pipeline::integrate(std::int64_t k_samples, double dt, Eigen::Vector3d& pos_m, Eigen::Vector3d& vel_mps) noexcept {
   if (fixed_) {
     std::int64_t x_q40[2][3], v_q40[2][3];
@@ -172,6 +191,8 @@ void Pipeline::step(const Frame& f) noexcept {
   if (f.flags & frame_flag::not_finite) quality_ |= quality_flag::not_finite;
   if (f.flags & frame_flag::gap_before) quality_ |= quality_flag::frames_lost;
   compensate(f);
+  supports_.psd_frame(f);
+  const bool accel_valid = (f.flags & kAccelBad) == 0;
   const std::int64_t k_samples = prev_index_ >= 0 ? f.sample_index - prev_index_ : 1;
   const double dt = static_cast<double>(k_samples) * dt_s_;
   prev_index_ = f.sample_index;
@@ -201,9 +222,11 @@ void Pipeline::step(const Frame& f) noexcept {
           }
         }
         ++bias_n_;
+        supports_.rest_sample(fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]));
         return;
       }
       start_motion();
+      supports_.start();
       // The programs dwell 0.1 s after M101; a trigger that reaches the DAQ clock a few
       // samples late must not flag a good rest.
       if (bias_n_ < static_cast<std::size_t>(0.05 / dt_s_)) quality_ |= quality_flag::short_rest_window;
@@ -213,6 +236,8 @@ void Pipeline::step(const Frame& f) noexcept {
       start_index_ = motion_end_index_ = f.sample_index;
       phase_ = Phase::moving;
       live_.integrating = true;
+      if (m_.sample_index.size() < config_.capacity_samples)
+        supports_.step(0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(), cmd_valid, cmd_moved, cmd);
       store(f, start_pos_mm_, Eigen::Vector3d::Zero());
       return;
     case Phase::moving: {
@@ -221,75 +246,16 @@ void Pipeline::step(const Frame& f) noexcept {
       integrate(k_samples, dt, pos_m, vel_mps);
       const Eigen::Vector3d pos_mm = start_pos_mm_ + pos_m * 1000.0;
       const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
-      // Predicted over the DAQ delay (what finish() re-indexes exactly).
-      live_.pos_mm = config_.dynamic == DynamicComp::none ? pos_mm : Eigen::Vector3d(pos_mm + vel_mm_s * (delay_samples_ * dt_s_));
-      live_.vel_mm_s = vel_mm_s;
+      const std::size_t k = m_.sample_index.size();
+      if (k < config_.capacity_samples)
+        supports_.step(k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd);
+      // The live filter's estimate, predicted over the DAQ delay (what finish() re-indexes).
+      const Eigen::Vector3d live_pos = pos_mm - supports_.live_dx_mm();
+      live_.vel_mm_s = vel_mm_s - supports_.live_dv_mm_s();
+      live_.pos_mm = config_.dynamic == DynamicComp::none ? live_pos : Eigen::Vector3d(live_pos + live_.vel_mm_s * (delay_samples_ * dt_s_));
       store(f, pos_mm, vel_mm_s);  // frames after M103 belong to the rest (ZUPT) window too
       return;
     }
-  }
-}
-
-void Pipeline::apply_zupt(Measurement& m) {
-  // (ch. 3.4.2 / 8.3.1) Zero-velocity updates at every standstill of the set-point: the
-  // integrated velocity should be zero there, and what is left is the integral of the
-  // acceleration error since the start. Between two standstills the error is taken as
-  // linear in time (a constant acceleration error per segment — each partial move its
-  // own offset, ch. 8.3.2); after the last one it is held. The correction is removed from
-  // the velocity and, integrated, from the position.
-  const double fs = config_.acquisition.fs_hz;
-  const auto n = m.sample_index.size();
-  const auto settle = static_cast<std::size_t>(std::ceil(config_.acquisition.daq_group_delay_samples + config_.zupt_settle_s * fs));
-  const auto min_window = static_cast<std::size_t>(0.05 * fs);
-  struct Knot {
-    double t_s;
-    Eigen::Vector3d dv;
-  };
-  std::vector<Knot> knots{{0.0, Eigen::Vector3d::Zero()}};  // integration starts at rest
-  std::size_t i = 0;
-  while (i < n) {
-    // A stationary stretch of the set-point.
-    std::size_t j = i;
-    while (j + 1 < n && (m.cmd_mm[j + 1] - m.cmd_mm[i]).cwiseAbs().maxCoeff() < 1e-9 &&
-           m.sample_index[j + 1] == m.sample_index[j] + 1)
-      ++j;
-    if (i > 0 && j - i + 1 >= settle + min_window) {
-      Eigen::Vector3d v = Eigen::Vector3d::Zero();
-      double t = 0.0;
-      for (std::size_t k = i + settle; k <= j; ++k) {
-        v += m.vel_mm_s[k];
-        t += static_cast<double>(m.sample_index[k] - start_index_) / fs;
-      }
-      const double cnt = static_cast<double>(j - i - settle + 1);
-      knots.push_back({t / cnt, v / cnt});
-      m.zupt_window_samples += j - i - settle + 1;
-      m.zupt_velocity_error_mm_s = v / cnt;
-    }
-    i = j + 1;
-  }
-  if (knots.size() < 2) {
-    quality_ |= quality_flag::no_zupt_window;
-    return;
-  }
-  std::size_t seg = 0;
-  Eigen::Vector3d pos_corr = Eigen::Vector3d::Zero(), prev_v = Eigen::Vector3d::Zero();
-  double prev_t = 0.0;
-  for (std::size_t k = 0; k < n; ++k) {
-    const double t = static_cast<double>(m.sample_index[k] - start_index_) / fs;
-    while (seg + 1 < knots.size() && t > knots[seg + 1].t_s) ++seg;
-    Eigen::Vector3d vc;
-    if (seg + 1 < knots.size()) {
-      const auto& a = knots[seg];
-      const auto& b = knots[seg + 1];
-      vc = a.dv + (b.dv - a.dv) * ((t - a.t_s) / (b.t_s - a.t_s));
-    } else {
-      vc = knots.back().dv;
-    }
-    if (k > 0) pos_corr += 0.5 * (vc + prev_v) * (t - prev_t);
-    prev_v = vc;
-    prev_t = t;
-    m.vel_mm_s[k] -= vc;
-    m.pos_mm[k] -= pos_corr;
   }
 }
 
@@ -316,47 +282,28 @@ void Pipeline::align_delay(Measurement& m) const {
   }
 }
 
-void Pipeline::apply_nbs(Measurement& m) const {
-  // Moves are the stretches where the set-point changes. Within one (and the settling
-  // after it) every axis whose set-point stays put is held at its level from before the
-  // move with zero velocity; what it would have drifted is subtracted from it afterwards,
-  // so the later rests keep their level relative to it.
-  const std::size_t n = m.pos_mm.size();
-  const auto tail = static_cast<std::size_t>(std::ceil(config_.zupt_settle_s * config_.acquisition.fs_hz));
-  auto moved = [&](std::size_t j) { return (m.cmd_mm[j] - m.cmd_mm[j - 1]).cwiseAbs().maxCoeff() >= 1e-12; };
-  Eigen::Vector3d carried = Eigen::Vector3d::Zero();
-  std::size_t k = 1;
-  while (k < n) {
-    if (!moved(k)) {
-      m.pos_mm[k] -= carried;
-      ++k;
-      continue;
-    }
-    std::size_t e = k;
-    while (e < n && moved(e)) ++e;
-    std::size_t end = e;  // the sensors see the move d samples late and settle: hold a little longer
-    while (end < n && end < e + tail + static_cast<std::size_t>(delay_samples_) && !moved(end)) ++end;
-    bool still[3];
-    for (int a = 0; a < 3; ++a) {
-      still[a] = true;
-      for (std::size_t j = k; j < e && still[a]; ++j) still[a] = m.cmd_mm[j][a] == m.cmd_mm[k - 1][a];
-    }
-    const Eigen::Vector3d level = m.pos_mm[k - 1];  // corrected already
-    Eigen::Vector3d last_raw = level;
-    for (std::size_t j = k; j < end; ++j)
-      for (int a = 0; a < 3; ++a) {
-        if (still[a]) {
-          last_raw[a] = m.pos_mm[j][a];
-          m.pos_mm[j][a] = level[a];
-          m.vel_mm_s[j][a] = 0.0;
-        } else {
-          m.pos_mm[j][a] -= carried[a];
-        }
-      }
-    for (int a = 0; a < 3; ++a)
-      if (still[a]) carried[a] = last_raw[a] - level[a];
-    k = end;
+void Pipeline::apply_supports(Measurement& m) {
+  // The raw integrated velocity at the last standstill: what ZUPT takes out there.
+  std::vector<Eigen::Vector3d> sigma;
+  const std::vector<Eigen::Vector3d> raw_vel = m.vel_mm_s;
+  m.supports = supports_.finish(m.sample_index, m.pos_mm, m.vel_mm_s, sigma);
+  m.sigma_um = std::move(sigma);
+  if (m.supports.diverged) quality_ |= quality_flag::supports_diverged;
+  const std::int64_t motion_end_sensor = motion_end_index_ + static_cast<std::int64_t>(std::ceil(delay_samples_));
+  bool rest_after = false;
+  for (const RestWindow& w : m.supports.rest_windows) {
+    m.zupt_window_samples += w.samples;
+    rest_after |= w.last_index > motion_end_sensor;
   }
+  if (!m.supports.rest_windows.empty()) {
+    const RestWindow& last = m.supports.rest_windows.back();
+    Eigen::Vector3d v = Eigen::Vector3d::Zero();
+    std::size_t cnt = 0;
+    for (std::size_t k = 0; k < m.sample_index.size() && k < raw_vel.size(); ++k)
+      if (m.sample_index[k] >= last.first_index && m.sample_index[k] <= last.last_index) v += raw_vel[k], ++cnt;
+    if (cnt > 0) m.zupt_velocity_error_mm_s = v / static_cast<double>(cnt);
+  }
+  if (config_.zupt && !rest_after) quality_ |= quality_flag::no_zupt_window;
 }
 
 Measurement Pipeline::finish() {
@@ -368,10 +315,11 @@ Measurement Pipeline::finish() {
   m.motion_end_index = motion_end_index_;
   if (phase_ != Phase::moving) quality_ |= quality_flag::no_motion;
 
-  // DynamicComp::none leaves the DAQ delay in as well (the thesis' "uncompensated").
+  // Supports in the sensors' time base (the PSD channels are delayed like the sensors),
+  // then onto the set-point's time. DynamicComp::none leaves the DAQ delay in as well
+  // (the thesis' "uncompensated").
+  if (phase_ == Phase::moving && !m.sample_index.empty()) apply_supports(m);
   if (config_.dynamic != DynamicComp::none && phase_ == Phase::moving && !m.sample_index.empty()) align_delay(m);
-  if (config_.zupt && phase_ == Phase::moving && !m.sample_index.empty()) apply_zupt(m);
-  if (config_.nbs && phase_ == Phase::moving && !m.sample_index.empty()) apply_nbs(m);
   m.flags = quality_flag_names(quality_);
   m.degraded = quality_ != 0;
   return m;

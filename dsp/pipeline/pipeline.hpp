@@ -12,10 +12,11 @@
 //   4 trapezoid integration of each sensor from the start of the motion with the dynamic
 //     compensation of the PT2 at the chosen level (SensorIntegrator / FixedIntegrator);
 //     relative = head − table (3-1), starting at the set-point there
-//   5 finish(): the DAQ delay removed by re-indexing the trace (exact for any signal; the
-//     live estimate is predicted over it instead), then ZUPT at every standstill of the
-//     set-point — the velocity left there is the integrated acceleration error; it is
-//     removed piecewise linearly in time
+//   5 supports and fusion (SupportStage): ZUPT at every standstill the automatic detector
+//     finds, NBS for held axes, CUPT from the PSD strips; the forward Kalman filter live,
+//     the same filter again plus the RTS smoother in finish()
+//   6 finish(): the DAQ delay removed by re-indexing the trace (exact for any signal; the
+//     live estimate is predicted over it instead)
 #include "dsp/core/frame.hpp"
 #include "dsp/core/run_meta.hpp"
 #include "dsp/pipeline/coriolis.hpp"
@@ -24,6 +25,7 @@
 #include "dsp/pipeline/fixed_static_comp.hpp"
 #include "dsp/pipeline/sensor_integrator.hpp"
 #include "dsp/pipeline/static_comp.hpp"
+#include "dsp/pipeline/support_stage.hpp"
 
 #include <Eigen/Core>
 
@@ -45,6 +47,7 @@ struct PipelineConfig {
   Site site;
   SensorSpec sensors[2];
   StaticCalibration calibration[2];  // cross terms and mounting (6-4, 6-18); default: data sheet
+  std::vector<PsdSpec> psd;          // the run's PSD strips (CUPT)
   std::size_t capacity_samples = 0;  // longest measurement the trace can hold
   DynamicComp dynamic = DynamicComp::two_stage;
   StaticCompOptions static_comp;     // temperature (6-16) and nonlinearity (6-17) on/off
@@ -52,12 +55,15 @@ struct PipelineConfig {
   // leave it out (sc.coriolis), and correcting a term that is absent adds it. Real runs: on.
   bool coriolis = false;
   Arithmetic arithmetic = Arithmetic::double_precision;
-  double zupt_settle_s = 0.05;       // after the set-point stops (plus the DAQ delay)
   bool zupt = true;
   // NBS (Bild 7-8): an axis whose set-point does not move during a move is held still —
   // its integrated drift there is removed (and so is any real motion of it: straightness of
   // the moving axis is no longer seen). For rectangles and other axis-parallel programs.
   bool nbs = false;
+  bool cupt = true;    // PSD strips as position fixes (when the run has [[psd]])
+  bool smooth = true;  // RTS pass in finish() (off: the forward filter's causal result)
+  fusion::ErrorModel fusion;  // pipeline_config() sets the noise from the sensors' data sheet
+  supports::StandstillOptions standstill;
 };
 
 PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples);
@@ -75,6 +81,7 @@ inline constexpr std::uint32_t no_zupt_window = 1u << 7;
 inline constexpr std::uint32_t capacity_exceeded = 1u << 8;
 inline constexpr std::uint32_t no_end_trigger = 1u << 9;
 inline constexpr std::uint32_t fixed_saturated = 1u << 10;
+inline constexpr std::uint32_t supports_diverged = 1u << 11;
 }  // namespace quality_flag
 
 std::vector<std::string> quality_flag_names(std::uint32_t bits);
@@ -101,8 +108,10 @@ struct Measurement {
   bool degraded = false;
   std::vector<std::string> flags;
   Eigen::Vector3d rest_bias_rel_mps2 = Eigen::Vector3d::Zero();  // head − table, incl. gravity
-  Eigen::Vector3d zupt_velocity_error_mm_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d zupt_velocity_error_mm_s = Eigen::Vector3d::Zero();  // integrated velocity at the last standstill
   std::size_t rest_window_samples = 0, zupt_window_samples = 0;
+  std::vector<Eigen::Vector3d> sigma_um;   // posterior σ of pos_mm per axis (after finish())
+  SupportSummary supports;
 };
 
 class Pipeline {
@@ -120,12 +129,12 @@ class Pipeline {
 
  private:
   enum class Phase { wait_start, rest, moving };
-  void apply_zupt(Measurement& m);
-  void apply_nbs(Measurement& m) const;
+  void apply_supports(Measurement& m);
   void align_delay(Measurement& m) const;
   void store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept;
   void compensate(const Frame& f) noexcept;
   void start_motion() noexcept;
+  [[nodiscard]] Eigen::Vector3d bias_free(int sensor) const noexcept;
   void integrate(std::int64_t k_samples, double dt_s, Eigen::Vector3d& pos_m, Eigen::Vector3d& vel_mps) noexcept;
 
   PipelineConfig config_;
@@ -135,6 +144,7 @@ class Pipeline {
   SensorIntegrator integ_[2];
   FixedIntegrator finteg_[2];
   CoriolisComp coriolis_;
+  SupportStage supports_;
   fx::Saturation saturation_;
   double dt_s_;
   double delay_samples_ = 0.0;  // DAQ group delay, removed by re-indexing in finish()

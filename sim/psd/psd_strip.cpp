@@ -38,8 +38,8 @@ void PsdStrip::step(const Eigen::Vector3d& p, double& i1_v, double& i2_v) noexce
     const double uc = std::clamp(u, -half_l, half_l);
     const double r = 2.0 * uc / spec_.length_mm;
     const double um = uc * (1.0 + truth_.nonlinearity * r * r);
-    target1 = light * truth_.full_scale_v * (0.5 - um / spec_.length_mm);
-    target2 = light * truth_.full_scale_v * (0.5 + um / spec_.length_mm);
+    target1 = light * truth_.full_scale_v * (0.5 + um / spec_.length_mm);
+    target2 = light * truth_.full_scale_v * (0.5 - um / spec_.length_mm);
   }
   i1_ += alpha_ * (target1 - i1_);
   i2_ += alpha_ * (target2 - i2_);

@@ -72,7 +72,7 @@ TEST(PsdStrip, SharesTheLightByPositionAndIsDarkOffTheStrip) {
   for (double u : {-3.0, -1.0, 0.0, 2.5}) {
     strip.step(Eigen::Vector3d(u, -10.0, 0.0), i1, i2);
     EXPECT_NEAR(i1 + i2, truth.full_scale_v, 1e-9);
-    EXPECT_NEAR((i2 - i1) / (i1 + i2) * spec.length_mm / 2.0, u, 1e-9);
+    EXPECT_NEAR((i1 - i2) / (i1 + i2) * spec.length_mm / 2.0, u, 1e-9);  // electrode 1 at +u
   }
   strip.step(Eigen::Vector3d(0.0, -9.0, 0.0), i1, i2);  // 1 mm beside the 0.5 mm strip
   EXPECT_EQ(i1 + i2, 0.0);

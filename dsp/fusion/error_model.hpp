@@ -1,0 +1,56 @@
+#pragma once
+// The error of the integrated relative motion along one machine axis (ch. 5.5: the
+// forward, or feed-forward, configuration of Bild 2-6: the integration runs on, the filter
+// estimates what it is off by). State e = [δx µm, δv µm/s, δb µm/s²]: position, velocity
+// and acceleration-bias error of head − table after the rest-window bias was removed.
+//
+//   δx' = δv,   δv' = δb + w_a,   δb' = w_b
+//
+// w_a: the two sensors' white noise, two-sided density n per sensor (run-format.md), so
+// q_a = n_table² + n_head²; w_b: the bias random walk (6-5, 6-6), q_b = walk² (both
+// sensors). Exact discretisation over a step h (Van Loan for this chain):
+//   F = [1 h h²/2; 0 1 h; 0 0 1]
+//   Q = q_a [h³/3 h²/2 0; h²/2 h 0; 0 0 0]
+//     + q_b [h⁵/20 h⁴/8 h³/6; h⁴/8 h³/3 h²/2; h³/6 h²/2 h]
+// Units are µm and seconds so that the covariances stay near 1 (well conditioned).
+#include <Eigen/Core>
+
+namespace eical::dsp::fusion {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+// What the filter assumes about the sensors and the supports; defaults are the data
+// sheet's (SF3000L, ch. 6.2) and what the thesis measured (ch. 8.3.2).
+struct ErrorModel {
+  double accel_noise_um_s2_rthz = 5.55;   // relative, two-sided: √2 · 0.4 µg/√Hz · g
+  double bias_walk_um_s2_rts = 2.0;       // relative bias random walk, ≈ 0.2 µg/√s
+  // Each partial move has its own offset (ch. 8.3.2): at every start of a move the bias
+  // may jump by this much (σ) from what the rest before it showed.
+  double bias_step_um_s2 = 20.0;          // ≈ 2 µg
+  double start_position_um = 2.0;         // σ of the start position against the set-point
+  double start_velocity_um_s = 1.0;       // σ of the velocity at the start (at rest)
+  double zupt_sigma_um_s = 2.0;           // σ of the velocity at a standstill (vibration, creep)
+  double nbs_sigma_um_s = 5.0;            // σ of a held axis' velocity (straightness, vibration)
+  double psd_floor_um = 0.05;             // added to every PSD fix's σ (model error of the strip)
+  double gate_nis = 25.0;                 // innovation test: reject beyond 5 σ
+  // A standstill whose velocity the filter keeps rejecting means the model was too sure
+  // (a bias jump it did not expect): after this many rejections in a row (per-sample
+  // ZUPT; a window mean counts 100) the covariance is opened by what was unexplained.
+  int reset_after_rejections = 100;
+};
+
+struct Discrete {
+  Mat3 F = Mat3::Identity();
+  Mat3 Q = Mat3::Zero();
+  double h_s = 0.0;
+};
+
+Discrete discretise(const ErrorModel& model, double h_s);
+
+// Covariance of one axis' error at the start of the motion: the start position against
+// the set-point, the velocity at rest, the rest-window bias (σ given) and its jump into
+// the first move.
+Mat3 initial_covariance(const ErrorModel& model, double start_bias_sigma_um_s2);
+
+}  // namespace eical::dsp::fusion

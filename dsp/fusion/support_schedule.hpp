@@ -1,0 +1,49 @@
+#pragma once
+// Which supports hold at which sample of a measurement's trace: the input of the offline
+// smoother, built from the same decisions the live filter makes (standstill detector, NBS
+// from the set-point, PSD fixes), refined with hindsight (a standstill is known from its
+// first quiet sample, not from the end of the detector's window).
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace eical::dsp::fusion {
+
+namespace schedule_flag {
+inline constexpr std::uint8_t rest = 1u << 0;        // ZUPT on every axis
+inline constexpr std::uint8_t nbs_x = 1u << 1;       // NBS: axis held (bit 1 + axis)
+inline constexpr std::uint8_t move_start = 1u << 4;  // a move begins: the bias may jump (ch. 8.3.2)
+inline constexpr std::uint8_t invalid = 1u << 5;     // no valid acceleration: no velocity support
+}  // namespace schedule_flag
+
+inline constexpr std::uint8_t nbs_flag(int axis) { return static_cast<std::uint8_t>(schedule_flag::nbs_x << axis); }
+
+// A position fix from a PSD strip: the relative position along `axis` at trace sample k.
+struct PositionFix {
+  std::size_t k = 0;
+  int axis = 0;
+  double position_um = 0.0;  // in the trace's frame (the set-point at the start)
+  double sigma_um = 0.0;
+};
+
+// The mean integrated velocity over a window ending at sample k of a standstill where the
+// machine still rings: δv_k − δb·lag is what it observes (the bias acts over the window).
+struct VelocityMean {
+  std::size_t k = 0;
+  double mean_um_s[3] = {0, 0, 0};
+  double sigma_um_s = 0.0;
+  double lag_s = 0.0;  // from the window's mean time to sample k
+};
+
+struct SupportSchedule {
+  std::vector<std::uint8_t> flags;  // one per trace sample
+  std::vector<PositionFix> fixes;   // ascending k
+  // Per trace sample when present: 0 — a standstill's velocity with the model's
+  // zupt_sigma_um_s; negative — a ringing standstill, whose samples are not used one by one
+  // (their swings are correlated) but through velocity_means.
+  std::vector<float> zupt_sigma_um_s;
+  std::vector<VelocityMean> velocity_means;  // ascending k
+  bool zupt = true;  // off: standstills are found and reported, not used
+};
+
+}  // namespace eical::dsp::fusion

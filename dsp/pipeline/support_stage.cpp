@@ -1,0 +1,260 @@
+#include "dsp/pipeline/support_stage.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace eical::dsp {
+namespace {
+
+constexpr std::size_t kMaxRestWindows = 4096;
+
+}  // namespace
+
+SupportStage::SupportStage(const SupportConfig& c, const Acquisition& acq, const std::vector<PsdSpec>& psd, double noise_var,
+                           std::size_t capacity)
+    : cfg_(c), fs_hz_(acq.fs_hz), delay_samples_(acq.daq_group_delay_samples), step_(fusion::discretise(c.model, 1.0 / acq.fs_hz)),
+      detector_(c.standstill, acq.fs_hz, acq.daq_group_delay_samples, noise_var), capacity_(capacity) {
+  for (const auto& s : psd) {
+    if (psd_.size() >= static_cast<std::size_t>(kMaxPsd)) break;
+    psd_.emplace_back(s, acq);
+  }
+  schedule_.flags.reserve(capacity);
+  schedule_.zupt_sigma_um_s.reserve(capacity);
+  schedule_.zupt = c.zupt;
+  schedule_.fixes.reserve(capacity);
+  schedule_.velocity_means.reserve(capacity / 100 + 16);
+  rests_.reserve(kMaxRestWindows);
+  block_len_ = static_cast<std::size_t>(std::max(1.0, std::round(0.02 * acq.fs_hz)));
+  block_means_.reserve(kMaxRestWindows);
+  reset();
+}
+
+void SupportStage::reset() noexcept {
+  for (auto& d : psd_) d.reset();
+  psd_now_ = {};
+  detector_.reset();
+  schedule_.flags.clear();
+  schedule_.zupt_sigma_um_s.clear();
+  schedule_.velocity_means.clear();
+  schedule_.fixes.clear();
+  rest_sum_.setZero(), rest_sq_.setZero();
+  rest_n_ = 0;
+  block_means_.clear();
+  block_sum_.setZero();
+  block_n_ = 0;
+  start_bias_sigma_.setZero();
+  at_rest_ = started_ = false;
+  cmd_at_rest_.setZero();
+  open_ = RestWindow{};
+  rests_.clear();
+  rests_dropped_ = fixes_dropped_ = 0;
+  ringing_count_ = 0;
+  live_.start(cfg_.model, Eigen::Vector3d::Constant(cfg_.model.bias_step_um_s2));
+}
+
+void SupportStage::psd_frame(const Frame& f) noexcept {
+  for (std::size_t k = 0; k < psd_.size(); ++k)
+    psd_now_[k] = psd_[k].step(f.psd_counts[2 * k], f.psd_counts[2 * k + 1], (f.flags & frame_flag::psd_missing) != 0);
+}
+
+void SupportStage::rest_sample(const Eigen::Vector3d& a) noexcept {
+  if (!a.allFinite()) return;
+  rest_sum_ += a;
+  rest_sq_ += a.cwiseProduct(a);
+  ++rest_n_;
+  block_sum_ += a;
+  if (++block_n_ == block_len_) {
+    if (block_means_.size() < block_means_.capacity()) block_means_.push_back(block_sum_ / static_cast<double>(block_len_));
+    block_sum_.setZero();
+    block_n_ = 0;
+  }
+}
+
+void SupportStage::start() noexcept {
+  // The rest window's own scatter: the detector's noise level and how well it fixed the bias.
+  if (rest_n_ >= 100) {
+    const double n = static_cast<double>(rest_n_);
+    const Eigen::Vector3d var = (rest_sq_ / n - (rest_sum_ / n).cwiseAbs2()).cwiseMax(0.0);
+    detector_.set_noise(var.mean());
+    start_bias_sigma_ = (var / n).cwiseSqrt() * 1e6;  // m/s² → µm/s², white samples
+    const std::size_t nb = block_means_.size();
+    if (nb >= 3) {  // batch means: σ of the mean = spread of the block means / √blocks
+      Eigen::Vector3d mb = Eigen::Vector3d::Zero(), vb = Eigen::Vector3d::Zero();
+      for (const auto& b : block_means_) mb += b;
+      mb /= static_cast<double>(nb);
+      for (const auto& b : block_means_) vb += (b - mb).cwiseAbs2();
+      vb /= static_cast<double>(nb - 1);
+      start_bias_sigma_ = start_bias_sigma_.cwiseMax((vb / static_cast<double>(nb)).cwiseSqrt() * 1e6);
+    }
+  } else {
+    start_bias_sigma_ = Eigen::Vector3d::Constant(std::sqrt(detector_.noise_var() / std::max<double>(1.0, static_cast<double>(rest_n_))) * 1e6);
+  }
+  live_.start(cfg_.model, start_bias_sigma_);
+  started_ = true;
+  at_rest_ = false;
+}
+
+Eigen::Vector3d SupportStage::live_dx_mm() const noexcept {
+  return Eigen::Vector3d(live_.axis[0].e[0], live_.axis[1].e[0], live_.axis[2].e[0]) / 1000.0;
+}
+
+Eigen::Vector3d SupportStage::live_dv_mm_s() const noexcept {
+  return Eigen::Vector3d(live_.axis[0].e[1], live_.axis[1].e[1], live_.axis[2].e[1]) / 1000.0;
+}
+
+void SupportStage::close_rest_window() noexcept {
+  if (open_.samples == 0) return;
+  open_.table_mps2 /= static_cast<double>(open_.samples);
+  open_.head_mps2 /= static_cast<double>(open_.samples);
+  if (rests_.size() < kMaxRestWindows) rests_.push_back(open_);
+  else ++rests_dropped_;
+  open_ = RestWindow{};
+}
+
+void SupportStage::step(std::size_t k, std::int64_t gap, bool accel_valid, const Eigen::Vector3d& a_table,
+                        const Eigen::Vector3d& a_head, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
+                        bool cmd_valid, bool cmd_moved, const Eigen::Vector3d& cmd_mm) noexcept {
+  const Eigen::Vector3d a_rel = a_head - a_table;
+  const Eigen::Vector3d vel_corr = vel_mm_s - live_dv_mm_s();
+  double pvv = 0.0;
+  for (const auto& f : live_.axis) pvv = std::max(pvv, f.P(1, 1));
+  const supports::StandstillDetector::Decision det =
+      detector_.step(accel_valid ? a_rel : Eigen::Vector3d::Constant(NAN), vel_mm_s, live_dv_mm_s(), std::sqrt(pvv) / 1000.0, cmd_valid,
+                     cmd_moved);
+  const bool rest = accel_valid && det.rest;  // found and reported even when ZUPT is off
+  // A ringing standstill (its velocity spreads beyond what the noise makes of it): not its
+  // samples one by one (their swings are correlated) but the mean velocity over each
+  // vibration window. A sine's mean over a window at least twice its period is below 0.2
+  // of its rms: 0.3 of the spread is the σ of that mean.
+  double zupt_sigma_um_s = 0.0;
+  bool mean_update = false;
+  fusion::VelocityMean vm;
+  if (rest && det.vibration_sigma_mm_s * 1000.0 > 3.0 * cfg_.model.zupt_sigma_um_s) {
+    zupt_sigma_um_s = -1.0;
+    if (++ringing_count_ % detector_.vibration_window() == 0) {
+      mean_update = true;
+      vm.k = k;
+      for (int a = 0; a < 3; ++a) vm.mean_um_s[a] = det.window_mean_mm_s[a] * 1000.0;
+      vm.sigma_um_s = 0.3 * det.vibration_sigma_mm_s * 1000.0;
+      vm.lag_s = det.window_lag_s;
+    }
+  } else {
+    ringing_count_ = 0;
+  }
+
+  std::uint8_t flags = 0;
+  if (!accel_valid) flags |= fusion::schedule_flag::invalid;
+  if (rest) {
+    flags |= fusion::schedule_flag::rest;
+    if (cmd_valid) cmd_at_rest_ = cmd_mm;
+  } else if (cfg_.nbs && cmd_valid) {
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(cmd_mm[a] - cmd_at_rest_[a]) < 1e-9) flags |= fusion::nbs_flag(a);
+  }
+  if (k == 0 && cmd_valid) cmd_at_rest_ = cmd_mm;  // the set-point where the motion starts
+  const bool move_start = k > 0 && at_rest_ && !rest;
+  if (move_start) flags |= fusion::schedule_flag::move_start;
+
+  if (k > 0) live_.predict(gap == 1 ? step_ : fusion::discretise(cfg_.model, static_cast<double>(gap) / fs_hz_), move_start, cfg_.model);
+  live_.velocity_supports(flags, vel_mm_s * 1000.0, cfg_.model, zupt_sigma_um_s, cfg_.zupt);
+  if (mean_update) {
+    live_.velocity_mean(vm, cfg_.model, cfg_.zupt);
+    if (schedule_.velocity_means.size() < schedule_.velocity_means.capacity()) schedule_.velocity_means.push_back(vm);
+  }
+  if (cfg_.cupt) {
+    for (std::size_t s = 0; s < psd_.size(); ++s) {
+      const supports::PsdReading& r = psd_now_[s];
+      if (!r.valid) continue;
+      const int ax = psd_[s].axis();
+      // The lock-in output lags the spot by its time constant: add τ·v.
+      const double fix_um = (psd_[s].centre_mm() + r.u_mm + psd_[s].lockin_tau_s() * vel_corr[ax]) * 1000.0;
+      live_.position_fix(ax, pos_mm[ax] * 1000.0, fix_um, r.sigma_mm * 1000.0, cfg_.model);
+      if (schedule_.fixes.size() < capacity_) schedule_.fixes.push_back({k, ax, fix_um, r.sigma_mm * 1000.0});
+      else ++fixes_dropped_;
+    }
+  }
+  if (schedule_.flags.size() < capacity_) {
+    schedule_.flags.push_back(flags);
+    schedule_.zupt_sigma_um_s.push_back(static_cast<float>(zupt_sigma_um_s));
+  }
+
+  if (rest) {  // the sensors' mean at a standstill: their bias there (drift between rests)
+    if (open_.samples == 0) open_.first_index = static_cast<std::int64_t>(k);
+    open_.last_index = static_cast<std::int64_t>(k);
+    open_.table_mps2 += a_table;
+    open_.head_mps2 += a_head;
+    open_.quiet = open_.quiet && det.quiet;
+    ++open_.samples;
+  } else {
+    close_rest_window();
+  }
+  at_rest_ = rest;
+}
+
+SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::vector<Eigen::Vector3d>& pos_mm,
+                                    std::vector<Eigen::Vector3d>& vel_mm_s, std::vector<Eigen::Vector3d>& sigma_x_um) {
+  close_rest_window();
+  SupportSummary sum;
+  const std::size_t n = std::min({idx.size(), pos_mm.size(), schedule_.flags.size()});
+  auto& flags = schedule_.flags;
+  flags.resize(n);
+  schedule_.zupt_sigma_um_s.resize(n);
+  // Hindsight: a standstill began where the detector's quiet window began.
+  const std::size_t back = detector_.window() > 0 ? detector_.window() - 1 : 0;
+  namespace sf = fusion::schedule_flag;
+  for (std::size_t k = 1; k < n; ++k) {
+    // Only a quiet window vouches for its past (a ringing standstill was found by the
+    // set-point, with its acceleration still in the window).
+    if (!(flags[k] & sf::rest) || (flags[k - 1] & sf::rest) || schedule_.zupt_sigma_um_s[k] != 0.0F) continue;
+    for (std::size_t j = k; j-- > 0 && k - j <= back;) {
+      if (flags[j] & (sf::rest | sf::invalid)) break;
+      flags[j] = static_cast<std::uint8_t>((flags[j] & ~(sf::move_start | fusion::nbs_flag(0) | fusion::nbs_flag(1) | fusion::nbs_flag(2))) | sf::rest);
+      schedule_.zupt_sigma_um_s[j] = schedule_.zupt_sigma_um_s[k];
+    }
+  }
+  for (std::size_t k = 1; k < n; ++k) {
+    flags[k] = static_cast<std::uint8_t>(flags[k] & ~sf::move_start);
+    if ((flags[k - 1] & sf::rest) && !(flags[k] & sf::rest)) flags[k] |= sf::move_start;
+  }
+  // Rest windows in sample indices (after the hindsight above they start a window earlier).
+  for (auto w : rests_) {
+    const auto first = static_cast<std::size_t>(std::max<std::int64_t>(0, w.first_index - static_cast<std::int64_t>(back)));
+    w.first_index = idx[std::min(first, n - 1)];
+    w.last_index = idx[std::min(static_cast<std::size_t>(w.last_index), n - 1)];
+    sum.rest_windows.push_back(w);
+  }
+  sum.psd_fixes = schedule_.fixes.size();
+  sum.psd_fixes_dropped = fixes_dropped_;
+  if (n == 0) return sum;
+
+  std::vector<std::int64_t> index(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(n));
+  pos_mm.resize(n), vel_mm_s.resize(n);
+  fusion::SmootherInput in;
+  in.sample_index = &index;
+  in.vel_mm_s = &vel_mm_s;
+  in.pos_mm = &pos_mm;
+  in.schedule = &schedule_;
+  in.fs_hz = fs_hz_;
+  in.model = cfg_.model;
+  in.start_bias_sigma_um_s2 = start_bias_sigma_;
+  in.forward_only = !cfg_.smooth;
+  const fusion::SmootherOutput out = fusion::smooth(in);
+  bool finite = true;
+  for (std::size_t k = 0; k < n && finite; ++k) finite = out.dx_um[k].allFinite() && out.dv_um_s[k].allFinite();
+  if (!finite) {  // an input the model cannot take (a saturated channel): leave the trace as integrated
+    sum.diverged = true;
+    sigma_x_um.assign(n, Eigen::Vector3d::Constant(NAN));
+    return sum;
+  }
+  for (std::size_t k = 0; k < n; ++k) {
+    pos_mm[k] -= out.dx_um[k] / 1000.0;
+    vel_mm_s[k] -= out.dv_um_s[k] / 1000.0;
+  }
+  sigma_x_um = out.sigma_x_um;
+  sum.tally = out.tally;
+  sum.resets = out.resets;
+  sum.smoothed = cfg_.smooth;
+  return sum;
+}
+
+}  // namespace eical::dsp

@@ -1,0 +1,117 @@
+#pragma once
+// Stage 4 of the pipeline: the supports of the integration (ch. 5, 7.3) and their fusion.
+//   ZUPT  at every standstill, found by the automatic detector (standstill_detector.hpp)
+//   NBS   an axis whose set-point does not move during a move is held (Bild 7-8)
+//   CUPT  every lit sample of a PSD strip is a position fix along its axis (psd_decoder.hpp)
+// Live, the forward Kalman filter (fusion/forward_filter.hpp) corrects the estimate per
+// sample; offline, finish() runs it again with hindsight (a standstill counts from its
+// first quiet sample) and smooths backwards (Rauch–Tung–Striebel) over the same model.
+// Everything here works in the sensors' time base — the PSD channels pass the same DAQ
+// filter as the accelerometers, so they line up without the delay; the pipeline re-indexes
+// the corrected trace onto the set-point's time afterwards.
+#include "dsp/core/frame.hpp"
+#include "dsp/core/run_meta.hpp"
+#include "dsp/fusion/forward_filter.hpp"
+#include "dsp/fusion/rts_smoother.hpp"
+#include "dsp/supports/psd_decoder.hpp"
+#include "dsp/supports/standstill_detector.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace eical::dsp {
+
+struct SupportConfig {
+  bool zupt = true;
+  bool nbs = false;
+  bool cupt = true;    // PSD strips as position fixes, when the run has any
+  bool smooth = true;  // offline RTS pass (off: the forward filter's result, as live)
+  fusion::ErrorModel model;
+  supports::StandstillOptions standstill;
+};
+
+// A standstill found by the detector: where, and each sensor's mean acceleration there
+// (machine axes, after the first rest window's bias: the bias drift between rests).
+struct RestWindow {
+  std::int64_t first_index = 0, last_index = 0;  // sample indices, sensor time base
+  Eigen::Vector3d table_mps2 = Eigen::Vector3d::Zero(), head_mps2 = Eigen::Vector3d::Zero();
+  std::size_t samples = 0;
+  bool quiet = true;  // the acceleration confirmed it (false: found by the set-point, machine ringing)
+};
+
+// What the supports did in one measurement (published with the result).
+struct SupportSummary {
+  std::array<std::array<fusion::SupportTally, fusion::kSupportKinds>, 3> tally{};  // [axis][zupt|cupt|nbs]
+  std::vector<RestWindow> rest_windows;
+  std::size_t psd_fixes = 0, psd_fixes_dropped = 0;
+  std::size_t resets = 0;  // covariance resets (a standstill the model could not explain)
+  bool smoothed = false;
+  bool diverged = false;   // the fusion met values it cannot take: trace left as integrated
+};
+
+class SupportStage {
+ public:
+  SupportStage() = default;
+  // Allocates everything the measurement can need (capacity_samples of trace).
+  SupportStage(const SupportConfig& config, const Acquisition& acquisition, const std::vector<PsdSpec>& psd,
+               double sensor_noise_var_mps2, std::size_t capacity_samples);
+
+  void reset() noexcept;
+  // Every frame (the PSD noise is learnt at rest too).
+  void psd_frame(const Frame& f) noexcept;
+  // A sample of the rest window before the motion: the relative acceleration's noise.
+  void rest_sample(const Eigen::Vector3d& a_rel_mps2) noexcept;
+  // The motion starts at trace index 0; `rest_bias` is what the pipeline subtracts.
+  void start() noexcept;
+  // One sample of the motion at trace index k (the pipeline's stored sample). a_*:
+  // bias-free accelerations (m/s², machine axes); pos/vel: the integrated relative motion.
+  void step(std::size_t k, std::int64_t gap_samples, bool accel_valid, const Eigen::Vector3d& a_table,
+            const Eigen::Vector3d& a_head, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s, bool cmd_valid,
+            bool cmd_moved, const Eigen::Vector3d& cmd_mm) noexcept;
+
+  // The live filter's current error estimate (subtract from the integrated motion).
+  [[nodiscard]] Eigen::Vector3d live_dx_mm() const noexcept;
+  [[nodiscard]] Eigen::Vector3d live_dv_mm_s() const noexcept;
+  [[nodiscard]] bool at_rest() const noexcept { return at_rest_; }
+
+  // Offline: corrects pos/vel of the trace (sensor time base) in place; returns what was
+  // done. sigma_x_um receives the posterior σ of the position per sample and axis.
+  SupportSummary finish(const std::vector<std::int64_t>& sample_index, std::vector<Eigen::Vector3d>& pos_mm,
+                        std::vector<Eigen::Vector3d>& vel_mm_s, std::vector<Eigen::Vector3d>& sigma_x_um);
+
+  // The schedule the offline pass used (after finish()), for identification and tests.
+  [[nodiscard]] const fusion::SupportSchedule& schedule() const noexcept { return schedule_; }
+
+ private:
+  void close_rest_window() noexcept;
+
+  SupportConfig cfg_;
+  double fs_hz_ = 10000.0, delay_samples_ = 0.0;
+  fusion::Discrete step_;
+  supports::StandstillDetector detector_;
+  std::vector<supports::PsdDecoder> psd_;
+  std::array<supports::PsdReading, kMaxPsd> psd_now_{};
+  fusion::ForwardFilter live_;
+  fusion::SupportSchedule schedule_;
+  std::size_t capacity_ = 0;
+  // Rest window before the motion: Σa, Σa² of the relative acceleration.
+  Eigen::Vector3d rest_sum_ = Eigen::Vector3d::Zero(), rest_sq_ = Eigen::Vector3d::Zero();
+  std::size_t rest_n_ = 0;
+  // Batch means of the rest window (blocks of 20 ms): how well its mean fixed the bias when
+  // the samples are not independent (a tone over an incomplete number of periods, ch. 8.3.1).
+  std::vector<Eigen::Vector3d> block_means_;
+  Eigen::Vector3d block_sum_ = Eigen::Vector3d::Zero();
+  std::size_t block_n_ = 0, block_len_ = 200;
+  Eigen::Vector3d start_bias_sigma_ = Eigen::Vector3d::Zero();
+  // Detected rests.
+  bool at_rest_ = false, started_ = false;
+  Eigen::Vector3d cmd_at_rest_ = Eigen::Vector3d::Zero();
+  RestWindow open_{};
+  std::vector<RestWindow> rests_;
+  std::size_t rests_dropped_ = 0, fixes_dropped_ = 0, ringing_count_ = 0;
+};
+
+}  // namespace eical::dsp

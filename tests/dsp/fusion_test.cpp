@@ -1,0 +1,197 @@
+// The fusion layer against independent formulations: the discrete noise against numerical
+// integration of the continuous model, the scalar update against the textbook Kalman
+// update, and the RTS smoother against the batch posterior of the whole trajectory
+// (Gaussian conditioning of the stacked states) — they must agree to rounding.
+#include "dsp/fusion/axis_filter.hpp"
+#include "dsp/fusion/error_model.hpp"
+#include "dsp/fusion/rts_smoother.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <random>
+
+namespace eical::dsp::fusion {
+namespace {
+
+TEST(ErrorModel, DiscreteNoiseEqualsTheIntegralOfTheContinuousModel) {
+  ErrorModel m;
+  m.accel_noise_um_s2_rthz = 3.0;
+  m.bias_walk_um_s2_rts = 7.0;
+  const double h = 0.01;
+  // Q = ∫0^h e^{As} G Qc Gᵀ e^{Aᵀs} ds, A = [0 1 0; 0 0 1; 0 0 0], noise into δv and δb.
+  Mat3 qc = Mat3::Zero();
+  qc(1, 1) = 9.0, qc(2, 2) = 49.0;
+  Mat3 q = Mat3::Zero();
+  const int steps = 20000;
+  for (int i = 0; i < steps; ++i) {
+    const double s = (i + 0.5) * h / steps;
+    Mat3 phi;
+    phi << 1, s, s * s / 2, 0, 1, s, 0, 0, 1;
+    q += phi * qc * phi.transpose() * (h / steps);
+  }
+  const Discrete d = discretise(m, h);
+  EXPECT_LT((d.Q - q).cwiseAbs().maxCoeff() / q.cwiseAbs().maxCoeff(), 1e-8);
+  EXPECT_DOUBLE_EQ(d.F(0, 2), h * h / 2);
+}
+
+TEST(AxisFilter, ScalarUpdateEqualsTheGeneralKalmanUpdate) {
+  AxisFilter f;
+  f.e << 1.0, -2.0, 0.5;
+  Eigen::Matrix3d a = Eigen::Matrix3d::Random();
+  f.P = a * a.transpose() + Eigen::Matrix3d::Identity();
+  const Vec3 e0 = f.e;
+  const Mat3 p0 = f.P;
+  const double z = 0.3, r = 0.7;
+  const UpdateRecord rec = f.update(1, z, r, 1e9);
+  Eigen::RowVector3d h(0, 1, 0);
+  const double s = (h * p0 * h.transpose())(0) + r;
+  const Vec3 k = p0 * h.transpose() / s;
+  EXPECT_LT((f.e - (e0 + k * (z - h * e0))).norm(), 1e-12);
+  EXPECT_LT((f.P - (Mat3::Identity() - k * h) * p0).norm(), 1e-12);
+  EXPECT_TRUE(rec.accepted);
+  EXPECT_NEAR(rec.nis, (z - e0[1]) * (z - e0[1]) / s, 1e-12);
+}
+
+TEST(AxisFilter, GateRejectsAnOutlierAndLeavesTheStateAlone) {
+  AxisFilter f;
+  f.P = Mat3::Identity();
+  const UpdateRecord rec = f.update(0, 100.0, 1.0, 25.0);
+  EXPECT_FALSE(rec.accepted);
+  EXPECT_EQ(f.e, Vec3::Zero());
+  EXPECT_EQ(f.P, Mat3::Identity());
+  EXPECT_FALSE(f.update(0, std::nan(""), 1.0, 25.0).accepted);  // NaN never enters
+}
+
+// The batch posterior of the stacked trajectory X = [e_0 … e_{n−1}] given every
+// observation, by Gaussian conditioning: E[X|Z] = Σ Hᵀ (H Σ Hᵀ + R)⁻¹ Z.
+struct Batch {
+  Eigen::VectorXd mean;
+  Eigen::MatrixXd cov;
+};
+
+Batch batch_posterior(const ErrorModel& m, double h, const Vec3& bias0, const SupportSchedule& sch,
+                      const std::vector<Eigen::Vector3d>& vel, const std::vector<Eigen::Vector3d>& pos, int axis) {
+  const auto n = static_cast<Eigen::Index>(sch.flags.size());
+  const Discrete d = discretise(m, h);
+  std::vector<Mat3> p(static_cast<std::size_t>(n));
+  p[0] = initial_covariance(m, bias0[axis]);
+  for (Eigen::Index k = 1; k < n; ++k) {
+    p[static_cast<std::size_t>(k)] = d.F * p[static_cast<std::size_t>(k - 1)] * d.F.transpose() + d.Q;
+    if (sch.flags[static_cast<std::size_t>(k)] & schedule_flag::move_start) p[static_cast<std::size_t>(k)](2, 2) += m.bias_step_um_s2 * m.bias_step_um_s2;
+  }
+  Eigen::MatrixXd sigma(3 * n, 3 * n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    Mat3 fpow = Mat3::Identity();
+    for (Eigen::Index j = i; j < n; ++j) {
+      const Mat3 c = fpow * p[static_cast<std::size_t>(i)];  // Cov(x_j, x_i)
+      sigma.block<3, 3>(3 * j, 3 * i) = c;
+      sigma.block<3, 3>(3 * i, 3 * j) = c.transpose();
+      fpow = d.F * fpow;
+    }
+  }
+  std::vector<Eigen::Index> rows;
+  std::vector<double> z, r;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const auto f = sch.flags[static_cast<std::size_t>(k)];
+    if (f & schedule_flag::rest) rows.push_back(3 * k + 1), z.push_back(vel[static_cast<std::size_t>(k)][axis] * 1000), r.push_back(m.zupt_sigma_um_s * m.zupt_sigma_um_s);
+    else if (f & nbs_flag(axis)) rows.push_back(3 * k + 1), z.push_back(vel[static_cast<std::size_t>(k)][axis] * 1000), r.push_back(m.nbs_sigma_um_s * m.nbs_sigma_um_s);
+    for (const auto& fx : sch.fixes)
+      if (static_cast<Eigen::Index>(fx.k) == k && fx.axis == axis)
+        rows.push_back(3 * k), z.push_back(pos[fx.k][axis] * 1000 - fx.position_um), r.push_back(fx.sigma_um * fx.sigma_um + m.psd_floor_um * m.psd_floor_um);
+  }
+  const auto nz = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd hs(nz, 3 * n);  // H Σ
+  Eigen::MatrixXd s(nz, nz);
+  Eigen::VectorXd zv(nz);
+  for (Eigen::Index i = 0; i < nz; ++i) {
+    hs.row(i) = sigma.row(rows[static_cast<std::size_t>(i)]);
+    zv[i] = z[static_cast<std::size_t>(i)];
+  }
+  for (Eigen::Index i = 0; i < nz; ++i)
+    for (Eigen::Index j = 0; j < nz; ++j) s(i, j) = hs(i, rows[static_cast<std::size_t>(j)]) + (i == j ? r[static_cast<std::size_t>(i)] : 0.0);
+  const Eigen::LDLT<Eigen::MatrixXd> ls(s);
+  Batch b;
+  b.mean = hs.transpose() * ls.solve(zv);
+  b.cov = sigma - hs.transpose() * ls.solve(hs);
+  return b;
+}
+
+TEST(RtsSmoother, EqualsTheBatchPosteriorOfTheWholeTrajectory) {
+  ErrorModel m;
+  m.gate_nis = 1e12;  // compare the algebra, not the gate
+  m.bias_walk_um_s2_rts = 30.0;
+  const double fs = 1000.0;
+  const std::size_t n = 60;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> g(0.0, 1.0);
+  SupportSchedule sch;
+  sch.flags.assign(n, 0);
+  for (std::size_t k = 0; k < 8; ++k) sch.flags[k] = schedule_flag::rest;
+  sch.flags[8] |= schedule_flag::move_start;
+  for (std::size_t k = 20; k < 30; ++k) sch.flags[k] = nbs_flag(1);
+  for (std::size_t k = 50; k < n; ++k) sch.flags[k] = schedule_flag::rest;
+  for (std::size_t k : {15u, 16u, 17u, 40u}) sch.fixes.push_back({k, 0, g(rng) * 5.0, 0.3});
+  sch.fixes.push_back({33, 1, g(rng) * 5.0, 0.5});
+  std::vector<Eigen::Vector3d> vel(n), pos(n);
+  std::vector<std::int64_t> idx(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    vel[k] = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.01;
+    pos[k] = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.01;
+    idx[k] = static_cast<std::int64_t>(k);
+  }
+  SmootherInput in;
+  in.sample_index = &idx, in.vel_mm_s = &vel, in.pos_mm = &pos, in.schedule = &sch, in.fs_hz = fs, in.model = m;
+  in.start_bias_sigma_um_s2 = Vec3(5.0, 8.0, 3.0);
+  in.keep_gains = true;
+  const SmootherOutput out = smooth(in);
+  for (int a = 0; a < 2; ++a) {
+    const Batch b = batch_posterior(m, 1.0 / fs, in.start_bias_sigma_um_s2, sch, vel, pos, a);
+    for (std::size_t k = 0; k < n; ++k) {
+      const auto i = static_cast<Eigen::Index>(3 * k);
+      EXPECT_NEAR(out.dx_um[k][a], b.mean[i], 1e-7 * (1.0 + std::abs(b.mean[i]))) << "axis " << a << " sample " << k;
+      EXPECT_NEAR(out.dv_um_s[k][a], b.mean[i + 1], 1e-6 * (1.0 + std::abs(b.mean[i + 1])));
+      EXPECT_NEAR(out.sigma_x_um[k][a], std::sqrt(b.cov(i, i)), 1e-7 * (1.0 + std::sqrt(b.cov(i, i))));
+    }
+    // Cross-time covariance from the gains: Cov(x_j, x_k | all) = C_j … C_{k−1} P_k|N.
+    Mat3 chain = out.p_smoothed[a][45];
+    for (std::size_t j = 45; j-- > 35;) chain = out.gain[a][j] * chain;
+    EXPECT_NEAR(chain(0, 0), b.cov(3 * 35, 3 * 45), 1e-7 * (1.0 + std::abs(b.cov(3 * 35, 3 * 45))));
+  }
+  EXPECT_EQ(out.tally[0][static_cast<int>(Support::cupt)].accepted, 4u);
+  EXPECT_EQ(out.tally[1][static_cast<int>(Support::nbs)].accepted, 10u);
+  EXPECT_EQ(out.tally[2][static_cast<int>(Support::zupt)].accepted, 18u);
+}
+
+TEST(RtsSmoother, ForwardOnlyIsTheCausalFilterAndNeverBetterThanTheSmoother) {
+  ErrorModel m;
+  const std::size_t n = 400;
+  SupportSchedule sch;
+  sch.flags.assign(n, 0);
+  for (std::size_t k = 350; k < n; ++k) sch.flags[k] = schedule_flag::rest;
+  std::vector<Eigen::Vector3d> vel(n, Eigen::Vector3d::Constant(0.002)), pos(n, Eigen::Vector3d::Zero());
+  std::vector<std::int64_t> idx(n);
+  for (std::size_t k = 0; k < n; ++k) idx[k] = static_cast<std::int64_t>(k);
+  SmootherInput in;
+  in.sample_index = &idx, in.vel_mm_s = &vel, in.pos_mm = &pos, in.schedule = &sch, in.fs_hz = 1000.0, in.model = m;
+  const SmootherOutput s = smooth(in);
+  in.forward_only = true;
+  const SmootherOutput f = smooth(in);
+  EXPECT_EQ(f.dx_um[100][0], 0.0);  // before the first standstill the filter knows nothing yet
+  EXPECT_NE(s.dx_um[100][0], 0.0);  // the smoother carries the standstill's news back
+  for (std::size_t k = 0; k < n; ++k) EXPECT_LE(s.sigma_x_um[k][0], f.sigma_x_um[k][0] + 1e-12);
+}
+
+TEST(RtsSmoother, MismatchedLengthsAreAnError) {
+  SupportSchedule sch;
+  sch.flags.assign(3, 0);
+  std::vector<Eigen::Vector3d> v(2);
+  std::vector<std::int64_t> idx(3);
+  SmootherInput in;
+  in.sample_index = &idx, in.vel_mm_s = &v, in.pos_mm = &v, in.schedule = &sch;
+  EXPECT_THROW((void)smooth(in), std::exception);
+}
+
+}  // namespace
+}  // namespace eical::dsp::fusion
