@@ -1,5 +1,7 @@
 #include "sim/scenario.hpp"
 
+#include "sim/gcode/generate.hpp"
+
 #include <cmath>
 
 namespace eical::sim {
@@ -83,6 +85,23 @@ Scenario rectangle_scenario(double size_a_mm, double size_b_mm, double feed_mm_m
 Scenario gcode_scenario(const std::string& gcode, const std::string& kind, std::uint64_t seed) {
   Scenario sc = base_scenario(kind, seed, "G-code program, ideal machine");
   sc.meta.program.gcode = gcode;
+  return sc;
+}
+
+std::vector<dsp::PsdSpec> psd_config_b(double r) {
+  dsp::PsdSpec x, y;
+  x.measures = "x", x.center_mm[0] = 0.0, x.center_mm[1] = -r;
+  y.measures = "y", y.center_mm[0] = r, y.center_mm[1] = 0.0;
+  return {x, y};
+}
+
+Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vector<std::string>& axes, std::uint64_t seed) {
+  gcode::IdentifyPlan plan;
+  plan.psd = psd;
+  plan.axes = axes;
+  Scenario sc = base_scenario("identify", seed, "on-site identification across the PSD strips, ideal machine");
+  sc.meta.program.gcode = gcode::identify_program(plan);
+  sc.meta.psd = psd;
   return sc;
 }
 

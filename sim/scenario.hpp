@@ -176,4 +176,13 @@ Scenario rectangle_scenario(double size_a_mm = 50.0, double size_b_mm = 50.0, do
 // A scenario running the given G-code (a free-form program or any generated one).
 Scenario gcode_scenario(const std::string& gcode, const std::string& kind = "freeform", std::uint64_t seed = 1);
 
+// PSD configuration B of the sample runs for a circle of radius R about the origin: a strip
+// measuring x where the circle crosses −y, one measuring y where it crosses +x (each 10 mm
+// long, tangent to the circle: the spot runs along it for millimetres).
+std::vector<dsp::PsdSpec> psd_config_b(double radius_mm = 10.0);
+
+// On-site identification (sim/gcode identify_program) over the given strips and further
+// axes, with those strips in the run.
+Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vector<std::string>& axes = {"z"}, std::uint64_t seed = 1);
+
 }  // namespace eical::sim

@@ -1,4 +1,5 @@
 // eical analyze RUN [--json]: the pipeline and the program's evaluation on a recorded run.
+#include "drivers/config/sensor_calibration.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "tools/commands.hpp"
@@ -12,7 +13,7 @@ namespace eical::tools {
 
 void register_analyze(CLI::App& app) {
   struct Opt {
-    std::string run, dynamic = "two-stage";
+    std::string run, dynamic = "two-stage", calibration;
     bool json = false, no_zupt = false, coriolis = false;
     std::string nbs = "auto";
   };
@@ -26,9 +27,13 @@ void register_analyze(CLI::App& app) {
       ->default_val("auto")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   cmd->add_flag("--coriolis", o->coriolis, "correct the Earth-rate Coriolis acceleration (3-6) with [site] latitude and heading");
+  cmd->add_option("--calibration", o->calibration, "sensor calibration (eical-sensor-cal/1, from eical identify) instead of the run's data sheet")
+      ->check(CLI::ExistingFile);
   cmd->callback([o] {
-    const dsp::Run run = drivers::read_run(o->run);
+    dsp::Run run = drivers::read_run(o->run);
     dsp::AnalysisOptions opt;
+    if (!o->calibration.empty())
+      drivers::apply_calibration(drivers::read_sensor_calibration(o->calibration, run.meta), run.meta, opt);
     opt.dynamic = o->dynamic == "none" ? dsp::DynamicComp::none : dsp::DynamicComp::two_stage;
     opt.zupt = !o->no_zupt;
     if (o->nbs != "auto") opt.nbs = o->nbs == "on";

@@ -144,14 +144,48 @@ void add_rectangle(CLI::App* gen) {
   c->callback([o] { o->program.kind = "rectangle"; emit(*o); });
 }
 
+// --psd x:0,-10 (the strip measures x; its centre at x = 0, y = −10, as run.toml's [[psd]]).
+dsp::PsdSpec parse_psd(const std::string& text) {
+  const auto colon = text.find(':');
+  const auto comma = text.find(',', colon == std::string::npos ? 0 : colon);
+  if (colon == std::string::npos || comma == std::string::npos)
+    throw std::runtime_error("--psd '" + text + "': expected MEASURES:CX,CY (e.g. x:0,-10)");
+  dsp::PsdSpec s;
+  s.measures = text.substr(0, colon);
+  if (s.measures != "x" && s.measures != "y") throw std::runtime_error("--psd '" + text + "': a strip measures x or y");
+  try {
+    s.center_mm[0] = std::stod(text.substr(colon + 1, comma - colon - 1));
+    s.center_mm[1] = std::stod(text.substr(comma + 1));
+  } catch (const std::exception&) {
+    throw std::runtime_error("--psd '" + text + "': the centre is not two numbers");
+  }
+  return s;
+}
+
 void add_identify(CLI::App* gen) {
-  auto o = std::make_shared<GenOptions>();
-  dsp::Program& p = o->program;
-  auto* c = gen->add_subcommand("identify", "on-site sensor identification across a PSD strip");
-  c->add_option("--axis", p.axis, "x, y or z")->default_val("x")->check(CLI::IsMember({"x", "y", "z"}));
-  c->add_option("--psd-center", p.targets_mm, "position of the PSD strip centre on the axis, mm")->required()->expected(1);
-  add_output(c, *o);
-  c->callback([o] { o->program.kind = "identify"; emit(*o); });
+  struct Id {
+    std::vector<std::string> psd, axes;
+    sim::gcode::IdentifyPlan plan;
+    std::string out, meta_out;
+  };
+  auto o = std::make_shared<Id>();
+  auto* c = gen->add_subcommand("identify", "on-site sensor identification: swings across the PSD strips (and further axes)");
+  c->add_option("--psd", o->psd, "a strip as MEASURES:CX,CY, e.g. x:0,-10 (repeat for each strip)");
+  c->add_option("--axis", o->axes, "a further axis to swing without a strip, e.g. z (repeatable)")->check(CLI::IsMember({"x", "y", "z"}));
+  c->add_option("--swing", o->plan.swing_mm, "swing, peak to peak, mm")->default_val(50.0);
+  c->add_option("--feeds", o->plan.feeds_mm_min, "feeds in mm/min (comma separated)")->delimiter(',')->default_str("2000,4000,6500");
+  c->add_option("-o,--out", o->out, "G-code file (default: stdout)");
+  c->add_option("--meta", o->meta_out, "also write the [program] table for run.toml");
+  c->callback([o] {
+    for (const auto& t : o->psd) o->plan.psd.push_back(parse_psd(t));
+    o->plan.axes = o->axes;
+    if (o->plan.feeds_mm_min.empty()) o->plan.feeds_mm_min = {2000.0, 4000.0, 6500.0};
+    const std::string g = sim::gcode::identify_program(o->plan);
+    write_text(o->out, g);
+    dsp::Program p;
+    p.kind = "identify";
+    if (!o->meta_out.empty()) write_text(o->meta_out, program_toml(p, g));
+  });
 }
 
 }  // namespace

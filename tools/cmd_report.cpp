@@ -1,4 +1,5 @@
 // eical report RUN [--out DIR]: HTML report with SVG plots and CSV traces.
+#include "drivers/config/sensor_calibration.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "tools/commands.hpp"
@@ -13,15 +14,19 @@ namespace eical::tools {
 
 void register_report(CLI::App& app) {
   struct Opt {
-    std::string run, out;
+    std::string run, out, calibration;
   };
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand("report", "Render the HTML report of a recorded run");
   cmd->add_option("run", o->run, "run directory (eical-run/1)")->required();
   cmd->add_option("-o,--out", o->out, "report folder (default: RUN/report)");
+  cmd->add_option("--calibration", o->calibration, "sensor calibration (eical-sensor-cal/1) instead of the run's data sheet")->check(CLI::ExistingFile);
   cmd->callback([o] {
-    const dsp::Run run = drivers::read_run(o->run);
-    const dsp::Analysis a = dsp::analyze_run(run);
+    dsp::Run run = drivers::read_run(o->run);
+    dsp::AnalysisOptions opt;
+    if (!o->calibration.empty())
+      drivers::apply_calibration(drivers::read_sensor_calibration(o->calibration, run.meta), run.meta, opt);
+    const dsp::Analysis a = dsp::analyze_run(run, opt);
     const std::filesystem::path dir = o->out.empty() ? std::filesystem::path(o->run) / "report" : std::filesystem::path(o->out);
     const auto file = report::write_run_report(run, a, dir);
     write_file_atomic(dir / "result.json", drivers::result_json(run, a).dump(2) + "\n");

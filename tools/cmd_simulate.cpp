@@ -12,7 +12,7 @@ namespace eical::tools {
 
 void register_simulate(CLI::App& app) {
   struct Opt {
-    std::string program = "circle", direction = "ccw", plane = "xy", out, scenario;
+    std::string program = "circle", direction = "ccw", plane = "xy", out, scenario, psd = "none";
     double arc_deg = 360.0, radius_mm = 10.0, feed_mm_min = 2500.0, noise_ug = 0.4, from_mm = 0.0, to_mm = 50.0;
     int repeats = 5, runs = 2;
     std::vector<double> targets{0.0, 10.0, 20.0, 30.0, 40.0};
@@ -23,10 +23,13 @@ void register_simulate(CLI::App& app) {
   auto* cmd = app.add_subcommand("simulate", "Simulate a machine and its sensors; write a recorded run (eical-run/1)");
   auto* scenario = cmd->add_option("--scenario", o->scenario, "scenario file (eical-scenario/1, config/scenarios/README.md): machine errors, vibration, sensor truth, every effect")
                        ->check(CLI::ExistingFile);
-  cmd->add_option("--program", o->program, "circle, step, positioning, rectangle or freeform")
+  cmd->add_option("--program", o->program, "circle, step, positioning, rectangle, freeform or identify")
       ->default_val("circle")
-      ->check(CLI::IsMember({"circle", "step", "positioning", "rectangle", "freeform"}))
+      ->check(CLI::IsMember({"circle", "step", "positioning", "rectangle", "freeform", "identify"}))
       ->excludes(scenario);
+  cmd->add_option("--psd", o->psd, "PSD strips: B (configuration B of the sample runs, for a circle of --radius), none; identify: B by default")
+      ->default_val("none")
+      ->check(CLI::IsMember({"B", "none"}));
   cmd->add_option("--plane", o->plane, "circle, rectangle: xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
   cmd->add_option("--arc-deg", o->arc_deg, "circle: evaluated arc in deg (below 360: partial arc, up to 340)")->default_val(360.0)->check(CLI::Range(1.0, 360.0));
   cmd->add_option("--targets", o->targets, "positioning: targets on x, mm (comma separated)")->delimiter(',');
@@ -51,7 +54,9 @@ void register_simulate(CLI::App& app) {
            : o->program == "step"      ? sim::step_scenario(o->from_mm, o->to_mm, o->feed_mm_min, o->runs, o->seed)
            : o->program == "rectangle" ? sim::rectangle_scenario(20.0, 10.0, o->feed_mm_min, o->plane, 1, o->seed)
            : o->program == "freeform"  ? freeform_scenario(o->feed_mm_min, o->seed)
+           : o->program == "identify"  ? sim::identify_scenario(sim::psd_config_b(o->radius_mm), {"z"}, o->seed)
                                        : sim::positioning_scenario(o->targets, o->runs, o->feed_mm_min, o->seed);
+      if (o->psd == "B") sc.meta.psd = sim::psd_config_b(o->radius_mm);
       if (o->program == "circle") {
         sc.meta.program.plane = o->plane;
         sc.meta.program.arc_deg = o->arc_deg;

@@ -97,4 +97,22 @@ void apply_calibration(const SensorCalibration& cal, dsp::PipelineConfig& config
   if (cal.daq_group_delay_samples) config.acquisition.daq_group_delay_samples = *cal.daq_group_delay_samples;
 }
 
+void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta, dsp::AnalysisOptions& options) {
+  apply_calibration(cal, meta);
+  for (int s = 0; s < 2; ++s) options.calibration[s].cross_g_per_g = cal.static_cal[s].cross_g_per_g;
+  options.sensor_model = cal.method;
+}
+
+SensorCalibration calibration_from(const dsp::identify::Identification& id, const std::string& run_id) {
+  SensorCalibration cal;
+  cal.method = id.method;
+  cal.run_id = run_id;
+  if (id.delay_identified) cal.daq_group_delay_samples = id.daq_group_delay_samples;
+  for (int s = 0; s < 2; ++s) {
+    cal.sensors[s] = id.sensors[s];
+    cal.static_cal[s] = id.calibration[s];
+  }
+  return cal;
+}
+
 }  // namespace eical::drivers

@@ -15,7 +15,9 @@
 //   [sensors.head]
 //
 // Keys are read strictly (a typo is an error naming file, line and key).
+#include "dsp/analysis/analyze_run.hpp"
 #include "dsp/core/run_meta.hpp"
+#include "dsp/identify/sensor_identification.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 
 #include <filesystem>
@@ -43,5 +45,10 @@ void write_sensor_calibration(const SensorCalibration& cal, const std::filesyste
 // terms: what the pipeline then compensates with.
 void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta);
 void apply_calibration(const SensorCalibration& cal, dsp::PipelineConfig& config);
+// The run's metadata and the analysis options (cross terms, where the model came from).
+void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta, dsp::AnalysisOptions& options);
+
+// What an identification found, as the file stores it.
+SensorCalibration calibration_from(const dsp::identify::Identification& id, const std::string& run_id);
 
 }  // namespace eical::drivers

@@ -87,7 +87,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   j["run_id"] = run.meta.id;
   j["program"] = kind;
   j["quality"] = {{"degraded", a.degraded}, {"flags", a.flags}};
-  j["sensor_model"] = {{"identified", false}, {"source", "datasheet"}};
+  j["sensor_model"] = {{"identified", a.sensor_model != "datasheet"}, {"source", a.sensor_model}};
   if (a.circle) {
     j["circle"] = circle_json(run.meta.program, *a.circle);
   } else if (kind == "circle") {

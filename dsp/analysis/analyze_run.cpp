@@ -121,10 +121,14 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   cfg.zupt = options.zupt;
   cfg.nbs = options.nbs.value_or(run.meta.program.kind == "rectangle");
   cfg.coriolis = options.coriolis;
+  cfg.cupt = options.cupt;
+  cfg.keep_raw = options.keep_raw;
+  cfg.calibration[0] = options.calibration[0], cfg.calibration[1] = options.calibration[1];
   Pipeline pipeline(cfg);
   for (const auto& f : run.frames) pipeline.step(f);
   Analysis a;
   a.dynamic = cfg.dynamic, a.nbs = cfg.nbs, a.coriolis = cfg.coriolis;
+  a.sensor_model = options.sensor_model;
   a.measurement = pipeline.finish();
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;

@@ -24,12 +24,20 @@ struct AnalysisOptions {
   bool zupt = true;
   std::optional<bool> nbs;  // unset: on for rectangles (axis-parallel moves), off otherwise
   bool coriolis = false;    // (3-6) Earth rate from [site]; real machines: on (simulated runs have it only when injected)
+  bool cupt = true;         // PSD strips as position fixes
+  bool keep_raw = false;    // Measurement::raw (identification, explain, the accuracy bound)
+  // What the sensors are compensated with beyond run.toml's [sensors.*] (cross terms of a
+  // calibration file) and where that model came from: "datasheet", or the calibration's
+  // method ("psd", "ref", "explain").
+  StaticCalibration calibration[2];
+  std::string sensor_model = "datasheet";
 };
 
 struct Analysis {
   Measurement measurement;
   DynamicComp dynamic = DynamicComp::two_stage;  // what the pipeline did
   bool nbs = false, coriolis = false;
+  std::string sensor_model = "datasheet";
   std::optional<eval::CircleResult> circle;             // both directions combined when the run has both
   std::optional<eval::CircleResult> circle_reference;  // the same evaluation of the reference channel
   std::optional<double> circle_accuracy_rms_um;        // RMS of (measured − reference) radius deviation

@@ -31,6 +31,7 @@ struct ErrorModel {
   double start_position_um = 2.0;         // σ of the start position against the set-point
   double start_velocity_um_s = 1.0;       // σ of the velocity at the start (at rest)
   double zupt_sigma_um_s = 2.0;           // σ of the velocity at a standstill (vibration, creep)
+  double zupt_onset_skip_s = 0.1;         // offline: a standstill's first 0.1 s (settling) unused
   double nbs_sigma_um_s = 5.0;            // σ of a held axis' velocity (straightness, vibration)
   double psd_floor_um = 0.05;             // added to every PSD fix's σ (model error of the strip)
   double gate_nis = 25.0;                 // innovation test: reject beyond 5 σ

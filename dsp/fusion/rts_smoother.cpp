@@ -61,7 +61,7 @@ SmootherOutput smooth(const SmootherInput& in) {
       if (means[next_mean].k == k) fwd.velocity_mean(means[next_mean], m, in.schedule->zupt);
     for (; next_fix < fixes.size() && fixes[next_fix].k == k; ++next_fix) {
       const PositionFix& f = fixes[next_fix];
-      fwd.position_fix(f.axis, (*in.pos_mm)[k][f.axis] * 1000.0, f.position_um, f.sigma_um, m);
+      if (in.schedule->cupt) fwd.position_fix(f.axis, (*in.pos_mm)[k][f.axis] * 1000.0, f.position_um, f.sigma_um, m);
     }
     for (int a = 0; a < 3; ++a) ef[a][k] = fwd.axis[a].e, pf[a][k] = fwd.axis[a].P;
   }

@@ -24,6 +24,7 @@ struct PositionFix {
   int axis = 0;
   double position_um = 0.0;  // in the trace's frame (the set-point at the start)
   double sigma_um = 0.0;
+  int strip = 0;             // which PSD strip
 };
 
 // The mean integrated velocity over a window ending at sample k of a standstill where the
@@ -44,6 +45,7 @@ struct SupportSchedule {
   std::vector<float> zupt_sigma_um_s;
   std::vector<VelocityMean> velocity_means;  // ascending k
   bool zupt = true;  // off: standstills are found and reported, not used
+  bool cupt = true;  // off: PSD fixes are recorded, not used
 };
 
 }  // namespace eical::dsp::fusion

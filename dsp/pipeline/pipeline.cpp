@@ -76,6 +76,8 @@ Pipeline::Pipeline(const PipelineConfig& c)
   m_.fs_hz = c.acquisition.fs_hz;
   for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->reserve(c.capacity_samples);
   m_.sample_index.reserve(c.capacity_samples);
+  if (c.keep_raw)
+    for (auto* v : {&m_.raw.table_mps2, &m_.raw.head_mps2}) v->reserve(c.capacity_samples);
   m_.triggers.reserve(trigger_capacity_);
   reset();
 }
@@ -98,6 +100,7 @@ void Pipeline::reset() noexcept {
   m_.sample_index.clear();
   for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->clear();
   m_.triggers.clear();
+  m_.raw.table_mps2.clear(), m_.raw.head_mps2.clear();
   supports_.reset();
 }
 
@@ -109,6 +112,10 @@ void Pipeline::store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen:
   m_.sample_index.push_back(f.sample_index);  // within the reserve: no allocation
   m_.pos_mm.push_back(pos_mm);
   m_.vel_mm_s.push_back(vel_mm_s);
+  if (config_.keep_raw) {
+    m_.raw.table_mps2.push_back(bias_free(0));
+    m_.raw.head_mps2.push_back(bias_free(1));
+  }
   m_.cmd_mm.emplace_back(f.cmd_mm[0], f.cmd_mm[1], f.cmd_mm[2]);
   m_.ref_mm.emplace_back(f.ref_mm[0], f.ref_mm[1], f.ref_mm[2]);
 }
@@ -283,10 +290,17 @@ void Pipeline::align_delay(Measurement& m) const {
 }
 
 void Pipeline::apply_supports(Measurement& m) {
+  if (config_.keep_raw) {
+    m.raw.pos_mm = m.pos_mm;
+    m.raw.vel_mm_s = m.vel_mm_s;
+    m.raw.rest_bias_mps2[0] = bias_[0];
+    m.raw.rest_bias_mps2[1] = bias_[1];
+  }
   // The raw integrated velocity at the last standstill: what ZUPT takes out there.
   std::vector<Eigen::Vector3d> sigma;
   const std::vector<Eigen::Vector3d> raw_vel = m.vel_mm_s;
   m.supports = supports_.finish(m.sample_index, m.pos_mm, m.vel_mm_s, sigma);
+  if (config_.keep_raw) m.raw.schedule = supports_.schedule();
   m.sigma_um = std::move(sigma);
   if (m.supports.diverged) quality_ |= quality_flag::supports_diverged;
   const std::int64_t motion_end_sensor = motion_end_index_ + static_cast<std::int64_t>(std::ceil(delay_samples_));

@@ -63,6 +63,7 @@ struct PipelineConfig {
   bool cupt = true;    // PSD strips as position fixes (when the run has [[psd]])
   bool smooth = true;  // RTS pass in finish() (off: the forward filter's causal result)
   fusion::ErrorModel fusion;  // pipeline_config() sets the noise from the sensors' data sheet
+  bool keep_raw = false;      // Measurement::raw (identification, explain; offline only)
   supports::StandstillOptions standstill;
 };
 
@@ -98,6 +99,16 @@ struct TriggerMark {
   int code;
 };
 
+// The trace in the sensors' time base before supports and delay alignment, with what went
+// into it (PipelineConfig::keep_raw): what identification and explain fit their models to.
+struct RawTrace {
+  std::vector<Eigen::Vector3d> pos_mm, vel_mm_s;       // integrated relative motion (dynamic comp applied)
+  std::vector<Eigen::Vector3d> table_mps2, head_mps2;  // each sensor, bias-free, machine axes
+  fusion::SupportSchedule schedule;                    // standstills, held axes, PSD fixes (µm)
+  Eigen::Vector3d rest_bias_mps2[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};  // table, head; incl. gravity
+  [[nodiscard]] bool empty() const noexcept { return pos_mm.empty(); }
+};
+
 struct Measurement {
   double fs_hz = 0.0;
   std::vector<std::int64_t> sample_index;  // from the start of the motion to the end
@@ -112,6 +123,7 @@ struct Measurement {
   std::size_t rest_window_samples = 0, zupt_window_samples = 0;
   std::vector<Eigen::Vector3d> sigma_um;   // posterior σ of pos_mm per axis (after finish())
   SupportSummary supports;
+  RawTrace raw;                            // only with PipelineConfig::keep_raw
 };
 
 class Pipeline {

@@ -21,6 +21,7 @@ SupportStage::SupportStage(const SupportConfig& c, const Acquisition& acq, const
   schedule_.flags.reserve(capacity);
   schedule_.zupt_sigma_um_s.reserve(capacity);
   schedule_.zupt = c.zupt;
+  schedule_.cupt = c.cupt;
   schedule_.fixes.reserve(capacity);
   schedule_.velocity_means.reserve(capacity / 100 + 16);
   rests_.reserve(kMaxRestWindows);
@@ -122,14 +123,14 @@ void SupportStage::step(std::size_t k, std::int64_t gap, bool accel_valid, const
       detector_.step(accel_valid ? a_rel : Eigen::Vector3d::Constant(NAN), vel_mm_s, live_dv_mm_s(), std::sqrt(pvv) / 1000.0, cmd_valid,
                      cmd_moved);
   const bool rest = accel_valid && det.rest;  // found and reported even when ZUPT is off
-  // A ringing standstill (its velocity spreads beyond what the noise makes of it): not its
-  // samples one by one (their swings are correlated) but the mean velocity over each
-  // vibration window. A sine's mean over a window at least twice its period is below 0.2
+  // A ringing standstill — its acceleration not quiet, or its velocity spreading over the
+  // detector's window beyond what the noise makes of it — is not used sample by sample
+  // (its swings are correlated) but by the mean velocity over each vibration window. A sine's mean over a window at least twice its period is below 0.2
   // of its rms: 0.3 of the spread is the σ of that mean.
   double zupt_sigma_um_s = 0.0;
   bool mean_update = false;
   fusion::VelocityMean vm;
-  if (rest && det.vibration_sigma_mm_s * 1000.0 > 3.0 * cfg_.model.zupt_sigma_um_s) {
+  if (rest && !(det.quiet && det.velocity_spread_mm_s * 1000.0 <= 3.0 * cfg_.model.zupt_sigma_um_s)) {
     zupt_sigma_um_s = -1.0;
     if (++ringing_count_ % detector_.vibration_window() == 0) {
       mean_update = true;
@@ -161,17 +162,15 @@ void SupportStage::step(std::size_t k, std::int64_t gap, bool accel_valid, const
     live_.velocity_mean(vm, cfg_.model, cfg_.zupt);
     if (schedule_.velocity_means.size() < schedule_.velocity_means.capacity()) schedule_.velocity_means.push_back(vm);
   }
-  if (cfg_.cupt) {
-    for (std::size_t s = 0; s < psd_.size(); ++s) {
-      const supports::PsdReading& r = psd_now_[s];
-      if (!r.valid) continue;
-      const int ax = psd_[s].axis();
-      // The lock-in output lags the spot by its time constant: add τ·v.
-      const double fix_um = (psd_[s].centre_mm() + r.u_mm + psd_[s].lockin_tau_s() * vel_corr[ax]) * 1000.0;
-      live_.position_fix(ax, pos_mm[ax] * 1000.0, fix_um, r.sigma_mm * 1000.0, cfg_.model);
-      if (schedule_.fixes.size() < capacity_) schedule_.fixes.push_back({k, ax, fix_um, r.sigma_mm * 1000.0});
-      else ++fixes_dropped_;
-    }
+  for (std::size_t s = 0; s < psd_.size(); ++s) {  // recorded always, used when CUPT is on
+    const supports::PsdReading& r = psd_now_[s];
+    if (!r.valid) continue;
+    const int ax = psd_[s].axis();
+    // The lock-in output lags the spot by its time constant: add τ·v.
+    const double fix_um = (psd_[s].centre_mm() + r.u_mm + psd_[s].lockin_tau_s() * vel_corr[ax]) * 1000.0;
+    if (cfg_.cupt) live_.position_fix(ax, pos_mm[ax] * 1000.0, fix_um, r.sigma_mm * 1000.0, cfg_.model);
+    if (schedule_.fixes.size() < capacity_) schedule_.fixes.push_back({k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(s)});
+    else ++fixes_dropped_;
   }
   if (schedule_.flags.size() < capacity_) {
     schedule_.flags.push_back(flags);
@@ -199,31 +198,46 @@ SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::v
   auto& flags = schedule_.flags;
   flags.resize(n);
   schedule_.zupt_sigma_um_s.resize(n);
-  // Hindsight: a standstill began where the detector's quiet window began.
-  const std::size_t back = detector_.window() > 0 ? detector_.window() - 1 : 0;
+  // Hindsight: the velocity is trusted only from zupt_onset_skip_s into a standstill on.
+  // A machine settles into its standstill (the position loop takes up its lag over a few
+  // time constants, the sensors ring out); the live filter cannot wait, the offline pass
+  // can, and a few µm/s taken for zero at the onset would bend the whole move before it.
   namespace sf = fusion::schedule_flag;
-  for (std::size_t k = 1; k < n; ++k) {
-    // Only a quiet window vouches for its past (a ringing standstill was found by the
-    // set-point, with its acceleration still in the window).
-    if (!(flags[k] & sf::rest) || (flags[k - 1] & sf::rest) || schedule_.zupt_sigma_um_s[k] != 0.0F) continue;
-    for (std::size_t j = k; j-- > 0 && k - j <= back;) {
-      if (flags[j] & (sf::rest | sf::invalid)) break;
-      flags[j] = static_cast<std::uint8_t>((flags[j] & ~(sf::move_start | fusion::nbs_flag(0) | fusion::nbs_flag(1) | fusion::nbs_flag(2))) | sf::rest);
-      schedule_.zupt_sigma_um_s[j] = schedule_.zupt_sigma_um_s[k];
-    }
+  const auto skip = static_cast<std::size_t>(std::llround(cfg_.model.zupt_onset_skip_s * fs_hz_));
+  // A standstill that became quiet is used by its quiet samples alone: its window means
+  // (kept for a machine that never stops ringing) would count the settling as velocity.
+  std::vector<std::pair<std::size_t, std::size_t>> quiet_runs;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!(flags[k] & sf::rest) || (k > 0 && (flags[k - 1] & sf::rest))) continue;
+    std::size_t e = k;
+    while (e + 1 < n && (flags[e + 1] & sf::rest)) ++e;
+    // From its first quiet sample on (the position loop may still be taking up its lag
+    // while the set-point rests: that is motion, however slow).
+    std::size_t q = k;
+    while (q <= e && schedule_.zupt_sigma_um_s[q] != 0.0F) ++q;
+    for (std::size_t j = q; j <= e && j < q + skip; ++j) schedule_.zupt_sigma_um_s[j] = -1.0F;
+    if (q <= e) quiet_runs.push_back({k, e});
   }
+  auto& means = schedule_.velocity_means;
+  means.erase(std::remove_if(means.begin(), means.end(),
+                             [&](const fusion::VelocityMean& v) {
+                               for (const auto& r : quiet_runs)
+                                 if (v.k >= r.first && v.k <= r.second) return true;
+                               return false;
+                             }),
+              means.end());
   for (std::size_t k = 1; k < n; ++k) {
     flags[k] = static_cast<std::uint8_t>(flags[k] & ~sf::move_start);
     if ((flags[k - 1] & sf::rest) && !(flags[k] & sf::rest)) flags[k] |= sf::move_start;
   }
-  // Rest windows in sample indices (after the hindsight above they start a window earlier).
+  // Rest windows in sample indices.
   for (auto w : rests_) {
-    const auto first = static_cast<std::size_t>(std::max<std::int64_t>(0, w.first_index - static_cast<std::int64_t>(back)));
-    w.first_index = idx[std::min(first, n - 1)];
+    w.first_index = idx[std::min(static_cast<std::size_t>(w.first_index), n - 1)];
     w.last_index = idx[std::min(static_cast<std::size_t>(w.last_index), n - 1)];
     sum.rest_windows.push_back(w);
   }
   sum.psd_fixes = schedule_.fixes.size();
+  sum.start_bias_sigma_um_s2 = start_bias_sigma_;
   sum.psd_fixes_dropped = fixes_dropped_;
   if (n == 0) return sum;
 

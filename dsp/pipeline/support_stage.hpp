@@ -50,6 +50,7 @@ struct SupportSummary {
   std::size_t resets = 0;  // covariance resets (a standstill the model could not explain)
   bool smoothed = false;
   bool diverged = false;   // the fusion met values it cannot take: trace left as integrated
+  Eigen::Vector3d start_bias_sigma_um_s2 = Eigen::Vector3d::Zero();  // how well the first rest fixed the bias
 };
 
 class SupportStage {

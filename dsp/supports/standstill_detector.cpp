@@ -9,7 +9,7 @@ StandstillDetector::StandstillDetector(const StandstillOptions& o, double fs_hz,
     : opt_(o), var_(var > 0.0 ? var : 1.0), datasheet_var_(var_), fs_hz_(fs_hz) {
   const auto w = static_cast<std::size_t>(std::max(8.0, std::round(o.window_s * fs_hz)));
   ring_.assign(w, 0.0);
-  vring_.assign(static_cast<std::size_t>(std::max(8.0, std::round(o.vibration_window_s * fs_hz))), Eigen::Vector3d::Zero());
+  vring_.assign(std::max(w, static_cast<std::size_t>(std::round(o.vibration_window_s * fs_hz))), Eigen::Vector3d::Zero());
   gamma_ = 1.0 + o.z * std::sqrt(2.0 / (3.0 * static_cast<double>(w)));
   cmd_needed_ = static_cast<std::int64_t>(w) + static_cast<std::int64_t>(std::ceil(std::max(delay_samples, 0.0)));
 }
@@ -19,7 +19,7 @@ void StandstillDetector::reset() noexcept {
   head_ = filled_ = since_recompute_ = bad_ = 0;
   std::fill(vring_.begin(), vring_.end(), Eigen::Vector3d::Zero());
   vhead_ = vfilled_ = 0;
-  vsum_.setZero(), vsq_.setZero();
+  vsum_.setZero(), vsq_.setZero(), wsum_.setZero(), wsq_.setZero();
   sum_ = t_ = 0.0;
   cmd_still_samples_ = 0;
 }
@@ -40,6 +40,13 @@ StandstillDetector::Decision StandstillDetector::step(const Eigen::Vector3d& a, 
   head_ = (head_ + 1) % ring_.size();
   filled_ = std::min(filled_ + 1, ring_.size());
   const Eigen::Vector3d v = v_mm_s.allFinite() ? v_mm_s : Eigen::Vector3d::Zero();
+  // The velocity W samples ago leaves the short window (the vibration ring is longer).
+  const std::size_t vn = vring_.size(), w = ring_.size();
+  if (vfilled_ >= w) {
+    const Eigen::Vector3d& out = vring_[(vhead_ + vn - w) % vn];
+    wsum_ -= out, wsq_ -= out.cwiseAbs2();
+  }
+  wsum_ += v, wsq_ += v.cwiseAbs2();
   vsum_ += v - vring_[vhead_];
   vsq_ += v.cwiseAbs2() - vring_[vhead_].cwiseAbs2();
   vring_[vhead_] = v;
@@ -48,19 +55,24 @@ StandstillDetector::Decision StandstillDetector::step(const Eigen::Vector3d& a, 
   if (++since_recompute_ >= 65536) {  // the running sums' rounding, reset now and then
     sum_ = 0.0;
     for (double x : ring_) sum_ += std::max(x, 0.0);
-    vsum_.setZero(), vsq_.setZero();
+    vsum_.setZero(), vsq_.setZero(), wsum_.setZero(), wsq_.setZero();
     for (const auto& x : vring_) vsum_ += x, vsq_ += x.cwiseAbs2();
+    for (std::size_t i = 0; i < std::min(w, vfilled_); ++i) {
+      const Eigen::Vector3d& x = vring_[(vhead_ + vn - 1 - i) % vn];
+      wsum_ += x, wsq_ += x.cwiseAbs2();
+    }
     since_recompute_ = 0;
   }
   cmd_still_samples_ = cmd_moved ? 0 : cmd_still_samples_ + 1;
   if (filled_ < ring_.size() || bad_ > 0) return d;
-  const double w = static_cast<double>(ring_.size());
-  t_ = sum_ / (3.0 * w * var_);
+  t_ = sum_ / (3.0 * static_cast<double>(w) * var_);
   d.quiet = t_ <= gamma_;
   const bool commanded_rest = cmd_valid && cmd_still_samples_ >= cmd_needed_;
   if (!d.quiet && !commanded_rest) return d;
   if (cmd_valid && !commanded_rest) return d;
   {  // a slow mode rings with little acceleration: the velocity's own spread tells
+    const double nw = static_cast<double>(std::min(w, vfilled_));
+    d.velocity_spread_mm_s = std::sqrt((wsq_ / nw - (wsum_ / nw).cwiseAbs2()).cwiseMax(0.0).maxCoeff());
     const double nv = static_cast<double>(vfilled_);
     const Eigen::Vector3d var = (vsq_ / nv - (vsum_ / nv).cwiseAbs2()).cwiseMax(0.0);
     d.vibration_sigma_mm_s = std::sqrt(var.maxCoeff());

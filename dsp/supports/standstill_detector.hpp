@@ -50,7 +50,8 @@ class StandstillDetector {
   struct Decision {
     bool rest = false;
     bool quiet = false;             // test 1 passed (a confirmed, tight standstill)
-    double vibration_sigma_mm_s = 0.0;  // spread of the integrated velocity over the vibration window
+    double velocity_spread_mm_s = 0.0;  // spread of the integrated velocity over the detector's window
+    double vibration_sigma_mm_s = 0.0;  // ... over the vibration window (a ringing standstill's σ)
     Eigen::Vector3d window_mean_mm_s = Eigen::Vector3d::Zero();  // its mean there
     double window_lag_s = 0.0;          // from the window's mean time to this sample
   };
@@ -67,7 +68,8 @@ class StandstillDetector {
  private:
   StandstillOptions opt_;
   std::vector<double> ring_;
-  std::vector<Eigen::Vector3d> vring_;  // integrated velocity, mm/s
+  std::vector<Eigen::Vector3d> vring_;  // integrated velocity, mm/s (vibration window)
+  Eigen::Vector3d wsum_ = Eigen::Vector3d::Zero(), wsq_ = Eigen::Vector3d::Zero();  // over the detector's window
   std::size_t vhead_ = 0, vfilled_ = 0;
   Eigen::Vector3d vsum_ = Eigen::Vector3d::Zero(), vsq_ = Eigen::Vector3d::Zero();
   std::size_t head_ = 0, filled_ = 0, since_recompute_ = 0, bad_ = 0;

@@ -183,21 +183,62 @@ std::string rectangle_program(const dsp::Program& p, const RestTimes& rest) {
   return g;
 }
 
-std::string identify_program(const dsp::Program& p, const RestTimes& rest) {
-  require(!p.targets_mm.empty(), "identify needs targets_mm = [psd_centre]");
-  const char a = axis_letter(p.axis);
-  const double c = p.targets_mm[0];
-  const double half = p.size_mm[0] > 0 ? p.size_mm[0] / 2 : 20.0;  // swing ± half around the strip
-  std::string g = header("on-site identification: swings across the PSD at rising feeds", "G17", true);
-  g += std::string("G0 ") + a + num(c - half) + "\n";
-  g += start(rest);
-  for (double feed : {500.0, 1500.0, 3000.0, 6000.0}) {
-    const std::string f = " F" + fmt("%.0f", feed);
-    g += std::string("G1 ") + a + num(c + half) + f + "\nM102\nG4 P0.3\n";
-    g += std::string("G1 ") + a + num(c - half) + f + "\nM102\nG4 P0.3\n";
+std::string identify_program(const IdentifyPlan& plan, const RestTimes& rest) {
+  require(!plan.psd.empty() || !plan.axes.empty(), "identify needs a PSD strip or an axis to swing");
+  require(plan.swing_mm > 0.0 && !plan.feeds_mm_min.empty(), "identify needs a swing and feeds");
+  const double half = plan.swing_mm / 2.0;
+  std::string g = header("on-site identification: swings across the PSD strips at rising feeds", "G17", true);
+  const std::string dwell = "M102\nG4 P" + fmt("%.3g", plan.dwell_s) + "\n";
+  auto swings = [&](char a, double centre) {
+    std::string s;
+    for (double feed : plan.feeds_mm_min) {
+      const std::string f = " F" + fmt("%.0f", feed);
+      s += std::string("G1 ") + a + num(centre + half) + f + "\n" + dwell;
+      s += std::string("G1 ") + a + num(centre - half) + f + "\n" + dwell;
+    }
+    return s;
+  };
+  bool started = false;
+  for (const auto& strip : plan.psd) {
+    require(strip.measures == "x" || strip.measures == "y", "identify: a PSD strip measures x or y, not '" + strip.measures + "'");
+    const char along = axis_letter(strip.measures);
+    const char cross = along == 'X' ? 'Y' : 'X';
+    const double c_along = strip.center_mm[along == 'X' ? 0 : 1], c_cross = strip.center_mm[cross == 'X' ? 0 : 1];
+    const std::string to_start = std::string(" ") + along + num(c_along - half) + " " + cross + num(c_cross);
+    if (!started) {
+      g += "G0" + to_start + "\n" + start(rest);
+      started = true;
+    } else {
+      g += "G1" + to_start + " F3000\n" + dwell;
+    }
+    g += swings(along, c_along);
+  }
+  for (const auto& axis : plan.axes) {
+    const char a = axis_letter(axis);
+    if (!started) g += start(rest), started = true;
+    g += std::string("G91 G1 ") + a + num(-half) + " F3000\nG90\n" + dwell;  // from where it is: relative
+    // Back to absolute coordinates is unknown here, so the swings stay relative too.
+    for (double feed : plan.feeds_mm_min) {
+      const std::string f = " F" + fmt("%.0f", feed);
+      g += std::string("G91 G1 ") + a + num(2.0 * half) + f + "\nG90\n" + dwell;
+      g += std::string("G91 G1 ") + a + num(-2.0 * half) + f + "\nG90\n" + dwell;
+    }
+    g += std::string("G91 G1 ") + a + num(half) + " F3000\nG90\n" + dwell;
   }
   g += finish(rest);
   return g;
+}
+
+std::string identify_program(const dsp::Program& p, const RestTimes& rest) {
+  require(!p.targets_mm.empty(), "identify needs targets_mm = [psd_centre]");
+  IdentifyPlan plan;
+  dsp::PsdSpec strip;
+  strip.measures = p.axis;
+  require(p.axis == "x" || p.axis == "y", "identify: a PSD strip measures x or y, not '" + p.axis + "'");
+  strip.center_mm[p.axis == "x" ? 0 : 1] = p.targets_mm[0];
+  plan.psd.push_back(strip);
+  if (p.size_mm[0] > 0.0) plan.swing_mm = p.size_mm[0];
+  return identify_program(plan, rest);
 }
 
 std::string program_gcode(const dsp::Program& p) {

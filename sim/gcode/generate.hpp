@@ -8,6 +8,7 @@
 #include "dsp/core/run_meta.hpp"
 
 #include <string>
+#include <vector>
 
 namespace eical::sim::gcode {
 
@@ -44,9 +45,22 @@ std::string step_program(const dsp::Program& p, const RestTimes& rest = {});
 // corner, `repeats` times. G61.
 std::string rectangle_program(const dsp::Program& p, const RestTimes& rest = {});
 
-// On-site identification (ch. 8.2 without a KGM): moves along `axis` across its PSD
-// strip centred at `targets_mm[0]`, at rising feeds (accelerations), both directions,
-// each move followed by a dwell (ZUPT) and M102.
+// On-site identification (ch. 8.2 without a KGM). For every PSD strip: the spot is put
+// on the strip's cross line and swung along the strip through its centre, both ways, at
+// rising feeds (velocities for the damping term, accelerations for the scale and the
+// cross-axis terms); for every further axis (e.g. z, which no strip measures) the same
+// swings from where it is, seen by the set-point at the rests only. Every move ends in a
+// dwell (ZUPT, and the set-point as a position at rest) and M102. Exact stop.
+struct IdentifyPlan {
+  std::vector<dsp::PsdSpec> psd;
+  std::vector<std::string> axes;                        // swung without a strip
+  double swing_mm = 50.0;                               // peak to peak (the scale's lever)
+  std::vector<double> feeds_mm_min = {2000.0, 4000.0, 6500.0};
+  double dwell_s = 0.5;                                 // the position loop settles, then ZUPT
+};
+std::string identify_program(const IdentifyPlan& plan, const RestTimes& rest = {});
+// The Program form (kind "identify"): one strip along `axis` centred at targets_mm[0],
+// swing size_mm[0] (default 50 mm).
 std::string identify_program(const dsp::Program& p, const RestTimes& rest = {});
 
 // Dispatches on p.kind; throws InputError for an unknown or incomplete program.

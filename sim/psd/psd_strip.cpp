@@ -24,6 +24,7 @@ PsdStrip::PsdStrip(const dsp::PsdSpec& spec, const PsdTruth& truth, double h) : 
   if (!(spec.length_mm > 0.0) || !(spec.width_mm > 0.0)) throw dsp::InputError("psd: length_mm and width_mm must be positive");
   sigma_mm_ = std::max(truth.spot_mm, 1e-6) / 4.0;  // 1/e² diameter = 4σ
   alpha_ = spec.lockin_tau_s > 0.0 ? 1.0 - std::exp(-h / spec.lockin_tau_s) : 1.0;
+  h_ = h;
 }
 
 void PsdStrip::step(const Eigen::Vector3d& p, double& i1_v, double& i2_v) noexcept {
@@ -41,8 +42,14 @@ void PsdStrip::step(const Eigen::Vector3d& p, double& i1_v, double& i2_v) noexce
     target1 = light * truth_.full_scale_v * (0.5 + um / spec_.length_mm);
     target2 = light * truth_.full_scale_v * (0.5 - um / spec_.length_mm);
   }
-  i1_ += alpha_ * (target1 - i1_);
-  i2_ += alpha_ * (target2 - i2_);
+  // The lock-in's first-order lag, exact for an input linear over the step (a ramp comes
+  // out exactly τ late, as from the analogue filter): y ← a·y + x₁ − a·x₀ − τ·ṡ·(1 − a).
+  const double a = 1.0 - alpha_;
+  const double tau_slope1 = spec_.lockin_tau_s > 0.0 ? spec_.lockin_tau_s * (target1 - prev1_) / h_ : 0.0;
+  const double tau_slope2 = spec_.lockin_tau_s > 0.0 ? spec_.lockin_tau_s * (target2 - prev2_) / h_ : 0.0;
+  i1_ = a * i1_ + target1 - a * prev1_ - tau_slope1 * (1.0 - a);
+  i2_ = a * i2_ + target2 - a * prev2_ - tau_slope2 * (1.0 - a);
+  prev1_ = target1, prev2_ = target2;
   i1_v = i1_, i2_v = i2_;
 }
 

@@ -25,6 +25,7 @@ class PsdStrip {
   int along_, across_;
   double sigma_mm_, alpha_;
   double i1_ = 0.0, i2_ = 0.0;
+  double prev1_ = 0.0, prev2_ = 0.0, h_ = 1e-5;  // the inputs at the previous step
 };
 
 }  // namespace eical::sim

@@ -116,7 +116,18 @@ TEST(GcodeGenerate, RectangleAndIdentifyParse) {
   dsp::Program id;
   id.kind = "identify";
   id.targets_mm = {25.0};
-  EXPECT_EQ(count_triggers(parse(program_gcode(id)), 102), 8);
+  EXPECT_EQ(count_triggers(parse(program_gcode(id)), 102), 6);  // three feeds, both ways
+  // Two strips and z: 6 swings each, a transfer to the second strip, z out, 6, back.
+  IdentifyPlan plan;
+  plan.psd.resize(2);
+  plan.psd[0].measures = "x", plan.psd[0].center_mm[1] = -10.0;
+  plan.psd[1].measures = "y", plan.psd[1].center_mm[0] = 10.0;
+  plan.axes = {"z"};
+  const auto prog = parse(identify_program(plan));
+  EXPECT_EQ(count_triggers(prog, 102), 6 + 1 + 6 + 1 + 6 + 1);
+  plan.psd[0].measures = "z";
+  plan.psd.resize(1);
+  EXPECT_THROW((void)identify_program(plan), dsp::InputError);
 }
 
 TEST(GcodeGenerate, IncompleteProgramsAreRefused) {

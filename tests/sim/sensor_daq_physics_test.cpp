@@ -65,7 +65,7 @@ TEST(SensingElement, StaticModelWithCrossTerms) {
 TEST(PsdStrip, SharesTheLightByPositionAndIsDarkOffTheStrip) {
   dsp::PsdSpec spec;
   spec.measures = "x", spec.center_mm[0] = 0.0, spec.center_mm[1] = -10.0, spec.length_mm = 10.0, spec.width_mm = 0.5;
-  spec.lockin_tau_s = 1e-9;  // follow at once for this test
+  spec.lockin_tau_s = 0.0;  // no lock-in filter: follow at once for this test
   PsdTruth truth;
   PsdStrip strip(spec, truth, 1e-5);
   double i1 = 0, i2 = 0;
@@ -85,8 +85,14 @@ TEST(PsdStrip, LockInFollowsWithItsTimeConstant) {
   spec.lockin_tau_s = 2e-5;
   PsdStrip strip(spec, PsdTruth{}, 1e-5);
   double i1 = 0, i2 = 0;
-  strip.step(Eigen::Vector3d(0.0, 0.0, 0.0), i1, i2);  // one step of 10 µs = τ/2
-  EXPECT_NEAR(i1 + i2, 2.0 * (1.0 - std::exp(-0.5)), 1e-9);
+  // One step of 10 µs = τ/2 over which the light rises linearly from dark to full.
+  strip.step(Eigen::Vector3d(0.0, 0.0, 0.0), i1, i2);
+  EXPECT_NEAR(i1 + i2, 2.0 * (1.0 - 2.0 * (1.0 - std::exp(-0.5))), 1e-9);
+  // A spot moving along the strip at 100 mm/s reads exactly τ late (an analogue lock-in).
+  const double v = 100.0, h = 1e-5;
+  double u = -2.0;
+  for (int k = 0; k < 200; ++k) strip.step(Eigen::Vector3d(u += v * h, 0.0, 0.0), i1, i2);
+  EXPECT_NEAR((i1 - i2) / (i1 + i2) * 5.0, u - v * 2e-5, 1e-9);
 }
 
 TEST(Reference, ReadsWithScaleInterpolationErrorAndOneNanometre) {

@@ -1,0 +1,77 @@
+#include "dsp/identify/delay_estimate.hpp"
+
+#include <Eigen/Dense>
+
+#include <cmath>
+
+namespace eical::dsp::identify {
+namespace {
+
+double interp(const std::vector<Eigen::Vector3d>& x, double pos, int axis) {
+  if (pos <= 0.0) return x.front()[axis];
+  const auto i = static_cast<std::size_t>(pos);
+  if (i + 1 >= x.size()) return x.back()[axis];
+  const double f = pos - static_cast<double>(i);
+  return (1.0 - f) * x[i][axis] + f * x[i + 1][axis];
+}
+
+}  // namespace
+
+DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayReference against) {
+  DelayEstimate d;
+  d.against = against == DelayReference::setpoint ? "set-point" : "reference";
+  const auto& fixes = m.raw.schedule.fixes;
+  const auto& c = against == DelayReference::setpoint ? m.cmd_mm : m.ref_mm;
+  const int strips = static_cast<int>(meta.psd.size());
+  if (fixes.empty() || c.size() < 3 || strips == 0) return d;
+  const double d0 = meta.acquisition.daq_group_delay_samples, fs = m.fs_hz;
+  // Columns: per strip an offset and a direction term, then the velocity.
+  const int p = 2 * strips + 1;
+  std::vector<double> rows, ys;
+  int passes = 0;
+  std::size_t last_k = 0;
+  int count = 0;
+  for (const auto& fx : fixes) {
+    if (fx.strip < 0 || fx.strip >= strips) continue;
+    if (fx.k != last_k + 1) ++passes;
+    last_k = fx.k;
+    if (count++ % 10 != 0) continue;
+    const double pos = static_cast<double>(fx.k) - d0;
+    if (pos < 1.0 || pos + 2.0 >= static_cast<double>(c.size())) continue;
+    const double ref = interp(c, pos, fx.axis);
+    const double v = (interp(c, pos + 1.0, fx.axis) - interp(c, pos - 1.0, fx.axis)) / 2.0 * fs;  // mm/s
+    if (!std::isfinite(ref) || !std::isfinite(v) || std::abs(v) < 1.0) continue;
+    std::vector<double> r(static_cast<std::size_t>(p), 0.0);
+    r[static_cast<std::size_t>(2 * fx.strip)] = 1.0;
+    r[static_cast<std::size_t>(2 * fx.strip + 1)] = v > 0.0 ? 1.0 : -1.0;
+    r[static_cast<std::size_t>(p - 1)] = v;
+    rows.insert(rows.end(), r.begin(), r.end());
+    ys.push_back(fx.position_um / 1000.0 - ref);
+  }
+  const auto n = static_cast<Eigen::Index>(ys.size());
+  if (n < p + 4 || passes < 2) return d;
+  const Eigen::MatrixXd a = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(rows.data(), n, p);
+  const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(ys.data(), n);
+  // Only the columns that vary (a strip never crossed leaves its offset empty).
+  std::vector<Eigen::Index> used;
+  for (Eigen::Index j = 0; j < p; ++j)
+    if (a.col(j).cwiseAbs().maxCoeff() > 0.0) used.push_back(j);
+  Eigen::MatrixXd au(n, static_cast<Eigen::Index>(used.size()));
+  for (std::size_t j = 0; j < used.size(); ++j) au.col(static_cast<Eigen::Index>(j)) = a.col(used[j]);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(au);
+  if (qr.rank() < au.cols()) return d;
+  const Eigen::VectorXd beta = qr.solve(y);
+  const Eigen::VectorXd res = y - au * beta;
+  const double dof = static_cast<double>(n - au.cols());
+  const Eigen::MatrixXd cov = (au.transpose() * au).inverse() * (res.squaredNorm() / dof);
+  const Eigen::Index iv = au.cols() - 1;
+  // Neighbouring readings of a pass are not independent: count passes, not samples.
+  const double inflate = std::sqrt(std::max(1.0, static_cast<double>(n) / (2.0 * passes)));
+  d.samples = d0 - beta[iv] * fs;
+  d.sigma = std::sqrt(std::max(0.0, cov(iv, iv))) * fs * inflate;
+  d.fixes = static_cast<int>(n);
+  d.valid = std::isfinite(d.samples);
+  return d;
+}
+
+}  // namespace eical::dsp::identify

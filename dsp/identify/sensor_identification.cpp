@@ -1,0 +1,384 @@
+#include "dsp/identify/sensor_identification.hpp"
+
+#include "dsp/core/error.hpp"
+#include "dsp/identify/augmented_filter.hpp"
+#include "dsp/identify/delay_estimate.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace eical::dsp::identify {
+namespace {
+
+constexpr double kPriorError = 0.02;     // E_ij: scale and cross terms, 2 %
+constexpr double kPriorDampingMs = 0.2;  // Δ(2ζ/ω0), ms (data sheet 0.225 ms)
+constexpr double kPriorOffsetUm = 50.0;  // rest offsets, backlash, PSD mounting
+
+int axis_index(const std::string& a) { return a == "x" ? 0 : a == "y" ? 1 : a == "z" ? 2 : -1; }
+
+// Which sensor moves machine axis j: 0 table, 1 head, −1 neither.
+int owner(const RunMeta& meta, int j) {
+  for (const auto& a : meta.machine.table_axes)
+    if (axis_index(a) == j) return 0;
+  for (const auto& a : meta.machine.head_axes)
+    if (axis_index(a) == j) return 1;
+  return -1;
+}
+
+// Parameter indices of one axis' filter (−1: not fitted).
+struct Layout {
+  int e[3] = {-1, -1, -1};
+  int damping = -1, x0 = -1, backlash = -1;
+  std::vector<int> strip;  // per PSD strip of the run (−1 when it measures another axis)
+  int count = 0;
+};
+
+struct AxisFit {
+  Layout layout;
+  Eigen::VectorXd theta, sigma;
+};
+
+struct PassResult {
+  AxisFit axis[3];
+  bool moved[3] = {false, false, false};
+  double psd_rms_um = 0.0, rest_rms_um = 0.0;
+  std::size_t psd_obs = 0, rest_obs = 0, standstills = 0;
+  Measurement m;
+};
+
+double rms_about_mean(const std::vector<double>& v) {
+  if (v.empty()) return 0.0;
+  double mean = 0.0;
+  for (double x : v) mean += x;
+  mean /= static_cast<double>(v.size());
+  double ss = 0.0;
+  for (double x : v) ss += (x - mean) * (x - mean);
+  return std::sqrt(ss / static_cast<double>(v.size()));
+}
+
+// Linear interpolation of a trace column at a fractional trace position.
+double at(const std::vector<Eigen::Vector3d>& x, double pos, int axis) {
+  if (pos <= 0.0) return x.front()[axis];
+  const auto i = static_cast<std::size_t>(pos);
+  if (i + 1 >= x.size()) return x.back()[axis];
+  const double f = pos - static_cast<double>(i);
+  return (1.0 - f) * x[i][axis] + f * x[i + 1][axis];
+}
+
+PassResult fit_pass(const Run& run, const RunMeta& meta, const IdentifyOptions& o) {
+  PipelineConfig cfg = pipeline_config(meta, run.frames.size());
+  cfg.keep_raw = true;
+  cfg.cupt = false;
+  cfg.smooth = false;
+  Pipeline pipe(cfg);
+  for (const auto& f : run.frames) pipe.step(f);
+  PassResult r;
+  r.m = pipe.finish();
+  const Measurement& m = r.m;
+  const RawTrace& raw = m.raw;
+  if (raw.empty()) throw InputError("identify: the run has no motion to identify from (" + std::string(m.flags.empty() ? "" : m.flags.front()) + ")");
+  const std::size_t n = raw.pos_mm.size();
+  const auto& flags = raw.schedule.flags;
+  if (flags.size() != n) throw InputError("identify: the support schedule does not cover the trace");
+  namespace sf = fusion::schedule_flag;
+
+  // Standstills: runs of rest samples.
+  std::vector<std::pair<std::size_t, std::size_t>> rests;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!(flags[k] & sf::rest)) continue;
+    if (rests.empty() || rests.back().second + 1 != k) rests.push_back({k, k});
+    else rests.back().second = k;
+  }
+  r.standstills = rests.size();
+  if (rests.empty()) throw InputError("identify: no standstill in the run (the program must rest between its moves)");
+
+  for (int j = 0; j < 3; ++j) {
+    double lo = 1e300, hi = -1e300;
+    for (const auto& c : m.cmd_mm) lo = std::min(lo, c[j]), hi = std::max(hi, c[j]);
+    r.moved[j] = hi - lo > 0.5 && owner(meta, j) >= 0;
+  }
+  const int n_strips = static_cast<int>(meta.psd.size());
+  const double fs = m.fs_hz;
+  const fusion::ErrorModel& model = cfg.fusion;
+  const double zupt_sigma = model.zupt_sigma_um_s;
+
+  for (int i = 0; i < 3; ++i) {
+    Layout& L = r.axis[i].layout;
+    std::vector<double> prior;
+    for (int j = 0; j < 3; ++j)
+      if (r.moved[j]) L.e[j] = static_cast<int>(prior.size()), prior.push_back(kPriorError);
+    if (r.moved[i]) L.damping = static_cast<int>(prior.size()), prior.push_back(kPriorDampingMs);
+    if (!o.against_reference) {
+      L.x0 = static_cast<int>(prior.size()), prior.push_back(kPriorOffsetUm);
+      if (r.moved[i]) L.backlash = static_cast<int>(prior.size()), prior.push_back(kPriorOffsetUm);
+      L.strip.assign(static_cast<std::size_t>(n_strips), -1);
+      for (int s = 0; s < n_strips; ++s)
+        if (axis_index(meta.psd[static_cast<std::size_t>(s)].measures) == i)
+          L.strip[static_cast<std::size_t>(s)] = static_cast<int>(prior.size()), prior.push_back(kPriorOffsetUm);
+    } else {
+      L.x0 = static_cast<int>(prior.size()), prior.push_back(kPriorOffsetUm);  // the reference's zero
+    }
+    L.count = static_cast<int>(prior.size());
+    AugmentedFilter f(model, Eigen::Vector3d(kPriorOffsetUm, 1.0, 20.0), Eigen::Map<Eigen::VectorXd>(prior.data(), L.count));
+    const int np = L.count;
+    auto row = [&] { return Eigen::RowVectorXd::Zero(3 + np).eval(); };
+
+    // Direction of the last move of axis i (backlash), and the rest-window mid samples.
+    double dir = 0.0;
+    std::size_t next_rest = 0, next_fix = 0, next_mean = 0;
+    std::vector<int> strip_count(static_cast<std::size_t>(n_strips), 0);
+    std::vector<double> psd_res, rest_res;
+    const auto& fixes = raw.schedule.fixes;
+    const auto& means = raw.schedule.velocity_means;
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(np);
+    const auto& zs = raw.schedule.zupt_sigma_um_s;
+    for (std::size_t k = 0; k < n; ++k) {
+      const Eigen::Vector3d a_now = (raw.head_mps2[k] - raw.table_mps2[k]) * 1e6;  // µm/s²
+      if (k > 0) {
+        const Eigen::Vector3d a_prev = (raw.head_mps2[k - 1] - raw.table_mps2[k - 1]) * 1e6;
+        for (int j = 0; j < 3; ++j)
+          if (L.e[j] >= 0) g[L.e[j]] = 0.5 * (a_now[j] + a_prev[j]);
+        const double h = static_cast<double>(m.sample_index[k] - m.sample_index[k - 1]) / fs;
+        f.predict(h, g, (flags[k] & sf::move_start) != 0);
+        const double dc = m.cmd_mm[k][i] - m.cmd_mm[k - 1][i];
+        if (std::abs(dc) > 1e-9) dir = dc > 0.0 ? 1.0 : -1.0;
+      }
+      const double x_um = raw.pos_mm[k][i] * 1000.0, v_um_s = raw.vel_mm_s[k][i] * 1000.0;
+      if (k == 0 && !o.against_reference) {  // the integration starts at the set-point: δx0 = −(offset there)
+        Eigen::RowVectorXd h = row();
+        h[0] = 1.0, h[3 + L.x0] = 1.0;
+        if (L.backlash >= 0) h[3 + L.backlash] = 0.0;  // direction unknown before the first move
+        f.update(h, 0.0, 1e-3);
+      }
+      if ((flags[k] & sf::rest) && !(flags[k] & sf::invalid) && (k >= zs.size() || zs[k] == 0.0F)) {
+        Eigen::RowVectorXd h = row();
+        h[1] = 1.0;
+        f.update(h, v_um_s, zupt_sigma);
+      }
+      for (; next_mean < means.size() && means[next_mean].k <= k; ++next_mean) {
+        if (means[next_mean].k != k) continue;
+        Eigen::RowVectorXd h = row();
+        h[1] = 1.0, h[2] = -means[next_mean].lag_s;
+        f.update(h, means[next_mean].mean_um_s[i], std::max(zupt_sigma, means[next_mean].sigma_um_s));
+      }
+      if (!o.against_reference) {
+        // The set-point at the middle of each standstill.
+        while (next_rest < rests.size() && (rests[next_rest].first + rests[next_rest].second) / 2 < k) ++next_rest;
+        if (next_rest < rests.size() && (rests[next_rest].first + rests[next_rest].second) / 2 == k) {
+          Eigen::RowVectorXd h = row();
+          h[0] = 1.0, h[3 + L.x0] = 1.0;
+          if (L.backlash >= 0) h[3 + L.backlash] = dir / 2.0;
+          const double z = x_um - m.cmd_mm[k][i] * 1000.0;
+          rest_res.push_back(z);
+          f.update(h, z, o.rest_sigma_um);
+          ++r.rest_obs;
+        }
+        for (; next_fix < fixes.size() && fixes[next_fix].k <= k; ++next_fix) {
+          const fusion::PositionFix& fx = fixes[next_fix];
+          if (fx.k != k || fx.axis != i || fx.strip < 0 || fx.strip >= n_strips) continue;
+          if (strip_count[static_cast<std::size_t>(fx.strip)]++ % std::max(1, o.psd_every) != 0) continue;
+          Eigen::RowVectorXd h = row();
+          h[0] = 1.0;
+          if (L.damping >= 0) h[3 + L.damping] = v_um_s * 1e-3;  // ms × µm/s
+          h[3 + L.strip[static_cast<std::size_t>(fx.strip)]] = -1.0;
+          const double z = x_um - fx.position_um;
+          psd_res.push_back(z);
+          f.update(h, z, std::hypot(fx.sigma_um, model.psd_floor_um));
+          ++r.psd_obs;
+        }
+      } else if (run.channels.ref[i] && k % static_cast<std::size_t>(std::max(1, o.reference_every)) == 0) {
+        const double pos = static_cast<double>(k) - meta.acquisition.daq_group_delay_samples;  // sensors see k − d
+        const double ref = at(m.ref_mm, pos, i);
+        if (std::isfinite(ref) && pos >= 0.0) {
+          Eigen::RowVectorXd h = row();
+          h[0] = 1.0, h[3 + L.x0] = 1.0;
+          if (L.damping >= 0) h[3 + L.damping] = v_um_s * 1e-3;
+          f.update(h, x_um - ref * 1000.0, o.reference_sigma_um);
+          ++r.psd_obs;
+        }
+      }
+    }
+    r.axis[i].theta = f.state().tail(np);
+    r.axis[i].sigma.resize(np);
+    for (int p = 0; p < np; ++p) r.axis[i].sigma[p] = f.parameter_sigma(p);
+    // RMS of what the observations left about their offsets, before this pass's fit.
+    r.psd_rms_um = std::max(r.psd_rms_um, rms_about_mean(psd_res));
+    r.rest_rms_um = std::max(r.rest_rms_um, rms_about_mean(rest_res));
+  }
+  return r;
+}
+
+// How well the pipeline with these sensors — ZUPT and smoother, no PSD fixes — agrees with
+// the PSD readings (it did not use them) and with the set-point at the standstills:
+// RMS about each strip's (each axis') own mean.
+struct Agreement {
+  double psd_rms_um = 0.0, rest_rms_um = 0.0;
+};
+
+Agreement agreement(const Run& run, const RunMeta& meta) {
+  PipelineConfig cfg = pipeline_config(meta, run.frames.size());
+  cfg.keep_raw = true;
+  cfg.cupt = false;
+  Pipeline pipe(cfg);
+  for (const auto& f : run.frames) pipe.step(f);
+  const Measurement m = pipe.finish();
+  Agreement a;
+  if (m.raw.empty()) return a;
+  const double d = meta.acquisition.daq_group_delay_samples;
+  std::vector<std::vector<double>> per_strip(meta.psd.size());
+  for (const auto& fx : m.raw.schedule.fixes) {
+    if (fx.strip < 0 || static_cast<std::size_t>(fx.strip) >= per_strip.size()) continue;
+    const double pos = at(m.pos_mm, static_cast<double>(fx.k) - d, fx.axis);  // the trace is on the set-point's time
+    per_strip[static_cast<std::size_t>(fx.strip)].push_back(pos * 1000.0 - fx.position_um);
+  }
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (const auto& v : per_strip) {
+    const double r = rms_about_mean(v);
+    ss += r * r * static_cast<double>(v.size()), n += v.size();
+  }
+  a.psd_rms_um = n > 0 ? std::sqrt(ss / static_cast<double>(n)) : 0.0;
+  // Standstill mids (sensor time) → the trace at k − d.
+  namespace sf = fusion::schedule_flag;
+  const auto& flags = m.raw.schedule.flags;
+  std::vector<double> per_axis[3];
+  for (std::size_t k = 0; k < flags.size();) {
+    if (!(flags[k] & sf::rest)) {
+      ++k;
+      continue;
+    }
+    std::size_t e = k;
+    while (e + 1 < flags.size() && (flags[e + 1] & sf::rest)) ++e;
+    const double mid = static_cast<double>(k + e) / 2.0 - d;
+    for (int i = 0; i < 3; ++i) per_axis[i].push_back((at(m.pos_mm, mid, i) - at(m.cmd_mm, mid, i)) * 1000.0);
+    k = e + 1;
+  }
+  ss = 0.0, n = 0;
+  for (const auto& v : per_axis) {
+    const double r = rms_about_mean(v);
+    ss += r * r * static_cast<double>(v.size()), n += v.size();
+  }
+  a.rest_rms_um = n > 0 ? std::sqrt(ss / static_cast<double>(n)) : 0.0;
+  return a;
+}
+
+// (I + E)⁻¹ applied to the data-sheet mounting of one sensor: its corrected to_machine.
+void apply_sensor(const Eigen::Matrix3d& e, double damping_s, SensorSpec& spec) {
+  spec.to_machine = (Eigen::Matrix3d::Identity() + e).inverse() * spec.to_machine;
+  const double w0 = 2.0 * std::numbers::pi * spec.f0_hz;
+  const double c1 = 2.0 * spec.zeta / w0 - damping_s;
+  spec.zeta = std::max(0.0, c1 * w0 / 2.0);
+}
+
+}  // namespace
+
+Identification identify_sensors(const Run& run, const IdentifyOptions& o) {
+  if (run.frames.empty()) throw InputError("identify: run '" + run.meta.id + "' holds no frames");
+  Identification id;
+  id.method = o.against_reference ? "ref" : "psd";
+  if (o.against_reference && !(run.channels.ref[0] || run.channels.ref[1] || run.channels.ref[2]))
+    throw InputError("identify: run '" + run.meta.id + "' has no reference instrument to identify against");
+  if (!o.against_reference && run.meta.psd.empty())
+    id.notes.push_back("no PSD strips: scale and cross terms from the set-point at the standstills only, no damping term");
+  RunMeta meta = run.meta;
+  const Eigen::Matrix3d to_machine_ds[2] = {run.meta.sensors[0].to_machine, run.meta.sensors[1].to_machine};
+  PassResult last;
+  double damping_total[2] = {0.0, 0.0};
+  for (int it = 0; it < std::max(1, o.iterations); ++it) {
+    PassResult pr = fit_pass(run, meta, o);
+    // Per sensor: E from the columns it owns, Δ(2ζ/ω0) weighted over its axes.
+    for (int s = 0; s < 2; ++s) {
+      Eigen::Matrix3d e = Eigen::Matrix3d::Zero();
+      double wsum = 0.0, dsum = 0.0;
+      for (int j = 0; j < 3; ++j) {
+        if (owner(meta, j) != s || !pr.moved[j]) continue;
+        for (int i = 0; i < 3; ++i) e(i, j) = pr.axis[i].theta[pr.axis[i].layout.e[j]];
+        const AxisFit& af = pr.axis[j];
+        if (af.layout.damping >= 0 && af.sigma[af.layout.damping] < 0.5 * kPriorDampingMs) {
+          const double sg = af.sigma[af.layout.damping];
+          wsum += 1.0 / (sg * sg), dsum += af.theta[af.layout.damping] / (sg * sg);
+        }
+      }
+      const double damping_s = wsum > 0.0 ? dsum / wsum * 1e-3 : 0.0;
+      apply_sensor(e, damping_s, meta.sensors[s]);
+      damping_total[s] += damping_s;
+    }
+    last = std::move(pr);
+    id.iterations = it + 1;
+  }
+  id.psd_observations = last.psd_obs, id.rest_observations = last.rest_obs, id.standstills = last.standstills;
+  {  // What the data sheet and the identified model leave unexplained.
+    const Agreement before = agreement(run, run.meta), after = agreement(run, meta);
+    id.psd_rms_before_um = before.psd_rms_um, id.rest_rms_before_um = before.rest_rms_um;
+    id.psd_rms_after_um = after.psd_rms_um, id.rest_rms_after_um = after.rest_rms_um;
+  }
+
+  // Report: the total error against the data sheet, with the last pass's σ.
+  for (int s = 0; s < 2; ++s) {
+    SensorEstimate& se = id.sensor[s];
+    const Eigen::Matrix3d e_total = to_machine_ds[s] * meta.sensors[s].to_machine.inverse() - Eigen::Matrix3d::Identity();
+    double wsum = 0.0;
+    for (int j = 0; j < 3; ++j) {
+      if (owner(meta, j) != s || !last.moved[j]) continue;
+      se.moved = true;
+      for (int i = 0; i < 3; ++i) {
+        const AxisFit& af = last.axis[i];
+        se.error[i][j] = {e_total(i, j), af.sigma[af.layout.e[j]], true};
+      }
+      const AxisFit& own = last.axis[j];
+      // The damping term counts where the data said something (no PSD strip on z: nothing).
+      if (own.layout.damping >= 0 && own.sigma[own.layout.damping] < 0.5 * kPriorDampingMs)
+        wsum += 1.0 / std::pow(own.sigma[own.layout.damping] * 1e-3, 2);
+    }
+    if (wsum > 0.0) se.damping_s = {damping_total[s], 1.0 / std::sqrt(wsum), true};
+    else if (se.moved) id.notes.push_back(std::string(s == 0 ? "table" : "head") + " sensor: 2ζ/ω0 not identified (no PSD strip along its axes): data sheet kept");
+    // Bias at the first standstill (sensor axes, gravity removed): what the rest window took out.
+    const double g = meta.site.g_mps2;
+    const Eigen::Vector3d gravity(0.0, 0.0, g);
+    const Eigen::Vector3d b_machine = last.m.raw.rest_bias_mps2[s] - gravity;
+    se.rest_bias_g = run.meta.sensors[s].bias_g + meta.sensors[s].to_machine.inverse() * b_machine / g;
+  }
+  for (int i = 0; i < 3; ++i) {
+    const AxisFit& af = last.axis[i];
+    if (af.layout.x0 >= 0) id.rest_offset_um[i] = {af.theta[af.layout.x0], af.sigma[af.layout.x0], true};
+    if (af.layout.backlash >= 0) id.backlash_um[i] = {af.theta[af.layout.backlash], af.sigma[af.layout.backlash], true};
+  }
+  id.psd_offset_um.resize(run.meta.psd.size());
+  for (std::size_t s = 0; s < run.meta.psd.size(); ++s) {
+    const int i = axis_index(run.meta.psd[s].measures);
+    if (i < 0) continue;
+    const AxisFit& af = last.axis[i];
+    if (s < af.layout.strip.size() && af.layout.strip[s] >= 0)
+      id.psd_offset_um[s] = {af.theta[af.layout.strip[s]], af.sigma[af.layout.strip[s]], true};
+  }
+
+  // The DAQ delay: PSD readings behind the set-point (with servo lag) and the reference.
+  id.delay_setpoint = estimate_delay(last.m, meta, DelayReference::setpoint);
+  if (run.channels.ref[0] || run.channels.ref[1]) id.delay_reference = estimate_delay(last.m, meta, DelayReference::reference);
+  id.daq_group_delay_samples = run.meta.acquisition.daq_group_delay_samples;
+  if (id.delay_reference.valid) {
+    id.daq_group_delay_samples = id.delay_reference.samples, id.delay_identified = true;
+  } else if (o.delay_from_setpoint && id.delay_setpoint.valid) {
+    id.daq_group_delay_samples = id.delay_setpoint.samples, id.delay_identified = true;
+    id.notes.push_back("DAQ delay taken from the PSD readings against the set-point: it includes the axes' mean servo lag");
+  } else if (id.delay_setpoint.valid) {
+    id.notes.push_back("DAQ delay kept at the data sheet's: against the set-point the PSD readings lag by the delay plus the servo lag (no reference in the run)");
+  }
+  for (int s = 0; s < 2; ++s) id.sensors[s] = meta.sensors[s];
+  if (!id.sensor[0].moved && !id.sensor[1].moved) throw InputError("identify: no axis moved more than 0.5 mm");
+  return id;
+}
+
+void apply_identification(const Identification& id, RunMeta& meta, PipelineConfig* config) {
+  for (int s = 0; s < 2; ++s) meta.sensors[s] = id.sensors[s];
+  meta.acquisition.daq_group_delay_samples = id.daq_group_delay_samples;
+  if (config) {
+    for (int s = 0; s < 2; ++s) config->sensors[s] = id.sensors[s], config->calibration[s] = id.calibration[s];
+    config->acquisition.daq_group_delay_samples = id.daq_group_delay_samples;
+  }
+}
+
+}  // namespace eical::dsp::identify
