@@ -123,6 +123,7 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   cfg.coriolis = options.coriolis;
   cfg.cupt = options.cupt;
   cfg.keep_raw = options.keep_raw;
+  if (options.sensor_model != "datasheet") cfg.fusion.scale_uncertainty = 3e-5;  // identified on site
   cfg.calibration[0] = options.calibration[0], cfg.calibration[1] = options.calibration[1];
   Pipeline pipeline(cfg);
   for (const auto& f : run.frames) pipeline.step(f);

@@ -13,13 +13,15 @@ ErrorCovariance::ErrorCovariance(const SupportSchedule& schedule, const std::vec
   model.start_position_um = 0.0;    // measured from where it starts
   model.reset_after_rejections = 1 << 30;
   const std::size_t n = sample_index.size();
+  SupportSchedule noise_only = schedule;  // the strips' own noise: the bound is the sensors'
+  for (auto& f : noise_only.fixes) f.model_sigma_um = 0.0;
   // The smoother wants a trace; the covariance does not depend on it.
   const std::vector<Eigen::Vector3d> zero(n, Eigen::Vector3d::Zero());
   SmootherInput in;
   in.sample_index = &sample_index;
   in.vel_mm_s = &zero;
   in.pos_mm = &zero;
-  in.schedule = &schedule;
+  in.schedule = &noise_only;
   in.fs_hz = fs_hz;
   in.model = model;
   in.start_bias_sigma_um_s2 = start_bias_sigma_um_s2;

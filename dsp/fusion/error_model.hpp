@@ -34,6 +34,10 @@ struct ErrorModel {
   double zupt_onset_skip_s = 0.1;         // offline: a standstill's first 0.1 s (settling) unused
   double nbs_sigma_um_s = 5.0;            // σ of a held axis' velocity (straightness, vibration)
   double psd_floor_um = 0.05;             // added to every PSD fix's σ (model error of the strip)
+  // The sensors' scale and mounting are known to this (relative, data sheet: a few 1e-4;
+  // identified on site: a few 1e-5): a PSD fix d mm from where the integration started
+  // cannot be trusted closer than this times d — the error there is no wandering bias.
+  double scale_uncertainty = 3e-4;
   double gate_nis = 25.0;                 // innovation test: reject beyond 5 σ
   // A standstill whose velocity the filter keeps rejecting means the model was too sure
   // (a bias jump it did not expect): after this many rejections in a row (per-sample

@@ -22,7 +22,7 @@ namespace eical::dsp::fusion {
 struct CovarianceReset {
   std::size_t k = 0;
   int axis = 0;
-  double add_vv = 0.0, add_bb = 0.0;
+  double add_vv = 0.0, add_bb = 0.0, add_xx = 0.0;
 };
 
 struct ForwardFilter {
@@ -38,8 +38,8 @@ struct ForwardFilter {
       axis[a].P = initial_covariance(m, start_bias_sigma_um_s2[a]);
     }
     tally = {};
-    rejections_ = {};
-    since_velocity_s_ = {};
+    rejections_ = {}, fix_rejections_ = {};
+    since_velocity_s_ = {}, since_position_s_ = {};
     k = reset_count = 0;
   }
 
@@ -49,6 +49,7 @@ struct ForwardFilter {
       axis[a].predict(d);
       if (move_start) axis[a].P(2, 2) += m.bias_step_um_s2 * m.bias_step_um_s2;
       since_velocity_s_[a] += d.h_s;
+      since_position_s_[a] += d.h_s;
     }
   }
 
@@ -76,9 +77,25 @@ struct ForwardFilter {
   }
 
   // CUPT: the integrated position minus the PSD's is the position error.
+  // A strip the filter keeps rejecting is reset to like a standstill (the position error is
+  // ν; the bias that would have made it since the last position support, 2ν/T²).
   UpdateRecord position_fix(int a, double ins_pos_um, double fix_pos_um, double sigma_um, const ErrorModel& m) noexcept {
     const double s = sigma_um * sigma_um + m.psd_floor_um * m.psd_floor_um;
-    const UpdateRecord r = axis[a].update(0, ins_pos_um - fix_pos_um, s, m.gate_nis);
+    UpdateRecord r = axis[a].update(0, ins_pos_um - fix_pos_um, s, m.gate_nis);
+    if (!r.accepted && std::isfinite(r.innovation) && std::abs(r.innovation) < 1e9) {
+      if (++fix_rejections_[a] >= m.reset_after_rejections) {
+        const double nu = r.innovation, t = std::max(since_position_s_[a], 0.1);
+        CovarianceReset reset{k, a, nu * nu * 4.0 / (t * t), 4.0 * nu * nu / (t * t * t * t)};
+        reset.add_xx = nu * nu;
+        axis[a].P(0, 0) += reset.add_xx;
+        axis[a].P(1, 1) += reset.add_vv;
+        axis[a].P(2, 2) += reset.add_bb;
+        if (resets && resets->size() < resets->capacity()) resets->push_back(reset);
+        ++reset_count;
+        r = axis[a].update(0, ins_pos_um - fix_pos_um, s, m.gate_nis);
+      }
+    }
+    if (r.accepted) fix_rejections_[a] = 0, since_position_s_[a] = 0.0;
     tally[a][static_cast<int>(Support::cupt)].add(r);
     return r;
   }
@@ -102,8 +119,8 @@ struct ForwardFilter {
     tally[a][static_cast<int>(Support::zupt)].add(rec);
   }
 
-  std::array<int, 3> rejections_{};
-  std::array<double, 3> since_velocity_s_{};
+  std::array<int, 3> rejections_{}, fix_rejections_{};
+  std::array<double, 3> since_velocity_s_{}, since_position_s_{};
 };
 
 }  // namespace eical::dsp::fusion

@@ -61,7 +61,7 @@ SmootherOutput smooth(const SmootherInput& in) {
       if (means[next_mean].k == k) fwd.velocity_mean(means[next_mean], m, in.schedule->zupt);
     for (; next_fix < fixes.size() && fixes[next_fix].k == k; ++next_fix) {
       const PositionFix& f = fixes[next_fix];
-      if (in.schedule->cupt) fwd.position_fix(f.axis, (*in.pos_mm)[k][f.axis] * 1000.0, f.position_um, f.sigma_um, m);
+      if (in.schedule->cupt) fwd.position_fix(f.axis, (*in.pos_mm)[k][f.axis] * 1000.0, f.position_um, std::hypot(f.sigma_um, f.model_sigma_um), m);
     }
     for (int a = 0; a < 3; ++a) ef[a][k] = fwd.axis[a].e, pf[a][k] = fwd.axis[a].P;
   }
@@ -69,7 +69,7 @@ SmootherOutput smooth(const SmootherInput& in) {
   out.resets = fwd.reset_count;
   // Per axis and sample: the process noise a reset added (the backward pass needs it).
   std::array<std::vector<std::pair<std::size_t, Vec3>>, 3> extra;
-  for (const auto& r : resets) extra[r.axis].push_back({r.k, Vec3(0.0, r.add_vv, r.add_bb)});
+  for (const auto& r : resets) extra[r.axis].push_back({r.k, Vec3(r.add_xx, r.add_vv, r.add_bb)});
 
   // Backward (RTS), in place over the forward arrays.
   out.dx_um.assign(n, Eigen::Vector3d::Zero());

@@ -23,8 +23,9 @@ struct PositionFix {
   std::size_t k = 0;
   int axis = 0;
   double position_um = 0.0;  // in the trace's frame (the set-point at the start)
-  double sigma_um = 0.0;
-  int strip = 0;             // which PSD strip
+  double sigma_um = 0.0;      // the strip's own noise
+  int strip = 0;              // which PSD strip
+  double model_sigma_um = 0.0;  // what the sensor model's uncertainty adds there (scale × distance)
 };
 
 // The mean integrated velocity over a window ending at sample k of a standstill where the

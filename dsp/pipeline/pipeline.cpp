@@ -39,6 +39,7 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
       "no_end_trigger: no M103 (103) trigger; the measurement ends with the data",
       "fixed_saturated: the fixed-point path clamped a value outside its Q-format range",
       "supports_diverged: the support fusion met values it cannot take (trace left as integrated, no ZUPT/NBS/CUPT)",
+      "psd_disagrees: the PSD readings contradict the integrated motion beyond their noise (sensor model off? run eical identify); fused without them",
   };
   std::vector<std::string> out;
   for (std::uint32_t b = 0; b < std::size(names); ++b)
@@ -303,6 +304,7 @@ void Pipeline::apply_supports(Measurement& m) {
   if (config_.keep_raw) m.raw.schedule = supports_.schedule();
   m.sigma_um = std::move(sigma);
   if (m.supports.diverged) quality_ |= quality_flag::supports_diverged;
+  if (m.supports.psd_disagrees) quality_ |= quality_flag::psd_disagrees;
   const std::int64_t motion_end_sensor = motion_end_index_ + static_cast<std::int64_t>(std::ceil(delay_samples_));
   bool rest_after = false;
   for (const RestWindow& w : m.supports.rest_windows) {

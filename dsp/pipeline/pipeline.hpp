@@ -83,6 +83,7 @@ inline constexpr std::uint32_t capacity_exceeded = 1u << 8;
 inline constexpr std::uint32_t no_end_trigger = 1u << 9;
 inline constexpr std::uint32_t fixed_saturated = 1u << 10;
 inline constexpr std::uint32_t supports_diverged = 1u << 11;
+inline constexpr std::uint32_t psd_disagrees = 1u << 12;
 }  // namespace quality_flag
 
 std::vector<std::string> quality_flag_names(std::uint32_t bits);

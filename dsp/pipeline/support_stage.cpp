@@ -93,6 +93,7 @@ void SupportStage::start() noexcept {
   live_.start(cfg_.model, start_bias_sigma_);
   started_ = true;
   at_rest_ = false;
+  start_pos_mm_ = Eigen::Vector3d::Constant(NAN);
 }
 
 Eigen::Vector3d SupportStage::live_dx_mm() const noexcept {
@@ -115,6 +116,7 @@ void SupportStage::close_rest_window() noexcept {
 void SupportStage::step(std::size_t k, std::int64_t gap, bool accel_valid, const Eigen::Vector3d& a_table,
                         const Eigen::Vector3d& a_head, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
                         bool cmd_valid, bool cmd_moved, const Eigen::Vector3d& cmd_mm) noexcept {
+  if (k == 0) start_pos_mm_ = pos_mm;  // where the integration is anchored
   const Eigen::Vector3d a_rel = a_head - a_table;
   const Eigen::Vector3d vel_corr = vel_mm_s - live_dv_mm_s();
   double pvv = 0.0;
@@ -168,8 +170,9 @@ void SupportStage::step(std::size_t k, std::int64_t gap, bool accel_valid, const
     const int ax = psd_[s].axis();
     // The lock-in output lags the spot by its time constant: add τ·v.
     const double fix_um = (psd_[s].centre_mm() + r.u_mm + psd_[s].lockin_tau_s() * vel_corr[ax]) * 1000.0;
-    if (cfg_.cupt) live_.position_fix(ax, pos_mm[ax] * 1000.0, fix_um, r.sigma_mm * 1000.0, cfg_.model);
-    if (schedule_.fixes.size() < capacity_) schedule_.fixes.push_back({k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(s)});
+    const double model_um = cfg_.model.scale_uncertainty * (pos_mm - start_pos_mm_).norm() * 1000.0;
+    if (cfg_.cupt) live_.position_fix(ax, pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model);
+    if (schedule_.fixes.size() < capacity_) schedule_.fixes.push_back({k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(s), model_um});
     else ++fixes_dropped_;
   }
   if (schedule_.flags.size() < capacity_) {
@@ -252,7 +255,20 @@ SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::v
   in.model = cfg_.model;
   in.start_bias_sigma_um_s2 = start_bias_sigma_;
   in.forward_only = !cfg_.smooth;
-  const fusion::SmootherOutput out = fusion::smooth(in);
+  fusion::SmootherOutput out = fusion::smooth(in);
+  // PSD readings the integration cannot follow — its strip resets, or rejections of more
+  // than 5 % — mean the sensor model is off (uncalibrated scale or mounting: the error is
+  // then no slowly wandering bias, and pulling the trace to the strips would bend it far
+  // between them). The measurement is then fused without them, and says so.
+  std::size_t cupt_ok = 0, cupt_bad = 0;
+  for (int a = 0; a < 3; ++a) cupt_ok += out.tally[a][1].accepted, cupt_bad += out.tally[a][1].rejected;
+  if (schedule_.cupt && cupt_ok + cupt_bad > 0 && (out.resets > 0 || 20 * cupt_bad > cupt_ok + cupt_bad)) {
+    sum.psd_disagrees = true;
+    sum.psd_rejected = cupt_bad;
+    schedule_.cupt = false;
+    out = fusion::smooth(in);
+    schedule_.cupt = true;
+  }
   bool finite = true;
   for (std::size_t k = 0; k < n && finite; ++k) finite = out.dx_um[k].allFinite() && out.dv_um_s[k].allFinite();
   if (!finite) {  // an input the model cannot take (a saturated channel): leave the trace as integrated

@@ -20,6 +20,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace eical::dsp {
@@ -48,6 +49,8 @@ struct SupportSummary {
   std::vector<RestWindow> rest_windows;
   std::size_t psd_fixes = 0, psd_fixes_dropped = 0;
   std::size_t resets = 0;  // covariance resets (a standstill the model could not explain)
+  bool psd_disagrees = false;   // the PSD readings contradicted the integration: not used
+  std::size_t psd_rejected = 0;
   bool smoothed = false;
   bool diverged = false;   // the fusion met values it cannot take: trace left as integrated
   Eigen::Vector3d start_bias_sigma_um_s2 = Eigen::Vector3d::Zero();  // how well the first rest fixed the bias
@@ -109,6 +112,7 @@ class SupportStage {
   Eigen::Vector3d start_bias_sigma_ = Eigen::Vector3d::Zero();
   // Detected rests.
   bool at_rest_ = false, started_ = false;
+  Eigen::Vector3d start_pos_mm_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   Eigen::Vector3d cmd_at_rest_ = Eigen::Vector3d::Zero();
   RestWindow open_{};
   std::vector<RestWindow> rests_;
