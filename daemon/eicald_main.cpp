@@ -4,6 +4,7 @@
 // result.json, and reports to systemd (READY, STATUS, WATCHDOG, STOPPING).
 #include "daemon/config/daemon_config.hpp"
 #include "daemon/service/service.hpp"
+#include "drivers/config/sensor_calibration.hpp"
 #include "daemon/system/log.hpp"
 #include "daemon/system/notify.hpp"
 #include "drivers/source/source.hpp"
@@ -44,6 +45,11 @@ int main(int argc, char** argv) {
     try {
       auto source = Service::make_source(config);
       source->open();
+      if (!config.calibration_file.empty()) {
+        const auto cal = eical::drivers::read_sensor_calibration(config.calibration_file, source->meta());
+        std::printf("%s: calibration %s (%s, from run %s) reads\n", config_file.c_str(), config.calibration_file.c_str(), cal.method.c_str(),
+                    cal.run_id.c_str());
+      }
       std::printf("%s: configuration valid; source '%.*s' opens\n", config_file.c_str(), static_cast<int>(source->name().size()),
                   source->name().data());
       return 0;

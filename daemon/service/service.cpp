@@ -7,6 +7,7 @@
 #include "daemon/system/log.hpp"
 #include "daemon/system/realtime.hpp"
 #include "drivers/acquisition/pump.hpp"
+#include "drivers/config/sensor_calibration.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/source/replay_source.hpp"
@@ -72,6 +73,7 @@ std::unique_ptr<drivers::Source> make_base_source(const DaemonConfig& c) {
   sc.meta.machine = c.machine;
   sc.meta.sensors[0] = c.sensors[0];
   sc.meta.sensors[1] = c.sensors[1];
+  sc.meta.psd = c.psd;  // the strips the simulated machine carries
   for (int s = 0; s < 2; ++s) sc.truth[s].spec = c.sensors[s];
   return std::make_unique<drivers::SimSource>(
       sc, drivers::SimSourceOptions{pacing, c.source.sim_repeat_program, c.source.sim_idle_s});
@@ -99,15 +101,25 @@ std::unique_ptr<drivers::Source> Service::make_source(const DaemonConfig& c) {
 void Service::run(const std::atomic<bool>& stop, const std::function<void(const ServiceStatus&)>& on_status) {
   drivers::StampedSource source(make_source(config_));
   source.open();  // absent hardware: a clear error at start, not a retry loop
-  const dsp::RunMeta meta = source.meta();
+  dsp::RunMeta meta = source.meta();
   log(LogLevel::info, "source %.*s open: %.0f Hz", static_cast<int>(source.name().size()), source.name().data(), meta.acquisition.fs_hz);
+  // The identified calibration (eical identify) replaces the data sheet for the live path,
+  // the recordings and their evaluation; a file that cannot be read stops the start.
+  dsp::AnalysisOptions analysis;
+  if (!config_.calibration_file.empty()) {
+    const drivers::SensorCalibration cal = drivers::read_sensor_calibration(config_.calibration_file, meta);
+    drivers::apply_calibration(cal, meta, analysis);
+    log(LogLevel::info, "calibration %s (%s, from run %s) in use", config_.calibration_file.c_str(), cal.method.c_str(), cal.run_id.c_str());
+  }
 
   drivers::FrameRing ring(config_.limits.ring_capacity_frames);
   dsp::SessionConfig scfg;
   scfg.fs_hz = meta.acquisition.fs_hz;
   scfg.max_measurement_s = config_.limits.max_measurement_s;
   dsp::MeasurementSession session(scfg);
-  dsp::Pipeline live(dsp::pipeline_config(meta, session.recorder_capacity()));
+  dsp::PipelineConfig live_cfg = dsp::pipeline_config(meta, session.recorder_capacity());
+  for (int s = 0; s < 2; ++s) live_cfg.calibration[s] = analysis.calibration[s];
+  dsp::Pipeline live(live_cfg);
   FrameGuard guard(static_cast<float>(meta.sensors[0].temp_ref_c), static_cast<float>(meta.sensors[1].temp_ref_c));
 
   // The HMI bus; without it the service still measures and records (and says so).
@@ -155,14 +167,14 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
       run.meta = meta;
       run.meta.id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
       run.meta.created = utc_now("%Y-%m-%dT%H:%M:%SZ");
-      run.channels.psd_count = 0;
+      run.channels.psd_count = static_cast<int>(std::min<std::size_t>(meta.psd.size(), dsp::kMaxPsd));
       run.frames = std::move(job.frames);
       const auto dir = config_.recording.dir / run.meta.id;
       std::string error;
       try {
         // The run first: what was measured is durable before anything can fail.
         drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false});
-        dsp::Analysis a = dsp::analyze_run(run);
+        dsp::Analysis a = dsp::analyze_run(run, analysis);
         if (!job.cause.empty()) a.flags.push_back(job.cause), a.degraded = true;
         if (job.nonfinite_frames > 0) {
           a.flags.push_back("not_finite: " + std::to_string(job.nonfinite_frames) +

@@ -147,6 +147,38 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
                                                 : std::string(dsp::dynamic_comp_name(a.dynamic)) + ", DAQ delay removed by re-indexing"},
                    {"nbs", a.nbs},
                    {"coriolis", a.coriolis}};
+  // What the supports did: accepted and rejected updates per kind and axis, the
+  // standstills found, the strips' readings, and the measurement's own noise-limited σ.
+  nlohmann::json sup;
+  const char* axes[3] = {"x", "y", "z"};
+  for (int k = 0; k < dsp::fusion::kSupportKinds; ++k) {
+    nlohmann::json kind_j;
+    for (int ax = 0; ax < 3; ++ax) {
+      const auto& t = m.supports.tally[ax][k];
+      kind_j[axes[ax]] = {{"accepted", t.accepted}, {"rejected", t.rejected}};
+    }
+    sup[dsp::fusion::support_name(static_cast<dsp::fusion::Support>(k))] = kind_j;
+  }
+  sup["standstills"] = m.supports.rest_windows.size();
+  sup["psd_readings"] = m.supports.psd_fixes;
+  sup["psd_disagrees"] = m.supports.psd_disagrees;
+  sup["resets"] = m.supports.resets;
+  sup["smoothed"] = m.supports.smoothed;
+  Eigen::Vector3d worst = Eigen::Vector3d::Zero();
+  for (const auto& sg : m.sigma_um)
+    if (sg.allFinite()) worst = worst.cwiseMax(sg);
+  sup["position_sigma_max_um"] = {worst.x(), worst.y(), worst.z()};
+  j["pipeline"]["supports"] = sup;
+  // Repeats of one segment (between M102 marks) averaged sample by sample (6-44).
+  nlohmann::json reps = nlohmann::json::array();
+  for (const auto& g : a.repeats) {
+    nlohmann::json moving = nlohmann::json::array();
+    for (int ax = 0; ax < 3; ++ax)
+      if (g.axis_moves[ax]) moving.push_back(axes[ax]);
+    reps.push_back({{"repeats", g.repeats()}, {"samples", g.samples}, {"axes", moving}, {"mean_deviation_rms_um", g.mean_rms_um},
+                    {"scatter_rms_um", g.scatter_rms_um}});
+  }
+  j["repeats"] = reps;
   explain_nulls(j);
   return j;
 }

@@ -134,6 +134,14 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;
   if (a.measurement.sample_index.empty()) return a;  // no motion: nothing to evaluate
+  {
+    eval::RepeatInput ri;
+    ri.sample_index = &a.measurement.sample_index, ri.pos_mm = &a.measurement.pos_mm, ri.cmd_mm = &a.measurement.cmd_mm;
+    for (const auto& t : a.measurement.triggers)
+      if (t.code == 102) ri.marks.push_back(t.sample_index);
+    ri.fs_hz = a.measurement.fs_hz;
+    a.repeats = eval::average_repeats(ri);
+  }
   const std::string& kind = run.meta.program.kind;
   if (kind == "circle") detail::evaluate_circle_program(run, a);
   else if (kind == "step") evaluate_step_program(run, a);

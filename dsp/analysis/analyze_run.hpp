@@ -10,6 +10,7 @@
 #include "dsp/eval/path_deviation.hpp"
 #include "dsp/eval/positioning.hpp"
 #include "dsp/eval/rectangle.hpp"
+#include "dsp/eval/repeats.hpp"
 #include "dsp/eval/step_response.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 
@@ -48,6 +49,7 @@ struct Analysis {
   std::string step_axis;
   std::optional<eval::RectangleResult> rectangle;
   std::optional<eval::PathDeviation> path;  // free form (and the rectangle's contour)
+  std::vector<eval::RepeatGroup> repeats;  // segments between M102 marks run more than once, averaged
   bool degraded = false;
   std::vector<std::string> flags;  // pipeline quality flags and evaluation failures
 };

@@ -67,13 +67,18 @@ std::vector<RepeatGroup> average_repeats(const RepeatInput& in) {
       g.first_index.push_back(idx[segs[m].begin]);
       for (std::size_t k = 0; k < len; ++k) g.mean_deviation_um[k] += (pos[segs[m].begin + k] - cmd[segs[m].begin + k]) * 1000.0 / nr;
     }
+    const Segment& first = segs[members.front()];
+    for (int a = 0; a < 3; ++a)
+      for (std::size_t k = 1; k < len && !g.axis_moves[a]; ++k) g.axis_moves[a] = std::abs(cmd[first.begin + k][a] - cmd[first.begin][a]) > 1e-6;
+    Eigen::Vector3d mask;
+    for (int a = 0; a < 3; ++a) mask[a] = g.axis_moves[a] ? 1.0 : 0.0;
     double ss_spread = 0.0, ss_mean = 0.0;
     for (std::size_t k = 0; k < len; ++k) {
       Eigen::Vector3d var = Eigen::Vector3d::Zero();
       for (std::size_t m : members) var += ((pos[segs[m].begin + k] - cmd[segs[m].begin + k]) * 1000.0 - g.mean_deviation_um[k]).cwiseAbs2();
       g.spread_um[k] = (var / (nr - 1.0)).cwiseSqrt();
-      ss_spread += g.spread_um[k].squaredNorm();
-      ss_mean += g.mean_deviation_um[k].squaredNorm();
+      ss_spread += g.spread_um[k].cwiseProduct(mask).squaredNorm();
+      ss_mean += g.mean_deviation_um[k].cwiseProduct(mask).squaredNorm();
     }
     g.scatter_rms_um = std::sqrt(ss_spread / static_cast<double>(len));
     g.mean_rms_um = std::sqrt(ss_mean / static_cast<double>(len));

@@ -19,8 +19,9 @@ struct RepeatGroup {
   std::size_t samples = 0;                // common length
   std::vector<Eigen::Vector3d> mean_deviation_um;  // per sample of the segment
   std::vector<Eigen::Vector3d> spread_um;          // sample standard deviation across the repeats
-  double scatter_rms_um = 0.0;   // RMS over the segment of the spread (Euclidean)
-  double mean_rms_um = 0.0;      // RMS of the mean deviation (Euclidean)
+  bool axis_moves[3] = {false, false, false};  // the set-point moves along it in the segment
+  double scatter_rms_um = 0.0;   // RMS over the segment of the spread, over the moving axes
+  double mean_rms_um = 0.0;      // RMS of the mean deviation, over the moving axes
   [[nodiscard]] int repeats() const noexcept { return static_cast<int>(first_index.size()); }
 };
 
