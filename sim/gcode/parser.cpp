@@ -65,7 +65,7 @@ class LineParser {
         continue;
       }
       if (!std::isalpha(static_cast<unsigned char>(c)))
-        fail(static_cast<int>(i) + 1, std::string("expected a word letter, got '") + c + "'");
+        fail(static_cast<int>(i) + 1, "expected a word letter, got '" + std::string(1, c) + "'");
       const int column = static_cast<int>(i) + 1;
       const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
       ++i;
@@ -83,7 +83,7 @@ class LineParser {
       const auto* last = number.data() + number.size();
       auto [ptr, ec] = std::from_chars(first, last, v);
       if (number.empty() || ec != std::errc() || ptr != last)
-        fail(column, std::string("word '") + letter + "' needs a number");
+        fail(column, "word '" + std::string(1, letter) + "' needs a number");
       out.push_back({letter, v, column});
     }
     return out;
@@ -133,11 +133,11 @@ Program parse(std::string_view text, std::string_view name, const ParseOptions& 
         case 'N': break;  // line number
         case 'X': case 'Y': case 'Z': case 'I': case 'J': case 'K': case 'R': case 'F': case 'P': case 'Q': {
           auto& slot = value[static_cast<std::size_t>(w.letter - 'A')];
-          if (slot) lp.fail(w.column, std::string("word '") + w.letter + "' appears twice in one block");
+          if (slot) lp.fail(w.column, "word '" + std::string(1, w.letter) + "' appears twice in one block");
           slot = w;
           break;
         }
-        default: lp.fail(w.column, std::string("unsupported word '") + w.letter + "'");
+        default: lp.fail(w.column, "unsupported word '" + std::string(1, w.letter) + "'");
       }
     }
     const auto word = [&](char l) -> const std::optional<Word>& { return value[static_cast<std::size_t>(l - 'A')]; };
