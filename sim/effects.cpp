@@ -35,12 +35,12 @@ std::vector<std::string> effects_in(const Scenario& sc) {
     add("sensor.cross_coupling", t.k_cross_g_per_g.squaredNorm() > 0.0 || t.k_cross2_g_per_g2.squaredNorm() > 0.0);
     add("sensor.misalignment", (t.spec.to_machine - n.to_machine).norm() > 1e-12);
     add("sensor.dynamics", differs(t.spec.f0_hz, n.f0_hz) || differs(t.spec.zeta, n.zeta));
-    add("sensor.damping_amplitude", t.zeta_per_g != 0.0);
+    add("sensor.damping_amplitude", t.zeta_per_g != n.zeta_per_g);
     add("sensor.scale_temperature", t.temperature.rise_c != 0.0 &&
                                         (t.spec.tc_k1_ppm_per_c != 0.0 || t.spec.tc_bias_ug_per_c != 0.0));
   }
   add("daq.group_delay", differs(sc.daq.group_delay_samples, sc.meta.acquisition.daq_group_delay_samples) ||
-                             sc.daq.skew_head_samples != 0.0);
+                             sc.daq.skew_head_samples != sc.meta.acquisition.daq_skew_head_samples);
   add("site.coriolis", sc.coriolis);
   add("machine.common_vibration", sc.common_vibration.on());
   add("machine.differential_vibration", sc.differential_vibration.gain.squaredNorm() > 0.0 || !sc.differential_tones.empty());

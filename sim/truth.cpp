@@ -59,12 +59,12 @@ std::string sensors_with(const Scenario& sc, bool (*pred)(const Scenario&, int))
 std::string effect_table(const Scenario& sc, const std::string& name) {
   std::string o = "\n[effects.\"" + name + "\"]\n";
   const MachineErrors& m = sc.machine;
-  auto per_axis = [&](auto pred, auto body) {
+  // The axis with the largest size (the others may carry the same effect at background level).
+  auto per_axis = [&](auto size, auto body) {
+    int best = -1;
     for (int i = 0; i < 3; ++i)
-      if (pred(i)) {
-        o += "axis = " + str(kAxis[i]) + "\n" + body(i);
-        return;
-      }
+      if (size(i) != 0.0 && (best < 0 || std::abs(size(i)) > std::abs(size(best)))) best = i;
+    if (best >= 0) o += "axis = " + str(kAxis[best]) + "\n" + body(best);
   };
   if (name.rfind("sensor.", 0) == 0) {
     bool (*pred)(const Scenario&, int) = nullptr;
@@ -74,7 +74,7 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
     if (name == "sensor.cross_coupling") pred = [](const Scenario& s, int i) { return s.truth[i].k_cross_g_per_g.squaredNorm() + s.truth[i].k_cross2_g_per_g2.squaredNorm() > 0.0; };
     if (name == "sensor.misalignment") pred = [](const Scenario& s, int i) { return (s.truth[i].spec.to_machine - s.meta.sensors[i].to_machine).norm() > 1e-12; };
     if (name == "sensor.dynamics") pred = [](const Scenario& s, int i) { return std::abs(s.truth[i].spec.f0_hz - s.meta.sensors[i].f0_hz) + std::abs(s.truth[i].spec.zeta - s.meta.sensors[i].zeta) > 1e-12; };
-    if (name == "sensor.damping_amplitude") pred = [](const Scenario& s, int i) { return s.truth[i].zeta_per_g != 0.0; };
+    if (name == "sensor.damping_amplitude") pred = [](const Scenario& s, int i) { return s.truth[i].zeta_per_g != s.meta.sensors[i].zeta_per_g; };
     if (name == "sensor.scale_temperature") pred = [](const Scenario& s, int i) { return s.truth[i].temperature.rise_c != 0.0; };
     const std::string which = pred ? sensors_with(sc, pred) : "none";
     o += "sensor = " + str(which) + "\n";
@@ -107,9 +107,9 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
     for (const Tone& t : sc.differential_tones)
       o += "\n[[effects.\"" + name + "\".tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) + "\nphase_deg = " + num(t.phase_deg) + "\n";
   } else if (name == "machine.backlash") {
-    per_axis([&](int i) { return m.backlash_um[i] != 0.0; }, [&](int i) { return "value_um = " + num(m.backlash_um[i]) + "\n"; });
+    per_axis([&](int i) { return m.backlash_um[i]; }, [&](int i) { return "value_um = " + num(m.backlash_um[i]) + "\n"; });
   } else if (name == "machine.reversal_spike") {
-    per_axis([&](int i) { return m.spike[i].amp_um != 0.0; },
+    per_axis([&](int i) { return m.spike[i].amp_um; },
              [&](int i) { return "amp_um = " + num(m.spike[i].amp_um) + "\ntau_ms = " + num(m.spike[i].tau_ms) + "\n"; });
   } else if (name == "machine.servo_mismatch") {
     for (int i = 0; i < 3; ++i)
@@ -121,16 +121,16 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
   } else if (name == "machine.scale_mismatch") {
     for (int i = 0; i < 3; ++i) o += std::string(kAxis[i]) + "_ppm = " + num(m.scale_ppm[i]) + "\n";
   } else if (name == "machine.cyclic_error") {
-    per_axis([&](int i) { return m.cyclic[i].amp_um != 0.0; }, [&](int i) {
+    per_axis([&](int i) { return m.cyclic[i].amp_um; }, [&](int i) {
       return "amp_um = " + num(m.cyclic[i].amp_um) + "\npitch_mm = " + num(m.cyclic[i].pitch_mm) + "\nphase_deg = " + num(m.cyclic[i].phase_deg) + "\n";
     });
   } else if (name == "machine.straightness") {
-    per_axis([&](int i) { return m.straightness[i].direction >= 0 && m.straightness[i].bow_um != 0.0; }, [&](int i) {
+    per_axis([&](int i) { return m.straightness[i].direction >= 0 ? m.straightness[i].bow_um : 0.0; }, [&](int i) {
       return "direction = " + str(kAxis[m.straightness[i].direction]) + "\nbow_um = " + num(m.straightness[i].bow_um) +
              "\nspan_mm = " + arr(m.straightness[i].span_mm, 2) + "\n";
     });
   } else if (name == "machine.stick_slip") {
-    per_axis([&](int i) { return m.stick_slip[i].amp_um != 0.0; }, [&](int i) {
+    per_axis([&](int i) { return m.stick_slip[i].amp_um; }, [&](int i) {
       return "amp_um = " + num(m.stick_slip[i].amp_um) + "\nbelow_mm_min = " + num(m.stick_slip[i].below_mm_min) + "\nslip_ms = " +
              num(m.stick_slip[i].slip_ms) + "\n";
     });

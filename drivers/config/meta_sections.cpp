@@ -29,6 +29,8 @@ dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& default
   a.adc_offset_counts = t.integer("adc_offset_counts", a.adc_offset_counts);
   a.daq_group_delay_samples = t.number("daq_group_delay_samples", a.daq_group_delay_samples);
   if (a.daq_group_delay_samples < 0.0) t.fail("daq_group_delay_samples", "must not be negative");
+  a.daq_skew_head_samples = t.number("daq_skew_head_samples", a.daq_skew_head_samples);
+  if (!(std::abs(a.daq_skew_head_samples) < 1000.0)) t.fail("daq_skew_head_samples", "must be within (-1000, 1000) samples");
   if (u == Unknown::reject) t.finish();
   return a;
 }
@@ -81,6 +83,8 @@ dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults, Unkn
   if (s.f0_hz <= 0.0) t.fail("f0_hz", "must be positive");
   s.zeta = t.number("zeta", s.zeta);
   if (s.zeta <= 0.0 || s.zeta > 5.0) t.fail("zeta", "must be within (0, 5]");
+  s.zeta_per_g = t.number("zeta_per_g", s.zeta_per_g);
+  if (!(std::abs(s.zeta_per_g) <= 100.0)) t.fail("zeta_per_g", "must be within [-100, 100] per g");
   s.noise_ug_per_rthz = t.number("noise_ug_per_rthz", s.noise_ug_per_rthz);
   if (s.noise_ug_per_rthz < 0.0) t.fail("noise_ug_per_rthz", "must not be negative");
   s.temp_ref_c = t.number("temp_ref_c", s.temp_ref_c);

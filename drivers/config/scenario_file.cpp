@@ -188,7 +188,7 @@ void read_effect(const std::string& name, StrictTable t, sim::Scenario& sc) {
     read_sensor_effect(name, t, sc);
   } else if (name == "daq.group_delay") {
     sc.daq.group_delay_samples = t.number("group_delay_samples", sc.meta.acquisition.daq_group_delay_samples);
-    sc.daq.skew_head_samples = t.number("skew_head_samples", 0.0);
+    sc.daq.skew_head_samples = t.number("skew_head_samples", sc.meta.acquisition.daq_skew_head_samples);
     if (sc.daq.group_delay_samples < 0.0) t.fail("group_delay_samples", "must not be negative");
   } else if (name == "site.coriolis") {
     sc.coriolis = t.boolean("on", true);
@@ -228,8 +228,9 @@ sim::Scenario read_scenario_file(const std::string& path) {
     if (auto t = sensors->optional_table("head")) sc.meta.sensors[1] = read_sensor(*t);
     sensors->finish();
   }
-  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s];
+  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s], sc.truth[s].zeta_per_g = sc.meta.sensors[s].zeta_per_g;
   sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples;
+  sc.daq.skew_head_samples = sc.meta.acquisition.daq_skew_head_samples;
 
   StrictTable program = root.table("program");
   const std::string gcode_file = program.string("gcode_file", "");

@@ -5,6 +5,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <stdexcept>
 
@@ -49,6 +50,11 @@ SensorCalibration read_sensor_calibration(const std::filesystem::path& file, con
       if (!(d >= 0.0 && d < 10000.0)) acq->fail("daq_group_delay_samples", "must be within [0, 10000) samples");
       cal.daq_group_delay_samples = d;
     }
+    if (acq->has("daq_skew_head_samples")) {
+      const double d = acq->number("daq_skew_head_samples");
+      if (!(std::abs(d) < 1000.0)) acq->fail("daq_skew_head_samples", "must be within (-1000, 1000) samples");
+      cal.daq_skew_head_samples = d;
+    }
     acq->finish();
   }
   for (int s = 0; s < 2; ++s) cal.sensors[s] = datasheet.sensors[s];
@@ -76,7 +82,9 @@ void write_sensor_calibration(const SensorCalibration& cal, const std::filesyste
   o += "\"\nrun = \"";
   o += cal.run_id;
   o += "\"\n";
-  if (cal.daq_group_delay_samples) o += "\n[acquisition]\ndaq_group_delay_samples = " + toml_number(*cal.daq_group_delay_samples) + "\n";
+  if (cal.daq_group_delay_samples || cal.daq_skew_head_samples) o += "\n[acquisition]\n";
+  if (cal.daq_group_delay_samples) o += "daq_group_delay_samples = " + toml_number(*cal.daq_group_delay_samples) + "\n";
+  if (cal.daq_skew_head_samples) o += "daq_skew_head_samples = " + toml_number(*cal.daq_skew_head_samples) + "\n";
   for (int s = 0; s < 2; ++s) {
     o += sensor_section_toml(kSensorNames[s], cal.sensors[s]);
     o += "cross_g_per_g = " + matrix_toml(cal.static_cal[s].cross_g_per_g) + "\n";
@@ -87,6 +95,7 @@ void write_sensor_calibration(const SensorCalibration& cal, const std::filesyste
 void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta) {
   for (int s = 0; s < 2; ++s) meta.sensors[s] = cal.sensors[s];
   if (cal.daq_group_delay_samples) meta.acquisition.daq_group_delay_samples = *cal.daq_group_delay_samples;
+  if (cal.daq_skew_head_samples) meta.acquisition.daq_skew_head_samples = *cal.daq_skew_head_samples;
 }
 
 void apply_calibration(const SensorCalibration& cal, dsp::PipelineConfig& config) {
@@ -95,6 +104,7 @@ void apply_calibration(const SensorCalibration& cal, dsp::PipelineConfig& config
     config.calibration[s].cross_g_per_g = cal.static_cal[s].cross_g_per_g;
   }
   if (cal.daq_group_delay_samples) config.acquisition.daq_group_delay_samples = *cal.daq_group_delay_samples;
+  if (cal.daq_skew_head_samples) config.acquisition.daq_skew_head_samples = *cal.daq_skew_head_samples;
 }
 
 void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta, dsp::AnalysisOptions& options) {

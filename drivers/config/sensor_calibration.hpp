@@ -9,6 +9,7 @@
 //   run = "identify-0001"     # the run it was identified from
 //   [acquisition]
 //   daq_group_delay_samples = 38.93
+//   daq_skew_head_samples = 0.9  # optional: the head's channels lag the table's
 //   [sensors.table]           # any key of run.toml's [sensors.*]; absent keys: data sheet
 //   k1_v_per_g = [...]  bias_g = [...]  f0_hz = ...  zeta = ...  to_machine = [[...], ...]
 //   cross_g_per_g = [[...], [...], [...]]   # (6-4) cross-axis terms, optional
@@ -30,6 +31,7 @@ struct SensorCalibration {
   std::string method = "psd";
   std::string run_id;
   std::optional<double> daq_group_delay_samples;
+  std::optional<double> daq_skew_head_samples;
   dsp::SensorSpec sensors[2];              // complete (data sheet where the file is silent)
   dsp::StaticCalibration static_cal[2];    // cross terms (mounting is in sensors[].to_machine)
 };

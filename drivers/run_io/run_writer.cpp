@@ -78,6 +78,7 @@ std::string sensor_section_toml(const char* name, const dsp::SensorSpec& s) {
        "\ntc_k1_ppm_per_c = " + toml_double(s.tc_k1_ppm_per_c) + "\ntc_bias_ug_per_c = " + toml_double(s.tc_bias_ug_per_c) +
        "\nf0_hz = " + toml_double(s.f0_hz) + "\nzeta = " + toml_double(s.zeta) + "\nnoise_ug_per_rthz = " +
        toml_double(s.noise_ug_per_rthz) + "\ntemp_ref_c = " + toml_double(s.temp_ref_c) + "\n";
+  if (s.zeta_per_g != 0.0) o += "zeta_per_g = " + toml_double(s.zeta_per_g) + "\n";  // not a data-sheet key: only when found
   return o;
 }
 
@@ -234,6 +235,7 @@ std::string run_toml_text(const dsp::RunMeta& m) {
   o += "\n[acquisition]\nfs_hz = " + toml_double(a.fs_hz) + "\nadc_bits = " + std::to_string(a.adc_bits) +
        "\nadc_lsb_volt = " + toml_double(a.adc_lsb_volt) + "\nadc_offset_counts = " + std::to_string(a.adc_offset_counts) +
        "\ndaq_group_delay_samples = " + toml_double(a.daq_group_delay_samples) + "\n";
+  if (a.daq_skew_head_samples != 0.0) o += "daq_skew_head_samples = " + toml_double(a.daq_skew_head_samples) + "\n";
   o += "\n[site]\nlatitude_deg = " + toml_double(m.site.latitude_deg) + "\nheading_deg = " + toml_double(m.site.heading_deg) +
        "\ng_mps2 = " + toml_double(m.site.g_mps2) + "\n";
   o += "\n[machine]\nname = " + toml_str(m.machine.name) + "\ntable_axes = " + strs(m.machine.table_axes) +

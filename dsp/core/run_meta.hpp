@@ -16,6 +16,9 @@ struct Acquisition {
   double adc_lsb_volt = 1.1920929e-6;  // 20 V span / 2^24
   std::int64_t adc_offset_counts = 0;
   double daq_group_delay_samples = 38.8;  // nominal (data sheet)
+  // The head's channels lag the table's by this much more (a skew between the DAQ's
+  // channels; 0 on the data sheet, found by eical explain; run.toml writes it when set).
+  double daq_skew_head_samples = 0.0;
 };
 
 struct Site {
@@ -43,6 +46,9 @@ struct SensorSpec {
   double tc_bias_ug_per_c = 100.0;
   double f0_hz = 1000.0;
   double zeta = 0.707;
+  // Squeeze-film damping that grows with the acceleration, ζ = ζ0 (1 + zeta_per_g |a|/g)
+  // (ch. 8.3.1); 0 on the data sheet, found by eical explain (written when set).
+  double zeta_per_g = 0.0;
   double noise_ug_per_rthz = 0.4;
   double temp_ref_c = 20.0;
 };

@@ -42,11 +42,18 @@ double AugmentedFilter::update(const Eigen::RowVectorXd& row, double z, double s
   const double s = row.dot(ph) + sigma * sigma;
   if (!(s > 0.0) || !std::isfinite(z)) return 0.0;
   const double nu = z - row.dot(x_);
+  last_innovation_ = nu;
+  last_log_density_ = -0.5 * (nu * nu / s + std::log(2.0 * 3.141592653589793 * s));
   const Eigen::VectorXd k = ph / s;
   x_ += k * nu;
   p_ -= k * ph.transpose();
   p_ = 0.5 * (p_ + p_.transpose()).eval();
   return nu * nu / s;
+}
+
+void AugmentedFilter::predict_observation(const Eigen::RowVectorXd& row, double z, double sigma, double& innovation, double& variance) const {
+  innovation = z - row.dot(x_);
+  variance = row.dot(p_ * row.transpose()) + sigma * sigma;
 }
 
 double AugmentedFilter::parameter_sigma(int j) const { return std::sqrt(std::max(0.0, p_(3 + j, 3 + j))); }

@@ -30,6 +30,11 @@ class AugmentedFilter {
   void predict(double h_s, const Eigen::VectorXd& accel_gain, bool bias_step);
   // z = row·state + noise (row has 3 + p entries); returns the normalised innovation².
   double update(const Eigen::RowVectorXd& row, double z, double sigma);
+  // The innovation and its variance of an observation, without updating (held-out data).
+  void predict_observation(const Eigen::RowVectorXd& row, double z, double sigma, double& innovation, double& variance) const;
+  // ln of the innovation's density of the last update (for likelihoods).
+  [[nodiscard]] double last_log_density() const noexcept { return last_log_density_; }
+  [[nodiscard]] double last_innovation() const noexcept { return last_innovation_; }
 
   [[nodiscard]] const Eigen::VectorXd& state() const noexcept { return x_; }
   [[nodiscard]] const Eigen::MatrixXd& covariance() const noexcept { return p_; }
@@ -41,6 +46,7 @@ class AugmentedFilter {
   fusion::Discrete step_;  // cached for the last h
   Eigen::VectorXd x_;
   Eigen::MatrixXd p_;
+  double last_log_density_ = 0.0, last_innovation_ = 0.0;
 };
 
 }  // namespace eical::dsp::identify

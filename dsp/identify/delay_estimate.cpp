@@ -53,9 +53,27 @@ DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayRef
   const Eigen::MatrixXd a = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(rows.data(), n, p);
   const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(ys.data(), n);
   // Only the columns that vary (a strip never crossed leaves its offset empty).
+  // Only what this run's crossings can tell apart. A strip crossed at one speed one way (a
+  // circle's tangent strips) cannot separate its mounting offset from the lag: the strip is
+  // then taken where run.toml puts it. The direction term (backlash) needs both directions
+  // at more than one speed.
   std::vector<Eigen::Index> used;
-  for (Eigen::Index j = 0; j < p; ++j)
-    if (a.col(j).cwiseAbs().maxCoeff() > 0.0) used.push_back(j);
+  for (int st = 0; st < strips; ++st) {
+    std::vector<double> sp;
+    bool pos = false, neg = false;
+    for (Eigen::Index i = 0; i < n; ++i)
+      if (a(i, 2 * st) != 0.0) sp.push_back(std::abs(a(i, p - 1))), (a(i, p - 1) > 0.0 ? pos : neg) = true;
+    if (sp.empty()) continue;
+    double mean = 0.0, var = 0.0;
+    for (double x : sp) mean += x;
+    mean /= static_cast<double>(sp.size());
+    for (double x : sp) var += (x - mean) * (x - mean);
+    const bool speeds = std::sqrt(var / static_cast<double>(sp.size())) > 0.2 * mean;
+    if (speeds || (pos && neg)) used.push_back(2 * st);
+    if (speeds && pos && neg) used.push_back(2 * st + 1);
+    if (!(speeds || (pos && neg))) d.mounting_assumed = true;
+  }
+  used.push_back(p - 1);
   Eigen::MatrixXd au(n, static_cast<Eigen::Index>(used.size()));
   for (std::size_t j = 0; j < used.size(); ++j) au.col(static_cast<Eigen::Index>(j)) = a.col(used[j]);
   const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(au);

@@ -58,6 +58,7 @@ struct DelayEstimate {
   double samples = 0.0, sigma = 0.0;  // identified delay (DAQ delay for "reference"; + servo lag for "set-point")
   std::string against;                // "set-point" | "reference"
   int fixes = 0;
+  bool mounting_assumed = false;      // a strip crossed at one speed one way: taken where run.toml puts it
 };
 
 struct Identification {

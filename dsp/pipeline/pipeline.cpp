@@ -3,6 +3,7 @@
 #include "dsp/core/error.hpp"
 
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace eical::dsp {
@@ -50,6 +51,8 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
 Pipeline::Pipeline(const PipelineConfig& c)
     : config_(c), fixed_(c.arithmetic == Arithmetic::fixed_q), dt_s_(1.0 / c.acquisition.fs_hz) {
   if (fixed_ && c.coriolis) throw InputError("pipeline: the fixed-point path has no Coriolis term; use double arithmetic");
+  if (fixed_ && (c.sensors[0].zeta_per_g != 0.0 || c.sensors[1].zeta_per_g != 0.0))
+    throw InputError("pipeline: the fixed-point path does not compensate damping that grows with the acceleration (zeta_per_g); use double arithmetic");
   if (fixed_ && c.dynamic != DynamicComp::none && c.dynamic != DynamicComp::position_level)
     throw InputError(std::string("pipeline: the fixed-point path compensates the dynamics at the position level only, not ") +
                      dynamic_comp_name(c.dynamic));
@@ -63,8 +66,12 @@ Pipeline::Pipeline(const PipelineConfig& c)
   for (int s = 0; s < 2; ++s) {
     comp_[s] = StaticComp(c.sensors[s], c.acquisition, c.site, c.calibration[s], c.static_comp);
     fcomp_[s] = FixedStaticComp(comp_[s]);
-    const DynamicCoefficients dyn = dynamic_coefficients(c.sensors[s], 0.0, c.dynamic);
+    // A skew of the head's channels against the table's is a delay of that sensor's own:
+    // the series inverts it with the PT2 (a fraction of a sample, no transient to mind).
+    const double skew_s = s == 1 ? c.acquisition.daq_skew_head_samples * dt_s_ : 0.0;
+    const DynamicCoefficients dyn = dynamic_coefficients(c.sensors[s], skew_s, c.dynamic);
     integ_[s] = SensorIntegrator(c.dynamic, dyn, dt_s_);
+    integ_[s].c_amp_s3_per_m = c.sensors[s].zeta * c.sensors[s].zeta_per_g / (2.0 * std::numbers::pi * c.sensors[s].f0_hz * c.site.g_mps2);
     finteg_[s] = FixedIntegrator(dt_s_, dyn);
     temp_c_[s] = static_cast<float>(c.sensors[s].temp_ref_c);
   }
@@ -101,7 +108,7 @@ void Pipeline::reset() noexcept {
   m_.sample_index.clear();
   for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->clear();
   m_.triggers.clear();
-  m_.raw.table_mps2.clear(), m_.raw.head_mps2.clear();
+  m_.raw.table_mps2.clear(), m_.raw.head_mps2.clear(), m_.raw.rest_rel_mps2.clear();
   supports_.reset();
 }
 
@@ -230,7 +237,9 @@ void Pipeline::step(const Frame& f) noexcept {
           }
         }
         ++bias_n_;
-        supports_.rest_sample(fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]));
+        const Eigen::Vector3d rel = fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]);
+        supports_.rest_sample(rel);
+        if (config_.keep_raw) m_.raw.rest_rel_mps2.push_back(rel);  // offline only: may allocate
         return;
       }
       start_motion();

@@ -105,6 +105,7 @@ struct TriggerMark {
 struct RawTrace {
   std::vector<Eigen::Vector3d> pos_mm, vel_mm_s;       // integrated relative motion (dynamic comp applied)
   std::vector<Eigen::Vector3d> table_mps2, head_mps2;  // each sensor, bias-free, machine axes
+  std::vector<Eigen::Vector3d> rest_rel_mps2;          // head − table in the rest before the motion (incl. bias)
   fusion::SupportSchedule schedule;                    // standstills, held axes, PSD fixes (µm)
   Eigen::Vector3d rest_bias_mps2[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};  // table, head; incl. gravity
   [[nodiscard]] bool empty() const noexcept { return pos_mm.empty(); }

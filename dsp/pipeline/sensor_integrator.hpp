@@ -17,6 +17,11 @@ struct SensorIntegrator {
   Eigen::Vector3d x_m = Eigen::Vector3d::Zero();           // second integral
   Eigen::Vector3d integrand1_prev = Eigen::Vector3d::Zero(), integrand2_prev = Eigen::Vector3d::Zero();
   Eigen::Vector3d x_out_m = Eigen::Vector3d::Zero(), v_out_mps = Eigen::Vector3d::Zero();  // compensated
+  // Damping growing with the acceleration, ζ = ζ0 (1 + k|a|/g) (ch. 8.3.1): the sensor
+  // drops a further (2ζ0 k/(ω0 g))·|a|·ȧ = c_amp·d(a|a|)/dt, given back at the velocity
+  // (c_amp·a|a|) and the position (c_amp·∫a|a|dt) levels. c_amp = ζ0 k/(ω0 g), s³/m.
+  double c_amp_s3_per_m = 0.0;
+  Eigen::Vector3d amp_int_m2_s3 = Eigen::Vector3d::Zero(), amp_prev_m2_s4 = Eigen::Vector3d::Zero();
 
   SensorIntegrator() = default;
   SensorIntegrator(DynamicComp m, const DynamicCoefficients& c, double dt_s) : mode(m), c1_s(c.c1_s), c2_s2(c.c2_s2), dt_nominal_s(dt_s) {}
@@ -37,6 +42,8 @@ struct SensorIntegrator {
     integrand1_prev = mode == DynamicComp::acceleration_level ? Eigen::Vector3d(a + c1_s * d1(a) + c2_s2 * d2(a)) : a;
     integrand2_prev = mode == DynamicComp::velocity_level ? Eigen::Vector3d(c1_s * a + c2_s2 * d1(a)) : Eigen::Vector3d::Zero();
     x_out_m.setZero(), v_out_mps = integrand2_prev;
+    amp_int_m2_s3.setZero(), amp_prev_m2_s4 = a.cwiseProduct(a.cwiseAbs());
+    if (mode != DynamicComp::none) v_out_mps += c_amp_s3_per_m * amp_prev_m2_s4;
     push(a);
   }
 
@@ -55,6 +62,12 @@ struct SensorIntegrator {
     } else {
       x_out_m = x_m;
       v_out_mps = i2;
+    }
+    if (c_amp_s3_per_m != 0.0 && mode != DynamicComp::none) {
+      const Eigen::Vector3d aa = a.cwiseProduct(a.cwiseAbs());
+      amp_int_m2_s3 += 0.5 * (aa + amp_prev_m2_s4) * dt_s;
+      amp_prev_m2_s4 = aa;
+      x_out_m += c_amp_s3_per_m * amp_int_m2_s3, v_out_mps += c_amp_s3_per_m * aa;
     }
     push(a);
   }
