@@ -1,6 +1,8 @@
 // eical simulate: a synthetic recorded run (eical-run/1 with truth.toml) from the simulator.
 #include "drivers/config/scenario_file.hpp"
+#include "dsp/core/error.hpp"
 #include "drivers/run_io/run_writer.hpp"
+#include "sim/hidden/hidden_effects.hpp"
 #include "sim/simulate.hpp"
 #include "tools/commands.hpp"
 #include "tools/sim_programs.hpp"
@@ -16,11 +18,18 @@ void register_simulate(CLI::App& app) {
     double arc_deg = 360.0, radius_mm = 10.0, feed_mm_min = 2500.0, noise_ug = 0.4, from_mm = 0.0, to_mm = 50.0;
     int repeats = 5, runs = 2;
     std::vector<double> targets{0.0, 10.0, 20.0, 30.0, 40.0};
+    std::vector<std::string> hide;
     std::uint64_t seed = 1;
-    bool gzip = false, overwrite = false;
+    bool gzip = false, overwrite = false, background = false;
   };
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand("simulate", "Simulate a machine and its sensors; write a recorded run (eical-run/1)");
+  std::string effects_help = "hide these effects (comma separated; run-format.md names) among tolerance-level deviations of sensors, machine, "
+                             "PSD strips and KGM, at the sizes a faulty machine shows (sim/hidden/hidden_effects.cpp); with --program circle or step "
+                             "(default: the program the first effect shows best in), --seed. Names:";
+  for (const auto& e : sim::hideable_effects()) effects_help += " " + e;
+  cmd->add_option("--hide", o->hide, effects_help)->delimiter(',')->check(CLI::IsMember(sim::hideable_effects()));
+  cmd->add_flag("--background", o->background, "a baseline with the tolerance-level deviations only (no effect hidden)");
   auto* scenario = cmd->add_option("--scenario", o->scenario, "scenario file (eical-scenario/1, config/scenarios/README.md): machine errors, vibration, sensor truth, every effect")
                        ->check(CLI::ExistingFile);
   cmd->add_option("--program", o->program, "circle, step, positioning, rectangle, freeform or identify")
@@ -45,10 +54,17 @@ void register_simulate(CLI::App& app) {
   cmd->add_option("-o,--out", o->out, "run directory to write")->required();
   cmd->add_flag("--gzip", o->gzip, "write samples.csv.gz");
   cmd->add_flag("--overwrite", o->overwrite, "replace an existing run");
-  cmd->callback([o] {
+  auto* program_opt = cmd->get_option("--program");
+  cmd->callback([o, program_opt] {
+    const bool program_given = program_opt->count() > 0;
     sim::Scenario sc;
     if (!o->scenario.empty()) {
       sc = drivers::read_scenario_file(o->scenario);
+    } else if (!o->hide.empty() || o->background) {
+      const bool chosen = o->program == "circle" || o->program == "step";
+      const std::string kind = o->hide.empty() ? (chosen ? o->program : "circle") : (program_given && chosen ? o->program : sim::program_for(o->hide.front()));
+      if (program_given && !chosen) throw dsp::InputError("simulate --hide/--background: --program must be circle or step");
+      sc = sim::hidden_effect_scenario(o->hide, kind, o->seed);
     } else {
       sc = o->program == "circle"      ? sim::circle_scenario(o->radius_mm, o->feed_mm_min, o->repeats, o->direction, o->seed)
            : o->program == "step"      ? sim::step_scenario(o->from_mm, o->to_mm, o->feed_mm_min, o->runs, o->seed)

@@ -20,6 +20,7 @@ void register_comp(CLI::App& app);
 void register_hmi(CLI::App& app);
 void register_validate_sim(CLI::App& app);
 void register_identify(CLI::App& app);
+void register_explain(CLI::App& app);
 
 // The list main() registers, in the order `eical --help` shows them.
 inline void register_all(CLI::App& app) {
@@ -28,6 +29,7 @@ inline void register_all(CLI::App& app) {
   register_validate_sim(app);
   register_analyze(app);
   register_identify(app);
+  register_explain(app);
   register_hmi(app);
   register_report(app);
   register_iso230_2(app);

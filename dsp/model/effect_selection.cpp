@@ -120,11 +120,11 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
         v.correlation = std::max(v.correlation, abs_corr(cur_fit, rows(Eigen::VectorXd(candidates[k].regressors.col(c)), s.fit)));
       v.param_names = candidates[k].param_names;
       v.params = x.tail(candidates[k].regressors.cols());
-      if (v.bic_drop > best_drop) best_drop = v.bic_drop, best = static_cast<int>(k), best_v = v;
+      // Only an extension that also predicts the held-out data better may be taken.
+      const bool gain = v.heldout_rms_after < (1.0 - opt.min_heldout_gain) * v.heldout_rms_before;
+      if (gain && v.bic_drop > best_drop) best_drop = v.bic_drop, best = static_cast<int>(k), best_v = v;
     }
-    if (best < 0) break;
-    const bool gain = best_v.heldout_rms_after < (1.0 - opt.min_heldout_gain) * best_v.heldout_rms_before;
-    if (best_v.bic_drop < opt.min_bic_drop || !gain) break;
+    if (best < 0 || best_v.bic_drop < opt.min_bic_drop) break;
     best_v.significant = true;
     done[static_cast<std::size_t>(best)] = true;
     const auto& cand = candidates[static_cast<std::size_t>(best)];
@@ -140,9 +140,14 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
   // Parameters of the accepted effects from the final joint fit.
   if (accepted_fit.cols() > 0) {
     const Eigen::VectorXd x = solve(accepted_fit, y_fit);
+    // cov = (AᵀA)⁻¹ · RSS / n_eff: the residual's variance counted per independent sample.
+    const Eigen::MatrixXd ata = accepted_fit.transpose() * accepted_fit;
+    const Eigen::VectorXd var = ata.completeOrthogonalDecomposition().pseudoInverse().diagonal() *
+                                ((y_fit - accepted_fit * x).squaredNorm() / std::max(out.n_eff - static_cast<double>(x.size()), 1.0));
     Eigen::Index off = 0;
     for (auto& e : out.effects) {
       e.params = x.segment(off, static_cast<Eigen::Index>(e.param_names.size()));
+      e.param_sigma = var.segment(off, static_cast<Eigen::Index>(e.param_names.size())).cwiseMax(0.0).cwiseSqrt();
       off += static_cast<Eigen::Index>(e.param_names.size());
     }
     out.final_residual = residual - accepted_all * x;

@@ -40,6 +40,7 @@ struct EffectVerdict {
   double correlation = 0.0;     // |corr| of the residual with the block's best single regressor
   std::vector<std::string> param_names;
   Eigen::VectorXd params;       // fitted with the accepted model (all samples of the fitting set)
+  Eigen::VectorXd param_sigma;  // their standard errors, residual variance per effective sample
 };
 
 struct SelectionResult {

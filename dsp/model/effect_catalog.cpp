@@ -1,0 +1,465 @@
+#include "dsp/model/effect_catalog.hpp"
+
+#include <Eigen/QR>
+
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+namespace eical::dsp::model {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+const char* kAxis[3] = {"x", "y", "z"};
+
+std::string ax(int a) { return kAxis[a]; }
+
+double max_abs(const Eigen::VectorXd& p) { return p.size() ? p.cwiseAbs().maxCoeff() : 0.0; }
+
+EffectModel effect(const char* name) {
+  EffectModel e;
+  e.name = name;
+  return e;
+}
+
+Eigen::MatrixXd on_axis(const Eigen::VectorXd& v, int a) {
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(v.size(), 3);
+  c.col(a) = v;
+  return c;
+}
+
+// Sign of the last motion of an axis (held through rests, 0 before the first) and where it reverses.
+void directions(const RunResiduals& r, int axis, Eigen::VectorXd& dir, std::vector<int>& reversals) {
+  dir = Eigen::VectorXd::Zero(r.n);
+  double d = 0.0;
+  for (int s = 0; s < r.n; ++s) {
+    const double v = r.v_cmd(s, axis);
+    if (std::abs(v) > 1e-3) {
+      const double nd = v > 0.0 ? 1.0 : -1.0;
+      if (d != 0.0 && nd != d) reversals.push_back(s);
+      d = nd;
+    }
+    dir[s] = d;
+  }
+}
+
+double hint_corr(const Eigen::MatrixXd& hint, const Eigen::VectorXd& col, int axis) {
+  if (hint.rows() != col.size()) return 0.0;
+  double sxy = 0.0, sxx = 0.0, syy = 0.0;
+  for (Eigen::Index s = 0; s < col.size(); ++s) {
+    const double y = hint(s, axis);
+    if (!std::isfinite(y)) continue;
+    sxy += col[s] * y, sxx += col[s] * col[s], syy += y * y;
+  }
+  return sxx > 0.0 && syy > 0.0 ? std::abs(sxy) / std::sqrt(sxx * syy) : 0.0;
+}
+
+double get(const std::map<std::string, double>& v, const std::string& k) {
+  const auto it = v.find(k);
+  return it == v.end() ? 0.0 : it->second;
+}
+
+}  // namespace
+
+std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
+  std::vector<ParamGroup> out;
+  std::vector<int> moving;
+  for (int a = 0; a < 3; ++a)
+    if (r.moving[a]) moving.push_back(a);
+  if (moving.empty()) return out;
+  const double g = r.meta.site.g_mps2;
+  const Eigen::MatrixXd a_um = r.a_meas * 1000.0;  // µm/s²
+  auto param = [](std::string name, int axis, bool accel, Eigen::VectorXd input, double prior) {
+    AxisParam p;
+    p.name = std::move(name), p.axis = axis, p.accel = accel, p.input = std::move(input), p.prior_sigma = prior;
+    return p;
+  };
+  {
+    ParamGroup gp{"scale", {}};
+    for (int j : moving) gp.params.push_back(param("scale_" + ax(j) + "_ppm", j, true, a_um.col(j) * 1e-6, 1e4));
+    out.push_back(gp);
+  }
+  {
+    ParamGroup gp{"cross_axis", {}};
+    for (int j : moving)
+      for (int i = 0; i < 3; ++i)
+        if (i != j) gp.params.push_back(param("E_" + ax(i) + ax(j) + "_ppm", i, true, a_um.col(j) * 1e-6, 2e4));
+    out.push_back(gp);
+  }
+  {
+    ParamGroup gp{"nonlinearity", {}};
+    for (int j : moving) {
+      const Eigen::VectorXd ag = r.a_meas.col(j) / (1000.0 * g);  // in g
+      const double sign = r.owner[j] == 0 ? -1.0 : 1.0;         // the table sees −a: its square term changes sign in head − table
+      gp.params.push_back(param("k2_" + ax(j) + "_1e-6_per_g", j, true, sign * ag.array().square().matrix() * g, 1e4));
+      gp.params.push_back(param("k3_" + ax(j) + "_1e-6_per_g2", j, true, ag.array().cube().matrix() * g, 1e4));
+    }
+    out.push_back(gp);
+  }
+  {
+    ParamGroup gp{"timing", {}};
+    for (int j : moving) gp.params.push_back(param("timing_" + ax(j) + "_us", j, false, r.v_meas.col(j) * 1e-3, 300.0));
+    out.push_back(gp);
+  }
+  {
+    // ζ = ζ0 (1 + k |a|/g) (ch. 8.3.1): the PT2 drops (2ζ/ω0)·ȧ, so the extra damping
+    // drops −(2ζ0 k/(ω0 g))·|a|·ȧ = −(ζ0 k/(ω0 g))·d(a|a|)/dt of acceleration, i.e.
+    // −(ζ0 k/(ω0 g))·∫ a|a| dt of position — a plateau over a move's cruise that its
+    // deceleration takes back; on a circle, odd harmonics a constant 2ζ/ω0 does not have.
+    ParamGroup gp{"damping_amplitude", {}};
+    for (int j : moving) {
+      const dsp::SensorSpec& sp = r.meta.sensors[std::max(0, r.owner[j])];
+      const double k = -sp.zeta / (2.0 * kPi * sp.f0_hz * g) * 1e6;  // µm per (m²/s³) of ∫a|a|dt
+      Eigen::VectorXd col(r.n);
+      double acc = 0.0, prev = 0.0;
+      for (Eigen::Index s = 0; s < r.n; ++s) {
+        const double a = r.a_meas(s, j) / 1000.0, cur = a * std::abs(a);
+        if (s > 0) acc += 0.5 * (cur + prev) * (r.t_s[s] - r.t_s[s - 1]);
+        prev = cur, col[s] = k * acc;
+      }
+      gp.params.push_back(param("zeta_per_g_" + ax(j), j, false, col, 10.0));
+    }
+    out.push_back(gp);
+  }
+  {
+    ParamGroup gp{"bias_drift", {}};
+    for (int i = 0; i < 3; ++i) gp.params.push_back(param("drift_" + ax(i) + "_ug_per_s", i, true, r.t_s * g, 100.0));
+    out.push_back(gp);
+  }
+  {
+    const double range = std::max(r.temp_c.col(0).cwiseAbs().maxCoeff(), r.temp_c.col(1).cwiseAbs().maxCoeff());
+    if (range > 0.02) {
+      ParamGroup gp{"scale_temperature", {}};
+      for (int j : moving) gp.params.push_back(param("scale_tc_" + ax(j) + "_ppm_per_c", j, true, r.temp_c.col(std::max(0, r.owner[j])).cwiseProduct(a_um.col(j)) * 1e-6, 1e4));
+      const Eigen::VectorXd mean_t = 0.5 * (r.temp_c.col(0) + r.temp_c.col(1));
+      for (int i = 0; i < 3; ++i) gp.params.push_back(param("bias_tc_" + ax(i) + "_ug_per_c", i, true, mean_t * g, 1e3));
+      out.push_back(gp);
+    }
+  }
+  return out;
+}
+
+std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std::string& group, const std::map<std::string, double>& v) {
+  std::vector<Attribution> out;
+  auto attr = [](const char* name, double mag, double tol, const char* unit, const char* reg) {
+    Attribution a;
+    a.name = name, a.magnitude = mag, a.tolerance = tol, a.unit = unit, a.regressor = reg;
+    return a;
+  };
+  if (group == "scale") {
+    double m = 0.0;
+    for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
+    Attribution a = attr("sensor.scale", m, 1000.0, "ppm", "the doubly integrated acceleration along the axis");
+    a.plausible_max = 5e4;  // 5 %: a wrong sensor type, not a calibration
+    a.params = v;
+    out.push_back(a);
+  } else if (group == "cross_axis") {
+    // Two moving axes of one sensor: the antisymmetric part of their pair is a rotation of
+    // the mounting, the symmetric part axes that are not square to each other or respond
+    // across (cross coupling) — a rotation cannot make it. A sensor whose pairs show cross
+    // coupling is named for it alone (a general cross-axis matrix explains the rotation
+    // too), unless the rotation clearly dominates (3×); a moving axis' response on an axis
+    // that does not move (a tilt) goes with what its sensor's pairs show, mounting when
+    // the sensor has no pair (the two are one effect then, and the evidence says so).
+    Attribution mis = attr("sensor.misalignment", 0.0, 1.0, "mrad", "the other axes' doubly integrated acceleration, antisymmetric");
+    Attribution cross = attr("sensor.cross_coupling", 0.0, 500.0, "ppm", "the other axes' doubly integrated acceleration, symmetric");
+    double rot_max[2] = {0.0, 0.0}, sym_max[2] = {0.0, 0.0}, tilt_max[2] = {0.0, 0.0};
+    bool has_pair[2] = {false, false};
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        if (i == j || !r.moving[j] || r.owner[j] < 0) continue;
+        const int s = r.owner[j];
+        const double eij = get(v, "E_" + ax(i) + ax(j) + "_ppm");
+        if (r.moving[i] && r.owner[i] == s) {
+          if (i < j) continue;
+          const double eji = get(v, "E_" + ax(j) + ax(i) + "_ppm");
+          const double rot = 0.5 * (eij - eji) / 1000.0, sym = 0.5 * (eij + eji);
+          mis.params["rotation_" + ax(j) + ax(i) + "_mrad"] = rot;
+          cross.params["cross_" + ax(j) + ax(i) + "_ppm"] = sym;
+          rot_max[s] = std::max(rot_max[s], std::abs(rot)), sym_max[s] = std::max(sym_max[s], std::abs(sym));
+          has_pair[s] = true;
+        } else {
+          mis.params["tilt_" + ax(j) + "_into_" + ax(i) + "_mrad"] = eij / 1000.0;
+          tilt_max[s] = std::max(tilt_max[s], std::abs(eij) / 1000.0);
+        }
+      }
+    for (int s = 0; s < 2; ++s) {
+      const bool crossed = has_pair[s] && sym_max[s] > cross.tolerance && rot_max[s] < 3.0 * sym_max[s] * 1e-3;
+      if (crossed) {
+        // Rotation and tilts are cross-axis terms of this sensor too: sized in ppm with it.
+        cross.magnitude = std::max({cross.magnitude, sym_max[s], rot_max[s] * 1000.0, tilt_max[s] * 1000.0});
+        mis.params[std::string("included_in_cross_coupling_") + (s == 0 ? "table" : "head")] = 1.0;
+      } else {
+        cross.magnitude = std::max(cross.magnitude, sym_max[s]);
+        mis.magnitude = std::max({mis.magnitude, rot_max[s], tilt_max[s]});
+      }
+    }
+    if (!has_pair[0] && !has_pair[1]) mis.regressor += " (one moving axis per sensor: mounting and cross coupling are one effect here)";
+    out.push_back(mis), out.push_back(cross);
+  } else if (group == "nonlinearity") {
+    double m = 0.0;
+    for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
+    Attribution a = attr("sensor.nonlinearity", m, 200.0, "1e-6/g", "the doubly integrated square and cube of the acceleration");
+    a.plausible_max = 1e4;  // 1 %/g: fifty times a servo accelerometer's data-sheet band
+    a.params = v;
+    out.push_back(a);
+  } else if (group == "timing") {
+    // Per sensor the common shift (2ζ/ω0, or a delay); against the set-point only, what the
+    // axes differ by is their position loops'.
+    Attribution dyn = attr("sensor.dynamics", 0.0, 15.0, "us", "the velocity (2ζ/ω0 · v, (6-38))");
+    Attribution servo = attr("machine.servo_mismatch", 0.0, 0.05, "ms", "each axis' velocity (lag), the difference between axes");
+    for (int s = 0; s < 2; ++s) {
+      double sum = 0.0;
+      int n = 0;
+      for (int j = 0; j < 3; ++j)
+        if (r.moving[j] && r.owner[j] == s) sum += get(v, "timing_" + ax(j) + "_us"), ++n;
+      if (n == 0) continue;
+      const double mean = sum / n;
+      dyn.params[std::string("damping_term_error_us_") + (s == 0 ? "table" : "head")] = mean;
+      dyn.magnitude = std::max(dyn.magnitude, std::abs(mean));
+    }
+    double lo = 1e300, hi = -1e300;
+    int cmd_axes = 0;
+    for (int j = 0; j < 3; ++j)
+      if (r.moving[j] && r.axis_reference[static_cast<std::size_t>(j)] == "cmd") {
+        const double lag_ms = -get(v, "timing_" + ax(j) + "_us") * 1e-3;
+        servo.params["lag_" + ax(j) + "_ms"] = lag_ms;
+        lo = std::min(lo, lag_ms), hi = std::max(hi, lag_ms), ++cmd_axes;
+      }
+    if (cmd_axes >= 2) servo.magnitude = hi - lo;
+    out.push_back(dyn);
+    if (cmd_axes >= 2) out.push_back(servo);
+  } else if (group == "damping_amplitude") {
+    double m = 0.0;
+    for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
+    Attribution a = attr("sensor.damping_amplitude", m, 0.2, "1/g", "the integral of a·|a| (damping growing with the acceleration)");
+    a.params = v;
+    out.push_back(a);
+  } else if (group == "bias_drift") {
+    double m = 0.0;
+    for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
+    Attribution a = attr("sensor.bias_drift", m, 0.3, "ug/s", "the doubly integrated time (a linear bias drift)");
+    a.params = v;
+    out.push_back(a);
+  } else if (group == "scale_temperature") {
+    const double range = std::max(r.temp_c.col(0).cwiseAbs().maxCoeff(), r.temp_c.col(1).cwiseAbs().maxCoeff());
+    double m = 0.0;
+    for (const auto& [k, x] : v) m = std::max(m, std::abs(x) * range * (k.rfind("bias", 0) == 0 ? 50.0 : 1.0));
+    Attribution a = attr("sensor.scale_temperature", m, 50.0, "ppm over the run (1 ug as 50 ppm)", "the temperature change times the acceleration, and alone");
+    a.params = v;
+    a.params["temperature_change_c"] = range;
+    out.push_back(a);
+  } else if (group == "coriolis") {
+    double sum = 0.0;
+    int n = 0;
+    for (const auto& [k, x] : v) sum += x, ++n;
+    Attribution a = attr("site.coriolis", n ? std::abs(sum / n) : 0.0, 0.5, "x Earth rate", "the doubly integrated 2 ω × v");
+    a.params = v;
+    out.push_back(a);
+  }
+  return out;
+}
+
+std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::MatrixXd& hint, const LagColumns& lag) {
+  std::vector<EffectModel> out;
+  const Eigen::Index n = r.n;
+  std::vector<int> moving;
+  for (int a = 0; a < 3; ++a)
+    if (r.moving[a]) moving.push_back(a);
+  if (moving.empty()) return out;
+  Eigen::VectorXd dir[3];
+  std::vector<int> rev[3];
+  for (int a : moving) directions(r, a, dir[a], rev[a]);
+  {
+    EffectModel e = effect("machine.backlash");
+    for (int a : moving)
+      if (!rev[a].empty()) e.params.push_back("backlash_" + ax(a) + "_um"), e.columns.push_back(on_axis(-0.5 * dir[a], a));
+    e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "half the play against the direction of the last motion";
+    if (!e.params.empty()) out.push_back(e);
+  }
+  {
+    EffectModel e = effect("machine.reversal_spike");
+    for (int a : moving) {
+      if (rev[a].empty()) continue;
+      Eigen::VectorXd best;
+      double best_c = -1.0, best_tau = 0.0;
+      for (double tau_ms : {5.0, 8.0, 12.0, 16.0, 20.0, 25.0, 30.0, 40.0, 50.0}) {
+        Eigen::VectorXd col = Eigen::VectorXd::Zero(n);
+        for (int s0 : rev[a]) {
+          const double sign = -dir[a][s0];  // the slide lags behind its new direction
+          // Friction holds the slide as the axis reverses: the lag grows from zero like t²
+          // (position and velocity continuous), peaks at tau with the given size, decays.
+          for (Eigen::Index s = s0; s < n; ++s) {
+            const double t = (r.t_s[s] - r.t_s[s0]) / (tau_ms * 1e-3);
+            if (t > 12.0) break;
+            col[s] += sign * t * t * std::exp(2.0 * (1.0 - t));
+          }
+        }
+        const double c = hint_corr(hint, col, a);
+        if (c > best_c) best_c = c, best = col, best_tau = tau_ms;
+      }
+      e.params.push_back("spike_" + ax(a) + "_um_tau_" + std::to_string(static_cast<int>(best_tau)) + "ms");
+      e.columns.push_back(on_axis(best, a));
+    }
+    e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "a lag peaking tau after each reversal";
+    if (!e.params.empty()) out.push_back(e);
+  }
+  if (moving.size() >= 2) {  // the common lag is the base model's (machine_base_columns); this is what axes differ by
+    EffectModel e = effect("machine.servo_mismatch");
+    for (std::size_t i = 1; i < moving.size(); ++i) {
+      const int a = moving[i];
+      e.params.push_back("lag_" + ax(a) + "_minus_" + ax(moving[0]) + "_ms"), e.columns.push_back(on_axis(lag.velocity.col(a), a));
+    }
+    e.magnitude = max_abs;
+    e.tolerance = 0.05, e.unit = "ms", e.regressor = "an axis' commanded velocity (lag) beyond the others'";
+    out.push_back(e);
+  }
+  {
+    EffectModel e = effect("machine.scale_mismatch");
+    for (int a : moving)
+      e.params.push_back("scale_" + ax(a) + "_ppm"), e.columns.push_back(on_axis((r.cmd.col(a).array() - r.cmd.col(a).mean()).matrix() * 1e-3, a));
+    e.magnitude = [](const Eigen::VectorXd& p) { return p.size() > 1 ? p.maxCoeff() - p.minCoeff() : std::abs(p[0]); };
+    e.tolerance = 10.0, e.unit = "ppm", e.regressor = "the commanded position along the axis";
+    out.push_back(e);
+  }
+  {
+    EffectModel e = effect("machine.squareness");
+    for (std::size_t p = 0; p < moving.size(); ++p)
+      for (std::size_t q = p + 1; q < moving.size(); ++q) {
+        const int i = moving[p], j = moving[q];
+        e.params.push_back("squareness_" + ax(i) + ax(j) + "_urad");
+        Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, 3);
+        c.col(i) = -0.5e-3 * (r.cmd.col(j).array() - r.cmd.col(j).mean()).matrix();
+        c.col(j) = -0.5e-3 * (r.cmd.col(i).array() - r.cmd.col(i).mean()).matrix();
+        e.columns.push_back(c);
+      }
+    e.magnitude = max_abs, e.tolerance = 10.0, e.unit = "urad", e.regressor = "each axis' commanded position on the other";
+    if (!e.params.empty()) out.push_back(e);
+  }
+  {
+    EffectModel e = effect("machine.cyclic_error");
+    for (int a : moving) {
+      const double span = r.cmd.col(a).maxCoeff() - r.cmd.col(a).minCoeff();
+      double best_c = -1.0, best_p = 0.0;
+      for (double pitch : {1.0, 2.0, 2.5, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0}) {
+        if (pitch > span / 1.5) continue;
+        const Eigen::VectorXd sn = (2.0 * kPi * r.cmd.col(a).array() / pitch).sin().matrix();
+        const Eigen::VectorXd cs = (2.0 * kPi * r.cmd.col(a).array() / pitch).cos().matrix();
+        const double c = std::hypot(hint_corr(hint, sn, a), hint_corr(hint, cs, a));
+        if (c > best_c) best_c = c, best_p = pitch;
+      }
+      if (best_p <= 0.0) continue;
+      char name[64];
+      std::snprintf(name, sizeof name, "cyclic_%s_pitch_%gmm", kAxis[a], best_p);
+      e.params.push_back(std::string(name) + "_sin_um");
+      e.columns.push_back(on_axis((2.0 * kPi * r.cmd.col(a).array() / best_p).sin().matrix(), a));
+      e.params.push_back(std::string(name) + "_cos_um");
+      e.columns.push_back(on_axis((2.0 * kPi * r.cmd.col(a).array() / best_p).cos().matrix(), a));
+    }
+    e.magnitude = [](const Eigen::VectorXd& p) {
+      double m = 0.0;
+      for (Eigen::Index i = 0; i + 1 < p.size(); i += 2) m = std::max(m, std::hypot(p[i], p[i + 1]));
+      return m;
+    };
+    e.tolerance = 0.5, e.unit = "um", e.regressor = "a sine of the commanded position (ball-screw pitch)";
+    if (!e.params.empty()) out.push_back(e);
+  }
+  {
+    EffectModel e = effect("machine.straightness");
+    for (int i : moving) {
+      const double lo = r.cmd.col(i).minCoeff(), hi = r.cmd.col(i).maxCoeff();
+      if (hi - lo < 5.0) continue;
+      const Eigen::VectorXd u = ((2.0 * r.cmd.col(i).array() - lo - hi) / (hi - lo)).matrix();
+      Eigen::VectorXd bow = (1.0 - u.array().square()).matrix();
+      bow.array() -= bow.mean();
+      for (int j = 0; j < 3; ++j)
+        if (j != i) e.params.push_back("bow_of_" + ax(i) + "_in_" + ax(j) + "_um"), e.columns.push_back(on_axis(bow, j));
+    }
+    e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "a bow over the axis' travel, sideways";
+    if (!e.params.empty()) out.push_back(e);
+  }
+  return out;
+}
+
+LagColumns common_lag_columns(const RunResiduals& r, double tau_s) {
+  LagColumns c;
+  c.tau_s = tau_s;
+  c.velocity = Eigen::MatrixXd::Zero(r.n, 3), c.acceleration = Eigen::MatrixXd::Zero(r.n, 3);
+  for (int a = 0; a < 3; ++a) {
+    if (!r.moving[a]) continue;
+    double v = 0.0, acc = 0.0;
+    for (Eigen::Index s = 0; s < r.n; ++s) {
+      const double h = s > 0 ? r.t_s[s] - r.t_s[s - 1] : 0.0;
+      const double k = tau_s > 0.0 ? 1.0 - std::exp(-h / tau_s) : 1.0;  // exact for a held input
+      v += (r.v_cmd(s, a) - v) * (s == 0 ? 1.0 : k), acc += (r.a_cmd(s, a) - acc) * (s == 0 ? 1.0 : k);
+      c.velocity(s, a) = -v;             // mm/s × ms = µm
+      c.acceleration(s, a) = acc * 1e-3;  // mm/s² × ms² = 1e-3 µm
+    }
+  }
+  return c;
+}
+
+Eigen::MatrixXd without_lag(const Eigen::MatrixXd& hint, const LagColumns& c) {
+  Eigen::MatrixXd out = hint;
+  for (int a = 0; a < 3; ++a) {
+    std::vector<Eigen::Index> rows;
+    for (Eigen::Index s = 0; s < hint.rows(); ++s)
+      if (std::isfinite(hint(s, a))) rows.push_back(s);
+    if (rows.size() < 20 || c.velocity.col(a).cwiseAbs().maxCoeff() <= 0.0) continue;
+    Eigen::MatrixXd x(static_cast<Eigen::Index>(rows.size()), 3);
+    Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const auto ii = static_cast<Eigen::Index>(i);
+      x(ii, 0) = 1.0, x(ii, 1) = c.velocity(rows[i], a), x(ii, 2) = c.acceleration(rows[i], a), y[ii] = hint(rows[i], a);
+    }
+    const Eigen::VectorXd e = y - x * x.colPivHouseholderQr().solve(y);
+    for (std::size_t i = 0; i < rows.size(); ++i) out(rows[i], a) = e[static_cast<Eigen::Index>(i)];
+  }
+  return out;
+}
+
+double loop_time_constant_s(const RunResiduals& r, const Eigen::MatrixXd& hint) {
+  double best_tau = 0.0, best_rss = INFINITY;
+  for (double tau_ms : {0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 50.0, 70.0, 100.0}) {
+    const LagColumns c = common_lag_columns(r, tau_ms * 1e-3);
+    double rss = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      if (!r.moving[a]) continue;
+      // Per axis: offset, LP(v) and LP(a) by least squares on the known rows.
+      std::vector<Eigen::Index> rows;
+      for (Eigen::Index s = 0; s < r.n; ++s)
+        if (std::isfinite(hint(s, a))) rows.push_back(s);
+      if (rows.size() < 20) continue;
+      Eigen::MatrixXd x(static_cast<Eigen::Index>(rows.size()), 3);
+      Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        const auto ii = static_cast<Eigen::Index>(i);
+        x(ii, 0) = 1.0, x(ii, 1) = c.velocity(rows[i], a), x(ii, 2) = c.acceleration(rows[i], a), y[ii] = hint(rows[i], a);
+      }
+      const Eigen::VectorXd beta = x.colPivHouseholderQr().solve(y);
+      rss += (y - x * beta).squaredNorm();
+    }
+    if (rss < best_rss) best_rss = rss, best_tau = tau_ms * 1e-3;
+  }
+  return best_tau;
+}
+
+ParamGroup as_group(const EffectModel& e, const std::array<bool, 3>& axes) {
+  ParamGroup g{e.name, {}};
+  for (std::size_t p = 0; p < e.params.size(); ++p) {
+    int used = 0;
+    for (int a = 0; a < 3; ++a) used += axes[static_cast<std::size_t>(a)] && e.columns[p].col(a).cwiseAbs().maxCoeff() > 0.0;
+    for (int a = 0; a < 3; ++a) {
+      if (!axes[static_cast<std::size_t>(a)] || e.columns[p].col(a).cwiseAbs().maxCoeff() <= 0.0) continue;
+      AxisParam ap;
+      ap.name = used > 1 ? e.params[p] + "@" + ax(a) : e.params[p];
+      ap.axis = a, ap.accel = false, ap.input = e.columns[p].col(a), ap.prior_sigma = 1e3;
+      g.params.push_back(ap);
+    }
+  }
+  return g;
+}
+
+}  // namespace eical::dsp::model

@@ -1,0 +1,480 @@
+#include "dsp/model/explain.hpp"
+
+#include "dsp/core/error.hpp"
+#include "dsp/identify/delay_estimate.hpp"
+#include "dsp/model/effect_catalog.hpp"
+#include "dsp/model/effect_selection.hpp"
+#include "dsp/model/extension.hpp"
+#include "dsp/model/kf_selection.hpp"
+#include "dsp/model/spectral_tests.hpp"
+#include "dsp/model/standstill_bias.hpp"
+#include "dsp/model/stick_slip_test.hpp"
+#include "dsp/pipeline/coriolis.hpp"
+
+#include <Eigen/QR>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+namespace eical::dsp::model {
+namespace {
+
+std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, f, a, b, c, d);
+  return buf;
+}
+
+
+// An effect's columns on this channel's rows (µm per unit).
+Eigen::MatrixXd columns_on(const EffectModel& e, const Channel& ch) {
+  Eigen::MatrixXd m(ch.rows(), static_cast<Eigen::Index>(e.columns.size()));
+  for (std::size_t p = 0; p < e.columns.size(); ++p)
+    for (Eigen::Index i = 0; i < ch.rows(); ++i) m(i, static_cast<Eigen::Index>(p)) = e.columns[p](ch.sample[static_cast<std::size_t>(i)], ch.axis[static_cast<std::size_t>(i)]);
+  return m;
+}
+
+struct ChannelResult {
+  std::vector<ExplainedEffect> effects;
+  Eigen::VectorXd before_um, after_um;
+  std::vector<bool> heldout;
+};
+
+ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const std::vector<EffectModel>& catalog, const LagColumns& lag,
+                              const ExplainOptions& o) {
+  ChannelResult out;
+  const Eigen::Index rows = ch.rows();
+  // Weighted (whitened) residual and regressors, each axis' offset projected out.
+  Eigen::MatrixXd nuis = Eigen::MatrixXd::Zero(rows, 3);
+  for (Eigen::Index i = 0; i < rows; ++i) nuis(i, ch.axis[static_cast<std::size_t>(i)]) = 1.0 / ch.sigma_um[i];
+  std::vector<Eigen::Index> used_cols;
+  for (int a = 0; a < 3; ++a)
+    if (nuis.col(a).squaredNorm() > 0.0) used_cols.push_back(a);
+  // Each axis' offset and the axes' common position-loop lag belong to the base model.
+  Eigen::VectorXd lag_rows(rows), acc_rows(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) {
+    const int sm = ch.sample[static_cast<std::size_t>(i)], axi = ch.axis[static_cast<std::size_t>(i)];
+    lag_rows[i] = lag.velocity(sm, axi) / ch.sigma_um[i];
+    acc_rows[i] = lag.acceleration(sm, axi) / ch.sigma_um[i];
+  }
+  const bool with_lag = lag_rows.norm() > 0.0;
+  Eigen::MatrixXd nu(rows, static_cast<Eigen::Index>(used_cols.size()) + (with_lag ? 2 : 0));
+  for (std::size_t c = 0; c < used_cols.size(); ++c) nu.col(static_cast<Eigen::Index>(c)) = nuis.col(used_cols[c]);
+  if (with_lag) nu.col(nu.cols() - 2) = lag_rows, nu.col(nu.cols() - 1) = acc_rows;
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(nu);
+  const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(rows, nu.cols());
+  auto project = [&](const Eigen::MatrixXd& m) { return Eigen::MatrixXd(m - q * (q.transpose() * m)); };
+  const Eigen::VectorXd w = ch.sigma_um.cwiseInverse();
+  const Eigen::VectorXd y = project(ch.residual_um.cwiseProduct(w));
+
+  std::vector<Candidate> cands;
+  std::vector<const EffectModel*> models;
+  for (const auto& e : catalog) {
+    const Eigen::MatrixXd c = columns_on(e, ch);
+    if (c.cwiseAbs().maxCoeff() <= 0.0) continue;  // nothing of it on this channel's axes
+    Candidate cand;
+    cand.name = e.name;
+    cand.regressors = project(w.asDiagonal() * c);
+    // A parameter without any footprint here would only make the fit singular.
+    std::vector<Eigen::Index> keep;
+    for (Eigen::Index p = 0; p < c.cols(); ++p)
+      if (cand.regressors.col(p).norm() > 1e-12 * (1.0 + y.norm())) keep.push_back(p);
+    if (keep.empty()) continue;
+    if (static_cast<Eigen::Index>(keep.size()) < c.cols()) {
+      Eigen::MatrixXd r(rows, static_cast<Eigen::Index>(keep.size()));
+      for (std::size_t k = 0; k < keep.size(); ++k) r.col(static_cast<Eigen::Index>(k)) = cand.regressors.col(keep[k]);
+      cand.regressors = r;
+    }
+    for (Eigen::Index p : keep) cand.param_names.push_back(e.params[static_cast<std::size_t>(p)]);
+    cands.push_back(std::move(cand));
+    models.push_back(&e);
+  }
+  out.heldout.resize(static_cast<std::size_t>(rows));
+  for (Eigen::Index i = 0; i < rows; ++i) out.heldout[static_cast<std::size_t>(i)] = rr.heldout[static_cast<std::size_t>(ch.sample[static_cast<std::size_t>(i)])];
+  out.before_um = y.cwiseProduct(ch.sigma_um);  // the base model's residual (offsets and common lag out), µm
+  out.after_um = out.before_um;
+  if (cands.empty() || rows < 50) return out;
+  SelectionOptions so;
+  so.min_bic_drop = o.min_bic_drop, so.min_heldout_gain = o.min_heldout_gain, so.max_effects = 10;
+  const SelectionResult sel = select_effects(y, cands, out.heldout, so);
+
+  auto split_rms = [&](const Eigen::VectorXd& v, bool held) {
+    double s = 0.0;
+    std::size_t n = 0;
+    for (Eigen::Index i = 0; i < v.size(); ++i)
+      if (out.heldout[static_cast<std::size_t>(i)] == held) s += v[i] * v[i], ++n;
+    return n ? std::sqrt(s / static_cast<double>(n)) : 0.0;
+  };
+  for (const auto& v : sel.effects) {
+    std::size_t k = 0;
+    while (k < cands.size() && cands[k].name != v.name) ++k;
+    if (k == cands.size()) continue;
+    const EffectModel& e = *models[k];
+    ExplainedEffect x;
+    x.name = v.name, x.channel = ch.name, x.bic_drop = v.bic_drop, x.correlation = v.correlation;
+    Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(e.params.size()));
+    for (std::size_t p = 0; p < v.param_names.size(); ++p) {
+      x.params[v.param_names[p]] = v.params[static_cast<Eigen::Index>(p)];
+      for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
+        if (e.params[q2] == v.param_names[p]) full[static_cast<Eigen::Index>(q2)] = v.params[static_cast<Eigen::Index>(p)];
+    }
+    x.magnitude = e.magnitude(full), x.tolerance = e.tolerance, x.unit = e.unit;
+    // Outside the tolerance with confidence: each parameter moved 2σ towards zero.
+    Eigen::VectorXd sure = full;
+    for (std::size_t p = 0; p < v.param_names.size() && static_cast<Eigen::Index>(p) < v.param_sigma.size(); ++p)
+      for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
+        if (e.params[q2] == v.param_names[p]) {
+          const double a = full[static_cast<Eigen::Index>(q2)], s2 = 2.0 * v.param_sigma[static_cast<Eigen::Index>(p)];
+          sure[static_cast<Eigen::Index>(q2)] = std::abs(a) > s2 ? a - std::copysign(s2, a) : 0.0;
+        }
+    const double sure_magnitude = e.magnitude(sure);
+    // Its own prediction in µm, against the nominal residual (offsets out).
+    const Eigen::VectorXd pred = project(w.asDiagonal() * (columns_on(e, ch) * full)).cwiseProduct(ch.sigma_um);
+    const Eigen::VectorXd after = out.before_um - pred;
+    x.residual_rms_before_um = split_rms(out.before_um, false), x.residual_rms_after_um = split_rms(after, false);
+    x.heldout_rms_before_um = split_rms(out.before_um, true), x.heldout_rms_after_um = split_rms(after, true);
+    x.importance_um = x.residual_rms_before_um - x.residual_rms_after_um;
+    x.significant = v.significant && sure_magnitude > x.tolerance;
+    x.evidence = "residual correlates with " + e.regressor + fmt(" (r = %.2f); BIC drop %.0f; held-out RMS %.3f -> %.3f um; ", v.correlation, v.bic_drop,
+                                                              x.heldout_rms_before_um, x.heldout_rms_after_um) +
+                 fmt("size %.3g (%.3g at 2 sigma) ", x.magnitude, sure_magnitude) + x.unit + fmt(" against a tolerance of %.3g ", x.tolerance) + x.unit;
+    if (v.significant && !x.significant) x.evidence += " (not clearly outside the tolerance: background)";
+    if (x.significant) out.after_um -= pred;
+    out.effects.push_back(std::move(x));
+  }
+  return out;
+}
+
+void merge(std::vector<ExplainedEffect>& all, ExplainedEffect e) {
+  for (auto& a : all) {
+    if (a.name != e.name) continue;
+    const bool take = (e.significant && !a.significant) || (e.significant == a.significant && e.importance_um > a.importance_um);
+    for (const auto& [k, v] : (take ? a : e).params) (take ? e : a).params.emplace(k, v);
+    if (take) a = std::move(e);
+    return;
+  }
+  all.push_back(std::move(e));
+}
+
+}  // namespace
+
+RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RunExplanation ex;
+  RunResiduals rr = build_residuals(run);
+  ex.run_id = rr.run_id, ex.reference = rr.reference;
+  // Shapes (spike time constant, cyclic pitch) are chosen on the residual that shows
+  // machine effects: reference minus set-point, else the pipeline against the set-point.
+  Eigen::MatrixXd hint = Eigen::MatrixXd::Constant(rr.n, 3, NAN);
+  for (const Channel* hc : {&rr.pipeline, &rr.machine})
+    for (Eigen::Index i = 0; i < hc->rows(); ++i)
+      if (hc == &rr.machine || rr.axis_reference[static_cast<std::size_t>(hc->axis[static_cast<std::size_t>(i)])] == "cmd")
+        hint(hc->sample[static_cast<std::size_t>(i)], hc->axis[static_cast<std::size_t>(i)]) = hc->residual_um[i];
+  const LagColumns lag = common_lag_columns(rr, loop_time_constant_s(rr, hint));
+  const std::vector<EffectModel> machine = machine_effects(rr, without_lag(hint, lag), lag);
+  std::vector<ExplainedEffect> all;
+
+  // 1. The integrated motion against each axis' reference, through the integration's noise
+  // model: the sensor effects, and the machine effects of axes with the set-point only.
+  std::array<bool, 3> cmd_axes{};
+  for (int a = 0; a < 3; ++a) cmd_axes[static_cast<std::size_t>(a)] = rr.axis_reference[static_cast<std::size_t>(a)] == "cmd" && rr.moving[a];
+  std::vector<ParamGroup> groups = sensor_groups(rr);
+  const std::size_t n_sensor_groups = groups.size();
+  for (const auto& e : machine) {
+    ParamGroup g = as_group(e, cmd_axes);
+    if (!g.params.empty()) groups.push_back(std::move(g));
+  }
+  KfSelectionOptions ko;
+  ko.min_bic_drop = o.min_bic_drop, ko.min_heldout_gain = o.min_heldout_gain;
+  const KfSelection ks = select_groups_kf(rr.tracks, groups, pipeline_config(rr.meta, 1).fusion, ko);
+  for (const auto& v : ks.groups) {
+    const bool is_sensor = std::find_if(groups.begin(), groups.begin() + static_cast<std::ptrdiff_t>(n_sensor_groups),
+                                        [&](const ParamGroup& g) { return g.name == v.name; }) != groups.begin() + static_cast<std::ptrdiff_t>(n_sensor_groups);
+    // Each value moved 2σ towards zero: the size that is outside the tolerance with confidence.
+    std::map<std::string, double> sure_value = v.value;
+    for (auto& [k, x] : sure_value)
+      if (const auto sg = v.sigma.find(k); sg != v.sigma.end()) x = std::abs(x) > 2.0 * sg->second ? x - std::copysign(2.0 * sg->second, x) : 0.0;
+    std::vector<Attribution> atts, sure_atts;
+    if (is_sensor) {
+      atts = attribute_sensor_group(rr, v.name, v.value);
+      sure_atts = attribute_sensor_group(rr, v.name, sure_value);
+    } else {
+      const auto it = std::find_if(machine.begin(), machine.end(), [&](const EffectModel& e) { return e.name == v.name; });
+      if (it == machine.end()) continue;
+      Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(it->params.size()));
+      Attribution a;
+      a.name = it->name, a.tolerance = it->tolerance, a.unit = it->unit, a.regressor = it->regressor;
+      for (std::size_t p = 0; p < it->params.size(); ++p) {
+        double sum = 0.0;
+        int cnt = 0;
+        for (const auto& [k, x] : v.value)
+          if (k == it->params[p] || k.rfind(it->params[p] + "@", 0) == 0) sum += x, ++cnt;
+        full[static_cast<Eigen::Index>(p)] = cnt ? sum / cnt : 0.0;
+        if (cnt) a.params[it->params[p]] = full[static_cast<Eigen::Index>(p)];
+      }
+      a.magnitude = it->magnitude(full);
+      atts.push_back(a);
+      for (std::size_t p = 0; p < it->params.size(); ++p) {
+        double sum = 0.0;
+        int cnt = 0;
+        for (const auto& [k, x] : sure_value)
+          if (k == it->params[p] || k.rfind(it->params[p] + "@", 0) == 0) sum += x, ++cnt;
+        full[static_cast<Eigen::Index>(p)] = cnt ? sum / cnt : 0.0;
+      }
+      a.magnitude = it->magnitude(full);
+      sure_atts.push_back(a);
+    }
+    // One group's gain shared by the effects it stands for, by how far each is outside its band.
+    double excess_sum = 0.0;
+    for (const auto& at : atts) excess_sum += at.tolerance > 0.0 ? at.magnitude / at.tolerance : 0.0;
+    for (const auto& at : atts) {
+      ExplainedEffect x;
+      x.name = at.name, x.params = at.params, x.magnitude = at.magnitude, x.tolerance = at.tolerance, x.unit = at.unit;
+      x.channel = is_sensor ? rr.reference : "total";
+      x.bic_drop = v.bic_drop;
+      x.residual_rms_before_um = v.fit_rms_before_um, x.residual_rms_after_um = v.fit_rms_after_um;
+      x.heldout_rms_before_um = v.held_rms_before_um, x.heldout_rms_after_um = v.held_rms_after_um;
+      x.importance_um = std::max(0.0, v.held_rms_before_um - v.held_rms_after_um);
+      if (atts.size() > 1 && excess_sum > 0.0 && at.tolerance > 0.0) x.importance_um *= at.magnitude / at.tolerance / excess_sum;
+      double sure_magnitude = 0.0;
+      for (const auto& sa : sure_atts)
+        if (sa.name == at.name) sure_magnitude = sa.magnitude;
+      x.significant = v.accepted && sure_magnitude > x.tolerance;
+      char nums[256];
+      std::snprintf(nums, sizeof nums, " (model group '%s'); BIC drop %.0f; prediction error at the held-out samples %.3f -> %.3f um; size %.3g (%.3g at 2 sigma) ",
+                    v.name.c_str(), v.bic_drop, v.held_rms_before_um, v.held_rms_after_um, x.magnitude, sure_magnitude);
+      x.evidence = "the integrated motion against the " + rr.reference + " follows " + at.regressor + nums + x.unit + fmt(" against a tolerance of %.3g ", x.tolerance) + x.unit;
+      if (v.accepted && !x.significant) x.evidence += " (not clearly outside the tolerance: background)";
+      if (x.significant && x.magnitude > at.plausible_max) {
+        x.significant = false;
+        x.evidence += fmt("; larger than a sensor can have (%.3g ", at.plausible_max) + x.unit +
+                      "): it stands in for a residual the catalogue does not describe";
+      }
+      merge(all, std::move(x));
+    }
+  }
+  ex.heldout_nominal_rms_um = ks.held_rms_nominal_um, ex.heldout_final_rms_um = ks.held_rms_final_um;
+
+  // 2. Reference minus set-point: the machine effects of axes with a reference.
+  ChannelResult machine_fit;
+  if (rr.machine.rows() >= 50) {
+    machine_fit = analyse_channel(rr, rr.machine, machine, lag, o);
+    for (auto& e : machine_fit.effects) merge(all, std::move(e));
+  }
+  // The timing of the sensors' path: 2ζ/ω0 and the DAQ delay shift it alike. The PSD strips
+  // pass the DAQ filter but not the sensors' PT2: against the reference they give the delay.
+  const bool has_psd = rr.has_psd[0] || rr.has_psd[1];
+  auto find = [&](const std::string& name) -> ExplainedEffect* {
+    for (auto& e : all)
+      if (e.name == name) return &e;
+    return nullptr;
+  };
+  ExplainedEffect* dyn = find("sensor.dynamics");
+  ExplainedEffect* del = find("daq.group_delay");
+  if (rr.reference == "ref" && has_psd) {
+    const identify::DelayEstimate de = identify::estimate_delay(rr.measurement, rr.meta, identify::DelayReference::reference);
+    if (de.valid) {
+      ExplainedEffect d;
+      d.name = "daq.group_delay", d.channel = "psd", d.unit = "samples", d.tolerance = 0.3;
+      const double dd = de.samples - rr.delay_samples;
+      d.params["group_delay_samples"] = de.samples, d.params["delay_error_samples"] = dd, d.params["sigma_samples"] = de.sigma;
+      d.magnitude = std::abs(dd);
+      d.significant = std::abs(dd) > d.tolerance && std::abs(dd) > 3.0 * de.sigma;
+      d.importance_um = std::abs(dd) / rr.fs_hz * rr.v_cmd.cwiseAbs().maxCoeff() * 1000.0 / std::sqrt(2.0);
+      d.bic_drop = de.sigma > 0.0 ? (dd / de.sigma) * (dd / de.sigma) : 0.0;
+      d.evidence = fmt("the PSD readings (through the DAQ filter, not the sensors) lag the reference by %.3f +- %.3f samples against %.3f nominal", de.samples,
+                       de.sigma, rr.delay_samples);
+      if (de.mounting_assumed) d.evidence += " (strips crossed at one speed: taken where run.toml puts them)";
+      // What each sensor's own timing is once the delay is known. Both sensors off by the
+      // same: their dynamics (2ζ/ω0); the head off against the table: the DAQ's skew between
+      // their channels (run-format: "table and head channels are skewed in time") — the
+      // simpler of two explanations when the DAQ already shows a delay error.
+      if (dyn) {
+        const double delay_us = -dd * 1e6 / rr.fs_hz;
+        double own[2] = {NAN, NAN};
+        for (int s2 = 0; s2 < 2; ++s2)
+          if (auto it = dyn->params.find(std::string("damping_term_error_us_") + (s2 == 0 ? "table" : "head")); it != dyn->params.end())
+            own[s2] = it->second - delay_us;
+        const double base = std::isfinite(own[0]) ? own[0] : own[1];
+        if (std::isfinite(own[0]) && std::isfinite(own[1])) {
+          const double skew = -(own[1] - own[0]) * rr.fs_hz / 1e6;  // head later, samples
+          d.params["skew_head_samples"] = skew;
+          if (std::abs(skew) > 0.3) {
+            d.magnitude = std::max(d.magnitude, std::abs(skew));
+            d.significant = d.significant || (dyn->bic_drop > o.min_bic_drop && std::abs(skew) > d.tolerance);
+            d.evidence += fmt("; the head's channels lag the table's by %.2f samples more", skew);
+          }
+        }
+        dyn->magnitude = std::abs(base);
+        dyn->params["damping_term_error_us_after_delay"] = base;
+        dyn->significant = dyn->bic_drop > o.min_bic_drop && std::abs(base) > dyn->tolerance;
+        dyn->evidence += fmt("; %.1f us of it is the DAQ delay the PSD readings show", delay_us);
+      }
+      if (del) *del = d;
+      else all.push_back(d);
+    }
+  } else if (del) {  // without strips and a reference the two are one shift: name the sensor's
+    if (del->significant) {
+      if (dyn && !dyn->significant) {
+        dyn->significant = true, dyn->importance_um = del->importance_um;
+        for (const auto& [k, v] : del->params) dyn->params[k] = v;
+      }
+      del->significant = false;
+    }
+    del->evidence += " (not separable from 2ζ/ω0 without PSD strips and a reference: reported as sensor.dynamics)";
+    if (dyn) dyn->evidence += " (or daq.group_delay: the two shift the path alike without PSD strips and a reference)";
+  }
+  // Earth rate: known from the site, not fitted (on a circle a common scale error looks the
+  // same); its size says whether it matters.
+  {
+    ExplainedEffect c;
+    c.name = "site.coriolis", c.channel = "site", c.unit = "ug", c.tolerance = 1.0;
+    const Eigen::Vector3d two_w = 2.0 * earth_rate_machine_radps(rr.meta.site);
+    double peak = 0.0;
+    for (int s2 = 0; s2 < rr.n; ++s2) peak = std::max(peak, two_w.cross(Eigen::Vector3d(rr.v_meas.row(s2).transpose()) * 1e-3).norm());
+    c.magnitude = peak / (rr.meta.site.g_mps2 * 1e-6);
+    c.params["peak_ug"] = c.magnitude;
+    c.evidence = fmt("2 w x v of this motion peaks at %.2f ug; not fitted (a common scale error looks the same on a circle); eical analyze --coriolis corrects it",
+                     c.magnitude);
+    all.push_back(c);
+  }
+  // The bias at the standstills (ch. 8.3.2): steps between moves, drift, temperature.
+  {
+    const StandstillBias sb = standstill_bias(rr);
+    const bool temp = sb.pattern == "temperature";
+    ExplainedEffect b;
+    b.name = temp ? "sensor.scale_temperature" : "sensor.bias_drift", b.channel = "standstills", b.unit = "ug", b.tolerance = 1.0;
+    b.magnitude = sb.largest_change_ug, b.significant = sb.changed;
+    b.bic_drop = sb.chi2 - sb.dof;
+    b.params["largest_bias_change_ug"] = sb.largest_change_ug, b.params["standstills"] = static_cast<double>(sb.windows.size());
+    if (temp) b.params["bias_tc_ug_per_c"] = sb.temp_coeff_ug_per_c, b.params["temperature_change_c"] = sb.temperature_change_c;
+    else if (sb.pattern == "steps") b.params["step_ug"] = sb.step_ug;
+    else if (sb.pattern == "drift") b.params["drift_ug_per_s"] = sb.drift_ug_per_s;
+    // Ranking: the position error the change makes over a quarter-second move, µm.
+    b.importance_um = sb.changed ? 0.5 * sb.largest_change_ug * rr.meta.site.g_mps2 * 0.0625 : 0.0;
+    b.evidence = sb.evidence;
+    if (ExplainedEffect* reg = find(b.name)) {
+      reg->evidence += "; " + b.evidence;
+      for (const auto& [k, v] : b.params) reg->params[k] = v;
+      if (b.significant && !reg->significant) reg->importance_um = std::max(reg->importance_um, b.importance_um), reg->channel = "standstills";
+      reg->significant = reg->significant || b.significant;
+    } else {
+      all.push_back(b);
+    }
+    // One cause for one change: the standstills say whether the bias followed the
+    // temperature or the time; the integrated motion's drift group is the same change.
+    const char* other = temp ? "sensor.bias_drift" : "sensor.scale_temperature";
+    if (ExplainedEffect* oe = find(other); oe && oe->significant && sb.changed && (temp || sb.temperature_change_c < 0.05)) {
+      oe->significant = false;
+      oe->evidence += temp ? " (the drift follows the case temperature: see sensor.scale_temperature)" : " (the case temperature hardly changed: see sensor.bias_drift)";
+    }
+  }
+  // Stick-slip: trains of slips while an axis creeps.
+  {
+    const StickSlipFinding ss = stick_slip_test(rr);
+    ExplainedEffect x;
+    x.name = "machine.stick_slip", x.channel = "acceleration", x.unit = "bursts per creep zone", x.tolerance = 8.0;
+    x.magnitude = ss.bursts_per_zone, x.significant = ss.found;
+    x.params["bursts_in_creep"] = ss.bursts_in_creep, x.params["bursts_elsewhere"] = ss.bursts_elsewhere, x.params["creep_zones"] = ss.creep_zones;
+    if (ss.slip_um > 0.0) x.params["slip_um"] = ss.slip_um;
+    if (ss.axis >= 0) x.params[std::string("axis_") + "xyz"[ss.axis]] = 1.0;
+    x.importance_um = ss.found ? std::max(ss.slip_um, 1.0) : 0.0;
+    x.bic_drop = ss.bursts_in_creep;
+    x.evidence = ss.evidence;
+    all.push_back(x);
+  }
+  // Vibration.
+  {
+    const VibrationTests v = vibration_tests(rr);
+    ExplainedEffect c, d;
+    c.name = "machine.common_vibration", c.channel = "spectrum", c.unit = "mg", c.tolerance = 0.05, c.magnitude = v.common.rms_mg;
+    c.params["rms_mg"] = v.common.rms_mg, c.params["coherence"] = v.common.coherence;
+    for (std::size_t i = 0; i < v.common.lines.size(); ++i) c.params["line" + std::to_string(i) + "_hz"] = v.common.lines[i].freq_hz;
+    c.significant = v.common.found && v.common.rms_mg > c.tolerance;
+    c.importance_um = c.significant ? 1.0 + v.common.rms_mg : 0.0;
+    c.evidence = v.common.evidence;
+    d.name = "machine.differential_vibration", d.channel = "spectrum", d.unit = "um", d.tolerance = 0.1, d.magnitude = v.differential.displacement_um;
+    d.params["rms_mg"] = v.differential.rms_mg, d.params["displacement_um"] = v.differential.displacement_um;
+    for (std::size_t i = 0; i < v.differential.lines.size(); ++i) d.params["line" + std::to_string(i) + "_hz"] = v.differential.lines[i].freq_hz;
+    d.significant = v.differential.found && v.differential.displacement_um > d.tolerance;
+    d.importance_um = d.significant ? v.differential.displacement_um : 0.0;
+    d.evidence = v.differential.evidence;
+    all.push_back(c), all.push_back(d);
+  }
+  // The gain: the pipeline's path against each axis' reference, with the nominal model and
+  // with the extended one (the significant sensor effects in the sensors, the machine
+  // effects of set-point-only axes subtracted).
+  {
+    auto offsets_out = [](const Channel& ch) {
+      Eigen::VectorXd v = ch.residual_um;
+      for (int a = 0; a < 3; ++a) {
+        double sum = 0.0;
+        int cnt = 0;
+        for (Eigen::Index i = 0; i < ch.rows(); ++i)
+          if (ch.axis[static_cast<std::size_t>(i)] == a) sum += v[i], ++cnt;
+        for (Eigen::Index i = 0; i < ch.rows(); ++i)
+          if (cnt && ch.axis[static_cast<std::size_t>(i)] == a) v[i] -= sum / cnt;
+      }
+      return v;
+    };
+    const Extension ext = extend_sensors(rr.meta, all);
+    Run extended = run;
+    for (int s2 = 0; s2 < 2; ++s2) extended.meta.sensors[s2] = ext.sensors[s2];
+    extended.meta.acquisition.daq_group_delay_samples = ext.daq_group_delay_samples;
+    extended.meta.acquisition.daq_skew_head_samples = ext.daq_skew_head_samples;
+    const RunResiduals after = build_residuals(extended);
+    Eigen::VectorXd pred = Eigen::VectorXd::Zero(after.pipeline.rows());
+    for (const auto& e : all) {
+      if (!e.significant || e.channel != "total") continue;
+      const auto it = std::find_if(machine.begin(), machine.end(), [&](const EffectModel& m) { return m.name == e.name; });
+      if (it == machine.end()) continue;
+      Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(it->params.size()));
+      for (std::size_t p = 0; p < it->params.size(); ++p)
+        if (auto f = e.params.find(it->params[p]); f != e.params.end()) full[static_cast<Eigen::Index>(p)] = f->second;
+      const Eigen::MatrixXd cols = columns_on(*it, after.pipeline);
+      for (Eigen::Index i = 0; i < after.pipeline.rows(); ++i)
+        if (cmd_axes[static_cast<std::size_t>(after.pipeline.axis[static_cast<std::size_t>(i)])]) pred[i] += cols.row(i).dot(full);
+    }
+    const Eigen::VectorXd before_v = offsets_out(rr.pipeline);
+    Channel after_ch = after.pipeline;
+    after_ch.residual_um -= pred;
+    const Eigen::VectorXd after_v = offsets_out(after_ch);
+    double sb = 0.0, sa = 0.0;
+    std::size_t nb = 0, na = 0;
+    RunExplanation::Trace tr;
+    tr.channel = rr.reference;
+    for (Eigen::Index i = 0; i < before_v.size(); ++i) {
+      const int a = rr.pipeline.axis[static_cast<std::size_t>(i)];
+      if (!rr.moving[a]) continue;
+      sb += before_v[i] * before_v[i], ++nb;
+    }
+    for (Eigen::Index i = 0; i < after_v.size(); ++i) {
+      const int a = after_ch.axis[static_cast<std::size_t>(i)];
+      if (!rr.moving[a]) continue;
+      sa += after_v[i] * after_v[i], ++na;
+    }
+    ex.nominal_residual_rms_um = nb ? std::sqrt(sb / static_cast<double>(nb)) : 0.0;
+    ex.final_residual_rms_um = na ? std::sqrt(sa / static_cast<double>(na)) : 0.0;
+    const Eigen::Index rows = std::min(before_v.size(), after_v.size());
+    const auto step = static_cast<Eigen::Index>(std::max<Eigen::Index>(1, rows / 6000));
+    for (Eigen::Index i = 0; i < rows; i += step) {
+      if (rr.pipeline.axis[static_cast<std::size_t>(i)] != after_ch.axis[static_cast<std::size_t>(i)]) continue;
+      tr.t_s.push_back(rr.t_s[rr.pipeline.sample[static_cast<std::size_t>(i)]]);
+      tr.axis.push_back(rr.pipeline.axis[static_cast<std::size_t>(i)]);
+      tr.before_um.push_back(before_v[i]), tr.after_um.push_back(after_v[i]);
+    }
+    ex.traces.push_back(std::move(tr));
+  }
+  std::stable_sort(all.begin(), all.end(), [](const ExplainedEffect& a, const ExplainedEffect& b) {
+    if (a.significant != b.significant) return a.significant;
+    if (a.significant) return a.importance_um > b.importance_um;
+    return a.bic_drop > b.bic_drop;
+  });
+  ex.effects = std::move(all);
+  ex.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return ex;
+}
+
+}  // namespace eical::dsp::model

@@ -1,0 +1,103 @@
+#include "dsp/model/extension.hpp"
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <numbers>
+
+namespace eical::dsp::model {
+namespace {
+
+int axis_of(char c) { return c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1; }
+
+int owner(const RunMeta& m, int a) {
+  const char* n[3] = {"x", "y", "z"};
+  for (const auto& t : m.machine.table_axes)
+    if (t == n[a]) return 0;
+  for (const auto& h : m.machine.head_axes)
+    if (h == n[a]) return 1;
+  return -1;
+}
+
+bool two_axes(const std::string& name, const std::string& prefix, int& a, int& b) {
+  if (name.rfind(prefix, 0) != 0 || name.size() < prefix.size() + 2) return false;
+  a = axis_of(name[prefix.size()]), b = axis_of(name[prefix.size() + 1]);
+  return a >= 0 && b >= 0;
+}
+
+}  // namespace
+
+Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>& effects) {
+  Extension x;
+  for (int s = 0; s < 2; ++s) x.sensors[s] = meta.sensors[s];
+  x.daq_group_delay_samples = meta.acquisition.daq_group_delay_samples;
+  x.daq_skew_head_samples = meta.acquisition.daq_skew_head_samples;
+  Eigen::Matrix3d e[2] = {Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero()};  // measured = (I + E) true, machine axes
+  for (const auto& ef : effects) {
+    if (!ef.significant) continue;
+    const auto& p = ef.params;
+    if (ef.name == "sensor.scale") {
+      for (const auto& [k, v] : p)
+        if (k.rfind("scale_", 0) == 0 && k.size() > 6) {
+          const int a = axis_of(k[6]);
+          if (a >= 0 && owner(meta, a) >= 0) e[owner(meta, a)](a, a) += v * 1e-6;
+        }
+    } else if (ef.name == "sensor.misalignment") {
+      for (const auto& [k, v] : p) {
+        int j = 0, i = 0;
+        if (two_axes(k, "rotation_", j, i) && owner(meta, j) >= 0) {
+          e[owner(meta, j)](i, j) += v * 1e-3, e[owner(meta, j)](j, i) -= v * 1e-3;
+        } else if (k.rfind("tilt_", 0) == 0 && k.size() > 12) {
+          const int jj = axis_of(k[5]), ii = axis_of(k[12]);
+          if (jj >= 0 && ii >= 0 && owner(meta, jj) >= 0) e[owner(meta, jj)](ii, jj) += v * 1e-3;
+        }
+      }
+    } else if (ef.name == "sensor.cross_coupling") {
+      for (const auto& [k, v] : p) {
+        int i = 0, j = 0;
+        if (two_axes(k, "cross_", i, j) && owner(meta, i) >= 0) e[owner(meta, i)](i, j) += v * 1e-6, e[owner(meta, i)](j, i) += v * 1e-6;
+      }
+    } else if (ef.name == "sensor.nonlinearity") {
+      for (const auto& [k, v] : p) {
+        const int a = k.size() > 3 ? axis_of(k[3]) : -1;
+        if (a < 0 || owner(meta, a) < 0) continue;
+        auto& sp = x.sensors[owner(meta, a)];
+        if (k.rfind("k2_", 0) == 0) sp.k2_g_per_g2[a] += v * 1e-6;
+        if (k.rfind("k3_", 0) == 0) sp.k3_g_per_g3[a] += v * 1e-6;
+      }
+    } else if (ef.name == "sensor.dynamics") {
+      for (int s = 0; s < 2; ++s) {
+        const std::string who = s == 0 ? "table" : "head";
+        auto it = p.find("damping_term_error_us_after_delay");
+        if (it == p.end()) it = p.find("damping_term_error_us_" + who);
+        if (it == p.end()) continue;
+        auto& sp = x.sensors[s];
+        const double w0 = 2.0 * std::numbers::pi * sp.f0_hz;
+        sp.zeta = std::max(0.0, (2.0 * sp.zeta / w0 - it->second * 1e-6) * w0 / 2.0);
+      }
+      x.notes.push_back("sensor.dynamics: 2ζ/ω0 into ζ (f0 kept)");
+    } else if (ef.name == "daq.group_delay") {
+      if (auto it = p.find("group_delay_samples"); it != p.end()) x.daq_group_delay_samples = it->second, x.delay_changed = true;
+      if (auto it = p.find("skew_head_samples"); it != p.end() && std::abs(it->second) > 0.3)
+        x.daq_skew_head_samples += it->second, x.skew_changed = true;
+    } else if (ef.name == "sensor.damping_amplitude") {
+      // Per axis fitted; per sensor the mean over the axes it moves (one ζ(|a|) law per sensor).
+      double sum[2] = {0.0, 0.0};
+      int cnt[2] = {0, 0};
+      for (const auto& [k, v] : p)
+        if (k.rfind("zeta_per_g_", 0) == 0 && k.size() == 12) {
+          const int a = axis_of(k[11]);
+          if (a >= 0 && owner(meta, a) >= 0) sum[owner(meta, a)] += v, ++cnt[owner(meta, a)];
+        }
+      for (int s = 0; s < 2; ++s)  // a sensor whose own axes stay in the band keeps its law
+        if (cnt[s] && std::abs(sum[s] / cnt[s]) > ef.tolerance) x.sensors[s].zeta_per_g += sum[s] / cnt[s];
+    } else if (ef.name.rfind("sensor.", 0) == 0 || ef.name == "site.coriolis") {
+      x.notes.push_back(ef.name + ": found; the pipeline does not compensate it from a calibration (yet)");
+    }
+  }
+  for (int s = 0; s < 2; ++s)
+    if (e[s].cwiseAbs().maxCoeff() > 0.0) x.sensors[s].to_machine = (Eigen::Matrix3d::Identity() + e[s]).inverse() * x.sensors[s].to_machine;
+  return x;
+}
+
+}  // namespace eical::dsp::model

@@ -1,0 +1,193 @@
+#include "dsp/model/run_residuals.hpp"
+
+#include "dsp/core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace eical::dsp::model {
+namespace {
+
+int axis_index(const std::string& a) { return a == "x" ? 0 : a == "y" ? 1 : a == "z" ? 2 : -1; }
+
+// Linear interpolation of a column of a trace at a fractional position (clamped).
+double at(const std::vector<Eigen::Vector3d>& x, double pos, int axis) {
+  if (x.empty()) return NAN;
+  if (pos <= 0.0) return x.front()[axis];
+  const auto i = static_cast<std::size_t>(pos);
+  if (i + 1 >= x.size()) return x.back()[axis];
+  const double f = pos - static_cast<double>(i);
+  return (1.0 - f) * x[i][axis] + f * x[i + 1][axis];
+}
+
+void add_row(Channel& c, int sample, int axis, double r_um, double sigma_um, std::vector<double>& r, std::vector<double>& s) {
+  c.sample.push_back(sample), c.axis.push_back(axis);
+  r.push_back(r_um), s.push_back(sigma_um);
+}
+
+void finish(Channel& c, const std::vector<double>& r, const std::vector<double>& s) {
+  c.residual_um = Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()));
+  c.sigma_um = Eigen::Map<const Eigen::VectorXd>(s.data(), static_cast<Eigen::Index>(s.size()));
+}
+
+}  // namespace
+
+RunResiduals build_residuals(const Run& run) {
+  if (run.frames.empty()) throw InputError("explain: run '" + run.meta.id + "' holds no frames");
+  RunResiduals d;
+  d.run_id = run.meta.id;
+  d.meta = run.meta;
+  PipelineConfig cfg = pipeline_config(run.meta, run.frames.size());
+  cfg.keep_raw = true;
+  cfg.cupt = false;  // the strips are a reference here
+  cfg.nbs = run.meta.program.kind == "rectangle";
+  Pipeline pipe(cfg);
+  for (const auto& f : run.frames) pipe.step(f);
+  d.measurement = pipe.finish();
+  const Measurement& m = d.measurement;
+  if (m.sample_index.size() < 100 || m.raw.empty()) throw InputError("explain: run '" + run.meta.id + "' has no motion to explain");
+  d.fs_hz = m.fs_hz;
+  d.delay_samples = run.meta.acquisition.daq_group_delay_samples;
+  const std::size_t n_full = m.sample_index.size();
+  const auto step = static_cast<std::size_t>(std::max(1.0, std::round(m.fs_hz / 1000.0)));
+  d.dt_s = static_cast<double>(step) / m.fs_hz;
+  for (std::size_t k = 0; k < n_full; k += step) d.trace.push_back(k);
+  d.n = static_cast<int>(d.trace.size());
+  const Eigen::Index n = d.n;
+
+  // Set-point kinematics (full rate, central differences), then decimated.
+  std::vector<Eigen::Vector3d> v_cmd(n_full, Eigen::Vector3d::Zero()), a_cmd(n_full, Eigen::Vector3d::Zero());
+  for (std::size_t k = 1; k + 1 < n_full; ++k) {
+    v_cmd[k] = (m.cmd_mm[k + 1] - m.cmd_mm[k - 1]) * (m.fs_hz / 2.0);
+    a_cmd[k] = (m.cmd_mm[k + 1] - 2.0 * m.cmd_mm[k] + m.cmd_mm[k - 1]) * (m.fs_hz * m.fs_hz);
+  }
+  d.cmd.resize(n, 3), d.v_cmd.resize(n, 3), d.a_cmd.resize(n, 3), d.x_meas.resize(n, 3), d.v_meas.resize(n, 3), d.a_meas.resize(n, 3);
+  d.temp_c.resize(n, 2);
+  d.t_s.resize(n);
+  d.segment.assign(static_cast<std::size_t>(n), 0);
+  std::vector<std::int64_t> marks;
+  for (const auto& t : m.triggers)
+    if (t.code == 102) marks.push_back(t.sample_index);
+  const std::int64_t first_frame = run.frames.front().sample_index;
+  const double dly = d.delay_samples;
+  float t0[2] = {NAN, NAN};
+  for (Eigen::Index s = 0; s < n; ++s) {
+    const std::size_t k = d.trace[static_cast<std::size_t>(s)];
+    const double ks = static_cast<double>(k) + dly;  // the same moment in the sensors' time
+    for (int a = 0; a < 3; ++a) {
+      d.cmd(s, a) = m.cmd_mm[k][a];
+      d.v_cmd(s, a) = v_cmd[k][a];
+      d.a_cmd(s, a) = a_cmd[k][a];
+      d.x_meas(s, a) = m.pos_mm[k][a];
+      d.v_meas(s, a) = m.vel_mm_s[k][a];
+      d.a_meas(s, a) = (at(m.raw.head_mps2, ks, a) - at(m.raw.table_mps2, ks, a)) * 1000.0;  // mm/s²
+    }
+    d.t_s[s] = static_cast<double>(m.sample_index[k] - m.sample_index.front()) / m.fs_hz;
+    const auto fi = static_cast<std::size_t>(std::clamp<std::int64_t>(m.sample_index[k] - first_frame, 0, static_cast<std::int64_t>(run.frames.size()) - 1));
+    for (int sn = 0; sn < 2; ++sn) {
+      if (std::isnan(t0[sn])) t0[sn] = run.frames[fi].temp_c[sn];
+      d.temp_c(s, sn) = std::isfinite(run.frames[fi].temp_c[sn]) ? static_cast<double>(run.frames[fi].temp_c[sn] - t0[sn]) : 0.0;
+    }
+    d.segment[static_cast<std::size_t>(s)] =
+        static_cast<int>(std::upper_bound(marks.begin(), marks.end(), m.sample_index[k]) - marks.begin());
+  }
+  for (int a = 0; a < 3; ++a) {
+    const double lo = d.cmd.col(a).minCoeff(), hi = d.cmd.col(a).maxCoeff();
+    for (const auto& ax : run.meta.machine.table_axes)
+      if (axis_index(ax) == a) d.owner[a] = 0;
+    for (const auto& ax : run.meta.machine.head_axes)
+      if (axis_index(ax) == a) d.owner[a] = 1;
+    d.moving[a] = hi - lo > 0.5 && d.owner[a] >= 0;
+    bool finite = run.channels.ref[a];
+    for (Eigen::Index s = 0; s < n && finite; ++s) finite = std::isfinite(m.ref_mm[d.trace[static_cast<std::size_t>(s)]][a]);
+    d.has_ref[a] = finite;
+  }
+  for (const auto& p : run.meta.psd) {
+    const int a = axis_index(p.measures);
+    if (a >= 0) d.has_psd[a] = true;
+  }
+  d.reference = (d.has_ref[0] || d.has_ref[1] || d.has_ref[2]) ? "ref" : (d.has_psd[0] || d.has_psd[1]) ? "psd" : "cmd";
+
+  // Held out of the fits: every other stretch between M102 marks, or every other half second.
+  int max_seg = 0;
+  for (int sg : d.segment) max_seg = std::max(max_seg, sg);
+  d.heldout.resize(static_cast<std::size_t>(n));
+  for (Eigen::Index s = 0; s < n; ++s)
+    d.heldout[static_cast<std::size_t>(s)] = max_seg >= 3 ? d.segment[static_cast<std::size_t>(s)] % 2 == 1 : static_cast<int>(d.t_s[s] / 0.5) % 2 == 1;
+
+  // The tracks: the integrated motion as it was integrated (sensor time, moved onto the
+  // set-point's time), the standstills the pipeline found, the moves' starts.
+  namespace sf = fusion::schedule_flag;
+  const auto& sched = m.raw.schedule;
+  const auto ns = static_cast<double>(sched.flags.size());
+  auto sensor_pos = [&](Eigen::Index s) { return static_cast<double>(d.trace[static_cast<std::size_t>(s)]) + dly; };
+  std::vector<Eigen::Vector3d> x_ins(static_cast<std::size_t>(n)), v_ins(static_cast<std::size_t>(n));
+  std::vector<std::uint8_t> zupt(static_cast<std::size_t>(n), 0), bias_step(static_cast<std::size_t>(n), 0);
+  std::size_t prev_k = 0;
+  for (Eigen::Index s = 0; s < n; ++s) {
+    const double ks = sensor_pos(s);
+    for (int a = 0; a < 3; ++a) x_ins[static_cast<std::size_t>(s)][a] = at(m.raw.pos_mm, ks, a), v_ins[static_cast<std::size_t>(s)][a] = at(m.raw.vel_mm_s, ks, a);
+    const auto k = static_cast<std::size_t>(std::clamp(std::round(ks), 0.0, ns - 1.0));
+    zupt[static_cast<std::size_t>(s)] = (sched.flags[k] & sf::rest) && k < sched.zupt_sigma_um_s.size() && sched.zupt_sigma_um_s[k] == 0.0F;
+    for (std::size_t j = s == 0 ? k : prev_k + 1; j <= k && j < sched.flags.size(); ++j)
+      if (sched.flags[j] & sf::move_start) bias_step[static_cast<std::size_t>(s)] = 1;
+    prev_k = k;
+  }
+  // PSD readings per axis (every 10th of each strip), on the set-point's time.
+  std::vector<std::vector<const fusion::PositionFix*>> fixes(3);
+  std::vector<int> count(run.meta.psd.size() + 1, 0);
+  for (const auto& fx : sched.fixes) {
+    if (fx.strip < 0 || static_cast<std::size_t>(fx.strip) >= run.meta.psd.size()) continue;
+    if (count[static_cast<std::size_t>(fx.strip)]++ % 10 != 0) continue;
+    fixes[static_cast<std::size_t>(fx.axis)].push_back(&fx);
+  }
+  std::vector<double> mr, ms, pr, ps;
+  d.machine.name = "machine", d.pipeline.name = "pipeline";
+  for (int a = 0; a < 3; ++a) {
+    AxisTrack& t = d.tracks[static_cast<std::size_t>(a)];
+    t.present = true;
+    t.h_s = Eigen::VectorXd::Constant(n, d.dt_s);
+    for (Eigen::Index s = 1; s < n; ++s)
+      t.h_s[s] = static_cast<double>(m.sample_index[d.trace[static_cast<std::size_t>(s)]] - m.sample_index[d.trace[static_cast<std::size_t>(s - 1)]]) / m.fs_hz;
+    t.bias_step = bias_step, t.zupt = zupt;
+    t.v_um_s.resize(n);
+    for (Eigen::Index s = 0; s < n; ++s) t.v_um_s[s] = v_ins[static_cast<std::size_t>(s)][a] * 1000.0;
+    if (d.has_ref[a]) {
+      d.axis_reference[static_cast<std::size_t>(a)] = "ref";
+      for (Eigen::Index s = 0; s < n; ++s) {
+        const std::size_t k = d.trace[static_cast<std::size_t>(s)];
+        const double ref = m.ref_mm[k][a];
+        t.obs.push_back({static_cast<int>(s), (x_ins[static_cast<std::size_t>(s)][a] - ref) * 1000.0, 0.1, d.heldout[static_cast<std::size_t>(s)], -1});
+        add_row(d.machine, static_cast<int>(s), a, (ref - m.cmd_mm[k][a]) * 1000.0, 0.2, mr, ms);
+        add_row(d.pipeline, static_cast<int>(s), a, (m.pos_mm[k][a] - ref) * 1000.0, 1.0, pr, ps);
+      }
+    } else if (!fixes[static_cast<std::size_t>(a)].empty()) {
+      d.axis_reference[static_cast<std::size_t>(a)] = "psd";
+      std::vector<int> tag_of(run.meta.psd.size(), -1);
+      for (const auto* fx : fixes[static_cast<std::size_t>(a)]) {
+        const double pos = static_cast<double>(fx->k) - dly;  // on the set-point's time
+        const auto s = static_cast<int>(std::lround(pos / static_cast<double>(step)));
+        if (s < 0 || s >= n) continue;
+        auto& tag = tag_of[static_cast<std::size_t>(fx->strip)];
+        if (tag < 0) tag = t.tags++;
+        t.obs.push_back({s, m.raw.pos_mm[fx->k][a] * 1000.0 - fx->position_um, std::hypot(fx->sigma_um, 0.05), d.heldout[static_cast<std::size_t>(s)], tag});
+        const double c = at(m.cmd_mm, pos, a) * 1000.0;
+        add_row(d.machine, s, a, fx->position_um - c, std::hypot(fx->sigma_um, 0.2), mr, ms);
+        add_row(d.pipeline, s, a, at(m.pos_mm, pos, a) * 1000.0 - fx->position_um, 1.0, pr, ps);
+      }
+      std::stable_sort(t.obs.begin(), t.obs.end(), [](const auto& x, const auto& y) { return x.sample < y.sample; });
+    } else {
+      d.axis_reference[static_cast<std::size_t>(a)] = "cmd";
+      for (Eigen::Index s = 0; s < n; ++s) {
+        const std::size_t k = d.trace[static_cast<std::size_t>(s)];
+        t.obs.push_back({static_cast<int>(s), (x_ins[static_cast<std::size_t>(s)][a] - m.cmd_mm[k][a]) * 1000.0, 0.5, d.heldout[static_cast<std::size_t>(s)], -1});
+        add_row(d.pipeline, static_cast<int>(s), a, (m.pos_mm[k][a] - m.cmd_mm[k][a]) * 1000.0, 1.0, pr, ps);
+      }
+    }
+  }
+  finish(d.machine, mr, ms);
+  finish(d.pipeline, pr, ps);
+  return d;
+}
+
+}  // namespace eical::dsp::model

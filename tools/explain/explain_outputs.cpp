@@ -1,0 +1,193 @@
+#include "tools/explain/explain_outputs.hpp"
+
+#include "tools/explain/extended_model.hpp"
+#include "tools/report/html.hpp"
+#include "tools/report/svg.hpp"
+
+#include <unsupported/Eigen/FFT>
+
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <algorithm>
+#include <map>
+
+namespace eical::tools::explain {
+namespace {
+
+std::string report_fmt(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
+nlohmann::json effect_json(const dsp::model::ExplainedEffect& e) {
+  nlohmann::json p = nlohmann::json::object();
+  for (const auto& [k, v] : e.params) p[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+  return {{"name", e.name},
+          {"significant", e.significant},
+          {"evidence", e.evidence},
+          {"params", p},
+          {"channel", e.channel},
+          {"size", e.magnitude},
+          {"tolerance", e.tolerance},
+          {"unit", e.unit},
+          {"bic_drop", e.bic_drop},
+          {"residual_rms_before_um", e.residual_rms_before_um},
+          {"residual_rms_after_um", e.residual_rms_after_um},
+          {"heldout_rms_before_um", e.heldout_rms_before_um},
+          {"heldout_rms_after_um", e.heldout_rms_after_um}};
+}
+
+}  // namespace
+
+nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex) {
+  nlohmann::json j;
+  j["format"] = "eical-explain/1";
+  j["runs"] = nlohmann::json::array();
+  for (const auto& r : runs) j["runs"].push_back(r.meta.id);
+  std::string reference = ex.empty() ? "cmd" : ex.front().reference;
+  for (const auto& e : ex)
+    if (e.reference != reference) reference = "mixed";
+  j["reference"] = reference;
+  // Over all runs: an effect is significant when it is in any run; its figures are from
+  // the run where it explains most.
+  std::vector<dsp::model::ExplainedEffect> merged;
+  double before = 0.0, after = 0.0, hb = 0.0, ha = 0.0, seconds = 0.0;
+  for (const auto& r : ex) {
+    before += r.nominal_residual_rms_um * r.nominal_residual_rms_um, after += r.final_residual_rms_um * r.final_residual_rms_um;
+    hb += r.heldout_nominal_rms_um * r.heldout_nominal_rms_um, ha += r.heldout_final_rms_um * r.heldout_final_rms_um;
+    seconds += r.seconds;
+    for (const auto& e : r.effects) {
+      auto it = std::find_if(merged.begin(), merged.end(), [&](const auto& m) { return m.name == e.name; });
+      if (it == merged.end()) merged.push_back(e);
+      else if ((e.significant && !it->significant) || (e.significant == it->significant && e.importance_um > it->importance_um)) *it = e;
+    }
+  }
+  std::stable_sort(merged.begin(), merged.end(), [](const auto& a, const auto& b) {
+    if (a.significant != b.significant) return a.significant;
+    return a.significant ? a.importance_um > b.importance_um : a.bic_drop > b.bic_drop;
+  });
+  const double n = std::max<double>(1.0, static_cast<double>(ex.size()));
+  j["nominal_residual_rms_um"] = std::sqrt(before / n);
+  j["effects"] = nlohmann::json::array();
+  for (const auto& e : merged) j["effects"].push_back(effect_json(e));
+  j["final_residual_rms_um"] = std::sqrt(after / n);
+  j["heldout_nominal_residual_rms_um"] = std::sqrt(hb / n);
+  j["heldout_final_residual_rms_um"] = std::sqrt(ha / n);
+  j["runtime_s_per_run"] = seconds / n;
+  j["per_run"] = nlohmann::json::array();
+  for (const auto& r : ex) {
+    nlohmann::json pr = {{"run_id", r.run_id},
+                         {"reference", r.reference},
+                         {"nominal_residual_rms_um", r.nominal_residual_rms_um},
+                         {"final_residual_rms_um", r.final_residual_rms_um},
+                         {"heldout_nominal_residual_rms_um", r.heldout_nominal_rms_um},
+                         {"heldout_final_residual_rms_um", r.heldout_final_rms_um},
+                         {"runtime_s", r.seconds}};
+    pr["significant"] = nlohmann::json::array();
+    for (const auto& e : r.effects)
+      if (e.significant) pr["significant"].push_back(e.name);
+    j["per_run"].push_back(pr);
+  }
+  return j;
+}
+
+std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex) {
+  std::string o;
+  char b[512];
+  for (const auto& r : ex) {
+    std::snprintf(b, sizeof b, "%s (compared with: %s): residual %.3f um RMS -> %.3f um with the significant effects (held out %.3f -> %.3f um), %.1f s\n",
+                  r.run_id.c_str(), r.reference.c_str(), r.nominal_residual_rms_um, r.final_residual_rms_um, r.heldout_nominal_rms_um,
+                  r.heldout_final_rms_um, r.seconds);
+    o += b;
+    int sig = 0;
+    for (const auto& e : r.effects) {
+      if (!e.significant) continue;
+      ++sig;
+      std::snprintf(b, sizeof b, "  %d. %s  [%s]  %s\n", sig, e.name.c_str(), e.channel.c_str(), e.evidence.c_str());
+      o += b;
+    }
+    if (sig == 0) o += "  no significant effect: the nominal model explains the run within its noise and the tolerance bands\n";
+  }
+  return o;
+}
+
+void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex, const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  for (std::size_t i = 0; i < runs.size() && i < ex.size(); ++i) {
+    const auto& r = ex[i];
+    report::Page page;
+    page.title = "What the simulation gets wrong";
+    page.run_id = r.run_id;
+    page.program = runs[i].meta.program.kind;
+    page.context = {{"compared with", r.reference},
+                    {"residual RMS (fitting)", report_fmt(r.nominal_residual_rms_um) + " -> " + report_fmt(r.final_residual_rms_um) + " um"},
+                    {"residual RMS (held out)", report_fmt(r.heldout_nominal_rms_um) + " -> " + report_fmt(r.heldout_final_rms_um) + " um"}};
+    // The effects, significant first.
+    report::Section table;
+    table.heading = "Effects tested";
+    table.lead = "each effect of the run format as a model extension: BIC with an effective sample count, a held-out guard, and the tolerance band";
+    report::Grid g;
+    g.header = {"", "effect", "size", "tolerance", "residual RMS before -> after (um)", "evidence"};
+    for (const auto& e : r.effects)
+      g.rows.push_back({e.significant ? "significant" : "", e.name, report_fmt(e.magnitude) + " " + e.unit, report_fmt(e.tolerance),
+                        report_fmt(e.residual_rms_before_um) + " -> " + report_fmt(e.residual_rms_after_um), e.evidence});
+    table.grids.push_back(g);
+    page.sections.push_back(table);
+    // Residuals before and after, per channel and axis, in time and frequency.
+    const char* axes[3] = {"x", "y", "z"};
+    for (const auto& tr : r.traces) {
+      report::Section s;
+      s.heading = "Residual, " + tr.channel;
+      s.lead = tr.channel == "sensor" ? "inertial minus the reference instrument: what the sensor model gets wrong"
+               : tr.channel == "machine" ? "reference minus the set-point: what the ideal machine gets wrong"
+                                          : "inertial minus the set-point: both";
+      for (int a = 0; a < 3; ++a) {
+        report::LineSeries before, after;
+        before.label = "nominal model", before.color = report::kRed;
+        after.label = "with the significant effects", after.color = report::kBlue;
+        std::vector<double> yb;
+        for (std::size_t k = 0; k < tr.t_s.size(); ++k) {
+          if (tr.axis[k] != a) continue;
+          before.x.push_back(tr.t_s[k]), before.y.push_back(tr.before_um[k]);
+          after.x.push_back(tr.t_s[k]), after.y.push_back(tr.after_um[k]);
+        }
+        if (before.x.size() < 16) continue;
+        s.svgs.push_back(report::line_plot({before, after}, std::string(axes[a]) + ": residual in time", "time (s)", "residual (um)"));
+        // Amplitude spectrum of both (the samples are at ~1 kHz, not exactly uniform where thinned).
+        const std::size_t m = before.y.size();
+        std::size_t nfft = 1;
+        while (nfft * 2 <= m) nfft *= 2;
+        const double dt = (before.x[nfft - 1] - before.x[0]) / static_cast<double>(nfft - 1);
+        Eigen::FFT<double> fft;
+        report::LineSeries sb, sa;
+        sb.label = before.label, sb.color = before.color, sa.label = after.label, sa.color = after.color;
+        for (auto* pr : {&before, &after}) {
+          std::vector<double> in(pr->y.begin(), pr->y.begin() + static_cast<std::ptrdiff_t>(nfft));
+          std::vector<std::complex<double>> out;
+          fft.fwd(out, in);
+          auto& dst = pr == &before ? sb : sa;
+          for (std::size_t f = 1; f < nfft / 2; ++f) {
+            dst.x.push_back(static_cast<double>(f) / (static_cast<double>(nfft) * dt));
+            dst.y.push_back(2.0 * std::abs(out[f]) / static_cast<double>(nfft));
+          }
+        }
+        s.svgs.push_back(report::line_plot({sb, sa}, std::string(axes[a]) + ": residual amplitude spectrum", "frequency (Hz)", "amplitude (um)"));
+      }
+      page.sections.push_back(s);
+    }
+    const auto model = extended_model(runs[i], r);
+    report::Section ext;
+    ext.heading = "The extended model";
+    ext.lead = "the significant sensor effects as a sensor calibration, the machine effects as a scenario the simulator reproduces the run with";
+    ext.notes = model.notes;
+    page.files.push_back(r.run_id + "-calibration.toml");
+    page.files.push_back(r.run_id + "-scenario.toml");
+    page.sections.push_back(ext);
+    report::write_html(page, dir / (r.run_id + ".html"));
+    write_extended_model(model, dir / (r.run_id + "-calibration.toml"), dir / (r.run_id + "-scenario.toml"));
+  }
+}
+
+}  // namespace eical::tools::explain

@@ -1,0 +1,114 @@
+#include "tools/explain/extended_model.hpp"
+
+#include "drivers/run_io/run_writer.hpp"
+#include "dsp/model/extension.hpp"
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+namespace eical::tools::explain {
+namespace {
+
+int axis_of(char c) { return c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1; }
+
+std::string num(double v) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+// The parameter's axis letters after a prefix, e.g. "rotation_xy_mrad" → ('x', 'y').
+bool two_axes(const std::string& name, const std::string& prefix, int& a, int& b) {
+  if (name.rfind(prefix, 0) != 0 || name.size() < prefix.size() + 2) return false;
+  a = axis_of(name[prefix.size()]), b = axis_of(name[prefix.size() + 1]);
+  return a >= 0 && b >= 0;
+}
+
+}  // namespace
+
+ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanation& ex) {
+  ExtendedModel m;
+  const dsp::RunMeta& meta = run.meta;
+  auto& cal = m.calibration;
+  cal.method = "explain";
+  cal.run_id = meta.id;
+  for (int s = 0; s < 2; ++s) cal.sensors[s] = meta.sensors[s];
+  const dsp::model::Extension ext = dsp::model::extend_sensors(meta, ex.effects);
+  for (int s = 0; s < 2; ++s) cal.sensors[s] = ext.sensors[s];
+  if (ext.delay_changed) cal.daq_group_delay_samples = ext.daq_group_delay_samples;
+  if (ext.skew_changed) cal.daq_skew_head_samples = ext.daq_skew_head_samples;
+  m.notes = ext.notes;
+  std::string effects_toml, servo_toml;
+  for (const auto& x : ex.effects) {
+    if (!x.significant) continue;
+    const auto& p = x.params;
+    if (x.name.rfind("sensor.", 0) == 0 || x.name == "daq.group_delay" || x.name == "site.coriolis") {
+      continue;
+    } else if (x.name == "machine.backlash") {
+      for (const auto& [k, v] : p)
+        if (k.rfind("backlash_", 0) == 0)
+          effects_toml += "\n[effects.\"machine.backlash\"]\naxis = \"" + std::string(1, k[9]) + "\"\nvalue_um = " + num(std::abs(v)) + "\n";
+    } else if (x.name == "machine.reversal_spike") {
+      for (const auto& [k, v] : p)
+        if (k.rfind("spike_", 0) == 0) {
+          const auto tau = k.find("tau_");
+          const double tau_ms = tau == std::string::npos ? 15.0 : std::atof(k.c_str() + tau + 4);
+          effects_toml += "\n[effects.\"machine.reversal_spike\"]\naxis = \"" + std::string(1, k[6]) + "\"\namp_um = " + num(std::abs(v)) +
+                          "\ntau_ms = " + num(tau_ms) + "\n";
+        }
+    } else if (x.name == "machine.squareness") {
+      for (const auto& [k, v] : p) {
+        int i = 0, j = 0;
+        if (!two_axes(k, "squareness_", i, j)) continue;
+        const char* plane = (i == 0 && j == 1) ? "xy" : (i == 1 && j == 2) ? "yz" : "zx";
+        effects_toml += "\n[effects.\"machine.squareness\"]\nplane = \"" + std::string(plane) + "\"\nvalue_urad = " + num(v) + "\n";
+      }
+    } else if (x.name == "machine.scale_mismatch") {
+      for (const auto& [k, v] : p)
+        if (k.rfind("scale_", 0) == 0)
+          effects_toml += "\n[effects.\"machine.scale_mismatch\"]\naxis = \"" + std::string(1, k[6]) + "\"\nvalue_ppm = " + num(v) + "\n";
+    } else if (x.name == "machine.cyclic_error") {
+      for (const auto& [k, v] : p) {
+        if (k.rfind("cyclic_", 0) != 0 || k.find("_sin_um") == std::string::npos) continue;
+        const std::string base = k.substr(0, k.size() - 7);
+        const auto c = p.find(base + "_cos_um");
+        const double cs = c == p.end() ? 0.0 : c->second;
+        const auto pos = base.find("pitch_");
+        const double pitch = pos == std::string::npos ? 10.0 : std::atof(base.c_str() + pos + 6);
+        effects_toml += "\n[effects.\"machine.cyclic_error\"]\naxis = \"" + std::string(1, k[7]) + "\"\namp_um = " + num(std::hypot(v, cs)) +
+                        "\npitch_mm = " + num(pitch) + "\nphase_deg = " + num(std::atan2(cs, v) * 180.0 / std::numbers::pi) + "\n";
+      }
+    } else {
+      m.notes.push_back(x.name + ": found; not taken into the scenario (its shape is not one of the simulator's tables)");
+    }
+    if (x.name.rfind("machine.", 0) == 0) m.notes.push_back(x.name + ": into the scenario");
+  }
+  // The axes' lags as position loops (feed-forward assumed 99 %).
+  for (const auto& x : ex.effects)
+    if (x.name == "machine.servo_mismatch")
+      for (const auto& [k, v] : x.params)
+        if (k.rfind("lag_", 0) == 0 && v > 1e-4) servo_toml += "\n[servo." + std::string(1, k[4]) + "]\nkv_per_s = " + num(0.01 / (v * 1e-3)) + "\nfeedforward = 0.99\n";
+  // The scenario: what eical is told = the extended sensors (so they are also the truth).
+  dsp::RunMeta sm = meta;
+  for (int s = 0; s < 2; ++s) sm.sensors[s] = cal.sensors[s];
+  if (cal.daq_group_delay_samples) sm.acquisition.daq_group_delay_samples = *cal.daq_group_delay_samples;
+  if (cal.daq_skew_head_samples) sm.acquisition.daq_skew_head_samples = *cal.daq_skew_head_samples;
+  std::string text = drivers::run_toml_text(sm);
+  const auto eol = text.find('\n');
+  text = "format = \"eical-scenario/1\"\nname = \"explained-" + meta.id + "\"\ndescription = \"what eical explain found in " + meta.id + "\"" +
+         text.substr(eol);
+  if (const auto c = text.find("\ncreated = "); c != std::string::npos) text.erase(c, text.find('\n', c + 1) - c);
+  m.scenario_toml = "# Written by eical explain: the run's program with the effects it found; eical simulate --scenario this-file -o RUN\n" + text +
+                    servo_toml + effects_toml;
+  return m;
+}
+
+void write_extended_model(const ExtendedModel& m, const std::filesystem::path& calibration_file, const std::filesystem::path& scenario_file) {
+  drivers::write_sensor_calibration(m.calibration, calibration_file);
+  drivers::write_text_atomic(scenario_file, m.scenario_toml);
+}
+
+}  // namespace eical::tools::explain
