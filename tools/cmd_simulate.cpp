@@ -62,7 +62,7 @@ void register_simulate(CLI::App& app) {
       sc = drivers::read_scenario_file(o->scenario);
     } else if (!o->hide.empty() || o->background) {
       const bool chosen = o->program == "circle" || o->program == "step";
-      const std::string kind = o->hide.empty() ? (chosen ? o->program : "circle") : (program_given && chosen ? o->program : sim::program_for(o->hide.front()));
+      const std::string kind = o->hide.empty() ? (chosen ? o->program : "circle") : (program_given && chosen ? o->program : sim::program_for(o->hide));
       if (program_given && !chosen) throw dsp::InputError("simulate --hide/--background: --program must be circle or step");
       sc = sim::hidden_effect_scenario(o->hide, kind, o->seed);
     } else {

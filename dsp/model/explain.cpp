@@ -290,20 +290,26 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
       // What each sensor's own timing is once the delay is known. Both sensors off by the
       // same: their dynamics (2ζ/ω0); the head off against the table: the DAQ's skew between
       // their channels (run-format: "table and head channels are skewed in time") — the
-      // simpler of two explanations when the DAQ already shows a delay error.
+      // simpler of two explanations only when the DAQ already shows a delay error; else one
+      // sensor's own dynamics.
       if (dyn) {
         const double delay_us = -dd * 1e6 / rr.fs_hz;
         double own[2] = {NAN, NAN};
         for (int s2 = 0; s2 < 2; ++s2)
           if (auto it = dyn->params.find(std::string("damping_term_error_us_") + (s2 == 0 ? "table" : "head")); it != dyn->params.end())
             own[s2] = it->second - delay_us;
-        const double base = std::isfinite(own[0]) ? own[0] : own[1];
+        double base = std::isfinite(own[0]) ? own[0] : own[1];
         if (std::isfinite(own[0]) && std::isfinite(own[1])) {
           const double skew = -(own[1] - own[0]) * rr.fs_hz / 1e6;  // head later, samples
-          d.params["skew_head_samples"] = skew;
-          if (std::abs(skew) > 0.3) {
+          // The DAQ shown off: its delay error beyond the tolerance by two standard errors.
+          const bool daq_off = std::abs(dd) > d.tolerance && std::abs(dd) > 2.0 * de.sigma;
+          if (!daq_off) {
+            // The larger of the two sensors' own timing errors.
+            if (std::abs(own[1]) > std::abs(own[0])) base = own[1];
+          } else if (std::abs(skew) > 0.3) {
+            d.params["skew_head_samples"] = skew;
             d.magnitude = std::max(d.magnitude, std::abs(skew));
-            d.significant = d.significant || (dyn->bic_drop > o.min_bic_drop && std::abs(skew) > d.tolerance);
+            d.significant = dyn->bic_drop > o.min_bic_drop;
             d.evidence += fmt("; the head's channels lag the table's by %.2f samples more", skew);
           }
         }

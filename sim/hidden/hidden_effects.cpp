@@ -227,6 +227,12 @@ std::string program_for(const std::string& e) {
   return std::find(step.begin(), step.end(), e) != step.end() ? "step" : "circle";
 }
 
+std::string program_for(const std::vector<std::string>& effects) {
+  for (const auto& e : effects)
+    if (program_for(e) == "circle") return "circle";
+  return effects.empty() ? "circle" : "step";
+}
+
 Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const std::string& kind, std::uint64_t seed) {
   Draw d(stream_seed(seed, 7001));
   Scenario sc;

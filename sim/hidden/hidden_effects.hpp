@@ -27,6 +27,9 @@ const std::vector<std::string>& hidden_programs();
 // The program an effect shows itself in best (circle for the geometry and the loops, step
 // for what needs acceleration or standstills).
 std::string program_for(const std::string& effect);
+// Several effects: a circle when any of them needs two moving axes (geometry, loops),
+// else the step.
+std::string program_for(const std::vector<std::string>& effects);
 
 // Every effect name of run-format.md's table that can be hidden.
 const std::vector<std::string>& hideable_effects();
