@@ -9,6 +9,7 @@
 #include "tools/commands.hpp"
 #include "tools/explain/explain_outputs.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 
@@ -32,10 +33,17 @@ void register_explain(CLI::App& app) {
       runs.push_back(drivers::read_run(path));
       ex.push_back(dsp::model::explain_run(runs.back()));
     }
-    const nlohmann::json doc = explain::explain_json(runs, ex);
+    // Held out across runs: what one run's explanation took into the model, on the others
+    // (runs of the same machine: the same sensors and DAQ).
+    std::vector<dsp::model::TransferGain> transfers;
+    for (std::size_t i = 0; i < runs.size(); ++i)
+      for (std::size_t j = 0; j < runs.size(); ++j)
+        if (i != j && std::any_of(ex[i].effects.begin(), ex[i].effects.end(), [](const auto& e) { return e.taken_into_model; }))
+          transfers.push_back(dsp::model::transfer_gain(runs[j], ex[i]));
+    const nlohmann::json doc = explain::explain_json(runs, ex, transfers);
     if (!o->report.empty()) explain::write_explain_report(runs, ex, o->report);
     if (o->json) std::printf("%s\n", doc.dump(2).c_str());
-    else std::fputs(explain::explain_text(ex).c_str(), stdout);
+    else std::fputs(explain::explain_text(ex, transfers).c_str(), stdout);
   });
 }
 

@@ -202,7 +202,7 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     double m = 0.0;
     for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
     Attribution a = attr("sensor.nonlinearity", m, 200.0, "1e-6/g", "the doubly integrated square and cube of the acceleration");
-    a.plausible_max = 1e4;  // 1 %/g: fifty times a servo accelerometer's data-sheet band
+    a.plausible_max = 2e4;  // 2 %/g: a hundred times a servo accelerometer's data-sheet band
     a.params = v;
     out.push_back(a);
   } else if (group == "timing") {

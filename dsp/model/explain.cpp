@@ -147,6 +147,60 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
   return out;
 }
 
+// A channel's residual with each axis' offset taken out (the reference's zero is arbitrary).
+Eigen::VectorXd offsets_out(const Channel& ch) {
+  Eigen::VectorXd v = ch.residual_um;
+  for (int a = 0; a < 3; ++a) {
+    double sum = 0.0;
+    int cnt = 0;
+    for (Eigen::Index i = 0; i < ch.rows(); ++i)
+      if (ch.axis[static_cast<std::size_t>(i)] == a) sum += v[i], ++cnt;
+    for (Eigen::Index i = 0; i < ch.rows(); ++i)
+      if (cnt && ch.axis[static_cast<std::size_t>(i)] == a) v[i] -= sum / cnt;
+  }
+  return v;
+}
+
+// RMS over the rows of the axes the program moves.
+double moving_axes_rms(const RunResiduals& rr, const Eigen::VectorXd& v, const Channel& ch) {
+  double sum = 0.0;
+  std::size_t cnt = 0;
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (rr.moving[ch.axis[static_cast<std::size_t>(i)]]) sum += v[i] * v[i], ++cnt;
+  return cnt ? std::sqrt(sum / static_cast<double>(cnt)) : 0.0;
+}
+
+// The run with the sensor-side extensions of `taken` in its meta.
+Run extended_run(const Run& run, const std::vector<ExplainedEffect>& taken) {
+  const Extension ext = extend_sensors(run.meta, taken);
+  Run extended = run;
+  for (int s = 0; s < 2; ++s) extended.meta.sensors[s] = ext.sensors[s];
+  extended.meta.acquisition.daq_group_delay_samples = ext.daq_group_delay_samples;
+  extended.meta.acquisition.daq_skew_head_samples = ext.daq_skew_head_samples;
+  return extended;
+}
+
+}  // namespace
+
+TransferGain transfer_gain(const Run& to, const RunExplanation& from) {
+  TransferGain g;
+  g.from_run = from.run_id, g.to_run = to.meta.id;
+  std::vector<ExplainedEffect> taken;
+  for (const auto& e : from.effects)
+    if (e.taken_into_model) taken.push_back(e);
+  const RunResiduals before = build_residuals(to);
+  g.before_um = moving_axes_rms(before, offsets_out(before.pipeline), before.pipeline);
+  if (taken.empty()) {
+    g.after_um = g.before_um;
+    return g;
+  }
+  const RunResiduals after = build_residuals(extended_run(to, taken));
+  g.after_um = moving_axes_rms(after, offsets_out(after.pipeline), after.pipeline);
+  return g;
+}
+
+namespace {
+
 void merge(std::vector<ExplainedEffect>& all, ExplainedEffect e) {
   for (auto& a : all) {
     if (a.name != e.name) continue;
@@ -232,6 +286,7 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
     for (const auto& at : atts) {
       ExplainedEffect x;
       x.name = at.name, x.params = at.params, x.magnitude = at.magnitude, x.tolerance = at.tolerance, x.unit = at.unit;
+      if (v.accepted) x.params["model_group_accepted"] = 1.0;  // its values are part of the fitted model
       x.channel = is_sensor ? rr.reference : "total";
       x.bic_drop = v.bic_drop;
       x.residual_rms_before_um = v.fit_rms_before_um, x.residual_rms_after_um = v.fit_rms_after_um;
@@ -355,7 +410,10 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
     b.magnitude = sb.largest_change_ug, b.significant = sb.changed;
     b.bic_drop = sb.chi2 - sb.dof;
     b.params["largest_bias_change_ug"] = sb.largest_change_ug, b.params["standstills"] = static_cast<double>(sb.windows.size());
-    if (temp) b.params["bias_tc_ug_per_c"] = sb.temp_coeff_ug_per_c, b.params["temperature_change_c"] = sb.temperature_change_c;
+    if (temp) {
+      b.params["bias_tc_error_ug_per_c"] = sb.temp_coeff_ug_per_c, b.params["temperature_change_c"] = sb.temperature_change_c;
+      b.params["bias_tc_of_head"] = sb.temp_coeff_sensor == 1 ? 1.0 : 0.0;
+    }
     else if (sb.pattern == "steps") b.params["step_ug"] = sb.step_ug;
     else if (sb.pattern == "drift") b.params["drift_ug_per_s"] = sb.drift_ug_per_s;
     // Ranking: the position error the change makes over a quarter-second move, µm.
@@ -404,65 +462,71 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
     d.name = "machine.differential_vibration", d.channel = "spectrum", d.unit = "um", d.tolerance = 0.1, d.magnitude = v.differential.displacement_um;
     d.params["rms_mg"] = v.differential.rms_mg, d.params["displacement_um"] = v.differential.displacement_um;
     for (std::size_t i = 0; i < v.differential.lines.size(); ++i) d.params["line" + std::to_string(i) + "_hz"] = v.differential.lines[i].freq_hz;
-    d.significant = v.differential.found && v.differential.displacement_um > d.tolerance;
+    // Relative motion that matters for the position (0.1 µm), or an acceleration ten times
+    // the sensors' own noise over the band (0.3 mg RMS) that a light structure shows.
+    d.significant = v.differential.found && (v.differential.displacement_um > d.tolerance || v.differential.rms_mg > 0.3);
     d.importance_um = d.significant ? v.differential.displacement_um : 0.0;
     d.evidence = v.differential.evidence;
     all.push_back(c), all.push_back(d);
   }
   // The gain: the pipeline's path against each axis' reference, with the nominal model and
   // with the extended one (the significant sensor effects in the sensors, the machine
-  // effects of set-point-only axes subtracted).
+  // effects of set-point-only axes subtracted). A sensor-side extension is taken into the
+  // model only when the pipeline with it follows the reference better: one at a time, the
+  // most important first (a fit can be significant and still not transfer to the pipeline).
   {
-    auto offsets_out = [](const Channel& ch) {
-      Eigen::VectorXd v = ch.residual_um;
-      for (int a = 0; a < 3; ++a) {
-        double sum = 0.0;
-        int cnt = 0;
+    auto moving_rms = [&](const Eigen::VectorXd& v, const Channel& ch) { return moving_axes_rms(rr, v, ch); };
+    // The machine effects of set-point-only axes, predicted on a channel's rows.
+    auto machine_prediction = [&](const Channel& ch) {
+      Eigen::VectorXd pred = Eigen::VectorXd::Zero(ch.rows());
+      for (const auto& e : all) {
+        if (!e.significant || e.channel != "total") continue;
+        const auto it = std::find_if(machine.begin(), machine.end(), [&](const EffectModel& m) { return m.name == e.name; });
+        if (it == machine.end()) continue;
+        Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(it->params.size()));
+        for (std::size_t p = 0; p < it->params.size(); ++p)
+          if (auto f = e.params.find(it->params[p]); f != e.params.end()) full[static_cast<Eigen::Index>(p)] = f->second;
+        const Eigen::MatrixXd cols = columns_on(*it, ch);
         for (Eigen::Index i = 0; i < ch.rows(); ++i)
-          if (ch.axis[static_cast<std::size_t>(i)] == a) sum += v[i], ++cnt;
-        for (Eigen::Index i = 0; i < ch.rows(); ++i)
-          if (cnt && ch.axis[static_cast<std::size_t>(i)] == a) v[i] -= sum / cnt;
+          if (cmd_axes[static_cast<std::size_t>(ch.axis[static_cast<std::size_t>(i)])]) pred[i] += cols.row(i).dot(full);
       }
-      return v;
+      return pred;
     };
-    const Extension ext = extend_sensors(rr.meta, all);
-    Run extended = run;
-    for (int s2 = 0; s2 < 2; ++s2) extended.meta.sensors[s2] = ext.sensors[s2];
-    extended.meta.acquisition.daq_group_delay_samples = ext.daq_group_delay_samples;
-    extended.meta.acquisition.daq_skew_head_samples = ext.daq_skew_head_samples;
-    const RunResiduals after = build_residuals(extended);
-    Eigen::VectorXd pred = Eigen::VectorXd::Zero(after.pipeline.rows());
-    for (const auto& e : all) {
-      if (!e.significant || e.channel != "total") continue;
-      const auto it = std::find_if(machine.begin(), machine.end(), [&](const EffectModel& m) { return m.name == e.name; });
-      if (it == machine.end()) continue;
-      Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(it->params.size()));
-      for (std::size_t p = 0; p < it->params.size(); ++p)
-        if (auto f = e.params.find(it->params[p]); f != e.params.end()) full[static_cast<Eigen::Index>(p)] = f->second;
-      const Eigen::MatrixXd cols = columns_on(*it, after.pipeline);
-      for (Eigen::Index i = 0; i < after.pipeline.rows(); ++i)
-        if (cmd_axes[static_cast<std::size_t>(after.pipeline.axis[static_cast<std::size_t>(i)])]) pred[i] += cols.row(i).dot(full);
-    }
+    // The pipeline's residual with the sensor-side effects `taken` in the model.
+    auto with_model = [&](const std::vector<ExplainedEffect>& taken) {
+      Channel ch = build_residuals(extended_run(run, taken)).pipeline;
+      ch.residual_um -= machine_prediction(ch);
+      return ch;
+    };
     const Eigen::VectorXd before_v = offsets_out(rr.pipeline);
-    Channel after_ch = after.pipeline;
-    after_ch.residual_um -= pred;
+    ex.nominal_residual_rms_um = moving_rms(before_v, rr.pipeline);
+    Channel after_ch = rr.pipeline;
+    after_ch.residual_um -= machine_prediction(after_ch);
+    double best = moving_rms(offsets_out(after_ch), after_ch);
+    static const char* kPipelineSide[] = {"sensor.scale", "sensor.misalignment", "sensor.cross_coupling", "sensor.nonlinearity", "sensor.dynamics",
+                                          "sensor.damping_amplitude", "sensor.scale_temperature", "daq.group_delay"};
+    std::vector<std::size_t> order;
+    for (std::size_t k = 0; k < all.size(); ++k)
+      if (all[k].significant && std::any_of(std::begin(kPipelineSide), std::end(kPipelineSide), [&](const char* n) { return all[k].name == n; }))
+        order.push_back(k);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return all[a].importance_um > all[b].importance_um; });
+    std::vector<ExplainedEffect> taken;
+    for (std::size_t k : order) {
+      std::vector<ExplainedEffect> trial = taken;
+      trial.push_back(all[k]);
+      Channel ch = with_model(trial);
+      const double r = moving_rms(offsets_out(ch), ch);
+      if (r < best) {
+        best = r, after_ch = std::move(ch), taken = std::move(trial);
+        all[k].taken_into_model = true;
+      } else {
+        all[k].evidence += fmt("; not taken into the model: the pipeline with it follows the reference no better (%.3f -> %.3f um)", best, r);
+      }
+    }
     const Eigen::VectorXd after_v = offsets_out(after_ch);
-    double sb = 0.0, sa = 0.0;
-    std::size_t nb = 0, na = 0;
+    ex.final_residual_rms_um = best;
     RunExplanation::Trace tr;
     tr.channel = rr.reference;
-    for (Eigen::Index i = 0; i < before_v.size(); ++i) {
-      const int a = rr.pipeline.axis[static_cast<std::size_t>(i)];
-      if (!rr.moving[a]) continue;
-      sb += before_v[i] * before_v[i], ++nb;
-    }
-    for (Eigen::Index i = 0; i < after_v.size(); ++i) {
-      const int a = after_ch.axis[static_cast<std::size_t>(i)];
-      if (!rr.moving[a]) continue;
-      sa += after_v[i] * after_v[i], ++na;
-    }
-    ex.nominal_residual_rms_um = nb ? std::sqrt(sb / static_cast<double>(nb)) : 0.0;
-    ex.final_residual_rms_um = na ? std::sqrt(sa / static_cast<double>(na)) : 0.0;
     const Eigen::Index rows = std::min(before_v.size(), after_v.size());
     const auto step = static_cast<Eigen::Index>(std::max<Eigen::Index>(1, rows / 6000));
     for (Eigen::Index i = 0; i < rows; i += step) {

@@ -34,6 +34,7 @@ struct ExplainedEffect {
   double residual_rms_before_um = 0.0, residual_rms_after_um = 0.0;  // fitting samples, this effect alone
   double heldout_rms_before_um = 0.0, heldout_rms_after_um = 0.0;
   double importance_um = 0.0;  // the residual RMS it explains (ranking)
+  bool taken_into_model = false;  // a sensor-side extension the pipeline now compensates with
 };
 
 struct RunExplanation {
@@ -57,5 +58,13 @@ struct ExplainOptions {
 };
 
 RunExplanation explain_run(const Run& run, const ExplainOptions& options = {});
+
+// Held out across runs: the pipeline's residual on run `to` (another run of the same
+// machine) with the nominal model and with what `from`'s explanation took into the model.
+struct TransferGain {
+  std::string from_run, to_run;
+  double before_um = 0.0, after_um = 0.0;
+};
+TransferGain transfer_gain(const Run& to, const RunExplanation& from);
 
 }  // namespace eical::dsp::model

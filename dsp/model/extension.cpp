@@ -91,6 +91,32 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
         }
       for (int s = 0; s < 2; ++s)  // a sensor whose own axes stay in the band keeps its law
         if (cnt[s] && std::abs(sum[s] / cnt[s]) > ef.tolerance) x.sensors[s].zeta_per_g += sum[s] / cnt[s];
+    } else if (ef.name == "sensor.scale_temperature") {
+      // (6-16) with the coefficients the run shows. Head − table is what is measured: the
+      // bias coefficient (the moving axes' mean) goes to the sensor the standstills name;
+      // each axis' scale coefficient to the sensor that moves it.
+      const int s = p.count("bias_tc_of_head") && p.at("bias_tc_of_head") < 0.5 ? 0 : 1;
+      double bias_sum = 0.0, k1_sum[2] = {0.0, 0.0};
+      int bias_n = 0, k1_n[2] = {0, 0};
+      for (const auto& [k, v] : p) {
+        if (!p.count("model_group_accepted")) break;  // the standstills alone: no coefficient per axis
+        if (k.size() == 18 && k.rfind("bias_tc_", 0) == 0) {  // bias_tc_<a>_ug_per_c, of the moving axes (they have a scale term)
+          const int a = axis_of(k[8]);
+          std::string scale_key = "scale_tc_";
+          scale_key.append(1, k[8]).append("_ppm_per_c");
+          if (a >= 0 && p.count(scale_key)) bias_sum += v, ++bias_n;
+        } else if (k.rfind("scale_tc_", 0) == 0 && k.size() > 9) {
+          const int a = axis_of(k[9]);
+          if (a >= 0 && owner(meta, a) >= 0) k1_sum[owner(meta, a)] += v, ++k1_n[owner(meta, a)];
+        }
+      }
+      // A coefficient beyond what a sensor can have (900 µg/°C, 500 ppm/°C) has absorbed a
+      // drift that only looks like the warming: not taken over.
+      constexpr double kMaxBiasTc = 900.0, kMaxScaleTc = 500.0;
+      if (bias_n && std::abs(bias_sum / bias_n) <= kMaxBiasTc) x.sensors[s].tc_bias_ug_per_c += (s == 1 ? 1.0 : -1.0) * bias_sum / bias_n;
+      else if (bias_n) x.notes.push_back("sensor.scale_temperature: bias coefficient beyond a sensor's (not taken over)");
+      for (int k = 0; k < 2; ++k)
+        if (k1_n[k] && std::abs(k1_sum[k] / k1_n[k]) <= kMaxScaleTc) x.sensors[k].tc_k1_ppm_per_c += k1_sum[k] / k1_n[k];
     } else if (ef.name.rfind("sensor.", 0) == 0 || ef.name == "site.coriolis") {
       x.notes.push_back(ef.name + ": found; the pipeline does not compensate it from a calibration (yet)");
     }

@@ -201,7 +201,15 @@ StandstillBias standstill_bias(const RunResiduals& r) {
     if (ax == out.axis) {
       out.drift_ug_per_s = bd[0];
       if (bs.size() == 2) out.step_ug = 2.0 * bs[1];
-      if (bt.size() > 0) out.temp_coeff_ug_per_c = bt[bt.size() > 1 && std::abs(bt[1]) > std::abs(bt[0]) ? 1 : 0];
+      // Columns (head, −table): each sensor's own coefficient; one column (the mean of the
+      // two): head minus table's, given to the sensor whose own mean moved more.
+      if (bt.size() > 1) {
+        const int col = std::abs(bt[1]) > std::abs(bt[0]) ? 1 : 0;
+        out.temp_coeff_ug_per_c = bt[col], out.temp_coeff_sensor = col == 0 ? 1 : 0;
+      } else if (bt.size() == 1) {
+        out.temp_coeff_sensor = out.sensor < 0 ? 1 : out.sensor;
+        out.temp_coeff_ug_per_c = out.temp_coeff_sensor == 1 ? bt[0] : -bt[0];
+      }
     }
   }
   if (temp_coeff_max > kMaxTempCoeff) temp_plausible = false;

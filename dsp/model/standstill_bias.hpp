@@ -36,6 +36,7 @@ struct StandstillBias {
   double largest_change_ug = 0.0;
   std::string pattern = "none";         // "drift" | "steps" | "temperature" | "walk"
   double drift_ug_per_s = 0.0, step_ug = 0.0, temp_coeff_ug_per_c = 0.0;  // of the axis with the largest change
+  int temp_coeff_sensor = -1;           // whose bias coefficient temp_coeff_ug_per_c is (0 table, 1 head)
   int sensor = -1, axis = -1;           // where the largest change is (sensor: the one whose own mean moved more)
   double temperature_change_c = 0.0;
   std::string evidence;

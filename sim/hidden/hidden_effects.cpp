@@ -112,10 +112,14 @@ void background(Scenario& sc, Draw& d) {
 int moving_sensor(const Scenario& sc, Draw& d) {
   const bool head_moves = std::find(sc.meta.machine.head_axes.begin(), sc.meta.machine.head_axes.end(), "y") != sc.meta.machine.head_axes.end();
   const bool circle = sc.meta.program.kind == "circle";
-  return circle && head_moves ? d.pick(2) : 0;  // x (and y) are the table's otherwise
+  const int pick = d.pick(2);  // drawn always: the sizes after it do not depend on the program
+  return circle && head_moves ? pick : 0;  // x (and y) are the table's otherwise
 }
 
-int moving_axis(const Scenario& sc, Draw& d) { return sc.meta.program.kind == "circle" ? d.pick(2) : 0; }
+int moving_axis(const Scenario& sc, Draw& d) {
+  const int pick = d.pick(2);
+  return sc.meta.program.kind == "circle" ? pick : 0;
+}
 
 void inject(Scenario& sc, const std::string& e, Draw& d) {
   auto& m = sc.machine;
@@ -240,13 +244,19 @@ Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const s
   // Damping that grows with |a| and nonlinearity show with the acceleration of a fast move
   // (the sample run of sensor.damping_amplitude: 6.5 m/min).
   auto has = [&](const char* e) { return std::find(effects.begin(), effects.end(), e) != effects.end(); };
-  program(sc, kind, d, has("sensor.damping_amplitude") || has("sensor.nonlinearity"));
+  // The program draws from its own stream: one seed is one machine (sensors, errors),
+  // whichever program measures it.
+  Draw dp(stream_seed(seed, 7002));
+  program(sc, kind, dp, has("sensor.damping_amplitude") || has("sensor.nonlinearity"));
   background(sc, d);
   // Cross coupling differs from a rotated mounting only where one sensor moves two axes.
   if (has("sensor.cross_coupling"))
     sc.meta.machine.table_axes = {"x", "y"}, sc.meta.machine.head_axes = {"z"};
   for (const auto& e : effects) {
-    inject(sc, e, d);
+    // Each effect from its own stream: its size does not depend on what else is hidden.
+    const auto& names = hideable_effects();
+    Draw de(stream_seed(seed, 7100 + static_cast<std::uint64_t>(std::find(names.begin(), names.end(), e) - names.begin())));
+    inject(sc, e, de);
     sc.effects_present.push_back(e);
     sc.effects_background.erase(std::remove(sc.effects_background.begin(), sc.effects_background.end(), e), sc.effects_background.end());
   }

@@ -22,6 +22,8 @@ namespace eical::sim {
 //             configuration B, KGM on x and y;
 //   "step":   x 0 → 40..60 mm and back, 3 runs at 3250..6500 mm/min, 0.5 s dwell, KGM.
 // Both with the table moving x and y, or (every other seed) the table x and the head y.
+// One seed is one machine: the same sensors, errors and hidden sizes under either program
+// (as far as an effect's draw does not depend on which axes the program moves).
 const std::vector<std::string>& hidden_programs();
 
 // The program an effect shows itself in best (circle for the geometry and the loops, step

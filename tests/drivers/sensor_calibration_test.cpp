@@ -48,6 +48,41 @@ TEST(SensorCalibration, RoundTripKeepsEveryIdentifiedValue) {
   EXPECT_DOUBLE_EQ(config.calibration[1].cross_g_per_g(2, 0), 0.0021);
 }
 
+// What eical explain takes into the model beyond the data sheet: the head channels' DAQ
+// skew and damping that grows with the acceleration.
+TEST(SensorCalibration, ExplainExtensionsRoundTripAndReachThePipeline) {
+  eical::dsp::RunMeta meta;
+  SensorCalibration cal;
+  cal.method = "explain";
+  cal.run_id = "hidden-daq-0001";
+  for (int s = 0; s < 2; ++s) cal.sensors[s] = meta.sensors[s];
+  cal.daq_skew_head_samples = 0.75;
+  cal.sensors[0].zeta_per_g = 0.9;
+  const fs::path p = temp_file("explain");
+  eical::drivers::write_sensor_calibration(cal, p);
+  const SensorCalibration back = eical::drivers::read_sensor_calibration(p, meta);
+  fs::remove(p);
+  ASSERT_TRUE(back.daq_skew_head_samples.has_value());
+  EXPECT_DOUBLE_EQ(*back.daq_skew_head_samples, 0.75);
+  EXPECT_FALSE(back.daq_group_delay_samples.has_value());
+  EXPECT_DOUBLE_EQ(back.sensors[0].zeta_per_g, 0.9);
+  EXPECT_DOUBLE_EQ(back.sensors[1].zeta_per_g, 0.0);
+  eical::dsp::PipelineConfig config;
+  eical::drivers::apply_calibration(back, config);
+  EXPECT_DOUBLE_EQ(config.acquisition.daq_skew_head_samples, 0.75);
+  EXPECT_DOUBLE_EQ(config.sensors[0].zeta_per_g, 0.9);
+
+  const fs::path bad = temp_file("badskew");
+  write_text(bad, "format = \"eical-sensor-cal/1\"\n[acquisition]\ndaq_skew_head_samples = 1e9\n");
+  try {
+    (void)eical::drivers::read_sensor_calibration(bad, meta);
+    ADD_FAILURE() << "a skew of 1e9 samples was accepted";
+  } catch (const eical::dsp::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("daq_skew_head_samples"), std::string::npos) << e.what();
+  }
+  fs::remove(bad);
+}
+
 TEST(SensorCalibration, KeysAbsentFromTheFileKeepTheDataSheet) {
   eical::dsp::RunMeta meta;
   meta.sensors[1].noise_ug_per_rthz = 0.7;

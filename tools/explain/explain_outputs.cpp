@@ -26,6 +26,7 @@ nlohmann::json effect_json(const dsp::model::ExplainedEffect& e) {
   for (const auto& [k, v] : e.params) p[k] = std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
   return {{"name", e.name},
           {"significant", e.significant},
+          {"taken_into_model", e.taken_into_model},
           {"evidence", e.evidence},
           {"params", p},
           {"channel", e.channel},
@@ -41,7 +42,8 @@ nlohmann::json effect_json(const dsp::model::ExplainedEffect& e) {
 
 }  // namespace
 
-nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex) {
+nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex,
+                            const std::vector<dsp::model::TransferGain>& transfers) {
   nlohmann::json j;
   j["format"] = "eical-explain/1";
   j["runs"] = nlohmann::json::array();
@@ -90,14 +92,18 @@ nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector
       if (e.significant) pr["significant"].push_back(e.name);
     j["per_run"].push_back(pr);
   }
+  // Held out across runs: each run's extension applied to the other runs.
+  j["heldout_runs"] = nlohmann::json::array();
+  for (const auto& t : transfers)
+    j["heldout_runs"].push_back({{"model_from", t.from_run}, {"applied_to", t.to_run}, {"residual_rms_before_um", t.before_um}, {"residual_rms_after_um", t.after_um}});
   return j;
 }
 
-std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex) {
+std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex, const std::vector<dsp::model::TransferGain>& transfers) {
   std::string o;
   char b[512];
   for (const auto& r : ex) {
-    std::snprintf(b, sizeof b, "%s (compared with: %s): residual %.3f um RMS -> %.3f um with the significant effects (held out %.3f -> %.3f um), %.1f s\n",
+    std::snprintf(b, sizeof b, "%s (compared with: %s): pipeline residual %.3f um RMS -> %.3f um with the extended model; model prediction at held-out points %.3f -> %.3f um; %.1f s\n",
                   r.run_id.c_str(), r.reference.c_str(), r.nominal_residual_rms_um, r.final_residual_rms_um, r.heldout_nominal_rms_um,
                   r.heldout_final_rms_um, r.seconds);
     o += b;
@@ -109,6 +115,11 @@ std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex) {
       o += b;
     }
     if (sig == 0) o += "  no significant effect: the nominal model explains the run within its noise and the tolerance bands\n";
+  }
+  for (const auto& t : transfers) {
+    std::snprintf(b, sizeof b, "held out: %s with the model extended on %s: pipeline residual %.3f -> %.3f um RMS\n", t.to_run.c_str(), t.from_run.c_str(),
+                  t.before_um, t.after_um);
+    o += b;
   }
   return o;
 }

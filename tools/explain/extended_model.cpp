@@ -36,7 +36,12 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
   cal.method = "explain";
   cal.run_id = meta.id;
   for (int s = 0; s < 2; ++s) cal.sensors[s] = meta.sensors[s];
-  const dsp::model::Extension ext = dsp::model::extend_sensors(meta, ex.effects);
+  // The sensor side: what explain took into the model (it made the pipeline follow the
+  // reference better); the rest stays a finding.
+  std::vector<dsp::model::ExplainedEffect> taken;
+  for (const auto& x : ex.effects)
+    if (x.taken_into_model) taken.push_back(x);
+  const dsp::model::Extension ext = dsp::model::extend_sensors(meta, taken);
   for (int s = 0; s < 2; ++s) cal.sensors[s] = ext.sensors[s];
   if (ext.delay_changed) cal.daq_group_delay_samples = ext.daq_group_delay_samples;
   if (ext.skew_changed) cal.daq_skew_head_samples = ext.daq_skew_head_samples;
