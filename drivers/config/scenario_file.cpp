@@ -231,6 +231,25 @@ sim::Scenario read_scenario_file(const std::string& path) {
   for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s], sc.truth[s].zeta_per_g = sc.meta.sensors[s].zeta_per_g;
   sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples;
   sc.daq.skew_head_samples = sc.meta.acquisition.daq_skew_head_samples;
+  // [truth.sensors.*] / [truth.daq]: the true sensors and DAQ in full (run.toml's sensor
+  // keys, starting from what eical is told) — what eical explain writes to reproduce a run.
+  if (auto truth = root.optional_table("truth")) {
+    if (auto sensors = truth->optional_table("sensors")) {
+      for (int s = 0; s < 2; ++s)
+        if (auto t = sensors->optional_table(s == 0 ? "table" : "head")) {
+          sc.truth[s].spec = read_sensor(*t, sc.meta.sensors[s]);
+          sc.truth[s].zeta_per_g = sc.truth[s].spec.zeta_per_g;
+        }
+      sensors->finish();
+    }
+    if (auto d = truth->optional_table("daq")) {
+      sc.daq.group_delay_samples = d->number("group_delay_samples", sc.daq.group_delay_samples);
+      sc.daq.skew_head_samples = d->number("skew_head_samples", sc.daq.skew_head_samples);
+      if (!(sc.daq.group_delay_samples >= 0.0)) d->fail("group_delay_samples", "must not be negative");
+      d->finish();
+    }
+    truth->finish();
+  }
 
   StrictTable program = root.table("program");
   const std::string gcode_file = program.string("gcode_file", "");

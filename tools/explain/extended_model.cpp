@@ -96,18 +96,22 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
     if (x.name == "machine.servo_mismatch")
       for (const auto& [k, v] : x.params)
         if (k.rfind("lag_", 0) == 0 && v > 1e-4) servo_toml += "\n[servo." + std::string(1, k[4]) + "]\nkv_per_s = " + num(0.01 / (v * 1e-3)) + "\nfeedforward = 0.99\n";
-  // The scenario: what eical is told = the extended sensors (so they are also the truth).
-  dsp::RunMeta sm = meta;
-  for (int s = 0; s < 2; ++s) sm.sensors[s] = cal.sensors[s];
-  if (cal.daq_group_delay_samples) sm.acquisition.daq_group_delay_samples = *cal.daq_group_delay_samples;
-  if (cal.daq_skew_head_samples) sm.acquisition.daq_skew_head_samples = *cal.daq_skew_head_samples;
-  std::string text = drivers::run_toml_text(sm);
+  // The scenario: what eical is told = the run's own data sheet, the truth = the extended
+  // sensors and DAQ ([truth.*]): simulated, it shows what the recorded run showed.
+  std::string truth_toml = "\n[truth.daq]\ngroup_delay_samples = " + num(cal.daq_group_delay_samples.value_or(meta.acquisition.daq_group_delay_samples)) +
+                           "\nskew_head_samples = " + num(cal.daq_skew_head_samples.value_or(meta.acquisition.daq_skew_head_samples)) + "\n";
+  for (int s = 0; s < 2; ++s) {
+    std::string sec = drivers::sensor_section_toml(s == 0 ? "table" : "head", cal.sensors[s]);
+    sec.replace(sec.find("[sensors."), 9, "[truth.sensors.");
+    truth_toml += sec;
+  }
+  std::string text = drivers::run_toml_text(meta);
   const auto eol = text.find('\n');
   text = "format = \"eical-scenario/1\"\nname = \"explained-" + meta.id + "\"\ndescription = \"what eical explain found in " + meta.id + "\"" +
          text.substr(eol);
   if (const auto c = text.find("\ncreated = "); c != std::string::npos) text.erase(c, text.find('\n', c + 1) - c);
   m.scenario_toml = "# Written by eical explain: the run's program with the effects it found; eical simulate --scenario this-file -o RUN\n" + text +
-                    servo_toml + effects_toml;
+                    servo_toml + effects_toml + truth_toml;
   return m;
 }
 
