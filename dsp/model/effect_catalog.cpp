@@ -141,6 +141,14 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
   return out;
 }
 
+namespace {
+double largest_abs(const std::map<std::string, double>& v) {
+  double m = 0.0;
+  for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
+  return m;
+}
+}  // namespace
+
 std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std::string& group, const std::map<std::string, double>& v) {
   std::vector<Attribution> out;
   auto attr = [](const char* name, double mag, double tol, const char* unit, const char* reg) {
@@ -149,8 +157,7 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     return a;
   };
   if (group == "scale") {
-    double m = 0.0;
-    for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
+    const double m = largest_abs(v);
     Attribution a = attr("sensor.scale", m, 1000.0, "ppm", "the doubly integrated acceleration along the axis");
     a.plausible_max = 5e4;  // 5 %: a wrong sensor type, not a calibration
     a.params = v;
@@ -199,8 +206,7 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     if (!has_pair[0] && !has_pair[1]) mis.regressor += " (one moving axis per sensor: mounting and cross coupling are one effect here)";
     out.push_back(mis), out.push_back(cross);
   } else if (group == "nonlinearity") {
-    double m = 0.0;
-    for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
+    const double m = largest_abs(v);
     Attribution a = attr("sensor.nonlinearity", m, 200.0, "1e-6/g", "the doubly integrated square and cube of the acceleration");
     a.plausible_max = 2e4;  // 2 %/g: a hundred times a servo accelerometer's data-sheet band
     a.params = v;
@@ -232,14 +238,12 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     out.push_back(dyn);
     if (cmd_axes >= 2) out.push_back(servo);
   } else if (group == "damping_amplitude") {
-    double m = 0.0;
-    for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
+    const double m = largest_abs(v);
     Attribution a = attr("sensor.damping_amplitude", m, 0.2, "1/g", "the integral of a·|a| (damping growing with the acceleration)");
     a.params = v;
     out.push_back(a);
   } else if (group == "bias_drift") {
-    double m = 0.0;
-    for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
+    const double m = largest_abs(v);
     Attribution a = attr("sensor.bias_drift", m, 0.3, "ug/s", "the doubly integrated time (a linear bias drift)");
     a.params = v;
     out.push_back(a);

@@ -1,6 +1,7 @@
 #include "sim/hidden/hidden_effects.hpp"
 
 #include "dsp/core/error.hpp"
+#include "sim/effects.hpp"
 #include "sim/simulate.hpp"
 
 #include <Eigen/Geometry>
@@ -214,15 +215,8 @@ const std::vector<std::string>& hidden_programs() {
   return p;
 }
 
-const std::vector<std::string>& hideable_effects() {
-  static const std::vector<std::string> e = {
-      "sensor.scale", "sensor.bias_drift", "sensor.nonlinearity", "sensor.cross_coupling", "sensor.misalignment",
-      "sensor.dynamics", "sensor.damping_amplitude", "sensor.scale_temperature", "daq.group_delay", "site.coriolis",
-      "machine.common_vibration", "machine.differential_vibration", "machine.backlash", "machine.reversal_spike",
-      "machine.servo_mismatch", "machine.squareness", "machine.scale_mismatch", "machine.cyclic_error",
-      "machine.straightness", "machine.stick_slip"};
-  return e;
-}
+// Every effect of the table can be hidden (the simulator's own list of them).
+const std::vector<std::string>& hideable_effects() { return effect_names(); }
 
 std::string program_for(const std::string& e) {
   static const std::vector<std::string> step = {"sensor.scale", "sensor.bias_drift", "sensor.nonlinearity", "sensor.dynamics",
