@@ -180,6 +180,52 @@ Run extended_run(const Run& run, const std::vector<ExplainedEffect>& taken) {
   return extended;
 }
 
+// Pearson r of the nominal residual of each moving axis with the candidate regressors.
+std::vector<RunExplanation::Correlation> regressor_correlations(const RunResiduals& rr) {
+  std::vector<RunExplanation::Correlation> out;
+  const Eigen::VectorXd resid = offsets_out(rr.pipeline);
+  const auto& raw = rr.measurement.raw;
+  for (int a = 0; a < 3; ++a) {
+    if (!rr.moving[a]) continue;
+    std::vector<Eigen::Index> rows;
+    for (Eigen::Index i = 0; i < rr.pipeline.rows(); ++i)
+      if (rr.pipeline.axis[static_cast<std::size_t>(i)] == a) rows.push_back(i);
+    if (rows.size() < 10) continue;
+    const auto m = static_cast<Eigen::Index>(rows.size());
+    Eigen::VectorXd y(m);
+    Eigen::MatrixXd x = Eigen::MatrixXd::Zero(m, 10);
+    double direction = 0.0;
+    int last_sample = -1;
+    for (Eigen::Index k = 0; k < m; ++k) {
+      const int s = rr.pipeline.sample[static_cast<std::size_t>(rows[static_cast<std::size_t>(k)])];
+      y[k] = resid[rows[static_cast<std::size_t>(k)]];
+      for (int q = last_sample + 1; q <= s; ++q)
+        if (std::abs(rr.v_cmd(q, a)) > 1e-6) direction = rr.v_cmd(q, a) > 0.0 ? 1.0 : -1.0;
+      last_sample = s;
+      const double acc = rr.a_meas(s, a), vel = rr.v_meas(s, a);
+      double cross = 0.0;
+      for (int b = 0; b < 3; ++b)
+        if (b != a && rr.moving[b]) cross += rr.a_meas(s, b);
+      const std::size_t tr = s < static_cast<int>(rr.trace.size()) ? rr.trace[static_cast<std::size_t>(s)] : 0;
+      const int other = rr.owner[a] == 1 ? 0 : 1;
+      const auto& other_sig = other == 0 ? raw.table_mps2 : raw.head_mps2;
+      x(k, 0) = rr.cmd(s, a), x(k, 1) = vel, x(k, 2) = acc, x(k, 3) = std::abs(acc) * vel;
+      x(k, 4) = s > 0 ? (acc - rr.a_meas(s - 1, a)) / rr.dt_s : 0.0;
+      x(k, 5) = cross, x(k, 6) = 0.5 * (rr.temp_c(s, 0) + rr.temp_c(s, 1)), x(k, 7) = rr.t_s[s];
+      x(k, 8) = tr < other_sig.size() ? other_sig[tr][a] : 0.0, x(k, 9) = direction;
+    }
+    static const char* kNames[10] = {"position", "velocity", "acceleration", "|a|*v", "jerk", "other axes' acceleration", "temperature", "time",
+                                     "the other sensor's signal", "direction since the last reversal"};
+    const Eigen::VectorXd yc = y.array() - y.mean();
+    for (int c = 0; c < 10; ++c) {
+      const Eigen::VectorXd xc = x.col(c).array() - x.col(c).mean();
+      const double d = xc.norm() * yc.norm();
+      out.push_back({a, kNames[c], d > 0.0 ? xc.dot(yc) / d : 0.0});
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 TransferGain transfer_gain(const Run& to, const RunExplanation& from) {
@@ -543,6 +589,7 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
     return a.bic_drop > b.bic_drop;
   });
   ex.effects = std::move(all);
+  ex.correlations = regressor_correlations(rr);
   ex.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return ex;
 }

@@ -49,6 +49,16 @@ struct RunExplanation {
     std::vector<int> axis;
   };
   std::vector<Trace> traces;
+  // Show: the nominal residual of each moving axis against the candidate regressors
+  // (Pearson r over the run): position, velocity, acceleration, |a|·v, jerk, the other
+  // axes' acceleration, temperature, time, the other sensor's signal, the direction since
+  // the last reversal.
+  struct Correlation {
+    int axis = 0;
+    std::string regressor;
+    double r = 0.0;
+  };
+  std::vector<Correlation> correlations;
   double seconds = 0.0;
 };
 

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace eical {
 namespace {
@@ -50,6 +51,16 @@ TEST(ExplainJson, KeysOfResultsMdAndNamesOfTheEffectTable) {
   EXPECT_EQ(h.at("applied_to"), runs[1].meta.id);
   EXPECT_TRUE(h.at("residual_rms_before_um").is_number() && h.at("residual_rms_after_um").is_number());
   ASSERT_EQ(j.at("per_run").size(), 2u);
+  // Show: the step run's residual against the regressors; a scale error follows the position.
+  const auto& corr = j.at("per_run").front().at("correlations");
+  ASSERT_GE(corr.size(), 10u);
+  double r_position = 0.0;
+  for (const auto& c : corr) {
+    EXPECT_TRUE(c.at("r").is_number());
+    EXPECT_LE(std::abs(c.at("r").get<double>()), 1.0 + 1e-9);
+    if (c.at("axis") == "x" && c.at("regressor") == "position") r_position = c.at("r");
+  }
+  EXPECT_GT(std::abs(r_position), 0.5);
 }
 
 }  // namespace

@@ -87,6 +87,8 @@ nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector
                          {"heldout_nominal_residual_rms_um", r.heldout_nominal_rms_um},
                          {"heldout_final_residual_rms_um", r.heldout_final_rms_um},
                          {"runtime_s", r.seconds}};
+    pr["correlations"] = nlohmann::json::array();
+    for (const auto& c : r.correlations) pr["correlations"].push_back({{"axis", std::string(1, "xyz"[c.axis])}, {"regressor", c.regressor}, {"r", c.r}});
     pr["significant"] = nlohmann::json::array();
     for (const auto& e : r.effects)
       if (e.significant) pr["significant"].push_back(e.name);
@@ -133,8 +135,8 @@ void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<d
     page.run_id = r.run_id;
     page.program = runs[i].meta.program.kind;
     page.context = {{"compared with", r.reference},
-                    {"residual RMS (fitting)", report_fmt(r.nominal_residual_rms_um) + " -> " + report_fmt(r.final_residual_rms_um) + " um"},
-                    {"residual RMS (held out)", report_fmt(r.heldout_nominal_rms_um) + " -> " + report_fmt(r.heldout_final_rms_um) + " um"}};
+                    {"pipeline residual RMS, extended model", report_fmt(r.nominal_residual_rms_um) + " -> " + report_fmt(r.final_residual_rms_um) + " um"},
+                    {"prediction at held-out reference points", report_fmt(r.heldout_nominal_rms_um) + " -> " + report_fmt(r.heldout_final_rms_um) + " um"}};
     // The effects, significant first.
     report::Section table;
     table.heading = "Effects tested";
@@ -146,14 +148,24 @@ void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<d
                         report_fmt(e.residual_rms_before_um) + " -> " + report_fmt(e.residual_rms_after_um), e.evidence});
     table.grids.push_back(g);
     page.sections.push_back(table);
+    if (!r.correlations.empty()) {
+      report::Section cs;
+      cs.heading = "Residual against the candidate regressors";
+      cs.lead = "Pearson r of the nominal model's residual with each regressor, per moving axis (|r| near 1: the residual follows it)";
+      report::Grid cg;
+      cg.header = {"axis", "regressor", "r"};
+      for (const auto& c : r.correlations) cg.rows.push_back({std::string(1, "xyz"[c.axis]), c.regressor, report_fmt(c.r)});
+      cs.grids.push_back(cg);
+      page.sections.push_back(cs);
+    }
     // Residuals before and after, per channel and axis, in time and frequency.
     const char* axes[3] = {"x", "y", "z"};
     for (const auto& tr : r.traces) {
       report::Section s;
       s.heading = "Residual, " + tr.channel;
-      s.lead = tr.channel == "sensor" ? "inertial minus the reference instrument: what the sensor model gets wrong"
-               : tr.channel == "machine" ? "reference minus the set-point: what the ideal machine gets wrong"
-                                          : "inertial minus the set-point: both";
+      s.lead = tr.channel == "ref" ? "the pipeline's path minus the reference instrument, each axis' offset out"
+               : tr.channel == "psd" ? "the pipeline's path minus the PSD readings, each axis' offset out"
+                                     : "the pipeline's path minus the set-point (sensor and machine together), each axis' offset out";
       for (int a = 0; a < 3; ++a) {
         report::LineSeries before, after;
         before.label = "nominal model", before.color = report::kRed;
