@@ -10,6 +10,7 @@ namespace eical::dsp::model {
 namespace {
 
 constexpr double kTagPrior = 50.0;  // µm: a strip's mounting
+constexpr double kTieBic = 6.0;     // Kass–Raftery: below 6, no strong evidence either way
 
 struct AxisFit {
   double logl = 0.0, fit_ss = 0.0, held_ss = 0.0;
@@ -133,9 +134,13 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
   };
   std::vector<bool> done(groups.size(), false);
   for (int round = 0; round < o.max_groups; ++round) {
-    int best = -1;
-    GroupVerdict best_v;
-    Model best_m;
+    struct Trial {
+      std::size_t g;
+      GroupVerdict v;
+      Model m;
+    };
+    std::vector<Trial> trials;
+    double top_bic = -INFINITY;
     for (std::size_t g = 0; g < groups.size(); ++g) {
       if (done[g] || groups[g].params.empty()) continue;
       Model m = with(cur, groups[g]);
@@ -143,9 +148,19 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
       // Only an extension that also predicts the held-out data better may be taken.
       const bool gain = v.held_rms_after_um < (1.0 - o.min_heldout_gain) * v.held_rms_before_um;
       if (!gain) continue;
-      if (best < 0 || v.bic_drop > best_v.bic_drop) best = static_cast<int>(g), best_v = v, best_m = std::move(m);
+      top_bic = std::max(top_bic, v.bic_drop);
+      trials.push_back({g, std::move(v), std::move(m)});
     }
-    if (best < 0 || best_v.bic_drop < o.min_bic_drop) break;
+    // Groups the BIC cannot tell apart (within kTieBic: less than "strong" evidence for
+    // one over the other — ζ(|a|) and a constant ζ error in a move of one acceleration
+    // level) are decided by what predicts the held-out observations better.
+    const Trial* pick = nullptr;
+    for (const auto& t : trials)
+      if (t.v.bic_drop >= top_bic - kTieBic && (!pick || t.v.held_rms_after_um < pick->v.held_rms_after_um)) pick = &t;
+    if (!pick || pick->v.bic_drop < o.min_bic_drop) break;
+    const int best = static_cast<int>(pick->g);
+    GroupVerdict best_v = pick->v;
+    Model best_m = pick->m;
     best_v.accepted = true;
     done[static_cast<std::size_t>(best)] = true;
     cur = std::move(best_m);
