@@ -351,7 +351,16 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
       if (x.significant && x.magnitude > at.plausible_max) {
         x.significant = false;
         x.evidence += fmt("; larger than a sensor can have (%.3g ", at.plausible_max) + x.unit +
-                      "): it stands in for a residual the catalogue does not describe";
+                      "): it stands in for a residual the catalogue does not describe (other.residual_like_" + v.name + ")";
+        // Outside the table: the residual has a shape no effect of it explains at a
+        // plausible size. Reported with what it resembles and what it explains.
+        ExplainedEffect other = x;
+        other.name = "other.residual_like_" + v.name;
+        other.significant = true, other.taken_into_model = false;
+        other.magnitude = x.importance_um, other.tolerance = 0.0, other.unit = "um explained at the held-out points";
+        other.evidence = "a residual shaped like " + at.regressor + " but " + fmt("%.3g ", x.magnitude) + x.unit + fmt(" (a sensor has at most %.3g); ", at.plausible_max) +
+                     fmt("BIC drop %.0f; prediction error at the held-out samples %.3f -> %.3f um", v.bic_drop, v.held_rms_before_um, v.held_rms_after_um);
+        all.push_back(std::move(other));
       }
       merge(all, std::move(x));
     }
@@ -583,8 +592,13 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
     }
     ex.traces.push_back(std::move(tr));
   }
+  // Significant first — the table's effects before what lies outside it (other.*: a
+  // residual no effect explains at a plausible size is named once the named ones are) —
+  // the one that explains most first.
   std::stable_sort(all.begin(), all.end(), [](const ExplainedEffect& a, const ExplainedEffect& b) {
     if (a.significant != b.significant) return a.significant;
+    const bool ao = a.name.rfind("other.", 0) == 0, bo = b.name.rfind("other.", 0) == 0;
+    if (a.significant && ao != bo) return bo;
     if (a.significant) return a.importance_um > b.importance_um;
     return a.bic_drop > b.bic_drop;
   });

@@ -68,6 +68,8 @@ nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector
   }
   std::stable_sort(merged.begin(), merged.end(), [](const auto& a, const auto& b) {
     if (a.significant != b.significant) return a.significant;
+    const bool ao = a.name.rfind("other.", 0) == 0, bo = b.name.rfind("other.", 0) == 0;
+    if (a.significant && ao != bo) return bo;  // the table's effects first, as explain_run orders them
     return a.significant ? a.importance_um > b.importance_um : a.bic_drop > b.bic_drop;
   });
   const double n = std::max<double>(1.0, static_cast<double>(ex.size()));
