@@ -10,6 +10,7 @@
 #include "tools/explain/explain_outputs.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <memory>
 
@@ -31,7 +32,9 @@ void register_explain(CLI::App& app) {
     std::vector<dsp::model::RunExplanation> ex;
     for (const auto& path : o->runs) {
       runs.push_back(drivers::read_run(path));
+      const auto t0 = std::chrono::steady_clock::now();
       ex.push_back(dsp::model::explain_run(runs.back()));
+      ex.back().seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     }
     // Held out across runs: what one run's explanation took into the model, on the others
     // (runs of the same machine: the same sensors and DAQ).

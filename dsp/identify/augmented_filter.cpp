@@ -1,6 +1,7 @@
 #include "dsp/identify/augmented_filter.hpp"
 
 #include <cmath>
+#include <numbers>
 
 namespace eical::dsp::identify {
 
@@ -43,7 +44,7 @@ double AugmentedFilter::update(const Eigen::RowVectorXd& row, double z, double s
   if (!(s > 0.0) || !std::isfinite(z)) return 0.0;
   const double nu = z - row.dot(x_);
   last_innovation_ = nu;
-  last_log_density_ = -0.5 * (nu * nu / s + std::log(2.0 * 3.141592653589793 * s));
+  last_log_density_ = -0.5 * (nu * nu / s + std::log(2.0 * std::numbers::pi * s));
   const Eigen::VectorXd k = ph / s;
   x_ += k * nu;
   p_ -= k * ph.transpose();

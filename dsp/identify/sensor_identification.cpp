@@ -1,5 +1,6 @@
 #include "dsp/identify/sensor_identification.hpp"
 
+#include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/identify/augmented_filter.hpp"
 #include "dsp/identify/delay_estimate.hpp"
@@ -17,16 +18,8 @@ constexpr double kPriorError = 0.02;     // E_ij: scale and cross terms, 2 %
 constexpr double kPriorDampingMs = 0.2;  // Δ(2ζ/ω0), ms (data sheet 0.225 ms)
 constexpr double kPriorOffsetUm = 50.0;  // rest offsets, backlash, PSD mounting
 
-int axis_index(const std::string& a) { return a == "x" ? 0 : a == "y" ? 1 : a == "z" ? 2 : -1; }
-
 // Which sensor moves machine axis j: 0 table, 1 head, −1 neither.
-int owner(const RunMeta& meta, int j) {
-  for (const auto& a : meta.machine.table_axes)
-    if (axis_index(a) == j) return 0;
-  for (const auto& a : meta.machine.head_axes)
-    if (axis_index(a) == j) return 1;
-  return -1;
-}
+int owner(const RunMeta& meta, int j) { return axis_owner(meta.machine, j); }
 
 // Parameter indices of one axis' filter (−1: not fitted).
 struct Layout {

@@ -30,20 +30,6 @@ Eigen::MatrixXd on_axis(const Eigen::VectorXd& v, int a) {
   return c;
 }
 
-// Sign of the last motion of an axis (held through rests, 0 before the first) and where it reverses.
-void directions(const RunResiduals& r, int axis, Eigen::VectorXd& dir, std::vector<int>& reversals) {
-  dir = Eigen::VectorXd::Zero(r.n);
-  double d = 0.0;
-  for (int s = 0; s < r.n; ++s) {
-    const double v = r.v_cmd(s, axis);
-    if (std::abs(v) > 1e-3) {
-      const double nd = v > 0.0 ? 1.0 : -1.0;
-      if (d != 0.0 && nd != d) reversals.push_back(s);
-      d = nd;
-    }
-    dir[s] = d;
-  }
-}
 
 double hint_corr(const Eigen::MatrixXd& hint, const Eigen::VectorXd& col, int axis) {
   if (hint.rows() != col.size()) return 0.0;
@@ -62,6 +48,20 @@ double get(const std::map<std::string, double>& v, const std::string& k) {
 }
 
 }  // namespace
+
+void axis_directions(const RunResiduals& r, int axis, Eigen::VectorXd& dir, std::vector<int>& reversals) {
+  dir = Eigen::VectorXd::Zero(r.n);
+  double d = 0.0;
+  for (int s = 0; s < r.n; ++s) {
+    const double v = r.v_cmd(s, axis);
+    if (std::abs(v) > 1e-3) {
+      const double nd = v > 0.0 ? 1.0 : -1.0;
+      if (d != 0.0 && nd != d) reversals.push_back(s);
+      d = nd;
+    }
+    dir[s] = d;
+  }
+}
 
 std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
   std::vector<ParamGroup> out;
@@ -255,13 +255,6 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     a.params = v;
     a.params["temperature_change_c"] = range;
     out.push_back(a);
-  } else if (group == "coriolis") {
-    double sum = 0.0;
-    int n = 0;
-    for (const auto& [k, x] : v) sum += x, ++n;
-    Attribution a = attr("site.coriolis", n ? std::abs(sum / n) : 0.0, 0.5, "x Earth rate", "the doubly integrated 2 ω × v");
-    a.params = v;
-    out.push_back(a);
   }
   return out;
 }
@@ -275,7 +268,7 @@ std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::Mat
   if (moving.empty()) return out;
   Eigen::VectorXd dir[3];
   std::vector<int> rev[3];
-  for (int a : moving) directions(r, a, dir[a], rev[a]);
+  for (int a : moving) axis_directions(r, a, dir[a], rev[a]);
   {
     EffectModel e = effect("machine.backlash");
     for (int a : moving)
@@ -405,20 +398,30 @@ LagColumns common_lag_columns(const RunResiduals& r, double tau_s) {
   return c;
 }
 
+namespace {
+// Per axis: offset, LP(v) and LP(a) by least squares on the rows where the hint is known;
+// the residual of those rows (none below 20 rows).
+std::pair<std::vector<Eigen::Index>, Eigen::VectorXd> lag_fit_residual(const Eigen::MatrixXd& hint, const LagColumns& c, int a) {
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index s = 0; s < hint.rows(); ++s)
+    if (std::isfinite(hint(s, a))) rows.push_back(s);
+  if (rows.size() < 20) return {};
+  Eigen::MatrixXd x(static_cast<Eigen::Index>(rows.size()), 3);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const auto ii = static_cast<Eigen::Index>(i);
+    x(ii, 0) = 1.0, x(ii, 1) = c.velocity(rows[i], a), x(ii, 2) = c.acceleration(rows[i], a), y[ii] = hint(rows[i], a);
+  }
+  Eigen::VectorXd e = y - x * x.colPivHouseholderQr().solve(y);
+  return {std::move(rows), std::move(e)};
+}
+}  // namespace
+
 Eigen::MatrixXd without_lag(const Eigen::MatrixXd& hint, const LagColumns& c) {
   Eigen::MatrixXd out = hint;
   for (int a = 0; a < 3; ++a) {
-    std::vector<Eigen::Index> rows;
-    for (Eigen::Index s = 0; s < hint.rows(); ++s)
-      if (std::isfinite(hint(s, a))) rows.push_back(s);
-    if (rows.size() < 20 || c.velocity.col(a).cwiseAbs().maxCoeff() <= 0.0) continue;
-    Eigen::MatrixXd x(static_cast<Eigen::Index>(rows.size()), 3);
-    Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      const auto ii = static_cast<Eigen::Index>(i);
-      x(ii, 0) = 1.0, x(ii, 1) = c.velocity(rows[i], a), x(ii, 2) = c.acceleration(rows[i], a), y[ii] = hint(rows[i], a);
-    }
-    const Eigen::VectorXd e = y - x * x.colPivHouseholderQr().solve(y);
+    if (c.velocity.col(a).cwiseAbs().maxCoeff() <= 0.0) continue;
+    const auto [rows, e] = lag_fit_residual(hint, c, a);
     for (std::size_t i = 0; i < rows.size(); ++i) out(rows[i], a) = e[static_cast<Eigen::Index>(i)];
   }
   return out;
@@ -429,22 +432,8 @@ double loop_time_constant_s(const RunResiduals& r, const Eigen::MatrixXd& hint) 
   for (double tau_ms : {0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 50.0, 70.0, 100.0}) {
     const LagColumns c = common_lag_columns(r, tau_ms * 1e-3);
     double rss = 0.0;
-    for (int a = 0; a < 3; ++a) {
-      if (!r.moving[a]) continue;
-      // Per axis: offset, LP(v) and LP(a) by least squares on the known rows.
-      std::vector<Eigen::Index> rows;
-      for (Eigen::Index s = 0; s < r.n; ++s)
-        if (std::isfinite(hint(s, a))) rows.push_back(s);
-      if (rows.size() < 20) continue;
-      Eigen::MatrixXd x(static_cast<Eigen::Index>(rows.size()), 3);
-      Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
-      for (std::size_t i = 0; i < rows.size(); ++i) {
-        const auto ii = static_cast<Eigen::Index>(i);
-        x(ii, 0) = 1.0, x(ii, 1) = c.velocity(rows[i], a), x(ii, 2) = c.acceleration(rows[i], a), y[ii] = hint(rows[i], a);
-      }
-      const Eigen::VectorXd beta = x.colPivHouseholderQr().solve(y);
-      rss += (y - x * beta).squaredNorm();
-    }
+    for (int a = 0; a < 3; ++a)
+      if (r.moving[a]) rss += lag_fit_residual(hint, c, a).second.squaredNorm();
     if (rss < best_rss) best_rss = rss, best_tau = tau_ms * 1e-3;
   }
   return best_tau;

@@ -63,6 +63,10 @@ std::vector<EffectModel> machine_effects(const RunResiduals& run, const Eigen::M
 ParamGroup as_group(const EffectModel& e, const std::array<bool, 3>& axes);
 
 // A named effect's size from fitted parameters (name → value) and its band.
+// The sign of an axis' last commanded motion per sample (held through rests, 0 before the
+// first) and the samples where it reverses.
+void axis_directions(const RunResiduals& run, int axis, Eigen::VectorXd& dir, std::vector<int>& reversals);
+
 struct Attribution {
   std::string name;
   double magnitude = 0.0, tolerance = 0.0;

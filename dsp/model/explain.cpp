@@ -14,7 +14,6 @@
 #include <Eigen/QR>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -194,14 +193,12 @@ std::vector<RunExplanation::Correlation> regressor_correlations(const RunResidua
     const auto m = static_cast<Eigen::Index>(rows.size());
     Eigen::VectorXd y(m);
     Eigen::MatrixXd x = Eigen::MatrixXd::Zero(m, 10);
-    double direction = 0.0;
-    int last_sample = -1;
+    Eigen::VectorXd direction;
+    std::vector<int> reversals;
+    axis_directions(rr, a, direction, reversals);
     for (Eigen::Index k = 0; k < m; ++k) {
       const int s = rr.pipeline.sample[static_cast<std::size_t>(rows[static_cast<std::size_t>(k)])];
       y[k] = resid[rows[static_cast<std::size_t>(k)]];
-      for (int q = last_sample + 1; q <= s; ++q)
-        if (std::abs(rr.v_cmd(q, a)) > 1e-6) direction = rr.v_cmd(q, a) > 0.0 ? 1.0 : -1.0;
-      last_sample = s;
       const double acc = rr.a_meas(s, a), vel = rr.v_meas(s, a);
       double cross = 0.0;
       for (int b = 0; b < 3; ++b)
@@ -212,7 +209,7 @@ std::vector<RunExplanation::Correlation> regressor_correlations(const RunResidua
       x(k, 0) = rr.cmd(s, a), x(k, 1) = vel, x(k, 2) = acc, x(k, 3) = std::abs(acc) * vel;
       x(k, 4) = s > 0 ? (acc - rr.a_meas(s - 1, a)) / rr.dt_s : 0.0;
       x(k, 5) = cross, x(k, 6) = 0.5 * (rr.temp_c(s, 0) + rr.temp_c(s, 1)), x(k, 7) = rr.t_s[s];
-      x(k, 8) = tr < other_sig.size() ? other_sig[tr][a] : 0.0, x(k, 9) = direction;
+      x(k, 8) = tr < other_sig.size() ? other_sig[tr][a] : 0.0, x(k, 9) = direction[s];
     }
     static const char* kNames[10] = {"position", "velocity", "acceleration", "|a|*v", "jerk", "other axes' acceleration", "temperature", "time",
                                      "the other sensor's signal", "direction since the last reversal"};
@@ -261,7 +258,6 @@ void merge(std::vector<ExplainedEffect>& all, ExplainedEffect e) {
 }  // namespace
 
 RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
-  const auto t0 = std::chrono::steady_clock::now();
   RunExplanation ex;
   RunResiduals rr = build_residuals(run);
   ex.run_id = rr.run_id, ex.reference = rr.reference;
@@ -604,7 +600,6 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
   });
   ex.effects = std::move(all);
   ex.correlations = regressor_correlations(rr);
-  ex.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return ex;
 }
 

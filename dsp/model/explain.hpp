@@ -59,7 +59,7 @@ struct RunExplanation {
     double r = 0.0;
   };
   std::vector<Correlation> correlations;
-  double seconds = 0.0;
+  double seconds = 0.0;  // wall time of the explanation: the caller times it (dsp/ reads no clock)
 };
 
 struct ExplainOptions {

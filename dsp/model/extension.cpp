@@ -1,5 +1,7 @@
 #include "dsp/model/extension.hpp"
 
+#include "dsp/core/axes.hpp"
+
 #include <Eigen/Dense>
 
 #include <cmath>
@@ -8,22 +10,7 @@
 namespace eical::dsp::model {
 namespace {
 
-int axis_of(char c) { return c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1; }
-
-int owner(const RunMeta& m, int a) {
-  const char* n[3] = {"x", "y", "z"};
-  for (const auto& t : m.machine.table_axes)
-    if (t == n[a]) return 0;
-  for (const auto& h : m.machine.head_axes)
-    if (h == n[a]) return 1;
-  return -1;
-}
-
-bool two_axes(const std::string& name, const std::string& prefix, int& a, int& b) {
-  if (name.rfind(prefix, 0) != 0 || name.size() < prefix.size() + 2) return false;
-  a = axis_of(name[prefix.size()]), b = axis_of(name[prefix.size() + 1]);
-  return a >= 0 && b >= 0;
-}
+int owner(const RunMeta& m, int a) { return axis_owner(m.machine, a); }
 
 }  // namespace
 
@@ -39,7 +26,7 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
     if (ef.name == "sensor.scale") {
       for (const auto& [k, v] : p)
         if (k.rfind("scale_", 0) == 0 && k.size() > 6) {
-          const int a = axis_of(k[6]);
+          const int a = axis_index(k[6]);
           if (a >= 0 && owner(meta, a) >= 0) e[owner(meta, a)](a, a) += v * 1e-6;
         }
     } else if (ef.name == "sensor.misalignment") {
@@ -48,7 +35,7 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
         if (two_axes(k, "rotation_", j, i) && owner(meta, j) >= 0) {
           e[owner(meta, j)](i, j) += v * 1e-3, e[owner(meta, j)](j, i) -= v * 1e-3;
         } else if (k.rfind("tilt_", 0) == 0 && k.size() > 12) {
-          const int jj = axis_of(k[5]), ii = axis_of(k[12]);
+          const int jj = axis_index(k[5]), ii = axis_index(k[12]);
           if (jj >= 0 && ii >= 0 && owner(meta, jj) >= 0) e[owner(meta, jj)](ii, jj) += v * 1e-3;
         }
       }
@@ -59,7 +46,7 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
       }
     } else if (ef.name == "sensor.nonlinearity") {
       for (const auto& [k, v] : p) {
-        const int a = k.size() > 3 ? axis_of(k[3]) : -1;
+        const int a = k.size() > 3 ? axis_index(k[3]) : -1;
         if (a < 0 || owner(meta, a) < 0) continue;
         auto& sp = x.sensors[owner(meta, a)];
         if (k.rfind("k2_", 0) == 0) sp.k2_g_per_g2[a] += v * 1e-6;
@@ -86,7 +73,7 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
       int cnt[2] = {0, 0};
       for (const auto& [k, v] : p)
         if (k.rfind("zeta_per_g_", 0) == 0 && k.size() == 12) {
-          const int a = axis_of(k[11]);
+          const int a = axis_index(k[11]);
           if (a >= 0 && owner(meta, a) >= 0) sum[owner(meta, a)] += v, ++cnt[owner(meta, a)];
         }
       for (int s = 0; s < 2; ++s)  // a sensor whose own axes stay in the band keeps its law
@@ -101,12 +88,12 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
       for (const auto& [k, v] : p) {
         if (!p.count("model_group_accepted")) break;  // the standstills alone: no coefficient per axis
         if (k.size() == 18 && k.rfind("bias_tc_", 0) == 0) {  // bias_tc_<a>_ug_per_c, of the moving axes (they have a scale term)
-          const int a = axis_of(k[8]);
+          const int a = axis_index(k[8]);
           std::string scale_key = "scale_tc_";
           scale_key.append(1, k[8]).append("_ppm_per_c");
           if (a >= 0 && p.count(scale_key)) bias_sum += v, ++bias_n;
         } else if (k.rfind("scale_tc_", 0) == 0 && k.size() > 9) {
-          const int a = axis_of(k[9]);
+          const int a = axis_index(k[9]);
           if (a >= 0 && owner(meta, a) >= 0) k1_sum[owner(meta, a)] += v, ++k1_n[owner(meta, a)];
         }
       }

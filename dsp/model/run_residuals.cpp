@@ -1,5 +1,6 @@
 #include "dsp/model/run_residuals.hpp"
 
+#include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
 
 #include <algorithm>
@@ -7,8 +8,6 @@
 
 namespace eical::dsp::model {
 namespace {
-
-int axis_index(const std::string& a) { return a == "x" ? 0 : a == "y" ? 1 : a == "z" ? 2 : -1; }
 
 // Linear interpolation of a column of a trace at a fractional position (clamped).
 double at(const std::vector<Eigen::Vector3d>& x, double pos, int axis) {
@@ -93,10 +92,7 @@ RunResiduals build_residuals(const Run& run) {
   }
   for (int a = 0; a < 3; ++a) {
     const double lo = d.cmd.col(a).minCoeff(), hi = d.cmd.col(a).maxCoeff();
-    for (const auto& ax : run.meta.machine.table_axes)
-      if (axis_index(ax) == a) d.owner[a] = 0;
-    for (const auto& ax : run.meta.machine.head_axes)
-      if (axis_index(ax) == a) d.owner[a] = 1;
+    d.owner[a] = axis_owner(run.meta.machine, a);
     d.moving[a] = hi - lo > 0.5 && d.owner[a] >= 0;
     bool finite = run.channels.ref[a];
     for (Eigen::Index s = 0; s < n && finite; ++s) finite = std::isfinite(m.ref_mm[d.trace[static_cast<std::size_t>(s)]][a]);

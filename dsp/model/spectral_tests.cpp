@@ -1,5 +1,8 @@
 #include "dsp/model/spectral_tests.hpp"
 
+#include "dsp/core/chi2.hpp"
+#include "dsp/core/median.hpp"
+
 #include <unsupported/Eigen/FFT>
 
 #include <algorithm>
@@ -22,18 +25,8 @@ struct Spectra {
   int segments = 0;
 };
 
-// χ²(2K)/2K exceeded with probability ~3e-7 (z = 5, Wilson–Hilferty).
-double threshold(int k) {
-  const double nu = 2.0 * k, z = 5.0;
-  const double c = 1.0 - 2.0 / (9.0 * nu) + z * std::sqrt(2.0 / (9.0 * nu));
-  return c * c * c;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 1.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
+// χ²(2K)/2K exceeded with probability ~3e-7 (z = 5).
+double threshold(int k) { return chi2_quantile(2.0 * k, 5.0) / (2.0 * k); }
 
 }  // namespace
 
@@ -110,8 +103,8 @@ VibrationTests vibration_tests(const RunResiduals& r) {
         rh.push_back(S.ph[a][f] * scale / floor_of(1));
         rr.push_back(S.pr[a][f] * scale / (floor_of(0) + floor_of(1)));
       }
-      const double ft0 = floor_of(0) * std::max(0.5, median(rt)), fh0 = floor_of(1) * std::max(0.5, median(rh));
-      const double fr0 = (floor_of(0) + floor_of(1)) * std::max(0.5, median(rr));
+      const double ft0 = floor_of(0) * std::max(0.5, dsp::median(rt, 1.0)), fh0 = floor_of(1) * std::max(0.5, dsp::median(rh, 1.0));
+      const double fr0 = (floor_of(0) + floor_of(1)) * std::max(0.5, dsp::median(rr, 1.0));
       double ex_common = 0.0, ex_diff = 0.0, disp = 0.0;
       for (std::size_t f = f_lo; f < f_hi; ++f) {
         const double pt = S.pt[a][f] * scale, ph = S.ph[a][f] * scale, pr = S.pr[a][f] * scale;

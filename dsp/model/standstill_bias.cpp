@@ -1,11 +1,14 @@
 #include "dsp/model/standstill_bias.hpp"
 
+#include "dsp/core/chi2.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 namespace eical::dsp::model {
 namespace {
@@ -19,6 +22,11 @@ constexpr double kTempPrior = 300.0;     // µg/°C: the prior σ of each coeffi
 constexpr int kBatches = 8;
 constexpr double kBlockS = 0.1;          // a still-ringing mode of 10 Hz or more shows in its spread
 constexpr double kRingingFactor = 1.5;
+
+// Weight of sample i of n in a Hann-weighted mean.
+double hann_weight(std::size_t i, std::size_t n) {
+  return 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * (static_cast<double>(i) + 0.5) / static_cast<double>(n));
+}
 
 // Generalised least squares of y on the columns of x under the covariance whose Cholesky
 // factor is `l`; returns χ² of the residual.
@@ -72,7 +80,7 @@ StandstillBias standstill_bias(const RunResiduals& r) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     double wsum = 0.0;
     for (std::size_t i = 0; i < rest.size(); ++i) {
-      const double hann = 0.5 - 0.5 * std::cos(2.0 * M_PI * (static_cast<double>(i) + 0.5) / static_cast<double>(rest.size()));
+      const double hann = hann_weight(i, rest.size());
       sum += hann * rest[i], wsum += hann;
     }
     ref_offset = sum / wsum - m.rest_bias_rel_mps2;
@@ -115,7 +123,7 @@ StandstillBias standstill_bias(const RunResiduals& r) {
       for (std::int64_t i = a + k * len; i < a + (k + 1) * len; ++i) {
         const auto u = static_cast<std::size_t>(i);
         const Eigen::Vector3d rel = m.raw.head_mps2[u] - m.raw.table_mps2[u];
-        const double hann = 0.5 - 0.5 * std::cos(2.0 * M_PI * (static_cast<double>(i - a) + 0.5) / static_cast<double>(n_used));
+        const double hann = hann_weight(static_cast<std::size_t>(i - a), static_cast<std::size_t>(n_used));
         batch[k] += rel, mean += hann * rel, wsum += hann;
         own[0] += m.raw.table_mps2[u], own[1] += m.raw.head_mps2[u];
       }
@@ -166,8 +174,7 @@ StandstillBias standstill_bias(const RunResiduals& r) {
         out.sensor = std::abs(w.sensor_ug[1][ax]) >= std::abs(w.sensor_ug[0][ax]) ? 1 : 0;
       }
   }
-  const double nu = out.dof, z5 = 5.0, c = 1.0 - 2.0 / (9.0 * nu) + z5 * std::sqrt(2.0 / (9.0 * nu));  // Wilson–Hilferty
-  out.changed = out.chi2 > nu * c * c * c && out.largest_change_ug > 1.0;
+  out.changed = out.chi2 > chi2_quantile(out.dof, 5.0) && out.largest_change_ug > 1.0;
 
   // Which pattern: per axis its own parameters, χ² summed, BIC with the window count. The
   // temperature enters with both sensors' case temperatures (each its own coefficient).

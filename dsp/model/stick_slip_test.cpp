@@ -1,5 +1,7 @@
 #include "dsp/model/stick_slip_test.hpp"
 
+#include "dsp/core/median.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,12 +14,6 @@ constexpr double kCreepMmS = 10.0;     // below this an axis creeps (600 mm/min)
 constexpr double kStillMmS = 0.02;     // below this it stands
 constexpr double kBurstSigma = 10.0;   // a burst: the high-passed acceleration beyond 10 σ
 constexpr double kHalfWindowS = 1e-3;  // high-pass: minus the mean over ±1 ms
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
 
 }  // namespace
 
@@ -54,7 +50,7 @@ StickSlipFinding stick_slip_test(const RunResiduals& r) {
     for (std::size_t k = 0; k < n; k += 3)
       if (zone[k] == 2) fast.push_back(std::abs(hp[k]));
     if (fast.size() < 200) continue;
-    const double sigma = 1.4826 * median(fast);
+    const double sigma = 1.4826 * dsp::median(fast, 0.0);
     if (!(sigma > 0.0)) continue;
     // Bursts: local peaks beyond the threshold, at least 1 ms apart.
     int in_creep = 0, elsewhere = 0;
@@ -79,7 +75,7 @@ StickSlipFinding stick_slip_test(const RunResiduals& r) {
       }
     }
     if (in_zone) per_zone.push_back(zone_bursts), ++zone_count;
-    const double mz = median(per_zone);
+    const double mz = dsp::median(per_zone, 0.0);
     if (mz > best_per_zone) {
       best_per_zone = mz;
       out.axis = a, out.creep_zones = zone_count, out.bursts_in_creep = in_creep, out.bursts_elsewhere = elsewhere, out.bursts_per_zone = mz;

@@ -85,7 +85,7 @@ Pipeline::Pipeline(const PipelineConfig& c)
   for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->reserve(c.capacity_samples);
   m_.sample_index.reserve(c.capacity_samples);
   if (c.keep_raw)
-    for (auto* v : {&m_.raw.table_mps2, &m_.raw.head_mps2}) v->reserve(c.capacity_samples);
+    for (auto* v : {&m_.raw.table_mps2, &m_.raw.head_mps2, &m_.raw.rest_rel_mps2}) v->reserve(c.capacity_samples);
   m_.triggers.reserve(trigger_capacity_);
   reset();
 }
@@ -239,7 +239,7 @@ void Pipeline::step(const Frame& f) noexcept {
         ++bias_n_;
         const Eigen::Vector3d rel = fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]);
         supports_.rest_sample(rel);
-        if (config_.keep_raw) m_.raw.rest_rel_mps2.push_back(rel);  // offline only: may allocate
+        if (config_.keep_raw && m_.raw.rest_rel_mps2.size() < config_.capacity_samples) m_.raw.rest_rel_mps2.push_back(rel);  // within the reserve
         return;
       }
       start_motion();

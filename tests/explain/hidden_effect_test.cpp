@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -32,7 +33,11 @@ std::string joined(const std::vector<std::string>& v) {
 }
 
 dsp::model::RunExplanation explain_hidden(const std::vector<std::string>& effects, const std::string& program, std::uint64_t seed) {
-  return dsp::model::explain_run(sim::simulate(sim::hidden_effect_scenario(effects, program, seed)));
+  const dsp::Run run = sim::simulate(sim::hidden_effect_scenario(effects, program, seed));
+  const auto t0 = std::chrono::steady_clock::now();
+  auto ex = dsp::model::explain_run(run);
+  ex.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return ex;
 }
 
 class HiddenEffect : public ::testing::TestWithParam<std::string> {};

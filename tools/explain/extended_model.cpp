@@ -1,33 +1,15 @@
 #include "tools/explain/extended_model.hpp"
 
 #include "drivers/run_io/run_writer.hpp"
+#include "dsp/core/axes.hpp"
 #include "dsp/model/extension.hpp"
 
 #include <Eigen/Dense>
 
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 
 namespace eical::tools::explain {
-namespace {
-
-int axis_of(char c) { return c == 'x' ? 0 : c == 'y' ? 1 : c == 'z' ? 2 : -1; }
-
-std::string num(double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
-// The parameter's axis letters after a prefix, e.g. "rotation_xy_mrad" → ('x', 'y').
-bool two_axes(const std::string& name, const std::string& prefix, int& a, int& b) {
-  if (name.rfind(prefix, 0) != 0 || name.size() < prefix.size() + 2) return false;
-  a = axis_of(name[prefix.size()]), b = axis_of(name[prefix.size() + 1]);
-  return a >= 0 && b >= 0;
-}
-
-}  // namespace
 
 ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanation& ex) {
   ExtendedModel m;
@@ -55,26 +37,26 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
     } else if (x.name == "machine.backlash") {
       for (const auto& [k, v] : p)
         if (k.rfind("backlash_", 0) == 0)
-          effects_toml += "\n[effects.\"machine.backlash\"]\naxis = \"" + std::string(1, k[9]) + "\"\nvalue_um = " + num(std::abs(v)) + "\n";
+          effects_toml += "\n[effects.\"machine.backlash\"]\naxis = \"" + std::string(1, k[9]) + "\"\nvalue_um = " + drivers::toml_number(std::abs(v)) + "\n";
     } else if (x.name == "machine.reversal_spike") {
       for (const auto& [k, v] : p)
         if (k.rfind("spike_", 0) == 0) {
           const auto tau = k.find("tau_");
           const double tau_ms = tau == std::string::npos ? 15.0 : std::atof(k.c_str() + tau + 4);
-          effects_toml += "\n[effects.\"machine.reversal_spike\"]\naxis = \"" + std::string(1, k[6]) + "\"\namp_um = " + num(std::abs(v)) +
-                          "\ntau_ms = " + num(tau_ms) + "\n";
+          effects_toml += "\n[effects.\"machine.reversal_spike\"]\naxis = \"" + std::string(1, k[6]) + "\"\namp_um = " + drivers::toml_number(std::abs(v)) +
+                          "\ntau_ms = " + drivers::toml_number(tau_ms) + "\n";
         }
     } else if (x.name == "machine.squareness") {
       for (const auto& [k, v] : p) {
         int i = 0, j = 0;
-        if (!two_axes(k, "squareness_", i, j)) continue;
+        if (!dsp::two_axes(k, "squareness_", i, j)) continue;
         const char* plane = (i == 0 && j == 1) ? "xy" : (i == 1 && j == 2) ? "yz" : "zx";
-        effects_toml += "\n[effects.\"machine.squareness\"]\nplane = \"" + std::string(plane) + "\"\nvalue_urad = " + num(v) + "\n";
+        effects_toml += "\n[effects.\"machine.squareness\"]\nplane = \"" + std::string(plane) + "\"\nvalue_urad = " + drivers::toml_number(v) + "\n";
       }
     } else if (x.name == "machine.scale_mismatch") {
       for (const auto& [k, v] : p)
         if (k.rfind("scale_", 0) == 0)
-          effects_toml += "\n[effects.\"machine.scale_mismatch\"]\naxis = \"" + std::string(1, k[6]) + "\"\nvalue_ppm = " + num(v) + "\n";
+          effects_toml += "\n[effects.\"machine.scale_mismatch\"]\naxis = \"" + std::string(1, k[6]) + "\"\nvalue_ppm = " + drivers::toml_number(v) + "\n";
     } else if (x.name == "machine.cyclic_error") {
       for (const auto& [k, v] : p) {
         if (k.rfind("cyclic_", 0) != 0 || k.find("_sin_um") == std::string::npos) continue;
@@ -83,8 +65,8 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
         const double cs = c == p.end() ? 0.0 : c->second;
         const auto pos = base.find("pitch_");
         const double pitch = pos == std::string::npos ? 10.0 : std::atof(base.c_str() + pos + 6);
-        effects_toml += "\n[effects.\"machine.cyclic_error\"]\naxis = \"" + std::string(1, k[7]) + "\"\namp_um = " + num(std::hypot(v, cs)) +
-                        "\npitch_mm = " + num(pitch) + "\nphase_deg = " + num(std::atan2(cs, v) * 180.0 / std::numbers::pi) + "\n";
+        effects_toml += "\n[effects.\"machine.cyclic_error\"]\naxis = \"" + std::string(1, k[7]) + "\"\namp_um = " + drivers::toml_number(std::hypot(v, cs)) +
+                        "\npitch_mm = " + drivers::toml_number(pitch) + "\nphase_deg = " + drivers::toml_number(std::atan2(cs, v) * 180.0 / std::numbers::pi) + "\n";
       }
     } else {
       m.notes.push_back(x.name + ": found; not taken into the scenario (its shape is not one of the simulator's tables)");
@@ -95,11 +77,11 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
   for (const auto& x : ex.effects)
     if (x.name == "machine.servo_mismatch")
       for (const auto& [k, v] : x.params)
-        if (k.rfind("lag_", 0) == 0 && v > 1e-4) servo_toml += "\n[servo." + std::string(1, k[4]) + "]\nkv_per_s = " + num(0.01 / (v * 1e-3)) + "\nfeedforward = 0.99\n";
+        if (k.rfind("lag_", 0) == 0 && v > 1e-4) servo_toml += "\n[servo." + std::string(1, k[4]) + "]\nkv_per_s = " + drivers::toml_number(0.01 / (v * 1e-3)) + "\nfeedforward = 0.99\n";
   // The scenario: what eical is told = the run's own data sheet, the truth = the extended
   // sensors and DAQ ([truth.*]): simulated, it shows what the recorded run showed.
-  std::string truth_toml = "\n[truth.daq]\ngroup_delay_samples = " + num(cal.daq_group_delay_samples.value_or(meta.acquisition.daq_group_delay_samples)) +
-                           "\nskew_head_samples = " + num(cal.daq_skew_head_samples.value_or(meta.acquisition.daq_skew_head_samples)) + "\n";
+  std::string truth_toml = "\n[truth.daq]\ngroup_delay_samples = " + drivers::toml_number(cal.daq_group_delay_samples.value_or(meta.acquisition.daq_group_delay_samples)) +
+                           "\nskew_head_samples = " + drivers::toml_number(cal.daq_skew_head_samples.value_or(meta.acquisition.daq_skew_head_samples)) + "\n";
   for (int s = 0; s < 2; ++s) {
     std::string sec = drivers::sensor_section_toml(s == 0 ? "table" : "head", cal.sensors[s]);
     sec.replace(sec.find("[sensors."), 9, "[truth.sensors.");
