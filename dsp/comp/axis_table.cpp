@@ -61,18 +61,6 @@ AxisTable without_reversal(const AxisTable& t) {
   return m;
 }
 
-Grid covering_grid(double from_mm, double to_mm, double spacing_mm) {
-  if (!(spacing_mm > 0.0) || !std::isfinite(spacing_mm)) throw InputError("comp: the table spacing must be a positive number of mm");
-  if (!(to_mm >= from_mm)) throw InputError("comp: empty travel " + mm(from_mm) + " .. " + mm(to_mm) + " mm");
-  Grid g;
-  g.spacing_mm = spacing_mm;
-  // 1e-9 mm: positions that are multiples of the spacing up to rounding stay on the grid.
-  g.first_mm = std::floor(from_mm / spacing_mm + 1e-9) * spacing_mm;
-  g.points = static_cast<int>(std::ceil((to_mm - g.first_mm) / spacing_mm - 1e-9)) + 1;
-  g.points = std::max(g.points, 2);
-  return g;
-}
-
 AxisTable resample(const AxisTable& t, double first_mm, double spacing_mm, int points) {
   validate(t);
   AxisTable r;

@@ -59,15 +59,6 @@ AxisTable without_reversal(const AxisTable& t);
 // eical never extrapolates a measurement.
 AxisTable resample(const AxisTable& t, double first_mm, double spacing_mm, int points);
 
-// The smallest equidistant grid with this spacing that covers [from, to], starting on a
-// multiple of the spacing (so that repeated calibrations share their points).
-struct Grid {
-  double first_mm = 0.0, spacing_mm = 0.0;
-  int points = 0;
-  [[nodiscard]] double last_mm() const { return first_mm + spacing_mm * (points - 1); }
-};
-Grid covering_grid(double from_mm, double to_mm, double spacing_mm);
-
 // InputError when [from, to] is not inside the table's range, naming what needs it:
 // "comp: the x table covers 0 .. 40 mm; circle run c1 measured x from -10 to 10 mm".
 void require_coverage(const AxisTable& t, double from_mm, double to_mm, const std::string& who);
