@@ -20,6 +20,7 @@ nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::js
 
 nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult& c) {
   nlohmann::json j = {{"plane", p.plane},
+                      {"center_mm", {p.center_mm[0], p.center_mm[1]}},  // programmed, in the plane's axes
                       {"radius_nominal_mm", p.radius_mm},
                       {"feed_mm_min", p.feed_mm_min},
                       {"direction", c.direction},
