@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -102,9 +103,23 @@ void remove_stale() {
   }
 }
 
+// Configure time found it (EICAL_PG_BINDIR); else the newest Debian server installed since.
+std::string server_bindir() {
+  std::string dir = EICAL_PG_BINDIR;
+  if (!dir.empty() && fs::exists(fs::path(dir) / "postgres")) return dir;
+  std::error_code ec;
+  std::vector<std::string> found;
+  for (const auto& e : fs::directory_iterator("/usr/lib/postgresql", ec))
+    if (fs::exists(e.path() / "bin" / "postgres")) found.push_back((e.path() / "bin").string());
+  std::sort(found.begin(), found.end(), [](const std::string& a, const std::string& b) {
+    return a.size() != b.size() ? a.size() < b.size() : a < b;  // "9" < "15" by length first
+  });
+  return found.empty() ? dir : found.back();
+}
+
 }  // namespace
 
-ScratchServer::ScratchServer(ServerOptions options) : options_(options), bindir_(EICAL_PG_BINDIR) {
+ScratchServer::ScratchServer(ServerOptions options) : options_(options), bindir_(server_bindir()) {
   if (bindir_.empty() || !fs::exists(fs::path(bindir_) / "initdb") || !fs::exists(fs::path(bindir_) / "postgres"))
     throw std::runtime_error("pg_scratch: no PostgreSQL server programs (initdb, postgres) in '" + bindir_ +
                              "': install Debian's postgresql (scripts/deps.sh test) and re-run cmake");

@@ -5,10 +5,11 @@
 //
 //   eical_schema (version)                                   one row
 //   results (id, machine, run_id, program, measured_at, verdict, degraded, run_path,
-//            software_version, sensor_calibration, document, added_at)
+//            software_version, sensor_calibration, added_at)
 //            UNIQUE (machine, run_id): a result is keyed by its machine and run id
 //   figures (result_id → results.id, name "<section>.<key>", value, uncertainty_k2)
 //            PRIMARY KEY (result_id, name); value/uncertainty NULL when not determined/given
+//   documents (result_id → results.id, document): the eical-result/1 JSON
 #include "history/sql/connection.hpp"
 
 #include <stdexcept>

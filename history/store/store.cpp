@@ -59,12 +59,13 @@ int Store::schema_version() { return history::schema_version(*c_); }
 AddOutcome Store::insert(const Record& r) {
   const auto rows = c_->query(
       "INSERT INTO results (machine, run_id, program, measured_at, verdict, degraded, run_path, software_version, "
-      "sensor_calibration, document, added_at) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11) "
+      "sensor_calibration, added_at) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10) "
       "ON CONFLICT (machine, run_id) DO NOTHING RETURNING id",
       {r.machine, r.run_id, r.program, r.measured_at, text_or_null(r.verdict), static_cast<std::int64_t>(r.degraded ? 1 : 0),
-       r.run_path, text_or_null(r.software_version), r.sensor_calibration, r.document, utc_now()});
+       r.run_path, text_or_null(r.software_version), r.sensor_calibration, utc_now()});
   if (rows.empty()) return AddOutcome::duplicate;
   const std::int64_t id = sql::to_int(rows[0][0]);
+  c_->exec("INSERT INTO documents (result_id, document) VALUES ($1, $2)", {id, r.document});
   for (std::size_t first = 0; first < r.figures.size(); first += kFigureRowsPerInsert) {
     const std::size_t n = std::min(kFigureRowsPerInsert, r.figures.size() - first);
     std::string s = "INSERT INTO figures (result_id, name, value, uncertainty_k2) VALUES ";
@@ -113,10 +114,10 @@ std::vector<Summary> Store::list(const Filter& f) {
 std::vector<Record> Store::find(const std::string& run_id, const std::string& machine) {
   std::vector<Value> p{run_id};
   std::string s =
-      "SELECT id, machine, run_id, program, measured_at, verdict, degraded, run_path, software_version, sensor_calibration, document "
-      "FROM results WHERE run_id = $1";
-  if (!machine.empty()) s += " AND machine = $2", p.emplace_back(machine);
-  s += " ORDER BY machine";
+      "SELECT r.id, r.machine, r.run_id, r.program, r.measured_at, r.verdict, r.degraded, r.run_path, r.software_version, "
+      "r.sensor_calibration, d.document FROM results r JOIN documents d ON d.result_id = r.id WHERE r.run_id = $1";
+  if (!machine.empty()) s += " AND r.machine = $2", p.emplace_back(machine);
+  s += " ORDER BY r.machine";
   std::vector<Record> out;
   for (const auto& row : c_->query(s, p)) {
     Record r;

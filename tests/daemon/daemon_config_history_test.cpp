@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 
 namespace {
@@ -48,11 +49,17 @@ TEST(DaemonConfigHistory, BadValuesAreRefusedNamingTheKey) {
   EXPECT_NE(error_of("[machine]\nname = \"\"\n[history]\nenabled = true\n").find("[machine] name is required"), std::string::npos);
 }
 
-TEST(DaemonConfigHistory, TheInstalledExampleKeepsAHistory) {
+TEST(DaemonConfigHistory, TheInstalledExampleKeepsAHistoryWhereTheServiceMayWrite) {
   const auto c = load_daemon_config(fs::path(EICAL_SOURCE_DIR) / "config" / "eicald.toml");
   EXPECT_TRUE(c.history.enabled);
   EXPECT_EQ(c.history.db, "/var/lib/eical/history.db");
   EXPECT_EQ(c.history.spool_dir, "/var/lib/eical/history-spool");
+  // The unit's ProtectSystem=strict leaves only ReadWritePaths writable.
+  std::ifstream unit(fs::path(EICAL_SOURCE_DIR) / "systemd" / "eicald.service");
+  const std::string text{std::istreambuf_iterator<char>(unit), std::istreambuf_iterator<char>()};
+  EXPECT_NE(text.find("\nReadWritePaths=/var/lib/eical\n"), std::string::npos);
+  EXPECT_EQ(c.history.db.rfind("/var/lib/eical/", 0), 0u);
+  EXPECT_EQ(c.history.spool_dir.string().rfind("/var/lib/eical/", 0), 0u);
 }
 
 }  // namespace

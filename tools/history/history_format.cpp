@@ -28,10 +28,12 @@ std::string fixed(double v, int decimals) {
   return b;
 }
 
+// A value without an uncertainty: three significant digits, never finer than 0.001 (no
+// instrument of this kind resolves below a nanometre, whatever the arithmetic printed).
 std::string plain(double v) {
-  char b[64];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
+  const double a = std::abs(v);
+  const int decimals = a > 0 ? std::clamp(2 - static_cast<int>(std::floor(std::log10(a))), 0, 3) : 0;
+  return fixed(v, decimals);
 }
 
 std::string pad(std::string s, std::size_t n) {

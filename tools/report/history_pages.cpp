@@ -46,6 +46,16 @@ std::vector<PolarTrace> polar_traces(const history::Record& r, const std::string
 
 std::string short_date(const std::string& t) { return t.substr(0, 10); }
 
+std::string judgement_text(history::Judgement j) {
+  switch (j) {
+    case history::Judgement::significant: return "significant";
+    case history::Judgement::within_uncertainty: return "within the uncertainty";
+    case history::Judgement::not_judged: return "not judged (no uncertainty)";
+    case history::Judgement::missing: return "not determined";
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string trend_plot(const std::string& figure, const std::vector<history::TrendPoint>& points, const std::vector<std::string>& marked) {
@@ -138,13 +148,15 @@ Page compare_page(const history::Comparison& c, const history::Record& before, c
   } else {
     p.notes.push_back("Polar plots need two circular tests with their traces; these results are " + before.program + " and " + after.program + ".");
   }
-  Table sig{"Significant changes", {}};
+  Grid sig{"Significant changes", {"figure", "before", "after", "difference"}, {}};
   for (const auto& f : c.figures)
-    if (f.judgement == history::Judgement::significant)
-      sig.rows.push_back({history::label_of(f.name), f.difference, history::unit_of(f.name), 2,
-                          "± " + hv::measure(f.uncertainty_k2, std::nullopt, history::unit_of(f.name))});
-  if (sig.rows.empty()) sig.rows.push_back({"none", std::nullopt, "", 0, "every change within its uncertainty or not judged"});
-  p.tables.push_back(sig);
+    if (f.judgement == history::Judgement::significant) {
+      const std::string unit = history::unit_of(f.name);
+      sig.rows.push_back({history::label_of(f.name), hv::measure(f.before, f.u_before, unit), hv::measure(f.after, f.u_after, unit),
+                          hv::measure(f.difference, f.uncertainty_k2, unit)});
+    }
+  if (sig.rows.empty()) p.notes.push_back("No figure changed significantly: every change is within its uncertainty or could not be judged.");
+  else p.grids.push_back(sig);
   page.sections.push_back(std::move(p));
 
   Section f;
@@ -154,7 +166,7 @@ Page compare_page(const history::Comparison& c, const history::Record& before, c
   for (const auto& fc : c.figures) {
     const std::string unit = history::unit_of(fc.name);
     g.rows.push_back({history::label_of(fc.name) + " (" + fc.name + ")", hv::measure(fc.before, fc.u_before, unit), hv::measure(fc.after, fc.u_after, unit),
-                      fc.difference ? hv::measure(fc.difference, fc.uncertainty_k2, unit) : "-", history::judgement_name(fc.judgement)});
+                      fc.difference ? hv::measure(fc.difference, fc.uncertainty_k2, unit) : "-", judgement_text(fc.judgement)});
   }
   f.grids.push_back(g);
   page.sections.push_back(std::move(f));
