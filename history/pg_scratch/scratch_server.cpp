@@ -85,20 +85,23 @@ std::string tail(const fs::path& file, std::size_t lines) {
   return out;
 }
 
-// Leftovers of a test that was killed: a directory whose server is gone (or that never got
-// one and is older than an hour). A live server's directory is never touched.
+bool alive(const fs::path& pidfile) {
+  std::ifstream is(pidfile);
+  long pid = 0;
+  return (is >> pid) && pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH);
+}
+
+// Leftovers of a test that was killed: a directory whose owner (the process that started
+// the server, owner.pid) is gone and whose server is gone too; one without an owner file
+// when it is older than an hour. A live server's directory is never touched.
 void remove_stale() {
   std::error_code ec;
   const auto now = fs::file_time_type::clock::now();
   for (const auto& e : fs::directory_iterator(fs::temp_directory_path(), ec)) {
     if (!e.is_directory() || e.path().filename().string().rfind(kPrefix, 0) != 0) continue;
-    std::ifstream pidfile(e.path() / "data" / "postmaster.pid");
-    long pid = 0;
-    if (pidfile >> pid) {
-      if (pid > 0 && (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH)) continue;
-    } else if (now - fs::last_write_time(e.path(), ec) < std::chrono::hours(1)) {
+    if (alive(e.path() / "data" / "postmaster.pid")) continue;
+    if (fs::exists(e.path() / "owner.pid") ? alive(e.path() / "owner.pid") : now - fs::last_write_time(e.path(), ec) < std::chrono::hours(1))
       continue;
-    }
     fs::remove_all(e.path(), ec);
   }
 }
@@ -127,6 +130,7 @@ ScratchServer::ScratchServer(ServerOptions options) : options_(options), bindir_
   std::string tmpl = (fs::temp_directory_path() / (std::string(kPrefix) + "XXXXXX")).string();
   if (!::mkdtemp(tmpl.data())) throw std::runtime_error("pg_scratch: cannot create a temporary directory: " + std::string(std::strerror(errno)));
   dir_ = tmpl;
+  std::ofstream(dir_ + "/owner.pid") << ::getpid() << "\n";
   const RunAs who = run_as();
   if (who.uid != static_cast<uid_t>(-1) && ::chown(dir_.c_str(), who.uid, who.gid) != 0) {
     const int err = errno;
@@ -169,7 +173,7 @@ void ScratchServer::start() {
   if (running()) return;
   // Unix socket in our directory only; SIGQUIT (immediate shutdown) when the test dies.
   pid_ = spawn({bindir_ + "/postgres", "-D", dir_ + "/data", "-k", dir_, "-p", "5432", "-c", "listen_addresses=", "-c",
-                std::string("fsync=") + (options_.fsync ? "on" : "off"), "-c", "max_connections=40", "-c", "shared_buffers=32MB"},
+                std::string("fsync=") + (options_.fsync ? "on" : "off")},
                dir_ + "/server.log", run_as(), SIGQUIT);
   const std::string conninfo = "host=" + dir_ + " port=5432 user=eical dbname=postgres connect_timeout=2";
   const auto end = std::chrono::steady_clock::now() + 60s;
