@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <algorithm>
 #include <map>
 
 namespace eical::history {
@@ -72,6 +73,11 @@ std::vector<TrendSummary> summarize(const std::vector<TrendPoint>& points) {
       w.push_back(has_u ? 1.0 / std::pow(*p->uncertainty_k2 / 2.0, 2) : 1.0);
     }
     if (!all_u) std::fill(w.begin(), w.end(), 1.0);
+    if (!t.empty()) s.span_days = (*std::max_element(t.begin(), t.end()) - *std::min_element(t.begin(), t.end())) * 30.0;
+    if (s.span_days < kMinDriftSpanDays) {
+      out.push_back(std::move(s));
+      continue;
+    }
     if (const auto f = fit_slope(t, y, w, all_u)) {
       s.slope_per_30d = f->first;
       s.slope_u_k2 = 2.0 * f->second;

@@ -4,7 +4,9 @@
 // scatter more than their uncertainties allow (χ²/dof > 1) the slope's uncertainty grows
 // by √(χ²/dof); points without an uncertainty are fitted unweighted, the slope's
 // uncertainty then from the residuals alone (needs three points). A drift is significant
-// when |slope| exceeds its expanded uncertainty (k = 2).
+// when |slope| exceeds its expanded uncertainty (k = 2). Results that span less than a day
+// give no drift: a rate per 30 days from minutes of data would be an extrapolation, not a
+// measurement.
 #include "history/store/store.hpp"
 
 #include <optional>
@@ -19,7 +21,10 @@ struct TrendSummary {
   std::optional<TrendPoint> first, last;           // the first and last with a value
   std::optional<double> slope_per_30d, slope_u_k2;  // figure unit per 30 days
   bool drift_significant = false;
+  double span_days = 0.0;                          // first to last result with a value
 };
+
+inline constexpr double kMinDriftSpanDays = 1.0;
 
 // One summary per machine of the points, machines in order of name.
 std::vector<TrendSummary> summarize(const std::vector<TrendPoint>& points);

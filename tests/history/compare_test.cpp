@@ -75,5 +75,19 @@ TEST(HistoryTrend, AKnownDriftIsFoundWithinItsUncertainty) {
   EXPECT_NEAR(*s[1].slope_u_k2, 2.0 * 0.1 / std::sqrt(stt), 1e-9);
 }
 
+TEST(HistoryTrend, ResultsOfLessThanADayGiveNoDrift) {
+  std::vector<history::TrendPoint> pts;
+  for (int s = 0; s < 5; ++s) {
+    char t[32];
+    std::snprintf(t, sizeof t, "2026-01-01T10:00:%02dZ", 10 * s);
+    pts.push_back({"maho-1", "r" + std::to_string(s), t, std::nullopt, false, 15.0 - 0.3 * s, std::nullopt});
+  }
+  const auto s = history::summarize(pts);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_FALSE(s[0].slope_per_30d);  // not 10^5 µm per 30 days from forty seconds
+  EXPECT_LT(s[0].span_days, history::kMinDriftSpanDays);
+  EXPECT_EQ(s[0].last->run_id, "r4");
+}
+
 }  // namespace
 }  // namespace eical::test

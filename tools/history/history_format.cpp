@@ -128,6 +128,8 @@ std::string trend_text(const std::string& figure, const std::vector<history::Tre
            measure(s.last->value, s.last->uncertainty_k2, unit) + " (" + when(s.last->measured_at).substr(0, 10) + ")";
     if (s.slope_per_30d && s.slope_u_k2)
       out += ", drift " + measure(s.slope_per_30d, s.slope_u_k2, unit) + " per 30 days (" + (s.drift_significant ? "significant" : "within its uncertainty") + ")";
+    else if (s.span_days < history::kMinDriftSpanDays)
+      out += ", drift: the results span less than a day";
     else
       out += ", drift: too few results";
     out += "\n";

@@ -108,7 +108,9 @@ Page trend_page(const std::string& figure, const std::vector<history::TrendPoint
   for (const auto& m : summaries)
     drift.rows.push_back({m.machine, m.first ? hv::measure(m.first->value, m.first->uncertainty_k2, unit) : "n/a",
                           m.last ? hv::measure(m.last->value, m.last->uncertainty_k2, unit) : "n/a",
-                          m.slope_per_30d ? hv::measure(m.slope_per_30d, m.slope_u_k2, unit) : "too few results",
+                          m.slope_per_30d                             ? hv::measure(m.slope_per_30d, m.slope_u_k2, unit)
+                          : m.span_days < history::kMinDriftSpanDays ? "results span less than a day"
+                                                                      : "too few results",
                           m.slope_per_30d ? (m.drift_significant ? "significant" : "within its uncertainty") : ""});
   s.grids.push_back(drift);
   Grid all{"Results", {"measured (UTC)", "machine", "run", "value ± U (k = 2)", "verdict"}, {}};
