@@ -1,5 +1,6 @@
 #include "drivers/results/result_json.hpp"
 
+#include "drivers/results/software_version.hpp"
 #include "drivers/run_io/run_writer.hpp"
 
 #include <algorithm>
@@ -87,6 +88,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   j["format"] = "eical-result/1";
   j["run_id"] = run.meta.id;
   j["program"] = kind;
+  j["software"] = software_version();
   j["quality"] = {{"degraded", a.degraded}, {"flags", a.flags}};
   j["sensor_model"] = {{"identified", a.sensor_model != "datasheet"}, {"source", a.sensor_model}};
   if (a.circle) {
