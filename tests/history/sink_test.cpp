@@ -83,7 +83,8 @@ TEST_P(SinkTest, AStoreOfANewerSchemaKeepsResultsSpooledAndSaysWhy) {
   Messages msg;
   Sink sink(config(), msg.log());
   sink.submit(sample("a"));
-  ASSERT_TRUE(eventually([&] { return !sink.problem().empty(); }));
+  // The problem is set before its message is logged: wait for both.
+  ASSERT_TRUE(eventually([&] { return !sink.problem().empty() && msg.errors().find("results wait in") != std::string::npos; })) << msg.errors();
   EXPECT_NE(sink.problem().find("schema version 99"), std::string::npos) << sink.problem();
   EXPECT_NE(msg.errors().find("1 results wait in " + (dir_ / "spool").string()), std::string::npos) << msg.errors();
   EXPECT_EQ(history::Spool(dir_ / "spool").waiting().size(), 1u);
