@@ -330,7 +330,7 @@ sim::Scenario read_scenario_file(const std::string& path) {
         for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
         effects->fail(name, "unknown effect (known: " + list + ")");
       }
-      read_effect(name, effects->table(name), sc);
+      for (StrictTable& t : effects->table_or_tables(name)) read_effect(name, std::move(t), sc);
       sc.effects_present.push_back(name);
     }
     effects->finish();
