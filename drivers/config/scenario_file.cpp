@@ -88,7 +88,7 @@ void read_sensor_effect(const std::string& name, StrictTable& t, sim::Scenario& 
       if (t.has("axes_map")) {
         const std::string map = t.string("axes_map");
         try {
-          st.spec.to_machine = sim::axes_map_matrix(map, "axes_map") * st.spec.to_machine;
+          st.spec.to_machine = sim::axes_map_matrix(map, "") * st.spec.to_machine;
         } catch (const dsp::InputError& e) {
           t.fail("axes_map", e.what());
         }
@@ -264,7 +264,17 @@ void read_sweep(StrictTable t, sim::Scenario& sc) {
   k.sweeping_accel_mm_s2 = t.number("sweeping_accel_mm_s2", k.sweeping_accel_mm_s2);
   k.sweeping_period_s = t.number("sweeping_period_s", k.sweeping_period_s);
   k.stop_accel_mm_s2 = t.number("stop_accel_mm_s2", k.stop_accel_mm_s2);
-  if (const std::string why = k.invalid_reason(); !why.empty()) t.fail("freq_start_hz", why);
+  if (const std::string why = k.invalid_reason(); !why.empty()) {
+    // The key the reason is about (invalid_reason names it first).
+    const char* key = why.rfind("freq_start", 0) == 0 ? "freq_start_hz"
+                      : why.rfind("freq_end", 0) == 0 ? "freq_end_hz"
+                      : why.rfind("accel_per_hz", 0) == 0 ? "accel_per_hz"
+                      : why.rfind("hz_per_sec", 0) == 0 ? "hz_per_sec"
+                      : why.rfind("sweeping", 0) == 0 ? "sweeping_accel_mm_s2"
+                      : why.rfind("the stop", 0) == 0 ? "stop_accel_mm_s2"
+                                                       : "preset";
+    t.fail(t.has(key) ? key : "preset", why);
+  }
   sc.sweep.start_mm = vec3(t, "start_mm", Eigen::Vector3d::Zero());
   sc.sweep.lead_in_s = t.number("lead_in_s", 0.0);
   sc.sweep.tail_s = t.number("tail_s", 0.0);

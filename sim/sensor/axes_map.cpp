@@ -12,7 +12,8 @@ Eigen::Matrix3d axes_map_matrix(std::string_view map, const std::string& what) {
   int row = 0;
   std::size_t pos = 0;
   auto fail = [&](const std::string& why) -> Eigen::Matrix3d {
-    throw dsp::InputError(what + ": axes map '" + std::string(map) + "': " + why + " (expected e.g. \"x,y,z\" or \"-y,x,z\")");
+    throw dsp::InputError((what.empty() ? std::string() : what + ": ") + "axes map '" + std::string(map) + "': " + why +
+                          " (expected e.g. \"x,y,z\" or \"-y,x,z\")");
   };
   while (pos <= map.size()) {
     const std::size_t comma = map.find(',', pos);

@@ -11,7 +11,7 @@
 
 namespace eical::sim {
 
-// Throws InputError naming `what` unless `map` names each of x, y, z once.
+// Throws InputError naming `what` (if not empty) unless `map` names each of x, y, z once.
 Eigen::Matrix3d axes_map_matrix(std::string_view map, const std::string& what);
 
 // The map's text for a signed permutation matrix ("" when the matrix is not one).
