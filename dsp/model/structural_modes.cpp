@@ -296,6 +296,15 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
     }
     out.modes = std::move(refit);
   }
+  {
+    std::vector<Eigen::VectorXd> cols;
+    for (const auto& md : out.modes)
+      if (md.significant)
+        for (auto& col : mode_cols(md.frequency_hz, md.damping_ratio)) cols.push_back(std::move(col));
+    const double per = 1.0 / (static_cast<double>(nn) * 3.0);
+    out.residual_rms_before_mg = out.residual_rms_after_mg = std::sqrt(tm.base_rss() * per) / kMmS2PerMg;
+    if (!cols.empty()) out.residual_rms_after_mg = std::sqrt(tm.fit(cols).rss * per) / kMmS2PerMg;
+  }
   std::sort(out.modes.begin(), out.modes.end(), [](const StructuralMode& a, const StructuralMode& b) {
     if (a.significant != b.significant) return a.significant;
     return a.chi2_drop > b.chi2_drop;
