@@ -1,4 +1,5 @@
 #include "tools/commands.hpp"
+#include "tools/version.hpp"
 
 #include <cstdio>
 
@@ -6,7 +7,7 @@ namespace eical::tools {
 
 void register_version(CLI::App& app) {
   auto* cmd = app.add_subcommand("version", "Print the eical version and the formats it speaks");
-  cmd->callback([] { std::printf("eical 0.1.0 (eical-run/1, eical-result/1, eical-explain/1)\n"); });
+  cmd->callback([] { std::printf("eical %s (eical-run/1, eical-result/1, eical-explain/1, eical-sensor-cal/1, eical-tolerances/1, eical-plan/1)\n", kVersion); });
 }
 
 }  // namespace eical::tools
