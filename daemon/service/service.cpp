@@ -2,6 +2,7 @@
 
 #include "daemon/config/linuxcnc_source_config.hpp"
 #include "daemon/service/frame_guard.hpp"
+#include "daemon/service/history_hook.hpp"
 #include "daemon/service/hmi_link.hpp"
 #include "daemon/service/trace_builder.hpp"
 #include "daemon/system/log.hpp"
@@ -19,6 +20,7 @@
 #include "dsp/session/measurement_session.hpp"
 #include "sim/scenario.hpp"
 #include "drivers/results/result_json.hpp"
+#include "drivers/results/software_version.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -106,9 +108,11 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   // The identified calibration (eical identify) replaces the data sheet for the live path,
   // the recordings and their evaluation; a file that cannot be read stops the start.
   dsp::AnalysisOptions analysis;
+  std::string sensor_calibration = "datasheet";  // what the results were compensated with (history, Result)
   if (!config_.calibration_file.empty()) {
     const drivers::SensorCalibration cal = drivers::read_sensor_calibration(config_.calibration_file, meta);
     drivers::apply_calibration(cal, meta, analysis);
+    sensor_calibration = cal.method + ": " + config_.calibration_file.string() + " (run " + cal.run_id + ")";
     log(LogLevel::info, "calibration %s (%s, from run %s) in use", config_.calibration_file.c_str(), cal.method.c_str(), cal.run_id.c_str());
   }
 
@@ -131,6 +135,9 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   } catch (const std::exception& e) {
     log(LogLevel::warning, "dds unavailable, running without the HMI bus: %s", e.what());
   }
+  // The calibration history ([history]): results leave through an on-disk spool, never lost.
+  std::unique_ptr<HistoryHook> history;
+  if (config_.history.enabled) history = std::make_unique<HistoryHook>(config_.history, sensor_calibration);
   const bool dds_triggers = has_input(config_.triggers, "dds");
   // Without the "frame" input the DAQ's trigger channel is ignored (the NC sends its
   // M-codes another way; a floating trigger line must not start measurements).
@@ -182,9 +189,13 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
           a.degraded = true;
         }
         drivers::write_result(run, a, dir / "result.json");
+        if (history) history->append(run, a, dir);
         if (hmi) {
           drivers::dds::ResultMsg r;
+          r.machine = run.meta.machine.name;
           r.program_id = run.meta.id;
+          r.measured_at = run.meta.created, r.run_path = dir.string(), r.software_version = drivers::software_version();
+          r.sensor_calibration = sensor_calibration;
           r.program = run.meta.program.kind;
           r.degraded = a.degraded;
           if (a.circle) r.circular_deviation_G_um = a.circle->circular_deviation_G_um, r.radius_mean_deviation_um = a.circle->radius_mean_deviation_um;
@@ -244,6 +255,7 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
       s = status;
     }
     s.state = state;
+    if (history && s.fault.empty()) s.fault = history->problem();
     s.frames = session.counters().frames;
     s.overruns = ring.overruns();
     s.frames_lost = session.counters().frames_lost;

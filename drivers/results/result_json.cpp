@@ -1,5 +1,6 @@
 #include "drivers/results/result_json.hpp"
 
+#include "drivers/results/software_version.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/analysis/figures.hpp"
 #include "dsp/analysis/verdict.hpp"
@@ -47,6 +48,7 @@ nlohmann::json uncertainty_json(const dsp::Analysis& a) {
 
 nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult& c) {
   nlohmann::json j = {{"plane", p.plane},
+                      {"center_mm", {p.center_mm[0], p.center_mm[1]}},  // programmed, in the plane's axes
                       {"radius_nominal_mm", p.radius_mm},
                       {"feed_mm_min", p.feed_mm_min},
                       {"direction", c.direction},
@@ -117,6 +119,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   j["format"] = "eical-result/1";
   j["run_id"] = run.meta.id;
   j["program"] = kind;
+  j["software"] = software_version();
   j["quality"] = {{"degraded", a.degraded}, {"verdict", a.verdict}, {"verdict_reasons", a.verdict_reasons}, {"flags", a.flags}};
   nlohmann::json severity = nlohmann::json::array();
   for (const auto& f : a.flags) severity.push_back(dsp::severity_name(dsp::flag_severity(f)));

@@ -3,6 +3,7 @@
 #include "dsp/analysis/figures.hpp"
 #include "dsp/uncertainty/resolved.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -51,7 +52,12 @@ void judge(const Program& program, Analysis& a) {
   if (lim) {
     const FigureValue* h = find_figure(figs, lim->headline);
     const FigureValue* l = find_figure(figs, lim->limited);
-    if (!h || !l) {
+    const auto unsupported = std::find_if(a.flags.begin(), a.flags.end(), [](const std::string& f) { return starts_with(f, kPositionNullFlag); });
+    if (!h && unsupported != a.flags.end()) {
+      // Nothing holds the double integral: no position figure at all, whatever its size.
+      not_measurable = true;
+      a.verdict_reasons.push_back(std::string(lim->name) + " is not measurable: " + unsupported->substr(std::string(kPositionNullFlag).size()));
+    } else if (!h || !l) {
       a.verdict_reasons.push_back(std::string(lim->name) + " could not be determined (see the flags)");
     } else if (a.uncertainty_k2.empty()) {
       a.verdict_reasons.push_back("the figures' uncertainty was not estimated" + (a.uncertainty_note.empty() ? "" : ": " + a.uncertainty_note));
@@ -74,13 +80,13 @@ void judge(const Program& program, Analysis& a) {
   else a.verdict = "ok";
   if (a.degraded)
     for (const auto& f : a.flags)
-      if (flag_severity(f) == FlagSeverity::critical) a.verdict_reasons.push_back(f);
+      if (flag_severity(f) == FlagSeverity::critical && !starts_with(f, kPositionNullFlag)) a.verdict_reasons.push_back(f);
 }
 
 FlagSeverity flag_severity(const std::string& f) {
   // The measurement itself is wrong or incomplete.
   for (const char* p : {"accel_missing", "accel_saturated", "frames_lost", "not_finite", "capacity_exceeded", "fixed_saturated",
-                        "supports_diverged", "psd_disagrees", "no_motion", "interrupted", "source_stopped"})
+                        "supports_diverged", "psd_disagrees", "no_motion", "interrupted", "source_stopped", kPositionNullFlag})
     if (starts_with(f, p)) return FlagSeverity::critical;
   // An evaluation that failed ("circle: …", "positioning: …" without "null").
   for (const char* p : {"circle: ", "step: ", "rectangle: null", "freeform: null"})

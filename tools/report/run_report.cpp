@@ -1,7 +1,7 @@
 #include "tools/report/run_report.hpp"
 
 #include "dsp/analysis/verdict.hpp"
-#include "tools/version.hpp"
+#include "drivers/results/software_version.hpp"
 
 #include "tools/report/html.hpp"
 #include "tools/report/sections.hpp"
@@ -165,7 +165,7 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs:
                   {"operator", op.empty() ? "not given" : op},
                   {"run recorded", run.meta.created.empty() ? "not recorded" : run.meta.created},
                   {"temperatures", temperatures(run)},
-                  {"software", std::string("eical ") + kVersion},
+                  {"software", std::string(drivers::software_version())},
                   {"test settings", settings(run, a)},
                   {"sensors", run.meta.sensors[0].model + " (table), " + run.meta.sensors[1].model + " (head)"}};
   if (run.meta.reference) page.context.emplace_back("reference", run.meta.reference->kind);
