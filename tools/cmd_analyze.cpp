@@ -22,7 +22,7 @@ void register_analyze(CLI::App& app) {
     std::string nbs = "auto";
   };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("analyze", "Evaluate a recorded run (circle: ISO 230-4 + diagnostics; step)");
+  auto* cmd = app.add_subcommand("analyze", "Evaluate a recorded run: every program's figures with their uncertainty U (k = 2) and the verdict");
   cmd->add_option("run", o->run, "run directory (eical-run/1)")->required();
   cmd->add_flag("--json", o->json, "print the eical-result/1 document");
   cmd->add_option("--dynamic", o->dynamic, "dynamic compensation: two-stage or none")->default_val("two-stage")->check(CLI::IsMember({"two-stage", "none"}));

@@ -12,8 +12,9 @@ void register_help(CLI::App& app) {
   cmd->add_option("command", *topic, "a command (e.g. analyze)");
   CLI::App* root = &app;
   cmd->callback([root, topic] {
+    // Not root->help(): while `help` itself is the parsed subcommand, CLI11 delegates to it.
     if (topic->empty()) {
-      std::fputs(root->help().c_str(), stdout);
+      std::fputs(root->get_formatter()->make_help(root, "eical", CLI::AppFormatMode::Normal).c_str(), stdout);
       return;
     }
     CLI::App* sub = nullptr;
@@ -22,7 +23,7 @@ void register_help(CLI::App& app) {
     } catch (const CLI::OptionNotFound&) {
       throw std::runtime_error("help: no command '" + *topic + "' (eical help lists them)");
     }
-    std::fputs(sub->help().c_str(), stdout);
+    std::fputs(sub->help("eical").c_str(), stdout);
   });
 }
 
