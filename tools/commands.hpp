@@ -23,6 +23,7 @@ void register_identify(CLI::App& app);
 void register_explain(CLI::App& app);
 void register_plan(CLI::App& app);
 void register_help(CLI::App& app);
+void register_import(CLI::App& app);
 void register_history(CLI::App& app);
 void register_collect(CLI::App& app);
 
@@ -30,6 +31,7 @@ void register_collect(CLI::App& app);
 inline void register_all(CLI::App& app) {
   register_demo(app);
   register_simulate(app);
+  register_import(app);
   register_validate_sim(app);
   register_analyze(app);
   register_plan(app);

@@ -99,11 +99,8 @@ Measurement decimate(const Measurement& m, std::size_t q);
 // approach direction; a run is one pass up and one pass down (ISO 230-2 linear cycle).
 eval::PositioningInput positioning_deviations(const Measurement& m, const Program& program);
 
-// Why the integrated motion of `m` is no position (empty: it is): no rest before the
-// motion (kMinRestS), none after it, no PSD fix — nothing holds the double integral.
-inline constexpr double kMinRestS = 0.05;
-std::string unsupported_integration(const Measurement& m);
-// The flag that says so, followed by that reason.
+// The flag of a run whose integrated motion is no position (pipeline/integration_support.hpp),
+// followed by the reason.
 inline constexpr const char* kPositionNullFlag = "position: null, ";
 
 // Plane axes of a program ("xy" → 0, 1; "zx" → 2, 0; "yz" → 1, 2).

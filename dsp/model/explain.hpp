@@ -35,6 +35,8 @@ struct ExplainedEffect {
   double heldout_rms_before_um = 0.0, heldout_rms_after_um = 0.0;
   double importance_um = 0.0;  // the residual RMS it explains (ranking)
   bool taken_into_model = false;  // a sensor-side extension the pipeline now compensates with
+  std::string group;              // the model group it was fitted as (other.residual_like_<group>)
+  std::string resembles;          // what its regressor is, in words
 };
 
 struct RunExplanation {

@@ -28,36 +28,6 @@ constexpr double kZetaMin = 0.002, kZetaMax = 0.4;
 constexpr double kMaterialUm = 0.1, kMaterialMg = 0.3;  // machine.differential_vibration's tolerance
 constexpr double kMmS2PerMg = 9.80665e-3 * 1000.0;     // 1 mg in mm/s²
 
-// The mode's relative acceleration m'' for a unit input along its drive: m'' + 2ζω m' + ω² m
-// = u (base excitation), u held over each sample, the state stepped exactly (the 2×2
-// transition matrix by scaling and squaring).
-Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_hz, double zeta) {
-  const double om = 2.0 * std::numbers::pi * f_hz, h = 1.0 / fs_hz;
-  Eigen::Matrix2d a;
-  a << 0.0, 1.0, -om * om, -2.0 * zeta * om;
-  int squarings = 0;
-  double norm = (a * h).cwiseAbs().rowwise().sum().maxCoeff();
-  while (norm > 0.25) norm /= 2.0, ++squarings;
-  const Eigen::Matrix2d ah = a * (h / std::pow(2.0, squarings));
-  Eigen::Matrix2d phi = Eigen::Matrix2d::Identity(), term = Eigen::Matrix2d::Identity(), gam = Eigen::Matrix2d::Identity() * (h / std::pow(2.0, squarings));
-  Eigen::Matrix2d gterm = gam;
-  for (int k = 1; k <= 10; ++k) {
-    term = term * ah / k;
-    phi += term;
-    gterm = gterm * ah / (k + 1);
-    gam += gterm;  // ∫₀ʰ e^{As} ds by the same series
-  }
-  for (int k = 0; k < squarings; ++k) gam = gam + phi * gam, phi = phi * phi;
-  const Eigen::Vector2d b(0.0, 1.0), gb = gam * b;
-  Eigen::VectorXd y(u.size());
-  Eigen::Vector2d x = Eigen::Vector2d::Zero();
-  for (Eigen::Index k = 0; k < u.size(); ++k) {
-    y[k] = u[k] - 2.0 * zeta * om * x[1] - om * om * x[0];
-    x = phi * x + gb * u[k];
-  }
-  return y;
-}
-
 // Least squares of every output on the nuisance columns (offset, each input's commanded
 // acceleration and its rate: the servo's gain and lag) and, with a mode, its response to
 // each input. The nuisance is projected out once (an orthonormal basis); each trial of a
@@ -135,6 +105,35 @@ std::vector<PeakCandidate> peaks(const FrequencyResponse& fr, int input, double 
 
 }  // namespace
 
+// u held over each sample, the state stepped exactly (the 2×2 transition matrix by
+// scaling and squaring).
+Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_hz, double zeta, bool displacement) {
+  const double om = 2.0 * std::numbers::pi * f_hz, h = 1.0 / fs_hz;
+  Eigen::Matrix2d a;
+  a << 0.0, 1.0, -om * om, -2.0 * zeta * om;
+  int squarings = 0;
+  double norm = (a * h).cwiseAbs().rowwise().sum().maxCoeff();
+  while (norm > 0.25) norm /= 2.0, ++squarings;
+  const Eigen::Matrix2d ah = a * (h / std::pow(2.0, squarings));
+  Eigen::Matrix2d phi = Eigen::Matrix2d::Identity(), term = Eigen::Matrix2d::Identity(), gam = Eigen::Matrix2d::Identity() * (h / std::pow(2.0, squarings));
+  Eigen::Matrix2d gterm = gam;
+  for (int k = 1; k <= 10; ++k) {
+    term = term * ah / k;
+    phi += term;
+    gterm = gterm * ah / (k + 1);
+    gam += gterm;  // ∫₀ʰ e^{As} ds by the same series
+  }
+  for (int k = 0; k < squarings; ++k) gam = gam + phi * gam, phi = phi * phi;
+  const Eigen::Vector2d b(0.0, 1.0), gb = gam * b;
+  Eigen::VectorXd y(u.size());
+  Eigen::Vector2d x = Eigen::Vector2d::Zero();
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    y[k] = displacement ? x[0] : u[k] - 2.0 * zeta * om * x[1] - om * om * x[0];
+    x = phi * x + gb * u[k];
+  }
+  return y;
+}
+
 ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz, const std::array<bool, 3>& driven,
                                  double max_hz) {
   ModeSearch out;
@@ -183,7 +182,7 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
   const TimeModel tm(e, nuisance);
   auto mode_cols = [&](double f, double z) {
     std::vector<Eigen::VectorXd> cols;
-    for (int j : inputs_used) cols.push_back(mode_response(a_cmd.col(j).head(nn), fs_hz, f, z));
+    for (int j : inputs_used) cols.push_back(mode_response(a_cmd.col(j).head(nn), fs_hz, f, z, false));
     return cols;
   };
   for (const PeakCandidate& c : cands) {
@@ -238,7 +237,7 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
     for (std::size_t k = 0; k < f0.f_hz.size(); ++k)
       if (std::abs(f0.f_hz[k] - best_f) <= out.df_hz) md.coherence = std::max(md.coherence, f0.coherence[k]);
     {
-      const Eigen::VectorXd y = mode_response(a_cmd.col(md.input_axis).head(nn), fs_hz, best_f, best_z) * best.g(bj, bi);
+      const Eigen::VectorXd y = mode_response(a_cmd.col(md.input_axis).head(nn), fs_hz, best_f, best_z, false) * best.g(bj, bi);
       md.response_rms_mg = std::sqrt(y.squaredNorm() / static_cast<double>(nn)) / kMmS2PerMg;
       const double om = 2.0 * std::numbers::pi * best_f;
       md.displacement_rms_um = md.response_rms_mg * kMmS2PerMg / (om * om) * 1000.0;

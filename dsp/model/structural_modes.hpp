@@ -38,6 +38,10 @@ struct ModeSearch {
   std::string evidence;               // what was searched, or why nothing could be
 };
 
+// A mode's response to its drive u (mm/s²): m'' + 2ζω m' + ω² m = u (base excitation);
+// its relative acceleration m'' (mm/s²), or its displacement m (mm) when `displacement`.
+Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_hz, double zeta, bool displacement);
+
 // `a_meas`, `a_cmd`: n × 3 (mm/s², same time base, sample rate fs_hz); `driven`: the axes the
 // set-point moves (the inputs); `max_hz`: the highest frequency a mode may have here (the
 // sensors' own dynamics and the DAQ filter shape the response above it).

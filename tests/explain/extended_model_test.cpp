@@ -55,5 +55,23 @@ TEST(ExtendedModel, ScenarioReproducesTheRunAndTheCalibrationRemovesTheEffect) {
   EXPECT_LT(after, 0.1 * recorded);
 }
 
+// A machine effect on two axes (backlash on x and y of a circle) is written as an array of
+// tables the scenario reader takes back, with each axis' value.
+TEST(ExtendedModel, AnEffectOnTwoAxesRoundTripsThroughTheScenario) {
+  sim::Scenario sc = sim::hidden_effect_scenario({"machine.backlash"}, "circle", 101);
+  sc.machine.backlash_um[0] = 6.0, sc.machine.backlash_um[1] = 4.0;
+  const dsp::Run run = sim::simulate(sc);
+  const auto ex = dsp::model::explain_run(run);
+  const auto model = tools::explain::extended_model(run, ex);
+  const fs::path dir = fs::temp_directory_path() / ("eical_ext2_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  tools::explain::write_extended_model(model, dir / "cal.toml", dir / "scenario.toml");
+  const sim::Scenario back = drivers::read_scenario_file((dir / "scenario.toml").string());
+  fs::remove_all(dir);
+  std::printf("backlash x %.2f y %.2f um read back from the written scenario\n", back.machine.backlash_um[0], back.machine.backlash_um[1]);
+  EXPECT_NEAR(back.machine.backlash_um[0], 6.0, 1.5);
+  EXPECT_NEAR(back.machine.backlash_um[1], 4.0, 1.5);
+}
+
 }  // namespace
 }  // namespace eical

@@ -37,13 +37,13 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
     } else if (x.name == "machine.backlash") {
       for (const auto& [k, v] : p)
         if (k.rfind("backlash_", 0) == 0)
-          effects_toml += "\n[effects.\"machine.backlash\"]\naxis = \"" + std::string(1, k[9]) + "\"\nvalue_um = " + drivers::toml_number(std::abs(v)) + "\n";
+          effects_toml += "\n[[effects.\"machine.backlash\"]]\naxis = \"" + std::string(1, k[9]) + "\"\nvalue_um = " + drivers::toml_number(std::abs(v)) + "\n";
     } else if (x.name == "machine.reversal_spike") {
       for (const auto& [k, v] : p)
         if (k.rfind("spike_", 0) == 0) {
           const auto tau = k.find("tau_");
           const double tau_ms = tau == std::string::npos ? 15.0 : std::atof(k.c_str() + tau + 4);
-          effects_toml += "\n[effects.\"machine.reversal_spike\"]\naxis = \"" + std::string(1, k[6]) + "\"\namp_um = " + drivers::toml_number(std::abs(v)) +
+          effects_toml += "\n[[effects.\"machine.reversal_spike\"]]\naxis = \"" + std::string(1, k[6]) + "\"\namp_um = " + drivers::toml_number(std::abs(v)) +
                           "\ntau_ms = " + drivers::toml_number(tau_ms) + "\n";
         }
     } else if (x.name == "machine.squareness") {
@@ -51,12 +51,12 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
         int i = 0, j = 0;
         if (!dsp::two_axes(k, "squareness_", i, j)) continue;
         const char* plane = (i == 0 && j == 1) ? "xy" : (i == 1 && j == 2) ? "yz" : "zx";
-        effects_toml += "\n[effects.\"machine.squareness\"]\nplane = \"" + std::string(plane) + "\"\nvalue_urad = " + drivers::toml_number(v) + "\n";
+        effects_toml += "\n[[effects.\"machine.squareness\"]]\nplane = \"" + std::string(plane) + "\"\nvalue_urad = " + drivers::toml_number(v) + "\n";
       }
     } else if (x.name == "machine.scale_mismatch") {
       for (const auto& [k, v] : p)
         if (k.rfind("scale_", 0) == 0)
-          effects_toml += "\n[effects.\"machine.scale_mismatch\"]\naxis = \"" + std::string(1, k[6]) + "\"\nvalue_ppm = " + drivers::toml_number(v) + "\n";
+          effects_toml += "\n[[effects.\"machine.scale_mismatch\"]]\naxis = \"" + std::string(1, k[6]) + "\"\nvalue_ppm = " + drivers::toml_number(v) + "\n";
     } else if (x.name == "machine.cyclic_error") {
       for (const auto& [k, v] : p) {
         if (k.rfind("cyclic_", 0) != 0 || k.find("_sin_um") == std::string::npos) continue;
@@ -65,7 +65,7 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
         const double cs = c == p.end() ? 0.0 : c->second;
         const auto pos = base.find("pitch_");
         const double pitch = pos == std::string::npos ? 10.0 : std::atof(base.c_str() + pos + 6);
-        effects_toml += "\n[effects.\"machine.cyclic_error\"]\naxis = \"" + std::string(1, k[7]) + "\"\namp_um = " + drivers::toml_number(std::hypot(v, cs)) +
+        effects_toml += "\n[[effects.\"machine.cyclic_error\"]]\naxis = \"" + std::string(1, k[7]) + "\"\namp_um = " + drivers::toml_number(std::hypot(v, cs)) +
                         "\npitch_mm = " + drivers::toml_number(pitch) + "\nphase_deg = " + drivers::toml_number(std::atan2(cs, v) * 180.0 / std::numbers::pi) + "\n";
       }
     } else {
