@@ -317,7 +317,7 @@ void Pipeline::apply_supports(Measurement& m) {
   std::vector<Eigen::Vector3d> sigma;
   const std::vector<Eigen::Vector3d> raw_vel = m.vel_mm_s;
   m.supports = supports_.finish(m.sample_index, m.pos_mm, m.vel_mm_s, sigma);
-  if (config_.keep_raw) m.raw.schedule = supports_.schedule();
+  if (config_.keep_raw || config_.keep_schedule) m.raw.schedule = supports_.schedule();
   m.sigma_um = std::move(sigma);
   if (m.supports.diverged) quality_ |= quality_flag::supports_diverged;
   if (m.supports.psd_disagrees) quality_ |= quality_flag::psd_disagrees;
