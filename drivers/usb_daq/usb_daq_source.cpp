@@ -4,7 +4,6 @@
 
 #include <charconv>
 #include <cstdio>
-#include <vector>
 
 namespace eical::drivers {
 
@@ -22,17 +21,22 @@ UsbDaqOptions parse_usb_id(const std::string& id) {
 }
 
 UsbDaqSource::UsbDaqSource(dsp::RunMeta meta, UsbDaqOptions options)
-    : meta_(std::move(meta)), options_(options), decoder_(static_cast<int>(meta_.psd.size())) {}
+    : meta_(std::move(meta)), options_(options), frames_(static_cast<int>(meta_.psd.size())) {}
 
-UsbDaqSource::~UsbDaqSource() {
+UsbDaqSource::~UsbDaqSource() { close(); }
+
+void UsbDaqSource::close() noexcept {
   if (handle_) {
     libusb_release_interface(handle_, 0);
     libusb_close(handle_);
+    handle_ = nullptr;
   }
-  if (ctx_) libusb_exit(ctx_);
+  if (ctx_) libusb_exit(ctx_), ctx_ = nullptr;
 }
 
 void UsbDaqSource::open() {
+  close();  // a reopen (after the DAQ failed) starts from scratch
+  frames_.reset();
   if (const int rc = libusb_init(&ctx_); rc != 0) throw SourceError(std::string("usb_daq: libusb_init failed: ") + libusb_error_name(rc));
   libusb_device** list = nullptr;
   const ssize_t n = libusb_get_device_list(ctx_, &list);
@@ -49,17 +53,28 @@ void UsbDaqSource::open() {
 }
 
 std::size_t UsbDaqSource::read(std::span<dsp::Frame> out) {
-  while (pending_.size() < out.size()) {
+  if (frames_.size() < out.size()) {
     unsigned char buf[16384];
     int got = 0;
     const int rc = libusb_bulk_transfer(handle_, options_.endpoint, buf, sizeof buf, &got, options_.timeout_ms);
-    if (rc == LIBUSB_ERROR_TIMEOUT) break;
-    if (rc != 0) throw SourceError(std::string("usb_daq: bulk transfer failed: ") + libusb_error_name(rc));
-    decoder_.feed(std::span<const std::uint8_t>(buf, static_cast<std::size_t>(got)), [&](const dsp::Frame& f) { pending_.push_back(f); });
+    if (rc != 0 && rc != LIBUSB_ERROR_TIMEOUT) throw SourceError(std::string("usb_daq: bulk transfer failed: ") + libusb_error_name(rc));
+    if (got > 0) {
+      frames_.feed(std::span<const std::uint8_t>(buf, static_cast<std::size_t>(got)));
+      const auto& s = frames_.stats();
+      decode_errors_.store(s.crc_errors + s.unknown_packets, std::memory_order_relaxed);
+      lost_samples_.store(s.lost_samples, std::memory_order_relaxed);
+      dropped_.store(frames_.dropped(), std::memory_order_relaxed);
+    }
   }
-  std::size_t n = 0;
-  while (n < out.size() && !pending_.empty()) out[n++] = pending_.front(), pending_.pop_front();
-  return n;
+  return frames_.pop(out);
+}
+
+SourceCounters UsbDaqSource::counters() const {
+  SourceCounters c;
+  c.decode_errors = decode_errors_.load(std::memory_order_relaxed);
+  c.lost_samples = lost_samples_.load(std::memory_order_relaxed);
+  c.dropped_frames = dropped_.load(std::memory_order_relaxed);
+  return c;
 }
 
 }  // namespace eical::drivers

@@ -3,10 +3,10 @@
 // open() finds the device by vendor:product; an absent device is a SourceError that says
 // so (with the number of USB devices visible), never a crash.
 #include "drivers/source/source.hpp"
-#include "drivers/usb_daq/protocol.hpp"
+#include "drivers/usb_daq/decoded_frames.hpp"
 
+#include <atomic>
 #include <cstdint>
-#include <deque>
 #include <string>
 
 struct libusb_context;
@@ -34,14 +34,17 @@ class UsbDaqSource final : public Source {
   [[nodiscard]] bool at_end() const override { return false; }  // a DAQ streams until stopped
   [[nodiscard]] std::string_view name() const override { return "usb_daq"; }
   [[nodiscard]] Backpressure backpressure() const override { return Backpressure::drop_newest; }
+  [[nodiscard]] SourceCounters counters() const override;
 
  private:
+  void close() noexcept;
+
   dsp::RunMeta meta_;
   UsbDaqOptions options_;
-  usb_daq::Decoder decoder_;
+  usb_daq::DecodedFrames frames_;  // decoder + fixed queue: read() never allocates
   libusb_context* ctx_ = nullptr;
   libusb_device_handle* handle_ = nullptr;
-  std::deque<dsp::Frame> pending_;
+  std::atomic<std::uint64_t> decode_errors_{0}, lost_samples_{0}, dropped_{0};
 };
 
 }  // namespace eical::drivers
