@@ -45,8 +45,7 @@ void ServoStreamReader::open() {
   used_ = 0;
   stats_ = {};
   last_ = {};
-  clock_.reset();
-  error_.clear();
+  error_.clear();  // the clock keeps the last stream's mapping until the new stream's first line
   std::uint64_t n = 0;
   (void)!::read(wake_fd_, &n, sizeof n);  // a stale wake-up does not end the new stream
 }
@@ -55,7 +54,6 @@ void ServoStreamReader::restart() noexcept {
   stats_.last_number = -1;
   stats_.first_number = -1;
   last_ = {};
-  clock_.reset();
 }
 
 void ServoStreamReader::close() noexcept {
@@ -130,6 +128,7 @@ ServoStreamReader::LineResult ServoStreamReader::take_line(std::string_view line
     }
   } else {
     stats_.first_number = s.number;
+    clock_.reset();  // a new stream: its own cycle numbers
   }
   clock_.observe(s.number, arrival_ns_);
   stats_.last_number = s.number;
