@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <ctime>
+#include <optional>
 
 namespace eical::daemon {
 namespace {
@@ -81,12 +82,32 @@ dsp::Run Evaluator::make_run(RecordingJob& job) const {
   return run;
 }
 
+std::optional<std::pair<int, dsp::Program>> Evaluator::named_program(const RecordingNotes& notes, std::vector<std::string>& flags) const {
+  const auto& sp = config_.setpoint;
+  const int number = std::isfinite(notes.program_p) ? static_cast<int>(std::lround(notes.program_p)) : sp.default_program;
+  if (number < 0) {
+    flags.push_back("setpoint: M101 named no program (P word) and [setpoint.program] default_program is not set");
+    return std::nullopt;
+  }
+  try {
+    return std::pair{number, drivers::ProgramCatalog(sp.program_dir).program(number)};
+  } catch (const std::exception& e) {
+    flags.push_back(std::string("setpoint: program ") + std::to_string(number) + ": " + e.what());
+    return std::nullopt;
+  }
+}
+
 std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingNotes& notes) const {
   const auto& sp = config_.setpoint;
   std::vector<std::string> flags;
+  if (sp.source == "none") return flags;
+  const auto program = named_program(notes, flags);
   if (sp.source == "servo_stream") {
+    // The set-point is LinuxCNC's; the program (when named) says what to evaluate.
+    if (program) run.meta.program = program->second;
     dsp::SetPointOrigin s;
     s.source = "servo_stream";
+    s.program_number = program ? program->first : -1;
     s.servo_rate_hz = sp.servo_rate_hz;
     const auto a = servo_ ? servo_->alignment() : drivers::ServoAlignment{};
     if (a.known && !run.frames.empty())
@@ -97,24 +118,20 @@ std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingN
     for (const auto& f : run.frames) missing += (f.flags & dsp::frame_flag::cmd_missing) != 0;
     if (missing > 0) flags.push_back("setpoint: " + std::to_string(missing) + " frames had no servo cycle of the set-point (LinuxCNC's stream absent or late)");
     run.meta.setpoint = s;
+    log(LogLevel::info, "setpoint: servo stream, cycle %.3f at the first sample; measured lags it by %+.2f ms, residual %s",
+        s.servo_cycle_at_first_sample, s.lag_s * 1e3, percent(s.residual_ratio).c_str());
     return flags;
   }
-  if (sp.source != "program") return flags;
-  const int number = std::isfinite(notes.program_p) ? static_cast<int>(std::lround(notes.program_p)) : sp.default_program;
-  if (number < 0) {
-    flags.push_back("setpoint: M101 named no program (P word) and [setpoint.program] default_program is not set: no set-point");
-    return flags;
-  }
+  if (!program) return flags;
   try {
-    const dsp::Program program = drivers::ProgramCatalog(sp.program_dir).program(number);
     drivers::ProgramSetPointOptions o;
     o.limits.a_max_mm_s2 = sp.a_max_mm_s2, o.limits.j_max_mm_s3 = sp.j_max_mm_s3, o.limits.rapid_mm_min = sp.rapid_mm_min;
     o.max_lag_s = sp.max_lag_s;
     o.mcode_stops = sp.mcode_stops;
-    const drivers::ProgramAlignment a = drivers::apply_program_setpoint(run, program, o);
+    const drivers::ProgramAlignment a = drivers::apply_program_setpoint(run, program->second, o);
     dsp::SetPointOrigin s;
     s.source = "program";
-    s.program_number = number;
+    s.program_number = program->first;
     if (!a.blocks.empty()) {
       s.marks_offset_s = a.blocks.front().marks_offset_s, s.offset_s = a.blocks.front().offset_s;
       const auto [lo, hi] = std::minmax_element(a.blocks.begin(), a.blocks.end(), [](const auto& x, const auto& y) { return x.offset_s < y.offset_s; });
@@ -124,10 +141,10 @@ std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingN
     s.lag_s = a.lag_s, s.correlation = a.correlation, s.residual_ratio = a.residual_ratio;
     run.meta.setpoint = s;
     flags.insert(flags.end(), a.flags.begin(), a.flags.end());
-    log(LogLevel::info, "setpoint: program %d aligned: marks %+.2f ms, cross-correlation %+.2f ms over %d block(s), residual %s", number,
+    log(LogLevel::info, "setpoint: program %d aligned: marks %+.2f ms, cross-correlation %+.2f ms over %d block(s), residual %s", s.program_number,
         s.marks_offset_s * 1e3, (s.offset_s - s.marks_offset_s) * 1e3, s.blocks, percent(s.residual_ratio).c_str());
   } catch (const std::exception& e) {
-    flags.push_back(std::string("setpoint: program ") + std::to_string(number) + ": " + e.what());
+    flags.push_back(std::string("setpoint: program ") + std::to_string(program->first) + ": " + e.what());
   }
   return flags;
 }

@@ -11,6 +11,8 @@
 
 #include <cstdint>
 #include <mutex>
+#include <optional>
+#include <utility>
 #include <string>
 #include <thread>
 #include <vector>
@@ -47,7 +49,9 @@ class Evaluator {
   void loop();
   void evaluate(RecordingJob& job);
   dsp::Run make_run(RecordingJob& job) const;
-  // Fills cmd_* and [setpoint]; returns flags for the result (empty: nothing doubtful).
+  // The program M101's P word (or [setpoint.program] default_program) names.
+  std::optional<std::pair<int, dsp::Program>> named_program(const RecordingNotes& notes, std::vector<std::string>& flags) const;
+  // Fills cmd_*, [program] and [setpoint]; returns flags for the result (empty: nothing doubtful).
   std::vector<std::string> add_setpoint(dsp::Run& run, const RecordingNotes& notes) const;
   void publish(const dsp::Run& run, const dsp::Analysis& a, std::uint64_t result_number);
 

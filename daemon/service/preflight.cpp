@@ -48,8 +48,10 @@ std::optional<std::string> dds_config_problem(const DdsConfig& dds) {
 }
 
 std::optional<std::string> setpoint_problem(const SetPointConfig& sp) {
-  if (sp.source != "program") return std::nullopt;
-  if (!fs::is_directory(sp.program_dir))
+  if (sp.source == "none") return std::nullopt;
+  // The program set-point needs its programs; beside the servo stream they only name
+  // what to evaluate, so a missing directory matters only when a default is set.
+  if (!fs::is_directory(sp.program_dir) && (sp.source == "program" || sp.default_program >= 0))
     return "setpoint: the program directory " + sp.program_dir.string() + " does not exist ([setpoint.program] directory)";
   if (sp.default_program >= 0) {
     try {

@@ -19,7 +19,8 @@ std::optional<std::string> recording_dir_problem(const std::filesystem::path& di
 // The configuration in use: [dds] config_uri, else $CYCLONEDDS_URI; each file:// (or
 // plain path) entry must be a readable file; inline XML is not checked here.
 std::optional<std::string> dds_config_problem(const DdsConfig& dds);
-// [setpoint] source = "program": the directory exists and the default program reads.
+// [setpoint]: the program directory exists (always for source = "program"; beside the
+// servo stream when a default program is set) and the default program reads.
 std::optional<std::string> setpoint_problem(const SetPointConfig& setpoint);
 
 }  // namespace eical::daemon

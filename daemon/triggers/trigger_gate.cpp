@@ -16,7 +16,9 @@ TriggerVerdict TriggerGate::decide(const TriggerRequest& r, std::int64_t sample_
   State s = state;
   for (std::size_t k = 0; k < count_; ++k) {
     if (queued_[k].code == kProgramStart && (s == State::idle || s == State::done || s == State::armed)) s = State::measuring;
-    else if (queued_[k].code == kProgramEnd && s == State::measuring) s = State::evaluating;
+    // A measurement ended by a queued M103 is handed over at once (the evaluator is
+    // normally free): the next program may be queued behind it.
+    else if (queued_[k].code == kProgramEnd && s == State::measuring) s = State::done;
   }
   TriggerVerdict v;
   v.id = r.id;

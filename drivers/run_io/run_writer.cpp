@@ -259,10 +259,11 @@ std::string run_toml_text(const dsp::RunMeta& m) {
   if (m.setpoint) {
     const auto& s = *m.setpoint;
     o += "\n[setpoint]\nsource = " + toml_str(s.source) + "\n";
+    if (s.program_number >= 0) o += "program_number = " + std::to_string(s.program_number) + "\n";
     if (s.source == "servo_stream")
       o += "servo_cycle_at_first_sample = " + toml_double(s.servo_cycle_at_first_sample) + "\nservo_rate_hz = " + toml_double(s.servo_rate_hz) + "\n";
     if (s.source == "program")
-      o += "program_number = " + std::to_string(s.program_number) + "\nmarks_offset_s = " + toml_double(s.marks_offset_s) +
+      o += "marks_offset_s = " + toml_double(s.marks_offset_s) +
            "\noffset_s = " + toml_double(s.offset_s) + "\nblocks = " + std::to_string(s.blocks) +
            "\nblock_offset_spread_s = " + toml_double(s.block_offset_spread_s) + "\n";
     o += "lag_s = " + toml_double(s.lag_s) + "\ncorrelation = " + toml_double(s.correlation) + "\nresidual_ratio = " +

@@ -9,7 +9,10 @@
 namespace eical::dsp::align {
 namespace {
 
-// Block means of `d` samples: a boxcar low-pass and decimation in one.
+// Block means of `d` samples: a boxcar low-pass and decimation in one. Applied to a signal
+// smoothed over about d samples first (below), it keeps every pulse's centroid: a set-point
+// interpolated linearly between servo cycles has its acceleration in pulses at the cycles,
+// which a plain block mean would move to the block's centre (up to half a block).
 std::vector<Eigen::Vector3d> decimate(const std::vector<Eigen::Vector3d>& x, std::size_t d) {
   std::vector<Eigen::Vector3d> out(x.size() / d, Eigen::Vector3d::Zero());
   for (std::size_t k = 0; k < out.size(); ++k) {
@@ -77,8 +80,9 @@ LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_in, const std::
   const std::size_t d = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fs_hz / o.rate_hz)));
   const double rate = fs_hz / static_cast<double>(d);
   const std::size_t h = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(0.002 * rate)));  // ±2 ms
-  const auto cmd = smooth(decimate(cmd_in, d), h);
-  auto meas = smooth(decimate(meas_in, d), h);
+  const std::size_t pre = d / 2;  // ≈ d samples, centred: pulses keep their centroid
+  const auto cmd = smooth(decimate(pre > 0 ? smooth(cmd_in, pre) : cmd_in, d), h);
+  auto meas = smooth(decimate(pre > 0 ? smooth(meas_in, pre) : meas_in, d), h);
   const std::size_t n = std::min(cmd.size(), meas.size());
   if (n < 10) return r;
 

@@ -96,10 +96,10 @@ struct SetPointOrigin {
   // mapping, from their minimum-filtered arrival times).
   double servo_cycle_at_first_sample = 0.0;
   double servo_rate_hz = 0.0;
-  // program: program number (M101's P word), DAQ time − program time of the first motion
-  // block from the marks alone and after the cross-correlation, number of motion blocks
-  // aligned separately and the spread (max − min) of their offsets.
-  int program_number = -1;
+  int program_number = -1;  // M101's P word (or the default program); -1 = none named
+  // program: DAQ time − program time of the first motion block from the marks alone and
+  // after the cross-correlation, number of motion blocks aligned separately and the spread
+  // (max − min) of their offsets.
   double marks_offset_s = 0.0;
   double offset_s = 0.0;
   int blocks = 0;
