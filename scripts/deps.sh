@@ -4,9 +4,10 @@
 set -euo pipefail
 build_pkgs=(g++ cmake ninja-build pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev
   nlohmann-json3-dev zlib1g-dev libsystemd-dev libusb-1.0-0-dev libgpiod-dev
-  cyclonedds-dev cyclonedds-tools libgtest-dev libbenchmark-dev libboost-dev)
+  cyclonedds-dev cyclonedds-tools libgtest-dev libbenchmark-dev libboost-dev dpkg-dev)
 # chromium + fonts: the report screenshot test; linuxcnc-uspace: the end-to-end test with a
-# real NC (tests/linuxcnc), Depends only.
+# real NC (tests/linuxcnc), Depends only. dpkg-dev (build): the .deb's library
+# dependencies (dpkg-shlibdeps, `--target package`).
 test_pkgs=(systemd chromium fonts-dejavu-core linuxcnc-uspace)
 want=("${build_pkgs[@]}")
 [[ "${1:-build}" == test ]] && want+=("${test_pkgs[@]}")

@@ -29,7 +29,7 @@ void FrameLoop::on_frame(const dsp::Frame& in) noexcept {
   continue_clock(f);
   filter_frame_trigger(f);
   const bool nonfinite = guard_.apply(f);
-  const std::int64_t acquired_ns = observe_acquisition(in, f.sample_index);
+  const std::int64_t acquired_ns = observe_acquisition(in);
   gate_.on_frame(f.sample_index);
   take_external_triggers(f);
   session_.on_frame(f);
@@ -52,14 +52,13 @@ void FrameLoop::filter_frame_trigger(dsp::Frame& f) const noexcept {
   if (!options_.frame_triggers) f.trigger = 0;
 }
 
-std::int64_t FrameLoop::observe_acquisition(const dsp::Frame& in, std::int64_t index) noexcept {
+std::int64_t FrameLoop::observe_acquisition(const dsp::Frame& in) noexcept {
   const std::int64_t acquired_ns = source_.acquired_ns(in.sample_index);
   const auto& stamp = source_.current_stamp();
   if (acquired_ns != 0 && stamp.last_index != stamp_seen_) {
     stamp_seen_ = stamp.last_index;
     daq_clock_.observe(stamp.last_index + index_offset_, stamp.t_ns);
   }
-  (void)index;
   return acquired_ns;
 }
 

@@ -52,7 +52,8 @@ class FrameLoop {
  private:
   void continue_clock(dsp::Frame& f) noexcept;
   void filter_frame_trigger(dsp::Frame& f) const noexcept;
-  std::int64_t observe_acquisition(const dsp::Frame& in, std::int64_t index) noexcept;
+  // The acquisition stamp of the frame (CLOCK_MONOTONIC; 0 unknown), fed to the DAQ clock.
+  std::int64_t observe_acquisition(const dsp::Frame& in) noexcept;
   void take_external_triggers(const dsp::Frame& f) noexcept;
   void track_measurement(bool nonfinite) noexcept;
   void step_live(const dsp::Frame& f) noexcept;
