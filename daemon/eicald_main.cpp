@@ -39,10 +39,14 @@ int check_config(const std::string& file, const eical::daemon::DaemonConfig& con
   } catch (const std::exception& e) {
     problems.push_back(std::string("source: ") + e.what());
   }
-  try {
-    for (const auto& input : open_trigger_inputs(config.triggers)) fine.push_back("trigger input " + input->name() + " opens");
-  } catch (const std::exception& e) {
-    problems.push_back(std::string("triggers: ") + e.what() + " ([triggers] inputs)");
+  for (const auto& kind : config.triggers.inputs) {  // each device on its own: every absent one is named
+    TriggerConfig one = config.triggers;
+    one.inputs = {kind};
+    try {
+      for (const auto& input : open_trigger_inputs(one)) fine.push_back("trigger input " + input->name() + " opens");
+    } catch (const std::exception& e) {
+      problems.push_back(std::string("triggers: ") + e.what() + " ([triggers] inputs)");
+    }
   }
   for (auto problem : {recording_dir_problem(config.recording.dir), dds_config_problem(config.dds), setpoint_problem(config.setpoint)})
     if (problem) problems.push_back(*problem);
