@@ -5,13 +5,15 @@
 
 namespace eical::dsp::identify {
 
-AugmentedFilter::AugmentedFilter(const fusion::ErrorModel& model, const Eigen::Vector3d& start_sigma, const Eigen::VectorXd& prior_sigma)
+AugmentedFilter::AugmentedFilter(const fusion::ErrorModel& model, const Eigen::Vector3d& start_sigma, const Eigen::VectorXd& prior_sigma,
+                                 const Eigen::VectorXd& prior_mean)
     : model_(model) {
   const Eigen::Index n = 3 + prior_sigma.size();
   x_ = Eigen::VectorXd::Zero(n);
   p_ = Eigen::MatrixXd::Zero(n, n);
   for (int i = 0; i < 3; ++i) p_(i, i) = start_sigma[i] * start_sigma[i];
   for (Eigen::Index j = 0; j < prior_sigma.size(); ++j) p_(3 + j, 3 + j) = prior_sigma[j] * prior_sigma[j];
+  if (prior_mean.size() == prior_sigma.size()) x_.tail(prior_mean.size()) = prior_mean;
 }
 
 void AugmentedFilter::predict(double h, const Eigen::VectorXd& g, bool bias_step) {

@@ -21,8 +21,9 @@ namespace eical::dsp::identify {
 
 class AugmentedFilter {
  public:
-  // `prior_sigma`: σ of each parameter (its prior mean is 0); `start` the INS error's.
-  AugmentedFilter(const fusion::ErrorModel& model, const Eigen::Vector3d& start_sigma, const Eigen::VectorXd& prior_sigma);
+  // `prior_sigma`: σ of each parameter, `prior_mean` its mean (empty: 0); `start` the INS error's.
+  AugmentedFilter(const fusion::ErrorModel& model, const Eigen::Vector3d& start_sigma, const Eigen::VectorXd& prior_sigma,
+                  const Eigen::VectorXd& prior_mean = {});
 
   [[nodiscard]] int parameters() const noexcept { return static_cast<int>(x_.size()) - 3; }
   // One step of h seconds; `accel_gain[j]` = g_j averaged over the step (0 for parameters

@@ -1,5 +1,7 @@
 #include "dsp/model/effect_catalog.hpp"
 
+#include "dsp/pipeline/coriolis.hpp"
+
 #include <Eigen/QR>
 
 
@@ -42,10 +44,30 @@ double hint_corr(const Eigen::MatrixXd& hint, const Eigen::VectorXd& col, int ax
   return sxx > 0.0 && syy > 0.0 ? std::abs(sxy) / std::sqrt(sxx * syy) : 0.0;
 }
 
+// Slide minus command of a play operator of width `play_um` (starting centred), per µm of
+// play: −½ against the direction of motion once the play is taken up.
+Eigen::VectorXd play_operator_column(const Eigen::VectorXd& cmd_mm, double play_um) {
+  const double half_mm = 0.5 * play_um * 1e-3;
+  Eigen::VectorXd col(cmd_mm.size());
+  double slide = cmd_mm.size() ? cmd_mm[0] : 0.0;
+  for (Eigen::Index s = 0; s < cmd_mm.size(); ++s) {
+    slide = std::clamp(slide, cmd_mm[s] - half_mm, cmd_mm[s] + half_mm);
+    col[s] = (slide - cmd_mm[s]) * 1e3 / play_um;
+  }
+  return col;
+}
+
 double get(const std::map<std::string, double>& v, const std::string& k) {
   const auto it = v.find(k);
   return it == v.end() ? 0.0 : it->second;
 }
+
+// The acceleration the acceleration-level effects act on: the set-point's, mm/s². The
+// measured acceleration holds the sensors' noise, whose double integral is the very
+// residual being explained: as a regressor it fits that noise (a scale "found" in a slow
+// move, a nonlinearity in the slips of a creeping slide). The slide follows its set-point
+// within the servo's lag, a few milliseconds, far below the scale of these effects.
+Eigen::MatrixXd driven_acceleration(const RunResiduals& r) { return r.a_cmd; }
 
 }  // namespace
 
@@ -70,7 +92,8 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
     if (r.moving[a]) moving.push_back(a);
   if (moving.empty()) return out;
   const double g = r.meta.site.g_mps2;
-  const Eigen::MatrixXd a_um = r.a_meas * 1000.0;  // µm/s²
+  const Eigen::MatrixXd a_drv = driven_acceleration(r);  // mm/s²
+  const Eigen::MatrixXd a_um = a_drv * 1000.0;            // µm/s²
   auto param = [](std::string name, int axis, bool accel, Eigen::VectorXd input, double prior) {
     AxisParam p;
     p.name = std::move(name), p.axis = axis, p.accel = accel, p.input = std::move(input), p.prior_sigma = prior;
@@ -78,7 +101,7 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
   };
   {
     ParamGroup gp{"scale", {}};
-    for (int j : moving) gp.params.push_back(param("scale_" + ax(j) + "_ppm", j, true, a_um.col(j) * 1e-6, 1e4));
+    for (int j : moving) gp.params.push_back(param("scale_" + ax(j) + "_ppm", j, true, a_um.col(j) * 1e-6, 5e3));
     out.push_back(gp);
   }
   {
@@ -91,7 +114,7 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
   {
     ParamGroup gp{"nonlinearity", {}};
     for (int j : moving) {
-      const Eigen::VectorXd ag = r.a_meas.col(j) / (1000.0 * g);  // in g
+      const Eigen::VectorXd ag = a_drv.col(j) / (1000.0 * g);  // in g
       const double sign = r.owner[j] == 0 ? -1.0 : 1.0;         // the table sees −a: its square term changes sign in head − table
       gp.params.push_back(param("k2_" + ax(j) + "_1e-6_per_g", j, true, sign * ag.array().square().matrix() * g, 1e4));
       gp.params.push_back(param("k3_" + ax(j) + "_1e-6_per_g2", j, true, ag.array().cube().matrix() * g, 1e4));
@@ -99,9 +122,11 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
     out.push_back(gp);
   }
   {
+    // Against the set-point alone an axis' timing is its servo's (the base model's lag).
     ParamGroup gp{"timing", {}};
-    for (int j : moving) gp.params.push_back(param("timing_" + ax(j) + "_us", j, false, r.v_meas.col(j) * 1e-3, 300.0));
-    out.push_back(gp);
+    for (int j : moving)
+      if (r.axis_reference[static_cast<std::size_t>(j)] != "cmd") gp.params.push_back(param("timing_" + ax(j) + "_us", j, false, r.v_meas.col(j) * 1e-3, 300.0));
+    if (!gp.params.empty()) out.push_back(gp);
   }
   {
     // ζ = ζ0 (1 + k |a|/g) (ch. 8.3.1): the PT2 drops (2ζ/ω0)·ȧ, so the extra damping
@@ -115,13 +140,34 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
       Eigen::VectorXd col(r.n);
       double acc = 0.0, prev = 0.0;
       for (Eigen::Index s = 0; s < r.n; ++s) {
-        const double a = r.a_meas(s, j) / 1000.0, cur = a * std::abs(a);
+        const double a = a_drv(s, j) / 1000.0, cur = a * std::abs(a);
         if (s > 0) acc += 0.5 * (cur + prev) * (r.t_s[s] - r.t_s[s - 1]);
         prev = cur, col[s] = k * acc;
       }
       gp.params.push_back(param("zeta_per_g_" + ax(j), j, false, col, 10.0));
     }
     out.push_back(gp);
+  }
+  {
+    // An axis whose Coriolis acceleration stays below 0.1 µg (1 µm/s²) has no say in it.
+    constexpr double kCoriolisFloorUmS2 = 1.0;
+    // The Earth rate is known: the group is the site's prediction (gain 1, held there),
+    // tested against the final model, not selected.
+    constexpr double kCoriolisGainSigma = 1e-3;
+    // Earth-rate Coriolis (3-6): the sensors measure 2ω×v on top of the motion; ω from the
+    // site, one gain per axis it reaches (1: the site's prediction).
+    const Eigen::Vector3d two_w = 2.0 * earth_rate_machine_radps(r.meta.site);
+    Eigen::MatrixXd acc_um(r.n, 3);
+    for (Eigen::Index s = 0; s < r.n; ++s) acc_um.row(s) = two_w.cross(Eigen::Vector3d(r.v_meas.row(s).transpose())).transpose() * 1000.0;  // mm/s → µm/s²
+    ParamGroup gp{"coriolis", {}};
+    for (int i = 0; i < 3; ++i)
+      if (acc_um.col(i).cwiseAbs().maxCoeff() > kCoriolisFloorUmS2) {
+        AxisParam cp = param("coriolis_gain_" + ax(i), i, true, acc_um.col(i), kCoriolisGainSigma);
+        cp.prior_mean = 1.0;  // the site's Earth rate
+        gp.params.push_back(std::move(cp));
+      }
+    gp.known = true;
+    if (!gp.params.empty()) out.push_back(gp);
   }
   {
     ParamGroup gp{"bias_drift", {}};
@@ -215,32 +261,38 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     // Per sensor the common shift (2ζ/ω0, or a delay); against the set-point only, what the
     // axes differ by is their position loops'.
     Attribution dyn = attr("sensor.dynamics", 0.0, 15.0, "us", "the velocity (2ζ/ω0 · v, (6-38))");
-    Attribution servo = attr("machine.servo_mismatch", 0.0, 0.05, "ms", "each axis' velocity (lag), the difference between axes");
     for (int s = 0; s < 2; ++s) {
       double sum = 0.0;
       int n = 0;
+      // Against the set-point alone the axis' servo lag is unknown: its timing says
+      // nothing about the sensor.
       for (int j = 0; j < 3; ++j)
-        if (r.moving[j] && r.owner[j] == s) sum += get(v, "timing_" + ax(j) + "_us"), ++n;
+        if (r.moving[j] && r.owner[j] == s && r.axis_reference[static_cast<std::size_t>(j)] != "cmd") sum += get(v, "timing_" + ax(j) + "_us"), ++n;
       if (n == 0) continue;
       const double mean = sum / n;
       dyn.params[std::string("damping_term_error_us_") + (s == 0 ? "table" : "head")] = mean;
       dyn.magnitude = std::max(dyn.magnitude, std::abs(mean));
     }
-    double lo = 1e300, hi = -1e300;
-    int cmd_axes = 0;
-    for (int j = 0; j < 3; ++j)
-      if (r.moving[j] && r.axis_reference[static_cast<std::size_t>(j)] == "cmd") {
-        const double lag_ms = -get(v, "timing_" + ax(j) + "_us") * 1e-3;
-        servo.params["lag_" + ax(j) + "_ms"] = lag_ms;
-        lo = std::min(lo, lag_ms), hi = std::max(hi, lag_ms), ++cmd_axes;
-      }
-    if (cmd_axes >= 2) servo.magnitude = hi - lo;
     out.push_back(dyn);
-    if (cmd_axes >= 2) out.push_back(servo);
   } else if (group == "damping_amplitude") {
     const double m = largest_abs(v);
     Attribution a = attr("sensor.damping_amplitude", m, 0.2, "1/g", "the integral of a·|a| (damping growing with the acceleration)");
     a.params = v;
+    out.push_back(a);
+  } else if (group == "coriolis") {
+    // The site's prediction, held at gain 1: its size is the peak Coriolis acceleration of
+    // the motion. Within one move it acts like a bias; a run shows it where it changes sign
+    // with the direction of motion — the filter's likelihood decides that, not its size.
+    const Eigen::Vector3d two_w = 2.0 * earth_rate_machine_radps(r.meta.site);
+    double peak_ug = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      if (v.find("coriolis_gain_" + ax(i)) == v.end()) continue;
+      for (Eigen::Index s2 = 0; s2 < r.n; ++s2)
+        peak_ug = std::max(peak_ug, std::abs(two_w.cross(Eigen::Vector3d(r.v_meas.row(s2).transpose()))[i]) * 1e-3 / (r.meta.site.g_mps2 * 1e-6));
+    }
+    Attribution a = attr("site.coriolis", peak_ug, 1.0, "ug", "the Earth rate's 2ω×v of the motion (3-6), from the site");
+    a.params = v;
+    a.params["peak_ug"] = peak_ug;
     out.push_back(a);
   } else if (group == "bias_drift") {
     const double m = largest_abs(v);
@@ -270,9 +322,22 @@ std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::Mat
   std::vector<int> rev[3];
   for (int a : moving) axis_directions(r, a, dir[a], rev[a]);
   {
+    // Lost motion as a play operator on the commanded position: after a reversal the slide
+    // stands while the command crosses the play, so near a circle's quadrant, where the
+    // axis reverses slowly, the play is taken up over milliseconds, not in a step. The
+    // play's width shapes the column; the fitted coefficient is its size.
     EffectModel e = effect("machine.backlash");
-    for (int a : moving)
-      if (!rev[a].empty()) e.params.push_back("backlash_" + ax(a) + "_um"), e.columns.push_back(on_axis(-0.5 * dir[a], a));
+    for (int a : moving) {
+      if (rev[a].empty()) continue;
+      Eigen::VectorXd best;
+      double best_c = -1.0;
+      for (double play_um : {0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 15.0, 20.0, 30.0}) {
+        const Eigen::VectorXd col = play_operator_column(r.cmd.col(a), play_um);
+        const double c = hint_corr(hint, col, a);
+        if (c > best_c) best_c = c, best = col;
+      }
+      e.params.push_back("backlash_" + ax(a) + "_um"), e.columns.push_back(on_axis(best, a));
+    }
     e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "half the play against the direction of the last motion";
     if (!e.params.empty()) out.push_back(e);
   }
@@ -380,12 +445,13 @@ std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::Mat
   return out;
 }
 
-LagColumns common_lag_columns(const RunResiduals& r, double tau_s) {
+LagColumns common_lag_columns(const RunResiduals& r, const std::array<double, 3>& tau_s_per_axis) {
   LagColumns c;
-  c.tau_s = tau_s;
+  c.tau_s = tau_s_per_axis;
   c.velocity = Eigen::MatrixXd::Zero(r.n, 3), c.acceleration = Eigen::MatrixXd::Zero(r.n, 3);
   for (int a = 0; a < 3; ++a) {
     if (!r.moving[a]) continue;
+    const double tau_s = tau_s_per_axis[static_cast<std::size_t>(a)];
     double v = 0.0, acc = 0.0;
     for (Eigen::Index s = 0; s < r.n; ++s) {
       const double h = s > 0 ? r.t_s[s] - r.t_s[s - 1] : 0.0;
@@ -427,16 +493,44 @@ Eigen::MatrixXd without_lag(const Eigen::MatrixXd& hint, const LagColumns& c) {
   return out;
 }
 
-double loop_time_constant_s(const RunResiduals& r, const Eigen::MatrixXd& hint) {
-  double best_tau = 0.0, best_rss = INFINITY;
-  for (double tau_ms : {0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 40.0, 50.0, 70.0, 100.0}) {
-    const LagColumns c = common_lag_columns(r, tau_ms * 1e-3);
-    double rss = 0.0;
-    for (int a = 0; a < 3; ++a)
-      if (r.moving[a]) rss += lag_fit_residual(hint, c, a).second.squaredNorm();
-    if (rss < best_rss) best_rss = rss, best_tau = tau_ms * 1e-3;
+std::array<double, 3> loop_time_constant_s(const RunResiduals& r, const Eigen::MatrixXd& hint) {
+  // Per axis: each axis' loop has its own gain (kv) and so its own time constant; a common
+  // one leaves τ·a-shaped residuals that look like scale mismatch on a circle.
+  std::array<double, 3> best_tau{};
+  for (int a = 0; a < 3; ++a) {
+    if (!r.moving[a]) continue;
+    auto rss_at = [&](double tau_s) {
+      std::array<double, 3> t{};
+      t[static_cast<std::size_t>(a)] = tau_s;
+      return lag_fit_residual(hint, common_lag_columns(r, t), a).second.squaredNorm();
+    };
+    double best_rss = INFINITY, tau = 0.0;
+    for (double tau_ms = 0.0; tau_ms <= 100.0; tau_ms += tau_ms < 60.0 ? 2.0 : 10.0)
+      if (const double q = rss_at(tau_ms * 1e-3); q < best_rss) best_rss = q, tau = tau_ms * 1e-3;
+    // Golden-section refinement within one grid step either side.
+    double lo = std::max(0.0, tau - 2e-3), hi = tau + 2e-3;
+    constexpr double kGolden = 0.6180339887498949;
+    for (int it = 0; it < 12; ++it) {
+      const double m1 = hi - kGolden * (hi - lo), m2 = lo + kGolden * (hi - lo);
+      (rss_at(m1) < rss_at(m2) ? hi : lo) = (rss_at(m1) < rss_at(m2) ? m2 : m1);
+    }
+    best_tau[static_cast<std::size_t>(a)] = 0.5 * (lo + hi);
   }
   return best_tau;
+}
+
+std::vector<AxisParam> servo_base(const RunResiduals& r, const LagColumns& lag) {
+  std::vector<AxisParam> out;
+  for (int a = 0; a < 3; ++a) {
+    if (!r.moving[a] || r.axis_reference[static_cast<std::size_t>(a)] != "cmd") continue;
+    AxisParam p;
+    p.axis = a, p.accel = false;
+    p.name = "servo_lag_" + ax(a) + "_ms", p.input = lag.velocity.col(a), p.prior_sigma = 10.0;
+    out.push_back(p);
+    p.name = "servo_acc_" + ax(a) + "_ms2", p.input = lag.acceleration.col(a), p.prior_sigma = 1e3;
+    out.push_back(p);
+  }
+  return out;
 }
 
 ParamGroup as_group(const EffectModel& e, const std::array<bool, 3>& axes) {

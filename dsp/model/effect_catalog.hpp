@@ -45,12 +45,12 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& run);
 // time constant 1/kv; a velocity loop behind it adds a term in LP(a). Columns (n × 3):
 // −LP(v) in µm per ms of lag, LP(a) in µm per ms².
 struct LagColumns {
-  double tau_s = 0.0;
+  std::array<double, 3> tau_s{};  // per axis
   Eigen::MatrixXd velocity, acceleration;
 };
-LagColumns common_lag_columns(const RunResiduals& run, double tau_s);
-// The loop's time constant: the grid value whose columns fit `hint` best (0: none moving).
-double loop_time_constant_s(const RunResiduals& run, const Eigen::MatrixXd& hint);
+LagColumns common_lag_columns(const RunResiduals& run, const std::array<double, 3>& tau_s_per_axis);
+// Each axis loop's time constant: the value whose columns fit `hint` best (0: not moving).
+std::array<double, 3> loop_time_constant_s(const RunResiduals& run, const Eigen::MatrixXd& hint);
 // `hint` with each axis' offset and loop lag (these columns) fitted and taken out: what
 // the effects' shapes are chosen on.
 Eigen::MatrixXd without_lag(const Eigen::MatrixXd& hint, const LagColumns& lag);
@@ -58,6 +58,10 @@ Eigen::MatrixXd without_lag(const Eigen::MatrixXd& hint, const LagColumns& lag);
 // `hint` (n × 3, NaN where unknown): the residual that shows machine effects, to pick the
 // reversal spike's time constant and the cyclic error's pitch; `lag` the base model's loop.
 std::vector<EffectModel> machine_effects(const RunResiduals& run, const Eigen::MatrixXd& hint, const LagColumns& lag);
+
+// The servo of each moving axis that has only its set-point as reference: its loop lag and
+// acceleration term (the lag columns), for the base model of the augmented filters.
+std::vector<AxisParam> servo_base(const RunResiduals& run, const LagColumns& lag);
 
 // A machine effect as per-axis position-level parameters (for axes with the set-point only).
 ParamGroup as_group(const EffectModel& e, const std::array<bool, 3>& axes);

@@ -50,6 +50,37 @@ double abs_corr(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   return d > 0.0 ? std::abs(x.dot(y)) / d : 0.0;
 }
 
+// Block-jackknife standard errors of the least-squares parameters of A·x ≈ y: each block
+// left out in turn (the normal equations less its share), the spread of the refits.
+Eigen::VectorXd jackknife_sigma(const Eigen::MatrixXd& A, const Eigen::VectorXd& y, const std::vector<int>& block) {
+  const Eigen::Index p = A.cols();
+  if (block.size() != static_cast<std::size_t>(A.rows()) || p == 0) return Eigen::VectorXd::Zero(p);
+  Eigen::VectorXd norm = A.colwise().norm().transpose();
+  for (Eigen::Index c = 0; c < p; ++c)
+    if (norm(c) <= 0.0) norm(c) = 1.0;
+  const Eigen::MatrixXd As = A * norm.cwiseInverse().asDiagonal();
+  std::vector<int> ids(block);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  if (ids.size() < 4) return Eigen::VectorXd::Zero(p);
+  const Eigen::MatrixXd ata = As.transpose() * As;
+  const Eigen::VectorXd aty = As.transpose() * y;
+  std::vector<Eigen::VectorXd> est;
+  for (int b : ids) {
+    Eigen::MatrixXd m = ata;
+    Eigen::VectorXd v = aty;
+    for (Eigen::Index i = 0; i < As.rows(); ++i)
+      if (block[static_cast<std::size_t>(i)] == b) m -= As.row(i).transpose() * As.row(i), v -= As.row(i).transpose() * y[i];
+    est.push_back(m.completeOrthogonalDecomposition().solve(v).cwiseQuotient(norm));
+  }
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(p), var = Eigen::VectorXd::Zero(p);
+  for (const auto& e : est) mean += e;
+  mean /= static_cast<double>(est.size());
+  for (const auto& e : est) var += (e - mean).cwiseAbs2();
+  const double nb = static_cast<double>(est.size());
+  return (var * (nb - 1.0) / nb).cwiseSqrt();
+}
+
 }  // namespace
 
 double integrated_autocorrelation_time(const Eigen::VectorXd& x, int max_lag) {
@@ -90,7 +121,15 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
   out.rms_nominal = rms(y_fit);
   out.heldout_rms_nominal = rms(y_chk);
   const double nf = static_cast<double>(s.fit.size());
-  out.n_eff = nf / integrated_autocorrelation_time(y_fit);
+  // The effective count is the noise's: the residual's autocorrelation once every
+  // candidate is fitted (a structured residual — the very effects to be found — is smooth
+  // and would count as a handful of samples, hiding them).
+  {
+    Eigen::MatrixXd all(static_cast<Eigen::Index>(s.fit.size()), 0);
+    for (const auto& c : candidates) all = hcat(all, rows(c.regressors, s.fit));
+    const Eigen::VectorXd noise = all.cols() > 0 && all.cols() < static_cast<Eigen::Index>(s.fit.size()) / 4 ? Eigen::VectorXd(y_fit - all * solve(all, y_fit)) : y_fit;
+    out.n_eff = nf / integrated_autocorrelation_time(noise);
+  }
 
   Eigen::MatrixXd accepted_fit(static_cast<Eigen::Index>(s.fit.size()), 0), accepted_chk(static_cast<Eigen::Index>(s.check.size()), 0);
   Eigen::MatrixXd accepted_all(n, 0);
@@ -144,10 +183,15 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
     const Eigen::MatrixXd ata = accepted_fit.transpose() * accepted_fit;
     const Eigen::VectorXd var = ata.completeOrthogonalDecomposition().pseudoInverse().diagonal() *
                                 ((y_fit - accepted_fit * x).squaredNorm() / std::max(out.n_eff - static_cast<double>(x.size()), 1.0));
+    std::vector<int> fit_blocks;
+    if (!opt.block.empty())
+      for (Eigen::Index i : s.fit) fit_blocks.push_back(opt.block[static_cast<std::size_t>(i)]);
+    const Eigen::VectorXd jack = jackknife_sigma(accepted_fit, y_fit, fit_blocks);
     Eigen::Index off = 0;
     for (auto& e : out.effects) {
       e.params = x.segment(off, static_cast<Eigen::Index>(e.param_names.size()));
-      e.param_sigma = var.segment(off, static_cast<Eigen::Index>(e.param_names.size())).cwiseMax(0.0).cwiseSqrt();
+      e.param_sigma = var.segment(off, static_cast<Eigen::Index>(e.param_names.size())).cwiseMax(0.0).cwiseSqrt().cwiseMax(
+          jack.segment(off, static_cast<Eigen::Index>(e.param_names.size())));
       off += static_cast<Eigen::Index>(e.param_names.size());
     }
     out.final_residual = residual - accepted_all * x;

@@ -27,6 +27,11 @@ struct Candidate {
 
 struct SelectionOptions {
   double min_bic_drop = 10.0;
+  // Per sample: the block it belongs to for the jackknife standard errors (empty: none).
+  // The residual of a model fitted to data it does not describe exactly is correlated in
+  // ways a white-noise formula misses; leaving out one block at a time shows how much a
+  // parameter depends on any one stretch of the run.
+  std::vector<int> block;
   double min_heldout_gain = 0.02;  // 2 % lower held-out RMS
   int max_effects = 8;
 };
@@ -40,7 +45,7 @@ struct EffectVerdict {
   double correlation = 0.0;     // |corr| of the residual with the block's best single regressor
   std::vector<std::string> param_names;
   Eigen::VectorXd params;       // fitted with the accepted model (all samples of the fitting set)
-  Eigen::VectorXd param_sigma;  // their standard errors, residual variance per effective sample
+  Eigen::VectorXd param_sigma;  // their standard errors: the larger of residual variance per effective sample and block jackknife
 };
 
 struct SelectionResult {

@@ -20,6 +20,17 @@
 namespace eical::dsp::model {
 namespace {
 
+// Jackknife blocks of the machine channel: half a second, several per move.
+constexpr double kJackknifeBlockS = 0.5;
+// What the rest before a move leaves the bias uncertain by (≈ 0.3 µg: the noise over a
+// few tenths of a second of rest), µm/s².
+constexpr double kNominalBiasStepUmS2 = 3.0;
+// A known effect (the Earth rate) is named when the run favours it: 2 ln(likelihood ratio)
+// above 2, "positive" evidence on the Kass–Raftery scale.
+constexpr double kKnownEffectEvidence = 2.0;
+// What an effect outside the table must explain to be named: half the instrument's 1 µm.
+constexpr double kMaterialUm = 0.5;
+
 std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
   char buf[256];
   std::snprintf(buf, sizeof buf, f, a, b, c, d);
@@ -41,27 +52,52 @@ struct ChannelResult {
   std::vector<bool> heldout;
 };
 
+// The base model of reference − set-point, weighted: what every machine has and no effect
+// of the table describes — each axis' offset (the reference's zero is arbitrary), the axes'
+// common position-loop lag, each axis' acceleration term (its own velocity loop and gain:
+// on a circle at one feed this is the same column as a scale mismatch, which that program
+// then cannot show), and the rotation of a reference instrument that measures two axes
+// against the machine axes ((−θ·y, θ·x): squareness is the symmetric shear of the pair,
+// whatever the split in the data).
+Eigen::MatrixXd base_columns(const RunResiduals& rr, const Channel& ch, const LagColumns& lag) {
+  const Eigen::Index rows = ch.rows();
+  std::vector<Eigen::VectorXd> cols;
+  auto add = [&](const Eigen::VectorXd& c) {
+    if (c.norm() > 0.0) cols.push_back(c);
+  };
+  for (int a = 0; a < 3; ++a) {
+    Eigen::VectorXd offset = Eigen::VectorXd::Zero(rows), acc = Eigen::VectorXd::Zero(rows);
+    for (Eigen::Index i = 0; i < rows; ++i)
+      if (ch.axis[static_cast<std::size_t>(i)] == a) {
+        offset[i] = 1.0 / ch.sigma_um[i];
+        acc[i] = lag.acceleration(ch.sample[static_cast<std::size_t>(i)], a) / ch.sigma_um[i];
+      }
+    add(offset), add(acc);
+  }
+  Eigen::VectorXd lag_rows(rows);
+  for (Eigen::Index i = 0; i < rows; ++i) lag_rows[i] = lag.velocity(ch.sample[static_cast<std::size_t>(i)], ch.axis[static_cast<std::size_t>(i)]) / ch.sigma_um[i];
+  add(lag_rows);
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j) {
+      if (rr.axis_reference[static_cast<std::size_t>(i)] != "ref" || rr.axis_reference[static_cast<std::size_t>(j)] != "ref" || !rr.moving[i] || !rr.moving[j]) continue;
+      Eigen::VectorXd c(rows);
+      const double mi = rr.cmd.col(i).mean(), mj = rr.cmd.col(j).mean();
+      for (Eigen::Index k = 0; k < rows; ++k) {
+        const int sm = ch.sample[static_cast<std::size_t>(k)], axk = ch.axis[static_cast<std::size_t>(k)];
+        c[k] = (axk == i ? -(rr.cmd(sm, j) - mj) : axk == j ? rr.cmd(sm, i) - mi : 0.0) * 1e-3 / ch.sigma_um[k];
+      }
+      add(c);
+    }
+  Eigen::MatrixXd m(rows, static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t c = 0; c < cols.size(); ++c) m.col(static_cast<Eigen::Index>(c)) = cols[c];
+  return m;
+}
+
 ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const std::vector<EffectModel>& catalog, const LagColumns& lag,
                               const ExplainOptions& o) {
   ChannelResult out;
   const Eigen::Index rows = ch.rows();
-  // Weighted (whitened) residual and regressors, each axis' offset projected out.
-  Eigen::MatrixXd nuis = Eigen::MatrixXd::Zero(rows, 3);
-  for (Eigen::Index i = 0; i < rows; ++i) nuis(i, ch.axis[static_cast<std::size_t>(i)]) = 1.0 / ch.sigma_um[i];
-  std::vector<Eigen::Index> used_cols;
-  for (int a = 0; a < 3; ++a)
-    if (nuis.col(a).squaredNorm() > 0.0) used_cols.push_back(a);
-  // Each axis' offset and the axes' common position-loop lag belong to the base model.
-  Eigen::VectorXd lag_rows(rows), acc_rows(rows);
-  for (Eigen::Index i = 0; i < rows; ++i) {
-    const int sm = ch.sample[static_cast<std::size_t>(i)], axi = ch.axis[static_cast<std::size_t>(i)];
-    lag_rows[i] = lag.velocity(sm, axi) / ch.sigma_um[i];
-    acc_rows[i] = lag.acceleration(sm, axi) / ch.sigma_um[i];
-  }
-  const bool with_lag = lag_rows.norm() > 0.0;
-  Eigen::MatrixXd nu(rows, static_cast<Eigen::Index>(used_cols.size()) + (with_lag ? 2 : 0));
-  for (std::size_t c = 0; c < used_cols.size(); ++c) nu.col(static_cast<Eigen::Index>(c)) = nuis.col(used_cols[c]);
-  if (with_lag) nu.col(nu.cols() - 2) = lag_rows, nu.col(nu.cols() - 1) = acc_rows;
+  const Eigen::MatrixXd nu = base_columns(rr, ch, lag);
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(nu);
   const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(rows, nu.cols());
   auto project = [&](const Eigen::MatrixXd& m) { return Eigen::MatrixXd(m - q * (q.transpose() * m)); };
@@ -97,6 +133,8 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
   if (cands.empty() || rows < 50) return out;
   SelectionOptions so;
   so.min_bic_drop = o.min_bic_drop, so.min_heldout_gain = o.min_heldout_gain, so.max_effects = 10;
+  so.block.resize(static_cast<std::size_t>(rows));
+  for (Eigen::Index i = 0; i < rows; ++i) so.block[static_cast<std::size_t>(i)] = static_cast<int>(rr.t_s[ch.sample[static_cast<std::size_t>(i)]] / kJackknifeBlockS);
   const SelectionResult sel = select_effects(y, cands, out.heldout, so);
 
   auto split_rms = [&](const Eigen::VectorXd& v, bool held) {
@@ -279,12 +317,43 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
   std::vector<ParamGroup> groups = sensor_groups(rr);
   const std::size_t n_sensor_groups = groups.size();
   for (const auto& e : machine) {
+    if (e.name == "machine.servo_mismatch") continue;  // the servos of set-point-only axes are the base model's
     ParamGroup g = as_group(e, cmd_axes);
     if (!g.params.empty()) groups.push_back(std::move(g));
   }
   KfSelectionOptions ko;
   ko.min_bic_drop = o.min_bic_drop, ko.min_heldout_gain = o.min_heldout_gain;
-  const KfSelection ks = select_groups_kf(rr.tracks, groups, pipeline_config(rr.meta, 1).fusion, ko);
+  // The nominal model's noise: the data sheet's, without the pipeline's allowance for a bias
+  // jump at every move start — a jump between moves is an effect to find (sensor.bias_drift),
+  // and so is anything else that acts like one (Earth-rate Coriolis during a long move).
+  fusion::ErrorModel noise_model = pipeline_config(rr.meta, 1).fusion;
+  noise_model.bias_step_um_s2 = kNominalBiasStepUmS2;
+  const std::vector<AxisParam> servo = servo_base(rr, lag);
+  const KfSelection ks = select_groups_kf(rr.tracks, groups, noise_model, ko, servo);
+  // Servo mismatch of the set-point-only axes: their base lags, compared.
+  {
+    std::vector<std::pair<int, std::pair<double, double>>> lags;
+    for (int a = 0; a < 3; ++a)
+      if (const auto it = ks.base_value.find(std::string("servo_lag_") + "xyz"[a] + "_ms"); it != ks.base_value.end())
+        lags.push_back({a, {it->second, ks.base_sigma.at(it->first)}});
+    if (lags.size() >= 2) {
+      ExplainedEffect x;
+      x.name = "machine.servo_mismatch", x.channel = "total", x.unit = "ms", x.tolerance = 0.05;
+      double sure = 0.0;
+      for (std::size_t i = 0; i < lags.size(); ++i)
+        for (std::size_t j = i + 1; j < lags.size(); ++j) {
+          const double d = lags[j].second.first - lags[i].second.first, sd = std::hypot(lags[i].second.second, lags[j].second.second);
+          x.params[std::string("lag_") + "xyz"[lags[j].first] + "_minus_" + "xyz"[lags[i].first] + "_ms"] = d;
+          x.magnitude = std::max(x.magnitude, std::abs(d)), sure = std::max(sure, std::abs(d) - 2.0 * sd);
+        }
+      for (const auto& [a, l] : lags) x.params[std::string("lag_") + "xyz"[a] + "_ms"] = l.first;
+      x.significant = sure > x.tolerance;
+      x.importance_um = x.significant ? x.magnitude * rr.v_cmd.cwiseAbs().maxCoeff() : 0.0;
+      x.evidence = fmt("the axes' servo lags against the set-point (the integrated motion's base model) differ by %.3g ms (%.3g at 2 sigma) against a tolerance of %.3g ms",
+                       x.magnitude, sure, x.tolerance);
+      merge(all, std::move(x));
+    }
+  }
   for (const auto& v : ks.groups) {
     const bool is_sensor = std::find_if(groups.begin(), groups.begin() + static_cast<std::ptrdiff_t>(n_sensor_groups),
                                         [&](const ParamGroup& g) { return g.name == v.name; }) != groups.begin() + static_cast<std::ptrdiff_t>(n_sensor_groups);
@@ -339,6 +408,13 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
       for (const auto& sa : sure_atts)
         if (sa.name == at.name) sure_magnitude = sa.magnitude;
       x.significant = v.accepted && sure_magnitude > x.tolerance;
+      // Known from the site, not fitted: named when it matters for the motion and the run
+      // agrees with it at least as well as without it.
+      if (v.name == "coriolis") {
+        x.significant = x.magnitude > x.tolerance && v.loglik_gain > kKnownEffectEvidence;
+        x.importance_um = x.significant ? std::max(0.0, v.held_rms_before_um - v.held_rms_after_um) : 0.0;
+        x.evidence += fmt("; the run with it is %.1f (2 ln L, effective count) more likely than without", v.loglik_gain);
+      }
       char nums[256];
       std::snprintf(nums, sizeof nums, " (model group '%s'); BIC drop %.0f; prediction error at the held-out samples %.3f -> %.3f um; size %.3g (%.3g at 2 sigma) ",
                     v.name.c_str(), v.bic_drop, v.held_rms_before_um, v.held_rms_after_um, x.magnitude, sure_magnitude);
@@ -352,7 +428,9 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
         // plausible size. Reported with what it resembles and what it explains.
         ExplainedEffect other = x;
         other.name = "other.residual_like_" + v.name;
-        other.significant = true, other.taken_into_model = false;
+        // Named only when what it explains matters for a measurement (kMaterialUm at the
+        // held-out points): a fraction of a micrometre is not a finding.
+        other.significant = std::max(0.0, v.held_rms_before_um - v.held_rms_after_um) >= kMaterialUm, other.taken_into_model = false;
         other.magnitude = x.importance_um, other.tolerance = 0.0, other.unit = "um explained at the held-out points";
         other.evidence = "a residual shaped like " + at.regressor + " but " + fmt("%.3g ", x.magnitude) + x.unit + fmt(" (a sensor has at most %.3g); ", at.plausible_max) +
                      fmt("BIC drop %.0f; prediction error at the held-out samples %.3f -> %.3f um", v.bic_drop, v.held_rms_before_um, v.held_rms_after_um);
@@ -448,9 +526,14 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
     for (int s2 = 0; s2 < rr.n; ++s2) peak = std::max(peak, two_w.cross(Eigen::Vector3d(rr.v_meas.row(s2).transpose()) * 1e-3).norm());
     c.magnitude = peak / (rr.meta.site.g_mps2 * 1e-6);
     c.params["peak_ug"] = c.magnitude;
-    c.evidence = fmt("2 w x v of this motion peaks at %.2f ug; not fitted (a common scale error looks the same on a circle); eical analyze --coriolis corrects it",
-                     c.magnitude);
-    all.push_back(c);
+    c.evidence = fmt("2 w x v of this motion peaks at %.2f ug from the site's latitude and heading; eical analyze --coriolis corrects it", c.magnitude);
+    if (ExplainedEffect* fitted = find("site.coriolis")) {
+      fitted->evidence += "; " + c.evidence;
+      fitted->params["peak_ug"] = c.magnitude;
+    } else {
+      c.evidence += " (not fitted here: the motion does not separate it from a scale error)";
+      all.push_back(c);
+    }
   }
   // The bias at the standstills (ch. 8.3.2): steps between moves, drift, temperature.
   {

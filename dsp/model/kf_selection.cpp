@@ -4,6 +4,7 @@
 #include "dsp/model/effect_selection.hpp"
 
 #include <algorithm>
+#include <numbers>
 #include <cmath>
 
 namespace eical::dsp::model {
@@ -14,6 +15,7 @@ constexpr double kTieBic = 6.0;     // Kass–Raftery: below 6, no strong eviden
 
 struct AxisFit {
   double logl = 0.0, fit_ss = 0.0, held_ss = 0.0;
+  double held_lpd = 0.0;  // log predictive density of the held-out observations (a proper score)
   std::size_t fit_n = 0, held_n = 0;
   Eigen::VectorXd value, sigma;
   std::vector<double> innovations;  // of the fitting observations (for the effective count)
@@ -22,14 +24,16 @@ struct AxisFit {
 AxisFit fit_axis(const AxisTrack& t, const std::vector<const AxisParam*>& ps, const fusion::ErrorModel& model, double zupt_sigma, bool keep_innov) {
   const auto p = static_cast<Eigen::Index>(ps.size());
   Eigen::VectorXd prior(p + t.tags);
-  for (Eigen::Index j = 0; j < p; ++j) prior[j] = ps[static_cast<std::size_t>(j)]->prior_sigma;
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(p + t.tags);
+  for (Eigen::Index j = 0; j < p; ++j) prior[j] = ps[static_cast<std::size_t>(j)]->prior_sigma, mean[j] = ps[static_cast<std::size_t>(j)]->prior_mean;
   for (int k = 0; k < t.tags; ++k) prior[p + k] = kTagPrior;
-  identify::AugmentedFilter f(model, Eigen::Vector3d(50.0, 1.0, model.bias_step_um_s2), prior);
+  identify::AugmentedFilter f(model, Eigen::Vector3d(50.0, 1.0, std::hypot(model.bias_step_um_s2, t.start_bias_sigma_um_s2)), prior, mean);
   const Eigen::Index n = t.h_s.size();
   Eigen::VectorXd g = Eigen::VectorXd::Zero(p + t.tags);
   Eigen::RowVectorXd zrow = Eigen::RowVectorXd::Zero(3 + p + t.tags);
   zrow[1] = 1.0;
   AxisFit out;
+  std::vector<bool> tag_seen(static_cast<std::size_t>(t.tags), false);
   std::size_t next = 0;
   for (Eigen::Index s = 0; s < n; ++s) {
     if (s > 0) {
@@ -55,8 +59,12 @@ AxisFit fit_axis(const AxisTrack& t, const std::vector<const AxisParam*>& ps, co
       if (o.heldout) {
         double nu = 0.0, var = 0.0;
         f.predict_observation(row, o.z_um, o.sigma_um, nu, var);
-        out.held_ss += nu * nu, ++out.held_n;
+        out.held_lpd += -0.5 * (std::log(2.0 * std::numbers::pi * var) + nu * nu / var);
+        // A strip not yet seen in the fitting observations has an unknown mounting: its
+        // prediction says nothing about the model (the score above weighs it by its variance).
+        if (o.tag < 0 || tag_seen[static_cast<std::size_t>(o.tag)]) out.held_ss += nu * nu, ++out.held_n;
       } else {
+        if (o.tag >= 0) tag_seen[static_cast<std::size_t>(o.tag)] = true;
         f.update(row, o.z_um, o.sigma_um);
         out.logl += f.last_log_density();
         out.fit_ss += f.last_innovation() * f.last_innovation(), ++out.fit_n;
@@ -76,21 +84,23 @@ struct Model {
 };
 
 double total_logl(const Model& m) { return m.fit[0].logl + m.fit[1].logl + m.fit[2].logl; }
+double total_held_lpd(const Model& m) { return m.fit[0].held_lpd + m.fit[1].held_lpd + m.fit[2].held_lpd; }
 
 double rms(double ss, std::size_t n) { return n ? std::sqrt(ss / static_cast<double>(n)) : 0.0; }
 
 }  // namespace
 
 KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::vector<ParamGroup>& groups, const fusion::ErrorModel& model,
-                             const KfSelectionOptions& o) {
+                             const KfSelectionOptions& o, const std::vector<AxisParam>& base) {
   KfSelection out;
   auto fit = [&](int a, const std::vector<const AxisParam*>& ps, bool keep = false) {
     return tracks[a].present ? fit_axis(tracks[a], ps, model, o.zupt_sigma_um_s, keep) : AxisFit{};
   };
   Model cur;
+  for (const auto& p : base) cur.params[static_cast<std::size_t>(p.axis)].push_back(&p);
   std::vector<double> base_innov;
   for (int a = 0; a < 3; ++a) {
-    cur.fit[a] = fit(a, {}, true);
+    cur.fit[a] = fit(a, cur.params[static_cast<std::size_t>(a)], true);
     base_innov.insert(base_innov.end(), cur.fit[a].innovations.begin(), cur.fit[a].innovations.end());
   }
   auto sums = [](const Model& m, double& fs, std::size_t& fn, double& hs, std::size_t& hn) {
@@ -109,8 +119,8 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
   // by the effective count, as the BIC's penalty is.
   const double scale = out.n_eff / static_cast<double>(fn);
 
-  auto with = [&](const Model& base, const ParamGroup& gp) {
-    Model m = base;
+  auto with = [&](const Model& from, const ParamGroup& gp) {
+    Model m = from;
     std::array<bool, 3> touched{};
     for (const auto& p : gp.params) m.params[p.axis].push_back(&p), touched[p.axis] = true, ++m.k;
     for (int a = 0; a < 3; ++a)
@@ -120,12 +130,14 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
   auto verdict = [&](const Model& before, const Model& after, const ParamGroup& gp) {
     GroupVerdict v;
     v.name = gp.name;
-    v.bic_drop = 2.0 * scale * (total_logl(after) - total_logl(before)) - static_cast<double>(after.k - before.k) * ln_n;
+    v.loglik_gain = 2.0 * scale * (total_logl(after) - total_logl(before));
+    v.bic_drop = v.loglik_gain - static_cast<double>(after.k - before.k) * ln_n;
     double a_fs, a_hs, b_fs, b_hs;
     std::size_t a_fn, a_hn, b_fn, b_hn;
     sums(before, b_fs, b_fn, b_hs, b_hn), sums(after, a_fs, a_fn, a_hs, a_hn);
     v.fit_rms_before_um = rms(b_fs, b_fn), v.fit_rms_after_um = rms(a_fs, a_fn);
     v.held_rms_before_um = rms(b_hs, b_hn), v.held_rms_after_um = rms(a_hs, a_hn);
+    v.held_score_gain = scale * (total_held_lpd(after) - total_held_lpd(before));
     for (int a = 0; a < 3; ++a)
       for (std::size_t j = 0; j < after.params[a].size(); ++j)
         for (const auto& p : gp.params)
@@ -142,11 +154,13 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
     std::vector<Trial> trials;
     double top_bic = -INFINITY;
     for (std::size_t g = 0; g < groups.size(); ++g) {
-      if (done[g] || groups[g].params.empty()) continue;
+      if (done[g] || groups[g].params.empty() || groups[g].known) continue;
       Model m = with(cur, groups[g]);
       GroupVerdict v = verdict(cur, m, groups[g]);
       // Only an extension that also predicts the held-out data better may be taken.
-      const bool gain = v.held_rms_after_um < (1.0 - o.min_heldout_gain) * v.held_rms_before_um;
+      // The score is the held-out observations' log predictive density (in effective
+      // counts, as the BIC): it weighs each prediction by how well it could be known.
+      const bool gain = v.held_score_gain > o.min_heldout_score_gain;
       if (!gain) continue;
       top_bic = std::max(top_bic, v.bic_drop);
       trials.push_back({g, std::move(v), std::move(m)});
@@ -177,6 +191,10 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
         }
   sums(cur, fs, fn, hs, hn);
   out.fit_rms_final_um = rms(fs, fn), out.held_rms_final_um = rms(hs, hn);
+  for (int a = 0; a < 3; ++a)
+    for (std::size_t j = 0; j < cur.params[a].size(); ++j)
+      for (const auto& p : base)
+        if (&p == cur.params[a][j]) out.base_value[p.name] = cur.fit[a].value[static_cast<Eigen::Index>(j)], out.base_sigma[p.name] = cur.fit[a].sigma[static_cast<Eigen::Index>(j)];
   std::vector<GroupVerdict> rest;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     if (done[g] || groups[g].params.empty()) continue;

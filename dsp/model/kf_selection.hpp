@@ -29,11 +29,15 @@ struct AxisParam {
   bool accel = false;
   Eigen::VectorXd input;
   double prior_sigma = 1.0;
+  double prior_mean = 0.0;  // what is known before the data (the Earth rate's Coriolis gain: 1)
 };
 
 struct ParamGroup {
   std::string name;
   std::vector<AxisParam> params;
+  // Known from outside the run (the Earth rate): not selected, only tested once against the
+  // final model — does the run agree with it (loglik_gain ≥ 0)?
+  bool known = false;
 };
 
 struct AxisTrack {
@@ -50,6 +54,7 @@ struct AxisTrack {
   };
   std::vector<Obs> obs;                  // ascending sample
   int tags = 0;
+  double start_bias_sigma_um_s2 = 0.0;   // how well the rest before the motion fixed the bias
 };
 
 struct GroupVerdict {
@@ -58,6 +63,8 @@ struct GroupVerdict {
   double bic_drop = 0.0;
   double fit_rms_before_um = 0.0, fit_rms_after_um = 0.0;    // innovations of the fitting observations
   double held_rms_before_um = 0.0, held_rms_after_um = 0.0;  // prediction errors at the held-out ones
+  double held_score_gain = 0.0;  // gain in the held-out log predictive density (effective count)
+  double loglik_gain = 0.0;      // 2 × log-likelihood gain in effective counts (the BIC drop without its penalty)
   std::map<std::string, double> value, sigma;
 };
 
@@ -66,16 +73,20 @@ struct KfSelection {
   double fit_rms_nominal_um = 0.0, fit_rms_final_um = 0.0;
   double held_rms_nominal_um = 0.0, held_rms_final_um = 0.0;
   double n_eff = 0.0;
+  std::map<std::string, double> base_value, base_sigma;  // the base parameters in the final model
 };
 
 struct KfSelectionOptions {
   double min_bic_drop = 10.0;
   double min_heldout_gain = 0.02;
+  double min_heldout_score_gain = 1.0;  // an e-fold better held-out prediction
   int max_groups = 8;
   double zupt_sigma_um_s = 2.0;
 };
 
+// `base`: parameters every model carries (nuisances such as the servo lag of an axis seen
+// against its set-point only); not selected, not counted in the BIC.
 KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::vector<ParamGroup>& groups, const fusion::ErrorModel& model,
-                             const KfSelectionOptions& options = {});
+                             const KfSelectionOptions& options = {}, const std::vector<AxisParam>& base = {});
 
 }  // namespace eical::dsp::model

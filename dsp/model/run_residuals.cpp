@@ -9,6 +9,11 @@
 namespace eical::dsp::model {
 namespace {
 
+// Held out of the fits: every other quarter second. Short blocks keep both sets balanced
+// over the axes a program moves in turn (a rectangle's sides alternate x and y: holding
+// out every other side would fit x and predict y).
+constexpr double kHeldOutBlockS = 0.25;
+
 // Linear interpolation of a column of a trace at a fractional position (clamped).
 double at(const std::vector<Eigen::Vector3d>& x, double pos, int axis) {
   if (x.empty()) return NAN;
@@ -109,7 +114,7 @@ RunResiduals build_residuals(const Run& run) {
   for (int sg : d.segment) max_seg = std::max(max_seg, sg);
   d.heldout.resize(static_cast<std::size_t>(n));
   for (Eigen::Index s = 0; s < n; ++s)
-    d.heldout[static_cast<std::size_t>(s)] = max_seg >= 3 ? d.segment[static_cast<std::size_t>(s)] % 2 == 1 : static_cast<int>(d.t_s[s] / 0.5) % 2 == 1;
+    d.heldout[static_cast<std::size_t>(s)] = static_cast<int>(d.t_s[s] / kHeldOutBlockS) % 2 == 1;
 
   // The tracks: the integrated motion as it was integrated (sensor time, moved onto the
   // set-point's time), the standstills the pipeline found, the moves' starts.
@@ -146,6 +151,7 @@ RunResiduals build_residuals(const Run& run) {
     for (Eigen::Index s = 1; s < n; ++s)
       t.h_s[s] = static_cast<double>(m.sample_index[d.trace[static_cast<std::size_t>(s)]] - m.sample_index[d.trace[static_cast<std::size_t>(s - 1)]]) / m.fs_hz;
     t.bias_step = bias_step, t.zupt = zupt;
+    t.start_bias_sigma_um_s2 = m.supports.start_bias_sigma_um_s2[a];
     t.v_um_s.resize(n);
     for (Eigen::Index s = 0; s < n; ++s) t.v_um_s[s] = v_ins[static_cast<std::size_t>(s)][a] * 1000.0;
     if (d.has_ref[a]) {

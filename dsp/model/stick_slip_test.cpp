@@ -14,6 +14,7 @@ constexpr double kCreepMmS = 10.0;     // below this an axis creeps (600 mm/min)
 constexpr double kStillMmS = 0.02;     // below this it stands
 constexpr double kBurstSigma = 10.0;   // a burst: the high-passed acceleration beyond 10 σ
 constexpr double kHalfWindowS = 1e-3;  // high-pass: minus the mean over ±1 ms
+constexpr double kSawtoothHalfWindowS = 0.025;
 
 }  // namespace
 
@@ -45,12 +46,18 @@ StickSlipFinding stick_slip_test(const RunResiduals& r) {
       const double v = std::abs(m.cmd_mm[static_cast<std::size_t>(c + 1)][a] - m.cmd_mm[static_cast<std::size_t>(c - 1)][a]) * fs / 2.0;
       zone[k] = v >= kCreepMmS ? 2 : v > kStillMmS ? 1 : 0;
     }
-    // Noise: the robust spread of the high-passed signal where the axis moves fast.
-    std::vector<double> fast;
-    for (std::size_t k = 0; k < n; k += 3)
+    // Noise: the robust spread of the high-passed signal where the axis moves fast (what
+    // the drive and the sensors show without slipping); a run that only creeps has the
+    // creep itself for that — slips last milliseconds a few times a second, so the median
+    // of the creep's spread is its noise.
+    std::vector<double> fast, creep;
+    for (std::size_t k = 0; k < n; k += 3) {
       if (zone[k] == 2) fast.push_back(std::abs(hp[k]));
-    if (fast.size() < 200) continue;
-    const double sigma = 1.4826 * dsp::median(fast, 0.0);
+      if (zone[k] == 1) creep.push_back(std::abs(hp[k]));
+    }
+    const std::vector<double>& quiet = fast.size() >= 200 ? fast : creep;
+    if (quiet.size() < 200) continue;
+    const double sigma = 1.4826 * dsp::median(quiet, 0.0);
     if (!(sigma > 0.0)) continue;
     // Bursts: local peaks beyond the threshold, at least 1 ms apart.
     int in_creep = 0, elsewhere = 0;
@@ -90,17 +97,23 @@ StickSlipFinding stick_slip_test(const RunResiduals& r) {
   // step of acceleration, ring through the DAQ filter (its impulse response spans ~8 ms)
   // as a handful of peaks a millisecond apart, once per reversal.
   out.found = out.bursts_per_zone >= 8.0 && out.bursts_in_creep >= 20;
-  // Its size where the reference shows it: the sawtooth's RMS × √12 in the creep zones.
+  // Its size where the reference shows it: the sawtooth's RMS × √12 in the creep zones,
+  // about the running mean over ±25 ms (a slower wander is no slip).
   if (r.has_ref[out.axis]) {
+    const auto w = static_cast<std::ptrdiff_t>(std::max(2.0, std::round(kSawtoothHalfWindowS * fs)));
+    const std::size_t nr = m.ref_mm.size();
+    std::vector<double> e(nr, 0.0), pre(nr + 1, 0.0);
+    for (std::size_t k = 0; k < nr; ++k) {
+      e[k] = m.ref_mm[k][out.axis] - m.cmd_mm[k][out.axis];
+      pre[k + 1] = pre[k] + (std::isfinite(e[k]) ? e[k] : 0.0);
+    }
     double ss = 0.0;
     std::size_t cnt = 0;
-    for (std::size_t k = 2; k + 2 < m.ref_mm.size(); ++k) {
+    for (std::size_t k = static_cast<std::size_t>(w); k + static_cast<std::size_t>(w) + 1 < nr; ++k) {
       const double v = std::abs(m.cmd_mm[k + 1][out.axis] - m.cmd_mm[k - 1][out.axis]) * fs / 2.0;
-      if (!(v > kStillMmS && v < kCreepMmS)) continue;
-      const double e0 = m.ref_mm[k][out.axis] - m.cmd_mm[k][out.axis];
-      const double em = 0.25 * ((m.ref_mm[k - 2][out.axis] - m.cmd_mm[k - 2][out.axis]) + (m.ref_mm[k - 1][out.axis] - m.cmd_mm[k - 1][out.axis]) +
-                                (m.ref_mm[k + 1][out.axis] - m.cmd_mm[k + 1][out.axis]) + (m.ref_mm[k + 2][out.axis] - m.cmd_mm[k + 2][out.axis]));
-      if (std::isfinite(e0) && std::isfinite(em)) ss += (e0 - em) * (e0 - em), ++cnt;
+      if (!(v > kStillMmS && v < kCreepMmS) || !std::isfinite(e[k])) continue;
+      const double mean = (pre[k + static_cast<std::size_t>(w) + 1] - pre[k - static_cast<std::size_t>(w)]) / static_cast<double>(2 * w + 1);
+      ss += (e[k] - mean) * (e[k] - mean), ++cnt;
     }
     if (cnt > 0) out.slip_um = std::sqrt(ss / static_cast<double>(cnt)) * 1000.0 * std::sqrt(12.0);
   }
