@@ -117,6 +117,7 @@ void FrameLoop::publish_counters(const dsp::Frame& f) noexcept {
   constexpr auto relaxed = std::memory_order_relaxed;
   counters_.frames.store(k.frames, relaxed);
   counters_.frames_lost.store(k.frames_lost, relaxed);
+  counters_.frames_flagged.store(k.frames_flagged, relaxed);
   counters_.bad_frames.store(guard_.bad_frames(), relaxed);
   counters_.measurements_started.store(k.measurements_started, relaxed);
   counters_.measurements.store(k.measurements_completed, relaxed);
@@ -126,6 +127,8 @@ void FrameLoop::publish_counters(const dsp::Frame& f) noexcept {
   counters_.recorder_overflow.store(session_.recorder_overflow(), relaxed);
   counters_.state.store(static_cast<int>(session_.state().state()), relaxed);
   counters_.sample_index.store(f.sample_index, relaxed);
+  counters_.temp_c[0].store(f.temp_c[0], relaxed);
+  counters_.temp_c[1].store(f.temp_c[1], relaxed);
 }
 
 void FrameLoop::continue_after_reopen() noexcept {

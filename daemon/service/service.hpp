@@ -26,6 +26,7 @@ struct StatusCounters {
   std::uint64_t recorder_overflow = 0, handoffs_deferred = 0;
   std::uint64_t source_decode_errors = 0, source_lost_samples = 0, source_dropped_frames = 0;
   std::uint64_t setpoint_samples = 0, setpoint_missing = 0;
+  std::uint64_t frames_flagged = 0, commands = 0;
 };
 
 struct ServiceStatus {
@@ -35,6 +36,7 @@ struct ServiceStatus {
   std::uint64_t measurements = 0, results_written = 0;
   std::string last_result;       // path of the last result.json
   std::int64_t sample_index = 0, sample_time_ns = 0;  // DAQ clock ↔ CLOCK_MONOTONIC
+  float temp_table_c = 0.0f, temp_head_c = 0.0f;      // the sensors' case temperatures now
   StatusCounters counters;
 };
 

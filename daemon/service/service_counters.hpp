@@ -11,6 +11,7 @@ namespace eical::daemon {
 struct ServiceCounters {
   std::atomic<std::uint64_t> frames{0};
   std::atomic<std::uint64_t> frames_lost{0};          // frames marked gap_before
+  std::atomic<std::uint64_t> frames_flagged{0};       // frames with any quality flag
   std::atomic<std::uint64_t> bad_frames{0};           // non-finite channels the guard replaced
   std::atomic<std::uint64_t> measurements_started{0};
   std::atomic<std::uint64_t> measurements{0};         // completed (M103 or cut short)
@@ -21,6 +22,7 @@ struct ServiceCounters {
   std::atomic<std::uint64_t> handoffs_deferred{0};    // a finished measurement waited for the evaluator
   std::atomic<int> state{static_cast<int>(dsp::State::idle)};
   std::atomic<std::int64_t> sample_index{0};          // the last frame handled
+  std::atomic<float> temp_c[2] = {0.0f, 0.0f};        // its case temperatures, table and head
   std::atomic<bool> faulted{false};                   // the run loop is reopening a failed source
 
   [[nodiscard]] dsp::State measurement_state() const noexcept { return static_cast<dsp::State>(state.load(std::memory_order_relaxed)); }

@@ -52,8 +52,10 @@ ServiceStatus StatusReporter::collect() const {
   st.last_result = ev.last_result;
   st.sample_index = k.sample_index.load(relaxed);
   st.sample_time_ns = s_.daq_clock->time_ns(st.sample_index);
+  st.temp_table_c = k.temp_c[0].load(relaxed), st.temp_head_c = k.temp_c[1].load(relaxed);
   StatusCounters& c = st.counters;
   c.bad_frames = k.bad_frames.load(relaxed);
+  c.frames_flagged = k.frames_flagged.load(relaxed);
   c.stamp_overruns = s_.source->stamp_overruns();
   c.triggers_late = k.triggers_late.load(relaxed);
   c.triggers_refused = k.triggers_refused.load(relaxed) + k.trigger_queue_full.load(relaxed);
@@ -64,7 +66,7 @@ ServiceStatus StatusReporter::collect() const {
     c.triggers_refused += ch->refused() + ch->dropped();
   }
   for (const auto* l : s_.listeners) c.trigger_events_ignored += l->ignored();
-  if (s_.hmi) c.live_overruns = s_.hmi->live_overruns(), c.dds_write_errors = s_.hmi->write_errors();
+  if (s_.hmi) c.live_overruns = s_.hmi->live_overruns(), c.dds_write_errors = s_.hmi->write_errors(), c.commands = s_.hmi->commands_received();
   const drivers::SourceCounters sc = s_.source->counters();
   c.source_decode_errors = sc.decode_errors, c.source_lost_samples = sc.lost_samples, c.source_dropped_frames = sc.dropped_frames;
   c.setpoint_samples = sc.setpoint_samples, c.setpoint_missing = sc.setpoint_missing;
@@ -80,12 +82,14 @@ void StatusReporter::report() {
   m.state = st.state, m.fault = st.fault, m.frames = st.frames, m.overruns = st.overruns, m.frames_lost = st.frames_lost;
   m.measurements = st.measurements, m.results = st.results_written;
   m.sample_index = st.sample_index, m.sample_time_ns = st.sample_time_ns;
+  m.temp_table_c = st.temp_table_c, m.temp_head_c = st.temp_head_c;
   const StatusCounters& c = st.counters;
   m.bad_frames = c.bad_frames, m.live_overruns = c.live_overruns, m.stamp_overruns = c.stamp_overruns, m.dds_write_errors = c.dds_write_errors;
   m.triggers_accepted = c.triggers_accepted, m.triggers_refused = c.triggers_refused, m.triggers_late = c.triggers_late;
   m.trigger_events_ignored = c.trigger_events_ignored, m.recorder_overflow = c.recorder_overflow, m.handoffs_deferred = c.handoffs_deferred;
   m.source_decode_errors = c.source_decode_errors, m.source_lost_samples = c.source_lost_samples;
   m.source_dropped_frames = c.source_dropped_frames, m.setpoint_samples = c.setpoint_samples, m.setpoint_missing = c.setpoint_missing;
+  m.frames_flagged = c.frames_flagged, m.commands = c.commands;
   s_.hmi->set_status(m);
 }
 

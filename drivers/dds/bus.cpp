@@ -107,6 +107,7 @@ bool Bus::publish(const StatusMsg& m) {
   s.trigger_events_ignored = m.trigger_events_ignored, s.recorder_overflow = m.recorder_overflow, s.handoffs_deferred = m.handoffs_deferred;
   s.source_decode_errors = m.source_decode_errors, s.source_lost_samples = m.source_lost_samples;
   s.source_dropped_frames = m.source_dropped_frames, s.setpoint_samples = m.setpoint_samples, s.setpoint_missing = m.setpoint_missing;
+  s.frames_flagged = m.frames_flagged, s.commands = m.commands;
   const bool ok = impl_->status.writer > 0 && dds_write(impl_->status.writer, &s) >= 0;
   if (!ok) write_errors_.fetch_add(1, std::memory_order_relaxed);
   return ok;
@@ -183,6 +184,7 @@ std::optional<StatusMsg> Bus::take_status(std::chrono::milliseconds timeout) {
     out.recorder_overflow = s.recorder_overflow, out.handoffs_deferred = s.handoffs_deferred;
     out.source_decode_errors = s.source_decode_errors, out.source_lost_samples = s.source_lost_samples;
     out.source_dropped_frames = s.source_dropped_frames, out.setpoint_samples = s.setpoint_samples, out.setpoint_missing = s.setpoint_missing;
+    out.frames_flagged = s.frames_flagged, out.commands = s.commands;
   });
   return ok ? std::optional(out) : std::nullopt;
 }

@@ -21,6 +21,7 @@ struct StatusMsg {
   std::uint64_t recorder_overflow = 0, handoffs_deferred = 0;
   std::uint64_t source_decode_errors = 0, source_lost_samples = 0, source_dropped_frames = 0;
   std::uint64_t setpoint_samples = 0, setpoint_missing = 0;
+  std::uint64_t frames_flagged = 0, commands = 0;
 };
 
 struct LiveMsg {

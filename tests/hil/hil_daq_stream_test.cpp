@@ -286,7 +286,7 @@ TEST(HilDaqStream, ServoStreamSetPointBesideTheDaq) {
   // The triggers on the DAQ's input carry no P word: the program evaluated is the default.
   const fs::path cfg = write_daq_config(dir, domain, "[\"frame\"]",
                                         "[setpoint]\nsource = \"servo_stream\"\n[setpoint.servo_stream]\nfifo = \"" + (dir / "servo.fifo").string() +
-                                            "\"\nhold_ms = 100.0\n[setpoint.program]\ndirectory = \"" + (dir / "programs").string() +
+                                            "\"\nhold_ms = 300.0\n[setpoint.program]\ndirectory = \"" + (dir / "programs").string() +
                                             "\"\ndefault_program = 7\n");
   ChildProcess eicald({EICALD_BIN, "--config", cfg.string()}, (dir / "eicald.log").string());
   Outcome o;
