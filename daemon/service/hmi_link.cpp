@@ -26,7 +26,9 @@ std::int64_t now_ns() {
 
 HmiLink::HmiLink(const DdsConfig& config, std::string daemon_name, int publisher_priority)
     : config_(config), name_(std::move(daemon_name)), publisher_priority_(publisher_priority) {
-  status_.state = "STARTING";
+  drivers::dds::StatusMsg starting;
+  starting.state = "STARTING";
+  status_.fill(starting);
   if (!config_.config_uri.empty()) ::setenv("CYCLONEDDS_URI", config_.config_uri.c_str(), 1);
   bus_ = std::make_unique<drivers::dds::Bus>(config_.domain_id, drivers::dds::Role::daemon);
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -55,9 +57,10 @@ void HmiLink::publish_trace(const drivers::dds::TraceMsg& t) {
   if (!bus_->publish(t)) log(LogLevel::warning, "dds: trace %s not published", t.program_id.c_str());
 }
 
-void HmiLink::set_status(const drivers::dds::StatusMsg& s) {
-  std::lock_guard lk(mu_);
-  status_ = s;
+void HmiLink::set_status(const drivers::dds::StatusMsg& s, dsp::State state) {
+  status_.back() = s;
+  status_.publish();
+  state_.store(static_cast<int>(state), std::memory_order_relaxed);
 }
 
 void HmiLink::publish_result(const drivers::dds::ResultMsg& r) {
@@ -95,11 +98,10 @@ void HmiLink::publisher() {
       (void)bus_->publish(m);
     }
     if (clock::now() >= next_status) {
-      drivers::dds::StatusMsg st;
-      {
-        std::lock_guard lk(mu_);
-        st = status_;
-      }
+      // The newest Status the status thread handed over (its strings are the front
+      // buffer's: nothing is copied here).
+      (void)status_.update();
+      drivers::dds::StatusMsg& st = status_.front();
       st.daemon = name_;
       st.time_ns = now_ns();
       (void)bus_->publish(st);
@@ -154,17 +156,13 @@ void HmiLink::commander() {
       reply = seen->reply;  // `eical trigger` resends until it sees a Reply
     } else if (cmd->action == "trigger" && is_nc_trigger(cmd->code)) {
       reply = answer_trigger(*cmd);
-      {
-        std::lock_guard lk(mu_);
-        if (reply.state.empty()) reply.state = status_.state;
-      }
+      if (reply.state.empty()) reply.state = std::string(dsp::to_string(static_cast<dsp::State>(state_.load())));
       answered_.push_back({cmd->sender, cmd->request_id, reply});
       if (answered_.size() > 64) answered_.pop_front();
     } else {
       reply.ok = false;
       reply.message = "unknown command '" + cmd->action + "' (code " + std::to_string(cmd->code) + "); use trigger 101|102|103";
-      std::lock_guard lk(mu_);
-      reply.state = status_.state;
+      reply.state = std::string(dsp::to_string(static_cast<dsp::State>(state_.load())));
     }
     reply.sender = cmd->sender;
     reply.request_id = cmd->request_id;

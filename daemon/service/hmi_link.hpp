@@ -10,6 +10,8 @@
 #include "daemon/triggers/trigger_channel.hpp"
 #include "drivers/dds/bus.hpp"
 #include "drivers/ring/spsc_ring.hpp"
+#include "drivers/ring/triple_buffer.hpp"
+#include "dsp/session/measurement_state.hpp"
 
 #include <atomic>
 #include <deque>
@@ -41,8 +43,10 @@ class HmiLink {
   // The NC triggers of the Command topic, for the DSP thread's FrameLoop.
   [[nodiscard]] TriggerChannel& triggers() noexcept { return triggers_; }
 
-  // Any thread (copied under a mutex; called at the status rate and per result).
-  void set_status(const drivers::dds::StatusMsg& s);
+  // The status thread: the next Status and the state command replies name. Lock-free (a
+  // triple buffer): the real-time publisher never waits for the status thread.
+  void set_status(const drivers::dds::StatusMsg& s, dsp::State state);
+  // Any thread (the evaluation thread).
   void publish_result(const drivers::dds::ResultMsg& r);
   void publish_trace(const drivers::dds::TraceMsg& t);
 
@@ -61,8 +65,8 @@ class HmiLink {
   drivers::SpscRing<LiveSample> live_{1024};
   TriggerChannel triggers_{"dds"};
   std::uint32_t next_trigger_id_ = 0;  // command thread
-  std::mutex mu_;
-  drivers::dds::StatusMsg status_;
+  drivers::TripleBuffer<drivers::dds::StatusMsg> status_;  // status thread → publisher
+  std::atomic<int> state_{static_cast<int>(dsp::State::idle)};  // for the command thread's replies
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> commands_{0};
   int publisher_priority_ = 0;

@@ -90,7 +90,8 @@ void StatusReporter::report() {
   m.source_decode_errors = c.source_decode_errors, m.source_lost_samples = c.source_lost_samples;
   m.source_dropped_frames = c.source_dropped_frames, m.setpoint_samples = c.setpoint_samples, m.setpoint_missing = c.setpoint_missing;
   m.frames_flagged = c.frames_flagged, m.commands = c.commands;
-  s_.hmi->set_status(m);
+  const dsp::State state = s_.counters->faulted.load() ? dsp::State::fault : s_.counters->measurement_state();
+  s_.hmi->set_status(m, state);
 }
 
 }  // namespace eical::daemon
