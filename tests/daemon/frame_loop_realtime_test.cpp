@@ -76,12 +76,13 @@ TEST(FrameLoopRealTime, WholeMeasurementsAllocateNothingOnTheDspThread) {
   loop.add_channel(nc);
 
   // The evaluation thread's part: take each recording and give its storage back.
-  std::atomic<int> jobs{0};
+  std::atomic<int> jobs{0}, returned{0};
   std::thread evaluator([&] {
     RecordingJob job;
     while (handoff.wait_job(job)) {
       ++jobs;
       handoff.give_back(std::move(job.frames));
+      ++returned;
     }
   });
 
@@ -109,9 +110,9 @@ TEST(FrameLoopRealTime, WholeMeasurementsAllocateNothingOnTheDspThread) {
         sent_during = true;
       }
     }
-    // Let the evaluator return the storage before the second program ends (it would in
-    // real time: 10 kHz frames against a swap of two vectors).
-    if (session.measurement_ready()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    // The evaluator returns the storage long before the next program ends in real time
+    // (a swap of two vectors against seconds of 10 kHz frames); free-running, wait for it.
+    for (int i = 0; i < 2000 && returned.load() < jobs.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   t_counting = false;
   const std::size_t allocations = t_allocations;

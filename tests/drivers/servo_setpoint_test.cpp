@@ -49,8 +49,16 @@ TEST(ServoSetPoint, TheServoStreamBecomesTheFramesSetPointOnTheDaqClock) {
   ServoSetPointSource src(std::make_unique<ReplaySource>(daq, Pacing::realtime), o);
   const std::int64_t n0 = 734512;     // LinuxCNC's cycle count since the sampler loaded
   const double delta_s = 0.0037;      // cycle n0 happens 3.7 ms after DAQ sample 0
-  const std::int64_t t_open = monotonic_ns();
   src.open();
+  // The replayed DAQ's sample clock starts at the first read: sample 0 is now.
+  std::array<dsp::Frame, 256> block;
+  const std::int64_t t_open = monotonic_ns();
+  std::vector<dsp::Frame> got;
+  got.reserve(daq->frames.size());
+  {
+    const std::size_t n = src.read(block);
+    got.insert(got.end(), block.begin(), block.begin() + static_cast<std::ptrdiff_t>(n));
+  }
   std::atomic<bool> stop{false};
   std::thread linuxcnc([&] {
     for (int i = 0; i < 500 && !fs::is_fifo(o.stream.fifo); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
@@ -73,9 +81,6 @@ TEST(ServoSetPoint, TheServoStreamBecomesTheFramesSetPointOnTheDaqClock) {
     ::close(fd);
   });
 
-  std::vector<dsp::Frame> got;
-  got.reserve(daq->frames.size());
-  std::array<dsp::Frame, 256> block;
   std::size_t allocations = 0;
   const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   while (got.size() < daq->frames.size() && std::chrono::steady_clock::now() < end) {
