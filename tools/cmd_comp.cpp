@@ -1,97 +1,205 @@
-// eical comp RUN...: compensation proposals for the control from measured runs — the
-// circle's backlash, squareness and scale mismatch, and pitch tables (forward/reverse)
-// from positioning runs — written as LinuxCNC INI settings and compensation files.
-#include "drivers/run_io/run_reader.hpp"
-#include "dsp/analysis/analyze_run.hpp"
-#include "dsp/comp/lincomp.hpp"
+// eical comp INPUT...: compensation proposals for the control from measured results —
+// positioning runs give each axis its deviation table (the reversal folded in), circles
+// the backlash of axes without one — written for LinuxCNC (INI sections, COMP_FILEs, or
+// merged into the machine's INI), SINUMERIK, FANUC and HEIDENHAIN, with comp.json saying
+// which figure each term comes from. Never from a figure that is not resolved (unless
+// told), never over an existing file (unless --force); on any error nothing is written.
+#include "dsp/core/axes.hpp"
+#include "dsp/core/error.hpp"
 #include "tools/commands.hpp"
+#include "tools/comp/comp_plan.hpp"
+#include "tools/comp/fanuc_export.hpp"
+#include "tools/comp/heidenhain_export.hpp"
+#include "tools/comp/linuxcnc_export.hpp"
+#include "tools/comp/sinumerik_export.hpp"
 #include "tools/run_files.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <memory>
+#include <set>
 
 namespace eical::tools {
+namespace {
+
+namespace fs = std::filesystem;
+using comp::AxisProposal;
+using comp::OutputFile;
+
+struct Opt {
+  std::vector<std::string> inputs, controls = {"linuxcnc"}, travel, sinumerik_axes = {"X1", "Y1", "Z1"};
+  std::string out = "comp", merge_ini;
+  double spacing_mm = 0.0, fanuc_unit_um = 1.0, fanuc_reference_mm = 0.0;
+  bool force = false, allow_unresolved = false, skip_unresolved = false;
+};
+
+comp::TravelRange parse_travel(const std::string& s) {
+  // x:-20,20
+  const auto colon = s.find(':'), comma = s.find(',');
+  comp::TravelRange t;
+  t.axis = colon == 1 ? dsp::axis_index(s[0]) : -1;
+  if (t.axis < 0 || comma == std::string::npos || comma < colon)
+    throw dsp::InputError("--travel '" + s + "': expected AXIS:MIN,MAX in mm, e.g. x:-200,300");
+  try {
+    t.from_mm = std::stod(s.substr(colon + 1, comma - colon - 1));
+    t.to_mm = std::stod(s.substr(comma + 1));
+  } catch (const std::exception&) {
+    throw dsp::InputError("--travel '" + s + "': MIN and MAX must be numbers (mm)");
+  }
+  if (!(t.to_mm > t.from_mm)) throw dsp::InputError("--travel '" + s + "': MAX must exceed MIN");
+  t.who = "--travel asks for";
+  return t;
+}
+
+std::string slurp(const std::string& file) {
+  std::ifstream is(file, std::ios::binary);
+  if (!is) throw dsp::InputError(file + ": cannot open");
+  return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
+}
+
+std::vector<OutputFile> linuxcnc_outputs(const std::vector<AxisProposal>& axes, const Opt& o, nlohmann::json& axes_json) {
+  std::map<char, int> joints = {{'x', 0}, {'y', 1}, {'z', 2}};
+  std::string ini_text;
+  if (!o.merge_ini.empty()) ini_text = slurp(o.merge_ini), joints = comp::joint_map(ini_text, o.merge_ini);
+  std::vector<comp::JointSettings> settings;
+  std::vector<OutputFile> out;
+  for (const auto& p : axes) {
+    const char a = dsp::comp::axis_letter(p.axis);
+    if (!joints.count(a)) throw dsp::InputError(o.merge_ini + ": no joint moves axis " + std::string(1, a));
+    comp::JointSettings j;
+    j.joint = joints[a];
+    j.axis = a;
+    j.comments.push_back("axis " + std::string(1, a) + ": " + p.source);
+    if (p.table) {
+      const std::string name = "eical_joint" + std::to_string(j.joint) + ".comp";
+      j.comp_file = name;
+      j.comments.push_back("the reversal is folded into the table's forward/reverse columns (LinuxCNC does not use BACKLASH with a COMP_FILE)");
+      out.push_back({"linuxcnc/" + name, comp::linuxcnc_comp_file(*p.table, "eical comp, joint " + std::to_string(j.joint) + " (" +
+                                                                                std::string(1, a) + "): " + p.source)});
+    } else {
+      j.backlash_mm = *p.lost_motion_um * 1e-3;
+    }
+    axes_json[std::string(1, a)]["linuxcnc_joint"] = j.joint;
+    settings.push_back(j);
+  }
+  out.push_back({"linuxcnc/eical-comp.ini",
+                 comp::linuxcnc_ini_snippet(settings, "# eical comp: proposed LinuxCNC settings, one section per joint; merge into the machine's INI\n"
+                                                      "# (or run eical comp with --merge-ini) and copy the .comp files next to it.\n")});
+  if (!o.merge_ini.empty())
+    out.push_back({"linuxcnc/" + fs::path(o.merge_ini).filename().string(), comp::merge_linuxcnc_ini(ini_text, o.merge_ini, settings)});
+  return out;
+}
+
+nlohmann::json axis_json(const AxisProposal& p) {
+  nlohmann::json j = {{"source", p.source}};
+  if (p.table) {
+    nlohmann::json pts = nlohmann::json::array();
+    const auto& t = *p.table;
+    for (std::size_t i = 0; i < t.pos_mm.size(); ++i)
+      pts.push_back({{"pos_mm", t.pos_mm[i]},
+                     {"forward_deviation_um", t.forward_um[i]},
+                     {"reverse_deviation_um", t.reverse_um[i]},
+                     {"forward_correction_um", dsp::comp::correction_from_deviation_um(t.forward_um[i])},
+                     {"reverse_correction_um", dsp::comp::correction_from_deviation_um(t.reverse_um[i])}});
+    j["table"] = pts;
+    j["lost_motion_in_table_um"] = t.mean_lost_motion_um();
+  }
+  if (p.lost_motion_um) j["lost_motion_um"] = *p.lost_motion_um;
+  return j;
+}
+
+}  // namespace
 
 void register_comp(CLI::App& app) {
-  struct Opt {
-    std::vector<std::string> runs;
-    std::string out = "comp";
-    double spacing = 0.0;
-  };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("comp", "Propose compensation (backlash, pitch tables, squareness, scale) from measured runs");
-  cmd->add_option("runs", o->runs, "run directories (circle and positioning runs)")->required();
+  auto* cmd = app.add_subcommand("comp", "Propose axis compensation (tables with the reversal folded in, backlash) for the control from measured results");
+  cmd->add_option("inputs", o->inputs, "eical-result/1 files (eical analyze --json) or run directories: positioning and circle runs")->required();
   cmd->add_option("-o,--out", o->out, "output folder")->default_val("comp");
-  cmd->add_option("--spacing-mm", o->spacing, "resample pitch tables to this spacing (default: the measured targets)");
+  cmd->add_option("--control", o->controls, "linuxcnc, sinumerik, fanuc, heidenhain or all (comma separated)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"linuxcnc", "sinumerik", "fanuc", "heidenhain", "all"}))
+      ->default_str("linuxcnc");
+  cmd->add_option("--merge-ini", o->merge_ini, "LinuxCNC machine INI: also write it with the [JOINT_n] keys merged (trivkins)")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--spacing-mm", o->spacing_mm, "interval of the equidistant SINUMERIK/FANUC/HEIDENHAIN tables (default: mean target spacing)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--travel", o->travel, "AXIS:MIN,MAX the table must cover (mm), besides what the inputs measured (repeatable)");
+  cmd->add_option("--sinumerik-axes", o->sinumerik_axes, "SINUMERIK machine axis names of x, y, z")->delimiter(',')->expected(3);
+  cmd->add_option("--fanuc-detection-unit-um", o->fanuc_unit_um, "FANUC detection unit")->default_val(1.0)->check(CLI::PositiveNumber);
+  cmd->add_option("--fanuc-reference-mm", o->fanuc_reference_mm, "FANUC reference position (machine coordinate) of No. 3620")->default_val(0.0);
+  cmd->add_flag("--force", o->force, "overwrite existing output files");
+  auto* allow = cmd->add_flag("--allow-unresolved", o->allow_unresolved,
+                              "propose terms from figures not larger than their uncertainty (or without one), marked in comp.json");
+  auto* skip = cmd->add_flag("--skip-unresolved", o->skip_unresolved, "leave out the terms whose figure is not resolved");
+  allow->excludes(skip);
   cmd->callback([o] {
-    namespace fs = std::filesystem;
-    nlohmann::json j = {{"format", "eical-comp/1"}, {"runs", o->runs}};
-    std::string ini = "# eical comp: proposed LinuxCNC settings (merge into the machine's INI file)\n";
-    std::vector<std::pair<std::string, std::string>> files;  // name, text
-    int n_circle = 0, n_pos = 0;
-    for (const auto& path : o->runs) {
-      const dsp::Run run = drivers::read_run(path);
-      const dsp::Analysis a = dsp::analyze_run(run);
-      if (a.diagnostics) {
-        const auto& d = *a.diagnostics;
-        ++n_circle;
-        j["circle"][run.meta.id] = {{"backlash_x_um", d.backlash_x_um},
-                                    {"backlash_y_um", d.backlash_y_um},
-                                    {"squareness_xwy_urad", d.squareness_urad},
-                                    {"scale_mismatch_ppm", d.scale_mismatch_ppm},
-                                    {"cyclic_error_x_um", d.cyclic_error_x_um},
-                                    {"cyclic_error_y_um", d.cyclic_error_y_um},
-                                    {"cyclic_pitch_mm", d.cyclic_pitch_mm}};
-        char b[512];
-        std::snprintf(b, sizeof b,
-                      "# from circle run %s\n[JOINT_0]\nBACKLASH = %.6f\n[JOINT_1]\nBACKLASH = %.6f\n"
-                      "# squareness X-Y %.1f urad and scale mismatch X-Y %.1f ppm: enter as xwy and a linear\n"
-                      "# term in eical-volumetric/1 (no INI key in LinuxCNC's trivial kinematics)\n",
-                      run.meta.id.c_str(), std::max(0.0, d.backlash_x_um) / 1000.0, std::max(0.0, d.backlash_y_um) / 1000.0,
-                      d.squareness_urad, d.scale_mismatch_ppm);
-        ini += b;
-      }
-      if (a.positioning && a.positioning_input) {
-        ++n_pos;
-        const auto& p = *a.positioning;
-        const std::string axis = p.axis;
-        dsp::comp::ErrorCurve up, down;
-        for (const auto& t : p.targets) {
-          up.pos_mm.push_back(t.target_mm), up.error_um.push_back(t.mean_up_um);
-          down.pos_mm.push_back(t.target_mm), down.error_um.push_back(t.mean_down_um);
-        }
-        const double spacing = o->spacing > 0 ? o->spacing : (up.pos_mm.back() - up.pos_mm.front()) / static_cast<double>(up.pos_mm.size() - 1);
-        const auto tu = dsp::comp::correction_table(up, up.pos_mm.front(), spacing);
-        const auto td = dsp::comp::correction_table(down, down.pos_mm.front(), spacing);
-        std::string text = "# eical comp: axis " + axis + " from run " + run.meta.id + "; COMP_FILE_TYPE = 0 (nominal forward reverse, mm)\n";
-        nlohmann::json table = nlohmann::json::array();
-        for (std::size_t i = 0; i < tu.pos_mm.size(); ++i) {
-          char line[128];
-          std::snprintf(line, sizeof line, "%.4f %.6f %.6f\n", tu.pos_mm[i], tu.pos_mm[i] - tu.correction_um[i] / 1000.0,
-                        td.pos_mm[i] - td.correction_um[i] / 1000.0);
-          text += line;
-          table.push_back({{"pos_mm", tu.pos_mm[i]}, {"forward_deviation_um", tu.correction_um[i]}, {"reverse_deviation_um", td.correction_um[i]}});
-        }
-        const std::string name = "axis_" + axis + ".comp";
-        files.emplace_back(name, text);
-        const int joint = axis == "x" ? 0 : axis == "y" ? 1 : 2;
-        ini += "# from positioning run " + run.meta.id + " (ISO 230-2 A " + std::to_string(p.A_um) + " um)\n[JOINT_" + std::to_string(joint) +
-               "]\nCOMP_FILE = " + name + "\nCOMP_FILE_TYPE = 0\n";
-        j["positioning"][run.meta.id] = {{"axis", axis}, {"A_um", p.A_um}, {"B_mean_um", p.B_mean_um}, {"spacing_mm", spacing}, {"table", table}, {"file", name}};
-      }
-      if (!a.diagnostics && !a.positioning)
-        j["skipped"].push_back({{"run", path}, {"reason", "program '" + run.meta.program.kind + "' gives no compensation terms"}});
+    std::vector<comp::CompInput> inputs;
+    for (const auto& p : o->inputs) inputs.push_back(comp::load_comp_input(p));
+    comp::PlanOptions po;
+    po.unresolved = o->allow_unresolved ? comp::Unresolved::allow : o->skip_unresolved ? comp::Unresolved::skip : comp::Unresolved::refuse;
+    for (const auto& t : o->travel) po.travel.push_back(parse_travel(t));
+    const comp::Plan plan = comp::build_plan(inputs, po);
+    if (plan.axes.empty())
+      throw dsp::InputError("comp: no term is left to propose (the unresolved ones were skipped); nothing written");
+
+    std::set<std::string> controls(o->controls.begin(), o->controls.end());
+    if (controls.count("all")) controls = {"linuxcnc", "sinumerik", "fanuc", "heidenhain"};
+    nlohmann::json axes = nlohmann::json::object();
+    for (const auto& p : plan.axes) axes[std::string(1, dsp::comp::axis_letter(p.axis))] = axis_json(p);
+    std::vector<OutputFile> files;
+    const comp::GridOptions grid{o->spacing_mm};
+    if (controls.count("linuxcnc"))
+      for (auto& f : linuxcnc_outputs(plan.axes, *o, axes)) files.push_back(std::move(f));
+    if (controls.count("sinumerik"))
+      for (auto& f : comp::sinumerik_outputs(plan.axes, {grid, o->sinumerik_axes})) files.push_back(std::move(f));
+    if (controls.count("fanuc"))
+      for (auto& f : comp::fanuc_outputs(plan.axes, {grid, o->fanuc_unit_um, o->fanuc_reference_mm, 0})) files.push_back(std::move(f));
+    if (controls.count("heidenhain"))
+      for (auto& f : comp::heidenhain_outputs(plan.axes, {grid})) files.push_back(std::move(f));
+
+    nlohmann::json j = {{"format", "eical-comp/1"},
+                        {"sign_convention", "deviation = actual - nominal; correction = -deviation, what the control adds to the command"},
+                        {"axes", axes},
+                        {"figures", plan.figures},
+                        {"not_compensated", plan.not_compensated},
+                        {"skipped", plan.skipped}};
+    nlohmann::json ins = nlohmann::json::array();
+    for (const auto& in : inputs) ins.push_back({{"input", in.name}, {"run_id", in.run_id}, {"program", in.result.value("program", std::string())}});
+    j["inputs"] = ins;
+    if (!plan.unresolved_used.empty()) j["proposed_from_unresolved_figures"] = plan.unresolved_used;
+    nlohmann::json names = nlohmann::json::array();
+    for (const auto& f : files) names.push_back(f.path);
+    j["files"] = names;
+    files.push_back({"comp.json", j.dump(2) + "\n"});
+
+    // Nothing is written unless everything can be: existing files first.
+    std::vector<std::string> existing;
+    for (const auto& f : files)
+      if (fs::exists(fs::path(o->out) / f.path)) existing.push_back((fs::path(o->out) / f.path).string());
+    if (!existing.empty() && !o->force) {
+      std::string msg = "comp: would overwrite " + std::to_string(existing.size()) + " existing file(s), nothing written (--force to replace them):";
+      for (const auto& e : existing) msg += "\n  " + e;
+      throw dsp::InputError(msg);
     }
-    if (n_circle == 0 && n_pos == 0) throw std::runtime_error("comp: none of the runs is a circle or positioning run that could be evaluated");
-    fs::create_directories(o->out);
-    for (const auto& [name, text] : files) write_file_atomic(fs::path(o->out) / name, text);
-    write_file_atomic(fs::path(o->out) / "linuxcnc.ini", ini);
-    write_file_atomic(fs::path(o->out) / "comp.json", j.dump(2) + "\n");
-    std::printf("comp: %d circle and %d positioning runs -> %s (linuxcnc.ini, comp.json%s)\n", n_circle, n_pos, o->out.c_str(),
-                files.empty() ? "" : ", axis tables");
+    for (const auto& f : files) {
+      const fs::path p = fs::path(o->out) / f.path;
+      fs::create_directories(p.parent_path());
+      write_file_atomic(p, f.text);
+    }
+    for (const auto& p : plan.axes) {
+      const char a = dsp::comp::axis_letter(p.axis);
+      if (p.table)
+        std::printf("comp: %c table, %zu points %.3f .. %.3f mm, lost motion in it %.2f um (%s)\n", a, p.table->pos_mm.size(), p.table->first_mm(),
+                    p.table->last_mm(), p.table->mean_lost_motion_um(), p.source.c_str());
+      else
+        std::printf("comp: %c backlash %.2f um (%s)\n", a, *p.lost_motion_um, p.source.c_str());
+    }
+    for (const auto& u : plan.unresolved_used) std::printf("comp: WARNING proposed from an unresolved figure (--allow-unresolved): %s\n", u.c_str());
+    std::printf("comp: %zu files -> %s\n", files.size(), o->out.c_str());
   });
 }
 

@@ -3,9 +3,11 @@
 // On a real control the M-codes are user M-functions (LinuxCNC: executables M101..M103 in
 // the PROGRAM_PREFIX directory, which call `eical trigger`; Siemens/Heidenhain: a PLC
 // output wired to the trigger input, or a CAN frame) — see README "NC triggers".
+#include "sim/gcode/dialect.hpp"
 #include "sim/gcode/generate.hpp"
 #include "tools/commands.hpp"
 
+#include <cctype>
 #include <cstdio>
 #include <fstream>
 #include <memory>
@@ -24,6 +26,9 @@ struct GenOptions {
   std::optional<double> arc_start_deg;
   std::string out;
   std::string meta_out;
+  std::string dialect = "linuxcnc";
+  int program_number = 1000;
+  std::string program_name;
 };
 
 std::string toml_list(const std::vector<double>& v) {
@@ -63,9 +68,39 @@ void write_text(const std::string& path, const std::string& text) {
   if (!os.flush()) throw std::runtime_error(path + ": write failed");
 }
 
-void add_output(CLI::App* cmd, GenOptions& o) {
-  cmd->add_option("-o,--out", o.out, "G-code file (default: standard output)");
-  cmd->add_option("--meta", o.meta_out, "also write the run's [program] table (TOML) here");
+void add_output(CLI::App* cmd, std::string& out, std::string& meta_out, std::string& dialect, int& number, std::string& name) {
+  cmd->add_option("-o,--out", out, "G-code file (default: standard output)");
+  cmd->add_option("--meta", meta_out, "also write the run's [program] table (TOML) here; its gcode is the program as eical simulates it");
+  cmd->add_option("--dialect", dialect, "the control that runs it: linuxcnc, fanuc, sinumerik or heidenhain-iso")
+      ->default_val("linuxcnc")
+      ->check(CLI::IsMember({"linuxcnc", "fanuc", "sinumerik", "heidenhain-iso"}));
+  cmd->add_option("--program-number", number, "FANUC program number O<n>")->default_val(1000)->check(CLI::Range(1, 9999));
+  cmd->add_option("--program-name", name, "SINUMERIK / HEIDENHAIN program name (default EICAL_<KIND>)");
+}
+void add_output(CLI::App* cmd, GenOptions& o) { add_output(cmd, o.out, o.meta_out, o.dialect, o.program_number, o.program_name); }
+
+// The canonical program written for the control, and its [program] table with the
+// LinuxCNC form (what eical's reader and simulator take).
+void write_program(const std::string& canonical, dsp::Program p, const std::string& title, const std::string& out, const std::string& meta_out,
+                   const std::string& dialect, int number, std::string name) {
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') throw std::runtime_error("--program-name: letters, digits and _ only");
+  const sim::gcode::ProgramIdentity id{number, name.empty() ? "EICAL_" + p.kind : name, title};
+  write_text(out, sim::gcode::write_dialect(canonical, sim::gcode::dialect_from_name(dialect), id));
+  p.gcode = sim::gcode::write_dialect(canonical, sim::gcode::Dialect::linuxcnc, id);
+  if (!meta_out.empty()) write_text(meta_out, program_toml(p, p.gcode));
+}
+
+std::string title_of(const dsp::Program& p) {
+  char b[160];
+  if (p.kind == "circle")
+    std::snprintf(b, sizeof b, "eical circle R%g F%g %s, %d revolutions, plane %s", p.radius_mm, p.feed_mm_min, p.direction.c_str(), p.repeats,
+                  p.plane.c_str());
+  else if (p.kind == "rectangle")
+    std::snprintf(b, sizeof b, "eical rectangle %gx%g mm F%g, plane %s", p.size_mm[0], p.size_mm[1], p.feed_mm_min, p.plane.c_str());
+  else
+    std::snprintf(b, sizeof b, "eical %s %s, %zu targets, %d runs, F%g", p.kind.c_str(), p.axis.c_str(), p.targets_mm.size(), p.runs, p.feed_mm_min);
+  return b;
 }
 
 void emit(GenOptions& o) {
@@ -75,9 +110,7 @@ void emit(GenOptions& o) {
   p.size_mm[0] = o.size.at(0), p.size_mm[1] = o.size.at(1);
   const std::string g = p.kind == "positioning" ? sim::gcode::positioning_program(p, o.overrun_mm)
                                                 : sim::gcode::program_gcode(p);
-  p.gcode = g;
-  write_text(o.out, g);
-  if (!o.meta_out.empty()) write_text(o.meta_out, program_toml(p, g));
+  write_program(g, p, title_of(p), o.out, o.meta_out, o.dialect, o.program_number, o.program_name);
 }
 
 // One option set per program kind: CLI11 writes defaults into the bound variables when
@@ -166,7 +199,8 @@ void add_identify(CLI::App* gen) {
   struct Id {
     std::vector<std::string> psd, axes;
     sim::gcode::IdentifyPlan plan;
-    std::string out, meta_out;
+    std::string out, meta_out, dialect = "linuxcnc", name;
+    int number = 1000;
   };
   auto o = std::make_shared<Id>();
   auto* c = gen->add_subcommand("identify", "on-site sensor identification: swings across the PSD strips (and further axes)");
@@ -174,17 +208,15 @@ void add_identify(CLI::App* gen) {
   c->add_option("--axis", o->axes, "a further axis to swing without a strip, e.g. z (repeatable)")->check(CLI::IsMember({"x", "y", "z"}));
   c->add_option("--swing", o->plan.swing_mm, "swing, peak to peak, mm")->default_val(50.0);
   c->add_option("--feeds", o->plan.feeds_mm_min, "feeds in mm/min (comma separated)")->delimiter(',')->default_str("2000,4000,6500");
-  c->add_option("-o,--out", o->out, "G-code file (default: stdout)");
-  c->add_option("--meta", o->meta_out, "also write the [program] table for run.toml");
+  add_output(c, o->out, o->meta_out, o->dialect, o->number, o->name);
   c->callback([o] {
     for (const auto& t : o->psd) o->plan.psd.push_back(parse_psd(t));
     o->plan.axes = o->axes;
     if (o->plan.feeds_mm_min.empty()) o->plan.feeds_mm_min = {2000.0, 4000.0, 6500.0};
     const std::string g = sim::gcode::identify_program(o->plan);
-    write_text(o->out, g);
     dsp::Program p;
     p.kind = "identify";
-    if (!o->meta_out.empty()) write_text(o->meta_out, program_toml(p, g));
+    write_program(g, p, "eical identify: swings across the PSD strips", o->out, o->meta_out, o->dialect, o->number, o->name);
   });
 }
 

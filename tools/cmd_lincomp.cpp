@@ -1,8 +1,10 @@
 // eical lincomp: piecewise-linear axis compensation table from an error curve (seed 002),
 // with the worst residual over grid shifts, and exports for the control.
+#include "dsp/comp/axis_table.hpp"
 #include "dsp/comp/lincomp.hpp"
 #include "dsp/core/error.hpp"
 #include "tools/commands.hpp"
+#include "tools/comp/linuxcnc_export.hpp"
 #include "tools/io/csv_table.hpp"
 #include "tools/run_files.hpp"
 
@@ -70,6 +72,7 @@ void register_lincomp(CLI::App& app) {
   struct Opt {
     std::string curve, positioning, linuxcnc, csv;
     double spacing = 50.0, shift_step = 1.0, u = 0.0;
+    std::vector<double> travel;
     bool json = false;
   };
   auto o = std::make_shared<Opt>();
@@ -82,7 +85,8 @@ void register_lincomp(CLI::App& app) {
   cmd->add_option("--shift-step-mm", o->shift_step, "grid shift step")->default_val(1.0)->check(CLI::PositiveNumber);
   cmd->add_option("--period-error-um", o->u, "position error within one signal period u (magnitude)")->default_val(0.0)->check(CLI::NonNegativeNumber);
   cmd->add_option("--linuxcnc", o->linuxcnc, "write a LinuxCNC compensation file (COMP_FILE_TYPE = 0)");
-  cmd->add_option("--csv", o->csv, "write the table as CSV (pos_mm,correction_um)");
+  cmd->add_option("--csv", o->csv, "write the table as CSV (pos_mm, deviation_um, correction_um = -deviation, per direction)");
+  cmd->add_option("--travel-mm", o->travel, "MIN,MAX the table must cover (mm); refused when the curve does not")->expected(2)->delimiter(',');
   cmd->add_flag("--json", o->json, "print the result as JSON");
   cmd->callback([o] {
     if (o->curve.empty() && o->positioning.empty()) throw dsp::InputError("lincomp: give --curve or --positioning");
@@ -91,37 +95,40 @@ void register_lincomp(CLI::App& app) {
     const auto r = dsp::comp::piecewise_linear(c.mean, opt);  // validates before anything is written
     const auto up = dsp::comp::correction_table(c.up, c.up.pos_mm.front(), o->spacing);
     const auto down = dsp::comp::correction_table(c.down, c.down.pos_mm.front(), o->spacing);
-    if (!o->linuxcnc.empty()) {
-      // LinuxCNC [JOINT_n] COMP_FILE_TYPE = 0: "nominal forward reverse" per line, machine
-      // units (mm), ascending nominal. forward/reverse are the positions to command so
-      // that the axis arrives at nominal: nominal − deviation (deviation = actual − nominal).
-      std::string text = "# eical lincomp: spacing " + std::to_string(o->spacing) + " mm; COMP_FILE_TYPE = 0 (nominal forward reverse, mm)\n";
-      for (std::size_t i = 0; i < up.pos_mm.size(); ++i) {
-        char line[128];
-        std::snprintf(line, sizeof line, "%.4f %.6f %.6f\n", up.pos_mm[i], up.pos_mm[i] - up.correction_um[i] / 1000.0,
-                      down.pos_mm[i] - down.correction_um[i] / 1000.0);
-        text += line;
-      }
-      write_file_atomic(o->linuxcnc, text);
-    }
+    // One sign convention (dsp/comp/axis_table.hpp): deviation = actual − nominal,
+    // correction = −deviation, in every export.
+    dsp::comp::AxisTable table;
+    table.axis = 0;
+    table.pos_mm = up.pos_mm;
+    table.forward_um = up.deviation_um;
+    table.reverse_um = down.deviation_um;
+    if (o->travel.size() == 2) dsp::comp::require_coverage(table, o->travel[0], o->travel[1], "--travel-mm asks for");
+    std::vector<std::pair<std::string, std::string>> files;
+    if (!o->linuxcnc.empty())
+      files.emplace_back(o->linuxcnc, comp::linuxcnc_comp_file(table, "eical lincomp: spacing " + std::to_string(o->spacing) + " mm"));
     if (!o->csv.empty()) {
-      std::string text = "pos_mm,correction_um,correction_up_um,correction_down_um\n";
+      std::string text = "pos_mm,deviation_um,correction_um,correction_up_um,correction_down_um\n";
       for (std::size_t i = 0; i < r.table.pos_mm.size(); ++i) {
-        char line[160];
-        std::snprintf(line, sizeof line, "%.4f,%.4f,%.4f,%.4f\n", r.table.pos_mm[i], r.table.correction_um[i], up.correction_um[i],
-                      down.correction_um[i]);
+        char line[200];
+        std::snprintf(line, sizeof line, "%.4f,%.4f,%.4f,%.4f,%.4f\n", r.table.pos_mm[i], r.table.deviation_um[i],
+                      dsp::comp::correction_from_deviation_um(r.table.deviation_um[i]), dsp::comp::correction_from_deviation_um(up.deviation_um[i]),
+                      dsp::comp::correction_from_deviation_um(down.deviation_um[i]));
         text += line;
       }
-      write_file_atomic(o->csv, text);
+      files.emplace_back(o->csv, text);
     }
+    for (const auto& [file, text] : files)  // after every check: a bad input writes nothing
+      write_file_atomic(file, text);
     if (o->json) {
-      nlohmann::json table = nlohmann::json::array();
+      nlohmann::json points = nlohmann::json::array();
       for (std::size_t i = 0; i < r.table.pos_mm.size(); ++i)
-        table.push_back({{"pos_mm", r.table.pos_mm[i]}, {"correction_um", r.table.correction_um[i]}});
+        points.push_back({{"pos_mm", r.table.pos_mm[i]},
+                         {"deviation_um", r.table.deviation_um[i]},
+                         {"correction_um", dsp::comp::correction_from_deviation_um(r.table.deviation_um[i])}});
       const nlohmann::json j = {{"spacing_mm", r.spacing_mm},           {"max_residual_um", r.max_residual_um},
                                 {"worst_shift_mm", r.worst_shift_mm},   {"total_um", r.total_um},
                                 {"period_error_um", o->u},              {"residual_unshifted_um", r.residual_unshifted_um},
-                                {"shift_step_mm", o->shift_step},       {"table", table}};
+                                {"shift_step_mm", o->shift_step},       {"table", points}};
       std::printf("%s\n", j.dump(2).c_str());
     } else {
       std::printf("spacing %.3f mm: F_rest %.3f um (worst grid shift %.1f mm), F_total = F_rest + u = %.3f um, %zu correction points\n",

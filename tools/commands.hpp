@@ -21,6 +21,8 @@ void register_hmi(CLI::App& app);
 void register_validate_sim(CLI::App& app);
 void register_identify(CLI::App& app);
 void register_explain(CLI::App& app);
+void register_history(CLI::App& app);
+void register_collect(CLI::App& app);
 
 // The list main() registers, in the order `eical --help` shows them.
 inline void register_all(CLI::App& app) {
@@ -31,6 +33,8 @@ inline void register_all(CLI::App& app) {
   register_identify(app);
   register_explain(app);
   register_hmi(app);
+  register_history(app);
+  register_collect(app);
   register_report(app);
   register_iso230_2(app);
   register_gen_nc(app);

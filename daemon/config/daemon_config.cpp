@@ -181,6 +181,17 @@ void read_recording(StrictTable t, RecordingConfig& r) {
   t.finish();
 }
 
+void read_history(StrictTable t, HistoryConfig& h) {
+  h.enabled = t.boolean("enabled", h.enabled);
+  h.db = t.string("db", h.db);
+  if (h.db.empty()) t.fail("db", "must not be empty (a SQLite file or a postgresql:// URI)");
+  h.spool_dir = t.string("spool_dir", h.spool_dir.string());
+  if (h.spool_dir.empty()) t.fail("spool_dir", "must not be empty");
+  h.retry_s = t.number("retry_s", h.retry_s);
+  if (h.retry_s < 0.1 || h.retry_s > 3600.0) t.fail("retry_s", "must be within 0.1..3600");
+  t.finish();
+}
+
 void read_limits(StrictTable t, Limits& l) {
   const auto cap = t.integer("ring_capacity_frames", static_cast<std::int64_t>(l.ring_capacity_frames));
   if (cap < 1024 || (cap & (cap - 1)) != 0) t.fail("ring_capacity_frames", "must be a power of two >= 1024");
@@ -215,6 +226,7 @@ DaemonConfig load_daemon_config(const std::filesystem::path& file) {
   if (auto s = t.optional_table("triggers")) read_triggers(*s, c.triggers);
   if (auto s = t.optional_table("dds")) read_dds(*s, c.dds);
   if (auto s = t.optional_table("recording")) read_recording(*s, c.recording);
+  if (auto s = t.optional_table("history")) read_history(*s, c.history);
   if (auto s = t.optional_table("limits")) read_limits(*s, c.limits);
   if (auto s = t.optional_table("realtime")) read_realtime(*s, c.realtime);
   if (auto s = t.optional_table("acquisition")) c.acquisition = drivers::read_acquisition(*s);
@@ -231,6 +243,7 @@ DaemonConfig load_daemon_config(const std::filesystem::path& file) {
   }
   for (auto& p : t.tables("psd")) c.psd.push_back(drivers::read_psd(p));
   if (c.triggers.inputs.empty()) t.fail("triggers", "no trigger input configured: the NC could not start a measurement");
+  if (c.history.enabled && c.machine.name.empty()) t.fail("history", "[machine] name is required: the history keys results by machine");
   t.finish();
   return c;
 }

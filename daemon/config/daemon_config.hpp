@@ -103,6 +103,15 @@ struct RecordingConfig {
   bool gzip = true;
 };
 
+// [history]: every evaluated result also goes into the calibration history (eical history
+// list | trend | compare). Off unless the config turns it on (the installed eicald.toml does).
+struct HistoryConfig {
+  bool enabled = false;
+  std::string db = "/var/lib/eical/history.db";                  // SQLite file, or postgresql://...
+  std::filesystem::path spool_dir = "/var/lib/eical/history-spool";  // results waiting for the store
+  double retry_s = 30.0;                                          // an unavailable store is tried again
+};
+
 struct Limits {
   std::size_t ring_capacity_frames = 65536;  // 6.5 s at 10 kHz: rides out a stalled DSP thread
   double max_measurement_s = 600.0;          // recorder capacity, pre-allocated at start
@@ -123,6 +132,7 @@ struct DaemonConfig {
   TriggerConfig triggers;
   DdsConfig dds;
   RecordingConfig recording;
+  HistoryConfig history;
   Limits limits;
   RealtimeConfig realtime;
   dsp::Acquisition acquisition;

@@ -1,9 +1,11 @@
 #include "daemon/service/evaluator.hpp"
 
+#include "daemon/service/history_hook.hpp"
 #include "daemon/service/hmi_link.hpp"
 #include "daemon/service/trace_builder.hpp"
 #include "daemon/system/log.hpp"
 #include "drivers/results/result_json.hpp"
+#include "drivers/results/software_version.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/setpoint/program_catalog.hpp"
 #include "drivers/setpoint/program_setpoint.hpp"
@@ -42,8 +44,8 @@ void measure_alignment(const dsp::Run& run, dsp::SetPointOrigin& s) {
 }  // namespace
 
 Evaluator::Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingHandoff& handoff,
-                     HmiLink* hmi, const drivers::ServoSetPointSource* servo)
-    : config_(config), meta_(std::move(meta)), analysis_(std::move(analysis)), handoff_(handoff), hmi_(hmi), servo_(servo),
+                     EvaluatorLinks links)
+    : config_(config), meta_(std::move(meta)), analysis_(std::move(analysis)), handoff_(handoff), links_(std::move(links)),
       thread_([this] { loop(); }) {}
 
 Evaluator::~Evaluator() { finish(); }
@@ -109,7 +111,7 @@ std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingN
     s.source = "servo_stream";
     s.program_number = program ? program->first : -1;
     s.servo_rate_hz = sp.servo_rate_hz;
-    const auto a = servo_ ? servo_->alignment() : drivers::ServoAlignment{};
+    const auto a = links_.servo ? links_.servo->alignment() : drivers::ServoAlignment{};
     if (a.known && !run.frames.empty())
       s.servo_cycle_at_first_sample = a.servo_cycle_at_sample0 + static_cast<double>(run.frames.front().sample_index - notes.index_offset) /
                                                                       run.fs_hz() * a.servo_rate_hz;
@@ -166,6 +168,7 @@ void Evaluator::evaluate(RecordingJob& job) {
     }
     for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
     drivers::write_result(run, a, dir / "result.json");
+    if (links_.history) links_.history->append(run, a, dir);
     std::uint64_t number = 0;
     {
       // Counted before it is published: an HMI never sees a Result ahead of the count.
@@ -173,7 +176,7 @@ void Evaluator::evaluate(RecordingJob& job) {
       number = ++status_.results;
       status_.last_result = (dir / "result.json").string();
     }
-    publish(run, a, number);
+    publish(run, a, dir, number);
     log(LogLevel::notice, "measurement %s written (%zu frames)%s", run.meta.id.c_str(), run.frames.size(), a.degraded ? ", result degraded" : "");
   } catch (const std::exception& e) {
     error = e.what();
@@ -183,17 +186,20 @@ void Evaluator::evaluate(RecordingJob& job) {
   job.frames.swap(run.frames);
 }
 
-void Evaluator::publish(const dsp::Run& run, const dsp::Analysis& a, std::uint64_t result_number) {
-  if (!hmi_) return;
+void Evaluator::publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir, std::uint64_t result_number) {
+  if (!links_.hmi) return;
   drivers::dds::ResultMsg r;
+  r.machine = run.meta.machine.name;
   r.program_id = run.meta.id;
+  r.measured_at = run.meta.created, r.run_path = dir.string(), r.software_version = drivers::software_version();
+  r.sensor_calibration = links_.sensor_calibration;
   r.program = run.meta.program.kind;
   r.degraded = a.degraded;
   r.results = result_number;
   if (a.circle) r.circular_deviation_G_um = a.circle->circular_deviation_G_um, r.radius_mean_deviation_um = a.circle->radius_mean_deviation_um;
   r.json = drivers::result_json(run, a).dump();
-  hmi_->publish_result(r);
-  if (auto t = make_trace(run, a, config_.dds.trace_max_points)) hmi_->publish_trace(*t);
+  links_.hmi->publish_result(r);
+  if (auto t = make_trace(run, a, config_.dds.trace_max_points)) links_.hmi->publish_trace(*t);
 }
 
 }  // namespace eical::daemon

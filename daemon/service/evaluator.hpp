@@ -10,6 +10,7 @@
 #include "dsp/core/run.hpp"
 
 #include <cstdint>
+#include <filesystem>
 #include <mutex>
 #include <optional>
 #include <utility>
@@ -24,6 +25,15 @@ class ServoSetPointSource;
 namespace eical::daemon {
 
 class HmiLink;
+class HistoryHook;
+
+// Where results go besides the run directory, and what the set-point may come from.
+struct EvaluatorLinks {
+  HmiLink* hmi = nullptr;                               // Result and Trace (none without DDS)
+  const drivers::ServoSetPointSource* servo = nullptr;  // the servo stream's clock alignment
+  HistoryHook* history = nullptr;                       // [history] enabled
+  std::string sensor_calibration = "datasheet";         // provenance in Result
+};
 
 // What the evaluations did, for Status (evaluation thread writes, status thread reads).
 struct EvaluationStatus {
@@ -34,8 +44,7 @@ struct EvaluationStatus {
 
 class Evaluator {
  public:
-  Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingHandoff& handoff, HmiLink* hmi,
-            const drivers::ServoSetPointSource* servo);
+  Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingHandoff& handoff, EvaluatorLinks links);
   ~Evaluator();  // finish()
   // Evaluates what was handed over, then stops the thread; status() stays readable.
   void finish();
@@ -53,14 +62,13 @@ class Evaluator {
   std::optional<std::pair<int, dsp::Program>> named_program(const RecordingNotes& notes, std::vector<std::string>& flags) const;
   // Fills cmd_*, [program] and [setpoint]; returns flags for the result (empty: nothing doubtful).
   std::vector<std::string> add_setpoint(dsp::Run& run, const RecordingNotes& notes) const;
-  void publish(const dsp::Run& run, const dsp::Analysis& a, std::uint64_t result_number);
+  void publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir, std::uint64_t result_number);
 
   const DaemonConfig& config_;
   dsp::RunMeta meta_;
   dsp::AnalysisOptions analysis_;
   RecordingHandoff& handoff_;
-  HmiLink* hmi_;
-  const drivers::ServoSetPointSource* servo_;
+  EvaluatorLinks links_;
   mutable std::mutex mu_;
   EvaluationStatus status_;
   std::thread thread_;

@@ -4,6 +4,7 @@
 #include "daemon/service/evaluator.hpp"
 #include "daemon/service/frame_guard.hpp"
 #include "daemon/service/frame_loop.hpp"
+#include "daemon/service/history_hook.hpp"
 #include "daemon/service/hmi_link.hpp"
 #include "daemon/service/preflight.hpp"
 #include "daemon/service/recording_handoff.hpp"
@@ -116,7 +117,9 @@ struct Parts {
   const drivers::ServoSetPointSource* servo = nullptr;
   dsp::RunMeta meta;
   dsp::AnalysisOptions analysis;
+  std::string sensor_calibration = "datasheet";  // what the results were compensated with (history, Result)
   std::unique_ptr<HmiLink> hmi;
+  std::unique_ptr<HistoryHook> history;
   std::vector<std::unique_ptr<TriggerChannel>> channels;  // hardware inputs
   std::vector<std::unique_ptr<TriggerListener>> listeners;
   std::unique_ptr<drivers::FrameRing> ring;
@@ -147,6 +150,7 @@ void apply_calibration(Parts& p) {
   if (p.config.calibration_file.empty()) return;
   const drivers::SensorCalibration cal = drivers::read_sensor_calibration(p.config.calibration_file, p.meta);
   drivers::apply_calibration(cal, p.meta, p.analysis);
+  p.sensor_calibration = cal.method + ": " + p.config.calibration_file.string() + " (run " + cal.run_id + ")";
   log(LogLevel::info, "calibration %s (%s, from run %s) in use", p.config.calibration_file.c_str(), cal.method.c_str(), cal.run_id.c_str());
 }
 
@@ -193,8 +197,16 @@ void make_measurement(Parts& p) {
   p.handoff = std::make_unique<RecordingHandoff>(p.session->recorder_capacity());
 }
 
+// The calibration history ([history]): results leave through an on-disk spool, never lost.
+void start_history(Parts& p) {
+  if (p.config.history.enabled) p.history = std::make_unique<HistoryHook>(p.config.history, p.sensor_calibration);
+}
+
 void start_evaluator(Parts& p) {
-  p.evaluator = std::make_unique<Evaluator>(p.config, p.meta, p.analysis, *p.handoff, p.hmi.get(), p.servo);
+  EvaluatorLinks links;
+  links.hmi = p.hmi.get(), links.servo = p.servo, links.history = p.history.get();
+  links.sensor_calibration = p.sensor_calibration;
+  p.evaluator = std::make_unique<Evaluator>(p.config, p.meta, p.analysis, *p.handoff, std::move(links));
   if (auto problem = recording_dir_problem(p.config.recording.dir)) p.evaluator->set_fault(*problem);
 }
 
@@ -216,6 +228,7 @@ void start_status(Parts& p, const std::function<void(const ServiceStatus&)>& on_
   s.daq_clock = &p.loop->daq_clock();
   s.evaluator = p.evaluator.get();
   s.hmi = p.hmi.get();
+  s.history = p.history.get();
   if (p.hmi) s.channels.push_back(&p.hmi->triggers());
   for (const auto& ch : p.channels) s.channels.push_back(ch.get());
   for (const auto& l : p.listeners) s.listeners.push_back(l.get());
@@ -301,6 +314,7 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   start_hmi(p);
   open_trigger_inputs(p, trigger_inputs_);
   make_measurement(p);
+  start_history(p);
   start_evaluator(p);
   make_frame_loop(p);
   start_status(p, on_status);

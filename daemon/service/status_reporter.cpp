@@ -1,5 +1,6 @@
 #include "daemon/service/status_reporter.hpp"
 
+#include "daemon/service/history_hook.hpp"
 #include "daemon/service/hmi_link.hpp"
 #include "daemon/system/log.hpp"
 
@@ -44,6 +45,7 @@ ServiceStatus StatusReporter::collect() const {
   const EvaluationStatus ev = s_.evaluator->status();
   st.state = k.faulted.load() ? "FAULT" : std::string(dsp::to_string(k.measurement_state()));
   st.fault = ev.fault;
+  if (s_.history && st.fault.empty()) st.fault = s_.history->problem();
   st.frames = k.frames.load(relaxed);
   st.overruns = s_.ring->overruns();
   st.frames_lost = k.frames_lost.load(relaxed);

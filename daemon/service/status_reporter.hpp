@@ -23,6 +23,7 @@
 namespace eical::daemon {
 
 class HmiLink;
+class HistoryHook;
 
 struct StatusSources {
   const ServiceCounters* counters = nullptr;
@@ -31,6 +32,7 @@ struct StatusSources {
   const drivers::SampleClock* daq_clock = nullptr;
   const Evaluator* evaluator = nullptr;
   HmiLink* hmi = nullptr;
+  const HistoryHook* history = nullptr;  // [history] enabled: its problem is the fault when none other is
   std::vector<const TriggerChannel*> channels;
   std::vector<const TriggerListener*> listeners;
 };

@@ -127,7 +127,9 @@ bool Bus::publish(const LiveMsg& m) {
 
 bool Bus::publish(const ResultMsg& m) {
   eical_msg_Result s{};
-  s.program_id = cs(m.program_id), s.program = cs(m.program), s.json = cs(m.json);
+  s.machine = cs(m.machine), s.program_id = cs(m.program_id), s.program = cs(m.program), s.json = cs(m.json);
+  s.measured_at = cs(m.measured_at), s.run_path = cs(m.run_path), s.software_version = cs(m.software_version);
+  s.sensor_calibration = cs(m.sensor_calibration);
   s.degraded = m.degraded;
   s.circular_deviation_G_um = m.circular_deviation_G_um, s.radius_mean_deviation_um = m.radius_mean_deviation_um;
   s.results = m.results;
@@ -206,7 +208,8 @@ std::optional<ResultMsg> Bus::take_result(std::chrono::milliseconds timeout) {
   if (impl_->result.reader <= 0) return std::nullopt;
   ResultMsg out;
   const bool ok = impl_->take_one<eical_msg_Result>(impl_->result, timeout, [&](const eical_msg_Result& s) {
-    out = {str(s.program_id), str(s.program), s.degraded, s.circular_deviation_G_um, s.radius_mean_deviation_um, s.results, str(s.json)};
+    out = {str(s.machine), str(s.program_id), str(s.program), s.degraded, s.circular_deviation_G_um, s.radius_mean_deviation_um,
+           s.results, str(s.json), str(s.measured_at), str(s.run_path), str(s.software_version), str(s.sensor_calibration)};
   });
   return ok ? std::optional(out) : std::nullopt;
 }

@@ -33,11 +33,12 @@ struct LiveMsg {
 };
 
 struct ResultMsg {
-  std::string program_id, program;
+  std::string machine, program_id, program;  // key: machine + program_id (the run id)
   bool degraded = false;
   double circular_deviation_G_um = NAN, radius_mean_deviation_um = NAN;
   std::uint64_t results = 0;  // the daemon's result count, this one included
   std::string json;
+  std::string measured_at, run_path, software_version, sensor_calibration;  // provenance (history)
 };
 
 struct TraceMsg {

@@ -1,5 +1,6 @@
 #include "drivers/results/result_json.hpp"
 
+#include "drivers/results/software_version.hpp"
 #include "drivers/run_io/run_writer.hpp"
 
 #include <algorithm>
@@ -20,6 +21,7 @@ nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::js
 
 nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult& c) {
   nlohmann::json j = {{"plane", p.plane},
+                      {"center_mm", {p.center_mm[0], p.center_mm[1]}},  // programmed, in the plane's axes
                       {"radius_nominal_mm", p.radius_mm},
                       {"feed_mm_min", p.feed_mm_min},
                       {"direction", c.direction},
@@ -86,6 +88,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   j["format"] = "eical-result/1";
   j["run_id"] = run.meta.id;
   j["program"] = kind;
+  j["software"] = software_version();
   j["quality"] = {{"degraded", a.degraded}, {"flags", a.flags}};
   j["sensor_model"] = {{"identified", a.sensor_model != "datasheet"}, {"source", a.sensor_model}};
   if (a.circle) {

@@ -1,10 +1,13 @@
 #include "drivers/run_io/run_reader.hpp"
 
+#include <algorithm>
+
 #include "drivers/config/meta_sections.hpp"
 #include "drivers/config/strict_toml.hpp"
 #include "drivers/run_io/line_source.hpp"
 #include "dsp/core/error.hpp"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -137,7 +140,7 @@ void read_samples(const fs::path& file, dsp::Run& run) {
     for (int c = c_tax; c <= c_haz; ++c) {
       const auto v = parse_int(src, c, field(c), "integer ADC counts");
       if (!v) {
-        f.flags |= dsp::frame_flag::accel_missing;
+        f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::sensor_missing(c - c_tax < 3 ? 0 : 1);
         continue;
       }
       if (*v > INT32_MAX || *v < INT32_MIN) fail_at(src, c, "ADC counts out of the 32-bit range");
@@ -173,6 +176,20 @@ void read_samples(const fs::path& file, dsp::Run& run) {
     run.frames.push_back(f);
   }
   if (run.frames.empty()) throw dsp::InputError(file.string() + ": no samples after the header");
+  // A triplex empty in every row is absent (a single-sensor run), not missing: its empty
+  // fields flag nothing, and the other sensor's samples stay good.
+  for (int s = 0; s < 2; ++s) {
+    const std::uint32_t bit = dsp::frame_flag::sensor_missing(s);
+    run.meta.sensor_present[s] = !std::all_of(run.frames.begin(), run.frames.end(), [&](const dsp::Frame& f) { return (f.flags & bit) != 0; });
+  }
+  if (!run.meta.sensor_present[0] && !run.meta.sensor_present[1])
+    throw dsp::InputError(file.string() + ": no accelerometer data (every table_* and head_* field is empty)");
+  for (int s = 0; s < 2; ++s)
+    if (!run.meta.sensor_present[s])
+      for (auto& f : run.frames) {
+        f.flags &= ~dsp::frame_flag::sensor_missing(s);
+        if (!(f.flags & dsp::frame_flag::sensor_missing(1 - s))) f.flags &= ~dsp::frame_flag::accel_missing;
+      }
 }
 
 }  // namespace

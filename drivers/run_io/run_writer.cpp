@@ -198,7 +198,12 @@ void write_samples(const dsp::Run& run, const fs::path& file, bool gzip) {
     put_double(b, static_cast<double>(f.sample_index) / fs);
     for (int c = 0; c < 6; ++c) {
       b += ',';
-      if (!(f.flags & dsp::frame_flag::accel_missing)) put_int(f.accel_counts[c]);
+      const int sensor = c < 3 ? 0 : 1;
+      // An absent triplex is written empty; a missing field of a present one too (the
+      // reader's old single flag still marks the whole frame).
+      const bool missing = !run.meta.sensor_present[sensor] || (f.flags & dsp::frame_flag::sensor_missing(sensor)) ||
+                           ((f.flags & dsp::frame_flag::accel_missing) && !(f.flags & (dsp::frame_flag::table_missing | dsp::frame_flag::head_missing)));
+      if (!missing) put_int(f.accel_counts[c]);
     }
     for (int s = 0; s < 2; ++s) {
       b += ',';

@@ -11,7 +11,7 @@ namespace eical::drivers {
 
 struct ServoSample {
   std::int64_t number = 0;   // servo cycle count since the sampler was loaded
-  double cmd_mm[3] = {};     // joint.N.motor-pos-cmd
+  double cmd_mm[3] = {};     // joint.N.pos-cmd: programmed, before LinuxCNC's compensation
   double fb_mm[3] = {};      // joint.N.motor-pos-fb
   std::uint32_t marker = 0;  // mcode-marker (diagnostic)
 };

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace eical::dsp {
 
@@ -113,6 +114,21 @@ eval::PositioningInput positioning_deviations(const Measurement& m, const Progra
   return in;
 }
 
+std::string unsupported_integration(const Measurement& m) {
+  const bool rest_before = static_cast<double>(m.rest_window_samples) >= kMinRestS * m.fs_hz;
+  const bool held = rest_before || m.zupt_window_samples > 0 || m.supports.psd_fixes > 0;
+  if (held || m.sample_index.empty()) return {};
+  const double seconds = static_cast<double>(m.sample_index.back() - m.sample_index.front()) / m.fs_hz;
+  double sigma_um = 0.0;
+  for (const auto& s : m.sigma_um) sigma_um = std::max(sigma_um, s.maxCoeff());
+  char buf[240];
+  std::snprintf(buf, sizeof buf,
+                "no standstill before or after the motion and no position support: the acceleration integrated twice over %.1f s is no position "
+                "(its noise alone: sigma %.3g mm); compare in acceleration (eical explain)",
+                seconds, sigma_um * 1e-3);
+  return buf;
+}
+
 Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   if (run.frames.empty()) throw InputError("run '" + run.meta.id + "' holds no frames");
   if (!(run.meta.acquisition.fs_hz > 0.0)) throw InputError("run '" + run.meta.id + "': fs_hz must be positive");
@@ -134,6 +150,14 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;
   if (a.measurement.sample_index.empty()) return a;  // no motion: nothing to evaluate
+  if (const std::string why = unsupported_integration(a.measurement); !why.empty()) {
+    // run-format.md, "No standstill": a double integral with nothing to hold it is no
+    // position. Every positional figure is null with this reason; eical explain compares
+    // such runs in acceleration against the set-point.
+    a.flags.push_back("position: null, " + why);
+    a.degraded = true;
+    return a;
+  }
   {
     eval::RepeatInput ri;
     ri.sample_index = &a.measurement.sample_index, ri.pos_mm = &a.measurement.pos_mm, ri.cmd_mm = &a.measurement.cmd_mm;

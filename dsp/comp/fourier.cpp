@@ -188,7 +188,26 @@ FourierResult fourier_calibration(const std::vector<AngleSeries>& all, const Fou
     if (span < 360.0 / n * 0.95) throw InputError("fourier: the sweep covers " + std::to_string(span) + " deg, less than one interval (" + std::to_string(360.0 / n) + " deg)");
     std::vector<int> kn(r.lost_frequencies.begin(), r.lost_frequencies.end());
     if (kn.empty()) kn.push_back(n);
+    // A sweep moves continuously over the interval: its positions fall on many phases of
+    // it. Positions on the interleaved grid only (e.g. one of the series named as the
+    // sweep) see every f = k·n as a constant — the fit is singular and would print an
+    // amplitude of 1e12.
+    const double interval = 360.0 / n;
+    std::set<long long> phases;
+    for (double a : sweep->angle_deg) {
+      const double ph = std::fmod(std::fmod(a, interval) + interval, interval);
+      phases.insert(std::llround(ph * 1e3) % std::llround(interval * 1e3));  // 0.001° resolution
+    }
+    const std::size_t needed = 2 * kn.size() + 2;
+    if (phases.size() < needed)
+      throw InputError("fourier: series '" + sweep->name + "' is not a sweep: its " + std::to_string(sweep->angle_deg.size()) +
+                       " positions fall on " + std::to_string(phases.size()) + " phase(s) of the " + std::to_string(interval) +
+                       " deg interval; a sweep moves continuously over one interval (at least " + std::to_string(needed) + " phases for " +
+                       std::to_string(kn.size()) + " frequencies k*n)");
     const Fit sf = lsq(sweep->angle_deg, sy, kn, true);
+    for (Eigen::Index i = 0; i < sf.coef.size(); ++i)
+      if (!std::isfinite(sf.coef(i)) || !(sf.cov(i, i) >= 0.0) || !std::isfinite(sf.cov(i, i)))
+        throw InputError("fourier: the sweep '" + sweep->name + "' does not determine the f = k*n terms (singular fit): spread it over the interval");
     for (std::size_t l = 0; l < kn.size(); ++l) {
       FourierTerm t = term_of(sf, kn[l], 1 + 2 * static_cast<Eigen::Index>(l), opt.alpha);
       t.from_sweep = true;

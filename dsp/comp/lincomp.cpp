@@ -25,7 +25,7 @@ CorrectionTable correction_table(const ErrorCurve& c, double first_mm, double sp
   auto add = [&](double q) {
     if (!t.pos_mm.empty() && q <= t.pos_mm.back() + 1e-9) return;
     t.pos_mm.push_back(q);
-    t.correction_um.push_back(interpolate(c.pos_mm, c.error_um, q));
+    t.deviation_um.push_back(interpolate(c.pos_mm, c.error_um, q));
   };
   // Both ends of the travel always carry a point (a table covers the whole axis); the
   // grid points first + k·A lie in between.
@@ -42,7 +42,7 @@ CorrectionTable correction_table(const ErrorCurve& c, double first_mm, double sp
 double max_residual_um(const ErrorCurve& c, const CorrectionTable& t) {
   double worst = 0.0;
   for (std::size_t i = 0; i < c.pos_mm.size(); ++i)
-    worst = std::max(worst, std::abs(c.error_um[i] - interpolate(t.pos_mm, t.correction_um, c.pos_mm[i])));
+    worst = std::max(worst, std::abs(c.error_um[i] - interpolate(t.pos_mm, t.deviation_um, c.pos_mm[i])));
   return worst;
 }
 

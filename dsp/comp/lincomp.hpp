@@ -24,7 +24,7 @@ struct LinCompOptions {
 
 struct CorrectionTable {
   std::vector<double> pos_mm;
-  std::vector<double> correction_um;  // the error the table removes at each point
+  std::vector<double> deviation_um;  // the curve's deviation at each point (a control applies −deviation)
 };
 
 struct LinCompResult {

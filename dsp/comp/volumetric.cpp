@@ -17,8 +17,9 @@ enum C { xtx, xty, xtz, xrx, xry, xrz, ytx, yty, ytz, yrx, yry, yrz, ztx, zty, z
 void validate(const VolumetricModel& m) {
   const char* axes = "xyz";
   for (int a = 0; a < 3; ++a)
-    if (!(m.range_mm[a][0] < m.range_mm[a][1]) || !std::isfinite(m.range_mm[a][0]) || !std::isfinite(m.range_mm[a][1]))
-      throw InputError(std::string("volumetric: axis ") + axes[a] + " range must be [min, max] with min < max");
+    // min == max: the model describes the axis where it stood (a fit from runs that never moved it).
+    if (!(m.range_mm[a][0] <= m.range_mm[a][1]) || !std::isfinite(m.range_mm[a][0]) || !std::isfinite(m.range_mm[a][1]))
+      throw InputError(std::string("volumetric: axis ") + axes[a] + " range must be [min, max] with min <= max");
   for (double w : {m.xwy_urad, m.xwz_urad, m.ywz_urad})
     if (!std::isfinite(w)) throw InputError("volumetric: squareness must be finite");
   for (int k = 0; k < 18; ++k) {

@@ -23,6 +23,10 @@ inline constexpr std::uint32_t temp_missing = 1u << 3;
 inline constexpr std::uint32_t cmd_missing = 1u << 4;
 inline constexpr std::uint32_t gap_before = 1u << 5;       // frames were lost before this one
 inline constexpr std::uint32_t not_finite = 1u << 6;       // NaN/Inf in a float channel
+inline constexpr std::uint32_t table_missing = 1u << 7;    // a table accel field was empty (accel_missing set too)
+inline constexpr std::uint32_t head_missing = 1u << 8;     // a head accel field was empty (accel_missing set too)
+// The missing-field bit of sensor s (0 table, 1 head).
+constexpr std::uint32_t sensor_missing(int s) { return s == 0 ? table_missing : head_missing; }
 }  // namespace frame_flag
 
 struct Frame {

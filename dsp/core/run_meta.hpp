@@ -121,6 +121,9 @@ struct RunMeta {
   Site site;
   MachineLayout machine;
   SensorSpec sensors[2];  // index by Sensor: table, head
+  // A triplex whose every field is empty in samples.csv is not there (run-format.md, "One
+  // sensor"): the relative acceleration is the other sensor's absolute one.
+  bool sensor_present[2] = {true, true};
   std::vector<PsdSpec> psd;
   Program program;
   std::optional<Reference> reference;

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cmath>
 
 namespace eical::dsp::identify {
@@ -28,6 +29,7 @@ DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayRef
   // Columns: per strip an offset and a direction term, then the velocity.
   const int p = 2 * strips + 1;
   std::vector<double> rows, ys;
+  std::vector<int> pass_of;
   int passes = 0;
   std::size_t last_k = 0;
   int count = 0;
@@ -47,6 +49,7 @@ DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayRef
     r[static_cast<std::size_t>(p - 1)] = v;
     rows.insert(rows.end(), r.begin(), r.end());
     ys.push_back(fx.position_um / 1000.0 - ref);
+    pass_of.push_back(passes);
   }
   const auto n = static_cast<Eigen::Index>(ys.size());
   if (n < p + 4 || passes < 2) return d;
@@ -80,13 +83,24 @@ DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayRef
   if (qr.rank() < au.cols()) return d;
   const Eigen::VectorXd beta = qr.solve(y);
   const Eigen::VectorXd res = y - au * beta;
+  // Neighbouring readings of a pass share its errors (the spot's path, vibration): the
+  // covariance is clustered by pass (sandwich estimator, small-sample factor c/(c − 1)),
+  // and never below the white-noise one.
+  const Eigen::MatrixXd bread = (au.transpose() * au).inverse();
+  Eigen::MatrixXd meat = Eigen::MatrixXd::Zero(au.cols(), au.cols());
+  int clusters = 0;
+  for (Eigen::Index i = 0; i < n;) {
+    Eigen::VectorXd score = Eigen::VectorXd::Zero(au.cols());
+    const int pass = pass_of[static_cast<std::size_t>(i)];
+    for (; i < n && pass_of[static_cast<std::size_t>(i)] == pass; ++i) score += au.row(i).transpose() * res[i];
+    meat += score * score.transpose(), ++clusters;
+  }
   const double dof = static_cast<double>(n - au.cols());
-  const Eigen::MatrixXd cov = (au.transpose() * au).inverse() * (res.squaredNorm() / dof);
+  const Eigen::MatrixXd white = bread * (res.squaredNorm() / dof);
+  const Eigen::MatrixXd clustered = bread * meat * bread * (clusters > 1 ? static_cast<double>(clusters) / (clusters - 1) : 1.0);
   const Eigen::Index iv = au.cols() - 1;
-  // Neighbouring readings of a pass are not independent: count passes, not samples.
-  const double inflate = std::sqrt(std::max(1.0, static_cast<double>(n) / (2.0 * passes)));
   d.samples = d0 - beta[iv] * fs;
-  d.sigma = std::sqrt(std::max(0.0, cov(iv, iv))) * fs * inflate;
+  d.sigma = std::sqrt(std::max({0.0, white(iv, iv), clustered(iv, iv)})) * fs;
   d.fixes = static_cast<int>(n);
   d.valid = std::isfinite(d.samples);
   return d;

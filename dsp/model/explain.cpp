@@ -9,6 +9,7 @@
 #include "dsp/model/spectral_tests.hpp"
 #include "dsp/model/standstill_bias.hpp"
 #include "dsp/model/stick_slip_test.hpp"
+#include "dsp/model/structural_modes.hpp"
 #include "dsp/pipeline/coriolis.hpp"
 
 #include <Eigen/QR>
@@ -30,10 +31,14 @@ constexpr double kNominalBiasStepUmS2 = 3.0;
 constexpr double kKnownEffectEvidence = 2.0;
 // What an effect outside the table must explain to be named: half the instrument's 1 µm.
 constexpr double kMaterialUm = 0.5;
+// Structural modes of machine tools lie below this; a response feature above it is the
+// sensors' and the DAQ's business.
+constexpr double kModeMaxHz = 300.0;
 
-std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0, double d = 0.0) {
+template <typename... Num>
+std::string fmt(const char* f, Num... v) {
   char buf[256];
-  std::snprintf(buf, sizeof buf, f, a, b, c, d);
+  std::snprintf(buf, sizeof buf, f, static_cast<double>(v)...);
   return buf;
 }
 
@@ -601,7 +606,45 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& o) {
     d.significant = v.differential.found && (v.differential.displacement_um > d.tolerance || v.differential.rms_mg > 0.3);
     d.importance_um = d.significant ? v.differential.displacement_um : 0.0;
     d.evidence = v.differential.evidence;
-    all.push_back(c), all.push_back(d);
+    // Modes the motion drives: the frequency response of the measured relative acceleration
+    // over the commanded one. Measured by both sensors it is the head moving against the
+    // table (differential vibration); with one sensor it is the structure between the drive
+    // and the measured point (machine.resonance).
+    ExplainedEffect res;
+    res.name = "machine.resonance", res.channel = "frequency response", res.unit = "amplification", res.tolerance = 0.1;
+    // Up to a third of the slowest sensor's natural frequency: above it the sensor's own
+    // dynamics (what explain tests as sensor.dynamics) and the DAQ filter shape the response.
+    double f0_min = INFINITY;
+    for (int sn = 0; sn < 2; ++sn)
+      if (rr.meta.sensor_present[sn]) f0_min = std::min(f0_min, rr.meta.sensors[sn].f0_hz);
+    const ModeSearch ms = find_structural_modes(rr.a_meas, rr.a_cmd, 1.0 / rr.dt_s, rr.moving, std::min(kModeMaxHz, f0_min / 3.0));
+    const bool relative = rr.meta.sensor_present[0] && rr.meta.sensor_present[1];
+    ExplainedEffect& named = relative ? d : res;
+    int k = 0;
+    double largest = 0.0;
+    for (const auto& md : ms.modes) {
+      if (!md.significant) continue;
+      const std::string pre = "mode" + std::to_string(k++) + "_";
+      named.params[pre + "frequency_hz"] = md.frequency_hz, named.params[pre + "sigma_frequency_hz"] = md.sigma_frequency_hz;
+      named.params[pre + "damping_ratio"] = md.damping_ratio, named.params[pre + "sigma_damping_ratio"] = md.sigma_damping_ratio;
+      named.params[pre + "gain"] = md.gain, named.params[pre + "peak_amplification"] = md.peak_amplification;
+      for (int a = 0; a < 3; ++a) named.params[pre + "direction_" + "xyz"[a]] = md.direction[static_cast<std::size_t>(a)];
+      named.evidence += fmt("; a mode at %.2f +- %.2f Hz, damping %.3f +- %.3f, ", md.frequency_hz, md.sigma_frequency_hz, md.damping_ratio, md.sigma_damping_ratio) +
+                        fmt("gain %.3f (x%.2f at its peak), driven along ", md.gain, 1.0 + md.peak_amplification) + std::string(1, "xyz"[md.input_axis]) +
+                        fmt(", %.2f mg / %.2f um RMS in this run; chi2 drop %.0f against %.0f, coherence %.2f", md.response_rms_mg, md.displacement_rms_um, md.chi2_drop,
+                            md.chi2_threshold, md.coherence);
+      named.params[pre + "displacement_rms_um"] = md.displacement_rms_um;
+      largest = std::max(largest, md.peak_amplification);
+    }
+    if (k > 0) {
+      named.significant = true;
+      named.magnitude = std::max(named.magnitude, largest);
+      named.importance_um = std::max(named.importance_um, 1.0 + largest);
+      named.evidence = (relative ? "head against table: " : "") + named.evidence;
+    }
+    res.evidence = (k > 0 ? "the " : "") + res.evidence + (res.evidence.empty() ? ms.evidence + (k == 0 ? ": no mode stands out" : "") : "; " + ms.evidence);
+    if (k > 0 && relative) res.evidence = ms.evidence + ": the modes found are real relative motion of the two sensors (machine.differential_vibration)";
+    all.push_back(c), all.push_back(d), all.push_back(res);
   }
   // The gain: the pipeline's path against each axis' reference, with the nominal model and
   // with the extended one (the significant sensor effects in the sensors, the machine

@@ -19,10 +19,13 @@ PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples
   c.site = meta.site;
   c.sensors[0] = meta.sensors[0];
   c.sensors[1] = meta.sensors[1];
+  c.sensor_present[0] = meta.sensor_present[0], c.sensor_present[1] = meta.sensor_present[1];
   c.psd = meta.psd;
   c.capacity_samples = capacity_samples;
   // Relative noise density, µg/√Hz · g → µm/s²/√Hz (two-sided, run-format.md).
-  c.fusion.accel_noise_um_s2_rthz = std::hypot(meta.sensors[0].noise_ug_per_rthz, meta.sensors[1].noise_ug_per_rthz) * meta.site.g_mps2;
+  c.fusion.accel_noise_um_s2_rthz = std::hypot(meta.sensor_present[0] ? meta.sensors[0].noise_ug_per_rthz : 0.0,
+                                               meta.sensor_present[1] ? meta.sensors[1].noise_ug_per_rthz : 0.0) *
+                                    meta.site.g_mps2;
   return c;
 }
 
@@ -133,8 +136,12 @@ void Pipeline::store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen:
 void Pipeline::compensate(const Frame& f) noexcept {
   for (int s = 0; s < 2; ++s)
     if (!(f.flags & frame_flag::temp_missing) && std::isfinite(f.temp_c[s])) temp_c_[s] = f.temp_c[s];
-  const bool bad = (f.flags & kAccelBad) != 0;
   for (int s = 0; s < 2; ++s) {
+    if (!config_.sensor_present[s]) continue;  // absent: stays zero (reset)
+    // A field of this sensor missing holds this sensor only; saturation and NaN hold both
+    // (the frame's flag does not say which channel).
+    const bool bad = (f.flags & (frame_flag::sensor_missing(s) | frame_flag::accel_saturated | frame_flag::not_finite)) != 0 ||
+                     ((f.flags & frame_flag::accel_missing) && !(f.flags & (frame_flag::table_missing | frame_flag::head_missing)));
     if (fixed_) {
       if (!bad) fcomp_[s].apply(&f.accel_counts[3 * s], temp_q24_c(temp_c_[s]), last_valid_aq_[s], saturation_);
       for (int i = 0; i < 3; ++i) aq_[s][i] = last_valid_aq_[s][i];

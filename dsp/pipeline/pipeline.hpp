@@ -46,6 +46,7 @@ struct PipelineConfig {
   Acquisition acquisition;
   Site site;
   SensorSpec sensors[2];
+  bool sensor_present[2] = {true, true};  // an absent sensor reads zero (single-sensor runs)
   StaticCalibration calibration[2];  // cross terms and mounting (6-4, 6-18); default: data sheet
   std::vector<PsdSpec> psd;          // the run's PSD strips (CUPT)
   std::size_t capacity_samples = 0;  // longest measurement the trace can hold

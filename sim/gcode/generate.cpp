@@ -155,8 +155,10 @@ std::string step_program(const dsp::Program& p, const RestTimes& rest) {
   const char a = axis_letter(p.axis);
   const std::string f = " F" + fmt("%.0f", p.feed_mm_min);
   const std::string dwell = "G4 P" + fmt("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.5) + "\n";
-  // Starts where the machine stands (at targets_mm[0]), as the recorded step runs do.
+  // Approach the first target, then the rest before M101 (the recorded step runs, made
+  // without it, started standing there).
   std::string g = header("absolute, mm, XY plane, exact stop", "G17", true);
+  g += std::string("G0 ") + a + num(p.targets_mm[0]) + " (approach)\n";
   g += start(rest);
   for (int run = 0; run < p.runs; ++run) {
     g += std::string("G1 ") + a + num(p.targets_mm[1]) + f + "\nM102\n" + dwell;

@@ -38,7 +38,8 @@ double partial_arc_ramp_deg(const dsp::Program& p);
 // same way; dwell `dwell_s` and M102 at every target. G61 exact stop.
 std::string positioning_program(const dsp::Program& p, double overrun_mm = 2.0, const RestTimes& rest = {});
 
-// Step test: back and forth between the targets `runs` times, M102 at every arrival.
+// Step test: a rapid approach to targets_mm[0], then back and forth between the targets
+// `runs` times, M102 at every arrival.
 std::string step_program(const dsp::Program& p, const RestTimes& rest = {});
 
 // Rectangle: corner_mm, size_mm in the program plane, counter-clockwise, M102 at every

@@ -57,7 +57,13 @@ class LineParser {
       if (i >= text.size()) break;
       const char c = text[i];
       if (c == ';') break;
-      if (c == '%' && out.empty()) break;
+      if (c == '%' && out.empty()) break;  // tape start/end (%, or FANUC's "%" lines)
+      // Block delete: LinuxCNC runs the block unless the operator's switch is on (off by
+      // default); eical runs it.
+      if (c == '/' && out.empty()) {
+        ++i;
+        continue;
+      }
       if (c == '(') {
         const auto close = text.find(')', i);
         if (close == std::string_view::npos) fail(static_cast<int>(i) + 1, "comment '(' is not closed on this line");
@@ -85,6 +91,11 @@ class LineParser {
       if (number.empty() || ec != std::errc() || ptr != last)
         fail(column, "word '" + std::string(1, letter) + "' needs a number");
       out.push_back({letter, v, column});
+      if (letter == 'O') {  // a program number; LinuxCNC's O-word subroutines and loops are not
+        skip_space();
+        if (i < text.size() && std::isalpha(static_cast<unsigned char>(text[i])))
+          fail(static_cast<int>(i) + 1, "O-word control flow (sub, call, if, while, ...) is not supported; O<n> is read as a program number only");
+      }
     }
     return out;
   }
@@ -131,6 +142,8 @@ Program parse(std::string_view text, std::string_view name, const ParseOptions& 
         case 'G': gcodes.push_back(w); break;
         case 'M': mcodes.push_back(w); break;
         case 'N': break;  // line number
+        case 'O': break;  // program number (FANUC O1000)
+        case 'S': case 'T': break;  // spindle speed, tool number: no effect on the path (M3/M5/M6 below)
         case 'X': case 'Y': case 'Z': case 'I': case 'J': case 'K': case 'R': case 'F': case 'P': case 'Q': {
           auto& slot = value[static_cast<std::size_t>(w.letter - 'A')];
           if (slot) lp.fail(w.column, "word '" + std::string(1, w.letter) + "' appears twice in one block");
@@ -162,6 +175,11 @@ Program parse(std::string_view text, std::string_view name, const ParseOptions& 
       else if (is_code(c, 90.1)) arc_absolute = true;
       else if (is_code(c, 91.1)) arc_absolute = false;
       else if (is_code(c, 94)) {  // units per minute feed: the only feed mode supported
+      } else if (is_code(c, 40) || is_code(c, 49) || is_code(c, 80)) {
+        // Cutter radius, tool length and canned cycle CANCEL, from a part program's safety
+        // line: the state eical simulates (the path of the programmed point).
+      } else if (is_code(c, 54)) {
+        // The first work coordinate system: the program's coordinates are the set-point.
       } else {
         char buf[32];
         std::snprintf(buf, sizeof buf, "G%g", c);

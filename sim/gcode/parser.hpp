@@ -1,8 +1,13 @@
 #pragma once
-// ISO G-code (RS-274 subset) reader for calibration programs: G0/G1/G2/G3 (I/J/K or R),
-// G4 dwell, G17/G18/G19, G20/G21, G61/G64, G90/G91, F, N, M-functions; comments in
-// parentheses or after ';'. Anything else is an InputError naming line and column —
-// a calibration must never run a program it only half understood.
+// ISO G-code (RS-274 subset) reader for calibration programs and real part programs run as
+// free-form tests: G0/G1/G2/G3 (I/J/K or R), G4 dwell (P in seconds, LinuxCNC), G17/G18/
+// G19, G20/G21, G61/G64, G90/G91, G90.1/G91.1, G94; the safety-line cancels G40/G49/G80
+// and G54; F, N, O (program number), S and T (no effect on the path), M-functions (spindle,
+// coolant, tool change and program end pass, M100–M199 are triggers); "%" lines, block
+// delete "/", comments in parentheses or after ';'. Anything else — another motion word
+// (G5, G33, G38, canned cycles G73–G89, G28), tool length offsets, O-word subroutines,
+// parameters — is an InputError naming line and column: a calibration must never run a
+// program it only half understood.
 #include "sim/gcode/program.hpp"
 
 #include <string_view>

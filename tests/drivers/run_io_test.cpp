@@ -45,7 +45,10 @@ dsp::Run small_run() {
     f.cmd_mm[0] = 7.0710678118654755 + i * 1e-3, f.cmd_mm[1] = -1.0 / 3.0, f.cmd_mm[2] = 0.0;
     f.ref_mm[0] = f.cmd_mm[0] + 1e-6, f.ref_mm[1] = i == 10 ? std::nan("") : f.cmd_mm[1];
     f.trigger = i == 20 ? 101 : i == 280 ? 103 : 0;
-    if (i == 30) f.flags |= dsp::frame_flag::accel_missing, std::fill(std::begin(f.accel_counts), std::end(f.accel_counts), 0);
+    if (i == 30)
+      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::table_missing | dsp::frame_flag::head_missing,
+          std::fill(std::begin(f.accel_counts), std::end(f.accel_counts), 0);
+    if (i == 31) f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::head_missing, std::fill(std::begin(f.accel_counts) + 3, std::end(f.accel_counts), 0);
     r.frames.push_back(f);
   }
   r.truth_toml = "generator = \"unit\"\n";
@@ -83,6 +86,32 @@ TEST(RunIo, RoundTripPlainAndGzip) {
     write_run(run, dir, {.gzip = gz});
     EXPECT_TRUE(fs::exists(dir / (gz ? "samples.csv.gz" : "samples.csv")));
     expect_same(run, read_run(dir));
+  }
+}
+
+// run-format.md, "One sensor": a triplex empty in every row is absent, not missing — the
+// other sensor's samples stay good and nothing is flagged.
+TEST(RunIo, SingleSensorRunKeepsTheOtherSensorsData) {
+  TempDir tmp;
+  dsp::Run run = small_run();
+  run.meta.sensor_present[0] = false;
+  for (auto& f : run.frames) f.flags &= ~(dsp::frame_flag::table_missing | dsp::frame_flag::head_missing | dsp::frame_flag::accel_missing);
+  write_run(run, tmp.path / "one", {});
+  const dsp::Run back = read_run(tmp.path / "one");
+  EXPECT_FALSE(back.meta.sensor_present[0]);
+  EXPECT_TRUE(back.meta.sensor_present[1]);
+  for (std::size_t i = 0; i < back.frames.size(); ++i) {
+    ASSERT_EQ(back.frames[i].flags & (dsp::frame_flag::accel_missing | dsp::frame_flag::table_missing | dsp::frame_flag::head_missing), 0u) << i;
+    for (int c = 3; c < 6; ++c) ASSERT_EQ(back.frames[i].accel_counts[c], run.frames[i].accel_counts[c]) << i;
+  }
+  // Both triplexes empty: no accelerometer at all is an error naming the cause.
+  run.meta.sensor_present[1] = false;
+  write_run(run, tmp.path / "none", {});
+  try {
+    (void)read_run(tmp.path / "none");
+    FAIL() << "a run without accelerometer data was accepted";
+  } catch (const dsp::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no accelerometer data"), std::string::npos) << e.what();
   }
 }
 

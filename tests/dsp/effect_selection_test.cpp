@@ -1,5 +1,6 @@
 #include "dsp/core/error.hpp"
 #include "dsp/model/effect_selection.hpp"
+#include "dsp/model/effects.hpp"
 
 #include <gtest/gtest.h>
 
@@ -89,3 +90,17 @@ TEST(EffectSelection, BadInput) {
 
 }  // namespace
 }  // namespace eical::dsp::model
+
+// The effect catalogue: one entry per run-format.md effect, in the order of the enum, every
+// name unique and found again by effect_named.
+TEST(EffectCatalogue, OneEntryPerEffectInEnumOrder) {
+  const auto& cat = eical::dsp::model::effect_catalogue();
+  for (std::size_t i = 0; i < cat.size(); ++i) {
+    EXPECT_EQ(static_cast<std::size_t>(cat[i].id), i) << cat[i].name;
+    ASSERT_TRUE(eical::dsp::model::effect_named(cat[i].name).has_value()) << cat[i].name;
+    EXPECT_EQ(*eical::dsp::model::effect_named(cat[i].name), cat[i].id);
+    EXPECT_GT(cat[i].bound, cat[i].tolerance) << cat[i].name;
+    EXPECT_FALSE(cat[i].bound_reason.empty()) << cat[i].name;
+  }
+  EXPECT_FALSE(eical::dsp::model::effect_named("machine.nothing").has_value());
+}

@@ -113,5 +113,20 @@ TEST(Fourier, BadInput) {
   EXPECT_THROW((void)fourier_calibration(interleaved(false), o), InputError);
 }
 
+// Issue 19: a series named as the sweep that is not one (here an interleaved series: its
+// positions lie on the polygon grid) used to give an amplitude of 9.9e12.
+TEST(Fourier, ASweepThatIsNotASweepIsAClearError) {
+  auto series = interleaved(false);
+  FourierOptions o;
+  o.sweep_series = "series3";
+  try {
+    (void)fourier_calibration(series, o);
+    FAIL() << "a grid series was taken for a sweep";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("series 'series3' is not a sweep: its 12 positions fall on 1 phase(s) of the 30"), std::string::npos)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace eical::dsp::comp

@@ -77,7 +77,7 @@ TEST(LinComp, TableRemovesTheErrorAtItsPointsAndALinearErrorEverywhere) {
   const LinCompResult r = piecewise_linear(c, {.spacing_mm = 50.0, .shift_step_mm = 1.0, .period_error_um = 0.0});
   EXPECT_LT(r.max_residual_um, 1e-12);
   ASSERT_EQ(r.table.pos_mm.size(), 7u);  // 0, 50, ..., 300
-  EXPECT_DOUBLE_EQ(r.table.correction_um[2], 0.0);
+  EXPECT_DOUBLE_EQ(r.table.deviation_um[2], 0.0);
 }
 
 TEST(LinComp, BadInputIsRefusedWithTheReason) {

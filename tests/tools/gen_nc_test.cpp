@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -107,6 +108,77 @@ TEST(GenNc, PartialArcWithoutRoomForTheRampsIsRefused) {
     EXPECT_NE(std::string(e.what()).find("arc_deg <= 340"), std::string::npos) << e.what();
   }
   fs::remove(out);
+}
+
+}  // namespace
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string gen(std::vector<std::string> args) {
+  const fs::path out = fs::temp_directory_path() / ("gen-nc-d-" + std::to_string(std::random_device{}()) + ".nc");
+  const std::string text = run_to_file(std::move(args), out);
+  fs::remove(out);
+  return text;
+}
+
+// Each dialect's program start, dwell unit and end; the approach before the first
+// measured motion; and the exact text against golden files (EICAL_UPDATE_GOLDEN=1
+// rewrites them).
+TEST(GenNc, DialectsHaveTheirDwellUnitsProgramNumbersAndEndCodes) {
+  const std::string lcnc = gen({"gen-nc", "step", "--targets", "10,60", "--runs", "1"});
+  EXPECT_NE(lcnc.find("G0 X10.0000 (approach)\nG4 P0.4\nM101"), std::string::npos) << lcnc;
+  EXPECT_EQ(lcnc.substr(lcnc.size() - 3), "M2\n");
+  // What eical simulates: the approach, then the step from the first target.
+  const auto prog = eical::sim::gcode::parse(lcnc);
+  const auto& approach = std::get<eical::sim::gcode::Linear>(prog.blocks.front());
+  EXPECT_TRUE(approach.rapid);
+  EXPECT_NEAR(approach.to_mm.x(), 10.0, 1e-12);
+
+  const std::string fanuc = gen({"gen-nc", "step", "--targets", "10,60", "--runs", "1", "--dialect", "fanuc", "--program-number", "4711"});
+  EXPECT_EQ(fanuc.rfind("%\nO4711 (EICAL STEP", 0), 0u) << fanuc;
+  EXPECT_NE(fanuc.find("G04 P400\nM101\nG04 P100"), std::string::npos) << fanuc;  // milliseconds
+  EXPECT_EQ(fanuc.substr(fanuc.size() - 6), "M30\n%\n");
+
+  const std::string sin = gen({"gen-nc", "step", "--targets", "10,60", "--runs", "1", "--dialect", "sinumerik"});
+  EXPECT_EQ(sin.rfind("%_N_EICAL_STEP_MPF\n;$PATH=/_N_MPF_DIR\n", 0), 0u) << sin;
+  EXPECT_NE(sin.find("G90 G71 G17 G60 ; absolute"), std::string::npos) << sin;
+  EXPECT_NE(sin.find("G4 F0.400\nM101"), std::string::npos) << sin;  // seconds
+  EXPECT_EQ(sin.substr(sin.size() - 4), "M30\n");
+
+  const std::string tnc = gen({"gen-nc", "circle", "--repeats", "1", "--center", "5,0", "--dialect", "heidenhain-iso", "--program-name", "CAL1"});
+  EXPECT_EQ(tnc.rfind("%CAL1 G71 *\n", 0), 0u) << tnc;
+  EXPECT_NE(tnc.find("G04 F0.400 *\nN40 M101 *"), std::string::npos) << tnc;
+  EXPECT_NE(tnc.find(" I+5.0000 J+0.0000 *\nN70 G03 X-2.0711 Y+7.0711 F2500 *"), std::string::npos) << tnc;  // absolute centre
+  const std::string tnc_end = "\nN99999999 %CAL1 G71 *\n";
+  EXPECT_EQ(tnc.substr(tnc.size() - tnc_end.size()), tnc_end);
+
+  const fs::path golden = fs::path(EICAL_SOURCE_DIR) / "tests/tools/golden/gen-nc";
+  const bool update = std::getenv("EICAL_UPDATE_GOLDEN") && std::string(std::getenv("EICAL_UPDATE_GOLDEN")) == "1";
+  for (const char* d : {"linuxcnc", "fanuc", "sinumerik", "heidenhain-iso"})
+    for (const char* kind : {"circle", "positioning"}) {
+      std::vector<std::string> args = {"gen-nc", kind, "--dialect", d};
+      if (std::string(kind) == "circle") args.insert(args.end(), {"--repeats", "1", "--direction", "both"});
+      else args.insert(args.end(), {"--targets", "0,10", "--runs", "1"});
+      const std::string text = gen(args);
+      const fs::path p = golden / (std::string(d) + "-" + kind + ".nc");
+      if (update) {
+        fs::create_directories(p.parent_path());
+        std::ofstream(p, std::ios::binary) << text;
+        continue;
+      }
+      std::ifstream is(p, std::ios::binary);
+      ASSERT_TRUE(is) << p;
+      EXPECT_EQ(text, std::string(std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>())) << p;
+    }
+}
+
+TEST(GenNc, AnUnknownDialectIsRefused) {
+  CLI::App app;
+  eical::tools::register_all(app);
+  const char* argv[] = {"eical", "gen-nc", "circle", "--dialect", "haas"};
+  EXPECT_THROW(app.parse(5, argv), CLI::ValidationError);
 }
 
 }  // namespace

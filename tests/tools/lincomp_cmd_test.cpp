@@ -32,18 +32,39 @@ TEST(LinCompCmd, WritesLinuxCncAndCsvTables) {
   }
   run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "50", "--linuxcnc", (t.dir / "x.comp").string(), "--csv",
        (t.dir / "x.csv").string()});
+  // COMP_FILE_TYPE 0 (LinuxCNC usrmotLoadComp): "nominal actual-moving-up actual-moving-down",
+  // data from the first line (a comment above it would stop LinuxCNC reading).
   std::ifstream is(t.dir / "x.comp");
-  std::string header, line;
-  std::getline(is, header);
   std::vector<std::array<double, 3>> rows;
   double n, f, r;
   while (is >> n >> f >> r) rows.push_back({n, f, r});
   ASSERT_EQ(rows.size(), 5u);  // 0, 50, 100, 150, 200
-  // At 200 mm the axis goes 4 µm too far: command 4 µm less to arrive at nominal.
+  // At 200 mm the axis goes 4 µm too far: it arrives at 200.004 mm, so LinuxCNC's trim
+  // (nominal − actual) commands 4 µm less.
   EXPECT_NEAR(rows[4][0], 200.0, 1e-9);
-  EXPECT_NEAR(rows[4][1], 200.0 - 0.004, 1e-9);
-  EXPECT_NEAR(rows[4][2], 200.0 - 0.004, 1e-9);
+  EXPECT_NEAR(rows[4][1], 200.0 + 0.004, 1e-9);
+  EXPECT_NEAR(rows[4][2], 200.0 + 0.004, 1e-9);
+  // The CSV in the same convention: deviation +4 µm, correction −4 µm.
+  std::ifstream csv(t.dir / "x.csv");
+  std::string header, line, last;
+  std::getline(csv, header);
+  EXPECT_EQ(header, "pos_mm,deviation_um,correction_um,correction_up_um,correction_down_um");
+  while (std::getline(csv, line)) last = line;
+  EXPECT_EQ(last, "200.0000,4.0000,-4.0000,-4.0000,-4.0000");
   EXPECT_TRUE(fs::exists(t.dir / "x.csv"));
+}
+
+TEST(LinCompCmd, ACurveThatDoesNotCoverTheTravelWritesNothing) {
+  Tmp t;
+  std::ofstream(t.dir / "c.csv") << "pos_mm,error_um\n0,0\n50,1\n100,2\n";
+  try {
+    run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "50", "--travel-mm", "0,300", "--linuxcnc",
+             (t.dir / "x.comp").string()});
+    FAIL() << "accepted a table over 0..100 mm for a 0..300 mm travel";
+  } catch (const eical::dsp::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("covers 0 .. 100 mm"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(t.dir / "x.comp"));
 }
 
 TEST(LinCompCmd, BadCurveWritesNothing) {

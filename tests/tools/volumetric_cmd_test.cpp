@@ -1,5 +1,7 @@
 // `eical volumetric` in-process with the example model: results and refusals.
+#include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
+#include "sim/simulate.hpp"
 #include "tests/tools/cli_runner.hpp"
 
 #include <gtest/gtest.h>
@@ -45,6 +47,19 @@ TEST(VolumetricCmd, ExampleModelGivesDeviationsAndFlagsRanges) {
     EXPECT_NE(std::string(e.what()).find("yrq"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(dir / "o.csv"));
+  fs::remove_all(dir);
+}
+
+TEST(VolumetricCmd, FitWithoutAPositioningRunIsRefused) {
+  const fs::path dir = fs::temp_directory_path() / ("vol-" + std::to_string(std::random_device{}()));
+  eical::drivers::write_run(eical::sim::simulate(eical::sim::circle_scenario(10, 2500, 1)), dir / "circle");
+  try {
+    run_cli({"volumetric", "--fit", (dir / "circle").string(), "-o", (dir / "m.toml").string()});
+    FAIL() << "fitted a model without a positioning run";
+  } catch (const eical::dsp::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no positioning run"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir / "m.toml"));
   fs::remove_all(dir);
 }
 

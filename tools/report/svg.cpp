@@ -184,6 +184,13 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
   // Bands first, so that lines stay on top.
   for (const auto& ser : series) {
     const std::size_t n = std::min({ser.x.size(), ser.y_lo.size(), ser.y_hi.size()});
+    if (ser.error_bars) {
+      for (std::size_t i = 0; i < n; ++i)
+        if (std::isfinite(ser.x[i]) && std::isfinite(ser.y_lo[i]) && std::isfinite(ser.y_hi[i]))
+          s += "<line x1='" + num(X(ser.x[i])) + "' y1='" + num(Y(ser.y_lo[i])) + "' x2='" + num(X(ser.x[i])) + "' y2='" +
+               num(Y(ser.y_hi[i])) + "' stroke='" + ser.color + "' stroke-opacity='0.6' stroke-width='1.2'/>";
+      continue;
+    }
     if (n < 2) continue;
     std::string pts;
     for (std::size_t i = 0; i < n; ++i) pts += num(X(ser.x[i])) + "," + num(Y(ser.y_hi[i])) + " ";

@@ -35,6 +35,7 @@ struct LineSeries {
   bool markers = false;            // points instead of a line
   bool dashed = false;
   double width = 1.4;
+  bool error_bars = false;  // y_lo..y_hi as a bar at each point (separate measurements) instead of a band
 };
 
 // x/y plot with axes, ticks, grid and a legend; labels carry the units, e.g. "time (s)".

@@ -1,0 +1,269 @@
+#include "dsp/model/structural_modes.hpp"
+
+#include "dsp/core/chi2.hpp"
+#include "dsp/core/median.hpp"
+#include "dsp/model/effect_selection.hpp"
+#include "dsp/model/frequency_response.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <numbers>
+
+namespace eical::dsp::model {
+namespace {
+
+using cd = std::complex<double>;
+
+constexpr double kTargetDfHz = 0.25;      // resolves ζ ≈ 0.01 at 15 Hz (half-power band 2ζf)
+constexpr int kMinAverages = 4;
+constexpr double kMinCoherence = 0.5;     // at a candidate peak: the input drives it
+constexpr double kProminence = 1.08;      // |H| over its neighbourhood's median
+constexpr double kMinAmplification = 0.1; // the mode adds 10 % at its peak
+constexpr double kZ = 5.0;                // χ² threshold
+constexpr double kZetaMin = 0.002, kZetaMax = 0.4;
+constexpr double kMaterialUm = 0.1, kMaterialMg = 0.3;  // machine.differential_vibration's tolerance
+constexpr double kMmS2PerMg = 9.80665e-3 * 1000.0;     // 1 mg in mm/s²
+
+// The mode's relative acceleration m'' for a unit input along its drive: m'' + 2ζω m' + ω² m
+// = u (base excitation), u held over each sample, the state stepped exactly (the 2×2
+// transition matrix by scaling and squaring).
+Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_hz, double zeta) {
+  const double om = 2.0 * std::numbers::pi * f_hz, h = 1.0 / fs_hz;
+  Eigen::Matrix2d a;
+  a << 0.0, 1.0, -om * om, -2.0 * zeta * om;
+  int squarings = 0;
+  double norm = (a * h).cwiseAbs().rowwise().sum().maxCoeff();
+  while (norm > 0.25) norm /= 2.0, ++squarings;
+  const Eigen::Matrix2d ah = a * (h / std::pow(2.0, squarings));
+  Eigen::Matrix2d phi = Eigen::Matrix2d::Identity(), term = Eigen::Matrix2d::Identity(), gam = Eigen::Matrix2d::Identity() * (h / std::pow(2.0, squarings));
+  Eigen::Matrix2d gterm = gam;
+  for (int k = 1; k <= 10; ++k) {
+    term = term * ah / k;
+    phi += term;
+    gterm = gterm * ah / (k + 1);
+    gam += gterm;  // ∫₀ʰ e^{As} ds by the same series
+  }
+  for (int k = 0; k < squarings; ++k) gam = gam + phi * gam, phi = phi * phi;
+  const Eigen::Vector2d b(0.0, 1.0), gb = gam * b;
+  Eigen::VectorXd y(u.size());
+  Eigen::Vector2d x = Eigen::Vector2d::Zero();
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    y[k] = u[k] - 2.0 * zeta * om * x[1] - om * om * x[0];
+    x = phi * x + gb * u[k];
+  }
+  return y;
+}
+
+// Least squares of every output on the nuisance columns (offset, each input's commanded
+// acceleration and its rate: the servo's gain and lag) and, with a mode, its response to
+// each input. The nuisance is projected out once (an orthonormal basis); each trial of a
+// mode then solves only for its own gains. RSS summed over the outputs; G per (input, output).
+struct Fit {
+  double rss = INFINITY;
+  Eigen::MatrixXd g;  // inputs × 3
+};
+
+class TimeModel {
+ public:
+  TimeModel(const Eigen::MatrixXd& e, const std::vector<Eigen::VectorXd>& nuisance) {
+    Eigen::MatrixXd x(e.rows(), static_cast<Eigen::Index>(nuisance.size()));
+    for (std::size_t c = 0; c < nuisance.size(); ++c) x.col(static_cast<Eigen::Index>(c)) = nuisance[c] / std::max(nuisance[c].norm(), 1e-300);
+    const Eigen::HouseholderQR<Eigen::MatrixXd> qr(x);
+    q_ = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), x.cols());
+    e_ = project(e);
+    base_rss_ = e_.squaredNorm();
+  }
+  [[nodiscard]] double base_rss() const { return base_rss_; }
+  [[nodiscard]] Eigen::MatrixXd project(const Eigen::MatrixXd& m) const { return m - q_ * (q_.transpose() * m); }
+  [[nodiscard]] Fit fit(const std::vector<Eigen::VectorXd>& mode) const {
+    Fit out;
+    Eigen::MatrixXd y(e_.rows(), static_cast<Eigen::Index>(mode.size()));
+    for (std::size_t c = 0; c < mode.size(); ++c) y.col(static_cast<Eigen::Index>(c)) = mode[c];
+    y = project(y);
+    const Eigen::MatrixXd yty = y.transpose() * y;
+    out.g = yty.ldlt().solve(y.transpose() * e_);  // inputs × 3
+    out.rss = (e_ - y * out.g).squaredNorm();
+    return out;
+  }
+  [[nodiscard]] Eigen::MatrixXd residual(const std::vector<Eigen::VectorXd>& mode, const Fit& f) const {
+    Eigen::MatrixXd y(e_.rows(), static_cast<Eigen::Index>(mode.size()));
+    for (std::size_t c = 0; c < mode.size(); ++c) y.col(static_cast<Eigen::Index>(c)) = mode[c];
+    return e_ - project(y) * f.g;
+  }
+
+ private:
+  Eigen::MatrixXd q_, e_;
+  double base_rss_ = 0.0;
+};
+
+struct PeakCandidate {
+  int input = 0;
+  double f_hz = 0.0;
+  double prominence = 0.0;
+};
+constexpr std::size_t kMaxCandidates = 6;  // the most prominent peaks (a fit each costs a grid)
+
+// Local maxima of |H_jj| where the input drives the output (coherence) and the response
+// stands out of its neighbourhood.
+std::vector<PeakCandidate> peaks(const FrequencyResponse& fr, int input, double f_min, double f_max) {
+  std::vector<PeakCandidate> out;
+  const std::size_t nb = fr.f_hz.size();
+  // Coherence of unrelated signals over K averages exceeds c with probability (1 − c)^(K−1):
+  // over every bin searched, a 1 % chance of one false peak.
+  std::size_t searched = 0;
+  for (std::size_t k = 0; k < nb; ++k) searched += fr.f_hz[k] >= f_min && fr.f_hz[k] <= f_max;
+  const double c_min = std::max(kMinCoherence, 1.0 - std::pow(0.01 / static_cast<double>(std::max<std::size_t>(searched, 1)), 1.0 / std::max(1, fr.averages - 1)));
+  for (std::size_t k = 2; k + 2 < nb; ++k) {
+    const double f = fr.f_hz[k];
+    if (f < f_min || f > f_max || fr.coherence[k] < c_min) continue;
+    const double mag = std::abs(fr.h[k]);
+    bool top = true;
+    for (std::size_t j = k - 2; j <= k + 2; ++j) top = top && (j == k || std::abs(fr.h[j]) <= mag);
+    if (!top) continue;
+    std::vector<double> around;
+    for (std::size_t j = 0; j < nb; ++j)
+      if (fr.f_hz[j] >= f / 1.5 && fr.f_hz[j] <= f * 1.5 && fr.coherence[j] > 0.3) around.push_back(std::abs(fr.h[j]));
+    if (around.size() < 5 || mag < kProminence * median(around, mag)) continue;
+    out.push_back({input, f, mag / median(around, mag)});
+  }
+  return out;
+}
+
+}  // namespace
+
+ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz, const std::array<bool, 3>& driven,
+                                 double max_hz) {
+  ModeSearch out;
+  const auto n = static_cast<std::size_t>(std::min(a_meas.rows(), a_cmd.rows()));
+  const std::size_t seg = segment_for(n, fs_hz, kTargetDfHz, kMinAverages);
+  if (n < 4 * 128 || seg < 128) {
+    out.evidence = "too short a run for a frequency response (" + std::to_string(n) + " samples)";
+    return out;
+  }
+  // fr[j][i]: response of axis i to the commanded acceleration along j.
+  std::array<std::array<FrequencyResponse, 3>, 3> fr;
+  int inputs = 0;
+  for (int j = 0; j < 3; ++j) {
+    if (!driven[static_cast<std::size_t>(j)] || a_cmd.col(j).cwiseAbs().maxCoeff() <= 0.0) continue;
+    ++inputs;
+    for (int i = 0; i < 3; ++i) fr[j][i] = frequency_response(a_cmd.col(j), a_meas.col(i), fs_hz, seg);
+  }
+  if (inputs == 0) {
+    out.evidence = "no commanded acceleration to excite a mode";
+    return out;
+  }
+  out.df_hz = fs_hz / static_cast<double>(seg);
+  out.f_min_hz = std::max(2.0, 4.0 * out.df_hz);
+  out.f_max_hz = std::min(0.4 * fs_hz, max_hz);
+  std::vector<PeakCandidate> cands;
+  for (int j = 0; j < 3; ++j) {
+    if (fr[j][j].f_hz.empty()) continue;
+    out.averages = fr[j][j].averages;
+    for (const auto& c : peaks(fr[j][j], j, out.f_min_hz, out.f_max_hz)) cands.push_back(c);
+  }
+  std::sort(cands.begin(), cands.end(), [](const PeakCandidate& a, const PeakCandidate& b) { return a.prominence > b.prominence; });
+  if (cands.size() > kMaxCandidates) cands.resize(kMaxCandidates);
+  // The time-domain model: what the measured relative acceleration has beyond the
+  // commanded one, on the nuisance columns, then with a mode's response.
+  std::vector<int> inputs_used;
+  for (int j = 0; j < 3; ++j)
+    if (!fr[j][j].f_hz.empty()) inputs_used.push_back(j);
+  const auto nn = static_cast<Eigen::Index>(n);
+  Eigen::MatrixXd e = a_meas.topRows(nn) - a_cmd.topRows(nn);
+  std::vector<Eigen::VectorXd> nuisance{Eigen::VectorXd::Ones(nn)};
+  for (int j : inputs_used) {
+    Eigen::VectorXd jerk = Eigen::VectorXd::Zero(nn);
+    for (Eigen::Index k = 1; k + 1 < nn; ++k) jerk[k] = (a_cmd(k + 1, j) - a_cmd(k - 1, j)) * fs_hz / 2.0;
+    nuisance.push_back(a_cmd.col(j).head(nn)), nuisance.push_back(jerk);
+  }
+  const TimeModel tm(e, nuisance);
+  auto mode_cols = [&](double f, double z) {
+    std::vector<Eigen::VectorXd> cols;
+    for (int j : inputs_used) cols.push_back(mode_response(a_cmd.col(j).head(nn), fs_hz, f, z));
+    return cols;
+  };
+  for (const PeakCandidate& c : cands) {
+    double best_f = c.f_hz, best_z = 0.05;
+    Fit best;
+    auto search = [&](double f_lo, double f_hi, int f_n, double z_lo, double z_hi, int z_n) {
+      for (int fi = 0; fi < f_n; ++fi)
+        for (int zi = 0; zi < z_n; ++zi) {
+          const double f = f_lo + (f_hi - f_lo) * fi / std::max(1, f_n - 1);
+          const double z = z_lo * std::pow(z_hi / z_lo, static_cast<double>(zi) / std::max(1, z_n - 1));
+          Fit t = tm.fit(mode_cols(f, z));
+          if (t.rss < best.rss) best = std::move(t), best_f = f, best_z = z;
+        }
+    };
+    const double span = std::max(2.0 * out.df_hz, 0.1 * c.f_hz);
+    search(c.f_hz - span, c.f_hz + span, 21, kZetaMin, kZetaMax, 14);
+    const double fstep = 2.0 * span / 20.0;
+    search(best_f - fstep, best_f + fstep, 9, std::max(kZetaMin, best_z / 1.6), std::min(kZetaMax, best_z * 1.6), 9);
+    StructuralMode md;
+    md.frequency_hz = best_f, md.damping_ratio = best_z;
+    // The residual's effective count (it is no white noise: vibration, the servo's error).
+    const Eigen::Index ax_in = inputs_used.empty() ? 0 : inputs_used[0];
+    const Eigen::VectorXd resid = tm.residual(mode_cols(best_f, best_z), best).col(ax_in);
+    const double n_eff = static_cast<double>(nn) / integrated_autocorrelation_time(resid, 2000);
+    md.chi2_drop = n_eff * 3.0 * std::log(tm.base_rss() / best.rss);
+    const int dof = 2 + 3 * static_cast<int>(inputs_used.size());
+    md.chi2_threshold = chi2_quantile(dof, kZ);
+    // The strongest path: input j to output i.
+    Eigen::Index bj = 0, bi = 0;
+    best.g.cwiseAbs().maxCoeff(&bj, &bi);
+    md.input_axis = inputs_used[static_cast<std::size_t>(bj)];
+    md.gain = std::abs(best.g(bj, bi));
+    md.peak_amplification = md.gain / (2.0 * best_z);
+    const double gn = best.g.row(bj).norm(), gref = best.g(bj, md.input_axis);
+    for (int i = 0; i < 3; ++i) md.direction[static_cast<std::size_t>(i)] = gn > 0.0 ? best.g(bj, i) * (gref < 0.0 ? -1.0 : 1.0) / gn : 0.0;
+    // Profile uncertainty: χ² in effective counts rises by one.
+    auto bound = [&](bool freq, double dir) {
+      double step = freq ? std::max(1e-4 * best_f, out.df_hz / 100.0) : 0.01 * best_z;
+      double x = freq ? best_f : best_z;
+      for (int it = 0; it < 200; ++it) {
+        x += dir * step;
+        if (x <= 0.0) break;
+        const Fit t = tm.fit(mode_cols(freq ? x : best_f, freq ? best_z : x));
+        if (n_eff * 3.0 * std::log(t.rss / best.rss) > 1.0) return std::abs(x - (freq ? best_f : best_z));
+        step *= 1.3;
+      }
+      return std::abs(x - (freq ? best_f : best_z));
+    };
+    md.sigma_frequency_hz = 0.5 * (bound(true, -1.0) + bound(true, 1.0));
+    md.sigma_damping_ratio = 0.5 * (bound(false, -1.0) + bound(false, 1.0));
+    const FrequencyResponse& f0 = fr[static_cast<std::size_t>(md.input_axis)][static_cast<std::size_t>(md.input_axis)];
+    for (std::size_t k = 0; k < f0.f_hz.size(); ++k)
+      if (std::abs(f0.f_hz[k] - best_f) <= out.df_hz) md.coherence = std::max(md.coherence, f0.coherence[k]);
+    {
+      const Eigen::VectorXd y = mode_response(a_cmd.col(md.input_axis).head(nn), fs_hz, best_f, best_z) * best.g(bj, bi);
+      md.response_rms_mg = std::sqrt(y.squaredNorm() / static_cast<double>(nn)) / kMmS2PerMg;
+      const double om = 2.0 * std::numbers::pi * best_f;
+      md.displacement_rms_um = md.response_rms_mg * kMmS2PerMg / (om * om) * 1000.0;
+    }
+    md.significant = md.chi2_drop > md.chi2_threshold && md.peak_amplification >= kMinAmplification &&
+                     (md.displacement_rms_um >= kMaterialUm || md.response_rms_mg >= kMaterialMg) && best_z > kZetaMin * 1.1 &&
+                     best_z < kZetaMax / 1.1 && best_f >= out.f_min_hz && best_f <= out.f_max_hz;
+    // One mode seen from several inputs: keep its best fit.
+    bool merged = false;
+    for (auto& o : out.modes)
+      if (std::abs(o.frequency_hz - md.frequency_hz) <= 2.0 * out.df_hz + 2.0 * std::max(o.sigma_frequency_hz, md.sigma_frequency_hz)) {
+        if (md.chi2_drop > o.chi2_drop) o = md;
+        merged = true;
+      }
+    if (!merged) out.modes.push_back(md);
+  }
+  std::sort(out.modes.begin(), out.modes.end(), [](const StructuralMode& a, const StructuralMode& b) {
+    if (a.significant != b.significant) return a.significant;
+    return a.chi2_drop > b.chi2_drop;
+  });
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "frequency response of the measured over the commanded acceleration, %.1f-%.0f Hz in %.2f Hz bins over %d averages", out.f_min_hz,
+                out.f_max_hz, out.df_hz, out.averages);
+  out.evidence = buf;
+  return out;
+}
+
+}  // namespace eical::dsp::model

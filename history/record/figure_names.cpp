@@ -1,0 +1,86 @@
+#include "history/record/figure_names.hpp"
+
+#include <array>
+#include <cctype>
+#include <cstdio>
+#include <ctime>
+#include <utility>
+
+namespace eical::history {
+namespace {
+
+// Longest suffix first ("_mm_min" before "_min"-less "_mm").
+constexpr std::array<std::pair<const char*, const char*>, 9> kUnits = {{{"_mm_min", "mm/min"},
+                                                                           {"_urad", "µrad"},
+                                                                           {"_ppm", "ppm"},
+                                                                           {"_deg", "°"},
+                                                                           {"_um", "µm"},
+                                                                           {"_mm", "mm"},
+                                                                           {"_ms", "ms"},
+                                                                           {"_hz", "Hz"},
+                                                                           {"_s", "s"}}};
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
+std::string unit_of(const std::string& figure) {
+  for (const auto& [suffix, unit] : kUnits)
+    if (ends_with(figure, suffix)) return unit;
+  return "";
+}
+
+std::string label_of(const std::string& figure) {
+  std::string key = figure.substr(figure.rfind('.') == std::string::npos ? 0 : figure.rfind('.') + 1);
+  for (const auto& [suffix, unit] : kUnits)
+    if (ends_with(key, suffix)) {
+      key.resize(key.size() - std::char_traits<char>::length(suffix));
+      break;
+    }
+  std::string out;
+  std::size_t start = 0;
+  while (start <= key.size()) {
+    const std::size_t end = std::min(key.find('_', start), key.size());
+    std::string word = key.substr(start, end - start);
+    if (word == "x" || word == "y" || word == "z") word[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(word[0])));
+    if (!word.empty()) out += (out.empty() ? "" : " ") + word;
+    start = end + 1;
+  }
+  return out;
+}
+
+std::string utc_rfc3339(const std::string& text) {
+  int y = 0, mo = 0, d = 0, h = 0, mi = 0, s = 0, n = 0;
+  char sep = 0;
+  if (std::sscanf(text.c_str(), "%4d-%2d-%2d%c%2d:%2d%n", &y, &mo, &d, &sep, &h, &mi, &n) != 6 || (sep != 'T' && sep != 't' && sep != ' '))
+    return "";
+  std::size_t i = static_cast<std::size_t>(n);
+  if (i < text.size() && text[i] == ':') {
+    int used = 0;
+    if (std::sscanf(text.c_str() + i, ":%2d%n", &s, &used) != 1) return "";
+    i += static_cast<std::size_t>(used);
+  }
+  if (i < text.size() && text[i] == '.')
+    for (++i; i < text.size() && std::isdigit(static_cast<unsigned char>(text[i]));) ++i;  // fraction: dropped
+  long offset_s = 0;
+  if (i < text.size() && (text[i] == '+' || text[i] == '-')) {
+    int oh = 0, om = 0;
+    if (std::sscanf(text.c_str() + i + 1, "%2d:%2d", &oh, &om) != 2) return "";
+    offset_s = (text[i] == '-' ? -1 : 1) * (oh * 3600L + om * 60L);
+  } else if (i < text.size() && text[i] != 'Z' && text[i] != 'z') {
+    return "";
+  }
+  if (mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 || s > 60) return "";
+  std::tm tm{};
+  tm.tm_year = y - 1900, tm.tm_mon = mo - 1, tm.tm_mday = d, tm.tm_hour = h, tm.tm_min = mi, tm.tm_sec = s;
+  const std::time_t t = timegm(&tm) - offset_s;
+  std::tm out{};
+  gmtime_r(&t, &out);
+  char b[32];
+  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &out);
+  return b;
+}
+
+}  // namespace eical::history

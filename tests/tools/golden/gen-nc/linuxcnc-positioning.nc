@@ -1,0 +1,24 @@
+(eical positioning x, 2 targets, 1 runs, F2000)
+G90 G21 G17 G61 (ISO 230-2 linear cycle, exact stop)
+G0 X-2.0000
+G4 P0.4
+M101
+G4 P0.1
+G1 X0.0000 F2000
+M102
+G4 P0.5
+G1 X10.0000 F2000
+M102
+G4 P0.5
+G1 X12.0000 F2000 (overrun, reversal)
+G1 X10.0000 F2000
+M102
+G4 P0.5
+G1 X0.0000 F2000
+M102
+G4 P0.5
+G1 X-2.0000 F2000 (overrun, reversal)
+G4 P0.4
+M103
+G4 P0.1
+M2
