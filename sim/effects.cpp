@@ -17,7 +17,7 @@ const std::vector<std::string>& effect_names() {
       "sensor.dynamics", "sensor.damping_amplitude", "sensor.scale_temperature", "daq.group_delay", "site.coriolis",
       "machine.common_vibration", "machine.differential_vibration", "machine.backlash", "machine.reversal_spike",
       "machine.servo_mismatch", "machine.squareness", "machine.scale_mismatch", "machine.cyclic_error",
-      "machine.straightness", "machine.stick_slip"};
+      "machine.straightness", "machine.stick_slip", "machine.resonance"};
   return names;
 }
 
@@ -44,6 +44,7 @@ std::vector<std::string> effects_in(const Scenario& sc) {
   add("site.coriolis", sc.coriolis);
   add("machine.common_vibration", sc.common_vibration.on());
   add("machine.differential_vibration", sc.differential_vibration.gain.squaredNorm() > 0.0 || !sc.differential_tones.empty());
+  add("machine.resonance", sc.resonance.on());
   const MachineErrors& m = sc.machine;
   for (int i = 0; i < 3; ++i) {
     add("machine.backlash", m.backlash_um[i] != 0.0);

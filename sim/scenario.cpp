@@ -10,6 +10,12 @@ double CaseTemperature::at(double t_s) const {
   return rise_c == 0.0 ? t0_c : t0_c + rise_c * (1.0 - std::exp(-t_s / tau_s));
 }
 
+bool Resonance::on() const {
+  for (const auto& m : modes)
+    if (m.gain != 0.0) return true;
+  return false;
+}
+
 bool CommonVibration::on() const {
   return !tones.empty() || broadband_rms_mg.squaredNorm() > 0.0 || mode.gain.squaredNorm() > 0.0;
 }

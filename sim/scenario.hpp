@@ -5,6 +5,7 @@
 // Every effect of shared/spec/run-format.md maps onto fields here; all default to "off"
 // (an ideal machine that follows the set-point, data-sheet sensors, a nominal DAQ).
 #include "dsp/core/run_meta.hpp"
+#include "sim/nc/klipper_excitation.hpp"
 #include "sim/nc/trajectory.hpp"
 
 #include <Eigen/Core>
@@ -34,6 +35,10 @@ struct SensorTruth {
   double bias_step_ug = 0.0;        // bias jump at the start of every move (ch. 8.3.2), alternating sign
   double bias_drift_ug_per_s = 0.0;  // linear bias drift
   CaseTemperature temperature;
+  // A mounting that differs from run.toml's by more than a small rotation (a sign flip, a
+  // swap of two axes, a mirror), as an axes map ("y,x,z", Klipper's axes_map notation):
+  // spec.to_machine already holds it; this only names it for truth.toml. Empty: none.
+  std::string axes_map;
 };
 
 // Position loop of one axis: v = ff·v_cmd + Kv·(cmd − x), optionally through a first-order
@@ -107,6 +112,10 @@ struct CommonVibration {
 };
 
 struct DaqTruth {
+  // false: a digital MEMS sensor that samples its own low-pass output at fs, with no
+  // anti-alias filter before it (what lies above fs/2 aliases, as on a real chip); the
+  // group delay is then a pure delay.
+  bool anti_alias_filter = true;
   double group_delay_samples = 38.8;
   double skew_head_samples = 0.0;       // head channels later than table
   std::int64_t offset_counts[6] = {0, 0, 0, 0, 0, 0};
@@ -131,6 +140,35 @@ struct ReferenceTruth {
   double resolution_nm = 1.0;
 };
 
+// A structural mode between the drive and the measured point (run-format.md,
+// machine.resonance): the tool follows the drive through
+//   m'' + 2ζω m' + ω² m = −gain · (direction · a_drive)
+// along the unit `direction`; the measured point moves by m·direction on top of the drive.
+struct StructuralMode {
+  double frequency_hz = 50.0;
+  double damping_ratio = 0.02;
+  double gain = 0.0;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+};
+
+struct Resonance {
+  std::vector<StructuralMode> modes;
+  int part = 1;  // dsp::Sensor index of the part whose measured point rings: 0 table, 1 head
+  [[nodiscard]] bool on() const;
+};
+
+// Klipper's resonance test instead of a G-code program (sim/nc/klipper_excitation): one
+// axis (or direction) swept from the first sample to the last unless lead_in_s/tail_s
+// add rest around it.
+struct SweepExcitation {
+  bool on = false;
+  nc::KlipperTest test;
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();
+  Eigen::Vector3d start_mm = Eigen::Vector3d::Zero();
+  double lead_in_s = 0.0;
+  double tail_s = 0.0;
+};
+
 struct Scenario {
   std::string name = "baseline";
   std::string description;
@@ -143,10 +181,12 @@ struct Scenario {
   DriveMode differential_vibration;  // head against table: real relative motion (a mode)
   std::vector<Tone> differential_tones;  // ... and forced tones (spindle, drive): amp_mg is the
                                          // relative acceleration, the displacement amp/ω²
+  Resonance resonance;               // structural modes between drive and measured point
   bool coriolis = false;             // Earth rate from [site] latitude and heading
   std::vector<PsdTruth> psd;         // one per meta.psd strip (defaults when shorter)
   ReferenceTruth reference;
   nc::MachineLimits limits;
+  SweepExcitation sweep;       // on: runs Klipper's resonance test, not meta.program.gcode
   int oversample = 10;         // internal rate = oversample · fs (≥ 100 kHz at 10 kHz)
   bool noise = true;           // white sensor noise (quantisation is always on: for a
                                // near-ideal ADC use adc_bits = 32 and a tiny adc_lsb_volt)

@@ -3,8 +3,10 @@
 #include "dsp/core/error.hpp"
 #include "sim/daq/decimation_filter.hpp"
 #include "sim/gcode/generate.hpp"
+#include "sim/nc/klipper_excitation.hpp"
 #include "sim/machine/axis_motion.hpp"
 #include "sim/machine/geometry.hpp"
+#include "sim/machine/structural_modes.hpp"
 #include "sim/machine/vibration.hpp"
 #include "sim/psd/psd_strip.hpp"
 #include "sim/reference/reference_encoder.hpp"
@@ -43,6 +45,7 @@ void check(const Scenario& sc) {
     throw dsp::InputError("simulate: more than " + std::to_string(dsp::kMaxPsd) + " PSD strips");
   for (const auto& t : sc.truth)
     if (!(t.spec.f0_hz > 0.0) || !(t.spec.zeta > 0.0)) throw dsp::InputError("simulate: sensor f0_hz and zeta must be positive");
+  if (!sc.meta.sensor_present[0] && !sc.meta.sensor_present[1]) throw dsp::InputError("simulate: at least one sensor must be present");
 }
 
 }  // namespace
@@ -55,18 +58,29 @@ std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t purpose) noexcept {
   return z ^ (z >> 31);
 }
 
-dsp::Run simulate(const Scenario& sc) { return simulate(sc, static_cast<std::vector<Eigen::Vector3d>*>(nullptr)); }
-
-dsp::Run simulate(const Scenario& sc, std::vector<Eigen::Vector3d>* true_rel_mm) {
-  Scenario with_program = sc;
-  auto& p = with_program.meta.program;
-  if (p.gcode.empty()) p.gcode = gcode::program_gcode(p);
-  const nc::Trajectory tr = nc::interpolate_gcode(p.gcode, sc.meta.id + ".ngc", sc.limits);
-  return simulate(with_program, tr, true_rel_mm);
+std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& sc) {
+  if (sc.sweep.on)
+    return std::make_unique<nc::AccelProfileSetPoint>(nc::klipper_segments(sc.sweep.test), sc.sweep.direction, sc.sweep.start_mm,
+                                                      sc.sweep.lead_in_s, sc.sweep.tail_s);
+  const dsp::Program& p = sc.meta.program;
+  return std::make_unique<nc::Trajectory>(
+      nc::interpolate_gcode(p.gcode.empty() ? gcode::program_gcode(p) : p.gcode, sc.meta.id + ".ngc", sc.limits));
 }
 
-dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen::Vector3d>* true_rel_mm) {
+dsp::Run simulate(const Scenario& sc) { return simulate(sc, static_cast<std::vector<Eigen::Vector3d>*>(nullptr)); }
+
+dsp::Run simulate(const Scenario& sc, std::vector<Eigen::Vector3d>* true_rel_mm, JitteredCapture* capture) {
+  Scenario with_program = sc;
+  auto& p = with_program.meta.program;
+  if (!sc.sweep.on && p.gcode.empty()) p.gcode = gcode::program_gcode(p);
+  const auto tr = scenario_set_point(with_program);
+  return simulate(with_program, *tr, true_rel_mm, capture);
+}
+
+dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen::Vector3d>* true_rel_mm, JitteredCapture* capture) {
   check(sc);
+  if (capture && capture->jitter_s.size() != static_cast<std::size_t>(std::ceil(tr.duration_s() * sc.meta.acquisition.fs_hz)) + 1)
+    throw dsp::InputError("simulate: the jittered capture needs one sampling time per frame");
   const dsp::Acquisition& acq = sc.meta.acquisition;
   dsp::Run run;
   run.meta = sc.meta;
@@ -108,6 +122,7 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
                                     AxisMotion(sc.machine, 2, h, start[2])};
   const bool geometric = has_geometric_errors(sc.machine);
   DriveModeResponse common_mode(sc.common_vibration.mode, h), diff_mode(sc.differential_vibration, h);
+  StructuralModesResponse structure(sc.resonance.modes, h);
   CommonAcceleration common(sc.common_vibration, g, h, ov, stream_seed(sc.seed, broadband));
   const bool common_on = sc.common_vibration.on();
   const Eigen::Vector3d omega = sc.coriolis ? earth_rate_machine(sc.meta.site) : Eigen::Vector3d::Zero();
@@ -117,9 +132,12 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
   for (int s = 0; s < 2; ++s) to_sensor[s] = sc.truth[s].spec.to_machine.inverse();
 
   // Internal-grid channels: specific force per sensing element (g), PSD lock-in outputs (V).
+  // An absent sensor (a single-sensor run) is neither stored nor simulated.
+  const bool present[2] = {sc.meta.sensor_present[0], sc.meta.sensor_present[1]};
   std::array<std::array<std::vector<double>, 3>, 2> sensor_g;
-  for (auto& s : sensor_g)
-    for (auto& a : s) a.resize(n_int);
+  for (int s = 0; s < 2; ++s)
+    if (present[s])
+      for (auto& a : sensor_g[static_cast<std::size_t>(s)]) a.resize(n_int);
   std::vector<std::vector<double>> psd_v(2 * n_psd, std::vector<double>(n_int));
 
   // Deviations of table, head and the common base (relative-position sense, mm) over a
@@ -139,6 +157,7 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
       (head_mask[i] != 0.0 ? w.head : w.table) += d;
     }
     if (diff_mode.on()) w.head += diff_mode.step(ms.acc_mm_s2);
+    if (structure.on()) (sc.resonance.part == 1 ? w.head : w.table) += structure.step(ms.acc_mm_s2);
     for (const Tone& tone : sc.differential_tones) {  // displacement whose acceleration is amp·sin(ωt + φ)
       const double w_rad = 2.0 * std::numbers::pi * tone.freq_hz;
       w.head -= tone.amp_mg * 1e-3 * g * 1e3 / (w_rad * w_rad) * std::sin(w_rad * t + tone.phase_deg * std::numbers::pi / 180.0);
@@ -171,7 +190,10 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
     }
     const Eigen::Vector3d up(0.0, 0.0, g);
     const Eigen::Vector3d f_table = to_sensor[0] * (a_table + up) / g, f_head = to_sensor[1] * (a_head + up) / g;
-    for (int a = 0; a < 3; ++a) sensor_g[0][a][j] = f_table[a], sensor_g[1][a][j] = f_head[a];
+    for (int a = 0; a < 3; ++a) {
+      if (present[0]) sensor_g[0][a][j] = f_table[a];
+      if (present[1]) sensor_g[1][a][j] = f_head[a];
+    }
     const Eigen::Vector3d p_rel = ms_cur.pos_mm + w_cur.table + w_cur.head;
     for (std::size_t s = 0; s < n_psd; ++s) strips[s].step(p_rel, psd_v[2 * s][j], psd_v[2 * s + 1][j]);
     if (j % static_cast<std::size_t>(ov) == 0) {
@@ -189,25 +211,35 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
   const double e_noise_v = sc.daq.noise_nv_per_rthz * 1e-9 * std::sqrt(fs);
   std::mt19937_64 daq_rng(stream_seed(sc.seed, daq_noise));
   std::normal_distribution<double> unit(0.0, 1.0);
-  auto to_counts = [&](double volts, int channel, std::uint32_t& flags) {
-    double c = std::round((volts + (e_noise_v > 0.0 ? e_noise_v * unit(daq_rng) : 0.0)) / acq.adc_lsb_volt) +
-               static_cast<double>(acq.adc_offset_counts + sc.daq.offset_counts[channel]);
+  auto to_counts = [&](double volts, double e_noise, int channel, std::uint32_t& flags) {
+    double c = std::round((volts + e_noise) / acq.adc_lsb_volt) + static_cast<double>(acq.adc_offset_counts + sc.daq.offset_counts[channel]);
     if (c > full_scale - 1 || c < -full_scale) {
       c = std::clamp(c, -full_scale, full_scale - 1);
       flags |= dsp::frame_flag::accel_saturated;
     }
     return static_cast<std::int32_t>(std::llround(c));
   };
-  std::vector<double> filtered(n_frames);
+  std::vector<double> filtered(n_frames), filtered_jittered, positions;
+  if (capture) {
+    capture->counts.assign(n_frames, {});
+    filtered_jittered.resize(n_frames);
+    positions.resize(n_frames);
+    for (std::size_t n = 0; n < n_frames; ++n) positions[n] = static_cast<double>(n) + capture->jitter_s[n] * fs;
+  }
   for (int s = 0; s < 2; ++s) {
+    if (!present[s]) continue;
     const SensorTruth& st = sc.truth[s];
     sense(sensor_g[static_cast<std::size_t>(s)], st, h);
-    const DecimationFilter daq_filter(ov, sc.daq.group_delay_samples + (s == 1 ? sc.daq.skew_head_samples : 0.0));
+    // A digital MEMS chip has no anti-alias filter: its samples are its low-pass output,
+    // delayed (a design length of 0 makes the filter a pure delay).
+    const double delay = sc.daq.group_delay_samples + (s == 1 ? sc.daq.skew_head_samples : 0.0);
+    const DecimationFilter daq_filter = sc.daq.anti_alias_filter ? DecimationFilter(ov, delay) : DecimationFilter(ov, delay, 0.4863, 0.0);
     // Bias steps at the start of every move, alternating in sign (ch. 8.3.2).
     std::vector<std::size_t> move_starts;
     for (const auto& [from, to] : tr.move_spans_s()) move_starts.push_back(static_cast<std::size_t>(std::llround(from * fs)));
     for (int a = 0; a < 3; ++a) {
       daq_filter.apply(sensor_g[static_cast<std::size_t>(s)][static_cast<std::size_t>(a)], filtered.data(), n_frames);
+      if (capture) daq_filter.apply_at(sensor_g[static_cast<std::size_t>(s)][static_cast<std::size_t>(a)], positions.data(), filtered_jittered.data(), n_frames);
       std::mt19937_64 noise_rng(stream_seed(sc.seed, sensor_noise + static_cast<std::uint64_t>(3 * s + a)));
       std::mt19937_64 walk_rng(stream_seed(sc.seed, bias_walk + static_cast<std::uint64_t>(3 * s + a)));
       const double sigma_g = sc.noise ? st.spec.noise_ug_per_rthz * 1e-6 * std::sqrt(fs) : 0.0;
@@ -230,7 +262,13 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
         const double k1 = st.spec.k1_v_per_g[a] * (1.0 + st.spec.tc_k1_ppm_per_c * 1e-6 * dT);
         const double noise = sigma_g > 0.0 ? sigma_g * unit(noise_rng) : 0.0;
         auto& f = run.frames[n];
-        f.accel_counts[3 * s + a] = to_counts(k1 * (filtered[n] + bias + noise), 3 * s + a, f.flags);
+        const double e_noise = e_noise_v > 0.0 ? e_noise_v * unit(daq_rng) : 0.0;
+        f.accel_counts[3 * s + a] = to_counts(k1 * (filtered[n] + bias + noise), e_noise, 3 * s + a, f.flags);
+        // The capture's sample: the same slow terms, noise and ADC, a little earlier or later.
+        if (capture) {
+          std::uint32_t ignored = 0;
+          capture->counts[n][static_cast<std::size_t>(3 * s + a)] = to_counts(k1 * (filtered_jittered[n] + bias + noise), e_noise, 3 * s + a, ignored);
+        }
       }
     }
   }

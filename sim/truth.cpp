@@ -50,6 +50,12 @@ Eigen::Vector3d misalignment_mrad(const Eigen::Matrix3d& nominal, const Eigen::M
   return 1e3 * Eigen::Vector3d(0.5 * (r(2, 1) - r(1, 2)), 0.5 * (r(0, 2) - r(2, 0)), 0.5 * (r(1, 0) - r(0, 1)));
 }
 
+// What a mounting that is no small rotation is: "rotation" (proper: two signs flipped, or
+// two axes exchanged with one sign), "mirror" (improper: one sign flipped, two axes swapped).
+const char* mounting_kind(const Eigen::Matrix3d& nominal, const Eigen::Matrix3d& truth) {
+  return (nominal.inverse() * truth).determinant() > 0.0 ? "rotation" : "mirror";
+}
+
 // Which sensors an effect shows in.
 std::string sensors_with(const Scenario& sc, bool (*pred)(const Scenario&, int)) {
   const bool t = pred(sc, 0), h = pred(sc, 1);
@@ -79,13 +85,19 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
     const std::string which = pred ? sensors_with(sc, pred) : "none";
     o += "sensor = " + str(which) + "\n";
     const int s = which == "head" ? 1 : 0;
-    const SensorTruth& t = sc.truth[s];
+    const SensorTruth& st = sc.truth[s];
+    const SensorTruth& t = st;
     if (name == "sensor.scale") o += "k1_v_per_g = " + vec3(t.spec.k1_v_per_g) + "\n";
     if (name == "sensor.bias_drift")
       o += "rw_ug_per_rts = " + num(t.bias_rw_ug_per_rts) + "\nstep_ug = " + num(t.bias_step_ug) + "\ndrift_ug_per_s = " + num(t.bias_drift_ug_per_s) + "\n";
     if (name == "sensor.nonlinearity") o += "k2_g_per_g2 = " + vec3(t.spec.k2_g_per_g2) + "\nk3_g_per_g3 = " + vec3(t.spec.k3_g_per_g3) + "\n";
     if (name == "sensor.cross_coupling") o += "k_cross_g_per_g = " + mat3(t.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(t.k_cross2_g_per_g2) + "\n";
-    if (name == "sensor.misalignment") o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
+    if (name == "sensor.misalignment") {
+      // A sign flip, swap or mirror is no small rotation: the true matrix says what it is.
+      if (!st.axes_map.empty()) o += "axes_map = " + str(st.axes_map) + "\nmounting = " + str(mounting_kind(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
+      else o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
+      o += "to_machine = " + mat3(t.spec.to_machine) + "\n";
+    }
     if (name == "sensor.dynamics") o += "f0_hz = " + num(t.spec.f0_hz) + "\nzeta = " + num(t.spec.zeta) + "\n";
     if (name == "sensor.damping_amplitude") o += "zeta0 = " + num(t.spec.zeta) + "\nzeta_per_g = " + num(t.zeta_per_g) + "\n";
     if (name == "sensor.scale_temperature")
@@ -129,6 +141,11 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
       return "direction = " + str(kAxis[m.straightness[i].direction]) + "\nbow_um = " + num(m.straightness[i].bow_um) +
              "\nspan_mm = " + arr(m.straightness[i].span_mm, 2) + "\n";
     });
+  } else if (name == "machine.resonance") {
+    o += "part = " + str(kSensor[sc.resonance.part]) + "\n";
+    for (const StructuralMode& md : sc.resonance.modes)
+      o += "\n[[effects.\"" + name + "\".modes]]\nfrequency_hz = " + num(md.frequency_hz) + "\ndamping_ratio = " + num(md.damping_ratio) +
+           "\ngain = " + num(md.gain) + "\ndirection = " + vec3(md.direction.normalized()) + "\n";
   } else if (name == "machine.stick_slip") {
     per_axis([&](int i) { return m.stick_slip[i].amp_um; }, [&](int i) {
       return "amp_um = " + num(m.stick_slip[i].amp_um) + "\nbelow_mm_min = " + num(m.stick_slip[i].below_mm_min) + "\nslip_ms = " +
@@ -149,6 +166,7 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
   o += "# [sensors.*].to_machine is the true mounting; machine errors in relative-position sense.\n";
   o += "generator = \"eical-sim 2\"\n";
   o += "scenario = " + str(sc.name) + "\nseed = " + std::to_string(sc.seed) + "\ndescription = " + str(sc.description) + "\n";
+  o += std::string("sensors_present = ") + (sc.meta.sensor_present[0] && sc.meta.sensor_present[1] ? "\"both\"" : (sc.meta.sensor_present[1] ? "\"head\"" : "\"table\"")) + "\n";
   o += "\n[effects]\npresent = " + list(effects.present) + "\nbackground = " + list(effects.background) + "\n";
   for (const auto& e : effects.present) o += effect_table(sc, e);
 
@@ -162,7 +180,8 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
     o += "f0_hz = " + num(t.f0_hz) + "\nzeta = " + num(t.zeta) + "\nnoise_ug_per_rthz = " + num(sc.noise ? t.noise_ug_per_rthz : 0.0) + "\n";
     o += "temp_ref_c = " + num(t.temp_ref_c) + "\n";
     o += "k_cross_g_per_g = " + mat3(st.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(st.k_cross2_g_per_g2) + "\n";
-    o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.to_machine)) + "\n";
+    if (st.axes_map.empty()) o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.to_machine)) + "\n";
+    else o += "axes_map = " + str(st.axes_map) + "\n";
     o += "zeta_per_g = " + num(st.zeta_per_g) + "\nbias_rw_ug_per_rts = " + num(st.bias_rw_ug_per_rts) + "\nbias_step_ug = " + num(st.bias_step_ug) +
          "\nbias_drift_ug_per_s = " + num(st.bias_drift_ug_per_s) + "\n";
     o += std::string("\n[sensors.") + kSensor[s] + ".temperature]\nt0_c = " + num(st.temperature.t0_c) + "\nrise_c = " + num(st.temperature.rise_c) +
@@ -194,7 +213,7 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
          num(m.stick_slip[i].below_mm_min) + "\nslip_ms = " + num(m.stick_slip[i].slip_ms) + "\n";
   }
 
-  o += "\n[daq]\ngroup_delay_samples = " + num(sc.daq.group_delay_samples) + "\nskew_head_samples = " + num(sc.daq.skew_head_samples) + "\n";
+  o += "\n[daq]\nanti_alias_filter = " + std::string(sc.daq.anti_alias_filter ? "true" : "false") + "\ngroup_delay_samples = " + num(sc.daq.group_delay_samples) + "\nskew_head_samples = " + num(sc.daq.skew_head_samples) + "\n";
   o += "offset_counts = [";
   for (int c = 0; c < 6; ++c) o += (c ? ", " : "") + std::to_string(sc.daq.offset_counts[c]);
   o += "]\nnoise_nv_per_rthz = " + num(sc.daq.noise_nv_per_rthz) + "\noversample = " + std::to_string(sc.oversample) + "\n";
@@ -208,6 +227,17 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
   for (std::size_t k = 0; k < tr.triggers().size(); ++k)
     o += (k ? ", [" : "[") + num(tr.triggers()[k].t_s) + ", " + std::to_string(tr.triggers()[k].code) + "]";
   o += "]\n";
+  if (sc.sweep.on) {
+    const nc::KlipperTest& k = sc.sweep.test;
+    o += "\n[nc.sweep]\n# Klipper's resonance test (sim/nc/klipper_excitation)\nfreq_start_hz = " + num(k.freq_start_hz) + "\nfreq_end_hz = " + num(k.freq_end_hz) +
+         "\naccel_per_hz = " + num(k.accel_per_hz) + "\nhz_per_sec = " + num(k.hz_per_sec) + "\nsweeping_accel_mm_s2 = " + num(k.sweeping_accel_mm_s2) +
+         "\nsweeping_period_s = " + num(k.sweeping_period_s) + "\nlegacy = " + (k.legacy_moves ? "true" : "false") +
+         "\nstop_accel_mm_s2 = " + num(k.stop_accel_mm_s2) + "\ndirection = " + vec3(sc.sweep.direction.normalized()) + "\nstart_mm = " + vec3(sc.sweep.start_mm) +
+         "\nlead_in_s = " + num(sc.sweep.lead_in_s) + "\ntail_s = " + num(sc.sweep.tail_s) + "\n";
+  }
+  for (const StructuralMode& md : sc.resonance.modes)
+    o += "\n[[machine_errors.resonance]]\npart = " + str(kSensor[sc.resonance.part]) + "\nfrequency_hz = " + num(md.frequency_hz) +
+         "\ndamping_ratio = " + num(md.damping_ratio) + "\ngain = " + num(md.gain) + "\ndirection = " + vec3(md.direction.normalized()) + "\n";
   const CommonVibration& v = sc.common_vibration;
   o += "\n[vibration.common]\nbroadband_rms_mg = " + vec3(v.broadband_rms_mg) + "\nband_hz = " + arr(v.band_hz, 2) +
        "\nmode_freq_hz = " + num(v.mode.freq_hz) + "\nmode_zeta = " + num(v.mode.zeta) + "\nmode_gain = " + vec3(v.mode.gain) + "\n";

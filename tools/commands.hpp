@@ -21,6 +21,7 @@ void register_hmi(CLI::App& app);
 void register_validate_sim(CLI::App& app);
 void register_identify(CLI::App& app);
 void register_explain(CLI::App& app);
+void register_import(CLI::App& app);
 void register_history(CLI::App& app);
 void register_collect(CLI::App& app);
 
@@ -28,6 +29,7 @@ void register_collect(CLI::App& app);
 inline void register_all(CLI::App& app) {
   register_demo(app);
   register_simulate(app);
+  register_import(app);
   register_validate_sim(app);
   register_analyze(app);
   register_identify(app);

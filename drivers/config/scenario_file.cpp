@@ -5,6 +5,9 @@
 #include "dsp/core/error.hpp"
 #include "dsp/core/frame.hpp"
 #include "sim/effects.hpp"
+#include "sim/regimes/regimes.hpp"
+#include "sim/sensor/axes_map.hpp"
+#include "sim/sensor/mems_chip.hpp"
 
 #include <Eigen/Geometry>
 
@@ -81,6 +84,16 @@ void read_sensor_effect(const std::string& name, StrictTable& t, sim::Scenario& 
                                    Eigen::AngleAxisd(r[0], Eigen::Vector3d::UnitX()))
                                       .toRotationMatrix();
       st.spec.to_machine = nominal.to_machine * rot;
+      // A sign flip, swap or mirror on top (Klipper's axes_map notation).
+      if (t.has("axes_map")) {
+        const std::string map = t.string("axes_map");
+        try {
+          st.spec.to_machine = sim::axes_map_matrix(map, "") * st.spec.to_machine;
+        } catch (const dsp::InputError& e) {
+          t.fail("axes_map", e.what());
+        }
+        st.axes_map = map;
+      }
     } else if (name == "sensor.dynamics") {
       st.spec.f0_hz = positive(t, "f0_hz", nominal.f0_hz);
       st.spec.zeta = positive(t, "zeta", nominal.zeta);
@@ -140,6 +153,21 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
     sc.differential_tones = read_tones(t);
     if (sc.differential_vibration.gain.squaredNorm() == 0.0 && sc.differential_tones.empty())
       t.fail("gain", "differential vibration needs a mode gain or tones");
+  } else if (name == "machine.resonance") {
+    sc.resonance.part = t.choice("part", {"table", "head"}, "head") == "head" ? 1 : 0;
+    sc.resonance.modes.clear();
+    for (StrictTable mt : t.tables("modes")) {
+      sim::StructuralMode md;
+      md.frequency_hz = positive(mt, "frequency_hz", md.frequency_hz);
+      md.damping_ratio = positive(mt, "damping_ratio", md.damping_ratio);
+      if (!(md.damping_ratio < 1.0)) mt.fail("damping_ratio", "must be below 1 (a lightly damped mode: 0.01 .. 0.05)");
+      md.gain = mt.number("gain");
+      md.direction = vec3(mt, "direction", md.direction);
+      if (!(md.direction.norm() > 0.0)) mt.fail("direction", "must not be the zero vector");
+      mt.finish();
+      sc.resonance.modes.push_back(md);
+    }
+    if (!sc.resonance.on()) t.fail("modes", "machine.resonance needs at least one [[…modes]] table with a non-zero gain");
   } else if (name == "machine.backlash") {
     m.backlash_um[axis_of(t, "axis")] = t.number("value_um");
   } else if (name == "machine.reversal_spike") {
@@ -198,6 +226,64 @@ void read_effect(const std::string& name, StrictTable t, sim::Scenario& sc) {
   t.finish();
 }
 
+// [mems]: a digital MEMS chip on both sensors (sim/regimes apply_mems): a known chip and
+// any of its figures overridden, the true bias beside it.
+void read_mems(StrictTable t, sim::Scenario& sc) {
+  sim::MemsChip chip = sim::mems_chip(t.choice("chip", [] {
+    std::vector<std::string> names;
+    for (const auto& c : sim::mems_chips()) names.push_back(c.name);
+    return names;
+  }(), "adxl345"));
+  chip.fs_hz = positive(t, "fs_hz", chip.fs_hz);
+  chip.bits = static_cast<int>(t.integer("bits", chip.bits));
+  if (chip.bits < 8 || chip.bits > 24) t.fail("bits", "must be 8..24");
+  chip.range_g = positive(t, "range_g", chip.range_g);
+  chip.noise_ug_per_rthz = t.number("noise_ug_per_rthz", chip.noise_ug_per_rthz);
+  if (chip.noise_ug_per_rthz < 0.0) t.fail("noise_ug_per_rthz", "must not be negative");
+  if (t.has("bandwidth_hz")) chip.bandwidth_hz = positive(t, "bandwidth_hz", chip.bandwidth_hz), chip.bandwidth_follows_odr = false;
+  if (!(chip.fs_hz >= 100.0 && chip.fs_hz <= 51200.0)) t.fail("fs_hz", "must be 100 .. 51200 Hz");
+  const Eigen::Vector3d bias_g = vec3(t, "bias_mg", Eigen::Vector3d::Zero()) * 1e-3;
+  t.finish();
+  sim::apply_mems(sc, chip, chip.fs_hz, bias_g);
+}
+
+// [sweep]: Klipper's resonance test instead of the G-code program.
+void read_sweep(StrictTable t, sim::Scenario& sc) {
+  const std::string preset = t.choice("preset", {"current", "legacy"}, "current");
+  sim::nc::KlipperTest k = preset == "legacy" ? sim::nc::KlipperTest::legacy() : sim::nc::KlipperTest::current();
+  const std::string axis = t.string("axis", "x");
+  try {
+    sc.sweep.direction = sim::nc::test_direction(axis, "axis");
+  } catch (const dsp::InputError& e) {
+    t.fail("axis", e.what());
+  }
+  k.freq_start_hz = t.number("freq_start_hz", k.freq_start_hz);
+  k.freq_end_hz = t.number("freq_end_hz", k.freq_end_hz);
+  k.accel_per_hz = t.number("accel_per_hz", k.accel_per_hz);
+  k.hz_per_sec = t.number("hz_per_sec", k.hz_per_sec);
+  k.sweeping_accel_mm_s2 = t.number("sweeping_accel_mm_s2", k.sweeping_accel_mm_s2);
+  k.sweeping_period_s = t.number("sweeping_period_s", k.sweeping_period_s);
+  k.stop_accel_mm_s2 = t.number("stop_accel_mm_s2", k.stop_accel_mm_s2);
+  if (const std::string why = k.invalid_reason(); !why.empty()) {
+    // The key the reason is about (invalid_reason names it first).
+    const char* key = why.rfind("freq_start", 0) == 0 ? "freq_start_hz"
+                      : why.rfind("freq_end", 0) == 0 ? "freq_end_hz"
+                      : why.rfind("accel_per_hz", 0) == 0 ? "accel_per_hz"
+                      : why.rfind("hz_per_sec", 0) == 0 ? "hz_per_sec"
+                      : why.rfind("sweeping", 0) == 0 ? "sweeping_accel_mm_s2"
+                      : why.rfind("the stop", 0) == 0 ? "stop_accel_mm_s2"
+                                                       : "preset";
+    t.fail(t.has(key) ? key : "preset", why);
+  }
+  sc.sweep.start_mm = vec3(t, "start_mm", Eigen::Vector3d::Zero());
+  sc.sweep.lead_in_s = t.number("lead_in_s", 0.0);
+  sc.sweep.tail_s = t.number("tail_s", 0.0);
+  if (sc.sweep.lead_in_s < 0.0 || sc.sweep.tail_s < 0.0) t.fail(sc.sweep.lead_in_s < 0.0 ? "lead_in_s" : "tail_s", "must not be negative");
+  t.finish();
+  sc.sweep.on = true;
+  sc.sweep.test = k;
+}
+
 std::string read_text(const std::filesystem::path& p) {
   std::ifstream in(p);
   if (!in) throw dsp::InputError(p.string() + ": cannot read the G-code file");
@@ -231,6 +317,8 @@ sim::Scenario read_scenario_file(const std::string& path) {
   for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s], sc.truth[s].zeta_per_g = sc.meta.sensors[s].zeta_per_g;
   sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples;
   sc.daq.skew_head_samples = sc.meta.acquisition.daq_skew_head_samples;
+  if (auto t = root.optional_table("mems")) read_mems(*t, sc);
+  if (root.has("sensors_present")) sim::set_sensors_present(sc, root.choice("sensors_present", {"both", "head", "table"}, "both"));
   // [truth.sensors.*] / [truth.daq]: the true sensors and DAQ in full (run.toml's sensor
   // keys, starting from what eical is told) — what eical explain writes to reproduce a run.
   if (auto truth = root.optional_table("truth")) {
@@ -251,12 +339,18 @@ sim::Scenario read_scenario_file(const std::string& path) {
     truth->finish();
   }
 
-  StrictTable program = root.table("program");
-  const std::string gcode_file = program.string("gcode_file", "");
-  sc.meta.program = read_program(program);  // the copy knows gcode_file is used
-  if (!gcode_file.empty()) {
-    const std::filesystem::path p = std::filesystem::path(path).parent_path() / gcode_file;
-    sc.meta.program.gcode = read_text(p);
+  if (auto t = root.optional_table("sweep")) read_sweep(*t, sc);
+  // With a [sweep] the program is the test; [program] may still name its kind.
+  if (auto program = sc.sweep.on ? root.optional_table("program") : std::optional<StrictTable>(root.table("program"))) {
+    const std::string gcode_file = program->string("gcode_file", "");
+    sc.meta.program = read_program(*program);  // the copy knows gcode_file is used
+    if (!gcode_file.empty()) {
+      if (sc.sweep.on) program->fail("gcode_file", "a [sweep] scenario runs Klipper's test, not a G-code program");
+      const std::filesystem::path p = std::filesystem::path(path).parent_path() / gcode_file;
+      sc.meta.program.gcode = read_text(p);
+    }
+  } else {
+    sc.meta.program.kind = "freeform";
   }
 
   for (StrictTable p : root.tables("psd")) {
@@ -330,7 +424,7 @@ sim::Scenario read_scenario_file(const std::string& path) {
         for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
         effects->fail(name, "unknown effect (known: " + list + ")");
       }
-      read_effect(name, effects->table(name), sc);
+      for (StrictTable& t : effects->table_or_tables(name)) read_effect(name, std::move(t), sc);
       sc.effects_present.push_back(name);
     }
     effects->finish();

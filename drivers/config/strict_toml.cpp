@@ -196,6 +196,12 @@ std::vector<StrictTable> StrictTable::tables(std::string_view key) {
   return out;
 }
 
+std::vector<StrictTable> StrictTable::table_or_tables(std::string_view key) {
+  const toml::node* n = get(key, true);
+  if (n->is_table()) return {table(key)};
+  return tables(key);
+}
+
 std::vector<std::string> StrictTable::keys() const {
   std::vector<std::pair<std::uint32_t, std::string>> found;
   for (const auto& [k, v] : *table_) found.emplace_back(v.source().begin.line, std::string(k.str()));

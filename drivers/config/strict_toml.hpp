@@ -45,6 +45,8 @@ class StrictTable {
   StrictTable table(std::string_view key);
   std::optional<StrictTable> optional_table(std::string_view key);
   std::vector<StrictTable> tables(std::string_view key);
+  // One table or an array of tables under `key` ([k] or [[k]]: an effect on one axis or several).
+  std::vector<StrictTable> table_or_tables(std::string_view key);
 
   // Throws InputError for the first key that was never asked for.
   void finish() const;

@@ -62,11 +62,6 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options = {});
 // approach direction; a run is one pass up and one pass down (ISO 230-2 linear cycle).
 eval::PositioningInput positioning_deviations(const Measurement& m, const Program& program);
 
-// Why the integrated motion of `m` is no position (empty: it is): no rest before the
-// motion (kMinRestS), none after it, no PSD fix — nothing holds the double integral.
-inline constexpr double kMinRestS = 0.05;
-std::string unsupported_integration(const Measurement& m);
-
 // Plane axes of a program ("xy" → 0, 1; "zx" → 2, 0; "yz" → 1, 2).
 std::pair<int, int> plane_axes(const std::string& plane);
 

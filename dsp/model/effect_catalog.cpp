@@ -205,7 +205,6 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
   if (group == "scale") {
     const double m = largest_abs(v);
     Attribution a = attr("sensor.scale", m, 1000.0, "ppm", "the doubly integrated acceleration along the axis");
-    a.plausible_max = 5e4;  // 5 %: a wrong sensor type, not a calibration
     a.params = v;
     out.push_back(a);
   } else if (group == "cross_axis") {
@@ -254,7 +253,6 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
   } else if (group == "nonlinearity") {
     const double m = largest_abs(v);
     Attribution a = attr("sensor.nonlinearity", m, 200.0, "1e-6/g", "the doubly integrated square and cube of the acceleration");
-    a.plausible_max = 2e4;  // 2 %/g: a hundred times a servo accelerometer's data-sheet band
     a.params = v;
     out.push_back(a);
   } else if (group == "timing") {

@@ -74,10 +74,7 @@ void axis_directions(const RunResiduals& run, int axis, Eigen::VectorXd& dir, st
 struct Attribution {
   std::string name;
   double magnitude = 0.0, tolerance = 0.0;
-  // Beyond this no sensor of the kind has the effect: a fit this large stands in for a
-  // residual the catalogue does not describe (INFINITY: no such bound).
-  double plausible_max = INFINITY;
-  std::string unit, regressor;
+  std::string unit, regressor;  // sizes beyond a kind's bound: effects.hpp, apply_physical_bounds
   std::map<std::string, double> params;
 };
 // The named effects a sensor group's fit stands for (the cross-axis group splits into

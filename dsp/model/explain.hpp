@@ -35,12 +35,17 @@ struct ExplainedEffect {
   double heldout_rms_before_um = 0.0, heldout_rms_after_um = 0.0;
   double importance_um = 0.0;  // the residual RMS it explains (ranking)
   bool taken_into_model = false;  // a sensor-side extension the pipeline now compensates with
+  std::string group;              // the model group it was fitted as (other.residual_like_<group>)
+  std::string resembles;          // what its regressor is, in words
 };
 
 struct RunExplanation {
   std::string run_id, reference;
   double nominal_residual_rms_um = 0.0, final_residual_rms_um = 0.0;
   double heldout_nominal_rms_um = 0.0, heldout_final_rms_um = 0.0;
+  // Why no position was compared (nothing holds the double integral): the residuals above
+  // are then not computed (NaN) and the sensors are judged in acceleration.
+  std::string position_not_compared;
   std::vector<ExplainedEffect> effects;  // every effect tested, significant first
   // For the report: the residual per channel before and after the accepted extensions.
   struct Trace {

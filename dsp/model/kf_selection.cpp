@@ -16,6 +16,7 @@ constexpr double kTieBic = 6.0;     // Kass–Raftery: below 6, no strong eviden
 struct AxisFit {
   double logl = 0.0, fit_ss = 0.0, held_ss = 0.0;
   double held_lpd = 0.0;  // log predictive density of the held-out observations (a proper score)
+  double held_var = 0.0;  // sum of their predictive variances (what the model expects of them)
   std::size_t fit_n = 0, held_n = 0;
   Eigen::VectorXd value, sigma;
   std::vector<double> innovations;  // of the fitting observations (for the effective count)
@@ -62,7 +63,7 @@ AxisFit fit_axis(const AxisTrack& t, const std::vector<const AxisParam*>& ps, co
         out.held_lpd += -0.5 * (std::log(2.0 * std::numbers::pi * var) + nu * nu / var);
         // A strip not yet seen in the fitting observations has an unknown mounting: its
         // prediction says nothing about the model (the score above weighs it by its variance).
-        if (o.tag < 0 || tag_seen[static_cast<std::size_t>(o.tag)]) out.held_ss += nu * nu, ++out.held_n;
+        if (o.tag < 0 || tag_seen[static_cast<std::size_t>(o.tag)]) out.held_ss += nu * nu, out.held_var += var, ++out.held_n;
       } else {
         if (o.tag >= 0) tag_seen[static_cast<std::size_t>(o.tag)] = true;
         f.update(row, o.z_um, o.sigma_um);
@@ -180,6 +181,18 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
     cur = std::move(best_m);
     out.groups.push_back(best_v);
   }
+  // Known groups the run shows join the final model: their size is not a free choice, so
+  // no BIC penalty is charged, only the evidence that the run carries them.
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (done[g] || groups[g].params.empty() || !groups[g].known) continue;
+    Model m = with(cur, groups[g]);
+    GroupVerdict v = verdict(cur, m, groups[g]);
+    if (v.loglik_gain < o.known_min_loglik_gain || v.held_score_gain < 0.0) continue;
+    v.accepted = true;
+    done[g] = true;
+    cur = std::move(m);
+    out.groups.push_back(std::move(v));
+  }
   // The accepted groups' final values (fitted together), then every other group once more
   // against the final model.
   for (auto& v : out.groups)
@@ -191,6 +204,21 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
         }
   sums(cur, fs, fn, hs, hn);
   out.fit_rms_final_um = rms(fs, fn), out.held_rms_final_um = rms(hs, hn);
+  {
+    double var = 0.0;
+    for (const auto& f : cur.fit) var += f.held_var;
+    out.held_expected_rms_final_um = rms(var, hn);
+  }
+  {
+    Model all = cur;
+    for (std::size_t g = 0; g < groups.size(); ++g)
+      if (!done[g] && !groups[g].params.empty() && !groups[g].known) all = with(all, groups[g]);
+    double afs, ahs, var = 0.0;
+    std::size_t afn, ahn;
+    sums(all, afs, afn, ahs, ahn);
+    for (const auto& f : all.fit) var += f.held_var;
+    out.held_rms_all_um = rms(ahs, ahn), out.held_expected_rms_all_um = rms(var, ahn);
+  }
   for (int a = 0; a < 3; ++a)
     for (std::size_t j = 0; j < cur.params[a].size(); ++j)
       for (const auto& p : base)

@@ -35,8 +35,8 @@ struct AxisParam {
 struct ParamGroup {
   std::string name;
   std::vector<AxisParam> params;
-  // Known from outside the run (the Earth rate): not selected, only tested once against the
-  // final model — does the run agree with it (loglik_gain ≥ 0)?
+  // Known from outside the run (the Earth rate): not selected by the BIC; tested once against
+  // the final model and taken into it when the run shows it (known_min_loglik_gain).
   bool known = false;
 };
 
@@ -72,6 +72,10 @@ struct KfSelection {
   std::vector<GroupVerdict> groups;  // accepted first (in order), then the rest by BIC drop
   double fit_rms_nominal_um = 0.0, fit_rms_final_um = 0.0;
   double held_rms_nominal_um = 0.0, held_rms_final_um = 0.0;
+  double held_expected_rms_final_um = 0.0;  // what the final model's noise lets it expect there
+  // The same with every group of the table in the model at once: what no effect of the table
+  // accounts for (sub-tolerance effects together included).
+  double held_rms_all_um = 0.0, held_expected_rms_all_um = 0.0;
   double n_eff = 0.0;
   std::map<std::string, double> base_value, base_sigma;  // the base parameters in the final model
 };
@@ -82,6 +86,10 @@ struct KfSelectionOptions {
   double min_heldout_score_gain = 1.0;  // an e-fold better held-out prediction
   int max_groups = 8;
   double zupt_sigma_um_s = 2.0;
+  // A known group (its size fixed by physics, not fitted freely) joins the final model when
+  // the run favours it (2·Δlog L above this: "positive" evidence, Kass & Raftery) and it
+  // predicts the held-out data no worse.
+  double known_min_loglik_gain = 2.0;
 };
 
 // `base`: parameters every model carries (nuisances such as the servo lag of an axis seen

@@ -35,8 +35,15 @@ struct ModeSearch {
   std::vector<StructuralMode> modes;  // strongest first
   double f_min_hz = 0.0, f_max_hz = 0.0, df_hz = 0.0;
   int averages = 0;
+  // The gain of the modes found: measured − commanded acceleration beyond the drive's own
+  // response (gain, lag, curvature), RMS over the run without and with them, mg.
+  double residual_rms_before_mg = 0.0, residual_rms_after_mg = 0.0;
   std::string evidence;               // what was searched, or why nothing could be
 };
+
+// A mode's response to its drive u (mm/s²): m'' + 2ζω m' + ω² m = u (base excitation);
+// its relative acceleration m'' (mm/s²), or its displacement m (mm) when `displacement`.
+Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_hz, double zeta, bool displacement);
 
 // `a_meas`, `a_cmd`: n × 3 (mm/s², same time base, sample rate fs_hz); `driven`: the axes the
 // set-point moves (the inputs); `max_hz`: the highest frequency a mode may have here (the

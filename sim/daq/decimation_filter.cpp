@@ -91,4 +91,30 @@ void DecimationFilter::apply(const std::vector<double>& in, double* out, std::si
   }
 }
 
+double DecimationFilter::output_at(const std::vector<double>& x, long c) const {
+  const long m = static_cast<long>(taps_half_.size()) - 1;
+  const long n_in = static_cast<long>(x.size());
+  auto at = [&](long k) { return x[static_cast<std::size_t>(std::clamp(k, 0L, n_in - 1))]; };
+  double y = taps_half_[0] * at(c);
+  for (long j = 1; j <= m; ++j) y += taps_half_[static_cast<std::size_t>(j)] * (at(c - j) + at(c + j));
+  return y;
+}
+
+void DecimationFilter::apply_at(const std::vector<double>& in, const double* positions, double* out, std::size_t n_out) const {
+  if (in.empty()) throw dsp::InputError("DAQ filter: no input");
+  std::vector<double> shifted;
+  if (frac_ != 0.0) {
+    shifted.resize(in.size());
+    shifted[0] = in[0];
+    for (std::size_t k = 1; k < in.size(); ++k) shifted[k] = (1.0 - frac_) * in[k] + frac_ * in[k - 1];
+  }
+  const std::vector<double>& x = frac_ != 0.0 ? shifted : in;
+  for (std::size_t n = 0; n < n_out; ++n) {
+    const double c = positions[n] * ov_ - static_cast<double>(shift_);
+    const double c0 = std::floor(c), w = c - c0;
+    const long k = static_cast<long>(c0);
+    out[n] = w == 0.0 ? output_at(x, k) : (1.0 - w) * output_at(x, k) + w * output_at(x, k + 1);
+  }
+}
+
 }  // namespace eical::sim

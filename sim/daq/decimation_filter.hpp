@@ -22,11 +22,20 @@ class DecimationFilter {
   // at its last value.
   void apply(const std::vector<double>& in, double* out, std::size_t n_out) const;
 
+  // The filtered signal at fractional output positions (output sample units, e.g. a
+  // sample taken a little early or late): the output at the neighbouring internal
+  // samples, interpolated linearly (the output is band-limited far below the internal
+  // Nyquist frequency).
+  void apply_at(const std::vector<double>& in, const double* positions, double* out, std::size_t n_out) const;
+
   [[nodiscard]] std::size_t taps() const { return 2 * taps_half_.size() - 1; }
   // Gain at f (fraction of the output rate), for tests.
   [[nodiscard]] double gain(double f_over_fs) const;
 
  private:
+  // The filter's output centred on internal sample c of x (the ends held).
+  [[nodiscard]] double output_at(const std::vector<double>& x, long c) const;
+
   int ov_;
   long shift_;     // integer part of the delay, internal samples
   double frac_;    // fractional part

@@ -203,6 +203,16 @@ void inject(Scenario& sc, const std::string& e, Draw& d) {
     m.straightness[a] = Straightness{a == 0 ? 1 : 0, d.mag(2.0, 5.0), {sc.meta.program.kind == "circle" ? -span : 0.0, span}};
   } else if (e == "machine.stick_slip") {
     m.stick_slip[moving_axis(sc, d)] = StickSlip{d.u(1.0, 3.0), d.u(100.0, 200.0), 2.0};
+  } else if (e == "machine.resonance") {
+    // A lightly damped mode between the moving axis' drive and its part's measured point,
+    // rung by every acceleration ramp of the program.
+    const int a = moving_axis(sc, d);
+    const auto& head = sc.meta.machine.head_axes;
+    StructuralMode mode;
+    mode.frequency_hz = d.u(30.0, 120.0), mode.damping_ratio = d.u(0.01, 0.05), mode.gain = d.u(0.05, 0.2);
+    mode.direction = Eigen::Vector3d::Unit(a);
+    sc.resonance.modes = {mode};
+    sc.resonance.part = std::find(head.begin(), head.end(), std::string(1, static_cast<char>('x' + a))) != head.end() ? 1 : 0;
   } else {
     throw dsp::InputError("hidden effects: unknown effect '" + e + "'");
   }
@@ -221,7 +231,8 @@ const std::vector<std::string>& hideable_effects() { return effect_names(); }
 std::string program_for(const std::string& e) {
   static const std::vector<std::string> step = {"sensor.scale", "sensor.bias_drift", "sensor.nonlinearity", "sensor.dynamics",
                                                 "sensor.damping_amplitude", "sensor.scale_temperature", "machine.common_vibration",
-                                                "machine.differential_vibration", "machine.scale_mismatch", "site.coriolis"};
+                                                "machine.differential_vibration", "machine.scale_mismatch", "site.coriolis",
+                                                "machine.resonance"};
   return std::find(step.begin(), step.end(), e) != step.end() ? "step" : "circle";
 }
 

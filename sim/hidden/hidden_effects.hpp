@@ -27,7 +27,7 @@ namespace eical::sim {
 const std::vector<std::string>& hidden_programs();
 
 // The program an effect shows itself in best (circle for the geometry and the loops, step
-// for what needs acceleration or standstills).
+// for what needs acceleration or standstills: the resonance rings after every ramp).
 std::string program_for(const std::string& effect);
 // Several effects: a circle when any of them needs two moving axes (geometry, loops),
 // else the step.

@@ -45,6 +45,16 @@ TEST(ScenarioFile, BacklashExampleMatchesItsTruth) {
   EXPECT_EQ(sim::effect_lists(sc).present, (std::vector<std::string>{"machine.backlash", "machine.reversal_spike"}));
 }
 
+TEST(ScenarioFile, AnEffectOnSeveralAxesIsAnArrayOfTables) {
+  const std::string text = "format = \"eical-scenario/1\"\n[program]\nkind = \"circle\"\nradius_mm = 10.0\n"
+                           "[[effects.\"machine.backlash\"]]\naxis = \"x\"\nvalue_um = 3\n"
+                           "[[effects.\"machine.backlash\"]]\naxis = \"y\"\nvalue_um = 1.5\n";
+  const sim::Scenario sc = drivers::read_scenario_file(write_tmp("eical-scenario-axes.toml", text));
+  EXPECT_DOUBLE_EQ(sc.machine.backlash_um[0], 3.0);
+  EXPECT_DOUBLE_EQ(sc.machine.backlash_um[1], 1.5);
+  EXPECT_EQ(sim::effect_lists(sc).present, (std::vector<std::string>{"machine.backlash"}));
+}
+
 TEST(ScenarioFile, UnknownEffectKeyAndTypeAreNamedWithTheLine) {
   const std::string head = "format = \"eical-scenario/1\"\n[program]\nkind = \"circle\"\nradius_mm = 10.0\n";
   auto error_of = [&](const std::string& body) {

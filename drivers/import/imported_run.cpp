@@ -1,0 +1,117 @@
+#include "drivers/import/imported_run.hpp"
+
+#include "drivers/run_io/run_writer.hpp"
+#include "dsp/core/error.hpp"
+#include "sim/sensor/mems_chip.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace eical::drivers {
+
+dsp::SensorSpec import_sensor_spec(const ImportSetup& s, double fs_hz) {
+  dsp::SensorSpec spec = sim::mems_sensor_spec(sim::mems_chip(s.chip), fs_hz);
+  if (s.bandwidth_hz > 0.0) spec.f0_hz = s.bandwidth_hz;
+  if (s.noise_ug_per_rthz >= 0.0) spec.noise_ug_per_rthz = s.noise_ug_per_rthz;
+  spec.to_machine = s.to_machine;
+  return spec;
+}
+
+dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel, const ImportSetup& s, const ImportSetPoint& sp, double offset_s) {
+  if (accel.values.empty() || accel.values.size() != accel.grid_index.size()) throw dsp::InputError("import: no samples");
+  if (s.part != 0 && s.part != 1) throw dsp::InputError("import: the sensor must be on the table or the head");
+  dsp::Run run;
+  dsp::RunMeta& m = run.meta;
+  m.id = s.id;
+  m.acquisition.fs_hz = clock.fs_hz;
+  m.acquisition.adc_bits = 32;
+  m.acquisition.adc_lsb_volt = 1.0 / kImportCountsPerG;  // with k1 = 1 V/g: 1 count = 1 µg
+  m.acquisition.adc_offset_counts = 0;
+  m.acquisition.daq_group_delay_samples = 0.0;
+  m.site = s.site;
+  m.machine = s.machine;
+  const dsp::SensorSpec spec = import_sensor_spec(s, clock.fs_hz);
+  m.sensors[0] = m.sensors[1] = spec;
+  m.sensor_present[s.part] = true;
+  m.sensor_present[1 - s.part] = false;
+  m.program.kind = "freeform";
+  m.program.feed_mm_min = std::max(1.0, s.feed_mm_min);
+  m.program.repeats = 1;
+  run.frames.resize(accel.values.size());
+  const double full = std::ldexp(1.0, 31);
+  for (std::size_t k = 0; k < accel.values.size(); ++k) {
+    dsp::Frame& f = run.frames[k];
+    f.sample_index = accel.grid_index[k] - accel.grid_index.front();
+    for (int a = 0; a < 3; ++a) {
+      const double c = std::round(accel.values[k][a] * kImportCountsPerG);
+      if (c >= full - 1 || c <= -full) f.flags |= dsp::frame_flag::accel_saturated;
+      f.accel_counts[3 * s.part + a] = static_cast<std::int32_t>(std::clamp(c, -full, full - 1));
+    }
+    f.flags |= dsp::frame_flag::temp_missing;
+    const double t_sp = clock.time_at(accel.grid_index[k]) - offset_s;
+    if (!sp.hold_outside && (t_sp < sp.t_begin_s || t_sp > sp.t_end_s)) {
+      f.flags |= dsp::frame_flag::cmd_missing;
+    } else {
+      const Eigen::Vector3d p = sp.position_mm(std::clamp(t_sp, sp.t_begin_s, sp.t_end_s));
+      for (int a = 0; a < 3; ++a) f.cmd_mm[a] = p[a];
+    }
+  }
+  run.frames.front().trigger = 101;
+  run.frames.back().trigger = 103;
+  return run;
+}
+
+std::string import_report_toml(const ImportReport& r) {
+  auto str = [](const std::string& v) {
+    std::string o = "\"";
+    for (char c : v) o += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
+    return o + "\"";
+  };
+  auto clock = [&](const char* table, const UniformClock& c) {
+    return std::string("\n[") + table + "]\nfs_hz = " + toml_number(c.fs_hz) + "\nt0_s = " + toml_number(c.t0_s) + "\nmedian_dt_s = " + toml_number(c.median_dt_s) +
+           "\njitter_rms_s = " + toml_number(c.jitter_rms_s) + "\ngaps = " + std::to_string(c.gaps) + "\nlost_frames = " + std::to_string(c.lost_frames) + "\n";
+  };
+  std::string o = "# How this run was imported (eical import): the recorder's clock, the resampling\n"
+                  "# (cubic Lagrange onto the uniform clock, drivers/import/uniform_clock.hpp) and the\n"
+                  "# time offset recorder - set-point by cross-correlation (u: standard uncertainty, k = 1,\n"
+                  "# block jackknife).\n";
+  o += "format = \"eical-import/1\"\nkind = " + str(r.kind) + "\nsource = " + str(r.source) + "\n";
+  if (!r.nc_source.empty()) o += "nc_source = " + str(r.nc_source) + "\n";
+  o += "excitation = " + str(r.excitation) + "\nsamples = " + std::to_string(r.samples) + "\n";
+  o += clock("accel_clock", r.accel_clock);
+  if (r.nc_clock) o += clock("nc_clock", *r.nc_clock);
+  o += "\n[time_offset]\noffset_s = " + toml_number(r.offset.offset_s) + "\nu_s = " + toml_number(r.offset.u_s) + "\nexplained = " +
+       toml_number(r.offset.explained) + "\npeak_to_median = " + toml_number(r.offset.peak_to_median) + "\nblocks = " + std::to_string(r.offset.blocks) + "\nfine_step_s = " + toml_number(r.offset.fine_step_s) +
+       "\n# measured (sensor axes) = gain · commanded (machine axes), at the offset\ngain = [";
+  for (int i = 0; i < 3; ++i) {
+    o += i ? ", [" : "[";
+    for (int j = 0; j < 3; ++j) o += (j ? ", " : "") + toml_number(r.offset.gain(i, j));
+    o += "]";
+  }
+  return o + "]\n";
+}
+
+void write_import_report(const std::filesystem::path& dir, const ImportReport& r) { write_text_atomic(dir / "import.toml", import_report_toml(r)); }
+
+void require_alignment(const OffsetEstimate& o, const std::string& source) {
+  if (o.peak_to_median >= kMinPeakToMedian && o.explained >= kMinExplained) return;
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                ": the commanded acceleration is not found in the measured one (correlation peak %.1f x the median over all lags, %.0f needed; "
+                "it explains %.2f %%, %.0f %% needed): wrong test parameters, axis or file, or a sensor on a part that does not move?",
+                o.peak_to_median, kMinPeakToMedian, 100.0 * o.explained, 100.0 * kMinExplained);
+  throw dsp::InputError(source + buf);
+}
+
+std::vector<std::string> axis_list(const std::string& letters, const std::string& what) {
+  std::vector<std::string> out;
+  for (char c : letters) {
+    if (c < 'x' || c > 'z') throw dsp::InputError(what + ": '" + letters + "' is not a list of the letters x, y, z");
+    const std::string a(1, c);
+    if (std::find(out.begin(), out.end(), a) != out.end()) throw dsp::InputError(what + ": '" + letters + "' names an axis twice");
+    out.push_back(a);
+  }
+  return out;
+}
+
+}  // namespace eical::drivers

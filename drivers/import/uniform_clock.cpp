@@ -1,0 +1,123 @@
+#include "drivers/import/uniform_clock.hpp"
+
+#include "dsp/core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace eical::drivers {
+namespace {
+
+// Least-squares line t = t0 + index/fs.
+void fit_line(const std::vector<double>& t, UniformClock& c) {
+  const double n = static_cast<double>(t.size());
+  double mi = 0.0, mt = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k) mi += static_cast<double>(c.index[k]), mt += t[k] - t.front();
+  mi /= n, mt /= n;
+  double sii = 0.0, sit = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const double di = static_cast<double>(c.index[k]) - mi;
+    sii += di * di, sit += di * (t[k] - t.front() - mt);
+  }
+  const double dt = sit / sii;
+  c.fs_hz = 1.0 / dt;
+  c.t0_s = t.front() + mt - dt * mi;
+}
+
+void assign_indices(const std::vector<double>& t, double dt, double gap_threshold_s, UniformClock& c) {
+  c.index.assign(t.size(), 0);
+  c.gaps = c.lost_frames = 0;
+  for (std::size_t k = 1; k < t.size(); ++k) {
+    const double d = t[k] - t[k - 1];
+    std::int64_t step = 1;
+    if (d > gap_threshold_s) {
+      step = std::max<std::int64_t>(2, std::llround(d / dt));
+      ++c.gaps;
+      c.lost_frames += static_cast<std::size_t>(step - 1);
+    }
+    c.index[k] = c.index[k - 1] + step;
+  }
+}
+
+// Lagrange weights of the nodes x[0..m) at x.
+Eigen::Vector3d lagrange(const double* x, const Eigen::Vector3d* y, int m, double at) {
+  Eigen::Vector3d out = Eigen::Vector3d::Zero();
+  for (int i = 0; i < m; ++i) {
+    double w = 1.0;
+    for (int j = 0; j < m; ++j)
+      if (j != i) w *= (at - x[j]) / (x[i] - x[j]);
+    out += w * y[i];
+  }
+  return out;
+}
+
+// Four nodes around `at` within [lo, hi] (indices of one unbroken stretch), k the last
+// node at or before `at`.
+Eigen::Vector3d cubic_in(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, std::size_t lo, std::size_t hi, std::size_t k, double at) {
+  const std::size_t len = hi - lo + 1;
+  if (len == 1) return v[lo];
+  const std::size_t m = std::min<std::size_t>(4, len);
+  // Centre the window on [k, k+1]: nodes k−1 .. k+2, shifted into the stretch.
+  std::size_t first = k >= lo + 1 ? k - 1 : lo;
+  if (first + m - 1 > hi) first = hi - (m - 1);
+  return lagrange(&t[first], &v[first], static_cast<int>(m), at);
+}
+
+}  // namespace
+
+UniformClock fit_uniform_clock(const std::vector<double>& t, const std::string& source) {
+  if (t.size() < 4) throw dsp::InputError(source + ": " + std::to_string(t.size()) + " samples; at least 4 are needed for a clock");
+  std::vector<double> d(t.size() - 1);
+  for (std::size_t k = 1; k < t.size(); ++k) {
+    d[k - 1] = t[k] - t[k - 1];
+    if (!(d[k - 1] > 0.0)) throw dsp::InputError(source + ": time stamps do not increase at sample " + std::to_string(k + 1));
+  }
+  std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
+  UniformClock c;
+  c.median_dt_s = d[d.size() / 2];
+  const double gap = 2.0 * c.median_dt_s;
+  assign_indices(t, c.median_dt_s, gap, c);
+  fit_line(t, c);
+  assign_indices(t, 1.0 / c.fs_hz, gap, c);  // gaps measured with the fitted rate
+  fit_line(t, c);
+  double s2 = 0.0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const double r = t[k] - c.time_at(c.index[k]);
+    s2 += r * r;
+  }
+  c.jitter_rms_s = std::sqrt(s2 / static_cast<double>(t.size()));
+  return c;
+}
+
+UniformSeries resample(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, const UniformClock& c) {
+  if (t.size() != v.size() || t.size() != c.index.size()) throw dsp::InputError("resample: stamps, values and clock disagree in length");
+  UniformSeries out;
+  out.grid_index.reserve(t.size());
+  out.values.reserve(t.size());
+  // Unbroken stretches [lo, hi] between gaps; every sample's own grid point is produced.
+  std::size_t lo = 0;
+  while (lo < t.size()) {
+    std::size_t hi = lo;
+    while (hi + 1 < t.size() && c.index[hi + 1] == c.index[hi] + 1) ++hi;
+    std::size_t k = lo;
+    for (std::size_t s = lo; s <= hi; ++s) {
+      const double at = c.time_at(c.index[s]);
+      while (k < hi && t[k + 1] <= at) ++k;
+      while (k > lo && t[k] > at) --k;
+      out.grid_index.push_back(c.index[s]);
+      out.values.push_back(cubic_in(t, v, lo, hi, k, at));
+    }
+    lo = hi + 1;
+  }
+  return out;
+}
+
+Eigen::Vector3d interpolate_at(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, double at) {
+  if (t.empty()) throw dsp::InputError("interpolate: no samples");
+  if (at <= t.front()) return v.front();
+  if (at >= t.back()) return v.back();
+  const auto k = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), at) - t.begin()) - 1;
+  return cubic_in(t, v, 0, t.size() - 1, k, at);
+}
+
+}  // namespace eical::drivers

@@ -1,0 +1,161 @@
+// Stage: a residual that the accepted effects leave beyond the noise is reported
+// (other.unexplained, run-format.md): its size against the noise and where it sits in time
+// and frequency. "Within its noise" is said only when it is true.
+#include "dsp/model/explain/stages.hpp"
+
+#include <unsupported/Eigen/FFT>
+
+#include <cmath>
+#include <complex>
+
+namespace eical::dsp::model::stage {
+namespace {
+
+// A clear margin: the residual's RMS at least this many times what the noise explains.
+constexpr double kMargin = 2.0;
+
+// The time of the largest |r| and the strongest frequency of r (sampled at dt_s).
+void where(const std::vector<double>& t_s, const std::vector<double>& r, double& at_s, double& freq_hz) {
+  at_s = freq_hz = 0.0;
+  if (r.size() < 16 || t_s.size() != r.size()) return;
+  std::size_t k = 0;
+  for (std::size_t i = 1; i < r.size(); ++i)
+    if (std::abs(r[i]) > std::abs(r[k])) k = i;
+  at_s = t_s[k];
+  const double dt = (t_s.back() - t_s.front()) / static_cast<double>(r.size() - 1);
+  if (!(dt > 0.0)) return;
+  std::size_t n = 1;
+  while (n * 2 <= r.size()) n *= 2;
+  std::vector<double> x(r.end() - static_cast<std::ptrdiff_t>(n), r.end());
+  double mean = 0.0;
+  for (double v : x) mean += v;
+  mean /= static_cast<double>(n);
+  for (double& v : x) v -= mean;
+  Eigen::FFT<double> fft;
+  std::vector<std::complex<double>> f;
+  fft.fwd(f, x);
+  std::size_t best = 1;
+  for (std::size_t i = 1; i <= n / 2; ++i)
+    if (std::norm(f[i]) > std::norm(f[best])) best = i;
+  freq_hz = static_cast<double>(best) / (static_cast<double>(n) * dt);
+}
+
+ExplainedEffect unexplained(const std::string& channel, double rms_um, double noise_um, const std::string& what, double at_s, double freq_hz) {
+  ExplainedEffect x;
+  x.name = "other.unexplained", x.channel = channel, x.unit = "um", x.tolerance = kMaterialUm;
+  x.magnitude = rms_um;
+  x.params["residual_rms_um"] = rms_um, x.params["noise_rms_um"] = noise_um, x.params["largest_at_s"] = at_s, x.params["strongest_hz"] = freq_hz;
+  x.significant = rms_um > kMargin * noise_um && rms_um - noise_um >= kMaterialUm;
+  x.importance_um = x.significant ? rms_um - noise_um : 0.0;
+  x.evidence = what + fmt(" leaves %.3g um RMS where its noise explains %.3g um", rms_um, noise_um) +
+               (x.significant ? fmt("; largest at t = %.2f s, strongest at %.2f Hz", at_s, freq_hz) : std::string(": within its noise"));
+  return x;
+}
+
+// One mode's columns on a channel's rows: its displacement response to each driven axis'
+// acceleration and jerk (the mode is driven by the axis' actual acceleration, the
+// set-point's through its position loop: to first order a_cmd − τ·ȧ_cmd), per measured axis.
+std::vector<Eigen::VectorXd> mode_columns(const ExplainState& st, const Channel& rows, double f_hz, double zeta) {
+  std::vector<Eigen::VectorXd> cols;
+  const double fs = 1.0 / st.rr.dt_s;
+  const Eigen::Index n = rows.rows();
+  for (int j = 0; j < 3; ++j) {
+    if (!st.rr.moving[j]) continue;
+    const Eigen::VectorXd& a_j = st.rr.a_cmd.col(j);
+    Eigen::VectorXd jerk = Eigen::VectorXd::Zero(a_j.size());
+    for (Eigen::Index k = 1; k + 1 < a_j.size(); ++k) jerk[k] = (a_j[k + 1] - a_j[k - 1]) * fs / 2.0;
+    for (const Eigen::VectorXd& drive : {a_j, jerk}) {
+      const Eigen::VectorXd m_mm = mode_response(drive, fs, f_hz, zeta, true);
+      for (int a = 0; a < 3; ++a) {
+        Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
+        for (Eigen::Index i = 0; i < n; ++i)
+          if (rows.axis[static_cast<std::size_t>(i)] == a) c[i] = m_mm[rows.sample[static_cast<std::size_t>(i)]] * 1000.0;
+        if (c.norm() > 0.0) cols.push_back(c);
+      }
+    }
+  }
+  return cols;
+}
+
+Eigen::VectorXd residual_of(const Eigen::VectorXd& r, const std::vector<Eigen::VectorXd>& cols) {
+  if (cols.empty()) return r;
+  Eigen::MatrixXd x(r.size(), static_cast<Eigen::Index>(cols.size()));
+  for (std::size_t c = 0; c < cols.size(); ++c) x.col(static_cast<Eigen::Index>(c)) = cols[c];
+  return r - x * x.colPivHouseholderQr().solve(r);
+}
+
+// Reference − set-point less the relative displacement of the modes found: a mode the
+// vibration test named explains its ringing here too. Where a reference measures the
+// displacement itself, each mode's frequency and damping are refined on it (a fraction of a
+// per cent in f moves a ringing transient by micrometres).
+Eigen::VectorXd without_modes(const ExplainState& st, const Eigen::VectorXd& r, const Channel& rows) {
+  if (st.modes.empty()) return r;
+  std::vector<std::pair<double, double>> fz;
+  for (const auto& md : st.modes) fz.emplace_back(md.frequency_hz, md.damping_ratio);
+  auto all_cols = [&](std::size_t skip) {
+    std::vector<Eigen::VectorXd> cols;
+    for (std::size_t m = 0; m < fz.size(); ++m)
+      if (m != skip)
+        for (auto& c : mode_columns(st, rows, fz[m].first, fz[m].second)) cols.push_back(std::move(c));
+    return cols;
+  };
+  for (std::size_t m = 0; m < fz.size(); ++m) {
+    const auto others = all_cols(m);
+    const auto [f0, z0] = fz[m];
+    double best = INFINITY;
+    for (int fi = -3; fi <= 3; ++fi)
+      for (int zi = -3; zi <= 3; ++zi) {
+        const double f = f0 * (1.0 + 0.005 * fi), z = z0 * std::pow(1.12, zi);
+        auto cols = others;
+        for (auto& c : mode_columns(st, rows, f, z)) cols.push_back(std::move(c));
+        const double rss = residual_of(r, cols).squaredNorm();
+        if (rss < best) best = rss, fz[m] = {f, z};
+      }
+  }
+  return residual_of(r, all_cols(fz.size()));
+}
+
+}  // namespace
+
+void report_unexplained(ExplainState& st) {
+  const auto& lo = st.leftover;
+  std::vector<ExplainedEffect> found;
+  if (lo.held_expected_rms_um > 0.0) {
+    double at = 0.0, hz = 0.0;
+    if (!st.ex.traces.empty()) where(st.ex.traces.front().t_s, st.ex.traces.front().after_um, at, hz);
+    found.push_back(unexplained(st.rr.reference, lo.held_rms_um, lo.held_expected_rms_um,
+                                "the integrated motion with every effect of the table, predicted at the held-out points,", at, hz));
+  }
+  if (lo.machine_rows && lo.machine_residual.size() == lo.machine_rows->rows()) {
+    const Eigen::VectorXd left = without_modes(st, lo.machine_residual, *lo.machine_rows);
+    std::vector<double> t, r;
+    for (Eigen::Index i = 0; i < left.size(); ++i)
+      if (lo.machine_rows->axis[static_cast<std::size_t>(i)] == lo.machine_rows->axis.front())
+        t.push_back(st.rr.t_s[lo.machine_rows->sample[static_cast<std::size_t>(i)]]), r.push_back(left[i]);
+    double at = 0.0, hz = 0.0;
+    where(t, r, at, hz);
+    const double rms = std::sqrt(left.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, left.size())));
+    found.push_back(unexplained("machine", rms, lo.machine_noise_um,
+                                st.modes.empty() ? "reference - set-point after the base model and every effect of the table"
+                                                 : "reference - set-point after the base model, every effect of the table and the modes found",
+                                at, hz));
+  }
+  // A bias that wanders more than the data sheet says (named from the standstills) makes
+  // the integrated motion's held-out predictions worse than its noise model expects: that
+  // excess is the named effect, not an unexplained one.
+  for (const Effect noise_like : {Effect::sensor_bias_drift, Effect::sensor_scale_temperature})
+    if (const ExplainedEffect* e = st.find(name(noise_like)); e && e->significant && !found.empty() && found.front().channel == st.rr.reference &&
+                                                               found.front().significant) {
+      found.front().significant = false, found.front().importance_um = 0.0;
+      found.front().evidence += "; that excess is the " + e->name + " named above (not in the integration's noise model)";
+    }
+  // One finding: the larger excess.
+  if (found.empty()) return;
+  ExplainedEffect* best = &found.front();
+  for (auto& f : found)
+    if (f.significant && (!best->significant || f.importance_um > best->importance_um)) best = &f;
+  if (found.size() > 1 && !best->significant) best->evidence = found[0].evidence + "; " + found[1].evidence;
+  st.merge(*best);
+}
+
+}  // namespace eical::dsp::model::stage
