@@ -59,7 +59,7 @@ std::vector<CheckRow> check_plan(const TestProgram& p, int repeats, int draws) {
       id.meta.site = machine.meta.site, id.meta.machine = machine.meta.machine;
       for (int s = 0; s < 2; ++s) id.truth[s] = machine.truth[s];
       id.daq = machine.daq, id.machine = machine.machine, id.coriolis = machine.coriolis;
-      id.psd.assign(id.meta.psd.size(), machine.psd.empty() ? sim::PsdTruth{} : machine.psd.front());
+      id.psd = drawn_strips(id.meta.psd, seed);
       dsp::identify::apply_identification(dsp::identify::identify_sensors(sim::simulate(id)), run.meta);
       o.sensor_model = "psd";
     }
