@@ -55,8 +55,16 @@ std::vector<RunExplanation::Correlation> regressor_correlations(const RunResidua
 }  // namespace
 
 // One explanation is a flat list of stages over one state (explain/stages.hpp).
-RunExplanation explain_run(const Run& run, const ExplainOptions& options) {
+static RunExplanation explain_stages(const Run& run, const ExplainOptions& options, bool check_mounting) {
   stage::ExplainState st = stage::prepare(run, options);
+  if (check_mounting)
+    if (const auto m = stage::wrong_mounting(st)) {
+      Run remounted = run;
+      remounted.meta.sensors[static_cast<std::size_t>(m->sensor)].to_machine = m->to_machine;
+      RunExplanation ex = explain_stages(remounted, options, false);
+      ex.effects.insert(ex.effects.begin(), stage::mounting_effect(*m));
+      return ex;
+    }
   stage::fit_integrated_motion(st);
   stage::fit_reference_channel(st);
   stage::separate_timing(st);
@@ -64,6 +72,7 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& options) {
   stage::test_standstill_bias(st);
   stage::test_stick_slip(st);
   stage::test_vibration(st);
+  stage::compare_accelerations(st);
   stage::apply_physical_bounds(st);
   stage::extend_and_measure(st);
   stage::report_unexplained(st);
@@ -72,6 +81,8 @@ RunExplanation explain_run(const Run& run, const ExplainOptions& options) {
   st.ex.correlations = regressor_correlations(st.rr);
   return std::move(st.ex);
 }
+
+RunExplanation explain_run(const Run& run, const ExplainOptions& options) { return explain_stages(run, options, true); }
 
 TransferGain transfer_gain(const Run& to, const RunExplanation& from) {
   TransferGain g;

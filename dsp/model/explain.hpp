@@ -43,6 +43,9 @@ struct RunExplanation {
   std::string run_id, reference;
   double nominal_residual_rms_um = 0.0, final_residual_rms_um = 0.0;
   double heldout_nominal_rms_um = 0.0, heldout_final_rms_um = 0.0;
+  // Why no position was compared (nothing holds the double integral): the residuals above
+  // are then not computed (NaN) and the sensors are judged in acceleration.
+  std::string position_not_compared;
   std::vector<ExplainedEffect> effects;  // every effect tested, significant first
   // For the report: the residual per channel before and after the accepted extensions.
   struct Trace {

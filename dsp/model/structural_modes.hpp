@@ -35,6 +35,9 @@ struct ModeSearch {
   std::vector<StructuralMode> modes;  // strongest first
   double f_min_hz = 0.0, f_max_hz = 0.0, df_hz = 0.0;
   int averages = 0;
+  // The gain of the modes found: measured − commanded acceleration beyond the drive's own
+  // response (gain, lag, curvature), RMS over the run without and with them, mg.
+  double residual_rms_before_mg = 0.0, residual_rms_after_mg = 0.0;
   std::string evidence;               // what was searched, or why nothing could be
 };
 

@@ -261,7 +261,7 @@ void Pipeline::step(const Frame& f) noexcept {
       phase_ = Phase::moving;
       live_.integrating = true;
       if (m_.sample_index.size() < config_.capacity_samples)
-        supports_.step(0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(), cmd_valid, cmd_moved, cmd);
+        supports_.step({0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(), cmd_valid, cmd_moved, cmd});
       store(f, start_pos_mm_, Eigen::Vector3d::Zero());
       return;
     case Phase::moving: {
@@ -272,7 +272,7 @@ void Pipeline::step(const Frame& f) noexcept {
       const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
       const std::size_t k = m_.sample_index.size();
       if (k < config_.capacity_samples)
-        supports_.step(k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd);
+        supports_.step({k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd});
       // The live filter's estimate, predicted over the DAQ delay (what finish() re-indexes).
       const Eigen::Vector3d live_pos = pos_mm - supports_.live_dx_mm();
       live_.vel_mm_s = vel_mm_s - supports_.live_dv_mm_s();

@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
+#include <string>
 #include <numbers>
 #include <random>
 
@@ -103,4 +106,22 @@ TEST(EffectCatalogue, OneEntryPerEffectInEnumOrder) {
     EXPECT_FALSE(cat[i].bound_reason.empty()) << cat[i].name;
   }
   EXPECT_FALSE(eical::dsp::model::effect_named("machine.nothing").has_value());
+}
+
+// The README's table of physical bounds is the catalogue's: a bound changed in one place
+// and not the other fails here.
+TEST(EffectCatalogue, TheReadmeBoundsTableIsTheCatalogue) {
+  std::ifstream in(EICAL_SOURCE_DIR "/README.md");
+  ASSERT_TRUE(in.good());
+  const std::string readme((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto grouped = [](double v) {
+    if (v >= 1e9) return std::string("none");
+    std::string digits = std::to_string(static_cast<long long>(std::llround(v))), out;
+    for (std::size_t i = 0; i < digits.size(); ++i) out += (i && (digits.size() - i) % 3 == 0 ? " " : "") + std::string(1, digits[i]);
+    return out;
+  };
+  for (const auto& e : eical::dsp::model::effect_catalogue()) {
+    const std::string row = "| `" + std::string(e.name) + "` | " + std::string(e.unit) + " | " + grouped(e.bound) + " | " + grouped(e.bound_mems) + " | ";
+    EXPECT_NE(readme.find(row), std::string::npos) << row;
+  }
 }

@@ -7,6 +7,7 @@
 #include "dsp/model/explain.hpp"
 #include "dsp/model/run_residuals.hpp"
 #include "sim/hidden/hidden_effects.hpp"
+#include "sim/regimes/regimes.hpp"
 #include "sim/simulate.hpp"
 #include "tools/explain/extended_model.hpp"
 
@@ -71,6 +72,49 @@ TEST(ExtendedModel, AnEffectOnTwoAxesRoundTripsThroughTheScenario) {
   std::printf("backlash x %.2f y %.2f um read back from the written scenario\n", back.machine.backlash_um[0], back.machine.backlash_um[1]);
   EXPECT_NEAR(back.machine.backlash_um[0], 6.0, 1.5);
   EXPECT_NEAR(back.machine.backlash_um[1], 4.0, 1.5);
+}
+
+// Issue 15 item 5: the extended model carries the modes: the scenario explain writes
+// simulates a run in which explain finds them again.
+double mode_near(const dsp::model::RunExplanation& ex, double f_hz, double& zeta) {
+  for (const auto& e : ex.effects) {
+    if (e.name != "machine.resonance" || !e.significant) continue;
+    double best = INFINITY;
+    for (int k = 0; e.params.count("mode" + std::to_string(k) + "_frequency_hz"); ++k) {
+      const double f = e.params.at("mode" + std::to_string(k) + "_frequency_hz");
+      if (std::abs(f - f_hz) < std::abs(best - f_hz)) best = f, zeta = e.params.at("mode" + std::to_string(k) + "_damping_ratio");
+    }
+    return best;
+  }
+  return INFINITY;
+}
+
+TEST(ExtendedModel, TheModesFoundAreSimulatedAgainAndFoundAgain) {
+  sim::Scenario sc = sim::hidden_effect_scenario({}, "step", 101);
+  sim::set_sensors_present(sc, "head");
+  sim::StructuralMode md;
+  md.frequency_hz = 45.0, md.damping_ratio = 0.03, md.gain = 0.15, md.direction = Eigen::Vector3d::UnitX();
+  sc.resonance.modes = {md};
+  sc.resonance.part = 1;
+  const dsp::Run run = sim::simulate(sc);
+  const auto ex = dsp::model::explain_run(run);
+  const auto model = tools::explain::extended_model(run, ex);
+  const fs::path dir = fs::temp_directory_path() / ("eical_ext3_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  tools::explain::write_extended_model(model, dir / "cal.toml", dir / "scenario.toml");
+  const sim::Scenario back = drivers::read_scenario_file((dir / "scenario.toml").string());
+  fs::remove_all(dir);
+  ASSERT_EQ(back.resonance.modes.size(), 1u);
+  const auto again = dsp::model::explain_run(sim::simulate(back));
+  double z1 = NAN, z2 = NAN;
+  const double f1 = mode_near(ex, 45.0, z1), f2 = mode_near(again, 45.0, z2);
+  std::printf("mode 45 Hz zeta 0.030 gain 0.15: found %.2f Hz zeta %.4f; written gain %.3f; the written scenario simulated: %.2f Hz zeta %.4f\n", f1, z1,
+              back.resonance.modes[0].gain, f2, z2);
+  EXPECT_NEAR(f1, 45.0, 2.0);
+  EXPECT_NEAR(z1, 0.03, 0.009);
+  EXPECT_NEAR(back.resonance.modes[0].gain, 0.15, 0.045);
+  EXPECT_NEAR(f2, 45.0, 2.0);
+  EXPECT_NEAR(z2, 0.03, 0.009);
 }
 
 }  // namespace

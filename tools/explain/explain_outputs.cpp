@@ -89,6 +89,7 @@ nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector
                          {"heldout_nominal_residual_rms_um", r.heldout_nominal_rms_um},
                          {"heldout_final_residual_rms_um", r.heldout_final_rms_um},
                          {"runtime_s", r.seconds}};
+    if (!r.position_not_compared.empty()) pr["position_not_compared"] = r.position_not_compared;
     pr["correlations"] = nlohmann::json::array();
     for (const auto& c : r.correlations) pr["correlations"].push_back({{"axis", std::string(1, "xyz"[c.axis])}, {"regressor", c.regressor}, {"r", c.r}});
     pr["significant"] = nlohmann::json::array();
@@ -107,9 +108,13 @@ std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex, cons
   std::string o;
   char b[512];
   for (const auto& r : ex) {
-    std::snprintf(b, sizeof b, "%s (compared with: %s): pipeline residual %.3f um RMS -> %.3f um with the extended model; model prediction at held-out points %.3f -> %.3f um; %.1f s\n",
-                  r.run_id.c_str(), r.reference.c_str(), r.nominal_residual_rms_um, r.final_residual_rms_um, r.heldout_nominal_rms_um,
-                  r.heldout_final_rms_um, r.seconds);
+    if (!r.position_not_compared.empty())
+      std::snprintf(b, sizeof b, "%s (compared with: %s): no position compared: %s; %.1f s\n", r.run_id.c_str(), r.reference.c_str(),
+                    r.position_not_compared.c_str(), r.seconds);
+    else
+      std::snprintf(b, sizeof b, "%s (compared with: %s): pipeline residual %.3f um RMS -> %.3f um with the extended model; model prediction at held-out points %.3f -> %.3f um; %.1f s\n",
+                    r.run_id.c_str(), r.reference.c_str(), r.nominal_residual_rms_um, r.final_residual_rms_um, r.heldout_nominal_rms_um,
+                    r.heldout_final_rms_um, r.seconds);
     o += b;
     int sig = 0;
     for (const auto& e : r.effects) {

@@ -68,6 +68,24 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
         effects_toml += "\n[[effects.\"machine.cyclic_error\"]]\naxis = \"" + std::string(1, k[7]) + "\"\namp_um = " + drivers::toml_number(std::hypot(v, cs)) +
                         "\npitch_mm = " + drivers::toml_number(pitch) + "\nphase_deg = " + drivers::toml_number(std::atan2(cs, v) * 180.0 / std::numbers::pi) + "\n";
       }
+    } else if (x.name == "machine.resonance") {
+      // The simulator's mode: m'' + 2ζω m' + ω² m = −gain (d·a_drive) along d, so the
+      // response of axis i to input j is gain d_i d_j; explain reports the strongest |G|.
+      std::string modes;
+      for (int k = 0; p.count("mode" + std::to_string(k) + "_frequency_hz"); ++k) {
+        const std::string pre = "mode" + std::to_string(k) + "_";
+        Eigen::Vector3d d(p.at(pre + "direction_x"), p.at(pre + "direction_y"), p.at(pre + "direction_z"));
+        if (!(d.norm() > 0.0)) continue;
+        d.normalize();
+        const double in = d.cwiseAbs().maxCoeff();
+        modes += "\n[[effects.\"machine.resonance\".modes]]\nfrequency_hz = " + drivers::toml_number(p.at(pre + "frequency_hz")) +
+                 "\ndamping_ratio = " + drivers::toml_number(p.at(pre + "damping_ratio")) + "\ngain = " + drivers::toml_number(p.at(pre + "gain") / (in * in)) +
+                 "\ndirection = [" + drivers::toml_number(d.x()) + ", " + drivers::toml_number(d.y()) + ", " + drivers::toml_number(d.z()) + "]\n";
+      }
+      if (run.meta.program.kind == "freeform" && run.meta.program.gcode.empty())
+        m.notes.push_back("machine.resonance: into the scenario; the run's program (a recorded set-point, no G-code) has no generator: add a [sweep] or a gcode_file to simulate it");
+      if (!modes.empty())
+        effects_toml += std::string("\n[effects.\"machine.resonance\"]\npart = \"") + (run.meta.sensor_present[1] ? "head" : "table") + "\"\n" + modes;
     } else {
       m.notes.push_back(x.name + ": found; not taken into the scenario (its shape is not one of the simulator's tables)");
     }
@@ -89,7 +107,9 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
   }
   std::string text = drivers::run_toml_text(meta);
   const auto eol = text.find('\n');
-  text = "format = \"eical-scenario/1\"\nname = \"explained-" + meta.id + "\"\ndescription = \"what eical explain found in " + meta.id + "\"" +
+  // A run of one sensor is simulated with that sensor only (the other's columns empty).
+  const std::string present = meta.sensor_present[0] && meta.sensor_present[1] ? "" : meta.sensor_present[1] ? "\nsensors_present = \"head\"" : "\nsensors_present = \"table\"";
+  text = "format = \"eical-scenario/1\"\nname = \"explained-" + meta.id + "\"\ndescription = \"what eical explain found in " + meta.id + "\"" + present +
          text.substr(eol);
   if (const auto c = text.find("\ncreated = "); c != std::string::npos) text.erase(c, text.find('\n', c + 1) - c);
   m.scenario_toml = "# Written by eical explain: the run's program with the effects it found; eical simulate --scenario this-file -o RUN\n" + text +

@@ -8,6 +8,7 @@
 namespace eical::dsp::model::stage {
 
 void extend_and_measure(ExplainState& st) {
+  if (!st.integration_supported) return;  // no position to gain on
   const Run& run = st.run;
   RunResiduals& rr = st.rr;
   const std::vector<EffectModel>& machine = st.machine;

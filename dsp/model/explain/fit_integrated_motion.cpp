@@ -91,6 +91,7 @@ ExplainedEffect explained(const ExplainState& st, const GroupVerdict& v, bool is
 }  // namespace
 
 void fit_integrated_motion(ExplainState& st) {
+  if (!st.integration_supported) return;  // a double integral nothing holds shows no effect (compare_accelerations)
   const RunResiduals& rr = st.rr;
   std::vector<ParamGroup> groups = sensor_groups(rr);
   const std::size_t n_sensor_groups = groups.size();

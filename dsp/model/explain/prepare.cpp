@@ -14,6 +14,11 @@ ExplainState prepare(const Run& run, const ExplainOptions& options) {
   st.ex.run_id = rr.run_id, st.ex.reference = rr.reference;
   // A reference instrument holds the integration as a standstill does.
   st.integration_supported = unsupported_integration(rr.measurement).empty() || rr.has_ref[0] || rr.has_ref[1] || rr.has_ref[2];
+  if (!st.integration_supported) {
+    st.ex.position_not_compared = unsupported_integration(rr.measurement);
+    st.ex.nominal_residual_rms_um = st.ex.final_residual_rms_um = NAN;
+    st.ex.heldout_nominal_rms_um = st.ex.heldout_final_rms_um = NAN;
+  }
   // Shapes (spike time constant, cyclic pitch) are chosen on the residual that shows
   // machine effects: reference minus set-point, else the pipeline against the set-point.
   Eigen::MatrixXd hint = Eigen::MatrixXd::Constant(rr.n, 3, NAN);

@@ -2,6 +2,7 @@
 // The stages of eical explain (explain.hpp), each a function of the state they share: the
 // run's residuals and the effects found so far. explain_run calls them in a flat list.
 #include "dsp/core/run.hpp"
+#include "dsp/model/acceleration_comparison.hpp"
 #include "dsp/model/effect_catalog.hpp"
 #include "dsp/model/effects.hpp"
 #include "dsp/model/explain.hpp"
@@ -100,7 +101,11 @@ void report_earth_rate(ExplainState& st);       // site.coriolis from the site
 void test_standstill_bias(ExplainState& st);    // bias steps, drift, temperature at the standstills
 void test_stick_slip(ExplainState& st);
 void test_vibration(ExplainState& st);          // spectra and structural modes
-void compare_accelerations(ExplainState& st);   // runs nothing holds: mounting, scale, lag and bias in acceleration
+void compare_accelerations(ExplainState& st);   // runs nothing holds: mounting angle, scale, lag and bias in acceleration
+// A sensor mounted otherwise than run.toml says (flip, swap, mirror): explain_run then
+// explains the run with the mounting that fits, the finding first.
+std::optional<MountingFit> wrong_mounting(const ExplainState& st);
+ExplainedEffect mounting_effect(const MountingFit& m);
 void apply_physical_bounds(ExplainState& st);   // a size no sensor or machine can have is not that effect
 void report_unexplained(ExplainState& st);      // a residual beyond the noise that no effect explains
 void extend_and_measure(ExplainState& st);      // take the sensor side into the model, measure the gain

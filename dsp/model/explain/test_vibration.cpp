@@ -68,12 +68,18 @@ void test_vibration(ExplainState& st) {
     }
     if (k > 0) {
       named.significant = true;
+      named.params["residual_rms_before_mg"] = ms.residual_rms_before_mg, named.params["residual_rms_after_mg"] = ms.residual_rms_after_mg;
+      named.evidence += fmt("; with the modes, measured - commanded acceleration beyond the drive's own response falls from %.3g to %.3g mg RMS", ms.residual_rms_before_mg,
+                            ms.residual_rms_after_mg);
       named.magnitude = std::max(named.magnitude, relative ? largest_um : largest);
       named.importance_um = std::max(named.importance_um, 1.0 + largest);
       named.evidence = (relative ? "head against table: " : "") + named.evidence;
     }
-    res.evidence = (k > 0 ? "the " : "") + res.evidence + (res.evidence.empty() ? ms.evidence + (k == 0 ? ": no mode stands out" : "") : "; " + ms.evidence);
-    if (k > 0 && relative) res.evidence = ms.evidence + ": the modes found are real relative motion of the two sensors (machine.differential_vibration)";
+    if (!relative) {
+      std::string modes = res.evidence;  // "; a mode at …; a mode at …"
+      if (modes.rfind("; ", 0) == 0) modes.erase(0, 2);
+      res.evidence = k > 0 ? modes + "; " + ms.evidence : ms.evidence + ": no mode stands out";
+    } else if (k > 0) res.evidence = ms.evidence + ": the modes found are real relative motion of the two sensors (machine.differential_vibration)";
     all.push_back(c), all.push_back(d), all.push_back(res);
   }
 }
