@@ -77,7 +77,7 @@ RunResiduals build_residuals(const Run& run) {
   d.segment.assign(static_cast<std::size_t>(n), 0);
   std::vector<std::int64_t> marks;
   for (const auto& t : m.triggers)
-    if (t.code == 102) marks.push_back(t.sample_index);
+    if (t.code == trigger::segment_mark) marks.push_back(t.sample_index);
   const std::int64_t first_frame = run.frames.front().sample_index;
   const double dly = d.delay_samples;
   float t0[2] = {NAN, NAN};
