@@ -115,18 +115,23 @@ eval::PositioningInput positioning_deviations(const Measurement& m, const Progra
   return in;
 }
 
-Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
-  if (run.frames.empty()) throw InputError("run '" + run.meta.id + "' holds no frames");
-  if (!(run.meta.acquisition.fs_hz > 0.0)) throw InputError("run '" + run.meta.id + "': fs_hz must be positive");
-  PipelineConfig cfg = pipeline_config(run.meta, run.frames.size());
+PipelineConfig analysis_config(const RunMeta& meta, std::size_t capacity_samples, const AnalysisOptions& options) {
+  PipelineConfig cfg = pipeline_config(meta, capacity_samples);
   cfg.dynamic = options.dynamic;
   cfg.zupt = options.zupt;
-  cfg.nbs = options.nbs.value_or(run.meta.program.kind == "rectangle");
+  cfg.nbs = options.nbs.value_or(meta.program.kind == "rectangle");
   cfg.coriolis = options.coriolis;
   cfg.cupt = options.cupt;
   cfg.keep_raw = options.keep_raw;
   if (options.sensor_model != "datasheet") cfg.fusion.scale_uncertainty = 3e-5;  // identified on site
   cfg.calibration[0] = options.calibration[0], cfg.calibration[1] = options.calibration[1];
+  return cfg;
+}
+
+Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
+  if (run.frames.empty()) throw InputError("run '" + run.meta.id + "' holds no frames");
+  if (!(run.meta.acquisition.fs_hz > 0.0)) throw InputError("run '" + run.meta.id + "': fs_hz must be positive");
+  const PipelineConfig cfg = analysis_config(run.meta, run.frames.size(), options);
   Pipeline pipeline(cfg);
   for (const auto& f : run.frames) pipeline.step(f);
   Analysis a;
@@ -135,14 +140,19 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   a.measurement = pipeline.finish();
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;
-  if (a.measurement.sample_index.empty()) return a;  // no motion: nothing to evaluate
+  evaluate_measurement(run, a);
+  return a;
+}
+
+void evaluate_measurement(const Run& run, Analysis& a) {
+  if (a.measurement.sample_index.empty()) return;  // no motion: nothing to evaluate
   if (const std::string why = unsupported_integration(a.measurement); !why.empty()) {
     // run-format.md, "No standstill": a double integral with nothing to hold it is no
     // position. Every positional figure is null with this reason; eical explain compares
     // such runs in acceleration against the set-point.
     a.flags.push_back("position: null, " + why);
     a.degraded = true;
-    return a;
+    return;
   }
   {
     eval::RepeatInput ri;
@@ -152,6 +162,10 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
     ri.fs_hz = a.measurement.fs_hz;
     a.repeats = eval::average_repeats(ri);
   }
+  evaluate_program(run, a);
+}
+
+void evaluate_program(const Run& run, Analysis& a) {
   const std::string& kind = run.meta.program.kind;
   if (kind == "circle") detail::evaluate_circle_program(run, a);
   else if (kind == "step") evaluate_step_program(run, a);
@@ -159,7 +173,6 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   else if (kind == "rectangle") detail::evaluate_rectangle_program(run, a);
   else if (kind == "freeform") detail::evaluate_freeform_program(run, a);
   else a.flags.push_back("program kind '" + kind + "': no evaluation in this version");
-  return a;
 }
 
 }  // namespace eical::dsp

@@ -54,8 +54,18 @@ struct Analysis {
   std::vector<std::string> flags;  // pipeline quality flags and evaluation failures
 };
 
-// Throws InputError only when the run itself is unusable (no frames, fs ≤ 0).
+// Throws InputError only when the run itself is unusable (no frames, fs ≤ 0). Holds the
+// run's trace; runs of any length: analyze_stream() (dsp/stream), equal results.
 Analysis analyze_run(const Run& run, const AnalysisOptions& options = {});
+
+// The pipeline configuration of the analysis.
+PipelineConfig analysis_config(const RunMeta& meta, std::size_t capacity_samples, const AnalysisOptions& options);
+
+// What analyze_run does after the pipeline: the integration check, the repeats, the
+// program's evaluation (a.measurement set; failures into a.flags).
+void evaluate_measurement(const Run& run, Analysis& a);
+// The program's evaluation alone.
+void evaluate_program(const Run& run, Analysis& a);
 
 // Deviations at the targets of a positioning program: at each M102 (target reached) the
 // mean of measured − set-point over the second half of the dwell, grouped by target and

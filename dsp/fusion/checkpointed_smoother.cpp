@@ -94,7 +94,8 @@ void CheckpointedSmoother::forward(Checkpoint& c, std::size_t first, std::size_t
     }
     Vec3 vel = Vec3::Zero();  // read only where the flags say so
     if (reads_velocity(flags[k])) vel = track_.support_vel_mm_s[c.next_vel++];
-    fwd.velocity_supports(flags[k], vel * 1000.0, m, k < zs.size() ? static_cast<double>(zs[k]) : 0.0, sch.zupt);
+    const double zupt_sigma = k < zs.size() ? static_cast<double>(zs[k]) : (k < track_.zupt_unused.size() && track_.zupt_unused[k] ? -1.0 : 0.0);
+    fwd.velocity_supports(flags[k], vel * 1000.0, m, zupt_sigma, sch.zupt);
     for (; c.next_mean < means_.size() && means_[c.next_mean].k <= k; ++c.next_mean)
       if (means_[c.next_mean].k == k) fwd.velocity_mean(means_[c.next_mean], m, sch.zupt);
     for (; c.next_fix < fixes_.size() && fixes_[c.next_fix].k == k; ++c.next_fix) {

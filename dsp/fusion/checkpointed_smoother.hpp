@@ -41,6 +41,9 @@ struct SmootherTrack {
   std::vector<Vec3> support_vel_mm_s;
   // The integrated position (mm) along the fix's axis at each of schedule->fixes, same order.
   std::vector<double> fix_pos_mm;
+  // When schedule->zupt_sigma_um_s is empty: its values as bits (true: −1, a standstill
+  // sample whose velocity is not used; false: 0), an eighth of a byte per sample.
+  std::vector<bool> zupt_unused;
 };
 
 struct SmootherSettings {
