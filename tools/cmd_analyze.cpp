@@ -1,6 +1,7 @@
 // eical analyze RUN [--json]: the pipeline and the program's evaluation on a recorded run.
 #include "drivers/config/sensor_calibration.hpp"
-#include "drivers/run_io/run_reader.hpp"
+#include "drivers/run_io/file_spill.hpp"
+#include "drivers/run_io/run_stream.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "tools/commands.hpp"
 #include "drivers/results/result_json.hpp"
@@ -30,7 +31,9 @@ void register_analyze(CLI::App& app) {
   cmd->add_option("--calibration", o->calibration, "sensor calibration (eical-sensor-cal/1, from eical identify) instead of the run's data sheet")
       ->check(CLI::ExistingFile);
   cmd->callback([o] {
-    dsp::Run run = drivers::read_run(o->run);
+    // Read as it streams: memory bounded whatever the run's length (dsp/stream).
+    drivers::RunStream stream(o->run);
+    dsp::Run& run = stream.header();
     dsp::AnalysisOptions opt;
     if (!o->calibration.empty())
       drivers::apply_calibration(drivers::read_sensor_calibration(o->calibration, run.meta), run.meta, opt);
@@ -38,7 +41,10 @@ void register_analyze(CLI::App& app) {
     opt.zupt = !o->no_zupt;
     if (o->nbs != "auto") opt.nbs = o->nbs == "on";
     opt.coriolis = o->coriolis;
-    const dsp::Analysis a = dsp::analyze_run(run, opt);
+    dsp::StreamOptions so;
+    so.spills = drivers::file_spills(drivers::default_spill_dir());
+    so.spill_trace = true;  // a CSV reads slower than a spill
+    const dsp::Analysis a = drivers::analyze_stream(stream, opt, so);
     if (o->json) std::printf("%s\n", drivers::result_json(run, a).dump(2).c_str());
     else std::fputs(summary_text(run, a).c_str(), stdout);
   });
