@@ -43,7 +43,7 @@ void register_analyze(CLI::App& app) {
     opt.coriolis = o->coriolis;
     dsp::StreamOptions so;
     so.spills = drivers::file_spills(drivers::default_spill_dir());
-    so.spill_trace = true;  // a CSV reads slower than a spill
+    so.spill_trace = so.spill_corrections = true;  // a CSV reads slower than a spill, a spill faster than the smoother
     const dsp::Analysis a = drivers::analyze_stream(stream, opt, so);
     if (o->json) std::printf("%s\n", drivers::result_json(run, a).dump(2).c_str());
     else std::fputs(summary_text(run, a).c_str(), stdout);

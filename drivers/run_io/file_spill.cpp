@@ -59,6 +59,17 @@ class FileSpill final : public dsp::Spill {
       off += want;
     }
   }
+  void read_at(std::size_t offset, void* out, std::size_t bytes) override {
+    flush();
+    if (offset + bytes > size_) throw dsp::InputError("spill in " + dir_.string() + ": read beyond what was written");
+    auto* p = static_cast<unsigned char*>(out);
+    for (std::size_t got = 0; got < bytes;) {
+      const ssize_t r = ::pread(fd_, p + got, bytes - got, static_cast<off_t>(offset + got));
+      if (r < 0 && errno == EINTR) continue;
+      if (r <= 0) throw dsp::InputError("spill in " + dir_.string() + ": read failed: " + (r < 0 ? std::strerror(errno) : "end of file"));
+      got += static_cast<std::size_t>(r);
+    }
+  }
   [[nodiscard]] std::size_t bytes() const override { return size_ + buf_.size(); }
 
  private:

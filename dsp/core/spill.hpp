@@ -8,6 +8,7 @@
 #include <cstring>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <type_traits>
 #include <vector>
 
@@ -20,6 +21,8 @@ class Spill {
   virtual void write(const void* data, std::size_t bytes) = 0;
   // Everything written, from the start, in blocks that are whole multiples of record_bytes.
   virtual void read(std::size_t record_bytes, const std::function<void(const void* data, std::size_t bytes)>& block) = 0;
+  // `bytes` from `offset` (within what was written) into out.
+  virtual void read_at(std::size_t offset, void* out, std::size_t bytes) = 0;
   [[nodiscard]] virtual std::size_t bytes() const = 0;
 };
 
@@ -34,6 +37,10 @@ class MemorySpill final : public Spill {
   }
   void read(std::size_t, const std::function<void(const void*, std::size_t)>& block) override {
     if (!bytes_.empty()) block(bytes_.data(), bytes_.size());
+  }
+  void read_at(std::size_t offset, void* out, std::size_t bytes) override {
+    if (offset + bytes > bytes_.size()) throw std::out_of_range("spill: read beyond what was written");
+    std::memcpy(out, bytes_.data() + offset, bytes);
   }
   [[nodiscard]] std::size_t bytes() const override { return bytes_.size(); }
 

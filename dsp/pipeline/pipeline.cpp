@@ -394,7 +394,7 @@ void note_sigma(Measurement& m, const std::vector<Eigen::Vector3d>& sigma_um) {
   }
 }
 
-Pipeline::Tracked Pipeline::finish_track() {
+Pipeline::Tracked Pipeline::finish_track(fusion::SegmentSink* sink) {
   if (config_.trace != TraceKeeping::track) throw InputError("pipeline: finish_track() needs TraceKeeping::track");
   Tracked t;
   Measurement& m = t.measurement;
@@ -409,7 +409,7 @@ Pipeline::Tracked Pipeline::finish_track() {
   if (phase_ == Phase::moving && stored_ > 0) {
     const std::int64_t first = first_stored_;
     const SupportStage& stage = supports_;
-    m.supports = supports_.finish_track(stored_, [&](std::size_t k) { return stage.trace_index(first, k); }, t.correction);
+    m.supports = supports_.finish_track(stored_, [&](std::size_t k) { return stage.trace_index(first, k); }, t.correction, sink);
     Eigen::Vector3d v_rest = Eigen::Vector3d::Zero();
     if (!m.supports.rest_windows.empty() && t.correction) {
       // Rest windows in trace positions again (they are consecutive samples of the trace).

@@ -186,7 +186,8 @@ class Pipeline {
     std::unique_ptr<SmoothedCorrection> correction;
     double delay_samples = 0.0;  // to re-index by (0: none, DynamicComp::none)
   };
-  Tracked finish_track();
+  // sink: receives the smoothed errors as they are made (to keep them, not recompute them).
+  Tracked finish_track(fusion::SegmentSink* sink = nullptr);
   // Back to waiting for M101, keeping the reserved trace storage (for the live path,
   // which discards its causal estimate at the end of each measurement).
   void reset() noexcept;

@@ -268,7 +268,7 @@ SupportSummary SupportStage::refine(std::size_t n, const std::function<std::int6
   return sum;
 }
 
-std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, SupportSummary& sum, bool hand_over) {
+std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, SupportSummary& sum, bool hand_over, fusion::SegmentSink* sink) {
   auto c = std::make_unique<SmoothedCorrection>();
   c->track.n = n;
   c->track.schedule = &c->schedule;
@@ -293,7 +293,7 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   fusion::SmootherSettings st;
   st.fs_hz = fs_hz_, st.model = cfg_.model, st.start_bias_sigma_um_s2 = start_bias_sigma_;
   st.forward_only = !cfg_.smooth;
-  c->smoother = std::make_unique<fusion::CheckpointedSmoother>(c->track, st);
+  c->smoother = std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
   // PSD readings the integration cannot follow — its strip resets, or rejections of more
   // than 5 % — mean the sensor model is off (uncalibrated scale or mounting: the error is
   // then no slowly wandering bias, and pulling the trace to the strips would bend it far
@@ -304,7 +304,7 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
     sum.psd_disagrees = true;
     sum.psd_rejected = cupt_bad;
     c->schedule.cupt = false;  // for good: segments are recomputed from this schedule
-    c->smoother = std::make_unique<fusion::CheckpointedSmoother>(c->track, st);
+    c->smoother = std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
   }
   c->apply = c->smoother->finite();
   if (!c->apply) {  // an input the model cannot take (a saturated channel): leave the trace as integrated
@@ -343,11 +343,11 @@ SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::v
 }
 
 SupportSummary SupportStage::finish_track(std::size_t samples, const std::function<std::int64_t(std::size_t)>& index_at,
-                                          std::unique_ptr<SmoothedCorrection>& correction) {
+                                          std::unique_ptr<SmoothedCorrection>& correction, fusion::SegmentSink* sink) {
   SupportSummary sum = refine(samples, index_at);
   correction.reset();
   if (schedule_.flags.empty()) return sum;
-  correction = smooth_track(schedule_.flags.size(), sum, true);
+  correction = smooth_track(schedule_.flags.size(), sum, true, sink);
   return sum;
 }
 

@@ -115,7 +115,7 @@ class SupportStage {
   // applied segment by segment (`correction`, which takes the recorded schedule: call
   // recorded_velocity_sum() first). index_at(k): sample index of trace sample k.
   SupportSummary finish_track(std::size_t samples, const std::function<std::int64_t(std::size_t)>& index_at,
-                              std::unique_ptr<SmoothedCorrection>& correction);
+                              std::unique_ptr<SmoothedCorrection>& correction, fusion::SegmentSink* sink = nullptr);
   // The integrated velocity (mm/s, as recorded) of trace samples [first, last], summed
   // over those the smoother reads; and how many (what ZUPT takes out at a standstill).
   [[nodiscard]] std::pair<Eigen::Vector3d, std::size_t> recorded_velocity_sum(std::size_t first, std::size_t last) const {
@@ -133,7 +133,7 @@ class SupportStage {
   SupportSummary refine(std::size_t n, const std::function<std::int64_t(std::size_t)>& index_at);
   // The smoother over the recorded track (its second half); CUPT is dropped when the strips
   // disagree. hand_over: the recorded schedule and track move into the result.
-  std::unique_ptr<SmoothedCorrection> smooth_track(std::size_t n, SupportSummary& sum, bool hand_over);
+  std::unique_ptr<SmoothedCorrection> smooth_track(std::size_t n, SupportSummary& sum, bool hand_over, fusion::SegmentSink* sink = nullptr);
 
   SupportConfig cfg_;
   double fs_hz_ = 10000.0, delay_samples_ = 0.0;

@@ -72,6 +72,47 @@ class Scout final : public TraceSink {
   std::deque<std::int64_t> marks_;
 };
 
+// The smoothed errors as the smoother makes them, in a spill: the second pass reads each
+// segment's instead of recomputing it (a filter pass forward and one back).
+class CorrectionSpill final : public fusion::SegmentSink {
+ public:
+  explicit CorrectionSpill(SpillFactory factory) : factory_(std::move(factory)) {}
+  void restart() override {
+    spill_ = factory_();
+    where_.clear();
+    bytes_ = 0;
+  }
+  void segment(std::size_t j, const fusion::SmoothedSegment& s) override {
+    if (where_.size() <= j) where_.resize(j + 1);
+    where_[j] = {bytes_, s.first, s.size()};
+    buf_.resize(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i)
+      for (int a = 0; a < 3; ++a) buf_[i].v[a] = s.dx_um[i][a], buf_[i].v[3 + a] = s.dv_um_s[i][a], buf_[i].v[6 + a] = s.sigma_x_um[i][a];
+    spill_->write(buf_.data(), buf_.size() * sizeof(Doubles<9>));
+    bytes_ += buf_.size() * sizeof(Doubles<9>);
+  }
+  [[nodiscard]] bool has(std::size_t j) const { return j < where_.size() && where_[j].size > 0; }
+  void load(std::size_t j, fusion::SmoothedSegment& out) {
+    const Where& w = where_[j];
+    buf_.resize(w.size);
+    spill_->read_at(w.offset, buf_.data(), w.size * sizeof(Doubles<9>));
+    out.first = w.first;
+    out.dx_um.resize(w.size), out.dv_um_s.resize(w.size), out.sigma_x_um.resize(w.size);
+    for (std::size_t i = 0; i < w.size; ++i)
+      for (int a = 0; a < 3; ++a) out.dx_um[i][a] = buf_[i].v[a], out.dv_um_s[i][a] = buf_[i].v[3 + a], out.sigma_x_um[i][a] = buf_[i].v[6 + a];
+  }
+
+ private:
+  struct Where {
+    std::size_t offset = 0, first = 0, size = 0;
+  };
+  SpillFactory factory_;
+  std::unique_ptr<Spill> spill_;
+  std::vector<Where> where_;
+  std::size_t bytes_ = 0;
+  std::vector<Doubles<9>> buf_;
+};
+
 // A trace sample as the evaluation sees it: corrected by the supports, on the set-point's time.
 struct Corrected {
   std::size_t k = 0;
@@ -83,8 +124,9 @@ struct Corrected {
 // by segment (SupportStage::finish), then re-indexed by the DAQ delay (Pipeline::align_delay).
 class Emitter final : public TraceSink {
  public:
-  Emitter(const Pipeline::Tracked& t, std::function<void(const Corrected&)> out)
-      : n_(t.samples), correction_(t.correction.get()), d_(t.delay_samples), align_(t.delay_samples > 0.0 && t.samples >= 2), out_(std::move(out)) {}
+  Emitter(const Pipeline::Tracked& t, CorrectionSpill* kept, std::function<void(const Corrected&)> out)
+      : n_(t.samples), correction_(t.correction.get()), kept_(kept), d_(t.delay_samples), align_(t.delay_samples > 0.0 && t.samples >= 2),
+        out_(std::move(out)) {}
 
   void sample(const TraceSample& s) override {
     Corrected c;
@@ -95,7 +137,9 @@ class Emitter final : public TraceSink {
     if (correction_ && correction_->apply) {
       const auto& sm = *correction_->smoother;
       if (c.k >= seg_.first + seg_.size() || !loaded_) {
-        sm.segment(c.k / sm.segment_samples(), seg_);
+        const std::size_t j = c.k / sm.segment_samples();
+        if (kept_ && kept_->has(j)) kept_->load(j, seg_);
+        else sm.segment(j, seg_);
         loaded_ = true;
       }
       const std::size_t i = c.k - seg_.first;
@@ -143,6 +187,7 @@ class Emitter final : public TraceSink {
 
   std::size_t n_;
   const SmoothedCorrection* correction_;
+  CorrectionSpill* kept_;
   double d_;
   bool align_;
   std::function<void(const Corrected&)> out_;
@@ -182,6 +227,8 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   cfg.trace = TraceKeeping::track;
   cfg.sink = &scout;
   std::size_t n_frames = 0;
+  std::optional<CorrectionSpill> kept;
+  if (stream.spill_corrections) kept.emplace(stream.spills);
   Pipeline::Tracked t;
   {
     Pipeline pipeline(cfg);
@@ -191,7 +238,7 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
       ++n_frames;
     });
     if (n_frames == 0) throw InputError("run '" + header.meta.id + "' holds no frames");
-    t = pipeline.finish_track();
+    t = pipeline.finish_track(kept ? &*kept : nullptr);
   }
   scout.repeats.finish();
   Analysis a;
@@ -218,7 +265,7 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   }
   scout = Scout(header, false);  // what it decided is out; its set-point records can go
   scout.trace = nullptr;
-  Emitter emitter(t, [&](const Corrected& c) {
+  Emitter emitter(t, kept ? &*kept : nullptr, [&](const Corrected& c) {
     keep(m, c, q, n);
     if (c.sigma_um.allFinite()) m.sigma_max_um = m.sigma_max_um.cwiseMax(c.sigma_um);
     m.sigma_peak_um = std::max(m.sigma_peak_um, c.sigma_um.maxCoeff());

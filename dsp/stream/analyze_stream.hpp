@@ -28,6 +28,9 @@ struct StreamOptions {
   // on disk) instead of running the frames through the pipeline again: for frames that
   // are slow to read (a CSV file); frames in memory replay faster than a spill reads.
   bool spill_trace = false;
+  // The smoother's corrections kept in a spill as it makes them (72 B a sample) instead of
+  // recomputed segment by segment in the second pass (two of the smoother's five passes).
+  bool spill_corrections = false;
 };
 
 // header: the run's metadata and channels (its frames are not read; `frames` is).

@@ -188,7 +188,7 @@ TEST(AnalyzeStream, ReadFromDiskAsEicalAnalyzeReadsIt) {
       drivers::RunStream stream(run_dir);
       dsp::StreamOptions so;
       so.spills = drivers::file_spills(dir);
-      so.spill_trace = spill_trace;
+      so.spill_trace = so.spill_corrections = spill_trace;
       const dsp::Analysis s = drivers::analyze_stream(stream, {}, so);
       EXPECT_EQ(stream.header().meta.sensor_present[0], read.meta.sensor_present[0]);
       EXPECT_EQ(stream.header().meta.sensor_present[1], read.meta.sensor_present[1]);
