@@ -6,6 +6,7 @@
 
 #if EICAL_HAVE_DDS
 #include "drivers/dds/bus.hpp"
+#include "drivers/results/resolved.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -106,11 +107,22 @@ void register_hmi(CLI::App& app) {
                     nonzero_counters(*s).c_str(), s->fault.empty() ? "" : " — ", s->fault.c_str());
       }
       if (auto r = bus.take_result(std::chrono::milliseconds(10))) {
+        // The figures with their uncertainty and the verdict, from the result document.
+        std::string verdict = r->degraded ? "degraded" : "ok", g = "G n/a";
+        const auto doc = nlohmann::json::parse(r->json, nullptr, false);
+        if (!doc.is_discarded()) {
+          verdict = doc.value("/quality/verdict"_json_pointer, verdict);
+          const auto v = drivers::figure_value(doc, "circle.circular_deviation_G_um");
+          const auto u = drivers::uncertainty_k2(doc, "circle.circular_deviation_G_um");
+          char b[96];
+          if (v) std::snprintf(b, sizeof b, "G %.2f%s um%s", *v, u ? (" ± " + std::to_string(*u).substr(0, std::to_string(*u).find('.') + 3)).c_str() : "",
+                               u && !drivers::figure_resolved(doc, "circle.circular_deviation_G_um") ? " (not resolved)" : "");
+          if (v) g = b;
+        }
         daemon_seen = true;
         result_count = std::max(result_count, r->results);
-        std::printf("result %s (%s)%s: G %.2f um, mean radius deviation %.2f um (result %llu of the daemon)\n", r->program_id.c_str(),
-                    r->program.c_str(), r->degraded ? " DEGRADED" : "", r->circular_deviation_G_um, r->radius_mean_deviation_um,
-                    static_cast<unsigned long long>(r->results));
+        std::printf("result %s (%s): verdict %s, %s, mean radius deviation %.2f um (result %llu of the daemon)\n", r->program_id.c_str(), r->program.c_str(),
+                    verdict.c_str(), g.c_str(), r->radius_mean_deviation_um, static_cast<unsigned long long>(r->results));
         ++results;
       }
       if (auto t = bus.take_trace(std::chrono::milliseconds(10))) {

@@ -45,7 +45,7 @@ std::vector<std::string> temperature_flags(const dsp::Run& run, const Limits& li
     float lo = INFINITY, hi = -INFINITY;
     for (const auto& f : run.frames)
       if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s])) lo = std::min(lo, f.temp_c[s]), hi = std::max(hi, f.temp_c[s]);
-    if (!(lo <= hi) || (lo >= limits.temp_min_c && hi <= limits.temp_max_c)) continue;
+    if (!(lo <= hi) || (static_cast<double>(lo) >= limits.temp_min_c && static_cast<double>(hi) <= limits.temp_max_c)) continue;
     char b[200];
     std::snprintf(b, sizeof b, "temperature: the %s sensor was at %.1f..%.1f degC, outside [limits] temp_min_c..temp_max_c = %.1f..%.1f degC",
                   names[s], static_cast<double>(lo), static_cast<double>(hi), limits.temp_min_c, limits.temp_max_c);

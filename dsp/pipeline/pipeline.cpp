@@ -135,6 +135,8 @@ void Pipeline::store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen:
       TraceSample s;
       s.sample_index = f.sample_index;
       s.trigger = f.trigger;
+      s.temp_c[0] = f.temp_c[0], s.temp_c[1] = f.temp_c[1];
+      s.frame_flags = f.flags;
       s.pos_mm = pos_mm, s.vel_mm_s = vel_mm_s;
       s.cmd_mm = Eigen::Vector3d(f.cmd_mm[0], f.cmd_mm[1], f.cmd_mm[2]);
       s.ref_mm = Eigen::Vector3d(f.ref_mm[0], f.ref_mm[1], f.ref_mm[2]);
@@ -283,7 +285,7 @@ void Pipeline::step(const Frame& f) noexcept {
       phase_ = Phase::moving;
       live_.integrating = true;
       if (runs_supports() && stored_ < config_.capacity_samples)
-        supports_.step(0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(), cmd_valid, cmd_moved, cmd);
+        supports_.step({0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(), cmd_valid, cmd_moved, cmd});
       store(f, start_pos_mm_, Eigen::Vector3d::Zero());
       return;
     case Phase::moving: {
@@ -294,7 +296,7 @@ void Pipeline::step(const Frame& f) noexcept {
       const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
       const std::size_t k = stored_;
       if (runs_supports() && k < config_.capacity_samples)
-        supports_.step(k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd);
+        supports_.step({k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd});
       // The live filter's estimate, predicted over the DAQ delay (what finish() re-indexes).
       const Eigen::Vector3d live_pos = pos_mm - supports_.live_dx_mm();
       live_.vel_mm_s = vel_mm_s - supports_.live_dv_mm_s();
@@ -337,7 +339,7 @@ void Pipeline::apply_supports(Measurement& m) {
   }
   std::vector<Eigen::Vector3d> sigma;
   m.supports = supports_.finish(m.sample_index, m.pos_mm, m.vel_mm_s, sigma);
-  if (config_.keep_raw) m.raw.schedule = supports_.schedule();
+  if (config_.keep_raw || config_.keep_schedule) m.raw.schedule = supports_.schedule();
   m.sigma_um = std::move(sigma);
   // The raw integrated velocity at the last standstill: what ZUPT takes out there.
   Eigen::Vector3d v_rest = Eigen::Vector3d::Zero();

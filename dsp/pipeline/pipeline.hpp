@@ -51,6 +51,8 @@ enum class TraceKeeping {
 struct TraceSample {
   std::int64_t sample_index = 0;
   std::int32_t trigger = 0;  // the frame's NC trigger code (0: none)
+  float temp_c[2] = {0.0F, 0.0F};  // the frame's case temperatures (table, head)
+  std::uint32_t frame_flags = 0;   // the frame's frame_flag bits
   Eigen::Vector3d pos_mm = Eigen::Vector3d::Zero(), vel_mm_s = Eigen::Vector3d::Zero();
   Eigen::Vector3d cmd_mm = Eigen::Vector3d::Zero(), ref_mm = Eigen::Vector3d::Zero();
 };
@@ -92,6 +94,7 @@ struct PipelineConfig {
   bool smooth = true;  // RTS pass in finish() (off: the forward filter's causal result)
   fusion::ErrorModel fusion;  // pipeline_config() sets the noise from the sensors' data sheet
   bool keep_raw = false;      // Measurement::raw (identification, explain; offline only)
+  bool keep_schedule = false; // Measurement::raw.schedule alone (the uncertainty of the figures)
   TraceKeeping trace = TraceKeeping::whole;
   TraceSink* sink = nullptr;  // track and replay: where the stored samples go (may be none)
   supports::StandstillOptions standstill;
@@ -162,6 +165,9 @@ struct Measurement {
   // and the largest of any axis (NaN ignored) — what the result and the integration check quote.
   Eigen::Vector3d sigma_max_um = Eigen::Vector3d::Zero();
   double sigma_peak_um = 0.0;
+  // Streamed runs (no frames kept): each sample's case temperatures, table and head (the
+  // last finite ones), what the uncertainty reads from the frames otherwise.
+  std::vector<Eigen::Vector2d> temp_c;
   SupportSummary supports;
   RawTrace raw;                            // only with PipelineConfig::keep_raw
 };

@@ -1,5 +1,6 @@
 #include "dsp/stream/analyze_stream.hpp"
 
+#include "dsp/analysis/verdict.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/eval/circle_segments.hpp"
 #include "dsp/eval/repeats.hpp"
@@ -41,8 +42,10 @@ class Scout final : public TraceSink {
     marks_.push_back(f.sample_index);
   }
   void sample(const TraceSample& s) override {
-    if (trace) trace->put({{static_cast<double>(s.sample_index), static_cast<double>(s.trigger), s.pos_mm[0], s.pos_mm[1], s.pos_mm[2], s.vel_mm_s[0],
-                            s.vel_mm_s[1], s.vel_mm_s[2], s.cmd_mm[0], s.cmd_mm[1], s.cmd_mm[2], s.ref_mm[0], s.ref_mm[1], s.ref_mm[2]}});
+    if (trace)
+      trace->put({{static_cast<double>(s.sample_index), static_cast<double>(s.trigger), s.pos_mm[0], s.pos_mm[1], s.pos_mm[2], s.vel_mm_s[0],
+                   s.vel_mm_s[1], s.vel_mm_s[2], s.cmd_mm[0], s.cmd_mm[1], s.cmd_mm[2], s.ref_mm[0], s.ref_mm[1], s.ref_mm[2],
+                   static_cast<double>(s.temp_c[0]), static_cast<double>(s.temp_c[1]), static_cast<double>(s.frame_flags)}});
     if (circle_) {
       repeats.add(n, s.sample_index, s.cmd_mm);
       // A mark counts at the trace sample it falls on (or, between samples, at the next
@@ -59,7 +62,7 @@ class Scout final : public TraceSink {
   }
 
   std::size_t n = 0;  // trace samples
-  SpillWriter<Doubles<14>>* trace = nullptr;  // the integrated trace, for the second pass
+  SpillWriter<Doubles<17>>* trace = nullptr;  // the integrated trace, for the second pass
   bool circle_;
   eval::RepeatFinder repeats;
   std::optional<eval::CircleSegmentFinder> segments;
@@ -118,6 +121,8 @@ struct Corrected {
   std::size_t k = 0;
   std::int64_t sample_index = 0;
   Eigen::Vector3d pos_mm, vel_mm_s, cmd_mm, ref_mm, sigma_um;
+  float temp_c[2] = {0.0F, 0.0F};
+  std::uint32_t frame_flags = 0;
 };
 
 // The second pass: the replayed integrated trace, the smoothed corrections applied segment
@@ -133,6 +138,7 @@ class Emitter final : public TraceSink {
     c.k = seen_++;
     c.sample_index = s.sample_index;
     c.pos_mm = s.pos_mm, c.vel_mm_s = s.vel_mm_s, c.cmd_mm = s.cmd_mm, c.ref_mm = s.ref_mm;
+    c.temp_c[0] = s.temp_c[0], c.temp_c[1] = s.temp_c[1], c.frame_flags = s.frame_flags;
     c.sigma_um = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
     if (correction_ && correction_->apply) {
       const auto& sm = *correction_->smoother;
@@ -199,9 +205,22 @@ class Emitter final : public TraceSink {
   std::deque<Corrected> pending_;
 };
 
+// The schedule as the smoother used it, as the whole-trace pipeline keeps it for the
+// uncertainty (Measurement::raw.schedule): ZUPT σ per sample again, CUPT as configured.
+fusion::SupportSchedule schedule_as_fused(const SmoothedCorrection& c, const PipelineConfig& cfg) {
+  fusion::SupportSchedule s = c.schedule;
+  if (s.zupt_sigma_um_s.empty() && !c.track.zupt_unused.empty()) {
+    s.zupt_sigma_um_s.resize(c.track.zupt_unused.size());
+    for (std::size_t k = 0; k < s.zupt_sigma_um_s.size(); ++k) s.zupt_sigma_um_s[k] = c.track.zupt_unused[k] ? -1.0F : 0.0F;
+  }
+  s.cupt = cfg.cupt;
+  return s;
+}
+
 // The per-sample arrays of the measurement: every sample, or every q-th and the last.
-void keep(Measurement& m, const Corrected& c, std::size_t q, std::size_t n) {
+void keep(Measurement& m, const Corrected& c, std::size_t q, std::size_t n, const Eigen::Vector2d& temp) {
   if (c.k % q != 0 && c.k + 1 != n) return;
+  m.temp_c.push_back(temp);
   m.sample_index.push_back(c.sample_index);
   m.pos_mm.push_back(c.pos_mm);
   m.vel_mm_s.push_back(c.vel_mm_s);
@@ -222,7 +241,7 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   cfg.reserve_samples = frames.size_hint();
   Scout scout(header, circle);
   std::unique_ptr<Spill> trace_spill = stream.spill_trace ? stream.spills() : nullptr;
-  std::optional<SpillWriter<Doubles<14>>> trace_writer;
+  std::optional<SpillWriter<Doubles<17>>> trace_writer;
   if (trace_spill) scout.trace = &trace_writer.emplace(*trace_spill);
   cfg.trace = TraceKeeping::track;
   cfg.sink = &scout;
@@ -253,20 +272,27 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   // Second pass: the corrected trace, each sample to the evaluation as it goes by. A
   // circle is evaluated here; other programs keep the whole trace for theirs.
   const std::size_t n = t.samples;
-  const std::size_t q = circle ? std::max<std::size_t>(1, (n + stream.measurement_points - 1) / std::max<std::size_t>(1, stream.measurement_points)) : 1;
+  // A run short enough keeps its whole trace and is evaluated as analyze_run() does (the
+  // uncertainty's Monte Carlo included); a longer circle is evaluated as it streams.
+  const bool whole = !circle || n <= stream.materialize_samples;
+  const std::size_t q = whole ? 1 : std::max<std::size_t>(1, (n + stream.measurement_points - 1) / std::max<std::size_t>(1, stream.measurement_points));
+  if (whole && options.uncertainty.enabled && t.correction) a.measurement.raw.schedule = schedule_as_fused(*t.correction, cfg);
   Measurement& m = a.measurement;
   m.decimation = q;
   std::optional<CircleStream> circle_eval;
   std::optional<eval::RepeatAverager> repeats;
-  if (circle) {
+  if (!whole) {
     circle_eval.emplace(header, scout.segments ? scout.segments->segments() : std::vector<eval::CircleSegment>{}, scout.segment_error,
                         scout.ref_finite, stream.spills);
     repeats.emplace(scout.repeats.groups(), stream.spills(), stream.measurement_points);
   }
   scout = Scout(header, false);  // what it decided is out; its set-point records can go
   scout.trace = nullptr;
+  Eigen::Vector2d temp(header.meta.sensors[0].temp_ref_c, header.meta.sensors[1].temp_ref_c);  // the last finite case temperatures
   Emitter emitter(t, kept ? &*kept : nullptr, [&](const Corrected& c) {
-    keep(m, c, q, n);
+    for (int i = 0; i < 2; ++i)
+      if (!(c.frame_flags & frame_flag::temp_missing) && std::isfinite(c.temp_c[i])) temp[i] = c.temp_c[i];
+    keep(m, c, q, n, temp);
     if (c.sigma_um.allFinite()) m.sigma_max_um = m.sigma_max_um.cwiseMax(c.sigma_um);
     m.sigma_peak_um = std::max(m.sigma_peak_um, c.sigma_um.maxCoeff());
     if (circle_eval) circle_eval->sample(c.sample_index, c.pos_mm, c.cmd_mm, c.ref_mm);
@@ -274,12 +300,14 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   });
   if (trace_spill) {  // the integrated trace as the first pass saw it
     trace_writer->flush();
-    for_each_record<Doubles<14>>(*trace_spill, [&](const Doubles<14>& r) {
+    for_each_record<Doubles<17>>(*trace_spill, [&](const Doubles<17>& r) {
       TraceSample ts;
       ts.sample_index = static_cast<std::int64_t>(r.v[0]);
       ts.trigger = static_cast<std::int32_t>(r.v[1]);
       ts.pos_mm = {r.v[2], r.v[3], r.v[4]}, ts.vel_mm_s = {r.v[5], r.v[6], r.v[7]};
       ts.cmd_mm = {r.v[8], r.v[9], r.v[10]}, ts.ref_mm = {r.v[11], r.v[12], r.v[13]};
+      ts.temp_c[0] = static_cast<float>(r.v[14]), ts.temp_c[1] = static_cast<float>(r.v[15]);
+      ts.frame_flags = static_cast<std::uint32_t>(r.v[16]);
       emitter.sample(ts);
     });
     trace_writer.reset();
@@ -294,19 +322,23 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   emitter.finish();
   t.correction.reset();  // the smoother's records: done
 
-  if (!circle) {
-    evaluate_measurement(header, a);  // as analyze_run(): the whole trace is here
+  if (whole) {
+    evaluate_measurement(header, cfg, options, a);  // as analyze_run(): the whole trace is here
     return a;
   }
   if (const std::string why = unsupported_integration(m); !why.empty()) {
     // run-format.md, "No standstill": every positional figure null (evaluate_measurement()).
-    a.flags.push_back("position: null, " + why);
+    a.flags.push_back(std::string(kPositionNullFlag) + why);
     a.degraded = true;
-    return a;
+  } else {
+    circle_eval->finish(a);
+    circle_eval.reset();
+    a.repeats = repeats->result();
+    if (options.uncertainty.enabled)
+      a.uncertainty_note = "not estimated for a run evaluated as it streamed (" + std::to_string(n) + " samples, more than " +
+                           std::to_string(stream.materialize_samples) + "): the Monte Carlo of the uncertainty needs the whole trace";
   }
-  circle_eval->finish(a);
-  circle_eval.reset();
-  a.repeats = repeats->result();
+  judge(header.meta.program, a);
   return a;
 }
 

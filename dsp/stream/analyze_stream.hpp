@@ -24,6 +24,10 @@ namespace eical::dsp {
 struct StreamOptions {
   SpillFactory spills = memory_spills();   // where evaluations keep samples they read again
   std::size_t measurement_points = 50000;  // Analysis::measurement of a longer circle run: every n-th sample
+  // Up to this many trace samples (a minute at 10 kHz, about 100 MB) the trace is kept
+  // whole and evaluated as analyze_run() does, uncertainty included; a longer circle is
+  // evaluated as it streams (its uncertainty is not estimated: the note says so).
+  std::size_t materialize_samples = 600000;
   // The second pass reads the first pass's integrated trace from a spill (112 B a sample
   // on disk) instead of running the frames through the pipeline again: for frames that
   // are slow to read (a CSV file); frames in memory replay faster than a spill reads.

@@ -75,11 +75,23 @@ void expect_same_result(const dsp::Run& run, const dsp::Analysis& whole, const d
   EXPECT_EQ(whole.degraded, streamed.degraded);
 }
 
+// The figures without their uncertainty (its Monte Carlo needs the whole trace: a run
+// evaluated as it streams has none; AnalyzeStream.ShortRunsKeepTheirUncertainty).
+dsp::AnalysisOptions figures_only() {
+  dsp::AnalysisOptions o;
+  o.uncertainty.enabled = false;
+  return o;
+}
+
+dsp::Analysis whole_trace(const dsp::Run& run) { return dsp::analyze_run(run, figures_only()); }
+
+// Streamed however short the run (materialize_samples 0).
 dsp::Analysis streamed(const dsp::Run& run, std::size_t measurement_points = 50000) {
   dsp::StoredFrames frames(run.frames);
   dsp::StreamOptions so;
   so.measurement_points = measurement_points;
-  return dsp::analyze_stream(run, frames, {}, so);
+  so.materialize_samples = 0;
+  return dsp::analyze_stream(run, frames, figures_only(), so);
 }
 
 sim::Scenario circle(double radius, double feed, int repeats, const std::string& direction) {
@@ -89,7 +101,7 @@ sim::Scenario circle(double radius, double feed, int repeats, const std::string&
 
 TEST(AnalyzeStream, CircleBothDirectionsEqualsTheWholeTraceAnalysis) {
   const dsp::Run run = sim::simulate(circle(10.0, 2500.0, 3, "both"));
-  const dsp::Analysis whole = dsp::analyze_run(run);
+  const dsp::Analysis whole = whole_trace(run);
   ASSERT_TRUE(whole.circle && whole.diagnostics && whole.circle_accuracy_rms_um) << (whole.flags.empty() ? "" : whole.flags.front());
   ASSERT_EQ(whole.repeats.size(), 2u);  // three revolutions each way
   const dsp::Analysis s = streamed(run);
@@ -103,7 +115,7 @@ TEST(AnalyzeStream, CircleBothDirectionsEqualsTheWholeTraceAnalysis) {
 
 TEST(AnalyzeStream, ThinnedArraysOfALongRunKeepEveryFigure) {
   const dsp::Run run = sim::simulate(circle(10.0, 2500.0, 2, "both"));
-  const dsp::Analysis whole = dsp::analyze_run(run);
+  const dsp::Analysis whole = whole_trace(run);
   const dsp::Analysis s = streamed(run, 500);  // as if the run were a hundred times longer
   EXPECT_GT(s.measurement.decimation, 1u);
   EXPECT_LE(s.measurement.sample_index.size(), 502u);
@@ -121,7 +133,7 @@ TEST(AnalyzeStream, PartialArcsPsdStripsAndOneDirection) {
   psd.meta.psd = sim::psd_config_b(10.0);
   for (const auto& sc : {arc, psd}) {
     const dsp::Run run = sim::simulate(sc);
-    const dsp::Analysis whole = dsp::analyze_run(run);
+    const dsp::Analysis whole = whole_trace(run);
     ASSERT_TRUE(whole.circle) << (whole.flags.empty() ? "" : whole.flags.front());
     expect_same_result(run, whole, streamed(run));
   }
@@ -135,17 +147,17 @@ TEST(AnalyzeStream, LostAndBadFramesAndRunsWithoutTriggers) {
   for (std::size_t k = 40000; k < 40002; ++k) run.frames[k].flags |= dsp::frame_flag::gap_before;
   run.frames[50000].flags |= dsp::frame_flag::accel_saturated;
   run.frames[50010].temp_c[0] = NAN;
-  const dsp::Analysis whole = dsp::analyze_run(run);
+  const dsp::Analysis whole = whole_trace(run);
   expect_same_result(run, whole, streamed(run));
   dsp::Run bare = sim::simulate(circle(10.0, 2500.0, 1, "ccw"));
   for (auto& f : bare.frames) f.trigger = 0;  // no marks, no M101: nothing to evaluate, the same way
-  expect_same_result(bare, dsp::analyze_run(bare), streamed(bare));
+  expect_same_result(bare, whole_trace(bare), streamed(bare));
 }
 
 TEST(AnalyzeStream, OtherProgramsAreEvaluatedOverTheirWholeTrace) {
   for (const auto& sc : {sim::step_scenario(), sim::positioning_scenario({0.0, 10.0, 20.0}, 2), sim::rectangle_scenario(20.0, 10.0)}) {
     const dsp::Run run = sim::simulate(sc);
-    const dsp::Analysis whole = dsp::analyze_run(run);
+    const dsp::Analysis whole = whole_trace(run);
     const dsp::Analysis s = streamed(run);
     EXPECT_EQ(s.measurement.decimation, 1u);
     expect_same_result(run, whole, s);
@@ -183,13 +195,14 @@ TEST(AnalyzeStream, ReadFromDiskAsEicalAnalyzeReadsIt) {
     const fs::path run_dir = dir / c.name;
     drivers::write_run(c.run, run_dir, {.gzip = c.gzip, .overwrite = true});
     const dsp::Run read = drivers::read_run(run_dir);
-    const dsp::Analysis whole = dsp::analyze_run(read);
+    const dsp::Analysis whole = whole_trace(read);
     for (const bool spill_trace : {false, true}) {  // the second pass from the file or from the spilled trace
       drivers::RunStream stream(run_dir);
       dsp::StreamOptions so;
       so.spills = drivers::file_spills(dir);
       so.spill_trace = so.spill_corrections = spill_trace;
-      const dsp::Analysis s = drivers::analyze_stream(stream, {}, so);
+      so.materialize_samples = 0;
+      const dsp::Analysis s = drivers::analyze_stream(stream, figures_only(), so);
       EXPECT_EQ(stream.header().meta.sensor_present[0], read.meta.sensor_present[0]);
       EXPECT_EQ(stream.header().meta.sensor_present[1], read.meta.sensor_present[1]);
       EXPECT_EQ(stream.header().frame_count(), read.frames.size());
@@ -197,6 +210,27 @@ TEST(AnalyzeStream, ReadFromDiskAsEicalAnalyzeReadsIt) {
     }
   }
   fs::remove_all(dir);
+}
+
+// A run short enough is kept whole and evaluated as analyze_run() does, the
+// uncertainty of every figure included (the same draws: the same U).
+TEST(AnalyzeStream, ShortRunsKeepTheirUncertainty) {
+  dsp::AnalysisOptions o;
+  o.uncertainty.draws = 12;
+  const dsp::Run run = sim::simulate(circle(10.0, 2500.0, 2, "both"));
+  const dsp::Analysis whole = dsp::analyze_run(run, o);
+  ASSERT_FALSE(whole.uncertainty_k2.empty()) << whole.uncertainty_note;
+  dsp::StoredFrames frames(run.frames);
+  const dsp::Analysis s = dsp::analyze_stream(run, frames, o, {});
+  expect_same_result(run, whole, s);
+  EXPECT_EQ(s.verdict, whole.verdict);
+  // Longer than that: the circle's figures as it streams, the uncertainty not estimated (said).
+  dsp::StreamOptions so;
+  so.materialize_samples = 0;
+  const dsp::Analysis long_run = dsp::analyze_stream(run, frames, o, so);
+  EXPECT_TRUE(long_run.uncertainty_k2.empty());
+  EXPECT_NE(long_run.uncertainty_note.find("streamed"), std::string::npos) << long_run.uncertainty_note;
+  EXPECT_EQ(long_run.circle->circular_deviation_G_um, whole.circle->circular_deviation_G_um);
 }
 
 TEST(AnalyzeStream, BadInputNamesItsCause) {
