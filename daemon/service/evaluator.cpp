@@ -12,6 +12,7 @@
 #include "drivers/setpoint/program_setpoint.hpp"
 #include "drivers/source/servo_setpoint_source.hpp"
 #include "dsp/align/accel_lag.hpp"
+#include "dsp/analysis/verdict.hpp"
 #include "dsp/stream/analyze_stream.hpp"
 
 #include <algorithm>
@@ -193,6 +194,7 @@ void Evaluator::evaluate(RecordingJob& job) {
     }
     for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
     for (const auto& f : temperature_flags(run, config_.limits)) a.flags.push_back(f), a.degraded = true;
+    dsp::judge(run.meta.program, a);  // the verdict again, with the flags the daemon added
     drivers::write_result(run, a, dir / "result.json");
     if (links_.history) links_.history->append(run, a, dir);
     std::uint64_t number = 0;

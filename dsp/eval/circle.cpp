@@ -127,6 +127,8 @@ CircleResult CircleAccumulator::result() const {
   r.radial_deviation_F_max_um = dmax_;
   r.radial_deviation_F_min_um = dmin_;
   r.circular_deviation_G_um = dmax_ - dmin_;
+  const std::size_t d = r.direction == "cw" ? 1 : 0;
+  r.direction_F_max_um[d] = dmax_, r.direction_F_min_um[d] = dmin_;
   return r;
 }
 
@@ -163,6 +165,9 @@ CircleResult combine(const CircleResult& a, const CircleResult& b) {
   c.radial_deviation_F_max_um = std::max(a.radial_deviation_F_max_um, b.radial_deviation_F_max_um);
   c.radial_deviation_F_min_um = std::min(a.radial_deviation_F_min_um, b.radial_deviation_F_min_um);
   c.circular_deviation_G_um = c.radial_deviation_F_max_um - c.radial_deviation_F_min_um;
+  for (std::size_t d = 0; d < 2; ++d)
+    c.direction_F_max_um[d] = std::max(a.direction_F_max_um[d], b.direction_F_max_um[d]),
+    c.direction_F_min_um[d] = std::min(a.direction_F_min_um[d], b.direction_F_min_um[d]);
   c.centers_mm.insert(c.centers_mm.end(), b.centers_mm.begin(), b.centers_mm.end());
   c.radii_mm.insert(c.radii_mm.end(), b.radii_mm.begin(), b.radii_mm.end());
   auto append = [](auto& dst, const auto& src) { dst.insert(dst.end(), src.begin(), src.end()); };

@@ -59,6 +59,9 @@ struct CircleResult {
   std::vector<double> radii_mm;
   CircleTrace trace;
   std::size_t points = 0;  // radius deviations evaluated (all, whatever the trace keeps)
+  // The largest and smallest radius deviation of each direction's own points (counter-
+  // clockwise, clockwise; ±inf: not run): G per direction, whatever the trace keeps.
+  std::array<double, 2> direction_F_max_um{-INFINITY, -INFINITY}, direction_F_min_um{INFINITY, INFINITY};
   // Sum and count of the radius deviations per 1° of angle (H of combine()).
   std::array<double, 360> deviation_sum_by_deg{}, points_by_deg{};
 };

@@ -411,6 +411,7 @@ Pipeline::Tracked Pipeline::finish_track(fusion::SegmentSink* sink) {
   if (phase_ == Phase::moving && stored_ > 0) {
     const std::int64_t first = first_stored_;
     const SupportStage& stage = supports_;
+    t.first_index = first;
     m.supports = supports_.finish_track(stored_, [&](std::size_t k) { return stage.trace_index(first, k); }, t.correction, sink);
     Eigen::Vector3d v_rest = Eigen::Vector3d::Zero();
     if (!m.supports.rest_windows.empty() && t.correction) {

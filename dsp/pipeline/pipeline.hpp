@@ -189,6 +189,7 @@ class Pipeline {
   struct Tracked {
     Measurement measurement;   // every field but the per-sample arrays
     std::size_t samples = 0;   // trace samples (those a replay stores)
+    std::int64_t first_index = 0;  // sample index of the trace's first sample
     std::unique_ptr<SmoothedCorrection> correction;
     double delay_samples = 0.0;  // to re-index by (0: none, DynamicComp::none)
   };

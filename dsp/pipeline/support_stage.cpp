@@ -403,6 +403,15 @@ std::int64_t SupportStage::trace_index(std::int64_t first_index, std::size_t k) 
   return idx;
 }
 
+std::int64_t SmoothedCorrection::sample_index_of(std::int64_t first_index, std::size_t k) const noexcept {
+  std::int64_t idx = first_index + static_cast<std::int64_t>(k);
+  for (const auto& [p, g] : track.gaps) {
+    if (p > k) break;
+    idx += g - 1;
+  }
+  return idx;
+}
+
 std::size_t SmoothedCorrection::position_of(std::int64_t first_index, std::int64_t sample_index) const noexcept {
   std::int64_t skipped = 0;  // sample indices the lost frames took before the sample
   for (const auto& [p, g] : track.gaps) {

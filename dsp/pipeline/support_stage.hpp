@@ -82,6 +82,8 @@ struct SmoothedCorrection {
   bool apply = false;  // false: the fusion diverged, the trace stays as integrated (σ NaN)
   // Trace position of a sample index (the trace's first sample at first_index).
   [[nodiscard]] std::size_t position_of(std::int64_t first_index, std::int64_t sample_index) const noexcept;
+  // Sample index of trace position k (the inverse, from the recorded steps).
+  [[nodiscard]] std::int64_t sample_index_of(std::int64_t first_index, std::size_t k) const noexcept;
   SmoothedCorrection() = default;
   SmoothedCorrection(const SmoothedCorrection&) = delete;
   SmoothedCorrection& operator=(const SmoothedCorrection&) = delete;

@@ -1,5 +1,6 @@
 #include "dsp/stream/analyze_stream.hpp"
 
+#include "dsp/analysis/figure_uncertainty.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/eval/circle_segments.hpp"
@@ -267,13 +268,16 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   a.measurement.trace_samples = t.samples;
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;
-  if (t.samples == 0) return a;  // no motion: nothing to evaluate
+  if (t.samples == 0) {  // no motion: nothing to evaluate, a verdict all the same
+    judge(header.meta.program, a);
+    return a;
+  }
 
   // Second pass: the corrected trace, each sample to the evaluation as it goes by. A
   // circle is evaluated here; other programs keep the whole trace for theirs.
   const std::size_t n = t.samples;
-  // A run short enough keeps its whole trace and is evaluated as analyze_run() does (the
-  // uncertainty's Monte Carlo included); a longer circle is evaluated as it streams.
+  // A run short enough keeps its whole trace and is evaluated as analyze_run() does; a
+  // longer circle is evaluated as it streams.
   const bool whole = !circle || n <= stream.materialize_samples;
   const std::size_t q = whole ? 1 : std::max<std::size_t>(1, (n + stream.measurement_points - 1) / std::max<std::size_t>(1, stream.measurement_points));
   if (whole && options.uncertainty.enabled && t.correction) a.measurement.raw.schedule = schedule_as_fused(*t.correction, cfg);
@@ -286,6 +290,15 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
                         scout.ref_finite, stream.spills);
     repeats.emplace(scout.repeats.groups(), stream.spills(), stream.measurement_points);
   }
+  // A circle evaluated as it streams: the uncertainty reads what it needs of the trace as
+  // it goes by (figure_uncertainty.hpp).
+  std::optional<UncertaintyTrace> uncertainty;
+  if (!whole && options.uncertainty.enabled && t.correction) {
+    const SmoothedCorrection* c = t.correction.get();
+    const std::int64_t first = t.first_index;
+    uncertainty.emplace(header, cfg, options, a, c->schedule, n, [c, first](std::size_t k) { return c->sample_index_of(first, k); },
+                        &c->track.zupt_unused);
+  }
   scout = Scout(header, false);  // what it decided is out; its set-point records can go
   scout.trace = nullptr;
   Eigen::Vector2d temp(header.meta.sensors[0].temp_ref_c, header.meta.sensors[1].temp_ref_c);  // the last finite case temperatures
@@ -297,6 +310,7 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
     m.sigma_peak_um = std::max(m.sigma_peak_um, c.sigma_um.maxCoeff());
     if (circle_eval) circle_eval->sample(c.sample_index, c.pos_mm, c.cmd_mm, c.ref_mm);
     if (repeats) repeats->add(c.k, c.pos_mm, c.cmd_mm);
+    if (uncertainty) uncertainty->sample(c.k, c.sample_index, c.pos_mm, c.vel_mm_s, c.cmd_mm, c.ref_mm, temp);
   });
   if (trace_spill) {  // the integrated trace as the first pass saw it
     trace_writer->flush();
@@ -334,9 +348,8 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
     circle_eval->finish(a);
     circle_eval.reset();
     a.repeats = repeats->result();
-    if (options.uncertainty.enabled)
-      a.uncertainty_note = "not estimated for a run evaluated as it streamed (" + std::to_string(n) + " samples, more than " +
-                           std::to_string(stream.materialize_samples) + "): the Monte Carlo of the uncertainty needs the whole trace";
+    if (uncertainty) uncertainty->finish(header, a);
+    else if (options.uncertainty.enabled) a.uncertainty_note = "no support schedule: the uncertainty was not estimated";
   }
   judge(header.meta.program, a);
   return a;

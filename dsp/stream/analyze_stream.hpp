@@ -9,10 +9,12 @@
 // streams (one revolution in memory, the diagnostics' and the repeats' samples in spills
 // read back from disk); other programs keep their whole trace and are evaluated by
 // evaluate_measurement(), as analyze_run() does. Analysis::measurement keeps about
-// StreamOptions::measurement_points samples of a longer trace (every n-th, for plots).
+// StreamOptions::measurement_points samples of a longer trace (every n-th, for plots);
+// the uncertainty's Monte Carlo reads every sample it needs as it goes by (UncertaintyTrace).
 //
-// The figures equal analyze_run()'s: the same stages in the same order on the same
-// numbers (tests/dsp/analyze_stream_test.cpp compares every number of the result).
+// The figures and their uncertainty equal analyze_run()'s: the same stages in the same
+// order on the same numbers (tests/e2e/analyze_stream_test.cpp compares every number of
+// the result).
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/core/spill.hpp"
 #include "dsp/stream/frame_replay.hpp"
@@ -25,8 +27,8 @@ struct StreamOptions {
   SpillFactory spills = memory_spills();   // where evaluations keep samples they read again
   std::size_t measurement_points = 50000;  // Analysis::measurement of a longer circle run: every n-th sample
   // Up to this many trace samples (a minute at 10 kHz, about 100 MB) the trace is kept
-  // whole and evaluated as analyze_run() does, uncertainty included; a longer circle is
-  // evaluated as it streams (its uncertainty is not estimated: the note says so).
+  // whole and evaluated as analyze_run() does; a longer circle is evaluated as it streams,
+  // its uncertainty from what UncertaintyTrace collects on the way (the same draws).
   std::size_t materialize_samples = 600000;
   // The second pass reads the first pass's integrated trace from a spill (112 B a sample
   // on disk) instead of running the frames through the pipeline again: for frames that

@@ -1,6 +1,6 @@
 // The streamed analysis (dsp/stream) against analyze_run() on the same short runs: every
-// number, string and flag of the eical-result/1 document equal — circles in both
-// directions (revolutions, H, repeats, diagnostics, the reference channel), partial arcs,
+// number, string and flag of the eical-result/1 document equal (U and the verdict too) —
+// circles in both directions (revolutions, H, repeats, diagnostics, the reference channel), partial arcs,
 // PSD strips, lost and bad frames, the other programs; from memory and read from disk as
 // eical analyze reads a run (samples.csv and .gz, a sensor absent, spills in files), and
 // with the per-sample arrays thinned as for a long run.
@@ -75,15 +75,15 @@ void expect_same_result(const dsp::Run& run, const dsp::Analysis& whole, const d
   EXPECT_EQ(whole.degraded, streamed.degraded);
 }
 
-// The figures without their uncertainty (its Monte Carlo needs the whole trace: a run
-// evaluated as it streams has none; AnalyzeStream.ShortRunsKeepTheirUncertainty).
-dsp::AnalysisOptions figures_only() {
+// The figures and their uncertainty (fewer draws than eical analyze's 100, the same
+// draws both ways: the result documents compare U and the verdict too).
+dsp::AnalysisOptions with_uncertainty() {
   dsp::AnalysisOptions o;
-  o.uncertainty.enabled = false;
+  o.uncertainty.draws = 12;
   return o;
 }
 
-dsp::Analysis whole_trace(const dsp::Run& run) { return dsp::analyze_run(run, figures_only()); }
+dsp::Analysis whole_trace(const dsp::Run& run) { return dsp::analyze_run(run, with_uncertainty()); }
 
 // Streamed however short the run (materialize_samples 0).
 dsp::Analysis streamed(const dsp::Run& run, std::size_t measurement_points = 50000) {
@@ -91,7 +91,7 @@ dsp::Analysis streamed(const dsp::Run& run, std::size_t measurement_points = 500
   dsp::StreamOptions so;
   so.measurement_points = measurement_points;
   so.materialize_samples = 0;
-  return dsp::analyze_stream(run, frames, figures_only(), so);
+  return dsp::analyze_stream(run, frames, with_uncertainty(), so);
 }
 
 sim::Scenario circle(double radius, double feed, int repeats, const std::string& direction) {
@@ -202,7 +202,7 @@ TEST(AnalyzeStream, ReadFromDiskAsEicalAnalyzeReadsIt) {
       so.spills = drivers::file_spills(dir);
       so.spill_trace = so.spill_corrections = spill_trace;
       so.materialize_samples = 0;
-      const dsp::Analysis s = drivers::analyze_stream(stream, figures_only(), so);
+      const dsp::Analysis s = drivers::analyze_stream(stream, with_uncertainty(), so);
       EXPECT_EQ(stream.header().meta.sensor_present[0], read.meta.sensor_present[0]);
       EXPECT_EQ(stream.header().meta.sensor_present[1], read.meta.sensor_present[1]);
       EXPECT_EQ(stream.header().frame_count(), read.frames.size());
@@ -212,25 +212,26 @@ TEST(AnalyzeStream, ReadFromDiskAsEicalAnalyzeReadsIt) {
   fs::remove_all(dir);
 }
 
-// A run short enough is kept whole and evaluated as analyze_run() does, the
-// uncertainty of every figure included (the same draws: the same U).
-TEST(AnalyzeStream, ShortRunsKeepTheirUncertainty) {
-  dsp::AnalysisOptions o;
-  o.uncertainty.draws = 12;
+// The uncertainty of a circle evaluated as it streams is the whole trace's: its Monte
+// Carlo reads every sample it needs as the trace goes by, however thinned the kept arrays;
+// a run short enough is kept whole (materialize_samples) and gives the same.
+TEST(AnalyzeStream, UncertaintyOfAStreamedCircleIsTheWholeTracesWhateverTheThinning) {
   const dsp::Run run = sim::simulate(circle(10.0, 2500.0, 2, "both"));
-  const dsp::Analysis whole = dsp::analyze_run(run, o);
+  const dsp::Analysis whole = whole_trace(run);
   ASSERT_FALSE(whole.uncertainty_k2.empty()) << whole.uncertainty_note;
+  ASSERT_TRUE(whole.uncertainty_k2.count("circle.circular_deviation_G_um"));
   dsp::StoredFrames frames(run.frames);
-  const dsp::Analysis s = dsp::analyze_stream(run, frames, o, {});
-  expect_same_result(run, whole, s);
-  EXPECT_EQ(s.verdict, whole.verdict);
-  // Longer than that: the circle's figures as it streams, the uncertainty not estimated (said).
-  dsp::StreamOptions so;
-  so.materialize_samples = 0;
-  const dsp::Analysis long_run = dsp::analyze_stream(run, frames, o, so);
-  EXPECT_TRUE(long_run.uncertainty_k2.empty());
-  EXPECT_NE(long_run.uncertainty_note.find("streamed"), std::string::npos) << long_run.uncertainty_note;
-  EXPECT_EQ(long_run.circle->circular_deviation_G_um, whole.circle->circular_deviation_G_um);
+  const dsp::Analysis kept_whole = dsp::analyze_stream(run, frames, with_uncertainty(), {});
+  EXPECT_EQ(kept_whole.measurement.decimation, 1u);
+  expect_same_result(run, whole, kept_whole);
+  for (const std::size_t points : {std::size_t{50000000}, std::size_t{700}}) {
+    const dsp::Analysis s = streamed(run, points);
+    EXPECT_EQ(s.measurement.decimation > 1, points < whole.measurement.sample_index.size());
+    EXPECT_EQ(s.uncertainty_k2, whole.uncertainty_k2) << "kept points " << points;
+    EXPECT_EQ(s.uncertainty_note, whole.uncertainty_note);
+    EXPECT_EQ(s.verdict, whole.verdict);
+    EXPECT_EQ(s.verdict_reasons, whole.verdict_reasons);
+  }
 }
 
 TEST(AnalyzeStream, BadInputNamesItsCause) {
