@@ -5,13 +5,16 @@
 // peak resident set (getrusage ru_maxrss of the child) is its own.
 //
 //   eical analyze   the command as a user runs it (the run read as it streams, twice)
+//   eical analyze --no-suggest   the same without eical plan's suggestion for a test that
+//                   is not measurable (it simulates short variants, whatever the length)
 //   eicald eval     what eicald's evaluation thread runs on a recording it holds: the
 //                   frames in memory (as the recorder hands them over), then the streamed
-//                   analysis over them; "over the frames" is the peak less the frames'
-//                   own resident memory (measured after loading them)
+//                   analysis over them; "over them" is the process' peak during the
+//                   evaluation (VmHWM, reset after loading) less the frames' resident size.
+//                   Its peak RSS column is the whole process' (loading the frames included).
 //
 // Prints one line per run and analysis: minutes of data, samples, wall and CPU seconds,
-// × real time (wall and CPU) and peak RSS in MB.
+// × real time (wall and CPU), peak RSS in MB and the verdict (a result was written).
 //
 //   bench_long_run [--minutes 1,10,30] [--dir DIR] [--keep] [--no-daemon]
 #include "drivers/run_io/file_spill.hpp"
@@ -46,6 +49,7 @@ double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + static
 // Runs `child` in a forked process (stdout to /dev/null unless keep_stdout); its rusage.
 template <class F>
 Usage in_child(F&& child, bool quiet = true) {
+  std::fflush(stdout);  // else the child's freopen() writes the parent's buffered lines again
   const auto t0 = std::chrono::steady_clock::now();
   const pid_t pid = ::fork();
   if (pid == 0) {
@@ -80,6 +84,19 @@ int run_command(const std::vector<std::string>& args) {
   return 127;
 }
 
+// The process' peak resident size since the last reset_peak() (VmHWM), MB.
+double peak_mb() {
+  std::ifstream is("/proc/self/status");
+  std::string line;
+  while (std::getline(is, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  return NAN;
+}
+
+// Resets VmHWM to the current resident size (Linux ≥ 4.0: clear_refs 5): the peak of what
+// follows, not of what loaded the frames (their vector grows by doubling).
+void reset_peak() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
 double rss_now_mb() {
   std::ifstream is("/proc/self/statm");
   long pages_total = 0, pages_resident = 0;
@@ -87,11 +104,23 @@ double rss_now_mb() {
   return static_cast<double>(pages_resident) * static_cast<double>(::sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
 }
 
+// eical analyze's exit status: 0, 2 and 3 come with a result (verdict ok, degraded, not
+// measurable: README "Exit status"); anything else failed.
+std::string outcome(int status) {
+  if (!WIFEXITED(status)) return "  FAILED (killed)";
+  switch (WEXITSTATUS(status)) {
+    case 0: return "  verdict ok";
+    case 2: return "  verdict degraded";
+    case 3: return "  verdict not measurable";
+    default: return "  FAILED (exit " + std::to_string(WEXITSTATUS(status)) + ")";
+  }
+}
+
 void print(const char* what, double minutes, std::size_t samples, const Usage& u, const std::string& extra = "") {
   const double data_s = minutes * 60.0;
-  std::printf("%-14s %6.1f min %9zu samples  wall %7.2f s (%6.1fx real time)  cpu %7.2f s (%6.1fx)  peak RSS %7.1f MB%s%s\n", what,
+  std::printf("%-24s %6.1f min %9zu samples  wall %7.2f s (%6.1fx real time)  cpu %7.2f s (%6.1fx)  peak RSS %7.1f MB%s%s\n", what,
               minutes, samples, u.wall_s, data_s / u.wall_s, u.user_s + u.sys_s, data_s / (u.user_s + u.sys_s), u.peak_mb,
-              extra.c_str(), u.status == 0 ? "" : "  FAILED");
+              extra.c_str(), outcome(u.status).c_str());
   std::fflush(stdout);
 }
 
@@ -144,13 +173,19 @@ int main(int argc, char** argv) {
     const double data_min = static_cast<double>(rows) / meta.acquisition.fs_hz / 60.0;
     const Usage cli = in_child([&] { return run_command({eical, "analyze", run.string(), "--json"}); });
     print("eical analyze", data_min, rows, cli);
+    // A test that is not measurable gets a measurable variant suggested (eical plan: short
+    // simulated runs analysed whole, whatever the recording's length); without it, the
+    // analysis of the recording alone.
+    const Usage bare = in_child([&] { return run_command({eical, "analyze", run.string(), "--json", "--no-suggest"}); });
+    print("eical analyze --no-suggest", data_min, rows, bare);
     if (!no_daemon) {
       // The recorder's frames in memory, then eicald's evaluation over them; the pipe
       // carries the resident size the frames took.
       int fd[2];
       if (::pipe(fd) != 0) return 1;
       struct Inside {
-        double frames_mb = NAN, wall_s = NAN, cpu_s = NAN;
+        double frames_mb = NAN, peak_mb = NAN, wall_s = NAN, cpu_s = NAN;
+        int status = 1;
       };
       const Usage ev = in_child(
           [&] {
@@ -159,13 +194,17 @@ int main(int argc, char** argv) {
             r.frames.shrink_to_fit();
             Inside in;
             in.frames_mb = rss_now_mb();
+            reset_peak();
             rusage a{}, b{};
             ::getrusage(RUSAGE_SELF, &a);
             const auto t0 = std::chrono::steady_clock::now();
             eical::dsp::StoredFrames frames(r.frames);
-            (void)eical::dsp::analyze_stream(r, frames, {}, {eical::drivers::file_spills(eical::drivers::default_spill_dir())});
+            const eical::dsp::Analysis an =
+                eical::dsp::analyze_stream(r, frames, {}, {eical::drivers::file_spills(eical::drivers::default_spill_dir())});
             in.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             ::getrusage(RUSAGE_SELF, &b);
+            in.peak_mb = peak_mb();
+            in.status = an.verdict == "ok" ? 0 : an.verdict == "degraded" ? 2 : 3;
             in.cpu_s = seconds(b.ru_utime) + seconds(b.ru_stime) - seconds(a.ru_utime) - seconds(a.ru_stime);
             const ssize_t w = ::write(fd[1], &in, sizeof in);
             return w == sizeof in ? 0 : 1;
@@ -177,8 +216,10 @@ int main(int argc, char** argv) {
       ::close(fd[0]);
       Usage eval = ev;  // the evaluation alone: its own time; the peak is the process's
       eval.wall_s = in.wall_s, eval.user_s = in.cpu_s, eval.sys_s = 0.0;
-      char extra[96];
-      std::snprintf(extra, sizeof extra, "  (the frames %.1f MB, the evaluation over them %.1f MB)", in.frames_mb, ev.peak_mb - in.frames_mb);
+      if (ev.status == 0) eval.status = in.status << 8;  // the verdict, as eical analyze's exit status
+      char extra[160];
+      std::snprintf(extra, sizeof extra, "  (the frames %.1f MB; with the evaluation %.1f MB: %.1f MB over them)", in.frames_mb, in.peak_mb,
+                    in.peak_mb - in.frames_mb);
       print("eicald eval", data_min, rows, eval, extra);
     }
     if (!keep) fs::remove_all(run);

@@ -185,21 +185,4 @@ void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& opti
   else a.flags.push_back("program kind '" + kind + "': no evaluation in this version");
 }
 
-Measurement decimate(const Measurement& m, std::size_t q) {
-  Measurement d;
-  q = std::max<std::size_t>(1, q);
-  d.fs_hz = m.fs_hz / static_cast<double>(q);
-  const std::size_t n = std::min({m.sample_index.size(), m.pos_mm.size(), m.cmd_mm.size()});
-  for (std::size_t i = 0; i < n; i += q) {
-    d.sample_index.push_back(m.sample_index[i]);
-    d.pos_mm.push_back(m.pos_mm[i]);
-    d.vel_mm_s.push_back(i < m.vel_mm_s.size() ? m.vel_mm_s[i] : Eigen::Vector3d::Zero());
-    d.cmd_mm.push_back(m.cmd_mm[i]);
-    d.ref_mm.push_back(i < m.ref_mm.size() ? m.ref_mm[i] : Eigen::Vector3d::Constant(NAN));
-  }
-  d.triggers = m.triggers;
-  d.start_index = m.start_index, d.motion_end_index = m.motion_end_index;
-  return d;
-}
-
 }  // namespace eical::dsp

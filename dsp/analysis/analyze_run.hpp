@@ -99,10 +99,6 @@ void evaluate_measurement(const Run& run, const PipelineConfig& config, const An
 // after the pipeline); adds failures to a.flags.
 void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& options = {});
 
-// Every q-th sample of a measurement (fs/q), its triggers kept: what the uncertainty's
-// draws evaluate.
-Measurement decimate(const Measurement& m, std::size_t q);
-
 // Deviations at the targets of a positioning program: at each M102 (target reached) the
 // mean of measured − set-point over the second half of the dwell, grouped by target and
 // approach direction; a run is one pass up and one pass down (ISO 230-2 linear cycle).

@@ -103,7 +103,7 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& cfg, co
 void UncertaintyTrace::sample(std::size_t k, std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
                               const Eigen::Vector3d& cmd_mm, const Eigen::Vector3d& ref_mm, const Eigen::Vector2d& temp_c) {
   probe_->sample(k, pos_mm, vel_mm_s, temp_c);
-  if (k % q_ != 0 || k >= samples_) return;  // as decimate() keeps it
+  if (k % q_ != 0 || k >= samples_) return;
   nominal_.sample_index.push_back(sample_index);
   nominal_.pos_mm.push_back(pos_mm);
   nominal_.vel_mm_s.push_back(vel_mm_s);
@@ -135,7 +135,7 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
   eo.reference = false;
   if (a.diagnostics) eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
   Analysis nominal, ideal;
-  nominal.measurement = std::move(nominal_);  // decimate(m, q) of the whole trace
+  nominal.measurement = std::move(nominal_);  // every q-th sample (fs/q), the triggers kept
   nominal_ = Measurement{};
   nominal.measurement.fs_hz = m.fs_hz / static_cast<double>(q);
   nominal.measurement.triggers = m.triggers;

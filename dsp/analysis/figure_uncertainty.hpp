@@ -32,8 +32,8 @@ namespace eical::dsp {
 void estimate_uncertainty(const Run& run, const PipelineConfig& config, const AnalysisOptions& options, Analysis& a);
 
 // What the uncertainty reads of the corrected trace, sample by sample: the error field's
-// path on its coarse grid and the path the draws perturb (every draw_step()-th sample, as
-// decimate() keeps it) — a few MB whatever the run's length. estimate_uncertainty() feeds
+// path on its coarse grid and the path the draws perturb (every draw_step()-th sample) —
+// a few MB whatever the run's length. estimate_uncertainty() feeds
 // it the trace in memory; a streamed analysis (dsp/stream) each sample as it makes it:
 // the same numbers either way.
 class UncertaintyTrace {
