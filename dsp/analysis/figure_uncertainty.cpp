@@ -5,6 +5,7 @@
 #include "dsp/core/error.hpp"
 #include "dsp/uncertainty/error_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
