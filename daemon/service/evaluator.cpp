@@ -5,15 +5,19 @@
 #include "daemon/service/trace_builder.hpp"
 #include "daemon/system/log.hpp"
 #include "drivers/results/result_json.hpp"
+#include "drivers/run_io/file_spill.hpp"
 #include "drivers/results/software_version.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/setpoint/program_catalog.hpp"
 #include "drivers/setpoint/program_setpoint.hpp"
 #include "drivers/source/servo_setpoint_source.hpp"
 #include "dsp/align/accel_lag.hpp"
+#include "dsp/analysis/verdict.hpp"
+#include "dsp/stream/analyze_stream.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <optional>
 
@@ -31,6 +35,25 @@ std::string utc_now(const char* format) {
 }
 
 std::string percent(double ratio) { return std::to_string(static_cast<int>(std::lround(ratio * 100.0))) + " %"; }
+
+// [limits] temp_min_c, temp_max_c: a present sensor's case temperature outside them
+// (its compensation is specified within them) flags the result.
+std::vector<std::string> temperature_flags(const dsp::Run& run, const Limits& limits) {
+  std::vector<std::string> flags;
+  const char* names[2] = {"table", "head"};
+  for (int s = 0; s < 2; ++s) {
+    if (!run.meta.sensor_present[s]) continue;
+    float lo = INFINITY, hi = -INFINITY;
+    for (const auto& f : run.frames)
+      if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s])) lo = std::min(lo, f.temp_c[s]), hi = std::max(hi, f.temp_c[s]);
+    if (!(lo <= hi) || (static_cast<double>(lo) >= limits.temp_min_c && static_cast<double>(hi) <= limits.temp_max_c)) continue;
+    char b[200];
+    std::snprintf(b, sizeof b, "temperature: the %s sensor was at %.1f..%.1f degC, outside [limits] temp_min_c..temp_max_c = %.1f..%.1f degC",
+                  names[s], static_cast<double>(lo), static_cast<double>(hi), limits.temp_min_c, limits.temp_max_c);
+    flags.emplace_back(b);
+  }
+  return flags;
+}
 
 // The lag of the measured behind the recorded set-point and the alignment's residual.
 void measure_alignment(const dsp::Run& run, dsp::SetPointOrigin& s) {
@@ -159,7 +182,10 @@ void Evaluator::evaluate(RecordingJob& job) {
     const std::vector<std::string> setpoint_flags = add_setpoint(run, job.notes);
     // The run first: what was measured is durable before anything can fail.
     drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false});
-    dsp::Analysis a = dsp::analyze_run(run, analysis_);
+    // Streamed: the recording's trace is never held twice, its long evaluations spill to
+    // the recording directory's disk (dsp/stream/analyze_stream.hpp).
+    dsp::StoredFrames frames(run.frames);
+    dsp::Analysis a = dsp::analyze_stream(run, frames, analysis_, {drivers::file_spills(config_.recording.dir)});
     if (!job.cause.empty()) a.flags.push_back(job.cause), a.degraded = true;
     if (job.notes.nonfinite_frames > 0) {
       a.flags.push_back("not_finite: " + std::to_string(job.notes.nonfinite_frames) +
@@ -167,6 +193,8 @@ void Evaluator::evaluate(RecordingJob& job) {
       a.degraded = true;
     }
     for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
+    for (const auto& f : temperature_flags(run, config_.limits)) a.flags.push_back(f), a.degraded = true;
+    dsp::judge(run.meta.program, a);  // the verdict again, with the flags the daemon added
     drivers::write_result(run, a, dir / "result.json");
     if (links_.history) links_.history->append(run, a, dir);
     std::uint64_t number = 0;
