@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <ostream>
 #include <set>
 #include <sstream>
 #include <string>
@@ -31,6 +32,9 @@ struct Case {
   fs::path run;
   std::string name;     // the run directory's name
 };
+
+// ctest's test list shows the command and the run, not the parameter's bytes.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.command << " " << c.name; }
 
 std::vector<Case> cases() {
   std::vector<Case> out;
