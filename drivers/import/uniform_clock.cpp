@@ -112,6 +112,13 @@ UniformSeries resample(const std::vector<double>& t, const std::vector<Eigen::Ve
   return out;
 }
 
+std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, const UniformClock& c) {
+  const auto n = static_cast<std::size_t>(c.index.back()) + 1;
+  std::vector<Eigen::Vector3d> out(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = interpolate_at(t, v, c.time_at(static_cast<std::int64_t>(i)));
+  return out;
+}
+
 Eigen::Vector3d interpolate_at(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, double at) {
   if (t.empty()) throw dsp::InputError("interpolate: no samples");
   if (at <= t.front()) return v.front();

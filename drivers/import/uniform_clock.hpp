@@ -41,6 +41,10 @@ struct UniformSeries {
 };
 UniformSeries resample(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, const UniformClock& clock);
 
+// Values at every grid index from the first to the last sample, lost samples included,
+// each by interpolate_at (an NC trace: a set-point is smooth, its gaps are bridged).
+std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, const UniformClock& clock);
+
 // A stamped series evaluated at arbitrary times (for an NC trace: cubic Lagrange through
 // the four nearest stamps; held at the ends).
 Eigen::Vector3d interpolate_at(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, double t);
