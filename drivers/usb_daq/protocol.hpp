@@ -4,6 +4,7 @@
 // streams. Fixed-size buffer; feed() does not allocate.
 #include "dsp/core/frame.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -28,14 +29,19 @@ class Decoder {
  public:
   // `psd_count`: PSD strips expected per sample (the channel count is checked against it).
   explicit Decoder(int psd_count);
-  // Consumes bytes; calls `emit(frame)` for every sample decoded.
+  // Consumes bytes (a chunk of any size: UsbDaqSource reads 16 KiB transfers, twice the
+  // buffer); calls `emit(frame)` for every sample decoded. The buffer is parsed whenever
+  // it fills, so a chunk larger than the buffer loses nothing.
   template <class Emit>
   void feed(std::span<const std::uint8_t> bytes, Emit&& emit) {
-    for (std::uint8_t b : bytes) {
-      if (fill_ == buf_.size()) drop(1);  // cannot happen with valid packets; keeps us bounded
-      buf_[fill_++] = b;
+    while (!bytes.empty()) {
+      if (fill_ == buf_.size()) drop(1);  // parse leaves at most one partial packet: cannot happen; keeps us bounded
+      const std::size_t n = std::min(bytes.size(), buf_.size() - fill_);
+      std::copy_n(bytes.begin(), n, buf_.begin() + static_cast<std::ptrdiff_t>(fill_));
+      fill_ += n;
+      bytes = bytes.subspan(n);
+      parse([&](const dsp::Frame& f) { emit(f); });
     }
-    parse([&](const dsp::Frame& f) { emit(f); });
   }
   [[nodiscard]] const DecoderStats& stats() const { return stats_; }
   [[nodiscard]] float temp_c(int sensor) const { return temp_c_[sensor]; }
