@@ -36,6 +36,7 @@ std::optional<CommandMsg> decode_command(std::span<const std::uint8_t> payload, 
   const bool little = id == kCdrLe || id == kCdr2Le;
   const std::uint32_t xcdr = id == kCdrBe || id == kCdrLe ? kXcdr1 : kXcdr2;
   const auto size = static_cast<std::uint32_t>(payload.size() - kHeaderBytes);
+  if (size == 0) return refuse(why, "no body after the encapsulation header");
   if (pad > size) return refuse(why, "padding longer than the body");
   // Cyclone normalises in place (byte order) and needs the body 8-byte aligned.
   std::vector<std::uint64_t> body((size + 7) / 8);
