@@ -10,8 +10,9 @@ build_pkgs=(g++ cmake ninja-build pkg-config libeigen3-dev libtomlplusplus-dev l
 # chromium + fonts: the report screenshot test; linuxcnc-uspace: the end-to-end test with a
 # real NC (tests/linuxcnc), Depends only; postgresql: the history tests and benchmark start a
 # server of their own (initdb/postgres from /usr/lib/postgresql/<version>/bin; as root they
-# run it as user nobody, initdb refuses root).
-test_pkgs=(systemd chromium fonts-dejavu-core linuxcnc-uspace postgresql)
+# run it as user nobody, initdb refuses root); clang + libclang-rt-14-dev: the fuzz stage
+# (libFuzzer with ASan + UBSan, fuzz/).
+test_pkgs=(systemd chromium fonts-dejavu-core linuxcnc-uspace postgresql clang libclang-rt-14-dev)
 want=("${build_pkgs[@]}")
 [[ "${1:-build}" == test ]] && want+=("${test_pkgs[@]}")
 
