@@ -10,6 +10,17 @@
 #include <tuple>
 
 namespace eical::tools {
+namespace {
+
+// What ISO 230-2 needs of a table (evaluate_positioning checks it again, without a file
+// to name).
+void require_table(const std::string& file, std::size_t targets, long long runs, const char* what) {
+  if (targets < 2) throw dsp::InputError(file + ": at least 2 targets are needed for ISO 230-2 (the file has " + std::to_string(targets) + ")");
+  if (runs < 2)
+    throw dsp::InputError(file + ": at least 2 " + what + " per direction are needed for ISO 230-2 (the file has " + std::to_string(runs) + ")");
+}
+
+}  // namespace
 
 dsp::eval::PositioningInput read_deviation_csv(const std::string& file) {
   const CsvTable t(file, {"target_mm", "run", "direction", "deviation_um"});
@@ -29,6 +40,7 @@ dsp::eval::PositioningInput read_deviation_csv(const std::string& file) {
       throw dsp::InputError(t.where(r, "run") + ": target " + std::to_string(target) + " mm, run " + std::to_string(run) + ", " + d + " appears twice");
     max_run = std::max(max_run, run);
   }
+  require_table(file, target_of.size(), max_run, "runs");
   dsp::eval::PositioningInput in;
   for (const auto& [k, v] : target_of) in.targets_mm.push_back(v);
   in.up_um.assign(static_cast<std::size_t>(max_run), {});
@@ -90,6 +102,7 @@ dsp::eval::PositioningInput read_ecmc_dat(const std::string& file) {
   if (targets.empty()) throw dsp::InputError(file + ": no TGT_DATA lines");
   int cycles = 0;
   for (const auto& [k, v] : refs) cycles = std::max(cycles, std::get<2>(k));
+  require_table(file, targets.size(), cycles, "cycles");
   dsp::eval::PositioningInput in;
   for (const auto& [i, t] : targets) in.targets_mm.push_back(t);
   in.up_um.assign(static_cast<std::size_t>(cycles), {});

@@ -1,0 +1,51 @@
+// The inputs the fuzz targets found (fuzz/corpus/<target>/finding-*), each through the
+// normal reader as eical reads it: the clean one-line error naming the file, nothing else.
+#include "dsp/core/error.hpp"
+#include "tools/io/csv_inputs.hpp"
+#include "tools/io/positioning_readers.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The corpus file copied to a fresh temporary file; `read` must throw an InputError that
+// names that file and says `says`. Returns the message.
+std::string error_of(const std::string& target, const std::string& finding, const std::function<void(const std::string&)>& read) {
+  const fs::path src = fs::path(EICAL_SOURCE_DIR) / "fuzz" / "corpus" / target / finding;
+  EXPECT_TRUE(fs::exists(src)) << src;
+  const fs::path file = fs::temp_directory_path() / ("eical-finding-" + std::to_string(std::random_device{}()) + "-" + finding);
+  fs::copy_file(src, file, fs::copy_options::overwrite_existing);
+  std::string what;
+  try {
+    read(file.string());
+  } catch (const eical::dsp::InputError& e) {
+    what = e.what();
+  }
+  fs::remove(file);
+  EXPECT_NE(what.find(file.string()), std::string::npos) << "does not name the file: " << what;
+  EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  return what;
+}
+
+void expect_says(const std::string& what, const std::string& says) { EXPECT_NE(what.find(says), std::string::npos) << what; }
+
+// ISO 230-2 tables too small for the evaluation: evaluate_positioning refused them without
+// naming the file; the readers check it now.
+TEST(FuzzFindings, DeviationCsvWithOneTargetNamesTheFile) {
+  expect_says(error_of("deviation_csv", "finding-one-target", [](const std::string& f) { (void)eical::tools::read_deviation_csv(f); }),
+              "at least 2 targets are needed for ISO 230-2 (the file has 1)");
+}
+
+TEST(FuzzFindings, EcmcDatWithoutCyclesNamesTheFile) {
+  expect_says(error_of("ecmc_dat", "finding-no-cycles", [](const std::string& f) { (void)eical::tools::read_ecmc_dat(f); }),
+              "at least 2 cycles per direction are needed for ISO 230-2 (the file has 0)");
+}
+
+}  // namespace
