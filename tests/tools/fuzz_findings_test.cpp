@@ -3,6 +3,7 @@
 #include "dsp/core/error.hpp"
 #include "tools/io/csv_inputs.hpp"
 #include "tools/io/positioning_readers.hpp"
+#include "tools/io/volumetric_model_file.hpp"
 
 #include <gtest/gtest.h>
 
@@ -46,6 +47,14 @@ TEST(FuzzFindings, DeviationCsvWithOneTargetNamesTheFile) {
 TEST(FuzzFindings, EcmcDatWithoutCyclesNamesTheFile) {
   expect_says(error_of("ecmc_dat", "finding-no-cycles", [](const std::string& f) { (void)eical::tools::read_ecmc_dat(f); }),
               "at least 2 cycles per direction are needed for ISO 230-2 (the file has 0)");
+}
+
+// A component with more positions than values: the model's validation refused it without
+// naming the file; the reader checks the count with the line now.
+TEST(FuzzFindings, VolumetricModelValuesCountNamesFileAndLine) {
+  const std::string what =
+      error_of("volumetric_model", "finding-values-count", [](const std::string& f) { (void)eical::tools::read_volumetric_model(f); });
+  expect_says(what, ":23: component[1].values: expected 12 numbers, got 9");
 }
 
 }  // namespace

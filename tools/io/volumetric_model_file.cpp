@@ -1,6 +1,7 @@
 #include "tools/io/volumetric_model_file.hpp"
 
 #include "drivers/config/strict_toml.hpp"
+#include "dsp/core/error.hpp"
 
 #include <array>
 #include <cstdio>
@@ -60,7 +61,7 @@ dsp::comp::VolumetricFit read_volumetric_model(const std::string& file) {
     if (seen[k]) c.fail("name", "component '" + name + "' appears twice");
     seen[k] = true;
     m.component[k].pos_mm = c.numbers("positions_mm");
-    m.component[k].values = c.numbers("values");
+    m.component[k].values = c.numbers("values", m.component[k].pos_mm.size());
     auto& fit = f.component[k];
     if (c.has("u_k2")) {
       fit.u_k2 = c.numbers("u_k2", m.component[k].pos_mm.size());
@@ -71,7 +72,11 @@ dsp::comp::VolumetricFit read_volumetric_model(const std::string& file) {
     c.finish();
   }
   t.finish();
-  dsp::comp::validate(m);  // missing components, order, coverage
+  try {
+    dsp::comp::validate(m);  // missing components, order, coverage
+  } catch (const dsp::InputError& e) {
+    throw dsp::InputError(file + ": " + e.what());
+  }
   return f;
 }
 
