@@ -57,4 +57,26 @@ TEST(FuzzFindings, VolumetricModelValuesCountNamesFileAndLine) {
   expect_says(what, ":23: component[1].values: expected 12 numbers, got 9");
 }
 
+// A curve whose positions reach 5.6e13 mm: at 50 mm spacing lincomp built a table of 1e12
+// points (timeout). Refused now, promptly, with the figure.
+TEST(FuzzFindings, CurveWithAnImpossibleTravelIsRefused) {
+  const fs::path file = fs::path(EICAL_SOURCE_DIR) / "fuzz" / "corpus" / "curve_csv" / "finding-huge-travel";
+  const auto curve = eical::tools::read_error_curve_csv(file.string());
+  ASSERT_EQ(curve.pos_mm.size(), 2u);  // 49 mm and 5.6e13 mm
+  std::string what;
+  try {
+    (void)eical::dsp::comp::piecewise_linear(curve, {50.0, 1.0, 0.0});
+  } catch (const eical::dsp::InputError& e) {
+    what = e.what();
+  }
+  expect_says(what, "needs more than 100000 correction points (positions in mm?)");
+  try {
+    what.clear();
+    (void)eical::dsp::comp::piecewise_linear({{0.0, 100.0}, {0.0, 1.0}}, {10.0, 1e-4, 0.0});
+  } catch (const eical::dsp::InputError& e) {
+    what = e.what();
+  }
+  expect_says(what, "is more than 10000 grid shifts");
+}
+
 }  // namespace
