@@ -3,6 +3,8 @@
 #include "drivers/config/meta_sections.hpp"
 #include "drivers/config/strict_toml.hpp"
 
+#include <cmath>
+
 
 namespace eical::daemon {
 namespace {
@@ -103,8 +105,9 @@ void read_triggers(StrictTable t, TriggerConfig& c) {
   if (t.has("gpio_lines")) {
     const auto lines = t.numbers("gpio_lines", 3);
     for (std::size_t i = 0; i < 3; ++i) {
-      if (lines[i] < 0 || lines[i] != static_cast<double>(static_cast<int>(lines[i])))
-        t.fail("gpio_lines", "line offsets must be non-negative integers");
+      // Checked before the conversion: a double beyond int's range does not convert.
+      if (!(lines[i] >= 0.0 && lines[i] <= 65535.0) || lines[i] != std::floor(lines[i]))
+        t.fail("gpio_lines", "line offsets must be integers within 0..65535");
       c.gpio_lines[i] = static_cast<int>(lines[i]);
     }
   }
