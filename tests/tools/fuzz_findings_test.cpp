@@ -49,6 +49,16 @@ TEST(FuzzFindings, EcmcDatWithoutCyclesNamesTheFile) {
               "at least 2 cycles per direction are needed for ISO 230-2 (the file has 0)");
 }
 
+// A run (cycle) number far beyond the rows: the reader allocated a row for every run up to
+// it before finding the first missing one (ASan: allocation of 2.4e13 bytes; 48 GB for
+// the ecmc cycle). Runs are added as they are complete now.
+TEST(FuzzFindings, RunNumberFarBeyondTheRowsEndsAtTheFirstMissingRun) {
+  expect_says(error_of("deviation_csv", "review-run-1e12", [](const std::string& f) { (void)eical::tools::read_deviation_csv(f); }),
+              "no deviation for target 0.000000 mm, run 2, up");
+  expect_says(error_of("ecmc_dat", "review-cycle-2e9", [](const std::string& f) { (void)eical::tools::read_ecmc_dat(f); }),
+              "REF_DATA_FWD[1,1] is missing");
+}
+
 // A component with more positions than values: the model's validation refused it without
 // naming the file; the reader checks the count with the line now.
 TEST(FuzzFindings, VolumetricModelValuesCountNamesFileAndLine) {
