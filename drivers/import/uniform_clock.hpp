@@ -31,7 +31,8 @@ struct UniformClock {
   [[nodiscard]] double time_at(std::int64_t i) const { return t0_s + static_cast<double>(i) / fs_hz; }
 };
 
-// Throws InputError naming `source` for fewer than 4 samples or stamps that do not increase.
+// Throws InputError naming `source` for fewer than 4 samples, stamps that do not increase,
+// or gaps that lose more samples than were recorded.
 UniformClock fit_uniform_clock(const std::vector<double>& t_s, const std::string& source);
 
 // Values at every grid index that is not lost: grid_index[k] and values[k].

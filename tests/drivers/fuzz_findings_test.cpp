@@ -1,6 +1,8 @@
 // Inputs of the drivers' fuzz targets (fuzz/corpus/<target>/finding-* found by the fuzzer,
 // review-* by reading the reader while writing its target), through the normal readers:
 // the clean one-line error naming the file, nothing else.
+#include "drivers/import/capture_files.hpp"
+#include "drivers/import/uniform_clock.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/core/error.hpp"
 
@@ -55,6 +57,38 @@ TEST(DriversFuzz, AdcBitsBeyondIntIsRefusedNotNarrowed) {
   const fs::path dir = run_dir_of("review-adc-bits-beyond-int", tmp);
   const std::string what = error_of([&] { (void)eical::drivers::read_run(dir); });
   EXPECT_NE(what.find((dir / "run.toml").string() + ":7: acquisition.adc_bits: integer 4294967312 is out of range"), std::string::npos) << what;
+}
+
+// An nc_csv input as fuzz/nc_csv.cpp reads it (byte 0: options; 1 = columns t, x, y, z by
+// name, seconds), through the importer's path: the reader, the uniform clock, the bridged grid.
+std::string nc_trace_error(const std::string& input, const TempDir& tmp) {
+  const std::string text = corpus("nc_csv", input);
+  const fs::path file = tmp.path / "trace.csv";
+  std::ofstream(file, std::ios::binary) << text.substr(1);
+  eical::drivers::CsvColumns columns;
+  columns.time = "t", columns.values = {"x", "y", "z"};
+  const std::string what = error_of([&] {
+    const auto nc = eical::drivers::read_nc_csv(file, columns);
+    const auto clock = eical::drivers::fit_uniform_clock(nc.t_s, nc.source);
+    (void)eical::drivers::bridge_gaps(nc.t_s, nc.pos_mm, clock);
+  });
+  EXPECT_NE(what.find(file.string()), std::string::npos) << what;
+  return what;
+}
+
+// Four samples 1 ms apart, then one 1e9 s later: the clock counted 1e12 lost samples and
+// the importer asked for a grid of 1e12 set-points (ASan: allocation beyond its maximum).
+TEST(DriversFuzz, NcTraceWithAGapOfAGigasecondIsRefused) {
+  TempDir tmp;
+  const std::string what = nc_trace_error("review-gap-1e9-s", tmp);
+  EXPECT_NE(what.find("a gap of 999999999.997000 s after sample 4 loses more samples than the 5 recorded"), std::string::npos) << what;
+}
+
+// Two gaps of 5e18 samples each: the grid index overflowed int64 (UBSan: signed overflow).
+TEST(DriversFuzz, GapsWhoseIndicesWouldOverflowAreRefused) {
+  TempDir tmp;
+  const std::string what = nc_trace_error("review-gaps-overflow-index", tmp);
+  EXPECT_NE(what.find("loses more samples than the 7 recorded (time stamps in another unit?)"), std::string::npos) << what;
 }
 
 }  // namespace
