@@ -59,6 +59,18 @@ TEST(DriversFuzz, AdcBitsBeyondIntIsRefusedNotNarrowed) {
   EXPECT_NE(what.find((dir / "run.toml").string() + ":7: acquisition.adc_bits: integer 4294967312 is out of range"), std::string::npos) << what;
 }
 
+// A PSD current of 1e300 V became llround(1e300 / lsb): an unspecified value cut to 32 bits,
+// recorded as a plausible count; a temperature of -1e300 C was converted to float
+// (undefined beyond its range). Both are refused with the line and column now.
+TEST(DriversFuzz, SampleValuesBeyondWhatTheDaqRecordsAreRefused) {
+  TempDir tmp;
+  std::string what = error_of([&] { (void)eical::drivers::read_run(run_dir_of("review-psd-beyond-adc", tmp)); });
+  EXPECT_NE(what.find("samples.csv:3: column 'psd0_i1': PSD value beyond the ADC's 32-bit range ('1e300')"), std::string::npos) << what;
+  TempDir tmp2;
+  what = error_of([&] { (void)eical::drivers::read_run(run_dir_of("review-temperature-beyond-float", tmp2)); });
+  EXPECT_NE(what.find("samples.csv:4: column 'table_temp': temperature beyond +-1000 C ('-1e300')"), std::string::npos) << what;
+}
+
 // An nc_csv input as fuzz/nc_csv.cpp reads it (byte 0: options; 1 = columns t, x, y, z by
 // name, seconds), through the importer's path: the reader, the uniform clock, the bridged grid.
 std::string nc_trace_error(const std::string& input, const TempDir& tmp) {
