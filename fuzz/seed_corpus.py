@@ -35,7 +35,7 @@ def head_lines(text, n):
 
 
 def eical(*args, cwd=None):
-    subprocess.run([EICAL, *args], check=True, cwd=cwd, stdout=subprocess.DEVNULL)
+    subprocess.run([EICAL, *args], check=True, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
 # --- run directory: run.toml, "\n%%samples\n", samples (plain or gzip), "\n%%truth\n", truth.toml
@@ -166,6 +166,17 @@ while len(stream) < 16384 - 600:
 put("usb_daq", "full-transfer", bytes([1]) + stream)
 
 
+# --- CAN trigger frame: struct can_frame (id, len, 3 pad bytes, data[8])
+def can_frame(can_id, data, length=8):
+    return struct.pack("<IB3x", can_id, length) + bytes(data).ljust(8, b"\x00")
+
+
+put("can_trigger", "m101", can_frame(0x1E0, [1, 0, 0, 0, 0, 0x80]))
+put("can_trigger", "m102-p2500", can_frame(0x1E0, [2, 7] + list(struct.pack("<i", 2500000))))
+put("can_trigger", "broken-other-id", can_frame(0x1E1, [3, 1]))
+put("can_trigger", "broken-short", can_frame(0x1E0, [3, 1], length=2))
+
+
 # --- DDS Command: encapsulation header + CDR of eical::msg::Command (sender, request_id,
 # action, code, p, q, time_ns)
 def cdr_command(sender, request_id, action, code, p, q, t_ns, big=False, xcdr2=False):
@@ -202,7 +213,7 @@ put("dds_command", "broken-string-length", cdr_command("x", 1, "trigger", 103, n
 # --- what eical itself writes (gen-nc dialects, an exported Klipper capture)
 if EICAL:
     with tempfile.TemporaryDirectory() as tmp:
-        for prog, extra in (("circle", ["--direction", "both"]), ("positioning", []), ("step", []), ("rectangle", []),
+        for prog, extra in (("circle", ["--direction", "both"]), ("positioning", ["--targets", "0,50,100"]), ("step", ["--targets", "0,10"]), ("rectangle", []),
                             ("identify", ["--psd", "x:0,-10", "--psd", "y:10,0"])):
             for dialect in ("linuxcnc", "fanuc", "sinumerik", "heidenhain-iso"):
                 out = os.path.join(tmp, f"{prog}-{dialect}.ngc")
