@@ -3,7 +3,9 @@
 // every M101..M103 of the NC program, writes each as an eical-run/1 directory with its
 // result.json, and reports to systemd (READY, STATUS, WATCHDOG, STOPPING).
 #include "daemon/config/daemon_config.hpp"
+#include "daemon/service/preflight.hpp"
 #include "daemon/service/service.hpp"
+#include "daemon/triggers/trigger_input.hpp"
 #include "drivers/config/sensor_calibration.hpp"
 #include "daemon/system/log.hpp"
 #include "daemon/system/notify.hpp"
@@ -16,10 +18,45 @@
 #include <csignal>
 #include <cstdio>
 #include <thread>
+#include <vector>
 
 namespace {
 
 std::atomic<bool> g_stop{false};
+
+// --check: everything the service needs on this machine, each problem on its own line.
+int check_config(const std::string& file, const eical::daemon::DaemonConfig& config) {
+  using namespace eical::daemon;
+  std::vector<std::string> problems, fine;
+  try {
+    auto source = Service::make_source(config);
+    source->open();
+    fine.push_back("source '" + std::string(source->name()) + "' opens");
+    if (!config.calibration_file.empty()) {
+      const auto cal = eical::drivers::read_sensor_calibration(config.calibration_file, source->meta());
+      fine.push_back("calibration " + config.calibration_file.string() + " (" + cal.method + ", from run " + cal.run_id + ") reads");
+    }
+  } catch (const std::exception& e) {
+    problems.push_back(std::string("source: ") + e.what());
+  }
+  for (const auto& kind : config.triggers.inputs) {  // each device on its own: every absent one is named
+    TriggerConfig one = config.triggers;
+    one.inputs = {kind};
+    try {
+      for (const auto& input : open_trigger_inputs(one)) fine.push_back("trigger input " + input->name() + " opens");
+    } catch (const std::exception& e) {
+      problems.push_back(std::string("triggers: ") + e.what() + " ([triggers] inputs)");
+    }
+  }
+  for (auto problem : {recording_dir_problem(config.recording.dir), dds_config_problem(config.dds), setpoint_problem(config.setpoint)})
+    if (problem) problems.push_back(*problem);
+  for (const auto& p : problems) log(LogLevel::error, "%s: %s", file.c_str(), p.c_str());
+  if (!problems.empty()) return 3;
+  std::string summary;
+  for (const auto& f : fine) summary += "; " + f;
+  std::printf("%s: configuration valid%s; recording path %s writable\n", file.c_str(), summary.c_str(), config.recording.dir.c_str());
+  return 0;
+}
 
 extern "C" void on_signal(int) { g_stop.store(true); }
 
@@ -41,23 +78,7 @@ int main(int argc, char** argv) {
     log(LogLevel::error, "configuration: %s", e.what());
     return 2;
   }
-  if (check) {
-    try {
-      auto source = Service::make_source(config);
-      source->open();
-      if (!config.calibration_file.empty()) {
-        const auto cal = eical::drivers::read_sensor_calibration(config.calibration_file, source->meta());
-        std::printf("%s: calibration %s (%s, from run %s) reads\n", config_file.c_str(), config.calibration_file.c_str(), cal.method.c_str(),
-                    cal.run_id.c_str());
-      }
-      std::printf("%s: configuration valid; source '%.*s' opens\n", config_file.c_str(), static_cast<int>(source->name().size()),
-                  source->name().data());
-      return 0;
-    } catch (const std::exception& e) {
-      log(LogLevel::error, "source: %s", e.what());
-      return 3;
-    }
-  }
+  if (check) return check_config(config_file, config);
 
   struct sigaction sa{};
   sa.sa_handler = on_signal;

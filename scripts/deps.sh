@@ -5,13 +5,14 @@ set -euo pipefail
 # libsqlite3-dev, libpq-dev: the calibration history (SQLite on the control PC, PostgreSQL client).
 build_pkgs=(g++ cmake ninja-build pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev
   nlohmann-json3-dev zlib1g-dev libsystemd-dev libusb-1.0-0-dev libgpiod-dev
-  cyclonedds-dev cyclonedds-tools libgtest-dev libbenchmark-dev libboost-dev
+  cyclonedds-dev cyclonedds-tools libgtest-dev libbenchmark-dev libboost-dev dpkg-dev
   libsqlite3-dev libpq-dev)
 # chromium + fonts: the report screenshot test; linuxcnc-uspace: the end-to-end test with a
 # real NC (tests/linuxcnc), Depends only; postgresql: the history tests and benchmark start a
 # server of their own (initdb/postgres from /usr/lib/postgresql/<version>/bin; as root they
-# run it as user nobody, initdb refuses root); clang + libclang-rt-14-dev: the fuzz stage
-# (libFuzzer with ASan + UBSan, fuzz/).
+# run it as user nobody, initdb refuses root). dpkg-dev (build): the .deb's library
+# dependencies (dpkg-shlibdeps, `--target package`). clang + libclang-rt-14-dev: the fuzz
+# stage (libFuzzer with ASan + UBSan, fuzz/).
 test_pkgs=(systemd chromium fonts-dejavu-core linuxcnc-uspace postgresql clang libclang-rt-14-dev)
 want=("${build_pkgs[@]}")
 [[ "${1:-build}" == test ]] && want+=("${test_pkgs[@]}")

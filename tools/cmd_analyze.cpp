@@ -4,6 +4,8 @@
 #include "dsp/analysis/analyze_run.hpp"
 #include "tools/commands.hpp"
 #include "drivers/results/result_json.hpp"
+#include "tools/exit_codes.hpp"
+#include "tools/plan/test_plan.hpp"
 #include "tools/run_files.hpp"
 
 #include <cstdio>
@@ -15,10 +17,12 @@ void register_analyze(CLI::App& app) {
   struct Opt {
     std::string run, dynamic = "two-stage", calibration;
     bool json = false, no_zupt = false, coriolis = false;
+    int draws = 100;
+    bool no_suggest = false;
     std::string nbs = "auto";
   };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("analyze", "Evaluate a recorded run (circle: ISO 230-4 + diagnostics; step)");
+  auto* cmd = app.add_subcommand("analyze", "Evaluate a recorded run: every program's figures with their uncertainty U (k = 2) and the verdict");
   cmd->add_option("run", o->run, "run directory (eical-run/1)")->required();
   cmd->add_flag("--json", o->json, "print the eical-result/1 document");
   cmd->add_option("--dynamic", o->dynamic, "dynamic compensation: two-stage or none")->default_val("two-stage")->check(CLI::IsMember({"two-stage", "none"}));
@@ -29,6 +33,9 @@ void register_analyze(CLI::App& app) {
   cmd->add_flag("--coriolis", o->coriolis, "correct the Earth-rate Coriolis acceleration (3-6) with [site] latitude and heading");
   cmd->add_option("--calibration", o->calibration, "sensor calibration (eical-sensor-cal/1, from eical identify) instead of the run's data sheet")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--draws", o->draws, "Monte Carlo draws of the uncertainty (seeded, deterministic)")->default_val(100)->check(CLI::Range(10, 100000));
+  cmd->add_flag("--no-suggest", o->no_suggest, "do not look for a measurable variant when the test is not measurable (it simulates variants: seconds)");
+  cmd->footer("Exit status: 0 verdict ok, 2 degraded, 3 not measurable, 1 an error (README \"Exit status\").");
   cmd->callback([o] {
     dsp::Run run = drivers::read_run(o->run);
     dsp::AnalysisOptions opt;
@@ -38,9 +45,13 @@ void register_analyze(CLI::App& app) {
     opt.zupt = !o->no_zupt;
     if (o->nbs != "auto") opt.nbs = o->nbs == "on";
     opt.coriolis = o->coriolis;
-    const dsp::Analysis a = dsp::analyze_run(run, opt);
+    opt.uncertainty.draws = o->draws;
+    dsp::Analysis a = dsp::analyze_run(run, opt);
+    if (a.verdict == "not_measurable" && !o->no_suggest) plan::suggest_measurable_test(run, a);
     if (o->json) std::printf("%s\n", drivers::result_json(run, a).dump(2).c_str());
     else std::fputs(summary_text(run, a).c_str(), stdout);
+    std::fflush(stdout);
+    if (const int code = verdict_exit_code(a.verdict); code != kExitOk) throw CLI::RuntimeError(code);
   });
 }
 

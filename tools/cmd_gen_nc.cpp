@@ -6,6 +6,7 @@
 #include "sim/gcode/dialect.hpp"
 #include "sim/gcode/generate.hpp"
 #include "tools/commands.hpp"
+#include "tools/io/psd_option.hpp"
 
 #include <cctype>
 #include <cstdio>
@@ -175,24 +176,6 @@ void add_rectangle(CLI::App* gen) {
   c->add_option("--plane", p.plane, "xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
   add_output(c, *o);
   c->callback([o] { o->program.kind = "rectangle"; emit(*o); });
-}
-
-// --psd x:0,-10 (the strip measures x; its centre at x = 0, y = −10, as run.toml's [[psd]]).
-dsp::PsdSpec parse_psd(const std::string& text) {
-  const auto colon = text.find(':');
-  const auto comma = text.find(',', colon == std::string::npos ? 0 : colon);
-  if (colon == std::string::npos || comma == std::string::npos)
-    throw std::runtime_error("--psd '" + text + "': expected MEASURES:CX,CY (e.g. x:0,-10)");
-  dsp::PsdSpec s;
-  s.measures = text.substr(0, colon);
-  if (s.measures != "x" && s.measures != "y") throw std::runtime_error("--psd '" + text + "': a strip measures x or y");
-  try {
-    s.center_mm[0] = std::stod(text.substr(colon + 1, comma - colon - 1));
-    s.center_mm[1] = std::stod(text.substr(comma + 1));
-  } catch (const std::exception&) {
-    throw std::runtime_error("--psd '" + text + "': the centre is not two numbers");
-  }
-  return s;
 }
 
 void add_identify(CLI::App* gen) {

@@ -6,6 +6,7 @@
 
 #if EICAL_HAVE_DDS
 #include "drivers/dds/bus.hpp"
+#include "drivers/results/resolved.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -47,13 +48,27 @@ void save_trace(const std::filesystem::path& dir, const drivers::dds::TraceMsg& 
   std::filesystem::rename(tmp, file);
 }
 
+// ", 2 triggers refused, 1 decode errors": the counters of a Status that are not zero.
+std::string nonzero_counters(const drivers::dds::StatusMsg& s) {
+  const std::pair<const char*, std::uint64_t> all[] = {
+      {"bad frames", s.bad_frames},           {"Live overruns", s.live_overruns},          {"stamp overruns", s.stamp_overruns},
+      {"DDS write errors", s.dds_write_errors}, {"triggers refused", s.triggers_refused},  {"triggers late", s.triggers_late},
+      {"trigger events ignored", s.trigger_events_ignored}, {"recorder overflow", s.recorder_overflow},
+      {"decode errors", s.source_decode_errors}, {"samples lost by the source", s.source_lost_samples},
+      {"frames dropped by the source", s.source_dropped_frames}, {"frames without set-point", s.setpoint_missing}};
+  std::string out;
+  for (const auto& [name, value] : all)
+    if (value != 0) out += ", " + std::to_string(value) + " " + name;
+  return out;
+}
+
 }  // namespace
 
 void register_hmi(CLI::App& app) {
   struct Opt {
     int domain = 0, results = 0, traces = 0;
     std::string save_traces;
-    double timeout_s = 0.0;
+    double timeout_s = 0.0, connect_timeout_s = 10.0;
     std::string uri;
     int code = 0;
     double p = NAN, q = NAN;
@@ -66,22 +81,48 @@ void register_hmi(CLI::App& app) {
   hmi->add_option("--traces", o->traces, "also wait for this many traces before exiting with --results")->default_val(0);
   hmi->add_option("--save-traces", o->save_traces, "write every trace received to DIR/<program id>.trace.csv");
   hmi->add_option("--timeout", o->timeout_s, "exit after this many seconds (0 = never)")->default_val(0.0);
+  hmi->add_option("--connect-timeout", o->connect_timeout_s, "exit non-zero when no eicald Status arrives within this many seconds")
+      ->default_val(10.0);
   hmi->callback([o] {
     use_uri(o->uri);
     drivers::dds::Bus bus(o->domain, drivers::dds::Role::hmi);
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                             std::chrono::duration<double>(o->timeout_s > 0 ? o->timeout_s : 1e9));
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto end = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(o->timeout_s > 0 ? o->timeout_s : 1e9));
+    const auto connect_end = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(o->connect_timeout_s));
     int results = 0, traces = 0;
+    bool daemon_seen = false;
+    // The daemon's result count as this HMI knows it: a Result carries the count it was
+    // published with, so a Status that left before it can never show fewer.
+    std::uint64_t result_count = 0;
     const auto done = [&] { return o->results > 0 && results >= o->results && traces >= o->traces; };
     while (std::chrono::steady_clock::now() < end) {
-      if (auto s = bus.take_status(std::chrono::milliseconds(100)))
-        std::printf("status %s: %s, %llu frames, %llu overruns, %llu lost, %llu results%s%s\n", s->daemon.c_str(), s->state.c_str(),
+      if (!daemon_seen && std::chrono::steady_clock::now() >= connect_end) break;
+      if (auto s = bus.take_status(std::chrono::milliseconds(100))) {
+        daemon_seen = true;
+        result_count = std::max(result_count, s->results);
+        std::printf("status %s: %s, %llu frames, %llu overruns, %llu lost, %llu results%s%s%s\n", s->daemon.c_str(), s->state.c_str(),
                     static_cast<unsigned long long>(s->frames), static_cast<unsigned long long>(s->overruns),
-                    static_cast<unsigned long long>(s->frames_lost), static_cast<unsigned long long>(s->results),
-                    s->fault.empty() ? "" : " — ", s->fault.c_str());
+                    static_cast<unsigned long long>(s->frames_lost), static_cast<unsigned long long>(result_count),
+                    nonzero_counters(*s).c_str(), s->fault.empty() ? "" : " — ", s->fault.c_str());
+      }
       if (auto r = bus.take_result(std::chrono::milliseconds(10))) {
-        std::printf("result %s (%s)%s: G %.2f um, mean radius deviation %.2f um\n", r->program_id.c_str(), r->program.c_str(),
-                    r->degraded ? " DEGRADED" : "", r->circular_deviation_G_um, r->radius_mean_deviation_um);
+        // The figures with their uncertainty and the verdict, from the result document.
+        std::string verdict = r->degraded ? "degraded" : "ok", g = "G n/a";
+        const auto doc = nlohmann::json::parse(r->json, nullptr, false);
+        if (!doc.is_discarded()) {
+          verdict = doc.value("/quality/verdict"_json_pointer, verdict);
+          const auto v = drivers::figure_value(doc, "circle.circular_deviation_G_um");
+          const auto u = drivers::uncertainty_k2(doc, "circle.circular_deviation_G_um");
+          char b[96];
+          if (v) std::snprintf(b, sizeof b, "G %.2f%s um%s", *v, u ? (" ± " + std::to_string(*u).substr(0, std::to_string(*u).find('.') + 3)).c_str() : "",
+                               u && !drivers::figure_resolved(doc, "circle.circular_deviation_G_um") ? " (not resolved)" : "");
+          if (v) g = b;
+        }
+        daemon_seen = true;
+        result_count = std::max(result_count, r->results);
+        std::printf("result %s (%s): verdict %s, %s, mean radius deviation %.2f um (result %llu of the daemon)\n", r->program_id.c_str(), r->program.c_str(),
+                    verdict.c_str(), g.c_str(), r->radius_mean_deviation_um, static_cast<unsigned long long>(r->results));
         ++results;
       }
       if (auto t = bus.take_trace(std::chrono::milliseconds(10))) {
@@ -94,6 +135,11 @@ void register_hmi(CLI::App& app) {
       }
       std::fflush(stdout);
       if (done()) return;
+    }
+    if (!daemon_seen) {
+      const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      throw std::runtime_error("hmi: no eicald on DDS domain " + std::to_string(o->domain) + " (no Status within " +
+                               std::to_string(static_cast<int>(std::lround(waited))) + " s; is eicald running with the same domain and DDS configuration?)");
     }
     if (o->results > 0)
       throw std::runtime_error("hmi: " + std::to_string(results) + " of " + std::to_string(o->results) + " results and " + std::to_string(traces) +

@@ -59,6 +59,11 @@ nlohmann::json identification_json(const dsp::identify::Identification& id) {
                     {"rest_rms_before_um", id.rest_rms_before_um}, {"rest_rms_after_um", id.rest_rms_after_um}};
   j["observations"] = {{"psd", id.psd_observations}, {"rest", id.rest_observations}, {"standstills", id.standstills}};
   j["iterations"] = id.iterations;
+  j["strip_crossings"] = id.strip_crossings;
+  j["crossing_speeds_mm_s"] = id.crossing_speeds_mm_s;
+  nlohmann::json sig = nlohmann::json::object();
+  for (int p = 0; p < dsp::uncertainty::kModelParameters; ++p) sig[dsp::uncertainty::parameter_name(p)] = id.covariance.sigma(p);
+  j["standard_uncertainty"] = sig;  // σ of every model parameter (the data sheet's where not identified)
   j["notes"] = id.notes;
   return j;
 }
@@ -127,6 +132,15 @@ void register_identify(CLI::App& app) {
     opt.rest_sigma_um = o->rest_sigma_um;
     opt.delay_from_setpoint = o->delay_from_setpoint;
     const dsp::identify::Identification id = dsp::identify::identify_sensors(run, opt);
+    // A calibration less certain than the data sheet would make every figure worse.
+    const auto worse = dsp::identify::less_certain_than_datasheet(id, dsp::uncertainty::datasheet_covariance(run.meta.sensors, run.meta.acquisition.fs_hz));
+    if (!worse.empty()) {
+      std::string list;
+      for (std::size_t i = 0; i < worse.size() && i < 4; ++i) list += (i ? "; " : "") + worse[i];
+      if (worse.size() > 4) list += "; and " + std::to_string(worse.size() - 4) + " more";
+      throw std::runtime_error("identify: run '" + run.meta.id + "' leaves " + list +
+                               " less certain than the data sheet: no calibration written (run the identification program, eical gen-nc identify)");
+    }
     nlohmann::json doc = {{"format", "eical-identify/1"}, {"run_id", run.meta.id}};
     doc["identification"] = identification_json(id);
     std::string text = summary(id);

@@ -36,6 +36,9 @@ void register_iso230_2(CLI::App& app) {
                 r.E_up_um, r.E_down_um, r.M_um);
     std::printf("  R %.3f um (up %.3f, down %.3f)   B %.3f um, mean reversal %.3f um\n", r.R_um, r.R_up_um, r.R_down_um, r.B_um, r.B_mean_um);
     if (o->vdi) std::printf("  VDI/DGQ 3441: P %.3f um, Pa %.3f um, U %.3f um, Ps %.3f um\n", r.vdi.P_um, r.vdi.Pa_um, r.vdi.U_um, r.vdi.Ps_um);
+    if (r.runs < dsp::eval::kIso230_2Runs)
+      std::printf("  note: %d runs per target and direction, ISO 230-2 asks for %d: evaluated by its formulas, outside the standard\n", r.runs,
+                  dsp::eval::kIso230_2Runs);
   });
 }
 

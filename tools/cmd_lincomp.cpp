@@ -68,7 +68,7 @@ void register_lincomp(CLI::App& app) {
     std::string curve, positioning, linuxcnc, csv;
     double spacing = 50.0, shift_step = 1.0, u = 0.0;
     std::vector<double> travel;
-    bool json = false;
+    bool json = false, force = false;
   };
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand("lincomp", "Piecewise-linear axis compensation table with its worst residual over grid shifts");
@@ -83,6 +83,7 @@ void register_lincomp(CLI::App& app) {
   cmd->add_option("--csv", o->csv, "write the table as CSV (pos_mm, deviation_um, correction_um = -deviation, per direction)");
   cmd->add_option("--travel-mm", o->travel, "MIN,MAX the table must cover (mm); refused when the curve does not")->expected(2)->delimiter(',');
   cmd->add_flag("--json", o->json, "print the result as JSON");
+  cmd->add_flag("--force", o->force, "overwrite existing output files");
   cmd->callback([o] {
     if (o->curve.empty() && o->positioning.empty()) throw dsp::InputError("lincomp: give --curve or --positioning");
     const Curves c = o->curve.empty() ? read_positioning_json(o->positioning) : read_curve_csv(o->curve);
@@ -112,8 +113,13 @@ void register_lincomp(CLI::App& app) {
       }
       files.emplace_back(o->csv, text);
     }
-    for (const auto& [file, text] : files)  // after every check: a bad input writes nothing
-      write_file_atomic(file, text);
+    // After every check: a bad input writes nothing, and nothing replaces a table a control
+    // may already load unless told (as eical comp).
+    std::string existing;
+    for (const auto& f : files)
+      if (std::filesystem::exists(f.first)) existing += "\n  " + f.first;
+    if (!existing.empty() && !o->force) throw dsp::InputError("lincomp: would overwrite existing file(s), nothing written (--force to replace them):" + existing);
+    for (const auto& [file, text] : files) write_file_atomic(file, text);
     if (o->json) {
       nlohmann::json points = nlohmann::json::array();
       for (std::size_t i = 0; i < r.table.pos_mm.size(); ++i)

@@ -14,21 +14,28 @@ namespace eical::tools {
 
 void register_report(CLI::App& app) {
   struct Opt {
-    std::string run, out, calibration;
+    std::string run, out, calibration, tolerances, operator_name, serial;
   };
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand("report", "Render the HTML report of a recorded run");
   cmd->add_option("run", o->run, "run directory (eical-run/1)")->required();
   cmd->add_option("-o,--out", o->out, "report folder (default: RUN/report)");
   cmd->add_option("--calibration", o->calibration, "sensor calibration (eical-sensor-cal/1) instead of the run's data sheet")->check(CLI::ExistingFile);
+  cmd->add_option("--tolerances", o->tolerances, "tolerance file (eical-tolerances/1): pass/fail of G, F (ISO 230-4) and A, B, R, E, M (ISO 230-2), header fields")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--operator", o->operator_name, "operator's name for the header");
+  cmd->add_option("--serial", o->serial, "the machine's serial number for the header");
   cmd->callback([o] {
     dsp::Run run = drivers::read_run(o->run);
     dsp::AnalysisOptions opt;
     if (!o->calibration.empty())
       drivers::apply_calibration(drivers::read_sensor_calibration(o->calibration, run.meta), run.meta, opt);
+    report::ReportOptions ro;
+    if (!o->tolerances.empty()) ro.tolerances = report::read_tolerances(o->tolerances);
+    ro.operator_name = o->operator_name, ro.serial = o->serial;
     const dsp::Analysis a = dsp::analyze_run(run, opt);
     const std::filesystem::path dir = o->out.empty() ? std::filesystem::path(o->run) / "report" : std::filesystem::path(o->out);
-    const auto file = report::write_run_report(run, a, dir);
+    const auto file = report::write_run_report(run, a, dir, ro);
     write_file_atomic(dir / "result.json", drivers::result_json(run, a).dump(2) + "\n");
     std::printf("report: %s\n", file.c_str());
   });

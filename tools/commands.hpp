@@ -1,7 +1,7 @@
 #pragma once
 // Every `eical` subcommand is one file tools/cmd_<name>.cpp exposing one register function.
 // A command reports failure by throwing (message printed as "eical: <what>", exit 1) or
-// CLI::RuntimeError(code) for a specific exit code.
+// CLI::RuntimeError(code) for a specific exit code (tools/exit_codes.hpp).
 #include <CLI/CLI.hpp>
 
 namespace eical::tools {
@@ -21,6 +21,8 @@ void register_hmi(CLI::App& app);
 void register_validate_sim(CLI::App& app);
 void register_identify(CLI::App& app);
 void register_explain(CLI::App& app);
+void register_plan(CLI::App& app);
+void register_help(CLI::App& app);
 void register_import(CLI::App& app);
 void register_history(CLI::App& app);
 void register_collect(CLI::App& app);
@@ -32,6 +34,7 @@ inline void register_all(CLI::App& app) {
   register_import(app);
   register_validate_sim(app);
   register_analyze(app);
+  register_plan(app);
   register_identify(app);
   register_explain(app);
   register_hmi(app);
@@ -45,6 +48,7 @@ inline void register_all(CLI::App& app) {
   register_fourier(app);
   register_volumetric(app);
   register_version(app);
+  register_help(app);
 }
 
 }  // namespace eical::tools

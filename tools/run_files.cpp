@@ -1,5 +1,11 @@
 #include "tools/run_files.hpp"
 
+#include "dsp/analysis/figures.hpp"
+#include "dsp/analysis/verdict.hpp"
+#include "dsp/uncertainty/resolved.hpp"
+#include "tools/exit_codes.hpp"
+#include "tools/figure_text.hpp"
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -21,28 +27,77 @@ void write_file_atomic(const std::filesystem::path& file, const std::string& tex
   if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
 }
 
+int verdict_exit_code(const std::string& verdict) {
+  if (verdict == "not_measurable") return kExitNotMeasurable;
+  if (verdict == "degraded") return kExitDegraded;
+  return kExitOk;
+}
+
+namespace {
+
+const char* section_title(const std::string& section) {
+  if (section == "circle") return "circular test (ISO 230-4)";
+  if (section == "diagnostics") return "diagnostics";
+  if (section == "positioning") return "positioning (ISO 230-2)";
+  if (section == "step") return "step response";
+  if (section == "rectangle") return "rectangle";
+  if (section == "freeform") return "free form";
+  return "";
+}
+
+}  // namespace
+
 std::string summary_text(const dsp::Run& run, const dsp::Analysis& a) {
   std::string o;
-  char b[256];
+  char b[320];
   std::snprintf(b, sizeof b, "run %s (%s, %zu samples at %.0f Hz)\n", run.meta.id.c_str(), run.meta.program.kind.c_str(),
                 run.frames.size(), run.meta.acquisition.fs_hz);
   o += b;
-  if (a.circle) {
-    std::snprintf(b, sizeof b, "  mean radius deviation   %8.2f um\n  circular deviation G    %8.2f um  (%d revolutions, %s)\n",
-                  a.circle->radius_mean_deviation_um, a.circle->circular_deviation_G_um, a.circle->revolutions, a.circle->direction.c_str());
-    o += b;
+  std::string section;
+  for (const dsp::FigureValue& f : dsp::figures_of(a)) {
+    const std::string sec = f.key.substr(0, f.key.find('.'));
+    if (sec != section) {
+      section = sec;
+      o += std::string("  ") + section_title(sec);
+      if (sec == "circle" && a.circle) o += ", " + std::to_string(a.circle->revolutions) + (a.circle->arc_deg < 360.0 ? " arcs, " : " revolutions, ") + a.circle->direction;
+      if (sec == "positioning" && a.positioning) o += ", axis " + a.positioning->axis + ", " + std::to_string(a.positioning->runs) + " runs";
+      o += "\n";
+    }
+    const std::string unit = figure_unit(f.key);
+    if (!f.array) {
+      const auto u = figure_u(a, f.key);
+      std::snprintf(b, sizeof b, "    %-34s %s%s\n", figure_label(f.key).c_str(), value_with_u(f.values[0], u, unit).c_str(),
+                    u && !dsp::uncertainty::resolved(f.values[0], *u) ? "   not resolved" : "");
+      o += b;
+      continue;
+    }
+    std::string line = "    " + figure_label(f.key) + " (" + unit + "):";
+    for (std::size_t i = 0; i < f.values.size() && i < 24; ++i) {
+      const auto u = figure_u(a, f.key, i);
+      char e[80];
+      if (u) std::snprintf(e, sizeof e, " %.2f±%.2f%s", f.values[i], *u, dsp::uncertainty::resolved(f.values[i], *u) ? "" : "*");
+      else std::snprintf(e, sizeof e, " %.2f", f.values[i]);
+      line += e;
+      if (f.columns > 1 && i % static_cast<std::size_t>(f.columns) != static_cast<std::size_t>(f.columns - 1)) line += ",";
+      else if (f.columns > 1) line += ";";
+    }
+    if (f.values.size() > 24) line += " …";
+    o += line + "\n";
   }
+  if (a.circle && !a.circle->circular_hysteresis_H_um) o += "    circular hysteresis H              n/a (needs both directions)\n";
   if (a.circle_accuracy_rms_um) {
-    std::snprintf(b, sizeof b, "  accuracy vs reference   %8.2f um RMS of (measured - true) radius deviation\n", *a.circle_accuracy_rms_um);
+    std::snprintf(b, sizeof b, "  against the reference: %.2f µm RMS of (measured − reference) radius deviation\n", *a.circle_accuracy_rms_um);
     o += b;
   }
-  if (a.step) {
-    std::snprintf(b, sizeof b, "  end-position error      %8.2f um\n  scatter                 %8.2f um\n  overshoot               %8.2f um\n",
-                  a.step->end_position_error_um, a.step->scatter_um, a.step->overshoot_um);
-    o += b;
+  if (!a.uncertainty_note.empty()) o += "  uncertainty: " + a.uncertainty_note + (a.uncertainty_k2.empty() ? "" : "; * not resolved (|value| <= U)") + "\n";
+  o += "  verdict: " + std::string(a.verdict == "not_measurable" ? "NOT MEASURABLE" : a.verdict == "degraded" ? "DEGRADED" : "ok") + "\n";
+  for (const auto& r : a.verdict_reasons) o += "    - " + r + "\n";
+  bool header = false;
+  for (const auto& f : a.flags) {
+    const auto s = dsp::flag_severity(f);
+    if (!header) o += "  flags:\n", header = true;
+    o += std::string("    [") + dsp::severity_name(s) + "] " + f + "\n";
   }
-  o += a.degraded ? "  result DEGRADED:\n" : "  quality: ok\n";
-  for (const auto& f : a.flags) o += "    - " + f + "\n";
   return o;
 }
 

@@ -2,6 +2,8 @@
 
 #include "drivers/config/meta_sections.hpp"
 #include "drivers/config/strict_toml.hpp"
+#include "drivers/setpoint/program_catalog.hpp"
+#include "dsp/core/error.hpp"
 
 #include <cmath>
 
@@ -12,16 +14,13 @@ namespace {
 using drivers::StrictTable;
 
 // The [program] table of a file written by `eical gen-nc ... --meta`; errors inside it
-// name that file and line.
+// name that file and line, and the key that named the file.
 dsp::Program read_program_file(StrictTable& t, const std::filesystem::path& path) {
-  const toml::table root = StrictTable::parse_file(path.string());
-  StrictTable file(root, path.string(), "");
-  auto program = file.optional_table("program");
-  if (!program) t.fail("program_file", path.string() + " has no [program] table (write it with eical gen-nc --meta)");
-  dsp::Program p = drivers::read_program(*program);
-  if (p.gcode.empty()) t.fail("program_file", path.string() + ": [program] has no gcode");
-  file.finish();
-  return p;
+  try {
+    return drivers::read_program_file(path);
+  } catch (const dsp::InputError& e) {
+    t.fail("program_file", e.what());
+  }
 }
 
 void read_linuxcnc(StrictTable t, LinuxcncConfig& l) {
@@ -50,8 +49,18 @@ void read_linuxcnc(StrictTable t, LinuxcncConfig& l) {
   t.finish();
 }
 
+void read_daq_stream(StrictTable t, DaqStreamConfig& d) {
+  d.path = t.string("path", d.path.string());
+  if (d.path.empty()) t.fail("path", "must not be empty");
+  d.connect_timeout_s = t.number("connect_timeout_s", d.connect_timeout_s);
+  if (d.connect_timeout_s < 0.1 || d.connect_timeout_s > 3600.0) t.fail("connect_timeout_s", "must be within 0.1..3600");
+  d.stall_timeout_s = t.number("stall_timeout_s", d.stall_timeout_s);
+  if (d.stall_timeout_s < 0.05 || d.stall_timeout_s > 3600.0) t.fail("stall_timeout_s", "must be within 0.05..3600");
+  t.finish();
+}
+
 void read_source(StrictTable t, SourceConfig& s) {
-  s.kind = t.choice("kind", {"sim", "replay", "usb_daq", "linuxcnc"}, s.kind);
+  s.kind = t.choice("kind", {"sim", "replay", "usb_daq", "daq_stream", "linuxcnc"}, s.kind);
   s.pacing = t.choice("pacing", {"realtime", "free_running"}, s.pacing);
   s.replay_run = t.string("replay_run", s.replay_run.string());
   if (s.kind == "replay" && s.replay_run.empty()) t.fail("replay_run", "required when kind = \"replay\"");
@@ -75,6 +84,7 @@ void read_source(StrictTable t, SourceConfig& s) {
     sim->finish();
   }
   if (auto l = t.optional_table("linuxcnc")) read_linuxcnc(*l, s.linuxcnc);
+  if (auto d = t.optional_table("daq_stream")) read_daq_stream(*d, s.daq_stream);
   if (s.kind == "linuxcnc" && !s.linuxcnc.program_loaded) t.fail("linuxcnc", "[source.linuxcnc] with program_file is required when kind = \"linuxcnc\"");
   s.retry_s = t.number("retry_s", s.retry_s);
   if (s.retry_s < 0.1 || s.retry_s > 3600.0) t.fail("retry_s", "must be within 0.1..3600");
@@ -96,6 +106,39 @@ void read_source(StrictTable t, SourceConfig& s) {
   t.finish();
 }
 
+void read_setpoint(StrictTable t, SetPointConfig& c, const SourceConfig& source) {
+  c.source = t.choice("source", {"none", "servo_stream", "program"}, c.source);
+  if (c.source != "none" && !source.is_daq())
+    t.fail("source", "a set-point source goes next to a DAQ ([source] kind = \"usb_daq\" or \"daq_stream\"); the " + source.kind +
+                         " source brings its own set-point");
+  if (auto s = t.optional_table("servo_stream")) {
+    c.servo_fifo = s->string("fifo", c.servo_fifo.string());
+    if (c.servo_fifo.empty()) s->fail("fifo", "must not be empty");
+    c.servo_rate_hz = s->number("servo_rate_hz", c.servo_rate_hz);
+    if (c.servo_rate_hz < 100.0 || c.servo_rate_hz > 20000.0) s->fail("servo_rate_hz", "must be within 100..20000");
+    c.hold_ms = s->number("hold_ms", c.hold_ms);
+    if (c.hold_ms < 20.0 || c.hold_ms > 10000.0) s->fail("hold_ms", "must be within 20..10000 (the servo lines arrive ~10 ms late)");
+    s->finish();
+  }
+  if (auto s = t.optional_table("program")) {
+    c.program_dir = s->string("directory", c.program_dir.string());
+    if (c.program_dir.empty()) s->fail("directory", "must not be empty");
+    c.default_program = static_cast<int>(s->integer("default_program", c.default_program));
+    if (c.default_program < -1) s->fail("default_program", "must be a program number (0 or more) or -1 for none");
+    c.mcode_stops = s->boolean("mcode_stops", c.mcode_stops);
+    c.max_lag_s = s->number("max_lag_s", c.max_lag_s);
+    if (c.max_lag_s < 0.005 || c.max_lag_s > 5.0) s->fail("max_lag_s", "must be within 0.005..5");
+    c.a_max_mm_s2 = s->number("a_max_mm_s2", c.a_max_mm_s2);
+    if (c.a_max_mm_s2 <= 0.0) s->fail("a_max_mm_s2", "must be positive");
+    c.j_max_mm_s3 = s->number("j_max_mm_s3", c.j_max_mm_s3);
+    if (c.j_max_mm_s3 <= 0.0) s->fail("j_max_mm_s3", "must be positive");
+    c.rapid_mm_min = s->number("rapid_mm_min", c.rapid_mm_min);
+    if (c.rapid_mm_min <= 0.0) s->fail("rapid_mm_min", "must be positive");
+    s->finish();
+  }
+  t.finish();
+}
+
 void read_triggers(StrictTable t, TriggerConfig& c) {
   if (t.has("inputs")) c.inputs = t.strings("inputs");
   for (const auto& in : c.inputs)
@@ -111,6 +154,8 @@ void read_triggers(StrictTable t, TriggerConfig& c) {
       c.gpio_lines[i] = static_cast<int>(lines[i]);
     }
   }
+  c.gpio_debounce_ms = t.number("gpio_debounce_ms", c.gpio_debounce_ms);
+  if (c.gpio_debounce_ms < 0.0 || c.gpio_debounce_ms > 1000.0) t.fail("gpio_debounce_ms", "must be within 0..1000");
   c.can_interface = t.string("can_interface", c.can_interface);
   const auto id = t.integer("can_id", c.can_id);
   if (id < 0 || id > 0x7FF) t.fail("can_id", "must be a standard 11-bit CAN id (0..0x7FF)");
@@ -180,6 +225,7 @@ DaemonConfig load_daemon_config(const std::filesystem::path& file) {
   DaemonConfig c;
   c.file = file.string();
   if (auto s = t.optional_table("source")) read_source(*s, c.source);
+  if (auto s = t.optional_table("setpoint")) read_setpoint(*s, c.setpoint, c.source);
   if (auto s = t.optional_table("triggers")) read_triggers(*s, c.triggers);
   if (auto s = t.optional_table("dds")) read_dds(*s, c.dds);
   if (auto s = t.optional_table("recording")) read_recording(*s, c.recording);

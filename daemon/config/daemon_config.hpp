@@ -28,8 +28,16 @@ struct LinuxcncConfig {
   std::uint64_t seed = 1;
 };
 
+// [source.daq_stream]: the DAQ's wire protocol from a named pipe or a Unix socket (a DAQ
+// bridge, or the device simulator of the hardware-in-the-loop tests).
+struct DaqStreamConfig {
+  std::filesystem::path path = "/run/eical/daq.stream";
+  double connect_timeout_s = 5.0;
+  double stall_timeout_s = 1.0;
+};
+
 struct SourceConfig {
-  std::string kind = "sim";           // sim | replay | usb_daq | linuxcnc
+  std::string kind = "sim";           // sim | replay | usb_daq | daq_stream | linuxcnc
   std::string pacing = "realtime";    // realtime | free_running (sim, replay)
   std::filesystem::path replay_run;   // replay: an eical-run/1 directory
   // sim: the calibration program the simulated NC runs; its M101/102/103 reach the
@@ -49,6 +57,26 @@ struct SourceConfig {
   drivers::FaultPlan fault;            // [source.fault]: injected faults (tests, commissioning)
   std::string usb_id = "1d50:6161";    // usb_daq: vendor:product
   LinuxcncConfig linuxcnc;             // [source.linuxcnc]
+  DaqStreamConfig daq_stream;          // [source.daq_stream]
+  [[nodiscard]] bool is_daq() const { return kind == "usb_daq" || kind == "daq_stream"; }
+};
+
+// [setpoint]: where the NC set-point comes from when the frames come from a DAQ (which
+// measures accelerations only). "servo_stream": LinuxCNC's servo-rate commanded positions
+// (integrations/linuxcnc) combined with the frames on the DAQ clock; "program": the program
+// M101's P word names, reconstructed by eical's interpolator and aligned at evaluation.
+struct SetPointConfig {
+  std::string source = "none";  // none | servo_stream | program
+  // [setpoint.servo_stream]
+  std::filesystem::path servo_fifo = "/run/eical/linuxcnc-servo.fifo";
+  double servo_rate_hz = 1000.0;
+  double hold_ms = 1000.0;  // frames wait this long: servo lines (~10 ms) and DDS triggers (~0.75 s) arrive first
+  // [setpoint.program]
+  std::filesystem::path program_dir = "/etc/eical/programs";  // <number>.toml from eical gen-nc --meta
+  int default_program = -1;    // used when M101 carries no P word (frame, GPIO triggers); -1 = none
+  bool mcode_stops = false;    // the NC stops at every M-code (LinuxCNC)
+  double max_lag_s = 0.3;      // cross-correlation search around the marks
+  double a_max_mm_s2 = 2000.0, j_max_mm_s3 = 50000.0, rapid_mm_min = 10000.0;  // the NC's path limits
 };
 
 struct TriggerConfig {
@@ -57,6 +85,7 @@ struct TriggerConfig {
   std::vector<std::string> inputs = {"frame", "dds"};
   std::string gpio_chip = "gpiochip0";
   std::vector<int> gpio_lines = {17, 27, 22};  // lines for M101, M102, M103 (rising edge)
+  double gpio_debounce_ms = 5.0;  // a second edge of one line within this time is contact bounce
   std::string can_interface = "can0";
   std::uint32_t can_id = 0x1E0;  // NC trigger frame id
 };
@@ -99,6 +128,7 @@ struct RealtimeConfig {
 struct DaemonConfig {
   std::string file;  // where it was read from (for messages)
   SourceConfig source;
+  SetPointConfig setpoint;
   TriggerConfig triggers;
   DdsConfig dds;
   RecordingConfig recording;

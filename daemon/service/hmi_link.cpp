@@ -26,7 +26,9 @@ std::int64_t now_ns() {
 
 HmiLink::HmiLink(const DdsConfig& config, std::string daemon_name, int publisher_priority)
     : config_(config), name_(std::move(daemon_name)), publisher_priority_(publisher_priority) {
-  status_.state = "STARTING";
+  drivers::dds::StatusMsg starting;
+  starting.state = "STARTING";
+  status_.fill(starting);
   if (!config_.config_uri.empty()) ::setenv("CYCLONEDDS_URI", config_.config_uri.c_str(), 1);
   bus_ = std::make_unique<drivers::dds::Bus>(config_.domain_id, drivers::dds::Role::daemon);
   wake_fd_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -55,14 +57,10 @@ void HmiLink::publish_trace(const drivers::dds::TraceMsg& t) {
   if (!bus_->publish(t)) log(LogLevel::warning, "dds: trace %s not published", t.program_id.c_str());
 }
 
-void HmiLink::set_status(const drivers::dds::StatusMsg& s) {
-  std::lock_guard lk(mu_);
-  status_ = s;
-}
-
-void HmiLink::set_state(const std::string& state) {
-  std::lock_guard lk(mu_);
-  state_ = state;
+void HmiLink::set_status(const drivers::dds::StatusMsg& s, dsp::State state) {
+  status_.back() = s;
+  status_.publish();
+  state_.store(static_cast<int>(state), std::memory_order_relaxed);
 }
 
 void HmiLink::publish_result(const drivers::dds::ResultMsg& r) {
@@ -100,11 +98,10 @@ void HmiLink::publisher() {
       (void)bus_->publish(m);
     }
     if (clock::now() >= next_status) {
-      drivers::dds::StatusMsg st;
-      {
-        std::lock_guard lk(mu_);
-        st = status_;
-      }
+      // The newest Status the status thread handed over (its strings are the front
+      // buffer's: nothing is copied here).
+      (void)status_.update();
+      drivers::dds::StatusMsg& st = status_.front();
       st.daemon = name_;
       st.time_ns = now_ns();
       (void)bus_->publish(st);
@@ -114,38 +111,64 @@ void HmiLink::publisher() {
   }
 }
 
+drivers::dds::ReplyMsg HmiLink::answer_trigger(const drivers::dds::CommandMsg& cmd) {
+  drivers::dds::ReplyMsg reply;
+  TriggerRequest r;
+  r.id = ++next_trigger_id_;
+  r.time_ns = cmd.time_ns;
+  r.code = cmd.code;
+  r.p = cmd.p;
+  if (!triggers_.send(r)) {
+    reply.ok = false;
+    reply.message = "M" + std::to_string(cmd.code) + " refused: the trigger queue is full";
+    return reply;
+  }
+  // The DSP thread decides at its next frame (it knows the measurement state and the
+  // triggers already queued). Verdicts of earlier, unanswered requests are skipped.
+  const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+  for (;;) {
+    TriggerVerdict v;
+    while (triggers_.take_verdict(v)) {
+      if (v.id != r.id) continue;
+      reply.ok = v.accepted;
+      reply.message = describe(v, cmd.code);
+      reply.state = std::string(dsp::to_string(v.state));
+      return reply;
+    }
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
+    if (left <= 0) break;
+    triggers_.wait_verdict(static_cast<int>(left));
+  }
+  reply.ok = true;
+  reply.message = "M" + std::to_string(cmd.code) + " queued for the DAQ clock (not confirmed yet: no frames handled for 0.5 s)";
+  return reply;
+}
+
 void HmiLink::commander() {
   while (!stop_.load()) {
     const auto cmd = bus_->take_command(std::chrono::milliseconds(500));
     if (!cmd) continue;
     ++commands_;
     drivers::dds::ReplyMsg reply;
-    reply.sender = cmd->sender;
-    reply.request_id = cmd->request_id;
-    // `eical trigger` resends until it sees a Reply: a resend of an accepted trigger is
-    // answered again but not queued twice (a doubled M102 would add a segment).
-    const std::pair<std::string, std::uint32_t> key{cmd->sender, cmd->request_id};
-    const bool resend = std::find(recent_triggers_.begin(), recent_triggers_.end(), key) != recent_triggers_.end();
-    if (cmd->action == "trigger" && resend) {
-      reply.ok = true;
-      reply.message = "M" + std::to_string(cmd->code) + " already queued (resend ignored)";
-    } else if (cmd->action == "trigger" && (cmd->code == 101 || cmd->code == 102 || cmd->code == 103)) {
-      reply.ok = triggers_.try_push({cmd->time_ns, cmd->code});
-      if (reply.ok) {
-        recent_triggers_.push_back(key);
-        if (recent_triggers_.size() > 64) recent_triggers_.pop_front();
-      }
-      reply.message = reply.ok ? "M" + std::to_string(cmd->code) + " queued for the DAQ clock" : "trigger queue full";
+    const auto seen = std::find_if(answered_.begin(), answered_.end(),
+                                   [&](const Answered& a) { return a.sender == cmd->sender && a.request_id == cmd->request_id; });
+    if (cmd->action == "trigger" && seen != answered_.end()) {
+      reply = seen->reply;  // `eical trigger` resends until it sees a Reply
+    } else if (cmd->action == "trigger" && is_nc_trigger(cmd->code)) {
+      reply = answer_trigger(*cmd);
+      if (reply.state.empty()) reply.state = std::string(dsp::to_string(static_cast<dsp::State>(state_.load())));
+      answered_.push_back({cmd->sender, cmd->request_id, reply});
+      if (answered_.size() > 64) answered_.pop_front();
     } else {
       reply.ok = false;
       reply.message = "unknown command '" + cmd->action + "' (code " + std::to_string(cmd->code) + "); use trigger 101|102|103";
+      reply.state = std::string(dsp::to_string(static_cast<dsp::State>(state_.load())));
     }
-    {
-      std::lock_guard lk(mu_);
-      reply.state = state_;
-    }
+    reply.sender = cmd->sender;
+    reply.request_id = cmd->request_id;
     (void)bus_->publish(reply);
-    log(LogLevel::info, "command from %s: %s %d -> %s", cmd->sender.c_str(), cmd->action.c_str(), cmd->code, reply.message.c_str());
+    log(reply.ok ? LogLevel::info : LogLevel::warning, "command from %s: %s %d -> %s", cmd->sender.c_str(), cmd->action.c_str(), cmd->code,
+        reply.message.c_str());
   }
 }
 

@@ -1,13 +1,17 @@
 #pragma once
 // eicald's side of the HMI bus: a publisher thread (Status at status_rate_hz, Live
 // samples handed over by the DSP thread through an SPSC ring, Results and Traces as they
-// are written) and a command thread (Command topic → NC triggers for the DSP thread, Reply).
-// The DSP thread only touches the two rings and an eventfd that wakes the publisher the
-// moment a Live sample is there (no lock, allocation or DDS call on the DSP thread; the
-// publisher sleeps on the eventfd, not on a timer, so Live latency is not a tick).
+// are written) and a command thread (Command topic → NC triggers for the DSP thread, whose
+// verdict it answers with a Reply: a refused M101 says why). The DSP thread only touches
+// rings and eventfds (the Live wake-up of the publisher, the verdict wake-up of the
+// command thread): no lock, allocation or DDS call on the DSP thread; the publisher sleeps
+// on the eventfd, not on a timer, so Live latency is not a tick.
 #include "daemon/config/daemon_config.hpp"
+#include "daemon/triggers/trigger_channel.hpp"
 #include "drivers/dds/bus.hpp"
 #include "drivers/ring/spsc_ring.hpp"
+#include "drivers/ring/triple_buffer.hpp"
+#include "dsp/session/measurement_state.hpp"
 
 #include <atomic>
 #include <deque>
@@ -25,11 +29,6 @@ struct LiveSample {
   std::int64_t acquired_ns;  // CLOCK_MONOTONIC when the acquisition thread had the sample
 };
 
-struct TriggerRequest {
-  std::int64_t time_ns;  // CLOCK_MONOTONIC when the M-code ran (0 = now)
-  int code;
-};
-
 class HmiLink {
  public:
   // Throws dds::BusError when the bus cannot start (bad CYCLONEDDS_URI, no network).
@@ -41,35 +40,46 @@ class HmiLink {
 
   // DSP thread.
   void push_live(const LiveSample& s) noexcept;
-  bool pop_trigger(TriggerRequest& t) noexcept { return triggers_.try_pop(t); }
+  // The NC triggers of the Command topic, for the DSP thread's FrameLoop.
+  [[nodiscard]] TriggerChannel& triggers() noexcept { return triggers_; }
 
-  // Any thread (copied under a mutex; called at 1 Hz and per result).
-  void set_status(const drivers::dds::StatusMsg& s);
+  // The status thread: the next Status and the state command replies name. Lock-free (a
+  // triple buffer): the real-time publisher never waits for the status thread.
+  void set_status(const drivers::dds::StatusMsg& s, dsp::State state);
+  // Any thread (the evaluation thread).
   void publish_result(const drivers::dds::ResultMsg& r);
   void publish_trace(const drivers::dds::TraceMsg& t);
-  // The current measurement state for command replies.
-  void set_state(const std::string& state);
 
   [[nodiscard]] std::uint64_t commands_received() const { return commands_.load(); }
+  [[nodiscard]] std::uint64_t live_overruns() const { return live_.overruns(); }
+  [[nodiscard]] std::uint64_t write_errors() const { return bus_->write_errors(); }
 
  private:
   void publisher();
   void commander();
+  drivers::dds::ReplyMsg answer_trigger(const drivers::dds::CommandMsg& cmd);
 
   DdsConfig config_;
   std::string name_;
   std::unique_ptr<drivers::dds::Bus> bus_;
   drivers::SpscRing<LiveSample> live_{1024};
-  drivers::SpscRing<TriggerRequest> triggers_{64};
-  std::mutex mu_;
-  drivers::dds::StatusMsg status_;
-  std::string state_ = "IDLE";
+  TriggerChannel triggers_{"dds"};
+  std::uint32_t next_trigger_id_ = 0;  // command thread
+  drivers::TripleBuffer<drivers::dds::StatusMsg> status_;  // status thread → publisher
+  std::atomic<int> state_{static_cast<int>(dsp::State::idle)};  // for the command thread's replies
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> commands_{0};
   int publisher_priority_ = 0;
   int wake_fd_ = -1;  // eventfd: DSP thread → publisher
   std::thread publisher_, commander_;
-  std::deque<std::pair<std::string, std::uint32_t>> recent_triggers_;  // commander thread: (sender, request id)
+  // Command thread: the replies to the last triggers, by (sender, request id): a resend is
+  // answered the same and never queued twice (a doubled M102 would add a segment).
+  struct Answered {
+    std::string sender;
+    std::uint32_t request_id;
+    drivers::dds::ReplyMsg reply;
+  };
+  std::deque<Answered> answered_;
 };
 
 }  // namespace eical::daemon

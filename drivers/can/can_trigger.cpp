@@ -46,6 +46,8 @@ CanTriggerInput::CanTriggerInput(const std::string& interface, std::uint32_t id)
   }
   can_filter filter{id & CAN_SFF_MASK, CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG};
   ::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, &filter, sizeof filter);
+  const int on = 1;
+  (void)::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
   sockaddr_can addr{};
   addr.can_family = AF_CAN;
   addr.can_ifindex = static_cast<int>(idx);
@@ -56,21 +58,51 @@ CanTriggerInput::CanTriggerInput(const std::string& interface, std::uint32_t id)
   }
 }
 
+CanTriggerInput CanTriggerInput::from_socket(int fd, std::uint32_t trigger_id) {
+  const int on = 1;
+  (void)::setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);  // where the socket supports it
+  return CanTriggerInput(fd, trigger_id, true);
+}
+
+CanTriggerInput::CanTriggerInput(CanTriggerInput&& o) noexcept : fd_(o.fd_), id_(o.id_), last_seq_(o.last_seq_), ignored_(o.ignored_) {
+  o.fd_ = -1;
+}
+
 CanTriggerInput::~CanTriggerInput() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-std::optional<std::pair<CanTrigger, std::int64_t>> CanTriggerInput::next(int timeout_ms) {
+std::optional<CanTriggerEvent> CanTriggerInput::next(int timeout_ms) {
   pollfd p{fd_, POLLIN, 0};
   if (::poll(&p, 1, timeout_ms) <= 0) return std::nullopt;
   can_frame f{};
-  if (::read(fd_, &f, sizeof f) != static_cast<ssize_t>(sizeof f)) return std::nullopt;
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
+  iovec iov{&f, sizeof f};
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
+  msghdr msg{};
+  msg.msg_iov = &iov;
+  msg.msg_iovlen = 1;
+  msg.msg_control = control;
+  msg.msg_controllen = sizeof control;
+  if (::recvmsg(fd_, &msg, 0) != static_cast<ssize_t>(sizeof f)) return std::nullopt;
+  timespec mono{}, real{};
+  clock_gettime(CLOCK_MONOTONIC, &mono);
+  clock_gettime(CLOCK_REALTIME, &real);
+  const auto ns = [](const timespec& t) { return static_cast<std::int64_t>(t.tv_sec) * 1000000000 + t.tv_nsec; };
+  std::int64_t t_ns = ns(mono);
+  for (cmsghdr* c = CMSG_FIRSTHDR(&msg); c; c = CMSG_NXTHDR(&msg, c))
+    if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+      timespec kernel{};
+      std::memcpy(&kernel, CMSG_DATA(c), sizeof kernel);
+      const std::int64_t age_ns = ns(real) - ns(kernel);
+      if (age_ns >= 0 && age_ns < 1'000'000'000) t_ns -= age_ns;  // a clock step makes it implausible: read time
+    }
   auto t = parse_can_trigger(f, id_);
-  if (!t || t->sequence == last_seq_) return std::nullopt;  // not ours, or a retransmission
+  if (!t || t->sequence == last_seq_) {  // not ours, or a retransmission
+    ++ignored_;
+    return std::nullopt;
+  }
   last_seq_ = t->sequence;
-  return std::pair{*t, static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec};
+  return CanTriggerEvent{*t, t_ns};
 }
 
 }  // namespace eical::drivers

@@ -144,4 +144,21 @@ dsp::Program read_program(StrictTable t, Unknown u) {
   return p;
 }
 
+dsp::SetPointOrigin read_setpoint_origin(StrictTable t, Unknown u) {
+  dsp::SetPointOrigin s;
+  s.source = t.choice("source", {"servo_stream", "program"}, "servo_stream");
+  s.servo_cycle_at_first_sample = t.number("servo_cycle_at_first_sample", s.servo_cycle_at_first_sample);
+  s.servo_rate_hz = t.number("servo_rate_hz", s.servo_rate_hz);
+  s.program_number = static_cast<int>(t.integer("program_number", s.program_number));
+  s.marks_offset_s = t.number("marks_offset_s", s.marks_offset_s);
+  s.offset_s = t.number("offset_s", s.offset_s);
+  s.blocks = static_cast<int>(t.integer("blocks", s.blocks));
+  s.block_offset_spread_s = t.number("block_offset_spread_s", s.block_offset_spread_s);
+  s.lag_s = t.number("lag_s", s.lag_s);
+  s.correlation = t.number("correlation", s.correlation);
+  s.residual_ratio = t.number("residual_ratio", s.residual_ratio);
+  if (u == Unknown::reject) t.finish();
+  return s;
+}
+
 }  // namespace eical::drivers

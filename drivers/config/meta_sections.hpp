@@ -17,5 +17,6 @@ dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& default
 dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults = {}, Unknown u = Unknown::reject);
 dsp::PsdSpec read_psd(StrictTable t, Unknown u = Unknown::reject);
 dsp::Program read_program(StrictTable t, Unknown u = Unknown::reject);
+dsp::SetPointOrigin read_setpoint_origin(StrictTable t, Unknown u = Unknown::reject);
 
 }  // namespace eical::drivers

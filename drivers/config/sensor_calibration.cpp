@@ -5,6 +5,9 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
 
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <stdexcept>
@@ -32,6 +35,37 @@ std::string matrix_toml(const Eigen::Matrix3d& m) {
     s += "]";
   }
   return s + "]";
+}
+
+// [covariance]: named parameters, a symmetric positive semi-definite matrix over them.
+dsp::uncertainty::SensorModelCovariance read_covariance(StrictTable& t, const dsp::RunMeta& datasheet) {
+  namespace u = dsp::uncertainty;
+  u::SensorModelCovariance c = u::datasheet_covariance(datasheet.sensors, datasheet.acquisition.fs_hz);
+  const std::vector<std::string> names = t.strings("parameters");
+  std::vector<int> index;
+  for (const auto& n : names) {
+    const int p = u::parameter_index(n);
+    if (p < 0) t.fail("parameters", "unknown parameter '" + n + "' (table.E_xx … head.E_zz, table.c1_s, head.c1_s, daq.delay_s)");
+    if (std::find(index.begin(), index.end(), p) != index.end()) t.fail("parameters", "'" + n + "' is listed twice");
+    index.push_back(p);
+  }
+  const auto rows = t.matrix("matrix", names.size(), names.size());
+  const auto m = static_cast<Eigen::Index>(names.size());
+  Eigen::MatrixXd cov(m, m);
+  for (Eigen::Index r = 0; r < m; ++r)
+    for (Eigen::Index k = 0; k < m; ++k) cov(r, k) = rows[static_cast<std::size_t>(r)][static_cast<std::size_t>(k)];
+  if (!cov.allFinite()) t.fail("matrix", "not finite");
+  const double scale = std::max(1e-300, cov.diagonal().cwiseAbs().maxCoeff());
+  if ((cov - cov.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale) t.fail("matrix", "not symmetric");
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov);
+  if (eig.eigenvalues().minCoeff() < -1e-9 * scale) t.fail("matrix", "not positive semi-definite (a variance below zero)");
+  for (Eigen::Index r = 0; r < m; ++r)
+    for (Eigen::Index k = 0; k < m; ++k) c.covariance(index[static_cast<std::size_t>(r)], index[static_cast<std::size_t>(k)]) = cov(r, k);
+  if (t.has("psd_offset_sigma_um")) {
+    c.psd_offset_sigma_um = t.number("psd_offset_sigma_um");
+    if (!(c.psd_offset_sigma_um >= 0.0 && c.psd_offset_sigma_um < 1000.0)) t.fail("psd_offset_sigma_um", "must be within [0, 1000) µm");
+  }
+  return c;
 }
 
 }  // namespace
@@ -68,6 +102,11 @@ SensorCalibration read_sensor_calibration(const std::filesystem::path& file, con
     }
     sensors->finish();
   }
+  if (auto cov = root.optional_table("covariance")) {
+    cal.covariance = read_covariance(*cov, datasheet);
+    cal.covariance->source = cal.method;
+    cov->finish();
+  }
   root.finish();
   return cal;
 }
@@ -88,6 +127,22 @@ void write_sensor_calibration(const SensorCalibration& cal, const std::filesyste
   for (int s = 0; s < 2; ++s) {
     o += sensor_section_toml(kSensorNames[s], cal.sensors[s]);
     o += "cross_g_per_g = " + matrix_toml(cal.static_cal[s].cross_g_per_g) + "\n";
+  }
+  if (cal.covariance) {
+    // The parameters with a variance (every other keeps the data sheet's, by definition).
+    namespace u = dsp::uncertainty;
+    std::vector<int> used;
+    for (int p = 0; p < u::kModelParameters; ++p)
+      if (cal.covariance->covariance(p, p) > 0.0) used.push_back(p);
+    o += "\n[covariance]  # of the parameters below (sensor_model_covariance.hpp): E dimensionless, c1 and delay in s\nparameters = [";
+    for (std::size_t i = 0; i < used.size(); ++i) o += (i ? ", \"" : "\"") + u::parameter_name(used[i]) + "\"";
+    o += "]\nmatrix = [";
+    for (std::size_t r = 0; r < used.size(); ++r) {
+      o += r ? ",\n  [" : "\n  [";
+      for (std::size_t k = 0; k < used.size(); ++k) o += (k ? ", " : "") + toml_number(cal.covariance->covariance(used[r], used[k]));
+      o += "]";
+    }
+    o += "]\npsd_offset_sigma_um = " + toml_number(cal.covariance->psd_offset_sigma_um) + "\n";
   }
   write_text_atomic(file, o);
 }
@@ -111,6 +166,9 @@ void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta, dsp::An
   apply_calibration(cal, meta);
   for (int s = 0; s < 2; ++s) options.calibration[s].cross_g_per_g = cal.static_cal[s].cross_g_per_g;
   options.sensor_model = cal.method;
+  // Without its own covariance a calibration is as uncertain as the data sheet.
+  options.model_covariance = cal.covariance ? *cal.covariance : dsp::uncertainty::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
+  if (!cal.covariance) options.model_covariance->source = cal.method + " (no covariance in the file: the data sheet's tolerance)";
 }
 
 SensorCalibration calibration_from(const dsp::identify::Identification& id, const std::string& run_id) {
@@ -122,6 +180,7 @@ SensorCalibration calibration_from(const dsp::identify::Identification& id, cons
     cal.sensors[s] = id.sensors[s];
     cal.static_cal[s] = id.calibration[s];
   }
+  cal.covariance = id.covariance;
   return cal;
 }
 

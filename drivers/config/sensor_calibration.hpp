@@ -14,6 +14,12 @@
 //   k1_v_per_g = [...]  bias_g = [...]  f0_hz = ...  zeta = ...  to_machine = [[...], ...]
 //   cross_g_per_g = [[...], [...], [...]]   # (6-4) cross-axis terms, optional
 //   [sensors.head]
+//   [covariance]              # the calibration's own uncertainty (eical identify writes it)
+//   parameters = ["table.E_xx", ..., "head.c1_s", "daq.delay_s"]   # sensor_model_covariance.hpp
+//   matrix = [[...], ...]     # symmetric, positive semi-definite; units of the parameters
+//   psd_offset_sigma_um = 0.1 # a strip's own systematic error, optional
+// Parameters the covariance does not list keep the data sheet's tolerance. A file without
+// [covariance] is as uncertain as the data sheet (the figures' U then says so).
 //
 // Keys are read strictly (a typo is an error naming file, line and key).
 #include "dsp/analysis/analyze_run.hpp"
@@ -34,6 +40,7 @@ struct SensorCalibration {
   std::optional<double> daq_skew_head_samples;
   dsp::SensorSpec sensors[2];              // complete (data sheet where the file is silent)
   dsp::StaticCalibration static_cal[2];    // cross terms (mounting is in sensors[].to_machine)
+  std::optional<dsp::uncertainty::SensorModelCovariance> covariance;  // [covariance]
 };
 
 // Reads `file`; keys it does not set keep the values of `datasheet` (a run's or the daemon

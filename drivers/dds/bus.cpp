@@ -102,8 +102,14 @@ bool Bus::publish(const StatusMsg& m) {
   s.frames = m.frames, s.overruns = m.overruns, s.frames_lost = m.frames_lost, s.measurements = m.measurements, s.results = m.results;
   s.temp_table_c = m.temp_table_c, s.temp_head_c = m.temp_head_c, s.time_ns = m.time_ns;
   s.sample_index = m.sample_index, s.sample_time_ns = m.sample_time_ns;
+  s.bad_frames = m.bad_frames, s.live_overruns = m.live_overruns, s.stamp_overruns = m.stamp_overruns, s.dds_write_errors = m.dds_write_errors;
+  s.triggers_accepted = m.triggers_accepted, s.triggers_refused = m.triggers_refused, s.triggers_late = m.triggers_late;
+  s.trigger_events_ignored = m.trigger_events_ignored, s.recorder_overflow = m.recorder_overflow, s.handoffs_deferred = m.handoffs_deferred;
+  s.source_decode_errors = m.source_decode_errors, s.source_lost_samples = m.source_lost_samples;
+  s.source_dropped_frames = m.source_dropped_frames, s.setpoint_samples = m.setpoint_samples, s.setpoint_missing = m.setpoint_missing;
+  s.frames_flagged = m.frames_flagged, s.commands = m.commands;
   const bool ok = impl_->status.writer > 0 && dds_write(impl_->status.writer, &s) >= 0;
-  if (!ok) ++write_errors_;
+  if (!ok) write_errors_.fetch_add(1, std::memory_order_relaxed);
   return ok;
 }
 
@@ -115,7 +121,7 @@ bool Bus::publish(const LiveMsg& m) {
   s.integrating = m.integrating;
   s.acquired_ns = m.acquired_ns;
   const bool ok = impl_->live.writer > 0 && dds_write(impl_->live.writer, &s) >= 0;
-  if (!ok) ++write_errors_;
+  if (!ok) write_errors_.fetch_add(1, std::memory_order_relaxed);
   return ok;
 }
 
@@ -126,8 +132,9 @@ bool Bus::publish(const ResultMsg& m) {
   s.sensor_calibration = cs(m.sensor_calibration);
   s.degraded = m.degraded;
   s.circular_deviation_G_um = m.circular_deviation_G_um, s.radius_mean_deviation_um = m.radius_mean_deviation_um;
+  s.results = m.results;
   const bool ok = impl_->result.writer > 0 && dds_write(impl_->result.writer, &s) >= 0;
-  if (!ok) ++write_errors_;
+  if (!ok) write_errors_.fetch_add(1, std::memory_order_relaxed);
   return ok;
 }
 
@@ -145,7 +152,7 @@ bool Bus::publish(const TraceMsg& m) {
   s.cw._length = s.cw._maximum = static_cast<uint32_t>(m.cw.size()), s.cw._buffer = cw.get();
   s.decimation = m.decimation;
   const bool ok = impl_->trace.writer > 0 && dds_write(impl_->trace.writer, &s) >= 0;
-  if (!ok) ++write_errors_;
+  if (!ok) write_errors_.fetch_add(1, std::memory_order_relaxed);
   return ok;
 }
 
@@ -154,7 +161,7 @@ bool Bus::publish(const ReplyMsg& m) {
   s.sender = cs(m.sender), s.message = cs(m.message), s.state = cs(m.state);
   s.request_id = m.request_id, s.ok = m.ok;
   const bool ok = impl_->reply.writer > 0 && dds_write(impl_->reply.writer, &s) >= 0;
-  if (!ok) ++write_errors_;
+  if (!ok) write_errors_.fetch_add(1, std::memory_order_relaxed);
   return ok;
 }
 
@@ -163,7 +170,7 @@ bool Bus::send(const CommandMsg& m) {
   s.sender = cs(m.sender), s.action = cs(m.action);
   s.request_id = m.request_id, s.code = m.code, s.p = m.p, s.q = m.q, s.time_ns = m.time_ns;
   const bool ok = impl_->command.writer > 0 && dds_write(impl_->command.writer, &s) >= 0;
-  if (!ok) ++write_errors_;
+  if (!ok) write_errors_.fetch_add(1, std::memory_order_relaxed);
   return ok;
 }
 
@@ -173,6 +180,13 @@ std::optional<StatusMsg> Bus::take_status(std::chrono::milliseconds timeout) {
   const bool ok = impl_->take_one<eical_msg_Status>(impl_->status, timeout, [&](const eical_msg_Status& s) {
     out = {str(s.daemon), str(s.state), str(s.fault), s.frames, s.overruns, s.frames_lost, s.measurements, s.results,
            s.temp_table_c, s.temp_head_c, s.time_ns, s.sample_index, s.sample_time_ns};
+    out.bad_frames = s.bad_frames, out.live_overruns = s.live_overruns, out.stamp_overruns = s.stamp_overruns;
+    out.dds_write_errors = s.dds_write_errors, out.triggers_accepted = s.triggers_accepted, out.triggers_refused = s.triggers_refused;
+    out.triggers_late = s.triggers_late, out.trigger_events_ignored = s.trigger_events_ignored;
+    out.recorder_overflow = s.recorder_overflow, out.handoffs_deferred = s.handoffs_deferred;
+    out.source_decode_errors = s.source_decode_errors, out.source_lost_samples = s.source_lost_samples;
+    out.source_dropped_frames = s.source_dropped_frames, out.setpoint_samples = s.setpoint_samples, out.setpoint_missing = s.setpoint_missing;
+    out.frames_flagged = s.frames_flagged, out.commands = s.commands;
   });
   return ok ? std::optional(out) : std::nullopt;
 }
@@ -195,7 +209,7 @@ std::optional<ResultMsg> Bus::take_result(std::chrono::milliseconds timeout) {
   ResultMsg out;
   const bool ok = impl_->take_one<eical_msg_Result>(impl_->result, timeout, [&](const eical_msg_Result& s) {
     out = {str(s.machine), str(s.program_id), str(s.program), s.degraded, s.circular_deviation_G_um, s.radius_mean_deviation_um,
-           str(s.json), str(s.measured_at), str(s.run_path), str(s.software_version), str(s.sensor_calibration)};
+           s.results, str(s.json), str(s.measured_at), str(s.run_path), str(s.software_version), str(s.sensor_calibration)};
   });
   return ok ? std::optional(out) : std::nullopt;
 }

@@ -5,6 +5,7 @@
 // another thread (guard condition), for shutdown.
 #include "drivers/dds/messages.hpp"
 
+#include <atomic>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -43,14 +44,15 @@ class Bus {
   std::optional<LiveMsg> take_live(std::chrono::milliseconds timeout);
 
   void wake();  // interrupts take_* waiting in another thread
-  [[nodiscard]] std::uint64_t write_errors() const { return write_errors_; }
+  // Any thread (the publisher, the evaluation and the command thread all write).
+  [[nodiscard]] std::uint64_t write_errors() const { return write_errors_.load(std::memory_order_relaxed); }
   // Number of matched readers of the Result writer (a connected HMI).
   [[nodiscard]] int matched_result_readers() const;
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
-  std::uint64_t write_errors_ = 0;
+  std::atomic<std::uint64_t> write_errors_{0};
 };
 
 }  // namespace eical::drivers::dds

@@ -15,6 +15,13 @@ struct StatusMsg {
   float temp_table_c = NAN, temp_head_c = NAN;
   std::int64_t time_ns = 0;
   std::int64_t sample_index = 0, sample_time_ns = 0;  // DAQ clock ↔ CLOCK_MONOTONIC
+  // Every counter of the service (eical.idl says what each one counts).
+  std::uint64_t bad_frames = 0, live_overruns = 0, stamp_overruns = 0, dds_write_errors = 0;
+  std::uint64_t triggers_accepted = 0, triggers_refused = 0, triggers_late = 0, trigger_events_ignored = 0;
+  std::uint64_t recorder_overflow = 0, handoffs_deferred = 0;
+  std::uint64_t source_decode_errors = 0, source_lost_samples = 0, source_dropped_frames = 0;
+  std::uint64_t setpoint_samples = 0, setpoint_missing = 0;
+  std::uint64_t frames_flagged = 0, commands = 0;
 };
 
 struct LiveMsg {
@@ -29,6 +36,7 @@ struct ResultMsg {
   std::string machine, program_id, program;  // key: machine + program_id (the run id)
   bool degraded = false;
   double circular_deviation_G_um = NAN, radius_mean_deviation_um = NAN;
+  std::uint64_t results = 0;  // the daemon's result count, this one included
   std::string json;
   std::string measured_at, run_path, software_version, sensor_calibration;  // provenance (history)
 };

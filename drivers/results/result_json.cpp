@@ -2,6 +2,8 @@
 
 #include "drivers/results/software_version.hpp"
 #include "drivers/run_io/run_writer.hpp"
+#include "dsp/analysis/figures.hpp"
+#include "dsp/analysis/verdict.hpp"
 
 #include <algorithm>
 #include <initializer_list>
@@ -18,6 +20,31 @@ void write_result(const dsp::Run& run, const dsp::Analysis& analysis, const std:
 }
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json uncertainty_json(const dsp::Analysis& a) {
+  nlohmann::json u = nlohmann::json::object();
+  for (const dsp::FigureValue& f : dsp::figures_of(a)) {
+    const auto it = a.uncertainty_k2.find(f.key);
+    const bool have = it != a.uncertainty_k2.end() && it->second.size() == f.values.size();
+    if (!f.array) {
+      u[f.key] = have ? number_or_null(it->second[0]) : nlohmann::json(nullptr);
+      continue;
+    }
+    nlohmann::json arr = nlohmann::json::array();
+    for (std::size_t i = 0; i < f.values.size(); i += static_cast<std::size_t>(f.columns)) {
+      if (f.columns == 1) {
+        arr.push_back(have ? number_or_null(it->second[i]) : nlohmann::json(nullptr));
+        continue;
+      }
+      nlohmann::json row = nlohmann::json::array();
+      for (int c = 0; c < f.columns && i + static_cast<std::size_t>(c) < f.values.size(); ++c)
+        row.push_back(have ? number_or_null(it->second[i + static_cast<std::size_t>(c)]) : nlohmann::json(nullptr));
+      arr.push_back(row);
+    }
+    u[f.key] = arr;
+  }
+  return u;
+}
 
 nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult& c) {
   nlohmann::json j = {{"plane", p.plane},
@@ -37,6 +64,10 @@ nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult&
   for (const auto& ctr : c.centers_mm) centers.push_back({ctr.x(), ctr.y()});
   j["revolution_centers_mm"] = centers;
   j["revolution_radii_mm"] = c.radii_mm;
+  if (c.direction == "both") {
+    j["circular_deviation_G_ccw_um"] = number_or_null(dsp::direction_G_um(c, "ccw"));
+    j["circular_deviation_G_cw_um"] = number_or_null(dsp::direction_G_um(c, "cw"));
+  }
   // The trace thinned to at most ~3600 points per revolution set: the plots need no more.
   const std::size_t n = c.trace.angle_deg.size();
   const std::size_t step = std::max<std::size_t>(1, n / 3600);
@@ -89,7 +120,13 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   j["run_id"] = run.meta.id;
   j["program"] = kind;
   j["software"] = software_version();
-  j["quality"] = {{"degraded", a.degraded}, {"flags", a.flags}};
+  j["quality"] = {{"degraded", a.degraded}, {"verdict", a.verdict}, {"verdict_reasons", a.verdict_reasons}, {"flags", a.flags}};
+  nlohmann::json severity = nlohmann::json::array();
+  for (const auto& f : a.flags) severity.push_back(dsp::severity_name(dsp::flag_severity(f)));
+  j["quality"]["flag_severity"] = severity;
+  j["uncertainty_k2"] = uncertainty_json(a);
+  j["uncertainty"] = {{"coverage_factor", 2}, {"sensor_model", a.uncertainty_source}, {"method", a.uncertainty_note},
+                      {"resolved_rule", "a figure is resolved when |value| > U (k = 2); one that is not is never compensated"}};
   j["sensor_model"] = {{"identified", a.sensor_model != "datasheet"}, {"source", a.sensor_model}};
   if (a.circle) {
     j["circle"] = circle_json(run.meta.program, *a.circle);
@@ -218,7 +255,8 @@ nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp
                       {"R_um", r.R_um},           {"R_up_um", r.R_up_um},
                       {"R_down_um", r.R_down_um}, {"B_um", r.B_um},
                       {"B_mean_um", r.B_mean_um}, {"deviation_um", {{"up", in.up_um}, {"down", in.down_um}}},
-                      {"per_target", targets},    {"standard", "ISO 230-2:2014"}};
+                      {"per_target", targets},    {"standard", "ISO 230-2:2014"},
+                      {"within_standard", r.runs >= dsp::eval::kIso230_2Runs}};
   if (vdi) j["vdi3441"] = {{"P_um", r.vdi.P_um}, {"Pa_um", r.vdi.Pa_um}, {"U_um", r.vdi.U_um}, {"Ps_um", r.vdi.Ps_um}};
   return j;
 }
@@ -253,7 +291,9 @@ nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r
   nlohmann::json moves = nlohmann::json::array();
   bool any_settled = false;
   std::map<std::pair<long long, int>, int> repeats;  // (target nm, direction) → moves: scatter needs a repeat
+  double largest = 0.0;
   for (const auto& m : r.moves) {
+    largest = std::max(largest, std::abs(m.step_measured_um));
     any_settled |= m.settled;
     ++repeats[{std::llround(m.to_mm * 1e6), m.to_mm > m.from_mm ? 1 : -1}];
     moves.push_back({{"from_mm", m.from_mm},
@@ -272,13 +312,15 @@ nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r
           {"settling_s", any_settled ? number_or_null(r.settling_s) : nlohmann::json(nullptr)},
           {"noise_um", number_or_null(r.noise_um)},
           {"smallest_step_resolved_um", r.smallest_step_resolved_um > 0 ? number_or_null(r.smallest_step_resolved_um) : nlohmann::json(nullptr)},
+          {"largest_step_measured_um", number_or_null(largest)},
           {"moves", moves}};
 }
 
 nlohmann::json rectangle_json(const dsp::eval::RectangleResult& r) {
   nlohmann::json corners = nlohmann::json::array(), errors = nlohmann::json::array(), sides = nlohmann::json::array();
   for (const auto& c : r.corners_mm) corners.push_back({c.x(), c.y()});
-  for (const auto& e : r.corner_errors_um) errors.push_back({e.x(), e.y()});
+  double worst = 0.0;
+  for (const auto& e : r.corner_errors_um) errors.push_back({e.x(), e.y()}), worst = std::max(worst, e.norm());
   for (const auto& s : r.sides)
     sides.push_back({{"from_mm", {s.from_mm.x(), s.from_mm.y()}},
                      {"to_mm", {s.to_mm.x(), s.to_mm.y()}},
@@ -286,6 +328,7 @@ nlohmann::json rectangle_json(const dsp::eval::RectangleResult& r) {
                      {"direction_error_urad", s.direction_error_urad}});
   return {{"corners_mm", corners},
           {"corner_errors_um", errors},
+          {"corner_error_max_um", r.corner_errors_um.empty() ? nlohmann::json(nullptr) : nlohmann::json(worst)},
           {"sides", sides},
           {"corner_angle_error_urad", r.corner_angle_error_urad}};
 }

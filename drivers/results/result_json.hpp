@@ -33,6 +33,10 @@ nlohmann::json path_json(const dsp::eval::PathDeviation& d);
 // Writes the document to `file` atomically (temporary + rename).
 void write_result(const dsp::Run& run, const dsp::Analysis& analysis, const std::filesystem::path& file);
 
+// uncertainty_k2: every figure's expanded uncertainty by result key (arrays keep their
+// figure's shape); null where it could not be estimated.
+nlohmann::json uncertainty_json(const dsp::Analysis& analysis);
+
 // A finite number, or null (callers add the reason to quality.flags).
 nlohmann::json number_or_null(double v);
 

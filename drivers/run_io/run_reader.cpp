@@ -235,6 +235,7 @@ dsp::RunMeta read_run_meta(const fs::path& file) {
     ref.axes = r->strings("axes");
     m.reference = ref;
   }
+  if (auto s = t.optional_table("setpoint")) m.setpoint = read_setpoint_origin(*s, Unknown::accept);
   return m;
 }
 

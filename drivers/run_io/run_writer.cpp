@@ -261,6 +261,19 @@ std::string run_toml_text(const dsp::RunMeta& m) {
          toml_double(s.length_mm) + "\nwidth_mm = " + toml_double(s.width_mm) + "\nlockin_tau_s = " + toml_double(s.lockin_tau_s) + "\n";
   }
   if (m.reference) o += "\n[reference]\nkind = " + toml_str(m.reference->kind) + "\naxes = " + strs(m.reference->axes) + "\n";
+  if (m.setpoint) {
+    const auto& s = *m.setpoint;
+    o += "\n[setpoint]\nsource = " + toml_str(s.source) + "\n";
+    if (s.program_number >= 0) o += "program_number = " + std::to_string(s.program_number) + "\n";
+    if (s.source == "servo_stream")
+      o += "servo_cycle_at_first_sample = " + toml_double(s.servo_cycle_at_first_sample) + "\nservo_rate_hz = " + toml_double(s.servo_rate_hz) + "\n";
+    if (s.source == "program")
+      o += "marks_offset_s = " + toml_double(s.marks_offset_s) +
+           "\noffset_s = " + toml_double(s.offset_s) + "\nblocks = " + std::to_string(s.blocks) +
+           "\nblock_offset_spread_s = " + toml_double(s.block_offset_spread_s) + "\n";
+    o += "lag_s = " + toml_double(s.lag_s) + "\ncorrelation = " + toml_double(s.correlation) + "\nresidual_ratio = " +
+         toml_double(s.residual_ratio) + "\n";
+  }
   return o;
 }
 

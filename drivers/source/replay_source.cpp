@@ -17,6 +17,7 @@ void ReplaySource::open() {
 }
 
 std::size_t ReplaySource::read(std::span<dsp::Frame> out) {
+  if (next_ == 0) start_ = std::chrono::steady_clock::now();  // paced from the first read, as a DAQ streams
   const std::size_t left = run_->frames.size() - next_;
   std::size_t n = std::min(out.size(), left);
   if (pacing_ == Pacing::realtime && n > 0) {

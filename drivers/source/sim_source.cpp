@@ -27,6 +27,9 @@ void SimSource::open() {
 bool SimSource::at_end() const { return finished_; }
 
 std::size_t SimSource::read(std::span<dsp::Frame> out) {
+  // The sample clock starts with the first read, as a DAQ streams from when it is read:
+  // the time between open() and the acquisition thread's start is not caught up in a burst.
+  if (next_index_ == 0) start_ = std::chrono::steady_clock::now();
   const std::size_t n_prog = run_->frames.size();
   std::size_t n = 0;
   while (n < out.size() && !finished_) {

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -23,6 +24,16 @@ class SourceError : public std::runtime_error {
 // sampling): the newest frame is dropped and counted. A source without a real-time
 // clock (free-running replay or simulation) has nothing to lose by waiting.
 enum class Backpressure { drop_newest, wait };
+
+// What a source lost or repaired on its own threads. Sources keep these in atomics, so any
+// thread (eicald's status thread) may read them; all zero for sources that count nothing.
+struct SourceCounters {
+  std::uint64_t decode_errors = 0;     // wire protocol: CRC errors and unknown packets
+  std::uint64_t lost_samples = 0;      // samples the device or stream lost (sequence jumps, lost servo cycles)
+  std::uint64_t dropped_frames = 0;    // frames the source had to drop itself (its own queue full)
+  std::uint64_t setpoint_samples = 0;  // set-point samples received (servo stream)
+  std::uint64_t setpoint_missing = 0;  // frames released without a set-point (none covered their time)
+};
 
 class Source {
  public:
@@ -45,6 +56,11 @@ class Source {
   // than "when read() returned it" (a source that delivers with latency, e.g. linuxcnc);
   // 0 = unknown.
   [[nodiscard]] virtual std::int64_t sample_time_ns(std::int64_t /*sample_index*/) const { return 0; }
+  [[nodiscard]] virtual SourceCounters counters() const { return {}; }
+  // Diagnostic lines the source collected on its own threads (e.g. the M-code markers of
+  // the LinuxCNC stream), handed over on a thread that may write streams (eicald's status
+  // thread, about once a second); the acquisition path itself never writes a stream.
+  virtual void drain_diagnostics(const std::function<void(const std::string&)>& /*sink*/) {}
 };
 
 }  // namespace eical::drivers

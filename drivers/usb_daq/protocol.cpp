@@ -40,14 +40,20 @@ std::uint16_t crc16_ccitt(std::span<const std::uint8_t> bytes, std::uint16_t crc
   return crc;
 }
 
-Decoder::Decoder(int psd_count) : psd_count_(psd_count) {}
+void Decoder::reset() noexcept {
+  fill_ = 0;
+  have_seq_ = false;
+  next_seq_ = 0;
+  next_index_ = 0;
+  pending_trigger_ = 0;
+}
 
-void Decoder::drop(std::size_t n) {
+void Decoder::drop(std::size_t n) noexcept {
   std::memmove(buf_.data(), buf_.data() + n, fill_ - n);
   fill_ -= n;
 }
 
-void Decoder::parse(const std::function<void(const dsp::Frame&)>& emit) {
+Decoder::Step Decoder::parse_one(dsp::Frame* out, int& n) noexcept {
   for (;;) {
     // Find the sync word.
     std::size_t i = 0;
@@ -56,17 +62,18 @@ void Decoder::parse(const std::function<void(const dsp::Frame&)>& emit) {
       stats_.resync_bytes += i;
       drop(i);
     }
-    if (fill_ < kHeader) return;
+    if (fill_ < kHeader) return Step::need_more;
     const std::uint8_t version = buf_[2], type = buf_[3], channels = buf_[4], samples = buf_[5];
     const std::size_t payload = type == kTypeSamples ? static_cast<std::size_t>(samples) * (1 + 3 * static_cast<std::size_t>(channels))
-                                                     : type == kTypeSlow ? 5 : 0;
-    if (version != kVersion || payload == 0 || samples > 64 || channels > 6 + 2 * dsp::kMaxPsd) {
+                                : type == kTypeSlow  ? kSlowPayload
+                                                     : 0;
+    if (version != kVersion || payload == 0 || samples > kMaxSamplesPerPacket || channels > kMaxChannels) {
       ++stats_.unknown_packets;
       drop(2);  // not a packet we understand: look for the next sync
       continue;
     }
     const std::size_t total = kHeader + payload + kCrc;
-    if (fill_ < total) return;
+    if (fill_ < total) return Step::need_more;
     const std::uint16_t crc = static_cast<std::uint16_t>(buf_[total - 2] | buf_[total - 1] << 8);
     if (crc16_ccitt(std::span<const std::uint8_t>(buf_.data() + 2, total - 4)) != crc) {
       ++stats_.crc_errors;
@@ -79,9 +86,14 @@ void Decoder::parse(const std::function<void(const dsp::Frame&)>& emit) {
     if (type == kTypeSlow) {
       temp_c_[0] = static_cast<float>(static_cast<std::int16_t>(p[0] | p[1] << 8)) / 100.0f;
       temp_c_[1] = static_cast<float>(static_cast<std::int16_t>(p[2] | p[3] << 8)) / 100.0f;
-      if (p[4] != 0) pending_trigger_ = p[4];
+      if (p[4] != 0) {
+        // Latched at `seq`: unwrapped against the samples seen so far.
+        pending_trigger_ = p[4];
+        pending_trigger_index_ = have_seq_ ? next_index_ + static_cast<std::int32_t>(seq - next_seq_) : static_cast<std::int64_t>(seq);
+      }
       drop(total);
-      continue;
+      n = 0;
+      return Step::consumed;
     }
     // Sequence numbers wrap at 2^32; the sample index is unwrapped from the last one.
     bool gap = false;
@@ -95,27 +107,28 @@ void Decoder::parse(const std::function<void(const dsp::Frame&)>& emit) {
       stats_.lost_samples += missing;
       first = next_index_ + missing;
     }
-    const int n_psd_ch = static_cast<int>(channels) - 6;
+    const int n_psd_ch = static_cast<int>(channels) - dsp::kAccelChannels;
     for (int k = 0; k < samples; ++k) {
-      dsp::Frame f;
+      dsp::Frame& f = out[k];
+      f = dsp::Frame{};
       const std::uint8_t status = *p++;
       f.sample_index = first + k;
-      for (int c = 0; c < 6 && c < channels; ++c, p += 3) f.accel_counts[c] = s24(p);
+      for (int c = 0; c < dsp::kAccelChannels && c < channels; ++c, p += 3) f.accel_counts[c] = s24(p);
       for (int c = 0; c < n_psd_ch; ++c, p += 3) f.psd_counts[c] = s24(p);
-      if (channels < 6) f.flags |= dsp::frame_flag::accel_missing;
+      if (channels < dsp::kAccelChannels) f.flags |= dsp::frame_flag::accel_missing;
       if (n_psd_ch < 2 * psd_count_) f.flags |= dsp::frame_flag::psd_missing;
-      if (status & 1) f.flags |= dsp::frame_flag::accel_saturated;
+      if (status & kStatusAccelOverload) f.flags |= dsp::frame_flag::accel_saturated;
       if (k == 0 && gap) f.flags |= dsp::frame_flag::gap_before;
       f.temp_c[0] = temp_c_[0], f.temp_c[1] = temp_c_[1];
       f.flags |= dsp::frame_flag::cmd_missing;  // the NC set-point comes from another source
-      for (double& v : f.cmd_mm) v = std::nan("");
-      if (k == 0 && pending_trigger_) f.trigger = pending_trigger_, pending_trigger_ = 0;
+      if (pending_trigger_ && f.sample_index >= pending_trigger_index_) f.trigger = pending_trigger_, pending_trigger_ = 0;
       ++stats_.frames;
-      emit(f);
     }
     next_seq_ = seq + samples;
     next_index_ = first + samples;
     drop(total);
+    n = samples;
+    return Step::consumed;
   }
 }
 

@@ -36,12 +36,12 @@ std::optional<eval::CircleResult> evaluate_channel(const Program& p, const std::
 
 }  // namespace
 
-void evaluate_circle_program(const Run& run, Analysis& a) {
+void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOptions& options) {
   const Measurement& m = a.measurement;
   const Program& p = run.meta.program;
   const auto [ia, ib] = plane_axes(p.plane);
   std::vector<Eigen::Vector2d> cmd, pos, ref;
-  bool ref_finite = run.channels.ref[ia] && run.channels.ref[ib];
+  bool ref_finite = options.reference && run.channels.ref[ia] && run.channels.ref[ib];
   for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
     cmd.emplace_back(m.cmd_mm[i][ia], m.cmd_mm[i][ib]);
     pos.emplace_back(m.pos_mm[i][ia], m.pos_mm[i][ib]);
@@ -109,6 +109,7 @@ void evaluate_circle_program(const Run& run, Analysis& a) {
   opt.centre_mm = {p.center_mm[0], p.center_mm[1]};
   opt.radius_mm = p.radius_mm;
   opt.feed_mm_min = p.feed_mm_min;
+  if (options.cyclic_pitch_mm) opt.cyclic_pitch_mm = options.cyclic_pitch_mm;
   try {
     a.diagnostics = eval::diagnose_circle(passes, opt);
     if (!a.diagnostics->servo_and_squareness_separated)

@@ -1,6 +1,8 @@
 #include "dsp/analysis/analyze_run.hpp"
 
+#include "dsp/analysis/figure_uncertainty.hpp"
 #include "dsp/analysis/program_evaluations.hpp"
+#include "dsp/analysis/verdict.hpp"
 #include "dsp/pipeline/integration_support.hpp"
 
 #include "dsp/core/error.hpp"
@@ -53,6 +55,11 @@ void evaluate_positioning_program(const Run& run, Analysis& a) {
   try {
     a.positioning_input = positioning_deviations(a.measurement, run.meta.program);
     a.positioning = eval::evaluate_positioning(*a.positioning_input);
+    // ISO 230-2:2014 clause 4.3.2: five runs per target and direction; fewer are evaluated
+    // by the same formulas, but the figures are outside the standard (s from < 5 runs).
+    if (a.positioning->runs < eval::kIso230_2Runs)
+      a.flags.push_back("positioning: " + std::to_string(a.positioning->runs) + " runs per target and direction, ISO 230-2 asks for " +
+                        std::to_string(eval::kIso230_2Runs) + ": evaluated by its formulas, outside the standard");
   } catch (const InputError& e) {
     a.flags.push_back(std::string("positioning: ") + e.what());
     a.degraded = true;
@@ -125,6 +132,7 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   cfg.coriolis = options.coriolis;
   cfg.cupt = options.cupt;
   cfg.keep_raw = options.keep_raw;
+  cfg.keep_schedule = options.uncertainty.enabled;
   if (options.sensor_model != "datasheet") cfg.fusion.scale_uncertainty = 3e-5;  // identified on site
   cfg.calibration[0] = options.calibration[0], cfg.calibration[1] = options.calibration[1];
   Pipeline pipeline(cfg);
@@ -132,34 +140,57 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   Analysis a;
   a.dynamic = cfg.dynamic, a.nbs = cfg.nbs, a.coriolis = cfg.coriolis;
   a.sensor_model = options.sensor_model;
+  a.program_kind = run.meta.program.kind;
   a.measurement = pipeline.finish();
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;
-  if (a.measurement.sample_index.empty()) return a;  // no motion: nothing to evaluate
-  if (const std::string why = unsupported_integration(a.measurement); !why.empty()) {
-    // run-format.md, "No standstill": a double integral with nothing to hold it is no
-    // position. Every positional figure is null with this reason; eical explain compares
-    // such runs in acceleration against the set-point.
-    a.flags.push_back("position: null, " + why);
+  // run-format.md, "No standstill": a double integral with nothing to hold it is no
+  // position. Every positional figure is null with this reason (the verdict: not
+  // measurable); eical explain compares such runs in acceleration against the set-point.
+  const std::string unsupported = a.measurement.sample_index.empty() ? std::string() : unsupported_integration(a.measurement);
+  if (!unsupported.empty()) {
+    a.flags.push_back(std::string(kPositionNullFlag) + unsupported);
     a.degraded = true;
-    return a;
-  }
-  {
+  } else if (!a.measurement.sample_index.empty()) {  // no motion: nothing to evaluate
     eval::RepeatInput ri;
     ri.sample_index = &a.measurement.sample_index, ri.pos_mm = &a.measurement.pos_mm, ri.cmd_mm = &a.measurement.cmd_mm;
     for (const auto& t : a.measurement.triggers)
       if (t.code == 102) ri.marks.push_back(t.sample_index);
     ri.fs_hz = a.measurement.fs_hz;
     a.repeats = eval::average_repeats(ri);
+    evaluate_program(run, a);
+    if (options.uncertainty.enabled) estimate_uncertainty(run, cfg, options, a);
   }
+  judge(run.meta.program, a);
+  return a;
+}
+
+void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& options) {
+  a.program_kind = run.meta.program.kind;
   const std::string& kind = run.meta.program.kind;
-  if (kind == "circle") detail::evaluate_circle_program(run, a);
+  if (kind == "circle") detail::evaluate_circle_program(run, a, options);
   else if (kind == "step") evaluate_step_program(run, a);
   else if (kind == "positioning") evaluate_positioning_program(run, a);
   else if (kind == "rectangle") detail::evaluate_rectangle_program(run, a);
   else if (kind == "freeform") detail::evaluate_freeform_program(run, a);
   else a.flags.push_back("program kind '" + kind + "': no evaluation in this version");
-  return a;
+}
+
+Measurement decimate(const Measurement& m, std::size_t q) {
+  Measurement d;
+  q = std::max<std::size_t>(1, q);
+  d.fs_hz = m.fs_hz / static_cast<double>(q);
+  const std::size_t n = std::min({m.sample_index.size(), m.pos_mm.size(), m.cmd_mm.size()});
+  for (std::size_t i = 0; i < n; i += q) {
+    d.sample_index.push_back(m.sample_index[i]);
+    d.pos_mm.push_back(m.pos_mm[i]);
+    d.vel_mm_s.push_back(i < m.vel_mm_s.size() ? m.vel_mm_s[i] : Eigen::Vector3d::Zero());
+    d.cmd_mm.push_back(m.cmd_mm[i]);
+    d.ref_mm.push_back(i < m.ref_mm.size() ? m.ref_mm[i] : Eigen::Vector3d::Constant(NAN));
+  }
+  d.triggers = m.triggers;
+  d.start_index = m.start_index, d.motion_end_index = m.motion_end_index;
+  return d;
 }
 
 }  // namespace eical::dsp

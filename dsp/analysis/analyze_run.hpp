@@ -13,6 +13,10 @@
 #include "dsp/eval/repeats.hpp"
 #include "dsp/eval/step_response.hpp"
 #include "dsp/pipeline/pipeline.hpp"
+#include "dsp/uncertainty/sensor_model_covariance.hpp"
+
+#include <cstdint>
+#include <map>
 
 #include <optional>
 #include <string>
@@ -32,6 +36,22 @@ struct AnalysisOptions {
   // method ("psd", "ref", "explain").
   StaticCalibration calibration[2];
   std::string sensor_model = "datasheet";
+  // The uncertainty of every figure (figure_uncertainty.hpp): Monte Carlo over the error
+  // field of the measurement, seeded. The sensor model's covariance is the calibration's
+  // when one is applied, else the data sheet's tolerances.
+  struct Uncertainty {
+    bool enabled = true;
+    int draws = 100;
+    std::uint64_t seed = 1;
+  } uncertainty;
+  std::optional<uncertainty::SensorModelCovariance> model_covariance;
+};
+
+// What the program's evaluation may leave out or fix (the uncertainty's draws re-evaluate
+// the same program many times on a perturbed path).
+struct EvaluationOptions {
+  bool reference = true;                   // also evaluate the reference channel
+  std::optional<double> cyclic_pitch_mm;   // diagnostics: this pitch instead of the search
 };
 
 struct Analysis {
@@ -50,17 +70,38 @@ struct Analysis {
   std::optional<eval::RectangleResult> rectangle;
   std::optional<eval::PathDeviation> path;  // free form (and the rectangle's contour)
   std::vector<eval::RepeatGroup> repeats;  // segments between M102 marks run more than once, averaged
+  std::string program_kind;
   bool degraded = false;
   std::vector<std::string> flags;  // pipeline quality flags and evaluation failures
+  // Expanded uncertainty (k = 2) of each figure by result key (figures.hpp), one value per
+  // element of the figure; absent when it could not be estimated (uncertainty_note says why).
+  std::map<std::string, std::vector<double>> uncertainty_k2;
+  std::string uncertainty_source;  // "datasheet" or the calibration's method
+  std::string uncertainty_note;    // how it was estimated, or why not
+  // quality.verdict of results.md: "ok", "degraded" or "not_measurable", and why.
+  std::string verdict = "ok";
+  std::vector<std::string> verdict_reasons;
 };
 
 // Throws InputError only when the run itself is unusable (no frames, fs ≤ 0).
 Analysis analyze_run(const Run& run, const AnalysisOptions& options = {});
 
+// The program's evaluation of an analysis whose measurement is set (what analyze_run does
+// after the pipeline); adds failures to a.flags.
+void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& options = {});
+
+// Every q-th sample of a measurement (fs/q), its triggers kept: what the uncertainty's
+// draws evaluate.
+Measurement decimate(const Measurement& m, std::size_t q);
+
 // Deviations at the targets of a positioning program: at each M102 (target reached) the
 // mean of measured − set-point over the second half of the dwell, grouped by target and
 // approach direction; a run is one pass up and one pass down (ISO 230-2 linear cycle).
 eval::PositioningInput positioning_deviations(const Measurement& m, const Program& program);
+
+// The flag of a run whose integrated motion is no position (pipeline/integration_support.hpp),
+// followed by the reason.
+inline constexpr const char* kPositionNullFlag = "position: null, ";
 
 // Plane axes of a program ("xy" → 0, 1; "zx" → 2, 0; "yz" → 1, 2).
 std::pair<int, int> plane_axes(const std::string& plane);

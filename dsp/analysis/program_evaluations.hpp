@@ -5,7 +5,7 @@
 
 namespace eical::dsp::detail {
 
-void evaluate_circle_program(const Run& run, Analysis& a);
+void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOptions& options);
 void evaluate_rectangle_program(const Run& run, Analysis& a);
 void evaluate_freeform_program(const Run& run, Analysis& a);
 

@@ -88,6 +88,31 @@ struct Reference {
   std::vector<std::string> axes;
 };
 
+// [setpoint]: where cmd_* came from when the NC is not eical's own, and how well it was
+// aligned with the DAQ clock (written by eicald; see README "The NC's set-point").
+struct SetPointOrigin {
+  std::string source;  // "servo_stream" (another NC's servo-rate positions) | "program" (eical's interpolator)
+  // servo_stream: fractional servo cycle number at the run's first sample (the two clocks'
+  // mapping, from their minimum-filtered arrival times).
+  double servo_cycle_at_first_sample = 0.0;
+  double servo_rate_hz = 0.0;
+  int program_number = -1;  // M101's P word (or the default program); -1 = none named
+  // program: DAQ time − program time of the first motion block from the marks alone and
+  // after the cross-correlation, number of motion blocks aligned separately and the spread
+  // (max − min) of their offsets.
+  double marks_offset_s = 0.0;
+  double offset_s = 0.0;
+  int blocks = 0;
+  double block_offset_spread_s = 0.0;
+  // Both: cross-correlation of measured against commanded acceleration over the motion,
+  // after the alignment: lag (measured later = positive; servo lag plus what the clocks
+  // missed), correlation at the peak, and the residual RMS(measured − commanded) relative to
+  // RMS(commanded) — the alignment's residual.
+  double lag_s = 0.0;
+  double correlation = 0.0;
+  double residual_ratio = 0.0;
+};
+
 struct RunMeta {
   std::string format = "eical-run/1";
   std::string id;
@@ -102,6 +127,7 @@ struct RunMeta {
   std::vector<PsdSpec> psd;
   Program program;
   std::optional<Reference> reference;
+  std::optional<SetPointOrigin> setpoint;
 };
 
 }  // namespace eical::dsp

@@ -44,7 +44,13 @@ struct SmootherOutput {
   std::array<std::vector<Mat3>, 3> gain, p_smoothed;
 };
 
-// Throws InputError when the arrays disagree in length.
+// Throws InputError when the arrays disagree in length. Runs the checkpointed smoother
+// (checkpointed_smoother.hpp) and gathers its segments: the same numbers, in memory.
 SmootherOutput smooth(const SmootherInput& in);
+
+struct SmootherTrack;
+// The compact track of a stored trace (what the checkpointed smoother reads).
+SmootherTrack smoother_track(const std::vector<std::int64_t>& sample_index, const std::vector<Eigen::Vector3d>& vel_mm_s,
+                             const std::vector<Eigen::Vector3d>& pos_mm, const SupportSchedule& schedule);
 
 }  // namespace eical::dsp::fusion

@@ -23,6 +23,7 @@
 // kept unless the reference is there or the caller accepts the set-point's figure.
 #include "dsp/core/run.hpp"
 #include "dsp/pipeline/pipeline.hpp"
+#include "dsp/uncertainty/sensor_model_covariance.hpp"
 
 #include <Eigen/Core>
 
@@ -78,10 +79,23 @@ struct Identification {
   int iterations = 0;
   std::string method;  // "psd" (PSD fixes + set-point at rest) | "ref"
   std::vector<std::string> notes;
+  // The calibration's covariance (sensor_model_covariance.hpp layout): each axis' filter
+  // block for the E terms it fitted, the damping terms and the delay; the data sheet's
+  // tolerance where nothing was identified (the data sheet is kept there).
+  uncertainty::SensorModelCovariance covariance;
+  // Strip crossings and their distinct speeds (mm/s), standstills in the motion.
+  std::size_t strip_crossings = 0;
+  std::vector<double> crossing_speeds_mm_s;
 };
 
-// Throws InputError when the run cannot identify anything (no motion, no standstill).
+// Throws InputError when the run cannot identify the sensors: no motion, fewer than two
+// standstills in the motion, or PSD strips crossed at one speed only (a scale error and a
+// damping error then look alike: the identification program crosses at 2, 4 and 6.5 m/min).
 Identification identify_sensors(const Run& run, const IdentifyOptions& options = {});
+
+// The parameters an identification fitted less certainly than the data sheet promises
+// (σ above the data sheet's u): a calibration with them would be worse than none.
+std::vector<std::string> less_certain_than_datasheet(const Identification& id, const uncertainty::SensorModelCovariance& datasheet);
 
 // The run's metadata with an identification applied (what the pipeline then uses).
 void apply_identification(const Identification& id, RunMeta& meta, PipelineConfig* config = nullptr);

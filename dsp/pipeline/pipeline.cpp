@@ -261,7 +261,7 @@ void Pipeline::step(const Frame& f) noexcept {
       phase_ = Phase::moving;
       live_.integrating = true;
       if (m_.sample_index.size() < config_.capacity_samples)
-        supports_.step(0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(), cmd_valid, cmd_moved, cmd);
+        supports_.step({0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(), cmd_valid, cmd_moved, cmd});
       store(f, start_pos_mm_, Eigen::Vector3d::Zero());
       return;
     case Phase::moving: {
@@ -272,7 +272,7 @@ void Pipeline::step(const Frame& f) noexcept {
       const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
       const std::size_t k = m_.sample_index.size();
       if (k < config_.capacity_samples)
-        supports_.step(k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd);
+        supports_.step({k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd});
       // The live filter's estimate, predicted over the DAQ delay (what finish() re-indexes).
       const Eigen::Vector3d live_pos = pos_mm - supports_.live_dx_mm();
       live_.vel_mm_s = vel_mm_s - supports_.live_dv_mm_s();
@@ -317,7 +317,7 @@ void Pipeline::apply_supports(Measurement& m) {
   std::vector<Eigen::Vector3d> sigma;
   const std::vector<Eigen::Vector3d> raw_vel = m.vel_mm_s;
   m.supports = supports_.finish(m.sample_index, m.pos_mm, m.vel_mm_s, sigma);
-  if (config_.keep_raw) m.raw.schedule = supports_.schedule();
+  if (config_.keep_raw || config_.keep_schedule) m.raw.schedule = supports_.schedule();
   m.sigma_um = std::move(sigma);
   if (m.supports.diverged) quality_ |= quality_flag::supports_diverged;
   if (m.supports.psd_disagrees) quality_ |= quality_flag::psd_disagrees;

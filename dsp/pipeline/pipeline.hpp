@@ -65,6 +65,7 @@ struct PipelineConfig {
   bool smooth = true;  // RTS pass in finish() (off: the forward filter's causal result)
   fusion::ErrorModel fusion;  // pipeline_config() sets the noise from the sensors' data sheet
   bool keep_raw = false;      // Measurement::raw (identification, explain; offline only)
+  bool keep_schedule = false; // Measurement::raw.schedule alone (the uncertainty of the figures)
   supports::StandstillOptions standstill;
 };
 

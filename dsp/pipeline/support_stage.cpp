@@ -10,10 +10,10 @@ constexpr std::size_t kMaxRestWindows = 4096;
 
 }  // namespace
 
-SupportStage::SupportStage(const SupportConfig& c, const Acquisition& acq, const std::vector<PsdSpec>& psd, double noise_var,
+SupportStage::SupportStage(const SupportConfig& c, const Acquisition& acq, const std::vector<PsdSpec>& psd, double noise_var_m2ps4,
                            std::size_t capacity)
-    : cfg_(c), fs_hz_(acq.fs_hz), delay_samples_(acq.daq_group_delay_samples), step_(fusion::discretise(c.model, 1.0 / acq.fs_hz)),
-      detector_(c.standstill, acq.fs_hz, acq.daq_group_delay_samples, noise_var), capacity_(capacity) {
+    : cfg_(c), fs_hz_(acq.fs_hz), step_(fusion::discretise(c.model, 1.0 / acq.fs_hz)),
+      detector_(c.standstill, acq.fs_hz, acq.daq_group_delay_samples, noise_var_m2ps4), capacity_(capacity) {
   for (const auto& s : psd) {
     if (psd_.size() >= static_cast<std::size_t>(kMaxPsd)) break;
     psd_.emplace_back(s, acq);
@@ -113,84 +113,111 @@ void SupportStage::close_rest_window() noexcept {
   open_ = RestWindow{};
 }
 
-void SupportStage::step(std::size_t k, std::int64_t gap, bool accel_valid, const Eigen::Vector3d& a_table,
-                        const Eigen::Vector3d& a_head, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
-                        bool cmd_valid, bool cmd_moved, const Eigen::Vector3d& cmd_mm) noexcept {
-  if (k == 0) start_pos_mm_ = pos_mm;  // where the integration is anchored
-  const Eigen::Vector3d a_rel = a_head - a_table;
-  const Eigen::Vector3d vel_corr = vel_mm_s - live_dv_mm_s();
+void SupportStage::step(const SupportSample& s) noexcept {
+  if (s.k == 0) start_pos_mm_ = s.pos_mm;  // where the integration is anchored
+  // The velocity as the live filter corrects it before this sample's update (the lock-in's lag).
+  const Eigen::Vector3d vel_corr_mm_s = s.vel_mm_s - live_dv_mm_s();
+  RestDecision r = find_rest(s);
+  zupt_or_window_mean(s, r);
+  const std::uint8_t flags = schedule_flags(s, r);
+  predict_and_support_velocity(s, r, flags);
+  position_fixes(s, vel_corr_mm_s);
+  record(flags, r);
+  track_rest_window(s, r);
+}
+
+SupportStage::RestDecision SupportStage::find_rest(const SupportSample& s) noexcept {
   double pvv = 0.0;
   for (const auto& f : live_.axis) pvv = std::max(pvv, f.P(1, 1));
-  const supports::StandstillDetector::Decision det =
-      detector_.step(accel_valid ? a_rel : Eigen::Vector3d::Constant(NAN), vel_mm_s, live_dv_mm_s(), std::sqrt(pvv) / 1000.0, cmd_valid,
-                     cmd_moved);
-  const bool rest = accel_valid && det.rest;  // found and reported even when ZUPT is off
-  // A ringing standstill — its acceleration not quiet, or its velocity spreading over the
-  // detector's window beyond what the noise makes of it — is not used sample by sample
-  // (its swings are correlated) but by the mean velocity over each vibration window. A sine's mean over a window at least twice its period is below 0.2
-  // of its rms: 0.3 of the spread is the σ of that mean.
-  double zupt_sigma_um_s = 0.0;
-  bool mean_update = false;
-  fusion::VelocityMean vm;
-  if (rest && !(det.quiet && det.velocity_spread_mm_s * 1000.0 <= 3.0 * cfg_.model.zupt_sigma_um_s)) {
-    zupt_sigma_um_s = -1.0;
-    if (++ringing_count_ % detector_.vibration_window() == 0) {
-      mean_update = true;
-      vm.k = k;
-      for (int a = 0; a < 3; ++a) vm.mean_um_s[a] = det.window_mean_mm_s[a] * 1000.0;
-      vm.sigma_um_s = 0.3 * det.vibration_sigma_mm_s * 1000.0;
-      vm.lag_s = det.window_lag_s;
-    }
-  } else {
+  RestDecision r;
+  r.det = detector_.step(s.accel_valid ? Eigen::Vector3d(s.a_head_mps2 - s.a_table_mps2) : Eigen::Vector3d::Constant(NAN), s.vel_mm_s, live_dv_mm_s(),
+                         std::sqrt(pvv) / 1000.0, s.cmd_valid, s.cmd_moved);
+  r.rest = s.accel_valid && r.det.rest;  // found and reported even when ZUPT is off
+  return r;
+}
+
+// A ringing standstill — its acceleration not quiet, or its velocity spreading over the
+// detector's window beyond what the noise makes of it — is not used sample by sample (its
+// swings are correlated) but by the mean velocity over each vibration window. A sine's mean
+// over a window at least twice its period is below 0.2 of its rms: 0.3 of the spread is the
+// σ of that mean.
+void SupportStage::zupt_or_window_mean(const SupportSample& s, RestDecision& r) noexcept {
+  if (!(r.rest && !(r.det.quiet && r.det.velocity_spread_mm_s * 1000.0 <= 3.0 * cfg_.model.zupt_sigma_um_s))) {
     ringing_count_ = 0;
+    return;
   }
+  r.zupt_sigma_um_s = -1.0;
+  if (++ringing_count_ % detector_.vibration_window() != 0) return;
+  r.mean_update = true;
+  r.mean.k = s.k;
+  for (int a = 0; a < 3; ++a) r.mean.mean_um_s[a] = r.det.window_mean_mm_s[a] * 1000.0;
+  r.mean.sigma_um_s = 0.3 * r.det.vibration_sigma_mm_s * 1000.0;
+  r.mean.lag_s = r.det.window_lag_s;
+}
 
+// Rest, NBS (an axis whose set-point has not moved since the last rest, Bild 7-8) and the
+// start of a move.
+std::uint8_t SupportStage::schedule_flags(const SupportSample& s, const RestDecision& r) noexcept {
   std::uint8_t flags = 0;
-  if (!accel_valid) flags |= fusion::schedule_flag::invalid;
-  if (rest) {
+  if (!s.accel_valid) flags |= fusion::schedule_flag::invalid;
+  if (r.rest) {
     flags |= fusion::schedule_flag::rest;
-    if (cmd_valid) cmd_at_rest_ = cmd_mm;
-  } else if (cfg_.nbs && cmd_valid) {
+    if (s.cmd_valid) cmd_at_rest_ = s.cmd_mm;
+  } else if (cfg_.nbs && s.cmd_valid) {
     for (int a = 0; a < 3; ++a)
-      if (std::abs(cmd_mm[a] - cmd_at_rest_[a]) < 1e-9) flags |= fusion::nbs_flag(a);
+      if (std::abs(s.cmd_mm[a] - cmd_at_rest_[a]) < 1e-9) flags |= fusion::nbs_flag(a);
   }
-  if (k == 0 && cmd_valid) cmd_at_rest_ = cmd_mm;  // the set-point where the motion starts
-  const bool move_start = k > 0 && at_rest_ && !rest;
-  if (move_start) flags |= fusion::schedule_flag::move_start;
+  if (s.k == 0 && s.cmd_valid) cmd_at_rest_ = s.cmd_mm;  // the set-point where the motion starts
+  if (s.k > 0 && at_rest_ && !r.rest) flags |= fusion::schedule_flag::move_start;
+  return flags;
+}
 
-  if (k > 0) live_.predict(gap == 1 ? step_ : fusion::discretise(cfg_.model, static_cast<double>(gap) / fs_hz_), move_start, cfg_.model);
-  live_.velocity_supports(flags, vel_mm_s * 1000.0, cfg_.model, zupt_sigma_um_s, cfg_.zupt);
-  if (mean_update) {
-    live_.velocity_mean(vm, cfg_.model, cfg_.zupt);
-    if (schedule_.velocity_means.size() < schedule_.velocity_means.capacity()) schedule_.velocity_means.push_back(vm);
+void SupportStage::predict_and_support_velocity(const SupportSample& s, const RestDecision& r, std::uint8_t flags) noexcept {
+  const bool move_start = (flags & fusion::schedule_flag::move_start) != 0;
+  if (s.k > 0)
+    live_.predict(s.gap_samples == 1 ? step_ : fusion::discretise(cfg_.model, static_cast<double>(s.gap_samples) / fs_hz_), move_start, cfg_.model);
+  live_.velocity_supports(flags, s.vel_mm_s * 1000.0, cfg_.model, r.zupt_sigma_um_s, cfg_.zupt);
+  if (r.mean_update) {
+    live_.velocity_mean(r.mean, cfg_.model, cfg_.zupt);
+    if (schedule_.velocity_means.size() < schedule_.velocity_means.capacity()) schedule_.velocity_means.push_back(r.mean);
   }
-  for (std::size_t s = 0; s < psd_.size(); ++s) {  // recorded always, used when CUPT is on
-    const supports::PsdReading& r = psd_now_[s];
+}
+
+// CUPT: every lit PSD strip is a position fix along its axis (recorded always, used when
+// CUPT is on).
+void SupportStage::position_fixes(const SupportSample& s, const Eigen::Vector3d& vel_corr) noexcept {
+  for (std::size_t p = 0; p < psd_.size(); ++p) {
+    const supports::PsdReading& r = psd_now_[p];
     if (!r.valid) continue;
-    const int ax = psd_[s].axis();
+    const int ax = psd_[p].axis();
     // The lock-in output lags the spot by its time constant: add τ·v.
-    const double fix_um = (psd_[s].centre_mm() + r.u_mm + psd_[s].lockin_tau_s() * vel_corr[ax]) * 1000.0;
-    const double model_um = cfg_.model.scale_uncertainty * (pos_mm - start_pos_mm_).norm() * 1000.0;
-    if (cfg_.cupt) live_.position_fix(ax, pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model);
-    if (schedule_.fixes.size() < capacity_) schedule_.fixes.push_back({k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(s), model_um});
+    const double fix_um = (psd_[p].centre_mm() + r.u_mm + psd_[p].lockin_tau_s() * vel_corr[ax]) * 1000.0;
+    const double model_um = cfg_.model.scale_uncertainty * (s.pos_mm - start_pos_mm_).norm() * 1000.0;
+    if (cfg_.cupt) live_.position_fix(ax, s.pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model);
+    if (schedule_.fixes.size() < capacity_) schedule_.fixes.push_back({s.k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(p), model_um});
     else ++fixes_dropped_;
   }
-  if (schedule_.flags.size() < capacity_) {
-    schedule_.flags.push_back(flags);
-    schedule_.zupt_sigma_um_s.push_back(static_cast<float>(zupt_sigma_um_s));
-  }
+}
 
-  if (rest) {  // the sensors' mean at a standstill: their bias there (drift between rests)
-    if (open_.samples == 0) open_.first_index = static_cast<std::int64_t>(k);
-    open_.last_index = static_cast<std::int64_t>(k);
-    open_.table_mps2 += a_table;
-    open_.head_mps2 += a_head;
-    open_.quiet = open_.quiet && det.quiet;
+void SupportStage::record(std::uint8_t flags, const RestDecision& r) noexcept {
+  if (schedule_.flags.size() >= capacity_) return;
+  schedule_.flags.push_back(flags);
+  schedule_.zupt_sigma_um_s.push_back(static_cast<float>(r.zupt_sigma_um_s));
+}
+
+// The sensors' mean at a standstill: their bias there (the drift between rests).
+void SupportStage::track_rest_window(const SupportSample& s, const RestDecision& r) noexcept {
+  if (r.rest) {
+    if (open_.samples == 0) open_.first_index = static_cast<std::int64_t>(s.k);
+    open_.last_index = static_cast<std::int64_t>(s.k);
+    open_.table_mps2 += s.a_table_mps2;
+    open_.head_mps2 += s.a_head_mps2;
+    open_.quiet = open_.quiet && r.det.quiet;
     ++open_.samples;
   } else {
     close_rest_window();
   }
-  at_rest_ = rest;
+  at_rest_ = r.rest;
 }
 
 SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::vector<Eigen::Vector3d>& pos_mm,
@@ -261,7 +288,10 @@ SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::v
   // then no slowly wandering bias, and pulling the trace to the strips would bend it far
   // between them). The measurement is then fused without them, and says so.
   std::size_t cupt_ok = 0, cupt_bad = 0;
-  for (int a = 0; a < 3; ++a) cupt_ok += out.tally[a][1].accepted, cupt_bad += out.tally[a][1].rejected;
+  for (int a = 0; a < 3; ++a) {
+    const auto& cupt = out.tally[a][static_cast<int>(fusion::Support::cupt)];
+    cupt_ok += cupt.accepted, cupt_bad += cupt.rejected;
+  }
   if (schedule_.cupt && cupt_ok + cupt_bad > 0 && (out.resets > 0 || 20 * cupt_bad > cupt_ok + cupt_bad)) {
     sum.psd_disagrees = true;
     sum.psd_rejected = cupt_bad;

@@ -56,12 +56,23 @@ struct SupportSummary {
   Eigen::Vector3d start_bias_sigma_um_s2 = Eigen::Vector3d::Zero();  // how well the first rest fixed the bias
 };
 
+// One sample of the motion as the supports see it (sensor time base).
+struct SupportSample {
+  std::size_t k = 0;               // trace index (the motion starts at 0)
+  std::int64_t gap_samples = 1;    // samples since the previous one (lost frames)
+  bool accel_valid = true;
+  Eigen::Vector3d a_table_mps2 = Eigen::Vector3d::Zero(), a_head_mps2 = Eigen::Vector3d::Zero();  // bias-free, machine axes
+  Eigen::Vector3d pos_mm = Eigen::Vector3d::Zero(), vel_mm_s = Eigen::Vector3d::Zero();         // the integrated relative motion
+  bool cmd_valid = false, cmd_moved = false;
+  Eigen::Vector3d cmd_mm = Eigen::Vector3d::Zero();
+};
+
 class SupportStage {
  public:
   SupportStage() = default;
   // Allocates everything the measurement can need (capacity_samples of trace).
   SupportStage(const SupportConfig& config, const Acquisition& acquisition, const std::vector<PsdSpec>& psd,
-               double sensor_noise_var_mps2, std::size_t capacity_samples);
+               double sensor_noise_var_m2ps4, std::size_t capacity_samples);
 
   void reset() noexcept;
   // Every frame (the PSD noise is learnt at rest too).
@@ -70,16 +81,15 @@ class SupportStage {
   void rest_sample(const Eigen::Vector3d& a_rel_mps2) noexcept;
   // The motion starts at trace index 0; `rest_bias` is what the pipeline subtracts.
   void start() noexcept;
-  // One sample of the motion at trace index k (the pipeline's stored sample). a_*:
-  // bias-free accelerations (m/s², machine axes); pos/vel: the integrated relative motion.
-  void step(std::size_t k, std::int64_t gap_samples, bool accel_valid, const Eigen::Vector3d& a_table,
-            const Eigen::Vector3d& a_head, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s, bool cmd_valid,
-            bool cmd_moved, const Eigen::Vector3d& cmd_mm) noexcept;
+  // One sample of the motion (the pipeline's stored sample at trace index s.k): the rest
+  // decision, then the live filter's supports, in this order:
+  //   find_rest → zupt_or_window_mean → schedule_flags → predict_and_support_velocity →
+  //   position_fixes → record → track_rest_window
+  void step(const SupportSample& s) noexcept;
 
   // The live filter's current error estimate (subtract from the integrated motion).
   [[nodiscard]] Eigen::Vector3d live_dx_mm() const noexcept;
   [[nodiscard]] Eigen::Vector3d live_dv_mm_s() const noexcept;
-  [[nodiscard]] bool at_rest() const noexcept { return at_rest_; }
 
   // Offline: corrects pos/vel of the trace (sensor time base) in place; returns what was
   // done. sigma_x_um receives the posterior σ of the position per sample and axis.
@@ -90,10 +100,26 @@ class SupportStage {
   [[nodiscard]] const fusion::SupportSchedule& schedule() const noexcept { return schedule_; }
 
  private:
+  // What the standstill detector decided for this sample, and how a ringing standstill is
+  // used (by the mean velocity over each vibration window, not sample by sample).
+  struct RestDecision {
+    supports::StandstillDetector::Decision det;
+    bool rest = false;
+    double zupt_sigma_um_s = 0.0;  // 0: the sample's own ZUPT; < 0: none (ringing)
+    bool mean_update = false;
+    fusion::VelocityMean mean;
+  };
+  RestDecision find_rest(const SupportSample& s) noexcept;
+  void zupt_or_window_mean(const SupportSample& s, RestDecision& r) noexcept;
+  std::uint8_t schedule_flags(const SupportSample& s, const RestDecision& r) noexcept;
+  void predict_and_support_velocity(const SupportSample& s, const RestDecision& r, std::uint8_t flags) noexcept;
+  void position_fixes(const SupportSample& s, const Eigen::Vector3d& vel_corr_mm_s) noexcept;
+  void record(std::uint8_t flags, const RestDecision& r) noexcept;
+  void track_rest_window(const SupportSample& s, const RestDecision& r) noexcept;
   void close_rest_window() noexcept;
 
   SupportConfig cfg_;
-  double fs_hz_ = 10000.0, delay_samples_ = 0.0;
+  double fs_hz_ = 10000.0;
   fusion::Discrete step_;
   supports::StandstillDetector detector_;
   std::vector<supports::PsdDecoder> psd_;

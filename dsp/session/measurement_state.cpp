@@ -1,5 +1,8 @@
 #include "dsp/session/measurement_state.hpp"
 
+#include <array>
+#include <string>
+
 namespace eical::dsp {
 
 std::string_view to_string(State s) {
@@ -28,15 +31,40 @@ std::string_view to_string(Event e) {
   return "?";
 }
 
+namespace {
+
+constexpr int kStates = 6, kEvents = 8;
+
+// "program_end (M103) is not allowed in state IDLE" for every pair, built once before
+// main() so that a refusal on the DSP thread only points at it.
+const std::array<std::array<std::string, kEvents>, kStates> kRefusals = [] {
+  std::array<std::array<std::string, kEvents>, kStates> t;
+  for (int s = 0; s < kStates; ++s)
+    for (int e = 0; e < kEvents; ++e)
+      t[static_cast<std::size_t>(s)][static_cast<std::size_t>(e)] =
+          std::string(to_string(static_cast<Event>(e))) + " is not allowed in state " + std::string(to_string(static_cast<State>(s)));
+  // The one refusal an NC meets in normal operation says what happens next.
+  t[static_cast<std::size_t>(State::measuring)][static_cast<std::size_t>(Event::program_start)] =
+      "program_start (M101) is not allowed in state MEASURING: the running measurement continues untouched (M103 ends it, abort drops it)";
+  return t;
+}();
+
+std::string_view refusal(State s, Event e) {
+  const auto si = static_cast<std::size_t>(s), ei = static_cast<std::size_t>(e);
+  if (si >= kRefusals.size() || ei >= kRefusals[0].size()) return "not allowed";
+  return kRefusals[si][ei];
+}
+
+}  // namespace
+
 Transition MeasurementState::handle(Event e, std::string_view reason) {
   const State from = state_;
-  auto go = [&](State to, Action a, std::string msg = {}) {
+  auto go = [&](State to, Action a, std::string_view msg = {}) {
     state_ = to;
-    return Transition{from, to, a, true, std::move(msg)};
+    return Transition{from, to, a, true, msg};
   };
   auto refuse = [&] {
-    return Transition{from, from, Action::none, false,
-                      std::string(to_string(e)) + " is not allowed in state " + std::string(to_string(from))};
+    return Transition{from, from, Action::none, false, refusal(from, e)};
   };
 
   if (e == Event::fault) {
@@ -68,11 +96,8 @@ Transition MeasurementState::handle(Event e, std::string_view reason) {
       }
       if (e == Event::program_end) return go(State::evaluating, Action::stop_and_evaluate);
       if (e == Event::abort) return go(State::idle, Action::discard);
-      // A second M101 without M103: the NC program was restarted. Start over.
-      if (e == Event::program_start) {
-        segments_ = 0;
-        return go(State::measuring, Action::start_measurement, "program restarted without M103");
-      }
+      // A second M101 is refused: splitting the running measurement would leave two
+      // broken ones. An NC program restarted after a reset sends abort, or M103 first.
       return refuse();
     case State::evaluating:
       if (e == Event::evaluation_done) return go(State::done, Action::publish_done);

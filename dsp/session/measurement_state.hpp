@@ -34,8 +34,10 @@ struct Transition {
   State from;
   State to;
   Action action;
-  bool accepted;        // false: the event is not allowed in this state (state unchanged)
-  std::string message;  // why it was refused, or the fault reason
+  bool accepted;  // false: the event is not allowed in this state (state unchanged)
+  // Why it was refused, or the fault reason. Static text or the state machine's fault
+  // reason (valid while it lives): a refusal on the DSP thread allocates nothing.
+  std::string_view message;
 };
 
 class MeasurementState {

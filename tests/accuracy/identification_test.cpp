@@ -2,6 +2,7 @@
 // and cross-coupled, with its own f0 and ζ, and a head sensor scaled on z, identified from
 // the identification program's PSD readings and set-point alone; every fitted term must
 // land within its stated uncertainty (4 σ, at least 30 ppm) of the truth.
+#include "dsp/core/error.hpp"
 #include "dsp/identify/sensor_identification.hpp"
 #include "sim/simulate.hpp"
 
@@ -76,6 +77,48 @@ TEST(Identification, ARunWithoutMotionOrStandstillIsAClearError) {
   } catch (const std::exception& e) {
     EXPECT_NE(std::string(e.what()).find("identify"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace eical
+
+namespace eical {
+namespace {
+
+// A run that cannot identify the sensors is refused with the reason: a circle crosses its
+// strips at one speed and rests once; the identification program passes and carries a
+// covariance no worse than the data sheet's.
+TEST(Identification, ACircleRunIsRefusedWithTheReason) {
+  sim::Scenario sc = sim::circle_scenario(10.0, 2500.0, 5, "ccw", 1);
+  sc.meta.psd = sim::psd_config_b(10.0);
+  try {
+    (void)dsp::identify::identify_sensors(sim::simulate(sc));
+    FAIL() << "identified from a circle";
+  } catch (const dsp::InputError& e) {
+    const std::string w = e.what();
+    EXPECT_TRUE(w.find("rests only once") != std::string::npos || w.find("one speed") != std::string::npos) << w;
+    EXPECT_NE(w.find("eical gen-nc identify"), std::string::npos) << w;
+  }
+}
+
+TEST(Identification, TheCalibrationCarriesACovarianceWithinTheDataSheetsTolerance) {
+  const dsp::Run run = sim::simulate(sim::identify_scenario(sim::psd_config_b(10.0), {"z"}, 2));
+  const dsp::identify::Identification id = dsp::identify::identify_sensors(run);
+  const auto ds = dsp::uncertainty::datasheet_covariance(run.meta.sensors, run.meta.acquisition.fs_hz);
+  EXPECT_TRUE(dsp::identify::less_certain_than_datasheet(id, ds).empty());
+  EXPECT_GE(id.crossing_speeds_mm_s.size(), 3u);  // 2, 4 and 6.5 m/min
+  // The fitted terms: the identification's own σ with its margin, well below the data sheet's.
+  const int xx = dsp::uncertainty::error_index(0, 0, 0);
+  EXPECT_NEAR(id.covariance.sigma(xx), 1.5 * id.sensor[0].error[0][0].sigma, 1e-12);
+  EXPECT_LT(id.covariance.sigma(xx), 0.2 * ds.sigma(xx));
+  // Terms it did not fit keep the data sheet's.
+  EXPECT_DOUBLE_EQ(id.covariance.sigma(dsp::uncertainty::error_index(1, 0, 0)), ds.sigma(dsp::uncertainty::error_index(1, 0, 0)));
+  // A fitted term as uncertain as the circle's E_zx is reported as worse than the data sheet.
+  dsp::identify::Identification bad = id;
+  bad.sensor[0].error[2][0] = {-3778e-6, 14106e-6, true};
+  const auto worse = dsp::identify::less_certain_than_datasheet(bad, ds);
+  ASSERT_EQ(worse.size(), 1u);
+  EXPECT_NE(worse[0].find("table.E_zx"), std::string::npos) << worse[0];
 }
 
 }  // namespace

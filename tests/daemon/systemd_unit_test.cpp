@@ -73,7 +73,7 @@ TEST(SystemdUnit, PassesSystemdAnalyzeVerify) {
   const fs::path dir = fs::temp_directory_path() / ("eicald-unit-" + std::to_string(rd()));
   fs::create_directories(dir);
   std::string unit = read_file(kUnit);
-  const std::string exec = "/usr/local/bin/eicald";
+  const std::string exec = "/usr/bin/eicald";
   unit.replace(unit.find(exec), exec.size(), "/bin/true");
   std::ofstream(dir / "eicald.service") << unit;
   const std::string cmd = "systemd-analyze verify " + (dir / "eicald.service").string() + " 2>&1";

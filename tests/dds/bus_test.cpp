@@ -44,6 +44,15 @@ TEST(DdsBus, StatusAndLiveRoundTrip) {
   s.frames_lost = 2;
   s.temp_table_c = 21.5f;
   s.time_ns = 42;
+  // Every counter travels (each a different value: a swapped field shows).
+  std::uint64_t StatusMsg::*const counters[] = {
+      &StatusMsg::bad_frames,       &StatusMsg::live_overruns,          &StatusMsg::stamp_overruns,    &StatusMsg::dds_write_errors,
+      &StatusMsg::triggers_accepted, &StatusMsg::triggers_refused,      &StatusMsg::triggers_late,     &StatusMsg::trigger_events_ignored,
+      &StatusMsg::recorder_overflow, &StatusMsg::handoffs_deferred,     &StatusMsg::source_decode_errors, &StatusMsg::source_lost_samples,
+      &StatusMsg::source_dropped_frames, &StatusMsg::setpoint_samples,  &StatusMsg::setpoint_missing,  &StatusMsg::frames_flagged,
+      &StatusMsg::commands};
+  std::uint64_t value = 1000;
+  for (auto c : counters) s.*c = ++value;
   // Reliable + volatile: publish until the reader has matched and taken one.
   const auto got = wait_for([&] {
     daemon.publish(s);
@@ -57,6 +66,7 @@ TEST(DdsBus, StatusAndLiveRoundTrip) {
   EXPECT_EQ(got->frames_lost, 2u);
   EXPECT_FLOAT_EQ(got->temp_table_c, 21.5f);
   EXPECT_EQ(got->time_ns, 42);
+  for (auto c : counters) EXPECT_EQ((*got).*c, s.*c);
 
   LiveMsg l;
   l.daemon = "eicald@test";
@@ -78,6 +88,7 @@ TEST(DdsBus, ResultReachesAnHmiThatJoinsLater) {
   r.program_id = "run-0001";
   r.program = "circle";
   r.circular_deviation_G_um = 6.25;
+  r.results = 17;
   r.json = R"({"format":"eical-result/1"})";
   ASSERT_TRUE(daemon.publish(r));
   Bus hmi(domain(), Role::hmi);  // created after the write: transient-local delivers it
@@ -86,6 +97,7 @@ TEST(DdsBus, ResultReachesAnHmiThatJoinsLater) {
   EXPECT_EQ(got->program_id, "run-0001");
   EXPECT_DOUBLE_EQ(got->circular_deviation_G_um, 6.25);
   EXPECT_TRUE(std::isnan(got->radius_mean_deviation_um));
+  EXPECT_EQ(got->results, 17u);
   EXPECT_EQ(got->json, r.json);
 }
 

@@ -119,3 +119,67 @@ TEST(SensorCalibration, TyposAndWrongFormatAreErrorsNamingTheKey) {
 }
 
 }  // namespace
+
+namespace {
+
+// The calibration's covariance: written, read back exactly, applied to the analysis; a
+// file without one is as uncertain as the data sheet.
+TEST(SensorCalibration, CovarianceRoundTripsAndIsApplied) {
+  namespace u = eical::dsp::uncertainty;
+  eical::dsp::RunMeta meta;
+  SensorCalibration cal;
+  for (int s = 0; s < 2; ++s) cal.sensors[s] = meta.sensors[s];
+  cal.covariance = u::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
+  auto& c = cal.covariance->covariance;
+  const int xx = u::error_index(0, 0, 0), xy = u::error_index(0, 0, 1);
+  c(xx, xx) = 2.0e-10, c(xy, xy) = 3.0e-10, c(xx, xy) = c(xy, xx) = 1.0e-10;
+  c(u::kDelayIndex, u::kDelayIndex) = 4e-12;
+  cal.covariance->psd_offset_sigma_um = 0.2;
+  const fs::path p = temp_file("covariance");
+  eical::drivers::write_sensor_calibration(cal, p);
+  const SensorCalibration back = eical::drivers::read_sensor_calibration(p, meta);
+  ASSERT_TRUE(back.covariance.has_value());
+  EXPECT_LT((back.covariance->covariance - c).cwiseAbs().maxCoeff(), 1e-24);
+  EXPECT_DOUBLE_EQ(back.covariance->psd_offset_sigma_um, 0.2);
+  eical::dsp::AnalysisOptions opt;
+  eical::drivers::apply_calibration(back, meta, opt);
+  ASSERT_TRUE(opt.model_covariance.has_value());
+  EXPECT_DOUBLE_EQ(opt.model_covariance->covariance(xx, xy), 1.0e-10);
+  fs::remove(p);
+
+  SensorCalibration plain = cal;
+  plain.covariance.reset();
+  eical::drivers::write_sensor_calibration(plain, p);
+  eical::dsp::AnalysisOptions opt2;
+  eical::drivers::apply_calibration(eical::drivers::read_sensor_calibration(p, meta), meta, opt2);
+  ASSERT_TRUE(opt2.model_covariance.has_value());
+  EXPECT_DOUBLE_EQ(opt2.model_covariance->covariance(xx, xx), u::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz).covariance(xx, xx));
+  EXPECT_NE(opt2.model_covariance->source.find("data sheet"), std::string::npos);
+  fs::remove(p);
+}
+
+TEST(SensorCalibration, CovarianceIsReadStrictly) {
+  eical::dsp::RunMeta meta;
+  const std::string head = "format = \"eical-sensor-cal/1\"\nmethod = \"psd\"\n[covariance]\n";
+  struct Case {
+    std::string body, cause;
+  };
+  for (const auto& c : {Case{"parameters = [\"table.E_xq\"]\nmatrix = [[1e-10]]\n", "unknown parameter 'table.E_xq'"},
+                        Case{"parameters = [\"table.E_xx\", \"table.E_xy\"]\nmatrix = [[1e-10, 2e-11], [0.0, 1e-10]]\n", "not symmetric"},
+                        Case{"parameters = [\"table.E_xx\", \"table.E_xy\"]\nmatrix = [[1e-10, 2e-10], [2e-10, 1e-10]]\n", "positive semi-definite"},
+                        Case{"parameters = [\"table.E_xx\", \"table.E_xx\"]\nmatrix = [[1e-10, 0.0], [0.0, 1e-10]]\n", "listed twice"},
+                        Case{"parameters = [\"table.E_xx\"]\nmatrix = [[1e-10]]\npsd_offset = 0.1\n", "psd_offset"}}) {
+    const fs::path p = temp_file("strict");
+    write_text(p, head + c.body);
+    try {
+      (void)eical::drivers::read_sensor_calibration(p, meta);
+      ADD_FAILURE() << "accepted: " << c.body;
+    } catch (const eical::dsp::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.cause), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("covariance"), std::string::npos) << e.what();
+    }
+    fs::remove(p);
+  }
+}
+
+}  // namespace

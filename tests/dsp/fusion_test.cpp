@@ -3,6 +3,7 @@
 // update, and the RTS smoother against the batch posterior of the whole trajectory
 // (Gaussian conditioning of the stacked states) — they must agree to rounding.
 #include "dsp/fusion/axis_filter.hpp"
+#include "dsp/fusion/checkpointed_smoother.hpp"
 #include "dsp/fusion/error_model.hpp"
 #include "dsp/fusion/rts_smoother.hpp"
 
@@ -181,6 +182,66 @@ TEST(RtsSmoother, ForwardOnlyIsTheCausalFilterAndNeverBetterThanTheSmoother) {
   EXPECT_EQ(f.dx_um[100][0], 0.0);  // before the first standstill the filter knows nothing yet
   EXPECT_NE(s.dx_um[100][0], 0.0);  // the smoother carries the standstill's news back
   for (std::size_t k = 0; k < n; ++k) EXPECT_LE(s.sigma_x_um[k][0], f.sigma_x_um[k][0] + 1e-12);
+}
+
+// The checkpointed smoother recomputes each segment from its checkpoint: however the
+// measurement is split, every output is the same number (to the bit), across lost frames,
+// covariance resets, window means and fixes on the segment boundaries.
+TEST(CheckpointedSmoother, TheSplitIntoSegmentsChangesNoBit) {
+  ErrorModel m;
+  m.reset_after_rejections = 3;  // resets happen (a standstill the model does not expect)
+  const std::size_t n = 500;
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> g(0.0, 1.0);
+  SupportSchedule sch;
+  sch.flags.assign(n, 0);
+  sch.zupt_sigma_um_s.assign(n, 0.0F);
+  for (std::size_t k = 0; k < 40; ++k) sch.flags[k] = schedule_flag::rest;
+  sch.flags[40] |= schedule_flag::move_start;
+  for (std::size_t k = 100; k < 180; ++k) sch.flags[k] = nbs_flag(2);
+  for (std::size_t k = 250; k < 330; ++k) sch.flags[k] = schedule_flag::rest, sch.zupt_sigma_um_s[k] = k < 280 ? -1.0F : 0.0F;
+  sch.flags[260] |= schedule_flag::invalid;
+  for (std::size_t k = 450; k < n; ++k) sch.flags[k] = schedule_flag::rest;
+  for (std::size_t k : {63u, 64u, 128u, 255u, 256u, 400u}) sch.fixes.push_back({k, static_cast<int>(k % 3), g(rng) * 5.0, 0.3});
+  sch.velocity_means.push_back({264, {1.0, -2.0, 0.5}, 3.0, 0.01});
+  sch.velocity_means.push_back({256, {0.5, 0.2, -0.1}, 3.0, 0.01});
+  std::vector<Eigen::Vector3d> vel(n), pos(n);
+  std::vector<std::int64_t> idx(n);
+  std::int64_t t = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    vel[k] = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.05 + Eigen::Vector3d::Constant(k > 450 ? 0.2 : 0.0);  // a bias jump at the end
+    pos[k] = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.01;
+    t += (k == 64 || k == 300) ? 3 : 1;  // lost frames, one on a boundary of the 64-sample split
+    idx[k] = t;
+  }
+  const SmootherTrack track = smoother_track(idx, vel, pos, sch);
+  for (const bool forward_only : {false, true}) {
+    SmootherSettings st;
+    st.fs_hz = 1000.0, st.model = m, st.forward_only = forward_only;
+    const CheckpointedSmoother whole(track, st, n);
+    ASSERT_EQ(whole.segments(), 1u);
+    SmoothedSegment ref;
+    whole.segment(0, ref, true);
+    EXPECT_GT(whole.resets(), 0u);
+    for (const std::size_t split : {1u, 7u, 64u, 256u}) {
+      const CheckpointedSmoother parts(track, st, split);
+      EXPECT_EQ(parts.resets(), whole.resets());
+      EXPECT_EQ(parts.finite(), whole.finite());
+      for (int a = 0; a < 3; ++a)
+        for (int s = 0; s < kSupportKinds; ++s) EXPECT_EQ(parts.tally()[a][s].accepted, whole.tally()[a][s].accepted);
+      SmoothedSegment seg;
+      for (std::size_t j = parts.segments(); j-- > 0;) {  // any order
+        parts.segment(j, seg, true);
+        for (std::size_t i = 0; i < seg.size(); ++i) {
+          const std::size_t k = seg.first + i;
+          ASSERT_EQ(seg.dx_um[i], ref.dx_um[k]) << "split " << split << " sample " << k;
+          ASSERT_EQ(seg.dv_um_s[i], ref.dv_um_s[k]);
+          ASSERT_EQ(seg.sigma_x_um[i], ref.sigma_x_um[k]);
+          for (int a = 0; a < 3; ++a) ASSERT_EQ(seg.gain[a][i], ref.gain[a][k]) << "split " << split << " sample " << k;
+        }
+      }
+    }
+  }
 }
 
 TEST(RtsSmoother, MismatchedLengthsAreAnError) {

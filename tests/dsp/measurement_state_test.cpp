@@ -64,14 +64,17 @@ TEST(MeasurementState, AbortDiscardsMeasurement) {
   EXPECT_EQ(t.action, Action::discard);
 }
 
-TEST(MeasurementState, RestartedProgramStartsOver) {
+TEST(MeasurementState, M101DuringAMeasurementIsRefusedAndItContinues) {
   MeasurementState m;
   m.handle(Event::program_start);
   m.handle(Event::segment_mark);
   auto t = m.handle(Event::program_start);
-  EXPECT_EQ(t.action, Action::start_measurement);
-  EXPECT_EQ(m.segments(), 0u);
-  EXPECT_FALSE(t.message.empty());
+  EXPECT_FALSE(t.accepted);
+  EXPECT_EQ(t.action, Action::none);
+  EXPECT_EQ(m.state(), State::measuring);
+  EXPECT_EQ(m.segments(), 1u) << "the running measurement keeps its segments";
+  EXPECT_NE(t.message.find("continues untouched"), std::string::npos) << t.message;
+  EXPECT_EQ(m.handle(Event::program_end).to, State::evaluating);
 }
 
 }  // namespace eical::dsp

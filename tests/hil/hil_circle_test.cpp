@@ -113,8 +113,10 @@ TEST(Hil, DdsTriggeredCircleResultEqualsAnalyzeOfTheRecording) {
   EXPECT_EQ(dds_json["circle"]["revolutions"], 2);
   const fs::path run = hc.recording_dir / result->program_id;
   ASSERT_TRUE(fs::exists(run / "run.toml")) << run;
-  const auto analyzed = run_capture({EICAL_CLI, "analyze", run.string(), "--json"}, 120s, &rc);
-  ASSERT_TRUE(analyzed && rc == 0) << "eical analyze failed";
+  // --no-suggest: the daemon's result carries no simulated variants; the exit status is the
+  // verdict's (0 ok, 2 degraded, 3 not measurable; 1 would be an error).
+  const auto analyzed = run_capture({EICAL_CLI, "analyze", run.string(), "--json", "--no-suggest"}, 120s, &rc);
+  ASSERT_TRUE(analyzed && (rc == 0 || rc == 2 || rc == 3)) << "eical analyze failed with " << rc;
   int differences = 0;
   expect_same(dds_json, nlohmann::json::parse(*analyzed), "", differences);
   EXPECT_EQ(differences, 0);

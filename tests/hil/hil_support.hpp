@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -76,16 +77,21 @@ class NcOnBus {
     return false;
   }
 
-  // Sends M`code` due at `time_ns` (CLOCK_MONOTONIC); true when eicald accepted it.
-  bool trigger(int code, std::int64_t time_ns) {
+  // Sends M`code` (P word `p`) due at `time_ns` (CLOCK_MONOTONIC); eicald's Reply.
+  std::optional<drivers::dds::ReplyMsg> trigger_reply(int code, std::int64_t time_ns, double p = std::nan("")) {
     drivers::dds::CommandMsg c;
     c.sender = sender_;
     c.request_id = ++id_;
     c.action = "trigger";
     c.code = code;
+    c.p = p;
     c.time_ns = time_ns;
-    if (!bus_.send(c)) return false;
-    const auto r = reply_for(c.request_id, 3000ms);
+    if (!bus_.send(c)) return std::nullopt;
+    return reply_for(c.request_id, 3000ms);
+  }
+  // True when eicald accepted it.
+  bool trigger(int code, std::int64_t time_ns, double p = std::nan("")) {
+    const auto r = trigger_reply(code, time_ns, p);
     return r && r->ok;
   }
 

@@ -62,7 +62,8 @@ double number(const nlohmann::json& j, const char* section, const char* key) {
 fs::path analyze(const ProgramOutcome& o, const fs::path& file) {
   int rc = -1;
   const auto out = run_capture({EICAL_CLI, "analyze", o.run_dir.string(), "--json"}, 120s, &rc);
-  EXPECT_TRUE(out && rc == 0) << "eical analyze " << o.run_dir;
+  // Exit status: the verdict's (0 ok, 2 degraded, 3 not measurable); 1 is an error.
+  EXPECT_TRUE(out && (rc == 0 || rc == 2 || rc == 3)) << "eical analyze " << o.run_dir << " exited " << rc;
   std::ofstream(file) << out.value_or("");
   return file;
 }
@@ -80,12 +81,10 @@ TEST(LinuxcncClosedLoop, CompensationFromEicalCompDropsIso230_2AandBandTheCircle
   const fs::path pos0_json = analyze(pos0, work / "pos-before.json"), circ0_json = analyze(circ0, work / "circle-before.json");
 
   // eical comp: LinuxCNC files merged into the machine's INI.
-  // TODO(uncertainty): --allow-unresolved only until branch `uncertainty` (issue 16) adds
-  // uncertainty_k2 to eical analyze's result: drop the flag then, the figures here are far
-  // above their uncertainty.
+  // No --allow-unresolved: the figures compensated here are far above their uncertainty.
   int rc = -1;
   const auto comp_out = run_capture({EICAL_CLI, "comp", pos0_json.string(), circ0_json.string(), "-o", (work / "comp").string(), "--merge-ini",
-                                     (work / "machine" / "eical-sim3.ini").string(), "--allow-unresolved"},
+                                     (work / "machine" / "eical-sim3.ini").string()},
                                     60s, &rc);
   ASSERT_TRUE(comp_out && rc == 0) << "eical comp failed:\n" << comp_out.value_or("");
   std::printf("%s", comp_out->c_str());

@@ -50,8 +50,8 @@ TEST(ServoStream, ParsesTheKitsLinesAndNamesWhatIsWrong) {
   EXPECT_NE(err.find("sample number"), std::string::npos) << err;
 }
 
-TEST(ServoClock, TheFreshestLineOfABurstSetsTheOffset) {
-  ServoClock c(1e-3, 100);
+TEST(SampleClock, TheFreshestLineOfABurstSetsTheOffset) {
+  SampleClock c(1e-3, 100);
   // Lines of cycles 0..9 all arrive together at 10.2 ms (a halsampler burst).
   for (int k = 0; k < 10; ++k) c.observe(k, 10'200'000);
   EXPECT_EQ(c.time_ns(9), 10'200'000);

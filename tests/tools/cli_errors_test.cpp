@@ -60,7 +60,55 @@ class CliErrors : public ::testing::Test {
   fs::path dir_;
 };
 
-TEST_F(CliErrors, GoodRunAnalyzesWithExitZero) { EXPECT_EQ(eical("analyze " + run()).exit_code, 0); }
+// A good run: the exit status is its verdict's (0 ok, 2 degraded, 3 not measurable), the
+// same the JSON says; never 1, which means an error.
+TEST_F(CliErrors, GoodRunExitsWithItsVerdict) {
+  const Outcome o = eical("analyze --no-suggest " + run());
+  EXPECT_NE(o.output.find(""), std::string::npos);
+  std::string cmd = EICAL_CLI;
+  cmd.append(" analyze --no-suggest --json ").append(run()).append(" 2>/dev/null");
+  FILE* p = ::popen(cmd.c_str(), "r");
+  std::string doc;
+  char buf[4096];
+  while (p && std::fgets(buf, sizeof buf, p)) doc += buf;
+  const int status = p ? ::pclose(p) : -1;
+  const auto at = doc.find("\"verdict\": \"");
+  ASSERT_NE(at, std::string::npos) << doc.substr(0, 400);
+  const std::string verdict = doc.substr(at + 12, doc.find('"', at + 12) - at - 12);
+  const int expected = verdict == "ok" ? 0 : verdict == "degraded" ? 2 : verdict == "not_measurable" ? 3 : -1;
+  ASSERT_NE(expected, -1) << verdict;
+  EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, expected);
+  EXPECT_EQ(o.exit_code, expected);
+}
+
+// The one place CLI11's errors become an exit status: a usage error is an error, exit 1,
+// one line (CLI11's own codes 105, 106, 109 never leak).
+TEST_F(CliErrors, UsageErrorsExitOneWithOneLine) {
+  expect_one_line_error(eical("analyze"), "run is required");
+  expect_one_line_error(eical("analyze " + run() + " --dynamic sideways"), "--dynamic");
+  expect_one_line_error(eical("analyze " + run() + " --no-such-option"), "--no-such-option");
+  expect_one_line_error(eical("no-such-command"), "no-such-command");
+  expect_one_line_error(eical("simulate --radius -3 -o x"), "--radius");
+}
+
+TEST_F(CliErrors, HelpWorks) {
+  std::string cmd = EICAL_CLI;
+  for (const char* args : {" help", " help analyze", " --help", " analyze --help"}) {
+    FILE* p = ::popen((cmd + args + " 2>&1").c_str(), "r");
+    std::string out;
+    char buf[512];
+    while (p && std::fgets(buf, sizeof buf, p)) out += buf;
+    const int status = p ? ::pclose(p) : -1;
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << args << ": " << out;
+    if (std::string(args).find("analyze") != std::string::npos) {
+      EXPECT_NE(out.find("--calibration"), std::string::npos) << args << ": " << out;
+    } else {  // the command list: every command, not the help of `help`
+      for (const char* c : {"simulate", "analyze", "plan", "identify", "report", "comp", "help"})
+        EXPECT_NE(out.find(std::string("  ") + c + " "), std::string::npos) << args << " does not list " << c << ": " << out;
+    }
+  }
+  expect_one_line_error(eical("help no-such-command"), "no command 'no-such-command'");
+}
 
 TEST_F(CliErrors, MissingRun) { expect_one_line_error(eical("analyze " + (dir_ / "nope").string()), "not a run directory"); }
 

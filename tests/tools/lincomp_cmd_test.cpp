@@ -52,6 +52,21 @@ TEST(LinCompCmd, WritesLinuxCncAndCsvTables) {
   while (std::getline(csv, line)) last = line;
   EXPECT_EQ(last, "200.0000,4.0000,-4.0000,-4.0000,-4.0000");
   EXPECT_TRUE(fs::exists(t.dir / "x.csv"));
+  // A second run does not replace the tables without --force, and writes neither file.
+  const auto before = fs::last_write_time(t.dir / "x.comp");
+  try {
+    run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "25", "--linuxcnc", (t.dir / "x.comp").string(), "--csv",
+             (t.dir / "x.csv").string()});
+    FAIL() << "overwrote x.comp without --force";
+  } catch (const eical::dsp::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(fs::last_write_time(t.dir / "x.comp"), before);
+  run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "25", "--linuxcnc", (t.dir / "x.comp").string(), "--force"});
+  std::ifstream again(t.dir / "x.comp");
+  std::size_t n_rows = 0;
+  while (again >> n >> f >> r) ++n_rows;
+  EXPECT_EQ(n_rows, 9u);  // 0, 25, ..., 200
 }
 
 TEST(LinCompCmd, ACurveThatDoesNotCoverTheTravelWritesNothing) {

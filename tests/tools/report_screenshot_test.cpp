@@ -17,7 +17,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <random>
+#include <fstream>
 #include <set>
+#include <sstream>
 
 namespace eical {
 namespace {
@@ -120,7 +122,11 @@ TEST(ReportScreenshot, CircleReportRendersWithPolarPlotAndDiagnostics) {
   EXPECT_GT(s.red, 200u) << "no clockwise trace visible";
   expect_contains(r.dom, "Circular test report");
   expect_contains(r.dom, "Circular test (ISO 230-4)");
-  expect_contains(r.dom, "Diagnostics (per axis)");
+  expect_contains(r.dom, "Diagnostics (per axis");
+  expect_contains(r.dom, "Verdict:");
+  expect_contains(r.dom, "start of a revolution");
+  expect_contains(r.dom, "G ccw");
+  expect_contains(r.dom, "± ");
   expect_contains(r.dom, "Radius deviation, xy plane");
   expect_contains(r.dom, "sim-circle-r10-f2500-s1");
   expect_contains(r.dom, "Circular hysteresis H");
@@ -155,6 +161,40 @@ TEST(ReportScreenshot, StepReportShowsTimePlots) {
   fs::remove_all(r.dir);
 }
 
+// The print stylesheet: Chromium prints the circle report to PDF on A4 pages (595 × 842 pt).
+TEST(ReportScreenshot, CircleReportPrintsToA4Pdf) {
+  const std::string chromium = find_chromium();
+  ASSERT_FALSE(chromium.empty()) << "chromium not found in PATH: install it with scripts/deps.sh test";
+  const fs::path dir = fs::temp_directory_path() / ("eical-report-pdf-" + std::to_string(std::random_device{}()));
+  const dsp::Run run = sim::simulate(sim::circle_scenario(10.0, 2500.0, 1, "both"));
+  const dsp::Analysis a = dsp::analyze_run(run);
+  const fs::path html = fs::absolute(tools::report::write_run_report(run, a, dir / "report"));
+  const fs::path pdf = dir / "report.pdf";
+  int st = 0;
+  (void)run_capture(chromium_cmd(chromium, dir / "profile-pdf", "--no-pdf-header-footer --print-to-pdf=" + pdf.string(), html), st);
+  EXPECT_EQ(st, 0) << "chromium --print-to-pdf failed";
+  ASSERT_TRUE(fs::exists(pdf));
+  std::ifstream is(pdf, std::ios::binary);
+  const std::string bytes{std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
+  ASSERT_EQ(bytes.rfind("%PDF-", 0), 0u) << "not a PDF";
+  // Pages and their size: every /MediaBox is A4 (595.28 × 841.89 pt, Chromium rounds).
+  std::size_t pages = 0, a4 = 0;
+  for (std::size_t at = bytes.find("/MediaBox"); at != std::string::npos; at = bytes.find("/MediaBox", at + 1)) {
+    ++pages;
+    const auto open = bytes.find('[', at), close = bytes.find(']', at);
+    std::istringstream box(bytes.substr(open + 1, close - open - 1));
+    double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    box >> x0 >> y0 >> x1 >> y1;
+    if (std::abs(x1 - x0 - 595.3) < 2.0 && std::abs(y1 - y0 - 841.9) < 2.0) ++a4;
+  }
+  std::printf("report.pdf: %zu bytes, %zu pages, %zu of them A4\n", bytes.size(), pages, a4);
+  EXPECT_GE(pages, 1u);
+  EXPECT_LE(pages, 6u) << "the print layout spreads one test over too many pages";
+  EXPECT_EQ(a4, pages);
+  if (const char* keep = std::getenv("EICAL_SCREENSHOT_DIR")) fs::copy_file(pdf, fs::path(keep) / "report-circle.pdf", fs::copy_options::overwrite_existing);
+  fs::remove_all(dir);
+}
+
 TEST(ReportScreenshot, RectangleAndFreeFormReportsShowThePathAndItsDeviation) {
   for (const auto& [sc, tag] : {std::pair{sim::rectangle_scenario(20.0, 10.0, 1500.0, "xy", 1, 1), std::string("rectangle")},
                                 std::pair{tools::freeform_scenario(1500.0, 1), std::string("freeform")}}) {
@@ -168,7 +208,7 @@ TEST(ReportScreenshot, RectangleAndFreeFormReportsShowThePathAndItsDeviation) {
     expect_contains(r.dom, "Deviation along the path");
     expect_contains(r.dom, "path length (mm)");
     expect_contains(r.dom, "Contour error (max)");
-    if (tag == "rectangle") expect_contains(r.dom, "Corners (in the order visited)");
+    if (tag == "rectangle") expect_contains(r.dom, "Corners (in the order visited");
     else expect_contains(r.dom, "Free-form contour report");
     fs::remove_all(r.dir);
   }

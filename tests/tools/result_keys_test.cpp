@@ -8,6 +8,7 @@
 #include "tools/sim_programs.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -54,8 +55,37 @@ bool flag_explains(const json& doc, const std::string& object, const std::string
   return false;
 }
 
+// Settings and choices among candidates: numbers that are not figures (no uncertainty).
+bool is_setting(const std::string& key) {
+  for (const char* k : {"radius_nominal_mm", "feed_mm_min", "arc_deg", "arc_start_deg", "revolutions", "runs", "cyclic_pitch_mm",
+                        "smallest_step_resolved_um", "path_length_mm"})
+    if (key == k) return true;
+  return false;
+}
+
+// Every numeric figure of the program's objects has its expanded uncertainty, keyed
+// <object>.<key> (results.md), a number — or null with the reason in uncertainty.method.
+void check_uncertainty(const json& doc, const std::string& obj, const json& o, const std::string& prefix) {
+  for (const auto& [key, value] : o.items()) {
+    if (value.is_object() && key != "trace") check_uncertainty(doc, obj, value, prefix + key + ".");
+    if (!value.is_number() || is_setting(key)) continue;
+    const std::string k = obj + "." + prefix + key;
+    ASSERT_TRUE(doc["uncertainty_k2"].contains(k)) << k << " has no uncertainty_k2 entry";
+    EXPECT_TRUE(doc["uncertainty_k2"][k].is_number()) << k << ": " << doc["uncertainty_k2"][k].dump();
+    if (doc["uncertainty_k2"][k].is_number()) {
+      EXPECT_GE(doc["uncertainty_k2"][k].get<double>(), 0.0) << k;
+    }
+  }
+}
+
 void check_document(const json& doc, const std::string& kind) {
   SCOPED_TRACE(kind);
+  const std::string verdict = doc.at("quality").at("verdict").get<std::string>();
+  EXPECT_TRUE(verdict == "ok" || verdict == "degraded" || verdict == "not_measurable") << verdict;
+  EXPECT_TRUE(doc.at("quality").at("verdict_reasons").is_array());
+  EXPECT_EQ(doc.at("quality").at("flag_severity").size(), doc.at("quality").at("flags").size());
+  ASSERT_TRUE(doc.at("uncertainty_k2").is_object());
+  EXPECT_EQ(doc.at("uncertainty").at("coverage_factor"), 2);
   EXPECT_EQ(doc.at("format"), "eical-result/1");
   EXPECT_TRUE(doc.at("run_id").is_string());
   EXPECT_EQ(doc.at("program"), kind);
@@ -71,6 +101,7 @@ void check_document(const json& doc, const std::string& kind) {
         EXPECT_TRUE(o.contains(key)) << obj << "." << key << " missing";
       }
     }
+    if (obj != "freeform" || !o.value("contour_error_max_um", json()).is_null()) check_uncertainty(doc, obj, o, "");
     for (const auto& [key, value] : o.items()) {
       if (value.is_number()) {
         EXPECT_TRUE(has_unit(key)) << obj << "." << key << " is a number without a unit in its name";
@@ -123,6 +154,12 @@ TEST(ResultKeys, Positioning) {
   const json doc = analysed(sim::positioning_scenario({0.0, 10.0, 20.0}, 2));
   check_document(doc, "positioning");
   EXPECT_EQ(doc["positioning"]["deviation_um"]["up"].size(), 2u);
+  // Fewer than 5 runs: evaluated, and said to be outside ISO 230-2.
+  EXPECT_FALSE(doc["positioning"]["within_standard"].get<bool>());
+  bool flagged = false;
+  for (const auto& f : doc["quality"]["flags"]) flagged |= f.get<std::string>().find("outside the standard") != std::string::npos;
+  EXPECT_TRUE(flagged);
+  EXPECT_EQ(doc["uncertainty_k2"]["positioning.per_target.mean_um"].size(), 3u);
   EXPECT_EQ(doc["positioning"]["deviation_um"]["up"][0].size(), 3u);
 }
 
@@ -141,6 +178,9 @@ TEST(ResultKeys, Rectangle) {
   EXPECT_NEAR(doc["rectangle"]["corners_mm"][1][0].get<double>(), 20.0, 1e-6);
   EXPECT_NEAR(doc["rectangle"]["corners_mm"][1][1].get<double>(), 10.0, 1e-6);
   EXPECT_TRUE(doc["rectangle"]["path_deviation"]["contour_error_max_um"].is_number());
+  // Arrays keep their figure's shape in uncertainty_k2: a pair per corner.
+  ASSERT_EQ(doc["uncertainty_k2"]["rectangle.corner_errors_um"].size(), 4u);
+  EXPECT_EQ(doc["uncertainty_k2"]["rectangle.corner_errors_um"][0].size(), 2u);
 }
 
 TEST(ResultKeys, FreeForm) {
@@ -159,9 +199,12 @@ TEST(ResultKeys, AnalyzeCommandPrintsTheDocument) {
   std::string out;
   char buf[4096];
   while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
-  EXPECT_EQ(pclose(p), 0);
+  const int status = pclose(p);
   const json doc = json::parse(out);
   check_document(doc, "step");
+  // The exit status is the verdict's (README "Exit status").
+  const std::string verdict = doc["quality"]["verdict"];
+  EXPECT_EQ(WEXITSTATUS(status), verdict == "ok" ? 0 : verdict == "degraded" ? 2 : 3) << verdict;
   std::filesystem::remove_all(dir);
 }
 

@@ -99,6 +99,7 @@ Analysed analyse(const sim::Scenario& sc, const Report& rep) {
     for (int s = 0; s < 2; ++s) r.run.meta.sensors[s] = sc.truth[s].spec;
   dsp::AnalysisOptions o;
   o.keep_raw = true;
+  o.uncertainty.enabled = false;  // the campaign's own bound is the point here
   if (rep.calibrated || rep.oracle) o.sensor_model = rep.oracle ? "oracle" : "psd";
   r.a = dsp::analyze_run(r.run, o);
   const auto& m = r.a.measurement;

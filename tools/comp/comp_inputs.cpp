@@ -4,6 +4,7 @@
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/uncertainty/resolved.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -57,7 +58,8 @@ CompInput load_comp_input(const std::string& path) {
   return in;
 }
 
-bool Figure::resolved() const { return u_k2 && std::isfinite(*u_k2) && std::abs(value) > *u_k2; }
+// The one rule of dsp/uncertainty/resolved.hpp (also the reports' and analyze's "not resolved").
+bool Figure::resolved() const { return u_k2 && dsp::uncertainty::resolved(value, *u_k2); }
 
 std::string Figure::describe() const {
   std::string s = key + " = " + num(value) + (u_k2 ? " (U = " + num(*u_k2) + ", k = 2)" : " (no uncertainty)") + " in " + input;

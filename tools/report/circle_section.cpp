@@ -15,56 +15,76 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
   s.heading = partial ? "Circular test (ISO 230-4), " + fmt("%.0f", c.arc_deg) + "° partial arc" : "Circular test (ISO 230-4)";
   s.lead = "Radius deviation along the path, both directions where measured; plot magnified about the reference circle as "
            "on a ballbar plot.";
-  // One polyline per revolution (each has its own centre: joining them would draw a jump).
+  // One trace per revolution and direction, each its own colour, closed when it is a full
+  // revolution, a marker where it begins.
+  const FigureRows fr(a);
   std::vector<PolarTrace> polar;
   for (const char* dir : {"ccw", "cw"}) {
     const bool ccw = std::string(dir) == "ccw";
-    bool labelled = false;
     for (int rev = 0; rev <= c.revolutions; ++rev) {
       PolarTrace t;
-      t.color = ccw ? kBlue : kRed;
+      t.color = revolution_colour(ccw, rev);
       for (std::size_t i = 0; i < c.trace.angle_deg.size(); ++i)
         if (c.trace.direction[i] == dir && c.trace.revolution[i] == rev)
           t.angle_deg.push_back(c.trace.angle_deg[i]), t.deviation_um.push_back(c.trace.radius_deviation_um[i]);
       if (t.angle_deg.empty()) continue;
-      if (!labelled) t.label = ccw ? "counter-clockwise (G3)" : "clockwise (G2)", labelled = true;
+      t.label = std::string(ccw ? "ccw (G3)" : "cw (G2)") + (partial ? ", arc " : ", revolution ") + std::to_string(rev + 1);
+      t.closed = !partial;
+      t.start_marker = true;
       polar.push_back(std::move(t));
     }
   }
-  s.svgs.push_back(polar_plot(polar, "Radius deviation, " + p.plane + " plane", "+" + na, "+" + nb));
-  Table iso{"ISO 230-4 figures", {}};
+  std::string subtitle;
+  if (c.direction == "both") {
+    auto g = [&](const char* key) {
+      const auto v = fr.value(key), u = fr.u(key);
+      return v ? fmt("%.2f", *v) + (u ? " ± " + fmt("%.2f", *u) : "") + " µm" : std::string("n/a");
+    };
+    subtitle = "G ccw " + g("circle.circular_deviation_G_ccw_um") + ",  G cw " + g("circle.circular_deviation_G_cw_um");
+  } else {
+    subtitle = "G " + fmt("%.2f", c.circular_deviation_G_um) + (fr.u("circle.circular_deviation_G_um") ? " ± " + fmt("%.2f", *fr.u("circle.circular_deviation_G_um")) : "") + " µm, " +
+               (c.direction == "cw" ? "clockwise" : "counter-clockwise");
+  }
+  s.svgs.push_back(polar_plot(polar, "Radius deviation, " + p.plane + " plane", "+" + na, "+" + nb, 0.0, subtitle));
+  Table iso{"ISO 230-4 figures (± U, k = 2)", {}};
   iso.rows = {{"Nominal radius", p.radius_mm, "mm", 3, ""},
               {"Feed", p.feed_mm_min, "mm/min", 0, ""},
               {partial ? "Arcs evaluated" : "Revolutions evaluated", static_cast<double>(c.revolutions), "", 0,
                c.direction == "both" ? "both directions" : c.direction},
-              {"Mean radius deviation", c.radius_mean_deviation_um, "µm", 2, "measured − nominal"},
-              {"Circular deviation G", c.circular_deviation_G_um, "µm", 2, partial ? "about the programmed centre" : "about the LSQ centre"},
-              {"Circular hysteresis H", c.circular_hysteresis_H_um, "µm", 2, c.circular_hysteresis_H_um ? "max over 1° bins" : "needs both directions"},
-              {"Radial deviation F max", c.radial_deviation_F_max_um, "µm", 2, ""},
-              {"Radial deviation F min", c.radial_deviation_F_min_um, "µm", 2, ""}};
+              fr.row("circle.radius_mean_deviation_um", "Mean radius deviation", "µm", 2, "measured − nominal"),
+              fr.row("circle.circular_deviation_G_um", "Circular deviation G", "µm", 2, partial ? "about the programmed centre" : "about the LSQ centre")};
+  if (c.direction == "both") {
+    iso.rows.push_back(fr.row("circle.circular_deviation_G_ccw_um", "G, counter-clockwise", "µm", 2));
+    iso.rows.push_back(fr.row("circle.circular_deviation_G_cw_um", "G, clockwise", "µm", 2));
+  }
+  Figure h = fr.row("circle.circular_hysteresis_H_um", "Circular hysteresis H", "µm", 2, c.circular_hysteresis_H_um ? "max over 1° bins" : "needs both directions");
+  iso.rows.push_back(h);
+  iso.rows.push_back(fr.row("circle.radial_deviation_F_max_um", "Radial deviation F max", "µm", 2));
+  iso.rows.push_back(fr.row("circle.radial_deviation_F_min_um", "Radial deviation F min", "µm", 2));
   s.tables.push_back(iso);
   if (a.diagnostics) {
     const auto& d = *a.diagnostics;
     const bool sep = d.servo_and_squareness_separated;
-    Table dt{"Diagnostics (per axis)", {}};
-    dt.rows = {{"Backlash " + na, d.backlash_x_um, "µm", 2, ""},
-               {"Backlash " + nb, d.backlash_y_um, "µm", 2, ""},
-               {"Reversal spike " + na, d.reversal_spike_x_um, "µm", 2, ""},
-               {"Reversal spike " + nb, d.reversal_spike_y_um, "µm", 2, ""},
-               {"Lateral play " + na, d.lateral_play_x_um, "µm", 2, ""},
-               {"Lateral play " + nb, d.lateral_play_y_um, "µm", 2, ""},
-               {"Cyclic error " + na, d.cyclic_error_x_um, "µm", 2, "pitch " + fmt("%.1f mm", d.cyclic_pitch_mm)},
-               {"Cyclic error " + nb, d.cyclic_error_y_um, "µm", 2, ""},
-               {"Servo mismatch", sep ? std::optional<double>(d.servo_mismatch_ms) : std::nullopt, "ms", 3,
-                sep ? na + " lag − " + nb + " lag" : "needs both directions"},
-               {"Squareness", d.squareness_urad, "µrad", 1, "+: angle above 90°"},
-               {"Scale mismatch", d.scale_mismatch_ppm, "ppm", 1, na + " − " + nb},
-               {"Straightness " + na, d.straightness_x_um, "µm", 2, ""},
-               {"Straightness " + nb, d.straightness_y_um, "µm", 2, ""},
-               {"Stick-slip", d.stick_slip_um, "µm", 2, "tangential, fast"},
-               {"Vibration", d.vibration_um, "µm", 2, "radial, fast"}};
+    Table dt{"Diagnostics (per axis, ± U)", {}};
+    dt.rows = {fr.row("diagnostics.backlash_x_um", "Backlash " + na, "µm", 2),
+               fr.row("diagnostics.backlash_y_um", "Backlash " + nb, "µm", 2),
+               fr.row("diagnostics.reversal_spike_x_um", "Reversal spike " + na, "µm", 2),
+               fr.row("diagnostics.reversal_spike_y_um", "Reversal spike " + nb, "µm", 2),
+               fr.row("diagnostics.lateral_play_x_um", "Lateral play " + na, "µm", 2),
+               fr.row("diagnostics.lateral_play_y_um", "Lateral play " + nb, "µm", 2),
+               fr.row("diagnostics.cyclic_error_x_um", "Cyclic error " + na, "µm", 2, "pitch " + fmt("%.1f mm", d.cyclic_pitch_mm)),
+               fr.row("diagnostics.cyclic_error_y_um", "Cyclic error " + nb, "µm", 2),
+               fr.row("diagnostics.servo_mismatch_ms", "Servo mismatch", "ms", 3, sep ? na + " lag − " + nb + " lag" : "needs both directions"),
+               fr.row("diagnostics.squareness_urad", "Squareness", "µrad", 1, "+: angle above 90°"),
+               fr.row("diagnostics.scale_mismatch_ppm", "Scale mismatch", "ppm", 1, na + " − " + nb),
+               fr.row("diagnostics.straightness_x_um", "Straightness " + na, "µm", 2),
+               fr.row("diagnostics.straightness_y_um", "Straightness " + nb, "µm", 2),
+               fr.row("diagnostics.stick_slip_um", "Stick-slip", "µm", 2, "tangential, fast"),
+               fr.row("diagnostics.vibration_um", "Vibration", "µm", 2, "radial, fast")};
     s.tables.push_back(dt);
     for (const auto& n : d.notes) s.notes.push_back(n);
+    s.notes.push_back("A diagnostic whose magnitude is not above its uncertainty U is marked \"not resolved\": the measurement cannot tell it "
+                      "from zero, and eical comp never compensates it.");
   } else {
     s.notes.push_back(partial ? "Diagnostics: not evaluated on a partial arc (they need full revolutions)."
                               : "Diagnostics: could not be determined (see the flags above).");

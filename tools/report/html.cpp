@@ -46,15 +46,78 @@ p.note{color:#3b4456;max-width:70em;font-size:13px;margin:10px 0 0}
 svg.plot{background:#fff;border:1px solid #e3e7ee;border-radius:4px}
 footer{color:#6b7385;font-size:12px;margin-top:10px}
 footer a{color:#1f5fbf}
+.flag{padding:6px 12px;margin:6px 0;font-size:13px;border-left:4px solid}
+.flag b{display:inline-block;min-width:5.5em;text-transform:uppercase;font-size:11px;letter-spacing:.06em}
+.flag.critical{background:#fdecea;border-color:#c0392b;color:#7b1d14}
+.flag.warning{background:#fff6e5;border-color:#e59400}
+.flag.note{background:#f1f3f6;border-color:#a8b0bd;color:#4a5366}
+.verdict{padding:10px 16px;margin:14px 0 6px;border-radius:6px;font-size:15px}
+.verdict b{font-size:16px;letter-spacing:.04em}
+.verdict ul{margin:4px 0 0;padding-left:20px;font-size:13px}
+.verdict.ok{background:#e8f5ee;border:1px solid #7cc49a}
+.verdict.degraded{background:#fff6e5;border:1px solid #e5b14d}
+.verdict.not_measurable{background:#fdecea;border:1px solid #d77a70}
+td.v .pm{font-weight:400;color:#5a6478}
+td.n .nr,.nr{color:#a35a00;font-style:italic}
+td.pass{color:#1e8449;font-weight:600;text-align:right}
+td.fail{color:#c0392b;font-weight:600;text-align:right}
+td.undecided{color:#a35a00;font-weight:600;text-align:right}
+@page{size:A4;margin:12mm 11mm}
+@media print{
+ body{background:#fff;font-size:9.5pt}
+ header{padding:10px 14px;-webkit-print-color-adjust:exact;print-color-adjust:exact}
+ .flag,.verdict,td.pass,td.fail{-webkit-print-color-adjust:exact;print-color-adjust:exact}
+ main{max-width:none;padding:0 2mm}
+ section{border:none;border-top:1px solid #c9d0db;border-radius:0;padding:8px 0;margin:8px 0;break-inside:auto}
+ .row{display:block}
+ .plots{display:block}
+ svg.plot{max-width:100%;height:auto;break-inside:avoid;border:none}
+ table{break-inside:avoid;font-size:9pt}
+ .tables{min-width:0}
+ h2{break-after:avoid}
+ footer a{color:#1d2330;text-decoration:none}
+}
 )";
 
 std::string format_value(const Figure& f) {
   if (!f.value || !std::isfinite(*f.value)) return "<span class=\"na\">n/a</span>";
-  char buf[64];
+  char buf[96];
   // No "-0.00": a value that rounds to zero is shown as zero.
   const double v = std::abs(*f.value) < 0.5 * std::pow(10.0, -f.decimals) ? 0.0 : *f.value;
   std::snprintf(buf, sizeof buf, "%.*f", f.decimals, v);
-  return buf;
+  std::string out = buf;
+  if (f.u && std::isfinite(*f.u)) {
+    std::snprintf(buf, sizeof buf, " <span class=\"pm\">± %.*f</span>", f.decimals, *f.u);
+    out += buf;
+  }
+  return out;
+}
+
+bool not_resolved(const Figure& f) { return f.value && f.u && std::isfinite(*f.value) && std::isfinite(*f.u) && !(std::abs(*f.value) > *f.u); }
+
+std::string cell_class(const std::string& text) {
+  if (text == "pass" || text == "fail" || text == "undecided") return text;
+  return "c";
+}
+
+const char* verdict_word(const std::string& v) {
+  if (v == "not_measurable") return "NOT MEASURABLE";
+  if (v == "degraded") return "DEGRADED";
+  return "OK";
+}
+
+std::string grid_html(const Grid& g) {
+  std::string out = "<table style=\"margin-top:14px\">";
+  if (!g.caption.empty()) out += "<caption>" + xml_escape(g.caption) + "</caption>";
+  out += "<tr>";
+  for (const auto& h : g.header) out += "<th>" + xml_escape(h) + "</th>";
+  out += "</tr>\n";
+  for (const auto& r : g.rows) {
+    out += "<tr>";
+    for (std::size_t i = 0; i < r.size(); ++i) out += (i ? "<td class=\"" + cell_class(r[i]) + "\">" : "<td>") + xml_escape(r[i]) + "</td>";
+    out += "</tr>\n";
+  }
+  return out + "</table>\n";
 }
 
 }  // namespace
@@ -72,6 +135,19 @@ std::string render_html(const Page& page) {
     out += "</dl>\n";
   }
   out += "</header>\n<main>\n";
+  if (!page.verdict.empty()) {
+    out += "<div class=\"verdict " + xml_escape(page.verdict) + "\">Verdict: <b>" + verdict_word(page.verdict) + "</b>";
+    if (!page.verdict_reasons.empty()) {
+      out += "<ul>";
+      for (const auto& r : page.verdict_reasons) out += "<li>" + xml_escape(r) + "</li>";
+      out += "</ul>";
+    }
+    out += "</div>\n";
+  }
+  for (const auto& g : page.summary) out += "<section>" + grid_html(g) + "</section>\n";
+  for (const char* sev : {"critical", "warning", "note"})
+    for (const auto& f : page.flags)
+      if (f.severity == sev) out += std::string("<div class=\"flag ") + sev + "\"><b>" + sev + "</b> " + xml_escape(f.text) + "</div>\n";
   for (const auto& w : page.warnings) out += "<div class=\"warn\">" + xml_escape(w) + "</div>\n";
   for (const auto& s : page.sections) {
     out += "<section><h2>" + xml_escape(s.heading) + "</h2>\n";
@@ -89,25 +165,14 @@ std::string render_html(const Page& page) {
         if (!t.caption.empty()) out += "<caption>" + xml_escape(t.caption) + "</caption>";
         for (const auto& f : t.rows)
           out += "<tr><td>" + xml_escape(f.label) + "</td><td class=\"v\">" + format_value(f) + "</td><td class=\"u\">" +
-                 xml_escape(f.unit) + "</td><td class=\"n\">" + xml_escape(f.note) + "</td></tr>\n";
+                 xml_escape(f.unit) + "</td><td class=\"n\">" + (not_resolved(f) ? "<span class=\"nr\">not resolved</span>" + std::string(f.note.empty() ? "" : "; ") : "") +
+                 xml_escape(f.note) + "</td></tr>\n";
         out += "</table>\n";
       }
       out += "</div>\n";
     }
     out += "</div>\n";
-    for (const auto& g : s.grids) {
-      out += "<table style=\"margin-top:14px\">";
-      if (!g.caption.empty()) out += "<caption>" + xml_escape(g.caption) + "</caption>";
-      out += "<tr>";
-      for (const auto& h : g.header) out += "<th>" + xml_escape(h) + "</th>";
-      out += "</tr>\n";
-      for (const auto& r : g.rows) {
-        out += "<tr>";
-        for (std::size_t i = 0; i < r.size(); ++i) out += (i ? "<td class=\"c\">" : "<td>") + xml_escape(r[i]) + "</td>";
-        out += "</tr>\n";
-      }
-      out += "</table>\n";
-    }
+    for (const auto& g : s.grids) out += grid_html(g);
     for (const auto& n : s.notes) out += "<p class=\"note\">" + xml_escape(n) + "</p>\n";
     out += "</section>\n";
   }
@@ -115,7 +180,9 @@ std::string render_html(const Page& page) {
     out += "<footer>Every trace behind the plots, as CSV: ";
     for (std::size_t i = 0; i < page.files.size(); ++i)
       out += std::string(i ? ", " : "") + "<a href=\"" + xml_escape(page.files[i]) + "\">" + xml_escape(page.files[i]) + "</a>";
-    out += ". Machine-readable figures: <a href=\"result.json\">result.json</a> (eical-result/1).</footer>\n";
+    out += ". Machine-readable figures: <a href=\"result.json\">result.json</a> (eical-result/1).";
+    if (!page.files_note.empty()) out += " " + xml_escape(page.files_note);
+    out += "</footer>\n";
   }
   out += "</main></body></html>\n";
   return out;

@@ -39,10 +39,12 @@ void path_plots(const dsp::Analysis& a, int ia, int ib, const std::string& na, c
             {t, d.arc_length_mm, d.normal_um, d.normal_magnitude_um, d.tangential_um});
 }
 
-Table path_table(const dsp::eval::PathDeviation& d) {
-  return {"Contour deviation", {{"Contour error (max)", d.contour_error_max_um, "µm", 2, "normal to the path"},
-                                {"Contour error (RMS)", d.contour_error_rms_um, "µm", 2, ""},
-                                {"Tangential deviation (RMS)", d.tangential_rms_um, "µm", 2, "lag along the path"},
+Table path_table(const dsp::Analysis& a, const std::string& prefix) {
+  const FigureRows fr(a);
+  const auto& d = *a.path;
+  return {"Contour deviation (± U, k = 2)", {fr.row(prefix + ".contour_error_max_um", "Contour error (max)", "µm", 2, "normal to the path"),
+                                fr.row(prefix + ".contour_error_rms_um", "Contour error (RMS)", "µm", 2),
+                                fr.row(prefix + ".tangential_rms_um", "Tangential deviation (RMS)", "µm", 2, "lag along the path"),
                                 {"Path length evaluated", d.arc_length_mm.empty() ? std::nullopt : std::optional<double>(d.arc_length_mm.back()), "mm", 1, ""}}};
 }
 
@@ -62,14 +64,17 @@ void rectangle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page,
       view.arrow_da_um.push_back(a.rectangle->corner_errors_um[k].x()), view.arrow_db_um.push_back(a.rectangle->corner_errors_um[k].y());
     }
   path_plots(a, ia, ib, na, nb, s, csv, "trace_rectangle_path.csv", view);
-  if (a.path) s.tables.push_back(path_table(*a.path));
+  if (a.path) s.tables.push_back(path_table(a, "rectangle.path_deviation"));
   if (a.rectangle) {
     const auto& r = *a.rectangle;
-    Grid g{"Corners (in the order visited)", {"stop", na + " (mm)", nb + " (mm)", "error " + na + " (µm)", "error " + nb + " (µm)"}, {}};
+    const FigureRows fr(a);
+    s.tables.push_back({"Rectangle (± U, k = 2)", {fr.row("rectangle.corner_error_max_um", "Largest corner error", "µm", 2, "|(error a, error b)|")}});
+    auto pm = [&](std::size_t i, double v) { return fmt("%.2f", v) + (fr.u("rectangle.corner_errors_um", i) ? " ± " + fmt("%.2f", *fr.u("rectangle.corner_errors_um", i)) : ""); };
+    Grid g{"Corners (in the order visited, ± U)", {"stop", na + " (mm)", nb + " (mm)", "error " + na + " (µm)", "error " + nb + " (µm)"}, {}};
     std::vector<double> ca, cb, ea, eb;
     for (std::size_t k = 0; k < r.corners_mm.size(); ++k) {
       g.rows.push_back({std::to_string(k + 1), fmt("%.3f", r.corners_mm[k].x()), fmt("%.3f", r.corners_mm[k].y()),
-                        fmt("%.2f", r.corner_errors_um[k].x()), fmt("%.2f", r.corner_errors_um[k].y())});
+                        pm(2 * k, r.corner_errors_um[k].x()), pm(2 * k + 1, r.corner_errors_um[k].y())});
       ca.push_back(r.corners_mm[k].x()), cb.push_back(r.corners_mm[k].y()), ea.push_back(r.corner_errors_um[k].x()), eb.push_back(r.corner_errors_um[k].y());
     }
     s.grids.push_back(g);
@@ -98,7 +103,7 @@ void freeform_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, 
   s.lead = "Deviation of the measured path from the set-point path, split into the part normal to the path (what the "
            "workpiece sees) and the part along it (lag).";
   path_plots(a, ia, ib, na, nb, s, csv, "trace_freeform.csv", {});
-  s.tables.push_back(path_table(*a.path));
+  s.tables.push_back(path_table(a, "freeform"));
   s.notes.push_back("Each measured point is matched to the closest point of the set-point polyline within ±0.2 s, so a path "
                     "that crosses itself is not matched to the wrong pass; points slower than 0.5 mm/s are left out.");
   page.sections.push_back(std::move(s));

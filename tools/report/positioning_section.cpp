@@ -32,30 +32,41 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
   LineSeries b{"reversal value B", kGreen, {}, {}};
   for (const auto& t : r.targets) b.x.push_back(t.target_mm), b.y.push_back(t.B_um);
   s.svgs.push_back(line_plot({b}, "Reversal value per target", "target position (mm)", "B (µm)", 680, 220));
-  Table t{"ISO 230-2 figures", {}};
-  t.rows = {{"Accuracy A", r.A_um, "µm", 2, "bidirectional"},
-            {"Accuracy A↑", r.A_up_um, "µm", 2, ""},
-            {"Accuracy A↓", r.A_down_um, "µm", 2, ""},
-            {"Systematic deviation E", r.E_um, "µm", 2, "bidirectional"},
-            {"Systematic deviation E↑", r.E_up_um, "µm", 2, ""},
-            {"Systematic deviation E↓", r.E_down_um, "µm", 2, ""},
-            {"Mean positional deviation M", r.M_um, "µm", 2, ""},
-            {"Repeatability R", r.R_um, "µm", 2, "bidirectional"},
-            {"Repeatability R↑", r.R_up_um, "µm", 2, ""},
-            {"Repeatability R↓", r.R_down_um, "µm", 2, ""},
-            {"Reversal value B", r.B_um, "µm", 2, "max |Bi|"},
-            {"Mean reversal value B̄", r.B_mean_um, "µm", 2, ""}};
+  const FigureRows fr(a);
+  const bool within = r.runs >= dsp::eval::kIso230_2Runs;
+  Table t{"ISO 230-2 figures (± U, k = 2)", {}};
+  t.rows = {fr.row("positioning.A_um", "Accuracy A", "µm", 2, "bidirectional"),
+            fr.row("positioning.A_up_um", "Accuracy A↑", "µm", 2),
+            fr.row("positioning.A_down_um", "Accuracy A↓", "µm", 2),
+            fr.row("positioning.E_um", "Systematic deviation E", "µm", 2, "bidirectional"),
+            fr.row("positioning.E_up_um", "Systematic deviation E↑", "µm", 2),
+            fr.row("positioning.E_down_um", "Systematic deviation E↓", "µm", 2),
+            fr.row("positioning.M_um", "Mean positional deviation M", "µm", 2),
+            fr.row("positioning.R_um", "Repeatability R", "µm", 2, "bidirectional"),
+            fr.row("positioning.R_up_um", "Repeatability R↑", "µm", 2),
+            fr.row("positioning.R_down_um", "Repeatability R↓", "µm", 2),
+            fr.row("positioning.B_um", "Reversal value B", "µm", 2, "max |Bi|"),
+            fr.row("positioning.B_mean_um", "Mean reversal value B̄", "µm", 2)};
   s.tables.push_back(t);
   Table v{"VDI/DGQ 3441", {}};
-  v.rows = {{"Positioning uncertainty P", r.vdi.P_um, "µm", 2, ""},
-            {"Position deviation Pa", r.vdi.Pa_um, "µm", 2, ""},
-            {"Reversal span U", r.vdi.U_um, "µm", 2, ""},
-            {"Position scatter Ps", r.vdi.Ps_um, "µm", 2, ""}};
+  v.rows = {fr.row("positioning.vdi3441.P_um", "Positioning uncertainty P", "µm", 2),
+            fr.row("positioning.vdi3441.Pa_um", "Position deviation Pa", "µm", 2),
+            fr.row("positioning.vdi3441.U_um", "Reversal span U", "µm", 2),
+            fr.row("positioning.vdi3441.Ps_um", "Position scatter Ps", "µm", 2)};
   s.tables.push_back(v);
-  Grid g{"Per target", {"target (mm)", "x̄↑ (µm)", "x̄↓ (µm)", "2s↑ (µm)", "2s↓ (µm)", "Bi (µm)", "Ri (µm)"}, {}};
-  for (const auto& tg : r.targets)
-    g.rows.push_back({fmt("%.3f", tg.target_mm), fmt("%.2f", tg.mean_up_um), fmt("%.2f", tg.mean_down_um), fmt("%.2f", 2 * tg.s_up_um),
-                      fmt("%.2f", 2 * tg.s_down_um), fmt("%.2f", tg.B_um), fmt("%.2f", tg.R_um)});
+  if (!within)
+    s.notes.push_back(std::to_string(r.runs) + " runs per target and direction: ISO 230-2 asks for " + std::to_string(dsp::eval::kIso230_2Runs) +
+                      ". The figures are evaluated by its formulas but are outside the standard (s from fewer runs is less certain).");
+  auto pm = [&](const char* key, std::size_t i) {
+    const auto val = fr.value(key, i), unc = fr.u(key, i);
+    return (val ? fmt("%.2f", *val) : std::string("n/a")) + (unc ? " ± " + fmt("%.2f", *unc) : "");
+  };
+  Grid g{"Per target (± U, k = 2)", {"target (mm)", "x̄↑ (µm)", "x̄↓ (µm)", "2s↑ (µm)", "2s↓ (µm)", "Bi (µm)", "Ri (µm)"}, {}};
+  for (std::size_t i = 0; i < r.targets.size(); ++i) {
+    const auto& tg = r.targets[i];
+    g.rows.push_back({fmt("%.3f", tg.target_mm), pm("positioning.per_target.mean_up_um", i), pm("positioning.per_target.mean_down_um", i), fmt("%.2f", 2 * tg.s_up_um),
+                      fmt("%.2f", 2 * tg.s_down_um), pm("positioning.per_target.B_um", i), pm("positioning.per_target.R_um", i)});
+  }
   s.grids.push_back(g);
   page.sections.push_back(std::move(s));
   std::vector<double> tg, run_no, dir, dev;

@@ -1,9 +1,13 @@
 #include "tools/report/run_report.hpp"
 
+#include "dsp/analysis/verdict.hpp"
+#include "drivers/results/software_version.hpp"
+
 #include "tools/report/html.hpp"
 #include "tools/report/sections.hpp"
 #include "tools/report/svg.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -30,8 +34,10 @@ void CsvFiles::write(const std::string& name, const std::vector<std::string>& he
   for (std::size_t c = 0; c < header.size(); ++c) os << (c ? "," : "") << header[c];
   os << "\n";
   const std::size_t n = cols.empty() ? 0 : cols[0].size();
+  const std::size_t q = (n + kMaxRows - 1) / kMaxRows;
+  thinned_ |= q > 1;
   char buf[32];
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n; i += std::max<std::size_t>(1, q)) {
     for (std::size_t c = 0; c < cols.size(); ++c) {
       std::snprintf(buf, sizeof buf, "%.6f", i < cols[c].size() ? cols[c][i] : 0.0);
       os << (c ? "," : "") << buf;
@@ -40,6 +46,25 @@ void CsvFiles::write(const std::string& name, const std::vector<std::string>& he
   }
   if (!os.flush()) throw std::runtime_error(file.string() + ": write failed");
   names_.push_back(name);
+}
+
+std::optional<double> FigureRows::value(const std::string& key, std::size_t i) const {
+  const dsp::FigureValue* f = dsp::find_figure(figs_, key);
+  if (!f || i >= f->values.size() || !std::isfinite(f->values[i])) return std::nullopt;
+  return f->values[i];
+}
+
+std::optional<double> FigureRows::u(const std::string& key, std::size_t i) const {
+  const auto it = a_.uncertainty_k2.find(key);
+  if (it == a_.uncertainty_k2.end() || i >= it->second.size() || !std::isfinite(it->second[i])) return std::nullopt;
+  return it->second[i];
+}
+
+Figure FigureRows::row(const std::string& key, std::string label, std::string unit, int decimals, std::string note, double scale) const {
+  Figure f{std::move(label), value(key), std::move(unit), decimals, std::move(note), u(key)};
+  if (f.value) *f.value *= scale;
+  if (f.u) *f.u *= scale;
+  return f;
 }
 
 namespace {
@@ -84,8 +109,13 @@ void measurement_section(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
                                    {"Velocity error removed by ZUPT, x", m.zupt_velocity_error_mm_s.x() * 1000.0, "µm/s", 2, ""},
                                    {"Velocity error removed by ZUPT, y", m.zupt_velocity_error_mm_s.y() * 1000.0, "µm/s", 2, ""},
                                    {"Velocity error removed by ZUPT, z", m.zupt_velocity_error_mm_s.z() * 1000.0, "µm/s", 2, ""}}});
-  p.notes.push_back("Pipeline: data-sheet static compensation, rest-window bias, trapezoid double integration, two-stage "
-                    "dynamic compensation (6-38) including the DAQ group delay, ZUPT at the standstills.");
+  p.notes.push_back("Pipeline: " + std::string(a.sensor_model == "datasheet" ? "data-sheet" : "calibrated (" + a.sensor_model + ")") +
+                    " static compensation, rest-window bias, trapezoid double integration, " + (a.dynamic == dsp::DynamicComp::none ? "no" : "two-stage") +
+                    " dynamic compensation (6-38) and the DAQ group delay, ZUPT at the standstills" + (a.nbs ? ", NBS on held axes" : "") +
+                    ", CUPT at the PSD strips, Rauch–Tung–Striebel smoother.");
+  if (!a.uncertainty_note.empty())
+    p.notes.push_back("Uncertainty (every ± in this report): " + a.uncertainty_note +
+                      ". A figure is resolved when its magnitude exceeds U; one that is not is marked \"not resolved\".");
   page.sections.push_back(std::move(p));
   std::vector<std::vector<double>> cols(7);
   for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
@@ -95,9 +125,31 @@ void measurement_section(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
   csv.write("trace_measurement.csv", {"t_s", "setpoint_x_mm", "setpoint_y_mm", "setpoint_z_mm", "measured_x_mm", "measured_y_mm", "measured_z_mm"}, cols);
 }
 
+// Case temperatures over the run: "table 22.10–22.11 °C, head 24.29 °C".
+std::string temperatures(const dsp::Run& run) {
+  std::string out;
+  const char* names[2] = {"table", "head"};
+  for (int s = 0; s < 2; ++s) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (const auto& f : run.frames)
+      if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s])) lo = std::min(lo, static_cast<double>(f.temp_c[s])), hi = std::max(hi, static_cast<double>(f.temp_c[s]));
+    if (!std::isfinite(lo)) continue;
+    out += std::string(out.empty() ? "" : ", ") + names[s] + " " + fmt("%.2f", lo) + (hi - lo >= 0.005 ? "–" + fmt("%.2f", hi) : "") + " °C";
+  }
+  return out.empty() ? "not recorded" : out;
+}
+
+std::string settings(const dsp::Run& run, const dsp::Analysis& a) {
+  std::string s = fmt("%.0f Hz", run.meta.acquisition.fs_hz) + ", " + std::to_string(run.frames.size()) + " samples, " +
+                  std::to_string(run.meta.psd.size()) + " PSD strip" + (run.meta.psd.size() == 1 ? "" : "s") + ", sensor model " +
+                  (a.sensor_model == "datasheet" ? std::string("data sheet") : "identified (" + a.sensor_model + ")") + ", dynamic compensation " +
+                  (a.dynamic == dsp::DynamicComp::none ? "off" : "two-stage") + (a.coriolis ? ", Earth rate corrected" : "");
+  return s;
+}
+
 }  // namespace
 
-fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs::path& dir) {
+fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs::path& dir, const ReportOptions& opt) {
   fs::create_directories(dir);
   CsvFiles csv(dir);
   Page page;
@@ -105,14 +157,28 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs:
   page.title = title_for(p.kind);
   page.run_id = run.meta.id;
   page.program = program_line(p);
-  page.context = {{"machine", run.meta.machine.name},
-                  {"sampling", fmt("%.0f Hz", run.meta.acquisition.fs_hz)},
-                  {"samples", std::to_string(run.frames.size())},
+  const Tolerances tol = opt.tolerances.value_or(Tolerances{});
+  const std::string machine = tol.machine.empty() ? run.meta.machine.name : tol.machine;
+  const std::string serial = !opt.serial.empty() ? opt.serial : tol.serial;
+  const std::string op = !opt.operator_name.empty() ? opt.operator_name : tol.operator_name;
+  page.context = {{"machine", machine + (serial.empty() ? ", serial not given" : ", serial " + serial)},
+                  {"operator", op.empty() ? "not given" : op},
+                  {"run recorded", run.meta.created.empty() ? "not recorded" : run.meta.created},
+                  {"temperatures", temperatures(run)},
+                  {"software", std::string(drivers::software_version())},
+                  {"test settings", settings(run, a)},
                   {"sensors", run.meta.sensors[0].model + " (table), " + run.meta.sensors[1].model + " (head)"}};
-  if (!run.meta.created.empty()) page.context.emplace_back("recorded", run.meta.created);
   if (run.meta.reference) page.context.emplace_back("reference", run.meta.reference->kind);
-  page.warnings = a.flags;
-  if (a.degraded && page.warnings.empty()) page.warnings.push_back("result degraded");
+  for (const auto& f : a.flags) page.flags.push_back({f, dsp::severity_name(dsp::flag_severity(f))});
+  page.verdict = a.verdict;
+  page.verdict_reasons = a.verdict_reasons;
+  if (opt.tolerances) {
+    Grid g{"Against the tolerances (ISO 14253-1 with U, k = 2)", {"figure", "measured (µm)", "U (µm)", "tolerance (µm)", "decision"}, {}};
+    for (const auto& d : decide(a, tol))
+      g.rows.push_back({d.figure, fmt("%.2f", d.value), d.u ? fmt("%.2f", *d.u) : std::string("unknown"), fmt("%.2f", d.tolerance), d.decision});
+    if (g.rows.empty()) g.rows.push_back({"(no toleranced figure in this test)", "", "", "", ""});
+    page.summary.push_back(g);
+  }
   circle_sections(run, a, page, csv);
   positioning_sections(run, a, page, csv);
   step_sections(a, page, csv);
@@ -120,6 +186,7 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs:
   if (p.kind == "freeform") freeform_sections(run, a, page, csv);
   measurement_section(a, page, csv);
   page.files = csv.names();
+  if (csv.thinned()) page.files_note = "Long traces are thinned to at most " + std::to_string(CsvFiles::kMaxRows) + " rows per file (the run holds every sample).";
   const fs::path file = dir / "report.html";
   write_html(page, file);
   return file;

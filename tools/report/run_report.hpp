@@ -5,11 +5,20 @@
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/core/run.hpp"
 
+#include "tools/report/tolerances.hpp"
+
 #include <filesystem>
+#include <optional>
 
 namespace eical::tools::report {
 
+struct ReportOptions {
+  std::optional<Tolerances> tolerances;  // pass/fail and the header's machine, serial, operator
+  std::string operator_name, serial;     // override the tolerance file's header
+};
+
 // Writes <dir>/report.html and <dir>/trace_*.csv; returns the path of the HTML file.
-std::filesystem::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, const std::filesystem::path& dir);
+std::filesystem::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, const std::filesystem::path& dir,
+                                       const ReportOptions& options = {});
 
 }  // namespace eical::tools::report

@@ -42,12 +42,13 @@ void step_sections(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
   }
   s.svgs.push_back(line_plot(arrivals, "Arrival at the target (moves overlaid)", "time since the set-point arrived (s)",
                              "measured − target (µm)", 680, 280));
-  Table f{"Step figures", {}};
-  f.rows = {{"End-position error (mean)", st.end_position_error_um, "µm", 2, "measured − commanded"},
-            {"Scatter over repeats", st.scatter_um, "µm", 2, "pooled s, same target and direction"},
-            {"Overshoot (max)", st.overshoot_um, "µm", 2, ""},
-            {"Settling time (max)", st.settling_s * 1000.0, "ms", 1, "into ±1 µm of the end value"},
-            {"Noise in the dwell", st.noise_um, "µm", 3, "RMS, median over dwells"},
+  const FigureRows fr(a);
+  Table f{"Step figures (± U, k = 2)", {}};
+  f.rows = {fr.row("step.end_position_error_um", "End-position error (mean)", "µm", 2, "measured − commanded"),
+            fr.row("step.scatter_um", "Scatter over repeats", "µm", 2, "pooled s, same target and direction"),
+            fr.row("step.overshoot_um", "Overshoot (max)", "µm", 2),
+            fr.row("step.settling_s", "Settling time (max)", "ms", 1, "into ±1 µm of the end value", 1000.0),
+            fr.row("step.noise_um", "Noise in the dwell", "µm", 3, "RMS, median over dwells"),
             {"Smallest step resolved", st.smallest_step_resolved_um > 0 ? std::optional<double>(st.smallest_step_resolved_um) : std::nullopt,
              "µm", 1, st.smallest_step_resolved_um > 0 ? "" : "no step resolved"}};
   s.tables.push_back(f);

@@ -80,11 +80,23 @@ double nice_step(double span, int target_ticks) {
   return nice * mag;
 }
 
+const char* revolution_colour(bool ccw, int revolution) {
+  static const char* const blues[] = {kBlue, "#0e8fa3", "#6a3fb5", "#2c4f8a", "#3aa35d", "#7d93d9", "#0b5563", "#9b59b6"};
+  static const char* const reds[] = {kRed, "#e67e22", "#a93270", "#8a4b08", "#d4a017", "#e0766a", "#6e2c00", "#c2185b"};
+  const int n = 8;
+  const int i = ((revolution % n) + n) % n;
+  return ccw ? blues[i] : reds[i];
+}
+
 std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title, const std::string& axis_a,
-                       const std::string& axis_b, double scale_um_per_div) {
+                       const std::string& axis_b, double scale_um_per_div, const std::string& subtitle) {
   // The reference circle (zero deviation) at r0 with `divisions` rings inside and outside,
   // each `ring` px: the ballbar plot's fixed geometry with a µm-per-division scale.
-  const double w = 500, h = 540, c = w / 2.0, cy = 266, r0 = 122.0, ring = 28.0;
+  std::size_t labelled = 0;
+  for (const auto& t : traces) labelled += t.label.empty() ? 0 : 1;
+  const double legend_rows = static_cast<double>((labelled + 1) / 2);
+  const double w = 500, cy = 276, r0 = 122.0, ring = 28.0, c = w / 2.0;
+  const double h = cy + 3 * ring + r0 + 34 + 15 * legend_rows + 34;
   const int divisions = 3;
   double max_abs_um = 0.0;
   for (const auto& t : traces)
@@ -93,51 +105,84 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
   if (scale_um_per_div <= 0.0) scale_um_per_div = nice_step(std::max(max_abs_um, 0.05) * 1.05, divisions);
   while (scale_um_per_div * divisions < max_abs_um) scale_um_per_div = next_nice(scale_um_per_div);
   const double px_per_um = ring / scale_um_per_div;
+  const auto px = [&](double ang_deg, double dev_um, double& x, double& y) {
+    const double th = ang_deg * kPi / 180.0;
+    const double r = std::max(0.0, r0 + dev_um * px_per_um);
+    x = c + r * std::cos(th), y = cy - r * std::sin(th);
+  };
+  const std::string halo = " stroke='#ffffff' stroke-width='3' paint-order='stroke' stroke-linejoin='round'";
 
   std::string s = svg_open(w, h);
   s += text(c, 18, title, "text-anchor='middle' font-size='14' font-weight='600'");
+  if (!subtitle.empty()) s += text(c, 34, subtitle, "text-anchor='middle' font-size='11' fill='#4a5366'");
+  // Grid first: rings and spokes under the traces.
   for (int k = -divisions; k <= divisions; ++k) {
     const double r = r0 + k * ring;
     s += "<circle cx='" + num(c) + "' cy='" + num(cy) + "' r='" + num(r) + "' fill='none' stroke='" + (k == 0 ? "#8a93a3" : "#d5d9e0") +
          "' stroke-width='" + (k == 0 ? "1.1" : "0.8") + (k == 0 ? "'" : "' stroke-dasharray='3,3'") + "/>";
-    if (k != 0 && k % 1 == 0)
-      s += text(c + 3, cy - r - 2, (k > 0 ? "+" : "") + tick_label(k * scale_um_per_div, scale_um_per_div), "fill='#6b7385' font-size='9'");
   }
+  const double r1 = r0 - divisions * ring, r2 = r0 + divisions * ring + 4;
   for (int a = 0; a < 360; a += 30) {
     const double th = a * kPi / 180.0;
-    const double r1 = r0 - divisions * ring, r2 = r0 + divisions * ring + 4;
     s += "<line x1='" + num(c + r1 * std::cos(th)) + "' y1='" + num(cy - r1 * std::sin(th)) + "' x2='" + num(c + r2 * std::cos(th)) +
          "' y2='" + num(cy - r2 * std::sin(th)) + "' stroke='#e6e9ee'/>";
-    std::string lab = std::to_string(a) + "°";
-    if (a == 0) lab = axis_a;
-    if (a == 90) lab = axis_b;
-    s += text(c + (r2 + 14) * std::cos(th), cy - (r2 + 14) * std::sin(th) + 4, lab,
-              "text-anchor='middle' fill='#4a5366'" + std::string(a % 90 == 0 ? " font-weight='600'" : ""));
   }
-  double legend_y = h - 36;
+  // Traces: one polyline per revolution, closed where it is a full one, a marker at its start.
+  std::string markers;
   for (const auto& t : traces) {
-    std::string pts;
     const std::size_t n = std::min(t.angle_deg.size(), t.deviation_um.size());
-    const std::size_t stride = stride_for(n, 2500);
-    double prev_ang = NAN;
+    if (n == 0) continue;
+    const std::size_t stride = stride_for(n, 1500);
+    std::string pts;
+    double prev_ang = NAN, x = 0, y = 0;
     for (std::size_t i = 0; i < n; i += stride) {
       if (!std::isfinite(t.deviation_um[i]) || !std::isfinite(t.angle_deg[i])) continue;
-      // A jump in angle (next revolution or arc) starts a new polyline.
+      // A jump in angle (a gap in the data) starts a new polyline.
       if (std::isfinite(prev_ang) && std::abs(t.angle_deg[i] - prev_ang) > 5.0 && std::abs(std::abs(t.angle_deg[i] - prev_ang) - 360.0) > 5.0) {
         s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" + pts + "'/>";
         pts.clear();
       }
       prev_ang = t.angle_deg[i];
-      const double th = t.angle_deg[i] * kPi / 180.0;
-      const double r = std::max(0.0, r0 + t.deviation_um[i] * px_per_um);
-      pts += num(c + r * std::cos(th)) + "," + num(cy - r * std::sin(th)) + " ";
+      px(t.angle_deg[i], t.deviation_um[i], x, y);
+      pts += num(x) + "," + num(y) + " ";
+    }
+    if (t.closed && n > 1) {  // back to where it began
+      px(t.angle_deg[0], t.deviation_um[0], x, y);
+      pts += num(x) + "," + num(y) + " ";
     }
     s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" + pts + "'/>";
-    if (t.label.empty()) continue;  // a further revolution of a trace already in the legend
-    s += "<rect x='10' y='" + num(legend_y - 5) + "' width='16' height='3' fill='" + t.color + "'/>";
-    s += text(32, legend_y, t.label);
-    legend_y += 15;
+    if (t.start_marker) {
+      px(t.angle_deg[0], t.deviation_um[0], x, y);
+      markers += "<circle cx='" + num(x) + "' cy='" + num(y) + "' r='3.6' fill='#ffffff' stroke='" + t.color + "' stroke-width='1.8'/>";
+    }
   }
+  s += markers;
+  // Labels above the traces.
+  for (int k = -divisions; k <= divisions; ++k)
+    if (k != 0) {
+      const double r = r0 + k * ring;
+      s += text(c + 3, cy - r - 2, (k > 0 ? "+" : "") + tick_label(k * scale_um_per_div, scale_um_per_div), "fill='#6b7385' font-size='9'" + halo);
+    }
+  for (int a = 0; a < 360; a += 30) {
+    const double th = a * kPi / 180.0;
+    std::string lab = std::to_string(a) + "°";
+    if (a == 0) lab = axis_a;
+    if (a == 90) lab = axis_b;
+    s += text(c + (r2 + 14) * std::cos(th), cy - (r2 + 14) * std::sin(th) + 4, lab,
+              "text-anchor='middle' fill='#4a5366'" + std::string(a % 90 == 0 ? " font-weight='600'" : "") + halo);
+  }
+  // Legend in two columns under the plot, the scale beside.
+  double ly = cy + r2 + 34;
+  std::size_t k = 0;
+  for (const auto& t : traces) {
+    if (t.label.empty()) continue;
+    const double lx = k % 2 == 0 ? 10.0 : 250.0;
+    s += "<rect x='" + num(lx) + "' y='" + num(ly - 5) + "' width='16' height='3' fill='" + t.color + "'/>";
+    s += text(lx + 22, ly, t.label);
+    if (k % 2 == 1) ly += 15;
+    ++k;
+  }
+  s += "<circle cx='" + num(14) + "' cy='" + num(h - 9) + "' r='3.6' fill='#ffffff' stroke='#4a5366' stroke-width='1.8'/>" + text(24, h - 5, "start of a revolution", "fill='#4a5366' font-size='10'");
   s += text(w - 10, h - 21, tick_label(scale_um_per_div, scale_um_per_div) + " µm / division", "text-anchor='end' fill='#4a5366'");
   s += text(w - 10, h - 5, "reference circle = 0 µm", "text-anchor='end' fill='#6b7385' font-size='10'");
   return s + "</svg>";

@@ -12,19 +12,26 @@ inline constexpr const char* kRed = "#c0392b";     // cw, ↓ (negative approach
 inline constexpr const char* kGrey = "#7b8494";    // set-point, reference
 inline constexpr const char* kGreen = "#1e8449";
 
-// One trace of a polar radius-deviation plot, e.g. one direction of a circular test.
+// One trace of a polar radius-deviation plot, e.g. one revolution of one direction.
 struct PolarTrace {
-  std::string label;  // empty: not in the legend (e.g. a further revolution of the same direction)
+  std::string label;  // empty: not in the legend
   std::string color;  // CSS colour
   std::vector<double> angle_deg;
   std::vector<double> deviation_um;
+  bool closed = false;        // a full revolution: the last point joins the first
+  bool start_marker = false;  // a marker where the trace begins (its direction shown by a tick)
 };
+
+// Colours of the revolutions of one direction: ccw blues, cw reds (first = kBlue / kRed).
+const char* revolution_colour(bool ccw, int revolution);
 
 // Ballbar-style polar plot: the deviation is drawn magnified about a reference circle
 // (zero deviation) with rings every `scale_um_per_div` (chosen when <= 0). `axis_a` and
-// `axis_b` name the plane's axes at 0° and 90° (e.g. "+X", "+Y").
+// `axis_b` name the plane's axes at 0° and 90° (e.g. "+X", "+Y"). Labels are drawn above
+// the traces (with a white halo) so that no trace hides them; `subtitle` (e.g. G per
+// direction) is printed under the title.
 std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title, const std::string& axis_a = "0°",
-                       const std::string& axis_b = "90°", double scale_um_per_div = 0.0);
+                       const std::string& axis_b = "90°", double scale_um_per_div = 0.0, const std::string& subtitle = "");
 
 struct LineSeries {
   std::string label = {};

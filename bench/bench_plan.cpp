@@ -1,0 +1,30 @@
+// eical plan against simulation (issue 16): per program the predicted U of its headline
+// figures beside the spread of the figures over repeats on machines drawn within the data
+// sheet's tolerances (tools/plan/plan_check.hpp).
+//   bench_plan [--repeats 20] [--draws 100]
+#include "tools/plan/plan_check.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cstdio>
+
+int main(int argc, char** argv) {
+  CLI::App app("eical plan-vs-simulation benchmark");
+  int repeats = 20, draws = 100;
+  std::vector<std::string> only;
+  app.add_option("--repeats", repeats, "simulated repeats per program");
+  app.add_option("--draws", draws, "Monte Carlo draws of the prediction");
+  app.add_option("--programs", only, "circle, step, positioning, rectangle (default: all)")->delimiter(',');
+  CLI11_PARSE(app, argc, argv);
+  std::vector<eical::tools::plan::CheckRow> rows;
+  for (const auto& p : eical::tools::plan::check_programs()) {
+    if (!only.empty() && std::find(only.begin(), only.end(), p.kind) == only.end()) continue;
+    const auto r = eical::tools::plan::check_plan(p, repeats, draws);
+    rows.insert(rows.end(), r.begin(), r.end());
+    std::fputs(eical::tools::plan::check_table(r).c_str(), stdout);
+    std::fflush(stdout);
+  }
+  std::printf("\nall programs, %d repeats each:\n%s", repeats, eical::tools::plan::check_table(rows).c_str());
+  return 0;
+}

@@ -1,0 +1,23 @@
+// Uncertainty benchmark (issue 16): a seeded campaign of simulated runs across programs on
+// machines within the data sheet's tolerances; prints per figure how often the error
+// against the simulator's truth lies within the expanded uncertainty U, the median U and
+// the RMS error (tools/uncertainty/coverage_campaign.hpp).
+//   bench_uncertainty [--seeds 1,2,...] [--draws 100] [--programs circle,step,...]
+#include "tools/uncertainty/coverage_campaign.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+
+int main(int argc, char** argv) {
+  CLI::App app("eical uncertainty coverage benchmark");
+  eical::tools::uncertainty::CampaignOptions o;
+  o.seeds = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
+  app.add_option("--seeds", o.seeds, "machines to draw (each its own sensors and errors)")->delimiter(',');
+  app.add_option("--programs", o.programs, "circle, step, positioning, rectangle")->delimiter(',');
+  app.add_option("--draws", o.draws, "Monte Carlo draws per run");
+  app.add_option("--write-runs", o.write_runs, "write every simulated run into this folder");
+  CLI11_PARSE(app, argc, argv);
+  std::fputs(eical::tools::uncertainty::coverage_table(eical::tools::uncertainty::run_campaign(o)).c_str(), stdout);
+  return 0;
+}

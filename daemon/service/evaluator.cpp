@@ -1,0 +1,205 @@
+#include "daemon/service/evaluator.hpp"
+
+#include "daemon/service/history_hook.hpp"
+#include "daemon/service/hmi_link.hpp"
+#include "daemon/service/trace_builder.hpp"
+#include "daemon/system/log.hpp"
+#include "drivers/results/result_json.hpp"
+#include "drivers/results/software_version.hpp"
+#include "drivers/run_io/run_writer.hpp"
+#include "drivers/setpoint/program_catalog.hpp"
+#include "drivers/setpoint/program_setpoint.hpp"
+#include "drivers/source/servo_setpoint_source.hpp"
+#include "dsp/align/accel_lag.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <optional>
+
+namespace eical::daemon {
+namespace {
+
+// UTC now in a strftime format: "%Y%m%dT%H%M%SZ" for run ids, RFC 3339 for run.toml.
+std::string utc_now(const char* format) {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char b[32];
+  std::strftime(b, sizeof b, format, &tm);
+  return b;
+}
+
+std::string percent(double ratio) { return std::to_string(static_cast<int>(std::lround(ratio * 100.0))) + " %"; }
+
+// The lag of the measured behind the recorded set-point and the alignment's residual.
+void measure_alignment(const dsp::Run& run, dsp::SetPointOrigin& s) {
+  std::vector<Eigen::Vector3d> cmd;
+  cmd.reserve(run.frames.size());
+  for (const auto& f : run.frames) cmd.emplace_back(f.cmd_mm[0], f.cmd_mm[1], f.cmd_mm[2]);
+  const auto lag = dsp::align::estimate_lag(dsp::align::setpoint_accel_mps2(cmd, run.fs_hz()), dsp::align::measured_accel_mps2(run), run.fs_hz());
+  s.lag_s = lag.lag_s, s.correlation = lag.correlation, s.residual_ratio = lag.residual_ratio;
+}
+
+}  // namespace
+
+Evaluator::Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingHandoff& handoff,
+                     EvaluatorLinks links)
+    : config_(config), meta_(std::move(meta)), analysis_(std::move(analysis)), handoff_(handoff), links_(std::move(links)),
+      thread_([this] { loop(); }) {}
+
+Evaluator::~Evaluator() { finish(); }
+
+void Evaluator::finish() {
+  if (!thread_.joinable()) return;
+  handoff_.quit();
+  thread_.join();
+}
+
+EvaluationStatus Evaluator::status() const {
+  std::lock_guard lk(mu_);
+  return status_;
+}
+
+void Evaluator::set_fault(const std::string& fault) {
+  std::lock_guard lk(mu_);
+  status_.fault = fault;
+}
+
+void Evaluator::loop() {
+  RecordingJob job;
+  while (handoff_.wait_job(job)) {
+    evaluate(job);
+    handoff_.give_back(std::move(job.frames));  // the storage goes back to the DSP thread
+  }
+}
+
+dsp::Run Evaluator::make_run(RecordingJob& job) const {
+  dsp::Run run;
+  run.meta = meta_;
+  run.meta.id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
+  run.meta.created = utc_now("%Y-%m-%dT%H:%M:%SZ");
+  run.channels.psd_count = static_cast<int>(std::min<std::size_t>(meta_.psd.size(), dsp::kMaxPsd));
+  run.frames.swap(job.frames);
+  return run;
+}
+
+std::optional<std::pair<int, dsp::Program>> Evaluator::named_program(const RecordingNotes& notes, std::vector<std::string>& flags) const {
+  const auto& sp = config_.setpoint;
+  const int number = std::isfinite(notes.program_p) ? static_cast<int>(std::lround(notes.program_p)) : sp.default_program;
+  if (number < 0) {
+    flags.push_back("setpoint: M101 named no program (P word) and [setpoint.program] default_program is not set");
+    return std::nullopt;
+  }
+  try {
+    return std::pair{number, drivers::ProgramCatalog(sp.program_dir).program(number)};
+  } catch (const std::exception& e) {
+    flags.push_back(std::string("setpoint: program ") + std::to_string(number) + ": " + e.what());
+    return std::nullopt;
+  }
+}
+
+std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingNotes& notes) const {
+  const auto& sp = config_.setpoint;
+  std::vector<std::string> flags;
+  if (sp.source == "none") return flags;
+  const auto program = named_program(notes, flags);
+  if (sp.source == "servo_stream") {
+    // The set-point is LinuxCNC's; the program (when named) says what to evaluate.
+    if (program) run.meta.program = program->second;
+    dsp::SetPointOrigin s;
+    s.source = "servo_stream";
+    s.program_number = program ? program->first : -1;
+    s.servo_rate_hz = sp.servo_rate_hz;
+    const auto a = links_.servo ? links_.servo->alignment() : drivers::ServoAlignment{};
+    if (a.known && !run.frames.empty())
+      s.servo_cycle_at_first_sample = a.servo_cycle_at_sample0 + static_cast<double>(run.frames.front().sample_index - notes.index_offset) /
+                                                                      run.fs_hz() * a.servo_rate_hz;
+    measure_alignment(run, s);
+    std::size_t missing = 0;
+    for (const auto& f : run.frames) missing += (f.flags & dsp::frame_flag::cmd_missing) != 0;
+    if (missing > 0) flags.push_back("setpoint: " + std::to_string(missing) + " frames had no servo cycle of the set-point (LinuxCNC's stream absent or late)");
+    run.meta.setpoint = s;
+    log(LogLevel::info, "setpoint: servo stream, cycle %.3f at the first sample; measured lags it by %+.2f ms, residual %s",
+        s.servo_cycle_at_first_sample, s.lag_s * 1e3, percent(s.residual_ratio).c_str());
+    return flags;
+  }
+  if (!program) return flags;
+  try {
+    drivers::ProgramSetPointOptions o;
+    o.limits.a_max_mm_s2 = sp.a_max_mm_s2, o.limits.j_max_mm_s3 = sp.j_max_mm_s3, o.limits.rapid_mm_min = sp.rapid_mm_min;
+    o.max_lag_s = sp.max_lag_s;
+    o.mcode_stops = sp.mcode_stops;
+    const drivers::ProgramAlignment a = drivers::apply_program_setpoint(run, program->second, o);
+    dsp::SetPointOrigin s;
+    s.source = "program";
+    s.program_number = program->first;
+    if (!a.blocks.empty()) {
+      s.marks_offset_s = a.blocks.front().marks_offset_s, s.offset_s = a.blocks.front().offset_s;
+      const auto [lo, hi] = std::minmax_element(a.blocks.begin(), a.blocks.end(), [](const auto& x, const auto& y) { return x.offset_s < y.offset_s; });
+      s.block_offset_spread_s = hi->offset_s - lo->offset_s;
+    }
+    s.blocks = static_cast<int>(a.blocks.size());
+    s.lag_s = a.lag_s, s.correlation = a.correlation, s.residual_ratio = a.residual_ratio;
+    run.meta.setpoint = s;
+    flags.insert(flags.end(), a.flags.begin(), a.flags.end());
+    log(LogLevel::info, "setpoint: program %d aligned: marks %+.2f ms, cross-correlation %+.2f ms over %d block(s), residual %s", s.program_number,
+        s.marks_offset_s * 1e3, (s.offset_s - s.marks_offset_s) * 1e3, s.blocks, percent(s.residual_ratio).c_str());
+  } catch (const std::exception& e) {
+    flags.push_back(std::string("setpoint: program ") + std::to_string(program->first) + ": " + e.what());
+  }
+  return flags;
+}
+
+void Evaluator::evaluate(RecordingJob& job) {
+  dsp::Run run = make_run(job);
+  const auto dir = config_.recording.dir / run.meta.id;
+  std::string error;
+  try {
+    const std::vector<std::string> setpoint_flags = add_setpoint(run, job.notes);
+    // The run first: what was measured is durable before anything can fail.
+    drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false});
+    dsp::Analysis a = dsp::analyze_run(run, analysis_);
+    if (!job.cause.empty()) a.flags.push_back(job.cause), a.degraded = true;
+    if (job.notes.nonfinite_frames > 0) {
+      a.flags.push_back("not_finite: " + std::to_string(job.notes.nonfinite_frames) +
+                        " frames had NaN/Inf in a temperature or set-point channel (last finite value held)");
+      a.degraded = true;
+    }
+    for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
+    drivers::write_result(run, a, dir / "result.json");
+    if (links_.history) links_.history->append(run, a, dir);
+    std::uint64_t number = 0;
+    {
+      // Counted before it is published: an HMI never sees a Result ahead of the count.
+      std::lock_guard lk(mu_);
+      number = ++status_.results;
+      status_.last_result = (dir / "result.json").string();
+    }
+    publish(run, a, dir, number);
+    log(LogLevel::notice, "measurement %s written (%zu frames)%s", run.meta.id.c_str(), run.frames.size(), a.degraded ? ", result degraded" : "");
+  } catch (const std::exception& e) {
+    error = e.what();
+    log(LogLevel::error, "recording %s: %s", run.meta.id.c_str(), e.what());
+  }
+  if (!error.empty()) set_fault("recording: " + error);
+  job.frames.swap(run.frames);
+}
+
+void Evaluator::publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir, std::uint64_t result_number) {
+  if (!links_.hmi) return;
+  drivers::dds::ResultMsg r;
+  r.machine = run.meta.machine.name;
+  r.program_id = run.meta.id;
+  r.measured_at = run.meta.created, r.run_path = dir.string(), r.software_version = drivers::software_version();
+  r.sensor_calibration = links_.sensor_calibration;
+  r.program = run.meta.program.kind;
+  r.degraded = a.degraded;
+  r.results = result_number;
+  if (a.circle) r.circular_deviation_G_um = a.circle->circular_deviation_G_um, r.radius_mean_deviation_um = a.circle->radius_mean_deviation_um;
+  r.json = drivers::result_json(run, a).dump();
+  links_.hmi->publish_result(r);
+  if (auto t = make_trace(run, a, config_.dds.trace_max_points)) links_.hmi->publish_trace(*t);
+}
+
+}  // namespace eical::daemon

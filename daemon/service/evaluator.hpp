@@ -1,0 +1,77 @@
+#pragma once
+// The evaluation thread: takes finished recordings from the DSP thread (RecordingHandoff)
+// and, as a flat list of stages, makes the run (metadata, id), puts the NC's set-point on
+// it when it comes from elsewhere (servo stream: the clocks' alignment; program: the
+// program M101 named, reconstructed and aligned), writes it (durable first), analyses it,
+// writes result.json and publishes Result and Trace. Not real-time: it allocates and writes.
+#include "daemon/config/daemon_config.hpp"
+#include "daemon/service/recording_handoff.hpp"
+#include "dsp/analysis/analyze_run.hpp"
+#include "dsp/core/run.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <mutex>
+#include <optional>
+#include <utility>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace eical::drivers {
+class ServoSetPointSource;
+}
+
+namespace eical::daemon {
+
+class HmiLink;
+class HistoryHook;
+
+// Where results go besides the run directory, and what the set-point may come from.
+struct EvaluatorLinks {
+  HmiLink* hmi = nullptr;                               // Result and Trace (none without DDS)
+  const drivers::ServoSetPointSource* servo = nullptr;  // the servo stream's clock alignment
+  HistoryHook* history = nullptr;                       // [history] enabled
+  std::string sensor_calibration = "datasheet";         // provenance in Result
+};
+
+// What the evaluations did, for Status (evaluation thread writes, status thread reads).
+struct EvaluationStatus {
+  std::uint64_t results = 0;
+  std::string last_result;  // path of the last result.json
+  std::string fault;        // the last recording or evaluation error
+};
+
+class Evaluator {
+ public:
+  Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingHandoff& handoff, EvaluatorLinks links);
+  ~Evaluator();  // finish()
+  // Evaluates what was handed over, then stops the thread; status() stays readable.
+  void finish();
+  Evaluator(const Evaluator&) = delete;
+  Evaluator& operator=(const Evaluator&) = delete;
+
+  [[nodiscard]] EvaluationStatus status() const;
+  void set_fault(const std::string& fault);
+
+ private:
+  void loop();
+  void evaluate(RecordingJob& job);
+  dsp::Run make_run(RecordingJob& job) const;
+  // The program M101's P word (or [setpoint.program] default_program) names.
+  std::optional<std::pair<int, dsp::Program>> named_program(const RecordingNotes& notes, std::vector<std::string>& flags) const;
+  // Fills cmd_*, [program] and [setpoint]; returns flags for the result (empty: nothing doubtful).
+  std::vector<std::string> add_setpoint(dsp::Run& run, const RecordingNotes& notes) const;
+  void publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir, std::uint64_t result_number);
+
+  const DaemonConfig& config_;
+  dsp::RunMeta meta_;
+  dsp::AnalysisOptions analysis_;
+  RecordingHandoff& handoff_;
+  EvaluatorLinks links_;
+  mutable std::mutex mu_;
+  EvaluationStatus status_;
+  std::thread thread_;
+};
+
+}  // namespace eical::daemon

@@ -1,0 +1,99 @@
+#include "daemon/service/status_reporter.hpp"
+
+#include "daemon/service/history_hook.hpp"
+#include "daemon/service/hmi_link.hpp"
+#include "daemon/system/log.hpp"
+
+#include <chrono>
+
+namespace eical::daemon {
+
+StatusReporter::StatusReporter(StatusSources sources, double rate_hz, std::function<void(const ServiceStatus&)> on_status)
+    : s_(std::move(sources)), rate_hz_(rate_hz), on_status_(std::move(on_status)), thread_([this] { loop(); }) {}
+
+StatusReporter::~StatusReporter() { stop(); }
+
+void StatusReporter::stop() {
+  if (!thread_.joinable()) return;
+  {
+    std::lock_guard lk(mu_);
+    stop_ = true;
+  }
+  cv_.notify_one();
+  thread_.join();
+}
+
+void StatusReporter::loop() {
+  const auto period = std::chrono::duration<double>(1.0 / rate_hz_);
+  std::unique_lock lk(mu_);
+  while (!cv_.wait_for(lk, period, [&] { return stop_; })) {
+    lk.unlock();
+    const std::uint64_t frames = s_.counters->frames.load(std::memory_order_relaxed);
+    // Progress of the DSP loop (or the run loop reopening a failed source) is what the
+    // watchdog is fed on: a stalled DSP thread gets no status, and systemd restarts eicald.
+    if (frames != last_frames_ || s_.counters->faulted.load()) report();
+    last_frames_ = frames;
+    s_.source->drain_diagnostics([](const std::string& line) { log(LogLevel::info, "%s", line.c_str()); });
+    lk.lock();
+  }
+}
+
+ServiceStatus StatusReporter::collect() const {
+  const ServiceCounters& k = *s_.counters;
+  constexpr auto relaxed = std::memory_order_relaxed;
+  ServiceStatus st;
+  const EvaluationStatus ev = s_.evaluator->status();
+  st.state = k.faulted.load() ? "FAULT" : std::string(dsp::to_string(k.measurement_state()));
+  st.fault = ev.fault;
+  if (s_.history && st.fault.empty()) st.fault = s_.history->problem();
+  st.frames = k.frames.load(relaxed);
+  st.overruns = s_.ring->overruns();
+  st.frames_lost = k.frames_lost.load(relaxed);
+  st.measurements = k.measurements.load(relaxed);
+  st.results_written = ev.results;
+  st.last_result = ev.last_result;
+  st.sample_index = k.sample_index.load(relaxed);
+  st.sample_time_ns = s_.daq_clock->time_ns(st.sample_index);
+  st.temp_table_c = k.temp_c[0].load(relaxed), st.temp_head_c = k.temp_c[1].load(relaxed);
+  StatusCounters& c = st.counters;
+  c.bad_frames = k.bad_frames.load(relaxed);
+  c.frames_flagged = k.frames_flagged.load(relaxed);
+  c.stamp_overruns = s_.source->stamp_overruns();
+  c.triggers_late = k.triggers_late.load(relaxed);
+  c.triggers_refused = k.triggers_refused.load(relaxed) + k.trigger_queue_full.load(relaxed);
+  c.recorder_overflow = k.recorder_overflow.load(relaxed);
+  c.handoffs_deferred = k.handoffs_deferred.load(relaxed);
+  for (const auto* ch : s_.channels) {
+    c.triggers_accepted += ch->accepted();
+    c.triggers_refused += ch->refused() + ch->dropped();
+  }
+  for (const auto* l : s_.listeners) c.trigger_events_ignored += l->ignored();
+  if (s_.hmi) c.live_overruns = s_.hmi->live_overruns(), c.dds_write_errors = s_.hmi->write_errors(), c.commands = s_.hmi->commands_received();
+  const drivers::SourceCounters sc = s_.source->counters();
+  c.source_decode_errors = sc.decode_errors, c.source_lost_samples = sc.lost_samples, c.source_dropped_frames = sc.dropped_frames;
+  c.setpoint_samples = sc.setpoint_samples, c.setpoint_missing = sc.setpoint_missing;
+  return st;
+}
+
+void StatusReporter::report() {
+  std::lock_guard lk(report_mu_);
+  const ServiceStatus st = collect();
+  on_status_(st);
+  if (!s_.hmi) return;
+  drivers::dds::StatusMsg m;
+  m.state = st.state, m.fault = st.fault, m.frames = st.frames, m.overruns = st.overruns, m.frames_lost = st.frames_lost;
+  m.measurements = st.measurements, m.results = st.results_written;
+  m.sample_index = st.sample_index, m.sample_time_ns = st.sample_time_ns;
+  m.temp_table_c = st.temp_table_c, m.temp_head_c = st.temp_head_c;
+  const StatusCounters& c = st.counters;
+  m.bad_frames = c.bad_frames, m.live_overruns = c.live_overruns, m.stamp_overruns = c.stamp_overruns, m.dds_write_errors = c.dds_write_errors;
+  m.triggers_accepted = c.triggers_accepted, m.triggers_refused = c.triggers_refused, m.triggers_late = c.triggers_late;
+  m.trigger_events_ignored = c.trigger_events_ignored, m.recorder_overflow = c.recorder_overflow, m.handoffs_deferred = c.handoffs_deferred;
+  m.source_decode_errors = c.source_decode_errors, m.source_lost_samples = c.source_lost_samples;
+  m.source_dropped_frames = c.source_dropped_frames, m.setpoint_samples = c.setpoint_samples, m.setpoint_missing = c.setpoint_missing;
+  m.frames_flagged = c.frames_flagged, m.commands = c.commands;
+  const dsp::State state = s_.counters->faulted.load() ? dsp::State::fault : s_.counters->measurement_state();
+  s_.hmi->set_status(m, state);
+}
+
+}  // namespace eical::daemon

@@ -1,0 +1,177 @@
+#include "dsp/analysis/figure_uncertainty.hpp"
+
+#include "dsp/analysis/figures.hpp"
+#include "dsp/core/axes.hpp"
+#include "dsp/core/error.hpp"
+#include "dsp/uncertainty/error_field.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <random>
+
+namespace eical::dsp {
+namespace {
+
+// Draws evaluate the path at about this rate (the error is smooth; the figures need no more).
+constexpr double kDrawRateHz = 1000.0;
+constexpr std::size_t kMaxDrawSamples = 30000;
+
+struct Accumulator {
+  std::vector<double> sum, sumsq;
+  std::vector<int> count;
+};
+
+}  // namespace
+
+double expanded_uncertainty(double mean_offset, double sd, int n) {
+  if (n < 2) return NAN;
+  const double mc = 2.0 * sd / std::sqrt(static_cast<double>(n));
+  const double bias = std::max(0.0, std::abs(mean_offset) - mc);
+  return 2.0 * sd + bias / (std::numbers::sqrt2 - 1.0);
+}
+
+void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const AnalysisOptions& o, Analysis& a) {
+  const Measurement& m = a.measurement;
+  const auto& fine = m.raw.schedule;
+  if (fine.flags.empty() || m.sample_index.size() < 2) {
+    a.uncertainty_note = "no support schedule: the uncertainty was not estimated";
+    return;
+  }
+  uncertainty::ErrorFieldInput in;
+  fusion::SupportSchedule schedule = fine;  // as the trace was actually fused
+  if (m.supports.psd_disagrees) schedule.cupt = false;
+  if (m.supports.diverged) {
+    schedule.zupt = schedule.cupt = false;
+    for (auto& f : schedule.flags) f = static_cast<std::uint8_t>(f & (fusion::schedule_flag::move_start | fusion::schedule_flag::invalid));
+  }
+  in.schedule = &schedule;
+  in.sample_index = &m.sample_index;
+  in.pos_mm = &m.pos_mm;
+  in.vel_mm_s = &m.vel_mm_s;
+  in.fs_hz = m.fs_hz;
+  in.delay_samples = a.dynamic == DynamicComp::none ? 0.0 : cfg.acquisition.daq_group_delay_samples;
+  in.model = cfg.fusion;
+  in.start_bias_sigma_um_s2 = m.supports.start_bias_sigma_um_s2;
+  in.model_covariance = o.model_covariance ? *o.model_covariance : uncertainty::datasheet_covariance(run.meta.sensors, m.fs_hz);
+  in.sensor_noise_ug_per_rthz[0] = run.meta.sensors[0].noise_ug_per_rthz;
+  in.sensor_noise_ug_per_rthz[1] = run.meta.sensors[1].noise_ug_per_rthz;
+  in.g_mps2 = run.meta.site.g_mps2;
+  // The case temperatures along the trace (α_b's effect), from the frames.
+  std::vector<Eigen::Vector2d> temp;
+  {
+    std::size_t f = 0;
+    Eigen::Vector2d last(run.meta.sensors[0].temp_ref_c, run.meta.sensors[1].temp_ref_c);
+    for (const std::int64_t idx : m.sample_index) {
+      while (f < run.frames.size() && run.frames[f].sample_index < idx) ++f;
+      if (f < run.frames.size()) {
+        const Frame& fr = run.frames[f];
+        for (int s = 0; s < 2; ++s)
+          if (!(fr.flags & frame_flag::temp_missing) && std::isfinite(fr.temp_c[s])) last[s] = fr.temp_c[s];
+      }
+      temp.push_back(last);
+    }
+  }
+  in.temp_c = &temp;
+  for (int j = 0; j < 3; ++j) in.owner[static_cast<std::size_t>(j)] = axis_owner(run.meta.machine, j);
+  a.uncertainty_source = in.model_covariance.source;
+  std::unique_ptr<uncertainty::ErrorField> field;
+  try {
+    field = std::make_unique<uncertainty::ErrorField>(in);
+  } catch (const InputError& e) {
+    a.uncertainty_note = std::string("the uncertainty was not estimated: ") + e.what();
+    return;
+  }
+
+  // The nominal evaluation at the draws' rate, and the positions the draws perturb. Two
+  // paths: the measured one (the plug-in: what the error does to this machine's figures) and
+  // the ideal one, the set-point (what the error alone makes of them: for a range, an
+  // amplitude or a spread — |f(t + e) − f(t)| ≤ f(e) — a bound whatever the machine).
+  const std::size_t n = m.sample_index.size();
+  std::size_t q = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(m.fs_hz / kDrawRateHz)));
+  q = std::max(q, (n + kMaxDrawSamples - 1) / kMaxDrawSamples);
+  EvaluationOptions eo;
+  eo.reference = false;
+  if (a.diagnostics) eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
+  Analysis nominal, ideal;
+  nominal.measurement = decimate(m, q);
+  nominal.dynamic = ideal.dynamic = a.dynamic, nominal.nbs = ideal.nbs = a.nbs;
+  ideal.measurement = nominal.measurement;
+  ideal.measurement.pos_mm = ideal.measurement.cmd_mm;
+  evaluate_program(run, nominal, eo);
+  evaluate_program(run, ideal, eo);
+  const std::vector<FigureValue> f0 = figures_of(nominal), g0 = figures_of(ideal);
+  std::vector<double> at;
+  for (std::size_t i = 0; i < n; i += q) at.push_back(static_cast<double>(i));
+
+  auto start = [](const std::vector<FigureValue>& f) {
+    std::vector<Accumulator> acc(f.size());
+    for (std::size_t k = 0; k < f.size(); ++k) {
+      const std::size_t e = f[k].values.size();
+      acc[k].sum.assign(e, 0.0), acc[k].sumsq.assign(e, 0.0), acc[k].count.assign(e, 0);
+    }
+    return acc;
+  };
+  auto add = [](const std::vector<FigureValue>& base, const std::vector<FigureValue>& drawn, std::vector<Accumulator>& acc) {
+    for (std::size_t k = 0; k < base.size(); ++k) {
+      const FigureValue* v = find_figure(drawn, base[k].key);
+      if (!v || v->values.size() != base[k].values.size()) continue;
+      for (std::size_t e = 0; e < v->values.size(); ++e) {
+        const double dv = v->values[e] - base[k].values[e];
+        if (!std::isfinite(dv)) continue;
+        acc[k].sum[e] += dv, acc[k].sumsq[e] += dv * dv, ++acc[k].count[e];
+      }
+    }
+  };
+  std::vector<Accumulator> acc = start(f0), acc_ideal = start(g0);
+  std::mt19937_64 rng(o.uncertainty.seed ^ 0x9e3779b97f4a7c15ULL);
+  std::vector<Eigen::Vector3d> err;
+  const int draws = std::max(2, o.uncertainty.draws);
+  for (int d = 0; d < draws; ++d) {
+    field->draw(rng, at, err);
+    for (Analysis* base : {&nominal, &ideal}) {
+      Analysis x;
+      x.measurement = base->measurement;
+      for (std::size_t i = 0; i < err.size() && i < x.measurement.pos_mm.size(); ++i) x.measurement.pos_mm[i] += err[i] / 1000.0;
+      x.dynamic = a.dynamic, x.nbs = a.nbs;
+      evaluate_program(run, x, eo);
+      if (base == &nominal) add(f0, figures_of(x), acc);
+      else add(g0, figures_of(x), acc_ideal);
+    }
+  }
+  // U of element e of figure k of a set of draws (NaN when most draws could not evaluate it).
+  auto u_of = [&](const std::vector<Accumulator>& ac, std::size_t k, std::size_t e, bool plug_in) {
+    const int c = ac[k].count[e];
+    if (2 * c < draws) return std::numeric_limits<double>::quiet_NaN();
+    const double mean = ac[k].sum[e] / c;
+    const double sd = std::sqrt(std::max(0.0, (ac[k].sumsq[e] - c * mean * mean) / std::max(1, c - 1)));
+    return plug_in ? expanded_uncertainty(mean, sd, c) : std::abs(mean) + 2.0 * sd;
+  };
+  auto index_of = [](const std::vector<FigureValue>& f, const std::string& key) {
+    std::size_t k = 0;
+    while (k < f.size() && f[k].key != key) ++k;
+    return k;
+  };
+  // Figures of the full-rate analysis: U from the draws where the shapes agree.
+  for (const FigureValue& full : figures_of(a)) {
+    const std::size_t k = index_of(f0, full.key), j = index_of(g0, full.key);
+    const bool plug = k < f0.size() && f0[k].values.size() == full.values.size();
+    const bool bound = j < g0.size() && g0[j].values.size() == full.values.size();
+    if (!plug && !bound) continue;
+    std::vector<double> u(full.values.size(), std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t e = 0; e < u.size(); ++e) {
+      const double up = plug ? u_of(acc, k, e, true) : std::numeric_limits<double>::quiet_NaN();
+      const double ub = bound ? u_of(acc_ideal, j, e, false) : std::numeric_limits<double>::quiet_NaN();
+      u[e] = std::isfinite(up) && std::isfinite(ub) ? std::max(up, ub) : std::isfinite(up) ? up : ub;
+    }
+    a.uncertainty_k2[full.key] = u;
+  }
+  char note[200];
+  std::snprintf(note, sizeof note, "GUM, k = 2: %d Monte Carlo draws of the error field (noise and bias walk between the supports, sensor model: %s, PSD strips), path at %.0f Hz",
+                draws, a.uncertainty_source.c_str(), m.fs_hz / static_cast<double>(q));
+  a.uncertainty_note = note;
+}
+
+}  // namespace eical::dsp

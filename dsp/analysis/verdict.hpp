@@ -1,0 +1,42 @@
+#pragma once
+// quality.verdict of a result (shared/spec/results.md):
+//   not_measurable  the program's headline figure is not above its uncertainty, or that
+//                   uncertainty exceeds what the test is meant to resolve (the table below);
+//   degraded        a quality flag (lost frames, saturation, the strips disagreeing, ...);
+//   ok              otherwise.
+// The figures are given in every case, with their uncertainty.
+//
+// What each program is meant to resolve (README "Verdict"): a circular test is a
+// ballbar-class test of G, a positioning test an interferometer-class test of A, a step
+// test resolves end positions to a few µm, a rectangle its corners, a free form its
+// contour.
+#include "dsp/analysis/analyze_run.hpp"
+
+#include <string>
+#include <vector>
+
+namespace eical::dsp {
+
+struct ResolutionLimit {
+  const char* program;    // kind
+  const char* headline;   // result key of the headline figure (must exceed its U)
+  const char* name;       // as a user reads it
+  const char* limited;    // result key whose U must stay within `limit_um`
+  const char* limited_name;
+  double limit;           // in the limited figure's unit
+  const char* unit;
+};
+
+const std::vector<ResolutionLimit>& resolution_limits();
+const ResolutionLimit* resolution_limit(const std::string& program_kind);
+
+// Sets a.verdict and a.verdict_reasons from the figures, their uncertainty and the flags.
+void judge(const Program& program, Analysis& a);
+
+// Severity of a quality flag: what a reader must not miss (the measurement is wrong or
+// incomplete), what limits it, and what only explains a figure that is absent.
+enum class FlagSeverity { critical, warning, note };
+FlagSeverity flag_severity(const std::string& flag);
+const char* severity_name(FlagSeverity s);
+
+}  // namespace eical::dsp

@@ -1,0 +1,99 @@
+#include "dsp/uncertainty/coarse_schedule.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <tuple>
+
+namespace eical::dsp::uncertainty {
+
+CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& idx, const fusion::ErrorModel& model,
+                       std::size_t q) {
+  namespace sf = fusion::schedule_flag;
+  CoarseSchedule c;
+  q = std::max<std::size_t>(1, q);
+  c.block = q;
+  const std::size_t n = std::min(fine.flags.size(), idx.size());
+  const std::size_t nc = (n + q - 1) / q;
+  c.model = model;
+  // σ is carried per coarse sample (zupt) and per fix: the model's floors are folded in.
+  c.model.zupt_sigma_um_s = 1e-9;
+  c.model.psd_floor_um = 0.0;
+  c.model.nbs_sigma_um_s = model.nbs_sigma_um_s / std::sqrt(static_cast<double>(q));
+  c.model.gate_nis = 1e300;
+  c.model.reset_after_rejections = 1 << 30;
+  auto& s = c.schedule;
+  s.zupt = fine.zupt;
+  s.cupt = fine.cupt;
+  s.flags.assign(nc, 0);
+  s.zupt_sigma_um_s.assign(nc, -1.0F);
+  c.sample_index.resize(nc);
+  c.fine_end.resize(nc);
+  for (std::size_t j = 0; j < nc; ++j) {
+    const std::size_t b = j * q, e = std::min(n, b + q);
+    c.fine_end[j] = e - 1;
+    c.sample_index[j] = idx[e - 1];
+    std::uint8_t any = 0;
+    std::size_t invalid = 0, rest_used = 0, nbs[3] = {0, 0, 0};
+    double info = 0.0;  // Σ 1/σ² of the block's standstill velocities
+    bool rest = false;
+    for (std::size_t k = b; k < e; ++k) {
+      const std::uint8_t f = fine.flags[k];
+      any |= f;
+      if (f & sf::invalid) {
+        ++invalid;
+        continue;
+      }
+      if (f & sf::rest) {
+        rest = true;
+        const double z = k < fine.zupt_sigma_um_s.size() ? static_cast<double>(fine.zupt_sigma_um_s[k]) : 0.0;
+        if (z >= 0.0) {
+          const double sg = std::max(model.zupt_sigma_um_s, z);
+          info += 1.0 / (sg * sg), ++rest_used;
+        }
+      } else {
+        for (int a = 0; a < 3; ++a)
+          if (f & fusion::nbs_flag(a)) ++nbs[a];
+      }
+    }
+    std::uint8_t flags = static_cast<std::uint8_t>(any & sf::move_start);
+    if (invalid == e - b) flags |= sf::invalid;
+    if (rest) {
+      flags |= sf::rest;
+      s.zupt_sigma_um_s[j] = rest_used > 0 ? static_cast<float>(1.0 / std::sqrt(info)) : -1.0F;
+    } else {
+      s.zupt_sigma_um_s[j] = 0.0F;
+      for (int a = 0; a < 3; ++a)
+        if (2 * nbs[a] >= e - b) flags |= fusion::nbs_flag(a);
+    }
+    s.flags[j] = flags;
+  }
+  // Fixes: one per (coarse sample, strip), inverse-variance combined.
+  // (axis, Σ w, Σ w² σ_noise²) with w = 1/var as the pipeline weighs each fix.
+  std::map<std::pair<std::size_t, int>, std::tuple<int, double, double>> comb;
+  for (const auto& f : fine.fixes) {
+    if (f.k >= n) continue;
+    const double noise = f.sigma_um * f.sigma_um + model.psd_floor_um * model.psd_floor_um;
+    const double var = noise + f.model_sigma_um * f.model_sigma_um;
+    if (!(var > 0.0) || !std::isfinite(var)) continue;
+    auto& [axis, w, wn] = comb[{f.k / q, f.strip}];
+    axis = f.axis;
+    w += 1.0 / var, wn += noise / (var * var);
+  }
+  for (const auto& [key, v] : comb) {
+    fusion::PositionFix f;
+    f.k = key.first, f.strip = key.second, f.axis = std::get<0>(v);
+    f.sigma_um = 1.0 / std::sqrt(std::get<1>(v));
+    s.fixes.push_back(f);
+    c.fix_noise_um.push_back(std::sqrt(std::get<2>(v)) / std::get<1>(v));  // σ of the weighted mean's noise
+  }
+  for (auto v : fine.velocity_means) {
+    if (v.k >= n) continue;
+    v.k /= q;
+    v.sigma_um_s = std::max(v.sigma_um_s, model.zupt_sigma_um_s);  // the floor the pipeline applied
+    s.velocity_means.push_back(v);
+  }
+  return c;
+}
+
+}  // namespace eical::dsp::uncertainty

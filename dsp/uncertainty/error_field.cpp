@@ -1,0 +1,241 @@
+#include "dsp/uncertainty/error_field.hpp"
+
+#include "dsp/core/error.hpp"
+#include "dsp/fusion/rts_smoother.hpp"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+namespace eical::dsp::uncertainty {
+namespace {
+
+// x = G z draws N(0, C): LDLᵀ with pivoting takes a semi-definite C. The parameters differ
+// in units by orders of magnitude (E ~ 1e-4, α_b ~ 100 µg/°C): factored in correlation form
+// so that the jitter that keeps it definite is relative to each parameter's own variance.
+Eigen::MatrixXd draw_factor(const Eigen::MatrixXd& c) {
+  const Eigen::Index m = c.rows();
+  if (m == 0) return {};
+  Eigen::VectorXd s = c.diagonal().cwiseMax(0.0).cwiseSqrt();
+  for (Eigen::Index i = 0; i < m; ++i)
+    if (!(s[i] > 0.0)) s[i] = 1.0;  // a parameter without variance: its row and column are zero
+  const Eigen::MatrixXd r = s.cwiseInverse().asDiagonal() * c * s.cwiseInverse().asDiagonal();
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(r + 1e-12 * Eigen::MatrixXd::Identity(m, m));
+  const Eigen::VectorXd d = ldlt.vectorD().cwiseMax(0.0).cwiseSqrt();
+  Eigen::MatrixXd l = ldlt.matrixL();
+  l = l * d.asDiagonal();
+  Eigen::MatrixXd g = ldlt.transpositionsP().transpose() * l;
+  for (Eigen::Index i = 0; i < m; ++i)
+    if (!(c(i, i) > 0.0)) g.row(i).setZero();
+  return s.asDiagonal() * g;
+}
+
+// Linear interpolation of a trace at a fractional position (clamped).
+template <typename V>
+V at(const std::vector<V>& x, double pos) {
+  if (pos <= 0.0) return x.front();
+  const auto i = static_cast<std::size_t>(pos);
+  if (i + 1 >= x.size()) return x.back();
+  const double f = pos - static_cast<double>(i);
+  return (1.0 - f) * x[i] + f * x[i + 1];
+}
+
+}  // namespace
+
+double ErrorField::coarse_position(double a) const {
+  const double c = (a + delay_ + 1.0) / static_cast<double>(coarse_.block) - 1.0;
+  return std::clamp(c, 0.0, static_cast<double>(coarse_.sample_index.size()) - 1.0);
+}
+
+ErrorField::ErrorField(const ErrorFieldInput& in) {
+  if (!in.schedule || !in.sample_index || !in.pos_mm || !in.vel_mm_s) throw InputError("uncertainty: input arrays missing");
+  const std::size_t n = std::min({in.schedule->flags.size(), in.sample_index->size(), in.pos_mm->size(), in.vel_mm_s->size()});
+  if (n < 2) throw InputError("uncertainty: the measurement holds fewer than 2 samples");
+  delay_ = in.delay_samples;
+  fs_hz_ = in.fs_hz;
+  owner_ = in.owner;
+  strip_sigma_um_ = in.model_covariance.psd_offset_sigma_um;
+  start_bias_sigma_ = in.start_bias_sigma_um_s2;
+  const std::size_t q = std::max<std::size_t>(1, (n + in.max_coarse - 1) / std::max<std::size_t>(1, in.max_coarse));
+  coarse_ = coarsen(*in.schedule, *in.sample_index, in.model, q);
+  const std::size_t nc = coarse_.sample_index.size();
+  // The truth the noise draws simulate: the data sheet's noise (with its spread) and bias walk.
+  truth_ = coarse_.model;
+  const double per_sensor = in.noise.bias_walk_ug_per_rts * 1e-6 * in.g_mps2 * 1e6;  // µm/s²/√s
+  truth_.bias_walk_um_s2_rts = std::max(in.model.bias_walk_um_s2_rts, std::sqrt(2.0) * per_sensor);
+  truth_.accel_noise_um_s2_rthz = std::max(in.model.accel_noise_um_s2_rthz, in.noise.noise_factor * std::hypot(in.sensor_noise_ug_per_rthz[0], in.sensor_noise_ug_per_rthz[1]) * in.g_mps2);
+
+  // The path's own motion (and temperatures) on the coarse grid: sensor time → aligned trace.
+  const auto& pos = *in.pos_mm;
+  const auto& vel = *in.vel_mm_s;
+  std::vector<Eigen::Vector3d> p(nc), v(nc), acc(nc);
+  std::vector<Eigen::Vector2d> temp(nc, Eigen::Vector2d::Zero());
+  const bool have_temp = in.temp_c && in.temp_c->size() >= n;
+  const double h = static_cast<double>(q);
+  for (std::size_t j = 0; j < nc; ++j) {
+    const double a = static_cast<double>(coarse_.fine_end[j]) - delay_;
+    p[j] = at(pos, a) - at(pos, -delay_);
+    v[j] = at(vel, a);
+    acc[j] = (at(vel, a + h) - at(vel, a - h)) * (in.fs_hz / (2.0 * h));
+    if (have_temp) temp[j] = (*in.temp_c)[coarse_.fine_end[j]] - (*in.temp_c)[0];  // since the rest window
+  }
+  // One smoother pass over pseudo-data: what is left of a unit error after the supports.
+  auto respond = [&](const std::vector<Eigen::Vector3d>& dx_mm, const std::vector<Eigen::Vector3d>& dv_mm_s, int strip, double unit) {
+    fusion::SupportSchedule sched = coarse_.schedule;
+    for (auto& f : sched.fixes) f.position_um = f.strip == strip ? 1.0 : 0.0;
+    for (auto& m : sched.velocity_means) {
+      const Eigen::Vector3d vm = dv_mm_s[m.k] * 1000.0;
+      for (int i = 0; i < 3; ++i) m.mean_um_s[i] = vm[i];
+    }
+    fusion::SmootherInput si;
+    si.sample_index = &coarse_.sample_index;
+    si.vel_mm_s = &dv_mm_s;
+    si.pos_mm = &dx_mm;
+    si.schedule = &sched;
+    si.fs_hz = in.fs_hz;
+    si.model = coarse_.model;
+    si.start_bias_sigma_um_s2 = in.start_bias_sigma_um_s2;
+    const fusion::SmootherOutput out = fusion::smooth(si);
+    std::vector<Eigen::Vector3d> r(nc);
+    for (std::size_t j = 0; j < nc; ++j) r[j] = (dx_mm[j] * 1000.0 - out.dx_um[j]) / unit;
+    return r;
+  };
+  const std::vector<Eigen::Vector3d> zero(nc, Eigen::Vector3d::Zero());
+  constexpr double kUnitE = 1e-4, kUnitTau = 1e-3;
+  for (int j = 0; j < 3; ++j) {
+    double lo = 1e300, hi = -1e300;
+    for (const auto& x : p) lo = std::min(lo, x[j]), hi = std::max(hi, x[j]);
+    const auto ju = static_cast<std::size_t>(j);
+    column_moves_[ju] = hi - lo > 1e-3 && owner_[ju] >= 0;
+    if (!column_moves_[ju]) continue;
+    std::vector<Eigen::Vector3d> dx(nc), dv(nc);
+    for (std::size_t k = 0; k < nc; ++k) dx[k] = Eigen::Vector3d::Constant(p[k][j] * kUnitE), dv[k] = Eigen::Vector3d::Constant(v[k][j] * kUnitE);
+    response_e_[ju] = respond(dx, dv, -1, kUnitE);
+  }
+  {
+    std::vector<Eigen::Vector3d> dx(nc), dv(nc);
+    for (std::size_t k = 0; k < nc; ++k) dx[k] = v[k] * kUnitTau, dv[k] = acc[k] * kUnitTau;
+    response_timing_ = respond(dx, dv, -1, kUnitTau);
+  }
+  if (have_temp) {
+    // α_b of 1 µg/°C: a bias (T − T_rest)·1 µg, integrated twice (trapezoid on the coarse grid).
+    const double unit_mps2 = 1e-6 * in.g_mps2;
+    for (int s = 0; s < 2; ++s) {
+      std::vector<Eigen::Vector3d> dx(nc, Eigen::Vector3d::Zero()), dv(nc, Eigen::Vector3d::Zero());
+      for (std::size_t k = 1; k < nc; ++k) {
+        const double dt = static_cast<double>(coarse_.sample_index[k] - coarse_.sample_index[k - 1]) / in.fs_hz;
+        const double a0 = temp[k - 1][s] * unit_mps2 * 1000.0, a1 = temp[k][s] * unit_mps2 * 1000.0;  // mm/s²
+        dv[k] = dv[k - 1] + Eigen::Vector3d::Constant(0.5 * (a0 + a1) * dt);
+        dx[k] = dx[k - 1] + 0.5 * (dv[k - 1] + dv[k]) * dt;
+      }
+      response_tc_[static_cast<std::size_t>(s)] = respond(dx, dv, -1, 1.0);
+    }
+  }
+  if (coarse_.schedule.cupt) {
+    std::set<int> strips;
+    for (const auto& f : coarse_.schedule.fixes) strips.insert(f.strip);
+    for (int s : strips) {
+      if (s < 0) continue;
+      if (response_strip_.size() <= static_cast<std::size_t>(s)) response_strip_.resize(static_cast<std::size_t>(s) + 1);
+      // The strip reads 1 µm too far: the (error-free) trace is pulled towards it.
+      response_strip_[static_cast<std::size_t>(s)] = respond(zero, zero, s, 1.0);
+    }
+  }
+  model_factor_ = draw_factor(in.model_covariance.covariance);
+}
+
+// One realisation of the integration's error after the pipeline's smoother (per coarse
+// sample, µm): the error simulated with the truth model, the supports' observations of it
+// with their own errors, the smoother with the pipeline's model subtracting its estimate.
+std::vector<Eigen::Vector3d> ErrorField::noise_draw(std::mt19937_64& rng) const {
+  namespace sf = fusion::schedule_flag;
+  std::normal_distribution<double> g;
+  const std::size_t nc = coarse_.sample_index.size();
+  const auto& flags = coarse_.schedule.flags;
+  std::vector<Eigen::Vector3d> ex(nc), ev(nc), eb(nc);
+  const fusion::Mat3 p0 = fusion::initial_covariance(truth_, 0.0);
+  for (int a = 0; a < 3; ++a) {
+    fusion::Vec3 e(0.0, std::sqrt(p0(1, 1)) * g(rng), std::hypot(start_bias_sigma_[a], truth_.bias_step_um_s2) * g(rng));
+    fusion::Discrete d;
+    std::int64_t last_gap = 0;
+    Eigen::LLT<fusion::Mat3> llt;
+    for (std::size_t k = 0; k < nc; ++k) {
+      if (k > 0) {
+        const std::int64_t gap = coarse_.sample_index[k] - coarse_.sample_index[k - 1];
+        if (gap != last_gap) {
+          d = fusion::discretise(truth_, static_cast<double>(gap) / fs_hz_);
+          llt.compute(d.Q + 1e-18 * fusion::Mat3::Identity());
+          last_gap = gap;
+        }
+        e = d.F * e + llt.matrixL() * fusion::Vec3(g(rng), g(rng), g(rng));
+        if (flags[k] & sf::move_start) e[2] += truth_.bias_step_um_s2 * g(rng);
+      }
+      ex[k][a] = e[0], ev[k][a] = e[1], eb[k][a] = e[2];
+    }
+  }
+  // What the pipeline integrated (the error: the motion itself is known) and saw at the supports.
+  std::vector<Eigen::Vector3d> pos(nc), vel(nc);
+  for (std::size_t k = 0; k < nc; ++k) {
+    pos[k] = ex[k] / 1000.0;
+    Eigen::Vector3d v = ev[k];
+    // A standstill's true velocity is not exactly zero, a held axis' not either.
+    const double s = flags[k] & sf::rest ? std::max(0.0, static_cast<double>(coarse_.schedule.zupt_sigma_um_s[k])) : coarse_.model.nbs_sigma_um_s;
+    for (int a = 0; a < 3; ++a) v[a] += s * g(rng);
+    vel[k] = v / 1000.0;
+  }
+  fusion::SupportSchedule sched = coarse_.schedule;
+  for (std::size_t i = 0; i < sched.fixes.size(); ++i) sched.fixes[i].position_um = coarse_.fix_noise_um[i] * g(rng);
+  for (auto& m : sched.velocity_means)
+    for (int a = 0; a < 3; ++a) m.mean_um_s[a] = ev[m.k][a] - m.lag_s * eb[m.k][a] + m.sigma_um_s * g(rng);
+  fusion::SmootherInput si;
+  si.sample_index = &coarse_.sample_index;
+  si.vel_mm_s = &vel;
+  si.pos_mm = &pos;
+  si.schedule = &sched;
+  si.fs_hz = fs_hz_;
+  si.model = coarse_.model;
+  si.start_bias_sigma_um_s2 = start_bias_sigma_;
+  const fusion::SmootherOutput out = fusion::smooth(si);
+  std::vector<Eigen::Vector3d> r(nc);
+  for (std::size_t k = 0; k < nc; ++k) r[k] = ex[k] - out.dx_um[k];
+  return r;
+}
+
+void ErrorField::draw(std::mt19937_64& rng, const std::vector<double>& at_pos, std::vector<Eigen::Vector3d>& error_um) const {
+  std::normal_distribution<double> g;
+  const std::vector<Eigen::Vector3d> noise = noise_draw(rng);
+  Eigen::VectorXd z(kModelParameters);
+  for (int i = 0; i < kModelParameters; ++i) z[i] = g(rng);
+  const Eigen::VectorXd theta = model_factor_ * z;
+  std::vector<double> offsets(response_strip_.size());
+  for (auto& o : offsets) o = strip_sigma_um_ * g(rng);
+
+  error_um.resize(at_pos.size());
+  for (std::size_t e = 0; e < at_pos.size(); ++e) {
+    const double c = coarse_position(at_pos[e]);
+    Eigen::Vector3d err = at(noise, c);
+    for (int j = 0; j < 3; ++j) {
+      const auto ju = static_cast<std::size_t>(j);
+      if (!column_moves_[ju]) continue;
+      const Eigen::Vector3d r = at(response_e_[ju], c);
+      for (int i = 0; i < 3; ++i) err[i] += theta[error_index(owner_[ju], i, j)] * r[i];
+    }
+    const Eigen::Vector3d rt = at(response_timing_, c);
+    for (int i = 0; i < 3; ++i) {
+      const int s = owner_[static_cast<std::size_t>(i)];
+      err[i] += ((s >= 0 ? theta[damping_index(s)] : 0.0) + theta[kDelayIndex]) * rt[i];
+    }
+    for (int s = 0; s < 2; ++s) {
+      if (response_tc_[static_cast<std::size_t>(s)].empty()) continue;
+      const Eigen::Vector3d r = at(response_tc_[static_cast<std::size_t>(s)], c);
+      for (int i = 0; i < 3; ++i) err[i] += theta[tc_bias_index(s, i)] * r[i];
+    }
+    for (std::size_t s = 0; s < response_strip_.size(); ++s)
+      if (!response_strip_[s].empty()) err += offsets[s] * at(response_strip_[s], c);
+    error_um[e] = err;
+  }
+}
+
+}  // namespace eical::dsp::uncertainty

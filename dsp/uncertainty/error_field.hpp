@@ -1,0 +1,82 @@
+#pragma once
+// What the measured relative path may be off by, as random draws for the uncertainty of
+// every figure (GUM supplement 1: propagation of distributions). Three sources:
+//   * the sensors' noise and bias walk between the supports. A draw simulates the error of
+//     the integration with the noise and bias walk the data sheet allows (DatasheetNoise,
+//     which may exceed what the fusion assumes), the supports' own errors (a standstill's
+//     residual velocity, a strip's noise), and runs the pipeline's own smoother over it:
+//     what the smoother leaves is one realisation of the path's error — also where the
+//     fusion's model is not the truth (a simulation smoother for a mismatched model);
+//   * the sensor model (sensor_model_covariance.hpp): each parameter's effect on the path,
+//     E·Δx, c1·v, delay·v, α_b·ΔT, and a PSD strip's own offset, after the supports took
+//     out what they see of it — the smoother is linear, so this is one pass per parameter
+//     group over the path's own motion; a draw weighs them with parameters drawn from
+//     the model's covariance;
+//   * the reference points' noise: in the first (each fix with its strip's noise) and as
+//     the strips' offsets in the second.
+// Everything runs on a coarse grid (coarse_schedule.hpp) in the sensors' time base and is
+// interpolated onto the set-point's (the pipeline's delay alignment) where it is asked for.
+// Draws are seeded and deterministic.
+#include "dsp/fusion/error_model.hpp"
+#include "dsp/fusion/support_schedule.hpp"
+#include "dsp/uncertainty/coarse_schedule.hpp"
+#include "dsp/uncertainty/sensor_model_covariance.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+namespace eical::dsp::uncertainty {
+
+struct ErrorFieldInput {
+  const fusion::SupportSchedule* schedule = nullptr;       // as the pipeline used it (sensor time)
+  const std::vector<std::int64_t>* sample_index = nullptr;
+  const std::vector<Eigen::Vector3d>* pos_mm = nullptr;    // the measured path, aligned to the set-point
+  const std::vector<Eigen::Vector3d>* vel_mm_s = nullptr;
+  const std::vector<Eigen::Vector2d>* temp_c = nullptr;    // case temperature of table, head per trace sample (optional)
+  double fs_hz = 10000.0;
+  double delay_samples = 0.0;        // aligned position = sensor position − delay
+  fusion::ErrorModel model;          // the pipeline's fusion model
+  Eigen::Vector3d start_bias_sigma_um_s2 = Eigen::Vector3d::Constant(20.0);
+  double sensor_noise_ug_per_rthz[2] = {0.4, 0.4};  // the data sheet's, per sensor
+  double g_mps2 = 9.81;
+  DatasheetNoise noise;
+  SensorModelCovariance model_covariance;
+  std::array<int, 3> owner{0, 0, 1};  // the sensor that carries each axis (−1: none)
+  std::size_t max_coarse = 4000;      // coarse samples of the smoother passes
+};
+
+class ErrorField {
+ public:
+  explicit ErrorField(const ErrorFieldInput& input);
+
+  // One draw of the path's error (µm per axis) at aligned trace positions (fractional
+  // allowed).
+  void draw(std::mt19937_64& rng, const std::vector<double>& at, std::vector<Eigen::Vector3d>& error_um) const;
+
+  [[nodiscard]] std::size_t coarse_samples() const noexcept { return coarse_.sample_index.size(); }
+
+ private:
+  [[nodiscard]] double coarse_position(double at) const;
+  [[nodiscard]] std::vector<Eigen::Vector3d> noise_draw(std::mt19937_64& rng) const;
+
+  CoarseSchedule coarse_;
+  double delay_ = 0.0, fs_hz_ = 10000.0;
+  fusion::ErrorModel truth_;            // what the draws simulate
+  Eigen::Vector3d start_bias_sigma_ = Eigen::Vector3d::Zero();
+  // Model responses per coarse sample, µm per unit parameter: per column j of E (all rows
+  // i at once), the timing term (v·τ), per sensor its α_b, per PSD strip its offset.
+  std::array<std::vector<Eigen::Vector3d>, 3> response_e_;
+  std::array<bool, 3> column_moves_{false, false, false};
+  std::vector<Eigen::Vector3d> response_timing_;
+  std::array<std::vector<Eigen::Vector3d>, 2> response_tc_;
+  std::vector<std::vector<Eigen::Vector3d>> response_strip_;
+  std::array<int, 3> owner_{0, 0, 1};
+  Eigen::MatrixXd model_factor_;  // θ = F z
+  double strip_sigma_um_ = 0.0;
+};
+
+}  // namespace eical::dsp::uncertainty

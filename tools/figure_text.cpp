@@ -1,0 +1,46 @@
+#include "tools/figure_text.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace eical::tools {
+
+std::string figure_unit(const std::string& key) {
+  for (const auto& [suffix, unit] : std::initializer_list<std::pair<const char*, const char*>>{
+           {"_um", "µm"}, {"_ms", "ms"}, {"_urad", "µrad"}, {"_ppm", "ppm"}, {"_s", "s"}, {"_mm", "mm"}}) {
+    const std::string s = suffix;
+    if (key.size() > s.size() && key.compare(key.size() - s.size(), s.size(), s) == 0) return unit;
+  }
+  return "";
+}
+
+std::string figure_label(const std::string& key) {
+  std::string k = key.substr(key.find('.') + 1);
+  for (const char* suffix : {"_um", "_ms", "_urad", "_ppm", "_s", "_mm"}) {
+    const std::string s = suffix;
+    if (k.size() > s.size() && k.compare(k.size() - s.size(), s.size(), s) == 0) {
+      k.resize(k.size() - s.size());
+      break;
+    }
+  }
+  for (auto& c : k)
+    if (c == '_' || c == '.') c = ' ';
+  return k;
+}
+
+std::string value_with_u(double v, std::optional<double> u, const std::string& unit) {
+  const double scale = std::max(std::abs(v), u ? *u : 0.0);
+  const int d = scale >= 1000.0 ? 0 : scale >= 100.0 ? 1 : scale >= 0.1 ? 2 : 3;
+  char b[96];
+  if (u && std::isfinite(*u)) std::snprintf(b, sizeof b, "%.*f ± %.*f %s", d, v, d, *u, unit.c_str());
+  else std::snprintf(b, sizeof b, "%.*f %s ± ?", d, v, unit.c_str());
+  return b;
+}
+
+std::optional<double> figure_u(const dsp::Analysis& a, const std::string& key, std::size_t i) {
+  const auto it = a.uncertainty_k2.find(key);
+  if (it == a.uncertainty_k2.end() || i >= it->second.size() || !std::isfinite(it->second[i])) return std::nullopt;
+  return it->second[i];
+}
+
+}  // namespace eical::tools

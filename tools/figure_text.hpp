@@ -1,0 +1,22 @@
+#pragma once
+// Figures as a person reads them: "circular deviation G   2.80 ± 1.10 µm", "not resolved"
+// when a figure is not above its uncertainty (dsp/uncertainty/resolved.hpp).
+#include "dsp/analysis/analyze_run.hpp"
+#include "dsp/analysis/figures.hpp"
+
+#include <optional>
+#include <string>
+
+namespace eical::tools {
+
+// "circle.circular_deviation_G_um" → "circular deviation G"; its unit ("µm", "ms", …).
+std::string figure_label(const std::string& key);
+std::string figure_unit(const std::string& key);
+
+// "2.80 ± 1.10 µm", or "2.80 µm ± ?" without an uncertainty; decimals by the unit.
+std::string value_with_u(double value, std::optional<double> u_k2, const std::string& unit);
+
+// U of element `i` of a figure, when estimated.
+std::optional<double> figure_u(const dsp::Analysis& a, const std::string& key, std::size_t i = 0);
+
+}  // namespace eical::tools

@@ -1,0 +1,267 @@
+#include "tools/plan/test_plan.hpp"
+
+#include "dsp/analysis/verdict.hpp"
+#include "dsp/core/error.hpp"
+#include "dsp/identify/sensor_identification.hpp"
+#include "sim/hidden/hidden_effects.hpp"
+#include "sim/simulate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace eical::tools::plan {
+
+std::vector<TestProgram> geometric_variants(const TestProgram& p);
+
+namespace {
+
+std::string g(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
+
+// The largest feed a variant may ask for: 20 m/min and 2 m/s² of centripetal acceleration.
+double feed_cap(const TestProgram& p) {
+  double f = 20000.0;
+  if (p.kind == "circle") f = std::min(f, std::sqrt(2000.0 * p.radius_mm) * 60.0);
+  return f;
+}
+
+}  // namespace
+
+std::string describe(const TestProgram& p) {
+  std::string s;
+  if (p.kind == "circle") {
+    s = "circle R" + g(p.radius_mm) + " F" + g(p.feed_mm_min) + " " + p.direction + " x" + std::to_string(p.repeats) + " in " + p.plane;
+    if (p.arc_deg < 360.0) s += ", " + g(p.arc_deg) + " deg arc";
+  } else if (p.kind == "positioning") {
+    s = "positioning x " + g(p.targets_mm.front()) + ".." + g(p.targets_mm.back()) + " mm, " + std::to_string(p.targets_mm.size()) + " targets, " +
+        std::to_string(p.runs) + " runs, F" + g(p.feed_mm_min);
+  } else if (p.kind == "step") {
+    s = "step x " + g(p.from_mm) + " -> " + g(p.to_mm) + " mm, " + std::to_string(p.runs) + " pairs, F" + g(p.feed_mm_min);
+  } else {
+    s = "rectangle " + g(p.size_mm[0]) + " x " + g(p.size_mm[1]) + " mm in " + p.plane + ", F" + g(p.feed_mm_min);
+  }
+  s += p.psd.empty() ? ", no PSD strips" : ", " + std::to_string(p.psd.size()) + " PSD strip" + (p.psd.size() > 1 ? "s" : "");
+  if (p.identified) s += ", sensors identified on site first (eical gen-nc identify, eical identify)";
+  return s;
+}
+
+std::vector<dsp::PsdSpec> strips_for(const TestProgram& p) {
+  if (p.kind == "circle") return sim::psd_config_b(p.radius_mm);
+  dsp::PsdSpec x;
+  x.measures = "x";
+  if (p.kind == "step") {
+    x.center_mm[0] = 0.5 * (p.from_mm + p.to_mm);
+    return {x};
+  }
+  if (p.kind == "positioning") {
+    x.center_mm[0] = 0.5 * (p.targets_mm.front() + p.targets_mm.back());
+    return {x};
+  }
+  dsp::PsdSpec y;  // rectangle from the origin: the middle of its first two sides
+  y.measures = "y";
+  x.center_mm[0] = 0.5 * p.size_mm[0], x.center_mm[1] = 0.0;
+  y.center_mm[0] = p.size_mm[0], y.center_mm[1] = 0.5 * p.size_mm[1];
+  return {x, y};
+}
+
+TestProgram program_of(const dsp::RunMeta& m) {
+  TestProgram p;
+  const auto& q = m.program;
+  p.kind = q.kind;
+  p.plane = q.plane, p.direction = q.direction;
+  p.radius_mm = q.radius_mm, p.feed_mm_min = q.feed_mm_min, p.arc_deg = q.arc_deg;
+  p.repeats = std::max(1, q.repeats);
+  if (!q.targets_mm.empty()) p.targets_mm = q.targets_mm;
+  p.runs = std::max(1, q.runs);
+  if (q.kind == "step" && q.targets_mm.size() >= 2) p.from_mm = q.targets_mm[0], p.to_mm = q.targets_mm[1];
+  p.size_mm[0] = q.size_mm[0] > 0.0 ? q.size_mm[0] : 50.0, p.size_mm[1] = q.size_mm[1] > 0.0 ? q.size_mm[1] : 50.0;
+  p.psd = m.psd;
+  p.noise_ug_per_rthz = std::hypot(m.sensors[0].noise_ug_per_rthz, m.sensors[1].noise_ug_per_rthz) / std::sqrt(2.0);
+  p.fs_hz = m.acquisition.fs_hz;
+  return p;
+}
+
+sim::Scenario scenario_of(const TestProgram& p, std::uint64_t seed) {
+  sim::Scenario sc;
+  if (p.kind == "circle") {
+    sc = sim::circle_scenario(p.radius_mm, p.feed_mm_min, p.repeats, p.direction, seed);
+    sc.meta.program.plane = p.plane;
+    sc.meta.program.arc_deg = p.arc_deg;
+  } else if (p.kind == "step") {
+    sc = sim::step_scenario(p.from_mm, p.to_mm, p.feed_mm_min, p.runs, seed);
+  } else if (p.kind == "positioning") {
+    sc = sim::positioning_scenario(p.targets_mm, p.runs, p.feed_mm_min, seed);
+  } else if (p.kind == "rectangle") {
+    sc = sim::rectangle_scenario(p.size_mm[0], p.size_mm[1], p.feed_mm_min, p.plane, std::max(1, p.repeats), seed);
+  } else {
+    throw dsp::InputError("plan: program kind '" + p.kind + "' (circle, positioning, step or rectangle)");
+  }
+  sc.meta.psd = p.psd;
+  sc.meta.acquisition.fs_hz = p.fs_hz;
+  for (auto& t : sc.truth) t.spec.noise_ug_per_rthz = p.noise_ug_per_rthz;
+  for (auto& s : sc.meta.sensors) s.noise_ug_per_rthz = p.noise_ug_per_rthz;
+  return sc;
+}
+
+sim::Scenario scenario_on_drawn_machine(const TestProgram& p, std::uint64_t seed) {
+  sim::Scenario sc = scenario_of(p, seed);
+  const sim::Scenario bg = sim::hidden_effect_scenario({}, p.kind == "circle" ? "circle" : "step", seed);
+  sc.meta.site = bg.meta.site;
+  sc.meta.machine = bg.meta.machine;
+  for (int s = 0; s < 2; ++s) {
+    sc.truth[s] = bg.truth[s];
+    sc.truth[s].spec.noise_ug_per_rthz = p.noise_ug_per_rthz * bg.truth[s].spec.noise_ug_per_rthz / bg.meta.sensors[s].noise_ug_per_rthz;
+  }
+  sc.daq = bg.daq;
+  sc.machine = bg.machine;
+  sc.coriolis = bg.coriolis;
+  sc.psd.assign(sc.meta.psd.size(), bg.psd.empty() ? sim::PsdTruth{} : bg.psd.front());
+  return sc;
+}
+
+sim::Scenario identification_scenario(const TestProgram& p, std::uint64_t seed) {
+  sim::Scenario sc = sim::identify_scenario(sim::psd_config_b(10.0), {"z"}, seed);
+  sc.meta.acquisition.fs_hz = p.fs_hz;
+  for (auto& t : sc.truth) t.spec.noise_ug_per_rthz = p.noise_ug_per_rthz;
+  for (auto& s : sc.meta.sensors) s.noise_ug_per_rthz = p.noise_ug_per_rthz;
+  return sc;
+}
+
+dsp::uncertainty::SensorModelCovariance typical_identification(const TestProgram& p) {
+  sim::Scenario sc = identification_scenario(p, 1);
+  return dsp::identify::identify_sensors(sim::simulate(sc)).covariance;
+}
+
+double duration_s(const dsp::Run& run) {
+  return run.frames.empty() ? 0.0 : static_cast<double>(run.frames.back().sample_index - run.frames.front().sample_index) / run.fs_hz();
+}
+
+Prediction predict(const TestProgram& p, std::uint64_t seed, int draws, const std::optional<dsp::uncertainty::SensorModelCovariance>& identified) {
+  const dsp::Run run = sim::simulate(scenario_of(p, seed));
+  dsp::AnalysisOptions o;
+  o.uncertainty.draws = draws;
+  if (p.identified) {
+    o.model_covariance = identified ? *identified : typical_identification(p);
+    o.sensor_model = "psd";
+  }
+  const dsp::Analysis a = dsp::analyze_run(run, o);
+  Prediction r;
+  r.program = p;
+  r.duration_s = duration_s(run);
+  for (const auto& [k, u] : a.uncertainty_k2)
+    if (u.size() == 1 && std::isfinite(u[0])) r.u_k2[k] = u[0];
+  if (const dsp::ResolutionLimit* lim = dsp::resolution_limit(p.kind)) {
+    r.headline = lim->headline, r.limited = lim->limited, r.limit = lim->limit;
+    const auto it = r.u_k2.find(lim->limited);
+    r.limited_u = it != r.u_k2.end() ? it->second : std::numeric_limits<double>::quiet_NaN();
+    r.measurable = it != r.u_k2.end() && it->second <= lim->limit;
+  }
+  return r;
+}
+
+std::vector<TestProgram> variants(const TestProgram& p) {
+  std::vector<TestProgram> v = geometric_variants(p);
+  if (!p.identified) {
+    TestProgram same = p;
+    same.identified = true;
+    std::vector<TestProgram> with_id{same};
+    for (TestProgram t : v) t.identified = true, with_id.push_back(t);
+    v.insert(v.end(), with_id.begin(), with_id.end());
+  }
+  return v;
+}
+
+std::vector<TestProgram> geometric_variants(const TestProgram& p) {
+  std::vector<TestProgram> v;
+  TestProgram s = p;
+  if (s.psd.empty()) {
+    s.psd = strips_for(s);
+    v.push_back(s);
+  }
+  const double cap = feed_cap(s);
+  for (double f : {2.0, 4.0}) {
+    TestProgram t = s;
+    t.feed_mm_min = std::min(cap, s.feed_mm_min * f);
+    if (t.feed_mm_min > s.feed_mm_min * 1.2) v.push_back(t);
+  }
+  if (p.kind == "circle") {
+    for (double r : {p.radius_mm / 3.0, 10.0}) {
+      TestProgram t = s;
+      t.radius_mm = std::max(10.0, std::round(r));
+      if (t.radius_mm >= p.radius_mm) continue;
+      t.feed_mm_min = std::min(s.feed_mm_min, feed_cap(t));
+      if (r == 10.0) t.feed_mm_min = 2500.0, t.repeats = std::min(t.repeats, 5);  // the thesis' circular test
+      t.psd = strips_for(t);
+      v.push_back(t);
+    }
+  } else if (p.kind == "step" || p.kind == "positioning") {
+    TestProgram t = s;
+    if (p.kind == "step") t.to_mm = t.from_mm + 0.5 * (t.to_mm - t.from_mm);
+    else
+      for (auto& x : t.targets_mm) x = t.targets_mm.front() + 0.5 * (x - t.targets_mm.front());
+    t.psd = strips_for(t);
+    v.push_back(t);
+  } else if (p.kind == "rectangle") {
+    TestProgram t = s;
+    t.size_mm[0] *= 0.5, t.size_mm[1] *= 0.5;
+    t.psd = strips_for(t);
+    v.push_back(t);
+  }
+  return v;
+}
+
+std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_duration_s, int draws) {
+  std::optional<dsp::uncertainty::SensorModelCovariance> identified;  // one simulated identification for all variants
+  for (const TestProgram& t : variants(p)) {
+    // A rough duration first (the set-point's time), so that long variants are not simulated.
+    double path_mm = 0.0;
+    if (t.kind == "circle") path_mm = 2.0 * 3.14159265358979 * t.radius_mm * t.arc_deg / 360.0 * t.repeats * (t.direction == "both" ? 2 : 1);
+    else if (t.kind == "step") path_mm = 2.0 * std::abs(t.to_mm - t.from_mm) * t.runs;
+    else if (t.kind == "positioning") path_mm = 2.0 * std::abs(t.targets_mm.back() - t.targets_mm.front()) * t.runs;
+    else path_mm = 2.0 * (t.size_mm[0] + t.size_mm[1]) * std::max(1, t.repeats);
+    if (path_mm / (t.feed_mm_min / 60.0) > max_duration_s) continue;
+    if (t.identified && !identified) identified = typical_identification(t);
+    Prediction r = predict(t, 1, draws, identified);
+    if (r.measurable) return r;
+  }
+  return std::nullopt;
+}
+
+}  // namespace eical::tools::plan
+
+namespace eical::tools::plan {
+
+void suggest_measurable_test(const dsp::Run& run, dsp::Analysis& a) {
+  const dsp::ResolutionLimit* lim = dsp::resolution_limit(run.meta.program.kind);
+  if (!lim) return;
+  if (a.measurement.supports.psd_disagrees)
+    a.verdict_reasons.push_back("the PSD readings disagree with the data sheet's sensor model: identify the sensors (eical gen-nc identify, eical identify)");
+  const auto it = a.uncertainty_k2.find(lim->limited);
+  if (it == a.uncertainty_k2.end() || it->second.size() != 1 || !(it->second[0] > lim->limit)) {
+    a.verdict_reasons.push_back("the test resolves what it is meant to: the machine's figure is within the test's uncertainty");
+    return;
+  }
+  TestProgram p;
+  try {
+    p = program_of(run.meta);
+    p.identified = a.sensor_model != "datasheet";
+    (void)scenario_of(p, 1);  // a kind plan knows
+  } catch (const std::exception&) {
+    return;
+  }
+  char b[256];
+  if (const auto best = nearest_measurable(p, 30.0, 60)) {
+    std::snprintf(b, sizeof b, "a test that would be measurable (eical plan): %s, predicted U(%s) = %.2f µm", describe(best->program).c_str(),
+                  lim->limited_name, best->limited_u);
+    a.verdict_reasons.push_back(b);
+  } else {
+    a.verdict_reasons.push_back("no nearby variant of this test is measurable (eical plan lists what was tried)");
+  }
+}
+
+}  // namespace eical::tools::plan

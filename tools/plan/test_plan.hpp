@@ -1,0 +1,89 @@
+#pragma once
+// `eical plan`: the uncertainty a test will have, before anything moves. The error
+// covariance of a measurement depends on its schedule of supports (standstills, strip
+// crossings, held axes), the sensors' noise, the DAQ and the sensor model — not on the
+// machine's errors — so a simulation of the program on an ideal machine with the given
+// sensors, DAQ and PSD strips, analysed like a real run, predicts the U of every figure
+// (dsp/analysis/figure_uncertainty.hpp). A program whose headline uncertainty exceeds what
+// the test is meant to resolve (dsp/analysis/verdict.hpp) gets the nearest variant that
+// does not: strips added, a higher feed (shorter gaps between the supports), a smaller
+// radius or travel, down to the thesis' test.
+#include "dsp/analysis/analyze_run.hpp"
+#include "dsp/core/run_meta.hpp"
+#include "sim/scenario.hpp"
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace eical::tools::plan {
+
+struct TestProgram {
+  std::string kind = "circle";   // circle | positioning | step | rectangle
+  std::string plane = "xy", direction = "ccw";
+  double radius_mm = 10.0, feed_mm_min = 2500.0, arc_deg = 360.0;
+  int repeats = 5;                                   // circle revolutions, rectangle laps
+  std::vector<double> targets_mm{0.0, 10.0, 20.0, 30.0, 40.0};  // positioning
+  int runs = 5;                                      // positioning runs, step pairs
+  double from_mm = 0.0, to_mm = 50.0;                // step
+  double size_mm[2] = {50.0, 50.0};                  // rectangle
+  std::vector<dsp::PsdSpec> psd;                     // the strips on the machine
+  double noise_ug_per_rthz = 0.4;                    // each sensor, two-sided
+  double fs_hz = 10000.0;                            // the DAQ's rate
+  bool identified = false;                           // sensors identified on site first (eical identify)
+};
+
+// "circle R10 F2500 ccw ×5 in xy, 2 PSD strips".
+std::string describe(const TestProgram& p);
+// Strips for the program: configuration B about a circle, one at mid travel of a 1-D
+// test, one per side's middle of a rectangle.
+std::vector<dsp::PsdSpec> strips_for(const TestProgram& p);
+// The program a recorded run ran (for analyze's suggestion).
+TestProgram program_of(const dsp::RunMeta& meta);
+// The simulated run of a program on an ideal machine with data-sheet sensors.
+sim::Scenario scenario_of(const TestProgram& p, std::uint64_t seed);
+// The same program on a machine drawn within the data sheet's tolerances (the background of
+// `eical simulate --background` for that seed: sensors, small machine errors, Earth rate).
+sim::Scenario scenario_on_drawn_machine(const TestProgram& p, std::uint64_t seed);
+// The identification program (eical gen-nc identify) over PSD configuration B of a R10
+// circle, with the program's sensors and DAQ: how a machine's sensors are identified on site.
+sim::Scenario identification_scenario(const TestProgram& p, std::uint64_t seed);
+// What that identification leaves the sensor model uncertain by (simulated on data-sheet
+// sensors): the covariance a calibration would carry.
+dsp::uncertainty::SensorModelCovariance typical_identification(const TestProgram& p);
+// Seconds the program runs (from the simulation's set-point).
+double duration_s(const dsp::Run& run);
+
+struct Prediction {
+  TestProgram program;
+  std::map<std::string, double> u_k2;  // scalar figures
+  std::string headline, limited;       // result keys (verdict.hpp)
+  double limited_u = 0.0, limit = 0.0;
+  bool measurable = false;             // U(limited) within what the test is meant to resolve
+  double duration_s = 0.0;
+};
+
+// Simulates and analyses the program; `draws` Monte Carlo draws. With p.identified the
+// sensor model's covariance is `identified` (or typical_identification(p) when not given).
+Prediction predict(const TestProgram& p, std::uint64_t seed = 1, int draws = 100,
+                   const std::optional<dsp::uncertainty::SensorModelCovariance>& identified = std::nullopt);
+
+// The nearest variants of a program, nearest first (the program itself not included): the
+// test's own changes with the sensors as they are, then the same after an identification.
+std::vector<TestProgram> variants(const TestProgram& p);
+
+// The first variant (nearest first) whose predicted U is within the limit; variants that
+// run longer than `max_duration_s` are not tried. nullopt when none is.
+std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_duration_s = 60.0, int draws = 60);
+
+}  // namespace eical::tools::plan
+
+namespace eical::tools::plan {
+
+// For a run whose verdict is not_measurable: the nearest measurable test, or why none is
+// proposed, appended to its verdict reasons.
+void suggest_measurable_test(const dsp::Run& run, dsp::Analysis& a);
+
+}  // namespace eical::tools::plan

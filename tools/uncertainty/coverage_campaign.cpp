@@ -1,0 +1,139 @@
+#include "tools/uncertainty/coverage_campaign.hpp"
+
+#include "drivers/run_io/run_writer.hpp"
+#include "dsp/analysis/analyze_run.hpp"
+#include "dsp/analysis/figures.hpp"
+#include "sim/hidden/hidden_effects.hpp"
+#include "sim/simulate.hpp"
+#include "tools/plan/test_plan.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+
+namespace eical::tools::uncertainty {
+namespace {
+
+sim::Scenario scenario(const std::string& program, std::uint64_t seed) {
+  if (program == "circle" || program == "step") return sim::hidden_effect_scenario({}, program, seed);
+  plan::TestProgram p;
+  p.kind = program;
+  if (program == "positioning") p.targets_mm = {0.0, 10.0, 20.0, 30.0}, p.runs = 3, p.feed_mm_min = 3000.0;
+  else p.size_mm[0] = 40.0, p.size_mm[1] = 30.0, p.feed_mm_min = 4000.0;
+  p.psd = plan::strips_for(p);
+  sim::Scenario sc = plan::scenario_on_drawn_machine(p, seed);
+  sc.meta.id = "coverage-" + program + "-s" + std::to_string(seed);
+  return sc;
+}
+
+void add(FigureCoverage& c, double err, double u) {
+  ++c.cases;
+  if (std::abs(err) <= u) ++c.covered;
+  c.u.push_back(u), c.abs_error.push_back(std::abs(err));
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+}  // namespace
+
+std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vector<Eigen::Vector3d>& truth, const dsp::Analysis& a) {
+  dsp::Analysis t;
+  t.measurement = a.measurement;
+  const std::int64_t first = run.frames.front().sample_index;
+  for (std::size_t k = 0; k < t.measurement.pos_mm.size(); ++k) {
+    const auto i = static_cast<std::size_t>(t.measurement.sample_index[k] - first);
+    if (i < truth.size()) t.measurement.pos_mm[k] = truth[i];
+  }
+  dsp::EvaluationOptions eo;
+  eo.reference = false;
+  if (a.diagnostics) eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
+  dsp::evaluate_program(run, t, eo);
+  return dsp::figures_of(t);
+}
+
+double FigureCoverage::median_u() const { return median(u); }
+
+double FigureCoverage::rms_error() const {
+  double ss = 0.0;
+  for (double e : abs_error) ss += e * e;
+  return abs_error.empty() ? std::numeric_limits<double>::quiet_NaN() : std::sqrt(ss / static_cast<double>(abs_error.size()));
+}
+
+const std::vector<std::string>& headline_keys() {
+  static const std::vector<std::string> keys = {
+      "circle.radius_mean_deviation_um", "circle.circular_deviation_G_um", "circle.radial_deviation_F_max_um",
+      "circle.radial_deviation_F_min_um", "step.end_position_error_um",     "positioning.A_um",
+      "positioning.E_um",                "positioning.M_um",                "positioning.B_um",
+      "rectangle.corner_error_max_um"};
+  return keys;
+}
+
+CampaignResult run_campaign(const CampaignOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  CampaignResult r;
+  r.headline.key = "headline figures, pooled";
+  for (const auto seed : o.seeds)
+    for (const auto& program : o.programs) {
+      const sim::Scenario sc = scenario(program, seed);
+      std::vector<Eigen::Vector3d> truth;
+      const dsp::Run run = sim::simulate(sc, &truth);
+      if (!o.write_runs.empty()) drivers::write_run(run, std::filesystem::path(o.write_runs) / sc.meta.id, {.gzip = false, .overwrite = true});
+      dsp::AnalysisOptions ao;
+      ao.coriolis = sc.coriolis;
+      ao.uncertainty.draws = o.draws;
+      ao.uncertainty.seed = seed;
+      const dsp::Analysis a = dsp::analyze_run(run, ao);
+      ++r.runs;
+      // The same evaluation of the true relative path.
+      const auto measured = dsp::figures_of(a), true_figs = true_figures(run, truth, a);
+      if (measured.empty()) {
+        r.failures.push_back(sc.meta.id + ": no figures (" + (a.flags.empty() ? std::string("?") : a.flags.front()) + ")");
+        continue;
+      }
+      for (const auto& f : measured) {
+        const dsp::FigureValue* tf = dsp::find_figure(true_figs, f.key);
+        const auto u = a.uncertainty_k2.find(f.key);
+        if (!tf || tf->values.size() != f.values.size() || u == a.uncertainty_k2.end() || u->second.size() != f.values.size()) continue;
+        FigureCoverage& c = r.figures[f.key];
+        c.key = f.key;
+        const bool headline = std::find(headline_keys().begin(), headline_keys().end(), f.key) != headline_keys().end();
+        for (std::size_t e = 0; e < f.values.size(); ++e) {
+          if (!std::isfinite(u->second[e])) continue;
+          const double err = f.values[e] - tf->values[e];
+          add(c, err, u->second[e]);
+          if (headline) add(r.headline, err, u->second[e]);
+        }
+      }
+    }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+std::string coverage_table(const CampaignResult& r) {
+  std::string o;
+  char b[256];
+  std::snprintf(b, sizeof b, "uncertainty coverage campaign: %zu runs, %.0f s\n", r.runs, r.seconds);
+  o += b;
+  std::snprintf(b, sizeof b, "  %-44s %6s %9s %11s %11s %8s\n", "figure", "cases", "coverage", "median U", "RMS error", "U/RMS");
+  o += b;
+  auto row = [&](const FigureCoverage& c, const char* mark) {
+    std::snprintf(b, sizeof b, "  %-44s %6zu %8.1f%% %11.3f %11.3f %8.2f%s\n", c.key.c_str(), c.cases, 100.0 * c.coverage(), c.median_u(), c.rms_error(),
+                  c.median_u() / c.rms_error(), mark);
+    o += b;
+  };
+  for (const auto& [k, c] : r.figures) row(c, std::find(headline_keys().begin(), headline_keys().end(), k) != headline_keys().end() ? "  *" : "");
+  row(r.headline, "  <- 90-99 %, U/RMS <= 3");
+  for (const auto& f : r.failures) o += "  failed: " + f + "\n";
+  o += "  (* headline figure; coverage: |measured - true| <= U; U/RMS: median U over the RMS error)\n";
+  return o;
+}
+
+}  // namespace eical::tools::uncertainty

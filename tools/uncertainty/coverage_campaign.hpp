@@ -1,0 +1,59 @@
+#pragma once
+// Is the uncertainty honest? A seeded campaign of simulated runs across programs, each on
+// a machine drawn within the data sheet's tolerances (the background of `eical simulate
+// --background`: sensors, small machine errors, Earth rate, PSD strips), analysed like a
+// real run; every figure is compared with the same evaluation of the simulator's true
+// relative path. A figure is covered when |measured − true| ≤ U. Honest means the
+// headline figures are covered in 90–99 % of the cases and U is not inflated: the median
+// U is at most 3× the RMS error (for a Gaussian error U = 2σ gives 95 % and a ratio of 2).
+//
+// Programs per seed: the background circle (R 8–15 mm, 2–3 m/min, 5 revolutions, PSD
+// configuration B), the background step (x 0 → 40–60 mm, 3 pairs, a strip at mid travel),
+// an ISO 230-2 cycle (x 0–30 mm, 4 targets, 3 runs, a strip at mid travel) and a rectangle
+// (40 × 30 mm at 4 m/min, a strip on each of its first two sides), all on that seed's
+// machine.
+#include "dsp/analysis/figures.hpp"
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace eical::tools::uncertainty {
+
+struct CampaignOptions {
+  std::vector<std::uint64_t> seeds{1, 2, 3};
+  std::vector<std::string> programs{"circle", "step", "positioning", "rectangle"};
+  int draws = 100;
+  std::string write_runs;  // a folder: every simulated run is written there (eical-run/1)
+};
+
+struct FigureCoverage {
+  std::string key;
+  std::size_t cases = 0, covered = 0;
+  std::vector<double> u, abs_error;  // per case
+  [[nodiscard]] double coverage() const { return cases ? static_cast<double>(covered) / static_cast<double>(cases) : 0.0; }
+  [[nodiscard]] double median_u() const;
+  [[nodiscard]] double rms_error() const;
+};
+
+struct CampaignResult {
+  std::size_t runs = 0;
+  std::vector<std::string> failures;          // runs that could not be analysed, why
+  std::map<std::string, FigureCoverage> figures;
+  FigureCoverage headline;                     // all headline figures pooled
+  double seconds = 0.0;
+};
+
+// The figures of the same evaluation of the simulator's true relative path (per frame).
+std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vector<Eigen::Vector3d>& truth, const dsp::Analysis& measured);
+
+// The headline figures of each program (the ones the campaign must cover).
+const std::vector<std::string>& headline_keys();
+
+CampaignResult run_campaign(const CampaignOptions& options);
+
+// The coverage table as bench_uncertainty prints it.
+std::string coverage_table(const CampaignResult& result);
+
+}  // namespace eical::tools::uncertainty
