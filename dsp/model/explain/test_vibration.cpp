@@ -79,7 +79,9 @@ void test_vibration(ExplainState& st) {
       std::string modes = res.evidence;  // "; a mode at …; a mode at …"
       if (modes.rfind("; ", 0) == 0) modes.erase(0, 2);
       res.evidence = k > 0 ? modes + "; " + ms.evidence : ms.evidence + ": no mode stands out";
-    } else if (k > 0) res.evidence = ms.evidence + ": the modes found are real relative motion of the two sensors (machine.differential_vibration)";
+    } else {
+      res.evidence = ms.evidence + (k > 0 ? ": the modes found are real relative motion of the two sensors (machine.differential_vibration)" : ": no mode stands out");
+    }
     all.push_back(c), all.push_back(d), all.push_back(res);
   }
 }
