@@ -1,7 +1,7 @@
 // eical plan against simulation (issue 16): per program the predicted U of its headline
 // figures beside the spread of the figures over repeats on machines drawn within the data
 // sheet's tolerances (tools/plan/plan_check.hpp).
-//   bench_plan [--repeats 20] [--draws 100]
+//   bench_plan [--repeats 20] [--draws 100] [--programs circle,...] [--datasheet]
 #include "tools/plan/plan_check.hpp"
 
 #include <CLI/CLI.hpp>
@@ -13,12 +13,14 @@ int main(int argc, char** argv) {
   CLI::App app("eical plan-vs-simulation benchmark");
   int repeats = 20, draws = 100;
   std::vector<std::string> only;
+  bool datasheet = false;
   app.add_option("--repeats", repeats, "simulated repeats per program");
   app.add_option("--draws", draws, "Monte Carlo draws of the prediction");
   app.add_option("--programs", only, "circle, step, positioning, rectangle (default: all)")->delimiter(',');
+  app.add_flag("--datasheet", datasheet, "the data sheet's sensor model instead of an identification before each test");
   CLI11_PARSE(app, argc, argv);
   std::vector<eical::tools::plan::CheckRow> rows;
-  for (const auto& p : eical::tools::plan::check_programs()) {
+  for (const auto& p : eical::tools::plan::check_programs(!datasheet)) {
     if (!only.empty() && std::find(only.begin(), only.end(), p.kind) == only.end()) continue;
     const auto r = eical::tools::plan::check_plan(p, repeats, draws);
     rows.insert(rows.end(), r.begin(), r.end());

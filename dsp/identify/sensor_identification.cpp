@@ -273,10 +273,9 @@ void apply_sensor(const Eigen::Matrix3d& e, double damping_s, SensorSpec& spec) 
 }
 
 // Strip crossings (runs of lit samples of one strip) and the set-point's speed along the
-// strip at each; distinct speeds differ by more than 25 %. Throws when there are strips but
-// no two speeds: scale (∝ distance) and 2ζ/ω0 (∝ speed) are then confounded at the strips.
+// strip at each; distinct speeds differ by more than 25 %. Throws when there are no two
+// speeds: scale (∝ distance) and 2ζ/ω0 (∝ speed) are then confounded at the strips.
 void check_crossings(const Measurement& m, const RunMeta& meta, Identification& id) {
-  if (meta.psd.empty()) return;
   const auto& fixes = m.raw.schedule.fixes;
   const double fs = m.fs_hz;
   const auto gap = static_cast<std::size_t>(std::max(1.0, 0.05 * fs));
@@ -318,10 +317,11 @@ void check_crossings(const Measurement& m, const RunMeta& meta, Identification& 
 // The identification's covariance in the layout of sensor_model_covariance.hpp: per axis i
 // the block of its filter's E_ij (the row's terms are fitted together), the damping and
 // delay variances; the data sheet's (diagonal) where nothing was fitted. The filter's σ
-// does not see what its model leaves out (the strips' nonlinearity, the bias following the
-// case temperature, the sensors' second-order terms): against the simulator's truth on 12
-// machines drawn within the data sheet the scale terms erred by 1.46 σ rms, the cross terms
-// by 0.9 σ (tests/accuracy); the calibration carries σ × kSigmaMargin.
+// does not see what its model leaves out (the bias following the case temperature, the
+// sensors' second-order terms; the strips' nonlinearity is added below): against the
+// simulator's truth on 12 machines drawn within the data sheet the scale terms erred by
+// 1.46 σ rms, the cross terms by 0.9 σ (tests/accuracy); the calibration carries
+// σ × kSigmaMargin.
 constexpr double kSigmaMargin = 1.5;
 uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const Identification& id, const RunMeta& meta) {
   uncertainty::SensorModelCovariance c = uncertainty::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
@@ -340,6 +340,14 @@ uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const I
       }
     }
   }
+  // The strips' nonlinearity, which the filter takes for the truth: a scale error of the
+  // axes they measure (sensor_model_covariance.hpp), added to each fitted scale term.
+  for (int i = 0; i < 3 && id.method == "psd"; ++i) {
+    const bool measured = std::any_of(meta.psd.begin(), meta.psd.end(), [&](const PsdSpec& strip) { return axis_index(strip.measures) == i; });
+    const int s = owner(meta, i);
+    if (!measured || s < 0 || last.axis[i].layout.e[i] < 0) continue;
+    c.covariance(uncertainty::error_index(s, i, i), uncertainty::error_index(s, i, i)) += uncertainty::strip_nonlinearity_scale_variance();
+  }
   for (int s = 0; s < 2; ++s)
     if (id.sensor[s].damping_s.fitted)
       c.covariance(uncertainty::damping_index(s), uncertainty::damping_index(s)) = std::pow(kSigmaMargin * id.sensor[s].damping_s.sigma, 2);
@@ -354,23 +362,24 @@ uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const I
 }  // namespace
 
 std::vector<std::string> less_certain_than_datasheet(const Identification& id, const uncertainty::SensorModelCovariance& ds) {
+  // What the calibration would carry (its covariance, margins included) against the data sheet.
   std::vector<std::string> out;
   char b[200];
   for (int s = 0; s < 2; ++s) {
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
         const Estimate& e = id.sensor[s].error[i][j];
-        const double lim = ds.sigma(uncertainty::error_index(s, i, j));
-        if (e.fitted && !(e.sigma <= lim)) {
-          std::snprintf(b, sizeof b, "%s (%+.0f ± %.0f ppm, the data sheet ± %.0f ppm)", uncertainty::parameter_name(uncertainty::error_index(s, i, j)).c_str(),
-                        e.value * 1e6, e.sigma * 1e6, lim * 1e6);
+        const int p = uncertainty::error_index(s, i, j);
+        const double u = id.covariance.sigma(p), lim = ds.sigma(p);
+        if (e.fitted && !(u <= lim)) {
+          std::snprintf(b, sizeof b, "%s (%+.0f ± %.0f ppm, the data sheet ± %.0f ppm)", uncertainty::parameter_name(p).c_str(), e.value * 1e6, u * 1e6, lim * 1e6);
           out.emplace_back(b);
         }
       }
-    const Estimate& d = id.sensor[s].damping_s;
-    const double lim = ds.sigma(uncertainty::damping_index(s));
-    if (d.fitted && !(d.sigma <= lim)) {
-      std::snprintf(b, sizeof b, "%s (± %.2f µs, the data sheet ± %.2f µs)", uncertainty::parameter_name(uncertainty::damping_index(s)).c_str(), d.sigma * 1e6, lim * 1e6);
+    const int p = uncertainty::damping_index(s);
+    const double u = id.covariance.sigma(p), lim = ds.sigma(p);
+    if (id.sensor[s].damping_s.fitted && !(u <= lim)) {
+      std::snprintf(b, sizeof b, "%s (± %.2f µs, the data sheet ± %.2f µs)", uncertainty::parameter_name(p).c_str(), u * 1e6, lim * 1e6);
       out.emplace_back(b);
     }
   }
@@ -383,8 +392,12 @@ Identification identify_sensors(const Run& run, const IdentifyOptions& o) {
   id.method = o.against_reference ? "ref" : "psd";
   if (o.against_reference && !(run.channels.ref[0] || run.channels.ref[1] || run.channels.ref[2]))
     throw InputError("identify: run '" + run.meta.id + "' has no reference instrument to identify against");
+  // Without strips the set-point at standstills alone leaves the damping term unknown and
+  // the scale barely better than the data sheet (a step without strips: E_xx ± 170 ppm
+  // against the data sheet's ± 260): refused like a run that crosses them at one speed.
   if (!o.against_reference && run.meta.psd.empty())
-    id.notes.push_back("no PSD strips: scale and cross terms from the set-point at the standstills only, no damping term");
+    throw InputError("identify: run '" + run.meta.id + "' has no PSD strips: the sensors are identified from strip crossings at several speeds "
+                     "(run the identification program, eical gen-nc identify, or identify against a reference, --compare-reference)");
   RunMeta meta = run.meta;
   const Eigen::Matrix3d to_machine_ds[2] = {run.meta.sensors[0].to_machine, run.meta.sensors[1].to_machine};
   PassResult last;

@@ -89,12 +89,14 @@ struct Identification {
 };
 
 // Throws InputError when the run cannot identify the sensors: no motion, fewer than two
-// standstills in the motion, or PSD strips crossed at one speed only (a scale error and a
-// damping error then look alike: the identification program crosses at 2, 4 and 6.5 m/min).
+// standstills in the motion, no PSD strips (unless against a reference) or strips crossed
+// at one speed only (a scale error and a damping error then look alike: the identification
+// program crosses at 2, 4 and 6.5 m/min).
 Identification identify_sensors(const Run& run, const IdentifyOptions& options = {});
 
 // The parameters an identification fitted less certainly than the data sheet promises
-// (σ above the data sheet's u): a calibration with them would be worse than none.
+// (the σ its covariance carries above the data sheet's u): a calibration with them would
+// be worse than none.
 std::vector<std::string> less_certain_than_datasheet(const Identification& id, const uncertainty::SensorModelCovariance& datasheet);
 
 // The run's metadata with an identification applied (what the pipeline then uses).

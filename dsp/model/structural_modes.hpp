@@ -8,7 +8,8 @@
 // says of its variance: var(H) = |H|² (1 − γ²) / (2 K γ²) for K averages. A mode counts
 // when the fit with it is better than a smooth response by χ² at z = 5 for its parameters
 // and it amplifies the commanded acceleration by at least 10 % at its peak, and what it adds
-// to this run matters: 0.1 µm RMS of relative position or 0.3 mg of acceleration.
+// to this run stands out of the sensors' noise: 0.1 µm RMS of relative position or 0.1 mg of
+// acceleration. A structural mode is lightly damped (ζ ≤ 0.1); broader shapes are none.
 #include <Eigen/Core>
 
 #include <array>

@@ -52,4 +52,9 @@ SensorModelCovariance datasheet_covariance(const SensorSpec sensors[2], double f
   return c;
 }
 
+double strip_nonlinearity_scale_variance(const DatasheetTolerance& t) {
+  const double a = 0.6 * t.psd_nonlinearity;
+  return a * a / 3.0;
+}
+
 }  // namespace eical::dsp::uncertainty

@@ -101,21 +101,35 @@ TEST(Identification, ACircleRunIsRefusedWithTheReason) {
   }
 }
 
+TEST(Identification, ARunWithoutStripsIsRefused) {
+  try {
+    (void)dsp::identify::identify_sensors(sim::simulate(sim::step_scenario(0.0, 50.0, 3250.0, 2, 1)));
+    FAIL() << "identified from a step without PSD strips";
+  } catch (const dsp::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("has no PSD strips"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Identification, TheCalibrationCarriesACovarianceWithinTheDataSheetsTolerance) {
   const dsp::Run run = sim::simulate(sim::identify_scenario(sim::psd_config_b(10.0), {"z"}, 2));
   const dsp::identify::Identification id = dsp::identify::identify_sensors(run);
   const auto ds = dsp::uncertainty::datasheet_covariance(run.meta.sensors, run.meta.acquisition.fs_hz);
   EXPECT_TRUE(dsp::identify::less_certain_than_datasheet(id, ds).empty());
   EXPECT_GE(id.crossing_speeds_mm_s.size(), 3u);  // 2, 4 and 6.5 m/min
-  // The fitted terms: the identification's own σ with its margin, well below the data sheet's.
-  const int xx = dsp::uncertainty::error_index(0, 0, 0);
-  EXPECT_NEAR(id.covariance.sigma(xx), 1.5 * id.sensor[0].error[0][0].sigma, 1e-12);
+  // The fitted terms: the identification's own σ with its margin (and, for a scale a strip
+  // measures, the strips' nonlinearity), well below the data sheet's.
+  const int xx = dsp::uncertainty::error_index(0, 0, 0), xy = dsp::uncertainty::error_index(0, 0, 1);
+  EXPECT_NEAR(id.covariance.sigma(xy), 1.5 * id.sensor[0].error[0][1].sigma, 1e-12);
+  EXPECT_NEAR(id.covariance.covariance(xx, xx), std::pow(1.5 * id.sensor[0].error[0][0].sigma, 2) + dsp::uncertainty::strip_nonlinearity_scale_variance(),
+              1e-18);
   EXPECT_LT(id.covariance.sigma(xx), 0.2 * ds.sigma(xx));
   // Terms it did not fit keep the data sheet's.
   EXPECT_DOUBLE_EQ(id.covariance.sigma(dsp::uncertainty::error_index(1, 0, 0)), ds.sigma(dsp::uncertainty::error_index(1, 0, 0)));
   // A fitted term as uncertain as the circle's E_zx is reported as worse than the data sheet.
   dsp::identify::Identification bad = id;
   bad.sensor[0].error[2][0] = {-3778e-6, 14106e-6, true};
+  const int zx = dsp::uncertainty::error_index(0, 2, 0);
+  bad.covariance.covariance(zx, zx) = 14106e-6 * 14106e-6;
   const auto worse = dsp::identify::less_certain_than_datasheet(bad, ds);
   ASSERT_EQ(worse.size(), 1u);
   EXPECT_NE(worse[0].find("table.E_zx"), std::string::npos) << worse[0];

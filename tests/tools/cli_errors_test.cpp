@@ -110,6 +110,14 @@ TEST_F(CliErrors, HelpWorks) {
   expect_one_line_error(eical("help no-such-command"), "no command 'no-such-command'");
 }
 
+// eical identify on a run that cannot identify the sensors (a circle without strips): one
+// line naming the cause, exit 1, and no calibration file.
+TEST_F(CliErrors, IdentifyRefusesACircleAndWritesNoCalibration) {
+  const fs::path cal = dir_ / "cal.toml";
+  expect_one_line_error(eical("identify " + run() + " -o " + cal.string()), "has no PSD strips");
+  EXPECT_FALSE(fs::exists(cal));
+}
+
 TEST_F(CliErrors, MissingRun) { expect_one_line_error(eical("analyze " + (dir_ / "nope").string()), "not a run directory"); }
 
 TEST_F(CliErrors, MissingColumn) {

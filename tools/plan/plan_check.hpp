@@ -24,7 +24,9 @@ struct CheckRow {
 // 230-2 cycle and a rectangle; `repeats` seeds each.
 // With p.identified every repeat's machine is first identified by the identification
 // program (tools/plan/test_plan.hpp), as a user of a measurable test would.
-std::vector<TestProgram> check_programs();
+// `identified`: each program after an on-site identification of the sensors (the plan's
+// measurable variants), else on the data sheet's sensor model.
+std::vector<TestProgram> check_programs(bool identified = true);
 std::vector<CheckRow> check_plan(const TestProgram& p, int repeats, int draws = 100);
 
 std::string check_table(const std::vector<CheckRow>& rows);

@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
+#include <random>
 
 namespace eical::tools::plan {
 
@@ -120,8 +122,22 @@ sim::Scenario scenario_on_drawn_machine(const TestProgram& p, std::uint64_t seed
   sc.daq = bg.daq;
   sc.machine = bg.machine;
   sc.coriolis = bg.coriolis;
-  sc.psd.assign(sc.meta.psd.size(), bg.psd.empty() ? sim::PsdTruth{} : bg.psd.front());
+  sc.psd = drawn_strips(sc.meta.psd, seed);
   return sc;
+}
+
+std::vector<sim::PsdTruth> drawn_strips(const std::vector<dsp::PsdSpec>& psd, std::uint64_t seed) {
+  std::vector<sim::PsdTruth> out;
+  const double bound = dsp::uncertainty::DatasheetTolerance{}.psd_nonlinearity;
+  for (const dsp::PsdSpec& s : psd) {
+    // Keyed by the strip's place: the identification and the test cross the same strip.
+    const std::string key = s.measures + ":" + std::to_string(std::llround(s.center_mm[0] * 1000.0)) + "," + std::to_string(std::llround(s.center_mm[1] * 1000.0));
+    std::mt19937_64 rng(seed ^ std::hash<std::string>{}(key));
+    sim::PsdTruth t;
+    t.nonlinearity = std::uniform_real_distribution<double>(-bound, bound)(rng);
+    out.push_back(t);
+  }
+  return out;
 }
 
 sim::Scenario identification_scenario(const TestProgram& p, std::uint64_t seed) {

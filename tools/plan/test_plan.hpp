@@ -47,6 +47,10 @@ sim::Scenario scenario_of(const TestProgram& p, std::uint64_t seed);
 // The same program on a machine drawn within the data sheet's tolerances (the background of
 // `eical simulate --background` for that seed: sensors, small machine errors, Earth rate).
 sim::Scenario scenario_on_drawn_machine(const TestProgram& p, std::uint64_t seed);
+// The PSD strips of the machine drawn for `seed`: each its own nonlinearity within the data
+// sheet's bound (DatasheetTolerance::psd_nonlinearity), the same for a strip at the same
+// place (the identification's strips and a test's are the machine's).
+std::vector<sim::PsdTruth> drawn_strips(const std::vector<dsp::PsdSpec>& psd, std::uint64_t seed);
 // The identification program (eical gen-nc identify) over PSD configuration B of a R10
 // circle, with the program's sensors and DAQ: how a machine's sensors are identified on site.
 sim::Scenario identification_scenario(const TestProgram& p, std::uint64_t seed);

@@ -243,7 +243,9 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
     s += "<polygon points='" + pts + "' fill='" + ser.color + "' fill-opacity='0.13' stroke='" + ser.color +
          "' stroke-opacity='0.35' stroke-width='0.7'/>";
   }
+  // The legend is drawn last, on a white panel: a trace may pass under it, never over it.
   double ly = top + 14;
+  std::string legend;
   for (const auto& ser : series) {
     const std::size_t n = std::min(ser.x.size(), ser.y.size());
     const std::size_t stride = stride_for(n, 3000);
@@ -259,11 +261,14 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
            (ser.dashed ? " stroke-dasharray='5,3'" : "") + " points='" + pts + "'/>";
     }
     if (ser.label.empty()) continue;
-    s += ser.markers ? "<circle cx='" + num(w - right - 176) + "' cy='" + num(ly - 4) + "' r='2.5' fill='" + ser.color + "'/>"
-                     : "<rect x='" + num(w - right - 184) + "' y='" + num(ly - 5) + "' width='16' height='3' fill='" + ser.color + "'/>";
-    s += text(w - right - 162, ly, ser.label, "fill='#1d2330'");
+    legend += ser.markers ? "<circle cx='" + num(w - right - 176) + "' cy='" + num(ly - 4) + "' r='2.5' fill='" + ser.color + "'/>"
+                          : "<rect x='" + num(w - right - 184) + "' y='" + num(ly - 5) + "' width='16' height='3' fill='" + ser.color + "'/>";
+    legend += text(w - right - 162, ly, ser.label, "fill='#1d2330'");
     ly += 14;
   }
+  if (!legend.empty())
+    s += "<rect x='" + num(w - right - 190) + "' y='" + num(top + 2) + "' width='186' height='" + num(ly - top - 4) +
+         "' fill='white' fill-opacity='0.85' stroke='#d5dae3' stroke-width='0.6' rx='2'/>" + legend;
   return s + "</svg>";
 }
 

@@ -29,10 +29,10 @@ void test_vibration(ExplainState& st) {
     d.significant = v.differential.found && (v.differential.displacement_um > d.tolerance || v.differential.rms_mg > 0.3);
     d.importance_um = d.significant ? v.differential.displacement_um : 0.0;
     d.evidence = v.differential.evidence;
-    // Modes the motion drives: the frequency response of the measured relative acceleration
-    // over the commanded one. Measured by both sensors it is the head moving against the
-    // table (differential vibration); with one sensor it is the structure between the drive
-    // and the measured point (machine.resonance).
+    // Modes the motion drives (machine.resonance, run-format.md): the frequency response of
+    // the measured relative acceleration over the commanded one, with one sensor or two. A
+    // mode is a property of the machine, named in its unit (amplification at its peak);
+    // machine.differential_vibration is the head moving against the table by itself.
     ExplainedEffect res;
     res.name = "machine.resonance", res.channel = "frequency response", res.unit = "amplification", res.tolerance = 0.1;
     // Up to a third of the slowest sensor's natural frequency: above it the sensor's own
@@ -41,46 +41,34 @@ void test_vibration(ExplainState& st) {
     for (int sn = 0; sn < 2; ++sn)
       if (rr.meta.sensor_present[sn]) f0_min = std::min(f0_min, rr.meta.sensors[sn].f0_hz);
     const ModeSearch ms = find_structural_modes(rr.a_meas, rr.a_cmd, 1.0 / rr.dt_s, rr.moving, std::min(kModeMaxHz, f0_min / 3.0));
-    const bool relative = rr.meta.sensor_present[0] && rr.meta.sensor_present[1];
-    ExplainedEffect& named = relative ? d : res;
     int k = 0;
     double largest = 0.0;
-    for (const auto& md : ms.modes)
-      if (md.significant) st.modes.push_back(md);
-    // Relative motion is named by what it does to the position (its unit, µm): a mode of
-    // the head against the table that moves it less than the tolerance is none to report,
-    // however clear (sensor dynamics a little off their data sheet make such shapes).
-    auto material = [&](const StructuralMode& md) { return md.significant && (!relative || md.displacement_rms_um >= d.tolerance); };
-    double largest_um = 0.0;
     for (const auto& md : ms.modes) {
-      if (!material(md)) continue;
+      if (!md.significant) continue;
+      st.modes.push_back(md);
       const std::string pre = "mode" + std::to_string(k++) + "_";
-      named.params[pre + "frequency_hz"] = md.frequency_hz, named.params[pre + "sigma_frequency_hz"] = md.sigma_frequency_hz;
-      named.params[pre + "damping_ratio"] = md.damping_ratio, named.params[pre + "sigma_damping_ratio"] = md.sigma_damping_ratio;
-      named.params[pre + "gain"] = md.gain, named.params[pre + "peak_amplification"] = md.peak_amplification;
-      for (int a = 0; a < 3; ++a) named.params[pre + "direction_" + "xyz"[a]] = md.direction[static_cast<std::size_t>(a)];
-      named.evidence += fmt("; a mode at %.2f +- %.2f Hz, damping %.3f +- %.3f, ", md.frequency_hz, md.sigma_frequency_hz, md.damping_ratio, md.sigma_damping_ratio) +
-                        fmt("gain %.3f (x%.2f at its peak), driven along ", md.gain, 1.0 + md.peak_amplification) + std::string(1, "xyz"[md.input_axis]) +
-                        fmt(", %.2f mg / %.2f um RMS in this run; chi2 drop %.0f against %.0f, coherence %.2f", md.response_rms_mg, md.displacement_rms_um, md.chi2_drop,
-                            md.chi2_threshold, md.coherence);
-      named.params[pre + "displacement_rms_um"] = md.displacement_rms_um;
-      largest = std::max(largest, md.peak_amplification), largest_um = std::max(largest_um, md.displacement_rms_um);
+      res.params[pre + "frequency_hz"] = md.frequency_hz, res.params[pre + "sigma_frequency_hz"] = md.sigma_frequency_hz;
+      res.params[pre + "damping_ratio"] = md.damping_ratio, res.params[pre + "sigma_damping_ratio"] = md.sigma_damping_ratio;
+      res.params[pre + "gain"] = md.gain, res.params[pre + "peak_amplification"] = md.peak_amplification;
+      for (int a = 0; a < 3; ++a) res.params[pre + "direction_" + "xyz"[a]] = md.direction[static_cast<std::size_t>(a)];
+      res.params[pre + "displacement_rms_um"] = md.displacement_rms_um;
+      res.evidence += fmt("; a mode at %.2f +- %.2f Hz, damping %.3f +- %.3f, ", md.frequency_hz, md.sigma_frequency_hz, md.damping_ratio, md.sigma_damping_ratio) +
+                      fmt("gain %.3f (x%.2f at its peak), driven along ", md.gain, 1.0 + md.peak_amplification) + std::string(1, "xyz"[md.input_axis]) +
+                      fmt(", %.2f mg / %.3f um RMS in this run; chi2 drop %.0f against %.0f, coherence %.2f", md.response_rms_mg, md.displacement_rms_um, md.chi2_drop,
+                          md.chi2_threshold, md.coherence);
+      largest = std::max(largest, md.peak_amplification);
     }
+    std::string modes = res.evidence;  // "; a mode at …; a mode at …"
+    if (modes.rfind("; ", 0) == 0) modes.erase(0, 2);
     if (k > 0) {
-      named.significant = true;
-      named.params["residual_rms_before_mg"] = ms.residual_rms_before_mg, named.params["residual_rms_after_mg"] = ms.residual_rms_after_mg;
-      named.evidence += fmt("; with the modes, measured - commanded acceleration beyond the drive's own response falls from %.3g to %.3g mg RMS", ms.residual_rms_before_mg,
-                            ms.residual_rms_after_mg);
-      named.magnitude = std::max(named.magnitude, relative ? largest_um : largest);
-      named.importance_um = std::max(named.importance_um, 1.0 + largest);
-      named.evidence = (relative ? "head against table: " : "") + named.evidence;
-    }
-    if (!relative) {
-      std::string modes = res.evidence;  // "; a mode at …; a mode at …"
-      if (modes.rfind("; ", 0) == 0) modes.erase(0, 2);
-      res.evidence = k > 0 ? modes + "; " + ms.evidence : ms.evidence + ": no mode stands out";
+      res.significant = true;
+      res.magnitude = largest, res.importance_um = 1.0 + largest;
+      res.params["residual_rms_before_mg"] = ms.residual_rms_before_mg, res.params["residual_rms_after_mg"] = ms.residual_rms_after_mg;
+      res.evidence = (rr.meta.sensor_present[0] && rr.meta.sensor_present[1] ? "head against table: " : "") + modes + "; " + ms.evidence +
+                     fmt("; with the modes, measured - commanded acceleration beyond the drive's own response falls from %.3g to %.3g mg RMS",
+                         ms.residual_rms_before_mg, ms.residual_rms_after_mg);
     } else {
-      res.evidence = ms.evidence + (k > 0 ? ": the modes found are real relative motion of the two sensors (machine.differential_vibration)" : ": no mode stands out");
+      res.evidence = ms.evidence + ": no mode stands out";
     }
     all.push_back(c), all.push_back(d), all.push_back(res);
   }
