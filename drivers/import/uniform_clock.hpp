@@ -1,7 +1,8 @@
 #pragma once
 // A recording with jittered time stamps onto a uniform clock (what eical-run/1 needs):
-//  1. dt = median of the stamp differences; a difference above 2·dt is a gap, whose
-//     missing samples are lost frames (round(gap/dt) − 1 of them);
+//  1. dt = median of the stamp differences; a difference above 1.5·dt is a gap (unless
+//     the sample was only late: the next difference is short by as much), whose missing
+//     samples are lost frames (round(gap/dt) − 1 of them);
 //  2. every sample gets a grid index (consecutive, or across a gap its rounded
 //     length); the clock is the least-squares line through (index, stamp): its slope
 //     gives fs — the median alone is limited by the stamps' printed resolution (Klipper's
