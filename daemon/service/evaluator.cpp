@@ -13,6 +13,7 @@
 #include "dsp/align/accel_lag.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <ctime>
 #include <optional>
@@ -77,7 +78,12 @@ void Evaluator::loop() {
 dsp::Run Evaluator::make_run(RecordingJob& job) const {
   dsp::Run run;
   run.meta = meta_;
-  run.meta.id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
+  const std::string id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
+  run.meta.id = id;
+  // The wall clock may step back (NTP, an operator) and a restarted source counts its
+  // samples from 0 again: an id an earlier run has gets a suffix, it never replaces it.
+  std::error_code ec;
+  for (int n = 2; std::filesystem::exists(config_.recording.dir / run.meta.id, ec); ++n) run.meta.id = id + "-" + std::to_string(n);
   run.meta.created = utc_now("%Y-%m-%dT%H:%M:%SZ");
   run.channels.psd_count = static_cast<int>(std::min<std::size_t>(meta_.psd.size(), dsp::kMaxPsd));
   run.frames.swap(job.frames);
@@ -158,7 +164,7 @@ void Evaluator::evaluate(RecordingJob& job) {
   try {
     const std::vector<std::string> setpoint_flags = add_setpoint(run, job.notes);
     // The run first: what was measured is durable before anything can fail.
-    drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false});
+    write_retrying("recording " + run.meta.id, [&] { drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false}); });
     dsp::Analysis a = dsp::analyze_run(run, analysis_);
     if (!job.cause.empty()) a.flags.push_back(job.cause), a.degraded = true;
     if (job.notes.nonfinite_frames > 0) {
@@ -167,7 +173,11 @@ void Evaluator::evaluate(RecordingJob& job) {
       a.degraded = true;
     }
     for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
-    drivers::write_result(run, a, dir / "result.json");
+    write_retrying("result of " + run.meta.id, [&] {
+      // The run directory removed meanwhile (an operator, a cleanup): the run again first.
+      if (!std::filesystem::exists(dir / "run.toml")) drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = true});
+      drivers::write_result(run, a, dir / "result.json");
+    });
     if (links_.history) links_.history->append(run, a, dir);
     std::uint64_t number = 0;
     {
@@ -184,6 +194,37 @@ void Evaluator::evaluate(RecordingJob& job) {
   }
   if (!error.empty()) set_fault("recording: " + error);
   job.frames.swap(run.frames);
+}
+
+bool Evaluator::stopping() const { return handoff_.quitting() || (links_.stop && links_.stop->load()); }
+
+// A disk that is full for a while, a recording directory removed or made unwritable:
+// the measurement waits in memory and the write is tried again every kWriteRetryS (the DSP
+// thread defers the next hand-over meanwhile, counted), so nothing measured is dropped for
+// a fault that an operator clears. Status.fault says what is retried; it is cleared when
+// the write succeeds. The service's stop ends the retries (the DSP thread then waits for
+// the evaluator to hand over what the stop cut short): the last error is reported.
+void Evaluator::write_retrying(const std::string& what, const std::function<void()>& write) {
+  std::string fault;
+  for (;;) {
+    try {
+      write();
+      break;
+    } catch (const std::exception& e) {
+      if (stopping()) throw;
+      const std::string now = "recording: " + what + ": " + e.what() + "; retried every " + std::to_string(static_cast<int>(kWriteRetryS)) +
+                              " s, the measurement is held in memory";
+      if (now != fault) log(LogLevel::error, "%s", now.c_str());  // once per distinct cause, not per retry
+      fault = now;
+      set_fault(fault);
+    }
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(kWriteRetryS);
+    while (std::chrono::steady_clock::now() < until && !stopping()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (fault.empty()) return;
+  log(LogLevel::notice, "%s written after the fault cleared", what.c_str());
+  std::lock_guard lk(mu_);
+  if (status_.fault == fault) status_.fault.clear();
 }
 
 void Evaluator::publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir, std::uint64_t result_number) {

@@ -143,6 +143,10 @@ void FrameLoop::close_measurement(const std::string& cause) {
   if (session_.close_now() || session_.measurement_ready()) {
     if (handoff_.offer_waiting(session_, notes_, cause)) session_.evaluation_done(), live_.reset();
   }
+  // No frame follows to publish them: the last Status counts the measurement cut short.
+  counters_.measurements_started.store(session_.counters().measurements_started, std::memory_order_relaxed);
+  counters_.measurements.store(session_.counters().measurements_completed, std::memory_order_relaxed);
+  counters_.state.store(static_cast<int>(session_.state().state()), std::memory_order_relaxed);
 }
 
 }  // namespace eical::daemon

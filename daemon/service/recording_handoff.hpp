@@ -46,6 +46,8 @@ class RecordingHandoff {
   // Evaluation thread: the storage of the job it finished (its capacity is kept).
   void give_back(std::vector<dsp::Frame>&& storage);
   void quit();
+  // Any thread: quit() was called (the evaluator stops retrying a failed write).
+  [[nodiscard]] bool quitting() const noexcept { return quit_.load(); }
 
  private:
   bool hand(dsp::MeasurementSession& session, const RecordingNotes& notes, const std::string* cause) noexcept;

@@ -202,9 +202,9 @@ void start_history(Parts& p) {
   if (p.config.history.enabled) p.history = std::make_unique<HistoryHook>(p.config.history, p.sensor_calibration);
 }
 
-void start_evaluator(Parts& p) {
+void start_evaluator(Parts& p, const std::atomic<bool>& stop) {
   EvaluatorLinks links;
-  links.hmi = p.hmi.get(), links.servo = p.servo, links.history = p.history.get();
+  links.hmi = p.hmi.get(), links.servo = p.servo, links.history = p.history.get(), links.stop = &stop;
   links.sensor_calibration = p.sensor_calibration;
   p.evaluator = std::make_unique<Evaluator>(p.config, p.meta, p.analysis, *p.handoff, std::move(links));
   if (auto problem = recording_dir_problem(p.config.recording.dir)) p.evaluator->set_fault(*problem);
@@ -315,7 +315,7 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   open_trigger_inputs(p, trigger_inputs_);
   make_measurement(p);
   start_history(p);
-  start_evaluator(p);
+  start_evaluator(p, stop);
   make_frame_loop(p);
   start_status(p, on_status);
   enter_realtime(p);
