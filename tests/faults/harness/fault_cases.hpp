@@ -1,0 +1,29 @@
+#pragma once
+// The faults of issue 21, each injected into the real service (in this process, or eicald
+// as a child process) and measured: tests/faults asserts on each outcome, bench_faults
+// prints them as the fault table. Every case runs in a scratch directory of its own and
+// on a DDS domain of its own, so cases and other tests on the host do not meet.
+#include "tests/faults/harness/fault_outcome.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace eical::faults {
+
+// The disk fills up while a measurement is recorded (files may not grow past 64 KiB:
+// RLIMIT_FSIZE, EFBIG as ENOSPC), then space is freed.
+FaultOutcome disk_full_mid_recording();
+// The recording directory is removed while the service runs.
+FaultOutcome recording_dir_removed();
+// The wall clock steps back: the run ids the new measurement would get are taken.
+FaultOutcome wall_clock_steps_back();
+
+struct FaultCase {
+  const char* name;
+  FaultOutcome (*run)();
+};
+// Every case, in the order of the table.
+const std::vector<FaultCase>& all_cases();
+
+}  // namespace eical::faults

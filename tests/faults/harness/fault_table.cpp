@@ -1,0 +1,14 @@
+#include "tests/faults/harness/fault_cases.hpp"
+
+namespace eical::faults {
+
+const std::vector<FaultCase>& all_cases() {
+  static const std::vector<FaultCase> cases = {
+      {"disk_full", disk_full_mid_recording},
+      {"recording_dir_removed", recording_dir_removed},
+      {"wall_clock_steps_back", wall_clock_steps_back},
+  };
+  return cases;
+}
+
+}  // namespace eical::faults
