@@ -6,6 +6,7 @@
 #include "daemon/system/log.hpp"
 #include "drivers/results/result_json.hpp"
 #include "drivers/results/software_version.hpp"
+#include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/setpoint/program_catalog.hpp"
 #include "drivers/setpoint/program_setpoint.hpp"
@@ -68,6 +69,7 @@ void Evaluator::set_fault(const std::string& fault) {
 }
 
 void Evaluator::loop() {
+  for (const auto& dir : links_.unevaluated) evaluate_recorded(dir);
   RecordingJob job;
   while (handoff_.wait_job(job)) {
     evaluate(job);
@@ -178,15 +180,7 @@ void Evaluator::evaluate(RecordingJob& job) {
       if (!std::filesystem::exists(dir / "run.toml")) drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = true});
       drivers::write_result(run, a, dir / "result.json");
     });
-    if (links_.history) links_.history->append(run, a, dir);
-    std::uint64_t number = 0;
-    {
-      // Counted before it is published: an HMI never sees a Result ahead of the count.
-      std::lock_guard lk(mu_);
-      number = ++status_.results;
-      status_.last_result = (dir / "result.json").string();
-    }
-    publish(run, a, dir, number);
+    finish_result(run, a, dir);
     log(LogLevel::notice, "measurement %s written (%zu frames)%s", run.meta.id.c_str(), run.frames.size(), a.degraded ? ", result degraded" : "");
   } catch (const std::exception& e) {
     error = e.what();
@@ -194,6 +188,39 @@ void Evaluator::evaluate(RecordingJob& job) {
   }
   if (!error.empty()) set_fault("recording: " + error);
   job.frames.swap(run.frames);
+}
+
+void Evaluator::finish_result(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir) {
+  if (links_.history) links_.history->append(run, a, dir);
+  std::uint64_t number = 0;
+  {
+    // Counted before it is published: an HMI never sees a Result ahead of the count.
+    std::lock_guard lk(mu_);
+    number = ++status_.results;
+    status_.last_result = (dir / "result.json").string();
+  }
+  publish(run, a, dir, number);
+}
+
+// The previous eicald stopped (kill -9, power, the watchdog) after the run was durable and
+// before its result.json: evaluated now as `eical analyze` would, flagged, because what
+// only the stopped DSP thread knew (a measurement cut short, non-finite channels held) is
+// not in the run.
+void Evaluator::evaluate_recorded(const std::filesystem::path& dir) {
+  try {
+    const dsp::Run run = drivers::read_run(dir);
+    dsp::Analysis a = dsp::analyze_run(run, analysis_);
+    a.flags.push_back(
+        "evaluated_after_restart: eicald stopped between writing this run and its result; evaluated at the next start, without the flags "
+        "only the stopped service knew (cut short, non-finite channels)");
+    a.degraded = true;
+    write_retrying("result of " + run.meta.id, [&] { drivers::write_result(run, a, dir / "result.json"); });
+    finish_result(run, a, dir);
+    log(LogLevel::notice, "run %s of the previous start evaluated now (it had no result.json)", run.meta.id.c_str());
+  } catch (const std::exception& e) {
+    log(LogLevel::error, "run %s of the previous start: %s", dir.c_str(), e.what());
+    set_fault("recording: " + dir.filename().string() + ": " + e.what());
+  }
 }
 
 bool Evaluator::stopping() const { return handoff_.quitting() || (links_.stop && links_.stop->load()); }

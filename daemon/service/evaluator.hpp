@@ -36,6 +36,7 @@ struct EvaluatorLinks {
   HistoryHook* history = nullptr;                       // [history] enabled
   std::string sensor_calibration = "datasheet";         // provenance in Result
   const std::atomic<bool>* stop = nullptr;              // the service's stop: ends write retries
+  std::vector<std::filesystem::path> unevaluated;       // runs written before a restart without result.json
 };
 
 // What the evaluations did, for Status (evaluation thread writes, status thread reads).
@@ -63,6 +64,10 @@ class Evaluator {
  private:
   void loop();
   void evaluate(RecordingJob& job);
+  // A run of the previous eicald that has no result.json: evaluated now, flagged.
+  void evaluate_recorded(const std::filesystem::path& dir);
+  // result.json written: counted, into the history, published.
+  void finish_result(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir);
   dsp::Run make_run(RecordingJob& job) const;
   // The program M101's P word (or [setpoint.program] default_program) names.
   std::optional<std::pair<int, dsp::Program>> named_program(const RecordingNotes& notes, std::vector<std::string>& flags) const;

@@ -7,6 +7,7 @@
 #include "daemon/service/history_hook.hpp"
 #include "daemon/service/hmi_link.hpp"
 #include "daemon/service/preflight.hpp"
+#include "daemon/service/recording_cleanup.hpp"
 #include "daemon/service/recording_handoff.hpp"
 #include "daemon/service/service_counters.hpp"
 #include "daemon/service/status_reporter.hpp"
@@ -131,6 +132,7 @@ struct Parts {
   std::unique_ptr<Evaluator> evaluator;
   std::unique_ptr<FrameLoop> loop;
   std::unique_ptr<StatusReporter> reporter;
+  std::vector<std::filesystem::path> unevaluated;  // runs of an earlier start without result.json
 };
 
 void open_source(Parts& p) {
@@ -160,6 +162,17 @@ void check_machine(Parts& p) {
   if (auto problem = setpoint_problem(p.config.setpoint)) throw std::runtime_error(*problem);
   // Reported (Status.fault, journal), not refused: measuring goes on, every write retries.
   if (auto problem = recording_dir_problem(p.config.recording.dir)) log(LogLevel::error, "%s", problem->c_str());
+}
+
+// What an interrupted start left in the recording directory: temporaries removed, runs
+// moved aside restored, runs without result.json handed to the evaluator.
+void clean_recording(Parts& p) {
+  RecordingCleanup c = clean_recording_dir(p.config.recording.dir);
+  if (c.removed + c.restored > 0)
+    log(LogLevel::notice, "recording: %zu temporaries of an interrupted write removed, %zu runs restored, in %s", c.removed, c.restored,
+        p.config.recording.dir.c_str());
+  if (!c.unevaluated.empty()) log(LogLevel::notice, "recording: %zu runs without result.json are evaluated now", c.unevaluated.size());
+  p.unevaluated = std::move(c.unevaluated);
 }
 
 // The HMI bus; without it the service still measures and records (and says so).
@@ -205,6 +218,7 @@ void start_history(Parts& p) {
 void start_evaluator(Parts& p, const std::atomic<bool>& stop) {
   EvaluatorLinks links;
   links.hmi = p.hmi.get(), links.servo = p.servo, links.history = p.history.get(), links.stop = &stop;
+  links.unevaluated = std::move(p.unevaluated);
   links.sensor_calibration = p.sensor_calibration;
   p.evaluator = std::make_unique<Evaluator>(p.config, p.meta, p.analysis, *p.handoff, std::move(links));
   if (auto problem = recording_dir_problem(p.config.recording.dir)) p.evaluator->set_fault(*problem);
@@ -311,6 +325,7 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   open_source(p);
   apply_calibration(p);
   check_machine(p);
+  clean_recording(p);
   start_hmi(p);
   open_trigger_inputs(p, trigger_inputs_);
   make_measurement(p);
