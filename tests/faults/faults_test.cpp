@@ -2,8 +2,15 @@
 // real service, each one test. Each must end in a flagged result or a clean state, with the
 // service alive (measuring again) and every completed recording intact.
 #include "tests/faults/harness/fault_cases.hpp"
+#include "tests/faults/harness/recording_dir.hpp"
+#include "tests/faults/harness/service_thread.hpp"
+
+#include "drivers/run_io/run_writer.hpp"
+#include "sim/scenario.hpp"
+#include "sim/simulate.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cstdio>
 
@@ -48,6 +55,33 @@ TEST(Faults, WallClockSteppingBackReplacesNoRun) {
   EXPECT_TRUE(o.clean);
   EXPECT_EQ(o.runs_after, 1u);
   EXPECT_EQ(o.measurements_lost, 0);
+}
+
+TEST(Faults, Kill9DuringTheWriteLeavesNoTornRunAndTheNextStartCleansUp) {
+  const FaultOutcome o = kill9_during_write();
+  expect_survived(o);
+  EXPECT_TRUE(o.clean) << "temporaries survived the next start";
+  EXPECT_TRUE(o.flagged) << "a run left without result was not evaluated and flagged";
+  EXPECT_LT(o.recovery_s, 30.0);
+}
+
+// The kill can land between the run's rename and its result.json (the case above hits it
+// by chance): such a run is evaluated at the next start, flagged.
+TEST(Faults, ARunLeftWithoutResultIsEvaluatedAtTheNextStart) {
+  Scratch s("unevaluated");
+  const fs::path dir = s.dir / "runs";
+  drivers::write_run(sim::simulate(sim::circle_scenario(10.0, 2500.0, 2)), dir / "eicald-20260101T000000Z-0");
+  daemon::DaemonConfig c = base_config(dir);
+  c.source.sim_repeat_program = false;
+  ServiceThread svc(c);
+  ASSERT_TRUE(svc.wait_for([](const auto& st) { return st.results_written >= 1; }, std::chrono::seconds(60)));
+  svc.stop();
+  const fs::path result = dir / "eicald-20260101T000000Z-0" / "result.json";
+  ASSERT_TRUE(fs::exists(result));
+  const auto j = nlohmann::json::parse(slurp(result));
+  EXPECT_TRUE(j["quality"]["degraded"].get<bool>());
+  EXPECT_NE(j["quality"]["flags"].dump().find("evaluated_after_restart"), std::string::npos) << j["quality"]["flags"].dump();
+  EXPECT_TRUE(j["circle"].is_object()) << "the circle was not evaluated";
 }
 
 }  // namespace

@@ -18,6 +18,8 @@ FaultOutcome disk_full_mid_recording();
 FaultOutcome recording_dir_removed();
 // The wall clock steps back: the run ids the new measurement would get are taken.
 FaultOutcome wall_clock_steps_back();
+// eicald is killed (SIGKILL) while it writes a run; then started again.
+FaultOutcome kill9_during_write();
 
 struct FaultCase {
   const char* name;

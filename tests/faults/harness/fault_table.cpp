@@ -7,6 +7,7 @@ const std::vector<FaultCase>& all_cases() {
       {"disk_full", disk_full_mid_recording},
       {"recording_dir_removed", recording_dir_removed},
       {"wall_clock_steps_back", wall_clock_steps_back},
+      {"kill9_during_write", kill9_during_write},
   };
   return cases;
 }
