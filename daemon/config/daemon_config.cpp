@@ -101,6 +101,7 @@ void read_source(StrictTable t, SourceConfig& s) {
     if (p.saturate_channel < 0 || p.saturate_channel > 5) f->fail("saturate_channel", "must be within 0..5");
     p.nan_at_s = f->number("nan_at_s", p.nan_at_s);
     p.nan_s = f->number("nan_s", p.nan_s);
+    p.hang_dsp_at_s = f->number("hang_dsp_at_s", p.hang_dsp_at_s);
     f->finish();
   }
   t.finish();

@@ -250,6 +250,10 @@ void Evaluator::write_retrying(const std::string& what, const std::function<void
   }
   if (fault.empty()) return;
   log(LogLevel::notice, "%s written after the fault cleared", what.c_str());
+  clear_fault(fault);
+}
+
+void Evaluator::clear_fault(const std::string& fault) {
   std::lock_guard lk(mu_);
   if (status_.fault == fault) status_.fault.clear();
 }

@@ -57,6 +57,8 @@ class Evaluator {
 
   [[nodiscard]] EvaluationStatus status() const;
   void set_fault(const std::string& fault);
+  // Clears Status.fault when it is still `fault` (a later, other error stays).
+  void clear_fault(const std::string& fault);
 
   // A failed recording write is tried again this often while the service runs.
   static constexpr double kWriteRetryS = 1.0;

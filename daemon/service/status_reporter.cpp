@@ -5,6 +5,7 @@
 #include "daemon/system/log.hpp"
 
 #include <chrono>
+#include <cstdio>
 
 namespace eical::daemon {
 
@@ -31,11 +32,38 @@ void StatusReporter::loop() {
     const std::uint64_t frames = s_.counters->frames.load(std::memory_order_relaxed);
     // Progress of the DSP loop (or the run loop reopening a failed source) is what the
     // watchdog is fed on: a stalled DSP thread gets no status, and systemd restarts eicald.
-    if (frames != last_frames_ || s_.counters->faulted.load()) report();
+    const bool progress = frames != last_frames_ || s_.counters->faulted.load();
+    if (progress) report();
     last_frames_ = frames;
+    watch_stall(progress);
     s_.source->drain_diagnostics([](const std::string& line) { log(LogLevel::info, "%s", line.c_str()); });
     lk.lock();
   }
+}
+
+void StatusReporter::watch_stall(bool progress) {
+  ticks_without_progress_ = progress ? 0 : ticks_without_progress_ + 1;
+  const double stalled_s = ticks_without_progress_ / rate_hz_;
+  if (progress && stall_said_) {
+    stall_said_ = false;
+    log(LogLevel::notice, "frames are handled again");
+    if (s_.on_stall) s_.on_stall("");
+  }
+  if (progress || stall_said_ || stalled_s < kStallS) return;
+  stall_said_ = true;
+  const std::size_t waiting = s_.ring->size_approx();
+  const ServiceStatus st = collect();
+  char why[256];
+  if (waiting > 0)
+    std::snprintf(why, sizeof why, "the DSP thread has handled no frame for %.1f s while %zu wait in the ring (state %s, sample %lld)", stalled_s,
+                  waiting, st.state.c_str(), static_cast<long long>(st.sample_index));
+  else
+    std::snprintf(why, sizeof why, "no frame from the source %.*s for %.1f s (state %s, sample %lld)", static_cast<int>(s_.source->name().size()),
+                  s_.source->name().data(), stalled_s, st.state.c_str(), static_cast<long long>(st.sample_index));
+  log(LogLevel::error, "%s; the watchdog is not fed, systemd restarts eicald", why);
+  if (s_.on_stall) s_.on_stall(why);
+  std::lock_guard lk(report_mu_);
+  publish_to_hmi(collect());  // the HMI sees why; systemd does not hear of it (no progress)
 }
 
 ServiceStatus StatusReporter::collect() const {
@@ -79,6 +107,10 @@ void StatusReporter::report() {
   std::lock_guard lk(report_mu_);
   const ServiceStatus st = collect();
   on_status_(st);
+  publish_to_hmi(st);
+}
+
+void StatusReporter::publish_to_hmi(const ServiceStatus& st) {
   if (!s_.hmi) return;
   drivers::dds::StatusMsg m;
   m.state = st.state, m.fault = st.fault, m.frames = st.frames, m.overruns = st.overruns, m.frames_lost = st.frames_lost;

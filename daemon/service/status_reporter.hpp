@@ -35,6 +35,10 @@ struct StatusSources {
   const HistoryHook* history = nullptr;  // [history] enabled: its problem is the fault when none other is
   std::vector<const TriggerChannel*> channels;
   std::vector<const TriggerListener*> listeners;
+  // No frame handled for kStallS while the source is not being reopened: called once with
+  // what is stalled (the DSP thread, frames waiting in the ring; or the source, none
+  // arriving), and with "" when frames flow again.
+  std::function<void(const std::string&)> on_stall;
 };
 
 class StatusReporter {
@@ -51,13 +55,21 @@ class StatusReporter {
   [[nodiscard]] ServiceStatus collect() const;
   void report();
 
+  static constexpr double kStallS = 1.0;  // well inside systemd's WatchdogSec (5 s)
+
  private:
   void loop();
+  // A tick without progress: how long it lasts, said once; progress again: said once.
+  void watch_stall(bool progress);
+  // Status to the HMI only: systemd's watchdog is fed on progress (on_status), not on this.
+  void publish_to_hmi(const ServiceStatus& st);
 
   StatusSources s_;
   double rate_hz_;
   std::function<void(const ServiceStatus&)> on_status_;
   std::uint64_t last_frames_ = 0;
+  int ticks_without_progress_ = 0;
+  bool stall_said_ = false;
   std::mutex report_mu_;
   std::mutex mu_;
   std::condition_variable cv_;
