@@ -65,6 +65,13 @@ TEST(Faults, Kill9DuringTheWriteLeavesNoTornRunAndTheNextStartCleansUp) {
   EXPECT_LT(o.recovery_s, 30.0);
 }
 
+TEST(Faults, HungDspThreadStarvesTheWatchdogAndTheRestartedServiceSaysWhy) {
+  const FaultOutcome o = dsp_thread_hung();
+  expect_survived(o);
+  EXPECT_TRUE(o.flagged) << "the restarted eicald did not say why";
+  EXPECT_TRUE(o.clean);
+}
+
 // The kill can land between the run's rename and its result.json (the case above hits it
 // by chance): such a run is evaluated at the next start, flagged.
 TEST(Faults, ARunLeftWithoutResultIsEvaluatedAtTheNextStart) {

@@ -20,6 +20,8 @@ FaultOutcome recording_dir_removed();
 FaultOutcome wall_clock_steps_back();
 // eicald is killed (SIGKILL) while it writes a run; then started again.
 FaultOutcome kill9_during_write();
+// eicald's DSP thread hangs; systemd's watchdog (played by the case) ends it and starts it again.
+FaultOutcome dsp_thread_hung();
 
 struct FaultCase {
   const char* name;

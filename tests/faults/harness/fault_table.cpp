@@ -8,6 +8,7 @@ const std::vector<FaultCase>& all_cases() {
       {"recording_dir_removed", recording_dir_removed},
       {"wall_clock_steps_back", wall_clock_steps_back},
       {"kill9_during_write", kill9_during_write},
+      {"dsp_thread_hung", dsp_thread_hung},
   };
   return cases;
 }
