@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <optional>
 
@@ -175,6 +176,14 @@ void Evaluator::evaluate(RecordingJob& job) {
       a.degraded = true;
     }
     for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
+    if (job.notes.source_rate_ratio != 0.0) {
+      char b[240];
+      std::snprintf(b, sizeof b,
+                    "source_rate: the source delivered %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says during the measurement "
+                    "(a DAQ at another rate, a replay faster than real time): its times, speeds and lengths are wrong",
+                    job.notes.source_rate_ratio, run.fs_hz());
+      a.flags.push_back(b), a.degraded = true;
+    }
     write_retrying("result of " + run.meta.id, [&] {
       // The run directory removed meanwhile (an operator, a cleanup): the run again first.
       if (!std::filesystem::exists(dir / "run.toml")) drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = true});

@@ -58,6 +58,8 @@ std::int64_t FrameLoop::observe_acquisition(const dsp::Frame& in) noexcept {
   if (acquired_ns != 0 && stamp.last_index != stamp_seen_) {
     stamp_seen_ = stamp.last_index;
     daq_clock_.observe(stamp.last_index + index_offset_, stamp.t_ns);
+    counters_.stamp_index.store(stamp.last_index + index_offset_, std::memory_order_relaxed);
+    counters_.stamp_ns.store(stamp.t_ns, std::memory_order_relaxed);
   }
   return acquired_ns;
 }
@@ -87,7 +89,11 @@ void FrameLoop::track_measurement(bool nonfinite) noexcept {
     notes_.index_offset = index_offset_;
     requested_p_ = std::nan("");
   }
-  if (nonfinite && session_.state().state() == dsp::State::measuring) ++notes_.nonfinite_frames;
+  if (session_.state().state() != dsp::State::measuring) return;
+  if (nonfinite) ++notes_.nonfinite_frames;
+  // The farthest the source's rate was off during the measurement.
+  const double r = counters_.source_rate_ratio.load(std::memory_order_relaxed);
+  if (r != 0.0 && std::abs(r - 1.0) > std::abs(notes_.source_rate_ratio - 1.0)) notes_.source_rate_ratio = r;
 }
 
 void FrameLoop::step_live(const dsp::Frame& f) noexcept {

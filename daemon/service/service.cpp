@@ -260,6 +260,9 @@ void start_status(Parts& p, const std::function<void(const ServiceStatus&)>& on_
   if (p.hmi) s.channels.push_back(&p.hmi->triggers());
   for (const auto& ch : p.channels) s.channels.push_back(ch.get());
   for (const auto& l : p.listeners) s.listeners.push_back(l.get());
+  s.watch_rate = p.source->backpressure() == drivers::Backpressure::drop_newest;  // a live source
+  s.rate_too_slow_matters = p.config.source.is_daq();
+  s.fs_hz = p.meta.acquisition.fs_hz;
   // A stall is written down before systemd's watchdog ends this eicald: the next one says why.
   s.on_stall = [&p](const std::string& why) {
     p.stop_record->running(why);

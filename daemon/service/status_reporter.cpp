@@ -10,7 +10,11 @@
 namespace eical::daemon {
 
 StatusReporter::StatusReporter(StatusSources sources, double rate_hz, std::function<void(const ServiceStatus&)> on_status)
-    : s_(std::move(sources)), rate_hz_(rate_hz), on_status_(std::move(on_status)), thread_([this] { loop(); }) {}
+    : s_(std::move(sources)),
+      rate_hz_(rate_hz),
+      on_status_(std::move(on_status)),
+      rate_(s_.fs_hz, s_.rate_too_slow_matters),
+      thread_([this] { loop(); }) {}
 
 StatusReporter::~StatusReporter() { stop(); }
 
@@ -36,6 +40,7 @@ void StatusReporter::loop() {
     if (progress) report();
     last_frames_ = frames;
     watch_stall(progress);
+    watch_rate();
     s_.source->drain_diagnostics([](const std::string& line) { log(LogLevel::info, "%s", line.c_str()); });
     lk.lock();
   }
@@ -66,6 +71,21 @@ void StatusReporter::watch_stall(bool progress) {
   publish_to_hmi(collect());  // the HMI sees why; systemd does not hear of it (no progress)
 }
 
+void StatusReporter::watch_rate() {
+  if (!s_.watch_rate) return;
+  ServiceCounters& k = *s_.counters;
+  double ratio = 0.0;
+  if (k.faulted.load()) rate_.reset();  // reopening: the stamps start again
+  else ratio = rate_.observe(k.stamp_index.load(std::memory_order_relaxed), k.stamp_ns.load(std::memory_order_relaxed));
+  const double was = k.source_rate_ratio.exchange(ratio, std::memory_order_relaxed);
+  if ((was == 0.0) == (ratio == 0.0)) return;
+  if (ratio != 0.0)
+    log(LogLevel::error, "source: delivers %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says; measurements meanwhile are flagged source_rate",
+        ratio, s_.fs_hz);
+  else
+    log(LogLevel::notice, "source: its rate is within %.0f %% of fs_hz again", SourceRateWatch::kTolerance * 100.0);
+}
+
 ServiceStatus StatusReporter::collect() const {
   const ServiceCounters& k = *s_.counters;
   constexpr auto relaxed = std::memory_order_relaxed;
@@ -74,6 +94,11 @@ ServiceStatus StatusReporter::collect() const {
   st.state = k.faulted.load() ? "FAULT" : std::string(dsp::to_string(k.measurement_state()));
   st.fault = ev.fault;
   if (s_.history && st.fault.empty()) st.fault = s_.history->problem();
+  if (const double r = k.source_rate_ratio.load(std::memory_order_relaxed); r != 0.0 && st.fault.empty()) {
+    char b[160];
+    std::snprintf(b, sizeof b, "source_rate: %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says", r, s_.fs_hz);
+    st.fault = b;
+  }
   st.frames = k.frames.load(relaxed);
   st.overruns = s_.ring->overruns();
   st.frames_lost = k.frames_lost.load(relaxed);
