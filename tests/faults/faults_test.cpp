@@ -57,6 +57,22 @@ TEST(Faults, WallClockSteppingBackReplacesNoRun) {
   EXPECT_EQ(o.measurements_lost, 0);
 }
 
+TEST(Faults, SourceFasterThanRealTimeIsFlagged) {
+  const FaultOutcome o = source_faster_than_real_time();
+  expect_survived(o);
+  EXPECT_TRUE(o.flagged);
+  EXPECT_TRUE(o.clean);
+  EXPECT_EQ(o.measurements_lost, 0);
+}
+
+TEST(Faults, StallingSourceIsReopenedAndTheCutMeasurementFlagged) {
+  const FaultOutcome o = source_stalls();
+  expect_survived(o);
+  EXPECT_TRUE(o.flagged);
+  EXPECT_TRUE(o.clean);
+  EXPECT_EQ(o.measurements_lost, 0);
+}
+
 TEST(Faults, Kill9DuringTheWriteLeavesNoTornRunAndTheNextStartCleansUp) {
   const FaultOutcome o = kill9_during_write();
   expect_survived(o);

@@ -18,6 +18,10 @@ FaultOutcome disk_full_mid_recording();
 FaultOutcome recording_dir_removed();
 // The wall clock steps back: the run ids the new measurement would get are taken.
 FaultOutcome wall_clock_steps_back();
+// A DAQ (daq_stream) delivering three times faster than real time, then at its rate.
+FaultOutcome source_faster_than_real_time();
+// A DAQ that stops sending for 2 s in the middle of a measurement.
+FaultOutcome source_stalls();
 // eicald is killed (SIGKILL) while it writes a run; then started again.
 FaultOutcome kill9_during_write();
 // eicald's DSP thread hangs; systemd's watchdog (played by the case) ends it and starts it again.
