@@ -70,6 +70,12 @@ void FrameLoop::take_external_triggers(const dsp::Frame& f) noexcept {
     while (channels_[c]->take_request(r)) {
       // Its CLOCK_MONOTONIC time onto the DAQ clock; never before this frame.
       const double at = r.time_ns > 0 ? daq_clock_.number_at(r.time_ns) : std::nan("");
+      if (std::isfinite(at) && at - static_cast<double>(f.sample_index) > kMaxTriggerAheadS * options_.fs_hz) {
+        TriggerVerdict v;
+        v.id = r.id, v.refusal = Refusal::time_ahead, v.sample_index = f.sample_index, v.state = session_.state().state();
+        channels_[c]->answer(v);
+        continue;
+      }
       const std::int64_t idx = std::isfinite(at) ? std::max(static_cast<std::int64_t>(std::llround(at)), f.sample_index) : f.sample_index;
       TriggerVerdict v = gate_.decide(r, idx, session_.state().state());
       if (v.accepted && !session_.queue_trigger(idx, r.code)) v.accepted = false, v.refusal = Refusal::queue_full;
