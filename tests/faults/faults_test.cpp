@@ -73,6 +73,20 @@ TEST(Faults, StallingSourceIsReopenedAndTheCutMeasurementFlagged) {
   EXPECT_EQ(o.measurements_lost, 0);
 }
 
+TEST(Faults, CommandFloodAt1kHzIsAnsweredWithoutDisturbingTheMeasurement) {
+  const FaultOutcome o = command_flood();
+  expect_survived(o);
+  EXPECT_TRUE(o.clean) << "ring overruns or temporaries";
+  EXPECT_EQ(o.measurements_lost, 0);
+}
+
+TEST(Faults, MalformedAndOversizedCommandsAreRefusedAndChangeNothing) {
+  const FaultOutcome o = malformed_commands();
+  expect_survived(o);
+  EXPECT_TRUE(o.flagged) << "not every malformed command was refused";
+  EXPECT_EQ(o.measurements_lost, 0);
+}
+
 TEST(Faults, Kill9DuringTheWriteLeavesNoTornRunAndTheNextStartCleansUp) {
   const FaultOutcome o = kill9_during_write();
   expect_survived(o);

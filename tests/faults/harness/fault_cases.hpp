@@ -22,6 +22,10 @@ FaultOutcome wall_clock_steps_back();
 FaultOutcome source_faster_than_real_time();
 // A DAQ that stops sending for 2 s in the middle of a measurement.
 FaultOutcome source_stalls();
+// An HMI sending Command at 1 kHz for 5 s while the service measures.
+FaultOutcome command_flood();
+// Commands that are malformed (wall-clock times, unknown codes and actions) or oversized.
+FaultOutcome malformed_commands();
 // eicald is killed (SIGKILL) while it writes a run; then started again.
 FaultOutcome kill9_during_write();
 // eicald's DSP thread hangs; systemd's watchdog (played by the case) ends it and starts it again.

@@ -9,6 +9,8 @@ const std::vector<FaultCase>& all_cases() {
       {"wall_clock_steps_back", wall_clock_steps_back},
       {"source_faster_than_real_time", source_faster_than_real_time},
       {"source_stalls", source_stalls},
+      {"command_flood", command_flood},
+      {"malformed_commands", malformed_commands},
       {"kill9_during_write", kill9_during_write},
       {"dsp_thread_hung", dsp_thread_hung},
   };
