@@ -24,7 +24,7 @@ const char* yes(bool b) { return b ? "yes" : "NO"; }
 
 void print_row(const std::string& name, const FaultOutcome& o) {
   char recovery[32] = "-";
-  if (std::isfinite(o.recovery_s)) std::snprintf(recovery, sizeof recovery, "%.2f s", o.recovery_s);
+  if (std::isfinite(o.recovery_s)) std::snprintf(recovery, sizeof recovery, "%.3f s", o.recovery_s);
   std::printf("%-28s %-5s %-7s %-5s %3zu/%-3zu %3zu %9s  %s\n", name.c_str(), yes(o.service_alive), o.flagged ? "yes" : "-",
               o.clean ? "yes" : "-", o.runs_intact, o.runs_before, o.runs_after, recovery, o.data_lost.c_str());
   std::printf("%-28s   %s: %s\n", "", o.fault.c_str(), o.outcome.c_str());

@@ -93,7 +93,7 @@ FaultOutcome kill9_during_write() {
   o.outcome = "no torn run directory; the next start removed " + std::to_string(temps_left) + " temporar" + (temps_left == 1 ? "y" : "ies") +
               (unevaluated ? " and evaluated " + std::to_string(unevaluated) + " run(s) left without result (flagged evaluated_after_restart)" : "");
   o.measurements_lost = 1;
-  o.data_lost = "the measurement being written (in the killed process's memory); completed runs 0";
+  o.data_lost = "the measurement being written (in the killed process's memory); no completed run";
   return o;
 }
 

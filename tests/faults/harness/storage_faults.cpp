@@ -103,8 +103,13 @@ FaultOutcome disk_full_mid_recording() {
   else o.problem("the held measurement was not written after space was freed");
   if (!svc.wait_for([&](const auto& st) { return st.fault.empty(); }, 10s)) o.problem("Status.fault not cleared: " + svc.last().fault);
   o.service_alive = svc.wait_for([&](const auto& st) { return st.results_written > results_at_fault + 1; }, 60s);
-  o.outcome = "Status.fault \"" + at_fault.fault.substr(0, 60) + "...\"; the measurement held in memory, written when space returned; " +
-              std::to_string(svc.last().counters.triggers_refused - at_fault.counters.triggers_refused) + " M-codes refused meanwhile";
+  // The system's reason, as Status.fault gives it after the path ("...: File too large; retried ...").
+  const std::string& f = at_fault.fault;
+  const auto retried = f.find("; retried");
+  const auto reason = f.rfind(": ", retried);
+  o.outcome = "Status.fault \"recording ...: " + (reason == std::string::npos ? f : f.substr(reason + 2)) +
+              "\"; written when space returned; " + std::to_string(svc.last().counters.triggers_refused - at_fault.counters.triggers_refused) +
+              " M-codes refused (with a Reply) meanwhile";
   svc.stop();
   if (svc.error()) o.problem("the service ended with: " + *svc.error());
   o.runs_intact = intact_runs(before, dir);
