@@ -17,6 +17,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <malloc.h>
 #include <thread>
 #include <vector>
 
@@ -70,6 +71,9 @@ int main(int argc, char** argv) {
   app.add_option("-c,--config", config_file, "configuration file (config/eicald.toml documents every key)");
   app.add_flag("--check", check, "validate the configuration and the source, then exit");
   CLI11_PARSE(app, argc, argv);
+  // Buffers above 256 kB (a long recording's evaluation) are mapped and go back to the
+  // system when freed, not kept in the heap by glibc's adaptive threshold.
+  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
 
   DaemonConfig config;
   try {

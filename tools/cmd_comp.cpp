@@ -171,6 +171,7 @@ void register_comp(CLI::App& app) {
     for (const auto& in : inputs) ins.push_back({{"input", in.name}, {"run_id", in.run_id}, {"program", in.result.value("program", std::string())}});
     j["inputs"] = ins;
     if (!plan.unresolved_used.empty()) j["proposed_from_unresolved_figures"] = plan.unresolved_used;
+    if (!plan.unresolved_skipped.empty()) j["left_out_unresolved_figures"] = plan.unresolved_skipped;
     nlohmann::json names = nlohmann::json::array();
     for (const auto& f : files) names.push_back(f.path);
     j["files"] = names;
@@ -199,6 +200,7 @@ void register_comp(CLI::App& app) {
         std::printf("comp: %c backlash %.2f um (%s)\n", a, *p.lost_motion_um, p.source.c_str());
     }
     for (const auto& u : plan.unresolved_used) std::printf("comp: WARNING proposed from an unresolved figure (--allow-unresolved): %s\n", u.c_str());
+    for (const auto& u : plan.unresolved_skipped) std::printf("comp: left out, not resolved (--skip-unresolved): %s\n", u.c_str());
     std::printf("comp: %zu files -> %s\n", files.size(), o->out.c_str());
   });
 }

@@ -51,7 +51,7 @@ void register_demo(CLI::App& app) {
     std::atomic<bool> stop{false};
     const auto stats = drivers::pump(source, ring, [&](const dsp::Frame& f) {
       session.on_frame(f);
-      if (session.state().state() == dsp::State::measuring || f.trigger == 103) live.step(f);
+      if (session.state().state() == dsp::State::measuring || f.trigger == dsp::trigger::program_end) live.step(f);
     }, stop);
     if (!stats.source_error.empty()) throw std::runtime_error(stats.source_error);
     const auto t_acq = std::chrono::steady_clock::now();

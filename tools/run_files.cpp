@@ -51,7 +51,7 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& a) {
   std::string o;
   char b[320];
   std::snprintf(b, sizeof b, "run %s (%s, %zu samples at %.0f Hz)\n", run.meta.id.c_str(), run.meta.program.kind.c_str(),
-                run.frames.size(), run.meta.acquisition.fs_hz);
+                run.frame_count(), run.meta.acquisition.fs_hz);
   o += b;
   std::string section;
   for (const dsp::FigureValue& f : dsp::figures_of(a)) {

@@ -206,7 +206,10 @@ void read_limits(StrictTable t, Limits& l) {
   l.temp_max_c = t.number("temp_max_c", l.temp_max_c);
   if (l.temp_max_c <= l.temp_min_c) t.fail("temp_max_c", "must be above temp_min_c");
   const auto lost = t.integer("max_lost_frames", static_cast<std::int64_t>(l.max_lost_frames));
-  if (lost < 0) t.fail("max_lost_frames", "must not be negative");
+  // A lost frame is bridged with the last value by the integration: the result is degraded
+  // whatever the count (quality flag frames_lost). Tolerating some would need a lost-frame
+  // model in the uncertainty; until then only 0 says what happens.
+  if (lost != 0) t.fail("max_lost_frames", "only 0 is supported: every lost frame flags the result degraded (frames_lost)");
   l.max_lost_frames = static_cast<std::uint64_t>(lost);
   t.finish();
 }

@@ -5,6 +5,7 @@
 #include "daemon/service/trace_builder.hpp"
 #include "daemon/system/log.hpp"
 #include "drivers/results/result_json.hpp"
+#include "drivers/run_io/file_spill.hpp"
 #include "drivers/results/software_version.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_writer.hpp"
@@ -12,6 +13,8 @@
 #include "drivers/setpoint/program_setpoint.hpp"
 #include "drivers/source/servo_setpoint_source.hpp"
 #include "dsp/align/accel_lag.hpp"
+#include "dsp/analysis/verdict.hpp"
+#include "dsp/stream/analyze_stream.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -34,6 +37,25 @@ std::string utc_now(const char* format) {
 }
 
 std::string percent(double ratio) { return std::to_string(static_cast<int>(std::lround(ratio * 100.0))) + " %"; }
+
+// [limits] temp_min_c, temp_max_c: a present sensor's case temperature outside them
+// (its compensation is specified within them) flags the result.
+std::vector<std::string> temperature_flags(const dsp::Run& run, const Limits& limits) {
+  std::vector<std::string> flags;
+  const char* names[2] = {"table", "head"};
+  for (int s = 0; s < 2; ++s) {
+    if (!run.meta.sensor_present[s]) continue;
+    float lo = INFINITY, hi = -INFINITY;
+    for (const auto& f : run.frames)
+      if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s])) lo = std::min(lo, f.temp_c[s]), hi = std::max(hi, f.temp_c[s]);
+    if (!(lo <= hi) || (static_cast<double>(lo) >= limits.temp_min_c && static_cast<double>(hi) <= limits.temp_max_c)) continue;
+    char b[200];
+    std::snprintf(b, sizeof b, "temperature: the %s sensor was at %.1f..%.1f degC, outside [limits] temp_min_c..temp_max_c = %.1f..%.1f degC",
+                  names[s], static_cast<double>(lo), static_cast<double>(hi), limits.temp_min_c, limits.temp_max_c);
+    flags.emplace_back(b);
+  }
+  return flags;
+}
 
 // The lag of the measured behind the recorded set-point and the alignment's residual.
 void measure_alignment(const dsp::Run& run, dsp::SetPointOrigin& s) {
@@ -168,7 +190,10 @@ void Evaluator::evaluate(RecordingJob& job) {
     const std::vector<std::string> setpoint_flags = add_setpoint(run, job.notes);
     // The run first: what was measured is durable before anything can fail.
     write_retrying("recording " + run.meta.id, [&] { drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false}); });
-    dsp::Analysis a = dsp::analyze_run(run, analysis_);
+    // Streamed: the recording's trace is never held twice, its long evaluations spill to
+    // the recording directory's disk (dsp/stream/analyze_stream.hpp).
+    dsp::StoredFrames frames(run.frames);
+    dsp::Analysis a = dsp::analyze_stream(run, frames, analysis_, {drivers::file_spills(config_.recording.dir)});
     if (!job.cause.empty()) a.flags.push_back(job.cause), a.degraded = true;
     if (job.notes.nonfinite_frames > 0) {
       a.flags.push_back("not_finite: " + std::to_string(job.notes.nonfinite_frames) +
@@ -184,6 +209,8 @@ void Evaluator::evaluate(RecordingJob& job) {
                     job.notes.source_rate_ratio, run.fs_hz());
       a.flags.push_back(b), a.degraded = true;
     }
+    for (const auto& f : temperature_flags(run, config_.limits)) a.flags.push_back(f), a.degraded = true;
+    dsp::judge(run.meta.program, a);  // the verdict again, with the flags the daemon added
     write_retrying("result of " + run.meta.id, [&] {
       // The run directory removed meanwhile (an operator, a cleanup): the run again first.
       if (!std::filesystem::exists(dir / "run.toml")) drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = true});
@@ -217,12 +244,15 @@ void Evaluator::finish_result(const dsp::Run& run, const dsp::Analysis& a, const
 // not in the run.
 void Evaluator::evaluate_recorded(const std::filesystem::path& dir) {
   try {
-    const dsp::Run run = drivers::read_run(dir);
-    dsp::Analysis a = dsp::analyze_run(run, analysis_);
+    dsp::Run run = drivers::read_run(dir);
+    dsp::StoredFrames frames(run.frames);
+    dsp::Analysis a = dsp::analyze_stream(run, frames, analysis_, {drivers::file_spills(config_.recording.dir)});
     a.flags.push_back(
         "evaluated_after_restart: eicald stopped between writing this run and its result; evaluated at the next start, without the flags "
         "only the stopped service knew (cut short, non-finite channels)");
     a.degraded = true;
+    for (const auto& f : temperature_flags(run, config_.limits)) a.flags.push_back(f);
+    dsp::judge(run.meta.program, a);
     write_retrying("result of " + run.meta.id, [&] { drivers::write_result(run, a, dir / "result.json"); });
     finish_result(run, a, dir);
     log(LogLevel::notice, "run %s of the previous start evaluated now (it had no result.json)", run.meta.id.c_str());

@@ -2,6 +2,7 @@
 // An NC trigger (M101 tare + start, M102 segment, M103 stop) from an input that is not the
 // DAQ's own trigger channel (DDS Command, GPIO edge, CAN frame), and the DSP thread's
 // verdict on it. Plain data: they travel through SPSC rings.
+#include "dsp/core/frame.hpp"
 #include "dsp/session/measurement_state.hpp"
 
 #include <cmath>
@@ -10,8 +11,8 @@
 
 namespace eical::daemon {
 
-inline constexpr int kProgramStart = 101, kSegmentMark = 102, kProgramEnd = 103;
-inline bool is_nc_trigger(int code) { return code == kProgramStart || code == kSegmentMark || code == kProgramEnd; }
+inline constexpr int kProgramStart = dsp::trigger::program_start, kSegmentMark = dsp::trigger::segment_mark, kProgramEnd = dsp::trigger::program_end;
+inline bool is_nc_trigger(int code) { return dsp::trigger::is_nc_trigger(code); }
 
 struct TriggerRequest {
   std::uint32_t id = 0;    // per input, echoed in the verdict

@@ -1,5 +1,7 @@
 #include "drivers/gpio/gpio_trigger.hpp"
 
+#include "dsp/core/frame.hpp"
+
 #include <gpiod.h>
 
 #include <cerrno>
@@ -77,7 +79,7 @@ std::optional<GpioEdge> GpioTriggerInput::next(int timeout_ms) {
       return std::nullopt;
     }
     last_ns_[k] = ev->time_ns;
-    return GpioEdge{101 + static_cast<int>(k), ev->time_ns};
+    return GpioEdge{dsp::trigger::program_start + static_cast<int>(k), ev->time_ns};
   }
   return std::nullopt;
 }

@@ -56,8 +56,8 @@ dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel, con
       for (int a = 0; a < 3; ++a) f.cmd_mm[a] = p[a];
     }
   }
-  run.frames.front().trigger = 101;
-  run.frames.back().trigger = 103;
+  run.frames.front().trigger = dsp::trigger::program_start;
+  run.frames.back().trigger = dsp::trigger::program_end;
   return run;
 }
 

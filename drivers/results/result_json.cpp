@@ -69,8 +69,9 @@ nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult&
     j["circular_deviation_G_cw_um"] = number_or_null(dsp::direction_G_um(c, "cw"));
   }
   // The trace thinned to at most ~3600 points per revolution set: the plots need no more.
+  // (A trace already thinned as it streamed keeps exactly these points: all of them go.)
   const std::size_t n = c.trace.angle_deg.size();
-  const std::size_t step = std::max<std::size_t>(1, n / 3600);
+  const std::size_t step = c.trace.stride > 1 ? 1 : std::max<std::size_t>(1, n / 3600);
   nlohmann::json ang = nlohmann::json::array(), dev = nlohmann::json::array(), dir = nlohmann::json::array();
   for (std::size_t i = 0; i < n; i += step) {
     ang.push_back(std::round(c.trace.angle_deg[i] * 1000.0) / 1000.0);
@@ -204,9 +205,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   sup["psd_disagrees"] = m.supports.psd_disagrees;
   sup["resets"] = m.supports.resets;
   sup["smoothed"] = m.supports.smoothed;
-  Eigen::Vector3d worst = Eigen::Vector3d::Zero();
-  for (const auto& sg : m.sigma_um)
-    if (sg.allFinite()) worst = worst.cwiseMax(sg);
+  const Eigen::Vector3d& worst = m.sigma_max_um;  // over the whole trace
   sup["position_sigma_max_um"] = {worst.x(), worst.y(), worst.z()};
   j["pipeline"]["supports"] = sup;
   // Repeats of one segment (between M102 marks) averaged sample by sample (6-44).

@@ -62,6 +62,140 @@ std::optional<std::int64_t> parse_int(const LineSource& src, int col, std::strin
   return v;
 }
 
+}  // namespace
+
+SampleReader::SampleReader(const fs::path& file, const dsp::RunMeta& meta, dsp::ChannelPresence& channels)
+    : src_(std::make_unique<LineSource>(file)), file_(file), meta_(meta) {
+  std::string_view line;
+  if (!src_->next(line)) throw dsp::InputError(file.string() + ": empty file (no header line)");
+  where_.fill(-1);
+  n_fields_ = 0;
+  {
+    std::size_t pos = 0;
+    for (;;) {
+      const auto comma = line.find(',', pos);
+      const std::string_view name = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
+      for (int c = 0; c < c_count; ++c)
+        if (column_name(c) == name) {
+          if (where_[c] >= 0) throw dsp::InputError(file.string() + ":1: column '" + std::string(name) + "' appears twice");
+          where_[c] = n_fields_;
+        }
+      ++n_fields_;
+      if (comma == std::string_view::npos) break;
+      pos = comma + 1;
+    }
+  }
+  for (int c : {c_t, c_tax, c_tay, c_taz, c_hax, c_hay, c_haz, c_ttemp, c_htemp, c_cx, c_cy, c_cz, c_trig})
+    if (where_[c] < 0) throw dsp::InputError(file.string() + ":1: required column '" + column_name(c) + "' is missing");
+  n_psd_ = static_cast<int>(meta.psd.size());
+  if (n_psd_ > dsp::kMaxPsd) throw dsp::InputError(file.string() + ": more than " + std::to_string(dsp::kMaxPsd) + " [[psd]] strips");
+  for (int k = 0; k < dsp::kMaxPsd; ++k)
+    for (int e = 0; e < 2; ++e) {
+      const int c = c_psd0 + 2 * k + e;
+      if (k < n_psd_ && where_[c] < 0)
+        throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' is missing (run.toml has " + std::to_string(n_psd_) + " [[psd]])");
+      if (k >= n_psd_ && where_[c] >= 0)
+        throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' has no [[psd]] table in run.toml");
+    }
+  for (int a = 0; a < 3; ++a) channels.ref[a] = where_[c_rx + a] >= 0;
+  channels.psd_count = n_psd_;
+  fields_.resize(static_cast<std::size_t>(n_fields_));
+}
+
+SampleReader::~SampleReader() = default;
+
+bool SampleReader::next(dsp::Frame& out) {
+  std::string_view line;
+  if (!src_->next(line)) {
+    if (rows_ == 0) throw dsp::InputError(file_.string() + ": no samples after the header");
+    return false;
+  }
+  const LineSource& src = *src_;
+  const double fs = meta_.acquisition.fs_hz;
+  const double lsb = meta_.acquisition.adc_lsb_volt;
+  const auto offset = static_cast<double>(meta_.acquisition.adc_offset_counts);
+  const double full = std::ldexp(1.0, meta_.acquisition.adc_bits - 1);
+  // Split into exactly n_fields fields.
+  std::size_t k = 0, pos = 0;
+  for (;;) {
+    const auto comma = line.find(',', pos);
+    if (k < fields_.size()) fields_[k] = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
+    ++k;
+    if (comma == std::string_view::npos) break;
+    pos = comma + 1;
+  }
+  if (k != fields_.size()) {
+    const std::string why = !src.last_line_had_newline() ? "truncated file: the last line is incomplete" : "wrong number of fields";
+    throw dsp::InputError(file_.string() + ":" + std::to_string(src.line_number()) + ": " + why + " (" + std::to_string(k) +
+                          " fields, header has " + std::to_string(n_fields_) + ")");
+  }
+  auto field = [&](int c) { return fields_[static_cast<std::size_t>(where_[c])]; };
+  dsp::Frame f;
+  const auto t = parse_double(src, c_t, field(c_t));
+  if (!t) fail_at(src, c_t, "empty time");
+  const double idx_real = *t * fs;
+  const auto idx = static_cast<std::int64_t>(std::llround(idx_real));
+  // 1e-3 sample, plus what printing t with 10 significant digits can cost on long runs.
+  if (std::abs(idx_real - static_cast<double>(idx)) > 1e-3 + 1e-9 * std::abs(idx_real))
+    fail_at(src, c_t, "time " + std::string(field(c_t)) + " s is not on the sample grid of fs = " + std::to_string(fs) + " Hz");
+  if (prev_index_ >= 0 && idx <= prev_index_) fail_at(src, c_t, "time does not increase");
+  if (prev_index_ >= 0 && idx > prev_index_ + 1) f.flags |= dsp::frame_flag::gap_before;
+  prev_index_ = idx;
+  f.sample_index = idx;
+  for (int c = c_tax; c <= c_haz; ++c) {
+    const auto v = parse_int(src, c, field(c), "integer ADC counts");
+    if (!v) {
+      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::sensor_missing(c - c_tax < 3 ? 0 : 1);
+      continue;
+    }
+    if (*v > INT32_MAX || *v < INT32_MIN) fail_at(src, c, "ADC counts out of the 32-bit range");
+    f.accel_counts[c - c_tax] = static_cast<std::int32_t>(*v);
+    if (static_cast<double>(*v) >= full - 1 || static_cast<double>(*v) <= -full) f.flags |= dsp::frame_flag::accel_saturated;
+  }
+  for (int s = 0; s < 2; ++s) {
+    const auto v = parse_double(src, c_ttemp + s, field(c_ttemp + s));
+    // Checked before the conversion to float (beyond its range it is undefined).
+    if (v && !(std::abs(*v) <= kMaxTemp_c)) fail_at(src, c_ttemp + s, "temperature beyond +-1000 C ('" + std::string(field(c_ttemp + s)) + "')");
+    if (v) f.temp_c[s] = static_cast<float>(*v);
+    else f.flags |= dsp::frame_flag::temp_missing;
+  }
+  for (int a = 0; a < 3; ++a) {
+    const auto v = parse_double(src, c_cx + a, field(c_cx + a));
+    if (v) f.cmd_mm[a] = *v;
+    else f.flags |= dsp::frame_flag::cmd_missing;
+    if (where_[c_rx + a] >= 0) {
+      const auto r = parse_double(src, c_rx + a, field(c_rx + a));
+      if (r) f.ref_mm[a] = *r;
+    }
+  }
+  for (int c = c_psd0; c < c_psd0 + 2 * n_psd_; ++c) {
+    const auto v = parse_double(src, c, field(c));
+    if (!v) {
+      f.flags |= dsp::frame_flag::psd_missing;
+      continue;
+    }
+    const double counts = *v / lsb + offset;
+    if (!(std::abs(counts) <= INT32_MAX)) fail_at(src, c, "PSD value beyond the ADC's 32-bit range ('" + std::string(field(c)) + "')");
+    f.psd_counts[c - c_psd0] = static_cast<std::int32_t>(std::llround(counts));
+  }
+  const auto trig = parse_int(src, c_trig, field(c_trig), "an integer trigger code");
+  if (!trig) fail_at(src, c_trig, "empty trigger (0 means none)");
+  f.trigger = static_cast<std::int32_t>(*trig);
+  for (int s = 0; s < 2; ++s)
+    if (!(f.flags & dsp::frame_flag::sensor_missing(s))) seen_[s] = true;
+  ++rows_;
+  out = f;
+  return true;
+}
+
+void absent_sensors_are_not_missing(const bool present[2], dsp::Frame& f) {
+  for (int s = 0; s < 2; ++s)
+    if (!present[s]) {
+      f.flags &= ~dsp::frame_flag::sensor_missing(s);
+      if (!(f.flags & dsp::frame_flag::sensor_missing(1 - s))) f.flags &= ~dsp::frame_flag::accel_missing;
+    }
+}
+
 fs::path samples_file(const fs::path& dir) {
   const fs::path plain = dir / "samples.csv", gz = dir / "samples.csv.gz";
   const bool has_plain = fs::exists(plain), has_gz = fs::exists(gz);
@@ -70,133 +204,18 @@ fs::path samples_file(const fs::path& dir) {
   return has_plain ? plain : gz;
 }
 
-void read_samples(const fs::path& file, dsp::Run& run) {
-  LineSource src(file);
-  std::string_view line;
-  if (!src.next(line)) throw dsp::InputError(file.string() + ": empty file (no header line)");
-  std::array<int, c_count> where;
-  where.fill(-1);
-  int n_fields = 0;
-  {
-    std::size_t pos = 0;
-    for (;;) {
-      const auto comma = line.find(',', pos);
-      const std::string_view name = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
-      for (int c = 0; c < c_count; ++c)
-        if (column_name(c) == name) {
-          if (where[c] >= 0) throw dsp::InputError(file.string() + ":1: column '" + std::string(name) + "' appears twice");
-          where[c] = n_fields;
-        }
-      ++n_fields;
-      if (comma == std::string_view::npos) break;
-      pos = comma + 1;
-    }
-  }
-  for (int c : {c_t, c_tax, c_tay, c_taz, c_hax, c_hay, c_haz, c_ttemp, c_htemp, c_cx, c_cy, c_cz, c_trig})
-    if (where[c] < 0) throw dsp::InputError(file.string() + ":1: required column '" + column_name(c) + "' is missing");
-  const int n_psd = static_cast<int>(run.meta.psd.size());
-  if (n_psd > dsp::kMaxPsd) throw dsp::InputError(file.string() + ": more than " + std::to_string(dsp::kMaxPsd) + " [[psd]] strips");
-  for (int k = 0; k < dsp::kMaxPsd; ++k)
-    for (int e = 0; e < 2; ++e) {
-      const int c = c_psd0 + 2 * k + e;
-      if (k < n_psd && where[c] < 0)
-        throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' is missing (run.toml has " + std::to_string(n_psd) + " [[psd]])");
-      if (k >= n_psd && where[c] >= 0)
-        throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' has no [[psd]] table in run.toml");
-    }
-  for (int a = 0; a < 3; ++a) run.channels.ref[a] = where[c_rx + a] >= 0;
-  run.channels.psd_count = n_psd;
+namespace {
 
-  const double fs = run.meta.acquisition.fs_hz;
-  const double lsb = run.meta.acquisition.adc_lsb_volt;
-  const auto offset = static_cast<double>(run.meta.acquisition.adc_offset_counts);
-  std::vector<std::string_view> fields(static_cast<std::size_t>(n_fields));
-  std::int64_t prev_index = -1;
-  while (src.next(line)) {
-    // Split into exactly n_fields fields.
-    std::size_t k = 0, pos = 0;
-    for (;;) {
-      const auto comma = line.find(',', pos);
-      if (k < fields.size()) fields[k] = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
-      ++k;
-      if (comma == std::string_view::npos) break;
-      pos = comma + 1;
-    }
-    if (k != fields.size()) {
-      const std::string why = !src.last_line_had_newline() ? "truncated file: the last line is incomplete" : "wrong number of fields";
-      throw dsp::InputError(file.string() + ":" + std::to_string(src.line_number()) + ": " + why + " (" + std::to_string(k) +
-                            " fields, header has " + std::to_string(n_fields) + ")");
-    }
-    auto field = [&](int c) { return fields[static_cast<std::size_t>(where[c])]; };
-    dsp::Frame f;
-    const auto t = parse_double(src, c_t, field(c_t));
-    if (!t) fail_at(src, c_t, "empty time");
-    const double idx_real = *t * fs;
-    const auto idx = static_cast<std::int64_t>(std::llround(idx_real));
-    // 1e-3 sample, plus what printing t with 10 significant digits can cost on long runs.
-    if (std::abs(idx_real - static_cast<double>(idx)) > 1e-3 + 1e-9 * std::abs(idx_real))
-      fail_at(src, c_t, "time " + std::string(field(c_t)) + " s is not on the sample grid of fs = " + std::to_string(fs) + " Hz");
-    if (prev_index >= 0 && idx <= prev_index) fail_at(src, c_t, "time does not increase");
-    if (prev_index >= 0 && idx > prev_index + 1) f.flags |= dsp::frame_flag::gap_before;
-    prev_index = idx;
-    f.sample_index = idx;
-    for (int c = c_tax; c <= c_haz; ++c) {
-      const auto v = parse_int(src, c, field(c), "integer ADC counts");
-      if (!v) {
-        f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::sensor_missing(c - c_tax < 3 ? 0 : 1);
-        continue;
-      }
-      if (*v > INT32_MAX || *v < INT32_MIN) fail_at(src, c, "ADC counts out of the 32-bit range");
-      f.accel_counts[c - c_tax] = static_cast<std::int32_t>(*v);
-      const double full = std::ldexp(1.0, run.meta.acquisition.adc_bits - 1);
-      if (static_cast<double>(*v) >= full - 1 || static_cast<double>(*v) <= -full) f.flags |= dsp::frame_flag::accel_saturated;
-    }
-    for (int s = 0; s < 2; ++s) {
-      const auto v = parse_double(src, c_ttemp + s, field(c_ttemp + s));
-      // Checked before the conversion to float (beyond its range it is undefined).
-      if (v && !(std::abs(*v) <= kMaxTemp_c)) fail_at(src, c_ttemp + s, "temperature beyond +-1000 C ('" + std::string(field(c_ttemp + s)) + "')");
-      if (v) f.temp_c[s] = static_cast<float>(*v);
-      else f.flags |= dsp::frame_flag::temp_missing;
-    }
-    for (int a = 0; a < 3; ++a) {
-      const auto v = parse_double(src, c_cx + a, field(c_cx + a));
-      if (v) f.cmd_mm[a] = *v;
-      else f.flags |= dsp::frame_flag::cmd_missing;
-      if (where[c_rx + a] >= 0) {
-        const auto r = parse_double(src, c_rx + a, field(c_rx + a));
-        if (r) f.ref_mm[a] = *r;
-      }
-    }
-    for (int c = c_psd0; c < c_psd0 + 2 * n_psd; ++c) {
-      const auto v = parse_double(src, c, field(c));
-      if (!v) {
-        f.flags |= dsp::frame_flag::psd_missing;
-        continue;
-      }
-      const double counts = *v / lsb + offset;
-      if (!(std::abs(counts) <= INT32_MAX)) fail_at(src, c, "PSD value beyond the ADC's 32-bit range ('" + std::string(field(c)) + "')");
-      f.psd_counts[c - c_psd0] = static_cast<std::int32_t>(std::llround(counts));
-    }
-    const auto trig = parse_int(src, c_trig, field(c_trig), "an integer trigger code");
-    if (!trig) fail_at(src, c_trig, "empty trigger (0 means none)");
-    f.trigger = static_cast<std::int32_t>(*trig);
-    run.frames.push_back(f);
-  }
-  if (run.frames.empty()) throw dsp::InputError(file.string() + ": no samples after the header");
+void read_samples(const fs::path& file, dsp::Run& run) {
+  SampleReader reader(file, run.meta, run.channels);
+  dsp::Frame f;
+  while (reader.next(f)) run.frames.push_back(f);
   // A triplex empty in every row is absent (a single-sensor run), not missing: its empty
   // fields flag nothing, and the other sensor's samples stay good.
-  for (int s = 0; s < 2; ++s) {
-    const std::uint32_t bit = dsp::frame_flag::sensor_missing(s);
-    run.meta.sensor_present[s] = !std::all_of(run.frames.begin(), run.frames.end(), [&](const dsp::Frame& f) { return (f.flags & bit) != 0; });
-  }
+  for (int s = 0; s < 2; ++s) run.meta.sensor_present[s] = reader.sensor_seen(s);
   if (!run.meta.sensor_present[0] && !run.meta.sensor_present[1])
     throw dsp::InputError(file.string() + ": no accelerometer data (every table_* and head_* field is empty)");
-  for (int s = 0; s < 2; ++s)
-    if (!run.meta.sensor_present[s])
-      for (auto& f : run.frames) {
-        f.flags &= ~dsp::frame_flag::sensor_missing(s);
-        if (!(f.flags & dsp::frame_flag::sensor_missing(1 - s))) f.flags &= ~dsp::frame_flag::accel_missing;
-      }
+  for (auto& fr : run.frames) absent_sensors_are_not_missing(run.meta.sensor_present, fr);
 }
 
 }  // namespace

@@ -52,7 +52,7 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
   }
   std::vector<std::int64_t> marks;
   for (const auto& t : m.triggers)
-    if (t.code == 102) marks.push_back(t.sample_index);
+    if (t.code == trigger::segment_mark) marks.push_back(t.sample_index);
   Ranges ccw, cw;
   try {
     for (const auto& s : eval::find_circle_segments(cmd, m.sample_index, marks, {p.center_mm[0], p.center_mm[1]}, p.arc_deg))

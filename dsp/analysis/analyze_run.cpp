@@ -122,19 +122,24 @@ eval::PositioningInput positioning_deviations(const Measurement& m, const Progra
   return in;
 }
 
-Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
-  if (run.frames.empty()) throw InputError("run '" + run.meta.id + "' holds no frames");
-  if (!(run.meta.acquisition.fs_hz > 0.0)) throw InputError("run '" + run.meta.id + "': fs_hz must be positive");
-  PipelineConfig cfg = pipeline_config(run.meta, run.frames.size());
+PipelineConfig analysis_config(const RunMeta& meta, std::size_t capacity_samples, const AnalysisOptions& options) {
+  PipelineConfig cfg = pipeline_config(meta, capacity_samples);
   cfg.dynamic = options.dynamic;
   cfg.zupt = options.zupt;
-  cfg.nbs = options.nbs.value_or(run.meta.program.kind == "rectangle");
+  cfg.nbs = options.nbs.value_or(meta.program.kind == "rectangle");
   cfg.coriolis = options.coriolis;
   cfg.cupt = options.cupt;
   cfg.keep_raw = options.keep_raw;
   cfg.keep_schedule = options.uncertainty.enabled;
   if (options.sensor_model != "datasheet") cfg.fusion.scale_uncertainty = 3e-5;  // identified on site
   cfg.calibration[0] = options.calibration[0], cfg.calibration[1] = options.calibration[1];
+  return cfg;
+}
+
+Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
+  if (run.frames.empty()) throw InputError("run '" + run.meta.id + "' holds no frames");
+  if (!(run.meta.acquisition.fs_hz > 0.0)) throw InputError("run '" + run.meta.id + "': fs_hz must be positive");
+  const PipelineConfig cfg = analysis_config(run.meta, run.frames.size(), options);
   Pipeline pipeline(cfg);
   for (const auto& f : run.frames) pipeline.step(f);
   Analysis a;
@@ -144,6 +149,11 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   a.measurement = pipeline.finish();
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;
+  evaluate_measurement(run, cfg, options, a);
+  return a;
+}
+
+void evaluate_measurement(const Run& run, const PipelineConfig& cfg, const AnalysisOptions& options, Analysis& a) {
   // run-format.md, "No standstill": a double integral with nothing to hold it is no
   // position. Every positional figure is null with this reason (the verdict: not
   // measurable); eical explain compares such runs in acceleration against the set-point.
@@ -162,7 +172,6 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
     if (options.uncertainty.enabled) estimate_uncertainty(run, cfg, options, a);
   }
   judge(run.meta.program, a);
-  return a;
 }
 
 void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& options) {
@@ -174,23 +183,6 @@ void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& opti
   else if (kind == "rectangle") detail::evaluate_rectangle_program(run, a);
   else if (kind == "freeform") detail::evaluate_freeform_program(run, a);
   else a.flags.push_back("program kind '" + kind + "': no evaluation in this version");
-}
-
-Measurement decimate(const Measurement& m, std::size_t q) {
-  Measurement d;
-  q = std::max<std::size_t>(1, q);
-  d.fs_hz = m.fs_hz / static_cast<double>(q);
-  const std::size_t n = std::min({m.sample_index.size(), m.pos_mm.size(), m.cmd_mm.size()});
-  for (std::size_t i = 0; i < n; i += q) {
-    d.sample_index.push_back(m.sample_index[i]);
-    d.pos_mm.push_back(m.pos_mm[i]);
-    d.vel_mm_s.push_back(i < m.vel_mm_s.size() ? m.vel_mm_s[i] : Eigen::Vector3d::Zero());
-    d.cmd_mm.push_back(m.cmd_mm[i]);
-    d.ref_mm.push_back(i < m.ref_mm.size() ? m.ref_mm[i] : Eigen::Vector3d::Constant(NAN));
-  }
-  d.triggers = m.triggers;
-  d.start_index = m.start_index, d.motion_end_index = m.motion_end_index;
-  return d;
 }
 
 }  // namespace eical::dsp

@@ -83,16 +83,21 @@ struct Analysis {
   std::vector<std::string> verdict_reasons;
 };
 
-// Throws InputError only when the run itself is unusable (no frames, fs ≤ 0).
+// Throws InputError only when the run itself is unusable (no frames, fs ≤ 0). Holds the
+// run's trace; runs of any length: analyze_stream() (dsp/stream), equal results.
 Analysis analyze_run(const Run& run, const AnalysisOptions& options = {});
+
+// The pipeline configuration of the analysis.
+PipelineConfig analysis_config(const RunMeta& meta, std::size_t capacity_samples, const AnalysisOptions& options);
+
+// What analyze_run does after the pipeline: the integration check, the repeats, the
+// program's evaluation, the uncertainty (when the pipeline kept its schedule) and the
+// verdict (a.measurement set; failures into a.flags).
+void evaluate_measurement(const Run& run, const PipelineConfig& config, const AnalysisOptions& options, Analysis& a);
 
 // The program's evaluation of an analysis whose measurement is set (what analyze_run does
 // after the pipeline); adds failures to a.flags.
 void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& options = {});
-
-// Every q-th sample of a measurement (fs/q), its triggers kept: what the uncertainty's
-// draws evaluate.
-Measurement decimate(const Measurement& m, std::size_t q);
 
 // Deviations at the targets of a positioning program: at each M102 (target reached) the
 // mean of measured − set-point over the second half of the dwell, grouped by target and

@@ -5,6 +5,7 @@
 #include "dsp/core/error.hpp"
 #include "dsp/uncertainty/error_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -40,17 +41,35 @@ void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const Analy
     a.uncertainty_note = "no support schedule: the uncertainty was not estimated";
     return;
   }
-  uncertainty::ErrorFieldInput in;
-  fusion::SupportSchedule schedule = fine;  // as the trace was actually fused
-  if (m.supports.psd_disagrees) schedule.cupt = false;
-  if (m.supports.diverged) {
-    schedule.zupt = schedule.cupt = false;
-    for (auto& f : schedule.flags) f = static_cast<std::uint8_t>(f & (fusion::schedule_flag::move_start | fusion::schedule_flag::invalid));
+  const std::size_t n = std::min({m.sample_index.size(), m.pos_mm.size(), m.cmd_mm.size()});
+  UncertaintyTrace trace(run, cfg, o, a, fine, n, [&m](std::size_t k) { return m.sample_index[k]; });
+  // The case temperatures along the trace (α_b's effect): a streamed run's, else from the frames.
+  const bool streamed_temp = m.temp_c.size() == m.sample_index.size();
+  std::size_t f = 0;
+  Eigen::Vector2d last(run.meta.sensors[0].temp_ref_c, run.meta.sensors[1].temp_ref_c);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (streamed_temp) {
+      last = m.temp_c[k];
+    } else {
+      while (f < run.frames.size() && run.frames[f].sample_index < m.sample_index[k]) ++f;
+      if (f < run.frames.size()) {
+        const Frame& fr = run.frames[f];
+        for (int s = 0; s < 2; ++s)
+          if (!(fr.flags & frame_flag::temp_missing) && std::isfinite(fr.temp_c[s])) last[s] = fr.temp_c[s];
+      }
+    }
+    trace.sample(k, m.sample_index[k], m.pos_mm[k], k < m.vel_mm_s.size() ? m.vel_mm_s[k] : Eigen::Vector3d::Zero(), m.cmd_mm[k],
+                 k < m.ref_mm.size() ? m.ref_mm[k] : Eigen::Vector3d::Constant(NAN), last);
   }
-  in.schedule = &schedule;
-  in.sample_index = &m.sample_index;
-  in.pos_mm = &m.pos_mm;
-  in.vel_mm_s = &m.vel_mm_s;
+  trace.finish(run, a);
+}
+
+UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& cfg, const AnalysisOptions& o, const Analysis& a,
+                                   const fusion::SupportSchedule& schedule, std::size_t samples, std::function<std::int64_t(std::size_t)> index_at,
+                                   const std::vector<bool>* zupt_unused)
+    : samples_(samples), draws_(std::max(2, o.uncertainty.draws)), seed_(o.uncertainty.seed) {
+  const Measurement& m = a.measurement;
+  uncertainty::ErrorFieldInput& in = in_;
   in.fs_hz = m.fs_hz;
   in.delay_samples = a.dynamic == DynamicComp::none ? 0.0 : cfg.acquisition.daq_group_delay_samples;
   in.model = cfg.fusion;
@@ -59,44 +78,69 @@ void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const Analy
   in.sensor_noise_ug_per_rthz[0] = run.meta.sensors[0].noise_ug_per_rthz;
   in.sensor_noise_ug_per_rthz[1] = run.meta.sensors[1].noise_ug_per_rthz;
   in.g_mps2 = run.meta.site.g_mps2;
-  // The case temperatures along the trace (α_b's effect), from the frames.
-  std::vector<Eigen::Vector2d> temp;
-  {
-    std::size_t f = 0;
-    Eigen::Vector2d last(run.meta.sensors[0].temp_ref_c, run.meta.sensors[1].temp_ref_c);
-    for (const std::int64_t idx : m.sample_index) {
-      while (f < run.frames.size() && run.frames[f].sample_index < idx) ++f;
-      if (f < run.frames.size()) {
-        const Frame& fr = run.frames[f];
-        for (int s = 0; s < 2; ++s)
-          if (!(fr.flags & frame_flag::temp_missing) && std::isfinite(fr.temp_c[s])) last[s] = fr.temp_c[s];
-      }
-      temp.push_back(last);
-    }
-  }
-  in.temp_c = &temp;
   for (int j = 0; j < 3; ++j) in.owner[static_cast<std::size_t>(j)] = axis_owner(run.meta.machine, j);
-  a.uncertainty_source = in.model_covariance.source;
+
+  // The schedule as the trace was actually fused: without the strips when they disagreed,
+  // without any support when the fusion diverged (the trace stayed as integrated).
+  uncertainty::FineSchedule fine;
+  fine.schedule = &schedule;
+  fine.samples = std::min(samples, schedule.flags.size());
+  fine.index_at = std::move(index_at);
+  fine.zupt_unused = zupt_unused;
+  if (m.supports.diverged) fine.flag_mask = fusion::schedule_flag::move_start | fusion::schedule_flag::invalid;
+  uncertainty::CoarseSchedule& c = coarse_.emplace(uncertainty::coarsen(fine, in.model, uncertainty::ErrorField::block_for(fine.samples, in.max_coarse)));
+  if (m.supports.psd_disagrees) c.schedule.cupt = false;
+  if (m.supports.diverged) c.schedule.zupt = c.schedule.cupt = false;
+  probe_.emplace(c, in.delay_samples, samples, in.fs_hz);
+
+  // The draws evaluate the path at about kDrawRateHz, at most kMaxDrawSamples of it.
+  q_ = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(m.fs_hz / kDrawRateHz)));
+  q_ = std::max(q_, (samples + kMaxDrawSamples - 1) / kMaxDrawSamples);
+  const std::size_t kept = (samples + q_ - 1) / q_;
+  nominal_.sample_index.reserve(kept), nominal_.pos_mm.reserve(kept), nominal_.vel_mm_s.reserve(kept);
+  nominal_.cmd_mm.reserve(kept), nominal_.ref_mm.reserve(kept);
+}
+
+void UncertaintyTrace::sample(std::size_t k, std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
+                              const Eigen::Vector3d& cmd_mm, const Eigen::Vector3d& ref_mm, const Eigen::Vector2d& temp_c) {
+  probe_->sample(k, pos_mm, vel_mm_s, temp_c);
+  if (k % q_ != 0 || k >= samples_) return;
+  nominal_.sample_index.push_back(sample_index);
+  nominal_.pos_mm.push_back(pos_mm);
+  nominal_.vel_mm_s.push_back(vel_mm_s);
+  nominal_.cmd_mm.push_back(cmd_mm);
+  nominal_.ref_mm.push_back(ref_mm);
+}
+
+void UncertaintyTrace::finish(const Run& run, Analysis& a) {
+  const Measurement& m = a.measurement;
+  a.uncertainty_source = in_.model_covariance.source;
   std::unique_ptr<uncertainty::ErrorField> field;
   try {
-    field = std::make_unique<uncertainty::ErrorField>(in);
+    const uncertainty::CoarsePath path = probe_->path(true);
+    probe_.reset();
+    field = std::make_unique<uncertainty::ErrorField>(in_, std::move(*coarse_), path);
+    coarse_.reset();
   } catch (const InputError& e) {
     a.uncertainty_note = std::string("the uncertainty was not estimated: ") + e.what();
     return;
   }
+  const std::size_t q = q_;
+  const int draws = draws_;
 
   // The nominal evaluation at the draws' rate, and the positions the draws perturb. Two
   // paths: the measured one (the plug-in: what the error does to this machine's figures) and
   // the ideal one, the set-point (what the error alone makes of them: for a range, an
   // amplitude or a spread — |f(t + e) − f(t)| ≤ f(e) — a bound whatever the machine).
-  const std::size_t n = m.sample_index.size();
-  std::size_t q = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(m.fs_hz / kDrawRateHz)));
-  q = std::max(q, (n + kMaxDrawSamples - 1) / kMaxDrawSamples);
   EvaluationOptions eo;
   eo.reference = false;
   if (a.diagnostics) eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
   Analysis nominal, ideal;
-  nominal.measurement = decimate(m, q);
+  nominal.measurement = std::move(nominal_);  // every q-th sample (fs/q), the triggers kept
+  nominal_ = Measurement{};
+  nominal.measurement.fs_hz = m.fs_hz / static_cast<double>(q);
+  nominal.measurement.triggers = m.triggers;
+  nominal.measurement.start_index = m.start_index, nominal.measurement.motion_end_index = m.motion_end_index;
   nominal.dynamic = ideal.dynamic = a.dynamic, nominal.nbs = ideal.nbs = a.nbs;
   ideal.measurement = nominal.measurement;
   ideal.measurement.pos_mm = ideal.measurement.cmd_mm;
@@ -104,7 +148,7 @@ void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const Analy
   evaluate_program(run, ideal, eo);
   const std::vector<FigureValue> f0 = figures_of(nominal), g0 = figures_of(ideal);
   std::vector<double> at;
-  for (std::size_t i = 0; i < n; i += q) at.push_back(static_cast<double>(i));
+  for (std::size_t i = 0; i < samples_; i += q) at.push_back(static_cast<double>(i));
 
   auto start = [](const std::vector<FigureValue>& f) {
     std::vector<Accumulator> acc(f.size());
@@ -126,9 +170,8 @@ void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const Analy
     }
   };
   std::vector<Accumulator> acc = start(f0), acc_ideal = start(g0);
-  std::mt19937_64 rng(o.uncertainty.seed ^ 0x9e3779b97f4a7c15ULL);
+  std::mt19937_64 rng(seed_ ^ 0x9e3779b97f4a7c15ULL);
   std::vector<Eigen::Vector3d> err;
-  const int draws = std::max(2, o.uncertainty.draws);
   for (int d = 0; d < draws; ++d) {
     field->draw(rng, at, err);
     for (Analysis* base : {&nominal, &ideal}) {

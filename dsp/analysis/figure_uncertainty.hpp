@@ -19,12 +19,55 @@
 // its 95 % bound |mean| + 2·sd is a floor under U — where the error is itself a shape (a
 // scale mismatch drawing an ellipse) the plug-in alone would take it for the machine's.
 #include "dsp/analysis/analyze_run.hpp"
+#include "dsp/uncertainty/coarse_path.hpp"
+#include "dsp/uncertainty/error_field.hpp"
+
+#include <functional>
+#include <optional>
 
 namespace eical::dsp {
 
 // Fills a.uncertainty_k2 (and its source and note) from the pipeline's configuration.
 // Leaves it empty with a note when the measurement has no support schedule.
 void estimate_uncertainty(const Run& run, const PipelineConfig& config, const AnalysisOptions& options, Analysis& a);
+
+// What the uncertainty reads of the corrected trace, sample by sample: the error field's
+// path on its coarse grid and the path the draws perturb (every draw_step()-th sample) —
+// a few MB whatever the run's length. estimate_uncertainty() feeds
+// it the trace in memory; a streamed analysis (dsp/stream) each sample as it makes it:
+// the same numbers either way.
+class UncertaintyTrace {
+ public:
+  // After the pipeline, before the trace: `a` holds the measurement's supports, fs and
+  // triggers and the analysis' dynamic compensation; `schedule` is the support schedule the
+  // pipeline recorded (one flag per trace sample; zupt_unused as uncertainty::FineSchedule);
+  // index_at(k): sample index of trace sample k; samples: the trace's length.
+  UncertaintyTrace(const Run& run, const PipelineConfig& config, const AnalysisOptions& options, const Analysis& a,
+                   const fusion::SupportSchedule& schedule, std::size_t samples, std::function<std::int64_t(std::size_t)> index_at,
+                   const std::vector<bool>* zupt_unused = nullptr);
+  UncertaintyTrace(const UncertaintyTrace&) = delete;
+  UncertaintyTrace& operator=(const UncertaintyTrace&) = delete;
+
+  // Trace sample k (in order from 0) as evaluated: corrected, on the set-point's time;
+  // temp_c: the case temperatures of table and head there (the last finite ones).
+  void sample(std::size_t k, std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s, const Eigen::Vector3d& cmd_mm,
+              const Eigen::Vector3d& ref_mm, const Eigen::Vector2d& temp_c);
+
+  // After the last sample, `a` evaluated at full rate: the draws; fills a.uncertainty_k2,
+  // its source and note.
+  void finish(const Run& run, Analysis& a);
+
+  [[nodiscard]] std::size_t draw_step() const noexcept { return q_; }
+
+ private:
+  uncertainty::ErrorFieldInput in_;
+  std::optional<uncertainty::CoarseSchedule> coarse_;
+  std::optional<uncertainty::CoarsePathProbe> probe_;  // reads coarse_
+  Measurement nominal_;  // every q_-th trace sample
+  std::size_t samples_ = 0, q_ = 1;
+  int draws_ = 100;
+  std::uint64_t seed_ = 0;
+};
 
 // U from the draws' mean offset and spread (see above); n draws.
 double expanded_uncertainty(double mean_offset, double sd, int n);

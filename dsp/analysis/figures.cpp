@@ -106,9 +106,10 @@ void rectangle_figures(const Analysis& a, Out& o) {
 }  // namespace
 
 double direction_G_um(const eval::CircleResult& c, const std::string& direction) {
-  double hi = -std::numeric_limits<double>::infinity(), lo = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < c.trace.radius_deviation_um.size() && i < c.trace.direction.size(); ++i)
-    if (c.trace.direction[i] == direction) hi = std::max(hi, c.trace.radius_deviation_um[i]), lo = std::min(lo, c.trace.radius_deviation_um[i]);
+  // From every point of the direction (the trace of a long run keeps every n-th only).
+  if (direction != "ccw" && direction != "cw") return std::numeric_limits<double>::quiet_NaN();
+  const std::size_t d = direction == "cw" ? 1 : 0;
+  const double hi = c.direction_F_max_um[d], lo = c.direction_F_min_um[d];
   return hi >= lo ? hi - lo : std::numeric_limits<double>::quiet_NaN();
 }
 

@@ -29,6 +29,15 @@ inline constexpr std::uint32_t head_missing = 1u << 8;     // a head accel field
 constexpr std::uint32_t sensor_missing(int s) { return s == 0 ? table_missing : head_missing; }
 }  // namespace frame_flag
 
+// NC trigger codes in Frame::trigger: the calibration program's M-functions.
+namespace trigger {
+inline constexpr std::int32_t none = 0;
+inline constexpr std::int32_t program_start = 101;  // M101: tare, then measure
+inline constexpr std::int32_t segment_mark = 102;   // M102: a segment ends (standstill, target reached)
+inline constexpr std::int32_t program_end = 103;    // M103: stop and evaluate
+constexpr bool is_nc_trigger(std::int32_t code) { return code == program_start || code == segment_mark || code == program_end; }
+}  // namespace trigger
+
 struct Frame {
   std::int64_t sample_index = 0;                  // on the DAQ clock; time = index / fs_hz
   std::int32_t accel_counts[kAccelChannels] = {}; // sensor axes 1..3 of table, then head

@@ -20,6 +20,9 @@ struct Run {
   ChannelPresence channels;
   std::vector<Frame> frames;
   std::optional<std::string> truth_toml;  // synthetic runs: truth.toml verbatim
+  // Frames of a run read as it streams (frames stays empty; dsp/stream).
+  std::size_t streamed_frames = 0;
+  [[nodiscard]] std::size_t frame_count() const { return frames.empty() ? streamed_frames : frames.size(); }
 
   [[nodiscard]] double fs_hz() const { return meta.acquisition.fs_hz; }
   [[nodiscard]] double time_s(std::size_t i) const {

@@ -46,6 +46,92 @@ CircleFit fit_circle(const std::vector<Eigen::Vector2d>& pts) {
   return {c + mean, r};
 }
 
+CircleAccumulator::CircleAccumulator(Options o) : o_(std::move(o)) {
+  r_.direction = o_.direction;
+  r_.arc_deg = o_.arc_deg;
+  r_.trace.stride = std::max<std::size_t>(1, o_.trace_stride);
+}
+
+void CircleAccumulator::begin(std::size_t expected_samples) {
+  pts_.clear();
+  last_dev_.clear();
+  if (expected_samples > 0) {
+    if (o_.arc_deg >= 360.0) pts_.reserve(expected_samples);
+    last_dev_.reserve(expected_samples);
+  }
+  n_here_ = 0, sum_here_ = 0.0;
+  open_ = r_.revolutions;
+}
+
+void CircleAccumulator::put(const Eigen::Vector2d& d, double dev_um) {
+  double ang = std::atan2(d.y(), d.x()) * 180.0 / std::numbers::pi;
+  if (ang < 0) ang += 360.0;
+  if ((o_.trace_offset + r_.points) % r_.trace.stride == 0) {
+    r_.trace.angle_deg.push_back(ang);
+    r_.trace.radius_deviation_um.push_back(dev_um);
+    r_.trace.direction.push_back(o_.direction);
+    r_.trace.revolution.push_back(open_);
+  }
+  last_dev_.push_back(dev_um);
+  const auto k = static_cast<std::size_t>(std::min(359.0, std::floor(ang)));
+  r_.deviation_sum_by_deg[k] += dev_um;
+  r_.points_by_deg[k] += 1.0;
+  ++r_.points;
+  sum_dev_ += dev_um;
+  dmax_ = std::max(dmax_, dev_um);
+  dmin_ = std::min(dmin_, dev_um);
+}
+
+void CircleAccumulator::add(std::int64_t sample_index, const Eigen::Vector2d& pos_mm) {
+  const bool arc = o_.arc_deg < 360.0;
+  if (!pos_mm.allFinite())
+    throw InputError(std::string(arc ? "arc" : "circle") + " evaluation: non-finite position at sample " + std::to_string(sample_index));
+  if (!arc) {
+    pts_.push_back(pos_mm);
+    return;
+  }
+  const Eigen::Vector2d d = pos_mm - o_.center_mm;
+  const double dev_um = (d.norm() - o_.radius_mm) * 1000.0;
+  put(d, dev_um);
+  ++n_here_, sum_here_ += dev_um;
+}
+
+void CircleAccumulator::end() {
+  const int k = open_;
+  open_ = -1;
+  if (o_.arc_deg < 360.0) {
+    if (n_here_ < 20) throw InputError("arc evaluation: arc " + std::to_string(k + 1) + " has only " + std::to_string(n_here_) + " samples");
+    r_.centers_mm.push_back(o_.center_mm);
+    r_.radii_mm.push_back(o_.radius_mm + sum_here_ / static_cast<double>(n_here_) / 1000.0);  // mean radius of the arc
+    ++r_.revolutions;
+    return;
+  }
+  if (pts_.size() < 100) throw InputError("circle evaluation: revolution " + std::to_string(k + 1) + " has only " + std::to_string(pts_.size()) + " samples");
+  const CircleFit fit = fit_circle(pts_);
+  r_.centers_mm.push_back(fit.center);
+  r_.radii_mm.push_back(fit.radius);
+  open_ = k;  // put() names the revolution
+  for (const auto& p : pts_) {
+    const Eigen::Vector2d d = p - fit.center;
+    put(d, (d.norm() - o_.radius_mm) * 1000.0);
+  }
+  open_ = -1;
+  ++r_.revolutions;
+  std::vector<Eigen::Vector2d>().swap(pts_);  // one revolution in memory at a time
+}
+
+CircleResult CircleAccumulator::result() const {
+  if (r_.revolutions == 0) throw InputError("circle evaluation: no revolution evaluated");
+  CircleResult r = r_;
+  r.radius_mean_deviation_um = sum_dev_ / static_cast<double>(r.points);
+  r.radial_deviation_F_max_um = dmax_;
+  r.radial_deviation_F_min_um = dmin_;
+  r.circular_deviation_G_um = dmax_ - dmin_;
+  const std::size_t d = r.direction == "cw" ? 1 : 0;
+  r.direction_F_max_um[d] = dmax_, r.direction_F_min_um[d] = dmin_;
+  return r;
+}
+
 CircleResult evaluate_circle(const CircleInput& in) {
   if (in.pos_mm.size() != in.sample_index.size()) throw InputError("circle evaluation: positions and sample indices differ in length");
   if (!(in.radius_mm > 0.0)) throw InputError("circle evaluation: nominal radius must be positive");
@@ -59,55 +145,29 @@ CircleResult evaluate_circle(const CircleInput& in) {
   }
   if (ranges.empty())
     throw InputError("circle evaluation: fewer than two M102 marks inside the measurement (a circle program marks each revolution)");
-
-  CircleResult r;
-  r.direction = in.direction;
-  double sum_dev = 0.0;
-  std::size_t n_dev = 0;
-  double dmax = -INFINITY, dmin = INFINITY;
-  for (std::size_t k = 0; k < ranges.size(); ++k) {
-    std::vector<Eigen::Vector2d> pts;
+  CircleAccumulator acc({in.center_mm, in.radius_mm, in.direction, 360.0, 1, 0});
+  for (const auto& range : ranges) {
+    acc.begin();
     for (std::size_t i = 0; i < in.sample_index.size(); ++i)
-      if (in.sample_index[i] >= ranges[k].first && in.sample_index[i] < ranges[k].second) {
-        if (!in.pos_mm[i].allFinite()) throw InputError("circle evaluation: non-finite position at sample " + std::to_string(in.sample_index[i]));
-        pts.push_back(in.pos_mm[i]);
-      }
-    if (pts.size() < 100) throw InputError("circle evaluation: revolution " + std::to_string(k + 1) + " has only " + std::to_string(pts.size()) + " samples");
-    const CircleFit fit = fit_circle(pts);
-    r.centers_mm.push_back(fit.center);
-    r.radii_mm.push_back(fit.radius);
-    for (const auto& p : pts) {
-      const Eigen::Vector2d d = p - fit.center;
-      const double dev_um = (d.norm() - in.radius_mm) * 1000.0;
-      double ang = std::atan2(d.y(), d.x()) * 180.0 / std::numbers::pi;
-      if (ang < 0) ang += 360.0;
-      r.trace.angle_deg.push_back(ang);
-      r.trace.radius_deviation_um.push_back(dev_um);
-      r.trace.direction.push_back(in.direction);
-      r.trace.revolution.push_back(static_cast<int>(k));
-      sum_dev += dev_um;
-      ++n_dev;
-      dmax = std::max(dmax, dev_um);
-      dmin = std::min(dmin, dev_um);
-    }
+      if (in.sample_index[i] >= range.first && in.sample_index[i] < range.second) acc.add(in.sample_index[i], in.pos_mm[i]);
+    acc.end();
   }
-  r.revolutions = static_cast<int>(ranges.size());
-  r.radius_mean_deviation_um = sum_dev / static_cast<double>(n_dev);
-  r.radial_deviation_F_max_um = dmax;
-  r.radial_deviation_F_min_um = dmin;
-  r.circular_deviation_G_um = dmax - dmin;
-  return r;
+  return acc.result();
 }
 
 CircleResult combine(const CircleResult& a, const CircleResult& b) {
   CircleResult c = a;
   c.direction = a.direction == b.direction ? a.direction : "both";
   c.revolutions = a.revolutions + b.revolutions;
-  const double na = static_cast<double>(a.trace.radius_deviation_um.size()), nb = static_cast<double>(b.trace.radius_deviation_um.size());
+  const double na = static_cast<double>(a.points), nb = static_cast<double>(b.points);
+  c.points = a.points + b.points;
   c.radius_mean_deviation_um = (a.radius_mean_deviation_um * na + b.radius_mean_deviation_um * nb) / (na + nb);
   c.radial_deviation_F_max_um = std::max(a.radial_deviation_F_max_um, b.radial_deviation_F_max_um);
   c.radial_deviation_F_min_um = std::min(a.radial_deviation_F_min_um, b.radial_deviation_F_min_um);
   c.circular_deviation_G_um = c.radial_deviation_F_max_um - c.radial_deviation_F_min_um;
+  for (std::size_t d = 0; d < 2; ++d)
+    c.direction_F_max_um[d] = std::max(a.direction_F_max_um[d], b.direction_F_max_um[d]),
+    c.direction_F_min_um[d] = std::min(a.direction_F_min_um[d], b.direction_F_min_um[d]);
   c.centers_mm.insert(c.centers_mm.end(), b.centers_mm.begin(), b.centers_mm.end());
   c.radii_mm.insert(c.radii_mm.end(), b.radii_mm.begin(), b.radii_mm.end());
   auto append = [](auto& dst, const auto& src) { dst.insert(dst.end(), src.begin(), src.end()); };
@@ -115,20 +175,15 @@ CircleResult combine(const CircleResult& a, const CircleResult& b) {
   append(c.trace.radius_deviation_um, b.trace.radius_deviation_um);
   append(c.trace.direction, b.trace.direction);
   append(c.trace.revolution, b.trace.revolution);
+  for (std::size_t k = 0; k < 360; ++k)
+    c.deviation_sum_by_deg[k] += b.deviation_sum_by_deg[k], c.points_by_deg[k] += b.points_by_deg[k];
   if (a.direction != b.direction) {
-    std::vector<double> sa(360, 0.0), sb(360, 0.0), ca(360, 0.0), cb(360, 0.0);
-    auto bin = [](const CircleResult& r, std::vector<double>& s, std::vector<double>& n) {
-      for (std::size_t i = 0; i < r.trace.angle_deg.size(); ++i) {
-        const auto k = static_cast<std::size_t>(std::min(359.0, std::floor(r.trace.angle_deg[i])));
-        s[k] += r.trace.radius_deviation_um[i];
-        n[k] += 1.0;
-      }
-    };
-    bin(a, sa, ca);
-    bin(b, sb, cb);
+    // ISO 230-4 H: the largest difference of the two directions' mean deviation per 1° bin.
     double h = 0.0;
-    for (std::size_t k = 0; k < 360; ++k)
-      if (ca[k] > 0 && cb[k] > 0) h = std::max(h, std::abs(sa[k] / ca[k] - sb[k] / cb[k]));
+    for (std::size_t k = 0; k < 360; ++k) {
+      const double ca = a.points_by_deg[k], cb = b.points_by_deg[k];
+      if (ca > 0 && cb > 0) h = std::max(h, std::abs(a.deviation_sum_by_deg[k] / ca - b.deviation_sum_by_deg[k] / cb));
+    }
     c.circular_hysteresis_H_um = h;
   }
   return c;

@@ -14,6 +14,8 @@
 // nominal radius). Hysteresis H needs both directions (combine()).
 #include <Eigen/Core>
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <utility>
@@ -40,6 +42,9 @@ struct CircleTrace {
   std::vector<double> radius_deviation_um;
   std::vector<std::string> direction;       // per point, for combined traces
   std::vector<int> revolution;             // revolution or arc index within its direction
+  // 1: every point. n > 1: the points whose index in the (combined) trace is a multiple
+  // of n (long runs evaluated as they stream keep only what the plots show).
+  std::size_t stride = 1;
 };
 
 struct CircleResult {
@@ -53,6 +58,12 @@ struct CircleResult {
   std::vector<Eigen::Vector2d> centers_mm;  // per revolution (partial arc: the programmed centre)
   std::vector<double> radii_mm;
   CircleTrace trace;
+  std::size_t points = 0;  // radius deviations evaluated (all, whatever the trace keeps)
+  // The largest and smallest radius deviation of each direction's own points (counter-
+  // clockwise, clockwise; ±inf: not run): G per direction, whatever the trace keeps.
+  std::array<double, 2> direction_F_max_um{-INFINITY, -INFINITY}, direction_F_min_um{INFINITY, INFINITY};
+  // Sum and count of the radius deviations per 1° of angle (H of combine()).
+  std::array<double, 360> deviation_sum_by_deg{}, points_by_deg{};
 };
 
 // Geometric least-squares circle (Kasa algebraic start, Gauss–Newton on the distances).
@@ -65,6 +76,44 @@ CircleFit fit_circle(const std::vector<Eigen::Vector2d>& points);
 // Throws InputError when there are fewer than two M102 marks inside the trace or a
 // revolution has too few points.
 CircleResult evaluate_circle(const CircleInput& input);
+
+// One direction's revolutions (or partial arcs) evaluated as their samples arrive in
+// order, one revolution at a time: a full revolution is fitted when it ends, so memory
+// holds one revolution, never the whole trace. evaluate_circle() and evaluate_arc() feed
+// it from stored traces; the streamed analysis (dsp/stream) as the trace goes by.
+class CircleAccumulator {
+ public:
+  struct Options {
+    Eigen::Vector2d center_mm = Eigen::Vector2d::Zero();  // nominal (partial arc: the programmed centre)
+    double radius_mm = 10.0;
+    std::string direction = "ccw";
+    double arc_deg = 360.0;  // below 360: partial arcs about the programmed centre (circle_arc.hpp)
+    // The trace keeps the points whose index offset + i (i: this direction's own count) is
+    // a multiple of trace_stride (combine() appends directions in order).
+    std::size_t trace_stride = 1, trace_offset = 0;
+  };
+  explicit CircleAccumulator(Options o);
+  // A revolution (arc) starts; expected_samples (when known) sizes its buffer at once.
+  void begin(std::size_t expected_samples = 0);
+  // A sample of it; throws InputError on a position that is not finite.
+  void add(std::int64_t sample_index, const Eigen::Vector2d& pos_mm);
+  // It ends: fitted and evaluated; throws InputError when it has too few samples.
+  void end();
+  // Throws InputError when no revolution was evaluated.
+  [[nodiscard]] CircleResult result() const;
+  // The radius deviations (µm) of the revolution that ended last, in order.
+  [[nodiscard]] const std::vector<double>& revolution_deviations() const noexcept { return last_dev_; }
+
+ private:
+  void put(const Eigen::Vector2d& d, double dev_um);
+  Options o_;
+  CircleResult r_;
+  std::vector<Eigen::Vector2d> pts_;  // the open revolution (full circles)
+  std::vector<double> last_dev_;
+  std::size_t n_here_ = 0;            // samples of the open arc
+  double sum_here_ = 0.0, sum_dev_ = 0.0, dmax_ = -INFINITY, dmin_ = INFINITY;
+  int open_ = -1;  // index of the open revolution, -1 when none
+};
 
 // Both directions (ISO 230-4 H): G and F over both, H = max over 1° angle bins of |mean dev ccw − mean dev cw|.
 CircleResult combine(const CircleResult& a, const CircleResult& b);

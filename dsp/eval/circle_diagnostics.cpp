@@ -3,6 +3,7 @@
 #include "dsp/core/error.hpp"
 
 #include <Eigen/QR>
+#include <Eigen/Cholesky>
 
 #include <algorithm>
 #include <array>
@@ -16,194 +17,287 @@ constexpr double kUmPerMm = 1000.0;
 
 int sgn(double v, double eps) { return v > eps ? 1 : (v < -eps ? -1 : 0); }
 
-// Commanded velocity by central differences (mm/s); the set-point is noise-free.
-std::vector<Eigen::Vector2d> velocity(const CirclePass& p) {
-  const std::size_t n = p.cmd_mm.size();
-  std::vector<Eigen::Vector2d> v(n, Eigen::Vector2d::Zero());
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t a = i == 0 ? 0 : i - 1;
-    const std::size_t b = i + 1 == n ? i : i + 1;
-    if (b > a) v[i] = (p.cmd_mm[b] - p.cmd_mm[a]) * (p.fs_hz / static_cast<double>(b - a));
-  }
-  return v;
-}
-
-// Samples within `window` after a reversal of axis `a` (sign change of its velocity).
-std::vector<bool> near_reversal(const std::vector<Eigen::Vector2d>& v, int a, std::size_t window, double eps) {
-  std::vector<bool> mask(v.size(), false);
-  int last = 0;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const int s = sgn(v[i][a], eps);
-    if (s != 0 && last != 0 && s != last)
-      for (std::size_t k = i; k < std::min(v.size(), i + window); ++k) mask[k] = true;
-    if (s != 0) last = s;
-  }
-  return mask;
-}
-
 // Fixed columns of the per-axis model (after the per-pass drift polynomials).
 enum Col { scale, square, lag, backlash, lateral, cyc_sin, cyc_cos, bow, n_cols };
 
+// One sample as the fit sees it: the set-point, the measured position, the commanded
+// velocity (central differences: the set-point is noise-free) and whether it lies within
+// the window after a reversal of each axis (left out of that axis' fit, spikes there).
+struct Walked {
+  std::size_t pass = 0, i = 0, n = 0;
+  Eigen::Vector2d cmd, meas, vel;
+  bool skip[2] = {false, false};
+  double fs_hz = 0.0;
+};
+
+// Replays the passes and hands each sample over once its velocity is known (one sample
+// of lookahead), with the reversal masks; checks what the stored version checked.
+template <class F>
+void walk(PassReplay& replay, std::size_t window, F&& f) {
+  const auto& passes = replay.passes();
+  std::size_t cur = SIZE_MAX, i = 0, got = 0;
+  Eigen::Vector2d prev_cmd, cmd, meas;
+  int last[2] = {0, 0};
+  std::size_t until[2] = {0, 0};
+  auto emit = [&](const Eigen::Vector2d& ca, const Eigen::Vector2d& cb, std::size_t span) {
+    Walked w;
+    w.pass = cur, w.i = i, w.n = passes[cur].samples, w.cmd = cmd, w.meas = meas, w.fs_hz = passes[cur].fs_hz;
+    w.vel = span > 0 ? Eigen::Vector2d((cb - ca) * (w.fs_hz / static_cast<double>(span))) : Eigen::Vector2d::Zero();
+    for (int a = 0; a < 2; ++a) {
+      const int s = sgn(w.vel[a], 1e-6);
+      if (s != 0 && last[a] != 0 && s != last[a]) until[a] = std::max(until[a], i + window);
+      if (s != 0) last[a] = s;
+      w.skip[a] = i < until[a];
+    }
+    f(w);
+    ++i;
+  };
+  auto close_pass = [&] {
+    if (cur == SIZE_MAX || got == 0) return;
+    // The last sample: its velocity from the one before it (or none, alone).
+    if (got == 1) emit(cmd, cmd, 0);
+    else emit(prev_cmd, cmd, 1);
+  };
+  replay.replay([&](std::size_t pass, const Eigen::Vector2d& c, const Eigen::Vector2d& m) {
+    if (pass != cur) {
+      close_pass();
+      cur = pass, i = 0, got = 0, last[0] = last[1] = 0, until[0] = until[1] = 0;
+    }
+    if (!c.allFinite() || !m.allFinite()) throw InputError("circle diagnostics: non-finite position at sample " + std::to_string(got));
+    if (got >= 1) {  // the buffered sample's next one has come
+      if (got == 1) emit(cmd, c, 1);
+      else emit(prev_cmd, c, 2);
+      prev_cmd = cmd;
+    }
+    cmd = c, meas = m;
+    ++got;
+  });
+  close_pass();
+}
+
+// The rows of one axis' model for given settings (pitch, the play of the backlash operator).
+struct AxisModel {
+  int a = 0;              // 0 = x, 1 = y
+  DiagnosticsOptions opt;
+  std::vector<double> pitches_mm;  // the cyclic columns' pitches (one each: sin, cos)
+  double play_mm = 0.0;            // > 0: the play operator; else the step −sgn(v)/2
+  std::vector<int> d0;             // per pass: the first direction of motion of the axis
+  // Per pass state of the play operator.
+  double slide = 0.0;
+  // Fills the common features [1, t, t², scale, square, lag, backlash, lateral, bow] and
+  // the cyclic ones per pitch (sin, cos), and the target.
+  void row(const Walked& w, double* common9, double* cyc, double& target) {
+    const int b = 1 - a;
+    const double R = opt.radius_mm;
+    const Eigen::Vector2d& c = w.cmd;
+    const Eigen::Vector2d& v = w.vel;
+    const double t = static_cast<double>(w.i) / static_cast<double>(w.n) - 0.5;  // scaled time
+    common9[0] = 1.0, common9[1] = t, common9[2] = t * t;
+    common9[3] = c[a] - opt.centre_mm[a];
+    common9[4] = a == 0 ? -(c[1] - opt.centre_mm[1]) : 0.0;
+    common9[5] = -v[a];
+    // Backlash: the lost motion as the slide sees it. With a play estimate it is the play
+    // operator's output (the slide waits until the motor has crossed the play, so the step
+    // after a reversal takes time); without one, the step −sgn(v)/2.
+    if (play_mm > 0.0) {
+      const double x = c[a];
+      if (w.i == 0) slide = x - 0.5 * play_mm * d0[w.pass];  // play taken up in the first direction
+      slide = std::clamp(slide, x - 0.5 * play_mm, x + 0.5 * play_mm);
+      common9[6] = (slide - x) / play_mm;
+    } else {
+      common9[6] = -0.5 * sgn(v[a], 1e-6);
+    }
+    common9[7] = 0.5 * sgn(v[b], 1e-6);
+    const double u = (c[b] - opt.centre_mm[b]) / R;
+    common9[8] = u * u;
+    // sin, cos of 2π·x/p for every pitch; a pitch whose double is searched too takes the
+    // double angle of that one's (2 sin cos, cos² − sin²): 4 sincos for the usual 13 pitches.
+    for (std::size_t k = pitches_mm.size(); k-- > 0;) {
+      if (half_of_[k] >= 0) {
+        const double sn = cyc[2 * half_of_[k]], cs = cyc[2 * half_of_[k] + 1];
+        cyc[2 * k] = 2.0 * sn * cs;
+        cyc[2 * k + 1] = cs * cs - sn * sn;
+      } else {
+        const double arg = 2.0 * std::numbers::pi * c[a] / pitches_mm[k];
+        cyc[2 * k] = std::sin(arg);
+        cyc[2 * k + 1] = std::cos(arg);
+      }
+    }
+    target = w.meas[a] - c[a];
+  }
+  // For each pitch the index of its double among the pitches (−1: none); they ascend.
+  void set_pitches(std::vector<double> p) {
+    pitches_mm = std::move(p);
+    half_of_.assign(pitches_mm.size(), -1);
+    for (std::size_t k = 0; k < pitches_mm.size(); ++k)
+      for (std::size_t j = k + 1; j < pitches_mm.size(); ++j)
+        if (pitches_mm[j] == 2.0 * pitches_mm[k]) half_of_[k] = static_cast<int>(j);
+  }
+
+ private:
+  std::vector<int> half_of_;
+};
+
+// Normal equations of one axis, per pass, over the columns [common 9 | target | cyclic 2K],
+// accumulated a block of rows at a time. A fit uses the cyclic columns of one pitch only:
+// the products of two pitches' columns are never formed.
+struct AxisGram {
+  static constexpr std::size_t kTarget = 9, kCyc = 10;
+  std::size_t width = 0;
+  std::vector<Eigen::MatrixXd> m;  // per pass, lower triangle
+  std::vector<std::size_t> rows;   // per pass
+  Eigen::MatrixXd block;
+  std::size_t fill = 0, fill_pass = 0;
+  static constexpr std::size_t kBlock = 256;
+  AxisGram(std::size_t n_pass, std::size_t pitches) : width(9 + 2 * pitches + 1), m(n_pass, Eigen::MatrixXd::Zero(9 + 2 * pitches + 1, 9 + 2 * pitches + 1)), rows(n_pass, 0) {
+    block.resize(static_cast<Eigen::Index>(kBlock), static_cast<Eigen::Index>(width));
+  }
+  double* next_row(std::size_t pass) {
+    if (fill > 0 && pass != fill_pass) flush();
+    fill_pass = pass;
+    ++rows[pass];
+    return &block(static_cast<Eigen::Index>(fill++), 0);  // column-major: stride kBlock
+  }
+  void flush() {
+    if (fill == 0) return;
+    const auto f = block.topRows(static_cast<Eigen::Index>(fill));
+    auto& g = m[fill_pass];
+    const auto head = static_cast<Eigen::Index>(kCyc), cyc = static_cast<Eigen::Index>(width) - head;
+    g.topLeftCorner(head, head).selfadjointView<Eigen::Lower>().rankUpdate(f.leftCols(head).transpose());
+    if (cyc > 0) {
+      g.bottomLeftCorner(cyc, head).noalias() += f.rightCols(cyc).transpose() * f.leftCols(head);
+      for (Eigen::Index k = 0; k < cyc; k += 2)
+        g.block(head + k, head + k, 2, 2).noalias() += f.middleCols(head + k, 2).transpose() * f.middleCols(head + k, 2);
+    }
+    fill = 0;
+  }
+  [[nodiscard]] double at(std::size_t pass, std::size_t r, std::size_t c) const {
+    const auto& g = m[pass];
+    return r >= c ? g(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) : g(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(r));
+  }
+};
+
 struct AxisFit {
-  Eigen::VectorXd coef;  // fixed columns only
-  std::vector<std::vector<double>> residual_mm;  // per pass, per sample
+  Eigen::VectorXd coef;  // fixed columns only (n_cols)
+  Eigen::VectorXd x;     // every unknown (polynomials per pass, then the used fixed columns)
+  std::vector<int> col_of;  // unknown index of each fixed column, −1 when not used
   double rms_mm = 0.0;
 };
 
-struct Sample {
-  std::size_t pass, index;
-};
-
-// Least squares for axis `a` (0 = x, 1 = y). `use` selects the model columns; samples in
-// `skip` (reversal windows) are left out of the fit but get residuals.
-AxisFit fit_axis(const std::vector<CirclePass>& passes, const std::vector<std::vector<Eigen::Vector2d>>& vel,
-                 const std::vector<std::vector<bool>>& skip, int a, const std::array<bool, n_cols>& use,
-                 const DiagnosticsOptions& opt, double pitch_mm, double fixed_lag_s, double play_mm = 0.0) {
-  // Backlash column: the lost motion as the slide sees it. With a play estimate it is the
-  // play operator's output (the slide waits until the motor has crossed the play, so the
-  // step after a reversal takes time); without one, the step −sgn(v)/2.
-  std::vector<std::vector<double>> lost;
-  for (std::size_t pi = 0; pi < passes.size(); ++pi) {
-    const auto& p = passes[pi];
-    auto& col = lost.emplace_back(p.cmd_mm.size(), 0.0);
-    if (!(play_mm > 0.0)) {
-      for (std::size_t i = 0; i < col.size(); ++i) col[i] = -0.5 * sgn(vel[pi][i][a], 1e-6);
-      continue;
-    }
-    int d0 = 0;
-    for (std::size_t i = 0; i < col.size() && d0 == 0; ++i) d0 = sgn(vel[pi][i][a], 1e-6);
-    double slide = p.cmd_mm[0][a] - 0.5 * play_mm * d0;  // play taken up in the first direction
-    for (std::size_t i = 0; i < col.size(); ++i) {
-      const double x = p.cmd_mm[i][a];
-      slide = std::clamp(slide, x - 0.5 * play_mm, x + 0.5 * play_mm);
-      col[i] = (slide - x) / play_mm;
-    }
-  }
-  const int b = 1 - a;
-  const double R = opt.radius_mm;
-  const double eps = 1e-6;
-  const std::size_t n_pass = passes.size();
-  std::vector<int> col_of(n_cols, -1);
+// The least-squares fit of one axis from its normal equations: columns `use`, cyclic
+// columns of pitch k, a fixed lag moved to the target (target + L·v).
+AxisFit solve_axis(const AxisGram& g, std::size_t k, const std::array<bool, n_cols>& use, double fixed_lag_s) {
+  const std::size_t n_pass = g.m.size();
+  const std::size_t tgt = AxisGram::kTarget;
+  // Gram column of each fixed model column (lag is 5 even when not used: the fixed lag).
+  const std::size_t gcol[n_cols] = {3, 4, 5, 6, 7, AxisGram::kCyc + 2 * k, AxisGram::kCyc + 2 * k + 1, 8};
+  AxisFit fit;
+  fit.col_of.assign(n_cols, -1);
   int n_fixed = 0;
   for (int c = 0; c < n_cols; ++c)
-    if (use[static_cast<std::size_t>(c)]) col_of[static_cast<std::size_t>(c)] = n_fixed++;
-  const int n_poly = 3 * static_cast<int>(n_pass);
-
-  auto row_of = [&](std::size_t pi, std::size_t i, auto&& row, double& target) {
-    const CirclePass& p = passes[pi];
-    const Eigen::Vector2d c = p.cmd_mm[i];
-    const Eigen::Vector2d v = vel[pi][i];
-    const double t = (static_cast<double>(i) / static_cast<double>(p.cmd_mm.size()) - 0.5);  // scaled time
-    row.setZero();
-    row(static_cast<int>(3 * pi)) = 1.0;
-    row(static_cast<int>(3 * pi + 1)) = t;
-    row(static_cast<int>(3 * pi + 2)) = t * t;
-    auto put = [&](Col col, double value) {
-      if (col_of[col] >= 0) row(n_poly + col_of[col]) = value;
-    };
-    put(scale, c[a] - opt.centre_mm[a]);
-    put(square, a == 0 ? -(c[1] - opt.centre_mm[1]) : 0.0);
-    put(lag, -v[a]);
-    put(backlash, lost[pi][i]);
-    put(lateral, 0.5 * sgn(v[b], eps));
-    put(cyc_sin, std::sin(2.0 * std::numbers::pi * c[a] / pitch_mm));
-    put(cyc_cos, std::cos(2.0 * std::numbers::pi * c[a] / pitch_mm));
-    const double u = (c[b] - opt.centre_mm[b]) / R;
-    put(bow, u * u);
-    target = p.meas_mm[i][a] - c[a] + fixed_lag_s * v[a];  // a fixed lag is moved to the left side
+    if (use[static_cast<std::size_t>(c)]) fit.col_of[static_cast<std::size_t>(c)] = n_fixed++;
+  const auto n_poly = static_cast<Eigen::Index>(3 * n_pass);
+  const Eigen::Index n_unknown = n_poly + n_fixed;
+  // Unknown u → (pass or all, Gram column).
+  struct Where {
+    std::size_t pass;  // SIZE_MAX: every pass (a fixed column)
+    std::size_t col;
   };
-
-  std::vector<Sample> rows;
-  for (std::size_t pi = 0; pi < n_pass; ++pi)
-    for (std::size_t i = 0; i < passes[pi].cmd_mm.size(); ++i)
-      if (!skip[pi][i]) rows.push_back({pi, i});
-  const int n_unknown = n_poly + n_fixed;
-  Eigen::MatrixXd A(static_cast<Eigen::Index>(rows.size()), n_unknown);
-  Eigen::VectorXd y(static_cast<Eigen::Index>(rows.size()));
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    double target = 0.0;
-    row_of(rows[r].pass, rows[r].index, A.row(static_cast<Eigen::Index>(r)), target);
-    y(static_cast<Eigen::Index>(r)) = target;
+  std::vector<Where> where;
+  for (std::size_t p = 0; p < n_pass; ++p)
+    for (std::size_t j = 0; j < 3; ++j) where.push_back({p, j});
+  for (int c = 0; c < n_cols; ++c)
+    if (use[static_cast<std::size_t>(c)]) where.push_back({SIZE_MAX, gcol[c]});
+  auto sum = [&](const Where& u, std::size_t col) {  // Σ over the rows of feature(u)·feature(col)
+    if (u.pass != SIZE_MAX) return g.at(u.pass, u.col, col);
+    double s = 0.0;
+    for (std::size_t p = 0; p < n_pass; ++p) s += g.at(p, u.col, col);
+    return s;
+  };
+  Eigen::MatrixXd G(n_unknown, n_unknown);
+  Eigen::VectorXd b(n_unknown);
+  for (Eigen::Index u = 0; u < n_unknown; ++u) {
+    const Where& wu = where[static_cast<std::size_t>(u)];
+    for (Eigen::Index v = 0; v <= u; ++v) {
+      const Where& wv = where[static_cast<std::size_t>(v)];
+      double val = 0.0;
+      if (wu.pass != SIZE_MAX && wv.pass != SIZE_MAX) val = wu.pass == wv.pass ? g.at(wu.pass, wu.col, wv.col) : 0.0;
+      else if (wu.pass != SIZE_MAX) val = g.at(wu.pass, wu.col, wv.col);
+      else if (wv.pass != SIZE_MAX) val = g.at(wv.pass, wv.col, wu.col);
+      else val = sum(wu, wv.col);
+      G(u, v) = G(v, u) = val;
+    }
+    // Target + L·v with the lag column −v: Σ a·(t + L·v) = Σ a·t − L·Σ a·lag.
+    b(u) = sum(wu, tgt) - fixed_lag_s * sum(wu, gcol[lag]);
   }
-  // Column scaling keeps the QR well conditioned (mm, mm/s and ±0.5 columns differ a lot).
-  Eigen::VectorXd norm = A.colwise().norm().transpose();
+  double tt = 0.0, t_lag = 0.0, lag_lag = 0.0;
+  std::size_t rows = 0;
+  for (std::size_t p = 0; p < n_pass; ++p) tt += g.at(p, tgt, tgt), t_lag += g.at(p, tgt, gcol[lag]), lag_lag += g.at(p, gcol[lag], gcol[lag]), rows += g.rows[p];
+  tt += -2.0 * fixed_lag_s * t_lag + fixed_lag_s * fixed_lag_s * lag_lag;
+  // Column scaling keeps the solution well conditioned (mm, mm/s and ±0.5 columns differ a lot).
+  Eigen::VectorXd norm = G.diagonal().cwiseMax(0.0).cwiseSqrt();
   for (Eigen::Index c = 0; c < norm.size(); ++c)
     if (norm(c) <= 0.0) norm(c) = 1.0;
-  const Eigen::MatrixXd As = A * norm.cwiseInverse().asDiagonal();
-  const Eigen::VectorXd x = As.colPivHouseholderQr().solve(y).cwiseQuotient(norm);
-
-  AxisFit fit;
+  const Eigen::VectorXd inv = norm.cwiseInverse();
+  const Eigen::MatrixXd Gs = inv.asDiagonal() * G * inv.asDiagonal();
+  fit.x = Gs.colPivHouseholderQr().solve(inv.cwiseProduct(b)).cwiseQuotient(norm);
   fit.coef = Eigen::VectorXd::Zero(n_cols);
   for (int c = 0; c < n_cols; ++c)
-    if (col_of[static_cast<std::size_t>(c)] >= 0) fit.coef(c) = x(n_poly + col_of[static_cast<std::size_t>(c)]);
-  fit.residual_mm.resize(n_pass);
-  double ss = 0.0;
-  std::size_t n_ss = 0;
-  Eigen::RowVectorXd row(n_unknown);
-  for (std::size_t pi = 0; pi < n_pass; ++pi) {
-    fit.residual_mm[pi].resize(passes[pi].cmd_mm.size());
-    for (std::size_t i = 0; i < passes[pi].cmd_mm.size(); ++i) {
-      double target = 0.0;
-      row_of(pi, i, row, target);
-      const double r = target - row.dot(x);
-      fit.residual_mm[pi][i] = r;
-      if (!skip[pi][i]) {
-        ss += r * r;
-        ++n_ss;
-      }
-    }
-  }
-  fit.rms_mm = n_ss > 0 ? std::sqrt(ss / static_cast<double>(n_ss)) : 0.0;
+    if (fit.col_of[static_cast<std::size_t>(c)] >= 0) fit.coef(c) = fit.x(n_poly + fit.col_of[static_cast<std::size_t>(c)]);
+  const double rss = tt - 2.0 * fit.x.dot(b) + fit.x.dot(G * fit.x);
+  fit.rms_mm = rows > 0 ? std::sqrt(std::max(rss, 0.0) / static_cast<double>(rows)) : 0.0;
   return fit;
 }
 
-// Mean signed peak of the residual in the window after each reversal of axis `a`.
-double reversal_spike_um(const std::vector<CirclePass>& passes, const std::vector<std::vector<Eigen::Vector2d>>& vel,
-                         const AxisFit& fit, int a, std::size_t window) {
-  double sum = 0.0;
-  int count = 0;
-  for (std::size_t pi = 0; pi < passes.size(); ++pi) {
-    int last = 0;
-    for (std::size_t i = 0; i < vel[pi].size(); ++i) {
-      const int s = sgn(vel[pi][i][a], 1e-6);
-      if (s != 0 && last != 0 && s != last && i + window <= vel[pi].size()) {
-        double peak = 0.0;
-        for (std::size_t k = i; k < i + window; ++k)
-          if (std::abs(fit.residual_mm[pi][k]) > std::abs(peak)) peak = fit.residual_mm[pi][k];
-        // Positive when the axis lags behind its new direction (friction holds it at the
-        // reversal, the usual reversal spike); an overshoot is negative.
-        sum -= peak * s;
-        ++count;
-      }
-      if (s != 0) last = s;
-    }
-  }
-  return count > 0 ? sum / count * kUmPerMm : 0.0;
+// The fit's residual at a sample (target − model), rows as AxisModel makes them.
+double residual(const AxisFit& fit, const double* common9, const double* cyc, double target, std::size_t pass, double fixed_lag_s, double v_a) {
+  const std::size_t n_poly = fit.x.size() - static_cast<Eigen::Index>(std::count_if(fit.col_of.begin(), fit.col_of.end(), [](int c) { return c >= 0; }));
+  double model = 0.0;
+  for (std::size_t j = 0; j < 3; ++j) model += fit.x(static_cast<Eigen::Index>(3 * pass + j)) * common9[j];
+  const double fixed[n_cols] = {common9[3], common9[4], common9[5], common9[6], common9[7], cyc[0], cyc[1], common9[8]};
+  for (int c = 0; c < n_cols; ++c)
+    if (fit.col_of[static_cast<std::size_t>(c)] >= 0) model += fit.x(static_cast<Eigen::Index>(n_poly) + fit.col_of[static_cast<std::size_t>(c)]) * fixed[c];
+  return target + fixed_lag_s * v_a - model;
 }
+
+// Stored passes, replayed from memory.
+class StoredPasses final : public PassReplay {
+ public:
+  explicit StoredPasses(const std::vector<CirclePass>& p) : p_(p) {
+    for (const auto& x : p) info_.push_back({x.direction, x.fs_hz, x.cmd_mm.size()});
+  }
+  [[nodiscard]] const std::vector<Pass>& passes() const override { return info_; }
+  void replay(const std::function<void(std::size_t, const Eigen::Vector2d&, const Eigen::Vector2d&)>& f) override {
+    for (std::size_t k = 0; k < p_.size(); ++k)
+      for (std::size_t i = 0; i < p_[k].cmd_mm.size(); ++i) f(k, p_[k].cmd_mm[i], p_[k].meas_mm[i]);
+  }
+
+ private:
+  const std::vector<CirclePass>& p_;
+  std::vector<Pass> info_;
+};
 
 }  // namespace
 
 CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& opt) {
+  for (const auto& p : passes)
+    if (p.cmd_mm.size() != p.meas_mm.size()) throw InputError("circle diagnostics: commanded and measured traces differ in length");
+  StoredPasses replay(passes);
+  return diagnose_circle(replay, opt);
+}
+
+CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& opt) {
+  const auto& passes = replay.passes();
   if (passes.empty()) throw InputError("circle diagnostics: no pass to evaluate");
   if (!(opt.radius_mm > 0.0)) throw InputError("circle diagnostics: radius must be positive");
   bool both_directions = false;
   for (const auto& p : passes) {
-    if (p.cmd_mm.size() != p.meas_mm.size())
-      throw InputError("circle diagnostics: commanded and measured traces differ in length");
-    if (p.cmd_mm.size() < 100) throw InputError("circle diagnostics: a pass holds fewer than 100 samples");
+    if (p.samples < 100) throw InputError("circle diagnostics: a pass holds fewer than 100 samples");
     if (!(p.fs_hz > 0.0)) throw InputError("circle diagnostics: fs_hz must be positive");
     if (p.direction != passes.front().direction) both_directions = true;
-    for (std::size_t i = 0; i < p.cmd_mm.size(); ++i)
-      if (!p.cmd_mm[i].allFinite() || !p.meas_mm[i].allFinite())
-        throw InputError("circle diagnostics: non-finite position at sample " + std::to_string(i));
   }
-
-  std::vector<std::vector<Eigen::Vector2d>> vel;
-  for (const auto& p : passes) vel.push_back(velocity(p));
+  const std::size_t n_pass = passes.size();
   const auto window = static_cast<std::size_t>(std::lround(opt.spike_window_s * passes.front().fs_hz));
-  std::array<std::vector<std::vector<bool>>, 2> skip;
-  for (int a = 0; a < 2; ++a)
-    for (const auto& v : vel) skip[static_cast<std::size_t>(a)].push_back(near_reversal(v, a, window, 1e-6));
 
   std::array<bool, n_cols> use{};
   use.fill(true);
@@ -218,32 +312,80 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
     if (pitches.empty()) pitches = {opt.radius_mm};
   }
 
+  // First replay: every pitch with the backlash as a step, both axes; each axis' first
+  // direction of motion per pass (the play operator starts from it).
+  std::array<AxisModel, 2> model;
+  std::vector<AxisGram> gram;
+  for (int a = 0; a < 2; ++a) {
+    model[a].a = a, model[a].opt = opt;
+    model[a].set_pitches(pitches);
+    model[a].d0.assign(n_pass, 0);
+    gram.emplace_back(n_pass, pitches.size());
+  }
+  std::vector<double> cyc(2 * pitches.size());
+  walk(replay, window, [&](const Walked& w) {
+    for (int a = 0; a < 2; ++a) {
+      if (model[a].d0[w.pass] == 0) model[a].d0[w.pass] = sgn(w.vel[a], 1e-6);
+      if (w.skip[a]) continue;
+      double* r = gram[a].next_row(w.pass);
+      double c9[9], target = 0.0;
+      model[a].row(w, c9, cyc.data(), target);
+      const auto stride = static_cast<std::size_t>(AxisGram::kBlock);
+      for (std::size_t j = 0; j < 9; ++j) r[j * stride] = c9[j];
+      r[AxisGram::kTarget * stride] = target;
+      for (std::size_t j = 0; j < cyc.size(); ++j) r[(AxisGram::kCyc + j) * stride] = cyc[j];
+      if (gram[a].fill == AxisGram::kBlock) gram[a].flush();
+    }
+  });
+  for (auto& g : gram) g.flush();
+
   CircleDiagnostics d;
   // Y first: its lag is identifiable from one direction (v_y follows cos θ, squareness
   // sits in the x equation only), and a single-direction x fit borrows it.
-  std::array<AxisFit, 2> fits;
-  double best_pitch = pitches.front();
+  std::size_t best = 0;
   double best_rms = INFINITY;
-  for (double p : pitches) {
-    const double rms = fit_axis(passes, vel, skip[1], 1, use, opt, p, 0.0).rms_mm +
-                       fit_axis(passes, vel, skip[0], 0, use, opt, p, 0.0).rms_mm;
-    if (rms < best_rms) best_rms = rms, best_pitch = p;
+  for (std::size_t k = 0; k < pitches.size(); ++k) {
+    const double rms = solve_axis(gram[1], k, use, 0.0).rms_mm + solve_axis(gram[0], k, use, 0.0).rms_mm;
+    if (rms < best_rms) best_rms = rms, best = k;
   }
-  // Twice: first with a step for the backlash, then with the play operator of the play
-  // just found (a sharp step would leave the play's crossing time as a false reversal spike).
-  double play_mm[2] = {0.0, 0.0};
-  for (int round = 0; round < 2; ++round) {
-    fits[1] = fit_axis(passes, vel, skip[1], 1, use, opt, best_pitch, 0.0, play_mm[1]);
-    if (both_directions) {
-      fits[0] = fit_axis(passes, vel, skip[0], 0, use, opt, best_pitch, 0.0, play_mm[0]);
-    } else {
-      auto use_x = use;
-      use_x[lag] = false;
-      fits[0] = fit_axis(passes, vel, skip[0], 0, use_x, opt, best_pitch, fits[1].coef(lag), play_mm[0]);
-      fits[0].coef(lag) = fits[1].coef(lag);
+  const double best_pitch = pitches[best];
+  auto use_x = use;
+  use_x[lag] = false;
+  // Round one: the backlash as a step (what the pitch search fitted).
+  std::array<AxisFit, 2> fits;
+  fits[1] = solve_axis(gram[1], best, use, 0.0);
+  fits[0] = both_directions ? solve_axis(gram[0], best, use, 0.0) : solve_axis(gram[0], best, use_x, fits[1].coef(lag));
+  if (!both_directions) fits[0].coef(lag) = fits[1].coef(lag);
+  // Round two: the play operator of the play just found (a sharp step would leave the
+  // play's crossing time as a false reversal spike).
+  double play_mm[2];
+  for (int a = 0; a < 2; ++a) play_mm[a] = std::max(0.0, fits[static_cast<std::size_t>(a)].coef(backlash));
+  std::vector<AxisGram> gram2;
+  for (int a = 0; a < 2; ++a) {
+    model[a].set_pitches({best_pitch});
+    model[a].play_mm = play_mm[a];
+    gram2.emplace_back(n_pass, 1);
+  }
+  double cyc1[2];
+  walk(replay, window, [&](const Walked& w) {
+    for (int a = 0; a < 2; ++a) {
+      double c9[9], target = 0.0;
+      model[a].row(w, c9, cyc1, target);  // every sample: the play operator runs through the skipped ones too
+      if (w.skip[a]) continue;
+      double* r = gram2[a].next_row(w.pass);
+      const auto stride = static_cast<std::size_t>(AxisGram::kBlock);
+      for (std::size_t j = 0; j < 9; ++j) r[j * stride] = c9[j];
+      r[AxisGram::kTarget * stride] = target;
+      r[AxisGram::kCyc * stride] = cyc1[0], r[(AxisGram::kCyc + 1) * stride] = cyc1[1];
+      if (gram2[a].fill == AxisGram::kBlock) gram2[a].flush();
     }
-    for (int a = 0; a < 2; ++a) play_mm[a] = std::max(0.0, fits[static_cast<std::size_t>(a)].coef(backlash));
-  }
+  });
+  for (auto& g : gram2) g.flush();
+  fits[1] = solve_axis(gram2[1], 0, use, 0.0);
+  const double fixed_lag_x = both_directions ? 0.0 : fits[1].coef(lag);
+  fits[0] = both_directions ? solve_axis(gram2[0], 0, use, 0.0) : solve_axis(gram2[0], 0, use_x, fixed_lag_x);
+  if (!both_directions) fits[0].coef(lag) = fits[1].coef(lag);
+
   if (both_directions) d.servo_and_squareness_separated = true;
   else d.notes.push_back("one direction only: servo mismatch cannot be separated from squareness; equal lags assumed");
   const Eigen::VectorXd& cx = fits[0].coef;
@@ -265,24 +407,60 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
   // and one at the ends, hence the sign).
   d.straightness_x_um = -cy(bow) * kUmPerMm;
   d.straightness_y_um = -cx(bow) * kUmPerMm;
-  d.reversal_spike_x_um = reversal_spike_um(passes, vel, fits[0], 0, window);
-  d.reversal_spike_y_um = reversal_spike_um(passes, vel, fits[1], 1, window);
 
-  // What the model leaves (RMS over the samples outside the reversal windows): radially
-  // the vibration class, per axis the stick-slip class.
-  double ss_rad = 0.0, ss_axis[2] = {0.0, 0.0};
-  std::size_t n = 0;
-  for (std::size_t pi = 0; pi < passes.size(); ++pi)
-    for (std::size_t i = 0; i < passes[pi].cmd_mm.size(); ++i) {
-      if (skip[0][pi][i] || skip[1][pi][i]) continue;
-      const Eigen::Vector2d r(fits[0].residual_mm[pi][i], fits[1].residual_mm[pi][i]);
-      Eigen::Vector2d radial = passes[pi].cmd_mm[i] - opt.centre_mm;
-      if (radial.norm() <= 0.0) continue;
-      radial.normalize();
-      ss_rad += std::pow(r.dot(radial), 2);
-      ss_axis[0] += r[0] * r[0], ss_axis[1] += r[1] * r[1];
-      ++n;
+  // Third replay: the residuals of the final fits. Reversal spikes (the mean signed peak
+  // of the residual in the window after each reversal of the axis, the window within the
+  // pass); what the model leaves (RMS over the samples outside the reversal windows):
+  // radially the vibration class, per axis the stick-slip class.
+  for (int a = 0; a < 2; ++a) model[a].play_mm = play_mm[a];
+  struct Spike {
+    std::size_t end;  // window end (exclusive), within the pass
+    int s;
+    double peak = 0.0;
+  };
+  std::array<std::vector<Spike>, 2> open;
+  double spike_sum[2] = {0.0, 0.0};
+  int spike_count[2] = {0, 0};
+  int last[2] = {0, 0};
+  std::size_t pass_now = SIZE_MAX;
+  double ss_rad = 0.0, ss_axis[2] = {0.0, 0.0}, ss_fit[2] = {0.0, 0.0};
+  std::size_t n = 0, n_fit[2] = {0, 0};
+  walk(replay, window, [&](const Walked& w) {
+    if (w.pass != pass_now) pass_now = w.pass, last[0] = last[1] = 0, open[0].clear(), open[1].clear();
+    double r[2];
+    for (int a = 0; a < 2; ++a) {
+      double c9[9], target = 0.0;
+      model[a].row(w, c9, cyc1, target);
+      r[a] = residual(fits[a], c9, cyc1, target, w.pass, a == 0 ? fixed_lag_x : 0.0, w.vel[a]);
+      if (!w.skip[a]) ss_fit[a] += r[a] * r[a], ++n_fit[a];
+      // A reversal opens a window when the whole window lies within the pass.
+      const int s = sgn(w.vel[a], 1e-6);
+      if (s != 0 && last[a] != 0 && s != last[a] && w.i + window <= w.n) open[a].push_back({w.i + window, s});
+      if (s != 0) last[a] = s;
+      for (auto it = open[a].begin(); it != open[a].end();) {
+        if (std::abs(r[a]) > std::abs(it->peak)) it->peak = r[a];
+        if (w.i + 1 == it->end) {
+          // Positive when the axis lags behind its new direction (friction holds it at the
+          // reversal, the usual reversal spike); an overshoot is negative.
+          spike_sum[a] -= it->peak * it->s;
+          ++spike_count[a];
+          it = open[a].erase(it);
+        } else {
+          ++it;
+        }
+      }
     }
+    if (w.skip[0] || w.skip[1]) return;
+    const Eigen::Vector2d res(r[0], r[1]);
+    Eigen::Vector2d radial = w.cmd - opt.centre_mm;
+    if (radial.norm() <= 0.0) return;
+    radial.normalize();
+    ss_rad += std::pow(res.dot(radial), 2);
+    ss_axis[0] += res[0] * res[0], ss_axis[1] += res[1] * res[1];
+    ++n;
+  });
+  d.reversal_spike_x_um = spike_count[0] > 0 ? spike_sum[0] / spike_count[0] * kUmPerMm : 0.0;
+  d.reversal_spike_y_um = spike_count[1] > 0 ? spike_sum[1] / spike_count[1] * kUmPerMm : 0.0;
   if (n > 0) {
     if (opt.feed_mm_min > 0.0 && opt.feed_mm_min <= opt.creep_feed_mm_min) {
       // Creep feed: the fast residual of each axis is its slide sticking and slipping — a
@@ -295,7 +473,9 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
       d.vibration_um = std::sqrt(ss_rad / static_cast<double>(n)) * kUmPerMm;
     }
   }
-  d.residual_rms_um = std::hypot(fits[0].rms_mm, fits[1].rms_mm) * kUmPerMm;
+  const double rms_x = n_fit[0] > 0 ? std::sqrt(ss_fit[0] / static_cast<double>(n_fit[0])) : 0.0;
+  const double rms_y = n_fit[1] > 0 ? std::sqrt(ss_fit[1] / static_cast<double>(n_fit[1])) : 0.0;
+  d.residual_rms_um = std::hypot(rms_x, rms_y) * kUmPerMm;
   return d;
 }
 

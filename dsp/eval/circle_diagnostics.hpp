@@ -21,6 +21,7 @@
 // X scale − Y scale; servo mismatch positive when X lags Y.
 #include <Eigen/Core>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -68,5 +69,25 @@ struct CircleDiagnostics {
 
 // Throws InputError when the passes are empty, mismatched or do not go round.
 CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& options);
+
+// The passes' samples, read as often as the fit needs (three times): from stored passes,
+// or from a spill of a measurement too long to hold (dsp/stream).
+class PassReplay {
+ public:
+  struct Pass {
+    int direction = +1;
+    double fs_hz = 10000.0;
+    std::size_t samples = 0;
+  };
+  virtual ~PassReplay() = default;
+  [[nodiscard]] virtual const std::vector<Pass>& passes() const = 0;
+  // Every sample of every pass, pass by pass, in order.
+  virtual void replay(const std::function<void(std::size_t pass, const Eigen::Vector2d& cmd_mm, const Eigen::Vector2d& meas_mm)>& sample) = 0;
+};
+
+// The same fit over replayed passes; memory independent of their length. (The least
+// squares are solved from their normal equations, accumulated block by block, with the
+// columns scaled as before.)
+CircleDiagnostics diagnose_circle(PassReplay& passes, const DiagnosticsOptions& options);
 
 }  // namespace eical::dsp::eval

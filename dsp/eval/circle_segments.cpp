@@ -8,40 +8,53 @@
 
 namespace eical::dsp::eval {
 
+CircleSegmentFinder::CircleSegmentFinder(const Eigen::Vector2d& center_mm, double arc_deg) : centre_(center_mm), arc_deg_(arc_deg) {
+  if (!(arc_deg > 0.0 && arc_deg <= 360.0)) throw InputError("circle segments: arc_deg must be in (0, 360]");
+}
+
+void CircleSegmentFinder::add(std::int64_t sample_index, const Eigen::Vector2d& cmd, bool mark) {
+  constexpr double tol_deg = 2.0;         // the trigger sits on the nearest sample: far below 2°
+  constexpr double back_step_deg = 1e-3;  // a set-point step against the sweep larger than this breaks monotonicity
+  const double a = std::atan2(cmd.y() - centre_.y(), cmd.x() - centre_.x());
+  if (open_) {  // this sample belongs to the open stretch (the one that closes it too)
+    double d = a - prev_;  // unwrap
+    if (d > std::numbers::pi) d -= 2 * std::numbers::pi;
+    if (d < -std::numbers::pi) d += 2 * std::numbers::pi;
+    sweep_ += d;
+    fwd_ = std::max(fwd_, d), back_ = std::min(back_, d);
+    prev_ = a;
+    ++samples_;
+  }
+  if (!mark) return;
+  if (open_ && samples_ > 1) {
+    const double sweep_deg = sweep_ * 180.0 / std::numbers::pi;
+    const double against_deg = (sweep_ >= 0 ? -back_ : fwd_) * 180.0 / std::numbers::pi;
+    if (!(std::abs(std::abs(sweep_deg) - arc_deg_) > tol_deg || against_deg > back_step_deg))
+      out_.push_back({begin_index_, sample_index, sweep_deg >= 0 ? "ccw" : "cw", sweep_deg, samples_});
+  }
+  open_ = true;
+  begin_index_ = sample_index;
+  samples_ = 0;
+  prev_ = a, sweep_ = fwd_ = back_ = 0.0;
+}
+
 std::vector<CircleSegment> find_circle_segments(const std::vector<Eigen::Vector2d>& cmd,
                                                 const std::vector<std::int64_t>& idx,
                                                 const std::vector<std::int64_t>& marks_in, const Eigen::Vector2d& centre,
                                                 double arc_deg) {
   if (cmd.size() != idx.size()) throw InputError("circle segments: set-point and sample indices differ in length");
-  if (!(arc_deg > 0.0 && arc_deg <= 360.0)) throw InputError("circle segments: arc_deg must be in (0, 360]");
-  std::vector<std::int64_t> marks;
-  for (auto m : marks_in)
-    if (!idx.empty() && m >= idx.front() && m <= idx.back()) marks.push_back(m);
+  CircleSegmentFinder finder(centre, arc_deg);
+  std::vector<std::int64_t> marks = marks_in;
   std::sort(marks.begin(), marks.end());
-  constexpr double tol_deg = 2.0;      // the trigger sits on the nearest sample: far below 2°
-  constexpr double back_step_deg = 1e-3;  // a set-point step against the sweep larger than this breaks monotonicity
-  std::vector<CircleSegment> out;
-  for (std::size_t k = 0; k + 1 < marks.size(); ++k) {
-    const auto b = static_cast<std::size_t>(std::lower_bound(idx.begin(), idx.end(), marks[k]) - idx.begin());
-    const auto e = static_cast<std::size_t>(std::lower_bound(idx.begin(), idx.end(), marks[k + 1]) - idx.begin());
-    if (e <= b + 1 || e >= cmd.size()) continue;
-    double sweep = 0.0, fwd = 0.0, back = 0.0;
-    double prev = std::atan2(cmd[b].y() - centre.y(), cmd[b].x() - centre.x());
-    for (std::size_t i = b + 1; i <= e; ++i) {
-      const double a = std::atan2(cmd[i].y() - centre.y(), cmd[i].x() - centre.x());
-      double d = a - prev;  // unwrap
-      if (d > std::numbers::pi) d -= 2 * std::numbers::pi;
-      if (d < -std::numbers::pi) d += 2 * std::numbers::pi;
-      sweep += d;
-      fwd = std::max(fwd, d), back = std::min(back, d);
-      prev = a;
-    }
-    const double sweep_deg = sweep * 180.0 / std::numbers::pi;
-    const double against_deg = (sweep >= 0 ? -back : fwd) * 180.0 / std::numbers::pi;
-    if (std::abs(std::abs(sweep_deg) - arc_deg) > tol_deg || against_deg > back_step_deg) continue;
-    out.push_back({marks[k], marks[k + 1], sweep_deg >= 0 ? "ccw" : "cw", sweep_deg});
+  marks.erase(std::unique(marks.begin(), marks.end()), marks.end());
+  // A mark between two samples (lost frames) counts at the first sample after it.
+  std::size_t next = 0;
+  for (std::size_t i = 0; i < idx.size(); ++i) {
+    bool mark = false;
+    for (; next < marks.size() && marks[next] <= idx[i]; ++next) mark = mark || (i > 0 || marks[next] == idx[i]);
+    finder.add(idx[i], cmd[i], mark);
   }
-  return out;
+  return finder.segments();
 }
 
 }  // namespace eical::dsp::eval

@@ -10,7 +10,8 @@
 
 namespace eical::dsp::fusion {
 
-CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const SmootherSettings& settings, std::size_t segment_samples)
+CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const SmootherSettings& settings, std::size_t segment_samples,
+                                           SegmentSink* sink)
     : track_(track), settings_(settings), seg_(std::max<std::size_t>(1, segment_samples)), nominal_(discretise(settings.model, 1.0 / settings.fs_hz)) {
   if (!track.schedule) throw InputError("smoother: no schedule");
   const std::size_t n = track.n;
@@ -26,7 +27,9 @@ CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const Smo
   for (const std::size_t i : order) fixes_.push_back(track.schedule->fixes[i]), fix_pos_mm_.push_back(track.fix_pos_mm[i]);
   means_ = track.schedule->velocity_means;
   std::stable_sort(means_.begin(), means_.end(), [](const VelocityMean& a, const VelocityMean& b) { return a.k < b.k; });
+  if (sink) sink->restart();
   if (n == 0) return;
+  SmoothedSegment out;
 
   // Forward: the live filter's code over the track, a checkpoint at each segment's start.
   Checkpoint c;
@@ -42,9 +45,11 @@ CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const Smo
     checkpoints_.push_back(c);
     c.filter.resets = &resets;
     forward(c, first, last, settings_.forward_only ? &states : nullptr);
-    if (settings_.forward_only)  // the filtered errors are the result: they must be finite
+    if (settings_.forward_only) {  // the filtered errors are the result: they must be finite
       for (int a = 0; a < 3; ++a)
         for (const Vec3& e : states.e[a]) finite_ = finite_ && std::isfinite(e[0]) && std::isfinite(e[1]);
+      if (sink) output(states, out), sink->segment(j, out);
+    }
   }
   tally_ = c.filter.tally, reset_count_ = c.filter.reset_count;
   for (const auto& r : resets) extra_[r.axis].push_back({r.k, Vec3(r.add_xx, r.add_vv, r.add_bb)});
@@ -65,6 +70,7 @@ CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const Smo
       smoothed_p_[j][a] = states.p[a][0];
       for (const Vec3& e : states.e[a]) finite_ = finite_ && std::isfinite(e[0]) && std::isfinite(e[1]);
     }
+    if (sink) output(states, out), sink->segment(j, out);
   }
 }
 
@@ -94,7 +100,8 @@ void CheckpointedSmoother::forward(Checkpoint& c, std::size_t first, std::size_t
     }
     Vec3 vel = Vec3::Zero();  // read only where the flags say so
     if (reads_velocity(flags[k])) vel = track_.support_vel_mm_s[c.next_vel++];
-    fwd.velocity_supports(flags[k], vel * 1000.0, m, k < zs.size() ? static_cast<double>(zs[k]) : 0.0, sch.zupt);
+    const double zupt_sigma = k < zs.size() ? static_cast<double>(zs[k]) : (k < track_.zupt_unused.size() && track_.zupt_unused[k] ? -1.0 : 0.0);
+    fwd.velocity_supports(flags[k], vel * 1000.0, m, zupt_sigma, sch.zupt);
     for (; c.next_mean < means_.size() && means_[c.next_mean].k <= k; ++c.next_mean)
       if (means_[c.next_mean].k == k) fwd.velocity_mean(means_[c.next_mean], m, sch.zupt);
     for (; c.next_fix < fixes_.size() && fixes_[c.next_fix].k == k; ++c.next_fix) {
@@ -164,18 +171,22 @@ void CheckpointedSmoother::segment(std::size_t j, SmoothedSegment& out, bool kee
   } else if (keep_gains) {
     for (int a = 0; a < 3; ++a) out.gain[a].assign(last - first, Mat3::Zero());
   }
-  const std::size_t len = last - first;
-  out.first = first;
+  if (keep_gains)
+    for (int a = 0; a < 3; ++a) out.p_smoothed[a] = s.p[a];
+  output(s, out);
+}
+
+void CheckpointedSmoother::output(const SegmentStates& s, SmoothedSegment& out) {
+  const std::size_t len = s.gap.size();
+  out.first = s.first;
   out.dx_um.resize(len), out.dv_um_s.resize(len), out.bias_um_s2.resize(len), out.sigma_x_um.resize(len);
-  for (int a = 0; a < 3; ++a) {
-    if (keep_gains) out.p_smoothed[a] = s.p[a];
+  for (int a = 0; a < 3; ++a)
     for (std::size_t i = 0; i < len; ++i) {
       out.dx_um[i][a] = s.e[a][i][0];
       out.dv_um_s[i][a] = s.e[a][i][1];
       out.bias_um_s2[i][a] = s.e[a][i][2];
       out.sigma_x_um[i][a] = std::sqrt(std::max(s.p[a][i](0, 0), 0.0));
     }
-  }
 }
 
 }  // namespace eical::dsp::fusion

@@ -41,6 +41,9 @@ struct SmootherTrack {
   std::vector<Vec3> support_vel_mm_s;
   // The integrated position (mm) along the fix's axis at each of schedule->fixes, same order.
   std::vector<double> fix_pos_mm;
+  // When schedule->zupt_sigma_um_s is empty: its values as bits (true: −1, a standstill
+  // sample whose velocity is not used; false: 0), an eighth of a byte per sample.
+  std::vector<bool> zupt_unused;
 };
 
 struct SmootherSettings {
@@ -59,6 +62,16 @@ struct SmoothedSegment {
   [[nodiscard]] std::size_t size() const noexcept { return dx_um.size(); }
 };
 
+// Receives every segment's smoothed errors as the smoother makes them (the backward pass:
+// last segment first; forward only: in order), so that a caller can keep them instead of
+// having them recomputed (two more passes) — the streamed analysis spills them.
+class SegmentSink {
+ public:
+  virtual ~SegmentSink() = default;
+  virtual void restart() = 0;  // a smoothing starts (again): forget what came before
+  virtual void segment(std::size_t j, const SmoothedSegment& s) = 0;
+};
+
 class CheckpointedSmoother {
  public:
   static constexpr std::size_t kSegment = 4096;
@@ -67,7 +80,8 @@ class CheckpointedSmoother {
   // outlive the smoother (segment() reads it again). Throws InputError when the track's
   // arrays do not match its length. (segment_samples: tests check that the split changes
   // nothing.)
-  CheckpointedSmoother(const SmootherTrack& track, const SmootherSettings& settings, std::size_t segment_samples = kSegment);
+  CheckpointedSmoother(const SmootherTrack& track, const SmootherSettings& settings, std::size_t segment_samples = kSegment,
+                       SegmentSink* sink = nullptr);
   [[nodiscard]] std::size_t segment_samples() const noexcept { return seg_; }
 
   [[nodiscard]] std::size_t segments() const noexcept { return checkpoints_.size(); }
@@ -97,6 +111,8 @@ class CheckpointedSmoother {
   // leaves at `last`; the filtered states when asked.
   void forward(Checkpoint& c, std::size_t first, std::size_t last, SegmentStates* states) const;
   void refilter(std::size_t j, SegmentStates& states) const;
+  // The errors of segment states into `out` (σ from P).
+  static void output(const SegmentStates& s, SmoothedSegment& out);
   // The backward recursion over the segment's states (filtered in, smoothed out), from the
   // smoothed state of sample `last` (the next segment's first; none for the last segment,
   // whose last sample is smoothed as filtered); the gains when asked.

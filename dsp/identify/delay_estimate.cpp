@@ -1,5 +1,7 @@
 #include "dsp/identify/delay_estimate.hpp"
 
+#include "dsp/core/interpolate.hpp"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -7,14 +9,6 @@
 
 namespace eical::dsp::identify {
 namespace {
-
-double interp(const std::vector<Eigen::Vector3d>& x, double pos, int axis) {
-  if (pos <= 0.0) return x.front()[axis];
-  const auto i = static_cast<std::size_t>(pos);
-  if (i + 1 >= x.size()) return x.back()[axis];
-  const double f = pos - static_cast<double>(i);
-  return (1.0 - f) * x[i][axis] + f * x[i + 1][axis];
-}
 
 }  // namespace
 
@@ -40,8 +34,8 @@ DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayRef
     if (count++ % 10 != 0) continue;
     const double pos = static_cast<double>(fx.k) - d0;
     if (pos < 1.0 || pos + 2.0 >= static_cast<double>(c.size())) continue;
-    const double ref = interp(c, pos, fx.axis);
-    const double v = (interp(c, pos + 1.0, fx.axis) - interp(c, pos - 1.0, fx.axis)) / 2.0 * fs;  // mm/s
+    const double ref = interpolate_at(c, pos, fx.axis);
+    const double v = (interpolate_at(c, pos + 1.0, fx.axis) - interpolate_at(c, pos - 1.0, fx.axis)) / 2.0 * fs;  // mm/s
     if (!std::isfinite(ref) || !std::isfinite(v) || std::abs(v) < 1.0) continue;
     std::vector<double> r(static_cast<std::size_t>(p), 0.0);
     r[static_cast<std::size_t>(2 * fx.strip)] = 1.0;

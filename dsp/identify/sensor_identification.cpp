@@ -2,6 +2,7 @@
 
 #include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/interpolate.hpp"
 #include "dsp/identify/augmented_filter.hpp"
 #include "dsp/identify/delay_estimate.hpp"
 
@@ -52,15 +53,6 @@ double rms_about_mean(const std::vector<double>& v) {
   double ss = 0.0;
   for (double x : v) ss += (x - mean) * (x - mean);
   return std::sqrt(ss / static_cast<double>(v.size()));
-}
-
-// Linear interpolation of a trace column at a fractional trace position.
-double at(const std::vector<Eigen::Vector3d>& x, double pos, int axis) {
-  if (pos <= 0.0) return x.front()[axis];
-  const auto i = static_cast<std::size_t>(pos);
-  if (i + 1 >= x.size()) return x.back()[axis];
-  const double f = pos - static_cast<double>(i);
-  return (1.0 - f) * x[i][axis] + f * x[i + 1][axis];
 }
 
 PassResult fit_pass(const Run& run, const RunMeta& meta, const IdentifyOptions& o) {
@@ -189,7 +181,7 @@ PassResult fit_pass(const Run& run, const RunMeta& meta, const IdentifyOptions& 
         }
       } else if (run.channels.ref[i] && k % static_cast<std::size_t>(std::max(1, o.reference_every)) == 0) {
         const double pos = static_cast<double>(k) - meta.acquisition.daq_group_delay_samples;  // sensors see k − d
-        const double ref = at(m.ref_mm, pos, i);
+        const double ref = interpolate_at(m.ref_mm, pos, i);
         if (std::isfinite(ref) && pos >= 0.0) {
           Eigen::RowVectorXd h = row();
           h[0] = 1.0, h[3 + L.x0] = 1.0;
@@ -230,7 +222,7 @@ Agreement agreement(const Run& run, const RunMeta& meta) {
   std::vector<std::vector<double>> per_strip(meta.psd.size());
   for (const auto& fx : m.raw.schedule.fixes) {
     if (fx.strip < 0 || static_cast<std::size_t>(fx.strip) >= per_strip.size()) continue;
-    const double pos = at(m.pos_mm, static_cast<double>(fx.k) - d, fx.axis);  // the trace is on the set-point's time
+    const double pos = interpolate_at(m.pos_mm, static_cast<double>(fx.k) - d, fx.axis);  // the trace is on the set-point's time
     per_strip[static_cast<std::size_t>(fx.strip)].push_back(pos * 1000.0 - fx.position_um);
   }
   double ss = 0.0;
@@ -252,7 +244,7 @@ Agreement agreement(const Run& run, const RunMeta& meta) {
     std::size_t e = k;
     while (e + 1 < flags.size() && (flags[e + 1] & sf::rest)) ++e;
     const double mid = static_cast<double>(k + e) / 2.0 - d;
-    for (int i = 0; i < 3; ++i) per_axis[i].push_back((at(m.pos_mm, mid, i) - at(m.cmd_mm, mid, i)) * 1000.0);
+    for (int i = 0; i < 3; ++i) per_axis[i].push_back((interpolate_at(m.pos_mm, mid, i) - interpolate_at(m.cmd_mm, mid, i)) * 1000.0);
     k = e + 1;
   }
   ss = 0.0, n = 0;

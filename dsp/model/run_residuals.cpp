@@ -2,6 +2,7 @@
 
 #include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/interpolate.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,16 +14,6 @@ namespace {
 // over the axes a program moves in turn (a rectangle's sides alternate x and y: holding
 // out every other side would fit x and predict y).
 constexpr double kHeldOutBlockS = 0.25;
-
-// Linear interpolation of a column of a trace at a fractional position (clamped).
-double at(const std::vector<Eigen::Vector3d>& x, double pos, int axis) {
-  if (x.empty()) return NAN;
-  if (pos <= 0.0) return x.front()[axis];
-  const auto i = static_cast<std::size_t>(pos);
-  if (i + 1 >= x.size()) return x.back()[axis];
-  const double f = pos - static_cast<double>(i);
-  return (1.0 - f) * x[i][axis] + f * x[i + 1][axis];
-}
 
 void add_row(Channel& c, int sample, int axis, double r_um, double sigma_um, std::vector<double>& r, std::vector<double>& s) {
   c.sample.push_back(sample), c.axis.push_back(axis);
@@ -75,9 +66,9 @@ RunResiduals build_residuals(const Run& run) {
   // The measured acceleration averaged over each decimation step (a boxcar: what lies above
   // the decimated Nyquist folds back less).
   auto box = [&](const std::vector<Eigen::Vector3d>& x, double pos, int a) {
-    if (q <= 1) return at(x, pos, a);
+    if (q <= 1) return interpolate_at(x, pos, a);
     double sum = 0.0;
-    for (std::ptrdiff_t j = -q / 2; j < q - q / 2; ++j) sum += at(x, pos + static_cast<double>(j), a);
+    for (std::ptrdiff_t j = -q / 2; j < q - q / 2; ++j) sum += interpolate_at(x, pos + static_cast<double>(j), a);
     return sum / static_cast<double>(q);
   };
   d.cmd.resize(n, 3), d.v_cmd.resize(n, 3), d.a_cmd.resize(n, 3), d.x_meas.resize(n, 3), d.v_meas.resize(n, 3), d.a_meas.resize(n, 3);
@@ -86,7 +77,7 @@ RunResiduals build_residuals(const Run& run) {
   d.segment.assign(static_cast<std::size_t>(n), 0);
   std::vector<std::int64_t> marks;
   for (const auto& t : m.triggers)
-    if (t.code == 102) marks.push_back(t.sample_index);
+    if (t.code == trigger::segment_mark) marks.push_back(t.sample_index);
   const std::int64_t first_frame = run.frames.front().sample_index;
   const double dly = d.delay_samples;
   float t0[2] = {NAN, NAN};
@@ -142,7 +133,7 @@ RunResiduals build_residuals(const Run& run) {
   std::size_t prev_k = 0;
   for (Eigen::Index s = 0; s < n; ++s) {
     const double ks = sensor_pos(s);
-    for (int a = 0; a < 3; ++a) x_ins[static_cast<std::size_t>(s)][a] = at(m.raw.pos_mm, ks, a), v_ins[static_cast<std::size_t>(s)][a] = at(m.raw.vel_mm_s, ks, a);
+    for (int a = 0; a < 3; ++a) x_ins[static_cast<std::size_t>(s)][a] = interpolate_at(m.raw.pos_mm, ks, a), v_ins[static_cast<std::size_t>(s)][a] = interpolate_at(m.raw.vel_mm_s, ks, a);
     const auto k = static_cast<std::size_t>(std::clamp(std::round(ks), 0.0, ns - 1.0));
     zupt[static_cast<std::size_t>(s)] = (sched.flags[k] & sf::rest) && k < sched.zupt_sigma_um_s.size() && sched.zupt_sigma_um_s[k] == 0.0F;
     for (std::size_t j = s == 0 ? k : prev_k + 1; j <= k && j < sched.flags.size(); ++j)
@@ -188,9 +179,9 @@ RunResiduals build_residuals(const Run& run) {
         auto& tag = tag_of[static_cast<std::size_t>(fx->strip)];
         if (tag < 0) tag = t.tags++;
         t.obs.push_back({s, m.raw.pos_mm[fx->k][a] * 1000.0 - fx->position_um, std::hypot(fx->sigma_um, 0.05), d.heldout[static_cast<std::size_t>(s)], tag});
-        const double c = at(m.cmd_mm, pos, a) * 1000.0;
+        const double c = interpolate_at(m.cmd_mm, pos, a) * 1000.0;
         add_row(d.machine, s, a, fx->position_um - c, std::hypot(fx->sigma_um, 0.2), mr, ms);
-        add_row(d.pipeline, s, a, at(m.pos_mm, pos, a) * 1000.0 - fx->position_um, 1.0, pr, ps);
+        add_row(d.pipeline, s, a, interpolate_at(m.pos_mm, pos, a) * 1000.0 - fx->position_um, 1.0, pr, ps);
       }
       std::stable_sort(t.obs.begin(), t.obs.end(), [](const auto& x, const auto& y) { return x.sample < y.sample; });
     } else {

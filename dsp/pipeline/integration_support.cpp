@@ -10,8 +10,7 @@ std::string unsupported_integration(const Measurement& m) {
   const bool held = rest_before || m.zupt_window_samples > 0 || m.supports.psd_fixes > 0;
   if (held || m.sample_index.empty()) return {};
   const double seconds = static_cast<double>(m.sample_index.back() - m.sample_index.front()) / m.fs_hz;
-  double sigma_um = 0.0;
-  for (const auto& s : m.sigma_um) sigma_um = std::max(sigma_um, s.maxCoeff());
+  const double sigma_um = m.sigma_peak_um;  // over the whole trace (the arrays may keep every n-th sample)
   char buf[240];
   std::snprintf(buf, sizeof buf,
                 "no standstill before or after the motion and no position support: the acceleration integrated twice over %.1f s is no position "

@@ -2,6 +2,7 @@
 
 #include "dsp/core/error.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -80,13 +81,19 @@ Pipeline::Pipeline(const PipelineConfig& c)
   }
   SupportConfig sc;
   sc.zupt = c.zupt, sc.nbs = c.nbs, sc.cupt = c.cupt, sc.smooth = c.smooth;
+  sc.record = c.trace == TraceKeeping::whole || c.trace == TraceKeeping::track;
   sc.model = c.fusion;
   sc.standstill = c.standstill;
   const double noise_mps2 = c.fusion.accel_noise_um_s2_rthz * 1e-6;
-  supports_ = SupportStage(sc, c.acquisition, c.psd, noise_mps2 * noise_mps2 * c.acquisition.fs_hz, c.capacity_samples);
+  supports_ = SupportStage(sc, c.acquisition, c.psd, noise_mps2 * noise_mps2 * c.acquisition.fs_hz, c.capacity_samples,
+                           std::min(c.capacity_samples, c.reserve_samples));
   m_.fs_hz = c.acquisition.fs_hz;
-  for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->reserve(c.capacity_samples);
-  m_.sample_index.reserve(c.capacity_samples);
+  if (c.trace == TraceKeeping::whole) {
+    for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->reserve(c.capacity_samples);
+    m_.sample_index.reserve(c.capacity_samples);
+  } else if (c.keep_raw) {
+    throw InputError("pipeline: keep_raw needs the whole trace (TraceKeeping::whole)");
+  }
   if (c.keep_raw)
     for (auto* v : {&m_.raw.table_mps2, &m_.raw.head_mps2, &m_.raw.rest_rel_mps2}) v->reserve(c.capacity_samples);
   m_.triggers.reserve(trigger_capacity_);
@@ -107,6 +114,8 @@ void Pipeline::reset() noexcept {
     for (int i = 0; i < 3; ++i) aq_[s][i] = last_valid_aq_[s][i] = fbias_[s][i] = 0, fbias_sum_[s][i] = 0;
   }
   start_index_ = motion_end_index_ = -1;
+  stored_ = 0;
+  first_stored_ = -1;
   live_ = LiveEstimate{};
   m_.sample_index.clear();
   for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->clear();
@@ -116,8 +125,23 @@ void Pipeline::reset() noexcept {
 }
 
 void Pipeline::store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept {
-  if (m_.sample_index.size() >= config_.capacity_samples) {
+  if (stored_ >= config_.capacity_samples) {
     quality_ |= quality_flag::capacity_exceeded;
+    return;
+  }
+  if (stored_++ == 0) first_stored_ = f.sample_index;
+  if (config_.trace != TraceKeeping::whole) {
+    if (config_.sink) {
+      TraceSample s;
+      s.sample_index = f.sample_index;
+      s.trigger = f.trigger;
+      s.temp_c[0] = f.temp_c[0], s.temp_c[1] = f.temp_c[1];
+      s.frame_flags = f.flags;
+      s.pos_mm = pos_mm, s.vel_mm_s = vel_mm_s;
+      s.cmd_mm = Eigen::Vector3d(f.cmd_mm[0], f.cmd_mm[1], f.cmd_mm[2]);
+      s.ref_mm = Eigen::Vector3d(f.ref_mm[0], f.ref_mm[1], f.ref_mm[2]);
+      config_.sink->sample(s);
+    }
     return;
   }
   m_.sample_index.push_back(f.sample_index);  // within the reserve: no allocation
@@ -213,7 +237,7 @@ void Pipeline::step(const Frame& f) noexcept {
   if (f.flags & frame_flag::not_finite) quality_ |= quality_flag::not_finite;
   if (f.flags & frame_flag::gap_before) quality_ |= quality_flag::frames_lost;
   compensate(f);
-  supports_.psd_frame(f);
+  if (runs_supports()) supports_.psd_frame(f);
   const bool accel_valid = (f.flags & kAccelBad) == 0;
   const std::int64_t k_samples = prev_index_ >= 0 ? f.sample_index - prev_index_ : 1;
   const double dt = static_cast<double>(k_samples) * dt_s_;
@@ -245,12 +269,12 @@ void Pipeline::step(const Frame& f) noexcept {
         }
         ++bias_n_;
         const Eigen::Vector3d rel = fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]);
-        supports_.rest_sample(rel);
+        if (runs_supports()) supports_.rest_sample(rel);
         if (config_.keep_raw && m_.raw.rest_rel_mps2.size() < config_.capacity_samples) m_.raw.rest_rel_mps2.push_back(rel);  // within the reserve
         return;
       }
       start_motion();
-      supports_.start();
+      if (runs_supports()) supports_.start();
       // The programs dwell 0.1 s after M101; a trigger that reaches the DAQ clock a few
       // samples late must not flag a good rest.
       if (bias_n_ < static_cast<std::size_t>(0.05 / dt_s_)) quality_ |= quality_flag::short_rest_window;
@@ -260,7 +284,7 @@ void Pipeline::step(const Frame& f) noexcept {
       start_index_ = motion_end_index_ = f.sample_index;
       phase_ = Phase::moving;
       live_.integrating = true;
-      if (m_.sample_index.size() < config_.capacity_samples)
+      if (runs_supports() && stored_ < config_.capacity_samples)
         supports_.step({0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(), cmd_valid, cmd_moved, cmd});
       store(f, start_pos_mm_, Eigen::Vector3d::Zero());
       return;
@@ -270,8 +294,8 @@ void Pipeline::step(const Frame& f) noexcept {
       integrate(k_samples, dt, pos_m, vel_mps);
       const Eigen::Vector3d pos_mm = start_pos_mm_ + pos_m * 1000.0;
       const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
-      const std::size_t k = m_.sample_index.size();
-      if (k < config_.capacity_samples)
+      const std::size_t k = stored_;
+      if (runs_supports() && k < config_.capacity_samples)
         supports_.step({k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd});
       // The live filter's estimate, predicted over the DAQ delay (what finish() re-indexes).
       const Eigen::Vector3d live_pos = pos_mm - supports_.live_dx_mm();
@@ -313,12 +337,25 @@ void Pipeline::apply_supports(Measurement& m) {
     m.raw.rest_bias_mps2[0] = bias_[0];
     m.raw.rest_bias_mps2[1] = bias_[1];
   }
-  // The raw integrated velocity at the last standstill: what ZUPT takes out there.
   std::vector<Eigen::Vector3d> sigma;
-  const std::vector<Eigen::Vector3d> raw_vel = m.vel_mm_s;
   m.supports = supports_.finish(m.sample_index, m.pos_mm, m.vel_mm_s, sigma);
   if (config_.keep_raw || config_.keep_schedule) m.raw.schedule = supports_.schedule();
   m.sigma_um = std::move(sigma);
+  // The raw integrated velocity at the last standstill: what ZUPT takes out there.
+  Eigen::Vector3d v_rest = Eigen::Vector3d::Zero();
+  if (!m.supports.rest_windows.empty()) {
+    const RestWindow& last = m.supports.rest_windows.back();
+    const auto first = static_cast<std::size_t>(std::lower_bound(m.sample_index.begin(), m.sample_index.end(), last.first_index) - m.sample_index.begin());
+    const auto end = static_cast<std::size_t>(std::upper_bound(m.sample_index.begin(), m.sample_index.end(), last.last_index) - m.sample_index.begin());
+    if (end > first) {
+      const auto [v, cnt] = supports_.recorded_velocity_sum(first, end - 1);
+      if (cnt > 0) v_rest = v / static_cast<double>(cnt);
+    }
+  }
+  rest_windows_done(m, v_rest);
+}
+
+void Pipeline::rest_windows_done(Measurement& m, const Eigen::Vector3d& last_rest_velocity_mm_s) {
   if (m.supports.diverged) quality_ |= quality_flag::supports_diverged;
   if (m.supports.psd_disagrees) quality_ |= quality_flag::psd_disagrees;
   const std::int64_t motion_end_sensor = motion_end_index_ + static_cast<std::int64_t>(std::ceil(delay_samples_));
@@ -327,14 +364,7 @@ void Pipeline::apply_supports(Measurement& m) {
     m.zupt_window_samples += w.samples;
     rest_after |= w.last_index > motion_end_sensor;
   }
-  if (!m.supports.rest_windows.empty()) {
-    const RestWindow& last = m.supports.rest_windows.back();
-    Eigen::Vector3d v = Eigen::Vector3d::Zero();
-    std::size_t cnt = 0;
-    for (std::size_t k = 0; k < m.sample_index.size() && k < raw_vel.size(); ++k)
-      if (m.sample_index[k] >= last.first_index && m.sample_index[k] <= last.last_index) v += raw_vel[k], ++cnt;
-    if (cnt > 0) m.zupt_velocity_error_mm_s = v / static_cast<double>(cnt);
-  }
+  if (!m.supports.rest_windows.empty()) m.zupt_velocity_error_mm_s = last_rest_velocity_mm_s;
   if (config_.zupt && !rest_after) quality_ |= quality_flag::no_zupt_window;
 }
 
@@ -352,9 +382,51 @@ Measurement Pipeline::finish() {
   // (the thesis' "uncompensated").
   if (phase_ == Phase::moving && !m.sample_index.empty()) apply_supports(m);
   if (config_.dynamic != DynamicComp::none && phase_ == Phase::moving && !m.sample_index.empty()) align_delay(m);
+  m.trace_samples = m.sample_index.size();
+  note_sigma(m, m.sigma_um);
   m.flags = quality_flag_names(quality_);
   m.degraded = quality_ != 0;
   return m;
+}
+
+void note_sigma(Measurement& m, const std::vector<Eigen::Vector3d>& sigma_um) {
+  for (const auto& s : sigma_um) {
+    if (s.allFinite()) m.sigma_max_um = m.sigma_max_um.cwiseMax(s);
+    m.sigma_peak_um = std::max(m.sigma_peak_um, s.maxCoeff());
+  }
+}
+
+Pipeline::Tracked Pipeline::finish_track(fusion::SegmentSink* sink) {
+  if (config_.trace != TraceKeeping::track) throw InputError("pipeline: finish_track() needs TraceKeeping::track");
+  Tracked t;
+  Measurement& m = t.measurement;
+  m = std::move(m_);
+  m_ = Measurement{};
+  if (!saw_start_) quality_ |= quality_flag::no_start_trigger;
+  if (!saw_end_) quality_ |= quality_flag::no_end_trigger;
+  m.start_index = start_index_;
+  m.motion_end_index = motion_end_index_;
+  if (phase_ != Phase::moving) quality_ |= quality_flag::no_motion;
+  t.samples = stored_;
+  if (phase_ == Phase::moving && stored_ > 0) {
+    const std::int64_t first = first_stored_;
+    const SupportStage& stage = supports_;
+    t.first_index = first;
+    m.supports = supports_.finish_track(stored_, [&](std::size_t k) { return stage.trace_index(first, k); }, t.correction, sink);
+    Eigen::Vector3d v_rest = Eigen::Vector3d::Zero();
+    if (!m.supports.rest_windows.empty() && t.correction) {
+      // Rest windows in trace positions again (they are consecutive samples of the trace).
+      const RestWindow& last = m.supports.rest_windows.back();
+      const std::size_t a = t.correction->position_of(first, last.first_index), b = t.correction->position_of(first, last.last_index);
+      const auto [v, cnt] = support_velocity_sum(t.correction->schedule.flags, t.correction->track.support_vel_mm_s, a, b);
+      if (cnt > 0) v_rest = v / static_cast<double>(cnt);
+    }
+    rest_windows_done(m, v_rest);
+    if (config_.dynamic != DynamicComp::none) t.delay_samples = delay_samples_;
+  }
+  m.flags = quality_flag_names(quality_);
+  m.degraded = quality_ != 0;
+  return t;
 }
 
 }  // namespace eical::dsp

@@ -32,10 +32,37 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace eical::dsp {
+
+// How much of each measurement the pipeline keeps.
+enum class TraceKeeping {
+  whole,   // the trace in memory (Measurement), up to capacity_samples; finish() smooths it
+  track,   // only what the smoother reads (a few bytes per sample); finish_track() smooths
+           // it, and the streamed analysis (dsp/stream) replays the frames for the trace
+  replay,  // no supports: each stored sample goes to PipelineConfig::sink (that replay)
+  live,    // the live estimate only (eicald's DSP thread): nothing per sample is kept
+};
+
+// A trace sample as integrated: before the supports' corrections and the delay alignment.
+struct TraceSample {
+  std::int64_t sample_index = 0;
+  std::int32_t trigger = 0;  // the frame's NC trigger code (0: none)
+  float temp_c[2] = {0.0F, 0.0F};  // the frame's case temperatures (table, head)
+  std::uint32_t frame_flags = 0;   // the frame's frame_flag bits
+  Eigen::Vector3d pos_mm = Eigen::Vector3d::Zero(), vel_mm_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d cmd_mm = Eigen::Vector3d::Zero(), ref_mm = Eigen::Vector3d::Zero();
+};
+
+// Receives every stored trace sample (TraceKeeping::track and replay), in order.
+class TraceSink {
+ public:
+  virtual ~TraceSink() = default;
+  virtual void sample(const TraceSample& s) = 0;
+};
 
 // double: the reference path. fixed_q: static compensation, bias and integrators in
 // Q-format integers (fixed_point.hpp); supports DynamicComp none and position_level
@@ -50,6 +77,8 @@ struct PipelineConfig {
   StaticCalibration calibration[2];  // cross terms and mounting (6-4, 6-18); default: data sheet
   std::vector<PsdSpec> psd;          // the run's PSD strips (CUPT)
   std::size_t capacity_samples = 0;  // longest measurement the trace can hold
+  // Of the supports' per-sample records, how much to reserve up front (SIZE_MAX: the capacity).
+  std::size_t reserve_samples = SIZE_MAX;
   DynamicComp dynamic = DynamicComp::two_stage;
   StaticCompOptions static_comp;     // temperature (6-16) and nonlinearity (6-17) on/off
   // (3-6) Earth-rate Coriolis from [site]. Off by default: the simulator's built-in runs
@@ -66,6 +95,8 @@ struct PipelineConfig {
   fusion::ErrorModel fusion;  // pipeline_config() sets the noise from the sensors' data sheet
   bool keep_raw = false;      // Measurement::raw (identification, explain; offline only)
   bool keep_schedule = false; // Measurement::raw.schedule alone (the uncertainty of the figures)
+  TraceKeeping trace = TraceKeeping::whole;
+  TraceSink* sink = nullptr;  // track and replay: where the stored samples go (may be none)
   supports::StandstillOptions standstill;
 };
 
@@ -126,9 +157,23 @@ struct Measurement {
   Eigen::Vector3d zupt_velocity_error_mm_s = Eigen::Vector3d::Zero();  // integrated velocity at the last standstill
   std::size_t rest_window_samples = 0, zupt_window_samples = 0;
   std::vector<Eigen::Vector3d> sigma_um;   // posterior σ of pos_mm per axis (after finish())
+  // Long runs analysed as they stream (dsp/stream) keep every decimation-th sample of the
+  // trace in the arrays above (and its last); the figures are computed from every sample.
+  std::size_t decimation = 1;
+  std::size_t trace_samples = 0;           // samples of the whole trace
+  // Over the whole trace: the largest posterior σ per axis among samples whose σ is finite,
+  // and the largest of any axis (NaN ignored) — what the result and the integration check quote.
+  Eigen::Vector3d sigma_max_um = Eigen::Vector3d::Zero();
+  double sigma_peak_um = 0.0;
+  // Streamed runs (no frames kept): each sample's case temperatures, table and head (the
+  // last finite ones), what the uncertainty reads from the frames otherwise.
+  std::vector<Eigen::Vector2d> temp_c;
   SupportSummary supports;
   RawTrace raw;                            // only with PipelineConfig::keep_raw
 };
+
+// Folds σ of trace samples into Measurement::sigma_max_um and sigma_peak_um.
+void note_sigma(Measurement& m, const std::vector<Eigen::Vector3d>& sigma_um);
 
 class Pipeline {
  public:
@@ -139,6 +184,17 @@ class Pipeline {
   [[nodiscard]] std::uint32_t quality_bits() const noexcept { return quality_; }
   // Offline completion (allocates; not for the DSP thread's per-sample path). Call once.
   Measurement finish();
+  // TraceKeeping::track: the measurement without its per-sample arrays, and the smoothed
+  // corrections to apply to the replayed trace (none when nothing moved).
+  struct Tracked {
+    Measurement measurement;   // every field but the per-sample arrays
+    std::size_t samples = 0;   // trace samples (those a replay stores)
+    std::int64_t first_index = 0;  // sample index of the trace's first sample
+    std::unique_ptr<SmoothedCorrection> correction;
+    double delay_samples = 0.0;  // to re-index by (0: none, DynamicComp::none)
+  };
+  // sink: receives the smoothed errors as they are made (to keep them, not recompute them).
+  Tracked finish_track(fusion::SegmentSink* sink = nullptr);
   // Back to waiting for M101, keeping the reserved trace storage (for the live path,
   // which discards its causal estimate at the end of each measurement).
   void reset() noexcept;
@@ -146,6 +202,10 @@ class Pipeline {
  private:
   enum class Phase { wait_start, rest, moving };
   void apply_supports(Measurement& m);
+  // Rest-window bookkeeping after the supports: ZUPT window, the velocity ZUPT takes out,
+  // whether a rest follows the motion.
+  void rest_windows_done(Measurement& m, const Eigen::Vector3d& last_rest_velocity_mm_s);
+  [[nodiscard]] bool runs_supports() const noexcept { return config_.trace != TraceKeeping::replay; }
   void align_delay(Measurement& m) const;
   void store(const Frame& f, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s) noexcept;
   void compensate(const Frame& f) noexcept;
@@ -186,6 +246,8 @@ class Pipeline {
   std::int64_t start_index_ = -1, motion_end_index_ = -1;
   LiveEstimate live_;
   Measurement m_;  // trace storage, reserved in the constructor
+  std::size_t stored_ = 0;             // trace samples stored (or sent) in this measurement
+  std::int64_t first_stored_ = -1;     // sample index of the first
   std::size_t trigger_capacity_ = 4096;
 };
 

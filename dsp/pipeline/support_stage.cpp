@@ -11,19 +11,27 @@ constexpr std::size_t kMaxRestWindows = 4096;
 }  // namespace
 
 SupportStage::SupportStage(const SupportConfig& c, const Acquisition& acq, const std::vector<PsdSpec>& psd, double noise_var_m2ps4,
-                           std::size_t capacity)
+                           std::size_t capacity, std::size_t reserve)
     : cfg_(c), fs_hz_(acq.fs_hz), step_(fusion::discretise(c.model, 1.0 / acq.fs_hz)),
       detector_(c.standstill, acq.fs_hz, acq.daq_group_delay_samples, noise_var_m2ps4), capacity_(capacity) {
   for (const auto& s : psd) {
     if (psd_.size() >= static_cast<std::size_t>(kMaxPsd)) break;
     psd_.emplace_back(s, acq);
   }
-  schedule_.flags.reserve(capacity);
-  schedule_.zupt_sigma_um_s.reserve(capacity);
   schedule_.zupt = c.zupt;
   schedule_.cupt = c.cupt;
-  schedule_.fixes.reserve(capacity);
-  schedule_.velocity_means.reserve(capacity / 100 + 16);
+  if (!c.record) capacity = 0;  // live: the forward filter only, nothing per sample
+  capacity_ = capacity;
+  // Reserved, not touched: memory is taken as the measurement fills it (the live and the
+  // whole-trace pipelines reserve their capacity: no allocation per sample).
+  reserve = std::min(reserve, capacity);
+  schedule_.flags.reserve(reserve);
+  schedule_.zupt_sigma_um_s.reserve(reserve);
+  schedule_.fixes.reserve(reserve);
+  schedule_.velocity_means.reserve(reserve / 100 + 16);
+  gaps_.reserve(reserve);
+  support_vel_mm_s_.reserve(reserve);
+  fix_pos_mm_.reserve(reserve);
   rests_.reserve(kMaxRestWindows);
   block_len_ = static_cast<std::size_t>(std::max(1.0, std::round(0.02 * acq.fs_hz)));
   block_means_.reserve(kMaxRestWindows);
@@ -38,6 +46,9 @@ void SupportStage::reset() noexcept {
   schedule_.zupt_sigma_um_s.clear();
   schedule_.velocity_means.clear();
   schedule_.fixes.clear();
+  gaps_.clear();
+  support_vel_mm_s_.clear();
+  fix_pos_mm_.clear();
   rest_sum_.setZero(), rest_sq_.setZero();
   rest_n_ = 0;
   block_means_.clear();
@@ -122,7 +133,7 @@ void SupportStage::step(const SupportSample& s) noexcept {
   const std::uint8_t flags = schedule_flags(s, r);
   predict_and_support_velocity(s, r, flags);
   position_fixes(s, vel_corr_mm_s);
-  record(flags, r);
+  record(s, flags, r);
   track_rest_window(s, r);
 }
 
@@ -179,7 +190,8 @@ void SupportStage::predict_and_support_velocity(const SupportSample& s, const Re
   live_.velocity_supports(flags, s.vel_mm_s * 1000.0, cfg_.model, r.zupt_sigma_um_s, cfg_.zupt);
   if (r.mean_update) {
     live_.velocity_mean(r.mean, cfg_.model, cfg_.zupt);
-    if (schedule_.velocity_means.size() < schedule_.velocity_means.capacity()) schedule_.velocity_means.push_back(r.mean);
+    if (cfg_.record && (schedule_.velocity_means.size() < schedule_.velocity_means.capacity() || capacity_ == SIZE_MAX))
+      schedule_.velocity_means.push_back(r.mean);
   }
 }
 
@@ -194,15 +206,21 @@ void SupportStage::position_fixes(const SupportSample& s, const Eigen::Vector3d&
     const double fix_um = (psd_[p].centre_mm() + r.u_mm + psd_[p].lockin_tau_s() * vel_corr[ax]) * 1000.0;
     const double model_um = cfg_.model.scale_uncertainty * (s.pos_mm - start_pos_mm_).norm() * 1000.0;
     if (cfg_.cupt) live_.position_fix(ax, s.pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model);
-    if (schedule_.fixes.size() < capacity_) schedule_.fixes.push_back({s.k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(p), model_um});
-    else ++fixes_dropped_;
+    if (schedule_.fixes.size() < capacity_) {
+      schedule_.fixes.push_back({s.k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(p), model_um});
+      fix_pos_mm_.push_back(s.pos_mm[ax]);
+    } else if (cfg_.record) {
+      ++fixes_dropped_;
+    }
   }
 }
 
-void SupportStage::record(std::uint8_t flags, const RestDecision& r) noexcept {
-  if (schedule_.flags.size() >= capacity_) return;
+void SupportStage::record(const SupportSample& s, std::uint8_t flags, const RestDecision& r) noexcept {
+  if (schedule_.flags.size() >= capacity_) return;  // within the reserve: no allocation
   schedule_.flags.push_back(flags);
   schedule_.zupt_sigma_um_s.push_back(static_cast<float>(r.zupt_sigma_um_s));
+  if (s.k > 0 && s.gap_samples != 1) gaps_.emplace_back(s.k, s.gap_samples);
+  if (fusion::reads_velocity(flags)) support_vel_mm_s_.push_back(s.vel_mm_s);
 }
 
 // The sensors' mean at a standstill: their bias there (the drift between rests).
@@ -220,12 +238,16 @@ void SupportStage::track_rest_window(const SupportSample& s, const RestDecision&
   at_rest_ = r.rest;
 }
 
-SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::vector<Eigen::Vector3d>& pos_mm,
-                                    std::vector<Eigen::Vector3d>& vel_mm_s, std::vector<Eigen::Vector3d>& sigma_x_um) {
+SupportSummary SupportStage::refine(std::size_t n, const std::function<std::int64_t(std::size_t)>& index_at) {
   close_rest_window();
   SupportSummary sum;
-  const std::size_t n = std::min({idx.size(), pos_mm.size(), schedule_.flags.size()});
   auto& flags = schedule_.flags;
+  n = std::min(n, flags.size());
+  // Samples beyond n (a trace shorter than the schedule) take their velocities along.
+  std::size_t reads = 0;
+  for (std::size_t k = 0; k < n; ++k) reads += fusion::reads_velocity(flags[k]) ? 1 : 0;
+  support_vel_mm_s_.resize(std::min(reads, support_vel_mm_s_.size()));
+  while (!gaps_.empty() && gaps_.back().first >= n) gaps_.pop_back();
   flags.resize(n);
   schedule_.zupt_sigma_um_s.resize(n);
   // Hindsight: the velocity is trusted only from zupt_onset_skip_s into a standstill on.
@@ -262,59 +284,141 @@ SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::v
   }
   // Rest windows in sample indices.
   for (auto w : rests_) {
-    w.first_index = idx[std::min(static_cast<std::size_t>(w.first_index), n - 1)];
-    w.last_index = idx[std::min(static_cast<std::size_t>(w.last_index), n - 1)];
+    if (n == 0) break;
+    w.first_index = index_at(std::min(static_cast<std::size_t>(w.first_index), n - 1));
+    w.last_index = index_at(std::min(static_cast<std::size_t>(w.last_index), n - 1));
     sum.rest_windows.push_back(w);
   }
   sum.psd_fixes = schedule_.fixes.size();
   sum.start_bias_sigma_um_s2 = start_bias_sigma_;
   sum.psd_fixes_dropped = fixes_dropped_;
-  if (n == 0) return sum;
+  return sum;
+}
 
-  std::vector<std::int64_t> index(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(n));
-  pos_mm.resize(n), vel_mm_s.resize(n);
-  fusion::SmootherInput in;
-  in.sample_index = &index;
-  in.vel_mm_s = &vel_mm_s;
-  in.pos_mm = &pos_mm;
-  in.schedule = &schedule_;
-  in.fs_hz = fs_hz_;
-  in.model = cfg_.model;
-  in.start_bias_sigma_um_s2 = start_bias_sigma_;
-  in.forward_only = !cfg_.smooth;
-  fusion::SmootherOutput out = fusion::smooth(in);
+std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, SupportSummary& sum, bool hand_over, fusion::SegmentSink* sink) {
+  auto c = std::make_unique<SmoothedCorrection>();
+  c->track.n = n;
+  c->track.schedule = &c->schedule;
+  if (hand_over) {  // the stage is done with them (streamed analysis): no second copy
+    c->schedule = std::move(schedule_);
+    c->track.gaps = std::move(gaps_);
+    c->track.support_vel_mm_s = std::move(support_vel_mm_s_);
+    c->track.fix_pos_mm = std::move(fix_pos_mm_);
+    // ZUPT σ per sample is 0 or −1 (step() and refine() write nothing else): as bits.
+    auto& zs = c->schedule.zupt_sigma_um_s;
+    if (std::all_of(zs.begin(), zs.end(), [](float z) { return z == 0.0F || z == -1.0F; })) {
+      c->track.zupt_unused.resize(zs.size());
+      for (std::size_t k = 0; k < zs.size(); ++k) c->track.zupt_unused[k] = zs[k] == -1.0F;
+      std::vector<float>().swap(zs);
+    }
+  } else {
+    c->schedule = schedule_;
+    c->track.gaps = gaps_;
+    c->track.support_vel_mm_s = support_vel_mm_s_;
+    c->track.fix_pos_mm = fix_pos_mm_;
+  }
+  fusion::SmootherSettings st;
+  st.fs_hz = fs_hz_, st.model = cfg_.model, st.start_bias_sigma_um_s2 = start_bias_sigma_;
+  st.forward_only = !cfg_.smooth;
+  c->smoother = std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
   // PSD readings the integration cannot follow — its strip resets, or rejections of more
   // than 5 % — mean the sensor model is off (uncalibrated scale or mounting: the error is
   // then no slowly wandering bias, and pulling the trace to the strips would bend it far
   // between them). The measurement is then fused without them, and says so.
   std::size_t cupt_ok = 0, cupt_bad = 0;
   for (int a = 0; a < 3; ++a) {
-    const auto& cupt = out.tally[a][static_cast<int>(fusion::Support::cupt)];
+    const auto& cupt = c->smoother->tally()[a][static_cast<int>(fusion::Support::cupt)];
     cupt_ok += cupt.accepted, cupt_bad += cupt.rejected;
   }
-  if (schedule_.cupt && cupt_ok + cupt_bad > 0 && (out.resets > 0 || 20 * cupt_bad > cupt_ok + cupt_bad)) {
+  if (c->schedule.cupt && cupt_ok + cupt_bad > 0 && (c->smoother->resets() > 0 || 20 * cupt_bad > cupt_ok + cupt_bad)) {
     sum.psd_disagrees = true;
     sum.psd_rejected = cupt_bad;
-    schedule_.cupt = false;
-    out = fusion::smooth(in);
-    schedule_.cupt = true;
+    c->schedule.cupt = false;  // for good: segments are recomputed from this schedule
+    c->smoother = std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
   }
-  bool finite = true;
-  for (std::size_t k = 0; k < n && finite; ++k) finite = out.dx_um[k].allFinite() && out.dv_um_s[k].allFinite();
-  if (!finite) {  // an input the model cannot take (a saturated channel): leave the trace as integrated
+  c->apply = c->smoother->finite();
+  if (!c->apply) {  // an input the model cannot take (a saturated channel): leave the trace as integrated
     sum.diverged = true;
+    return c;
+  }
+  sum.tally = c->smoother->tally();
+  sum.resets = c->smoother->resets();
+  sum.smoothed = cfg_.smooth;
+  return c;
+}
+
+SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::vector<Eigen::Vector3d>& pos_mm,
+                                    std::vector<Eigen::Vector3d>& vel_mm_s, std::vector<Eigen::Vector3d>& sigma_x_um) {
+  const std::size_t n = std::min({idx.size(), pos_mm.size(), schedule_.flags.size()});
+  SupportSummary sum = refine(n, [&](std::size_t k) { return idx[k]; });
+  if (n == 0) return sum;
+  pos_mm.resize(n), vel_mm_s.resize(n);
+  const std::unique_ptr<SmoothedCorrection> c = smooth_track(n, sum, false);
+  if (!c->apply) {
     sigma_x_um.assign(n, Eigen::Vector3d::Constant(NAN));
     return sum;
   }
-  for (std::size_t k = 0; k < n; ++k) {
-    pos_mm[k] -= out.dx_um[k] / 1000.0;
-    vel_mm_s[k] -= out.dv_um_s[k] / 1000.0;
+  sigma_x_um.resize(n);
+  fusion::SmoothedSegment seg;
+  for (std::size_t j = 0; j < c->smoother->segments(); ++j) {
+    c->smoother->segment(j, seg);
+    for (std::size_t i = 0; i < seg.size(); ++i) {
+      const std::size_t k = seg.first + i;
+      pos_mm[k] -= seg.dx_um[i] / 1000.0;
+      vel_mm_s[k] -= seg.dv_um_s[i] / 1000.0;
+      sigma_x_um[k] = seg.sigma_x_um[i];
+    }
   }
-  sigma_x_um = out.sigma_x_um;
-  sum.tally = out.tally;
-  sum.resets = out.resets;
-  sum.smoothed = cfg_.smooth;
   return sum;
+}
+
+SupportSummary SupportStage::finish_track(std::size_t samples, const std::function<std::int64_t(std::size_t)>& index_at,
+                                          std::unique_ptr<SmoothedCorrection>& correction, fusion::SegmentSink* sink) {
+  SupportSummary sum = refine(samples, index_at);
+  correction.reset();
+  if (schedule_.flags.empty()) return sum;
+  correction = smooth_track(schedule_.flags.size(), sum, true, sink);
+  return sum;
+}
+
+std::pair<Eigen::Vector3d, std::size_t> support_velocity_sum(const std::vector<std::uint8_t>& flags,
+                                                             const std::vector<Eigen::Vector3d>& support_vel_mm_s, std::size_t first,
+                                                             std::size_t last) {
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  std::size_t count = 0, next = 0;
+  for (std::size_t k = 0; k < flags.size() && k <= last; ++k) {
+    if (!fusion::reads_velocity(flags[k])) continue;
+    if (k >= first && next < support_vel_mm_s.size()) v += support_vel_mm_s[next], ++count;
+    ++next;
+  }
+  return {v, count};
+}
+
+std::int64_t SupportStage::trace_index(std::int64_t first_index, std::size_t k) const noexcept {
+  std::int64_t idx = first_index + static_cast<std::int64_t>(k);
+  for (const auto& [p, g] : gaps_) {
+    if (p > k) break;
+    idx += g - 1;
+  }
+  return idx;
+}
+
+std::int64_t SmoothedCorrection::sample_index_of(std::int64_t first_index, std::size_t k) const noexcept {
+  std::int64_t idx = first_index + static_cast<std::int64_t>(k);
+  for (const auto& [p, g] : track.gaps) {
+    if (p > k) break;
+    idx += g - 1;
+  }
+  return idx;
+}
+
+std::size_t SmoothedCorrection::position_of(std::int64_t first_index, std::int64_t sample_index) const noexcept {
+  std::int64_t skipped = 0;  // sample indices the lost frames took before the sample
+  for (const auto& [p, g] : track.gaps) {
+    if (first_index + static_cast<std::int64_t>(p) + skipped + (g - 1) > sample_index) break;
+    skipped += g - 1;
+  }
+  return static_cast<std::size_t>(std::max<std::int64_t>(0, sample_index - first_index - skipped));
 }
 
 }  // namespace eical::dsp

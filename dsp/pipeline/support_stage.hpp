@@ -11,6 +11,7 @@
 // the corrected trace onto the set-point's time afterwards.
 #include "dsp/core/frame.hpp"
 #include "dsp/core/run_meta.hpp"
+#include "dsp/fusion/checkpointed_smoother.hpp"
 #include "dsp/fusion/forward_filter.hpp"
 #include "dsp/fusion/rts_smoother.hpp"
 #include "dsp/supports/psd_decoder.hpp"
@@ -20,7 +21,9 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <limits>
+#include <memory>
 #include <vector>
 
 namespace eical::dsp {
@@ -30,6 +33,9 @@ struct SupportConfig {
   bool nbs = false;
   bool cupt = true;    // PSD strips as position fixes, when the run has any
   bool smooth = true;  // offline RTS pass (off: the forward filter's result, as live)
+  // Record what the offline smoother reads (the schedule and its compact track); off for
+  // the live pipeline, which only needs the forward filter's estimate.
+  bool record = true;
   fusion::ErrorModel model;
   supports::StandstillOptions standstill;
 };
@@ -67,12 +73,34 @@ struct SupportSample {
   Eigen::Vector3d cmd_mm = Eigen::Vector3d::Zero();
 };
 
+// The offline supports of a measurement without its trace: the smoother over the recorded
+// track, from which each segment's corrections are recomputed on demand (TraceKeeping::track).
+struct SmoothedCorrection {
+  fusion::SupportSchedule schedule;  // as smoothed (CUPT off when the strips disagreed)
+  fusion::SmootherTrack track;       // track.schedule points at `schedule`
+  std::unique_ptr<fusion::CheckpointedSmoother> smoother;
+  bool apply = false;  // false: the fusion diverged, the trace stays as integrated (σ NaN)
+  // Trace position of a sample index (the trace's first sample at first_index).
+  [[nodiscard]] std::size_t position_of(std::int64_t first_index, std::int64_t sample_index) const noexcept;
+  // Sample index of trace position k (the inverse, from the recorded steps).
+  [[nodiscard]] std::int64_t sample_index_of(std::int64_t first_index, std::size_t k) const noexcept;
+  SmoothedCorrection() = default;
+  SmoothedCorrection(const SmoothedCorrection&) = delete;
+  SmoothedCorrection& operator=(const SmoothedCorrection&) = delete;
+};
+
+// The recorded integrated velocities (mm/s) of trace samples [first, last] that the
+// smoother reads (fusion::reads_velocity), summed, and how many.
+std::pair<Eigen::Vector3d, std::size_t> support_velocity_sum(const std::vector<std::uint8_t>& flags,
+                                                             const std::vector<Eigen::Vector3d>& support_vel_mm_s, std::size_t first,
+                                                             std::size_t last);
+
 class SupportStage {
  public:
   SupportStage() = default;
   // Allocates everything the measurement can need (capacity_samples of trace).
   SupportStage(const SupportConfig& config, const Acquisition& acquisition, const std::vector<PsdSpec>& psd,
-               double sensor_noise_var_m2ps4, std::size_t capacity_samples);
+               double sensor_noise_var_m2ps4, std::size_t capacity_samples, std::size_t reserve_samples = SIZE_MAX);
 
   void reset() noexcept;
   // Every frame (the PSD noise is learnt at rest too).
@@ -95,6 +123,18 @@ class SupportStage {
   // done. sigma_x_um receives the posterior σ of the position per sample and axis.
   SupportSummary finish(const std::vector<std::int64_t>& sample_index, std::vector<Eigen::Vector3d>& pos_mm,
                         std::vector<Eigen::Vector3d>& vel_mm_s, std::vector<Eigen::Vector3d>& sigma_x_um);
+  // Offline without the trace: the same schedule and smoother, the corrections left to be
+  // applied segment by segment (`correction`, which takes the recorded schedule).
+  // index_at(k): sample index of trace sample k; sink: the smoothed errors as they are made.
+  SupportSummary finish_track(std::size_t samples, const std::function<std::int64_t(std::size_t)>& index_at,
+                              std::unique_ptr<SmoothedCorrection>& correction, fusion::SegmentSink* sink = nullptr);
+  // The integrated velocity (mm/s, as recorded) of trace samples [first, last], summed
+  // over those the smoother reads; and how many (what ZUPT takes out at a standstill).
+  [[nodiscard]] std::pair<Eigen::Vector3d, std::size_t> recorded_velocity_sum(std::size_t first, std::size_t last) const {
+    return support_velocity_sum(schedule_.flags, support_vel_mm_s_, first, last);
+  }
+  // Sample index of trace sample k, the first at first_index (the recorded steps).
+  [[nodiscard]] std::int64_t trace_index(std::int64_t first_index, std::size_t k) const noexcept;
 
   // The schedule the offline pass used (after finish()), for identification and tests.
   [[nodiscard]] const fusion::SupportSchedule& schedule() const noexcept { return schedule_; }
@@ -114,9 +154,14 @@ class SupportStage {
   std::uint8_t schedule_flags(const SupportSample& s, const RestDecision& r) noexcept;
   void predict_and_support_velocity(const SupportSample& s, const RestDecision& r, std::uint8_t flags) noexcept;
   void position_fixes(const SupportSample& s, const Eigen::Vector3d& vel_corr_mm_s) noexcept;
-  void record(std::uint8_t flags, const RestDecision& r) noexcept;
+  void record(const SupportSample& s, std::uint8_t flags, const RestDecision& r) noexcept;
   void track_rest_window(const SupportSample& s, const RestDecision& r) noexcept;
   void close_rest_window() noexcept;
+  // The schedule with hindsight and the rest windows in sample indices (finish's first half).
+  SupportSummary refine(std::size_t n, const std::function<std::int64_t(std::size_t)>& index_at);
+  // The smoother over the recorded track (its second half); CUPT is dropped when the strips
+  // disagree. hand_over: the recorded schedule and track move into the result.
+  std::unique_ptr<SmoothedCorrection> smooth_track(std::size_t n, SupportSummary& sum, bool hand_over, fusion::SegmentSink* sink = nullptr);
 
   SupportConfig cfg_;
   double fs_hz_ = 10000.0;
@@ -126,6 +171,12 @@ class SupportStage {
   std::array<supports::PsdReading, kMaxPsd> psd_now_{};
   fusion::ForwardFilter live_;
   fusion::SupportSchedule schedule_;
+  // What the smoother reads besides the schedule, recorded as the samples pass: the steps
+  // that are not one sample, the integrated velocity where a velocity support reads it,
+  // the integrated position at each PSD fix.
+  std::vector<std::pair<std::size_t, std::int64_t>> gaps_;
+  std::vector<Eigen::Vector3d> support_vel_mm_s_;
+  std::vector<double> fix_pos_mm_;
   std::size_t capacity_ = 0;
   // Rest window before the motion: Σa, Σa² of the relative acceleration.
   Eigen::Vector3d rest_sum_ = Eigen::Vector3d::Zero(), rest_sq_ = Eigen::Vector3d::Zero();

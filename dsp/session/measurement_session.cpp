@@ -28,9 +28,9 @@ bool MeasurementSession::queue_trigger(std::int64_t sample_index, int code) noex
 void MeasurementSession::apply_trigger(int code) noexcept {
   Event e;
   switch (code) {
-    case 101: e = Event::program_start; break;
-    case 102: e = Event::segment_mark; break;
-    case 103: e = Event::program_end; break;
+    case trigger::program_start: e = Event::program_start; break;
+    case trigger::segment_mark: e = Event::segment_mark; break;
+    case trigger::program_end: e = Event::program_end; break;
     default: return;  // user M-codes are recorded in the frame only
   }
   // The state machine formats a message on refusal; triggers are rare (a few per run),
@@ -75,9 +75,9 @@ void MeasurementSession::on_frame(const Frame& in) noexcept {
   }
   pending_count_ = keep;
   if (f.trigger == 0 && external != 0) f.trigger = external;
-  if (f.trigger == 101) apply_trigger(101);  // start before the push: the M101 frame is recorded
+  if (f.trigger == trigger::program_start) apply_trigger(trigger::program_start);  // start before the push: the M101 frame is recorded
   recorder_.push(f);
-  if (f.trigger != 0 && f.trigger != 101) apply_trigger(f.trigger);
+  if (f.trigger != trigger::none && f.trigger != trigger::program_start) apply_trigger(f.trigger);
   if (external != 0 && in.trigger != 0 && external != in.trigger) {
     // Two triggers on one sample: keep the DAQ's own in the frame, apply the other next
     // frame (re-queued at this index so it counts as late once).

@@ -9,11 +9,26 @@ namespace eical::dsp::uncertainty {
 
 CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& idx, const fusion::ErrorModel& model,
                        std::size_t q) {
+  FineSchedule f;
+  f.schedule = &fine;
+  f.samples = std::min(fine.flags.size(), idx.size());
+  f.index_at = [&idx](std::size_t k) { return idx[k]; };
+  return coarsen(f, model, q);
+}
+
+CoarseSchedule coarsen(const FineSchedule& in, const fusion::ErrorModel& model, std::size_t q) {
   namespace sf = fusion::schedule_flag;
+  const fusion::SupportSchedule& fine = *in.schedule;
+  // ZUPT σ of fine sample k (0: its own; < 0: unused).
+  auto zupt_sigma = [&](std::size_t k) {
+    if (k < fine.zupt_sigma_um_s.size()) return static_cast<double>(fine.zupt_sigma_um_s[k]);
+    if (in.zupt_unused && k < in.zupt_unused->size()) return (*in.zupt_unused)[k] ? -1.0 : 0.0;
+    return 0.0;
+  };
   CoarseSchedule c;
   q = std::max<std::size_t>(1, q);
   c.block = q;
-  const std::size_t n = std::min(fine.flags.size(), idx.size());
+  const std::size_t n = std::min(fine.flags.size(), in.samples);
   const std::size_t nc = (n + q - 1) / q;
   c.model = model;
   // σ is carried per coarse sample (zupt) and per fix: the model's floors are folded in.
@@ -32,13 +47,13 @@ CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<st
   for (std::size_t j = 0; j < nc; ++j) {
     const std::size_t b = j * q, e = std::min(n, b + q);
     c.fine_end[j] = e - 1;
-    c.sample_index[j] = idx[e - 1];
+    c.sample_index[j] = in.index_at(e - 1);
     std::uint8_t any = 0;
     std::size_t invalid = 0, rest_used = 0, nbs[3] = {0, 0, 0};
     double info = 0.0;  // Σ 1/σ² of the block's standstill velocities
     bool rest = false;
     for (std::size_t k = b; k < e; ++k) {
-      const std::uint8_t f = fine.flags[k];
+      const auto f = static_cast<std::uint8_t>(fine.flags[k] & in.flag_mask);
       any |= f;
       if (f & sf::invalid) {
         ++invalid;
@@ -46,7 +61,7 @@ CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<st
       }
       if (f & sf::rest) {
         rest = true;
-        const double z = k < fine.zupt_sigma_um_s.size() ? static_cast<double>(fine.zupt_sigma_um_s[k]) : 0.0;
+        const double z = zupt_sigma(k);
         if (z >= 0.0) {
           const double sg = std::max(model.zupt_sigma_um_s, z);
           info += 1.0 / (sg * sg), ++rest_used;

@@ -13,6 +13,7 @@
 #include "dsp/fusion/support_schedule.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace eical::dsp::uncertainty {
@@ -25,6 +26,20 @@ struct CoarseSchedule {
   std::vector<double> fix_noise_um;      // per coarse fix: its strips' own noise (without the model's share)
   fusion::ErrorModel model;              // the pipeline's, with the per-sample σ folded into the schedule
 };
+
+// The schedule the pipeline used, as coarsen() reads it: also without the trace's sample
+// indices in memory (a streamed analysis knows them from the recorded steps).
+struct FineSchedule {
+  const fusion::SupportSchedule* schedule = nullptr;  // one flag per trace sample, the fixes, the window means
+  std::size_t samples = 0;                            // trace samples coarsened (at most schedule->flags.size())
+  std::function<std::int64_t(std::size_t)> index_at;  // sample index of trace sample k (read at block ends only)
+  // ZUPT σ per sample as bits (true: −1, unused) when schedule->zupt_sigma_um_s is empty
+  // (fusion::SmootherTrack::zupt_unused); absent: 0, each standstill sample used.
+  const std::vector<bool>* zupt_unused = nullptr;
+  std::uint8_t flag_mask = 0xFF;  // the flags kept (a diverged fusion: move starts and invalid samples)
+};
+
+CoarseSchedule coarsen(const FineSchedule& fine, const fusion::ErrorModel& model, std::size_t block);
 
 // `fine`: the schedule the pipeline used (one flag per trace sample); `block` ≥ 1.
 CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& sample_index, const fusion::ErrorModel& model,

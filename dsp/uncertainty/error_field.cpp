@@ -49,38 +49,44 @@ double ErrorField::coarse_position(double a) const {
   return std::clamp(c, 0.0, static_cast<double>(coarse_.sample_index.size()) - 1.0);
 }
 
+std::size_t ErrorField::block_for(std::size_t n, std::size_t max_coarse) noexcept {
+  return std::max<std::size_t>(1, (n + max_coarse - 1) / std::max<std::size_t>(1, max_coarse));
+}
+
 ErrorField::ErrorField(const ErrorFieldInput& in) {
   if (!in.schedule || !in.sample_index || !in.pos_mm || !in.vel_mm_s) throw InputError("uncertainty: input arrays missing");
   const std::size_t n = std::min({in.schedule->flags.size(), in.sample_index->size(), in.pos_mm->size(), in.vel_mm_s->size()});
   if (n < 2) throw InputError("uncertainty: the measurement holds fewer than 2 samples");
+  coarse_ = coarsen(*in.schedule, *in.sample_index, in.model, block_for(n, in.max_coarse));
+  const bool have_temp = in.temp_c && in.temp_c->size() >= n;
+  build(in, coarse_path(coarse_, in.delay_samples, in.fs_hz, *in.pos_mm, *in.vel_mm_s, have_temp ? in.temp_c : nullptr));
+}
+
+ErrorField::ErrorField(const ErrorFieldInput& in, CoarseSchedule coarse, const CoarsePath& path) : coarse_(std::move(coarse)) {
+  if (coarse_.sample_index.size() < 2) throw InputError("uncertainty: the measurement holds fewer than 2 samples");
+  build(in, path);
+}
+
+void ErrorField::build(const ErrorFieldInput& in, const CoarsePath& path) {
   delay_ = in.delay_samples;
   fs_hz_ = in.fs_hz;
   owner_ = in.owner;
   strip_sigma_um_ = in.model_covariance.psd_offset_sigma_um;
   start_bias_sigma_ = in.start_bias_sigma_um_s2;
-  const std::size_t q = std::max<std::size_t>(1, (n + in.max_coarse - 1) / std::max<std::size_t>(1, in.max_coarse));
-  coarse_ = coarsen(*in.schedule, *in.sample_index, in.model, q);
-  const std::size_t nc = coarse_.sample_index.size();
   // The truth the noise draws simulate: the data sheet's noise (with its spread) and bias walk.
   truth_ = coarse_.model;
   const double per_sensor = in.noise.bias_walk_ug_per_rts * 1e-6 * in.g_mps2 * 1e6;  // µm/s²/√s
   truth_.bias_walk_um_s2_rts = std::max(in.model.bias_walk_um_s2_rts, std::sqrt(2.0) * per_sensor);
   truth_.accel_noise_um_s2_rthz = std::max(in.model.accel_noise_um_s2_rthz, in.noise.noise_factor * std::hypot(in.sensor_noise_ug_per_rthz[0], in.sensor_noise_ug_per_rthz[1]) * in.g_mps2);
 
-  // The path's own motion (and temperatures) on the coarse grid: sensor time → aligned trace.
-  const auto& pos = *in.pos_mm;
-  const auto& vel = *in.vel_mm_s;
-  std::vector<Eigen::Vector3d> p(nc), v(nc), acc(nc);
-  std::vector<Eigen::Vector2d> temp(nc, Eigen::Vector2d::Zero());
-  const bool have_temp = in.temp_c && in.temp_c->size() >= n;
-  const double h = static_cast<double>(q);
-  for (std::size_t j = 0; j < nc; ++j) {
-    const double a = static_cast<double>(coarse_.fine_end[j]) - delay_;
-    p[j] = at(pos, a) - at(pos, -delay_);
-    v[j] = at(vel, a);
-    acc[j] = (at(vel, a + h) - at(vel, a - h)) * (in.fs_hz / (2.0 * h));
-    if (have_temp) temp[j] = (*in.temp_c)[coarse_.fine_end[j]] - (*in.temp_c)[0];  // since the rest window
-  }
+  const std::size_t nc = coarse_.sample_index.size();
+  const std::vector<Eigen::Vector3d>& p = path.pos_mm;
+  const std::vector<Eigen::Vector3d>& v = path.vel_mm_s;
+  const std::vector<Eigen::Vector3d>& acc = path.acc_mm_s2;
+  const std::vector<Eigen::Vector2d>& temp = path.temp_c;
+  const bool have_temp = !temp.empty();
+  if (p.size() != nc || v.size() != nc || acc.size() != nc || (have_temp && temp.size() != nc))
+    throw InputError("uncertainty: the coarse path does not match its schedule");
   // One smoother pass over pseudo-data: what is left of a unit error after the supports.
   auto respond = [&](const std::vector<Eigen::Vector3d>& dx_mm, const std::vector<Eigen::Vector3d>& dv_mm_s, int strip, double unit) {
     fusion::SupportSchedule sched = coarse_.schedule;

@@ -19,6 +19,7 @@
 // Draws are seeded and deterministic.
 #include "dsp/fusion/error_model.hpp"
 #include "dsp/fusion/support_schedule.hpp"
+#include "dsp/uncertainty/coarse_path.hpp"
 #include "dsp/uncertainty/coarse_schedule.hpp"
 #include "dsp/uncertainty/sensor_model_covariance.hpp"
 
@@ -32,6 +33,7 @@
 namespace eical::dsp::uncertainty {
 
 struct ErrorFieldInput {
+  // The trace (the first constructor; the second takes it coarsened and leaves these null).
   const fusion::SupportSchedule* schedule = nullptr;       // as the pipeline used it (sensor time)
   const std::vector<std::int64_t>* sample_index = nullptr;
   const std::vector<Eigen::Vector3d>* pos_mm = nullptr;    // the measured path, aligned to the set-point
@@ -52,6 +54,12 @@ struct ErrorFieldInput {
 class ErrorField {
  public:
   explicit ErrorField(const ErrorFieldInput& input);
+  // The trace already coarsened (a streamed analysis): coarsen() with input.max_coarse's
+  // block and the path a CoarsePathProbe collected over it; the same field.
+  ErrorField(const ErrorFieldInput& input, CoarseSchedule coarse, const CoarsePath& path);
+
+  // The coarse block of a trace of n samples.
+  [[nodiscard]] static std::size_t block_for(std::size_t samples, std::size_t max_coarse) noexcept;
 
   // One draw of the path's error (µm per axis) at aligned trace positions (fractional
   // allowed).
@@ -60,6 +68,7 @@ class ErrorField {
   [[nodiscard]] std::size_t coarse_samples() const noexcept { return coarse_.sample_index.size(); }
 
  private:
+  void build(const ErrorFieldInput& input, const CoarsePath& path);
   [[nodiscard]] double coarse_position(double at) const;
   [[nodiscard]] std::vector<Eigen::Vector3d> noise_draw(std::mt19937_64& rng) const;
 

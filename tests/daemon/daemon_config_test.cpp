@@ -75,6 +75,9 @@ TEST(DaemonConfig, OutOfRangeAndInvalidValuesAreRefused) {
   EXPECT_NE(error_of("[sensors.head]\nto_machine = [[1,0,0],[0,0,0],[0,0,1]]\n").find("singular"), std::string::npos);
   EXPECT_NE(error_of("[sensors.head]\nzeta = -0.1\n").find("sensors.head.zeta"), std::string::npos);
   EXPECT_NE(error_of("[machine]\ntable_axes = [\"x\"]\nhead_axes = [\"x\"]\n").find("both"), std::string::npos);
+  // Accepted, it would do nothing: every lost frame degrades the result.
+  EXPECT_NE(error_of("[limits]\nmax_lost_frames = 3\n").find("only 0"), std::string::npos);
+  EXPECT_NE(error_of("[limits]\ntemp_min_c = 40.0\ntemp_max_c = 30.0\n").find("temp_max_c"), std::string::npos);
 }
 
 TEST(DaemonConfig, SyntaxErrorNamesLineAndColumn) {

@@ -63,7 +63,9 @@ TEST(FrameLoopRealTime, WholeMeasurementsAllocateNothingOnTheDspThread) {
   scfg.fs_hz = run->fs_hz();
   scfg.max_measurement_s = 30.0;
   dsp::MeasurementSession session(scfg);
-  dsp::Pipeline live(dsp::pipeline_config(run->meta, session.recorder_capacity()));
+  dsp::PipelineConfig live_cfg = dsp::pipeline_config(run->meta, session.recorder_capacity());
+  live_cfg.trace = dsp::TraceKeeping::live;  // as the service runs it
+  dsp::Pipeline live(live_cfg);
   FrameGuard guard(20.0f, 20.0f);
   RecordingHandoff handoff(session.recorder_capacity());
   ServiceCounters counters;

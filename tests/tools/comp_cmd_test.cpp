@@ -160,6 +160,12 @@ TEST(CompCmd, UnresolvedFiguresAreRefusedByNameUnlessSkippedOrAllowed) {
   std::string snippet = slurp(t.dir / "out/linuxcnc/eical-comp.ini");
   EXPECT_NE(snippet.find("[JOINT_0]"), std::string::npos);
   EXPECT_EQ(snippet.find("[JOINT_1]"), std::string::npos) << snippet;
+  {
+    const auto left = nlohmann::json::parse(slurp(t.dir / "out/comp.json"));
+    ASSERT_TRUE(left.contains("left_out_unresolved_figures")) << "what was left out is said";
+    ASSERT_EQ(left["left_out_unresolved_figures"].size(), 1u);
+    EXPECT_NE(left["left_out_unresolved_figures"][0].get<std::string>().find("diagnostics.backlash_y_um"), std::string::npos);
+  }
   // --allow-unresolved: proposed and said so in comp.json.
   run_cli({"comp", bare.string(), "-o", (t.dir / "out3").string(), "--allow-unresolved"});
   const auto j = nlohmann::json::parse(slurp(t.dir / "out3/comp.json"));

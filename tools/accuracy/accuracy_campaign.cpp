@@ -114,7 +114,7 @@ Analysed analyse(const sim::Scenario& sc, const Report& rep) {
 std::vector<std::pair<std::size_t, std::size_t>> dwell_windows(const dsp::Measurement& m) {
   std::vector<std::pair<std::size_t, std::size_t>> w;
   for (const auto& t : m.triggers) {
-    if (t.code != 102) continue;
+    if (t.code != dsp::trigger::segment_mark) continue;
     const auto it = std::lower_bound(m.sample_index.begin(), m.sample_index.end(), t.sample_index);
     if (it == m.sample_index.end()) continue;
     const auto k = static_cast<std::size_t>(it - m.sample_index.begin());
@@ -169,7 +169,7 @@ void circle_figures(const Machine& mach, Report& rep) {
   for (const auto& c : m.cmd_mm) cmd.emplace_back(c.x(), c.y());
   std::vector<std::int64_t> marks;
   for (const auto& t : m.triggers)
-    if (t.code == 102) marks.push_back(t.sample_index);
+    if (t.code == dsp::trigger::segment_mark) marks.push_back(t.sample_index);
   const auto segs = dsp::eval::find_circle_segments(cmd, m.sample_index, marks, Eigen::Vector2d::Zero(), 360.0);
   std::vector<std::size_t> grid;
   std::vector<double> theta;

@@ -106,6 +106,7 @@ Plan build_plan(const std::vector<CompInput>& inputs, const PlanOptions& o) {
     if (!f.resolved()) {
       if (o.unresolved == Unresolved::allow) plan.unresolved_used.push_back(f.describe());
       if (o.unresolved == Unresolved::refuse) refused.push_back(f.describe() + " (for the " + use + ")");
+      if (o.unresolved == Unresolved::skip) plan.unresolved_skipped.push_back(f.describe() + " (for the " + use + ")");
     }
     return ok;
   };

@@ -39,6 +39,7 @@ struct Plan {
   nlohmann::json not_compensated = nlohmann::json::array();
   nlohmann::json skipped = nlohmann::json::array();       // inputs that give no compensation terms
   std::vector<std::string> unresolved_used;               // proposed anyway (allow)
+  std::vector<std::string> unresolved_skipped;            // left out (skip)
 };
 
 Plan build_plan(const std::vector<CompInput>& inputs, const PlanOptions& o);

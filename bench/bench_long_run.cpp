@@ -1,0 +1,228 @@
+// Long recordings (issue 17, item 7): peak memory and speed of `eical analyze` and of
+// eicald's evaluation for circular tests of 1, 10 and 30 minutes at 10 kHz (R150, both
+// directions, repeated; F1000 — the 1-minute run at F2000, since one revolution each way
+// at F1000 takes two minutes). Each analysis runs in a child process of its own, so its
+// peak resident set (getrusage ru_maxrss of the child) is its own.
+//
+//   eical analyze   the command as a user runs it (the run read as it streams, twice)
+//   eical analyze --no-suggest   the same without eical plan's suggestion for a test that
+//                   is not measurable (it simulates short variants, whatever the length)
+//   eicald eval     what eicald's evaluation thread runs on a recording it holds: the
+//                   frames in memory (as the recorder hands them over), then the streamed
+//                   analysis over them; "over them" is the process' peak during the
+//                   evaluation (VmHWM, reset after loading) less the frames' resident size.
+//                   Its peak RSS column is the whole process' (loading the frames included).
+//
+// Prints one line per run and analysis: minutes of data, samples, wall and CPU seconds,
+// × real time (wall and CPU), peak RSS in MB and the verdict (a result was written).
+//
+//   bench_long_run [--minutes 1,10,30] [--dir DIR] [--keep] [--no-daemon]
+#include "drivers/run_io/file_spill.hpp"
+#include "drivers/run_io/run_reader.hpp"
+#include "dsp/stream/analyze_stream.hpp"
+
+#include <CLI/CLI.hpp>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Usage {
+  double wall_s = 0, user_s = 0, sys_s = 0, peak_mb = 0;
+  int status = 0;
+};
+
+double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6; }
+
+// Runs `child` in a forked process (stdout to /dev/null unless keep_stdout); its rusage.
+template <class F>
+Usage in_child(F&& child, bool quiet = true) {
+  std::fflush(stdout);  // else the child's freopen() writes the parent's buffered lines again
+  const auto t0 = std::chrono::steady_clock::now();
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    if (quiet) {
+      std::FILE* null = std::freopen("/dev/null", "w", stdout);
+      (void)null;
+    }
+    int code = 1;
+    try {
+      code = child();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_long_run: %s\n", e.what());
+    }
+    std::fflush(stdout);
+    ::_exit(code);
+  }
+  Usage u;
+  rusage ru{};
+  ::wait4(pid, &u.status, 0, &ru);
+  u.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  u.user_s = seconds(ru.ru_utime), u.sys_s = seconds(ru.ru_stime);
+  u.peak_mb = static_cast<double>(ru.ru_maxrss) / 1024.0;
+  return u;
+}
+
+int run_command(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  ::execv(argv[0], argv.data());
+  std::perror("execv");
+  return 127;
+}
+
+// The process' peak resident size since the last reset_peak() (VmHWM), MB.
+double peak_mb() {
+  std::ifstream is("/proc/self/status");
+  std::string line;
+  while (std::getline(is, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  return NAN;
+}
+
+// Resets VmHWM to the current resident size (Linux ≥ 4.0: clear_refs 5): the peak of what
+// follows, not of what loaded the frames (their vector grows by doubling).
+void reset_peak() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
+double rss_now_mb() {
+  std::ifstream is("/proc/self/statm");
+  long pages_total = 0, pages_resident = 0;
+  is >> pages_total >> pages_resident;
+  return static_cast<double>(pages_resident) * static_cast<double>(::sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+// eical analyze's exit status: 0, 2 and 3 come with a result (verdict ok, degraded, not
+// measurable: README "Exit status"); anything else failed.
+std::string outcome(int status) {
+  if (!WIFEXITED(status)) return "  FAILED (killed)";
+  switch (WEXITSTATUS(status)) {
+    case 0: return "  verdict ok";
+    case 2: return "  verdict degraded";
+    case 3: return "  verdict not measurable";
+    default: return "  FAILED (exit " + std::to_string(WEXITSTATUS(status)) + ")";
+  }
+}
+
+void print(const char* what, double minutes, std::size_t samples, const Usage& u, const std::string& extra = "") {
+  const double data_s = minutes * 60.0;
+  std::printf("%-24s %6.1f min %9zu samples  wall %7.2f s (%6.1fx real time)  cpu %7.2f s (%6.1fx)  peak RSS %7.1f MB%s%s\n", what,
+              minutes, samples, u.wall_s, data_s / u.wall_s, u.user_s + u.sys_s, data_s / (u.user_s + u.sys_s), u.peak_mb,
+              extra.c_str(), outcome(u.status).c_str());
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"peak memory and speed of eical analyze and eicald's evaluation for long circular tests"};
+  std::vector<double> minutes{1, 10, 30};
+  std::string dir_opt;
+  bool keep = false, no_daemon = false;
+  app.add_option("--minutes", minutes, "lengths to measure (about: whole revolutions)")->delimiter(',');
+  app.add_option("--dir", dir_opt, "where the simulated runs go (default: /var/tmp; 0.8 GB a 10-minute run)");
+  app.add_flag("--keep", keep, "keep the runs (and reuse them next time)");
+  app.add_flag("--no-daemon", no_daemon, "eical analyze only");
+  CLI11_PARSE(app, argc, argv);
+  const fs::path base = dir_opt.empty() ? fs::path("/var/tmp") / "eical-bench-long-run" : fs::path(dir_opt);
+  fs::create_directories(base);
+  const std::string eical = EICAL_CLI_BENCH;
+  std::printf("machine: %ld online cores, load average %s", ::sysconf(_SC_NPROCESSORS_ONLN), [] {
+    std::ifstream is("/proc/loadavg");
+    static std::string l;
+    std::getline(is, l);
+    l += "\n";
+    return l.c_str();
+  }());
+  for (const double m : minutes) {
+    // R150 both directions: F1000 turns a revolution in 56.5 s, so repeats of both cover
+    // about 113 s each; the minute-long run turns at F2000.
+    const double feed = m < 2.0 ? 2000.0 : 1000.0;
+    const int repeats = std::max(1, static_cast<int>(std::lround(m * 60.0 / (feed < 1500.0 ? 113.1 : 56.5))));
+    const fs::path run = base / ("circle-r150-f" + std::to_string(static_cast<int>(feed)) + "-both-x" + std::to_string(repeats));
+    if (!fs::exists(run / "run.toml")) {
+      const Usage s = in_child([&] {
+        return run_command({eical, "simulate", "--program", "circle", "--radius", "150", "--feed", std::to_string(static_cast<int>(feed)),
+                            "--direction", "both", "--repeats", std::to_string(repeats), "-o", run.string(), "--overwrite"});
+      });
+      if (s.status != 0) {
+        std::fprintf(stderr, "bench_long_run: eical simulate failed\n");
+        return 1;
+      }
+    }
+    const auto meta = eical::drivers::read_run_meta(run / "run.toml");
+    std::size_t rows = 0;
+    {
+      std::ifstream is(run / "samples.csv");
+      std::string line;
+      while (std::getline(is, line)) ++rows;
+      rows = rows > 0 ? rows - 1 : 0;
+    }
+    const double data_min = static_cast<double>(rows) / meta.acquisition.fs_hz / 60.0;
+    const Usage cli = in_child([&] { return run_command({eical, "analyze", run.string(), "--json"}); });
+    print("eical analyze", data_min, rows, cli);
+    // A test that is not measurable gets a measurable variant suggested (eical plan: short
+    // simulated runs analysed whole, whatever the recording's length); without it, the
+    // analysis of the recording alone.
+    const Usage bare = in_child([&] { return run_command({eical, "analyze", run.string(), "--json", "--no-suggest"}); });
+    print("eical analyze --no-suggest", data_min, rows, bare);
+    if (!no_daemon) {
+      // The recorder's frames in memory, then eicald's evaluation over them; the pipe
+      // carries the resident size the frames took.
+      int fd[2];
+      if (::pipe(fd) != 0) return 1;
+      struct Inside {
+        double frames_mb = NAN, peak_mb = NAN, wall_s = NAN, cpu_s = NAN;
+        int status = 1;
+      };
+      const Usage ev = in_child(
+          [&] {
+            ::close(fd[0]);
+            eical::dsp::Run r = eical::drivers::read_run(run);
+            r.frames.shrink_to_fit();
+            Inside in;
+            in.frames_mb = rss_now_mb();
+            reset_peak();
+            rusage a{}, b{};
+            ::getrusage(RUSAGE_SELF, &a);
+            const auto t0 = std::chrono::steady_clock::now();
+            eical::dsp::StoredFrames frames(r.frames);
+            const eical::dsp::Analysis an =
+                eical::dsp::analyze_stream(r, frames, {}, {eical::drivers::file_spills(eical::drivers::default_spill_dir())});
+            in.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            ::getrusage(RUSAGE_SELF, &b);
+            in.peak_mb = peak_mb();
+            in.status = an.verdict == "ok" ? 0 : an.verdict == "degraded" ? 2 : 3;
+            in.cpu_s = seconds(b.ru_utime) + seconds(b.ru_stime) - seconds(a.ru_utime) - seconds(a.ru_stime);
+            const ssize_t w = ::write(fd[1], &in, sizeof in);
+            return w == sizeof in ? 0 : 1;
+          },
+          true);
+      ::close(fd[1]);
+      Inside in;
+      if (::read(fd[0], &in, sizeof in) != sizeof in) in = Inside{};
+      ::close(fd[0]);
+      Usage eval = ev;  // the evaluation alone: its own time; the peak is the process's
+      eval.wall_s = in.wall_s, eval.user_s = in.cpu_s, eval.sys_s = 0.0;
+      if (ev.status == 0) eval.status = in.status << 8;  // the verdict, as eical analyze's exit status
+      char extra[160];
+      std::snprintf(extra, sizeof extra, "  (the frames %.1f MB; with the evaluation %.1f MB: %.1f MB over them)", in.frames_mb, in.peak_mb,
+                    in.peak_mb - in.frames_mb);
+      print("eicald eval", data_min, rows, eval, extra);
+    }
+    if (!keep) fs::remove_all(run);
+  }
+  return 0;
+}

@@ -1,0 +1,358 @@
+#include "dsp/stream/analyze_stream.hpp"
+
+#include "dsp/analysis/figure_uncertainty.hpp"
+#include "dsp/analysis/verdict.hpp"
+#include "dsp/core/error.hpp"
+#include "dsp/eval/circle_segments.hpp"
+#include "dsp/eval/repeats.hpp"
+#include "dsp/pipeline/integration_support.hpp"
+#include "dsp/stream/circle_stream.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <optional>
+
+namespace eical::dsp {
+namespace {
+
+constexpr std::size_t kTriggerCapacity = 4096;  // triggers the pipeline records (Pipeline::trigger_capacity_)
+
+// The first pass's view of the trace: what the set-point alone decides — where a circle's
+// evaluated stretches are, which segments repeat, whether the reference channel is whole.
+class Scout final : public TraceSink {
+ public:
+  Scout(const Run& run, bool circle) : circle_(circle), repeats(std::vector<std::int64_t>{}) {
+    const auto [ia, ib] = plane_axes(run.meta.program.plane);
+    ia_ = ia, ib_ = ib;
+    ref_finite = run.channels.ref[ia] && run.channels.ref[ib];
+    if (!circle) return;
+    try {
+      segments.emplace(Eigen::Vector2d(run.meta.program.center_mm[0], run.meta.program.center_mm[1]), run.meta.program.arc_deg);
+    } catch (const InputError& e) {
+      segment_error = std::string(e.what());
+    }
+  }
+  // Every frame, before the pipeline: its M102 mark, as the pipeline records triggers.
+  void frame(const Frame& f) {
+    if (f.trigger == 0 || triggers_ >= kTriggerCapacity) return;
+    ++triggers_;
+    if (f.trigger != 102 || !circle_) return;
+    repeats.mark(f.sample_index);
+    marks_.push_back(f.sample_index);
+  }
+  void sample(const TraceSample& s) override {
+    if (trace)
+      trace->put({{static_cast<double>(s.sample_index), static_cast<double>(s.trigger), s.pos_mm[0], s.pos_mm[1], s.pos_mm[2], s.vel_mm_s[0],
+                   s.vel_mm_s[1], s.vel_mm_s[2], s.cmd_mm[0], s.cmd_mm[1], s.cmd_mm[2], s.ref_mm[0], s.ref_mm[1], s.ref_mm[2],
+                   static_cast<double>(s.temp_c[0]), static_cast<double>(s.temp_c[1]), static_cast<double>(s.frame_flags)}});
+    if (circle_) {
+      repeats.add(n, s.sample_index, s.cmd_mm);
+      // A mark counts at the trace sample it falls on (or, between samples, at the next
+      // one); marks before the trace start nothing.
+      bool mark = false;
+      while (!marks_.empty() && marks_.front() <= s.sample_index) {
+        mark = mark || n > 0 || marks_.front() == s.sample_index;
+        marks_.pop_front();
+      }
+      if (segments) segments->add(s.sample_index, Eigen::Vector2d(s.cmd_mm[ia_], s.cmd_mm[ib_]), mark);
+    }
+    if (ref_finite) ref_finite = Eigen::Vector2d(s.ref_mm[ia_], s.ref_mm[ib_]).allFinite();
+    ++n;
+  }
+
+  std::size_t n = 0;  // trace samples
+  SpillWriter<Doubles<17>>* trace = nullptr;  // the integrated trace, for the second pass
+  bool circle_;
+  eval::RepeatFinder repeats;
+  std::optional<eval::CircleSegmentFinder> segments;
+  std::optional<std::string> segment_error;
+  bool ref_finite = false;
+
+ private:
+  int ia_ = 0, ib_ = 1;
+  std::size_t triggers_ = 0;
+  std::deque<std::int64_t> marks_;
+};
+
+// The smoothed errors as the smoother makes them, in a spill: the second pass reads each
+// segment's instead of recomputing it (a filter pass forward and one back).
+class CorrectionSpill final : public fusion::SegmentSink {
+ public:
+  explicit CorrectionSpill(SpillFactory factory) : factory_(std::move(factory)) {}
+  void restart() override {
+    spill_ = factory_();
+    where_.clear();
+    bytes_ = 0;
+  }
+  void segment(std::size_t j, const fusion::SmoothedSegment& s) override {
+    if (where_.size() <= j) where_.resize(j + 1);
+    where_[j] = {bytes_, s.first, s.size()};
+    buf_.resize(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i)
+      for (int a = 0; a < 3; ++a) buf_[i].v[a] = s.dx_um[i][a], buf_[i].v[3 + a] = s.dv_um_s[i][a], buf_[i].v[6 + a] = s.sigma_x_um[i][a];
+    spill_->write(buf_.data(), buf_.size() * sizeof(Doubles<9>));
+    bytes_ += buf_.size() * sizeof(Doubles<9>);
+  }
+  [[nodiscard]] bool has(std::size_t j) const { return j < where_.size() && where_[j].size > 0; }
+  void load(std::size_t j, fusion::SmoothedSegment& out) {
+    const Where& w = where_[j];
+    buf_.resize(w.size);
+    spill_->read_at(w.offset, buf_.data(), w.size * sizeof(Doubles<9>));
+    out.first = w.first;
+    out.dx_um.resize(w.size), out.dv_um_s.resize(w.size), out.sigma_x_um.resize(w.size);
+    for (std::size_t i = 0; i < w.size; ++i)
+      for (int a = 0; a < 3; ++a) out.dx_um[i][a] = buf_[i].v[a], out.dv_um_s[i][a] = buf_[i].v[3 + a], out.sigma_x_um[i][a] = buf_[i].v[6 + a];
+  }
+
+ private:
+  struct Where {
+    std::size_t offset = 0, first = 0, size = 0;
+  };
+  SpillFactory factory_;
+  std::unique_ptr<Spill> spill_;
+  std::vector<Where> where_;
+  std::size_t bytes_ = 0;
+  std::vector<Doubles<9>> buf_;
+};
+
+// A trace sample as the evaluation sees it: corrected by the supports, on the set-point's time.
+struct Corrected {
+  std::size_t k = 0;
+  std::int64_t sample_index = 0;
+  Eigen::Vector3d pos_mm, vel_mm_s, cmd_mm, ref_mm, sigma_um;
+  float temp_c[2] = {0.0F, 0.0F};
+  std::uint32_t frame_flags = 0;
+};
+
+// The second pass: the replayed integrated trace, the smoothed corrections applied segment
+// by segment (SupportStage::finish), then re-indexed by the DAQ delay (Pipeline::align_delay).
+class Emitter final : public TraceSink {
+ public:
+  Emitter(const Pipeline::Tracked& t, CorrectionSpill* kept, std::function<void(const Corrected&)> out)
+      : n_(t.samples), correction_(t.correction.get()), kept_(kept), d_(t.delay_samples), align_(t.delay_samples > 0.0 && t.samples >= 2),
+        out_(std::move(out)) {}
+
+  void sample(const TraceSample& s) override {
+    Corrected c;
+    c.k = seen_++;
+    c.sample_index = s.sample_index;
+    c.pos_mm = s.pos_mm, c.vel_mm_s = s.vel_mm_s, c.cmd_mm = s.cmd_mm, c.ref_mm = s.ref_mm;
+    c.temp_c[0] = s.temp_c[0], c.temp_c[1] = s.temp_c[1], c.frame_flags = s.frame_flags;
+    c.sigma_um = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    if (correction_ && correction_->apply) {
+      const auto& sm = *correction_->smoother;
+      if (c.k >= seg_.first + seg_.size() || !loaded_) {
+        const std::size_t j = c.k / sm.segment_samples();
+        if (kept_ && kept_->has(j)) kept_->load(j, seg_);
+        else sm.segment(j, seg_);
+        loaded_ = true;
+      }
+      const std::size_t i = c.k - seg_.first;
+      c.pos_mm -= seg_.dx_um[i] / 1000.0;
+      c.vel_mm_s -= seg_.dv_um_s[i] / 1000.0;
+      c.sigma_um = seg_.sigma_x_um[i];
+    }
+    if (!align_) {
+      out_(c);
+      return;
+    }
+    src_.push_back({c.pos_mm, c.vel_mm_s});
+    pending_.push_back(c);
+    flush();
+  }
+  void finish() {
+    if (seen_ != n_) throw InputError("the run changed between two readings (" + std::to_string(seen_) + " trace samples, then " + std::to_string(n_) + ")");
+    flush();
+  }
+
+ private:
+  // Sample k of the trace holds what the sensors saw at k − d: k takes the value at k + d,
+  // linear between samples; the last d samples hold the final value.
+  void flush() {
+    while (!pending_.empty()) {
+      Corrected& c = pending_.front();
+      const double src = static_cast<double>(c.k) + d_;
+      const auto i = static_cast<std::size_t>(src);
+      if (i + 1 >= n_) {
+        if (seen_ < n_) return;  // the final value is not there yet
+        c.pos_mm = src_.back().first, c.vel_mm_s = src_.back().second;
+      } else {
+        if (i + 1 >= seen_) return;
+        const double f = src - static_cast<double>(i);
+        const auto& x0 = src_[i - base_];
+        const auto& x1 = src_[i + 1 - base_];
+        c.pos_mm = (1.0 - f) * x0.first + f * x1.first;
+        c.vel_mm_s = (1.0 - f) * x0.second + f * x1.second;
+        while (base_ < i) src_.pop_front(), ++base_;  // later samples read from i on
+      }
+      out_(c);
+      pending_.pop_front();
+    }
+  }
+
+  std::size_t n_;
+  const SmoothedCorrection* correction_;
+  CorrectionSpill* kept_;
+  double d_;
+  bool align_;
+  std::function<void(const Corrected&)> out_;
+  std::size_t seen_ = 0;
+  fusion::SmoothedSegment seg_;
+  bool loaded_ = false;
+  std::deque<std::pair<Eigen::Vector3d, Eigen::Vector3d>> src_;  // corrected pos, vel from base_ on
+  std::size_t base_ = 0;
+  std::deque<Corrected> pending_;
+};
+
+// The schedule as the smoother used it, as the whole-trace pipeline keeps it for the
+// uncertainty (Measurement::raw.schedule): ZUPT σ per sample again, CUPT as configured.
+fusion::SupportSchedule schedule_as_fused(const SmoothedCorrection& c, const PipelineConfig& cfg) {
+  fusion::SupportSchedule s = c.schedule;
+  if (s.zupt_sigma_um_s.empty() && !c.track.zupt_unused.empty()) {
+    s.zupt_sigma_um_s.resize(c.track.zupt_unused.size());
+    for (std::size_t k = 0; k < s.zupt_sigma_um_s.size(); ++k) s.zupt_sigma_um_s[k] = c.track.zupt_unused[k] ? -1.0F : 0.0F;
+  }
+  s.cupt = cfg.cupt;
+  return s;
+}
+
+// The per-sample arrays of the measurement: every sample, or every q-th and the last.
+void keep(Measurement& m, const Corrected& c, std::size_t q, std::size_t n, const Eigen::Vector2d& temp) {
+  if (c.k % q != 0 && c.k + 1 != n) return;
+  m.temp_c.push_back(temp);
+  m.sample_index.push_back(c.sample_index);
+  m.pos_mm.push_back(c.pos_mm);
+  m.vel_mm_s.push_back(c.vel_mm_s);
+  m.cmd_mm.push_back(c.cmd_mm);
+  m.ref_mm.push_back(c.ref_mm);
+  m.sigma_um.push_back(c.sigma_um);
+}
+
+}  // namespace
+
+Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOptions& options, const StreamOptions& stream) {
+  if (!(header.meta.acquisition.fs_hz > 0.0)) throw InputError("run '" + header.meta.id + "': fs_hz must be positive");
+  if (options.keep_raw) throw InputError("analysis: the raw trace (keep_raw) needs the whole run in memory (analyze_run)");
+  const bool circle = header.meta.program.kind == "circle";
+
+  // First pass: the pipeline keeping what the smoother reads; what the set-point decides.
+  PipelineConfig cfg = analysis_config(header.meta, std::numeric_limits<std::size_t>::max(), options);
+  cfg.reserve_samples = frames.size_hint();
+  Scout scout(header, circle);
+  std::unique_ptr<Spill> trace_spill = stream.spill_trace ? stream.spills() : nullptr;
+  std::optional<SpillWriter<Doubles<17>>> trace_writer;
+  if (trace_spill) scout.trace = &trace_writer.emplace(*trace_spill);
+  cfg.trace = TraceKeeping::track;
+  cfg.sink = &scout;
+  std::size_t n_frames = 0;
+  std::optional<CorrectionSpill> kept;
+  if (stream.spill_corrections) kept.emplace(stream.spills);
+  Pipeline::Tracked t;
+  {
+    Pipeline pipeline(cfg);
+    frames.replay([&](const Frame& f) {
+      scout.frame(f);
+      pipeline.step(f);
+      ++n_frames;
+    });
+    if (n_frames == 0) throw InputError("run '" + header.meta.id + "' holds no frames");
+    t = pipeline.finish_track(kept ? &*kept : nullptr);
+  }
+  scout.repeats.finish();
+  Analysis a;
+  a.dynamic = cfg.dynamic, a.nbs = cfg.nbs, a.coriolis = cfg.coriolis;
+  a.sensor_model = options.sensor_model;
+  a.measurement = std::move(t.measurement);
+  a.measurement.trace_samples = t.samples;
+  a.flags = a.measurement.flags;
+  a.degraded = a.measurement.degraded;
+  if (t.samples == 0) {  // no motion: nothing to evaluate, a verdict all the same
+    judge(header.meta.program, a);
+    return a;
+  }
+
+  // Second pass: the corrected trace, each sample to the evaluation as it goes by. A
+  // circle is evaluated here; other programs keep the whole trace for theirs.
+  const std::size_t n = t.samples;
+  // A run short enough keeps its whole trace and is evaluated as analyze_run() does; a
+  // longer circle is evaluated as it streams.
+  const bool whole = !circle || n <= stream.materialize_samples;
+  const std::size_t q = whole ? 1 : std::max<std::size_t>(1, (n + stream.measurement_points - 1) / std::max<std::size_t>(1, stream.measurement_points));
+  if (whole && options.uncertainty.enabled && t.correction) a.measurement.raw.schedule = schedule_as_fused(*t.correction, cfg);
+  Measurement& m = a.measurement;
+  m.decimation = q;
+  std::optional<CircleStream> circle_eval;
+  std::optional<eval::RepeatAverager> repeats;
+  if (!whole) {
+    circle_eval.emplace(header, scout.segments ? scout.segments->segments() : std::vector<eval::CircleSegment>{}, scout.segment_error,
+                        scout.ref_finite, stream.spills);
+    repeats.emplace(scout.repeats.groups(), stream.spills(), stream.measurement_points);
+  }
+  // A circle evaluated as it streams: the uncertainty reads what it needs of the trace as
+  // it goes by (figure_uncertainty.hpp).
+  std::optional<UncertaintyTrace> uncertainty;
+  if (!whole && options.uncertainty.enabled && t.correction) {
+    const SmoothedCorrection* c = t.correction.get();
+    const std::int64_t first = t.first_index;
+    uncertainty.emplace(header, cfg, options, a, c->schedule, n, [c, first](std::size_t k) { return c->sample_index_of(first, k); },
+                        &c->track.zupt_unused);
+  }
+  scout = Scout(header, false);  // what it decided is out; its set-point records can go
+  scout.trace = nullptr;
+  Eigen::Vector2d temp(header.meta.sensors[0].temp_ref_c, header.meta.sensors[1].temp_ref_c);  // the last finite case temperatures
+  Emitter emitter(t, kept ? &*kept : nullptr, [&](const Corrected& c) {
+    for (int i = 0; i < 2; ++i)
+      if (!(c.frame_flags & frame_flag::temp_missing) && std::isfinite(c.temp_c[i])) temp[i] = c.temp_c[i];
+    keep(m, c, q, n, temp);
+    if (c.sigma_um.allFinite()) m.sigma_max_um = m.sigma_max_um.cwiseMax(c.sigma_um);
+    m.sigma_peak_um = std::max(m.sigma_peak_um, c.sigma_um.maxCoeff());
+    if (circle_eval) circle_eval->sample(c.sample_index, c.pos_mm, c.cmd_mm, c.ref_mm);
+    if (repeats) repeats->add(c.k, c.pos_mm, c.cmd_mm);
+    if (uncertainty) uncertainty->sample(c.k, c.sample_index, c.pos_mm, c.vel_mm_s, c.cmd_mm, c.ref_mm, temp);
+  });
+  if (trace_spill) {  // the integrated trace as the first pass saw it
+    trace_writer->flush();
+    for_each_record<Doubles<17>>(*trace_spill, [&](const Doubles<17>& r) {
+      TraceSample ts;
+      ts.sample_index = static_cast<std::int64_t>(r.v[0]);
+      ts.trigger = static_cast<std::int32_t>(r.v[1]);
+      ts.pos_mm = {r.v[2], r.v[3], r.v[4]}, ts.vel_mm_s = {r.v[5], r.v[6], r.v[7]};
+      ts.cmd_mm = {r.v[8], r.v[9], r.v[10]}, ts.ref_mm = {r.v[11], r.v[12], r.v[13]};
+      ts.temp_c[0] = static_cast<float>(r.v[14]), ts.temp_c[1] = static_cast<float>(r.v[15]);
+      ts.frame_flags = static_cast<std::uint32_t>(r.v[16]);
+      emitter.sample(ts);
+    });
+    trace_writer.reset();
+    trace_spill.reset();
+  } else {  // the frames through the pipeline again (the same numbers: the same code)
+    PipelineConfig cfg2 = cfg;
+    cfg2.trace = TraceKeeping::replay;
+    cfg2.sink = &emitter;
+    Pipeline replay(cfg2);
+    frames.replay([&](const Frame& f) { replay.step(f); });
+  }
+  emitter.finish();
+  t.correction.reset();  // the smoother's records: done
+
+  if (whole) {
+    evaluate_measurement(header, cfg, options, a);  // as analyze_run(): the whole trace is here
+    return a;
+  }
+  if (const std::string why = unsupported_integration(m); !why.empty()) {
+    // run-format.md, "No standstill": every positional figure null (evaluate_measurement()).
+    a.flags.push_back(std::string(kPositionNullFlag) + why);
+    a.degraded = true;
+  } else {
+    circle_eval->finish(a);
+    circle_eval.reset();
+    a.repeats = repeats->result();
+    if (uncertainty) uncertainty->finish(header, a);
+    else if (options.uncertainty.enabled) a.uncertainty_note = "no support schedule: the uncertainty was not estimated";
+  }
+  judge(header.meta.program, a);
+  return a;
+}
+
+}  // namespace eical::dsp
