@@ -38,14 +38,20 @@ std::optional<CommandMsg> decode_command(std::span<const std::uint8_t> payload, 
   const auto size = static_cast<std::uint32_t>(payload.size() - kHeaderBytes);
   if (size == 0) return refuse(why, "no body after the encapsulation header");
   if (pad > size) return refuse(why, "padding longer than the body");
-  // Cyclone normalises in place (byte order) and needs the body 8-byte aligned.
-  std::vector<std::uint64_t> body((size + 7) / 8);
+  // Cyclone normalises in place (byte order) and needs the body 8-byte aligned. Cyclone
+  // 0.10.2 (Debian 12) reads up to 4 bytes beyond the size it is given on some malformed
+  // XCDR2 bodies and then reports having consumed them (fuzz/dds_command: 68 of a 64-byte
+  // body; a segfault where the buffer ended at a page): the body gets zeroed slack behind
+  // it, and an offset past the end is refused.
+  constexpr std::size_t kSlackWords = 2;
+  std::vector<std::uint64_t> body((size + 7) / 8 + kSlackWords, 0);
   std::memcpy(body.data(), payload.data() + kHeaderBytes, size);
   char* data = reinterpret_cast<char*>(body.data());
   std::uint32_t off = 0;
   const bool swap = little != (DDSRT_ENDIAN == DDSRT_LITTLE_ENDIAN);
   if (!dds_stream_normalize_data(data, &off, size - pad, swap, xcdr, eical_msg_Command_desc.m_ops))
     return refuse(why, "malformed CDR for eical::msg::Command");
+  if (off > size - pad) return refuse(why, "malformed CDR for eical::msg::Command (read past its end)");
   dds_istream_t is;
   dds_istream_init(&is, size - pad, data, xcdr);
   eical_msg_Command sample{};
