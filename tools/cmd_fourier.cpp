@@ -2,12 +2,11 @@
 // (seed 001) with per-term significance and the GUM expanded uncertainty.
 #include "dsp/comp/fourier.hpp"
 #include "tools/commands.hpp"
-#include "tools/io/csv_table.hpp"
+#include "tools/io/csv_inputs.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
-#include <map>
 #include <memory>
 
 namespace eical::tools {
@@ -28,17 +27,7 @@ void register_fourier(CLI::App& app) {
   cmd->add_option("--max-frequency", o->max_f, "highest candidate frequency per revolution (0 = Nyquist)")->default_val(0);
   cmd->add_flag("--json", o->json, "print JSON");
   cmd->callback([o] {
-    const CsvTable t(o->series, {"angle_deg", "deviation_arcsec", "series"});
-    std::map<std::string, dsp::comp::AngleSeries> by_name;
-    std::vector<std::string> order;
-    for (std::size_t r = 0; r < t.rows(); ++r) {
-      const std::string& name = t.text(r, "series");
-      if (!by_name.count(name)) order.push_back(name), by_name[name].name = name;
-      by_name[name].angle_deg.push_back(t.number(r, "angle_deg"));
-      by_name[name].deviation_arcsec.push_back(t.number(r, "deviation_arcsec"));
-    }
-    std::vector<dsp::comp::AngleSeries> series;
-    for (const auto& n : order) series.push_back(by_name[n]);
+    const auto series = read_angle_series_csv(o->series);
     dsp::comp::FourierOptions opt;
     opt.alpha = o->alpha;
     opt.positioning_bound_arcsec = o->bound;

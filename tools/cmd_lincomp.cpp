@@ -5,7 +5,7 @@
 #include "dsp/core/error.hpp"
 #include "tools/commands.hpp"
 #include "tools/comp/linuxcnc_export.hpp"
-#include "tools/io/csv_table.hpp"
+#include "tools/io/csv_inputs.hpp"
 #include "tools/run_files.hpp"
 
 #include <nlohmann/json.hpp>
@@ -22,13 +22,8 @@ struct Curves {
 };
 
 Curves read_curve_csv(const std::string& file) {
-  const CsvTable t(file, {"pos_mm", "error_um"});
   Curves c;
-  for (std::size_t r = 0; r < t.rows(); ++r) {
-    c.mean.pos_mm.push_back(t.number(r, "pos_mm"));
-    c.mean.error_um.push_back(t.number(r, "error_um"));
-  }
-  c.up = c.down = c.mean;
+  c.mean = c.up = c.down = read_error_curve_csv(file);
   return c;
 }
 

@@ -5,6 +5,8 @@
 #include "drivers/setpoint/program_catalog.hpp"
 #include "dsp/core/error.hpp"
 
+#include <cmath>
+
 
 namespace eical::daemon {
 namespace {
@@ -69,7 +71,7 @@ void read_source(StrictTable t, SourceConfig& s) {
     if (s.sim_radius_mm <= 0.0) sim->fail("radius_mm", "must be positive");
     s.sim_feed_mm_min = sim->number("feed_mm_min", s.sim_feed_mm_min);
     if (s.sim_feed_mm_min <= 0.0) sim->fail("feed_mm_min", "must be positive");
-    s.sim_repeats = static_cast<int>(sim->integer("repeats", s.sim_repeats));
+    s.sim_repeats = sim->int32("repeats", s.sim_repeats);
     if (s.sim_repeats < 1) sim->fail("repeats", "must be at least 1");
     const auto seed = sim->integer("seed", static_cast<std::int64_t>(s.sim_seed));
     if (seed < 0) sim->fail("seed", "must not be negative");
@@ -95,10 +97,11 @@ void read_source(StrictTable t, SourceConfig& s) {
     p.gap_frames = gap;
     p.saturate_at_s = f->number("saturate_at_s", p.saturate_at_s);
     p.saturate_s = f->number("saturate_s", p.saturate_s);
-    p.saturate_channel = static_cast<int>(f->integer("saturate_channel", p.saturate_channel));
+    p.saturate_channel = f->int32("saturate_channel", p.saturate_channel);
     if (p.saturate_channel < 0 || p.saturate_channel > 5) f->fail("saturate_channel", "must be within 0..5");
     p.nan_at_s = f->number("nan_at_s", p.nan_at_s);
     p.nan_s = f->number("nan_s", p.nan_s);
+    p.hang_dsp_at_s = f->number("hang_dsp_at_s", p.hang_dsp_at_s);
     f->finish();
   }
   t.finish();
@@ -146,8 +149,9 @@ void read_triggers(StrictTable t, TriggerConfig& c) {
   if (t.has("gpio_lines")) {
     const auto lines = t.numbers("gpio_lines", 3);
     for (std::size_t i = 0; i < 3; ++i) {
-      if (lines[i] < 0 || lines[i] != static_cast<double>(static_cast<int>(lines[i])))
-        t.fail("gpio_lines", "line offsets must be non-negative integers");
+      // Checked before the conversion: a double beyond int's range does not convert.
+      if (!(lines[i] >= 0.0 && lines[i] <= 65535.0) || lines[i] != std::floor(lines[i]))
+        t.fail("gpio_lines", "line offsets must be integers within 0..65535");
       c.gpio_lines[i] = static_cast<int>(lines[i]);
     }
   }
@@ -161,7 +165,7 @@ void read_triggers(StrictTable t, TriggerConfig& c) {
 }
 
 void read_dds(StrictTable t, DdsConfig& d) {
-  d.domain_id = static_cast<int>(t.integer("domain_id", d.domain_id));
+  d.domain_id = t.int32("domain_id", d.domain_id);
   if (d.domain_id < 0 || d.domain_id > 232) t.fail("domain_id", "must be within 0..232");
   d.config_uri = t.string("config_uri", d.config_uri);
   d.live_rate_hz = t.number("live_rate_hz", d.live_rate_hz);
@@ -211,7 +215,7 @@ void read_limits(StrictTable t, Limits& l) {
 }
 
 void read_realtime(StrictTable t, RealtimeConfig& r) {
-  r.sched_fifo_priority = static_cast<int>(t.integer("sched_fifo_priority", r.sched_fifo_priority));
+  r.sched_fifo_priority = t.int32("sched_fifo_priority", r.sched_fifo_priority);
   if (r.sched_fifo_priority < 0 || r.sched_fifo_priority > 99) t.fail("sched_fifo_priority", "must be within 0..99");
   r.mlockall = t.boolean("mlockall", r.mlockall);
   t.finish();

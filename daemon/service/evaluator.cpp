@@ -7,6 +7,7 @@
 #include "drivers/results/result_json.hpp"
 #include "drivers/run_io/file_spill.hpp"
 #include "drivers/results/software_version.hpp"
+#include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/setpoint/program_catalog.hpp"
 #include "drivers/setpoint/program_setpoint.hpp"
@@ -16,6 +17,7 @@
 #include "dsp/stream/analyze_stream.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -90,6 +92,7 @@ void Evaluator::set_fault(const std::string& fault) {
 }
 
 void Evaluator::loop() {
+  for (const auto& dir : links_.unevaluated) evaluate_recorded(dir);
   RecordingJob job;
   while (handoff_.wait_job(job)) {
     evaluate(job);
@@ -100,7 +103,12 @@ void Evaluator::loop() {
 dsp::Run Evaluator::make_run(RecordingJob& job) const {
   dsp::Run run;
   run.meta = meta_;
-  run.meta.id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
+  const std::string id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
+  run.meta.id = id;
+  // The wall clock may step back (NTP, an operator) and a restarted source counts its
+  // samples from 0 again: an id an earlier run has gets a suffix, it never replaces it.
+  std::error_code ec;
+  for (int n = 2; std::filesystem::exists(config_.recording.dir / run.meta.id, ec); ++n) run.meta.id = id + "-" + std::to_string(n);
   run.meta.created = utc_now("%Y-%m-%dT%H:%M:%SZ");
   run.channels.psd_count = static_cast<int>(std::min<std::size_t>(meta_.psd.size(), dsp::kMaxPsd));
   run.frames.swap(job.frames);
@@ -181,7 +189,7 @@ void Evaluator::evaluate(RecordingJob& job) {
   try {
     const std::vector<std::string> setpoint_flags = add_setpoint(run, job.notes);
     // The run first: what was measured is durable before anything can fail.
-    drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false});
+    write_retrying("recording " + run.meta.id, [&] { drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false}); });
     // Streamed: the recording's trace is never held twice, its long evaluations spill to
     // the recording directory's disk (dsp/stream/analyze_stream.hpp).
     dsp::StoredFrames frames(run.frames);
@@ -193,18 +201,22 @@ void Evaluator::evaluate(RecordingJob& job) {
       a.degraded = true;
     }
     for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
+    if (job.notes.source_rate_ratio != 0.0) {
+      char b[240];
+      std::snprintf(b, sizeof b,
+                    "source_rate: the source delivered %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says during the measurement "
+                    "(a DAQ at another rate, a replay faster than real time): its times, speeds and lengths are wrong",
+                    job.notes.source_rate_ratio, run.fs_hz());
+      a.flags.push_back(b), a.degraded = true;
+    }
     for (const auto& f : temperature_flags(run, config_.limits)) a.flags.push_back(f), a.degraded = true;
     dsp::judge(run.meta.program, a);  // the verdict again, with the flags the daemon added
-    drivers::write_result(run, a, dir / "result.json");
-    if (links_.history) links_.history->append(run, a, dir);
-    std::uint64_t number = 0;
-    {
-      // Counted before it is published: an HMI never sees a Result ahead of the count.
-      std::lock_guard lk(mu_);
-      number = ++status_.results;
-      status_.last_result = (dir / "result.json").string();
-    }
-    publish(run, a, dir, number);
+    write_retrying("result of " + run.meta.id, [&] {
+      // The run directory removed meanwhile (an operator, a cleanup): the run again first.
+      if (!std::filesystem::exists(dir / "run.toml")) drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = true});
+      drivers::write_result(run, a, dir / "result.json");
+    });
+    finish_result(run, a, dir);
     log(LogLevel::notice, "measurement %s written (%zu frames)%s", run.meta.id.c_str(), run.frames.size(), a.degraded ? ", result degraded" : "");
   } catch (const std::exception& e) {
     error = e.what();
@@ -212,6 +224,77 @@ void Evaluator::evaluate(RecordingJob& job) {
   }
   if (!error.empty()) set_fault("recording: " + error);
   job.frames.swap(run.frames);
+}
+
+void Evaluator::finish_result(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir) {
+  if (links_.history) links_.history->append(run, a, dir);
+  std::uint64_t number = 0;
+  {
+    // Counted before it is published: an HMI never sees a Result ahead of the count.
+    std::lock_guard lk(mu_);
+    number = ++status_.results;
+    status_.last_result = (dir / "result.json").string();
+  }
+  publish(run, a, dir, number);
+}
+
+// The previous eicald stopped (kill -9, power, the watchdog) after the run was durable and
+// before its result.json: evaluated now as `eical analyze` would, flagged, because what
+// only the stopped DSP thread knew (a measurement cut short, non-finite channels held) is
+// not in the run.
+void Evaluator::evaluate_recorded(const std::filesystem::path& dir) {
+  try {
+    dsp::Run run = drivers::read_run(dir);
+    dsp::StoredFrames frames(run.frames);
+    dsp::Analysis a = dsp::analyze_stream(run, frames, analysis_, {drivers::file_spills(config_.recording.dir)});
+    a.flags.push_back(
+        "evaluated_after_restart: eicald stopped between writing this run and its result; evaluated at the next start, without the flags "
+        "only the stopped service knew (cut short, non-finite channels)");
+    a.degraded = true;
+    for (const auto& f : temperature_flags(run, config_.limits)) a.flags.push_back(f);
+    dsp::judge(run.meta.program, a);
+    write_retrying("result of " + run.meta.id, [&] { drivers::write_result(run, a, dir / "result.json"); });
+    finish_result(run, a, dir);
+    log(LogLevel::notice, "run %s of the previous start evaluated now (it had no result.json)", run.meta.id.c_str());
+  } catch (const std::exception& e) {
+    log(LogLevel::error, "run %s of the previous start: %s", dir.c_str(), e.what());
+    set_fault("recording: " + dir.filename().string() + ": " + e.what());
+  }
+}
+
+bool Evaluator::stopping() const { return handoff_.quitting() || (links_.stop && links_.stop->load()); }
+
+// A disk that is full for a while, a recording directory removed or made unwritable:
+// the measurement waits in memory and the write is tried again every kWriteRetryS (the DSP
+// thread defers the next hand-over meanwhile, counted), so nothing measured is dropped for
+// a fault that an operator clears. Status.fault says what is retried; it is cleared when
+// the write succeeds. The service's stop ends the retries (the DSP thread then waits for
+// the evaluator to hand over what the stop cut short): the last error is reported.
+void Evaluator::write_retrying(const std::string& what, const std::function<void()>& write) {
+  std::string fault;
+  for (;;) {
+    try {
+      write();
+      break;
+    } catch (const std::exception& e) {
+      if (stopping()) throw;
+      const std::string now = "recording: " + what + ": " + e.what() + "; retried every " + std::to_string(static_cast<int>(kWriteRetryS)) +
+                              " s, the measurement is held in memory";
+      if (now != fault) log(LogLevel::error, "%s", now.c_str());  // once per distinct cause, not per retry
+      fault = now;
+      set_fault(fault);
+    }
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(kWriteRetryS);
+    while (std::chrono::steady_clock::now() < until && !stopping()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  if (fault.empty()) return;
+  log(LogLevel::notice, "%s written after the fault cleared", what.c_str());
+  clear_fault(fault);
+}
+
+void Evaluator::clear_fault(const std::string& fault) {
+  std::lock_guard lk(mu_);
+  if (status_.fault == fault) status_.fault.clear();
 }
 
 void Evaluator::publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir, std::uint64_t result_number) {

@@ -9,8 +9,10 @@
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/core/run.hpp"
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <utility>
@@ -33,6 +35,8 @@ struct EvaluatorLinks {
   const drivers::ServoSetPointSource* servo = nullptr;  // the servo stream's clock alignment
   HistoryHook* history = nullptr;                       // [history] enabled
   std::string sensor_calibration = "datasheet";         // provenance in Result
+  const std::atomic<bool>* stop = nullptr;              // the service's stop: ends write retries
+  std::vector<std::filesystem::path> unevaluated;       // runs written before a restart without result.json
 };
 
 // What the evaluations did, for Status (evaluation thread writes, status thread reads).
@@ -53,16 +57,28 @@ class Evaluator {
 
   [[nodiscard]] EvaluationStatus status() const;
   void set_fault(const std::string& fault);
+  // Clears Status.fault when it is still `fault` (a later, other error stays).
+  void clear_fault(const std::string& fault);
+
+  // A failed recording write is tried again this often while the service runs.
+  static constexpr double kWriteRetryS = 1.0;
 
  private:
   void loop();
   void evaluate(RecordingJob& job);
+  // A run of the previous eicald that has no result.json: evaluated now, flagged.
+  void evaluate_recorded(const std::filesystem::path& dir);
+  // result.json written: counted, into the history, published.
+  void finish_result(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir);
   dsp::Run make_run(RecordingJob& job) const;
   // The program M101's P word (or [setpoint.program] default_program) names.
   std::optional<std::pair<int, dsp::Program>> named_program(const RecordingNotes& notes, std::vector<std::string>& flags) const;
   // Fills cmd_*, [program] and [setpoint]; returns flags for the result (empty: nothing doubtful).
   std::vector<std::string> add_setpoint(dsp::Run& run, const RecordingNotes& notes) const;
   void publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir, std::uint64_t result_number);
+  // Runs `write` until it succeeds; throws its last error when the service stops first.
+  void write_retrying(const std::string& what, const std::function<void()>& write);
+  [[nodiscard]] bool stopping() const;
 
   const DaemonConfig& config_;
   dsp::RunMeta meta_;

@@ -58,6 +58,8 @@ std::int64_t FrameLoop::observe_acquisition(const dsp::Frame& in) noexcept {
   if (acquired_ns != 0 && stamp.last_index != stamp_seen_) {
     stamp_seen_ = stamp.last_index;
     daq_clock_.observe(stamp.last_index + index_offset_, stamp.t_ns);
+    counters_.stamp_index.store(stamp.last_index + index_offset_, std::memory_order_relaxed);
+    counters_.stamp_ns.store(stamp.t_ns, std::memory_order_relaxed);
   }
   return acquired_ns;
 }
@@ -68,6 +70,12 @@ void FrameLoop::take_external_triggers(const dsp::Frame& f) noexcept {
     while (channels_[c]->take_request(r)) {
       // Its CLOCK_MONOTONIC time onto the DAQ clock; never before this frame.
       const double at = r.time_ns > 0 ? daq_clock_.number_at(r.time_ns) : std::nan("");
+      if (std::isfinite(at) && at - static_cast<double>(f.sample_index) > kMaxTriggerAheadS * options_.fs_hz) {
+        TriggerVerdict v;
+        v.id = r.id, v.refusal = Refusal::time_ahead, v.sample_index = f.sample_index, v.state = session_.state().state();
+        channels_[c]->answer(v);
+        continue;
+      }
       const std::int64_t idx = std::isfinite(at) ? std::max(static_cast<std::int64_t>(std::llround(at)), f.sample_index) : f.sample_index;
       TriggerVerdict v = gate_.decide(r, idx, session_.state().state());
       if (v.accepted && !session_.queue_trigger(idx, r.code)) v.accepted = false, v.refusal = Refusal::queue_full;
@@ -87,7 +95,11 @@ void FrameLoop::track_measurement(bool nonfinite) noexcept {
     notes_.index_offset = index_offset_;
     requested_p_ = std::nan("");
   }
-  if (nonfinite && session_.state().state() == dsp::State::measuring) ++notes_.nonfinite_frames;
+  if (session_.state().state() != dsp::State::measuring) return;
+  if (nonfinite) ++notes_.nonfinite_frames;
+  // The farthest the source's rate was off during the measurement.
+  const double r = counters_.source_rate_ratio.load(std::memory_order_relaxed);
+  if (r != 0.0 && std::abs(r - 1.0) > std::abs(notes_.source_rate_ratio - 1.0)) notes_.source_rate_ratio = r;
 }
 
 void FrameLoop::step_live(const dsp::Frame& f) noexcept {
@@ -143,6 +155,10 @@ void FrameLoop::close_measurement(const std::string& cause) {
   if (session_.close_now() || session_.measurement_ready()) {
     if (handoff_.offer_waiting(session_, notes_, cause)) session_.evaluation_done(), live_.reset();
   }
+  // No frame follows to publish them: the last Status counts the measurement cut short.
+  counters_.measurements_started.store(session_.counters().measurements_started, std::memory_order_relaxed);
+  counters_.measurements.store(session_.counters().measurements_completed, std::memory_order_relaxed);
+  counters_.state.store(static_cast<int>(session_.state().state()), std::memory_order_relaxed);
 }
 
 }  // namespace eical::daemon

@@ -144,31 +144,63 @@ drivers::dds::ReplyMsg HmiLink::answer_trigger(const drivers::dds::CommandMsg& c
   return reply;
 }
 
+drivers::dds::ReplyMsg HmiLink::answer(const drivers::dds::CommandMsg& cmd) {
+  drivers::dds::ReplyMsg reply;
+  const auto state_now = [&] { return std::string(dsp::to_string(static_cast<dsp::State>(state_.load()))); };
+  if (cmd.sender.size() > kMaxSenderBytes || cmd.action.size() > kMaxActionBytes) {
+    reply.ok = false;
+    reply.message = "command refused: sender (" + std::to_string(cmd.sender.size()) + " bytes) or action (" + std::to_string(cmd.action.size()) +
+                    " bytes) longer than " + std::to_string(kMaxSenderBytes) + " / " + std::to_string(kMaxActionBytes);
+    reply.state = state_now();
+    return reply;
+  }
+  const auto seen = std::find_if(answered_.begin(), answered_.end(),
+                                 [&](const Answered& a) { return a.sender == cmd.sender && a.request_id == cmd.request_id; });
+  if (cmd.action == "trigger" && seen != answered_.end()) return seen->reply;  // `eical trigger` resends until it sees a Reply
+  if (cmd.action == "trigger" && is_nc_trigger(cmd.code)) {
+    reply = answer_trigger(cmd);
+    if (reply.state.empty()) reply.state = state_now();
+    answered_.push_back({cmd.sender, cmd.request_id, reply});
+    if (answered_.size() > 64) answered_.pop_front();
+    return reply;
+  }
+  reply.ok = false;
+  reply.message = "unknown command '" + cmd.action + "' (code " + std::to_string(cmd.code) + "); use trigger 101|102|103";
+  reply.state = state_now();
+  return reply;
+}
+
+void HmiLink::log_answer(const drivers::dds::CommandMsg& cmd, const drivers::dds::ReplyMsg& reply) {
+  const std::string sender = cmd.sender.substr(0, kMaxSenderBytes), action = cmd.action.substr(0, kMaxActionBytes);
+  if (reply.ok) {
+    log(LogLevel::info, "command from %s: %s %d -> %s", sender.c_str(), action.c_str(), cmd.code, reply.message.c_str());
+    return;
+  }
+  const auto now = std::chrono::steady_clock::now();
+  if (now - log_window_start_ > std::chrono::duration<double>(kLogWindowS)) {
+    if (refusals_unlogged_ > 0)
+      log(LogLevel::warning, "%llu more commands refused in %.0f s (not logged one by one)", static_cast<unsigned long long>(refusals_unlogged_),
+          kLogWindowS);
+    log_window_start_ = now, refusals_logged_ = 0, refusals_unlogged_ = 0;
+  }
+  if (refusals_logged_ < kRefusalsLogged) {
+    ++refusals_logged_;
+    log(LogLevel::warning, "command from %s: %s %d -> %s", sender.c_str(), action.c_str(), cmd.code, reply.message.c_str());
+  } else {
+    ++refusals_unlogged_;
+  }
+}
+
 void HmiLink::commander() {
   while (!stop_.load()) {
     const auto cmd = bus_->take_command(std::chrono::milliseconds(500));
     if (!cmd) continue;
     ++commands_;
-    drivers::dds::ReplyMsg reply;
-    const auto seen = std::find_if(answered_.begin(), answered_.end(),
-                                   [&](const Answered& a) { return a.sender == cmd->sender && a.request_id == cmd->request_id; });
-    if (cmd->action == "trigger" && seen != answered_.end()) {
-      reply = seen->reply;  // `eical trigger` resends until it sees a Reply
-    } else if (cmd->action == "trigger" && is_nc_trigger(cmd->code)) {
-      reply = answer_trigger(*cmd);
-      if (reply.state.empty()) reply.state = std::string(dsp::to_string(static_cast<dsp::State>(state_.load())));
-      answered_.push_back({cmd->sender, cmd->request_id, reply});
-      if (answered_.size() > 64) answered_.pop_front();
-    } else {
-      reply.ok = false;
-      reply.message = "unknown command '" + cmd->action + "' (code " + std::to_string(cmd->code) + "); use trigger 101|102|103";
-      reply.state = std::string(dsp::to_string(static_cast<dsp::State>(state_.load())));
-    }
-    reply.sender = cmd->sender;
+    drivers::dds::ReplyMsg reply = answer(*cmd);
+    reply.sender = cmd->sender.substr(0, kMaxSenderBytes);
     reply.request_id = cmd->request_id;
     (void)bus_->publish(reply);
-    log(reply.ok ? LogLevel::info : LogLevel::warning, "command from %s: %s %d -> %s", cmd->sender.c_str(), cmd->action.c_str(), cmd->code,
-        reply.message.c_str());
+    log_answer(*cmd, reply);
   }
 }
 

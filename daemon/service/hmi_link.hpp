@@ -14,6 +14,7 @@
 #include "dsp/session/measurement_state.hpp"
 
 #include <atomic>
+#include <chrono>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -51,6 +52,14 @@ class HmiLink {
   void publish_trace(const drivers::dds::TraceMsg& t);
 
   [[nodiscard]] std::uint64_t commands_received() const { return commands_.load(); }
+
+  // A Command's sender and action are short names; longer ones are refused before they are
+  // logged, remembered or echoed (a 1 MB sender would otherwise be kept for every answer).
+  static constexpr std::size_t kMaxSenderBytes = 64, kMaxActionBytes = 32;
+  // Refused commands are logged up to this many per kLogWindowS, then counted in one line
+  // (an HMI flooding at 1 kHz would otherwise write 1000 journal lines a second).
+  static constexpr int kRefusalsLogged = 5;
+  static constexpr double kLogWindowS = 10.0;
   [[nodiscard]] std::uint64_t live_overruns() const { return live_.overruns(); }
   [[nodiscard]] std::uint64_t write_errors() const { return bus_->write_errors(); }
 
@@ -58,6 +67,8 @@ class HmiLink {
   void publisher();
   void commander();
   drivers::dds::ReplyMsg answer_trigger(const drivers::dds::CommandMsg& cmd);
+  drivers::dds::ReplyMsg answer(const drivers::dds::CommandMsg& cmd);
+  void log_answer(const drivers::dds::CommandMsg& cmd, const drivers::dds::ReplyMsg& reply);
 
   DdsConfig config_;
   std::string name_;
@@ -80,6 +91,10 @@ class HmiLink {
     drivers::dds::ReplyMsg reply;
   };
   std::deque<Answered> answered_;
+  // Command thread: refusals logged in the current window, and those only counted.
+  std::chrono::steady_clock::time_point log_window_start_{};
+  int refusals_logged_ = 0;
+  std::uint64_t refusals_unlogged_ = 0;
 };
 
 }  // namespace eical::daemon

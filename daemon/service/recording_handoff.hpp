@@ -23,6 +23,7 @@ struct RecordingNotes {
   std::uint64_t nonfinite_frames = 0;  // frames whose NaN/Inf channels the guard replaced
   double program_p = std::nan("");     // M101's P word (program number); NaN = none given
   std::int64_t index_offset = 0;       // added to the source's sample indices (after reopens)
+  double source_rate_ratio = 0.0;      // the source's delivered rate / fs_hz while off (0: never off)
 };
 
 struct RecordingJob {
@@ -46,6 +47,8 @@ class RecordingHandoff {
   // Evaluation thread: the storage of the job it finished (its capacity is kept).
   void give_back(std::vector<dsp::Frame>&& storage);
   void quit();
+  // Any thread: quit() was called (the evaluator stops retrying a failed write).
+  [[nodiscard]] bool quitting() const noexcept { return quit_.load(); }
 
  private:
   bool hand(dsp::MeasurementSession& session, const RecordingNotes& notes, const std::string* cause) noexcept;

@@ -7,9 +7,11 @@
 #include "daemon/service/history_hook.hpp"
 #include "daemon/service/hmi_link.hpp"
 #include "daemon/service/preflight.hpp"
+#include "daemon/service/recording_cleanup.hpp"
 #include "daemon/service/recording_handoff.hpp"
 #include "daemon/service/service_counters.hpp"
 #include "daemon/service/status_reporter.hpp"
+#include "daemon/service/stop_record.hpp"
 #include "daemon/system/log.hpp"
 #include "daemon/system/realtime.hpp"
 #include "daemon/triggers/trigger_listener.hpp"
@@ -131,6 +133,9 @@ struct Parts {
   std::unique_ptr<Evaluator> evaluator;
   std::unique_ptr<FrameLoop> loop;
   std::unique_ptr<StatusReporter> reporter;
+  std::vector<std::filesystem::path> unevaluated;  // runs of an earlier start without result.json
+  std::unique_ptr<StopRecord> stop_record;         // how the previous eicald ended; how this one stalls
+  std::string stall;                               // what is stalled now (status thread)
 };
 
 void open_source(Parts& p) {
@@ -160,6 +165,28 @@ void check_machine(Parts& p) {
   if (auto problem = setpoint_problem(p.config.setpoint)) throw std::runtime_error(*problem);
   // Reported (Status.fault, journal), not refused: measuring goes on, every write retries.
   if (auto problem = recording_dir_problem(p.config.recording.dir)) log(LogLevel::error, "%s", problem->c_str());
+}
+
+// What an interrupted start left in the recording directory: temporaries removed, runs
+// moved aside restored, runs without result.json handed to the evaluator.
+void clean_recording(Parts& p) {
+  RecordingCleanup c = clean_recording_dir(p.config.recording.dir);
+  if (c.removed + c.restored > 0)
+    log(LogLevel::notice, "recording: %zu temporaries of an interrupted write removed, %zu runs restored, in %s", c.removed, c.restored,
+        p.config.recording.dir.c_str());
+  if (!c.unevaluated.empty()) log(LogLevel::notice, "recording: %zu runs without result.json are evaluated now", c.unevaluated.size());
+  p.unevaluated = std::move(c.unevaluated);
+}
+
+// The previous eicald did not stop cleanly (the watchdog, a crash, kill -9): said at once,
+// and in Status.fault until another error replaces it (report_previous_stop).
+void read_stop_record(Parts& p) {
+  p.stop_record = std::make_unique<StopRecord>(p.config.recording.dir);
+  if (const auto& previous = p.stop_record->previous()) log(LogLevel::error, "%s", previous->c_str());
+}
+
+void report_previous_stop(Parts& p) {
+  if (const auto& previous = p.stop_record->previous()) p.evaluator->set_fault("restarted: " + *previous);
 }
 
 // The HMI bus; without it the service still measures and records (and says so).
@@ -205,9 +232,10 @@ void start_history(Parts& p) {
   if (p.config.history.enabled) p.history = std::make_unique<HistoryHook>(p.config.history, p.sensor_calibration);
 }
 
-void start_evaluator(Parts& p) {
+void start_evaluator(Parts& p, const std::atomic<bool>& stop) {
   EvaluatorLinks links;
-  links.hmi = p.hmi.get(), links.servo = p.servo, links.history = p.history.get();
+  links.hmi = p.hmi.get(), links.servo = p.servo, links.history = p.history.get(), links.stop = &stop;
+  links.unevaluated = std::move(p.unevaluated);
   links.sensor_calibration = p.sensor_calibration;
   p.evaluator = std::make_unique<Evaluator>(p.config, p.meta, p.analysis, *p.handoff, std::move(links));
   if (auto problem = recording_dir_problem(p.config.recording.dir)) p.evaluator->set_fault(*problem);
@@ -235,6 +263,16 @@ void start_status(Parts& p, const std::function<void(const ServiceStatus&)>& on_
   if (p.hmi) s.channels.push_back(&p.hmi->triggers());
   for (const auto& ch : p.channels) s.channels.push_back(ch.get());
   for (const auto& l : p.listeners) s.listeners.push_back(l.get());
+  s.watch_rate = p.source->backpressure() == drivers::Backpressure::drop_newest;  // a live source
+  s.rate_too_slow_matters = p.config.source.is_daq();
+  s.fs_hz = p.meta.acquisition.fs_hz;
+  // A stall is written down before systemd's watchdog ends this eicald: the next one says why.
+  s.on_stall = [&p](const std::string& why) {
+    p.stop_record->running(why);
+    if (!why.empty()) p.evaluator->set_fault("stalled: " + why);
+    else p.evaluator->clear_fault("stalled: " + p.stall);
+    p.stall = why;
+  };
   p.reporter = std::make_unique<StatusReporter>(std::move(s), p.config.dds.status_rate_hz, on_status);
 }
 
@@ -283,11 +321,27 @@ bool reopen_source(Parts& p, const std::string& error, const std::atomic<bool>& 
   return true;
 }
 
+// [source.fault] hang_dsp_at_s: the DSP thread stops handling frames, as a hung
+// computation would, until the service is stopped (a test of the watchdog path).
+void hang_if_injected(const Parts& p, const dsp::Frame& f, const std::atomic<bool>& stop) {
+  const double at_s = p.config.source.fault.hang_dsp_at_s;
+  if (at_s < 0.0 || static_cast<double>(f.sample_index) < at_s * p.meta.acquisition.fs_hz || stop.load()) return;
+  log(LogLevel::warning, "injected fault: the DSP thread hangs at sample %lld ([source.fault] hang_dsp_at_s)", static_cast<long long>(f.sample_index));
+  while (!stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+}
+
 // The acquisition thread fills the ring, this (the DSP) thread runs the frame loop, until
 // the stop or the end of the data; a failed source is reopened.
 void acquire(Parts& p, const std::atomic<bool>& stop) {
+  p.stop_record->running();
   for (;;) {
-    const drivers::PumpStats stats = drivers::pump(*p.source, *p.ring, [&](const dsp::Frame& f) { p.loop->on_frame(f); }, stop);
+    const drivers::PumpStats stats = drivers::pump(
+        *p.source, *p.ring,
+        [&](const dsp::Frame& f) {
+          hang_if_injected(p, f, stop);
+          p.loop->on_frame(f);
+        },
+        stop);
     p.loop->close_measurement(end_cause(stats));
     if (stats.stopped || stats.source_error.empty()) return;
     if (!reopen_source(p, stats.source_error, stop)) return;
@@ -298,6 +352,7 @@ void finish(Parts& p) {
   p.reporter->stop();
   p.evaluator->finish();
   p.reporter->report();  // the last word: results and errors included
+  p.stop_record->stopped_cleanly();
   log(LogLevel::info, "stopped: %llu frames, %llu overruns", static_cast<unsigned long long>(p.counters.frames.load()),
       static_cast<unsigned long long>(p.ring->overruns()));
 }
@@ -314,11 +369,14 @@ void Service::run(const std::atomic<bool>& stop, const std::function<void(const 
   open_source(p);
   apply_calibration(p);
   check_machine(p);
+  clean_recording(p);
+  read_stop_record(p);
   start_hmi(p);
   open_trigger_inputs(p, trigger_inputs_);
   make_measurement(p);
   start_history(p);
-  start_evaluator(p);
+  start_evaluator(p, stop);
+  report_previous_stop(p);
   make_frame_loop(p);
   start_status(p, on_status);
   enter_realtime(p);

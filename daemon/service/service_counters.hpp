@@ -24,6 +24,11 @@ struct ServiceCounters {
   std::atomic<std::int64_t> sample_index{0};          // the last frame handled
   std::atomic<float> temp_c[2] = {0.0f, 0.0f};        // its case temperatures, table and head
   std::atomic<bool> faulted{false};                   // the run loop is reopening a failed source
+  // The last acquisition stamp the DSP thread saw (sample index on the DAQ clock,
+  // CLOCK_MONOTONIC), and what the status thread makes of the rate (SourceRateWatch):
+  // delivered / fs_hz when off, 0 when fine.
+  std::atomic<std::int64_t> stamp_index{-1}, stamp_ns{0};
+  std::atomic<double> source_rate_ratio{0.0};
 
   [[nodiscard]] dsp::State measurement_state() const noexcept { return static_cast<dsp::State>(state.load(std::memory_order_relaxed)); }
 };

@@ -5,11 +5,16 @@
 #include "daemon/system/log.hpp"
 
 #include <chrono>
+#include <cstdio>
 
 namespace eical::daemon {
 
 StatusReporter::StatusReporter(StatusSources sources, double rate_hz, std::function<void(const ServiceStatus&)> on_status)
-    : s_(std::move(sources)), rate_hz_(rate_hz), on_status_(std::move(on_status)), thread_([this] { loop(); }) {}
+    : s_(std::move(sources)),
+      rate_hz_(rate_hz),
+      on_status_(std::move(on_status)),
+      rate_(s_.fs_hz, s_.rate_too_slow_matters),
+      thread_([this] { loop(); }) {}
 
 StatusReporter::~StatusReporter() { stop(); }
 
@@ -31,11 +36,54 @@ void StatusReporter::loop() {
     const std::uint64_t frames = s_.counters->frames.load(std::memory_order_relaxed);
     // Progress of the DSP loop (or the run loop reopening a failed source) is what the
     // watchdog is fed on: a stalled DSP thread gets no status, and systemd restarts eicald.
-    if (frames != last_frames_ || s_.counters->faulted.load()) report();
+    const bool progress = frames != last_frames_ || s_.counters->faulted.load();
+    if (progress) report();
     last_frames_ = frames;
+    watch_stall(progress);
+    watch_rate();
     s_.source->drain_diagnostics([](const std::string& line) { log(LogLevel::info, "%s", line.c_str()); });
     lk.lock();
   }
+}
+
+void StatusReporter::watch_stall(bool progress) {
+  ticks_without_progress_ = progress ? 0 : ticks_without_progress_ + 1;
+  const double stalled_s = ticks_without_progress_ / rate_hz_;
+  if (progress && stall_said_) {
+    stall_said_ = false;
+    log(LogLevel::notice, "frames are handled again");
+    if (s_.on_stall) s_.on_stall("");
+  }
+  if (progress || stall_said_ || stalled_s < kStallS) return;
+  stall_said_ = true;
+  const std::size_t waiting = s_.ring->size_approx();
+  const ServiceStatus st = collect();
+  char why[256];
+  if (waiting > 0)
+    std::snprintf(why, sizeof why, "the DSP thread has handled no frame for %.1f s while %zu wait in the ring (state %s, sample %lld)", stalled_s,
+                  waiting, st.state.c_str(), static_cast<long long>(st.sample_index));
+  else
+    std::snprintf(why, sizeof why, "no frame from the source %.*s for %.1f s (state %s, sample %lld)", static_cast<int>(s_.source->name().size()),
+                  s_.source->name().data(), stalled_s, st.state.c_str(), static_cast<long long>(st.sample_index));
+  log(LogLevel::error, "%s; the watchdog is not fed, systemd restarts eicald", why);
+  if (s_.on_stall) s_.on_stall(why);
+  std::lock_guard lk(report_mu_);
+  publish_to_hmi(collect());  // the HMI sees why; systemd does not hear of it (no progress)
+}
+
+void StatusReporter::watch_rate() {
+  if (!s_.watch_rate) return;
+  ServiceCounters& k = *s_.counters;
+  double ratio = 0.0;
+  if (k.faulted.load()) rate_.reset();  // reopening: the stamps start again
+  else ratio = rate_.observe(k.stamp_index.load(std::memory_order_relaxed), k.stamp_ns.load(std::memory_order_relaxed));
+  const double was = k.source_rate_ratio.exchange(ratio, std::memory_order_relaxed);
+  if ((was == 0.0) == (ratio == 0.0)) return;
+  if (ratio != 0.0)
+    log(LogLevel::error, "source: delivers %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says; measurements meanwhile are flagged source_rate",
+        ratio, s_.fs_hz);
+  else
+    log(LogLevel::notice, "source: its rate is within %.0f %% of fs_hz again", SourceRateWatch::kTolerance * 100.0);
 }
 
 ServiceStatus StatusReporter::collect() const {
@@ -46,6 +94,11 @@ ServiceStatus StatusReporter::collect() const {
   st.state = k.faulted.load() ? "FAULT" : std::string(dsp::to_string(k.measurement_state()));
   st.fault = ev.fault;
   if (s_.history && st.fault.empty()) st.fault = s_.history->problem();
+  if (const double r = k.source_rate_ratio.load(std::memory_order_relaxed); r != 0.0 && st.fault.empty()) {
+    char b[160];
+    std::snprintf(b, sizeof b, "source_rate: %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says", r, s_.fs_hz);
+    st.fault = b;
+  }
   st.frames = k.frames.load(relaxed);
   st.overruns = s_.ring->overruns();
   st.frames_lost = k.frames_lost.load(relaxed);
@@ -79,6 +132,10 @@ void StatusReporter::report() {
   std::lock_guard lk(report_mu_);
   const ServiceStatus st = collect();
   on_status_(st);
+  publish_to_hmi(st);
+}
+
+void StatusReporter::publish_to_hmi(const ServiceStatus& st) {
   if (!s_.hmi) return;
   drivers::dds::StatusMsg m;
   m.state = st.state, m.fault = st.fault, m.frames = st.frames, m.overruns = st.overruns, m.frames_lost = st.frames_lost;

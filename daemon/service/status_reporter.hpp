@@ -7,6 +7,7 @@
 #include "daemon/service/evaluator.hpp"
 #include "daemon/service/service.hpp"
 #include "daemon/service/service_counters.hpp"
+#include "daemon/service/source_rate_watch.hpp"
 #include "daemon/triggers/trigger_listener.hpp"
 #include "drivers/acquisition/pump.hpp"
 #include "drivers/source/sample_clock.hpp"
@@ -26,7 +27,7 @@ class HmiLink;
 class HistoryHook;
 
 struct StatusSources {
-  const ServiceCounters* counters = nullptr;
+  ServiceCounters* counters = nullptr;  // the status thread writes source_rate_ratio only
   const drivers::FrameRing* ring = nullptr;
   drivers::StampedSource* source = nullptr;
   const drivers::SampleClock* daq_clock = nullptr;
@@ -35,6 +36,13 @@ struct StatusSources {
   const HistoryHook* history = nullptr;  // [history] enabled: its problem is the fault when none other is
   std::vector<const TriggerChannel*> channels;
   std::vector<const TriggerListener*> listeners;
+  // No frame handled for kStallS while the source is not being reopened: called once with
+  // what is stalled (the DSP thread, frames waiting in the ring; or the source, none
+  // arriving), and with "" when frames flow again.
+  std::function<void(const std::string&)> on_stall;
+  // The source's rate against fs_hz (live sources only; DAQs also when too slow).
+  bool watch_rate = false, rate_too_slow_matters = false;
+  double fs_hz = 0.0;
 };
 
 class StatusReporter {
@@ -51,13 +59,24 @@ class StatusReporter {
   [[nodiscard]] ServiceStatus collect() const;
   void report();
 
+  static constexpr double kStallS = 1.0;  // well inside systemd's WatchdogSec (5 s)
+
  private:
   void loop();
+  // A tick without progress: how long it lasts, said once; progress again: said once.
+  void watch_stall(bool progress);
+  // The delivered rate from the acquisition stamps; said when it goes off and comes back.
+  void watch_rate();
+  // Status to the HMI only: systemd's watchdog is fed on progress (on_status), not on this.
+  void publish_to_hmi(const ServiceStatus& st);
 
   StatusSources s_;
   double rate_hz_;
   std::function<void(const ServiceStatus&)> on_status_;
   std::uint64_t last_frames_ = 0;
+  int ticks_without_progress_ = 0;
+  bool stall_said_ = false;
+  SourceRateWatch rate_;
   std::mutex report_mu_;
   std::mutex mu_;
   std::condition_variable cv_;

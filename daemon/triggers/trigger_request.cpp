@@ -13,6 +13,9 @@ std::string describe(const TriggerVerdict& v, int code) {
     case Refusal::busy: return m + " refused: the previous measurement is still being evaluated (state " + state + ")";
     case Refusal::fault: return m + " refused: the service is in FAULT (see Status.fault)";
     case Refusal::queue_full: return m + " refused: too many triggers pending";
+    case Refusal::time_ahead:
+      return m + " refused: its time lies more than " + std::to_string(static_cast<int>(kMaxTriggerAheadS)) +
+             " s beyond the newest frame (time_ns must be CLOCK_MONOTONIC of eicald's host, or 0 for now)";
   }
   return m + " refused";
 }

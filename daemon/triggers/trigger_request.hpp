@@ -29,7 +29,13 @@ enum class Refusal : std::uint8_t {
   busy,                 // M101 while the previous measurement still waits for its evaluation
   fault,                // the service is in FAULT
   queue_full,           // more triggers pending than the session holds
+  time_ahead,           // its time lies far beyond the newest frame (not CLOCK_MONOTONIC?)
 };
+
+// An external trigger's time may lie this far beyond the newest frame (frames held back for
+// the servo stream arrive up to [setpoint.servo_stream] hold_ms after their trigger); one
+// further ahead would wait in the queue for hours, blocking every later M101 meanwhile.
+inline constexpr double kMaxTriggerAheadS = 10.0;
 
 struct TriggerVerdict {
   std::uint32_t id = 0;

@@ -22,7 +22,7 @@ dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& default
   dsp::Acquisition a = defaults;
   a.fs_hz = t.number("fs_hz", a.fs_hz);
   if (a.fs_hz <= 0.0) t.fail("fs_hz", "must be positive");
-  a.adc_bits = static_cast<int>(t.integer("adc_bits", a.adc_bits));
+  a.adc_bits = t.int32("adc_bits", a.adc_bits);
   if (a.adc_bits < 8 || a.adc_bits > 32) t.fail("adc_bits", "must be between 8 and 32");
   a.adc_lsb_volt = t.number("adc_lsb_volt", a.adc_lsb_volt);
   if (a.adc_lsb_volt <= 0.0) t.fail("adc_lsb_volt", "must be positive");
@@ -123,11 +123,11 @@ dsp::Program read_program(StrictTable t, Unknown u) {
   p.arc_deg = t.number("arc_deg", p.arc_deg);
   if (!(p.arc_deg > 0.0 && p.arc_deg <= 360.0)) t.fail("arc_deg", "must be in (0, 360]");
   if (t.has("arc_start_deg")) p.arc_start_deg = t.number("arc_start_deg");
-  p.repeats = static_cast<int>(t.integer("repeats", p.repeats));
+  p.repeats = t.int32("repeats", p.repeats);
   if (p.repeats < 1) t.fail("repeats", "must be at least 1");
   p.axis = t.choice("axis", {"x", "y", "z"}, p.axis);
   if (t.has("targets_mm")) p.targets_mm = t.numbers("targets_mm");
-  p.runs = static_cast<int>(t.integer("runs", p.runs));
+  p.runs = t.int32("runs", p.runs);
   if (p.runs < 1) t.fail("runs", "must be at least 1");
   p.dwell_s = t.number("dwell_s", p.dwell_s);
   if (p.dwell_s < 0.0) t.fail("dwell_s", "must not be negative");

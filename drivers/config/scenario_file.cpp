@@ -235,7 +235,7 @@ void read_mems(StrictTable t, sim::Scenario& sc) {
     return names;
   }(), "adxl345"));
   chip.fs_hz = positive(t, "fs_hz", chip.fs_hz);
-  chip.bits = static_cast<int>(t.integer("bits", chip.bits));
+  chip.bits = t.int32("bits", chip.bits);
   if (chip.bits < 8 || chip.bits > 24) t.fail("bits", "must be 8..24");
   chip.range_g = positive(t, "range_g", chip.range_g);
   chip.noise_ug_per_rthz = t.number("noise_ug_per_rthz", chip.noise_ug_per_rthz);
@@ -302,7 +302,7 @@ sim::Scenario read_scenario_file(const std::string& path) {
   sc.name = root.string("name", "scenario");
   sc.description = root.string("description", "");
   sc.seed = static_cast<std::uint64_t>(root.integer("seed", 1));
-  sc.oversample = static_cast<int>(root.integer("oversample", 10));
+  sc.oversample = root.int32("oversample", 10);
   if (sc.oversample < 1 || sc.oversample > 100) root.fail("oversample", "must be 1..100");
   sc.noise = root.boolean("noise", true);
   sc.meta.id = root.string("id", "sim-" + sc.name + "-s" + std::to_string(sc.seed));

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 namespace eical::drivers {
@@ -89,6 +90,12 @@ std::int64_t StrictTable::integer(std::string_view key) {
 
 std::int64_t StrictTable::integer(std::string_view key, std::int64_t fallback) {
   return has(key) ? integer(key) : (used_.emplace(key), fallback);
+}
+
+int StrictTable::int32(std::string_view key, int fallback) {
+  const std::int64_t v = integer(key, fallback);
+  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) fail(key, "integer " + std::to_string(v) + " is out of range");
+  return static_cast<int>(v);
 }
 
 std::string StrictTable::string(std::string_view key) {

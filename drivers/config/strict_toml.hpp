@@ -31,6 +31,9 @@ class StrictTable {
   double number(std::string_view key, double fallback);
   std::int64_t integer(std::string_view key);
   std::int64_t integer(std::string_view key, std::int64_t fallback);
+  // An integer that fits an int (counts, bits, priorities): anything beyond is refused
+  // rather than narrowed (4294967312 would become 16); ranges are checked by the caller.
+  int int32(std::string_view key, int fallback);
   std::string string(std::string_view key);
   std::string string(std::string_view key, std::string fallback);
   // A string that must be one of `allowed`.

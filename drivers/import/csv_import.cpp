@@ -15,9 +15,8 @@ ImportResult import_csv(const std::filesystem::path& accel_file, const std::file
   UniformSeries accel = resample(capture.t_s, capture.accel_mps2, clock);
   for (auto& v : accel.values) v /= o.setup.site.g_mps2;  // in g of the site, as run.toml's [site] says
   const UniformClock nc_clock = fit_uniform_clock(nc.t_s, nc.source);
-  const auto n_nc = static_cast<std::size_t>(nc_clock.index.back()) + 1;
-  std::vector<Eigen::Vector3d> nc_uniform(n_nc);
-  for (std::size_t i = 0; i < n_nc; ++i) nc_uniform[i] = interpolate_at(nc.t_s, nc.pos_mm, nc_clock.time_at(static_cast<std::int64_t>(i)));
+  const std::vector<Eigen::Vector3d> nc_uniform = bridge_gaps(nc.t_s, nc.pos_mm, nc_clock);
+  const std::size_t n_nc = nc_uniform.size();
   const sim::nc::SampledSetPoint sp(nc_uniform, nc_clock.fs_hz, {}, nc_clock.t0_s);
 
   MeasuredSeries measured{clock.fs_hz, clock.t0_s, accel.grid_index, accel.values};

@@ -24,14 +24,33 @@ void fit_line(const std::vector<double>& t, UniformClock& c) {
   c.t0_s = t.front() + mt - dt * mi;
 }
 
-void assign_indices(const std::vector<double>& t, double dt, double gap_threshold_s, UniformClock& c) {
+// A difference of more than 1.5·dt (the rounding boundary between one step and two) is a
+// gap: one lost sample leaves 2·dt, which a threshold at 2·dt would miss half the time
+// (jitter, or exact stamps a rounding error apart). Unless the sample was only late: then
+// the difference after it is short by as much, and the two together span two steps.
+bool is_gap(const std::vector<double>& t, std::size_t k, double dt) {
+  const double d = t[k] - t[k - 1];
+  if (!(d > 1.5 * dt)) return false;
+  if (d > 2.5 * dt || k + 1 == t.size()) return true;
+  return t[k + 1] - t[k - 1] > 2.5 * dt;
+}
+
+// Gaps may lose at most as many samples as the recording holds: a recording that is more
+// gap than samples has stamps in another unit or is not one recording, and the importer
+// would hold its whole grid in memory (a gap of 1e9 s at 1 kHz: 1e12 set-points).
+void assign_indices(const std::vector<double>& t, double dt, UniformClock& c, const std::string& source) {
   c.index.assign(t.size(), 0);
   c.gaps = c.lost_frames = 0;
+  const auto max_lost = static_cast<double>(t.size());
   for (std::size_t k = 1; k < t.size(); ++k) {
     const double d = t[k] - t[k - 1];
     std::int64_t step = 1;
-    if (d > gap_threshold_s) {
-      step = std::max<std::int64_t>(2, std::llround(d / dt));
+    if (is_gap(t, k, dt)) {
+      const double steps = d / dt;  // checked before it becomes an integer (and the indices add up)
+      if (!(static_cast<double>(c.lost_frames) + steps - 1.0 <= max_lost))
+        throw dsp::InputError(source + ": a gap of " + std::to_string(d) + " s after sample " + std::to_string(k) + " loses more samples than the " +
+                              std::to_string(t.size()) + " recorded (time stamps in another unit?)");
+      step = std::max<std::int64_t>(2, std::llround(steps));
       ++c.gaps;
       c.lost_frames += static_cast<std::size_t>(step - 1);
     }
@@ -75,10 +94,9 @@ UniformClock fit_uniform_clock(const std::vector<double>& t, const std::string& 
   std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
   UniformClock c;
   c.median_dt_s = d[d.size() / 2];
-  const double gap = 2.0 * c.median_dt_s;
-  assign_indices(t, c.median_dt_s, gap, c);
+  assign_indices(t, c.median_dt_s, c, source);
   fit_line(t, c);
-  assign_indices(t, 1.0 / c.fs_hz, gap, c);  // gaps measured with the fitted rate
+  assign_indices(t, 1.0 / c.fs_hz, c, source);  // gaps measured with the fitted rate
   fit_line(t, c);
   double s2 = 0.0;
   for (std::size_t k = 0; k < t.size(); ++k) {
@@ -109,6 +127,13 @@ UniformSeries resample(const std::vector<double>& t, const std::vector<Eigen::Ve
     }
     lo = hi + 1;
   }
+  return out;
+}
+
+std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, const UniformClock& c) {
+  const auto n = static_cast<std::size_t>(c.index.back()) + 1;
+  std::vector<Eigen::Vector3d> out(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = interpolate_at(t, v, c.time_at(static_cast<std::int64_t>(i)));
   return out;
 }
 

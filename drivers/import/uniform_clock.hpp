@@ -1,7 +1,8 @@
 #pragma once
 // A recording with jittered time stamps onto a uniform clock (what eical-run/1 needs):
-//  1. dt = median of the stamp differences; a difference above 2·dt is a gap, whose
-//     missing samples are lost frames (round(gap/dt) − 1 of them);
+//  1. dt = median of the stamp differences; a difference above 1.5·dt is a gap (unless
+//     the sample was only late: the next difference is short by as much), whose missing
+//     samples are lost frames (round(gap/dt) − 1 of them);
 //  2. every sample gets a grid index (consecutive, or across a gap its rounded
 //     length); the clock is the least-squares line through (index, stamp): its slope
 //     gives fs — the median alone is limited by the stamps' printed resolution (Klipper's
@@ -31,7 +32,8 @@ struct UniformClock {
   [[nodiscard]] double time_at(std::int64_t i) const { return t0_s + static_cast<double>(i) / fs_hz; }
 };
 
-// Throws InputError naming `source` for fewer than 4 samples or stamps that do not increase.
+// Throws InputError naming `source` for fewer than 4 samples, stamps that do not increase,
+// or gaps that lose more samples than were recorded.
 UniformClock fit_uniform_clock(const std::vector<double>& t_s, const std::string& source);
 
 // Values at every grid index that is not lost: grid_index[k] and values[k].
@@ -40,6 +42,10 @@ struct UniformSeries {
   std::vector<Eigen::Vector3d> values;
 };
 UniformSeries resample(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, const UniformClock& clock);
+
+// Values at every grid index from the first to the last sample, lost samples included,
+// each by interpolate_at (an NC trace: a set-point is smooth, its gaps are bridged).
+std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, const UniformClock& clock);
 
 // A stamped series evaluated at arbitrary times (for an NC trace: cubic Lagrange through
 // the four nearest stamps; held at the ends).

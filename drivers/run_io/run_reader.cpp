@@ -22,6 +22,9 @@ namespace {
 
 using Unknown = drivers::Unknown;
 
+// No case temperature of a working sensor is beyond this; a float could not hold 1e300.
+constexpr double kMaxTemp_c = 1000.0;
+
 enum Col : int {
   c_t, c_tax, c_tay, c_taz, c_hax, c_hay, c_haz, c_ttemp, c_htemp, c_cx, c_cy, c_cz, c_rx, c_ry, c_rz, c_trig,
   c_psd0,  // psd k i1 = c_psd0 + 2k, i2 = c_psd0 + 2k + 1
@@ -151,6 +154,8 @@ bool SampleReader::next(dsp::Frame& out) {
   }
   for (int s = 0; s < 2; ++s) {
     const auto v = parse_double(src, c_ttemp + s, field(c_ttemp + s));
+    // Checked before the conversion to float (beyond its range it is undefined).
+    if (v && !(std::abs(*v) <= kMaxTemp_c)) fail_at(src, c_ttemp + s, "temperature beyond +-1000 C ('" + std::string(field(c_ttemp + s)) + "')");
     if (v) f.temp_c[s] = static_cast<float>(*v);
     else f.flags |= dsp::frame_flag::temp_missing;
   }
@@ -169,7 +174,9 @@ bool SampleReader::next(dsp::Frame& out) {
       f.flags |= dsp::frame_flag::psd_missing;
       continue;
     }
-    f.psd_counts[c - c_psd0] = static_cast<std::int32_t>(std::llround(*v / lsb + offset));
+    const double counts = *v / lsb + offset;
+    if (!(std::abs(counts) <= INT32_MAX)) fail_at(src, c, "PSD value beyond the ADC's 32-bit range ('" + std::string(field(c)) + "')");
+    f.psd_counts[c - c_psd0] = static_cast<std::int32_t>(std::llround(counts));
   }
   const auto trig = parse_int(src, c_trig, field(c_trig), "an integer trigger code");
   if (!trig) fail_at(src, c_trig, "empty trigger (0 means none)");

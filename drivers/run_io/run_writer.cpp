@@ -86,13 +86,17 @@ std::string toml_number(double v) { return toml_double(v); }
 
 void write_text_atomic(const fs::path& file, const std::string& text) {
   const fs::path tmp = file.string() + ".tmp";
+  std::error_code ec;
   {
     std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
     if (!os) throw std::runtime_error(tmp.string() + ": cannot create");
     os << text;
-    if (!os.flush()) throw std::runtime_error(tmp.string() + ": write failed (disk full?)");
+    if (!os.flush()) {
+      os.close();
+      fs::remove(tmp, ec);  // no half file left beside the run
+      throw std::runtime_error(tmp.string() + ": write failed (disk full?)");
+    }
   }
-  std::error_code ec;
   fs::rename(tmp, file, ec);
   if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
 }

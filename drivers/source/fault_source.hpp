@@ -22,6 +22,10 @@ struct FaultPlan {
   int saturate_channel = 3;     // 0..5: table x,y,z, head x,y,z
   double nan_at_s = -1.0;       // head temperature NaN from here ...
   double nan_s = 0.0;           // ... for this long
+  // Not the source's: eicald's DSP thread stops handling frames from this time on (until
+  // the service is stopped), as a hung computation would (the watchdog test). The source
+  // wrapper ignores it; any() is about the source's faults.
+  double hang_dsp_at_s = -1.0;
 
   [[nodiscard]] bool any() const { return fail_at_s >= 0 || gap_at_s >= 0 || saturate_at_s >= 0 || nan_at_s >= 0; }
 };

@@ -63,6 +63,12 @@ LinCompResult piecewise_linear(const ErrorCurve& c, const LinCompOptions& o) {
   if (o.spacing_mm > travel)
     throw InputError("lincomp: spacing " + std::to_string(o.spacing_mm) + " mm is larger than the travel " + std::to_string(travel) + " mm");
   if (!(o.shift_step_mm > 0.0) || o.shift_step_mm > o.spacing_mm) throw InputError("lincomp: shift step must be in (0, spacing]");
+  if (travel / o.spacing_mm + 1.0 > kMaxCorrectionPoints)
+    throw InputError("lincomp: the travel " + std::to_string(travel) + " mm at spacing " + std::to_string(o.spacing_mm) + " mm needs more than " +
+                     std::to_string(kMaxCorrectionPoints) + " correction points (positions in mm?)");
+  if (o.spacing_mm / o.shift_step_mm > kMaxGridShifts)
+    throw InputError("lincomp: spacing " + std::to_string(o.spacing_mm) + " mm / shift step " + std::to_string(o.shift_step_mm) + " mm is more than " +
+                     std::to_string(kMaxGridShifts) + " grid shifts");
   if (!(o.period_error_um >= 0.0)) throw InputError("lincomp: period error u must not be negative");
 
   LinCompResult r;

@@ -37,8 +37,15 @@ struct LinCompResult {
   std::vector<double> residual_by_shift_um;  // per shift, for the report
 };
 
-// Validates the curve (monotone, finite, no duplicates, spacing within the travel) with
-// InputError naming the offending point.
+// Tables and grid shifts no machine needs (a 50 m axis at 0.5 mm spacing; a 1 µm shift
+// step at 10 mm spacing): beyond these the computation runs for hours, on a curve whose
+// positions are not in millimetres, so it is refused.
+inline constexpr int kMaxCorrectionPoints = 100000;
+inline constexpr int kMaxGridShifts = 10000;
+
+// Validates the curve (monotone, finite, no duplicates, spacing within the travel, at most
+// kMaxCorrectionPoints points and kMaxGridShifts shifts) with InputError naming the
+// offending point or figure.
 LinCompResult piecewise_linear(const ErrorCurve& curve, const LinCompOptions& options);
 
 // Correction table of a grid starting at `first_mm`, spacing A, over the curve's range.

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <random>
 
 namespace eical::drivers::usb_daq {
@@ -52,6 +54,43 @@ TEST(UsbDaqProtocol, FramesSurviveArbitraryChunking) {
   EXPECT_EQ(out[9].psd_counts[3], -9 * 1000 + 9);   // channel 9
   EXPECT_EQ(out[32].trigger, 101);  // the slow packet's trigger lands on the next sample
   EXPECT_FLOAT_EQ(out[40].temp_c[0], 21.55f);
+  EXPECT_EQ(d.stats().crc_errors, 0u);
+}
+
+// Found by fuzz/usb_daq.cpp (issue 21): the decoder buffered a whole chunk before parsing,
+// so of a 16 KiB bulk transfer (what UsbDaqSource reads) into its 8 KiB buffer the first
+// half was dropped byte by byte — 320 of 640 frames recorded. A chunk of any size is
+// parsed as it fills the buffer now.
+TEST(UsbDaqProtocol, AFullBulkTransferLosesNothing) {
+  std::vector<std::uint8_t> transfer;
+  std::uint32_t seq = 0;
+  while (transfer.size() < 16384 - 2000) {
+    const auto pk = encode_samples(seq, samples(64, static_cast<int>(seq)), 8);
+    transfer.insert(transfer.end(), pk.begin(), pk.end());
+    seq += 64;
+  }
+  ASSERT_GT(transfer.size(), 8192u);  // more than the decoder's buffer
+  Decoder d(1);
+  std::vector<dsp::Frame> out;
+  d.feed(transfer, [&](const dsp::Frame& f) { out.push_back(f); });
+  ASSERT_EQ(out.size(), seq);
+  for (std::size_t k = 0; k < out.size(); ++k) EXPECT_EQ(out[k].sample_index, static_cast<std::int64_t>(k));
+  EXPECT_EQ(d.stats().resync_bytes, 0u);
+  EXPECT_EQ(d.stats().lost_samples, 0u);
+  EXPECT_EQ(d.stats().packets, seq / 64);
+}
+
+// The seed that showed it, through the decoder as the source feeds it (fuzz/corpus/usb_daq:
+// byte 0 is the fuzz target's option byte).
+TEST(UsbDaqProtocol, FuzzSeedFullTransferDecodesEveryFrame) {
+  std::ifstream is(EICAL_SOURCE_DIR "/fuzz/corpus/usb_daq/full-transfer", std::ios::binary);
+  ASSERT_TRUE(is);
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 8193u);
+  Decoder d(1);
+  std::size_t frames = 0;
+  d.feed(std::span<const std::uint8_t>(bytes).subspan(1), [&](const dsp::Frame&) { ++frames; });
+  EXPECT_EQ(frames, 640u);
   EXPECT_EQ(d.stats().crc_errors, 0u);
 }
 

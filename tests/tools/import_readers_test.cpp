@@ -113,5 +113,39 @@ TEST(ImportReaders, UniformClockFromMicrosecondStampsWithJitterAndAGap) {
   EXPECT_NE(error_of([] { fit_uniform_clock({0.0, 1.0, 2.0}, "three"); }).find("at least 4"), std::string::npos);
 }
 
+// A single lost sample leaves a stamp difference of 2·dt, which the jitter puts on either
+// side of a 2·dt threshold: each one must count as a gap all the same (1.5·dt is the
+// rounding boundary between one step and two), or every later sample sits one period
+// early on the grid and the loss goes unflagged.
+TEST(ImportReaders, UniformClockCountsEverySingleLostSample) {
+  const double fs = 3187.3, jitter = 20e-6;
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::vector<double> t;
+  std::size_t lost = 0;
+  for (int k = 0; k < 100000; ++k) {
+    if (k % 500 == 250) {  // one sample lost every 500
+      ++lost;
+      continue;
+    }
+    t.push_back(std::round((7.25 + k / fs + jitter * unit(rng)) * 1e6) / 1e6);
+  }
+  const UniformClock c = fit_uniform_clock(t, "stamps");
+  std::printf("%zu single samples lost at 3187.3 Hz, 20 us jitter: %zu lost frames in %zu gaps found, jitter %.2f us, fs %.4f Hz\n", lost,
+              c.lost_frames, c.gaps, c.jitter_rms_s * 1e6, c.fs_hz);
+  EXPECT_EQ(c.lost_frames, lost);
+  EXPECT_EQ(c.gaps, lost);
+  EXPECT_EQ(c.index.back(), 99999);
+  EXPECT_NEAR(c.fs_hz, fs, 1e-2);
+  EXPECT_LT(c.jitter_rms_s, 1.5 * jitter);
+  // Exact stamps (halsampler's sample number × period): 2·dt is 2·median only to rounding.
+  std::vector<double> exact;
+  for (int n = 100; n < 5100; ++n)
+    if (n % 97 != 0) exact.push_back(n * 0.001);
+  const UniformClock e = fit_uniform_clock(exact, "halsampler");
+  EXPECT_EQ(e.lost_frames, 51u);
+  EXPECT_EQ(e.gaps, 51u);
+}
+
 }  // namespace
 }  // namespace eical::drivers

@@ -10,6 +10,17 @@
 #include <tuple>
 
 namespace eical::tools {
+namespace {
+
+// What ISO 230-2 needs of a table (evaluate_positioning checks it again, without a file
+// to name).
+void require_table(const std::string& file, std::size_t targets, long long runs, const char* what) {
+  if (targets < 2) throw dsp::InputError(file + ": at least 2 targets are needed for ISO 230-2 (the file has " + std::to_string(targets) + ")");
+  if (runs < 2)
+    throw dsp::InputError(file + ": at least 2 " + what + " per direction are needed for ISO 230-2 (the file has " + std::to_string(runs) + ")");
+}
+
+}  // namespace
 
 dsp::eval::PositioningInput read_deviation_csv(const std::string& file) {
   const CsvTable t(file, {"target_mm", "run", "direction", "deviation_um"});
@@ -29,18 +40,21 @@ dsp::eval::PositioningInput read_deviation_csv(const std::string& file) {
       throw dsp::InputError(t.where(r, "run") + ": target " + std::to_string(target) + " mm, run " + std::to_string(run) + ", " + d + " appears twice");
     max_run = std::max(max_run, run);
   }
+  require_table(file, target_of.size(), max_run, "runs");
   dsp::eval::PositioningInput in;
   for (const auto& [k, v] : target_of) in.targets_mm.push_back(v);
-  in.up_um.assign(static_cast<std::size_t>(max_run), {});
-  in.down_um.assign(static_cast<std::size_t>(max_run), {});
-  for (long long run = 1; run <= max_run; ++run)
+  // A run is added only when it is complete: a run number far beyond the rows (run
+  // 1000000000000) ends at the first missing run, never in an allocation of that size.
+  for (long long run = 1; run <= max_run; ++run) {
+    in.up_um.emplace_back(), in.down_um.emplace_back();
     for (const auto& [k, v] : target_of)
       for (int dir = 0; dir < 2; ++dir) {
         const auto it = value.find({k, run, dir});
         if (it == value.end())
           throw dsp::InputError(file + ": no deviation for target " + std::to_string(v) + " mm, run " + std::to_string(run) + ", " + (dir ? "down" : "up"));
-        (dir ? in.down_um : in.up_um)[static_cast<std::size_t>(run - 1)].push_back(it->second);
+        (dir ? in.down_um : in.up_um).back().push_back(it->second);
       }
+  }
   return in;
 }
 
@@ -90,18 +104,19 @@ dsp::eval::PositioningInput read_ecmc_dat(const std::string& file) {
   if (targets.empty()) throw dsp::InputError(file + ": no TGT_DATA lines");
   int cycles = 0;
   for (const auto& [k, v] : refs) cycles = std::max(cycles, std::get<2>(k));
+  require_table(file, targets.size(), cycles, "cycles");
   dsp::eval::PositioningInput in;
   for (const auto& [i, t] : targets) in.targets_mm.push_back(t);
-  in.up_um.assign(static_cast<std::size_t>(cycles), {});
-  in.down_um.assign(static_cast<std::size_t>(cycles), {});
-  for (int j = 1; j <= cycles; ++j)
+  for (int j = 1; j <= cycles; ++j) {  // a cycle is added when complete (as the deviation CSV's runs)
+    in.up_um.emplace_back(), in.down_um.emplace_back();
     for (const auto& [i, t] : targets)
       for (int dir = 0; dir < 2; ++dir) {
         const auto it = refs.find({dir, i, j});
         if (it == refs.end())
           throw dsp::InputError(file + ": REF_DATA_" + (dir ? "BWD" : "FWD") + "[" + std::to_string(i) + "," + std::to_string(j) + "] is missing");
-        (dir ? in.down_um : in.up_um)[static_cast<std::size_t>(j - 1)].push_back((it->second - t) * 1000.0);  // REF − TGT, µm
+        (dir ? in.down_um : in.up_um).back().push_back((it->second - t) * 1000.0);  // REF − TGT, µm
       }
+  }
   return in;
 }
 
