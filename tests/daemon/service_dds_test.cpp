@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <random>
 #include <thread>
@@ -38,13 +39,17 @@ TEST(ServiceDds, HmiReceivesResultAndCommandsAreAnswered) {
 
   eical::drivers::dds::Bus hmi(domain, eical::drivers::dds::Role::hmi);
   std::optional<eical::drivers::dds::ResultMsg> result;
-  for (int i = 0; i < 300 && !result; ++i) result = hmi.take_result(100ms);
+  // Deadlines, not durations: under ASan with another test on the second core the first
+  // Result took close to 30 s; the loops end as soon as it is there.
+  const auto deadline = std::chrono::steady_clock::now() + 180s;
+  while (!result && std::chrono::steady_clock::now() < deadline) result = hmi.take_result(100ms);
   eical::drivers::dds::CommandMsg cmd;
   cmd.sender = "test";
   cmd.request_id = 5;
   cmd.action = "dance";
   std::optional<eical::drivers::dds::ReplyMsg> reply;
-  for (int i = 0; i < 50 && !reply; ++i) {
+  const auto reply_deadline = std::chrono::steady_clock::now() + 30s;
+  while (!reply && std::chrono::steady_clock::now() < reply_deadline) {
     hmi.send(cmd);
     reply = hmi.take_reply(100ms);
   }

@@ -96,9 +96,11 @@ TEST(ServoSetPoint, TheServoStreamBecomesTheFramesSetPointOnTheDaqClock) {
   fs::remove_all(dir);
 
   ASSERT_TRUE(a.known);
-  // Cycle n0 is 3.7 ms after sample 0: sample 0 is at cycle n0 − 3.7 (within the clocks'
-  // latency floors: the replay releases a block one sample after its last one).
-  EXPECT_NEAR(a.servo_cycle_at_sample0, static_cast<double>(n0) - delta_s * 1e3, 0.3);
+  // Cycle n0 is 3.7 ms after sample 0: sample 0 is at cycle n0 − 3.7, within the difference
+  // of the two streams' latency floors the minimum filters find. That difference is the
+  // host's scheduling: ~0.1 ms on a quiet machine, 0.34 ms seen under ASan with another test
+  // on the second core (CI), so 0.5 cycles.
+  EXPECT_NEAR(a.servo_cycle_at_sample0, static_cast<double>(n0) - delta_s * 1e3, 0.5);
   ASSERT_GT(got.size(), 20000u);
   double worst_um = 0.0;
   std::size_t with_setpoint = 0;
@@ -110,8 +112,8 @@ TEST(ServoSetPoint, TheServoStreamBecomesTheFramesSetPointOnTheDaqClock) {
   EXPECT_GT(with_setpoint, 20000u);
   std::printf("servo cycle at DAQ sample 0: %.3f (true %.3f); set-point error at most %.2f um over %zu frames\n", a.servo_cycle_at_sample0,
               static_cast<double>(n0) - delta_s * 1e3, worst_um, with_setpoint);
-  // 0.3 ms at 41.7 mm/s is 12.5 µm.
-  EXPECT_LT(worst_um, 15.0);
+  // 0.5 ms at 41.7 mm/s is 21 µm.
+  EXPECT_LT(worst_um, 22.0);
   if (test::allocations_counted()) {
     EXPECT_EQ(allocations, 0u) << "read() allocated";
   }
