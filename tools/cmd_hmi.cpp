@@ -7,6 +7,7 @@
 #if EICAL_HAVE_DDS
 #include "drivers/dds/bus.hpp"
 #include "drivers/results/resolved.hpp"
+#include "dsp/core/frame.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -147,7 +148,7 @@ void register_hmi(CLI::App& app) {
   });
 
   auto* trig = app.add_subcommand("trigger", "Send an NC trigger (M101/M102/M103) to eicald over DDS");
-  trig->add_option("code", o->code, "101 (tare + start), 102 (segment), 103 (stop + evaluate)")->required()->check(CLI::IsMember({101, 102, 103}));
+  trig->add_option("code", o->code, "101 (tare + start), 102 (segment), 103 (stop + evaluate)")->required()->check(CLI::IsMember({dsp::trigger::program_start, dsp::trigger::segment_mark, dsp::trigger::program_end}));
   trig->add_option("-P", o->p, "the M-code's P word");
   trig->add_option("-Q", o->q, "the M-code's Q word");
   trig->add_option("--domain", o->domain, "DDS domain id")->default_val(0);

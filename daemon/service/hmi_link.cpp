@@ -165,7 +165,7 @@ drivers::dds::ReplyMsg HmiLink::answer(const drivers::dds::CommandMsg& cmd) {
     return reply;
   }
   reply.ok = false;
-  reply.message = "unknown command '" + cmd.action + "' (code " + std::to_string(cmd.code) + "); use trigger 101|102|103";
+  reply.message = "unknown command '" + cmd.action + "' (code " + std::to_string(cmd.code) + "); use trigger " + std::to_string(kProgramStart) + "|" + std::to_string(kSegmentMark) + "|" + std::to_string(kProgramEnd);
   reply.state = state_now();
   return reply;
 }

@@ -2,6 +2,7 @@
 
 #include "dsp/align/accel_lag.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/frame.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -10,8 +11,6 @@
 
 namespace eical::drivers {
 namespace {
-
-bool is_nc_trigger(int code) { return code == 101 || code == 102 || code == 103; }
 
 // Motion blocks: moves that follow each other without a rest are one block.
 std::vector<std::pair<double, double>> motion_blocks(const sim::nc::Trajectory& tr) {
@@ -50,7 +49,7 @@ std::string with_mcode_stops(const std::string& gcode) {
       while (q < code.size() && (std::isdigit(static_cast<unsigned char>(code[q])) || code[q] == '.')) ++q;
       if (q == p + 1) continue;
       const double m = std::atof(code.substr(p + 1, q - p - 1).c_str());
-      if (m == 101.0 || m == 102.0 || m == 103.0) {
+      if (m == std::floor(m) && m < 1e6 && dsp::trigger::is_nc_trigger(static_cast<std::int32_t>(m))) {
         out += "G4 P0\n";
         break;
       }
@@ -69,11 +68,11 @@ ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& progr
   // 1 Marks, in order; the first M101 of each is the anchor.
   std::vector<Mark> prog, rec;
   for (const auto& t : tr.triggers())
-    if (is_nc_trigger(t.code)) prog.push_back({t.t_s, t.code});
+    if (dsp::trigger::is_nc_trigger(t.code)) prog.push_back({t.t_s, t.code});
   for (const auto& f : run.frames)
-    if (is_nc_trigger(f.trigger)) rec.push_back({static_cast<double>(f.sample_index) / fs, f.trigger});
-  const auto p101 = std::find_if(prog.begin(), prog.end(), [](const Mark& m) { return m.code == 101; });
-  const auto r101 = std::find_if(rec.begin(), rec.end(), [](const Mark& m) { return m.code == 101; });
+    if (dsp::trigger::is_nc_trigger(f.trigger)) rec.push_back({static_cast<double>(f.sample_index) / fs, f.trigger});
+  const auto p101 = std::find_if(prog.begin(), prog.end(), [](const Mark& m) { return m.code == dsp::trigger::program_start; });
+  const auto r101 = std::find_if(rec.begin(), rec.end(), [](const Mark& m) { return m.code == dsp::trigger::program_start; });
   if (p101 == prog.end()) throw dsp::InputError("program set-point: the program has no M101");
   if (r101 == rec.end()) throw dsp::InputError("program set-point: the recording has no M101 mark");
   std::vector<std::pair<Mark, Mark>> pairs;  // (program, recorded)

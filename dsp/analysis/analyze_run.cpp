@@ -93,7 +93,7 @@ eval::PositioningInput positioning_deviations(const Measurement& m, const Progra
     }
   };
   for (const auto& t : m.triggers) {
-    if (t.code != 102) continue;
+    if (t.code != trigger::segment_mark) continue;
     const auto k = at(t.sample_index);
     if (k < 1) continue;
     const auto ku = static_cast<std::size_t>(k);
@@ -165,7 +165,7 @@ void evaluate_measurement(const Run& run, const PipelineConfig& cfg, const Analy
     eval::RepeatInput ri;
     ri.sample_index = &a.measurement.sample_index, ri.pos_mm = &a.measurement.pos_mm, ri.cmd_mm = &a.measurement.cmd_mm;
     for (const auto& t : a.measurement.triggers)
-      if (t.code == 102) ri.marks.push_back(t.sample_index);
+      if (t.code == trigger::segment_mark) ri.marks.push_back(t.sample_index);
     ri.fs_hz = a.measurement.fs_hz;
     a.repeats = eval::average_repeats(ri);
     evaluate_program(run, a);

@@ -243,8 +243,8 @@ void Pipeline::step(const Frame& f) noexcept {
   const double dt = static_cast<double>(k_samples) * dt_s_;
   prev_index_ = f.sample_index;
   if (f.trigger != 0 && m_.triggers.size() < trigger_capacity_) m_.triggers.push_back({f.sample_index, f.trigger});
-  if (f.trigger == 101) saw_start_ = true;
-  if (f.trigger == 103) saw_end_ = true;
+  if (f.trigger == trigger::program_start) saw_start_ = true;
+  if (f.trigger == trigger::program_end) saw_end_ = true;
 
   const Eigen::Vector3d cmd(f.cmd_mm[0], f.cmd_mm[1], f.cmd_mm[2]);
   const bool cmd_valid = !(f.flags & frame_flag::cmd_missing) && cmd.allFinite();
@@ -254,7 +254,7 @@ void Pipeline::step(const Frame& f) noexcept {
 
   switch (phase_) {
     case Phase::wait_start:
-      if (f.trigger != 101) return;
+      if (f.trigger != trigger::program_start) return;
       phase_ = Phase::rest;
       [[fallthrough]];
     case Phase::rest:

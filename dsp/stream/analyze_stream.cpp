@@ -38,7 +38,7 @@ class Scout final : public TraceSink {
   void frame(const Frame& f) {
     if (f.trigger == 0 || triggers_ >= kTriggerCapacity) return;
     ++triggers_;
-    if (f.trigger != 102 || !circle_) return;
+    if (f.trigger != trigger::segment_mark || !circle_) return;
     repeats.mark(f.sample_index);
     marks_.push_back(f.sample_index);
   }

@@ -1,6 +1,7 @@
 #include "sim/nc/klipper_excitation.hpp"
 
 #include "dsp/core/error.hpp"
+#include "dsp/core/frame.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -132,7 +133,7 @@ AccelProfileSetPoint::AccelProfileSetPoint(std::vector<AccelSegment> segments, c
     t += s.duration_s;
   }
   duration_ = lead_in_ + t + tail_s;
-  triggers_ = {{0.0, 101}, {duration_, 103}};
+  triggers_ = {{0.0, dsp::trigger::program_start}, {duration_, dsp::trigger::program_end}};
 }
 
 std::size_t AccelProfileSetPoint::segment_at(double tau) const {
