@@ -83,14 +83,14 @@ void finish(const Common& c, const drivers::ImportResult& r) {
 }
 
 void register_klipper(CLI::App* import) {
-  struct Opt {
+  struct KlipperOpt {
     Common c;
     std::string capture, axis = "x";
     bool legacy = false;
     double freq_start = 0.0, freq_end = 0.0, accel_per_hz = 0.0, hz_per_sec = 0.0, sweeping_accel = -1.0, sweeping_period = -1.0, max_accel = 0.0;
     std::vector<double> start{0.0, 0.0, 0.0};
   };
-  auto o = std::make_shared<Opt>();
+  auto o = std::make_shared<KlipperOpt>();
   auto* cmd = import->add_subcommand("klipper", "A Klipper raw accelerometer capture (#time,accel_x,accel_y,accel_z; print time, mm/s2) of TEST_RESONANCES; "
                                                 "the set-point from Klipper's resonance_tester.py, its start found by cross-correlation");
   cmd->add_option("capture", o->capture, "the capture (raw_data_*.csv)")->required();
@@ -134,12 +134,12 @@ std::array<std::string, 3> three(const std::string& list, const std::string& wha
 }
 
 void register_csv(CLI::App* import) {
-  struct Opt {
+  struct CsvOpt {
     Common c;
     std::string accel, nc, time_col, columns, unit = "mps2", time_unit = "s", nc_format = "halsampler", nc_time_col, nc_columns;
     double servo_period_s = 0.001;
   };
-  auto o = std::make_shared<Opt>();
+  auto o = std::make_shared<CsvOpt>();
   auto* cmd = import->add_subcommand("csv", "A generic accelerometer CSV plus an NC trace (LinuxCNC halsampler or a CSV servo trace); both onto one "
                                             "uniform clock, their offset found by cross-correlation");
   cmd->add_option("--accel", o->accel, "accelerometer CSV with a header row")->required();

@@ -1,5 +1,5 @@
 // eical validate-sim: the simulator against the thesis' figures (issue 3's proof table).
-#include "sim/validate/thesis_checks.hpp"
+#include "tools/validate/thesis_checks.hpp"
 #include "tools/commands.hpp"
 
 #include <cstdio>
@@ -8,12 +8,12 @@
 namespace eical::tools {
 
 void register_validate_sim(CLI::App& app) {
-  auto o = std::make_shared<sim::ValidationOptions>();
+  auto o = std::make_shared<ValidationOptions>();
   auto* cmd = app.add_subcommand("validate-sim", "Compare the simulator with the thesis' measured and simulated figures");
   cmd->add_option("--windows", o->monte_carlo_windows, "Monte-Carlo windows for the noise checks")->default_val(400)->check(CLI::Range(20, 100000));
   cmd->add_option("--seed", o->seed, "random seed")->default_val(1);
   cmd->callback([o] {
-    const auto rows = sim::validate_against_thesis(*o);
+    const auto rows = validate_against_thesis(*o);
     std::printf("%-58s %-34s %10s %10s %6s %-13s %s\n", "check", "thesis source", "thesis", "simulated", "ratio", "accepted", "");
     int failed = 0;
     for (const auto& r : rows) {

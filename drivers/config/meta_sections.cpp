@@ -1,4 +1,5 @@
 #include "drivers/config/meta_sections.hpp"
+#include "drivers/config/strict_eigen.hpp"
 
 #include <Eigen/LU>
 
@@ -7,12 +8,6 @@
 
 namespace eical::drivers {
 namespace {
-
-Eigen::Vector3d vec3(StrictTable& t, std::string_view key, const Eigen::Vector3d& fallback) {
-  if (!t.has(key)) return fallback;  // finish() only rejects keys that are present
-  const auto v = t.numbers(key, 3);
-  return {v[0], v[1], v[2]};
-}
 
 bool valid_axis(const std::string& a) { return a == "x" || a == "y" || a == "z"; }
 
@@ -71,12 +66,12 @@ dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults, Unkn
     // A mounting matrix is a rotation (plus small misalignment): reject typos such as a zero row.
     if (std::abs(s.to_machine.determinant()) < 0.5) t.fail("to_machine", "matrix is singular or far from a rotation");
   }
-  s.k1_v_per_g = vec3(t, "k1_v_per_g", s.k1_v_per_g);
+  s.k1_v_per_g = vec3_or(t, "k1_v_per_g", s.k1_v_per_g);
   for (int i = 0; i < 3; ++i)
     if (!(s.k1_v_per_g[i] > 0.0)) t.fail("k1_v_per_g", "scale factors must be positive");
-  s.k2_g_per_g2 = vec3(t, "k2_g_per_g2", s.k2_g_per_g2);
-  s.k3_g_per_g3 = vec3(t, "k3_g_per_g3", s.k3_g_per_g3);
-  s.bias_g = vec3(t, "bias_g", s.bias_g);
+  s.k2_g_per_g2 = vec3_or(t, "k2_g_per_g2", s.k2_g_per_g2);
+  s.k3_g_per_g3 = vec3_or(t, "k3_g_per_g3", s.k3_g_per_g3);
+  s.bias_g = vec3_or(t, "bias_g", s.bias_g);
   s.tc_k1_ppm_per_c = t.number("tc_k1_ppm_per_c", s.tc_k1_ppm_per_c);
   s.tc_bias_ug_per_c = t.number("tc_bias_ug_per_c", s.tc_bias_ug_per_c);
   s.f0_hz = t.number("f0_hz", s.f0_hz);

@@ -1,4 +1,5 @@
 #include "drivers/config/scenario_file.hpp"
+#include "drivers/config/strict_eigen.hpp"
 
 #include "drivers/config/meta_sections.hpp"
 #include "drivers/config/strict_toml.hpp"
@@ -24,12 +25,6 @@ int axis_of(StrictTable& t, std::string_view key) {
   const std::string a = t.choice(key, {"x", "y", "z"}, "");
   if (a.empty()) t.fail(key, "required: \"x\", \"y\" or \"z\"");
   return a[0] - 'x';
-}
-
-Eigen::Vector3d vec3(StrictTable& t, std::string_view key, const Eigen::Vector3d& fallback) {
-  if (!t.has(key)) return fallback;  // absent keys need no marking: finish() checks present ones
-  const auto v = t.numbers(key, 3);
-  return {v[0], v[1], v[2]};
 }
 
 Eigen::Matrix3d mat3(StrictTable& t, std::string_view key) {
@@ -61,24 +56,24 @@ void read_sensor_effect(const std::string& name, StrictTable& t, sim::Scenario& 
     const dsp::SensorSpec& nominal = sc.meta.sensors[s];
     if (name == "sensor.scale") {
       if (t.has("scale_ppm")) {
-        const Eigen::Vector3d ppm = vec3(t, "scale_ppm", Eigen::Vector3d::Zero());
+        const Eigen::Vector3d ppm = vec3_or(t, "scale_ppm", Eigen::Vector3d::Zero());
         st.spec.k1_v_per_g = nominal.k1_v_per_g.cwiseProduct(Eigen::Vector3d::Ones() + ppm * 1e-6);
         if (t.has("k1_v_per_g")) t.fail("k1_v_per_g", "give either scale_ppm or k1_v_per_g, not both");
       } else {
-        st.spec.k1_v_per_g = vec3(t, "k1_v_per_g", nominal.k1_v_per_g);
+        st.spec.k1_v_per_g = vec3_or(t, "k1_v_per_g", nominal.k1_v_per_g);
       }
     } else if (name == "sensor.bias_drift") {
       st.bias_rw_ug_per_rts = t.number("rw_ug_per_rts", 0.0);
       st.bias_step_ug = t.number("step_ug", 0.0);
       st.bias_drift_ug_per_s = t.number("drift_ug_per_s", 0.0);
     } else if (name == "sensor.nonlinearity") {
-      st.spec.k2_g_per_g2 = vec3(t, "k2_g_per_g2", nominal.k2_g_per_g2);
-      st.spec.k3_g_per_g3 = vec3(t, "k3_g_per_g3", nominal.k3_g_per_g3);
+      st.spec.k2_g_per_g2 = vec3_or(t, "k2_g_per_g2", nominal.k2_g_per_g2);
+      st.spec.k3_g_per_g3 = vec3_or(t, "k3_g_per_g3", nominal.k3_g_per_g3);
     } else if (name == "sensor.cross_coupling") {
       st.k_cross_g_per_g = mat3(t, "k_cross_g_per_g");
       st.k_cross2_g_per_g2 = mat3(t, "k_cross2_g_per_g2");
     } else if (name == "sensor.misalignment") {
-      const Eigen::Vector3d r = vec3(t, "misalignment_mrad", Eigen::Vector3d::Zero()) * 1e-3;
+      const Eigen::Vector3d r = vec3_or(t, "misalignment_mrad", Eigen::Vector3d::Zero()) * 1e-3;
       // Rotation about the sensor axes, applied after the nominal mounting.
       const Eigen::Matrix3d rot = (Eigen::AngleAxisd(r[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r[1], Eigen::Vector3d::UnitY()) *
                                    Eigen::AngleAxisd(r[0], Eigen::Vector3d::UnitX()))
@@ -116,7 +111,7 @@ std::vector<sim::Tone> read_tones(StrictTable& t) {
   for (StrictTable tone : t.tables("tones")) {
     sim::Tone x;
     x.freq_hz = positive(tone, "freq_hz", x.freq_hz);
-    x.amp_mg = vec3(tone, "amp_mg", Eigen::Vector3d::Zero());
+    x.amp_mg = vec3_or(tone, "amp_mg", Eigen::Vector3d::Zero());
     x.phase_deg = tone.number("phase_deg", 0.0);
     tone.finish();
     tones.push_back(x);
@@ -128,7 +123,7 @@ sim::DriveMode read_mode(StrictTable t, const std::string& gain_key = "gain") {
   sim::DriveMode m;
   m.freq_hz = positive(t, "freq_hz", m.freq_hz);
   m.zeta = positive(t, "zeta", m.zeta);
-  m.gain = vec3(t, gain_key, Eigen::Vector3d::Zero());
+  m.gain = vec3_or(t, gain_key, Eigen::Vector3d::Zero());
   t.finish();
   return m;
 }
@@ -137,7 +132,7 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
   sim::MachineErrors& m = sc.machine;
   if (name == "machine.common_vibration") {
     sim::CommonVibration& v = sc.common_vibration;
-    v.broadband_rms_mg = vec3(t, "broadband_rms_mg", Eigen::Vector3d::Zero());
+    v.broadband_rms_mg = vec3_or(t, "broadband_rms_mg", Eigen::Vector3d::Zero());
     if (t.has("band_hz")) {
       const auto b = t.numbers("band_hz", 2);
       if (!(b[0] > 0.0 && b[1] > b[0])) t.fail("band_hz", "must be [low, high] with 0 < low < high");
@@ -149,7 +144,7 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
   } else if (name == "machine.differential_vibration") {
     sc.differential_vibration.freq_hz = positive(t, "freq_hz", 9.0);
     sc.differential_vibration.zeta = positive(t, "zeta", 0.03);
-    sc.differential_vibration.gain = vec3(t, "gain", Eigen::Vector3d::Zero());
+    sc.differential_vibration.gain = vec3_or(t, "gain", Eigen::Vector3d::Zero());
     sc.differential_tones = read_tones(t);
     if (sc.differential_vibration.gain.squaredNorm() == 0.0 && sc.differential_tones.empty())
       t.fail("gain", "differential vibration needs a mode gain or tones");
@@ -162,7 +157,7 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
       md.damping_ratio = positive(mt, "damping_ratio", md.damping_ratio);
       if (!(md.damping_ratio < 1.0)) mt.fail("damping_ratio", "must be below 1 (a lightly damped mode: 0.01 .. 0.05)");
       md.gain = mt.number("gain");
-      md.direction = vec3(mt, "direction", md.direction);
+      md.direction = vec3_or(mt, "direction", md.direction);
       if (!(md.direction.norm() > 0.0)) mt.fail("direction", "must not be the zero vector");
       mt.finish();
       sc.resonance.modes.push_back(md);
@@ -242,7 +237,7 @@ void read_mems(StrictTable t, sim::Scenario& sc) {
   if (chip.noise_ug_per_rthz < 0.0) t.fail("noise_ug_per_rthz", "must not be negative");
   if (t.has("bandwidth_hz")) chip.bandwidth_hz = positive(t, "bandwidth_hz", chip.bandwidth_hz), chip.bandwidth_follows_odr = false;
   if (!(chip.fs_hz >= 100.0 && chip.fs_hz <= 51200.0)) t.fail("fs_hz", "must be 100 .. 51200 Hz");
-  const Eigen::Vector3d bias_g = vec3(t, "bias_mg", Eigen::Vector3d::Zero()) * 1e-3;
+  const Eigen::Vector3d bias_g = vec3_or(t, "bias_mg", Eigen::Vector3d::Zero()) * 1e-3;
   t.finish();
   sim::apply_mems(sc, chip, chip.fs_hz, bias_g);
 }
@@ -275,7 +270,7 @@ void read_sweep(StrictTable t, sim::Scenario& sc) {
                                                        : "preset";
     t.fail(t.has(key) ? key : "preset", why);
   }
-  sc.sweep.start_mm = vec3(t, "start_mm", Eigen::Vector3d::Zero());
+  sc.sweep.start_mm = vec3_or(t, "start_mm", Eigen::Vector3d::Zero());
   sc.sweep.lead_in_s = t.number("lead_in_s", 0.0);
   sc.sweep.tail_s = t.number("tail_s", 0.0);
   if (sc.sweep.lead_in_s < 0.0 || sc.sweep.tail_s < 0.0) t.fail(sc.sweep.lead_in_s < 0.0 ? "lead_in_s" : "tail_s", "must not be negative");

@@ -9,6 +9,5 @@ inline constexpr double kMPerMm = 1e-3;
 inline constexpr double kUgPerG = 1e6;
 inline constexpr double kEarthRateRadps = 7.2921159e-5;  // sidereal rotation rate
 inline constexpr double deg_to_rad(double deg) { return deg * kPi / 180.0; }
-inline constexpr double rad_to_deg(double rad) { return rad * 180.0 / kPi; }
 inline constexpr double mm_per_min_to_mps(double f) { return f / 60.0 / kMmPerM; }
 }  // namespace eical::dsp::units

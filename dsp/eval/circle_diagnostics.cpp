@@ -1,4 +1,5 @@
 #include "dsp/eval/circle_diagnostics.hpp"
+#include "dsp/core/units.hpp"
 
 #include "dsp/core/error.hpp"
 
@@ -13,7 +14,7 @@
 namespace eical::dsp::eval {
 namespace {
 
-constexpr double kUmPerMm = 1000.0;
+using units::kUmPerMm;
 
 int sgn(double v, double eps) { return v > eps ? 1 : (v < -eps ? -1 : 0); }
 

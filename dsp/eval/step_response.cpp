@@ -1,4 +1,5 @@
 #include "dsp/eval/step_response.hpp"
+#include "dsp/core/units.hpp"
 
 #include "dsp/core/error.hpp"
 
@@ -11,7 +12,7 @@
 namespace eical::dsp::eval {
 namespace {
 
-constexpr double kUmPerMm = 1000.0;
+using units::kUmPerMm;
 constexpr double kRestTolMm = 1e-9;  // the set-point is exact: "not moving" means unchanged
 
 double mean(const std::vector<double>& v, std::size_t a, std::size_t b) {

@@ -60,7 +60,6 @@ void MeasurementSession::on_frame(const Frame& in) noexcept {
   ++counters_.frames;
   if (f.flags & frame_flag::gap_before) ++counters_.frames_lost;
   if (f.flags != 0) ++counters_.frames_flagged;
-  last_index_ = f.sample_index;
   // External triggers due at (or before) this sample are written into the frame, so the
   // recording carries them exactly like triggers from the DAQ's own trigger input.
   std::size_t keep = 0;

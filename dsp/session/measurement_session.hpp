@@ -57,7 +57,6 @@ class MeasurementSession {
   [[nodiscard]] const SessionCounters& counters() const noexcept { return counters_; }
   [[nodiscard]] std::uint64_t recorder_overflow() const noexcept { return recorder_.overflow_frames(); }
   [[nodiscard]] std::size_t recorder_capacity() const noexcept { return recorder_.capacity(); }
-  [[nodiscard]] std::int64_t last_sample_index() const noexcept { return last_index_; }
 
  private:
   void apply_trigger(int code) noexcept;
@@ -72,7 +71,6 @@ class MeasurementSession {
   std::array<Pending, 16> pending_{};
   std::size_t pending_count_ = 0;
   SessionCounters counters_;
-  std::int64_t last_index_ = -1;
   std::size_t posttrigger_frames_;
 };
 

@@ -1,4 +1,5 @@
 #include "sim/gcode/dialect.hpp"
+#include "sim/gcode/format.hpp"
 
 #include "dsp/core/error.hpp"
 
@@ -13,14 +14,14 @@
 namespace eical::sim::gcode {
 namespace {
 
-struct Word {
+struct WrittenWord {
   char letter;
   std::string text;  // the number as written
   [[nodiscard]] double value() const { return std::stod(text); }
 };
 
 struct Line {
-  std::vector<Word> words;
+  std::vector<WrittenWord> words;
   std::string comment;
 };
 
@@ -37,7 +38,7 @@ Line split(const std::string& raw, int line_no) {
       l.comment += (l.comment.empty() ? "" : " ") + raw.substr(i + 1, e - i - 1);
       i = e + 1;
     } else if (std::isalpha(static_cast<unsigned char>(c))) {
-      Word w{static_cast<char>(std::toupper(static_cast<unsigned char>(c))), ""};
+      WrittenWord w{static_cast<char>(std::toupper(static_cast<unsigned char>(c))), ""};
       ++i;
       while (i < raw.size() && (std::isdigit(static_cast<unsigned char>(raw[i])) || raw[i] == '.' || raw[i] == '-' || raw[i] == '+')) w.text += raw[i++];
       if (w.text.empty()) throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": word '" + std::string(1, w.letter) + "' without a number");
@@ -49,23 +50,18 @@ Line split(const std::string& raw, int line_no) {
   return l;
 }
 
-bool is_g(const Word& w, int code) { return w.letter == 'G' && std::abs(w.value() - code) < 1e-9; }
+bool is_g(const WrittenWord& w, int code) { return w.letter == 'G' && std::abs(w.value() - code) < 1e-9; }
 
 std::string upper(std::string s) {
   for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return s;
 }
 
-std::string fmt(const char* f, double v) {
-  char b[48];
-  std::snprintf(b, sizeof b, f, v);
-  return b;
-}
 
 // Canonical G4 P<seconds> → the dwell value in the dialect's unit.
 std::string dwell(const Line& l, int line_no, bool millis) {
   for (const auto& w : l.words)
-    if (w.letter == 'P') return millis ? std::to_string(std::llround(w.value() * 1000.0)) : fmt("%.3f", w.value());
+    if (w.letter == 'P') return millis ? std::to_string(std::llround(w.value() * 1000.0)) : format_number("%.3f", w.value());
   throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": G4 without P");
 }
 
@@ -134,7 +130,7 @@ std::string heidenhain(const std::vector<Line>& lines, const ProgramIdentity& id
   std::array<double, 3> pos{0.0, 0.0, 0.0};
   bool absolute = true;
   int plane = 17;
-  auto signed_num = [](double v) { return fmt("%+.4f", std::abs(v) < 5e-5 ? 0.0 : v); };
+  auto signed_num = [](double v) { return format_number("%+.4f", std::abs(v) < 5e-5 ? 0.0 : v); };
   for (std::size_t n = 0; n < lines.size(); ++n) {
     const Line& l = lines[n];
     const int line_no = static_cast<int>(n + 1);

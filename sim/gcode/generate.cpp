@@ -1,4 +1,5 @@
 #include "sim/gcode/generate.hpp"
+#include "sim/gcode/format.hpp"
 
 #include "dsp/core/error.hpp"
 
@@ -10,25 +11,20 @@
 namespace eical::sim::gcode {
 namespace {
 
-struct PlaneAxes {
+struct PlaneWords {
   const char* g;       // G17 / G18 / G19
   char a, b;           // the two plane axes, counter-clockwise order seen from +normal
   char ia, ib;         // their centre-offset words
 };
 
-PlaneAxes plane_axes(const std::string& plane) {
+PlaneWords plane_axes(const std::string& plane) {
   if (plane == "xy") return {"G17", 'X', 'Y', 'I', 'J'};
   if (plane == "zx") return {"G18", 'Z', 'X', 'K', 'I'};
   if (plane == "yz") return {"G19", 'Y', 'Z', 'J', 'K'};
   throw dsp::InputError("program plane '" + plane + "' is not xy, zx or yz");
 }
 
-std::string fmt(const char* f, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, f, v);
-  return buf;
-}
-std::string num(double v) { return fmt("%.4f", std::abs(v) < 5e-5 ? 0.0 : v); }
+std::string num(double v) { return format_number("%.4f", std::abs(v) < 5e-5 ? 0.0 : v); }
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw dsp::InputError("program: " + what);
@@ -39,10 +35,10 @@ std::string header(const char* mode_comment, const std::string& plane_g, bool ex
 }
 
 std::string start(const RestTimes& r) {
-  return "G4 P" + fmt("%.3g", r.before_start_s) + "\nM101\nG4 P" + fmt("%.3g", r.after_start_s) + "\n";
+  return "G4 P" + format_number("%.3g", r.before_start_s) + "\nM101\nG4 P" + format_number("%.3g", r.after_start_s) + "\n";
 }
 std::string finish(const RestTimes& r) {
-  return "G4 P" + fmt("%.3g", r.before_end_s) + "\nM103\nG4 P" + fmt("%.3g", r.after_end_s) + "\n";
+  return "G4 P" + format_number("%.3g", r.before_end_s) + "\nM103\nG4 P" + format_number("%.3g", r.after_end_s) + "\n";
 }
 
 char axis_letter(const std::string& axis) {
@@ -70,7 +66,7 @@ std::string circle_program(const dsp::Program& p, const RestTimes& rest) {
   // A partial arc needs room for its ramp arcs outside the evaluated arc (feed constant
   // over the whole evaluated arc).
   require(!partial || partial_arc_ramp_deg(p) >= 10.0, "a partial arc must leave at least 20 deg for the ramps (arc_deg <= 340)");
-  const PlaneAxes ax = plane_axes(p.plane);
+  const PlaneWords ax = plane_axes(p.plane);
   const double r = p.radius_mm, c0 = p.center_mm[0], c1 = p.center_mm[1];
   constexpr double deg = std::numbers::pi / 180.0;
   auto pt = [&](double ang) { return std::pair{c0 + r * std::cos(ang), c1 + r * std::sin(ang)}; };
@@ -79,7 +75,7 @@ std::string circle_program(const dsp::Program& p, const RestTimes& rest) {
     const auto [ta, tb] = pt(to);
     std::string line = std::string(ccw ? "G3 " : "G2 ") + ax.a + num(ta) + " " + ax.b + num(tb) + " " + ax.ia +
                        num(c0 - fa) + " " + ax.ib + num(c1 - fb);
-    if (with_feed) line += " F" + fmt("%.0f", p.feed_mm_min);
+    if (with_feed) line += " F" + format_number("%.0f", p.feed_mm_min);
     if (comment[0]) line += std::string(" (") + comment + ")";
     return line + "\n";
   };
@@ -132,8 +128,8 @@ std::string positioning_program(const dsp::Program& p, double overrun_mm, const 
   require(p.feed_mm_min > 0.0, "feed_mm_min must be positive");
   require(overrun_mm >= 0.0, "overrun must not be negative");
   const char a = axis_letter(p.axis);
-  const std::string f = " F" + fmt("%.0f", p.feed_mm_min);
-  const std::string dwell = "G4 P" + fmt("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.5) + "\n";
+  const std::string f = " F" + format_number("%.0f", p.feed_mm_min);
+  const std::string dwell = "G4 P" + format_number("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.5) + "\n";
   std::string g = header("ISO 230-2 linear cycle, exact stop", "G17", true);
   g += std::string("G0 ") + a + num(p.targets_mm.front() - overrun_mm) + "\n";
   g += start(rest);
@@ -153,8 +149,8 @@ std::string step_program(const dsp::Program& p, const RestTimes& rest) {
   require(p.runs >= 1, "runs must be at least 1");
   require(p.feed_mm_min > 0.0, "feed_mm_min must be positive");
   const char a = axis_letter(p.axis);
-  const std::string f = " F" + fmt("%.0f", p.feed_mm_min);
-  const std::string dwell = "G4 P" + fmt("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.5) + "\n";
+  const std::string f = " F" + format_number("%.0f", p.feed_mm_min);
+  const std::string dwell = "G4 P" + format_number("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.5) + "\n";
   // Approach the first target, then the rest before M101 (the recorded step runs, made
   // without it, started standing there).
   std::string g = header("absolute, mm, XY plane, exact stop", "G17", true);
@@ -172,10 +168,10 @@ std::string rectangle_program(const dsp::Program& p, const RestTimes& rest) {
   require(p.size_mm[0] > 0.0 && p.size_mm[1] > 0.0, "size_mm must be positive");
   require(p.feed_mm_min > 0.0, "feed_mm_min must be positive");
   require(p.repeats >= 1, "repeats must be at least 1");
-  const PlaneAxes ax = plane_axes(p.plane);
+  const PlaneWords ax = plane_axes(p.plane);
   const double x0 = p.corner_mm[0], y0 = p.corner_mm[1], x1 = x0 + p.size_mm[0], y1 = y0 + p.size_mm[1];
-  const std::string f = " F" + fmt("%.0f", p.feed_mm_min);
-  const std::string dwell = "G4 P" + fmt("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.2) + "\n";
+  const std::string f = " F" + format_number("%.0f", p.feed_mm_min);
+  const std::string dwell = "G4 P" + format_number("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.2) + "\n";
   auto go = [&](double a, double b) { return std::string("G1 ") + ax.a + num(a) + " " + ax.b + num(b) + f + "\nM102\n" + dwell; };
   std::string g = header("rectangle, exact stop at the corners", ax.g, true);
   g += std::string("G0 ") + ax.a + num(x0) + " " + ax.b + num(y0) + "\n";
@@ -190,11 +186,11 @@ std::string identify_program(const IdentifyPlan& plan, const RestTimes& rest) {
   require(plan.swing_mm > 0.0 && !plan.feeds_mm_min.empty(), "identify needs a swing and feeds");
   const double half = plan.swing_mm / 2.0;
   std::string g = header("on-site identification: swings across the PSD strips at rising feeds", "G17", true);
-  const std::string dwell = "M102\nG4 P" + fmt("%.3g", plan.dwell_s) + "\n";
+  const std::string dwell = "M102\nG4 P" + format_number("%.3g", plan.dwell_s) + "\n";
   auto swings = [&](char a, double centre) {
     std::string s;
     for (double feed : plan.feeds_mm_min) {
-      const std::string f = " F" + fmt("%.0f", feed);
+      const std::string f = " F" + format_number("%.0f", feed);
       s += std::string("G1 ") + a + num(centre + half) + f + "\n" + dwell;
       s += std::string("G1 ") + a + num(centre - half) + f + "\n" + dwell;
     }
@@ -221,7 +217,7 @@ std::string identify_program(const IdentifyPlan& plan, const RestTimes& rest) {
     g += std::string("G91 G1 ") + a + num(-half) + " F3000\nG90\n" + dwell;  // from where it is: relative
     // Back to absolute coordinates is unknown here, so the swings stay relative too.
     for (double feed : plan.feeds_mm_min) {
-      const std::string f = " F" + fmt("%.0f", feed);
+      const std::string f = " F" + format_number("%.0f", feed);
       g += std::string("G91 G1 ") + a + num(2.0 * half) + f + "\nG90\n" + dwell;
       g += std::string("G91 G1 ") + a + num(-2.0 * half) + f + "\nG90\n" + dwell;
     }

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-namespace eical::sim {
+namespace eical::tools {
 
 struct ThesisCheck {
   std::string name;       // what is compared
@@ -28,4 +28,4 @@ struct ValidationOptions {
 
 std::vector<ThesisCheck> validate_against_thesis(const ValidationOptions& options = {});
 
-}  // namespace eical::sim
+}  // namespace eical::tools

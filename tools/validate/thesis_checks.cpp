@@ -1,4 +1,4 @@
-#include "sim/validate/thesis_checks.hpp"
+#include "tools/validate/thesis_checks.hpp"
 
 #include "dsp/analysis/analyze_run.hpp"
 #include "sim/simulate.hpp"
@@ -7,7 +7,10 @@
 #include <cmath>
 #include <numeric>
 
-namespace eical::sim {
+namespace eical::tools {
+// The simulator's scenarios and physics are what every check is made of.
+using namespace eical::sim;
+
 namespace {
 
 constexpr double kUg = 1e-6;
@@ -214,4 +217,4 @@ std::vector<ThesisCheck> validate_against_thesis(const ValidationOptions& o) {
   return rows;
 }
 
-}  // namespace eical::sim
+}  // namespace eical::tools

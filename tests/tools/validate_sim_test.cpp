@@ -1,10 +1,10 @@
 // Issue 3's proof: the simulator reproduces the thesis' figures within the stated
 // tolerances (the table `eical validate-sim` prints).
-#include "sim/validate/thesis_checks.hpp"
+#include "tools/validate/thesis_checks.hpp"
 
 #include <gtest/gtest.h>
 
-namespace eical::sim {
+namespace eical::tools {
 namespace {
 
 TEST(ValidateSim, EveryThesisFigureWithinItsTolerance) {
@@ -19,4 +19,4 @@ TEST(ValidateSim, EveryThesisFigureWithinItsTolerance) {
 }
 
 }  // namespace
-}  // namespace eical::sim
+}  // namespace eical::tools
