@@ -25,8 +25,9 @@ const char* yes(bool b) { return b ? "yes" : "NO"; }
 void print_row(const std::string& name, const FaultOutcome& o) {
   char recovery[32] = "-";
   if (std::isfinite(o.recovery_s)) std::snprintf(recovery, sizeof recovery, "%.3f s", o.recovery_s);
-  std::printf("%-28s %-5s %-7s %-5s %3zu/%-3zu %3zu %9s  %s\n", name.c_str(), yes(o.service_alive), o.flagged ? "yes" : "-",
-              o.clean ? "yes" : "-", o.runs_intact, o.runs_before, o.runs_after, recovery, o.data_lost.c_str());
+  std::printf("%-28s %-5s %-7s %-5s %3zu/%-3zu %3zu %9s  %s\n", name.c_str(), yes(o.service_alive),
+              o.flagged ? "yes" : "-", o.clean ? "yes" : "-", o.runs_intact, o.runs_before, o.runs_after, recovery,
+              o.data_lost.c_str());
   std::printf("%-28s   %s: %s\n", "", o.fault.c_str(), o.outcome.c_str());
   for (const auto& p : o.problems) std::printf("%-28s   PROBLEM: %s\n", "", p.c_str());
   std::fflush(stdout);
@@ -39,7 +40,9 @@ void print_fuzz(const fs::path& dir) {
   for (const auto& e : fs::directory_iterator(dir))
     if (e.is_directory() && fs::exists(e.path() / "log")) targets.push_back(e.path());
   std::sort(targets.begin(), targets.end());
-  std::printf("\nfuzzing (scripts/fuzz-long, %s): target, minutes, executions, cov, ft, oom/timeout/crash, findings kept\n", dir.c_str());
+  std::printf(
+      "\nfuzzing (scripts/fuzz-long, %s): target, minutes, executions, cov, ft, oom/timeout/crash, findings kept\n",
+      dir.c_str());
   const std::regex line(R"(^#(\d+):?\s.*cov: (\d+) ft: (\d+).*)");
   const std::regex fork(R"(oom/timeout/crash: (\d+/\d+/\d+) time: (\d+)s)");
   unsigned long long total = 0;
@@ -56,7 +59,8 @@ void print_fuzz(const fs::path& dir) {
       for ([[maybe_unused]] const auto& a : fs::directory_iterator(t / "artifacts")) ++kept;
     if (execs != "?") total += std::stoull(execs);
     const double minutes = secs == "?" ? std::nan("") : std::stod(secs) / 60.0;
-    std::printf("  %-20s %5.1f  %12s  %5s  %6s  %-7s  %zu\n", t.filename().c_str(), minutes, execs.c_str(), cov.c_str(), ft.c_str(), oom.c_str(), kept);
+    std::printf("  %-20s %5.1f  %12s  %5s  %6s  %-7s  %zu\n", t.filename().c_str(), minutes, execs.c_str(), cov.c_str(),
+                ft.c_str(), oom.c_str(), kept);
   }
   std::printf("  all targets: %llu executions\n", total);
 }
@@ -70,7 +74,8 @@ int main(int argc, char** argv) {
   app.add_option("--cases", only, "cases to run (default: all)")->delimiter(',');
   app.add_option("--fuzz", fuzz_dir, "a scripts/fuzz-long work directory: print its totals");
   CLI11_PARSE(app, argc, argv);
-  std::printf("%-28s %-5s %-7s %-5s %-7s %3s %9s  %s\n", "fault", "alive", "flagged", "clean", "intact", "new", "recovery", "data lost");
+  std::printf("%-28s %-5s %-7s %-5s %-7s %3s %9s  %s\n", "fault", "alive", "flagged", "clean", "intact", "new",
+              "recovery", "data lost");
   int failed = 0;
   for (const auto& c : eical::faults::all_cases()) {
     if (!only.empty() && std::find(only.begin(), only.end(), c.name) == only.end()) continue;
@@ -78,8 +83,11 @@ int main(int argc, char** argv) {
     failed += o.problems.empty() ? 0 : 1;
     print_row(c.name, o);
   }
-  std::printf("alive: measuring again afterwards; flagged: a degraded result or Status.fault names the cause; clean: no temporary or torn\n"
-              "run left; intact: completed runs before the fault unchanged byte for byte / runs before; new: runs written during and after.\n");
+  std::printf(
+      "alive: measuring again afterwards; flagged: a degraded result or Status.fault names the cause; clean: no "
+      "temporary or torn\n"
+      "run left; intact: completed runs before the fault unchanged byte for byte / runs before; new: runs written "
+      "during and after.\n");
   if (!fuzz_dir.empty()) print_fuzz(fuzz_dir);
   return failed == 0 ? 0 : 1;
 }

@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -24,7 +25,6 @@
 #include <filesystem>
 #include <functional>
 #include <random>
-#include <sys/stat.h>
 
 namespace {
 
@@ -32,30 +32,53 @@ namespace fs = std::filesystem;
 using eical::history::Record;
 using Clock = std::chrono::steady_clock;
 
-const char* const kFigures[] = {
-    "circle.circular_deviation_G_um", "circle.radial_deviation_F_max_um", "circle.radial_deviation_F_min_um",
-    "circle.radius_mean_deviation_um", "circle.circular_hysteresis_H_um", "diagnostics.backlash_x_um", "diagnostics.backlash_y_um",
-    "diagnostics.cyclic_error_x_um", "diagnostics.cyclic_error_y_um", "diagnostics.cyclic_pitch_mm", "diagnostics.lateral_play_x_um",
-    "diagnostics.lateral_play_y_um", "diagnostics.model_residual_rms_um", "diagnostics.reversal_spike_x_um",
-    "diagnostics.reversal_spike_y_um", "diagnostics.scale_mismatch_ppm", "diagnostics.servo_lag_x_ms", "diagnostics.servo_lag_y_ms",
-    "diagnostics.servo_mismatch_ms", "diagnostics.squareness_urad", "diagnostics.stick_slip_um", "diagnostics.straightness_x_um",
-    "diagnostics.straightness_y_um", "diagnostics.vibration_um", "reference_comparison.radius_deviation_error_rms_um",
-    "reference_comparison.reference_circular_deviation_G_um", "reference_comparison.reference_radius_mean_deviation_um"};
+const char* const kFigures[] = {"circle.circular_deviation_G_um",
+                                "circle.radial_deviation_F_max_um",
+                                "circle.radial_deviation_F_min_um",
+                                "circle.radius_mean_deviation_um",
+                                "circle.circular_hysteresis_H_um",
+                                "diagnostics.backlash_x_um",
+                                "diagnostics.backlash_y_um",
+                                "diagnostics.cyclic_error_x_um",
+                                "diagnostics.cyclic_error_y_um",
+                                "diagnostics.cyclic_pitch_mm",
+                                "diagnostics.lateral_play_x_um",
+                                "diagnostics.lateral_play_y_um",
+                                "diagnostics.model_residual_rms_um",
+                                "diagnostics.reversal_spike_x_um",
+                                "diagnostics.reversal_spike_y_um",
+                                "diagnostics.scale_mismatch_ppm",
+                                "diagnostics.servo_lag_x_ms",
+                                "diagnostics.servo_lag_y_ms",
+                                "diagnostics.servo_mismatch_ms",
+                                "diagnostics.squareness_urad",
+                                "diagnostics.stick_slip_um",
+                                "diagnostics.straightness_x_um",
+                                "diagnostics.straightness_y_um",
+                                "diagnostics.vibration_um",
+                                "reference_comparison.radius_deviation_error_rms_um",
+                                "reference_comparison.reference_circular_deviation_G_um",
+                                "reference_comparison.reference_radius_mean_deviation_um"};
 
 // A circle result document as the store keeps it (trace thinned to 720 points).
 std::string document(std::mt19937& rng, int k) {
   std::normal_distribution<double> n(0.0, 0.3);
-  nlohmann::json t = {{"angle_deg", nlohmann::json::array()}, {"radius_deviation_um", nlohmann::json::array()},
-                      {"direction", nlohmann::json::array()}, {"stored_every", 5}};
+  nlohmann::json t = {{"angle_deg", nlohmann::json::array()},
+                      {"radius_deviation_um", nlohmann::json::array()},
+                      {"direction", nlohmann::json::array()},
+                      {"stored_every", 5}};
   for (int i = 0; i < 720; ++i) {
     const double a = std::fmod(i * 1.0, 360.0);
     t["angle_deg"].push_back(std::round(a * 1000) / 1000);
     t["radius_deviation_um"].push_back(std::round((2.0 * std::sin(2 * a * M_PI / 180) + n(rng)) * 1000) / 1000);
     t["direction"].push_back(i < 360 ? "ccw" : "cw");
   }
-  nlohmann::json d = {{"format", "eical-result/1"}, {"run_id", "template-" + std::to_string(k)}, {"program", "circle"},
-                      {"quality", {{"degraded", false}, {"verdict", "ok"}, {"flags", nlohmann::json::array()}}},
-                      {"circle", {{"plane", "xy"}, {"radius_nominal_mm", 10.0}, {"feed_mm_min", 2500.0}, {"trace", t}}}};
+  nlohmann::json d = {
+      {"format", "eical-result/1"},
+      {"run_id", "template-" + std::to_string(k)},
+      {"program", "circle"},
+      {"quality", {{"degraded", false}, {"verdict", "ok"}, {"flags", nlohmann::json::array()}}},
+      {"circle", {{"plane", "xy"}, {"radius_nominal_mm", 10.0}, {"feed_mm_min", 2500.0}, {"trace", t}}}};
   nlohmann::json u = nlohmann::json::object();
   for (const char* f : kFigures) u[f] = 0.4;
   d["uncertainty_k2"] = u;
@@ -88,7 +111,8 @@ Timing run(const std::string& location, std::size_t results, int machines, std::
     r.machine = "machine-" + std::to_string(i % static_cast<std::size_t>(machines));
     r.run_id = "run-" + std::to_string(i);
     r.program = "circle";
-    const std::time_t t = 1767225600 + static_cast<std::time_t>(i / static_cast<std::size_t>(machines)) * 3600;  // from 2026-01-01
+    const std::time_t t =
+        1767225600 + static_cast<std::time_t>(i / static_cast<std::size_t>(machines)) * 3600;  // from 2026-01-01
     std::tm tm{};
     gmtime_r(&t, &tm);
     char b[32];
@@ -110,7 +134,9 @@ Timing run(const std::string& location, std::size_t results, int machines, std::
   const std::size_t n_single = std::min(single, results);
   auto t0 = Clock::now();
   for (std::size_t i = 0; i < n_single; ++i) store->add(make(i));
-  t.single_ms = n_single ? std::chrono::duration<double, std::milli>(Clock::now() - t0).count() / static_cast<double>(n_single) : 0;
+  t.single_ms =
+      n_single ? std::chrono::duration<double, std::milli>(Clock::now() - t0).count() / static_cast<double>(n_single)
+               : 0;
   double inserting_s = 0;
   for (std::size_t first = n_single; first < results; first += batch) {
     std::vector<Record> rs;
@@ -118,7 +144,8 @@ Timing run(const std::string& location, std::size_t results, int machines, std::
     t0 = Clock::now();
     store->add_many(rs);
     inserting_s += std::chrono::duration<double>(Clock::now() - t0).count();
-    if ((first / batch) % 10 == 0) std::fprintf(stderr, "\r  %zu of %zu inserted ", first + rs.size(), results), std::fflush(stderr);
+    if ((first / batch) % 10 == 0)
+      std::fprintf(stderr, "\r  %zu of %zu inserted ", first + rs.size(), results), std::fflush(stderr);
   }
   std::fprintf(stderr, "\r%40s\r", "");
   t.batched_s = inserting_s;
@@ -137,13 +164,15 @@ Timing run(const std::string& location, std::size_t results, int machines, std::
       return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     });
   };
-  t.trend_machine_ms = fresh([&](eical::history::Store& s) { t.trend_machine_points = s.trend(figure, {.machine = "machine-7"}).size(); });
+  t.trend_machine_ms = fresh(
+      [&](eical::history::Store& s) { t.trend_machine_points = s.trend(figure, {.machine = "machine-7"}).size(); });
   t.trend_fleet_ms = fresh([&](eical::history::Store& s) { t.trend_fleet_points = s.trend(figure, {}).size(); });
   t.latest_ms = fresh([&](eical::history::Store& s) { (void)s.list({.machine = "machine-7", .limit = 20}); });
   return t;
 }
 
-void print(const char* name, const Timing& t, std::size_t results, std::size_t batched, std::size_t single, const std::string& size) {
+void print(const char* name, const Timing& t, std::size_t results, std::size_t batched, std::size_t single,
+           const std::string& size) {
   std::printf("%s:\n", name);
   std::printf("  insert, one commit per result (first %zu):   %8.2f ms per result\n", single, t.single_ms);
   std::printf("  insert, %zu results in batches:           %8.1f s  = %.0f results/s\n", batched, t.batched_s,
@@ -172,7 +201,8 @@ int main(int argc, char** argv) {
   app.add_option("--machines", machines, "machines they come from")->check(CLI::PositiveNumber);
   app.add_option("--batch", batch, "results per transaction when batched")->check(CLI::PositiveNumber);
   app.add_option("--single", single, "results first inserted one commit each");
-  app.add_option("--store", which, "sqlite, postgresql or both")->check(CLI::IsMember({"sqlite", "postgresql", "both"}));
+  app.add_option("--store", which, "sqlite, postgresql or both")
+      ->check(CLI::IsMember({"sqlite", "postgresql", "both"}));
   CLI11_PARSE(app, argc, argv);
   std::printf("%zu circle results of %d machines, 27 figures each with its uncertainty\n", results, machines);
   const std::size_t batched = results - std::min(single, results);
@@ -192,7 +222,8 @@ int main(int argc, char** argv) {
     const Timing t = run(uri, results, machines, batch, single);
     auto store = eical::history::Store::open(uri);
     const auto rows = store->connection().query("SELECT pg_database_size(current_database())");
-    print("PostgreSQL 15 (local, Unix socket, fsync on)", t, results, batched, single, megabytes(std::stod(rows.at(0).at(0).value_or("0"))));
+    print("PostgreSQL 15 (local, Unix socket, fsync on)", t, results, batched, single,
+          megabytes(std::stod(rows.at(0).at(0).value_or("0"))));
   }
   return 0;
 }

@@ -7,13 +7,13 @@
 //
 //   bench_live_latency [--duration 600] [--load 1] [--rt-priority 80] [--json]
 #include "daemon/service/service.hpp"
+#include "daemon/system/realtime.hpp"
 #include "drivers/dds/bus.hpp"
 #include "drivers/dds/domain_claim.hpp"
-#include "daemon/system/realtime.hpp"
 #include "drivers/source/stamped_source.hpp"
 
-#include <CLI/CLI.hpp>
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -31,9 +31,11 @@ int main(int argc, char** argv) {
   bool json = false;
   app.add_option("--duration", duration_s, "seconds to measure")->default_val(600.0)->check(CLI::PositiveNumber);
   app.add_option("--load", load_threads, "busy threads loading the other core(s)")->default_val(0);
-  app.add_option("--rt-priority", rt_priority,
-                 "SCHED_FIFO priority of eicald's DSP thread (publisher 10 below); the subscriber, as a real-time HMI would, "
-                 "runs 20 below (0 = all normal)")->default_val(0);
+  app.add_option(
+         "--rt-priority", rt_priority,
+         "SCHED_FIFO priority of eicald's DSP thread (publisher 10 below); the subscriber, as a real-time HMI would, "
+         "runs 20 below (0 = all normal)")
+      ->default_val(0);
   app.add_option("--domain", domain, "DDS domain (default: derived from the pid)");
   app.add_flag("--json", json, "print one JSON object");
   CLI11_PARSE(app, argc, argv);
@@ -41,8 +43,8 @@ int main(int argc, char** argv) {
 
   const auto dir = std::filesystem::temp_directory_path() / ("eical-bench-latency-" + std::to_string(::getpid()));
   eical::daemon::DaemonConfig c;
-  c.source.pacing = "realtime";          // 10 kHz on the sample clock, like the DAQ
-  c.source.sim_repeat_program = true;    // measurements keep running: the DSP thread integrates
+  c.source.pacing = "realtime";        // 10 kHz on the sample clock, like the DAQ
+  c.source.sim_repeat_program = true;  // measurements keep running: the DSP thread integrates
   c.source.sim_repeats = 2;
   c.source.sim_idle_s = 1.0;
   c.recording.dir = dir;
@@ -84,13 +86,15 @@ int main(int argc, char** argv) {
     // Discovery first: the measurement starts with the first Live received.
     const auto first_deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
     bool started = false;
-    while (!started && std::chrono::steady_clock::now() < first_deadline) started = hmi.take_live(std::chrono::milliseconds(200)).has_value();
+    while (!started && std::chrono::steady_clock::now() < first_deadline)
+      started = hmi.take_live(std::chrono::milliseconds(200)).has_value();
     if (!started) {
       std::fprintf(stderr, "no Live sample within 30 s\n");
       std::exit(2);
     }
     overruns_at_start = overruns.load();
-    const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(duration_s));
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                            std::chrono::duration<double>(duration_s));
     while (std::chrono::steady_clock::now() < end) {
       const auto l = hmi.take_live(std::chrono::milliseconds(200));
       if (!l) continue;
@@ -114,16 +118,20 @@ int main(int argc, char** argv) {
     return 2;
   }
   std::sort(latency_ms.begin(), latency_ms.end());
-  auto pct = [&](double p) { return latency_ms[std::min(latency_ms.size() - 1, static_cast<std::size_t>(p * static_cast<double>(latency_ms.size())))]; };
+  auto pct = [&](double p) {
+    return latency_ms[std::min(latency_ms.size() - 1,
+                               static_cast<std::size_t>(p * static_cast<double>(latency_ms.size())))];
+  };
   const double p50 = pct(0.50), p99 = pct(0.99), pmax = latency_ms.back();
   if (json) {
-    std::printf("{\"duration_s\": %.1f, \"load_threads\": %d, \"rt_priority\": %d, \"samples\": %zu, \"unstamped\": %llu, "
-                "\"p50_ms\": %.4f, \"p99_ms\": %.4f, \"max_ms\": %.4f, \"overruns\": %llu, \"frames\": %llu}\n",
-                duration_s, load_threads, rt_priority, latency_ms.size(), static_cast<unsigned long long>(unstamped), p50, p99, pmax,
-                static_cast<unsigned long long>(overruns_measured), static_cast<unsigned long long>(frames.load()));
+    std::printf(
+        "{\"duration_s\": %.1f, \"load_threads\": %d, \"rt_priority\": %d, \"samples\": %zu, \"unstamped\": %llu, "
+        "\"p50_ms\": %.4f, \"p99_ms\": %.4f, \"max_ms\": %.4f, \"overruns\": %llu, \"frames\": %llu}\n",
+        duration_s, load_threads, rt_priority, latency_ms.size(), static_cast<unsigned long long>(unstamped), p50, p99,
+        pmax, static_cast<unsigned long long>(overruns_measured), static_cast<unsigned long long>(frames.load()));
   } else {
-    std::printf("sample -> Live latency over %.0f s at 10 kHz, %d busy thread(s), SCHED_FIFO %d: %zu Live samples\n", duration_s,
-                load_threads, rt_priority, latency_ms.size());
+    std::printf("sample -> Live latency over %.0f s at 10 kHz, %d busy thread(s), SCHED_FIFO %d: %zu Live samples\n",
+                duration_s, load_threads, rt_priority, latency_ms.size());
     std::printf("  p50 %.3f ms   p99 %.3f ms   max %.3f ms   overruns %llu   frames %llu\n", p50, p99, pmax,
                 static_cast<unsigned long long>(overruns_measured), static_cast<unsigned long long>(frames.load()));
   }

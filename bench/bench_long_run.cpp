@@ -21,10 +21,10 @@
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/stream/analyze_stream.hpp"
 
-#include <CLI/CLI.hpp>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <CLI/CLI.hpp>
 
 #include <chrono>
 #include <cmath>
@@ -118,9 +118,10 @@ std::string outcome(int status) {
 
 void print(const char* what, double minutes, std::size_t samples, const Usage& u, const std::string& extra = "") {
   const double data_s = minutes * 60.0;
-  std::printf("%-24s %6.1f min %9zu samples  wall %7.2f s (%6.1fx real time)  cpu %7.2f s (%6.1fx)  peak RSS %7.1f MB%s%s\n", what,
-              minutes, samples, u.wall_s, data_s / u.wall_s, u.user_s + u.sys_s, data_s / (u.user_s + u.sys_s), u.peak_mb,
-              extra.c_str(), outcome(u.status).c_str());
+  std::printf(
+      "%-24s %6.1f min %9zu samples  wall %7.2f s (%6.1fx real time)  cpu %7.2f s (%6.1fx)  peak RSS %7.1f MB%s%s\n",
+      what, minutes, samples, u.wall_s, data_s / u.wall_s, u.user_s + u.sys_s, data_s / (u.user_s + u.sys_s), u.peak_mb,
+      extra.c_str(), outcome(u.status).c_str());
   std::fflush(stdout);
 }
 
@@ -151,11 +152,13 @@ int main(int argc, char** argv) {
     // about 113 s each; the minute-long run turns at F2000.
     const double feed = m < 2.0 ? 2000.0 : 1000.0;
     const int repeats = std::max(1, static_cast<int>(std::lround(m * 60.0 / (feed < 1500.0 ? 113.1 : 56.5))));
-    const fs::path run = base / ("circle-r150-f" + std::to_string(static_cast<int>(feed)) + "-both-x" + std::to_string(repeats));
+    const fs::path run =
+        base / ("circle-r150-f" + std::to_string(static_cast<int>(feed)) + "-both-x" + std::to_string(repeats));
     if (!fs::exists(run / "run.toml")) {
       const Usage s = in_child([&] {
-        return run_command({eical, "simulate", "--program", "circle", "--radius", "150", "--feed", std::to_string(static_cast<int>(feed)),
-                            "--direction", "both", "--repeats", std::to_string(repeats), "-o", run.string(), "--overwrite"});
+        return run_command({eical, "simulate", "--program", "circle", "--radius", "150", "--feed",
+                            std::to_string(static_cast<int>(feed)), "--direction", "both", "--repeats",
+                            std::to_string(repeats), "-o", run.string(), "--overwrite"});
       });
       if (s.status != 0) {
         std::fprintf(stderr, "bench_long_run: eical simulate failed\n");
@@ -176,7 +179,9 @@ int main(int argc, char** argv) {
     // A test that is not measurable gets a measurable variant suggested (eical plan: short
     // simulated runs analysed whole, whatever the recording's length); without it, the
     // analysis of the recording alone.
-    const Usage bare = in_child([&] { return run_command({eical, "analyze", run.string(), "--json", "--no-suggest"}); });
+    const Usage bare = in_child([&] {
+      return run_command({eical, "analyze", run.string(), "--json", "--no-suggest"});
+    });
     print("eical analyze --no-suggest", data_min, rows, bare);
     if (!no_daemon) {
       // The recorder's frames in memory, then eicald's evaluation over them; the pipe
@@ -199,8 +204,8 @@ int main(int argc, char** argv) {
             ::getrusage(RUSAGE_SELF, &a);
             const auto t0 = std::chrono::steady_clock::now();
             eical::dsp::StoredFrames frames(r.frames);
-            const eical::dsp::Analysis an =
-                eical::dsp::analyze_stream(r, frames, {}, {eical::drivers::file_spills(eical::drivers::default_spill_dir())});
+            const eical::dsp::Analysis an = eical::dsp::analyze_stream(
+                r, frames, {}, {eical::drivers::file_spills(eical::drivers::default_spill_dir())});
             in.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             ::getrusage(RUSAGE_SELF, &b);
             in.peak_mb = peak_mb();
@@ -218,8 +223,8 @@ int main(int argc, char** argv) {
       eval.wall_s = in.wall_s, eval.user_s = in.cpu_s, eval.sys_s = 0.0;
       if (ev.status == 0) eval.status = in.status << 8;  // the verdict, as eical analyze's exit status
       char extra[160];
-      std::snprintf(extra, sizeof extra, "  (the frames %.1f MB; with the evaluation %.1f MB: %.1f MB over them)", in.frames_mb, in.peak_mb,
-                    in.peak_mb - in.frames_mb);
+      std::snprintf(extra, sizeof extra, "  (the frames %.1f MB; with the evaluation %.1f MB: %.1f MB over them)",
+                    in.frames_mb, in.peak_mb, in.peak_mb - in.frames_mb);
       print("eicald eval", data_min, rows, eval, extra);
     }
     if (!keep) fs::remove_all(run);

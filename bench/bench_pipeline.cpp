@@ -107,6 +107,7 @@ int main(int argc, char** argv) {
   (void)circle_run();  // simulate before anything is timed or counted
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
-  std::printf("heap allocations after start-up: %zu over %zu frames stepped\n", g_allocations.load(), g_frames_counted.load());
+  std::printf("heap allocations after start-up: %zu over %zu frames stepped\n", g_allocations.load(),
+              g_frames_counted.load());
   return g_allocations.load() == 0 ? 0 : 1;
 }

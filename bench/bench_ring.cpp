@@ -29,8 +29,10 @@ T make(std::int64_t i) {
 
 template <class T>
 std::int64_t key(const T& v) {
-  if constexpr (std::is_same_v<T, eical::dsp::Frame>) return v.sample_index;
-  else return static_cast<std::int64_t>(v);
+  if constexpr (std::is_same_v<T, eical::dsp::Frame>)
+    return v.sample_index;
+  else
+    return static_cast<std::int64_t>(v);
 }
 
 template <class T>

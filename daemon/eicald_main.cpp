@@ -5,19 +5,19 @@
 #include "daemon/config/daemon_config.hpp"
 #include "daemon/service/preflight.hpp"
 #include "daemon/service/service.hpp"
-#include "daemon/triggers/trigger_input.hpp"
-#include "drivers/config/sensor_calibration.hpp"
 #include "daemon/system/log.hpp"
 #include "daemon/system/notify.hpp"
+#include "daemon/triggers/trigger_input.hpp"
+#include "drivers/config/sensor_calibration.hpp"
 #include "drivers/source/source.hpp"
 #include "dsp/core/error.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <malloc.h>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
-#include <malloc.h>
 #include <thread>
 #include <vector>
 
@@ -35,7 +35,8 @@ int check_config(const std::string& file, const eical::daemon::DaemonConfig& con
     fine.push_back("source '" + std::string(source->name()) + "' opens");
     if (!config.calibration_file.empty()) {
       const auto cal = eical::drivers::read_sensor_calibration(config.calibration_file, source->meta());
-      fine.push_back("calibration " + config.calibration_file.string() + " (" + cal.method + ", from run " + cal.run_id + ") reads");
+      fine.push_back("calibration " + config.calibration_file.string() + " (" + cal.method + ", from run " +
+                     cal.run_id + ") reads");
     }
   } catch (const std::exception& e) {
     problems.push_back(std::string("source: ") + e.what());
@@ -49,13 +50,15 @@ int check_config(const std::string& file, const eical::daemon::DaemonConfig& con
       problems.push_back(std::string("triggers: ") + e.what() + " ([triggers] inputs)");
     }
   }
-  for (auto problem : {recording_dir_problem(config.recording.dir), dds_config_problem(config.dds), setpoint_problem(config.setpoint)})
+  for (auto problem :
+       {recording_dir_problem(config.recording.dir), dds_config_problem(config.dds), setpoint_problem(config.setpoint)})
     if (problem) problems.push_back(*problem);
   for (const auto& p : problems) log(LogLevel::error, "%s: %s", file.c_str(), p.c_str());
   if (!problems.empty()) return 3;
   std::string summary;
   for (const auto& f : fine) summary += "; " + f;
-  std::printf("%s: configuration valid%s; recording path %s writable\n", file.c_str(), summary.c_str(), config.recording.dir.c_str());
+  std::printf("%s: configuration valid%s; recording path %s writable\n", file.c_str(), summary.c_str(),
+              config.recording.dir.c_str());
   return 0;
 }
 
@@ -84,7 +87,7 @@ int main(int argc, char** argv) {
   }
   if (check) return check_config(config_file, config);
 
-  struct sigaction sa{};
+  struct sigaction sa {};
   sa.sa_handler = on_signal;
   sigemptyset(&sa.sa_mask);
   sigaction(SIGTERM, &sa, nullptr);
@@ -115,8 +118,10 @@ int main(int argc, char** argv) {
                     static_cast<unsigned long long>(s.frames), static_cast<unsigned long long>(s.overruns),
                     static_cast<unsigned long long>(s.frames_lost), static_cast<unsigned long long>(s.results_written),
                     s.fault.empty() ? "" : "; last error: ", s.fault.c_str());
-      if (!ready) notifier.ready(line), ready = true;
-      else notifier.status(line);
+      if (!ready)
+        notifier.ready(line), ready = true;
+      else
+        notifier.status(line);
     });
   } catch (const eical::drivers::SourceError& e) {
     log(LogLevel::error, "source: %s", e.what());

@@ -19,8 +19,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto again = drivers::dds::decode_command(drivers::dds::encode_command(*cmd), &why);
   if (!again) eical::fuzz::finding("an accepted command does not survive encode + decode: " + why);
   const auto bits_equal = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
-  if (again->sender != cmd->sender || again->action != cmd->action || again->request_id != cmd->request_id || again->code != cmd->code ||
-      !bits_equal(again->p, cmd->p) || !bits_equal(again->q, cmd->q) || again->time_ns != cmd->time_ns)
+  if (again->sender != cmd->sender || again->action != cmd->action || again->request_id != cmd->request_id ||
+      again->code != cmd->code || !bits_equal(again->p, cmd->p) || !bits_equal(again->q, cmd->q) ||
+      again->time_ns != cmd->time_ns)
     eical::fuzz::finding("encode + decode changed the command");
   return 0;
 }

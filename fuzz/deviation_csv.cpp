@@ -7,6 +7,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace eical;
   const auto file = fuzz::write_input("deviations.csv", fuzz::as_text(data, size));
-  fuzz::expect_clean(file.string(), [&] { (void)dsp::eval::evaluate_positioning(tools::read_deviation_csv(file.string())); });
+  fuzz::expect_clean(file.string(),
+                     [&] { (void)dsp::eval::evaluate_positioning(tools::read_deviation_csv(file.string())); });
   return 0;
 }

@@ -7,6 +7,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace eical;
   const auto file = fuzz::write_input("iso230-2.dat", fuzz::as_text(data, size));
-  fuzz::expect_clean(file.string(), [&] { (void)dsp::eval::evaluate_positioning(tools::read_ecmc_dat(file.string())); });
+  fuzz::expect_clean(file.string(),
+                     [&] { (void)dsp::eval::evaluate_positioning(tools::read_ecmc_dat(file.string())); });
   return 0;
 }

@@ -1,10 +1,10 @@
 #include "fuzz/fuzz_support.hpp"
 
+#include <unistd.h>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <system_error>
-#include <unistd.h>
 
 namespace eical::fuzz {
 namespace fs = std::filesystem;
@@ -12,9 +12,12 @@ namespace {
 
 fs::path make_scratch() {
   fs::path base;
-  if (const char* env = std::getenv("EICAL_FUZZ_SCRATCH"); env && *env) base = env;
-  else if (fs::is_directory("/dev/shm") && ::access("/dev/shm", W_OK) == 0) base = "/dev/shm";
-  else base = fs::temp_directory_path();
+  if (const char* env = std::getenv("EICAL_FUZZ_SCRATCH"); env && *env)
+    base = env;
+  else if (fs::is_directory("/dev/shm") && ::access("/dev/shm", W_OK) == 0)
+    base = "/dev/shm";
+  else
+    base = fs::temp_directory_path();
   fs::path dir = base / ("eical-fuzz-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir;

@@ -10,8 +10,8 @@
 namespace eical::fuzz {
 
 // `nc`: an NC trace, whose gaps the importer bridges on the grid (bridge_gaps).
-inline void to_uniform_clock(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, const std::string& source,
-                             bool nc = false) {
+inline void to_uniform_clock(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values,
+                             const std::string& source, bool nc = false) {
   const drivers::UniformClock clock = drivers::fit_uniform_clock(t_s, source);
   if (!(clock.fs_hz > 0.0) || !std::isfinite(clock.fs_hz)) finding("a clock whose rate is not positive and finite");
   const drivers::UniformSeries s = drivers::resample(t_s, values, clock);

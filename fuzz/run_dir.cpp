@@ -40,7 +40,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view samples = cut(rest, kTruth);
   fuzz::write_input("run/run.toml", toml);
   if (has_samples) {
-    const bool gz = samples.size() >= 2 && static_cast<unsigned char>(samples[0]) == 0x1f && static_cast<unsigned char>(samples[1]) == 0x8b;
+    const bool gz = samples.size() >= 2 && static_cast<unsigned char>(samples[0]) == 0x1f &&
+                    static_cast<unsigned char>(samples[1]) == 0x8b;
     fuzz::write_input(gz ? "run/samples.csv.gz" : "run/samples.csv", samples);
   }
   if (has_truth) fuzz::write_input("run/truth.toml", rest);
@@ -48,7 +49,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const dsp::Run run = drivers::read_run(dir);
     // What the pipeline relies on from an accepted run.
     if (run.frames.empty()) fuzz::finding("a run without frames was accepted");
-    if (!(run.meta.acquisition.fs_hz > 0.0) || !std::isfinite(run.meta.acquisition.fs_hz)) fuzz::finding("fs_hz not positive and finite");
+    if (!(run.meta.acquisition.fs_hz > 0.0) || !std::isfinite(run.meta.acquisition.fs_hz))
+      fuzz::finding("fs_hz not positive and finite");
     for (std::size_t i = 1; i < run.frames.size(); ++i)
       if (run.frames[i].sample_index <= run.frames[i - 1].sample_index) fuzz::finding("sample index does not increase");
   });

@@ -50,16 +50,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::size_t k = 0;
   const Decoded pieces = decode(psd_count, bytes, [&] { return 1 + (chunk_seed + 7 * k++) % 61; });
   if (whole.frames.size() != pieces.frames.size())
-    fuzz::finding("16 KiB transfers gave " + std::to_string(whole.frames.size()) + " frames, small chunks " + std::to_string(pieces.frames.size()));
+    fuzz::finding("16 KiB transfers gave " + std::to_string(whole.frames.size()) + " frames, small chunks " +
+                  std::to_string(pieces.frames.size()));
   for (std::size_t i = 0; i < whole.frames.size(); ++i) {
-    if (!same(whole.frames[i], pieces.frames[i])) fuzz::finding("frame " + std::to_string(i) + " differs between chunkings");
-    if (i > 0 && whole.frames[i].sample_index <= whole.frames[i - 1].sample_index) fuzz::finding("sample index does not increase");
+    if (!same(whole.frames[i], pieces.frames[i]))
+      fuzz::finding("frame " + std::to_string(i) + " differs between chunkings");
+    if (i > 0 && whole.frames[i].sample_index <= whole.frames[i - 1].sample_index)
+      fuzz::finding("sample index does not increase");
     if (!(whole.frames[i].flags & dsp::frame_flag::cmd_missing)) fuzz::finding("a DAQ frame without cmd_missing");
   }
   const auto& a = whole.stats;
   const auto& b = pieces.stats;
-  if (a.packets != b.packets || a.crc_errors != b.crc_errors || a.resync_bytes != b.resync_bytes || a.unknown_packets != b.unknown_packets ||
-      a.lost_samples != b.lost_samples)
+  if (a.packets != b.packets || a.crc_errors != b.crc_errors || a.resync_bytes != b.resync_bytes ||
+      a.unknown_packets != b.unknown_packets || a.lost_samples != b.lost_samples)
     fuzz::finding("decoder statistics differ between chunkings");
   return 0;
 }

@@ -13,11 +13,12 @@ bool differs(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return (a - b
 
 const std::vector<std::string>& effect_names() {
   static const std::vector<std::string> names = {
-      "sensor.scale", "sensor.bias_drift", "sensor.nonlinearity", "sensor.cross_coupling", "sensor.misalignment",
-      "sensor.dynamics", "sensor.damping_amplitude", "sensor.scale_temperature", "daq.group_delay", "site.coriolis",
-      "machine.common_vibration", "machine.differential_vibration", "machine.backlash", "machine.reversal_spike",
-      "machine.servo_mismatch", "machine.squareness", "machine.scale_mismatch", "machine.cyclic_error",
-      "machine.straightness", "machine.stick_slip", "machine.resonance"};
+      "sensor.scale",           "sensor.bias_drift",      "sensor.nonlinearity",      "sensor.cross_coupling",
+      "sensor.misalignment",    "sensor.dynamics",        "sensor.damping_amplitude", "sensor.scale_temperature",
+      "daq.group_delay",        "site.coriolis",          "machine.common_vibration", "machine.differential_vibration",
+      "machine.backlash",       "machine.reversal_spike", "machine.servo_mismatch",   "machine.squareness",
+      "machine.scale_mismatch", "machine.cyclic_error",   "machine.straightness",     "machine.stick_slip",
+      "machine.resonance"};
   return names;
 }
 
@@ -31,19 +32,21 @@ std::vector<std::string> effects_in(const Scenario& sc) {
     const dsp::SensorSpec& n = sc.meta.sensors[s];
     add("sensor.scale", differs(t.spec.k1_v_per_g, n.k1_v_per_g));
     add("sensor.bias_drift", t.bias_rw_ug_per_rts != 0.0 || t.bias_step_ug != 0.0 || t.bias_drift_ug_per_s != 0.0);
-    add("sensor.nonlinearity", differs(t.spec.k2_g_per_g2, n.k2_g_per_g2) || differs(t.spec.k3_g_per_g3, n.k3_g_per_g3));
+    add("sensor.nonlinearity",
+        differs(t.spec.k2_g_per_g2, n.k2_g_per_g2) || differs(t.spec.k3_g_per_g3, n.k3_g_per_g3));
     add("sensor.cross_coupling", t.k_cross_g_per_g.squaredNorm() > 0.0 || t.k_cross2_g_per_g2.squaredNorm() > 0.0);
     add("sensor.misalignment", (t.spec.to_machine - n.to_machine).norm() > 1e-12);
     add("sensor.dynamics", differs(t.spec.f0_hz, n.f0_hz) || differs(t.spec.zeta, n.zeta));
     add("sensor.damping_amplitude", t.zeta_per_g != n.zeta_per_g);
-    add("sensor.scale_temperature", t.temperature.rise_c != 0.0 &&
-                                        (t.spec.tc_k1_ppm_per_c != 0.0 || t.spec.tc_bias_ug_per_c != 0.0));
+    add("sensor.scale_temperature",
+        t.temperature.rise_c != 0.0 && (t.spec.tc_k1_ppm_per_c != 0.0 || t.spec.tc_bias_ug_per_c != 0.0));
   }
   add("daq.group_delay", differs(sc.daq.group_delay_samples, sc.meta.acquisition.daq_group_delay_samples) ||
                              sc.daq.skew_head_samples != sc.meta.acquisition.daq_skew_head_samples);
   add("site.coriolis", sc.coriolis);
   add("machine.common_vibration", sc.common_vibration.on());
-  add("machine.differential_vibration", sc.differential_vibration.gain.squaredNorm() > 0.0 || !sc.differential_tones.empty());
+  add("machine.differential_vibration",
+      sc.differential_vibration.gain.squaredNorm() > 0.0 || !sc.differential_tones.empty());
   add("machine.resonance", sc.resonance.on());
   const MachineErrors& m = sc.machine;
   for (int i = 0; i < 3; ++i) {

@@ -37,8 +37,8 @@ Scenario base_scenario(const std::string& kind, std::uint64_t seed, std::string 
 }
 
 // Single-axis programs on x with a 0.5 s dwell (step and positioning).
-Scenario axis_scenario(const std::string& kind, std::vector<double> targets_mm, double feed_mm_min, int runs, std::uint64_t seed,
-                       std::string description) {
+Scenario axis_scenario(const std::string& kind, std::vector<double> targets_mm, double feed_mm_min, int runs,
+                       std::uint64_t seed, std::string description) {
   Scenario sc = base_scenario(kind, seed, std::move(description));
   auto& p = sc.meta.program;
   p.axis = "x";
@@ -51,18 +51,19 @@ Scenario axis_scenario(const std::string& kind, std::vector<double> targets_mm, 
 
 }  // namespace
 
-Scenario circle_scenario(double radius_mm, double feed_mm_min, int repeats, const std::string& direction, std::uint64_t seed) {
+Scenario circle_scenario(double radius_mm, double feed_mm_min, int repeats, const std::string& direction,
+                         std::uint64_t seed) {
   Scenario sc = base_scenario("circle", seed,
-                              "R" + std::to_string(radius_mm) + " circle F" + std::to_string(feed_mm_min) + " x" + std::to_string(repeats) +
-                                  " " + direction + ", ideal machine, data-sheet sensors");
+                              "R" + std::to_string(radius_mm) + " circle F" + std::to_string(feed_mm_min) + " x" +
+                                  std::to_string(repeats) + " " + direction + ", ideal machine, data-sheet sensors");
   auto& p = sc.meta.program;
   p.plane = "xy";
   p.radius_mm = radius_mm;
   p.feed_mm_min = feed_mm_min;
   p.repeats = repeats;
   p.direction = direction;
-  sc.meta.id = "sim-circle-r" + std::to_string(static_cast<int>(radius_mm)) + "-f" + std::to_string(static_cast<int>(feed_mm_min)) +
-               "-s" + std::to_string(seed);
+  sc.meta.id = "sim-circle-r" + std::to_string(static_cast<int>(radius_mm)) + "-f" +
+               std::to_string(static_cast<int>(feed_mm_min)) + "-s" + std::to_string(seed);
   sc.truth[1].temperature.t0_c = 20.5;
   return sc;
 }
@@ -73,11 +74,15 @@ Scenario step_scenario(double from_mm, double to_mm, double feed_mm_min, int run
 }
 
 Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs, double feed_mm_min, std::uint64_t seed) {
-  return axis_scenario("positioning", targets_mm, feed_mm_min, runs, seed, "ISO 230-2 linear cycle on x, ideal machine");
+  return axis_scenario("positioning", targets_mm, feed_mm_min, runs, seed,
+                       "ISO 230-2 linear cycle on x, ideal machine");
 }
 
-Scenario rectangle_scenario(double size_a_mm, double size_b_mm, double feed_mm_min, const std::string& plane, int repeats, std::uint64_t seed) {
-  Scenario sc = base_scenario("rectangle", seed, "rectangle " + std::to_string(size_a_mm) + " x " + std::to_string(size_b_mm) + " mm, ideal machine");
+Scenario rectangle_scenario(double size_a_mm, double size_b_mm, double feed_mm_min, const std::string& plane,
+                            int repeats, std::uint64_t seed) {
+  Scenario sc = base_scenario(
+      "rectangle", seed,
+      "rectangle " + std::to_string(size_a_mm) + " x " + std::to_string(size_b_mm) + " mm, ideal machine");
   auto& p = sc.meta.program;
   p.plane = plane;
   p.corner_mm[0] = p.corner_mm[1] = 0.0;
@@ -101,7 +106,8 @@ std::vector<dsp::PsdSpec> psd_config_b(double r) {
   return {x, y};
 }
 
-Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vector<std::string>& axes, std::uint64_t seed) {
+Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vector<std::string>& axes,
+                           std::uint64_t seed) {
   gcode::IdentifyPlan plan;
   plan.psd = psd;
   plan.axes = axes;

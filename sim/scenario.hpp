@@ -30,9 +30,9 @@ struct SensorTruth {
   // (6-4) cross terms in g: row = sensor axis responding, column = axis across it.
   Eigen::Matrix3d k_cross_g_per_g = Eigen::Matrix3d::Zero();    // k_x a_y, k_y a_x, ...
   Eigen::Matrix3d k_cross2_g_per_g2 = Eigen::Matrix3d::Zero();  // k_zy a_z a_y, ...: (i,j) = a_i·a_j on axis row
-  double zeta_per_g = 0.0;          // squeeze-film damping: ζ = ζ0 (1 + zeta_per_g |a|/g) (ch. 8.3.1)
-  double bias_rw_ug_per_rts = 0.0;  // bias random walk (6-5, 6-6)
-  double bias_step_ug = 0.0;        // bias jump at the start of every move (ch. 8.3.2), alternating sign
+  double zeta_per_g = 0.0;           // squeeze-film damping: ζ = ζ0 (1 + zeta_per_g |a|/g) (ch. 8.3.1)
+  double bias_rw_ug_per_rts = 0.0;   // bias random walk (6-5, 6-6)
+  double bias_step_ug = 0.0;         // bias jump at the start of every move (ch. 8.3.2), alternating sign
   double bias_drift_ug_per_s = 0.0;  // linear bias drift
   CaseTemperature temperature;
   // A mounting that differs from run.toml's by more than a small rotation (a sign flip, a
@@ -50,7 +50,7 @@ struct AxisServo {
 };
 
 struct ReversalSpike {
-  double amp_um = 0.0;  // peak lag after a reversal
+  double amp_um = 0.0;   // peak lag after a reversal
   double tau_ms = 15.0;  // time to the peak; decays over a few tau
 };
 
@@ -117,16 +117,16 @@ struct DaqTruth {
   // group delay is then a pure delay.
   bool anti_alias_filter = true;
   double group_delay_samples = 38.8;
-  double skew_head_samples = 0.0;       // head channels later than table
+  double skew_head_samples = 0.0;  // head channels later than table
   std::int64_t offset_counts[6] = {0, 0, 0, 0, 0, 0};
-  double noise_nv_per_rthz = 0.0;       // electronic noise at the ADC input, two-sided
+  double noise_nv_per_rthz = 0.0;  // electronic noise at the ADC input, two-sided
 };
 
 // The laser spot on a 1-D PSD strip: what the data sheet of run.toml [[psd]] does not say.
 struct PsdTruth {
   double spot_mm = 0.03;
-  double full_scale_v = 2.0;      // i1 + i2 with the whole spot on the strip
-  double nonlinearity = 0.0;      // u_meas = u (1 + nl (2u/L)²)
+  double full_scale_v = 2.0;  // i1 + i2 with the whole spot on the strip
+  double nonlinearity = 0.0;  // u_meas = u (1 + nl (2u/L)²)
   double noise_v_per_rthz = 6e-7;
 };
 
@@ -134,7 +134,7 @@ struct PsdTruth {
 // signal period, 1 nm resolution.
 struct ReferenceTruth {
   double scale_ppm[3] = {0, 0, 0};
-  double interp_nm[3][2] = {{0, 0}, {0, 0}, {0, 0}};         // 1st and 2nd harmonic per axis
+  double interp_nm[3][2] = {{0, 0}, {0, 0}, {0, 0}};  // 1st and 2nd harmonic per axis
   double interp_phase_deg[3][2] = {{0, 0}, {0, 0}, {0, 0}};
   double signal_period_um = 4.0;
   double resolution_nm = 1.0;
@@ -173,23 +173,23 @@ struct Scenario {
   std::string name = "baseline";
   std::string description;
   std::uint64_t seed = 1;
-  dsp::RunMeta meta;           // nominal metadata written to run.toml; program.gcode may be empty
-  SensorTruth truth[2];        // table, head
+  dsp::RunMeta meta;     // nominal metadata written to run.toml; program.gcode may be empty
+  SensorTruth truth[2];  // table, head
   DaqTruth daq;
   MachineErrors machine;
   CommonVibration common_vibration;
-  DriveMode differential_vibration;  // head against table: real relative motion (a mode)
+  DriveMode differential_vibration;      // head against table: real relative motion (a mode)
   std::vector<Tone> differential_tones;  // ... and forced tones (spindle, drive): amp_mg is the
                                          // relative acceleration, the displacement amp/ω²
-  Resonance resonance;               // structural modes between drive and measured point
-  bool coriolis = false;             // Earth rate from [site] latitude and heading
-  std::vector<PsdTruth> psd;         // one per meta.psd strip (defaults when shorter)
+  Resonance resonance;                   // structural modes between drive and measured point
+  bool coriolis = false;                 // Earth rate from [site] latitude and heading
+  std::vector<PsdTruth> psd;             // one per meta.psd strip (defaults when shorter)
   ReferenceTruth reference;
   nc::MachineLimits limits;
-  SweepExcitation sweep;       // on: runs Klipper's resonance test, not meta.program.gcode
-  int oversample = 10;         // internal rate = oversample · fs (≥ 100 kHz at 10 kHz)
-  bool noise = true;           // white sensor noise (quantisation is always on: for a
-                               // near-ideal ADC use adc_bits = 32 and a tiny adc_lsb_volt)
+  SweepExcitation sweep;  // on: runs Klipper's resonance test, not meta.program.gcode
+  int oversample = 10;    // internal rate = oversample · fs (≥ 100 kHz at 10 kHz)
+  bool noise = true;      // white sensor noise (quantisation is always on: for a
+                          // near-ideal ADC use adc_bits = 32 and a tiny adc_lsb_volt)
   // Effects the scenario injected on purpose (names of run-format.md) and those present
   // only at tolerance level; truth.toml lists both. Empty `present`: derived from the
   // parameters that differ from nominal.
@@ -207,11 +207,12 @@ Scenario step_scenario(double from_mm = 0.0, double to_mm = 50.0, double feed_mm
                        std::uint64_t seed = 1);
 
 // ISO 230-2 linear cycle on x over `targets_mm` (ascending), `runs` bidirectional runs.
-Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs = 5, double feed_mm_min = 2000.0, std::uint64_t seed = 1);
+Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs = 5, double feed_mm_min = 2000.0,
+                              std::uint64_t seed = 1);
 
 // Rectangle `size_a_mm` × `size_b_mm` from the origin in `plane`, exact stop at the corners.
-Scenario rectangle_scenario(double size_a_mm = 50.0, double size_b_mm = 50.0, double feed_mm_min = 6500.0, const std::string& plane = "xy",
-                            int repeats = 1, std::uint64_t seed = 1);
+Scenario rectangle_scenario(double size_a_mm = 50.0, double size_b_mm = 50.0, double feed_mm_min = 6500.0,
+                            const std::string& plane = "xy", int repeats = 1, std::uint64_t seed = 1);
 
 // A scenario running the given G-code (a free-form program or any generated one).
 Scenario gcode_scenario(const std::string& gcode, const std::string& kind = "freeform", std::uint64_t seed = 1);
@@ -223,6 +224,7 @@ std::vector<dsp::PsdSpec> psd_config_b(double radius_mm = 10.0);
 
 // On-site identification (sim/gcode identify_program) over the given strips and further
 // axes, with those strips in the run.
-Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vector<std::string>& axes = {"z"}, std::uint64_t seed = 1);
+Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vector<std::string>& axes = {"z"},
+                           std::uint64_t seed = 1);
 
 }  // namespace eical::sim

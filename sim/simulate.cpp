@@ -3,11 +3,11 @@
 #include "dsp/core/error.hpp"
 #include "sim/daq/decimation_filter.hpp"
 #include "sim/gcode/generate.hpp"
-#include "sim/nc/klipper_excitation.hpp"
 #include "sim/machine/axis_motion.hpp"
 #include "sim/machine/geometry.hpp"
 #include "sim/machine/structural_modes.hpp"
 #include "sim/machine/vibration.hpp"
+#include "sim/nc/klipper_excitation.hpp"
 #include "sim/psd/psd_strip.hpp"
 #include "sim/reference/reference_encoder.hpp"
 #include "sim/sensor/earth_rate.hpp"
@@ -44,8 +44,10 @@ void check(const Scenario& sc) {
   if (sc.meta.psd.size() > static_cast<std::size_t>(dsp::kMaxPsd))
     throw dsp::InputError("simulate: more than " + std::to_string(dsp::kMaxPsd) + " PSD strips");
   for (const auto& t : sc.truth)
-    if (!(t.spec.f0_hz > 0.0) || !(t.spec.zeta > 0.0)) throw dsp::InputError("simulate: sensor f0_hz and zeta must be positive");
-  if (!sc.meta.sensor_present[0] && !sc.meta.sensor_present[1]) throw dsp::InputError("simulate: at least one sensor must be present");
+    if (!(t.spec.f0_hz > 0.0) || !(t.spec.zeta > 0.0))
+      throw dsp::InputError("simulate: sensor f0_hz and zeta must be positive");
+  if (!sc.meta.sensor_present[0] && !sc.meta.sensor_present[1])
+    throw dsp::InputError("simulate: at least one sensor must be present");
 }
 
 }  // namespace
@@ -60,8 +62,8 @@ std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t purpose) noexcept {
 
 std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& sc) {
   if (sc.sweep.on)
-    return std::make_unique<nc::AccelProfileSetPoint>(nc::klipper_segments(sc.sweep.test), sc.sweep.direction, sc.sweep.start_mm,
-                                                      sc.sweep.lead_in_s, sc.sweep.tail_s);
+    return std::make_unique<nc::AccelProfileSetPoint>(nc::klipper_segments(sc.sweep.test), sc.sweep.direction,
+                                                      sc.sweep.start_mm, sc.sweep.lead_in_s, sc.sweep.tail_s);
   const dsp::Program& p = sc.meta.program;
   return std::make_unique<nc::Trajectory>(
       nc::interpolate_gcode(p.gcode.empty() ? gcode::program_gcode(p) : p.gcode, sc.meta.id + ".ngc", sc.limits));
@@ -77,9 +79,11 @@ dsp::Run simulate(const Scenario& sc, std::vector<Eigen::Vector3d>* true_rel_mm,
   return simulate(with_program, *tr, true_rel_mm, capture);
 }
 
-dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen::Vector3d>* true_rel_mm, JitteredCapture* capture) {
+dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen::Vector3d>* true_rel_mm,
+                  JitteredCapture* capture) {
   check(sc);
-  if (capture && capture->jitter_s.size() != static_cast<std::size_t>(std::ceil(tr.duration_s() * sc.meta.acquisition.fs_hz)) + 1)
+  if (capture &&
+      capture->jitter_s.size() != static_cast<std::size_t>(std::ceil(tr.duration_s() * sc.meta.acquisition.fs_hz)) + 1)
     throw dsp::InputError("simulate: the jittered capture needs one sampling time per frame");
   const dsp::Acquisition& acq = sc.meta.acquisition;
   dsp::Run run;
@@ -105,7 +109,8 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
     for (int s = 0; s < 2; ++s) f.temp_c[s] = static_cast<float>(sc.truth[s].temperature.at(t));
   }
   for (const auto& t : tr.triggers()) {
-    const auto n = static_cast<std::size_t>(std::clamp<long long>(std::llround(t.t_s * fs), 0, static_cast<long long>(n_frames - 1)));
+    const auto n = static_cast<std::size_t>(
+        std::clamp<long long>(std::llround(t.t_s * fs), 0, static_cast<long long>(n_frames - 1)));
     run.frames[n].trigger = t.code;
   }
   const bool has_ref = sc.meta.reference.has_value();
@@ -116,7 +121,8 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
   if (true_rel_mm) true_rel_mm->assign(n_frames, Eigen::Vector3d::Zero());
 
   // Machine, vibration, Earth rate, PSD.
-  const Eigen::Vector3d table_mask = axis_mask(sc.meta.machine.table_axes), head_mask = axis_mask(sc.meta.machine.head_axes);
+  const Eigen::Vector3d table_mask = axis_mask(sc.meta.machine.table_axes),
+                        head_mask = axis_mask(sc.meta.machine.head_axes);
   const Eigen::Vector3d start = tr.at(0.0).pos_mm;
   std::array<AxisMotion, 3> axes = {AxisMotion(sc.machine, 0, h, start[0]), AxisMotion(sc.machine, 1, h, start[1]),
                                     AxisMotion(sc.machine, 2, h, start[2])};
@@ -127,7 +133,8 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
   const bool common_on = sc.common_vibration.on();
   const Eigen::Vector3d omega = sc.coriolis ? earth_rate_machine(sc.meta.site) : Eigen::Vector3d::Zero();
   std::vector<PsdStrip> strips;
-  for (std::size_t k = 0; k < n_psd; ++k) strips.emplace_back(sc.meta.psd[k], k < sc.psd.size() ? sc.psd[k] : PsdTruth{}, h);
+  for (std::size_t k = 0; k < n_psd; ++k)
+    strips.emplace_back(sc.meta.psd[k], k < sc.psd.size() ? sc.psd[k] : PsdTruth{}, h);
   Eigen::Matrix3d to_sensor[2];
   for (int s = 0; s < 2; ++s) to_sensor[s] = sc.truth[s].spec.to_machine.inverse();
 
@@ -152,7 +159,8 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
     Window w{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     for (int i = 0; i < 3; ++i) {
       Eigen::Vector3d d = Eigen::Vector3d::Zero();
-      if (axes[static_cast<std::size_t>(i)].active()) d[i] = axes[static_cast<std::size_t>(i)].step(ms.pos_mm[i], ms.vel_mm_s[i]);
+      if (axes[static_cast<std::size_t>(i)].active())
+        d[i] = axes[static_cast<std::size_t>(i)].step(ms.pos_mm[i], ms.vel_mm_s[i]);
       if (geometric) d += geometric_deviation_mm(sc.machine, i, ms.pos_mm);
       (head_mask[i] != 0.0 ? w.head : w.table) += d;
     }
@@ -160,7 +168,8 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
     if (structure.on()) (sc.resonance.part == 1 ? w.head : w.table) += structure.step(ms.acc_mm_s2);
     for (const Tone& tone : sc.differential_tones) {  // displacement whose acceleration is amp·sin(ωt + φ)
       const double w_rad = 2.0 * std::numbers::pi * tone.freq_hz;
-      w.head -= tone.amp_mg * 1e-3 * g * 1e3 / (w_rad * w_rad) * std::sin(w_rad * t + tone.phase_deg * std::numbers::pi / 180.0);
+      w.head -= tone.amp_mg * 1e-3 * g * 1e3 / (w_rad * w_rad) *
+                std::sin(w_rad * t + tone.phase_deg * std::numbers::pi / 180.0);
     }
     if (common_mode.on()) w.base = common_mode.step(ms.acc_mm_s2);
     return w;
@@ -178,8 +187,10 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
     }
     const std::size_t j = k - 1;  // the sample completed now
     const Eigen::Vector3d acc_cmd = ms_cur.acc_mm_s2 * 1e-3, vel_cmd = ms_cur.vel_mm_s * 1e-3;
-    Eigen::Vector3d a_table = -table_mask.cwiseProduct(acc_cmd) - (w_next.table - 2.0 * w_cur.table + w_prev.table) * inv_h2_m;
-    Eigen::Vector3d a_head = head_mask.cwiseProduct(acc_cmd) + (w_next.head - 2.0 * w_cur.head + w_prev.head) * inv_h2_m;
+    Eigen::Vector3d a_table =
+        -table_mask.cwiseProduct(acc_cmd) - (w_next.table - 2.0 * w_cur.table + w_prev.table) * inv_h2_m;
+    Eigen::Vector3d a_head =
+        head_mask.cwiseProduct(acc_cmd) + (w_next.head - 2.0 * w_cur.head + w_prev.head) * inv_h2_m;
     if (common_on) {
       const Eigen::Vector3d c = common.step() + (w_next.base - 2.0 * w_cur.base + w_prev.base) * inv_h2_m;
       a_table += c, a_head += c;
@@ -200,7 +211,8 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
       const std::size_t n = j / static_cast<std::size_t>(ov);
       auto& f = run.frames[n];
       for (int a = 0; a < 3; ++a)
-        f.ref_mm[a] = ref_mask[a] != 0.0 ? reference_reading_mm(sc.reference, a, p_rel[a]) : std::numeric_limits<double>::quiet_NaN();
+        f.ref_mm[a] = ref_mask[a] != 0.0 ? reference_reading_mm(sc.reference, a, p_rel[a])
+                                         : std::numeric_limits<double>::quiet_NaN();
       if (true_rel_mm) (*true_rel_mm)[n] = p_rel;
     }
     w_prev = w_cur, w_cur = w_next, ms_cur = ms_next;
@@ -212,7 +224,8 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
   std::mt19937_64 daq_rng(stream_seed(sc.seed, daq_noise));
   std::normal_distribution<double> unit(0.0, 1.0);
   auto to_counts = [&](double volts, double e_noise, int channel, std::uint32_t& flags) {
-    double c = std::round((volts + e_noise) / acq.adc_lsb_volt) + static_cast<double>(acq.adc_offset_counts + sc.daq.offset_counts[channel]);
+    double c = std::round((volts + e_noise) / acq.adc_lsb_volt) +
+               static_cast<double>(acq.adc_offset_counts + sc.daq.offset_counts[channel]);
     if (c > full_scale - 1 || c < -full_scale) {
       c = std::clamp(c, -full_scale, full_scale - 1);
       flags |= dsp::frame_flag::accel_saturated;
@@ -233,13 +246,17 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
     // A digital MEMS chip has no anti-alias filter: its samples are its low-pass output,
     // delayed (a design length of 0 makes the filter a pure delay).
     const double delay = sc.daq.group_delay_samples + (s == 1 ? sc.daq.skew_head_samples : 0.0);
-    const DecimationFilter daq_filter = sc.daq.anti_alias_filter ? DecimationFilter(ov, delay) : DecimationFilter(ov, delay, 0.4863, 0.0);
+    const DecimationFilter daq_filter =
+        sc.daq.anti_alias_filter ? DecimationFilter(ov, delay) : DecimationFilter(ov, delay, 0.4863, 0.0);
     // Bias steps at the start of every move, alternating in sign (ch. 8.3.2).
     std::vector<std::size_t> move_starts;
-    for (const auto& [from, to] : tr.move_spans_s()) move_starts.push_back(static_cast<std::size_t>(std::llround(from * fs)));
+    for (const auto& [from, to] : tr.move_spans_s())
+      move_starts.push_back(static_cast<std::size_t>(std::llround(from * fs)));
     for (int a = 0; a < 3; ++a) {
       daq_filter.apply(sensor_g[static_cast<std::size_t>(s)][static_cast<std::size_t>(a)], filtered.data(), n_frames);
-      if (capture) daq_filter.apply_at(sensor_g[static_cast<std::size_t>(s)][static_cast<std::size_t>(a)], positions.data(), filtered_jittered.data(), n_frames);
+      if (capture)
+        daq_filter.apply_at(sensor_g[static_cast<std::size_t>(s)][static_cast<std::size_t>(a)], positions.data(),
+                            filtered_jittered.data(), n_frames);
       std::mt19937_64 noise_rng(stream_seed(sc.seed, sensor_noise + static_cast<std::uint64_t>(3 * s + a)));
       std::mt19937_64 walk_rng(stream_seed(sc.seed, bias_walk + static_cast<std::uint64_t>(3 * s + a)));
       const double sigma_g = sc.noise ? st.spec.noise_ug_per_rthz * 1e-6 * std::sqrt(fs) : 0.0;
@@ -267,7 +284,8 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
         // The capture's sample: the same slow terms, noise and ADC, a little earlier or later.
         if (capture) {
           std::uint32_t ignored = 0;
-          capture->counts[n][static_cast<std::size_t>(3 * s + a)] = to_counts(k1 * (filtered_jittered[n] + bias + noise), e_noise, 3 * s + a, ignored);
+          capture->counts[n][static_cast<std::size_t>(3 * s + a)] =
+              to_counts(k1 * (filtered_jittered[n] + bias + noise), e_noise, 3 * s + a, ignored);
         }
       }
     }
@@ -281,9 +299,9 @@ dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen:
       daq_filter.apply(psd_v[c], filtered.data(), n_frames);
       for (std::size_t n = 0; n < n_frames; ++n) {
         const double v = filtered[n] + (sigma_v > 0.0 ? sigma_v * unit(rng) : 0.0);
-        run.frames[n].psd_counts[c] =
-            static_cast<std::int32_t>(std::llround(std::clamp(std::round(v / acq.adc_lsb_volt), -full_scale, full_scale - 1))) +
-            static_cast<std::int32_t>(acq.adc_offset_counts);
+        run.frames[n].psd_counts[c] = static_cast<std::int32_t>(std::llround(
+                                          std::clamp(std::round(v / acq.adc_lsb_volt), -full_scale, full_scale - 1))) +
+                                      static_cast<std::int32_t>(acq.adc_offset_counts);
       }
     }
   }

@@ -42,18 +42,19 @@ dsp::Run simulate(const Scenario& scenario);
 // n truly taken at n/fs + jitter_s[n], with the same slow terms, noise and ADC as the
 // run's frame n — only the sampling time differs, so the run itself is unchanged.
 struct JitteredCapture {
-  std::vector<double> jitter_s;                                        // in: one per frame
+  std::vector<double> jitter_s;                                       // in: one per frame
   std::vector<std::array<std::int32_t, dsp::kAccelChannels>> counts;  // out
 };
 
 // The same, also returning the true relative position at every frame (mm) — what an
 // ideal reference would read — for validation and tests, and optionally the capture.
-dsp::Run simulate(const Scenario& scenario, std::vector<Eigen::Vector3d>* true_rel_mm, JitteredCapture* capture = nullptr);
+dsp::Run simulate(const Scenario& scenario, std::vector<Eigen::Vector3d>* true_rel_mm,
+                  JitteredCapture* capture = nullptr);
 
 // The same for a set-point from elsewhere (another NC's servo-rate positions); the
 // program in scenario.meta is written to run.toml as it is (its gcode is not run).
-dsp::Run simulate(const Scenario& scenario, const nc::SetPoint& set_point, std::vector<Eigen::Vector3d>* true_rel_mm = nullptr,
-                  JitteredCapture* capture = nullptr);
+dsp::Run simulate(const Scenario& scenario, const nc::SetPoint& set_point,
+                  std::vector<Eigen::Vector3d>* true_rel_mm = nullptr, JitteredCapture* capture = nullptr);
 
 // The set-point a scenario runs: its Klipper sweep, or its program's G-code interpolated.
 std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& scenario);

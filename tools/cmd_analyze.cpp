@@ -1,16 +1,16 @@
 // eical analyze RUN [--json]: the pipeline and the program's evaluation on a recorded run.
 #include "drivers/config/sensor_calibration.hpp"
+#include "drivers/results/result_json.hpp"
 #include "drivers/run_io/file_spill.hpp"
 #include "drivers/run_io/run_stream.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "tools/commands.hpp"
-#include "drivers/results/result_json.hpp"
 #include "tools/exit_codes.hpp"
 #include "tools/plan/test_plan.hpp"
 #include "tools/run_files.hpp"
 
-#include <cstdio>
 #include <malloc.h>
+#include <cstdio>
 #include <memory>
 
 namespace eical::tools {
@@ -24,19 +24,28 @@ void register_analyze(CLI::App& app) {
     std::string nbs = "auto";
   };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("analyze", "Evaluate a recorded run: every program's figures with their uncertainty U (k = 2) and the verdict");
+  auto* cmd = app.add_subcommand(
+      "analyze", "Evaluate a recorded run: every program's figures with their uncertainty U (k = 2) and the verdict");
   cmd->add_option("run", o->run, "run directory (eical-run/1)")->required();
   cmd->add_flag("--json", o->json, "print the eical-result/1 document");
-  cmd->add_option("--dynamic", o->dynamic, "dynamic compensation: two-stage or none")->default_val("two-stage")->check(CLI::IsMember({"two-stage", "none"}));
+  cmd->add_option("--dynamic", o->dynamic, "dynamic compensation: two-stage or none")
+      ->default_val("two-stage")
+      ->check(CLI::IsMember({"two-stage", "none"}));
   cmd->add_flag("--no-zupt", o->no_zupt, "skip the zero-velocity update after the motion");
   cmd->add_option("--nbs", o->nbs, "hold axes whose set-point does not move (Bild 7-8): auto (rectangles), on, off")
       ->default_val("auto")
       ->check(CLI::IsMember({"auto", "on", "off"}));
-  cmd->add_flag("--coriolis", o->coriolis, "correct the Earth-rate Coriolis acceleration (3-6) with [site] latitude and heading");
-  cmd->add_option("--calibration", o->calibration, "sensor calibration (eical-sensor-cal/1, from eical identify) instead of the run's data sheet")
+  cmd->add_flag("--coriolis", o->coriolis,
+                "correct the Earth-rate Coriolis acceleration (3-6) with [site] latitude and heading");
+  cmd->add_option("--calibration", o->calibration,
+                  "sensor calibration (eical-sensor-cal/1, from eical identify) instead of the run's data sheet")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--draws", o->draws, "Monte Carlo draws of the uncertainty (seeded, deterministic)")->default_val(100)->check(CLI::Range(10, 100000));
-  cmd->add_flag("--no-suggest", o->no_suggest, "do not look for a measurable variant when the test is not measurable (it simulates variants: seconds)");
+  cmd->add_option("--draws", o->draws, "Monte Carlo draws of the uncertainty (seeded, deterministic)")
+      ->default_val(100)
+      ->check(CLI::Range(10, 100000));
+  cmd->add_flag(
+      "--no-suggest", o->no_suggest,
+      "do not look for a measurable variant when the test is not measurable (it simulates variants: seconds)");
   cmd->footer("Exit status: 0 verdict ok, 2 degraded, 3 not measurable, 1 an error (README \"Exit status\").");
   cmd->callback([o] {
     // Buffers above 256 kB are mapped and go back to the system when freed: the streamed
@@ -59,8 +68,10 @@ void register_analyze(CLI::App& app) {
     so.spill_trace = so.spill_corrections = true;  // a CSV reads slower than a spill, a spill faster than the smoother
     dsp::Analysis a = drivers::analyze_stream(stream, opt, so);
     if (a.verdict == "not_measurable" && !o->no_suggest) plan::suggest_measurable_test(run, a);
-    if (o->json) std::printf("%s\n", drivers::result_json(run, a).dump(2).c_str());
-    else std::fputs(summary_text(run, a).c_str(), stdout);
+    if (o->json)
+      std::printf("%s\n", drivers::result_json(run, a).dump(2).c_str());
+    else
+      std::fputs(summary_text(run, a).c_str(), stdout);
     std::fflush(stdout);
     if (const int code = verdict_exit_code(a.verdict); code != kExitOk) throw CLI::RuntimeError(code);
   });

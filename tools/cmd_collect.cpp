@@ -34,13 +34,19 @@ void register_collect(CLI::App& app) {
     double retry_s = 30.0, timeout_s = 0.0;
   };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("collect", "Store the results of every eicald on the DDS domain in one history (a fleet)");
-  cmd->add_option("--db", o->db, "history store: postgresql://user@host/db (or a SQLite file)")->envname("EICAL_HISTORY_DB")->required();
+  auto* cmd =
+      app.add_subcommand("collect", "Store the results of every eicald on the DDS domain in one history (a fleet)");
+  cmd->add_option("--db", o->db, "history store: postgresql://user@host/db (or a SQLite file)")
+      ->envname("EICAL_HISTORY_DB")
+      ->required();
   cmd->add_option("--domain", o->domain, "DDS domain id")->default_val(0);
   cmd->add_option("--dds-config", o->uri, "Cyclone DDS XML (file://...); default $CYCLONEDDS_URI");
   cmd->add_option("--spool", o->spool, "where results wait while the store is unavailable")->default_val(o->spool);
-  cmd->add_option("--retry-s", o->retry_s, "an unavailable store is tried again after this many seconds")->default_val(30.0)->check(CLI::Range(0.1, 3600.0));
-  cmd->add_option("--results", o->results, "exit after this many results received (0 = run until SIGINT/SIGTERM)")->default_val(0);
+  cmd->add_option("--retry-s", o->retry_s, "an unavailable store is tried again after this many seconds")
+      ->default_val(30.0)
+      ->check(CLI::Range(0.1, 3600.0));
+  cmd->add_option("--results", o->results, "exit after this many results received (0 = run until SIGINT/SIGTERM)")
+      ->default_val(0);
   cmd->add_option("--timeout", o->timeout_s, "exit after this many seconds (0 = never)")->default_val(0.0);
   cmd->callback([o] {
     if (!o->uri.empty()) ::setenv("CYCLONEDDS_URI", o->uri.c_str(), 1);
@@ -56,8 +62,9 @@ void register_collect(CLI::App& app) {
     drivers::dds::Bus bus(o->domain, drivers::dds::Role::hmi);
     std::printf("collecting results on DDS domain %d into %s\n", o->domain, history::sql::redact_uri(o->db).c_str());
     std::fflush(stdout);
-    const auto end = std::chrono::steady_clock::now() +
-                     std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(o->timeout_s > 0 ? o->timeout_s : 1e9));
+    const auto end =
+        std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                               std::chrono::duration<double>(o->timeout_s > 0 ? o->timeout_s : 1e9));
     int received = 0;
     while (!g_stop && std::chrono::steady_clock::now() < end && (o->results == 0 || received < o->results)) {
       const auto m = bus.take_result(std::chrono::milliseconds(300));
@@ -65,12 +72,15 @@ void register_collect(CLI::App& app) {
       ++received;
       try {
         const auto doc = nlohmann::json::parse(m->json);
-        history::Provenance p{m->machine, m->measured_at, m->run_path,
-                              m->software_version.empty() ? std::nullopt : std::optional<std::string>(m->software_version), m->sensor_calibration};
+        history::Provenance p{
+            m->machine, m->measured_at, m->run_path,
+            m->software_version.empty() ? std::nullopt : std::optional<std::string>(m->software_version),
+            m->sensor_calibration};
         sink.submit(history::record_from_result(doc, p));
         std::printf("received %s %s (%s)\n", m->machine.c_str(), m->program_id.c_str(), m->program.c_str());
       } catch (const std::exception& e) {
-        std::fprintf(stderr, "eical collect: result %s of %s not stored: %s\n", m->program_id.c_str(), m->machine.c_str(), e.what());
+        std::fprintf(stderr, "eical collect: result %s of %s not stored: %s\n", m->program_id.c_str(),
+                     m->machine.c_str(), e.what());
       }
       std::fflush(stdout);
     }
@@ -78,7 +88,8 @@ void register_collect(CLI::App& app) {
     (void)sink.wait_drained(std::chrono::seconds(10));
     const auto c = sink.counts();
     std::printf("collect: %d results received, %llu stored, %llu already stored, %zu waiting in %s\n", received,
-                static_cast<unsigned long long>(c.stored), static_cast<unsigned long long>(c.duplicates), sink.waiting(), o->spool.c_str());
+                static_cast<unsigned long long>(c.stored), static_cast<unsigned long long>(c.duplicates),
+                sink.waiting(), o->spool.c_str());
   });
 }
 
@@ -86,8 +97,10 @@ void register_collect(CLI::App& app) {
 #else
 namespace eical::tools {
 void register_collect(CLI::App& app) {
-  auto* cmd = app.add_subcommand("collect", "Store the results of every eicald on the DDS domain (this build has no DDS)");
-  cmd->callback([] { throw std::runtime_error("eical was built without Cyclone DDS (EICAL_BUILD_DAEMON=OFF): no collect"); });
+  auto* cmd =
+      app.add_subcommand("collect", "Store the results of every eicald on the DDS domain (this build has no DDS)");
+  cmd->callback(
+      [] { throw std::runtime_error("eical was built without Cyclone DDS (EICAL_BUILD_DAEMON=OFF): no collect"); });
 }
 }  // namespace eical::tools
 #endif

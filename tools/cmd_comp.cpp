@@ -61,7 +61,8 @@ std::string slurp(const std::string& file) {
   return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
 }
 
-std::vector<OutputFile> linuxcnc_outputs(const std::vector<AxisProposal>& axes, const Opt& o, nlohmann::json& axes_json) {
+std::vector<OutputFile> linuxcnc_outputs(const std::vector<AxisProposal>& axes, const Opt& o,
+                                         nlohmann::json& axes_json) {
   std::map<char, int> joints = {{'x', 0}, {'y', 1}, {'z', 2}};
   std::string ini_text;
   if (!o.merge_ini.empty()) ini_text = slurp(o.merge_ini), joints = comp::joint_map(ini_text, o.merge_ini);
@@ -77,9 +78,12 @@ std::vector<OutputFile> linuxcnc_outputs(const std::vector<AxisProposal>& axes, 
     if (p.table) {
       const std::string name = "eical_joint" + std::to_string(j.joint) + ".comp";
       j.comp_file = name;
-      j.comments.push_back("the reversal is folded into the table's forward/reverse columns (LinuxCNC does not use BACKLASH with a COMP_FILE)");
-      out.push_back({"linuxcnc/" + name, comp::linuxcnc_comp_file(*p.table, "eical comp, joint " + std::to_string(j.joint) + " (" +
-                                                                                std::string(1, a) + "): " + p.source)});
+      j.comments.push_back(
+          "the reversal is folded into the table's forward/reverse columns (LinuxCNC does not use BACKLASH with a "
+          "COMP_FILE)");
+      out.push_back(
+          {"linuxcnc/" + name, comp::linuxcnc_comp_file(*p.table, "eical comp, joint " + std::to_string(j.joint) +
+                                                                      " (" + std::string(1, a) + "): " + p.source)});
     } else {
       j.backlash_mm = *p.lost_motion_um * 1e-3;
     }
@@ -87,10 +91,13 @@ std::vector<OutputFile> linuxcnc_outputs(const std::vector<AxisProposal>& axes, 
     settings.push_back(j);
   }
   out.push_back({"linuxcnc/eical-comp.ini",
-                 comp::linuxcnc_ini_snippet(settings, "# eical comp: proposed LinuxCNC settings, one section per joint; merge into the machine's INI\n"
-                                                      "# (or run eical comp with --merge-ini) and copy the .comp files next to it.\n")});
+                 comp::linuxcnc_ini_snippet(
+                     settings,
+                     "# eical comp: proposed LinuxCNC settings, one section per joint; merge into the machine's INI\n"
+                     "# (or run eical comp with --merge-ini) and copy the .comp files next to it.\n")});
   if (!o.merge_ini.empty())
-    out.push_back({"linuxcnc/" + fs::path(o.merge_ini).filename().string(), comp::merge_linuxcnc_ini(ini_text, o.merge_ini, settings)});
+    out.push_back({"linuxcnc/" + fs::path(o.merge_ini).filename().string(),
+                   comp::merge_linuxcnc_ini(ini_text, o.merge_ini, settings)});
   return out;
 }
 
@@ -116,31 +123,48 @@ nlohmann::json axis_json(const AxisProposal& p) {
 
 void register_comp(CLI::App& app) {
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("comp", "Propose axis compensation (tables with the reversal folded in, backlash) for the control from measured results");
-  cmd->add_option("inputs", o->inputs, "eical-result/1 files (eical analyze --json) or run directories: positioning and circle runs")->required();
+  auto* cmd = app.add_subcommand(
+      "comp",
+      "Propose axis compensation (tables with the reversal folded in, backlash) for the control from measured results");
+  cmd->add_option("inputs", o->inputs,
+                  "eical-result/1 files (eical analyze --json) or run directories: positioning and circle runs")
+      ->required();
   cmd->add_option("-o,--out", o->out, "output folder")->default_val("comp");
   cmd->add_option("--control", o->controls, "linuxcnc, sinumerik, fanuc, heidenhain or all (comma separated)")
       ->delimiter(',')
       ->check(CLI::IsMember({"linuxcnc", "sinumerik", "fanuc", "heidenhain", "all"}))
       ->default_str("linuxcnc");
-  cmd->add_option("--merge-ini", o->merge_ini, "LinuxCNC machine INI: also write it with the [JOINT_n] keys merged (trivkins)")
+  cmd->add_option("--merge-ini", o->merge_ini,
+                  "LinuxCNC machine INI: also write it with the [JOINT_n] keys merged (trivkins)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--spacing-mm", o->spacing_mm, "interval of the equidistant SINUMERIK/FANUC/HEIDENHAIN tables (default: mean target spacing)")
+  cmd->add_option("--spacing-mm", o->spacing_mm,
+                  "interval of the equidistant SINUMERIK/FANUC/HEIDENHAIN tables (default: mean target spacing)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--travel", o->travel, "AXIS:MIN,MAX the table must cover (mm), besides what the inputs measured (repeatable)");
-  cmd->add_option("--sinumerik-axes", o->sinumerik_axes, "SINUMERIK machine axis names of x, y, z")->delimiter(',')->expected(3);
-  cmd->add_option("--fanuc-detection-unit-um", o->fanuc_unit_um, "FANUC detection unit")->default_val(1.0)->check(CLI::PositiveNumber);
-  cmd->add_option("--fanuc-reference-mm", o->fanuc_reference_mm, "FANUC reference position (machine coordinate) of No. 3620")->default_val(0.0);
+  cmd->add_option("--travel", o->travel,
+                  "AXIS:MIN,MAX the table must cover (mm), besides what the inputs measured (repeatable)");
+  cmd->add_option("--sinumerik-axes", o->sinumerik_axes, "SINUMERIK machine axis names of x, y, z")
+      ->delimiter(',')
+      ->expected(3);
+  cmd->add_option("--fanuc-detection-unit-um", o->fanuc_unit_um, "FANUC detection unit")
+      ->default_val(1.0)
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--fanuc-reference-mm", o->fanuc_reference_mm,
+                  "FANUC reference position (machine coordinate) of No. 3620")
+      ->default_val(0.0);
   cmd->add_flag("--force", o->force, "overwrite existing output files");
-  auto* allow = cmd->add_flag("--allow-unresolved", o->allow_unresolved,
-                              "propose terms from figures not larger than their uncertainty (or without one), marked in comp.json");
-  auto* skip = cmd->add_flag("--skip-unresolved", o->skip_unresolved, "leave out the terms whose figure is not resolved");
+  auto* allow = cmd->add_flag(
+      "--allow-unresolved", o->allow_unresolved,
+      "propose terms from figures not larger than their uncertainty (or without one), marked in comp.json");
+  auto* skip =
+      cmd->add_flag("--skip-unresolved", o->skip_unresolved, "leave out the terms whose figure is not resolved");
   allow->excludes(skip);
   cmd->callback([o] {
     std::vector<comp::CompInput> inputs;
     for (const auto& p : o->inputs) inputs.push_back(comp::load_comp_input(p));
     comp::PlanOptions po;
-    po.unresolved = o->allow_unresolved ? comp::Unresolved::allow : o->skip_unresolved ? comp::Unresolved::skip : comp::Unresolved::refuse;
+    po.unresolved = o->allow_unresolved  ? comp::Unresolved::allow
+                    : o->skip_unresolved ? comp::Unresolved::skip
+                                         : comp::Unresolved::refuse;
     for (const auto& t : o->travel) po.travel.push_back(parse_travel(t));
     const comp::Plan plan = comp::build_plan(inputs, po);
     if (plan.axes.empty())
@@ -157,18 +181,22 @@ void register_comp(CLI::App& app) {
     if (controls.count("sinumerik"))
       for (auto& f : comp::sinumerik_outputs(plan.axes, {grid, o->sinumerik_axes})) files.push_back(std::move(f));
     if (controls.count("fanuc"))
-      for (auto& f : comp::fanuc_outputs(plan.axes, {grid, o->fanuc_unit_um, o->fanuc_reference_mm, 0})) files.push_back(std::move(f));
+      for (auto& f : comp::fanuc_outputs(plan.axes, {grid, o->fanuc_unit_um, o->fanuc_reference_mm, 0}))
+        files.push_back(std::move(f));
     if (controls.count("heidenhain"))
       for (auto& f : comp::heidenhain_outputs(plan.axes, {grid})) files.push_back(std::move(f));
 
     nlohmann::json j = {{"format", "eical-comp/1"},
-                        {"sign_convention", "deviation = actual - nominal; correction = -deviation, what the control adds to the command"},
+                        {"sign_convention",
+                         "deviation = actual - nominal; correction = -deviation, what the control adds to the command"},
                         {"axes", axes},
                         {"figures", plan.figures},
                         {"not_compensated", plan.not_compensated},
                         {"skipped", plan.skipped}};
     nlohmann::json ins = nlohmann::json::array();
-    for (const auto& in : inputs) ins.push_back({{"input", in.name}, {"run_id", in.run_id}, {"program", in.result.value("program", std::string())}});
+    for (const auto& in : inputs)
+      ins.push_back(
+          {{"input", in.name}, {"run_id", in.run_id}, {"program", in.result.value("program", std::string())}});
     j["inputs"] = ins;
     if (!plan.unresolved_used.empty()) j["proposed_from_unresolved_figures"] = plan.unresolved_used;
     if (!plan.unresolved_skipped.empty()) j["left_out_unresolved_figures"] = plan.unresolved_skipped;
@@ -182,7 +210,8 @@ void register_comp(CLI::App& app) {
     for (const auto& f : files)
       if (fs::exists(fs::path(o->out) / f.path)) existing.push_back((fs::path(o->out) / f.path).string());
     if (!existing.empty() && !o->force) {
-      std::string msg = "comp: would overwrite " + std::to_string(existing.size()) + " existing file(s), nothing written (--force to replace them):";
+      std::string msg = "comp: would overwrite " + std::to_string(existing.size()) +
+                        " existing file(s), nothing written (--force to replace them):";
       for (const auto& e : existing) msg += "\n  " + e;
       throw dsp::InputError(msg);
     }
@@ -194,13 +223,16 @@ void register_comp(CLI::App& app) {
     for (const auto& p : plan.axes) {
       const char a = dsp::comp::axis_letter(p.axis);
       if (p.table)
-        std::printf("comp: %c table, %zu points %.3f .. %.3f mm, lost motion in it %.2f um (%s)\n", a, p.table->pos_mm.size(), p.table->first_mm(),
-                    p.table->last_mm(), p.table->mean_lost_motion_um(), p.source.c_str());
+        std::printf("comp: %c table, %zu points %.3f .. %.3f mm, lost motion in it %.2f um (%s)\n", a,
+                    p.table->pos_mm.size(), p.table->first_mm(), p.table->last_mm(), p.table->mean_lost_motion_um(),
+                    p.source.c_str());
       else
         std::printf("comp: %c backlash %.2f um (%s)\n", a, *p.lost_motion_um, p.source.c_str());
     }
-    for (const auto& u : plan.unresolved_used) std::printf("comp: WARNING proposed from an unresolved figure (--allow-unresolved): %s\n", u.c_str());
-    for (const auto& u : plan.unresolved_skipped) std::printf("comp: left out, not resolved (--skip-unresolved): %s\n", u.c_str());
+    for (const auto& u : plan.unresolved_used)
+      std::printf("comp: WARNING proposed from an unresolved figure (--allow-unresolved): %s\n", u.c_str());
+    for (const auto& u : plan.unresolved_skipped)
+      std::printf("comp: left out, not resolved (--skip-unresolved): %s\n", u.c_str());
     std::printf("comp: %zu files -> %s\n", files.size(), o->out.c_str());
   });
 }

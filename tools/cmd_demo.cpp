@@ -4,6 +4,7 @@
 // M103 stop) and the live pipeline → the recording written as an eical-run/1 directory →
 // the same analysis eicald runs → result.json and an HTML report.
 #include "drivers/acquisition/pump.hpp"
+#include "drivers/results/result_json.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/source/sim_source.hpp"
 #include "dsp/analysis/analyze_run.hpp"
@@ -11,7 +12,6 @@
 #include "dsp/session/measurement_session.hpp"
 #include "tools/commands.hpp"
 #include "tools/report/run_report.hpp"
-#include "drivers/results/result_json.hpp"
 #include "tools/run_files.hpp"
 
 #include <atomic>
@@ -49,10 +49,13 @@ void register_demo(CLI::App& app) {
     dsp::MeasurementSession session(scfg);
     dsp::Pipeline live(dsp::pipeline_config(meta, static_cast<std::size_t>(scfg.max_measurement_s * scfg.fs_hz)));
     std::atomic<bool> stop{false};
-    const auto stats = drivers::pump(source, ring, [&](const dsp::Frame& f) {
-      session.on_frame(f);
-      if (session.state().state() == dsp::State::measuring || f.trigger == dsp::trigger::program_end) live.step(f);
-    }, stop);
+    const auto stats = drivers::pump(
+        source, ring,
+        [&](const dsp::Frame& f) {
+          session.on_frame(f);
+          if (session.state().state() == dsp::State::measuring || f.trigger == dsp::trigger::program_end) live.step(f);
+        },
+        stop);
     if (!stats.source_error.empty()) throw std::runtime_error(stats.source_error);
     const auto t_acq = std::chrono::steady_clock::now();
 
@@ -80,12 +83,14 @@ void register_demo(CLI::App& app) {
     const double runtime_s = std::chrono::duration<double>(t1 - t0).count();
     std::printf("eical demo: simulated circular test R10 F2500 x5 (ccw), both sensors, 0.4 ug/sqrt(Hz), 10 kHz\n");
     std::printf("  frames acquired %llu, through the ring %llu, overruns %llu, lost %llu\n",
-                static_cast<unsigned long long>(stats.frames_read), static_cast<unsigned long long>(stats.frames_consumed),
-                static_cast<unsigned long long>(stats.overruns), static_cast<unsigned long long>(session.counters().frames_lost));
+                static_cast<unsigned long long>(stats.frames_read),
+                static_cast<unsigned long long>(stats.frames_consumed), static_cast<unsigned long long>(stats.overruns),
+                static_cast<unsigned long long>(session.counters().frames_lost));
     std::fputs(summary_text(run, a).c_str(), stdout);
     std::printf("  live (causal) estimate at M103, before ZUPT: x %.4f mm, y %.4f mm\n", live.live().pos_mm.x(),
                 live.live().pos_mm.y());
-    std::printf("  runtime %.2f s (acquisition and DSP %.2f s)\n", runtime_s, std::chrono::duration<double>(t_acq - t0).count());
+    std::printf("  runtime %.2f s (acquisition and DSP %.2f s)\n", runtime_s,
+                std::chrono::duration<double>(t_acq - t0).count());
     std::printf("  written: %s/run (recorded run), %s/result.json, %s\n", out.c_str(), out.c_str(), report.c_str());
   });
 }

@@ -23,10 +23,13 @@ void register_explain(CLI::App& app) {
     std::string report;
   };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("explain", "Show, name, extend and measure what the simulation gets wrong about recorded runs");
+  auto* cmd = app.add_subcommand("explain",
+                                 "Show, name, extend and measure what the simulation gets wrong about recorded runs");
   cmd->add_option("runs", o->runs, "run directories (eical-run/1)")->required();
   cmd->add_flag("--json", o->json, "print the eical-explain/1 document");
-  cmd->add_option("--report", o->report, "write the HTML report with residual plots, the fitted calibration and a scenario reproducing the run");
+  cmd->add_option(
+      "--report", o->report,
+      "write the HTML report with residual plots, the fitted calibration and a scenario reproducing the run");
   cmd->callback([o] {
     std::vector<dsp::Run> runs;
     std::vector<dsp::model::RunExplanation> ex;
@@ -41,12 +44,15 @@ void register_explain(CLI::App& app) {
     std::vector<dsp::model::TransferGain> transfers;
     for (std::size_t i = 0; i < runs.size(); ++i)
       for (std::size_t j = 0; j < runs.size(); ++j)
-        if (i != j && std::any_of(ex[i].effects.begin(), ex[i].effects.end(), [](const auto& e) { return e.taken_into_model; }))
+        if (i != j &&
+            std::any_of(ex[i].effects.begin(), ex[i].effects.end(), [](const auto& e) { return e.taken_into_model; }))
           transfers.push_back(dsp::model::transfer_gain(runs[j], ex[i]));
     const nlohmann::json doc = explain::explain_json(runs, ex, transfers);
     if (!o->report.empty()) explain::write_explain_report(runs, ex, o->report);
-    if (o->json) std::printf("%s\n", doc.dump(2).c_str());
-    else std::fputs(explain::explain_text(ex, transfers).c_str(), stdout);
+    if (o->json)
+      std::printf("%s\n", doc.dump(2).c_str());
+    else
+      std::fputs(explain::explain_text(ex, transfers).c_str(), stdout);
   });
 }
 

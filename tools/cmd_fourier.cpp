@@ -23,8 +23,10 @@ void register_fourier(CLI::App& app) {
   cmd->add_option("--series", o->series, "CSV: angle_deg,deviation_arcsec,series")->required();
   cmd->add_option("--sweep", o->sweep, "name of the series that sweeps one interval continuously (recovers f = k*n)");
   cmd->add_option("--alpha", o->alpha, "significance level per term")->default_val(0.05)->check(CLI::Range(1e-6, 0.5));
-  cmd->add_option("--positioning-bound-arcsec", o->bound, "positioning deviation bound +-a of the axis (GUM type B)")->default_val(0.0);
-  cmd->add_option("--max-frequency", o->max_f, "highest candidate frequency per revolution (0 = Nyquist)")->default_val(0);
+  cmd->add_option("--positioning-bound-arcsec", o->bound, "positioning deviation bound +-a of the axis (GUM type B)")
+      ->default_val(0.0);
+  cmd->add_option("--max-frequency", o->max_f, "highest candidate frequency per revolution (0 = Nyquist)")
+      ->default_val(0);
   cmd->add_flag("--json", o->json, "print JSON");
   cmd->callback([o] {
     const auto series = read_angle_series_csv(o->series);
@@ -63,10 +65,10 @@ void register_fourier(CLI::App& app) {
     for (int f : r.lost_frequencies) std::printf("%d ", f);
     std::printf("\n  f/rev   A (arcsec)   phase (deg)   u(A)    significant\n");
     for (const auto& term : r.terms)
-      std::printf("  %5d   %10.3f   %11.2f   %6.3f  %s%s\n", term.frequency, term.amplitude_arcsec, term.phase_deg, term.u_amplitude_arcsec,
-                  term.significant ? "yes" : "no", term.from_sweep ? " (sweep)" : "");
-    std::printf("residual RMS %.3f arcsec; U = 2*sqrt(u_x^2 + u_p^2) = %.3f arcsec (u_x %.3f, u_p %.3f)\n", r.residual_rms_arcsec,
-                r.expanded_U_arcsec, r.u_x_arcsec, r.u_p_arcsec);
+      std::printf("  %5d   %10.3f   %11.2f   %6.3f  %s%s\n", term.frequency, term.amplitude_arcsec, term.phase_deg,
+                  term.u_amplitude_arcsec, term.significant ? "yes" : "no", term.from_sweep ? " (sweep)" : "");
+    std::printf("residual RMS %.3f arcsec; U = 2*sqrt(u_x^2 + u_p^2) = %.3f arcsec (u_x %.3f, u_p %.3f)\n",
+                r.residual_rms_arcsec, r.expanded_U_arcsec, r.u_x_arcsec, r.u_p_arcsec);
   });
 }
 

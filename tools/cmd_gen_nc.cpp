@@ -44,12 +44,12 @@ std::string program_toml(const dsp::Program& p, const std::string& gcode) {
   t += "feed_mm_min = " + std::to_string(p.feed_mm_min) + "\n";
   if (p.kind == "circle") {
     t += "center_mm = " + toml_list({p.center_mm[0], p.center_mm[1]}) + "\nradius_mm = " + std::to_string(p.radius_mm) +
-         "\ndirection = \"" + p.direction + "\"\nrepeats = " + std::to_string(p.repeats) + "\narc_deg = " +
-         std::to_string(p.arc_deg) + "\n";
+         "\ndirection = \"" + p.direction + "\"\nrepeats = " + std::to_string(p.repeats) +
+         "\narc_deg = " + std::to_string(p.arc_deg) + "\n";
     if (p.arc_deg < 360.0) t += "arc_start_deg = " + std::to_string(sim::gcode::partial_arc_start_deg(p)) + "\n";
   } else if (p.kind == "rectangle") {
-    t += "corner_mm = " + toml_list({p.corner_mm[0], p.corner_mm[1]}) + "\nsize_mm = " +
-         toml_list({p.size_mm[0], p.size_mm[1]}) + "\ndwell_s = " + std::to_string(p.dwell_s) +
+    t += "corner_mm = " + toml_list({p.corner_mm[0], p.corner_mm[1]}) +
+         "\nsize_mm = " + toml_list({p.size_mm[0], p.size_mm[1]}) + "\ndwell_s = " + std::to_string(p.dwell_s) +
          "\nrepeats = " + std::to_string(p.repeats) + "\n";
   } else {
     t += "axis = \"" + p.axis + "\"\ntargets_mm = " + toml_list(p.targets_mm) + "\nruns = " + std::to_string(p.runs) +
@@ -69,23 +69,30 @@ void write_text(const std::string& path, const std::string& text) {
   if (!os.flush()) throw std::runtime_error(path + ": write failed");
 }
 
-void add_output(CLI::App* cmd, std::string& out, std::string& meta_out, std::string& dialect, int& number, std::string& name) {
+void add_output(CLI::App* cmd, std::string& out, std::string& meta_out, std::string& dialect, int& number,
+                std::string& name) {
   cmd->add_option("-o,--out", out, "G-code file (default: standard output)");
-  cmd->add_option("--meta", meta_out, "also write the run's [program] table (TOML) here; its gcode is the program as eical simulates it");
+  cmd->add_option("--meta", meta_out,
+                  "also write the run's [program] table (TOML) here; its gcode is the program as eical simulates it");
   cmd->add_option("--dialect", dialect, "the control that runs it: linuxcnc, fanuc, sinumerik or heidenhain-iso")
       ->default_val("linuxcnc")
       ->check(CLI::IsMember({"linuxcnc", "fanuc", "sinumerik", "heidenhain-iso"}));
-  cmd->add_option("--program-number", number, "FANUC program number O<n>")->default_val(1000)->check(CLI::Range(1, 9999));
+  cmd->add_option("--program-number", number, "FANUC program number O<n>")
+      ->default_val(1000)
+      ->check(CLI::Range(1, 9999));
   cmd->add_option("--program-name", name, "SINUMERIK / HEIDENHAIN program name (default EICAL_<KIND>)");
 }
-void add_output(CLI::App* cmd, GenOptions& o) { add_output(cmd, o.out, o.meta_out, o.dialect, o.program_number, o.program_name); }
+void add_output(CLI::App* cmd, GenOptions& o) {
+  add_output(cmd, o.out, o.meta_out, o.dialect, o.program_number, o.program_name);
+}
 
 // The canonical program written for the control, and its [program] table with the
 // LinuxCNC form (what eical's reader and simulator take).
-void write_program(const std::string& canonical, dsp::Program p, const std::string& title, const std::string& out, const std::string& meta_out,
-                   const std::string& dialect, int number, std::string name) {
+void write_program(const std::string& canonical, dsp::Program p, const std::string& title, const std::string& out,
+                   const std::string& meta_out, const std::string& dialect, int number, std::string name) {
   for (char& c : name)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') throw std::runtime_error("--program-name: letters, digits and _ only");
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_')
+      throw std::runtime_error("--program-name: letters, digits and _ only");
   const sim::gcode::ProgramIdentity id{number, name.empty() ? "EICAL_" + p.kind : name, title};
   write_text(out, sim::gcode::write_dialect(canonical, sim::gcode::dialect_from_name(dialect), id));
   p.gcode = sim::gcode::write_dialect(canonical, sim::gcode::Dialect::linuxcnc, id);
@@ -95,12 +102,14 @@ void write_program(const std::string& canonical, dsp::Program p, const std::stri
 std::string title_of(const dsp::Program& p) {
   char b[160];
   if (p.kind == "circle")
-    std::snprintf(b, sizeof b, "eical circle R%g F%g %s, %d revolutions, plane %s", p.radius_mm, p.feed_mm_min, p.direction.c_str(), p.repeats,
-                  p.plane.c_str());
+    std::snprintf(b, sizeof b, "eical circle R%g F%g %s, %d revolutions, plane %s", p.radius_mm, p.feed_mm_min,
+                  p.direction.c_str(), p.repeats, p.plane.c_str());
   else if (p.kind == "rectangle")
-    std::snprintf(b, sizeof b, "eical rectangle %gx%g mm F%g, plane %s", p.size_mm[0], p.size_mm[1], p.feed_mm_min, p.plane.c_str());
+    std::snprintf(b, sizeof b, "eical rectangle %gx%g mm F%g, plane %s", p.size_mm[0], p.size_mm[1], p.feed_mm_min,
+                  p.plane.c_str());
   else
-    std::snprintf(b, sizeof b, "eical %s %s, %zu targets, %d runs, F%g", p.kind.c_str(), p.axis.c_str(), p.targets_mm.size(), p.runs, p.feed_mm_min);
+    std::snprintf(b, sizeof b, "eical %s %s, %zu targets, %d runs, F%g", p.kind.c_str(), p.axis.c_str(),
+                  p.targets_mm.size(), p.runs, p.feed_mm_min);
   return b;
 }
 
@@ -109,8 +118,8 @@ void emit(GenOptions& o) {
   p.center_mm[0] = o.center.at(0), p.center_mm[1] = o.center.at(1);
   p.corner_mm[0] = o.corner.at(0), p.corner_mm[1] = o.corner.at(1);
   p.size_mm[0] = o.size.at(0), p.size_mm[1] = o.size.at(1);
-  const std::string g = p.kind == "positioning" ? sim::gcode::positioning_program(p, o.overrun_mm)
-                                                : sim::gcode::program_gcode(p);
+  const std::string g =
+      p.kind == "positioning" ? sim::gcode::positioning_program(p, o.overrun_mm) : sim::gcode::program_gcode(p);
   write_program(g, p, title_of(p), o.out, o.meta_out, o.dialect, o.program_number, o.program_name);
 }
 
@@ -123,11 +132,14 @@ void add_circle(CLI::App* gen) {
   c->add_option("--radius", p.radius_mm, "radius in mm")->default_val(10.0);
   c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2500.0);
   c->add_option("--repeats", p.repeats, "full revolutions")->default_val(5);
-  c->add_option("--direction", p.direction, "ccw, cw or both (ccw, then cw back)")->default_val("ccw")->check(CLI::IsMember({"ccw", "cw", "both"}));
+  c->add_option("--direction", p.direction, "ccw, cw or both (ccw, then cw back)")
+      ->default_val("ccw")
+      ->check(CLI::IsMember({"ccw", "cw", "both"}));
   c->add_option("--plane", p.plane, "xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
   c->add_option("--center", o->center, "centre in the plane, mm")->expected(2)->delimiter(',');
   c->add_option("--arc-deg", p.arc_deg, "evaluated arc in deg: 360 = full circle, up to 340 for a partial arc")
-      ->default_val(360.0)->check(CLI::Range(1.0, 360.0));
+      ->default_val(360.0)
+      ->check(CLI::Range(1.0, 360.0));
   c->add_option("--arc-start-deg", o->arc_start_deg, "partial arc: where it begins, deg (default 90 - arc/2)");
   add_output(c, *o);
   c->callback([o] {
@@ -148,7 +160,10 @@ void add_positioning(CLI::App* gen) {
   c->add_option("--dwell", p.dwell_s, "dwell at each target in s")->default_val(0.5);
   c->add_option("--overrun", o->overrun_mm, "overrun beyond the end targets in mm")->default_val(2.0);
   add_output(c, *o);
-  c->callback([o] { o->program.kind = "positioning"; emit(*o); });
+  c->callback([o] {
+    o->program.kind = "positioning";
+    emit(*o);
+  });
 }
 
 void add_step(CLI::App* gen) {
@@ -161,7 +176,10 @@ void add_step(CLI::App* gen) {
   c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(3250.0);
   c->add_option("--dwell", p.dwell_s, "dwell at each end in s")->default_val(0.5);
   add_output(c, *o);
-  c->callback([o] { o->program.kind = "step"; emit(*o); });
+  c->callback([o] {
+    o->program.kind = "step";
+    emit(*o);
+  });
 }
 
 void add_rectangle(CLI::App* gen) {
@@ -175,7 +193,10 @@ void add_rectangle(CLI::App* gen) {
   c->add_option("--repeats", p.repeats, "laps")->default_val(1);
   c->add_option("--plane", p.plane, "xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
   add_output(c, *o);
-  c->callback([o] { o->program.kind = "rectangle"; emit(*o); });
+  c->callback([o] {
+    o->program.kind = "rectangle";
+    emit(*o);
+  });
 }
 
 void add_identify(CLI::App* gen) {
@@ -186,11 +207,15 @@ void add_identify(CLI::App* gen) {
     int number = 1000;
   };
   auto o = std::make_shared<Id>();
-  auto* c = gen->add_subcommand("identify", "on-site sensor identification: swings across the PSD strips (and further axes)");
+  auto* c =
+      gen->add_subcommand("identify", "on-site sensor identification: swings across the PSD strips (and further axes)");
   c->add_option("--psd", o->psd, "a strip as MEASURES:CX,CY, e.g. x:0,-10 (repeat for each strip)");
-  c->add_option("--axis", o->axes, "a further axis to swing without a strip, e.g. z (repeatable)")->check(CLI::IsMember({"x", "y", "z"}));
+  c->add_option("--axis", o->axes, "a further axis to swing without a strip, e.g. z (repeatable)")
+      ->check(CLI::IsMember({"x", "y", "z"}));
   c->add_option("--swing", o->plan.swing_mm, "swing, peak to peak, mm")->default_val(50.0);
-  c->add_option("--feeds", o->plan.feeds_mm_min, "feeds in mm/min (comma separated)")->delimiter(',')->default_str("2000,4000,6500");
+  c->add_option("--feeds", o->plan.feeds_mm_min, "feeds in mm/min (comma separated)")
+      ->delimiter(',')
+      ->default_str("2000,4000,6500");
   add_output(c, o->out, o->meta_out, o->dialect, o->number, o->name);
   c->callback([o] {
     for (const auto& t : o->psd) o->plan.psd.push_back(parse_psd(t));
@@ -199,7 +224,8 @@ void add_identify(CLI::App* gen) {
     const std::string g = sim::gcode::identify_program(o->plan);
     dsp::Program p;
     p.kind = "identify";
-    write_program(g, p, "eical identify: swings across the PSD strips", o->out, o->meta_out, o->dialect, o->number, o->name);
+    write_program(g, p, "eical identify: swings across the PSD strips", o->out, o->meta_out, o->dialect, o->number,
+                  o->name);
   });
 }
 

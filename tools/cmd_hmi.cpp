@@ -1,7 +1,7 @@
 // eical hmi / eical trigger: the reference HMI on the DDS bus. `hmi` prints eicald's
 // Status and every Result and Trace it receives (a late HMI still gets the last Result and
-// Trace per program: transient-local) and can save the traces as CSV; `trigger` sends an M-code (101 tare + start, 102 segment, 103 stop)
-// as an NC user M-function would, and waits for the daemon's Reply.
+// Trace per program: transient-local) and can save the traces as CSV; `trigger` sends an M-code (101 tare + start, 102
+// segment, 103 stop) as an NC user M-function would, and waits for the daemon's Reply.
 #include "tools/commands.hpp"
 
 #if EICAL_HAVE_DDS
@@ -11,15 +11,15 @@
 
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <ctime>
 #include <memory>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace eical::tools {
 namespace {
@@ -51,12 +51,18 @@ void save_trace(const std::filesystem::path& dir, const drivers::dds::TraceMsg& 
 
 // ", 2 triggers refused, 1 decode errors": the counters of a Status that are not zero.
 std::string nonzero_counters(const drivers::dds::StatusMsg& s) {
-  const std::pair<const char*, std::uint64_t> all[] = {
-      {"bad frames", s.bad_frames},           {"Live overruns", s.live_overruns},          {"stamp overruns", s.stamp_overruns},
-      {"DDS write errors", s.dds_write_errors}, {"triggers refused", s.triggers_refused},  {"triggers late", s.triggers_late},
-      {"trigger events ignored", s.trigger_events_ignored}, {"recorder overflow", s.recorder_overflow},
-      {"decode errors", s.source_decode_errors}, {"samples lost by the source", s.source_lost_samples},
-      {"frames dropped by the source", s.source_dropped_frames}, {"frames without set-point", s.setpoint_missing}};
+  const std::pair<const char*, std::uint64_t> all[] = {{"bad frames", s.bad_frames},
+                                                       {"Live overruns", s.live_overruns},
+                                                       {"stamp overruns", s.stamp_overruns},
+                                                       {"DDS write errors", s.dds_write_errors},
+                                                       {"triggers refused", s.triggers_refused},
+                                                       {"triggers late", s.triggers_late},
+                                                       {"trigger events ignored", s.trigger_events_ignored},
+                                                       {"recorder overflow", s.recorder_overflow},
+                                                       {"decode errors", s.source_decode_errors},
+                                                       {"samples lost by the source", s.source_lost_samples},
+                                                       {"frames dropped by the source", s.source_dropped_frames},
+                                                       {"frames without set-point", s.setpoint_missing}};
   std::string out;
   for (const auto& [name, value] : all)
     if (value != 0) out += ", " + std::to_string(value) + " " + name;
@@ -79,10 +85,12 @@ void register_hmi(CLI::App& app) {
   hmi->add_option("--domain", o->domain, "DDS domain id")->default_val(0);
   hmi->add_option("--dds-config", o->uri, "Cyclone DDS XML (file://...); default $CYCLONEDDS_URI");
   hmi->add_option("--results", o->results, "exit after this many results (0 = run until the timeout)")->default_val(0);
-  hmi->add_option("--traces", o->traces, "also wait for this many traces before exiting with --results")->default_val(0);
+  hmi->add_option("--traces", o->traces, "also wait for this many traces before exiting with --results")
+      ->default_val(0);
   hmi->add_option("--save-traces", o->save_traces, "write every trace received to DIR/<program id>.trace.csv");
   hmi->add_option("--timeout", o->timeout_s, "exit after this many seconds (0 = never)")->default_val(0.0);
-  hmi->add_option("--connect-timeout", o->connect_timeout_s, "exit non-zero when no eicald Status arrives within this many seconds")
+  hmi->add_option("--connect-timeout", o->connect_timeout_s,
+                  "exit non-zero when no eicald Status arrives within this many seconds")
       ->default_val(10.0);
   hmi->callback([o] {
     use_uri(o->uri);
@@ -90,7 +98,8 @@ void register_hmi(CLI::App& app) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto end = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                               std::chrono::duration<double>(o->timeout_s > 0 ? o->timeout_s : 1e9));
-    const auto connect_end = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(o->connect_timeout_s));
+    const auto connect_end = t0 + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                      std::chrono::duration<double>(o->connect_timeout_s));
     int results = 0, traces = 0;
     bool daemon_seen = false;
     // The daemon's result count as this HMI knows it: a Result carries the count it was
@@ -102,10 +111,11 @@ void register_hmi(CLI::App& app) {
       if (auto s = bus.take_status(std::chrono::milliseconds(100))) {
         daemon_seen = true;
         result_count = std::max(result_count, s->results);
-        std::printf("status %s: %s, %llu frames, %llu overruns, %llu lost, %llu results%s%s%s\n", s->daemon.c_str(), s->state.c_str(),
-                    static_cast<unsigned long long>(s->frames), static_cast<unsigned long long>(s->overruns),
-                    static_cast<unsigned long long>(s->frames_lost), static_cast<unsigned long long>(result_count),
-                    nonzero_counters(*s).c_str(), s->fault.empty() ? "" : " — ", s->fault.c_str());
+        std::printf("status %s: %s, %llu frames, %llu overruns, %llu lost, %llu results%s%s%s\n", s->daemon.c_str(),
+                    s->state.c_str(), static_cast<unsigned long long>(s->frames),
+                    static_cast<unsigned long long>(s->overruns), static_cast<unsigned long long>(s->frames_lost),
+                    static_cast<unsigned long long>(result_count), nonzero_counters(*s).c_str(),
+                    s->fault.empty() ? "" : " — ", s->fault.c_str());
       }
       if (auto r = bus.take_result(std::chrono::milliseconds(10))) {
         // The figures with their uncertainty and the verdict, from the result document.
@@ -116,21 +126,25 @@ void register_hmi(CLI::App& app) {
           const auto v = drivers::figure_value(doc, "circle.circular_deviation_G_um");
           const auto u = drivers::uncertainty_k2(doc, "circle.circular_deviation_G_um");
           char b[96];
-          if (v) std::snprintf(b, sizeof b, "G %.2f%s um%s", *v, u ? (" ± " + std::to_string(*u).substr(0, std::to_string(*u).find('.') + 3)).c_str() : "",
-                               u && !drivers::figure_resolved(doc, "circle.circular_deviation_G_um") ? " (not resolved)" : "");
+          if (v)
+            std::snprintf(
+                b, sizeof b, "G %.2f%s um%s", *v,
+                u ? (" ± " + std::to_string(*u).substr(0, std::to_string(*u).find('.') + 3)).c_str() : "",
+                u && !drivers::figure_resolved(doc, "circle.circular_deviation_G_um") ? " (not resolved)" : "");
           if (v) g = b;
         }
         daemon_seen = true;
         result_count = std::max(result_count, r->results);
-        std::printf("result %s (%s): verdict %s, %s, mean radius deviation %.2f um (result %llu of the daemon)\n", r->program_id.c_str(), r->program.c_str(),
-                    verdict.c_str(), g.c_str(), r->radius_mean_deviation_um, static_cast<unsigned long long>(r->results));
+        std::printf("result %s (%s): verdict %s, %s, mean radius deviation %.2f um (result %llu of the daemon)\n",
+                    r->program_id.c_str(), r->program.c_str(), verdict.c_str(), g.c_str(), r->radius_mean_deviation_um,
+                    static_cast<unsigned long long>(r->results));
         ++results;
       }
       if (auto t = bus.take_trace(std::chrono::milliseconds(10))) {
         const auto [lo, hi] = std::minmax_element(t->y.begin(), t->y.end());
-        std::printf("trace %s (%s): %zu points, %s -> %s, %s %.3f .. %.3f (every %u. point)\n", t->program_id.c_str(), t->program.c_str(),
-                    t->x.size(), t->x_name.c_str(), t->y_name.c_str(), t->y_name.c_str(), t->y.empty() ? std::nan("") : *lo,
-                    t->y.empty() ? std::nan("") : *hi, t->decimation);
+        std::printf("trace %s (%s): %zu points, %s -> %s, %s %.3f .. %.3f (every %u. point)\n", t->program_id.c_str(),
+                    t->program.c_str(), t->x.size(), t->x_name.c_str(), t->y_name.c_str(), t->y_name.c_str(),
+                    t->y.empty() ? std::nan("") : *lo, t->y.empty() ? std::nan("") : *hi, t->decimation);
         if (!o->save_traces.empty()) save_trace(o->save_traces, *t);
         ++traces;
       }
@@ -140,15 +154,19 @@ void register_hmi(CLI::App& app) {
     if (!daemon_seen) {
       const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       throw std::runtime_error("hmi: no eicald on DDS domain " + std::to_string(o->domain) + " (no Status within " +
-                               std::to_string(static_cast<int>(std::lround(waited))) + " s; is eicald running with the same domain and DDS configuration?)");
+                               std::to_string(static_cast<int>(std::lround(waited))) +
+                               " s; is eicald running with the same domain and DDS configuration?)");
     }
     if (o->results > 0)
-      throw std::runtime_error("hmi: " + std::to_string(results) + " of " + std::to_string(o->results) + " results and " + std::to_string(traces) +
-                               " of " + std::to_string(o->traces) + " traces before the timeout");
+      throw std::runtime_error("hmi: " + std::to_string(results) + " of " + std::to_string(o->results) +
+                               " results and " + std::to_string(traces) + " of " + std::to_string(o->traces) +
+                               " traces before the timeout");
   });
 
   auto* trig = app.add_subcommand("trigger", "Send an NC trigger (M101/M102/M103) to eicald over DDS");
-  trig->add_option("code", o->code, "101 (tare + start), 102 (segment), 103 (stop + evaluate)")->required()->check(CLI::IsMember({dsp::trigger::program_start, dsp::trigger::segment_mark, dsp::trigger::program_end}));
+  trig->add_option("code", o->code, "101 (tare + start), 102 (segment), 103 (stop + evaluate)")
+      ->required()
+      ->check(CLI::IsMember({dsp::trigger::program_start, dsp::trigger::segment_mark, dsp::trigger::program_end}));
   trig->add_option("-P", o->p, "the M-code's P word");
   trig->add_option("-Q", o->q, "the M-code's Q word");
   trig->add_option("--domain", o->domain, "DDS domain id")->default_val(0);
@@ -168,17 +186,19 @@ void register_hmi(CLI::App& app) {
     c.q = o->q;
     c.time_ns = static_cast<std::int64_t>(ts.tv_sec) * 1000000000 + ts.tv_nsec;
     const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                             std::chrono::duration<double>(o->timeout_s));
+                                                            std::chrono::duration<double>(o->timeout_s));
     // Volatile command topic: resend until the daemon's reader has matched and replied.
     while (std::chrono::steady_clock::now() < end) {
       bus.send(c);
-      if (auto r = bus.take_reply(std::chrono::milliseconds(100)); r && r->sender == c.sender && r->request_id == c.request_id) {
+      if (auto r = bus.take_reply(std::chrono::milliseconds(100));
+          r && r->sender == c.sender && r->request_id == c.request_id) {
         std::printf("M%d: %s (state %s)\n", o->code, r->message.c_str(), r->state.c_str());
         if (!r->ok) throw std::runtime_error("trigger refused: " + r->message);
         return;
       }
     }
-    throw std::runtime_error("trigger: no eicald answered on DDS domain " + std::to_string(o->domain) + " within " + std::to_string(o->timeout_s) + " s");
+    throw std::runtime_error("trigger: no eicald answered on DDS domain " + std::to_string(o->domain) + " within " +
+                             std::to_string(o->timeout_s) + " s");
   });
 }
 
@@ -187,7 +207,8 @@ void register_hmi(CLI::App& app) {
 namespace eical::tools {
 void register_hmi(CLI::App& app) {
   auto* hmi = app.add_subcommand("hmi", "Reference HMI (this build has no DDS)");
-  hmi->callback([] { throw std::runtime_error("eical was built without Cyclone DDS (EICAL_BUILD_DAEMON=OFF): no hmi/trigger"); });
+  hmi->callback(
+      [] { throw std::runtime_error("eical was built without Cyclone DDS (EICAL_BUILD_DAEMON=OFF): no hmi/trigger"); });
 }
 }  // namespace eical::tools
 #endif

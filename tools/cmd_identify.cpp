@@ -55,14 +55,17 @@ nlohmann::json identification_json(const dsp::identify::Identification& id) {
   }
   j["psd_offset_um"] = nlohmann::json::array();
   for (const auto& o : id.psd_offset_um) j["psd_offset_um"].push_back(estimate_json(o));
-  j["agreement"] = {{"psd_rms_before_um", id.psd_rms_before_um}, {"psd_rms_after_um", id.psd_rms_after_um},
-                    {"rest_rms_before_um", id.rest_rms_before_um}, {"rest_rms_after_um", id.rest_rms_after_um}};
+  j["agreement"] = {{"psd_rms_before_um", id.psd_rms_before_um},
+                    {"psd_rms_after_um", id.psd_rms_after_um},
+                    {"rest_rms_before_um", id.rest_rms_before_um},
+                    {"rest_rms_after_um", id.rest_rms_after_um}};
   j["observations"] = {{"psd", id.psd_observations}, {"rest", id.rest_observations}, {"standstills", id.standstills}};
   j["iterations"] = id.iterations;
   j["strip_crossings"] = id.strip_crossings;
   j["crossing_speeds_mm_s"] = id.crossing_speeds_mm_s;
   nlohmann::json sig = nlohmann::json::object();
-  for (int p = 0; p < dsp::uncertainty::kModelParameters; ++p) sig[dsp::uncertainty::parameter_name(p)] = id.covariance.sigma(p);
+  for (int p = 0; p < dsp::uncertainty::kModelParameters; ++p)
+    sig[dsp::uncertainty::parameter_name(p)] = id.covariance.sigma(p);
   j["standard_uncertainty"] = sig;  // σ of every model parameter (the data sheet's where not identified)
   j["notes"] = id.notes;
   return j;
@@ -80,30 +83,37 @@ std::string summary(const dsp::identify::Identification& id) {
       o += "   ";
       for (int k = 0; k < 3; ++k) {
         const auto& e = se.error[i][k];
-        if (e.fitted) std::snprintf(b, sizeof b, "  E_%s%s %+9.1f ± %5.1f", kAxis[i], kAxis[k], e.value * 1e6, e.sigma * 1e6);
-        else std::snprintf(b, sizeof b, "  E_%s%s %17s", kAxis[i], kAxis[k], "—");
+        if (e.fitted)
+          std::snprintf(b, sizeof b, "  E_%s%s %+9.1f ± %5.1f", kAxis[i], kAxis[k], e.value * 1e6, e.sigma * 1e6);
+        else
+          std::snprintf(b, sizeof b, "  E_%s%s %17s", kAxis[i], kAxis[k], "—");
         o += b;
       }
       o += "\n";
     }
     if (se.damping_s.fitted)
-      std::snprintf(b, sizeof b, "   2ζ/ω0: data sheet − identified = %+.2f ± %.2f µs → ζ = %.4f at f0 = %.0f Hz\n", se.damping_s.value * 1e6,
-                    se.damping_s.sigma * 1e6, id.sensors[s].zeta, id.sensors[s].f0_hz);
+      std::snprintf(b, sizeof b, "   2ζ/ω0: data sheet − identified = %+.2f ± %.2f µs → ζ = %.4f at f0 = %.0f Hz\n",
+                    se.damping_s.value * 1e6, se.damping_s.sigma * 1e6, id.sensors[s].zeta, id.sensors[s].f0_hz);
     else
       std::snprintf(b, sizeof b, "   2ζ/ω0: not identified, data sheet kept\n");
     o += b;
   }
   if (id.delay_setpoint.valid) {
-    std::snprintf(b, sizeof b, "PSD behind the set-point: %.3f ± %.3f samples (DAQ delay + servo lag)\n", id.delay_setpoint.samples, id.delay_setpoint.sigma);
+    std::snprintf(b, sizeof b, "PSD behind the set-point: %.3f ± %.3f samples (DAQ delay + servo lag)\n",
+                  id.delay_setpoint.samples, id.delay_setpoint.sigma);
     o += b;
   }
   if (id.delay_reference.valid) {
-    std::snprintf(b, sizeof b, "PSD behind the reference: %.3f ± %.3f samples (DAQ delay)\n", id.delay_reference.samples, id.delay_reference.sigma);
+    std::snprintf(b, sizeof b, "PSD behind the reference: %.3f ± %.3f samples (DAQ delay)\n",
+                  id.delay_reference.samples, id.delay_reference.sigma);
     o += b;
   }
-  std::snprintf(b, sizeof b, "DAQ delay used: %.3f samples (%s)\n", id.daq_group_delay_samples, id.delay_identified ? "identified" : "data sheet");
+  std::snprintf(b, sizeof b, "DAQ delay used: %.3f samples (%s)\n", id.daq_group_delay_samples,
+                id.delay_identified ? "identified" : "data sheet");
   o += b;
-  std::snprintf(b, sizeof b, "agreement with the PSD readings (not used by the pipeline): %.2f → %.2f µm RMS; set-point at standstills: %.2f → %.2f µm RMS\n",
+  std::snprintf(b, sizeof b,
+                "agreement with the PSD readings (not used by the pipeline): %.2f → %.2f µm RMS; set-point at "
+                "standstills: %.2f → %.2f µm RMS\n",
                 id.psd_rms_before_um, id.psd_rms_after_um, id.rest_rms_before_um, id.rest_rms_after_um);
   o += b;
   for (const auto& n : id.notes) o += "note: " + n + "\n";
@@ -119,13 +129,20 @@ void register_identify(CLI::App& app) {
     double rest_sigma_um = 0.5;
   };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("identify", "Identify the sensors on site from an identification run (PSD strips + set-point); write the sensor calibration");
+  auto* cmd = app.add_subcommand(
+      "identify",
+      "Identify the sensors on site from an identification run (PSD strips + set-point); write the sensor calibration");
   cmd->add_option("run", o->run, "identification run (eical gen-nc identify)")->required();
   cmd->add_option("-o,--out", o->out, "write the calibration here (eical-sensor-cal/1)");
   cmd->add_flag("--json", o->json, "print the eical-identify/1 document");
-  cmd->add_flag("--compare-reference", o->compare_reference, "also identify against the run's reference instrument and compare");
-  cmd->add_flag("--delay-from-setpoint", o->delay_from_setpoint, "store the PSD-vs-set-point delay (includes the servo lag) as the DAQ delay");
-  cmd->add_option("--rest-sigma", o->rest_sigma_um, "the machine's position at a standstill against its set-point, µm (σ)")->default_val(0.5)->check(CLI::PositiveNumber);
+  cmd->add_flag("--compare-reference", o->compare_reference,
+                "also identify against the run's reference instrument and compare");
+  cmd->add_flag("--delay-from-setpoint", o->delay_from_setpoint,
+                "store the PSD-vs-set-point delay (includes the servo lag) as the DAQ delay");
+  cmd->add_option("--rest-sigma", o->rest_sigma_um,
+                  "the machine's position at a standstill against its set-point, µm (σ)")
+      ->default_val(0.5)
+      ->check(CLI::PositiveNumber);
   cmd->callback([o] {
     const dsp::Run run = drivers::read_run(o->run);
     dsp::identify::IdentifyOptions opt;
@@ -133,13 +150,15 @@ void register_identify(CLI::App& app) {
     opt.delay_from_setpoint = o->delay_from_setpoint;
     const dsp::identify::Identification id = dsp::identify::identify_sensors(run, opt);
     // A calibration less certain than the data sheet would make every figure worse.
-    const auto worse = dsp::identify::less_certain_than_datasheet(id, dsp::uncertainty::datasheet_covariance(run.meta.sensors, run.meta.acquisition.fs_hz));
+    const auto worse = dsp::identify::less_certain_than_datasheet(
+        id, dsp::uncertainty::datasheet_covariance(run.meta.sensors, run.meta.acquisition.fs_hz));
     if (!worse.empty()) {
       std::string list;
       for (std::size_t i = 0; i < worse.size() && i < 4; ++i) list += (i ? "; " : "") + worse[i];
       if (worse.size() > 4) list += "; and " + std::to_string(worse.size() - 4) + " more";
       throw std::runtime_error("identify: run '" + run.meta.id + "' leaves " + list +
-                               " less certain than the data sheet: no calibration written (run the identification program, eical gen-nc identify)");
+                               " less certain than the data sheet: no calibration written (run the identification "
+                               "program, eical gen-nc identify)");
     }
     nlohmann::json doc = {{"format", "eical-identify/1"}, {"run_id", run.meta.id}};
     doc["identification"] = identification_json(id);
@@ -160,7 +179,8 @@ void register_identify(CLI::App& app) {
             const double d = a.value - b.value, sg = std::hypot(a.sigma, b.sigma);
             diff[std::string(kSensor[s]) + ".E_" + kAxis[i] + kAxis[k]] = {{"difference", d}, {"sigma", sg}};
             char line[160];
-            std::snprintf(line, sizeof line, "  %s E_%s%s: %+.1f ppm (%.1f σ)\n", kSensor[s], kAxis[i], kAxis[k], d * 1e6, sg > 0 ? d / sg : 0.0);
+            std::snprintf(line, sizeof line, "  %s E_%s%s: %+.1f ppm (%.1f σ)\n", kSensor[s], kAxis[i], kAxis[k],
+                          d * 1e6, sg > 0 ? d / sg : 0.0);
             text += line;
           }
       doc["difference_psd_minus_reference"] = diff;
@@ -169,8 +189,10 @@ void register_identify(CLI::App& app) {
       drivers::write_sensor_calibration(drivers::calibration_from(id, run.meta.id), o->out);
       text += "wrote " + o->out + "\n";
     }
-    if (o->json) std::printf("%s\n", doc.dump(2).c_str());
-    else std::fputs(text.c_str(), stdout);
+    if (o->json)
+      std::printf("%s\n", doc.dump(2).c_str());
+    else
+      std::fputs(text.c_str(), stdout);
   });
 }
 

@@ -25,21 +25,30 @@ struct Common {
 void add_common(CLI::App* cmd, Common& c) {
   cmd->add_option("-o,--out", c.out, "run directory to write")->required();
   cmd->add_option("--id", c.id, "run id (default: the directory's name)");
-  cmd->add_option("--sensor", c.sensor, "the part that carries the sensor: head or table")->default_val("head")->check(CLI::IsMember({"head", "table"}));
+  cmd->add_option("--sensor", c.sensor, "the part that carries the sensor: head or table")
+      ->default_val("head")
+      ->check(CLI::IsMember({"head", "table"}));
   std::vector<std::string> chips;
   for (const auto& chip : sim::mems_chips()) chips.push_back(chip.name);
-  cmd->add_option("--chip", c.chip, "the sensor's chip (noise density and low-pass corner of its data sheet, sim/sensor/mems_chip.hpp)")
+  cmd->add_option("--chip", c.chip,
+                  "the sensor's chip (noise density and low-pass corner of its data sheet, sim/sensor/mems_chip.hpp)")
       ->default_val("adxl345")
       ->check(CLI::IsMember(chips));
-  cmd->add_option("--bandwidth-hz", c.bandwidth_hz, "the chip's low-pass corner, Hz (default: the chip's at the capture's rate)")->check(CLI::PositiveNumber);
-  cmd->add_option("--noise-ug-per-rthz", c.noise_ug, "noise density, ug/sqrt(Hz), two-sided as run-format.md (default: the chip's data sheet / sqrt(2))")
+  cmd->add_option("--bandwidth-hz", c.bandwidth_hz,
+                  "the chip's low-pass corner, Hz (default: the chip's at the capture's rate)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--noise-ug-per-rthz", c.noise_ug,
+                  "noise density, ug/sqrt(Hz), two-sided as run-format.md (default: the chip's data sheet / sqrt(2))")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--mounting", c.mounting, "the sensor's axes as machine axes, Klipper axes_map notation (x,y,z; -y,x,z ...): machine X, Y, Z "
-                                            "are the named columns of the file")
+  cmd->add_option("--mounting", c.mounting,
+                  "the sensor's axes as machine axes, Klipper axes_map notation (x,y,z; -y,x,z ...): machine X, Y, Z "
+                  "are the named columns of the file")
       ->default_val("x,y,z");
   cmd->add_option("--head-axes", c.head_axes, "machine axes the head moves")->default_val("xy");
   cmd->add_option("--table-axes", c.table_axes, "machine axes the table moves")->default_val("z");
-  cmd->add_option("--g-mps2", c.g_mps2, "gravity at the site, m/s2: converts the recorded acceleration to g (run.toml [site]; default standard gravity)")
+  cmd->add_option("--g-mps2", c.g_mps2,
+                  "gravity at the site, m/s2: converts the recorded acceleration to g (run.toml [site]; default "
+                  "standard gravity)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--gzip", c.gzip, "write samples.csv.gz");
   cmd->add_flag("--overwrite", c.overwrite, "replace an existing run");
@@ -65,20 +74,29 @@ void finish(const Common& c, const drivers::ImportResult& r) {
   drivers::write_import_report(c.out, r.report);
   const auto& k = r.report.accel_clock;
   const auto& off = r.report.offset;
-  std::printf("wrote %s: %zu frames at %.6g Hz (median dt %.2f us, jitter %.2f us rms, %zu lost frames in %zu gaps), one sensor (%s)\n",
-              c.out.c_str(), r.run.frames.size(), k.fs_hz, k.median_dt_s * 1e6, k.jitter_rms_s * 1e6, k.lost_frames, k.gaps, c.sensor.c_str());
-  std::printf("time offset recorder - set-point: %.6f s +- %.1f us (k=1, block jackknife of %d), commanded acceleration explains %.1f %% of the measured\n",
-              off.offset_s, off.u_s * 1e6, off.blocks, 100.0 * off.explained);
+  std::printf(
+      "wrote %s: %zu frames at %.6g Hz (median dt %.2f us, jitter %.2f us rms, %zu lost frames in %zu gaps), one "
+      "sensor (%s)\n",
+      c.out.c_str(), r.run.frames.size(), k.fs_hz, k.median_dt_s * 1e6, k.jitter_rms_s * 1e6, k.lost_frames, k.gaps,
+      c.sensor.c_str());
+  std::printf(
+      "time offset recorder - set-point: %.6f s +- %.1f us (k=1, block jackknife of %d), commanded acceleration "
+      "explains %.1f %% of the measured\n",
+      off.offset_s, off.u_s * 1e6, off.blocks, 100.0 * off.explained);
   // Where the commanded motion shows, through the stated mounting: a wrong --mounting or
   // --axis shows here (eical explain names it as sensor.misalignment).
-  const Eigen::Vector3d moved = (r.run.meta.sensors[r.run.meta.sensor_present[1] ? 1 : 0].to_machine * off.gain).colwise().norm().transpose();
+  const Eigen::Vector3d moved =
+      (r.run.meta.sensors[r.run.meta.sensor_present[1] ? 1 : 0].to_machine * off.gain).colwise().norm().transpose();
   const int axis = static_cast<int>(std::max_element(moved.data(), moved.data() + 3) - moved.data());
   const Eigen::Vector3d seen = r.run.meta.sensors[r.run.meta.sensor_present[1] ? 1 : 0].to_machine * off.gain.col(axis);
-  std::printf("commanded %c shows in the measured acceleration along machine [%.3f, %.3f, %.3f] (stated mounting), gain %.4g g per mm/s2\n",
-              static_cast<char>('x' + axis), seen.x() / seen.norm(), seen.y() / seen.norm(), seen.z() / seen.norm(), seen.norm());
+  std::printf(
+      "commanded %c shows in the measured acceleration along machine [%.3f, %.3f, %.3f] (stated mounting), gain %.4g g "
+      "per mm/s2\n",
+      static_cast<char>('x' + axis), seen.x() / seen.norm(), seen.y() / seen.norm(), seen.z() / seen.norm(),
+      seen.norm());
   if (r.report.nc_clock)
-    std::printf("NC trace: %.6g Hz, jitter %.2f us rms, %zu lost samples bridged\n", r.report.nc_clock->fs_hz, r.report.nc_clock->jitter_rms_s * 1e6,
-                r.report.nc_clock->lost_frames);
+    std::printf("NC trace: %.6g Hz, jitter %.2f us rms, %zu lost samples bridged\n", r.report.nc_clock->fs_hz,
+                r.report.nc_clock->jitter_rms_s * 1e6, r.report.nc_clock->lost_frames);
   std::printf("import.toml records the clock, the resampling and the offset\n");
 }
 
@@ -87,15 +105,19 @@ void register_klipper(CLI::App* import) {
     Common c;
     std::string capture, axis = "x";
     bool legacy = false;
-    double freq_start = 0.0, freq_end = 0.0, accel_per_hz = 0.0, hz_per_sec = 0.0, sweeping_accel = -1.0, sweeping_period = -1.0, max_accel = 0.0;
+    double freq_start = 0.0, freq_end = 0.0, accel_per_hz = 0.0, hz_per_sec = 0.0, sweeping_accel = -1.0,
+           sweeping_period = -1.0, max_accel = 0.0;
     std::vector<double> start{0.0, 0.0, 0.0};
   };
   auto o = std::make_shared<KlipperOpt>();
-  auto* cmd = import->add_subcommand("klipper", "A Klipper raw accelerometer capture (#time,accel_x,accel_y,accel_z; print time, mm/s2) of TEST_RESONANCES; "
-                                                "the set-point from Klipper's resonance_tester.py, its start found by cross-correlation");
+  auto* cmd = import->add_subcommand(
+      "klipper",
+      "A Klipper raw accelerometer capture (#time,accel_x,accel_y,accel_z; print time, mm/s2) of TEST_RESONANCES; "
+      "the set-point from Klipper's resonance_tester.py, its start found by cross-correlation");
   cmd->add_option("capture", o->capture, "the capture (raw_data_*.csv)")->required();
   cmd->add_option("--axis", o->axis, "the test's AXIS: x, y or dx,dy (as TEST_RESONANCES)")->default_val("x");
-  cmd->add_flag("--klipper-legacy", o->legacy, "older Klipper: max_freq 133.33 Hz, accel_per_hz 75, no sweeping, moves out and back");
+  cmd->add_flag("--klipper-legacy", o->legacy,
+                "older Klipper: max_freq 133.33 Hz, accel_per_hz 75, no sweeping, moves out and back");
   cmd->add_option("--freq-start", o->freq_start, "FREQ_START, Hz (default 5)");
   cmd->add_option("--freq-end", o->freq_end, "FREQ_END, Hz (default 200; legacy 133.33)");
   cmd->add_option("--accel-per-hz", o->accel_per_hz, "accel_per_hz, mm/s2 per Hz (default 60; legacy 75)");
@@ -103,7 +125,9 @@ void register_klipper(CLI::App* import) {
   cmd->add_option("--sweeping-accel", o->sweeping_accel, "sweeping_accel, mm/s2 (default 400; legacy none)");
   cmd->add_option("--sweeping-period", o->sweeping_period, "sweeping_period, s (default 1.2; 0: no sweeping)");
   cmd->add_option("--max-accel", o->max_accel, "the printer's max_accel, mm/s2: the stop after a sweep (default 5000)");
-  cmd->add_option("--start", o->start, "where the test starts, mm (Klipper's probe point)")->expected(3)->delimiter(',');
+  cmd->add_option("--start", o->start, "where the test starts, mm (Klipper's probe point)")
+      ->expected(3)
+      ->delimiter(',');
   add_common(cmd, o->c);
   cmd->callback([o] {
     drivers::KlipperImport k;
@@ -127,7 +151,8 @@ std::array<std::string, 3> three(const std::string& list, const std::string& wha
   std::array<std::string, 3> out;
   std::stringstream ss(list);
   for (auto& s : out)
-    if (!std::getline(ss, s, ',') || s.empty()) throw dsp::InputError(what + ": '" + list + "' must name three columns");
+    if (!std::getline(ss, s, ',') || s.empty())
+      throw dsp::InputError(what + ": '" + list + "' must name three columns");
   std::string extra;
   if (std::getline(ss, extra)) throw dsp::InputError(what + ": '" + list + "' must name three columns");
   return out;
@@ -136,31 +161,45 @@ std::array<std::string, 3> three(const std::string& list, const std::string& wha
 void register_csv(CLI::App* import) {
   struct CsvOpt {
     Common c;
-    std::string accel, nc, time_col, columns, unit = "mps2", time_unit = "s", nc_format = "halsampler", nc_time_col, nc_columns;
+    std::string accel, nc, time_col, columns, unit = "mps2", time_unit = "s", nc_format = "halsampler", nc_time_col,
+                                              nc_columns;
     double servo_period_s = 0.001;
   };
   auto o = std::make_shared<CsvOpt>();
-  auto* cmd = import->add_subcommand("csv", "A generic accelerometer CSV plus an NC trace (LinuxCNC halsampler or a CSV servo trace); both onto one "
-                                            "uniform clock, their offset found by cross-correlation");
+  auto* cmd = import->add_subcommand(
+      "csv",
+      "A generic accelerometer CSV plus an NC trace (LinuxCNC halsampler or a CSV servo trace); both onto one "
+      "uniform clock, their offset found by cross-correlation");
   cmd->add_option("--accel", o->accel, "accelerometer CSV with a header row")->required();
   cmd->add_option("--time-col", o->time_col, "its time column (default: the first)");
-  cmd->add_option("--columns", o->columns, "its three acceleration columns, sensor axes 1..3 (default: the three after the time)");
-  cmd->add_option("--unit", o->unit, "acceleration unit: mps2, mmps2 or g")->default_val("mps2")->check(CLI::IsMember({"mps2", "mmps2", "g"}));
-  cmd->add_option("--time-unit", o->time_unit, "time unit of both files' time columns: s, ms or us")->default_val("s")->check(CLI::IsMember({"s", "ms", "us"}));
+  cmd->add_option("--columns", o->columns,
+                  "its three acceleration columns, sensor axes 1..3 (default: the three after the time)");
+  cmd->add_option("--unit", o->unit, "acceleration unit: mps2, mmps2 or g")
+      ->default_val("mps2")
+      ->check(CLI::IsMember({"mps2", "mmps2", "g"}));
+  cmd->add_option("--time-unit", o->time_unit, "time unit of both files' time columns: s, ms or us")
+      ->default_val("s")
+      ->check(CLI::IsMember({"s", "ms", "us"}));
   cmd->add_option("--nc", o->nc, "NC trace of the commanded position")->required();
-  cmd->add_option("--nc-format", o->nc_format, "halsampler (<n> Xcmd Ycmd Zcmd Xfb Yfb Zfb marker) or csv (header; time, x, y, z)")
+  cmd->add_option("--nc-format", o->nc_format,
+                  "halsampler (<n> Xcmd Ycmd Zcmd Xfb Yfb Zfb marker) or csv (header; time, x, y, z)")
       ->default_val("halsampler")
       ->check(CLI::IsMember({"halsampler", "csv"}));
-  cmd->add_option("--servo-period-s", o->servo_period_s, "halsampler: the servo thread's period, s ([EMCMOT]SERVO_PERIOD)")->default_val(0.001)->check(CLI::PositiveNumber);
+  cmd->add_option("--servo-period-s", o->servo_period_s,
+                  "halsampler: the servo thread's period, s ([EMCMOT]SERVO_PERIOD)")
+      ->default_val(0.001)
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--nc-time-col", o->nc_time_col, "csv NC trace: its time column (default: the first)");
-  cmd->add_option("--nc-columns", o->nc_columns, "csv NC trace: its x, y, z columns, mm (default: the three after the time)");
+  cmd->add_option("--nc-columns", o->nc_columns,
+                  "csv NC trace: its x, y, z columns, mm (default: the three after the time)");
   add_common(cmd, o->c);
   cmd->callback([o] {
     drivers::CsvImport k;
     const double time_scale = o->time_unit == "s" ? 1.0 : (o->time_unit == "ms" ? 1e-3 : 1e-6);
     k.accel_columns.time = o->time_col, k.accel_columns.time_scale_s = time_scale;
     if (!o->columns.empty()) k.accel_columns.values = three(o->columns, "--columns");
-    k.unit = o->unit == "mps2" ? drivers::AccelUnit::mps2 : (o->unit == "mmps2" ? drivers::AccelUnit::mmps2 : drivers::AccelUnit::g);
+    k.unit = o->unit == "mps2" ? drivers::AccelUnit::mps2
+                               : (o->unit == "mmps2" ? drivers::AccelUnit::mmps2 : drivers::AccelUnit::g);
     k.nc_halsampler = o->nc_format == "halsampler";
     k.servo_period_s = o->servo_period_s;
     k.nc_columns.time = o->nc_time_col, k.nc_columns.time_scale_s = time_scale;
@@ -173,7 +212,9 @@ void register_csv(CLI::App* import) {
 }  // namespace
 
 void register_import(CLI::App& app) {
-  auto* cmd = app.add_subcommand("import", "Recordings made by other systems into eical-run/1 (one sensor, set-point reconstructed, time offset estimated)");
+  auto* cmd = app.add_subcommand(
+      "import",
+      "Recordings made by other systems into eical-run/1 (one sensor, set-point reconstructed, time offset estimated)");
   cmd->require_subcommand(1);
   register_klipper(cmd);
   register_csv(cmd);

@@ -38,7 +38,8 @@ Curves read_positioning_json(const std::string& file) {
   } catch (const nlohmann::json::exception& e) {
     throw dsp::InputError(file + ": not JSON: " + e.what());
   }
-  if (!j.contains("positioning") || !j["positioning"].is_object()) throw dsp::InputError(file + ": no 'positioning' object");
+  if (!j.contains("positioning") || !j["positioning"].is_object())
+    throw dsp::InputError(file + ": no 'positioning' object");
   const auto& p = j["positioning"];
   const auto targets = p.at("targets_mm").get<std::vector<double>>();
   Curves c;
@@ -48,7 +49,8 @@ Curves read_positioning_json(const std::string& file) {
     for (std::size_t i = 0; i < targets.size(); ++i) {
       double sum = 0.0;
       for (const auto& run : runs) {
-        if (run.size() != targets.size()) throw dsp::InputError(file + ": positioning.deviation_um." + dir + ": a run has the wrong number of targets");
+        if (run.size() != targets.size())
+          throw dsp::InputError(file + ": positioning.deviation_um." + dir + ": a run has the wrong number of targets");
         sum += run[i];
       }
       if (runs.empty()) throw dsp::InputError(file + ": positioning.deviation_um." + dir + " is empty");
@@ -57,7 +59,8 @@ Curves read_positioning_json(const std::string& file) {
     }
   }
   c.mean = c.up;
-  for (std::size_t i = 0; i < c.mean.error_um.size(); ++i) c.mean.error_um[i] = 0.5 * (c.up.error_um[i] + c.down.error_um[i]);
+  for (std::size_t i = 0; i < c.mean.error_um.size(); ++i)
+    c.mean.error_um[i] = 0.5 * (c.up.error_um[i] + c.down.error_um[i]);
   return c;
 }
 
@@ -71,17 +74,24 @@ void register_lincomp(CLI::App& app) {
     bool json = false, force = false;
   };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("lincomp", "Piecewise-linear axis compensation table with its worst residual over grid shifts");
+  auto* cmd = app.add_subcommand("lincomp",
+                                 "Piecewise-linear axis compensation table with its worst residual over grid shifts");
   auto* in_curve = cmd->add_option("--curve", o->curve, "error curve CSV: pos_mm,error_um (error = actual - nominal)");
-  auto* in_pos = cmd->add_option("--positioning", o->positioning,
-                                 "eical-result/1 JSON with a 'positioning' object: mean deviation per target is the curve");
+  auto* in_pos =
+      cmd->add_option("--positioning", o->positioning,
+                      "eical-result/1 JSON with a 'positioning' object: mean deviation per target is the curve");
   in_curve->excludes(in_pos);
   cmd->add_option("--spacing-mm", o->spacing, "correction point spacing A")->required()->check(CLI::PositiveNumber);
   cmd->add_option("--shift-step-mm", o->shift_step, "grid shift step")->default_val(1.0)->check(CLI::PositiveNumber);
-  cmd->add_option("--period-error-um", o->u, "position error within one signal period u (magnitude)")->default_val(0.0)->check(CLI::NonNegativeNumber);
+  cmd->add_option("--period-error-um", o->u, "position error within one signal period u (magnitude)")
+      ->default_val(0.0)
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--linuxcnc", o->linuxcnc, "write a LinuxCNC compensation file (COMP_FILE_TYPE = 0)");
-  cmd->add_option("--csv", o->csv, "write the table as CSV (pos_mm, deviation_um, correction_um = -deviation, per direction)");
-  cmd->add_option("--travel-mm", o->travel, "MIN,MAX the table must cover (mm); refused when the curve does not")->expected(2)->delimiter(',');
+  cmd->add_option("--csv", o->csv,
+                  "write the table as CSV (pos_mm, deviation_um, correction_um = -deviation, per direction)");
+  cmd->add_option("--travel-mm", o->travel, "MIN,MAX the table must cover (mm); refused when the curve does not")
+      ->expected(2)
+      ->delimiter(',');
   cmd->add_flag("--json", o->json, "print the result as JSON");
   cmd->add_flag("--force", o->force, "overwrite existing output files");
   cmd->callback([o] {
@@ -101,13 +111,15 @@ void register_lincomp(CLI::App& app) {
     if (o->travel.size() == 2) dsp::comp::require_coverage(table, o->travel[0], o->travel[1], "--travel-mm asks for");
     std::vector<std::pair<std::string, std::string>> files;
     if (!o->linuxcnc.empty())
-      files.emplace_back(o->linuxcnc, comp::linuxcnc_comp_file(table, "eical lincomp: spacing " + std::to_string(o->spacing) + " mm"));
+      files.emplace_back(
+          o->linuxcnc, comp::linuxcnc_comp_file(table, "eical lincomp: spacing " + std::to_string(o->spacing) + " mm"));
     if (!o->csv.empty()) {
       std::string text = "pos_mm,deviation_um,correction_um,correction_up_um,correction_down_um\n";
       for (std::size_t i = 0; i < r.table.pos_mm.size(); ++i) {
         char line[200];
         std::snprintf(line, sizeof line, "%.4f,%.4f,%.4f,%.4f,%.4f\n", r.table.pos_mm[i], r.table.deviation_um[i],
-                      dsp::comp::correction_from_deviation_um(r.table.deviation_um[i]), dsp::comp::correction_from_deviation_um(up.deviation_um[i]),
+                      dsp::comp::correction_from_deviation_um(r.table.deviation_um[i]),
+                      dsp::comp::correction_from_deviation_um(up.deviation_um[i]),
                       dsp::comp::correction_from_deviation_um(down.deviation_um[i]));
         text += line;
       }
@@ -118,22 +130,30 @@ void register_lincomp(CLI::App& app) {
     std::string existing;
     for (const auto& f : files)
       if (std::filesystem::exists(f.first)) existing += "\n  " + f.first;
-    if (!existing.empty() && !o->force) throw dsp::InputError("lincomp: would overwrite existing file(s), nothing written (--force to replace them):" + existing);
+    if (!existing.empty() && !o->force)
+      throw dsp::InputError("lincomp: would overwrite existing file(s), nothing written (--force to replace them):" +
+                            existing);
     for (const auto& [file, text] : files) write_file_atomic(file, text);
     if (o->json) {
       nlohmann::json points = nlohmann::json::array();
       for (std::size_t i = 0; i < r.table.pos_mm.size(); ++i)
         points.push_back({{"pos_mm", r.table.pos_mm[i]},
-                         {"deviation_um", r.table.deviation_um[i]},
-                         {"correction_um", dsp::comp::correction_from_deviation_um(r.table.deviation_um[i])}});
-      const nlohmann::json j = {{"spacing_mm", r.spacing_mm},           {"max_residual_um", r.max_residual_um},
-                                {"worst_shift_mm", r.worst_shift_mm},   {"total_um", r.total_um},
-                                {"period_error_um", o->u},              {"residual_unshifted_um", r.residual_unshifted_um},
-                                {"shift_step_mm", o->shift_step},       {"table", points}};
+                          {"deviation_um", r.table.deviation_um[i]},
+                          {"correction_um", dsp::comp::correction_from_deviation_um(r.table.deviation_um[i])}});
+      const nlohmann::json j = {{"spacing_mm", r.spacing_mm},
+                                {"max_residual_um", r.max_residual_um},
+                                {"worst_shift_mm", r.worst_shift_mm},
+                                {"total_um", r.total_um},
+                                {"period_error_um", o->u},
+                                {"residual_unshifted_um", r.residual_unshifted_um},
+                                {"shift_step_mm", o->shift_step},
+                                {"table", points}};
       std::printf("%s\n", j.dump(2).c_str());
     } else {
-      std::printf("spacing %.3f mm: F_rest %.3f um (worst grid shift %.1f mm), F_total = F_rest + u = %.3f um, %zu correction points\n",
-                  r.spacing_mm, r.max_residual_um, r.worst_shift_mm, r.total_um, r.table.pos_mm.size());
+      std::printf(
+          "spacing %.3f mm: F_rest %.3f um (worst grid shift %.1f mm), F_total = F_rest + u = %.3f um, %zu correction "
+          "points\n",
+          r.spacing_mm, r.max_residual_um, r.worst_shift_mm, r.total_um, r.table.pos_mm.size());
     }
   });
 }

@@ -1,10 +1,10 @@
 // eical report RUN [--out DIR]: HTML report with SVG plots and CSV traces.
 #include "drivers/config/sensor_calibration.hpp"
+#include "drivers/results/result_json.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "tools/commands.hpp"
 #include "tools/report/run_report.hpp"
-#include "drivers/results/result_json.hpp"
 #include "tools/run_files.hpp"
 
 #include <cstdio>
@@ -20,8 +20,12 @@ void register_report(CLI::App& app) {
   auto* cmd = app.add_subcommand("report", "Render the HTML report of a recorded run");
   cmd->add_option("run", o->run, "run directory (eical-run/1)")->required();
   cmd->add_option("-o,--out", o->out, "report folder (default: RUN/report)");
-  cmd->add_option("--calibration", o->calibration, "sensor calibration (eical-sensor-cal/1) instead of the run's data sheet")->check(CLI::ExistingFile);
-  cmd->add_option("--tolerances", o->tolerances, "tolerance file (eical-tolerances/1): pass/fail of G, F (ISO 230-4) and A, B, R, E, M (ISO 230-2), header fields")
+  cmd->add_option("--calibration", o->calibration,
+                  "sensor calibration (eical-sensor-cal/1) instead of the run's data sheet")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--tolerances", o->tolerances,
+                  "tolerance file (eical-tolerances/1): pass/fail of G, F (ISO 230-4) and A, B, R, E, M (ISO 230-2), "
+                  "header fields")
       ->check(CLI::ExistingFile);
   cmd->add_option("--operator", o->operator_name, "operator's name for the header");
   cmd->add_option("--serial", o->serial, "the machine's serial number for the header");
@@ -34,7 +38,8 @@ void register_report(CLI::App& app) {
     if (!o->tolerances.empty()) ro.tolerances = report::read_tolerances(o->tolerances);
     ro.operator_name = o->operator_name, ro.serial = o->serial;
     const dsp::Analysis a = dsp::analyze_run(run, opt);
-    const std::filesystem::path dir = o->out.empty() ? std::filesystem::path(o->run) / "report" : std::filesystem::path(o->out);
+    const std::filesystem::path dir =
+        o->out.empty() ? std::filesystem::path(o->run) / "report" : std::filesystem::path(o->out);
     const auto file = report::write_run_report(run, a, dir, ro);
     write_file_atomic(dir / "result.json", drivers::result_json(run, a).dump(2) + "\n");
     std::printf("report: %s\n", file.c_str());

@@ -1,7 +1,7 @@
 // eical simulate: a synthetic recorded run (eical-run/1 with truth.toml) from the simulator.
 #include "drivers/config/scenario_file.hpp"
-#include "dsp/core/error.hpp"
 #include "drivers/run_io/run_writer.hpp"
+#include "dsp/core/error.hpp"
 #include "sim/hidden/hidden_effects.hpp"
 #include "sim/regimes/klipper_like.hpp"
 #include "sim/regimes/regimes.hpp"
@@ -30,7 +30,8 @@ struct Opt {
   double fs_hz = 0.0;
   std::vector<std::string> resonance;
   bool klipper_legacy = false;
-  double freq_start = 0.0, freq_end = 0.0, hz_per_sec = 0.0, accel_per_hz = 0.0, sweeping_accel = -1.0, sweeping_period = -1.0;
+  double freq_start = 0.0, freq_end = 0.0, hz_per_sec = 0.0, accel_per_hz = 0.0, sweeping_accel = -1.0,
+         sweeping_period = -1.0;
   // Export.
   std::vector<std::string> export_to;
   std::string export_nc = "halsampler";
@@ -71,23 +72,31 @@ sim::nc::KlipperTest sweep_test(const Opt& o) {
 
 sim::Scenario base_scenario(const Opt& o, bool program_given) {
   if (!o.regime.empty()) {
-    if (!o.scenario.empty() || program_given) throw dsp::InputError("simulate --regime: the regime sets the program (no --scenario or --program)");
-    return sim::klipper_like_scenario(o.background ? std::vector<std::string>{} : (o.hide.empty() ? std::vector<std::string>{"machine.resonance"} : o.hide), o.seed);
+    if (!o.scenario.empty() || program_given)
+      throw dsp::InputError("simulate --regime: the regime sets the program (no --scenario or --program)");
+    return sim::klipper_like_scenario(o.background
+                                          ? std::vector<std::string>{}
+                                          : (o.hide.empty() ? std::vector<std::string>{"machine.resonance"} : o.hide),
+                                      o.seed);
   }
   if (!o.scenario.empty()) return drivers::read_scenario_file(o.scenario);
   if (!o.hide.empty() || o.background) {
     const bool chosen = o.program == "circle" || o.program == "step";
-    const std::string kind = o.hide.empty() ? (chosen ? o.program : "circle") : (program_given && chosen ? o.program : sim::program_for(o.hide));
-    if (program_given && !chosen) throw dsp::InputError("simulate --hide/--background: --program must be circle or step");
+    const std::string kind = o.hide.empty() ? (chosen ? o.program : "circle")
+                                            : (program_given && chosen ? o.program : sim::program_for(o.hide));
+    if (program_given && !chosen)
+      throw dsp::InputError("simulate --hide/--background: --program must be circle or step");
     return sim::hidden_effect_scenario(o.hide, kind, o.seed);
   }
-  sim::Scenario sc = o.program == "circle"      ? sim::circle_scenario(o.radius_mm, o.feed_mm_min, o.repeats, o.direction, o.seed)
-                     : o.program == "step"      ? sim::step_scenario(o.from_mm, o.to_mm, o.feed_mm_min, o.runs, o.seed)
-                     : o.program == "rectangle" ? sim::rectangle_scenario(20.0, 10.0, o.feed_mm_min, o.plane, 1, o.seed)
-                     : o.program == "freeform"  ? freeform_scenario(o.feed_mm_min, o.seed)
-                     : o.program == "identify"  ? sim::identify_scenario(sim::psd_config_b(o.radius_mm), {"z"}, o.seed)
-                     : o.program == "sweep"     ? sim::sweep_scenario(sweep_test(o), sim::nc::test_direction(o.sweep_axis, "--sweep-axis"), o.seed)
-                                                : sim::positioning_scenario(o.targets, o.runs, o.feed_mm_min, o.seed);
+  sim::Scenario sc =
+      o.program == "circle"      ? sim::circle_scenario(o.radius_mm, o.feed_mm_min, o.repeats, o.direction, o.seed)
+      : o.program == "step"      ? sim::step_scenario(o.from_mm, o.to_mm, o.feed_mm_min, o.runs, o.seed)
+      : o.program == "rectangle" ? sim::rectangle_scenario(20.0, 10.0, o.feed_mm_min, o.plane, 1, o.seed)
+      : o.program == "freeform"  ? freeform_scenario(o.feed_mm_min, o.seed)
+      : o.program == "identify"  ? sim::identify_scenario(sim::psd_config_b(o.radius_mm), {"z"}, o.seed)
+      : o.program == "sweep"
+          ? sim::sweep_scenario(sweep_test(o), sim::nc::test_direction(o.sweep_axis, "--sweep-axis"), o.seed)
+          : sim::positioning_scenario(o.targets, o.runs, o.feed_mm_min, o.seed);
   if (o.psd == "B") sc.meta.psd = sim::psd_config_b(o.radius_mm);
   if (o.program == "circle") {
     sc.meta.program.plane = o.plane;
@@ -102,11 +111,13 @@ sim::Scenario base_scenario(const Opt& o, bool program_given) {
 // then which sensors, the mounting and the modes.
 void apply_regime_flags(const Opt& o, sim::Scenario& sc) {
   const bool fixed = !o.regime.empty();
-  if (fixed && (!o.mems.empty() || o.fs_hz > 0.0 || !o.sensors.empty() || !o.wrong_mounting.empty() || !o.resonance.empty()))
+  if (fixed &&
+      (!o.mems.empty() || o.fs_hz > 0.0 || !o.sensors.empty() || !o.wrong_mounting.empty() || !o.resonance.empty()))
     throw dsp::InputError("simulate --regime: the regime draws chip, rate, sensors, mounting and modes itself");
   if (!o.mems.empty()) {
     if (!o.scenario.empty() || !o.hide.empty() || o.background)
-      throw dsp::InputError("simulate --mems: not with --scenario/--hide/--background (a scenario's [mems] table does it there)");
+      throw dsp::InputError(
+          "simulate --mems: not with --scenario/--hide/--background (a scenario's [mems] table does it there)");
     sim::apply_mems(sc, sim::mems_chip(o.mems), o.fs_hz);
   } else if (o.fs_hz > 0.0) {
     sim::set_daq_rate(sc, o.fs_hz);
@@ -114,12 +125,14 @@ void apply_regime_flags(const Opt& o, sim::Scenario& sc) {
   if (!o.sensors.empty()) sim::set_sensors_present(sc, o.sensors);
   if (!o.wrong_mounting.empty()) {
     sim::apply_wrong_mounting(sc, sc.meta.sensor_present[1] ? 1 : 0, o.wrong_mounting);
-    if (!sc.effects_present.empty() || !sc.effects_background.empty()) sc.effects_present.push_back("sensor.misalignment");
+    if (!sc.effects_present.empty() || !sc.effects_background.empty())
+      sc.effects_present.push_back("sensor.misalignment");
   }
   if (!o.resonance.empty()) {
     for (const auto& r : o.resonance) sc.resonance.modes.push_back(parse_mode(r));
     sc.resonance.part = sc.meta.sensor_present[1] ? 1 : 0;
-    if (!sc.effects_present.empty() || !sc.effects_background.empty()) sc.effects_present.push_back("machine.resonance");
+    if (!sc.effects_present.empty() || !sc.effects_background.empty())
+      sc.effects_present.push_back("machine.resonance");
   }
 }
 
@@ -128,68 +141,102 @@ void apply_regime_flags(const Opt& o, sim::Scenario& sc) {
 void register_simulate(CLI::App& app) {
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand("simulate", "Simulate a machine and its sensors; write a recorded run (eical-run/1)");
-  std::string effects_help = "hide these effects (comma separated; run-format.md names) among tolerance-level deviations of sensors, machine, "
-                             "PSD strips and KGM, at the sizes a faulty machine shows (sim/hidden/hidden_effects.cpp); with --program circle or step "
-                             "(default: the program the first effect shows best in), --seed; with --regime klipper-like: machine.resonance, "
-                             "sensor.misalignment. Names:";
+  std::string effects_help =
+      "hide these effects (comma separated; run-format.md names) among tolerance-level deviations of sensors, machine, "
+      "PSD strips and KGM, at the sizes a faulty machine shows (sim/hidden/hidden_effects.cpp); with --program circle "
+      "or step "
+      "(default: the program the first effect shows best in), --seed; with --regime klipper-like: machine.resonance, "
+      "sensor.misalignment. Names:";
   for (const auto& e : sim::hideable_effects()) effects_help += " " + e;
   cmd->add_option("--hide", o->hide, effects_help)->delimiter(',')->check(CLI::IsMember(sim::hideable_effects()));
-  cmd->add_flag("--background", o->background, "a baseline with the tolerance-level deviations only (no effect hidden)");
-  auto* scenario = cmd->add_option("--scenario", o->scenario, "scenario file (eical-scenario/1, config/scenarios/README.md): machine errors, vibration, sensor truth, every effect")
+  cmd->add_flag("--background", o->background,
+                "a baseline with the tolerance-level deviations only (no effect hidden)");
+  auto* scenario = cmd->add_option("--scenario", o->scenario,
+                                   "scenario file (eical-scenario/1, config/scenarios/README.md): machine errors, "
+                                   "vibration, sensor truth, every effect")
                        ->check(CLI::ExistingFile);
-  cmd->add_option("--program", o->program, "circle, step, positioning, rectangle, freeform, identify or sweep (Klipper's resonance test, no standstill)")
+  cmd->add_option(
+         "--program", o->program,
+         "circle, step, positioning, rectangle, freeform, identify or sweep (Klipper's resonance test, no standstill)")
       ->default_val("circle")
       ->check(CLI::IsMember({"circle", "step", "positioning", "rectangle", "freeform", "identify", "sweep"}))
       ->excludes(scenario);
-  cmd->add_option("--psd", o->psd, "PSD strips: B (configuration B of the sample runs, for a circle of --radius), none; identify: B by default")
+  cmd->add_option(
+         "--psd", o->psd,
+         "PSD strips: B (configuration B of the sample runs, for a circle of --radius), none; identify: B by default")
       ->default_val("none")
       ->check(CLI::IsMember({"B", "none"}));
-  cmd->add_option("--plane", o->plane, "circle, rectangle: xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
-  cmd->add_option("--arc-deg", o->arc_deg, "circle: evaluated arc in deg (below 360: partial arc, up to 340)")->default_val(360.0)->check(CLI::Range(1.0, 360.0));
+  cmd->add_option("--plane", o->plane, "circle, rectangle: xy, zx or yz")
+      ->default_val("xy")
+      ->check(CLI::IsMember({"xy", "zx", "yz"}));
+  cmd->add_option("--arc-deg", o->arc_deg, "circle: evaluated arc in deg (below 360: partial arc, up to 340)")
+      ->default_val(360.0)
+      ->check(CLI::Range(1.0, 360.0));
   cmd->add_option("--targets", o->targets, "positioning: targets on x, mm (comma separated)")->delimiter(',');
   cmd->add_option("--radius", o->radius_mm, "circle radius, mm")->default_val(10.0)->check(CLI::PositiveNumber);
   cmd->add_option("--feed", o->feed_mm_min, "feed, mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
   cmd->add_option("--repeats", o->repeats, "circle revolutions")->default_val(5)->check(CLI::Range(1, 1000));
-  cmd->add_option("--direction", o->direction, "ccw, cw or both")->default_val("ccw")->check(CLI::IsMember({"ccw", "cw", "both"}));
+  cmd->add_option("--direction", o->direction, "ccw, cw or both")
+      ->default_val("ccw")
+      ->check(CLI::IsMember({"ccw", "cw", "both"}));
   cmd->add_option("--from", o->from_mm, "step: start position on x, mm")->default_val(0.0);
   cmd->add_option("--to", o->to_mm, "step: end position on x, mm")->default_val(50.0);
   cmd->add_option("--runs", o->runs, "step: there-and-back pairs")->default_val(2)->check(CLI::Range(1, 1000));
-  cmd->add_option("--noise", o->noise_ug, "sensor noise density, ug/sqrt(Hz) (two-sided)")->default_val(0.4)->check(CLI::NonNegativeNumber);
+  cmd->add_option("--noise", o->noise_ug, "sensor noise density, ug/sqrt(Hz) (two-sided)")
+      ->default_val(0.4)
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--seed", o->seed, "random seed (same seed, same run)")->default_val(1);
   cmd->add_option("-o,--out", o->out, "run directory to write")->required();
   cmd->add_flag("--gzip", o->gzip, "write samples.csv.gz");
   cmd->add_flag("--overwrite", o->overwrite, "replace an existing run");
   // Regimes of runs measured by other systems (config/scenarios/README.md has the keys).
-  cmd->add_option("--regime", o->regime, "klipper-like: a CoreXY head under Klipper's resonance test, head MEMS sensor only (400 Hz .. 3.2 kHz), "
-                                         "two modes 30-80 Hz, per --seed (sim/regimes/klipper_like.hpp); with --hide, --background, --export")
+  cmd->add_option(
+         "--regime", o->regime,
+         "klipper-like: a CoreXY head under Klipper's resonance test, head MEMS sensor only (400 Hz .. 3.2 kHz), "
+         "two modes 30-80 Hz, per --seed (sim/regimes/klipper_like.hpp); with --hide, --background, --export")
       ->check(CLI::IsMember({sim::kKlipperLike}));
-  cmd->add_option("--sensors", o->sensors, "both, head or table: the absent triplex's columns are written empty")->check(CLI::IsMember({"both", "head", "table"}));
-  cmd->add_option("--fs", o->fs_hz, "sample rate, Hz: the DAQ's (100 .. 51200, anti-alias filter kept) or, with --mems, the chip's output data rate")
+  cmd->add_option("--sensors", o->sensors, "both, head or table: the absent triplex's columns are written empty")
+      ->check(CLI::IsMember({"both", "head", "table"}));
+  cmd->add_option("--fs", o->fs_hz,
+                  "sample rate, Hz: the DAQ's (100 .. 51200, anti-alias filter kept) or, with --mems, the chip's "
+                  "output data rate")
       ->check(CLI::Range(100.0, 51200.0));
   std::vector<std::string> chips;
   for (const auto& c : sim::mems_chips()) chips.push_back(c.name);
-  cmd->add_option("--mems", o->mems, "both sensors a digital MEMS chip: its resolution, noise and low-pass, no anti-alias filter (aliasing), "
-                                     "no DAQ delay (sim/sensor/mems_chip.hpp)")
+  cmd->add_option(
+         "--mems", o->mems,
+         "both sensors a digital MEMS chip: its resolution, noise and low-pass, no anti-alias filter (aliasing), "
+         "no DAQ delay (sim/sensor/mems_chip.hpp)")
       ->check(CLI::IsMember(chips));
-  cmd->add_option("--wrong-mounting", o->wrong_mounting, "the (head, else table) sensor truly mounted as this axes map applied to run.toml's "
-                                                         "to_machine: a sign flip (-x,-y,z), a swap (y,x,z), a mirror (-x,y,z)");
-  cmd->add_option("--resonance", o->resonance, "a structural mode FREQ_HZ,DAMPING_RATIO,GAIN,AXIS between the drive and the measured point "
-                                               "(machine.resonance; repeat for more modes)");
+  cmd->add_option("--wrong-mounting", o->wrong_mounting,
+                  "the (head, else table) sensor truly mounted as this axes map applied to run.toml's "
+                  "to_machine: a sign flip (-x,-y,z), a swap (y,x,z), a mirror (-x,y,z)");
+  cmd->add_option("--resonance", o->resonance,
+                  "a structural mode FREQ_HZ,DAMPING_RATIO,GAIN,AXIS between the drive and the measured point "
+                  "(machine.resonance; repeat for more modes)");
   cmd->add_option("--sweep-axis", o->sweep_axis, "sweep: Klipper's AXIS (x, y, z or dx,dy[,dz])")->default_val("x");
-  cmd->add_flag("--klipper-legacy", o->klipper_legacy, "sweep: the older Klipper test (max_freq 133.33 Hz, 75 mm/s2 per Hz, no sweeping)");
+  cmd->add_flag("--klipper-legacy", o->klipper_legacy,
+                "sweep: the older Klipper test (max_freq 133.33 Hz, 75 mm/s2 per Hz, no sweeping)");
   cmd->add_option("--freq-start", o->freq_start, "sweep: FREQ_START, Hz (default 5)");
   cmd->add_option("--freq-end", o->freq_end, "sweep: FREQ_END, Hz (default 200, legacy 133.33)");
   cmd->add_option("--hz-per-sec", o->hz_per_sec, "sweep: HZ_PER_SEC (default 1)");
   cmd->add_option("--accel-per-hz", o->accel_per_hz, "sweep: ACCEL_PER_HZ, mm/s2 per Hz (default 60, legacy 75)");
   cmd->add_option("--sweeping-accel", o->sweeping_accel, "sweep: SWEEPING_ACCEL, mm/s2 (default 400, legacy 0)");
   cmd->add_option("--sweeping-period", o->sweeping_period, "sweep: SWEEPING_PERIOD, s (default 1.2, legacy 0)");
-  cmd->add_option("--export", o->export_to, "also write the run as another system records it, with jittered stamps: 'klipper FILE' (a raw "
-                                            "accelerometer capture) or 'csv PREFIX' (PREFIX-accel.csv and an NC trace); truth.toml [export]")
+  cmd->add_option("--export", o->export_to,
+                  "also write the run as another system records it, with jittered stamps: 'klipper FILE' (a raw "
+                  "accelerometer capture) or 'csv PREFIX' (PREFIX-accel.csv and an NC trace); truth.toml [export]")
       ->expected(2);
-  cmd->add_option("--export-nc", o->export_nc, "csv export: NC trace as halsampler (PREFIX-nc.txt) or csv (PREFIX-nc.csv)")->check(CLI::IsMember({"halsampler", "csv"}));
-  cmd->add_option("--export-offset-s", o->export_offset_s, "export: the capture clock at the run's t = 0, s (klipper-like: drawn)");
-  cmd->add_option("--export-jitter-us", o->export_jitter_us, "export: stamp jitter rms, us (default 5 % of a sample; klipper-like: drawn)")->check(CLI::NonNegativeNumber);
-  cmd->add_option("--export-lost-batches", o->export_lost_batches, "export: batches lost (gaps)")->check(CLI::Range(0, 1000));
+  cmd->add_option("--export-nc", o->export_nc,
+                  "csv export: NC trace as halsampler (PREFIX-nc.txt) or csv (PREFIX-nc.csv)")
+      ->check(CLI::IsMember({"halsampler", "csv"}));
+  cmd->add_option("--export-offset-s", o->export_offset_s,
+                  "export: the capture clock at the run's t = 0, s (klipper-like: drawn)");
+  cmd->add_option("--export-jitter-us", o->export_jitter_us,
+                  "export: stamp jitter rms, us (default 5 % of a sample; klipper-like: drawn)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--export-lost-batches", o->export_lost_batches, "export: batches lost (gaps)")
+      ->check(CLI::Range(0, 1000));
   cmd->add_option("--export-batch", o->export_batch, "export: samples per batch")->check(CLI::Range(1, 4096));
   cmd->add_option("--export-nc-offset-s", o->export_nc_offset_s, "csv export: the NC clock at the run's t = 0, s");
   auto* program_opt = cmd->get_option("--program");
@@ -198,7 +245,8 @@ void register_simulate(CLI::App& app) {
     apply_regime_flags(*o, sc);
     if (!o->export_to.empty()) {
       ExportRequest req;
-      req.kind = o->export_to[0], req.target = o->export_to[1], req.nc_format = o->export_nc, req.nc_offset_s = o->export_nc_offset_s;
+      req.kind = o->export_to[0], req.target = o->export_to[1], req.nc_format = o->export_nc,
+      req.nc_offset_s = o->export_nc_offset_s;
       const double fs = sc.meta.acquisition.fs_hz;
       if (!o->regime.empty()) {
         req.clock = sim::klipper_like_capture_clock(o->seed, fs);
@@ -208,7 +256,8 @@ void register_simulate(CLI::App& app) {
         req.clock.lost_batches = o->export_lost_batches, req.clock.batch = o->export_batch, req.clock.seed = o->seed;
       }
       const std::string line = simulate_with_export(sc, req, o->out, o->gzip, o->overwrite);
-      std::printf("wrote %s (program %s, %.0f Hz)\n%s\n", o->out.c_str(), sc.meta.program.kind.c_str(), fs, line.c_str());
+      std::printf("wrote %s (program %s, %.0f Hz)\n%s\n", o->out.c_str(), sc.meta.program.kind.c_str(), fs,
+                  line.c_str());
       return;
     }
     const dsp::Run run = sim::simulate(sc);

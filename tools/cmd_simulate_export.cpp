@@ -22,8 +22,10 @@ std::size_t gaps_of(const sim::CaptureSamples& s) {
 
 }  // namespace
 
-std::string simulate_with_export(const sim::Scenario& sc, const ExportRequest& req, const std::string& out, bool gzip, bool overwrite) {
-  if (req.kind != "klipper" && req.kind != "csv") throw dsp::InputError("simulate --export: '" + req.kind + "' is not klipper or csv");
+std::string simulate_with_export(const sim::Scenario& sc, const ExportRequest& req, const std::string& out, bool gzip,
+                                 bool overwrite) {
+  if (req.kind != "klipper" && req.kind != "csv")
+    throw dsp::InputError("simulate --export: '" + req.kind + "' is not klipper or csv");
   const auto set_point = sim::scenario_set_point(sc);
   const double fs = sc.meta.acquisition.fs_hz;
   const auto n_frames = static_cast<std::size_t>(std::ceil(set_point->duration_s() * fs)) + 1;
@@ -32,9 +34,11 @@ std::string simulate_with_export(const sim::Scenario& sc, const ExportRequest& r
   dsp::Run run = sim::simulate(sc, *set_point, nullptr, &jittered);
   const int part = run.meta.sensor_present[1] ? 1 : 0;
 
-  std::string files, truth = "\n[export]\n# The run as another system recorded it (eical simulate --export): frame n taken at\n"
-                             "# n/fs + jitter, stamped offset_s + that time; lost batches left out. offset_s is what\n"
-                             "# eical import must find: recorder time - set-point time.\n";
+  std::string files,
+      truth =
+          "\n[export]\n# The run as another system recorded it (eical simulate --export): frame n taken at\n"
+          "# n/fs + jitter, stamped offset_s + that time; lost batches left out. offset_s is what\n"
+          "# eical import must find: recorder time - set-point time.\n";
   truth += "format = \"" + req.kind + "\"\nsensor = \"" + std::string(part ? "head" : "table") + "\"\n";
   const drivers::StampedAccel capture = drivers::exported_capture(run, jittered, samples, req.clock, part, req.target);
   if (req.kind == "klipper") {
@@ -46,20 +50,24 @@ std::string simulate_with_export(const sim::Scenario& sc, const ExportRequest& r
     const std::string nc_file = req.target + (req.nc_format == "halsampler" ? "-nc.txt" : "-nc.csv");
     drivers::write_accel_csv(accel_file, capture, drivers::AccelUnit::mps2);
     const drivers::NcTrace trace = drivers::exported_nc_trace(*set_point, req.servo_period_s, req.nc_offset_s, nc_file);
-    if (req.nc_format == "halsampler") drivers::write_halsampler(nc_file, trace, std::llround(trace.t_s.front() / req.servo_period_s));
-    else drivers::write_nc_csv(nc_file, trace);
+    if (req.nc_format == "halsampler")
+      drivers::write_halsampler(nc_file, trace, std::llround(trace.t_s.front() / req.servo_period_s));
+    else
+      drivers::write_nc_csv(nc_file, trace);
     files = accel_file + " and " + nc_file;
-    truth += "file = \"" + accel_file + "\"\nnc_file = \"" + nc_file + "\"\nnc_format = \"" + req.nc_format + "\"\nservo_period_s = " +
-             num(req.servo_period_s) + "\nnc_offset_s = " + num(req.nc_offset_s) + "\ncapture_offset_s = " + num(req.clock.offset_s) +
+    truth += "file = \"" + accel_file + "\"\nnc_file = \"" + nc_file + "\"\nnc_format = \"" + req.nc_format +
+             "\"\nservo_period_s = " + num(req.servo_period_s) + "\nnc_offset_s = " + num(req.nc_offset_s) +
+             "\ncapture_offset_s = " + num(req.clock.offset_s) +
              "\noffset_s = " + num(req.clock.offset_s - req.nc_offset_s) + "\n";
   }
-  truth += "jitter_rms_s = " + num(samples.jitter_rms_s) + "\nbatch = " + std::to_string(req.clock.batch) + "\nlost_frames = " + std::to_string(samples.lost) +
-           "\ngaps = " + std::to_string(gaps_of(samples)) + "\n";
+  truth += "jitter_rms_s = " + num(samples.jitter_rms_s) + "\nbatch = " + std::to_string(req.clock.batch) +
+           "\nlost_frames = " + std::to_string(samples.lost) + "\ngaps = " + std::to_string(gaps_of(samples)) + "\n";
   if (run.truth_toml) *run.truth_toml += truth;
   drivers::write_run(run, out, {.gzip = gzip, .overwrite = overwrite});
   char line[512];
-  std::snprintf(line, sizeof line, "exported %s: %zu samples (%zu lost in %zu gaps), jitter %.1f us rms, offset %.6f s", files.c_str(), capture.t_s.size(),
-                samples.lost, gaps_of(samples), samples.jitter_rms_s * 1e6, req.kind == "klipper" ? req.clock.offset_s : req.clock.offset_s - req.nc_offset_s);
+  std::snprintf(line, sizeof line, "exported %s: %zu samples (%zu lost in %zu gaps), jitter %.1f us rms, offset %.6f s",
+                files.c_str(), capture.t_s.size(), samples.lost, gaps_of(samples), samples.jitter_rms_s * 1e6,
+                req.kind == "klipper" ? req.clock.offset_s : req.clock.offset_s - req.nc_offset_s);
   return line;
 }
 

@@ -11,8 +11,8 @@
 namespace eical::tools {
 
 struct ExportRequest {
-  std::string kind;                // "klipper" | "csv"
-  std::string target;              // klipper: the capture file; csv: PREFIX-accel.csv, PREFIX-nc.{ngc.txt|csv}
+  std::string kind;                      // "klipper" | "csv"
+  std::string target;                    // klipper: the capture file; csv: PREFIX-accel.csv, PREFIX-nc.{ngc.txt|csv}
   std::string nc_format = "halsampler";  // csv: "halsampler" | "csv"
   double servo_period_s = 0.001;
   double nc_offset_s = 1234.5678;  // NC clock at the run's t = 0
@@ -21,6 +21,7 @@ struct ExportRequest {
 
 // Simulates the scenario with the capture's sampling, writes the run to `out` and the
 // export files; returns the line to print.
-std::string simulate_with_export(const sim::Scenario& scenario, const ExportRequest& request, const std::string& out, bool gzip, bool overwrite);
+std::string simulate_with_export(const sim::Scenario& scenario, const ExportRequest& request, const std::string& out,
+                                 bool gzip, bool overwrite);
 
 }  // namespace eical::tools

@@ -46,7 +46,8 @@ void fit_from_runs(const std::vector<std::string>& runs, const std::string& out,
     if (kind == "positioning") {
       const int axis = dsp::axis_index(run.meta.program.axis);
       passes.push_back({axis, path, dsp::comp::standstills(a.measurement)});
-      used.push_back(path + ": positioning along " + run.meta.program.axis + " (translations of " + run.meta.program.axis + " in x, y, z)");
+      used.push_back(path + ": positioning along " + run.meta.program.axis + " (translations of " +
+                     run.meta.program.axis + " in x, y, z)");
     } else if (kind == "circle" && a.diagnostics) {
       const auto [u, v] = dsp::plane_axes(run.meta.program.plane);
       const int pair = (u == 0 && v == 1) ? 0 : (u == 1 && v == 2) ? 1 : 2;
@@ -56,10 +57,13 @@ void fit_from_runs(const std::vector<std::string>& runs, const std::string& out,
           j["uncertainty_k2"]["diagnostics.squareness_urad"].is_number())
         uk2 = j["uncertainty_k2"]["diagnostics.squareness_urad"].get<double>();
       circles.push_back({pair, a.diagnostics->squareness_urad, uk2, path});
-      used.push_back(path + ": circle " + run.meta.program.plane + (uk2 ? " (squareness)" : " (squareness without uncertainty: not used)"));
+      used.push_back(path + ": circle " + run.meta.program.plane +
+                     (uk2 ? " (squareness)" : " (squareness without uncertainty: not used)"));
     } else if (kind == "rectangle") {
-      used.push_back(path + ": rectangle not used: NBS holds the standing axis of each side at zero, which takes the squareness out with "
-                            "the drift; without NBS the drift over a side buries it");
+      used.push_back(
+          path +
+          ": rectangle not used: NBS holds the standing axis of each side at zero, which takes the squareness out with "
+          "the drift; without NBS the drift over a side buries it");
     } else {
       used.push_back(path + ": " + kind + " not used");
     }
@@ -69,12 +73,15 @@ void fit_from_runs(const std::vector<std::string>& runs, const std::string& out,
   std::printf("volumetric fit -> %s\n", out.c_str());
   for (const auto& u : used) std::printf("  %s\n", u.c_str());
   for (int k = 0; k < 18; ++k)
-    std::printf("  %s: %s%s\n", kVolumetricComponents[k], f.component[k].observed ? "" : "NOT OBSERVED — ", f.component[k].note.c_str());
+    std::printf("  %s: %s%s\n", kVolumetricComponents[k], f.component[k].observed ? "" : "NOT OBSERVED — ",
+                f.component[k].note.c_str());
   const char* names[3] = {"xwy", "ywz", "xwz"};
   const double values[3] = {f.model.xwy_urad, f.model.ywz_urad, f.model.xwz_urad};
   for (int s = 0; s < 3; ++s)
-    if (f.squareness[s].observed) std::printf("  %s = %.1f urad (U = %.1f, k = 2)\n", names[s], values[s], f.squareness[s].u_k2_urad);
-    else std::printf("  %s: NOT OBSERVED — %s\n", names[s], f.squareness[s].note.c_str());
+    if (f.squareness[s].observed)
+      std::printf("  %s = %.1f urad (U = %.1f, k = 2)\n", names[s], values[s], f.squareness[s].u_k2_urad);
+    else
+      std::printf("  %s: NOT OBSERVED — %s\n", names[s], f.squareness[s].note.c_str());
 }
 
 }  // namespace
@@ -86,7 +93,8 @@ void register_volumetric(CLI::App& app) {
     bool force = false;
   };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("volumetric", "21-parameter volumetric model: deviations at points, or --fit the model from runs");
+  auto* cmd = app.add_subcommand("volumetric",
+                                 "21-parameter volumetric model: deviations at points, or --fit the model from runs");
   auto* model = cmd->add_option("--model", o->model, "model file (eical-volumetric/1 TOML)");
   auto* points = cmd->add_option("--points", o->points, "CSV x,y,z,xp,yp,zp in mm (position and tool offset)");
   cmd->add_option("--out,-o", o->out, "output: CSV of deviations, or with --fit the model file")->required();
@@ -98,7 +106,8 @@ void register_volumetric(CLI::App& app) {
       fit_from_runs(o->fit, o->out, o->force);
       return;
     }
-    if (o->model.empty() || o->points.empty()) throw dsp::InputError("volumetric: give --model and --points, or --fit RUN...");
+    if (o->model.empty() || o->points.empty())
+      throw dsp::InputError("volumetric: give --model and --points, or --fit RUN...");
     const auto f = read_volumetric_model(o->model);
     const bool with_u = has_uncertainty(f);
     const auto at = read_volumetric_points_csv(o->points);

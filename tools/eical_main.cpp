@@ -23,7 +23,8 @@ int main(int argc, char** argv) {
     // CLI11 reports an unknown command as "A subcommand is required": name it instead.
     if (argc > 1 && argv[1][0] != '-') {
       const auto commands = app.get_subcommands({});
-      const bool known = std::any_of(commands.begin(), commands.end(), [&](const CLI::App* c) { return c->check_name(argv[1]); });
+      const bool known =
+          std::any_of(commands.begin(), commands.end(), [&](const CLI::App* c) { return c->check_name(argv[1]); });
       if (!known) {
         std::fprintf(stderr, "eical: no command '%s' (eical help lists them)\n", argv[1]);
         return eical::tools::kExitError;

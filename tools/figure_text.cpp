@@ -32,8 +32,10 @@ std::string value_with_u(double v, std::optional<double> u, const std::string& u
   const double scale = std::max(std::abs(v), u ? *u : 0.0);
   const int d = scale >= 1000.0 ? 0 : scale >= 100.0 ? 1 : scale >= 0.1 ? 2 : 3;
   char b[96];
-  if (u && std::isfinite(*u)) std::snprintf(b, sizeof b, "%.*f ± %.*f %s", d, v, d, *u, unit.c_str());
-  else std::snprintf(b, sizeof b, "%.*f %s ± ?", d, v, unit.c_str());
+  if (u && std::isfinite(*u))
+    std::snprintf(b, sizeof b, "%.*f ± %.*f %s", d, v, d, *u, unit.c_str());
+  else
+    std::snprintf(b, sizeof b, "%.*f %s ± ?", d, v, unit.c_str());
   return b;
 }
 

@@ -50,8 +50,8 @@ const char* section_title(const std::string& section) {
 std::string summary_text(const dsp::Run& run, const dsp::Analysis& a) {
   std::string o;
   char b[320];
-  std::snprintf(b, sizeof b, "run %s (%s, %zu samples at %.0f Hz)\n", run.meta.id.c_str(), run.meta.program.kind.c_str(),
-                run.frame_count(), run.meta.acquisition.fs_hz);
+  std::snprintf(b, sizeof b, "run %s (%s, %zu samples at %.0f Hz)\n", run.meta.id.c_str(),
+                run.meta.program.kind.c_str(), run.frame_count(), run.meta.acquisition.fs_hz);
   o += b;
   std::string section;
   for (const dsp::FigureValue& f : dsp::figures_of(a)) {
@@ -59,14 +59,18 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& a) {
     if (sec != section) {
       section = sec;
       o += std::string("  ") + section_title(sec);
-      if (sec == "circle" && a.circle) o += ", " + std::to_string(a.circle->revolutions) + (a.circle->arc_deg < 360.0 ? " arcs, " : " revolutions, ") + a.circle->direction;
-      if (sec == "positioning" && a.positioning) o += ", axis " + a.positioning->axis + ", " + std::to_string(a.positioning->runs) + " runs";
+      if (sec == "circle" && a.circle)
+        o += ", " + std::to_string(a.circle->revolutions) + (a.circle->arc_deg < 360.0 ? " arcs, " : " revolutions, ") +
+             a.circle->direction;
+      if (sec == "positioning" && a.positioning)
+        o += ", axis " + a.positioning->axis + ", " + std::to_string(a.positioning->runs) + " runs";
       o += "\n";
     }
     const std::string unit = figure_unit(f.key);
     if (!f.array) {
       const auto u = figure_u(a, f.key);
-      std::snprintf(b, sizeof b, "    %-34s %s%s\n", figure_label(f.key).c_str(), value_with_u(f.values[0], u, unit).c_str(),
+      std::snprintf(b, sizeof b, "    %-34s %s%s\n", figure_label(f.key).c_str(),
+                    value_with_u(f.values[0], u, unit).c_str(),
                     u && !dsp::uncertainty::resolved(f.values[0], *u) ? "   not resolved" : "");
       o += b;
       continue;
@@ -75,22 +79,35 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& a) {
     for (std::size_t i = 0; i < f.values.size() && i < 24; ++i) {
       const auto u = figure_u(a, f.key, i);
       char e[80];
-      if (u) std::snprintf(e, sizeof e, " %.2f±%.2f%s", f.values[i], *u, dsp::uncertainty::resolved(f.values[i], *u) ? "" : "*");
-      else std::snprintf(e, sizeof e, " %.2f", f.values[i]);
+      if (u)
+        std::snprintf(e, sizeof e, " %.2f±%.2f%s", f.values[i], *u,
+                      dsp::uncertainty::resolved(f.values[i], *u) ? "" : "*");
+      else
+        std::snprintf(e, sizeof e, " %.2f", f.values[i]);
       line += e;
-      if (f.columns > 1 && i % static_cast<std::size_t>(f.columns) != static_cast<std::size_t>(f.columns - 1)) line += ",";
-      else if (f.columns > 1) line += ";";
+      if (f.columns > 1 && i % static_cast<std::size_t>(f.columns) != static_cast<std::size_t>(f.columns - 1))
+        line += ",";
+      else if (f.columns > 1)
+        line += ";";
     }
     if (f.values.size() > 24) line += " …";
     o += line + "\n";
   }
-  if (a.circle && !a.circle->circular_hysteresis_H_um) o += "    circular hysteresis H              n/a (needs both directions)\n";
+  if (a.circle && !a.circle->circular_hysteresis_H_um)
+    o += "    circular hysteresis H              n/a (needs both directions)\n";
   if (a.circle_accuracy_rms_um) {
-    std::snprintf(b, sizeof b, "  against the reference: %.2f µm RMS of (measured − reference) radius deviation\n", *a.circle_accuracy_rms_um);
+    std::snprintf(b, sizeof b, "  against the reference: %.2f µm RMS of (measured − reference) radius deviation\n",
+                  *a.circle_accuracy_rms_um);
     o += b;
   }
-  if (!a.uncertainty_note.empty()) o += "  uncertainty: " + a.uncertainty_note + (a.uncertainty_k2.empty() ? "" : "; * not resolved (|value| <= U)") + "\n";
-  o += "  verdict: " + std::string(a.verdict == "not_measurable" ? "NOT MEASURABLE" : a.verdict == "degraded" ? "DEGRADED" : "ok") + "\n";
+  if (!a.uncertainty_note.empty())
+    o += "  uncertainty: " + a.uncertainty_note + (a.uncertainty_k2.empty() ? "" : "; * not resolved (|value| <= U)") +
+         "\n";
+  o += "  verdict: " +
+       std::string(a.verdict == "not_measurable" ? "NOT MEASURABLE"
+                   : a.verdict == "degraded"     ? "DEGRADED"
+                                                 : "ok") +
+       "\n";
   for (const auto& r : a.verdict_reasons) o += "    - " + r + "\n";
   bool header = false;
   for (const auto& f : a.flags) {

@@ -7,7 +7,6 @@
 
 #include <cmath>
 
-
 namespace eical::daemon {
 namespace {
 
@@ -27,7 +26,8 @@ void read_linuxcnc(StrictTable t, LinuxcncConfig& l) {
   l.fifo = t.string("fifo", l.fifo.string());
   if (l.fifo.empty()) t.fail("fifo", "must not be empty");
   l.program_file = t.string("program_file", l.program_file.string());
-  if (l.program_file.empty()) t.fail("program_file", "required: the [program] table (eical gen-nc --meta) of what LinuxCNC runs");
+  if (l.program_file.empty())
+    t.fail("program_file", "required: the [program] table (eical gen-nc --meta) of what LinuxCNC runs");
   l.program_loaded = read_program_file(t, l.program_file);
   l.scenario_file = t.string("scenario_file", l.scenario_file.string());
   l.servo_rate_hz = t.number("servo_rate_hz", l.servo_rate_hz);
@@ -38,7 +38,8 @@ void read_linuxcnc(StrictTable t, LinuxcncConfig& l) {
   if (l.history_ms < 10.0 || l.history_ms > 10000.0) t.fail("history_ms", "must be within 10..10000");
   l.drive = t.choice("drive", {"command", "feedback"}, l.drive);
   l.connect_timeout_s = t.number("connect_timeout_s", l.connect_timeout_s);
-  if (l.connect_timeout_s < 0.1 || l.connect_timeout_s > 3600.0) t.fail("connect_timeout_s", "must be within 0.1..3600");
+  if (l.connect_timeout_s < 0.1 || l.connect_timeout_s > 3600.0)
+    t.fail("connect_timeout_s", "must be within 0.1..3600");
   l.stall_timeout_s = t.number("stall_timeout_s", l.stall_timeout_s);
   if (l.stall_timeout_s < 0.1 || l.stall_timeout_s > 3600.0) t.fail("stall_timeout_s", "must be within 0.1..3600");
   l.hold_ms = t.number("hold_ms", l.hold_ms);
@@ -53,7 +54,8 @@ void read_daq_stream(StrictTable t, DaqStreamConfig& d) {
   d.path = t.string("path", d.path.string());
   if (d.path.empty()) t.fail("path", "must not be empty");
   d.connect_timeout_s = t.number("connect_timeout_s", d.connect_timeout_s);
-  if (d.connect_timeout_s < 0.1 || d.connect_timeout_s > 3600.0) t.fail("connect_timeout_s", "must be within 0.1..3600");
+  if (d.connect_timeout_s < 0.1 || d.connect_timeout_s > 3600.0)
+    t.fail("connect_timeout_s", "must be within 0.1..3600");
   d.stall_timeout_s = t.number("stall_timeout_s", d.stall_timeout_s);
   if (d.stall_timeout_s < 0.05 || d.stall_timeout_s > 3600.0) t.fail("stall_timeout_s", "must be within 0.05..3600");
   t.finish();
@@ -85,7 +87,8 @@ void read_source(StrictTable t, SourceConfig& s) {
   }
   if (auto l = t.optional_table("linuxcnc")) read_linuxcnc(*l, s.linuxcnc);
   if (auto d = t.optional_table("daq_stream")) read_daq_stream(*d, s.daq_stream);
-  if (s.kind == "linuxcnc" && !s.linuxcnc.program_loaded) t.fail("linuxcnc", "[source.linuxcnc] with program_file is required when kind = \"linuxcnc\"");
+  if (s.kind == "linuxcnc" && !s.linuxcnc.program_loaded)
+    t.fail("linuxcnc", "[source.linuxcnc] with program_file is required when kind = \"linuxcnc\"");
   s.retry_s = t.number("retry_s", s.retry_s);
   if (s.retry_s < 0.1 || s.retry_s > 3600.0) t.fail("retry_s", "must be within 0.1..3600");
   if (auto f = t.optional_table("fault")) {
@@ -110,15 +113,16 @@ void read_source(StrictTable t, SourceConfig& s) {
 void read_setpoint(StrictTable t, SetPointConfig& c, const SourceConfig& source) {
   c.source = t.choice("source", {"none", "servo_stream", "program"}, c.source);
   if (c.source != "none" && !source.is_daq())
-    t.fail("source", "a set-point source goes next to a DAQ ([source] kind = \"usb_daq\" or \"daq_stream\"); the " + source.kind +
-                         " source brings its own set-point");
+    t.fail("source", "a set-point source goes next to a DAQ ([source] kind = \"usb_daq\" or \"daq_stream\"); the " +
+                         source.kind + " source brings its own set-point");
   if (auto s = t.optional_table("servo_stream")) {
     c.servo_fifo = s->string("fifo", c.servo_fifo.string());
     if (c.servo_fifo.empty()) s->fail("fifo", "must not be empty");
     c.servo_rate_hz = s->number("servo_rate_hz", c.servo_rate_hz);
     if (c.servo_rate_hz < 100.0 || c.servo_rate_hz > 20000.0) s->fail("servo_rate_hz", "must be within 100..20000");
     c.hold_ms = s->number("hold_ms", c.hold_ms);
-    if (c.hold_ms < 20.0 || c.hold_ms > 10000.0) s->fail("hold_ms", "must be within 20..10000 (the servo lines arrive ~10 ms late)");
+    if (c.hold_ms < 20.0 || c.hold_ms > 10000.0)
+      s->fail("hold_ms", "must be within 20..10000 (the servo lines arrive ~10 ms late)");
     s->finish();
   }
   if (auto s = t.optional_table("program")) {
@@ -201,7 +205,8 @@ void read_limits(StrictTable t, Limits& l) {
   if (cap < 1024 || (cap & (cap - 1)) != 0) t.fail("ring_capacity_frames", "must be a power of two >= 1024");
   l.ring_capacity_frames = static_cast<std::size_t>(cap);
   l.max_measurement_s = t.number("max_measurement_s", l.max_measurement_s);
-  if (l.max_measurement_s <= 0.0 || l.max_measurement_s > 3600.0) t.fail("max_measurement_s", "must be within (0, 3600]");
+  if (l.max_measurement_s <= 0.0 || l.max_measurement_s > 3600.0)
+    t.fail("max_measurement_s", "must be within (0, 3600]");
   l.temp_min_c = t.number("temp_min_c", l.temp_min_c);
   l.temp_max_c = t.number("temp_max_c", l.temp_max_c);
   if (l.temp_max_c <= l.temp_min_c) t.fail("temp_max_c", "must be above temp_min_c");
@@ -209,7 +214,8 @@ void read_limits(StrictTable t, Limits& l) {
   // A lost frame is bridged with the last value by the integration: the result is degraded
   // whatever the count (quality flag frames_lost). Tolerating some would need a lost-frame
   // model in the uncertainty; until then only 0 says what happens.
-  if (lost != 0) t.fail("max_lost_frames", "only 0 is supported: every lost frame flags the result degraded (frames_lost)");
+  if (lost != 0)
+    t.fail("max_lost_frames", "only 0 is supported: every lost frame flags the result degraded (frames_lost)");
   l.max_lost_frames = static_cast<std::uint64_t>(lost);
   t.finish();
 }
@@ -249,8 +255,10 @@ DaemonConfig load_daemon_config(const std::filesystem::path& file) {
     s->finish();
   }
   for (auto& p : t.tables("psd")) c.psd.push_back(drivers::read_psd(p));
-  if (c.triggers.inputs.empty()) t.fail("triggers", "no trigger input configured: the NC could not start a measurement");
-  if (c.history.enabled && c.machine.name.empty()) t.fail("history", "[machine] name is required: the history keys results by machine");
+  if (c.triggers.inputs.empty())
+    t.fail("triggers", "no trigger input configured: the NC could not start a measurement");
+  if (c.history.enabled && c.machine.name.empty())
+    t.fail("history", "[machine] name is required: the history keys results by machine");
   t.finish();
   return c;
 }

@@ -17,14 +17,14 @@ namespace eical::daemon {
 // sensors (integrations/linuxcnc streams them into `fifo`).
 struct LinuxcncConfig {
   std::filesystem::path fifo = "/run/eical/linuxcnc-servo.fifo";
-  std::filesystem::path program_file;             // eical gen-nc --meta: what LinuxCNC runs (the evaluation)
+  std::filesystem::path program_file;  // eical gen-nc --meta: what LinuxCNC runs (the evaluation)
   std::optional<dsp::Program> program_loaded;
-  std::filesystem::path scenario_file;            // eical-scenario/1: the machine and sensor truth (optional)
-  double servo_rate_hz = 1000.0;                  // [EMCMOT]SERVO_PERIOD
-  double block_ms = 200.0, history_ms = 300.0;    // simulation windows
-  std::string drive = "command";                  // command | feedback: which positions move the machine
+  std::filesystem::path scenario_file;          // eical-scenario/1: the machine and sensor truth (optional)
+  double servo_rate_hz = 1000.0;                // [EMCMOT]SERVO_PERIOD
+  double block_ms = 200.0, history_ms = 300.0;  // simulation windows
+  std::string drive = "command";                // command | feedback: which positions move the machine
   double connect_timeout_s = 10.0, stall_timeout_s = 2.0;
-  double hold_ms = 1000.0;                        // frame latency: must exceed the M-code → DDS trigger time
+  double hold_ms = 1000.0;  // frame latency: must exceed the M-code → DDS trigger time
   std::uint64_t seed = 1;
 };
 
@@ -37,9 +37,9 @@ struct DaqStreamConfig {
 };
 
 struct SourceConfig {
-  std::string kind = "sim";           // sim | replay | usb_daq | daq_stream | linuxcnc
-  std::string pacing = "realtime";    // realtime | free_running (sim, replay)
-  std::filesystem::path replay_run;   // replay: an eical-run/1 directory
+  std::string kind = "sim";          // sim | replay | usb_daq | daq_stream | linuxcnc
+  std::string pacing = "realtime";   // realtime | free_running (sim, replay)
+  std::filesystem::path replay_run;  // replay: an eical-run/1 directory
   // sim: the calibration program the simulated NC runs; its M101/102/103 reach the
   // daemon on the DAQ trigger channel, as a PLC wired to the DAQ's trigger input would.
   std::string sim_program = "circle";  // circle | step
@@ -47,17 +47,17 @@ struct SourceConfig {
   double sim_feed_mm_min = 2500.0;
   int sim_repeats = 5;
   std::uint64_t sim_seed = 1;
-  double sim_idle_s = 2.0;             // rest between repetitions of the program
-  bool sim_repeat_program = true;      // run the program again after each idle time
+  double sim_idle_s = 2.0;         // rest between repetitions of the program
+  bool sim_repeat_program = true;  // run the program again after each idle time
   // The [program] table written by `eical gen-nc ... --meta FILE` (kind, geometry and the
   // G-code the simulated NC runs); replaces program/radius/feed/repeats when set.
   std::filesystem::path sim_program_file;
   std::optional<dsp::Program> sim_program_loaded;  // read from sim_program_file at load
-  double retry_s = 2.0;                // a source that failed mid-run is reopened after this
-  drivers::FaultPlan fault;            // [source.fault]: injected faults (tests, commissioning)
-  std::string usb_id = "1d50:6161";    // usb_daq: vendor:product
-  LinuxcncConfig linuxcnc;             // [source.linuxcnc]
-  DaqStreamConfig daq_stream;          // [source.daq_stream]
+  double retry_s = 2.0;                            // a source that failed mid-run is reopened after this
+  drivers::FaultPlan fault;                        // [source.fault]: injected faults (tests, commissioning)
+  std::string usb_id = "1d50:6161";                // usb_daq: vendor:product
+  LinuxcncConfig linuxcnc;                         // [source.linuxcnc]
+  DaqStreamConfig daq_stream;                      // [source.daq_stream]
   [[nodiscard]] bool is_daq() const { return kind == "usb_daq" || kind == "daq_stream"; }
 };
 
@@ -73,9 +73,9 @@ struct SetPointConfig {
   double hold_ms = 1000.0;  // frames wait this long: servo lines (~10 ms) and DDS triggers (~0.75 s) arrive first
   // [setpoint.program]
   std::filesystem::path program_dir = "/etc/eical/programs";  // <number>.toml from eical gen-nc --meta
-  int default_program = -1;    // used when M101 carries no P word (frame, GPIO triggers); -1 = none
-  bool mcode_stops = false;    // the NC stops at every M-code (LinuxCNC)
-  double max_lag_s = 0.3;      // cross-correlation search around the marks
+  int default_program = -1;  // used when M101 carries no P word (frame, GPIO triggers); -1 = none
+  bool mcode_stops = false;  // the NC stops at every M-code (LinuxCNC)
+  double max_lag_s = 0.3;    // cross-correlation search around the marks
   double a_max_mm_s2 = 2000.0, j_max_mm_s3 = 50000.0, rapid_mm_min = 10000.0;  // the NC's path limits
 };
 
@@ -85,7 +85,7 @@ struct TriggerConfig {
   std::vector<std::string> inputs = {"frame", "dds"};
   std::string gpio_chip = "gpiochip0";
   std::vector<int> gpio_lines = {17, 27, 22};  // lines for M101, M102, M103 (rising edge)
-  double gpio_debounce_ms = 5.0;  // a second edge of one line within this time is contact bounce
+  double gpio_debounce_ms = 5.0;               // a second edge of one line within this time is contact bounce
   std::string can_interface = "can0";
   std::uint32_t can_id = 0x1E0;  // NC trigger frame id
 };
@@ -107,9 +107,9 @@ struct RecordingConfig {
 // list | trend | compare). Off unless the config turns it on (the installed eicald.toml does).
 struct HistoryConfig {
   bool enabled = false;
-  std::string db = "/var/lib/eical/history.db";                  // SQLite file, or postgresql://...
+  std::string db = "/var/lib/eical/history.db";                      // SQLite file, or postgresql://...
   std::filesystem::path spool_dir = "/var/lib/eical/history-spool";  // results waiting for the store
-  double retry_s = 30.0;                                          // an unavailable store is tried again
+  double retry_s = 30.0;                                             // an unavailable store is tried again
 };
 
 struct Limits {
@@ -138,7 +138,7 @@ struct DaemonConfig {
   dsp::Acquisition acquisition;
   dsp::Site site;
   dsp::MachineLayout machine;
-  dsp::SensorSpec sensors[2];            // data-sheet values, table and head
+  dsp::SensorSpec sensors[2];              // data-sheet values, table and head
   std::filesystem::path calibration_file;  // identified calibration (optional, overrides)
   std::vector<dsp::PsdSpec> psd;
 };

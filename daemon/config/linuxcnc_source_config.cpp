@@ -9,7 +9,8 @@ namespace eical::daemon {
 
 std::unique_ptr<drivers::Source> make_linuxcnc_source(const DaemonConfig& c) {
   const LinuxcncConfig& l = c.source.linuxcnc;
-  sim::Scenario sc = l.scenario_file.empty() ? sim::gcode_scenario("", "freeform", l.seed) : drivers::read_scenario_file(l.scenario_file.string());
+  sim::Scenario sc = l.scenario_file.empty() ? sim::gcode_scenario("", "freeform", l.seed)
+                                             : drivers::read_scenario_file(l.scenario_file.string());
   const bool truth_from_file = !l.scenario_file.empty();
   sc.seed = l.seed;
   sc.meta.program = *l.program_loaded;

@@ -5,8 +5,8 @@
 #include "daemon/service/trace_builder.hpp"
 #include "daemon/system/log.hpp"
 #include "drivers/results/result_json.hpp"
-#include "drivers/run_io/file_spill.hpp"
 #include "drivers/results/software_version.hpp"
+#include "drivers/run_io/file_spill.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/setpoint/program_catalog.hpp"
@@ -47,11 +47,15 @@ std::vector<std::string> temperature_flags(const dsp::Run& run, const Limits& li
     if (!run.meta.sensor_present[s]) continue;
     float lo = INFINITY, hi = -INFINITY;
     for (const auto& f : run.frames)
-      if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s])) lo = std::min(lo, f.temp_c[s]), hi = std::max(hi, f.temp_c[s]);
-    if (!(lo <= hi) || (static_cast<double>(lo) >= limits.temp_min_c && static_cast<double>(hi) <= limits.temp_max_c)) continue;
+      if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s]))
+        lo = std::min(lo, f.temp_c[s]), hi = std::max(hi, f.temp_c[s]);
+    if (!(lo <= hi) || (static_cast<double>(lo) >= limits.temp_min_c && static_cast<double>(hi) <= limits.temp_max_c))
+      continue;
     char b[200];
-    std::snprintf(b, sizeof b, "temperature: the %s sensor was at %.1f..%.1f degC, outside [limits] temp_min_c..temp_max_c = %.1f..%.1f degC",
-                  names[s], static_cast<double>(lo), static_cast<double>(hi), limits.temp_min_c, limits.temp_max_c);
+    std::snprintf(
+        b, sizeof b,
+        "temperature: the %s sensor was at %.1f..%.1f degC, outside [limits] temp_min_c..temp_max_c = %.1f..%.1f degC",
+        names[s], static_cast<double>(lo), static_cast<double>(hi), limits.temp_min_c, limits.temp_max_c);
     flags.emplace_back(b);
   }
   return flags;
@@ -62,15 +66,20 @@ void measure_alignment(const dsp::Run& run, dsp::SetPointOrigin& s) {
   std::vector<Eigen::Vector3d> cmd;
   cmd.reserve(run.frames.size());
   for (const auto& f : run.frames) cmd.emplace_back(f.cmd_mm[0], f.cmd_mm[1], f.cmd_mm[2]);
-  const auto lag = dsp::align::estimate_lag(dsp::align::setpoint_accel_mps2(cmd, run.fs_hz()), dsp::align::measured_accel_mps2(run), run.fs_hz());
+  const auto lag = dsp::align::estimate_lag(dsp::align::setpoint_accel_mps2(cmd, run.fs_hz()),
+                                            dsp::align::measured_accel_mps2(run), run.fs_hz());
   s.lag_s = lag.lag_s, s.correlation = lag.correlation, s.residual_ratio = lag.residual_ratio;
 }
 
 }  // namespace
 
-Evaluator::Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingHandoff& handoff,
-                     EvaluatorLinks links)
-    : config_(config), meta_(std::move(meta)), analysis_(std::move(analysis)), handoff_(handoff), links_(std::move(links)),
+Evaluator::Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis,
+                     RecordingHandoff& handoff, EvaluatorLinks links)
+    : config_(config),
+      meta_(std::move(meta)),
+      analysis_(std::move(analysis)),
+      handoff_(handoff),
+      links_(std::move(links)),
       thread_([this] { loop(); }) {}
 
 Evaluator::~Evaluator() { finish(); }
@@ -103,21 +112,25 @@ void Evaluator::loop() {
 dsp::Run Evaluator::make_run(RecordingJob& job) const {
   dsp::Run run;
   run.meta = meta_;
-  const std::string id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
+  const std::string id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" +
+                         std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
   run.meta.id = id;
   // The wall clock may step back (NTP, an operator) and a restarted source counts its
   // samples from 0 again: an id an earlier run has gets a suffix, it never replaces it.
   std::error_code ec;
-  for (int n = 2; std::filesystem::exists(config_.recording.dir / run.meta.id, ec); ++n) run.meta.id = id + "-" + std::to_string(n);
+  for (int n = 2; std::filesystem::exists(config_.recording.dir / run.meta.id, ec); ++n)
+    run.meta.id = id + "-" + std::to_string(n);
   run.meta.created = utc_now("%Y-%m-%dT%H:%M:%SZ");
   run.channels.psd_count = static_cast<int>(std::min<std::size_t>(meta_.psd.size(), dsp::kMaxPsd));
   run.frames.swap(job.frames);
   return run;
 }
 
-std::optional<std::pair<int, dsp::Program>> Evaluator::named_program(const RecordingNotes& notes, std::vector<std::string>& flags) const {
+std::optional<std::pair<int, dsp::Program>> Evaluator::named_program(const RecordingNotes& notes,
+                                                                     std::vector<std::string>& flags) const {
   const auto& sp = config_.setpoint;
-  const int number = std::isfinite(notes.program_p) ? static_cast<int>(std::lround(notes.program_p)) : sp.default_program;
+  const int number =
+      std::isfinite(notes.program_p) ? static_cast<int>(std::lround(notes.program_p)) : sp.default_program;
   if (number < 0) {
     flags.push_back("setpoint: M101 named no program (P word) and [setpoint.program] default_program is not set");
     return std::nullopt;
@@ -144,21 +157,26 @@ std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingN
     s.servo_rate_hz = sp.servo_rate_hz;
     const auto a = links_.servo ? links_.servo->alignment() : drivers::ServoAlignment{};
     if (a.known && !run.frames.empty())
-      s.servo_cycle_at_first_sample = a.servo_cycle_at_sample0 + static_cast<double>(run.frames.front().sample_index - notes.index_offset) /
-                                                                      run.fs_hz() * a.servo_rate_hz;
+      s.servo_cycle_at_first_sample =
+          a.servo_cycle_at_sample0 +
+          static_cast<double>(run.frames.front().sample_index - notes.index_offset) / run.fs_hz() * a.servo_rate_hz;
     measure_alignment(run, s);
     std::size_t missing = 0;
     for (const auto& f : run.frames) missing += (f.flags & dsp::frame_flag::cmd_missing) != 0;
-    if (missing > 0) flags.push_back("setpoint: " + std::to_string(missing) + " frames had no servo cycle of the set-point (LinuxCNC's stream absent or late)");
+    if (missing > 0)
+      flags.push_back("setpoint: " + std::to_string(missing) +
+                      " frames had no servo cycle of the set-point (LinuxCNC's stream absent or late)");
     run.meta.setpoint = s;
-    log(LogLevel::info, "setpoint: servo stream, cycle %.3f at the first sample; measured lags it by %+.2f ms, residual %s",
+    log(LogLevel::info,
+        "setpoint: servo stream, cycle %.3f at the first sample; measured lags it by %+.2f ms, residual %s",
         s.servo_cycle_at_first_sample, s.lag_s * 1e3, percent(s.residual_ratio).c_str());
     return flags;
   }
   if (!program) return flags;
   try {
     drivers::ProgramSetPointOptions o;
-    o.limits.a_max_mm_s2 = sp.a_max_mm_s2, o.limits.j_max_mm_s3 = sp.j_max_mm_s3, o.limits.rapid_mm_min = sp.rapid_mm_min;
+    o.limits.a_max_mm_s2 = sp.a_max_mm_s2, o.limits.j_max_mm_s3 = sp.j_max_mm_s3,
+    o.limits.rapid_mm_min = sp.rapid_mm_min;
     o.max_lag_s = sp.max_lag_s;
     o.mcode_stops = sp.mcode_stops;
     const drivers::ProgramAlignment a = drivers::apply_program_setpoint(run, program->second, o);
@@ -167,15 +185,18 @@ std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingN
     s.program_number = program->first;
     if (!a.blocks.empty()) {
       s.marks_offset_s = a.blocks.front().marks_offset_s, s.offset_s = a.blocks.front().offset_s;
-      const auto [lo, hi] = std::minmax_element(a.blocks.begin(), a.blocks.end(), [](const auto& x, const auto& y) { return x.offset_s < y.offset_s; });
+      const auto [lo, hi] = std::minmax_element(a.blocks.begin(), a.blocks.end(),
+                                                [](const auto& x, const auto& y) { return x.offset_s < y.offset_s; });
       s.block_offset_spread_s = hi->offset_s - lo->offset_s;
     }
     s.blocks = static_cast<int>(a.blocks.size());
     s.lag_s = a.lag_s, s.correlation = a.correlation, s.residual_ratio = a.residual_ratio;
     run.meta.setpoint = s;
     flags.insert(flags.end(), a.flags.begin(), a.flags.end());
-    log(LogLevel::info, "setpoint: program %d aligned: marks %+.2f ms, cross-correlation %+.2f ms over %d block(s), residual %s", s.program_number,
-        s.marks_offset_s * 1e3, (s.offset_s - s.marks_offset_s) * 1e3, s.blocks, percent(s.residual_ratio).c_str());
+    log(LogLevel::info,
+        "setpoint: program %d aligned: marks %+.2f ms, cross-correlation %+.2f ms over %d block(s), residual %s",
+        s.program_number, s.marks_offset_s * 1e3, (s.offset_s - s.marks_offset_s) * 1e3, s.blocks,
+        percent(s.residual_ratio).c_str());
   } catch (const std::exception& e) {
     flags.push_back(std::string("setpoint: program ") + std::to_string(program->first) + ": " + e.what());
   }
@@ -189,7 +210,8 @@ void Evaluator::evaluate(RecordingJob& job) {
   try {
     const std::vector<std::string> setpoint_flags = add_setpoint(run, job.notes);
     // The run first: what was measured is durable before anything can fail.
-    write_retrying("recording " + run.meta.id, [&] { drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false}); });
+    write_retrying("recording " + run.meta.id,
+                   [&] { drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false}); });
     // Streamed: the recording's trace is never held twice, its long evaluations spill to
     // the recording directory's disk (dsp/stream/analyze_stream.hpp).
     dsp::StoredFrames frames(run.frames);
@@ -204,7 +226,8 @@ void Evaluator::evaluate(RecordingJob& job) {
     if (job.notes.source_rate_ratio != 0.0) {
       char b[240];
       std::snprintf(b, sizeof b,
-                    "source_rate: the source delivered %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says during the measurement "
+                    "source_rate: the source delivered %.3g times the samples per second [acquisition] fs_hz = %.0f Hz "
+                    "says during the measurement "
                     "(a DAQ at another rate, a replay faster than real time): its times, speeds and lengths are wrong",
                     job.notes.source_rate_ratio, run.fs_hz());
       a.flags.push_back(b), a.degraded = true;
@@ -213,11 +236,13 @@ void Evaluator::evaluate(RecordingJob& job) {
     dsp::judge(run.meta.program, a);  // the verdict again, with the flags the daemon added
     write_retrying("result of " + run.meta.id, [&] {
       // The run directory removed meanwhile (an operator, a cleanup): the run again first.
-      if (!std::filesystem::exists(dir / "run.toml")) drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = true});
+      if (!std::filesystem::exists(dir / "run.toml"))
+        drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = true});
       drivers::write_result(run, a, dir / "result.json");
     });
     finish_result(run, a, dir);
-    log(LogLevel::notice, "measurement %s written (%zu frames)%s", run.meta.id.c_str(), run.frames.size(), a.degraded ? ", result degraded" : "");
+    log(LogLevel::notice, "measurement %s written (%zu frames)%s", run.meta.id.c_str(), run.frames.size(),
+        a.degraded ? ", result degraded" : "");
   } catch (const std::exception& e) {
     error = e.what();
     log(LogLevel::error, "recording %s: %s", run.meta.id.c_str(), e.what());
@@ -248,7 +273,8 @@ void Evaluator::evaluate_recorded(const std::filesystem::path& dir) {
     dsp::StoredFrames frames(run.frames);
     dsp::Analysis a = dsp::analyze_stream(run, frames, analysis_, {drivers::file_spills(config_.recording.dir)});
     a.flags.push_back(
-        "evaluated_after_restart: eicald stopped between writing this run and its result; evaluated at the next start, without the flags "
+        "evaluated_after_restart: eicald stopped between writing this run and its result; evaluated at the next start, "
+        "without the flags "
         "only the stopped service knew (cut short, non-finite channels)");
     a.degraded = true;
     for (const auto& f : temperature_flags(run, config_.limits)) a.flags.push_back(f);
@@ -278,14 +304,15 @@ void Evaluator::write_retrying(const std::string& what, const std::function<void
       break;
     } catch (const std::exception& e) {
       if (stopping()) throw;
-      const std::string now = "recording: " + what + ": " + e.what() + "; retried every " + std::to_string(static_cast<int>(kWriteRetryS)) +
-                              " s, the measurement is held in memory";
+      const std::string now = "recording: " + what + ": " + e.what() + "; retried every " +
+                              std::to_string(static_cast<int>(kWriteRetryS)) + " s, the measurement is held in memory";
       if (now != fault) log(LogLevel::error, "%s", now.c_str());  // once per distinct cause, not per retry
       fault = now;
       set_fault(fault);
     }
     const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(kWriteRetryS);
-    while (std::chrono::steady_clock::now() < until && !stopping()) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    while (std::chrono::steady_clock::now() < until && !stopping())
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   if (fault.empty()) return;
   log(LogLevel::notice, "%s written after the fault cleared", what.c_str());
@@ -297,7 +324,8 @@ void Evaluator::clear_fault(const std::string& fault) {
   if (status_.fault == fault) status_.fault.clear();
 }
 
-void Evaluator::publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir, std::uint64_t result_number) {
+void Evaluator::publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir,
+                        std::uint64_t result_number) {
   if (!links_.hmi) return;
   drivers::dds::ResultMsg r;
   r.machine = run.meta.machine.name;
@@ -307,7 +335,9 @@ void Evaluator::publish(const dsp::Run& run, const dsp::Analysis& a, const std::
   r.program = run.meta.program.kind;
   r.degraded = a.degraded;
   r.results = result_number;
-  if (a.circle) r.circular_deviation_G_um = a.circle->circular_deviation_G_um, r.radius_mean_deviation_um = a.circle->radius_mean_deviation_um;
+  if (a.circle)
+    r.circular_deviation_G_um = a.circle->circular_deviation_G_um,
+    r.radius_mean_deviation_um = a.circle->radius_mean_deviation_um;
   r.json = drivers::result_json(run, a).dump();
   links_.hmi->publish_result(r);
   if (auto t = make_trace(run, a, config_.dds.trace_max_points)) links_.hmi->publish_trace(*t);

@@ -15,9 +15,9 @@
 #include <functional>
 #include <mutex>
 #include <optional>
-#include <utility>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace eical::drivers {
@@ -48,7 +48,8 @@ struct EvaluationStatus {
 
 class Evaluator {
  public:
-  Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingHandoff& handoff, EvaluatorLinks links);
+  Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingHandoff& handoff,
+            EvaluatorLinks links);
   ~Evaluator();  // finish()
   // Evaluates what was handed over, then stops the thread; status() stays readable.
   void finish();
@@ -72,10 +73,12 @@ class Evaluator {
   void finish_result(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir);
   dsp::Run make_run(RecordingJob& job) const;
   // The program M101's P word (or [setpoint.program] default_program) names.
-  std::optional<std::pair<int, dsp::Program>> named_program(const RecordingNotes& notes, std::vector<std::string>& flags) const;
+  std::optional<std::pair<int, dsp::Program>> named_program(const RecordingNotes& notes,
+                                                            std::vector<std::string>& flags) const;
   // Fills cmd_*, [program] and [setpoint]; returns flags for the result (empty: nothing doubtful).
   std::vector<std::string> add_setpoint(dsp::Run& run, const RecordingNotes& notes) const;
-  void publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir, std::uint64_t result_number);
+  void publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir,
+               std::uint64_t result_number);
   // Runs `write` until it succeeds; throws its last error when the service stops first.
   void write_retrying(const std::string& what, const std::function<void()>& write);
   [[nodiscard]] bool stopping() const;

@@ -8,7 +8,8 @@
 namespace eical::daemon {
 
 FrameLoop::FrameLoop(const FrameLoopOptions& options, drivers::StampedSource& source, dsp::MeasurementSession& session,
-                     dsp::Pipeline& live, FrameGuard& guard, RecordingHandoff& handoff, ServiceCounters& counters, HmiLink* hmi)
+                     dsp::Pipeline& live, FrameGuard& guard, RecordingHandoff& handoff, ServiceCounters& counters,
+                     HmiLink* hmi)
     : options_(options),
       source_(source),
       session_(session),
@@ -72,11 +73,13 @@ void FrameLoop::take_external_triggers(const dsp::Frame& f) noexcept {
       const double at = r.time_ns > 0 ? daq_clock_.number_at(r.time_ns) : std::nan("");
       if (std::isfinite(at) && at - static_cast<double>(f.sample_index) > kMaxTriggerAheadS * options_.fs_hz) {
         TriggerVerdict v;
-        v.id = r.id, v.refusal = Refusal::time_ahead, v.sample_index = f.sample_index, v.state = session_.state().state();
+        v.id = r.id, v.refusal = Refusal::time_ahead, v.sample_index = f.sample_index,
+        v.state = session_.state().state();
         channels_[c]->answer(v);
         continue;
       }
-      const std::int64_t idx = std::isfinite(at) ? std::max(static_cast<std::int64_t>(std::llround(at)), f.sample_index) : f.sample_index;
+      const std::int64_t idx =
+          std::isfinite(at) ? std::max(static_cast<std::int64_t>(std::llround(at)), f.sample_index) : f.sample_index;
       TriggerVerdict v = gate_.decide(r, idx, session_.state().state());
       if (v.accepted && !session_.queue_trigger(idx, r.code)) v.accepted = false, v.refusal = Refusal::queue_full;
       if (v.accepted && r.code == kProgramStart) requested_p_ = r.p;
@@ -110,8 +113,11 @@ void FrameLoop::publish_live(const dsp::Frame& f, std::int64_t acquired_ns) noex
   ++frames_;
   if (!hmi_ || frames_ % options_.live_every != 0) return;
   const auto& l = live_.live();
-  hmi_->push_live({f.sample_index, {l.pos_mm.x(), l.pos_mm.y(), l.pos_mm.z()}, {l.vel_mm_s.x(), l.vel_mm_s.y(), l.vel_mm_s.z()},
-                   l.integrating, acquired_ns});
+  hmi_->push_live({f.sample_index,
+                   {l.pos_mm.x(), l.pos_mm.y(), l.pos_mm.z()},
+                   {l.vel_mm_s.x(), l.vel_mm_s.y(), l.vel_mm_s.z()},
+                   l.integrating,
+                   acquired_ns});
 }
 
 void FrameLoop::hand_over_if_ready() noexcept {

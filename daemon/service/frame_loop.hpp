@@ -25,16 +25,16 @@ class HmiLink;
 
 struct FrameLoopOptions {
   double fs_hz = 10000.0;
-  bool frame_triggers = true;       // the DAQ's own trigger channel is an input
-  std::uint64_t live_every = 100;   // every n-th frame goes to the Live topic
+  bool frame_triggers = true;      // the DAQ's own trigger channel is an input
+  std::uint64_t live_every = 100;  // every n-th frame goes to the Live topic
 };
 
 class FrameLoop {
  public:
   static constexpr std::size_t kMaxChannels = 4;  // DDS, GPIO, CAN, spare
 
-  FrameLoop(const FrameLoopOptions& options, drivers::StampedSource& source, dsp::MeasurementSession& session, dsp::Pipeline& live,
-            FrameGuard& guard, RecordingHandoff& handoff, ServiceCounters& counters, HmiLink* hmi);
+  FrameLoop(const FrameLoopOptions& options, drivers::StampedSource& source, dsp::MeasurementSession& session,
+            dsp::Pipeline& live, FrameGuard& guard, RecordingHandoff& handoff, ServiceCounters& counters, HmiLink* hmi);
 
   // Before the first frame: an input whose triggers this loop decides on.
   void add_channel(TriggerChannel& channel);
@@ -73,11 +73,11 @@ class FrameLoop {
   std::size_t n_channels_ = 0;
   TriggerGate gate_;
   drivers::SampleClock daq_clock_;
-  std::int64_t stamp_seen_ = -1;        // last acquisition stamp observed (source's index)
+  std::int64_t stamp_seen_ = -1;  // last acquisition stamp observed (source's index)
   std::int64_t index_offset_ = 0, last_index_ = -1;
   bool gap_after_reopen_ = false;
   std::uint64_t frames_ = 0, started_seen_ = 0;
-  RecordingNotes notes_;                // of the measurement running now
+  RecordingNotes notes_;               // of the measurement running now
   double requested_p_ = std::nan("");  // P of the last M101 accepted from an external input
 };
 

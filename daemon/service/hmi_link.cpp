@@ -5,13 +5,13 @@
 #include "daemon/system/log.hpp"
 #include "daemon/system/realtime.hpp"
 
+#include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
 #include <chrono>
 #include <cstdlib>
 #include <ctime>
-#include <poll.h>
 #include <stdexcept>
-#include <sys/eventfd.h>
-#include <unistd.h>
 
 namespace eical::daemon {
 namespace {
@@ -73,7 +73,8 @@ void HmiLink::publisher() {
     log(rt.ok ? LogLevel::info : LogLevel::warning, "%s", rt.message.c_str());
   }
   using clock = std::chrono::steady_clock;
-  const auto status_period = std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(1.0 / config_.status_rate_hz));
+  const auto status_period =
+      std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(1.0 / config_.status_rate_hz));
   auto next_status = clock::now();
   while (!stop_.load()) {
     // Sleep until a Live sample arrives or the next Status is due.
@@ -92,7 +93,9 @@ void HmiLink::publisher() {
       drivers::dds::LiveMsg m;
       m.daemon = name_;
       m.sample_index = latest.sample_index;
-      for (int i = 0; i < 3; ++i) m.pos_mm[static_cast<std::size_t>(i)] = latest.pos_mm[i], m.vel_mm_s[static_cast<std::size_t>(i)] = latest.vel_mm_s[i];
+      for (int i = 0; i < 3; ++i)
+        m.pos_mm[static_cast<std::size_t>(i)] = latest.pos_mm[i],
+        m.vel_mm_s[static_cast<std::size_t>(i)] = latest.vel_mm_s[i];
       m.integrating = latest.integrating;
       m.acquired_ns = latest.acquired_ns;
       (void)bus_->publish(m);
@@ -135,12 +138,14 @@ drivers::dds::ReplyMsg HmiLink::answer_trigger(const drivers::dds::CommandMsg& c
       reply.state = std::string(dsp::to_string(v.state));
       return reply;
     }
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
+    const auto left =
+        std::chrono::duration_cast<std::chrono::milliseconds>(end - std::chrono::steady_clock::now()).count();
     if (left <= 0) break;
     triggers_.wait_verdict(static_cast<int>(left));
   }
   reply.ok = true;
-  reply.message = "M" + std::to_string(cmd.code) + " queued for the DAQ clock (not confirmed yet: no frames handled for 0.5 s)";
+  reply.message =
+      "M" + std::to_string(cmd.code) + " queued for the DAQ clock (not confirmed yet: no frames handled for 0.5 s)";
   return reply;
 }
 
@@ -149,14 +154,17 @@ drivers::dds::ReplyMsg HmiLink::answer(const drivers::dds::CommandMsg& cmd) {
   const auto state_now = [&] { return std::string(dsp::to_string(static_cast<dsp::State>(state_.load()))); };
   if (cmd.sender.size() > kMaxSenderBytes || cmd.action.size() > kMaxActionBytes) {
     reply.ok = false;
-    reply.message = "command refused: sender (" + std::to_string(cmd.sender.size()) + " bytes) or action (" + std::to_string(cmd.action.size()) +
-                    " bytes) longer than " + std::to_string(kMaxSenderBytes) + " / " + std::to_string(kMaxActionBytes);
+    reply.message = "command refused: sender (" + std::to_string(cmd.sender.size()) + " bytes) or action (" +
+                    std::to_string(cmd.action.size()) + " bytes) longer than " + std::to_string(kMaxSenderBytes) +
+                    " / " + std::to_string(kMaxActionBytes);
     reply.state = state_now();
     return reply;
   }
-  const auto seen = std::find_if(answered_.begin(), answered_.end(),
-                                 [&](const Answered& a) { return a.sender == cmd.sender && a.request_id == cmd.request_id; });
-  if (cmd.action == "trigger" && seen != answered_.end()) return seen->reply;  // `eical trigger` resends until it sees a Reply
+  const auto seen = std::find_if(answered_.begin(), answered_.end(), [&](const Answered& a) {
+    return a.sender == cmd.sender && a.request_id == cmd.request_id;
+  });
+  if (cmd.action == "trigger" && seen != answered_.end())
+    return seen->reply;  // `eical trigger` resends until it sees a Reply
   if (cmd.action == "trigger" && is_nc_trigger(cmd.code)) {
     reply = answer_trigger(cmd);
     if (reply.state.empty()) reply.state = state_now();
@@ -165,7 +173,9 @@ drivers::dds::ReplyMsg HmiLink::answer(const drivers::dds::CommandMsg& cmd) {
     return reply;
   }
   reply.ok = false;
-  reply.message = "unknown command '" + cmd.action + "' (code " + std::to_string(cmd.code) + "); use trigger " + std::to_string(kProgramStart) + "|" + std::to_string(kSegmentMark) + "|" + std::to_string(kProgramEnd);
+  reply.message = "unknown command '" + cmd.action + "' (code " + std::to_string(cmd.code) + "); use trigger " +
+                  std::to_string(kProgramStart) + "|" + std::to_string(kSegmentMark) + "|" +
+                  std::to_string(kProgramEnd);
   reply.state = state_now();
   return reply;
 }
@@ -173,19 +183,21 @@ drivers::dds::ReplyMsg HmiLink::answer(const drivers::dds::CommandMsg& cmd) {
 void HmiLink::log_answer(const drivers::dds::CommandMsg& cmd, const drivers::dds::ReplyMsg& reply) {
   const std::string sender = cmd.sender.substr(0, kMaxSenderBytes), action = cmd.action.substr(0, kMaxActionBytes);
   if (reply.ok) {
-    log(LogLevel::info, "command from %s: %s %d -> %s", sender.c_str(), action.c_str(), cmd.code, reply.message.c_str());
+    log(LogLevel::info, "command from %s: %s %d -> %s", sender.c_str(), action.c_str(), cmd.code,
+        reply.message.c_str());
     return;
   }
   const auto now = std::chrono::steady_clock::now();
   if (now - log_window_start_ > std::chrono::duration<double>(kLogWindowS)) {
     if (refusals_unlogged_ > 0)
-      log(LogLevel::warning, "%llu more commands refused in %.0f s (not logged one by one)", static_cast<unsigned long long>(refusals_unlogged_),
-          kLogWindowS);
+      log(LogLevel::warning, "%llu more commands refused in %.0f s (not logged one by one)",
+          static_cast<unsigned long long>(refusals_unlogged_), kLogWindowS);
     log_window_start_ = now, refusals_logged_ = 0, refusals_unlogged_ = 0;
   }
   if (refusals_logged_ < kRefusalsLogged) {
     ++refusals_logged_;
-    log(LogLevel::warning, "command from %s: %s %d -> %s", sender.c_str(), action.c_str(), cmd.code, reply.message.c_str());
+    log(LogLevel::warning, "command from %s: %s %d -> %s", sender.c_str(), action.c_str(), cmd.code,
+        reply.message.c_str());
   } else {
     ++refusals_unlogged_;
   }

@@ -75,8 +75,8 @@ class HmiLink {
   std::unique_ptr<drivers::dds::Bus> bus_;
   drivers::SpscRing<LiveSample> live_{1024};
   TriggerChannel triggers_{"dds"};
-  std::uint32_t next_trigger_id_ = 0;  // command thread
-  drivers::TripleBuffer<drivers::dds::StatusMsg> status_;  // status thread → publisher
+  std::uint32_t next_trigger_id_ = 0;                           // command thread
+  drivers::TripleBuffer<drivers::dds::StatusMsg> status_;       // status thread → publisher
   std::atomic<int> state_{static_cast<int>(dsp::State::idle)};  // for the command thread's replies
   std::atomic<bool> stop_{false};
   std::atomic<std::uint64_t> commands_{0};

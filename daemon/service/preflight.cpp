@@ -41,8 +41,10 @@ std::optional<std::string> dds_config_problem(const DdsConfig& dds) {
     if (a == std::string::npos) continue;
     entry = entry.substr(a, b - a + 1);
     const std::string path = entry.rfind("file://", 0) == 0 ? entry.substr(7) : entry;
-    if (!fs::is_regular_file(path)) return "dds: the Cyclone DDS configuration " + path + " (" + origin + ") does not exist";
-    if (::access(path.c_str(), R_OK) != 0) return "dds: cannot read the Cyclone DDS configuration " + path + " (" + origin + "): " + std::strerror(errno);
+    if (!fs::is_regular_file(path))
+      return "dds: the Cyclone DDS configuration " + path + " (" + origin + ") does not exist";
+    if (::access(path.c_str(), R_OK) != 0)
+      return "dds: cannot read the Cyclone DDS configuration " + path + " (" + origin + "): " + std::strerror(errno);
   }
   return std::nullopt;
 }
@@ -52,7 +54,8 @@ std::optional<std::string> setpoint_problem(const SetPointConfig& sp) {
   // The program set-point needs its programs; beside the servo stream they only name
   // what to evaluate, so a missing directory matters only when a default is set.
   if (!fs::is_directory(sp.program_dir) && (sp.source == "program" || sp.default_program >= 0))
-    return "setpoint: the program directory " + sp.program_dir.string() + " does not exist ([setpoint.program] directory)";
+    return "setpoint: the program directory " + sp.program_dir.string() +
+           " does not exist ([setpoint.program] directory)";
   if (sp.default_program >= 0) {
     try {
       (void)drivers::ProgramCatalog(sp.program_dir).program(sp.default_program);

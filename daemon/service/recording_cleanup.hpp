@@ -12,8 +12,8 @@
 namespace eical::daemon {
 
 struct RecordingCleanup {
-  std::size_t removed = 0;   // temporaries removed
-  std::size_t restored = 0;  // runs moved back from .old-N
+  std::size_t removed = 0;                         // temporaries removed
+  std::size_t restored = 0;                        // runs moved back from .old-N
   std::vector<std::filesystem::path> unevaluated;  // run directories without result.json
 };
 

@@ -2,14 +2,17 @@
 
 namespace eical::daemon {
 
-bool RecordingHandoff::hand(dsp::MeasurementSession& session, const RecordingNotes& notes, const std::string* cause) noexcept {
+bool RecordingHandoff::hand(dsp::MeasurementSession& session, const RecordingNotes& notes,
+                            const std::string* cause) noexcept {
   if (!have_spare_ && returned_ready_.try_acquire()) spare_.swap(returned_), have_spare_ = true;
   if (!have_spare_ || !session.take(spare_)) return false;
   // The evaluator took the previous slot before it returned the spare: the slot is free.
   slot_.frames.swap(spare_);
   slot_.notes = notes;
-  if (cause) slot_.cause = *cause;  // end of the data only (not real-time)
-  else slot_.cause.clear();        // keeps the capacity: no allocation
+  if (cause)
+    slot_.cause = *cause;  // end of the data only (not real-time)
+  else
+    slot_.cause.clear();  // keeps the capacity: no allocation
   have_spare_ = false;
   job_ready_.release();
   return true;
@@ -19,7 +22,8 @@ bool RecordingHandoff::offer(dsp::MeasurementSession& session, const RecordingNo
   return hand(session, notes, nullptr);
 }
 
-bool RecordingHandoff::offer_waiting(dsp::MeasurementSession& session, const RecordingNotes& notes, const std::string& cause) {
+bool RecordingHandoff::offer_waiting(dsp::MeasurementSession& session, const RecordingNotes& notes,
+                                     const std::string& cause) {
   if (!have_spare_) returned_ready_.acquire(), spare_.swap(returned_), have_spare_ = true;
   return hand(session, notes, &cause);
 }

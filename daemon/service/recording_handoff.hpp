@@ -34,7 +34,9 @@ struct RecordingJob {
 
 class RecordingHandoff {
  public:
-  explicit RecordingHandoff(std::size_t capacity_frames) : capacity_(capacity_frames) { spare_.reserve(capacity_frames); }
+  explicit RecordingHandoff(std::size_t capacity_frames) : capacity_(capacity_frames) {
+    spare_.reserve(capacity_frames);
+  }
 
   // DSP thread, per frame: hands the session's complete recording over when the spare
   // buffer is back; false (nothing waits) otherwise.
@@ -58,7 +60,7 @@ class RecordingHandoff {
   bool have_spare_ = true;         // DSP thread
   RecordingJob slot_;              // DSP thread writes it while it has the spare; evaluator reads after job_ready_
   std::counting_semaphore<2> job_ready_{0};  // a job, then quit()
-  std::vector<dsp::Frame> returned_;  // evaluator writes, DSP reads after returned_ready_
+  std::vector<dsp::Frame> returned_;         // evaluator writes, DSP reads after returned_ready_
   std::binary_semaphore returned_ready_{0};
   std::atomic<bool> quit_{false};
 };

@@ -56,9 +56,11 @@ dsp::RunMeta daq_meta(const DaemonConfig& c) {
 }
 
 std::unique_ptr<drivers::Source> make_sim_source(const DaemonConfig& c, drivers::Pacing pacing) {
-  sim::Scenario sc = c.source.sim_program == "circle"
-                         ? sim::circle_scenario(c.source.sim_radius_mm, c.source.sim_feed_mm_min, c.source.sim_repeats, "ccw", c.source.sim_seed)
-                         : sim::step_scenario(0.0, 50.0, c.source.sim_feed_mm_min, c.source.sim_repeats, c.source.sim_seed);
+  sim::Scenario sc =
+      c.source.sim_program == "circle"
+          ? sim::circle_scenario(c.source.sim_radius_mm, c.source.sim_feed_mm_min, c.source.sim_repeats, "ccw",
+                                 c.source.sim_seed)
+          : sim::step_scenario(0.0, 50.0, c.source.sim_feed_mm_min, c.source.sim_repeats, c.source.sim_seed);
   // A program file (eical gen-nc --meta): the simulated NC runs its G-code.
   if (c.source.sim_program_loaded) sc.meta.program = *c.source.sim_program_loaded;
   // The daemon's configuration is what the service believes about its hardware.
@@ -69,21 +71,25 @@ std::unique_ptr<drivers::Source> make_sim_source(const DaemonConfig& c, drivers:
   sc.meta.sensors[1] = c.sensors[1];
   sc.meta.psd = c.psd;  // the strips the simulated machine carries
   for (int s = 0; s < 2; ++s) sc.truth[s].spec = c.sensors[s];
-  return std::make_unique<drivers::SimSource>(sc, drivers::SimSourceOptions{pacing, c.source.sim_repeat_program, c.source.sim_idle_s});
+  return std::make_unique<drivers::SimSource>(
+      sc, drivers::SimSourceOptions{pacing, c.source.sim_repeat_program, c.source.sim_idle_s});
 }
 
 // The frames' origin: a DAQ, a simulator, a recording, or LinuxCNC driving the simulator.
 std::unique_ptr<drivers::Source> make_sensor_source(const DaemonConfig& c) {
-  const drivers::Pacing pacing = c.source.pacing == "realtime" ? drivers::Pacing::realtime : drivers::Pacing::free_running;
+  const drivers::Pacing pacing =
+      c.source.pacing == "realtime" ? drivers::Pacing::realtime : drivers::Pacing::free_running;
   if (c.source.kind == "replay") {
     auto run = std::make_shared<const dsp::Run>(drivers::read_run(c.source.replay_run));
     return std::make_unique<drivers::ReplaySource>(run, pacing, "replay");
   }
   if (c.source.kind == "linuxcnc") return make_linuxcnc_source(c);
-  if (c.source.kind == "usb_daq") return std::make_unique<drivers::UsbDaqSource>(daq_meta(c), drivers::parse_usb_id(c.source.usb_id));
+  if (c.source.kind == "usb_daq")
+    return std::make_unique<drivers::UsbDaqSource>(daq_meta(c), drivers::parse_usb_id(c.source.usb_id));
   if (c.source.kind == "daq_stream") {
     const auto& d = c.source.daq_stream;
-    return std::make_unique<drivers::DaqStreamSource>(daq_meta(c), drivers::DaqStreamOptions{d.path, d.connect_timeout_s, d.stall_timeout_s});
+    return std::make_unique<drivers::DaqStreamSource>(
+        daq_meta(c), drivers::DaqStreamOptions{d.path, d.connect_timeout_s, d.stall_timeout_s});
   }
   return make_sim_source(c, pacing);
 }
@@ -97,7 +103,8 @@ struct SourceChain {
 SourceChain build_source(const DaemonConfig& c) {
   SourceChain chain;
   chain.source = make_sensor_source(c);
-  if (c.source.fault.any()) chain.source = std::make_unique<drivers::FaultSource>(std::move(chain.source), c.source.fault);
+  if (c.source.fault.any())
+    chain.source = std::make_unique<drivers::FaultSource>(std::move(chain.source), c.source.fault);
   if (c.setpoint.source == "servo_stream") {
     drivers::ServoSetPointOptions o;
     o.stream.fifo = c.setpoint.servo_fifo;
@@ -144,9 +151,11 @@ void open_source(Parts& p) {
   p.source = std::make_unique<drivers::StampedSource>(std::move(chain.source));
   p.source->open();  // absent hardware: a clear error at start, not a retry loop
   p.meta = p.source->meta();
-  log(LogLevel::info, "source %.*s open: %.0f Hz", static_cast<int>(p.source->name().size()), p.source->name().data(), p.meta.acquisition.fs_hz);
+  log(LogLevel::info, "source %.*s open: %.0f Hz", static_cast<int>(p.source->name().size()), p.source->name().data(),
+      p.meta.acquisition.fs_hz);
   if (p.config.source.is_daq() && p.config.setpoint.source == "none")
-    log(LogLevel::warning, "no NC set-point ([setpoint] source = \"none\"): recordings carry no cmd_* and are evaluated as free form");
+    log(LogLevel::warning,
+        "no NC set-point ([setpoint] source = \"none\"): recordings carry no cmd_* and are evaluated as free form");
 }
 
 // The identified calibration (eical identify) replaces the data sheet for the live path,
@@ -156,7 +165,8 @@ void apply_calibration(Parts& p) {
   const drivers::SensorCalibration cal = drivers::read_sensor_calibration(p.config.calibration_file, p.meta);
   drivers::apply_calibration(cal, p.meta, p.analysis);
   p.sensor_calibration = cal.method + ": " + p.config.calibration_file.string() + " (run " + cal.run_id + ")";
-  log(LogLevel::info, "calibration %s (%s, from run %s) in use", p.config.calibration_file.c_str(), cal.method.c_str(), cal.run_id.c_str());
+  log(LogLevel::info, "calibration %s (%s, from run %s) in use", p.config.calibration_file.c_str(), cal.method.c_str(),
+      cal.run_id.c_str());
 }
 
 // What must hold before measuring: refused at start, naming the cause.
@@ -172,9 +182,10 @@ void check_machine(Parts& p) {
 void clean_recording(Parts& p) {
   RecordingCleanup c = clean_recording_dir(p.config.recording.dir);
   if (c.removed + c.restored > 0)
-    log(LogLevel::notice, "recording: %zu temporaries of an interrupted write removed, %zu runs restored, in %s", c.removed, c.restored,
-        p.config.recording.dir.c_str());
-  if (!c.unevaluated.empty()) log(LogLevel::notice, "recording: %zu runs without result.json are evaluated now", c.unevaluated.size());
+    log(LogLevel::notice, "recording: %zu temporaries of an interrupted write removed, %zu runs restored, in %s",
+        c.removed, c.restored, p.config.recording.dir.c_str());
+  if (!c.unevaluated.empty())
+    log(LogLevel::notice, "recording: %zu runs without result.json are evaluated now", c.unevaluated.size());
   p.unevaluated = std::move(c.unevaluated);
 }
 
@@ -196,8 +207,10 @@ void start_hmi(Parts& p) {
     p.hmi = std::make_unique<HmiLink>(p.config.dds, "eicald@" + p.config.machine.name, rt > 10 ? rt - 10 : 0);
     log(LogLevel::info, "dds: publishing on domain %d", p.config.dds.domain_id);
   } catch (const std::exception& e) {
-    if (has_input(p.config.triggers, "dds")) log(LogLevel::error, "dds unavailable, NC triggers over DDS cannot arrive: %s", e.what());
-    else log(LogLevel::warning, "dds unavailable, running without the HMI bus: %s", e.what());
+    if (has_input(p.config.triggers, "dds"))
+      log(LogLevel::error, "dds unavailable, NC triggers over DDS cannot arrive: %s", e.what());
+    else
+      log(LogLevel::warning, "dds unavailable, running without the HMI bus: %s", e.what());
   }
 }
 
@@ -223,7 +236,8 @@ void make_measurement(Parts& p) {
   // live one keeps no trace (it kept 104 B a sample, 620 MB for ten minutes, locked).
   live_cfg.trace = dsp::TraceKeeping::live;
   p.live = std::make_unique<dsp::Pipeline>(live_cfg);
-  p.guard = std::make_unique<FrameGuard>(static_cast<float>(p.meta.sensors[0].temp_ref_c), static_cast<float>(p.meta.sensors[1].temp_ref_c));
+  p.guard = std::make_unique<FrameGuard>(static_cast<float>(p.meta.sensors[0].temp_ref_c),
+                                         static_cast<float>(p.meta.sensors[1].temp_ref_c));
   p.handoff = std::make_unique<RecordingHandoff>(p.session->recorder_capacity());
 }
 
@@ -246,7 +260,8 @@ void make_frame_loop(Parts& p) {
   o.fs_hz = p.meta.acquisition.fs_hz;
   o.frame_triggers = has_input(p.config.triggers, "frame");
   o.live_every = static_cast<std::uint64_t>(std::max(1.0, o.fs_hz / p.config.dds.live_rate_hz));
-  p.loop = std::make_unique<FrameLoop>(o, *p.source, *p.session, *p.live, *p.guard, *p.handoff, p.counters, p.hmi.get());
+  p.loop =
+      std::make_unique<FrameLoop>(o, *p.source, *p.session, *p.live, *p.guard, *p.handoff, p.counters, p.hmi.get());
   if (p.hmi && has_input(p.config.triggers, "dds")) p.loop->add_channel(p.hmi->triggers());
   for (auto& ch : p.channels) p.loop->add_channel(*ch);
 }
@@ -269,8 +284,10 @@ void start_status(Parts& p, const std::function<void(const ServiceStatus&)>& on_
   // A stall is written down before systemd's watchdog ends this eicald: the next one says why.
   s.on_stall = [&p](const std::string& why) {
     p.stop_record->running(why);
-    if (!why.empty()) p.evaluator->set_fault("stalled: " + why);
-    else p.evaluator->clear_fault("stalled: " + p.stall);
+    if (!why.empty())
+      p.evaluator->set_fault("stalled: " + why);
+    else
+      p.evaluator->clear_fault("stalled: " + p.stall);
     p.stall = why;
   };
   p.reporter = std::make_unique<StatusReporter>(std::move(s), p.config.dds.status_rate_hz, on_status);
@@ -287,7 +304,8 @@ void enter_realtime(const Parts& p) {
 
 // A measurement the data ended inside is kept: recorded, evaluated and flagged.
 std::string end_cause(const drivers::PumpStats& stats) {
-  if (stats.stopped) return "interrupted: the service was stopped during the measurement; frames up to the stop are kept";
+  if (stats.stopped)
+    return "interrupted: the service was stopped during the measurement; frames up to the stop are kept";
   if (!stats.source_error.empty()) return "source_stopped: " + stats.source_error;
   return "source_stopped: the source ended during the measurement";
 }
@@ -304,7 +322,8 @@ bool reopen_source(Parts& p, const std::string& error, const std::atomic<bool>& 
     p.reporter->report();  // FAULT with its reason at once, not at the next status tick
     // A retry timer, not a data poll: SIGTERM is noticed within one step.
     const auto step = std::chrono::duration<double>(std::min(p.config.source.retry_s, 1.0));
-    for (double waited = 0; waited < p.config.source.retry_s && !stop.load(); waited += step.count()) std::this_thread::sleep_for(step);
+    for (double waited = 0; waited < p.config.source.retry_s && !stop.load(); waited += step.count())
+      std::this_thread::sleep_for(step);
     if (stop.load()) break;
     try {
       p.source->open();
@@ -326,7 +345,8 @@ bool reopen_source(Parts& p, const std::string& error, const std::atomic<bool>& 
 void hang_if_injected(const Parts& p, const dsp::Frame& f, const std::atomic<bool>& stop) {
   const double at_s = p.config.source.fault.hang_dsp_at_s;
   if (at_s < 0.0 || static_cast<double>(f.sample_index) < at_s * p.meta.acquisition.fs_hz || stop.load()) return;
-  log(LogLevel::warning, "injected fault: the DSP thread hangs at sample %lld ([source.fault] hang_dsp_at_s)", static_cast<long long>(f.sample_index));
+  log(LogLevel::warning, "injected fault: the DSP thread hangs at sample %lld ([source.fault] hang_dsp_at_s)",
+      static_cast<long long>(f.sample_index));
   while (!stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(50));
 }
 

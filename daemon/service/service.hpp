@@ -30,11 +30,11 @@ struct StatusCounters {
 };
 
 struct ServiceStatus {
-  std::string state;             // IDLE, ARMED, MEASURING, EVALUATING, DONE, FAULT
-  std::string fault;             // reason when FAULT or the last write error
+  std::string state;  // IDLE, ARMED, MEASURING, EVALUATING, DONE, FAULT
+  std::string fault;  // reason when FAULT or the last write error
   std::uint64_t frames = 0, overruns = 0, frames_lost = 0;
   std::uint64_t measurements = 0, results_written = 0;
-  std::string last_result;       // path of the last result.json
+  std::string last_result;                            // path of the last result.json
   std::int64_t sample_index = 0, sample_time_ns = 0;  // DAQ clock ↔ CLOCK_MONOTONIC
   float temp_table_c = 0.0f, temp_head_c = 0.0f;      // the sensors' case temperatures now
   StatusCounters counters;

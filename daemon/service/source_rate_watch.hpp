@@ -15,8 +15,8 @@ namespace eical::daemon {
 
 class SourceRateWatch {
  public:
-  static constexpr double kWindowS = 4.0;      // bursts of a USB transfer or a pipe average out
-  static constexpr double kTolerance = 0.05;   // a crystal is 1e-4 off; 5 % is another rate
+  static constexpr double kWindowS = 4.0;     // bursts of a USB transfer or a pipe average out
+  static constexpr double kTolerance = 0.05;  // a crystal is 1e-4 off; 5 % is another rate
 
   SourceRateWatch(double fs_hz, bool check_slow) : fs_hz_(fs_hz), check_slow_(check_slow) {}
   // Status thread, each tick: the last stamp seen. Delivered rate / fs_hz when off by more

@@ -9,7 +9,8 @@
 
 namespace eical::daemon {
 
-StatusReporter::StatusReporter(StatusSources sources, double rate_hz, std::function<void(const ServiceStatus&)> on_status)
+StatusReporter::StatusReporter(StatusSources sources, double rate_hz,
+                               std::function<void(const ServiceStatus&)> on_status)
     : s_(std::move(sources)),
       rate_hz_(rate_hz),
       on_status_(std::move(on_status)),
@@ -60,11 +61,13 @@ void StatusReporter::watch_stall(bool progress) {
   const ServiceStatus st = collect();
   char why[256];
   if (waiting > 0)
-    std::snprintf(why, sizeof why, "the DSP thread has handled no frame for %.1f s while %zu wait in the ring (state %s, sample %lld)", stalled_s,
-                  waiting, st.state.c_str(), static_cast<long long>(st.sample_index));
+    std::snprintf(why, sizeof why,
+                  "the DSP thread has handled no frame for %.1f s while %zu wait in the ring (state %s, sample %lld)",
+                  stalled_s, waiting, st.state.c_str(), static_cast<long long>(st.sample_index));
   else
-    std::snprintf(why, sizeof why, "no frame from the source %.*s for %.1f s (state %s, sample %lld)", static_cast<int>(s_.source->name().size()),
-                  s_.source->name().data(), stalled_s, st.state.c_str(), static_cast<long long>(st.sample_index));
+    std::snprintf(why, sizeof why, "no frame from the source %.*s for %.1f s (state %s, sample %lld)",
+                  static_cast<int>(s_.source->name().size()), s_.source->name().data(), stalled_s, st.state.c_str(),
+                  static_cast<long long>(st.sample_index));
   log(LogLevel::error, "%s; the watchdog is not fed, systemd restarts eicald", why);
   if (s_.on_stall) s_.on_stall(why);
   std::lock_guard lk(report_mu_);
@@ -75,12 +78,16 @@ void StatusReporter::watch_rate() {
   if (!s_.watch_rate) return;
   ServiceCounters& k = *s_.counters;
   double ratio = 0.0;
-  if (k.faulted.load()) rate_.reset();  // reopening: the stamps start again
-  else ratio = rate_.observe(k.stamp_index.load(std::memory_order_relaxed), k.stamp_ns.load(std::memory_order_relaxed));
+  if (k.faulted.load())
+    rate_.reset();  // reopening: the stamps start again
+  else
+    ratio = rate_.observe(k.stamp_index.load(std::memory_order_relaxed), k.stamp_ns.load(std::memory_order_relaxed));
   const double was = k.source_rate_ratio.exchange(ratio, std::memory_order_relaxed);
   if ((was == 0.0) == (ratio == 0.0)) return;
   if (ratio != 0.0)
-    log(LogLevel::error, "source: delivers %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says; measurements meanwhile are flagged source_rate",
+    log(LogLevel::error,
+        "source: delivers %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says; measurements meanwhile "
+        "are flagged source_rate",
         ratio, s_.fs_hz);
   else
     log(LogLevel::notice, "source: its rate is within %.0f %% of fs_hz again", SourceRateWatch::kTolerance * 100.0);
@@ -96,7 +103,8 @@ ServiceStatus StatusReporter::collect() const {
   if (s_.history && st.fault.empty()) st.fault = s_.history->problem();
   if (const double r = k.source_rate_ratio.load(std::memory_order_relaxed); r != 0.0 && st.fault.empty()) {
     char b[160];
-    std::snprintf(b, sizeof b, "source_rate: %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says", r, s_.fs_hz);
+    std::snprintf(b, sizeof b, "source_rate: %.3g times the samples per second [acquisition] fs_hz = %.0f Hz says", r,
+                  s_.fs_hz);
     st.fault = b;
   }
   st.frames = k.frames.load(relaxed);
@@ -121,9 +129,12 @@ ServiceStatus StatusReporter::collect() const {
     c.triggers_refused += ch->refused() + ch->dropped();
   }
   for (const auto* l : s_.listeners) c.trigger_events_ignored += l->ignored();
-  if (s_.hmi) c.live_overruns = s_.hmi->live_overruns(), c.dds_write_errors = s_.hmi->write_errors(), c.commands = s_.hmi->commands_received();
+  if (s_.hmi)
+    c.live_overruns = s_.hmi->live_overruns(), c.dds_write_errors = s_.hmi->write_errors(),
+    c.commands = s_.hmi->commands_received();
   const drivers::SourceCounters sc = s_.source->counters();
-  c.source_decode_errors = sc.decode_errors, c.source_lost_samples = sc.lost_samples, c.source_dropped_frames = sc.dropped_frames;
+  c.source_decode_errors = sc.decode_errors, c.source_lost_samples = sc.lost_samples,
+  c.source_dropped_frames = sc.dropped_frames;
   c.setpoint_samples = sc.setpoint_samples, c.setpoint_missing = sc.setpoint_missing;
   return st;
 }
@@ -138,16 +149,20 @@ void StatusReporter::report() {
 void StatusReporter::publish_to_hmi(const ServiceStatus& st) {
   if (!s_.hmi) return;
   drivers::dds::StatusMsg m;
-  m.state = st.state, m.fault = st.fault, m.frames = st.frames, m.overruns = st.overruns, m.frames_lost = st.frames_lost;
+  m.state = st.state, m.fault = st.fault, m.frames = st.frames, m.overruns = st.overruns,
+  m.frames_lost = st.frames_lost;
   m.measurements = st.measurements, m.results = st.results_written;
   m.sample_index = st.sample_index, m.sample_time_ns = st.sample_time_ns;
   m.temp_table_c = st.temp_table_c, m.temp_head_c = st.temp_head_c;
   const StatusCounters& c = st.counters;
-  m.bad_frames = c.bad_frames, m.live_overruns = c.live_overruns, m.stamp_overruns = c.stamp_overruns, m.dds_write_errors = c.dds_write_errors;
+  m.bad_frames = c.bad_frames, m.live_overruns = c.live_overruns, m.stamp_overruns = c.stamp_overruns,
+  m.dds_write_errors = c.dds_write_errors;
   m.triggers_accepted = c.triggers_accepted, m.triggers_refused = c.triggers_refused, m.triggers_late = c.triggers_late;
-  m.trigger_events_ignored = c.trigger_events_ignored, m.recorder_overflow = c.recorder_overflow, m.handoffs_deferred = c.handoffs_deferred;
+  m.trigger_events_ignored = c.trigger_events_ignored, m.recorder_overflow = c.recorder_overflow,
+  m.handoffs_deferred = c.handoffs_deferred;
   m.source_decode_errors = c.source_decode_errors, m.source_lost_samples = c.source_lost_samples;
-  m.source_dropped_frames = c.source_dropped_frames, m.setpoint_samples = c.setpoint_samples, m.setpoint_missing = c.setpoint_missing;
+  m.source_dropped_frames = c.source_dropped_frames, m.setpoint_samples = c.setpoint_samples,
+  m.setpoint_missing = c.setpoint_missing;
   m.frames_flagged = c.frames_flagged, m.commands = c.commands;
   const dsp::State state = s_.counters->faulted.load() ? dsp::State::fault : s_.counters->measurement_state();
   s_.hmi->set_status(m, state);

@@ -23,7 +23,8 @@ std::string utc_now() {
 
 }  // namespace
 
-StopRecord::StopRecord(std::filesystem::path recording_dir) : file_(std::move(recording_dir) / kFileName), started_(utc_now()) {
+StopRecord::StopRecord(std::filesystem::path recording_dir)
+    : file_(std::move(recording_dir) / kFileName), started_(utc_now()) {
   std::ifstream is(file_);
   if (!is) return;
   std::string who, why;
@@ -36,7 +37,8 @@ StopRecord::StopRecord(std::filesystem::path recording_dir) : file_(std::move(re
 void StopRecord::running(const std::string& why) {
   std::lock_guard lk(mu_);
   try {
-    drivers::write_text_atomic(file_, "pid " + std::to_string(::getpid()) + ", started " + started_ + "\n" + why + "\n");
+    drivers::write_text_atomic(file_,
+                               "pid " + std::to_string(::getpid()) + ", started " + started_ + "\n" + why + "\n");
   } catch (const std::exception& e) {
     log(LogLevel::warning, "state file: %s", e.what());
   }

@@ -13,6 +13,7 @@
 namespace eical::daemon {
 
 // nullopt when the analysis has nothing to plot (no circle and no measured trace).
-std::optional<drivers::dds::TraceMsg> make_trace(const dsp::Run& run, const dsp::Analysis& analysis, std::size_t max_points);
+std::optional<drivers::dds::TraceMsg> make_trace(const dsp::Run& run, const dsp::Analysis& analysis,
+                                                 std::size_t max_points);
 
 }  // namespace eical::daemon

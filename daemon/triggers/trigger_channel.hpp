@@ -17,7 +17,8 @@ namespace eical::daemon {
 
 class TriggerChannel {
  public:
-  explicit TriggerChannel(std::string name) : name_(std::move(name)), verdict_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {
+  explicit TriggerChannel(std::string name)
+      : name_(std::move(name)), verdict_fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {
     if (verdict_fd_ < 0) throw std::runtime_error("trigger channel " + name_ + ": eventfd failed");
   }
   ~TriggerChannel() { ::close(verdict_fd_); }

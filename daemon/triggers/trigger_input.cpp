@@ -50,13 +50,17 @@ class CanInput final : public TriggerInput {
 
 std::array<int, 3> lines_of(const TriggerConfig& c) { return {c.gpio_lines[0], c.gpio_lines[1], c.gpio_lines[2]}; }
 
-bool wants(const TriggerConfig& c, const char* input) { return std::find(c.inputs.begin(), c.inputs.end(), input) != c.inputs.end(); }
+bool wants(const TriggerConfig& c, const char* input) {
+  return std::find(c.inputs.begin(), c.inputs.end(), input) != c.inputs.end();
+}
 
 }  // namespace
 
-std::unique_ptr<TriggerInput> make_gpio_input(std::unique_ptr<drivers::GpioEventSource> events, const TriggerConfig& c, std::string name) {
+std::unique_ptr<TriggerInput> make_gpio_input(std::unique_ptr<drivers::GpioEventSource> events, const TriggerConfig& c,
+                                              std::string name) {
   const auto debounce_ns = static_cast<std::int64_t>(std::llround(c.gpio_debounce_ms * 1e6));
-  return std::make_unique<GpioInput>(drivers::GpioTriggerInput(std::move(events), lines_of(c), debounce_ns), std::move(name));
+  return std::make_unique<GpioInput>(drivers::GpioTriggerInput(std::move(events), lines_of(c), debounce_ns),
+                                     std::move(name));
 }
 
 std::unique_ptr<TriggerInput> make_can_input_on_socket(int fd, const TriggerConfig& c, std::string name) {
@@ -65,8 +69,11 @@ std::unique_ptr<TriggerInput> make_can_input_on_socket(int fd, const TriggerConf
 
 std::vector<std::unique_ptr<TriggerInput>> open_trigger_inputs(const TriggerConfig& c) {
   std::vector<std::unique_ptr<TriggerInput>> out;
-  if (wants(c, "gpio")) out.push_back(make_gpio_input(drivers::open_gpio_lines(c.gpio_chip, lines_of(c)), c, "gpio " + c.gpio_chip));
-  if (wants(c, "can")) out.push_back(std::make_unique<CanInput>(drivers::CanTriggerInput(c.can_interface, c.can_id), "can " + c.can_interface));
+  if (wants(c, "gpio"))
+    out.push_back(make_gpio_input(drivers::open_gpio_lines(c.gpio_chip, lines_of(c)), c, "gpio " + c.gpio_chip));
+  if (wants(c, "can"))
+    out.push_back(
+        std::make_unique<CanInput>(drivers::CanTriggerInput(c.can_interface, c.can_id), "can " + c.can_interface));
   return out;
 }
 

@@ -27,8 +27,8 @@ class TriggerInput {
   [[nodiscard]] virtual std::uint64_t ignored() const = 0;
 };
 
-std::unique_ptr<TriggerInput> make_gpio_input(std::unique_ptr<drivers::GpioEventSource> events, const TriggerConfig& config,
-                                              std::string name);
+std::unique_ptr<TriggerInput> make_gpio_input(std::unique_ptr<drivers::GpioEventSource> events,
+                                              const TriggerConfig& config, std::string name);
 // A socket that delivers one can_frame per message (CAN_RAW, or a socketpair in tests).
 std::unique_ptr<TriggerInput> make_can_input_on_socket(int fd, const TriggerConfig& config, std::string name);
 

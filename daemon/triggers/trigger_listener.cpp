@@ -20,7 +20,8 @@ void TriggerListener::loop() {
     r->id = ++next_id_;
     codes_[r->id % 64] = r->code;
     received_.fetch_add(1, std::memory_order_relaxed);
-    if (!channel_.send(*r)) log(LogLevel::warning, "%s: M%d dropped: the trigger ring is full", input_->name().c_str(), r->code);
+    if (!channel_.send(*r))
+      log(LogLevel::warning, "%s: M%d dropped: the trigger ring is full", input_->name().c_str(), r->code);
   }
 }
 

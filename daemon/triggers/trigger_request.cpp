@@ -9,7 +9,8 @@ std::string describe(const TriggerVerdict& v, int code) {
     case Refusal::none: return m + " accepted at sample " + std::to_string(v.sample_index) + " of the DAQ clock";
     case Refusal::measurement_running:
       return m + " refused: a measurement is running (state " + state + "); it continues untouched — M103 ends it";
-    case Refusal::no_measurement: return m + " refused: no measurement is running (state " + state + "); M101 starts one";
+    case Refusal::no_measurement:
+      return m + " refused: no measurement is running (state " + state + "); M101 starts one";
     case Refusal::busy: return m + " refused: the previous measurement is still being evaluated (state " + state + ")";
     case Refusal::fault: return m + " refused: the service is in FAULT (see Status.fault)";
     case Refusal::queue_full: return m + " refused: too many triggers pending";

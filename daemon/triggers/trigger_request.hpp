@@ -11,14 +11,15 @@
 
 namespace eical::daemon {
 
-inline constexpr int kProgramStart = dsp::trigger::program_start, kSegmentMark = dsp::trigger::segment_mark, kProgramEnd = dsp::trigger::program_end;
+inline constexpr int kProgramStart = dsp::trigger::program_start, kSegmentMark = dsp::trigger::segment_mark,
+                     kProgramEnd = dsp::trigger::program_end;
 inline bool is_nc_trigger(int code) { return dsp::trigger::is_nc_trigger(code); }
 
 struct TriggerRequest {
-  std::uint32_t id = 0;    // per input, echoed in the verdict
+  std::uint32_t id = 0;      // per input, echoed in the verdict
   std::int64_t time_ns = 0;  // CLOCK_MONOTONIC when the M-code ran (0 = now)
   int code = 0;
-  double p = std::nan("");   // M101: program number (P word); NaN = absent
+  double p = std::nan("");  // M101: program number (P word); NaN = absent
 };
 
 // Why the DSP thread did not accept a trigger.
@@ -41,7 +42,7 @@ struct TriggerVerdict {
   std::uint32_t id = 0;
   bool accepted = false;
   Refusal refusal = Refusal::none;
-  std::int64_t sample_index = 0;  // where it lands (accepted) on the DAQ clock
+  std::int64_t sample_index = 0;        // where it lands (accepted) on the DAQ clock
   dsp::State state = dsp::State::idle;  // the measurement state projected at that sample
 };
 

@@ -16,10 +16,12 @@
 namespace eical::drivers {
 
 std::optional<CanTrigger> parse_can_trigger(const can_frame& f, std::uint32_t id) {
-  if ((f.can_id & CAN_EFF_FLAG) || (f.can_id & CAN_RTR_FLAG) || (f.can_id & CAN_SFF_MASK) != id || f.len != 8) return std::nullopt;
+  if ((f.can_id & CAN_EFF_FLAG) || (f.can_id & CAN_RTR_FLAG) || (f.can_id & CAN_SFF_MASK) != id || f.len != 8)
+    return std::nullopt;
   if (f.data[0] < 1 || f.data[0] > 3) return std::nullopt;
-  const auto raw = static_cast<std::int32_t>(static_cast<std::uint32_t>(f.data[2]) | static_cast<std::uint32_t>(f.data[3]) << 8 |
-                                             static_cast<std::uint32_t>(f.data[4]) << 16 | static_cast<std::uint32_t>(f.data[5]) << 24);
+  const auto raw = static_cast<std::int32_t>(
+      static_cast<std::uint32_t>(f.data[2]) | static_cast<std::uint32_t>(f.data[3]) << 8 |
+      static_cast<std::uint32_t>(f.data[4]) << 16 | static_cast<std::uint32_t>(f.data[5]) << 24);
   const double p = raw == INT32_MIN ? std::nan("") : raw / 1000.0;
   return CanTrigger{100 + f.data[0], p, f.data[1]};
 }
@@ -37,7 +39,9 @@ can_frame make_can_trigger(std::uint32_t id, int code, std::uint8_t sequence, do
 
 CanTriggerInput::CanTriggerInput(const std::string& interface, std::uint32_t id) : id_(id) {
   fd_ = ::socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
-  if (fd_ < 0) throw std::runtime_error(std::string("can: SocketCAN is not available in this kernel (socket(PF_CAN): ") + std::strerror(errno) + ")");
+  if (fd_ < 0)
+    throw std::runtime_error(std::string("can: SocketCAN is not available in this kernel (socket(PF_CAN): ") +
+                             std::strerror(errno) + ")");
   const unsigned idx = ::if_nametoindex(interface.c_str());
   if (idx == 0) {
     const int err = errno;
@@ -64,7 +68,8 @@ CanTriggerInput CanTriggerInput::from_socket(int fd, std::uint32_t trigger_id) {
   return CanTriggerInput(fd, trigger_id, true);
 }
 
-CanTriggerInput::CanTriggerInput(CanTriggerInput&& o) noexcept : fd_(o.fd_), id_(o.id_), last_seq_(o.last_seq_), ignored_(o.ignored_) {
+CanTriggerInput::CanTriggerInput(CanTriggerInput&& o) noexcept
+    : fd_(o.fd_), id_(o.id_), last_seq_(o.last_seq_), ignored_(o.ignored_) {
   o.fd_ = -1;
 }
 

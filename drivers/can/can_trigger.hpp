@@ -15,8 +15,8 @@
 namespace eical::drivers {
 
 struct CanTrigger {
-  int code;       // 101..103
-  double p;       // NaN when absent
+  int code;  // 101..103
+  double p;  // NaN when absent
   std::uint8_t sequence;
 };
 

@@ -25,7 +25,8 @@ dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& default
   a.daq_group_delay_samples = t.number("daq_group_delay_samples", a.daq_group_delay_samples);
   if (a.daq_group_delay_samples < 0.0) t.fail("daq_group_delay_samples", "must not be negative");
   a.daq_skew_head_samples = t.number("daq_skew_head_samples", a.daq_skew_head_samples);
-  if (!(std::abs(a.daq_skew_head_samples) < 1000.0)) t.fail("daq_skew_head_samples", "must be within (-1000, 1000) samples");
+  if (!(std::abs(a.daq_skew_head_samples) < 1000.0))
+    t.fail("daq_skew_head_samples", "must be within (-1000, 1000) samples");
   if (u == Unknown::reject) t.finish();
   return a;
 }
@@ -48,7 +49,8 @@ dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& default
   if (t.has("head_axes")) m.head_axes = t.strings("head_axes");
   for (const auto* list : {&m.table_axes, &m.head_axes})
     for (const auto& a : *list)
-      if (!valid_axis(a)) t.fail(list == &m.table_axes ? "table_axes" : "head_axes", "axis '" + a + "' is not x, y or z");
+      if (!valid_axis(a))
+        t.fail(list == &m.table_axes ? "table_axes" : "head_axes", "axis '" + a + "' is not x, y or z");
   for (const auto& a : m.table_axes)
     if (std::find(m.head_axes.begin(), m.head_axes.end(), a) != m.head_axes.end())
       t.fail("head_axes", "axis '" + a + "' is moved by both table and head");

@@ -75,9 +75,10 @@ void read_sensor_effect(const std::string& name, StrictTable& t, sim::Scenario& 
     } else if (name == "sensor.misalignment") {
       const Eigen::Vector3d r = vec3_or(t, "misalignment_mrad", Eigen::Vector3d::Zero()) * 1e-3;
       // Rotation about the sensor axes, applied after the nominal mounting.
-      const Eigen::Matrix3d rot = (Eigen::AngleAxisd(r[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r[1], Eigen::Vector3d::UnitY()) *
-                                   Eigen::AngleAxisd(r[0], Eigen::Vector3d::UnitX()))
-                                      .toRotationMatrix();
+      const Eigen::Matrix3d rot =
+          (Eigen::AngleAxisd(r[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r[1], Eigen::Vector3d::UnitY()) *
+           Eigen::AngleAxisd(r[0], Eigen::Vector3d::UnitX()))
+              .toRotationMatrix();
       st.spec.to_machine = nominal.to_machine * rot;
       // A sign flip, swap or mirror on top (Klipper's axes_map notation).
       if (t.has("axes_map")) {
@@ -162,7 +163,8 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
       mt.finish();
       sc.resonance.modes.push_back(md);
     }
-    if (!sc.resonance.on()) t.fail("modes", "machine.resonance needs at least one [[…modes]] table with a non-zero gain");
+    if (!sc.resonance.on())
+      t.fail("modes", "machine.resonance needs at least one [[…modes]] table with a non-zero gain");
   } else if (name == "machine.backlash") {
     m.backlash_um[axis_of(t, "axis")] = t.number("value_um");
   } else if (name == "machine.reversal_spike") {
@@ -224,18 +226,22 @@ void read_effect(const std::string& name, StrictTable t, sim::Scenario& sc) {
 // [mems]: a digital MEMS chip on both sensors (sim/regimes apply_mems): a known chip and
 // any of its figures overridden, the true bias beside it.
 void read_mems(StrictTable t, sim::Scenario& sc) {
-  sim::MemsChip chip = sim::mems_chip(t.choice("chip", [] {
-    std::vector<std::string> names;
-    for (const auto& c : sim::mems_chips()) names.push_back(c.name);
-    return names;
-  }(), "adxl345"));
+  sim::MemsChip chip = sim::mems_chip(t.choice(
+      "chip",
+      [] {
+        std::vector<std::string> names;
+        for (const auto& c : sim::mems_chips()) names.push_back(c.name);
+        return names;
+      }(),
+      "adxl345"));
   chip.fs_hz = positive(t, "fs_hz", chip.fs_hz);
   chip.bits = t.int32("bits", chip.bits);
   if (chip.bits < 8 || chip.bits > 24) t.fail("bits", "must be 8..24");
   chip.range_g = positive(t, "range_g", chip.range_g);
   chip.noise_ug_per_rthz = t.number("noise_ug_per_rthz", chip.noise_ug_per_rthz);
   if (chip.noise_ug_per_rthz < 0.0) t.fail("noise_ug_per_rthz", "must not be negative");
-  if (t.has("bandwidth_hz")) chip.bandwidth_hz = positive(t, "bandwidth_hz", chip.bandwidth_hz), chip.bandwidth_follows_odr = false;
+  if (t.has("bandwidth_hz"))
+    chip.bandwidth_hz = positive(t, "bandwidth_hz", chip.bandwidth_hz), chip.bandwidth_follows_odr = false;
   if (!(chip.fs_hz >= 100.0 && chip.fs_hz <= 51200.0)) t.fail("fs_hz", "must be 100 .. 51200 Hz");
   const Eigen::Vector3d bias_g = vec3_or(t, "bias_mg", Eigen::Vector3d::Zero()) * 1e-3;
   t.finish();
@@ -261,19 +267,20 @@ void read_sweep(StrictTable t, sim::Scenario& sc) {
   k.stop_accel_mm_s2 = t.number("stop_accel_mm_s2", k.stop_accel_mm_s2);
   if (const std::string why = k.invalid_reason(); !why.empty()) {
     // The key the reason is about (invalid_reason names it first).
-    const char* key = why.rfind("freq_start", 0) == 0 ? "freq_start_hz"
-                      : why.rfind("freq_end", 0) == 0 ? "freq_end_hz"
+    const char* key = why.rfind("freq_start", 0) == 0     ? "freq_start_hz"
+                      : why.rfind("freq_end", 0) == 0     ? "freq_end_hz"
                       : why.rfind("accel_per_hz", 0) == 0 ? "accel_per_hz"
-                      : why.rfind("hz_per_sec", 0) == 0 ? "hz_per_sec"
-                      : why.rfind("sweeping", 0) == 0 ? "sweeping_accel_mm_s2"
-                      : why.rfind("the stop", 0) == 0 ? "stop_accel_mm_s2"
-                                                       : "preset";
+                      : why.rfind("hz_per_sec", 0) == 0   ? "hz_per_sec"
+                      : why.rfind("sweeping", 0) == 0     ? "sweeping_accel_mm_s2"
+                      : why.rfind("the stop", 0) == 0     ? "stop_accel_mm_s2"
+                                                          : "preset";
     t.fail(t.has(key) ? key : "preset", why);
   }
   sc.sweep.start_mm = vec3_or(t, "start_mm", Eigen::Vector3d::Zero());
   sc.sweep.lead_in_s = t.number("lead_in_s", 0.0);
   sc.sweep.tail_s = t.number("tail_s", 0.0);
-  if (sc.sweep.lead_in_s < 0.0 || sc.sweep.tail_s < 0.0) t.fail(sc.sweep.lead_in_s < 0.0 ? "lead_in_s" : "tail_s", "must not be negative");
+  if (sc.sweep.lead_in_s < 0.0 || sc.sweep.tail_s < 0.0)
+    t.fail(sc.sweep.lead_in_s < 0.0 ? "lead_in_s" : "tail_s", "must not be negative");
   t.finish();
   sc.sweep.on = true;
   sc.sweep.test = k;
@@ -309,11 +316,13 @@ sim::Scenario read_scenario_file(const std::string& path) {
     if (auto t = sensors->optional_table("head")) sc.meta.sensors[1] = read_sensor(*t);
     sensors->finish();
   }
-  for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s], sc.truth[s].zeta_per_g = sc.meta.sensors[s].zeta_per_g;
+  for (int s = 0; s < 2; ++s)
+    sc.truth[s].spec = sc.meta.sensors[s], sc.truth[s].zeta_per_g = sc.meta.sensors[s].zeta_per_g;
   sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples;
   sc.daq.skew_head_samples = sc.meta.acquisition.daq_skew_head_samples;
   if (auto t = root.optional_table("mems")) read_mems(*t, sc);
-  if (root.has("sensors_present")) sim::set_sensors_present(sc, root.choice("sensors_present", {"both", "head", "table"}, "both"));
+  if (root.has("sensors_present"))
+    sim::set_sensors_present(sc, root.choice("sensors_present", {"both", "head", "table"}, "both"));
   // [truth.sensors.*] / [truth.daq]: the true sensors and DAQ in full (run.toml's sensor
   // keys, starting from what eical is told) — what eical explain writes to reproduce a run.
   if (auto truth = root.optional_table("truth")) {
@@ -357,7 +366,8 @@ sim::Scenario read_scenario_file(const std::string& path) {
     sc.meta.psd.push_back(read_psd(p));
     sc.psd.push_back(pt);
   }
-  if (sc.meta.psd.size() > static_cast<std::size_t>(dsp::kMaxPsd)) root.fail("psd", "at most " + std::to_string(dsp::kMaxPsd) + " strips");
+  if (sc.meta.psd.size() > static_cast<std::size_t>(dsp::kMaxPsd))
+    root.fail("psd", "at most " + std::to_string(dsp::kMaxPsd) + " strips");
 
   sc.meta.reference.reset();
   if (auto r = root.optional_table("reference")) {
@@ -369,12 +379,14 @@ sim::Scenario read_scenario_file(const std::string& path) {
     if (r->has("interp_nm")) {
       const auto m = r->matrix("interp_nm", 3, 2);
       for (int a = 0; a < 3; ++a)
-        for (int h = 0; h < 2; ++h) sc.reference.interp_nm[a][h] = m[static_cast<std::size_t>(a)][static_cast<std::size_t>(h)];
+        for (int h = 0; h < 2; ++h)
+          sc.reference.interp_nm[a][h] = m[static_cast<std::size_t>(a)][static_cast<std::size_t>(h)];
     }
     if (r->has("interp_phase_deg")) {
       const auto m = r->matrix("interp_phase_deg", 3, 2);
       for (int a = 0; a < 3; ++a)
-        for (int h = 0; h < 2; ++h) sc.reference.interp_phase_deg[a][h] = m[static_cast<std::size_t>(a)][static_cast<std::size_t>(h)];
+        for (int h = 0; h < 2; ++h)
+          sc.reference.interp_phase_deg[a][h] = m[static_cast<std::size_t>(a)][static_cast<std::size_t>(h)];
     }
     sc.reference.signal_period_um = positive(*r, "signal_period_um", sc.reference.signal_period_um);
     sc.reference.resolution_nm = r->number("resolution_nm", sc.reference.resolution_nm);
@@ -385,7 +397,7 @@ sim::Scenario read_scenario_file(const std::string& path) {
     sc.limits.a_max_mm_s2 = positive(*l, "a_max_mps2", sc.limits.a_max_mm_s2 / 1000.0) * 1000.0;
     sc.limits.j_max_mm_s3 = positive(*l, "jerk_mps3", sc.limits.j_max_mm_s3 / 1000.0) * 1000.0;
     sc.limits.rapid_mm_min = positive(*l, "rapid_mm_min", sc.limits.rapid_mm_min);
-    auto per_axis = [&](const char* key, double (&dst)[3], double unit) {
+    auto per_axis = [&](const char* key, double(&dst)[3], double unit) {
       if (!l->has(key)) return;
       const auto v = l->numbers(key, 3);
       for (int i = 0; i < 3; ++i) {

@@ -45,7 +45,9 @@ dsp::uncertainty::SensorModelCovariance read_covariance(StrictTable& t, const ds
   std::vector<int> index;
   for (const auto& n : names) {
     const int p = u::parameter_index(n);
-    if (p < 0) t.fail("parameters", "unknown parameter '" + n + "' (table.E_xx … head.E_zz, table.c1_s, head.c1_s, daq.delay_s)");
+    if (p < 0)
+      t.fail("parameters",
+             "unknown parameter '" + n + "' (table.E_xx … head.E_zz, table.c1_s, head.c1_s, daq.delay_s)");
     if (std::find(index.begin(), index.end(), p) != index.end()) t.fail("parameters", "'" + n + "' is listed twice");
     index.push_back(p);
   }
@@ -58,12 +60,15 @@ dsp::uncertainty::SensorModelCovariance read_covariance(StrictTable& t, const ds
   const double scale = std::max(1e-300, cov.diagonal().cwiseAbs().maxCoeff());
   if ((cov - cov.transpose()).cwiseAbs().maxCoeff() > 1e-9 * scale) t.fail("matrix", "not symmetric");
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(cov);
-  if (eig.eigenvalues().minCoeff() < -1e-9 * scale) t.fail("matrix", "not positive semi-definite (a variance below zero)");
+  if (eig.eigenvalues().minCoeff() < -1e-9 * scale)
+    t.fail("matrix", "not positive semi-definite (a variance below zero)");
   for (Eigen::Index r = 0; r < m; ++r)
-    for (Eigen::Index k = 0; k < m; ++k) c.covariance(index[static_cast<std::size_t>(r)], index[static_cast<std::size_t>(k)]) = cov(r, k);
+    for (Eigen::Index k = 0; k < m; ++k)
+      c.covariance(index[static_cast<std::size_t>(r)], index[static_cast<std::size_t>(k)]) = cov(r, k);
   if (t.has("psd_offset_sigma_um")) {
     c.psd_offset_sigma_um = t.number("psd_offset_sigma_um");
-    if (!(c.psd_offset_sigma_um >= 0.0 && c.psd_offset_sigma_um < 1000.0)) t.fail("psd_offset_sigma_um", "must be within [0, 1000) µm");
+    if (!(c.psd_offset_sigma_um >= 0.0 && c.psd_offset_sigma_um < 1000.0))
+      t.fail("psd_offset_sigma_um", "must be within [0, 1000) µm");
   }
   return c;
 }
@@ -134,12 +139,14 @@ void write_sensor_calibration(const SensorCalibration& cal, const std::filesyste
     std::vector<int> used;
     for (int p = 0; p < u::kModelParameters; ++p)
       if (cal.covariance->covariance(p, p) > 0.0) used.push_back(p);
-    o += "\n[covariance]  # of the parameters below (sensor_model_covariance.hpp): E dimensionless, c1 and delay in s\nparameters = [";
+    o += "\n[covariance]  # of the parameters below (sensor_model_covariance.hpp): E dimensionless, c1 and delay in "
+         "s\nparameters = [";
     for (std::size_t i = 0; i < used.size(); ++i) o += (i ? ", \"" : "\"") + u::parameter_name(used[i]) + "\"";
     o += "]\nmatrix = [";
     for (std::size_t r = 0; r < used.size(); ++r) {
       o += r ? ",\n  [" : "\n  [";
-      for (std::size_t k = 0; k < used.size(); ++k) o += (k ? ", " : "") + toml_number(cal.covariance->covariance(used[r], used[k]));
+      for (std::size_t k = 0; k < used.size(); ++k)
+        o += (k ? ", " : "") + toml_number(cal.covariance->covariance(used[r], used[k]));
       o += "]";
     }
     o += "]\npsd_offset_sigma_um = " + toml_number(cal.covariance->psd_offset_sigma_um) + "\n";
@@ -167,8 +174,10 @@ void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta, dsp::An
   for (int s = 0; s < 2; ++s) options.calibration[s].cross_g_per_g = cal.static_cal[s].cross_g_per_g;
   options.sensor_model = cal.method;
   // Without its own covariance a calibration is as uncertain as the data sheet.
-  options.model_covariance = cal.covariance ? *cal.covariance : dsp::uncertainty::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
-  if (!cal.covariance) options.model_covariance->source = cal.method + " (no covariance in the file: the data sheet's tolerance)";
+  options.model_covariance =
+      cal.covariance ? *cal.covariance : dsp::uncertainty::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
+  if (!cal.covariance)
+    options.model_covariance->source = cal.method + " (no covariance in the file: the data sheet's tolerance)";
 }
 
 SensorCalibration calibration_from(const dsp::identify::Identification& id, const std::string& run_id) {

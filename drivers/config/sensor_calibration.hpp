@@ -38,8 +38,8 @@ struct SensorCalibration {
   std::string run_id;
   std::optional<double> daq_group_delay_samples;
   std::optional<double> daq_skew_head_samples;
-  dsp::SensorSpec sensors[2];              // complete (data sheet where the file is silent)
-  dsp::StaticCalibration static_cal[2];    // cross terms (mounting is in sensors[].to_machine)
+  dsp::SensorSpec sensors[2];            // complete (data sheet where the file is silent)
+  dsp::StaticCalibration static_cal[2];  // cross terms (mounting is in sensors[].to_machine)
   std::optional<dsp::uncertainty::SensorModelCovariance> covariance;  // [covariance]
 };
 

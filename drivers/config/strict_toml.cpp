@@ -70,9 +70,12 @@ const toml::node* StrictTable::get(std::string_view key, bool required) {
 double StrictTable::number(std::string_view key) {
   const toml::node* n = get(key, true);
   double v;
-  if (auto i = n->value_exact<std::int64_t>()) v = static_cast<double>(*i);
-  else if (auto f = n->value_exact<double>()) v = *f;
-  else fail(key, "expected a number, got " + type_name(*n));
+  if (auto i = n->value_exact<std::int64_t>())
+    v = static_cast<double>(*i);
+  else if (auto f = n->value_exact<double>())
+    v = *f;
+  else
+    fail(key, "expected a number, got " + type_name(*n));
   if (!std::isfinite(v)) fail(key, "expected a finite number");
   return v;
 }
@@ -94,7 +97,8 @@ std::int64_t StrictTable::integer(std::string_view key, std::int64_t fallback) {
 
 int StrictTable::int32(std::string_view key, int fallback) {
   const std::int64_t v = integer(key, fallback);
-  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) fail(key, "integer " + std::to_string(v) + " is out of range");
+  if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max())
+    fail(key, "integer " + std::to_string(v) + " is out of range");
   return static_cast<int>(v);
 }
 
@@ -109,8 +113,7 @@ std::string StrictTable::string(std::string_view key, std::string fallback) {
   return has(key) ? string(key) : (used_.emplace(key), std::move(fallback));
 }
 
-std::string StrictTable::choice(std::string_view key, const std::vector<std::string>& allowed,
-                                std::string fallback) {
+std::string StrictTable::choice(std::string_view key, const std::vector<std::string>& allowed, std::string fallback) {
   std::string v = string(key, std::move(fallback));
   for (const auto& a : allowed)
     if (a == v) return v;
@@ -136,9 +139,12 @@ std::vector<double> StrictTable::numbers(std::string_view key, std::optional<std
   if (!arr) fail(key, "expected an array of numbers, got " + type_name(*n));
   std::vector<double> out;
   for (const toml::node& e : *arr) {
-    if (auto i = e.value_exact<std::int64_t>()) out.push_back(static_cast<double>(*i));
-    else if (auto f = e.value_exact<double>(); f && std::isfinite(*f)) out.push_back(*f);
-    else fail(key, "element " + std::to_string(out.size()) + " is not a finite number");
+    if (auto i = e.value_exact<std::int64_t>())
+      out.push_back(static_cast<double>(*i));
+    else if (auto f = e.value_exact<double>(); f && std::isfinite(*f))
+      out.push_back(*f);
+    else
+      fail(key, "element " + std::to_string(out.size()) + " is not a finite number");
   }
   if (exact_size && out.size() != *exact_size)
     fail(key, "expected " + std::to_string(*exact_size) + " numbers, got " + std::to_string(out.size()));
@@ -162,16 +168,21 @@ std::vector<std::vector<double>> StrictTable::matrix(std::string_view key, std::
   const toml::node* n = get(key, true);
   const toml::array* arr = n->as_array();
   const std::string shape = std::to_string(rows) + "x" + std::to_string(cols);
-  if (!arr || arr->size() != rows) fail(key, "expected a " + shape + " matrix (array of " + std::to_string(rows) + " rows)");
+  if (!arr || arr->size() != rows)
+    fail(key, "expected a " + shape + " matrix (array of " + std::to_string(rows) + " rows)");
   std::vector<std::vector<double>> out;
   for (const toml::node& row : *arr) {
     const toml::array* r = row.as_array();
-    if (!r || r->size() != cols) fail(key, "row " + std::to_string(out.size()) + " is not " + std::to_string(cols) + " numbers");
+    if (!r || r->size() != cols)
+      fail(key, "row " + std::to_string(out.size()) + " is not " + std::to_string(cols) + " numbers");
     auto& dst = out.emplace_back();
     for (const toml::node& e : *r) {
-      if (auto i = e.value_exact<std::int64_t>()) dst.push_back(static_cast<double>(*i));
-      else if (auto f = e.value_exact<double>(); f && std::isfinite(*f)) dst.push_back(*f);
-      else fail(key, "row " + std::to_string(out.size() - 1) + " holds a value that is not a finite number");
+      if (auto i = e.value_exact<std::int64_t>())
+        dst.push_back(static_cast<double>(*i));
+      else if (auto f = e.value_exact<double>(); f && std::isfinite(*f))
+        dst.push_back(*f);
+      else
+        fail(key, "row " + std::to_string(out.size() - 1) + " holds a value that is not a finite number");
     }
   }
   return out;

@@ -30,8 +30,10 @@ using Qos = std::unique_ptr<dds_qos_t, QosDeleter>;
 
 Qos qos(bool reliable, bool transient_local, int32_t depth) {
   Qos q(dds_create_qos());
-  if (reliable) dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
-  else dds_qset_reliability(q.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
+  if (reliable)
+    dds_qset_reliability(q.get(), DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+  else
+    dds_qset_reliability(q.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
   dds_qset_durability(q.get(), transient_local ? DDS_DURABILITY_TRANSIENT_LOCAL : DDS_DURABILITY_VOLATILE);
   dds_qset_history(q.get(), DDS_HISTORY_KEEP_LAST, depth);
   return q;
@@ -99,14 +101,18 @@ Bus::~Bus() {
 bool Bus::publish(const StatusMsg& m) {
   eical_msg_Status s{};
   s.daemon = cs(m.daemon), s.state = cs(m.state), s.fault = cs(m.fault);
-  s.frames = m.frames, s.overruns = m.overruns, s.frames_lost = m.frames_lost, s.measurements = m.measurements, s.results = m.results;
+  s.frames = m.frames, s.overruns = m.overruns, s.frames_lost = m.frames_lost, s.measurements = m.measurements,
+  s.results = m.results;
   s.temp_table_c = m.temp_table_c, s.temp_head_c = m.temp_head_c, s.time_ns = m.time_ns;
   s.sample_index = m.sample_index, s.sample_time_ns = m.sample_time_ns;
-  s.bad_frames = m.bad_frames, s.live_overruns = m.live_overruns, s.stamp_overruns = m.stamp_overruns, s.dds_write_errors = m.dds_write_errors;
+  s.bad_frames = m.bad_frames, s.live_overruns = m.live_overruns, s.stamp_overruns = m.stamp_overruns,
+  s.dds_write_errors = m.dds_write_errors;
   s.triggers_accepted = m.triggers_accepted, s.triggers_refused = m.triggers_refused, s.triggers_late = m.triggers_late;
-  s.trigger_events_ignored = m.trigger_events_ignored, s.recorder_overflow = m.recorder_overflow, s.handoffs_deferred = m.handoffs_deferred;
+  s.trigger_events_ignored = m.trigger_events_ignored, s.recorder_overflow = m.recorder_overflow,
+  s.handoffs_deferred = m.handoffs_deferred;
   s.source_decode_errors = m.source_decode_errors, s.source_lost_samples = m.source_lost_samples;
-  s.source_dropped_frames = m.source_dropped_frames, s.setpoint_samples = m.setpoint_samples, s.setpoint_missing = m.setpoint_missing;
+  s.source_dropped_frames = m.source_dropped_frames, s.setpoint_samples = m.setpoint_samples,
+  s.setpoint_missing = m.setpoint_missing;
   s.frames_flagged = m.frames_flagged, s.commands = m.commands;
   const bool ok = impl_->status.writer > 0 && dds_write(impl_->status.writer, &s) >= 0;
   if (!ok) write_errors_.fetch_add(1, std::memory_order_relaxed);
@@ -117,7 +123,8 @@ bool Bus::publish(const LiveMsg& m) {
   eical_msg_Live s{};
   s.daemon = cs(m.daemon);
   s.sample_index = m.sample_index;
-  for (int i = 0; i < 3; ++i) s.pos_mm[i] = m.pos_mm[static_cast<std::size_t>(i)], s.vel_mm_s[i] = m.vel_mm_s[static_cast<std::size_t>(i)];
+  for (int i = 0; i < 3; ++i)
+    s.pos_mm[i] = m.pos_mm[static_cast<std::size_t>(i)], s.vel_mm_s[i] = m.vel_mm_s[static_cast<std::size_t>(i)];
   s.integrating = m.integrating;
   s.acquired_ns = m.acquired_ns;
   const bool ok = impl_->live.writer > 0 && dds_write(impl_->live.writer, &s) >= 0;
@@ -178,14 +185,16 @@ std::optional<StatusMsg> Bus::take_status(std::chrono::milliseconds timeout) {
   if (impl_->status.reader <= 0) return std::nullopt;
   StatusMsg out;
   const bool ok = impl_->take_one<eical_msg_Status>(impl_->status, timeout, [&](const eical_msg_Status& s) {
-    out = {str(s.daemon), str(s.state), str(s.fault), s.frames, s.overruns, s.frames_lost, s.measurements, s.results,
-           s.temp_table_c, s.temp_head_c, s.time_ns, s.sample_index, s.sample_time_ns};
+    out = {str(s.daemon), str(s.state),   str(s.fault),  s.frames,  s.overruns,     s.frames_lost,   s.measurements,
+           s.results,     s.temp_table_c, s.temp_head_c, s.time_ns, s.sample_index, s.sample_time_ns};
     out.bad_frames = s.bad_frames, out.live_overruns = s.live_overruns, out.stamp_overruns = s.stamp_overruns;
-    out.dds_write_errors = s.dds_write_errors, out.triggers_accepted = s.triggers_accepted, out.triggers_refused = s.triggers_refused;
+    out.dds_write_errors = s.dds_write_errors, out.triggers_accepted = s.triggers_accepted,
+    out.triggers_refused = s.triggers_refused;
     out.triggers_late = s.triggers_late, out.trigger_events_ignored = s.trigger_events_ignored;
     out.recorder_overflow = s.recorder_overflow, out.handoffs_deferred = s.handoffs_deferred;
     out.source_decode_errors = s.source_decode_errors, out.source_lost_samples = s.source_lost_samples;
-    out.source_dropped_frames = s.source_dropped_frames, out.setpoint_samples = s.setpoint_samples, out.setpoint_missing = s.setpoint_missing;
+    out.source_dropped_frames = s.source_dropped_frames, out.setpoint_samples = s.setpoint_samples,
+    out.setpoint_missing = s.setpoint_missing;
     out.frames_flagged = s.frames_flagged, out.commands = s.commands;
   });
   return ok ? std::optional(out) : std::nullopt;
@@ -208,8 +217,18 @@ std::optional<ResultMsg> Bus::take_result(std::chrono::milliseconds timeout) {
   if (impl_->result.reader <= 0) return std::nullopt;
   ResultMsg out;
   const bool ok = impl_->take_one<eical_msg_Result>(impl_->result, timeout, [&](const eical_msg_Result& s) {
-    out = {str(s.machine), str(s.program_id), str(s.program), s.degraded, s.circular_deviation_G_um, s.radius_mean_deviation_um,
-           s.results, str(s.json), str(s.measured_at), str(s.run_path), str(s.software_version), str(s.sensor_calibration)};
+    out = {str(s.machine),
+           str(s.program_id),
+           str(s.program),
+           s.degraded,
+           s.circular_deviation_G_um,
+           s.radius_mean_deviation_um,
+           s.results,
+           str(s.json),
+           str(s.measured_at),
+           str(s.run_path),
+           str(s.software_version),
+           str(s.sensor_calibration)};
   });
   return ok ? std::optional(out) : std::nullopt;
 }
@@ -218,7 +237,8 @@ std::optional<TraceMsg> Bus::take_trace(std::chrono::milliseconds timeout) {
   if (impl_->trace.reader <= 0) return std::nullopt;
   TraceMsg out;
   const bool ok = impl_->take_one<eical_msg_Trace>(impl_->trace, timeout, [&](const eical_msg_Trace& s) {
-    out.program_id = str(s.program_id), out.program = str(s.program), out.x_name = str(s.x_name), out.y_name = str(s.y_name);
+    out.program_id = str(s.program_id), out.program = str(s.program), out.x_name = str(s.x_name),
+    out.y_name = str(s.y_name);
     out.x.assign(s.x._buffer, s.x._buffer + s.x._length);
     out.y.assign(s.y._buffer, s.y._buffer + s.y._length);
     out.series.assign(s.series._buffer, s.series._buffer + s.series._length);
@@ -231,9 +251,8 @@ std::optional<TraceMsg> Bus::take_trace(std::chrono::milliseconds timeout) {
 std::optional<CommandMsg> Bus::take_command(std::chrono::milliseconds timeout) {
   if (impl_->command.reader <= 0) return std::nullopt;
   CommandMsg out;
-  const bool ok = impl_->take_one<eical_msg_Command>(impl_->command, timeout, [&](const eical_msg_Command& s) {
-    out = from_idl(s);
-  });
+  const bool ok = impl_->take_one<eical_msg_Command>(impl_->command, timeout,
+                                                     [&](const eical_msg_Command& s) { out = from_idl(s); });
   return ok ? std::optional(out) : std::nullopt;
 }
 

@@ -22,12 +22,14 @@ class LibgpiodLines final : public GpioEventSource {
       if (!line) {
         const int err = errno;
         release();
-        throw std::runtime_error("gpio: " + chip + " has no line " + std::to_string(offset) + ": " + std::strerror(err));
+        throw std::runtime_error("gpio: " + chip + " has no line " + std::to_string(offset) + ": " +
+                                 std::strerror(err));
       }
       if (gpiod_line_request_rising_edge_events(line, "eicald") != 0) {
         const int err = errno;
         release();
-        throw std::runtime_error("gpio: cannot request edges on line " + std::to_string(offset) + " of " + chip + ": " + std::strerror(err));
+        throw std::runtime_error("gpio: cannot request edges on line " + std::to_string(offset) + " of " + chip + ": " +
+                                 std::strerror(err));
       }
       gpiod_line_bulk_add(&bulk_, line);
     }
@@ -63,7 +65,8 @@ std::unique_ptr<GpioEventSource> open_gpio_lines(const std::string& chip, const 
   return std::make_unique<LibgpiodLines>(chip, lines);
 }
 
-GpioTriggerInput::GpioTriggerInput(std::unique_ptr<GpioEventSource> events, const std::array<int, 3>& lines, std::int64_t debounce_ns)
+GpioTriggerInput::GpioTriggerInput(std::unique_ptr<GpioEventSource> events, const std::array<int, 3>& lines,
+                                   std::int64_t debounce_ns)
     : events_(std::move(events)), lines_(lines), debounce_ns_(debounce_ns) {}
 
 GpioTriggerInput::GpioTriggerInput(const std::string& chip, const std::array<int, 3>& lines)

@@ -14,7 +14,7 @@
 namespace eical::drivers {
 
 struct GpioLineEvent {
-  unsigned offset;       // line offset on the chip
+  unsigned offset;  // line offset on the chip
   bool rising;
   std::int64_t time_ns;  // kernel timestamp, CLOCK_MONOTONIC
 };
@@ -40,7 +40,8 @@ class GpioTriggerInput {
  public:
   // lines: offsets for M101, M102, M103. An edge on the same line within `debounce_ns`
   // of the previous one is contact bounce (a doubled M102 would add a segment): ignored.
-  GpioTriggerInput(std::unique_ptr<GpioEventSource> events, const std::array<int, 3>& lines, std::int64_t debounce_ns = 5'000'000);
+  GpioTriggerInput(std::unique_ptr<GpioEventSource> events, const std::array<int, 3>& lines,
+                   std::int64_t debounce_ns = 5'000'000);
   // Opens the chip (open_gpio_lines).
   GpioTriggerInput(const std::string& chip, const std::array<int, 3>& lines);
 

@@ -6,10 +6,11 @@
 
 namespace eical::drivers {
 
-StampedAccel exported_capture(const dsp::Run& run, const sim::JitteredCapture& j, const sim::CaptureSamples& samples, const sim::CaptureClock& clock,
-                              int part, const std::string& source) {
+StampedAccel exported_capture(const dsp::Run& run, const sim::JitteredCapture& j, const sim::CaptureSamples& samples,
+                              const sim::CaptureClock& clock, int part, const std::string& source) {
   if (part != 0 && part != 1) throw dsp::InputError("export: the sensor must be the table's or the head's");
-  if (!run.meta.sensor_present[part]) throw dsp::InputError(std::string("export: the run has no ") + (part ? "head" : "table") + " sensor");
+  if (!run.meta.sensor_present[part])
+    throw dsp::InputError(std::string("export: the run has no ") + (part ? "head" : "table") + " sensor");
   if (j.counts.size() != run.frames.size() || samples.jitter_s.size() != run.frames.size())
     throw dsp::InputError("export: the capture does not match the run's frames");
   const auto& acq = run.meta.acquisition;
@@ -20,8 +21,8 @@ StampedAccel exported_capture(const dsp::Run& run, const sim::JitteredCapture& j
     if (!samples.kept[n]) continue;
     Eigen::Vector3d a_mps2;
     for (int a = 0; a < 3; ++a)
-      a_mps2[a] = static_cast<double>(j.counts[n][static_cast<std::size_t>(3 * part + a)] - acq.adc_offset_counts) * acq.adc_lsb_volt /
-                  spec.k1_v_per_g[a] * run.meta.site.g_mps2;
+      a_mps2[a] = static_cast<double>(j.counts[n][static_cast<std::size_t>(3 * part + a)] - acq.adc_offset_counts) *
+                  acq.adc_lsb_volt / spec.k1_v_per_g[a] * run.meta.site.g_mps2;
     out.t_s.push_back(samples.stamp_s(n, acq.fs_hz, clock));
     out.accel_mps2.push_back(a_mps2);
   }

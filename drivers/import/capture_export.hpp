@@ -16,10 +16,12 @@
 namespace eical::drivers {
 
 // `part`: the sensor recorded (0 table, 1 head).
-StampedAccel exported_capture(const dsp::Run& run, const sim::JitteredCapture& jittered, const sim::CaptureSamples& samples,
-                              const sim::CaptureClock& clock, int part, const std::string& source);
+StampedAccel exported_capture(const dsp::Run& run, const sim::JitteredCapture& jittered,
+                              const sim::CaptureSamples& samples, const sim::CaptureClock& clock, int part,
+                              const std::string& source);
 
 // Sample numbers N on the servo grid (t_nc = N·period) covering the set-point's duration.
-NcTrace exported_nc_trace(const sim::nc::SetPoint& set_point, double period_s, double nc_offset_s, const std::string& source);
+NcTrace exported_nc_trace(const sim::nc::SetPoint& set_point, double period_s, double nc_offset_s,
+                          const std::string& source);
 
 }  // namespace eical::drivers

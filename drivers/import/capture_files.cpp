@@ -15,7 +15,9 @@ namespace {
 
 std::string where(const LineSource& src) { return src.name() + ":" + std::to_string(src.line_number()); }
 
-[[noreturn]] void fail(const LineSource& src, const std::string& why) { throw dsp::InputError(where(src) + ": " + why); }
+[[noreturn]] void fail(const LineSource& src, const std::string& why) {
+  throw dsp::InputError(where(src) + ": " + why);
+}
 [[noreturn]] void fail_column(const LineSource& src, const std::string& column, const std::string& why) {
   throw dsp::InputError(where(src) + ": column '" + column + "': " + why);
 }
@@ -43,14 +45,16 @@ double number(const LineSource& src, const std::string& column, std::string_view
   if (f.front() == '+') f.remove_prefix(1);
   double v = 0.0;
   const auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
-  if (ec != std::errc() || p != f.data() + f.size()) fail_column(src, column, "expected a number, got '" + std::string(f) + "'");
+  if (ec != std::errc() || p != f.data() + f.size())
+    fail_column(src, column, "expected a number, got '" + std::string(f) + "'");
   if (!std::isfinite(v)) fail_column(src, column, "NaN or Inf ('" + std::string(f) + "')");
   return v;
 }
 
 // Data lines of a CSV: blank lines are allowed at the end only; time must increase.
 template <class Row>
-void read_rows(LineSource& src, std::size_t n_fields, const std::string& time_column, std::vector<double>& t_s, Row&& row) {
+void read_rows(LineSource& src, std::size_t n_fields, const std::string& time_column, std::vector<double>& t_s,
+               Row&& row) {
   std::string_view line;
   std::vector<std::string_view> fields;
   std::size_t blank_at = 0;
@@ -62,7 +66,8 @@ void read_rows(LineSource& src, std::size_t n_fields, const std::string& time_co
     if (blank_at) throw dsp::InputError(src.name() + ":" + std::to_string(blank_at) + ": blank line inside the data");
     split(line, fields);
     if (fields.size() != n_fields)
-      fail(src, (src.last_line_had_newline() ? std::string("wrong number of fields (") : std::string("truncated file: the last line is incomplete (")) +
+      fail(src, (src.last_line_had_newline() ? std::string("wrong number of fields (")
+                                             : std::string("truncated file: the last line is incomplete (")) +
                     std::to_string(fields.size()) + ", header has " + std::to_string(n_fields) + ")");
     const double t = row(fields);
     if (!t_s.empty() && !(t > t_s.back())) {
@@ -76,14 +81,16 @@ void read_rows(LineSource& src, std::size_t n_fields, const std::string& time_co
 }
 
 // Column indices for `cols` in a header, or the positions 0..3 when names are empty.
-std::array<std::size_t, 4> resolve(const LineSource& src, const std::vector<std::string_view>& header, const CsvColumns& cols) {
+std::array<std::size_t, 4> resolve(const LineSource& src, const std::vector<std::string_view>& header,
+                                   const CsvColumns& cols) {
   const std::array<std::string, 4> names = {cols.time, cols.values[0], cols.values[1], cols.values[2]};
   std::array<std::size_t, 4> at{};
   std::string list;
   for (auto h : header) list += (list.empty() ? "" : ", ") + std::string(h);
   for (std::size_t k = 0; k < 4; ++k) {
     if (names[k].empty()) {
-      if (k >= header.size()) fail(src, "header has " + std::to_string(header.size()) + " columns, 4 needed (time and three values)");
+      if (k >= header.size())
+        fail(src, "header has " + std::to_string(header.size()) + " columns, 4 needed (time and three values)");
       at[k] = k;
       continue;
     }
@@ -120,7 +127,9 @@ Csv read_csv(const std::filesystem::path& file, const CsvColumns& cols, double v
   out.source = file.string();
   read_rows(src, header_copy.size(), header_copy[at[0]], out.t, [&](const std::vector<std::string_view>& f) {
     Eigen::Vector3d v;
-    for (int a = 0; a < 3; ++a) v[a] = number(src, header_copy[at[static_cast<std::size_t>(a + 1)]], f[at[static_cast<std::size_t>(a + 1)]]) * value_scale;
+    for (int a = 0; a < 3; ++a)
+      v[a] = number(src, header_copy[at[static_cast<std::size_t>(a + 1)]], f[at[static_cast<std::size_t>(a + 1)]]) *
+             value_scale;
     out.v.push_back(v);
     return number(src, header_copy[at[0]], f[at[0]]) * cols.time_scale_s;
   });
@@ -147,7 +156,8 @@ StampedAccel read_klipper_capture(const std::filesystem::path& file) {
   bool header = false;
   while (!header && src.next(line)) {
     if (line.rfind("##", 0) == 0) continue;  // older Klipper: "##<stats>" before the header
-    if (line != "#time,accel_x,accel_y,accel_z") fail(src, "expected Klipper's header '#time,accel_x,accel_y,accel_z', got '" + std::string(line) + "'");
+    if (line != "#time,accel_x,accel_y,accel_z")
+      fail(src, "expected Klipper's header '#time,accel_x,accel_y,accel_z', got '" + std::string(line) + "'");
     header = true;
   }
   if (!header) throw dsp::InputError(file.string() + ": empty file (no '#time,accel_x,accel_y,accel_z' header)");
@@ -156,7 +166,8 @@ StampedAccel read_klipper_capture(const std::filesystem::path& file) {
   static const std::string names[4] = {"time", "accel_x", "accel_y", "accel_z"};
   const double to_mps2 = accel_unit_in_mps2(AccelUnit::mmps2);
   read_rows(src, 4, names[0], out.t_s, [&](const std::vector<std::string_view>& f) {
-    out.accel_mps2.emplace_back(number(src, names[1], f[1]) * to_mps2, number(src, names[2], f[2]) * to_mps2, number(src, names[3], f[3]) * to_mps2);
+    out.accel_mps2.emplace_back(number(src, names[1], f[1]) * to_mps2, number(src, names[2], f[2]) * to_mps2,
+                                number(src, names[3], f[3]) * to_mps2);
     return number(src, names[0], f[0]);
   });
   return out;
@@ -204,7 +215,9 @@ NcTrace read_halsampler(const std::filesystem::path& file, double period_s) {
     if (!parsed) fail(src, error);
     if (parsed->kind == ServoLine::Kind::overrun) continue;  // the sample numbers jump over what was lost
     const ServoSample& s = parsed->sample;
-    if (s.number <= last) fail(src, "sample number " + std::to_string(s.number) + " does not increase (after " + std::to_string(last) + ")");
+    if (s.number <= last)
+      fail(src,
+           "sample number " + std::to_string(s.number) + " does not increase (after " + std::to_string(last) + ")");
     last = s.number;
     out.t_s.push_back(static_cast<double>(s.number) * period_s);
     out.pos_mm.emplace_back(s.cmd_mm[0], s.cmd_mm[1], s.cmd_mm[2]);
@@ -218,8 +231,9 @@ void write_halsampler(const std::filesystem::path& file, const NcTrace& trace, s
   char buf[256];
   for (std::size_t k = 0; k < trace.pos_mm.size(); ++k) {
     const Eigen::Vector3d& p = trace.pos_mm[k];
-    std::snprintf(buf, sizeof buf, "%lld %f %f %f %f %f %f 0\n", static_cast<long long>(first_number + static_cast<std::int64_t>(k)), p.x(), p.y(), p.z(),
-                  p.x(), p.y(), p.z());
+    std::snprintf(buf, sizeof buf, "%lld %f %f %f %f %f %f 0\n",
+                  static_cast<long long>(first_number + static_cast<std::int64_t>(k)), p.x(), p.y(), p.z(), p.x(),
+                  p.y(), p.z());
     out += buf;
   }
   write_lines(file, out);
@@ -234,7 +248,8 @@ void write_nc_csv(const std::filesystem::path& file, const NcTrace& trace) {
   std::string out = "t,x,y,z\n";
   char buf[160];
   for (std::size_t k = 0; k < trace.t_s.size(); ++k) {
-    std::snprintf(buf, sizeof buf, "%.9f,%.9f,%.9f,%.9f\n", trace.t_s[k], trace.pos_mm[k].x(), trace.pos_mm[k].y(), trace.pos_mm[k].z());
+    std::snprintf(buf, sizeof buf, "%.9f,%.9f,%.9f,%.9f\n", trace.t_s[k], trace.pos_mm[k].x(), trace.pos_mm[k].y(),
+                  trace.pos_mm[k].z());
     out += buf;
   }
   write_lines(file, out);

@@ -26,14 +26,14 @@ inline constexpr double kStandardGravity_mps2 = 9.80665;
 // An accelerometer recording on its recorder's clock: stamps and the sensor axes (m/s²).
 struct StampedAccel {
   std::string source;
-  std::vector<double> t_s;              // strictly increasing
+  std::vector<double> t_s;  // strictly increasing
   std::vector<Eigen::Vector3d> accel_mps2;
 };
 
 // The NC's commanded position on the NC's clock.
 struct NcTrace {
   std::string source;
-  std::vector<double> t_s;              // strictly increasing
+  std::vector<double> t_s;  // strictly increasing
   std::vector<Eigen::Vector3d> pos_mm;
 };
 

@@ -8,7 +8,8 @@
 
 namespace eical::drivers {
 
-ImportResult import_csv(const std::filesystem::path& accel_file, const std::filesystem::path& nc_file, const CsvImport& o) {
+ImportResult import_csv(const std::filesystem::path& accel_file, const std::filesystem::path& nc_file,
+                        const CsvImport& o) {
   const StampedAccel capture = read_accel_csv(accel_file, o.accel_columns, o.unit);
   const NcTrace nc = o.nc_halsampler ? read_halsampler(nc_file, o.servo_period_s) : read_nc_csv(nc_file, o.nc_columns);
   const UniformClock clock = fit_uniform_clock(capture.t_s, capture.source);
@@ -24,8 +25,10 @@ ImportResult import_csv(const std::filesystem::path& accel_file, const std::file
   ref.t_begin_s = nc_clock.t0_s, ref.t_end_s = sp.duration_s();
   Eigen::Vector3d lo = nc_uniform.front(), hi = nc_uniform.front();
   for (const auto& p : nc_uniform) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-  for (int a = 0; a < 3; ++a) ref.moving[a] = hi[a] - lo[a] > 1e-3 ? 1.0 : 0.0;  // axes that move more than a micrometre
-  if (ref.moving.sum() == 0.0) throw dsp::InputError(nc.source + ": the NC trace does not move (nothing to align the clocks with)");
+  for (int a = 0; a < 3; ++a)
+    ref.moving[a] = hi[a] - lo[a] > 1e-3 ? 1.0 : 0.0;  // axes that move more than a micrometre
+  if (ref.moving.sum() == 0.0)
+    throw dsp::InputError(nc.source + ": the NC trace does not move (nothing to align the clocks with)");
   ref.accel = [&sp](double t) { return sp.at(t).acc_mm_s2; };
   const dsp::SensorSpec spec = import_sensor_spec(o.setup, clock.fs_hz);
   ref.sensor_f0_hz = spec.f0_hz, ref.sensor_zeta = spec.zeta;
@@ -34,7 +37,8 @@ ImportResult import_csv(const std::filesystem::path& accel_file, const std::file
 
   ImportSetup setup = o.setup;
   double v_max = 0.0;
-  for (std::size_t i = 0; i < n_nc; ++i) v_max = std::max(v_max, sp.at(nc_clock.time_at(static_cast<std::int64_t>(i))).vel_mm_s.norm());
+  for (std::size_t i = 0; i < n_nc; ++i)
+    v_max = std::max(v_max, sp.at(nc_clock.time_at(static_cast<std::int64_t>(i))).vel_mm_s.norm());
   setup.feed_mm_min = v_max * 60.0;
   ImportSetPoint isp{[&sp](double t) { return sp.at(t).pos_mm; }, nc_clock.t0_s, sp.duration_s(), false};
   ImportResult out{imported_run(clock, accel, setup, isp, offset.offset_s), {}};
@@ -42,7 +46,8 @@ ImportResult import_csv(const std::filesystem::path& accel_file, const std::file
   r.kind = "csv";
   r.source = capture.source;
   r.nc_source = nc.source;
-  r.excitation = o.nc_halsampler ? "NC trace (LinuxCNC halsampler), natural cubic spline" : "NC trace (CSV), natural cubic spline";
+  r.excitation =
+      o.nc_halsampler ? "NC trace (LinuxCNC halsampler), natural cubic spline" : "NC trace (CSV), natural cubic spline";
   r.accel_clock = clock;
   r.nc_clock = nc_clock;
   r.samples = capture.t_s.size();

@@ -17,11 +17,12 @@ struct CsvImport {
   CsvColumns accel_columns;
   AccelUnit unit = AccelUnit::mps2;
   bool nc_halsampler = true;
-  double servo_period_s = 0.001;   // halsampler: [EMCMOT]SERVO_PERIOD
+  double servo_period_s = 0.001;  // halsampler: [EMCMOT]SERVO_PERIOD
   CsvColumns nc_columns;
   ImportSetup setup;
 };
 
-ImportResult import_csv(const std::filesystem::path& accel_file, const std::filesystem::path& nc_file, const CsvImport& options);
+ImportResult import_csv(const std::filesystem::path& accel_file, const std::filesystem::path& nc_file,
+                        const CsvImport& options);
 
 }  // namespace eical::drivers

@@ -17,8 +17,10 @@ dsp::SensorSpec import_sensor_spec(const ImportSetup& s, double fs_hz) {
   return spec;
 }
 
-dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel, const ImportSetup& s, const ImportSetPoint& sp, double offset_s) {
-  if (accel.values.empty() || accel.values.size() != accel.grid_index.size()) throw dsp::InputError("import: no samples");
+dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel, const ImportSetup& s,
+                      const ImportSetPoint& sp, double offset_s) {
+  if (accel.values.empty() || accel.values.size() != accel.grid_index.size())
+    throw dsp::InputError("import: no samples");
   if (s.part != 0 && s.part != 1) throw dsp::InputError("import: the sensor must be on the table or the head");
   dsp::Run run;
   dsp::RunMeta& m = run.meta;
@@ -68,20 +70,24 @@ std::string import_report_toml(const ImportReport& r) {
     return o + "\"";
   };
   auto clock = [&](const char* table, const UniformClock& c) {
-    return std::string("\n[") + table + "]\nfs_hz = " + toml_number(c.fs_hz) + "\nt0_s = " + toml_number(c.t0_s) + "\nmedian_dt_s = " + toml_number(c.median_dt_s) +
-           "\njitter_rms_s = " + toml_number(c.jitter_rms_s) + "\ngaps = " + std::to_string(c.gaps) + "\nlost_frames = " + std::to_string(c.lost_frames) + "\n";
+    return std::string("\n[") + table + "]\nfs_hz = " + toml_number(c.fs_hz) + "\nt0_s = " + toml_number(c.t0_s) +
+           "\nmedian_dt_s = " + toml_number(c.median_dt_s) + "\njitter_rms_s = " + toml_number(c.jitter_rms_s) +
+           "\ngaps = " + std::to_string(c.gaps) + "\nlost_frames = " + std::to_string(c.lost_frames) + "\n";
   };
-  std::string o = "# How this run was imported (eical import): the recorder's clock, the resampling\n"
-                  "# (cubic Lagrange onto the uniform clock, drivers/import/uniform_clock.hpp) and the\n"
-                  "# time offset recorder - set-point by cross-correlation (u: standard uncertainty, k = 1,\n"
-                  "# block jackknife).\n";
+  std::string o =
+      "# How this run was imported (eical import): the recorder's clock, the resampling\n"
+      "# (cubic Lagrange onto the uniform clock, drivers/import/uniform_clock.hpp) and the\n"
+      "# time offset recorder - set-point by cross-correlation (u: standard uncertainty, k = 1,\n"
+      "# block jackknife).\n";
   o += "format = \"eical-import/1\"\nkind = " + str(r.kind) + "\nsource = " + str(r.source) + "\n";
   if (!r.nc_source.empty()) o += "nc_source = " + str(r.nc_source) + "\n";
   o += "excitation = " + str(r.excitation) + "\nsamples = " + std::to_string(r.samples) + "\n";
   o += clock("accel_clock", r.accel_clock);
   if (r.nc_clock) o += clock("nc_clock", *r.nc_clock);
-  o += "\n[time_offset]\noffset_s = " + toml_number(r.offset.offset_s) + "\nu_s = " + toml_number(r.offset.u_s) + "\nexplained = " +
-       toml_number(r.offset.explained) + "\npeak_to_median = " + toml_number(r.offset.peak_to_median) + "\nblocks = " + std::to_string(r.offset.blocks) + "\nfine_step_s = " + toml_number(r.offset.fine_step_s) +
+  o += "\n[time_offset]\noffset_s = " + toml_number(r.offset.offset_s) + "\nu_s = " + toml_number(r.offset.u_s) +
+       "\nexplained = " + toml_number(r.offset.explained) +
+       "\npeak_to_median = " + toml_number(r.offset.peak_to_median) + "\nblocks = " + std::to_string(r.offset.blocks) +
+       "\nfine_step_s = " + toml_number(r.offset.fine_step_s) +
        "\n# measured (sensor axes) = gain · commanded (machine axes), at the offset\ngain = [";
   for (int i = 0; i < 3; ++i) {
     o += i ? ", [" : "[";
@@ -91,14 +97,18 @@ std::string import_report_toml(const ImportReport& r) {
   return o + "]\n";
 }
 
-void write_import_report(const std::filesystem::path& dir, const ImportReport& r) { write_text_atomic(dir / "import.toml", import_report_toml(r)); }
+void write_import_report(const std::filesystem::path& dir, const ImportReport& r) {
+  write_text_atomic(dir / "import.toml", import_report_toml(r));
+}
 
 void require_alignment(const OffsetEstimate& o, const std::string& source) {
   if (o.peak_to_median >= kMinPeakToMedian && o.explained >= kMinExplained) return;
   char buf[320];
   std::snprintf(buf, sizeof buf,
-                ": the commanded acceleration is not found in the measured one (correlation peak %.1f x the median over all lags, %.0f needed; "
-                "it explains %.2f %%, %.0f %% needed): wrong test parameters, axis or file, or a sensor on a part that does not move?",
+                ": the commanded acceleration is not found in the measured one (correlation peak %.1f x the median "
+                "over all lags, %.0f needed; "
+                "it explains %.2f %%, %.0f %% needed): wrong test parameters, axis or file, or a sensor on a part that "
+                "does not move?",
                 o.peak_to_median, kMinPeakToMedian, 100.0 * o.explained, 100.0 * kMinExplained);
   throw dsp::InputError(source + buf);
 }
@@ -108,7 +118,8 @@ std::vector<std::string> axis_list(const std::string& letters, const std::string
   for (char c : letters) {
     if (c < 'x' || c > 'z') throw dsp::InputError(what + ": '" + letters + "' is not a list of the letters x, y, z");
     const std::string a(1, c);
-    if (std::find(out.begin(), out.end(), a) != out.end()) throw dsp::InputError(what + ": '" + letters + "' names an axis twice");
+    if (std::find(out.begin(), out.end(), a) != out.end())
+      throw dsp::InputError(what + ": '" + letters + "' names an axis twice");
     out.push_back(a);
   }
   return out;

@@ -22,14 +22,14 @@ inline constexpr double kImportCountsPerG = 1e6;
 
 struct ImportSetup {
   std::string id;
-  int part = 1;                     // dsp::Sensor of the recording: 0 table, 1 head
-  std::string chip = "adxl345";     // sim/sensor/mems_chip: noise and corner of its data sheet
-  double bandwidth_hz = 0.0;        // > 0: overrides the chip's corner at the capture's rate
-  double noise_ug_per_rthz = -1.0;  // >= 0: overrides the chip's noise (two-sided)
+  int part = 1;                                              // dsp::Sensor of the recording: 0 table, 1 head
+  std::string chip = "adxl345";                              // sim/sensor/mems_chip: noise and corner of its data sheet
+  double bandwidth_hz = 0.0;                                 // > 0: overrides the chip's corner at the capture's rate
+  double noise_ug_per_rthz = -1.0;                           // >= 0: overrides the chip's noise (two-sided)
   Eigen::Matrix3d to_machine = Eigen::Matrix3d::Identity();  // the stated mounting
   dsp::MachineLayout machine;
   dsp::Site site;
-  double feed_mm_min = 1.0;         // the motion's peak speed
+  double feed_mm_min = 1.0;  // the motion's peak speed
 };
 
 // The sensor's data sheet for run.toml at the capture's rate.
@@ -44,14 +44,14 @@ struct ImportSetPoint {
 };
 
 // offset_s = recorder time − set-point time (estimate_offset).
-dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel_g, const ImportSetup& setup, const ImportSetPoint& set_point,
-                      double offset_s);
+dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel_g, const ImportSetup& setup,
+                      const ImportSetPoint& set_point, double offset_s);
 
 // What import.toml records.
 struct ImportReport {
-  std::string kind;                 // "klipper" | "csv"
+  std::string kind;  // "klipper" | "csv"
   std::string source, nc_source;
-  std::string excitation;           // how the set-point was made
+  std::string excitation;  // how the set-point was made
   UniformClock accel_clock;
   std::optional<UniformClock> nc_clock;
   std::size_t samples = 0;

@@ -36,9 +36,12 @@ ImportResult import_klipper(const std::filesystem::path& file, const KlipperImpo
   r.kind = "klipper";
   r.source = capture.source;
   char buf[256];
-  std::snprintf(buf, sizeof buf, "Klipper resonance test (%s executor): %.3g .. %.5g Hz, %.4g mm/s2 per Hz, %.3g Hz/s, sweeping %.4g mm/s2 / %.3g s, direction [%.4g, %.4g, %.4g], %.3f s",
-                o.test.legacy_moves ? "older" : "current", o.test.freq_start_hz, o.test.freq_end_hz, o.test.accel_per_hz, o.test.hz_per_sec,
-                o.test.sweeping_accel_mm_s2, o.test.sweeping_period_s, sp.direction().x(), sp.direction().y(), sp.direction().z(), sp.duration_s());
+  std::snprintf(buf, sizeof buf,
+                "Klipper resonance test (%s executor): %.3g .. %.5g Hz, %.4g mm/s2 per Hz, %.3g Hz/s, sweeping %.4g "
+                "mm/s2 / %.3g s, direction [%.4g, %.4g, %.4g], %.3f s",
+                o.test.legacy_moves ? "older" : "current", o.test.freq_start_hz, o.test.freq_end_hz,
+                o.test.accel_per_hz, o.test.hz_per_sec, o.test.sweeping_accel_mm_s2, o.test.sweeping_period_s,
+                sp.direction().x(), sp.direction().y(), sp.direction().z(), sp.duration_s());
   r.excitation = buf;
   r.accel_clock = clock;
   r.samples = capture.t_s.size();

@@ -16,7 +16,7 @@ struct KlipperImport {
   sim::nc::KlipperTest test = sim::nc::KlipperTest::current();
   Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  // Klipper's AXIS
   Eigen::Vector3d start_mm = Eigen::Vector3d::Zero();
-  ImportSetup setup;                 // sensor spec (chip, mounting), part, layout, id
+  ImportSetup setup;  // sensor spec (chip, mounting), part, layout, id
 };
 
 struct ImportResult {

@@ -34,7 +34,8 @@ double peak(const std::vector<double>& s) {
 OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal& ref, int F) {
   if (!(y_in.fs_hz > 0.0) || y_in.grid_index.size() != y_in.values.size() || y_in.values.size() < 16)
     throw dsp::InputError("time offset: the measurement needs a rate and at least 16 samples");
-  if (!(ref.t_end_s > ref.t_begin_s) || !ref.accel) throw dsp::InputError("time offset: the reference has no time span");
+  if (!(ref.t_end_s > ref.t_begin_s) || !ref.accel)
+    throw dsp::InputError("time offset: the reference has no time span");
   if (F < 1) throw dsp::InputError("time offset: oversample must be >= 1");
   std::vector<int> cols;
   for (int j = 0; j < 3; ++j)
@@ -79,7 +80,9 @@ OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal
   for (std::size_t k = 0; k < y_in.values.size(); ++k) {
     const auto i = static_cast<std::size_t>(y_in.grid_index[k] - y_in.grid_index.front());
     valid[i] = true;
-    for (int a = 0; a < 3; ++a) y[static_cast<std::size_t>(a)][i] = y_in.values[k][a] - mean[a], y_energy += y[static_cast<std::size_t>(a)][i] * y[static_cast<std::size_t>(a)][i];
+    for (int a = 0; a < 3; ++a)
+      y[static_cast<std::size_t>(a)][i] = y_in.values[k][a] - mean[a],
+      y_energy += y[static_cast<std::size_t>(a)][i] * y[static_cast<std::size_t>(a)][i];
   }
   const double t_y0 = y_in.t0_s + static_cast<double>(y_in.grid_index.front()) / fs;
 
@@ -100,9 +103,12 @@ OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal
     for (std::size_t m = 0; m < m_coarse; ++m) buf[m] = rf[c][m * static_cast<std::size_t>(F)];
     fft.fwd(R[c], buf);
     for (std::size_t d = 0; d < cols.size(); ++d)
-      for (std::size_t m = 0; m < m_coarse; ++m) g_coarse(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(d)) += rf[c][m * static_cast<std::size_t>(F)] * rf[d][m * static_cast<std::size_t>(F)];
+      for (std::size_t m = 0; m < m_coarse; ++m)
+        g_coarse(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(d)) +=
+            rf[c][m * static_cast<std::size_t>(F)] * rf[d][m * static_cast<std::size_t>(F)];
   }
-  if (!(g_coarse.determinant() > 0.0)) throw dsp::InputError("time offset: the commanded acceleration is zero (nothing to correlate with)");
+  if (!(g_coarse.determinant() > 0.0))
+    throw dsp::InputError("time offset: the commanded acceleration is zero (nothing to correlate with)");
   const Eigen::MatrixXd g_inv = g_coarse.inverse();
   // corr[a][c][lag mod L] = Σ_n y_a[n] r_c[n − lag]
   std::vector<double> best_score(L, 0.0);
@@ -127,7 +133,8 @@ OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal
   std::vector<double> all;
   all.reserve(n + m_coarse);
   for (long lag = -static_cast<long>(m_coarse) + 1; lag < static_cast<long>(n); ++lag) {
-    const double s = best_score[static_cast<std::size_t>((lag % static_cast<long>(L) + static_cast<long>(L)) % static_cast<long>(L))];
+    const double s = best_score[static_cast<std::size_t>((lag % static_cast<long>(L) + static_cast<long>(L)) %
+                                                         static_cast<long>(L))];
     all.push_back(s);
     if (s > best) best = s, lag0 = lag;
   }
@@ -153,12 +160,15 @@ OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal
       if (j == 0) g += r * r.transpose();
     }
   }
-  if (!(g.determinant() > 0.0)) throw dsp::InputError("time offset: the measurement does not overlap the commanded motion");
+  if (!(g.determinant() > 0.0))
+    throw dsp::InputError("time offset: the measurement does not overlap the commanded motion");
   const Eigen::MatrixXd gi = g.inverse();
   std::vector<Eigen::MatrixXd> total(static_cast<std::size_t>(n_lags), Eigen::MatrixXd::Zero(3, nc));
   for (int b = 0; b < kBlocks; ++b)
     for (int j = 0; j < n_lags; ++j) total[static_cast<std::size_t>(j)] += cb[static_cast<std::size_t>(b * n_lags + j)];
-  auto tau_of = [&](double j_peak) { return t_y0 - ref.t_begin_s + static_cast<double>(lag0) / fs + (j_peak - span) * hf; };
+  auto tau_of = [&](double j_peak) {
+    return t_y0 - ref.t_begin_s + static_cast<double>(lag0) / fs + (j_peak - span) * hf;
+  };
   std::vector<double> s(static_cast<std::size_t>(n_lags));
   for (int j = 0; j < n_lags; ++j) s[static_cast<std::size_t>(j)] = score(total[static_cast<std::size_t>(j)], gi);
   const double j_hat = peak(s);
@@ -175,7 +185,8 @@ OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal
   double loo_mean = 0.0;
   for (int b = 0; b < kBlocks; ++b) {
     for (int j = 0; j < n_lags; ++j)
-      s[static_cast<std::size_t>(j)] = score(total[static_cast<std::size_t>(j)] - cb[static_cast<std::size_t>(b * n_lags + j)], gi);
+      s[static_cast<std::size_t>(j)] =
+          score(total[static_cast<std::size_t>(j)] - cb[static_cast<std::size_t>(b * n_lags + j)], gi);
     loo[static_cast<std::size_t>(b)] = tau_of(peak(s));
     loo_mean += loo[static_cast<std::size_t>(b)] / kBlocks;
   }

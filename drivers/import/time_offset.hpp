@@ -29,16 +29,16 @@ namespace eical::drivers {
 
 struct MeasuredSeries {
   double fs_hz = 0.0;
-  double t0_s = 0.0;                        // recorder time of grid index 0
-  std::vector<std::int64_t> grid_index;     // increasing; missing indices are lost frames
-  std::vector<Eigen::Vector3d> values;      // sensor axes (any unit)
+  double t0_s = 0.0;                     // recorder time of grid index 0
+  std::vector<std::int64_t> grid_index;  // increasing; missing indices are lost frames
+  std::vector<Eigen::Vector3d> values;   // sensor axes (any unit)
 };
 
 struct ReferenceSignal {
-  double t_begin_s = 0.0, t_end_s = 0.0;    // set-point clock: where the reference is defined
-  Eigen::Vector3d moving = Eigen::Vector3d::Ones();   // 1 for the machine axes it uses
-  std::function<Eigen::Vector3d(double t_s)> accel;   // commanded acceleration (any unit)
-  double sensor_f0_hz = 0.0;                // 0: no sensor low-pass applied
+  double t_begin_s = 0.0, t_end_s = 0.0;             // set-point clock: where the reference is defined
+  Eigen::Vector3d moving = Eigen::Vector3d::Ones();  // 1 for the machine axes it uses
+  std::function<Eigen::Vector3d(double t_s)> accel;  // commanded acceleration (any unit)
+  double sensor_f0_hz = 0.0;                         // 0: no sensor low-pass applied
   double sensor_zeta = 0.707;
 };
 

@@ -48,8 +48,9 @@ void assign_indices(const std::vector<double>& t, double dt, UniformClock& c, co
     if (is_gap(t, k, dt)) {
       const double steps = d / dt;  // checked before it becomes an integer (and the indices add up)
       if (!(static_cast<double>(c.lost_frames) + steps - 1.0 <= max_lost))
-        throw dsp::InputError(source + ": a gap of " + std::to_string(d) + " s after sample " + std::to_string(k) + " loses more samples than the " +
-                              std::to_string(t.size()) + " recorded (time stamps in another unit?)");
+        throw dsp::InputError(source + ": a gap of " + std::to_string(d) + " s after sample " + std::to_string(k) +
+                              " loses more samples than the " + std::to_string(t.size()) +
+                              " recorded (time stamps in another unit?)");
       step = std::max<std::int64_t>(2, std::llround(steps));
       ++c.gaps;
       c.lost_frames += static_cast<std::size_t>(step - 1);
@@ -72,7 +73,8 @@ Eigen::Vector3d lagrange(const double* x, const Eigen::Vector3d* y, int m, doubl
 
 // Four nodes around `at` within [lo, hi] (indices of one unbroken stretch), k the last
 // node at or before `at`.
-Eigen::Vector3d cubic_in(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, std::size_t lo, std::size_t hi, std::size_t k, double at) {
+Eigen::Vector3d cubic_in(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, std::size_t lo,
+                         std::size_t hi, std::size_t k, double at) {
   const std::size_t len = hi - lo + 1;
   if (len == 1) return v[lo];
   const std::size_t m = std::min<std::size_t>(4, len);
@@ -85,11 +87,13 @@ Eigen::Vector3d cubic_in(const std::vector<double>& t, const std::vector<Eigen::
 }  // namespace
 
 UniformClock fit_uniform_clock(const std::vector<double>& t, const std::string& source) {
-  if (t.size() < 4) throw dsp::InputError(source + ": " + std::to_string(t.size()) + " samples; at least 4 are needed for a clock");
+  if (t.size() < 4)
+    throw dsp::InputError(source + ": " + std::to_string(t.size()) + " samples; at least 4 are needed for a clock");
   std::vector<double> d(t.size() - 1);
   for (std::size_t k = 1; k < t.size(); ++k) {
     d[k - 1] = t[k] - t[k - 1];
-    if (!(d[k - 1] > 0.0)) throw dsp::InputError(source + ": time stamps do not increase at sample " + std::to_string(k + 1));
+    if (!(d[k - 1] > 0.0))
+      throw dsp::InputError(source + ": time stamps do not increase at sample " + std::to_string(k + 1));
   }
   std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
   UniformClock c;
@@ -108,7 +112,8 @@ UniformClock fit_uniform_clock(const std::vector<double>& t, const std::string& 
 }
 
 UniformSeries resample(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, const UniformClock& c) {
-  if (t.size() != v.size() || t.size() != c.index.size()) throw dsp::InputError("resample: stamps, values and clock disagree in length");
+  if (t.size() != v.size() || t.size() != c.index.size())
+    throw dsp::InputError("resample: stamps, values and clock disagree in length");
   UniformSeries out;
   out.grid_index.reserve(t.size());
   out.values.reserve(t.size());
@@ -130,7 +135,8 @@ UniformSeries resample(const std::vector<double>& t, const std::vector<Eigen::Ve
   return out;
 }
 
-std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, const UniformClock& c) {
+std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v,
+                                         const UniformClock& c) {
   const auto n = static_cast<std::size_t>(c.index.back()) + 1;
   std::vector<Eigen::Vector3d> out(n);
   for (std::size_t i = 0; i < n; ++i) out[i] = interpolate_at(t, v, c.time_at(static_cast<std::int64_t>(i)));

@@ -23,9 +23,9 @@ namespace eical::drivers {
 
 struct UniformClock {
   double fs_hz = 0.0;
-  double t0_s = 0.0;            // stamp-clock time of grid index 0 (the first sample)
+  double t0_s = 0.0;  // stamp-clock time of grid index 0 (the first sample)
   double median_dt_s = 0.0;
-  double jitter_rms_s = 0.0;    // stamps about the fitted clock
+  double jitter_rms_s = 0.0;  // stamps about the fitted clock
   std::size_t gaps = 0;
   std::size_t lost_frames = 0;
   std::vector<std::int64_t> index;  // grid index of every input sample (0 for the first)
@@ -41,11 +41,13 @@ struct UniformSeries {
   std::vector<std::int64_t> grid_index;
   std::vector<Eigen::Vector3d> values;
 };
-UniformSeries resample(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, const UniformClock& clock);
+UniformSeries resample(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values,
+                       const UniformClock& clock);
 
 // Values at every grid index from the first to the last sample, lost samples included,
 // each by interpolate_at (an NC trace: a set-point is smooth, its gaps are bridged).
-std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, const UniformClock& clock);
+std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values,
+                                         const UniformClock& clock);
 
 // A stamped series evaluated at arbitrary times (for an NC trace: cubic Lagrange through
 // the four nearest stamps; held at the ends).

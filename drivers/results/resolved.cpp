@@ -9,14 +9,17 @@ namespace eical::drivers {
 namespace {
 
 void flatten(const nlohmann::json& j, std::vector<double>& out) {
-  if (j.is_number()) out.push_back(j.get<double>());
-  else if (j.is_null()) out.push_back(std::numeric_limits<double>::quiet_NaN());
+  if (j.is_number())
+    out.push_back(j.get<double>());
+  else if (j.is_null())
+    out.push_back(std::numeric_limits<double>::quiet_NaN());
   else if (j.is_array())
     for (const auto& e : j) flatten(e, out);
 }
 
 // Follows the dotted path; through an array of objects each element continues the path.
-void walk(const nlohmann::json& node, const std::vector<std::string>& parts, std::size_t i, std::vector<double>& out, bool& found) {
+void walk(const nlohmann::json& node, const std::vector<std::string>& parts, std::size_t i, std::vector<double>& out,
+          bool& found) {
   if (i == parts.size()) {
     found = true;
     flatten(node, out);
@@ -34,7 +37,8 @@ void walk(const nlohmann::json& node, const std::vector<std::string>& parts, std
 std::vector<std::string> split(const std::string& key) {
   std::vector<std::string> p;
   std::size_t a = 0;
-  for (std::size_t b = key.find('.'); b != std::string::npos; a = b + 1, b = key.find('.', a)) p.push_back(key.substr(a, b - a));
+  for (std::size_t b = key.find('.'); b != std::string::npos; a = b + 1, b = key.find('.', a))
+    p.push_back(key.substr(a, b - a));
   p.push_back(key.substr(a));
   return p;
 }

@@ -6,11 +6,11 @@
 #include "dsp/analysis/verdict.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <fstream>
 #include <initializer_list>
 #include <map>
-#include <fstream>
 #include <stdexcept>
-#include <cmath>
 
 namespace eical::drivers {
 
@@ -47,19 +47,22 @@ nlohmann::json uncertainty_json(const dsp::Analysis& a) {
 }
 
 nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult& c) {
-  nlohmann::json j = {{"plane", p.plane},
-                      {"center_mm", {p.center_mm[0], p.center_mm[1]}},  // programmed, in the plane's axes
-                      {"radius_nominal_mm", p.radius_mm},
-                      {"feed_mm_min", p.feed_mm_min},
-                      {"direction", c.direction},
-                      {"revolutions", c.revolutions},
-                      {"arc_deg", c.arc_deg},
-                      {"centre_reference", c.arc_deg < 360.0 ? "programmed centre (partial arc)" : "least-squares centre per revolution"},
-                      {"radius_mean_deviation_um", number_or_null(c.radius_mean_deviation_um)},
-                      {"circular_deviation_G_um", number_or_null(c.circular_deviation_G_um)},
-                      {"circular_hysteresis_H_um", c.circular_hysteresis_H_um ? nlohmann::json(*c.circular_hysteresis_H_um) : nlohmann::json(nullptr)},
-                      {"radial_deviation_F_max_um", number_or_null(c.radial_deviation_F_max_um)},
-                      {"radial_deviation_F_min_um", number_or_null(c.radial_deviation_F_min_um)}};
+  nlohmann::json j = {
+      {"plane", p.plane},
+      {"center_mm", {p.center_mm[0], p.center_mm[1]}},  // programmed, in the plane's axes
+      {"radius_nominal_mm", p.radius_mm},
+      {"feed_mm_min", p.feed_mm_min},
+      {"direction", c.direction},
+      {"revolutions", c.revolutions},
+      {"arc_deg", c.arc_deg},
+      {"centre_reference",
+       c.arc_deg < 360.0 ? "programmed centre (partial arc)" : "least-squares centre per revolution"},
+      {"radius_mean_deviation_um", number_or_null(c.radius_mean_deviation_um)},
+      {"circular_deviation_G_um", number_or_null(c.circular_deviation_G_um)},
+      {"circular_hysteresis_H_um",
+       c.circular_hysteresis_H_um ? nlohmann::json(*c.circular_hysteresis_H_um) : nlohmann::json(nullptr)},
+      {"radial_deviation_F_max_um", number_or_null(c.radial_deviation_F_max_um)},
+      {"radial_deviation_F_min_um", number_or_null(c.radial_deviation_F_min_um)}};
   nlohmann::json centers = nlohmann::json::array();
   for (const auto& ctr : c.centers_mm) centers.push_back({ctr.x(), ctr.y()});
   j["revolution_centers_mm"] = centers;
@@ -79,7 +82,8 @@ nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult&
     dir.push_back(c.trace.direction[i]);
   }
   j["trace"] = {{"angle_deg", ang}, {"radius_deviation_um", dev}, {"direction", dir}};
-  if (c.arc_deg < 360.0) j["arc_start_deg"] = p.arc_start_deg ? nlohmann::json(*p.arc_start_deg) : nlohmann::json(90.0 - c.arc_deg / 2.0);
+  if (c.arc_deg < 360.0)
+    j["arc_start_deg"] = p.arc_start_deg ? nlohmann::json(*p.arc_start_deg) : nlohmann::json(90.0 - c.arc_deg / 2.0);
   return j;
 }
 
@@ -121,13 +125,17 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   j["run_id"] = run.meta.id;
   j["program"] = kind;
   j["software"] = software_version();
-  j["quality"] = {{"degraded", a.degraded}, {"verdict", a.verdict}, {"verdict_reasons", a.verdict_reasons}, {"flags", a.flags}};
+  j["quality"] = {
+      {"degraded", a.degraded}, {"verdict", a.verdict}, {"verdict_reasons", a.verdict_reasons}, {"flags", a.flags}};
   nlohmann::json severity = nlohmann::json::array();
   for (const auto& f : a.flags) severity.push_back(dsp::severity_name(dsp::flag_severity(f)));
   j["quality"]["flag_severity"] = severity;
   j["uncertainty_k2"] = uncertainty_json(a);
-  j["uncertainty"] = {{"coverage_factor", 2}, {"sensor_model", a.uncertainty_source}, {"method", a.uncertainty_note},
-                      {"resolved_rule", "a figure is resolved when |value| > U (k = 2); one that is not is never compensated"}};
+  j["uncertainty"] = {
+      {"coverage_factor", 2},
+      {"sensor_model", a.uncertainty_source},
+      {"method", a.uncertainty_note},
+      {"resolved_rule", "a figure is resolved when |value| > U (k = 2); one that is not is never compensated"}};
   j["sensor_model"] = {{"identified", a.sensor_model != "datasheet"}, {"source", a.sensor_model}};
   if (a.circle) {
     j["circle"] = circle_json(run.meta.program, *a.circle);
@@ -138,16 +146,17 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
     j["circle"]["radius_nominal_mm"] = run.meta.program.radius_mm;
     j["circle"]["feed_mm_min"] = run.meta.program.feed_mm_min;
     j["circle"]["arc_deg"] = run.meta.program.arc_deg;
-    j["circle"]["trace"] = {{"angle_deg", nlohmann::json::array()}, {"radius_deviation_um", nlohmann::json::array()},
+    j["circle"]["trace"] = {{"angle_deg", nlohmann::json::array()},
+                            {"radius_deviation_um", nlohmann::json::array()},
                             {"direction", nlohmann::json::array()}};
   }
   if (a.diagnostics) {
     j["diagnostics"] = diagnostics_json(*a.diagnostics);
   } else if (kind == "circle") {
-    j["diagnostics"] = all_null({"backlash_x_um", "backlash_y_um", "reversal_spike_x_um", "reversal_spike_y_um",
-                                 "lateral_play_x_um", "lateral_play_y_um", "cyclic_error_x_um", "cyclic_error_y_um",
-                                 "servo_mismatch_ms", "squareness_urad", "scale_mismatch_ppm", "straightness_x_um",
-                                 "straightness_y_um", "stick_slip_um", "vibration_um"});
+    j["diagnostics"] =
+        all_null({"backlash_x_um", "backlash_y_um", "reversal_spike_x_um", "reversal_spike_y_um", "lateral_play_x_um",
+                  "lateral_play_y_um", "cyclic_error_x_um", "cyclic_error_y_um", "servo_mismatch_ms", "squareness_urad",
+                  "scale_mismatch_ppm", "straightness_x_um", "straightness_y_um", "stick_slip_um", "vibration_um"});
   }
   if (a.step) {
     j["step"] = step_json(a.step_axis, *a.step);
@@ -172,7 +181,8 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   if (kind == "rectangle" && j["rectangle"].is_object())
     j["rectangle"]["path_deviation"] = a.path ? path_json(*a.path) : nlohmann::json(nullptr);
   if (kind == "freeform")
-    j["freeform"] = a.path ? path_json(*a.path) : all_null({"contour_error_max_um", "contour_error_rms_um", "tangential_rms_um"});
+    j["freeform"] =
+        a.path ? path_json(*a.path) : all_null({"contour_error_max_um", "contour_error_rms_um", "tangential_rms_um"});
   if (a.circle_accuracy_rms_um) {
     j["reference_comparison"] = {{"reference", run.meta.reference ? run.meta.reference->kind : "ref"},
                                  {"radius_deviation_error_rms_um", *a.circle_accuracy_rms_um},
@@ -182,10 +192,12 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   const auto& m = a.measurement;
   j["pipeline"] = {{"rest_window_samples", m.rest_window_samples},
                    {"zupt_window_samples", m.zupt_window_samples},
-                   {"zupt_velocity_error_mm_s", {m.zupt_velocity_error_mm_s.x(), m.zupt_velocity_error_mm_s.y(), m.zupt_velocity_error_mm_s.z()}},
-                   {"dynamic_compensation", a.dynamic == dsp::DynamicComp::none
-                                                ? std::string("none (PT2 and DAQ delay uncompensated)")
-                                                : std::string(dsp::dynamic_comp_name(a.dynamic)) + ", DAQ delay removed by re-indexing"},
+                   {"zupt_velocity_error_mm_s",
+                    {m.zupt_velocity_error_mm_s.x(), m.zupt_velocity_error_mm_s.y(), m.zupt_velocity_error_mm_s.z()}},
+                   {"dynamic_compensation",
+                    a.dynamic == dsp::DynamicComp::none
+                        ? std::string("none (PT2 and DAQ delay uncompensated)")
+                        : std::string(dsp::dynamic_comp_name(a.dynamic)) + ", DAQ delay removed by re-indexing"},
                    {"nbs", a.nbs},
                    {"coriolis", a.coriolis}};
   // What the supports did: accepted and rejected updates per kind and axis, the
@@ -214,7 +226,10 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
     nlohmann::json moving = nlohmann::json::array();
     for (int ax = 0; ax < 3; ++ax)
       if (g.axis_moves[ax]) moving.push_back(axes[ax]);
-    reps.push_back({{"repeats", g.repeats()}, {"samples", g.samples}, {"axes", moving}, {"mean_deviation_rms_um", g.mean_rms_um},
+    reps.push_back({{"repeats", g.repeats()},
+                    {"samples", g.samples},
+                    {"axes", moving},
+                    {"mean_deviation_rms_um", g.mean_rms_um},
                     {"scatter_rms_um", g.scatter_rms_um}});
   }
   j["repeats"] = reps;
@@ -238,23 +253,40 @@ nlohmann::json path_json(const dsp::eval::PathDeviation& d) {
           {"trace", {{"arc_length_mm", s}, {"normal_um", nrm}, {"tangential_um", tan}}}};
 }
 
-nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp::eval::PositioningResult& r, bool vdi) {
+nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp::eval::PositioningResult& r,
+                                bool vdi) {
   nlohmann::json targets = nlohmann::json::array();
   for (const auto& t : r.targets)
-    targets.push_back({{"target_mm", t.target_mm}, {"mean_up_um", t.mean_up_um}, {"mean_down_um", t.mean_down_um},
-                       {"mean_um", t.mean_um}, {"s_up_um", t.s_up_um}, {"s_down_um", t.s_down_um},
+    targets.push_back({{"target_mm", t.target_mm},
+                       {"mean_up_um", t.mean_up_um},
+                       {"mean_down_um", t.mean_down_um},
+                       {"mean_um", t.mean_um},
+                       {"s_up_um", t.s_up_um},
+                       {"s_down_um", t.s_down_um},
                        {"band_up_um", {t.mean_up_um - 2 * t.s_up_um, t.mean_up_um + 2 * t.s_up_um}},
                        {"band_down_um", {t.mean_down_um - 2 * t.s_down_um, t.mean_down_um + 2 * t.s_down_um}},
-                       {"B_um", t.B_um}, {"R_up_um", t.R_up_um}, {"R_down_um", t.R_down_um}, {"R_um", t.R_um}});
-  nlohmann::json j = {{"axis", r.axis},           {"targets_mm", in.targets_mm},
-                      {"runs", r.runs},           {"A_um", r.A_um},
-                      {"A_up_um", r.A_up_um},     {"A_down_um", r.A_down_um},
-                      {"E_um", r.E_um},           {"E_up_um", r.E_up_um},
-                      {"E_down_um", r.E_down_um}, {"M_um", r.M_um},
-                      {"R_um", r.R_um},           {"R_up_um", r.R_up_um},
-                      {"R_down_um", r.R_down_um}, {"B_um", r.B_um},
-                      {"B_mean_um", r.B_mean_um}, {"deviation_um", {{"up", in.up_um}, {"down", in.down_um}}},
-                      {"per_target", targets},    {"standard", "ISO 230-2:2014"},
+                       {"B_um", t.B_um},
+                       {"R_up_um", t.R_up_um},
+                       {"R_down_um", t.R_down_um},
+                       {"R_um", t.R_um}});
+  nlohmann::json j = {{"axis", r.axis},
+                      {"targets_mm", in.targets_mm},
+                      {"runs", r.runs},
+                      {"A_um", r.A_um},
+                      {"A_up_um", r.A_up_um},
+                      {"A_down_um", r.A_down_um},
+                      {"E_um", r.E_um},
+                      {"E_up_um", r.E_up_um},
+                      {"E_down_um", r.E_down_um},
+                      {"M_um", r.M_um},
+                      {"R_um", r.R_um},
+                      {"R_up_um", r.R_up_um},
+                      {"R_down_um", r.R_down_um},
+                      {"B_um", r.B_um},
+                      {"B_mean_um", r.B_mean_um},
+                      {"deviation_um", {{"up", in.up_um}, {"down", in.down_um}}},
+                      {"per_target", targets},
+                      {"standard", "ISO 230-2:2014"},
                       {"within_standard", r.runs >= dsp::eval::kIso230_2Runs}};
   if (vdi) j["vdi3441"] = {{"P_um", r.vdi.P_um}, {"Pa_um", r.vdi.Pa_um}, {"U_um", r.vdi.U_um}, {"Ps_um", r.vdi.Ps_um}};
   return j;
@@ -310,7 +342,8 @@ nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r
           {"overshoot_um", number_or_null(r.overshoot_um)},
           {"settling_s", any_settled ? number_or_null(r.settling_s) : nlohmann::json(nullptr)},
           {"noise_um", number_or_null(r.noise_um)},
-          {"smallest_step_resolved_um", r.smallest_step_resolved_um > 0 ? number_or_null(r.smallest_step_resolved_um) : nlohmann::json(nullptr)},
+          {"smallest_step_resolved_um",
+           r.smallest_step_resolved_um > 0 ? number_or_null(r.smallest_step_resolved_um) : nlohmann::json(nullptr)},
           {"largest_step_measured_um", number_or_null(largest)},
           {"moves", moves}};
 }

@@ -23,7 +23,8 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis);
 
 nlohmann::json circle_json(const dsp::Program& program, const dsp::eval::CircleResult& c);
 // The positioning object of results.md; deviation_um.up/down are [run][target].
-nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp::eval::PositioningResult& r, bool vdi3441);
+nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp::eval::PositioningResult& r,
+                                bool vdi3441);
 nlohmann::json diagnostics_json(const dsp::eval::CircleDiagnostics& d);
 nlohmann::json step_json(const std::string& axis, const dsp::eval::StepResult& r);
 nlohmann::json rectangle_json(const dsp::eval::RectangleResult& r);

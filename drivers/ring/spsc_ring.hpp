@@ -11,9 +11,9 @@
 #include <cstdint>
 #include <memory>
 #include <new>
-#include <string>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 namespace eical::drivers {
@@ -27,8 +27,7 @@ class SpscRing {
   static_assert(std::is_trivially_copyable_v<T>, "ring payloads are plain data copied by value");
 
  public:
-  explicit SpscRing(std::size_t capacity)
-      : capacity_(capacity), mask_(capacity - 1) {
+  explicit SpscRing(std::size_t capacity) : capacity_(capacity), mask_(capacity - 1) {
     if (capacity < 2 || (capacity & (capacity - 1)) != 0)
       throw std::invalid_argument("SpscRing capacity must be a power of two >= 2, got " + std::to_string(capacity));
     slots_ = std::make_unique<T[]>(capacity);

@@ -24,7 +24,8 @@ class FileSpill final : public dsp::Spill {
       fd_ = ::mkstemp(name.data());
       if (fd_ >= 0) ::unlink(name.c_str());
     }
-    if (fd_ < 0) throw dsp::InputError("spill: cannot create a temporary file in " + dir.string() + ": " + std::strerror(errno));
+    if (fd_ < 0)
+      throw dsp::InputError("spill: cannot create a temporary file in " + dir.string() + ": " + std::strerror(errno));
     buf_.reserve(kBuffer);
   }
   ~FileSpill() override {
@@ -44,7 +45,8 @@ class FileSpill final : public dsp::Spill {
   }
   void read(std::size_t record_bytes, const std::function<void(const void*, std::size_t)>& block) override {
     flush();
-    const std::size_t chunk = std::max<std::size_t>(1, kBuffer / std::max<std::size_t>(1, record_bytes)) * std::max<std::size_t>(1, record_bytes);
+    const std::size_t chunk = std::max<std::size_t>(1, kBuffer / std::max<std::size_t>(1, record_bytes)) *
+                              std::max<std::size_t>(1, record_bytes);
     std::vector<unsigned char> in(chunk);
     for (std::size_t off = 0; off < size_;) {
       const std::size_t want = std::min(chunk, size_ - off);
@@ -52,7 +54,9 @@ class FileSpill final : public dsp::Spill {
       while (got < want) {
         const ssize_t r = ::pread(fd_, in.data() + got, want - got, static_cast<off_t>(off + got));
         if (r < 0 && errno == EINTR) continue;
-        if (r <= 0) throw dsp::InputError("spill in " + dir_.string() + ": read failed: " + (r < 0 ? std::strerror(errno) : "end of file"));
+        if (r <= 0)
+          throw dsp::InputError("spill in " + dir_.string() +
+                                ": read failed: " + (r < 0 ? std::strerror(errno) : "end of file"));
         got += static_cast<std::size_t>(r);
       }
       block(in.data(), want);
@@ -66,7 +70,9 @@ class FileSpill final : public dsp::Spill {
     for (std::size_t got = 0; got < bytes;) {
       const ssize_t r = ::pread(fd_, p + got, bytes - got, static_cast<off_t>(offset + got));
       if (r < 0 && errno == EINTR) continue;
-      if (r <= 0) throw dsp::InputError("spill in " + dir_.string() + ": read failed: " + (r < 0 ? std::strerror(errno) : "end of file"));
+      if (r <= 0)
+        throw dsp::InputError("spill in " + dir_.string() +
+                              ": read failed: " + (r < 0 ? std::strerror(errno) : "end of file"));
       got += static_cast<std::size_t>(r);
     }
   }

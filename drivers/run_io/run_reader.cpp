@@ -26,13 +26,29 @@ using Unknown = drivers::Unknown;
 constexpr double kMaxTemp_c = 1000.0;
 
 enum Col : int {
-  c_t, c_tax, c_tay, c_taz, c_hax, c_hay, c_haz, c_ttemp, c_htemp, c_cx, c_cy, c_cz, c_rx, c_ry, c_rz, c_trig,
+  c_t,
+  c_tax,
+  c_tay,
+  c_taz,
+  c_hax,
+  c_hay,
+  c_haz,
+  c_ttemp,
+  c_htemp,
+  c_cx,
+  c_cy,
+  c_cz,
+  c_rx,
+  c_ry,
+  c_rz,
+  c_trig,
   c_psd0,  // psd k i1 = c_psd0 + 2k, i2 = c_psd0 + 2k + 1
   c_count = c_psd0 + 2 * dsp::kMaxPsd
 };
 
-const char* const kNames[] = {"t", "table_ax", "table_ay", "table_az", "head_ax", "head_ay", "head_az", "table_temp",
-                              "head_temp", "cmd_x", "cmd_y", "cmd_z", "ref_x", "ref_y", "ref_z", "trigger"};
+const char* const kNames[] = {"t",       "table_ax",   "table_ay",  "table_az", "head_ax", "head_ay",
+                              "head_az", "table_temp", "head_temp", "cmd_x",    "cmd_y",   "cmd_z",
+                              "ref_x",   "ref_y",      "ref_z",     "trigger"};
 
 std::string column_name(int c) {
   if (c < c_psd0) return kNames[c];
@@ -41,14 +57,16 @@ std::string column_name(int c) {
 }
 
 [[noreturn]] void fail_at(const LineSource& src, int col, const std::string& what) {
-  throw dsp::InputError(src.name() + ":" + std::to_string(src.line_number()) + ": column '" + column_name(col) + "': " + what);
+  throw dsp::InputError(src.name() + ":" + std::to_string(src.line_number()) + ": column '" + column_name(col) +
+                        "': " + what);
 }
 
 std::optional<double> parse_double(const LineSource& src, int col, std::string_view f) {
   if (f.empty()) return std::nullopt;
   double v = 0.0;
   const auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
-  if (ec != std::errc() || p != f.data() + f.size()) fail_at(src, col, "expected a number, got '" + std::string(f) + "'");
+  if (ec != std::errc() || p != f.data() + f.size())
+    fail_at(src, col, "expected a number, got '" + std::string(f) + "'");
   if (!std::isfinite(v)) fail_at(src, col, "NaN or Inf in a sample ('" + std::string(f) + "')");
   return v;
 }
@@ -57,8 +75,10 @@ std::optional<std::int64_t> parse_int(const LineSource& src, int col, std::strin
   if (f.empty()) return std::nullopt;
   std::int64_t v = 0;
   const auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
-  if (ec == std::errc::result_out_of_range) fail_at(src, col, std::string(what) + " out of range: '" + std::string(f) + "'");
-  if (ec != std::errc() || p != f.data() + f.size()) fail_at(src, col, std::string("expected ") + what + ", got '" + std::string(f) + "'");
+  if (ec == std::errc::result_out_of_range)
+    fail_at(src, col, std::string(what) + " out of range: '" + std::string(f) + "'");
+  if (ec != std::errc() || p != f.data() + f.size())
+    fail_at(src, col, std::string("expected ") + what + ", got '" + std::string(f) + "'");
   return v;
 }
 
@@ -74,10 +94,12 @@ SampleReader::SampleReader(const fs::path& file, const dsp::RunMeta& meta, dsp::
     std::size_t pos = 0;
     for (;;) {
       const auto comma = line.find(',', pos);
-      const std::string_view name = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
+      const std::string_view name =
+          line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
       for (int c = 0; c < c_count; ++c)
         if (column_name(c) == name) {
-          if (where_[c] >= 0) throw dsp::InputError(file.string() + ":1: column '" + std::string(name) + "' appears twice");
+          if (where_[c] >= 0)
+            throw dsp::InputError(file.string() + ":1: column '" + std::string(name) + "' appears twice");
           where_[c] = n_fields_;
         }
       ++n_fields_;
@@ -88,12 +110,14 @@ SampleReader::SampleReader(const fs::path& file, const dsp::RunMeta& meta, dsp::
   for (int c : {c_t, c_tax, c_tay, c_taz, c_hax, c_hay, c_haz, c_ttemp, c_htemp, c_cx, c_cy, c_cz, c_trig})
     if (where_[c] < 0) throw dsp::InputError(file.string() + ":1: required column '" + column_name(c) + "' is missing");
   n_psd_ = static_cast<int>(meta.psd.size());
-  if (n_psd_ > dsp::kMaxPsd) throw dsp::InputError(file.string() + ": more than " + std::to_string(dsp::kMaxPsd) + " [[psd]] strips");
+  if (n_psd_ > dsp::kMaxPsd)
+    throw dsp::InputError(file.string() + ": more than " + std::to_string(dsp::kMaxPsd) + " [[psd]] strips");
   for (int k = 0; k < dsp::kMaxPsd; ++k)
     for (int e = 0; e < 2; ++e) {
       const int c = c_psd0 + 2 * k + e;
       if (k < n_psd_ && where_[c] < 0)
-        throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' is missing (run.toml has " + std::to_string(n_psd_) + " [[psd]])");
+        throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' is missing (run.toml has " +
+                              std::to_string(n_psd_) + " [[psd]])");
       if (k >= n_psd_ && where_[c] >= 0)
         throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' has no [[psd]] table in run.toml");
     }
@@ -119,15 +143,17 @@ bool SampleReader::next(dsp::Frame& out) {
   std::size_t k = 0, pos = 0;
   for (;;) {
     const auto comma = line.find(',', pos);
-    if (k < fields_.size()) fields_[k] = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
+    if (k < fields_.size())
+      fields_[k] = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
     ++k;
     if (comma == std::string_view::npos) break;
     pos = comma + 1;
   }
   if (k != fields_.size()) {
-    const std::string why = !src.last_line_had_newline() ? "truncated file: the last line is incomplete" : "wrong number of fields";
-    throw dsp::InputError(file_.string() + ":" + std::to_string(src.line_number()) + ": " + why + " (" + std::to_string(k) +
-                          " fields, header has " + std::to_string(n_fields_) + ")");
+    const std::string why =
+        !src.last_line_had_newline() ? "truncated file: the last line is incomplete" : "wrong number of fields";
+    throw dsp::InputError(file_.string() + ":" + std::to_string(src.line_number()) + ": " + why + " (" +
+                          std::to_string(k) + " fields, header has " + std::to_string(n_fields_) + ")");
   }
   auto field = [&](int c) { return fields_[static_cast<std::size_t>(where_[c])]; };
   dsp::Frame f;
@@ -137,7 +163,8 @@ bool SampleReader::next(dsp::Frame& out) {
   const auto idx = static_cast<std::int64_t>(std::llround(idx_real));
   // 1e-3 sample, plus what printing t with 10 significant digits can cost on long runs.
   if (std::abs(idx_real - static_cast<double>(idx)) > 1e-3 + 1e-9 * std::abs(idx_real))
-    fail_at(src, c_t, "time " + std::string(field(c_t)) + " s is not on the sample grid of fs = " + std::to_string(fs) + " Hz");
+    fail_at(src, c_t,
+            "time " + std::string(field(c_t)) + " s is not on the sample grid of fs = " + std::to_string(fs) + " Hz");
   if (prev_index_ >= 0 && idx <= prev_index_) fail_at(src, c_t, "time does not increase");
   if (prev_index_ >= 0 && idx > prev_index_ + 1) f.flags |= dsp::frame_flag::gap_before;
   prev_index_ = idx;
@@ -150,19 +177,25 @@ bool SampleReader::next(dsp::Frame& out) {
     }
     if (*v > INT32_MAX || *v < INT32_MIN) fail_at(src, c, "ADC counts out of the 32-bit range");
     f.accel_counts[c - c_tax] = static_cast<std::int32_t>(*v);
-    if (static_cast<double>(*v) >= full - 1 || static_cast<double>(*v) <= -full) f.flags |= dsp::frame_flag::accel_saturated;
+    if (static_cast<double>(*v) >= full - 1 || static_cast<double>(*v) <= -full)
+      f.flags |= dsp::frame_flag::accel_saturated;
   }
   for (int s = 0; s < 2; ++s) {
     const auto v = parse_double(src, c_ttemp + s, field(c_ttemp + s));
     // Checked before the conversion to float (beyond its range it is undefined).
-    if (v && !(std::abs(*v) <= kMaxTemp_c)) fail_at(src, c_ttemp + s, "temperature beyond +-1000 C ('" + std::string(field(c_ttemp + s)) + "')");
-    if (v) f.temp_c[s] = static_cast<float>(*v);
-    else f.flags |= dsp::frame_flag::temp_missing;
+    if (v && !(std::abs(*v) <= kMaxTemp_c))
+      fail_at(src, c_ttemp + s, "temperature beyond +-1000 C ('" + std::string(field(c_ttemp + s)) + "')");
+    if (v)
+      f.temp_c[s] = static_cast<float>(*v);
+    else
+      f.flags |= dsp::frame_flag::temp_missing;
   }
   for (int a = 0; a < 3; ++a) {
     const auto v = parse_double(src, c_cx + a, field(c_cx + a));
-    if (v) f.cmd_mm[a] = *v;
-    else f.flags |= dsp::frame_flag::cmd_missing;
+    if (v)
+      f.cmd_mm[a] = *v;
+    else
+      f.flags |= dsp::frame_flag::cmd_missing;
     if (where_[c_rx + a] >= 0) {
       const auto r = parse_double(src, c_rx + a, field(c_rx + a));
       if (r) f.ref_mm[a] = *r;
@@ -175,7 +208,8 @@ bool SampleReader::next(dsp::Frame& out) {
       continue;
     }
     const double counts = *v / lsb + offset;
-    if (!(std::abs(counts) <= INT32_MAX)) fail_at(src, c, "PSD value beyond the ADC's 32-bit range ('" + std::string(field(c)) + "')");
+    if (!(std::abs(counts) <= INT32_MAX))
+      fail_at(src, c, "PSD value beyond the ADC's 32-bit range ('" + std::string(field(c)) + "')");
     f.psd_counts[c - c_psd0] = static_cast<std::int32_t>(std::llround(counts));
   }
   const auto trig = parse_int(src, c_trig, field(c_trig), "an integer trigger code");
@@ -199,7 +233,8 @@ void absent_sensors_are_not_missing(const bool present[2], dsp::Frame& f) {
 fs::path samples_file(const fs::path& dir) {
   const fs::path plain = dir / "samples.csv", gz = dir / "samples.csv.gz";
   const bool has_plain = fs::exists(plain), has_gz = fs::exists(gz);
-  if (has_plain && has_gz) throw dsp::InputError(dir.string() + ": both samples.csv and samples.csv.gz exist; keep one");
+  if (has_plain && has_gz)
+    throw dsp::InputError(dir.string() + ": both samples.csv and samples.csv.gz exist; keep one");
   if (!has_plain && !has_gz) throw dsp::InputError(dir.string() + ": no samples.csv or samples.csv.gz");
   return has_plain ? plain : gz;
 }

@@ -35,7 +35,8 @@ std::size_t estimate_rows(const fs::path& file) {
     is.seekg(-4, std::ios::end);
     unsigned char b[4] = {};
     if (!is.read(reinterpret_cast<char*>(b), 4)) return 0;
-    const std::uint32_t size_mod_4g = b[0] | (std::uint32_t{b[1]} << 8) | (std::uint32_t{b[2]} << 16) | (std::uint32_t{b[3]} << 24);
+    const std::uint32_t size_mod_4g =
+        b[0] | (std::uint32_t{b[1]} << 8) | (std::uint32_t{b[2]} << 16) | (std::uint32_t{b[3]} << 24);
     const auto isize = static_cast<double>(size_mod_4g);
     if (bytes * 40.0 > 4294967296.0 || isize < bytes) return 0;  // it may have wrapped
     plain = isize;
@@ -63,7 +64,8 @@ RunStream::RunStream(const fs::path& dir) {
     dsp::Frame f;
     reader.next(f);
     for (int s = 0; s < 2; ++s) header_.meta.sensor_present[s] = reader.sensor_seen(s);
-    if (!header_.meta.sensor_present[0] && !header_.meta.sensor_present[1]) header_.meta.sensor_present[0] = header_.meta.sensor_present[1] = true;
+    if (!header_.meta.sensor_present[0] && !header_.meta.sensor_present[1])
+      header_.meta.sensor_present[0] = header_.meta.sensor_present[1] = true;
   }
   const fs::path truth = dir / "truth.toml";
   if (fs::exists(truth)) {
@@ -147,7 +149,8 @@ void RunStream::replay(const std::function<void(const dsp::Frame&)>& frame) {
   reader.join();
   if (error) std::rethrow_exception(error);  // the row that was wrong (file, line, column)
   for (int s = 0; s < 2; ++s) seen_[s] = seen[s];
-  if (!seen_[0] && !seen_[1]) throw dsp::InputError(file_.string() + ": no accelerometer data (every table_* and head_* field is empty)");
+  if (!seen_[0] && !seen_[1])
+    throw dsp::InputError(file_.string() + ": no accelerometer data (every table_* and head_* field is empty)");
   header_.streamed_frames = n;
   replayed_ = true;
 }

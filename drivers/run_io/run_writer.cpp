@@ -75,10 +75,12 @@ std::string sensor_section_toml(const char* name, const dsp::SensorSpec& s) {
   }
   o += "]\nk1_v_per_g = " + vec(s.k1_v_per_g.data(), 3) + "\nk2_g_per_g2 = " + vec(s.k2_g_per_g2.data(), 3) +
        "\nk3_g_per_g3 = " + vec(s.k3_g_per_g3.data(), 3) + "\nbias_g = " + vec(s.bias_g.data(), 3) +
-       "\ntc_k1_ppm_per_c = " + toml_double(s.tc_k1_ppm_per_c) + "\ntc_bias_ug_per_c = " + toml_double(s.tc_bias_ug_per_c) +
-       "\nf0_hz = " + toml_double(s.f0_hz) + "\nzeta = " + toml_double(s.zeta) + "\nnoise_ug_per_rthz = " +
-       toml_double(s.noise_ug_per_rthz) + "\ntemp_ref_c = " + toml_double(s.temp_ref_c) + "\n";
-  if (s.zeta_per_g != 0.0) o += "zeta_per_g = " + toml_double(s.zeta_per_g) + "\n";  // not a data-sheet key: only when found
+       "\ntc_k1_ppm_per_c = " + toml_double(s.tc_k1_ppm_per_c) +
+       "\ntc_bias_ug_per_c = " + toml_double(s.tc_bias_ug_per_c) + "\nf0_hz = " + toml_double(s.f0_hz) +
+       "\nzeta = " + toml_double(s.zeta) + "\nnoise_ug_per_rthz = " + toml_double(s.noise_ug_per_rthz) +
+       "\ntemp_ref_c = " + toml_double(s.temp_ref_c) + "\n";
+  if (s.zeta_per_g != 0.0)
+    o += "zeta_per_g = " + toml_double(s.zeta_per_g) + "\n";  // not a data-sheet key: only when found
   return o;
 }
 
@@ -206,7 +208,8 @@ void write_samples(const dsp::Run& run, const fs::path& file, bool gzip) {
       // An absent triplex is written empty; a missing field of a present one too (the
       // reader's old single flag still marks the whole frame).
       const bool missing = !run.meta.sensor_present[sensor] || (f.flags & dsp::frame_flag::sensor_missing(sensor)) ||
-                           ((f.flags & dsp::frame_flag::accel_missing) && !(f.flags & (dsp::frame_flag::table_missing | dsp::frame_flag::head_missing)));
+                           ((f.flags & dsp::frame_flag::accel_missing) &&
+                            !(f.flags & (dsp::frame_flag::table_missing | dsp::frame_flag::head_missing)));
       if (!missing) put_int(f.accel_counts[c]);
     }
     for (int s = 0; s < 2; ++s) {
@@ -242,41 +245,47 @@ std::string run_toml_text(const dsp::RunMeta& m) {
   if (!m.created.empty()) o += "created = " + m.created + "\n";
   const auto& a = m.acquisition;
   o += "\n[acquisition]\nfs_hz = " + toml_double(a.fs_hz) + "\nadc_bits = " + std::to_string(a.adc_bits) +
-       "\nadc_lsb_volt = " + toml_double(a.adc_lsb_volt) + "\nadc_offset_counts = " + std::to_string(a.adc_offset_counts) +
+       "\nadc_lsb_volt = " + toml_double(a.adc_lsb_volt) +
+       "\nadc_offset_counts = " + std::to_string(a.adc_offset_counts) +
        "\ndaq_group_delay_samples = " + toml_double(a.daq_group_delay_samples) + "\n";
   if (a.daq_skew_head_samples != 0.0) o += "daq_skew_head_samples = " + toml_double(a.daq_skew_head_samples) + "\n";
-  o += "\n[site]\nlatitude_deg = " + toml_double(m.site.latitude_deg) + "\nheading_deg = " + toml_double(m.site.heading_deg) +
-       "\ng_mps2 = " + toml_double(m.site.g_mps2) + "\n";
+  o += "\n[site]\nlatitude_deg = " + toml_double(m.site.latitude_deg) +
+       "\nheading_deg = " + toml_double(m.site.heading_deg) + "\ng_mps2 = " + toml_double(m.site.g_mps2) + "\n";
   o += "\n[machine]\nname = " + toml_str(m.machine.name) + "\ntable_axes = " + strs(m.machine.table_axes) +
        "\nhead_axes = " + strs(m.machine.head_axes) + "\n";
   o += sensor_section_toml("table", m.sensors[0]);
   o += sensor_section_toml("head", m.sensors[1]);
   const auto& p = m.program;
-  o += "\n[program]\nkind = " + toml_str(p.kind) + "\nplane = " + toml_str(p.plane) + "\ncenter_mm = " + vec(p.center_mm, 2) +
-       "\nradius_mm = " + toml_double(p.radius_mm) + "\nfeed_mm_min = " + toml_double(p.feed_mm_min) +
-       "\ndirection = " + toml_str(p.direction) + "\nrepeats = " + std::to_string(p.repeats) + "\naxis = " + toml_str(p.axis) +
-       "\ntargets_mm = " + vec(p.targets_mm.data(), static_cast<int>(p.targets_mm.size())) + "\nruns = " + std::to_string(p.runs) +
-       "\ndwell_s = " + toml_double(p.dwell_s) + "\ncorner_mm = " + vec(p.corner_mm, 2) + "\nsize_mm = " + vec(p.size_mm, 2) + "\n";
+  o += "\n[program]\nkind = " + toml_str(p.kind) + "\nplane = " + toml_str(p.plane) +
+       "\ncenter_mm = " + vec(p.center_mm, 2) + "\nradius_mm = " + toml_double(p.radius_mm) +
+       "\nfeed_mm_min = " + toml_double(p.feed_mm_min) + "\ndirection = " + toml_str(p.direction) +
+       "\nrepeats = " + std::to_string(p.repeats) + "\naxis = " + toml_str(p.axis) +
+       "\ntargets_mm = " + vec(p.targets_mm.data(), static_cast<int>(p.targets_mm.size())) +
+       "\nruns = " + std::to_string(p.runs) + "\ndwell_s = " + toml_double(p.dwell_s) +
+       "\ncorner_mm = " + vec(p.corner_mm, 2) + "\nsize_mm = " + vec(p.size_mm, 2) + "\n";
   if (p.arc_deg < 360.0) o += "arc_deg = " + toml_double(p.arc_deg) + "\n";
   if (p.arc_start_deg) o += "arc_start_deg = " + toml_double(*p.arc_start_deg) + "\n";
   if (!p.gcode.empty()) o += "gcode = \"\"\"\n" + p.gcode + "\"\"\"\n";
   for (const auto& s : m.psd) {
-    o += "\n[[psd]]\nmeasures = " + toml_str(s.measures) + "\ncenter_mm = " + vec(s.center_mm, 2) + "\nlength_mm = " +
-         toml_double(s.length_mm) + "\nwidth_mm = " + toml_double(s.width_mm) + "\nlockin_tau_s = " + toml_double(s.lockin_tau_s) + "\n";
+    o += "\n[[psd]]\nmeasures = " + toml_str(s.measures) + "\ncenter_mm = " + vec(s.center_mm, 2) +
+         "\nlength_mm = " + toml_double(s.length_mm) + "\nwidth_mm = " + toml_double(s.width_mm) +
+         "\nlockin_tau_s = " + toml_double(s.lockin_tau_s) + "\n";
   }
-  if (m.reference) o += "\n[reference]\nkind = " + toml_str(m.reference->kind) + "\naxes = " + strs(m.reference->axes) + "\n";
+  if (m.reference)
+    o += "\n[reference]\nkind = " + toml_str(m.reference->kind) + "\naxes = " + strs(m.reference->axes) + "\n";
   if (m.setpoint) {
     const auto& s = *m.setpoint;
     o += "\n[setpoint]\nsource = " + toml_str(s.source) + "\n";
     if (s.program_number >= 0) o += "program_number = " + std::to_string(s.program_number) + "\n";
     if (s.source == "servo_stream")
-      o += "servo_cycle_at_first_sample = " + toml_double(s.servo_cycle_at_first_sample) + "\nservo_rate_hz = " + toml_double(s.servo_rate_hz) + "\n";
+      o += "servo_cycle_at_first_sample = " + toml_double(s.servo_cycle_at_first_sample) +
+           "\nservo_rate_hz = " + toml_double(s.servo_rate_hz) + "\n";
     if (s.source == "program")
-      o += "marks_offset_s = " + toml_double(s.marks_offset_s) +
-           "\noffset_s = " + toml_double(s.offset_s) + "\nblocks = " + std::to_string(s.blocks) +
+      o += "marks_offset_s = " + toml_double(s.marks_offset_s) + "\noffset_s = " + toml_double(s.offset_s) +
+           "\nblocks = " + std::to_string(s.blocks) +
            "\nblock_offset_spread_s = " + toml_double(s.block_offset_spread_s) + "\n";
-    o += "lag_s = " + toml_double(s.lag_s) + "\ncorrelation = " + toml_double(s.correlation) + "\nresidual_ratio = " +
-         toml_double(s.residual_ratio) + "\n";
+    o += "lag_s = " + toml_double(s.lag_s) + "\ncorrelation = " + toml_double(s.correlation) +
+         "\nresidual_ratio = " + toml_double(s.residual_ratio) + "\n";
   }
   return o;
 }
@@ -288,7 +297,8 @@ void write_run(const dsp::Run& run, const fs::path& dir_in, const WriteOptions& 
     throw std::runtime_error(dir.string() + ": a run already exists here (not overwritten)");
   const fs::path parent = dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
   if (!fs::exists(parent, ec)) fs::create_directories(parent, ec);  // like mkdir -p; errors surface below
-  if (!fs::is_directory(parent, ec)) throw std::runtime_error(parent.string() + ": not a directory or cannot be created");
+  if (!fs::is_directory(parent, ec))
+    throw std::runtime_error(parent.string() + ": not a directory or cannot be created");
   std::random_device rd;
   const fs::path tmp = parent / ("." + dir.filename().string() + ".tmp-" + std::to_string(rd()));
   if (::mkdir(tmp.c_str(), 0755) != 0) sys_fail(tmp, "cannot create", errno);

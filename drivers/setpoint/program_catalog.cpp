@@ -19,7 +19,8 @@ dsp::Program read_program_file(const std::filesystem::path& path) {
 }
 
 dsp::Program ProgramCatalog::program(int number) const {
-  if (number < 0) throw dsp::InputError("program number " + std::to_string(number) + " is not valid (M101 P must be 0 or more)");
+  if (number < 0)
+    throw dsp::InputError("program number " + std::to_string(number) + " is not valid (M101 P must be 0 or more)");
   return read_program_file(file_of(number));
 }
 

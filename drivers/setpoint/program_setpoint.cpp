@@ -16,8 +16,10 @@ namespace {
 std::vector<std::pair<double, double>> motion_blocks(const sim::nc::Trajectory& tr) {
   std::vector<std::pair<double, double>> blocks;
   for (const auto& [a, b] : tr.move_spans_s()) {
-    if (!blocks.empty() && a - blocks.back().second < 1e-6) blocks.back().second = b;
-    else blocks.emplace_back(a, b);
+    if (!blocks.empty() && a - blocks.back().second < 1e-6)
+      blocks.back().second = b;
+    else
+      blocks.emplace_back(a, b);
   }
   return blocks;
 }
@@ -40,9 +42,12 @@ std::string with_mcode_stops(const std::string& gcode) {
     int depth = 0;
     for (char c : line) {
       if (c == ';' && depth == 0) break;
-      if (c == '(') ++depth;
-      else if (c == ')' && depth > 0) --depth;
-      else if (depth == 0 && c != ' ' && c != '\t') code += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+      if (c == '(')
+        ++depth;
+      else if (c == ')' && depth > 0)
+        --depth;
+      else if (depth == 0 && c != ' ' && c != '\t')
+        code += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     }
     for (std::size_t p = code.find('M'); p != std::string::npos; p = code.find('M', p + 1)) {
       std::size_t q = p + 1;
@@ -71,18 +76,22 @@ ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& progr
     if (dsp::trigger::is_nc_trigger(t.code)) prog.push_back({t.t_s, t.code});
   for (const auto& f : run.frames)
     if (dsp::trigger::is_nc_trigger(f.trigger)) rec.push_back({static_cast<double>(f.sample_index) / fs, f.trigger});
-  const auto p101 = std::find_if(prog.begin(), prog.end(), [](const Mark& m) { return m.code == dsp::trigger::program_start; });
-  const auto r101 = std::find_if(rec.begin(), rec.end(), [](const Mark& m) { return m.code == dsp::trigger::program_start; });
+  const auto p101 =
+      std::find_if(prog.begin(), prog.end(), [](const Mark& m) { return m.code == dsp::trigger::program_start; });
+  const auto r101 =
+      std::find_if(rec.begin(), rec.end(), [](const Mark& m) { return m.code == dsp::trigger::program_start; });
   if (p101 == prog.end()) throw dsp::InputError("program set-point: the program has no M101");
   if (r101 == rec.end()) throw dsp::InputError("program set-point: the recording has no M101 mark");
   std::vector<std::pair<Mark, Mark>> pairs;  // (program, recorded)
-  for (auto p = p101, r = r101; p != prog.end() && r != rec.end() && p->code == r->code; ++p, ++r) pairs.emplace_back(*p, *r);
+  for (auto p = p101, r = r101; p != prog.end() && r != rec.end() && p->code == r->code; ++p, ++r)
+    pairs.emplace_back(*p, *r);
   out.marks_program = static_cast<int>(prog.end() - p101);
   out.marks_recorded = static_cast<int>(rec.end() - r101);
   out.marks_matched = static_cast<int>(pairs.size());
   if (out.marks_matched != out.marks_program || out.marks_matched != out.marks_recorded)
-    out.flags.push_back("setpoint: the recording's marks (" + std::to_string(out.marks_recorded) + " from M101) and the program's (" +
-                        std::to_string(out.marks_program) + ") agree for the first " + std::to_string(out.marks_matched) +
+    out.flags.push_back("setpoint: the recording's marks (" + std::to_string(out.marks_recorded) +
+                        " from M101) and the program's (" + std::to_string(out.marks_program) +
+                        ") agree for the first " + std::to_string(out.marks_matched) +
                         " only; the rest is aligned by the motion alone");
   auto marks_offset = [&](double program_t) {
     double off = pairs.front().second.t_s - pairs.front().first.t_s;
@@ -101,10 +110,13 @@ ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& progr
     b.marks_offset_s = b.offset_s = marks_offset(s);
     // The window on the DAQ clock around where the marks put the block.
     const double t0 = s + b.offset_s - o.max_lag_s - 0.05, t1 = e + b.offset_s + o.max_lag_s + 0.05;
-    const auto i0 = static_cast<std::size_t>(std::clamp<double>(std::floor(t0 * fs) - static_cast<double>(first_index), 0.0, static_cast<double>(n)));
-    const auto i1 = static_cast<std::size_t>(std::clamp<double>(std::ceil(t1 * fs) - static_cast<double>(first_index), 0.0, static_cast<double>(n)));
+    const auto i0 = static_cast<std::size_t>(
+        std::clamp<double>(std::floor(t0 * fs) - static_cast<double>(first_index), 0.0, static_cast<double>(n)));
+    const auto i1 = static_cast<std::size_t>(
+        std::clamp<double>(std::ceil(t1 * fs) - static_cast<double>(first_index), 0.0, static_cast<double>(n)));
     if (i1 > i0 + 100) {
-      std::vector<Eigen::Vector3d> cmd_acc(i1 - i0), meas_w(meas.begin() + static_cast<std::ptrdiff_t>(i0), meas.begin() + static_cast<std::ptrdiff_t>(i1));
+      std::vector<Eigen::Vector3d> cmd_acc(i1 - i0),
+          meas_w(meas.begin() + static_cast<std::ptrdiff_t>(i0), meas.begin() + static_cast<std::ptrdiff_t>(i1));
       for (std::size_t i = i0; i < i1; ++i) {
         const double t = static_cast<double>(first_index + static_cast<std::int64_t>(i)) / fs - b.offset_s;
         // Only this block's motion: the neighbours' would correlate with their own lag.
@@ -118,7 +130,8 @@ ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& progr
     }
     out.blocks.push_back(b);
   }
-  if (out.blocks.empty()) out.flags.push_back("setpoint: the program does not move; its set-point is its start position");
+  if (out.blocks.empty())
+    out.flags.push_back("setpoint: the program does not move; its set-point is its start position");
 
   // 3 The set-point on the DAQ clock: inside a block by its offset, at rest in between.
   for (std::size_t k = 1; k < out.blocks.size(); ++k) {
@@ -126,8 +139,8 @@ ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& progr
     const auto& b = out.blocks[k];
     if (b.program_start_s + b.offset_s < a.program_end_s + a.offset_s - 1e-4)
       out.flags.push_back("setpoint: motion blocks " + std::to_string(k) + " and " + std::to_string(k + 1) +
-                          " overlap on the DAQ clock after the alignment (offsets " + std::to_string(a.offset_s) + " s, " +
-                          std::to_string(b.offset_s) + " s)");
+                          " overlap on the DAQ clock after the alignment (offsets " + std::to_string(a.offset_s) +
+                          " s, " + std::to_string(b.offset_s) + " s)");
   }
   auto program_time = [&](double tau) {
     if (out.blocks.empty()) return tau - marks_offset(0.0);
@@ -151,8 +164,9 @@ ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& progr
   out.lag_s = lag.lag_s, out.correlation = lag.correlation, out.residual_ratio = lag.residual_ratio;
   if (!lag.valid || lag.residual_ratio > o.poor_residual_ratio)
     out.flags.push_back("setpoint: the program's set-point does not match the measured motion (residual " +
-                        std::to_string(static_cast<int>(std::lround(lag.residual_ratio * 100.0))) + " % of the commanded acceleration, correlation " +
-                        std::to_string(lag.correlation) + "): another program, a feed override or other machine limits?");
+                        std::to_string(static_cast<int>(std::lround(lag.residual_ratio * 100.0))) +
+                        " % of the commanded acceleration, correlation " + std::to_string(lag.correlation) +
+                        "): another program, a feed override or other machine limits?");
   run.meta.program = program;
   return out;
 }

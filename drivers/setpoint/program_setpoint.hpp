@@ -37,20 +37,21 @@ struct BlockAlignment {
   double marks_offset_s = 0.0;  // DAQ time − program time from the marks
   double offset_s = 0.0;        // after the cross-correlation
   double correlation = 0.0;
-  bool correlated = false;      // false: the marks' offset kept (too little motion or no clear peak)
+  bool correlated = false;  // false: the marks' offset kept (too little motion or no clear peak)
 };
 
 struct ProgramAlignment {
   std::vector<BlockAlignment> blocks;
   int marks_program = 0, marks_recorded = 0, marks_matched = 0;
   double lag_s = 0.0, correlation = 0.0, residual_ratio = 1.0;  // of the final set-point
-  std::vector<std::string> flags;  // why the alignment is doubtful (empty: fine)
+  std::vector<std::string> flags;                               // why the alignment is doubtful (empty: fine)
 };
 
 // Fills every frame's cmd_mm from `program` (clearing cmd_missing) and sets
 // run.meta.program. Throws dsp::InputError when the program cannot be interpolated or the
 // recording has no M101 mark.
-ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& program, const ProgramSetPointOptions& options);
+ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& program,
+                                        const ProgramSetPointOptions& options);
 
 // The G-code with a zero dwell after every M101/M102/M103 block: eical's interpolator then
 // stops there, as an NC that drains its queue for user M-codes does.

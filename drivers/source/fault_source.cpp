@@ -26,7 +26,8 @@ bool FaultSource::within(std::int64_t index, double at_s, double for_s) const {
 
 std::size_t FaultSource::read(std::span<dsp::Frame> out) {
   const std::size_t n = inner_->read(out);
-  if (n > 0 && opens_ == 1 && plan_.fail_at_s >= 0 && static_cast<double>(out[0].sample_index) / fs_hz_ >= plan_.fail_at_s)
+  if (n > 0 && opens_ == 1 && plan_.fail_at_s >= 0 &&
+      static_cast<double>(out[0].sample_index) / fs_hz_ >= plan_.fail_at_s)
     throw SourceError("injected fault: the DAQ stopped delivering at " + std::to_string(plan_.fail_at_s) + " s");
   const double full = std::ldexp(1.0, inner_->meta().acquisition.adc_bits - 1) - 1.0;
   std::size_t kept = 0;

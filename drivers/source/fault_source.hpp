@@ -40,9 +40,13 @@ class FaultSource final : public Source {
   [[nodiscard]] bool at_end() const override { return inner_->at_end(); }
   [[nodiscard]] std::string_view name() const override { return inner_->name(); }
   [[nodiscard]] Backpressure backpressure() const override { return inner_->backpressure(); }
-  [[nodiscard]] std::int64_t sample_time_ns(std::int64_t sample_index) const override { return inner_->sample_time_ns(sample_index); }
+  [[nodiscard]] std::int64_t sample_time_ns(std::int64_t sample_index) const override {
+    return inner_->sample_time_ns(sample_index);
+  }
   [[nodiscard]] SourceCounters counters() const override { return inner_->counters(); }
-  void drain_diagnostics(const std::function<void(const std::string&)>& sink) override { inner_->drain_diagnostics(sink); }
+  void drain_diagnostics(const std::function<void(const std::string&)>& sink) override {
+    inner_->drain_diagnostics(sink);
+  }
 
  private:
   [[nodiscard]] bool within(std::int64_t index, double at_s, double for_s) const;

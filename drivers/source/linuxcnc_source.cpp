@@ -22,9 +22,9 @@ LinuxcncSource::LinuxcncSource(sim::Scenario scenario, LinuxcncSourceOptions opt
   ratio_ = probe.ratio();
   ring_ = std::make_unique<SpscRing<dsp::Frame>>(options_.ring_frames);
   const auto hold_frames = static_cast<std::size_t>(std::ceil(options_.hold_s * scenario_.meta.acquisition.fs_hz));
-  held_ = std::make_unique<FixedQueue<dsp::Frame>>(hold_frames + 2 * probe.frames_per_block() +
-                                                   static_cast<std::size_t>(ratio_) * (options_.window.lookahead_cycles + 2 * options_.max_fill_cycles) +
-                                                   1024);
+  held_ = std::make_unique<FixedQueue<dsp::Frame>>(
+      hold_frames + 2 * probe.frames_per_block() +
+      static_cast<std::size_t>(ratio_) * (options_.window.lookahead_cycles + 2 * options_.max_fill_cycles) + 1024);
   markers_ = std::make_unique<SpscRing<MarkerEvent>>(256);
   ServoStreamOptions so;
   so.fifo = options_.fifo;
@@ -65,7 +65,9 @@ void LinuxcncSource::open() {
     error_.clear();
     first_line_ = false;
   }
-  for (auto* a : {&shared_.lines, &shared_.lost_cycles, &shared_.overrun_lines, &shared_.dropped_frames, &shared_.blocks}) a->store(0);
+  for (auto* a :
+       {&shared_.lines, &shared_.lost_cycles, &shared_.overrun_lines, &shared_.dropped_frames, &shared_.blocks})
+    a->store(0);
   shared_.first_number.store(-1);
   failed_.store(false);
   first_number_.store(-1);
@@ -80,12 +82,14 @@ void LinuxcncSource::open() {
 
   const std::string path = options_.fifo.string();
   std::unique_lock lk(mu_);
-  const bool got = cv_.wait_for(lk, std::chrono::duration<double>(options_.connect_timeout_s), [&] { return first_line_ || !error_.empty(); });
+  const bool got = cv_.wait_for(lk, std::chrono::duration<double>(options_.connect_timeout_s),
+                                [&] { return first_line_ || !error_.empty(); });
   if (!error_.empty() || !got) {
-    const std::string why = !error_.empty() ? "linuxcnc: " + error_
-                                            : "no servo samples on " + path + " within " + std::to_string(options_.connect_timeout_s) +
-                                                  " s: is LinuxCNC running with the eical kit (eical_sampler.hal loads eical-halsampler, "
-                                                  "which writes this pipe)?";
+    const std::string why =
+        !error_.empty() ? "linuxcnc: " + error_
+                        : "no servo samples on " + path + " within " + std::to_string(options_.connect_timeout_s) +
+                              " s: is LinuxCNC running with the eical kit (eical_sampler.hal loads eical-halsampler, "
+                              "which writes this pipe)?";
     lk.unlock();
     stop_worker();
     throw SourceError(why);
@@ -115,11 +119,13 @@ std::int64_t LinuxcncSource::sample_time_ns(std::int64_t sample_index) const {
 
 LinuxcncStreamStats LinuxcncSource::stats() const {
   LinuxcncStreamStats s;
-  s.lines = shared_.lines.load(), s.lost_cycles = shared_.lost_cycles.load(), s.overrun_lines = shared_.overrun_lines.load();
+  s.lines = shared_.lines.load(), s.lost_cycles = shared_.lost_cycles.load(),
+  s.overrun_lines = shared_.overrun_lines.load();
   s.dropped_frames = shared_.dropped_frames.load(), s.blocks = shared_.blocks.load();
   s.first_number = shared_.first_number.load(), s.clock_offset_ns = shared_.clock_offset_ns.load();
   s.mean_delay_ms = shared_.mean_delay_ms.load(), s.max_delay_ms = shared_.max_delay_ms.load();
-  s.max_block_sim_ms = shared_.max_block_sim_ms.load(), s.max_following_error_mm = shared_.max_following_error_mm.load();
+  s.max_block_sim_ms = shared_.max_block_sim_ms.load(),
+  s.max_following_error_mm = shared_.max_following_error_mm.load();
   return s;
 }
 
@@ -134,8 +140,8 @@ void LinuxcncSource::drain_diagnostics(const std::function<void(const std::strin
   MarkerEvent m{};
   while (markers_->try_pop(m)) {
     char line[160];
-    std::snprintf(line, sizeof line, "linuxcnc: M-code marker %u at servo cycle %lld = sample %lld", m.marker, static_cast<long long>(m.cycle),
-                  static_cast<long long>(m.sample));
+    std::snprintf(line, sizeof line, "linuxcnc: M-code marker %u at servo cycle %lld = sample %lld", m.marker,
+                  static_cast<long long>(m.cycle), static_cast<long long>(m.sample));
     sink(line);
   }
 }
@@ -143,14 +149,16 @@ void LinuxcncSource::drain_diagnostics(const std::function<void(const std::strin
 std::string LinuxcncSource::summary() const {
   const LinuxcncStreamStats s = stats();
   char line[512];
-  std::snprintf(line, sizeof line,
-                "<6>linuxcnc: %llu lines, %llu cycles lost, %llu overrun lines, %llu frames dropped, %llu blocks (longest %.1f ms); "
-                "servo clock: cycle 0 at %lld ns CLOCK_MONOTONIC, lines %.2f ms (mean) / %.2f ms (max) behind their cycle; "
-                "max |cmd - fb| %.4f mm",
-                static_cast<unsigned long long>(s.lines), static_cast<unsigned long long>(s.lost_cycles),
-                static_cast<unsigned long long>(s.overrun_lines), static_cast<unsigned long long>(s.dropped_frames),
-                static_cast<unsigned long long>(s.blocks), s.max_block_sim_ms, static_cast<long long>(s.clock_offset_ns), s.mean_delay_ms,
-                s.max_delay_ms, s.max_following_error_mm);
+  std::snprintf(
+      line, sizeof line,
+      "<6>linuxcnc: %llu lines, %llu cycles lost, %llu overrun lines, %llu frames dropped, %llu blocks (longest %.1f "
+      "ms); "
+      "servo clock: cycle 0 at %lld ns CLOCK_MONOTONIC, lines %.2f ms (mean) / %.2f ms (max) behind their cycle; "
+      "max |cmd - fb| %.4f mm",
+      static_cast<unsigned long long>(s.lines), static_cast<unsigned long long>(s.lost_cycles),
+      static_cast<unsigned long long>(s.overrun_lines), static_cast<unsigned long long>(s.dropped_frames),
+      static_cast<unsigned long long>(s.blocks), s.max_block_sim_ms, static_cast<long long>(s.clock_offset_ns),
+      s.mean_delay_ms, s.max_delay_ms, s.max_following_error_mm);
   return line;
 }
 
@@ -170,7 +178,8 @@ void LinuxcncSource::publish(const ServoStreamReader& reader, const LinuxcncStre
 
 void LinuxcncSource::work() {
   WindowedSim sim(scenario_, options_.window);
-  std::vector<dsp::Frame> frames(sim.frames_per_block() + static_cast<std::size_t>(sim.ratio()) * options_.window.lookahead_cycles + 16);
+  std::vector<dsp::Frame> frames(sim.frames_per_block() +
+                                 static_cast<std::size_t>(sim.ratio()) * options_.window.lookahead_cycles + 16);
   bool drop_flag = false;
   std::uint32_t last_marker = 0;
   LinuxcncStreamStats local;
@@ -239,18 +248,22 @@ void LinuxcncSource::work() {
     using S = ServoStreamReader::Status;
     if (status == S::woken) break;  // stop_worker()
     if (status == S::timeout) {
-      fail(before_first ? "no servo samples within the connect timeout"
-                        : "no servo samples for " + std::to_string(options_.stall_timeout_s) + " s (LinuxCNC stalled?)");
+      fail(before_first
+               ? "no servo samples within the connect timeout"
+               : "no servo samples for " + std::to_string(options_.stall_timeout_s) + " s (LinuxCNC stalled?)");
       break;
     }
     if (status == S::error || status == S::closed) {
       emit(true);  // the cycles before the end or the bad line still become frames
       release(true);
       publish(reader, local);
-      if (status == S::error) fail(reader.error());
-      else if (before_first) fail("the servo stream closed before its first line (eical-halsampler failed? see LinuxCNC's log)");
-      else fail("LinuxCNC closed the servo stream after cycle " + std::to_string(reader.stats().last_number) +
-                " (LinuxCNC stopped or eical-halsampler exited)");
+      if (status == S::error)
+        fail(reader.error());
+      else if (before_first)
+        fail("the servo stream closed before its first line (eical-halsampler failed? see LinuxCNC's log)");
+      else
+        fail("LinuxCNC closed the servo stream after cycle " + std::to_string(reader.stats().last_number) +
+             " (LinuxCNC stopped or eical-halsampler exited)");
       break;
     }
     release(false);

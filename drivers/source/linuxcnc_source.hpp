@@ -40,11 +40,11 @@ namespace eical::drivers {
 struct LinuxcncSourceOptions {
   std::filesystem::path fifo = "/run/eical/linuxcnc-servo.fifo";
   WindowedSimOptions window;
-  bool drive_from_feedback = false;   // feedback (LinuxCNC's plant) instead of the command drives the machine
-  double connect_timeout_s = 10.0;    // open(): first servo line within this time, else "LinuxCNC absent"
-  double stall_timeout_s = 2.0;       // no line for this long while streaming: the source fails
-  double hold_s = 1.0;                // frames are released this long after their servo cycle (DDS trigger latency)
-  std::size_t max_fill_cycles = 1000; // lost cycles up to this many are interpolated; more fail the source
+  bool drive_from_feedback = false;    // feedback (LinuxCNC's plant) instead of the command drives the machine
+  double connect_timeout_s = 10.0;     // open(): first servo line within this time, else "LinuxCNC absent"
+  double stall_timeout_s = 2.0;        // no line for this long while streaming: the source fails
+  double hold_s = 1.0;                 // frames are released this long after their servo cycle (DDS trigger latency)
+  std::size_t max_fill_cycles = 1000;  // lost cycles up to this many are interpolated; more fail the source
   std::size_t ring_frames = 1u << 16;
 };
 
@@ -52,10 +52,10 @@ struct LinuxcncSourceOptions {
 struct LinuxcncStreamStats {
   std::uint64_t lines = 0, lost_cycles = 0, overrun_lines = 0, dropped_frames = 0, blocks = 0;
   std::int64_t first_number = -1;
-  std::int64_t clock_offset_ns = 0;     // CLOCK_MONOTONIC of servo cycle 0 (SampleClock)
+  std::int64_t clock_offset_ns = 0;                // CLOCK_MONOTONIC of servo cycle 0 (SampleClock)
   double mean_delay_ms = 0.0, max_delay_ms = 0.0;  // lines behind their cycle
-  double max_block_sim_ms = 0.0;        // longest simulation of one block
-  double max_following_error_mm = 0.0;  // |cmd − fb| largest seen
+  double max_block_sim_ms = 0.0;                   // longest simulation of one block
+  double max_following_error_mm = 0.0;             // |cmd − fb| largest seen
 };
 
 class LinuxcncSource final : public Source {
@@ -105,7 +105,7 @@ class LinuxcncSource final : public Source {
   std::unique_ptr<ServoStreamReader> reader_;
   std::atomic<bool> failed_{false};
   std::atomic<std::int64_t> first_number_{-1};
-  int ratio_ = 10;  // frames per servo cycle
+  int ratio_ = 10;         // frames per servo cycle
   mutable std::mutex mu_;  // error_ and the first line (failure and start only, never per sample)
   std::condition_variable cv_;
   bool first_line_ = false;

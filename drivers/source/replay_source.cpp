@@ -24,9 +24,9 @@ std::size_t ReplaySource::read(std::span<dsp::Frame> out) {
     // Release frames when their sample time has come, as a DAQ delivering blocks would.
     const double fs_hz = run_->meta.acquisition.fs_hz;
     const auto first_index = run_->frames[next_].sample_index - run_->frames.front().sample_index;
-    const auto last_due = start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                       std::chrono::duration<double>(
-                                           static_cast<double>(first_index + static_cast<std::int64_t>(n)) / fs_hz));
+    const auto last_due =
+        start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(
+                     static_cast<double>(first_index + static_cast<std::int64_t>(n)) / fs_hz));
     std::this_thread::sleep_until(last_due);
   }
   std::copy_n(run_->frames.begin() + static_cast<std::ptrdiff_t>(next_), n, out.begin());

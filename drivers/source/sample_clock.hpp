@@ -53,7 +53,9 @@ class SampleClock {
   [[nodiscard]] std::int64_t offset_ns() const noexcept { return offset_ns_.load(std::memory_order_acquire); }
   [[nodiscard]] double period_ns() const noexcept { return period_ns_; }
   // Observer thread only: how late samples arrived behind their time.
-  [[nodiscard]] double mean_delay_ms() const noexcept { return observed_ ? delay_sum_ns_ / static_cast<double>(observed_) * 1e-6 : 0.0; }
+  [[nodiscard]] double mean_delay_ms() const noexcept {
+    return observed_ ? delay_sum_ns_ / static_cast<double>(observed_) * 1e-6 : 0.0;
+  }
   [[nodiscard]] double max_delay_ms() const noexcept { return static_cast<double>(max_delay_ns_) * 1e-6; }
 
   static constexpr std::int64_t kNone = std::numeric_limits<std::int64_t>::max();

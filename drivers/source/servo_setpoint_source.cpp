@@ -21,7 +21,8 @@ ServoSetPointSource::ServoSetPointSource(std::unique_ptr<Source> sensors, ServoS
       name_(std::string(sensors_->name()) + "+servo"),
       reader_(options_.stream),
       // 2 s windows of samples for the DAQ's minimum filter (as the servo clock's 2000 cycles).
-      daq_clock_(1.0 / sensors_->meta().acquisition.fs_hz, static_cast<std::int64_t>(2.0 * sensors_->meta().acquisition.fs_hz)),
+      daq_clock_(1.0 / sensors_->meta().acquisition.fs_hz,
+                 static_cast<std::int64_t>(2.0 * sensors_->meta().acquisition.fs_hz)),
       held_(held_capacity(*sensors_, options_.hold_s)) {}
 
 ServoSetPointSource::~ServoSetPointSource() { stop_feed(); }
@@ -70,7 +71,8 @@ void ServoSetPointSource::feed() {
       if (s == S::data || s == S::timeout) continue;
       if (s == S::woken) return;
       // The writer went away or the stream broke: a new stream starts with new numbers.
-      (void)notes_.push_or_drop({s == S::closed ? FeedEvent::closed : FeedEvent::malformed, reader_.stats().last_number});
+      (void)notes_.push_or_drop(
+          {s == S::closed ? FeedEvent::closed : FeedEvent::malformed, reader_.stats().last_number});
       restart = true;
       if (s == S::error) {
         reader_.restart();  // keep the pipe: closing it would break LinuxCNC's writer
@@ -138,7 +140,8 @@ std::size_t ServoSetPointSource::read(std::span<dsp::Frame> out) {
   // History older than the oldest frame still waiting is no longer needed.
   const double oldest = held_.empty() ? reader_.clock().number_at(now - hold_ns)
                                       : reader_.clock().number_at(daq_clock_.time_ns(held_.front().sample_index));
-  while (std::isfinite(oldest) && history_.size() > 2 && static_cast<double>(history_.at(1).number) < oldest - 2.0) history_.pop();
+  while (std::isfinite(oldest) && history_.size() > 2 && static_cast<double>(history_.at(1).number) < oldest - 2.0)
+    history_.pop();
   return released;
 }
 
@@ -156,9 +159,16 @@ void ServoSetPointSource::drain_diagnostics(const std::function<void(const std::
   while (notes_.try_pop(n)) {
     const std::string pipe = options_.stream.fifo.string();
     switch (n.event) {
-      case FeedEvent::connected: sink("setpoint: servo stream on " + pipe + " connected at cycle " + std::to_string(n.cycle)); break;
-      case FeedEvent::closed: sink("setpoint: servo stream on " + pipe + " closed after cycle " + std::to_string(n.cycle) + "; waiting for LinuxCNC"); break;
-      case FeedEvent::malformed: sink("setpoint: servo stream on " + pipe + " broken after cycle " + std::to_string(n.cycle) + "; restarted"); break;
+      case FeedEvent::connected:
+        sink("setpoint: servo stream on " + pipe + " connected at cycle " + std::to_string(n.cycle));
+        break;
+      case FeedEvent::closed:
+        sink("setpoint: servo stream on " + pipe + " closed after cycle " + std::to_string(n.cycle) +
+             "; waiting for LinuxCNC");
+        break;
+      case FeedEvent::malformed:
+        sink("setpoint: servo stream on " + pipe + " broken after cycle " + std::to_string(n.cycle) + "; restarted");
+        break;
       case FeedEvent::cannot_open: sink("setpoint: cannot open the servo stream pipe " + pipe + "; retrying"); break;
     }
   }

@@ -30,8 +30,8 @@ namespace eical::drivers {
 
 struct ServoSetPointOptions {
   ServoStreamOptions stream;
-  double hold_s = 1.0;          // frames leave this long after their sample time
-  double reopen_s = 1.0;        // the pipe is reopened this often while it cannot be opened
+  double hold_s = 1.0;    // frames leave this long after their sample time
+  double reopen_s = 1.0;  // the pipe is reopened this often while it cannot be opened
 };
 
 // The two clocks' relation: what a recording writes as its set-point alignment.
@@ -39,7 +39,7 @@ struct ServoAlignment {
   bool known = false;
   double servo_cycle_at_sample0 = 0.0;  // fractional servo cycle number at DAQ sample 0
   double servo_rate_hz = 1000.0;
-  double daq_delay_ms = 0.0;            // mean lateness of DAQ blocks behind their last sample
+  double daq_delay_ms = 0.0;  // mean lateness of DAQ blocks behind their last sample
 };
 
 class ServoSetPointSource final : public Source {
@@ -55,7 +55,9 @@ class ServoSetPointSource final : public Source {
   [[nodiscard]] bool at_end() const override { return sensors_->at_end() && held_.empty(); }
   [[nodiscard]] std::string_view name() const override { return name_; }
   [[nodiscard]] Backpressure backpressure() const override { return sensors_->backpressure(); }
-  [[nodiscard]] std::int64_t sample_time_ns(std::int64_t sample_index) const override { return daq_clock_.time_ns(sample_index); }
+  [[nodiscard]] std::int64_t sample_time_ns(std::int64_t sample_index) const override {
+    return daq_clock_.time_ns(sample_index);
+  }
   [[nodiscard]] SourceCounters counters() const override;
   void drain_diagnostics(const std::function<void(const std::string&)>& sink) override;
 

@@ -46,7 +46,8 @@ std::optional<ServoLine> parse_servo_line(std::string_view line, std::string& er
   }
   const std::string_view m = next_field(rest);
   if (!parse_number(m, s.marker)) {
-    error = "column 8 (mcode-marker, u32) is not an unsigned integer: '" + std::string(m) + "' (expected sampler cfg=ffffffu)";
+    error = "column 8 (mcode-marker, u32) is not an unsigned integer: '" + std::string(m) +
+            "' (expected sampler cfg=ffffffu)";
     return std::nullopt;
   }
   if (!next_field(rest).empty()) {

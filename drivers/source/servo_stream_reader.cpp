@@ -3,13 +3,13 @@
 #include "drivers/source/source.hpp"
 #include "drivers/source/stamped_source.hpp"
 
-#include <cerrno>
-#include <cstring>
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/eventfd.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <cerrno>
+#include <cstring>
 
 namespace eical::drivers {
 
@@ -27,7 +27,7 @@ ServoStreamReader::~ServoStreamReader() {
 void ServoStreamReader::open() {
   close();
   const std::string path = options_.fifo.string();
-  struct stat st{};
+  struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     if (errno != ENOENT) throw SourceError("linuxcnc: " + path + ": " + std::strerror(errno));
     std::error_code ec;
@@ -96,7 +96,8 @@ ServoStreamReader::Status ServoStreamReader::wait_and_read(int timeout_ms) {
 ServoStreamReader::LineResult ServoStreamReader::take_line(std::string_view line, ServoCycle& out, int& n_fill) {
   const auto parsed = parse_servo_line(line, error_);
   if (!parsed) {
-    error_ = "malformed servo line " + std::to_string(stats_.lines + 1) + ": " + error_ + " in '" + std::string(line.substr(0, 120)) + "'";
+    error_ = "malformed servo line " + std::to_string(stats_.lines + 1) + ": " + error_ + " in '" +
+             std::string(line.substr(0, 120)) + "'";
     return LineResult::bad;
   }
   ++stats_.lines;
@@ -112,8 +113,8 @@ ServoStreamReader::LineResult ServoStreamReader::take_line(std::string_view line
   n_fill = 0;
   if (stats_.last_number >= 0) {
     if (s.number <= stats_.last_number) {
-      error_ = "servo cycle numbers went back from " + std::to_string(stats_.last_number) + " to " + std::to_string(s.number) +
-               " (LinuxCNC restarted?)";
+      error_ = "servo cycle numbers went back from " + std::to_string(stats_.last_number) + " to " +
+               std::to_string(s.number) + " (LinuxCNC restarted?)";
       return LineResult::bad;
     }
     if (s.number > stats_.last_number + 1) {

@@ -39,11 +39,11 @@ struct ServoStreamStats {
 class ServoStreamReader {
  public:
   enum class Status {
-    data,      // lines were read (possibly only part of one)
-    timeout,   // nothing within the timeout
-    closed,    // the writer closed the pipe (LinuxCNC stopped or eical-halsampler exited)
-    woken,     // wake() was called
-    error,     // malformed or inconsistent stream: error() says why
+    data,     // lines were read (possibly only part of one)
+    timeout,  // nothing within the timeout
+    closed,   // the writer closed the pipe (LinuxCNC stopped or eical-halsampler exited)
+    woken,    // wake() was called
+    error,    // malformed or inconsistent stream: error() says why
   };
 
   explicit ServoStreamReader(ServoStreamOptions options);

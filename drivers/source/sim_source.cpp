@@ -8,7 +8,8 @@
 
 namespace eical::drivers {
 
-SimSource::SimSource(sim::Scenario scenario, SimSourceOptions options) : scenario_(std::move(scenario)), options_(options) {
+SimSource::SimSource(sim::Scenario scenario, SimSourceOptions options)
+    : scenario_(std::move(scenario)), options_(options) {
   run_ = std::make_shared<const dsp::Run>(sim::simulate(scenario_));
   const double fs = run_->meta.acquisition.fs_hz;
   idle_frames_ = options_.repeat ? static_cast<std::size_t>(std::llround(options_.idle_s * fs)) : 0;
@@ -43,8 +44,10 @@ std::size_t SimSource::read(std::span<dsp::Frame> out) {
     f.sample_index = next_index_++;
     out[n++] = f;
     if (++pos_ == n_prog + idle_frames_) {
-      if (options_.repeat) pos_ = 0;
-      else finished_ = true;
+      if (options_.repeat)
+        pos_ = 0;
+      else
+        finished_ = true;
     }
   }
   if (options_.pacing == Pacing::realtime && n > 0) {

@@ -37,10 +37,10 @@ class SimSource final : public Source {
   sim::Scenario scenario_;
   SimSourceOptions options_;
   std::shared_ptr<const dsp::Run> run_;
-  std::size_t pos_ = 0;           // position within program + idle cycle
-  std::size_t idle_frames_ = 0;   // idle frames after each program pass
-  std::size_t rest_frames_ = 0;   // rest frames at the program's start, cycled while idle
-  std::int64_t next_index_ = 0;   // sample index of the next frame
+  std::size_t pos_ = 0;          // position within program + idle cycle
+  std::size_t idle_frames_ = 0;  // idle frames after each program pass
+  std::size_t rest_frames_ = 0;  // rest frames at the program's start, cycled while idle
+  std::int64_t next_index_ = 0;  // sample index of the next frame
   bool finished_ = false;
   std::chrono::steady_clock::time_point start_{};
 };

@@ -43,9 +43,13 @@ class StampedSource final : public Source {
   [[nodiscard]] bool at_end() const override { return inner_->at_end(); }
   [[nodiscard]] std::string_view name() const override { return inner_->name(); }
   [[nodiscard]] Backpressure backpressure() const override { return inner_->backpressure(); }
-  [[nodiscard]] std::int64_t sample_time_ns(std::int64_t sample_index) const override { return inner_->sample_time_ns(sample_index); }
+  [[nodiscard]] std::int64_t sample_time_ns(std::int64_t sample_index) const override {
+    return inner_->sample_time_ns(sample_index);
+  }
   [[nodiscard]] SourceCounters counters() const override { return inner_->counters(); }
-  void drain_diagnostics(const std::function<void(const std::string&)>& sink) override { inner_->drain_diagnostics(sink); }
+  void drain_diagnostics(const std::function<void(const std::string&)>& sink) override {
+    inner_->drain_diagnostics(sink);
+  }
   // Stamps dropped because the DSP thread fell far behind (their frames then map by the
   // last stamp seen).
   [[nodiscard]] std::uint64_t stamp_overruns() const noexcept { return stamps_.overruns(); }

@@ -31,14 +31,16 @@ std::string stateful_effects(const sim::Scenario& sc, double history_s) {
       add(std::string("reversal spike on ") + axis + " (decays over 12 tau, longer than history)");
     const auto& sv = sc.machine.servo[a];
     // The loop forgets the window's start as exp(−Kv t): 8/Kv leaves 3e-4 of it.
-    if (sv.kv_per_s > 0.0 && sv.kv_per_s * history_s < 8.0) add(std::string("servo on ") + axis + " slower than the history (needs history >= 8/Kv)");
+    if (sv.kv_per_s > 0.0 && sv.kv_per_s * history_s < 8.0)
+      add(std::string("servo on ") + axis + " slower than the history (needs history >= 8/Kv)");
   }
   return out;
 }
 
 }  // namespace
 
-WindowedSim::WindowedSim(sim::Scenario scenario, WindowedSimOptions options) : scenario_(std::move(scenario)), options_(options) {
+WindowedSim::WindowedSim(sim::Scenario scenario, WindowedSimOptions options)
+    : scenario_(std::move(scenario)), options_(options) {
   const double fs = scenario_.meta.acquisition.fs_hz;
   const double r = fs / options_.servo_rate_hz;
   if (!(options_.servo_rate_hz > 0.0) || r < 1.0 || std::abs(r - std::round(r)) > 1e-9)
@@ -47,9 +49,11 @@ WindowedSim::WindowedSim(sim::Scenario scenario, WindowedSimOptions options) : s
   ratio_ = static_cast<int>(std::lround(r));
   if (options_.block_cycles < 10) throw SourceError("linuxcnc: block must be at least 10 servo cycles");
   if (options_.prefix_cycles < 12) throw SourceError("linuxcnc: the approach prefix needs at least 12 servo cycles");
-  const std::string bad = stateful_effects(scenario_, static_cast<double>(options_.history_cycles) / options_.servo_rate_hz);
+  const std::string bad =
+      stateful_effects(scenario_, static_cast<double>(options_.history_cycles) / options_.servo_rate_hz);
   if (!bad.empty())
-    throw SourceError("linuxcnc: the block-wise simulation cannot continue these scenario effects across blocks: " + bad);
+    throw SourceError("linuxcnc: the block-wise simulation cannot continue these scenario effects across blocks: " +
+                      bad);
   hist_.reserve(options_.history_cycles + 2 * (options_.block_cycles + options_.lookahead_cycles));
   filled_.reserve(hist_.capacity());
   cmd_.reserve(hist_.capacity());
@@ -66,7 +70,7 @@ void WindowedSim::push(const Eigen::Vector3d& drive_mm, const Eigen::Vector3d& c
 std::size_t WindowedSim::simulate_block(std::span<dsp::Frame> out, bool flush) {
   const std::size_t block = flush ? (pending_ > 0 ? pending_ : 0) : options_.block_cycles;
   if (block == 0 || (!flush && !block_ready()) || hist_.size() < 2) return 0;
-  const std::size_t n_hist = hist_.size() - pending_;    // already emitted cycles kept as history
+  const std::size_t n_hist = hist_.size() - pending_;  // already emitted cycles kept as history
   const std::size_t lookahead = flush ? 0 : pending_ - block;
 
   // Prefix: hold short of the first position, then a smooth approach in the last direction.
@@ -89,7 +93,7 @@ std::size_t WindowedSim::simulate_block(std::span<dsp::Frame> out, bool flush) {
 
   // Frames after the last emitted cycle up to the block's last cycle. Cycle j of the
   // window sits on frame j·ratio.
-  const std::size_t first_cycle = np + n_hist;            // first cycle of the block in window_
+  const std::size_t first_cycle = np + n_hist;  // first cycle of the block in window_
   const std::size_t last_cycle = first_cycle + block - 1;
   const std::size_t r = static_cast<std::size_t>(ratio_);
   std::size_t from = (first_cycle - 1) * r + 1, to = last_cycle * r;  // inclusive

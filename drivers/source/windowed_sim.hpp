@@ -59,15 +59,15 @@ class WindowedSim {
  private:
   sim::Scenario scenario_;
   WindowedSimOptions options_;
-  int ratio_ = 10;                        // DAQ frames per servo cycle
-  std::vector<Eigen::Vector3d> hist_;     // history + pending cycles (drive positions)
-  std::vector<Eigen::Vector3d> cmd_;      // the commanded positions of the same cycles
-  std::vector<char> filled_;              // per entry of hist_
-  std::size_t pending_ = 0;               // cycles of hist_ not yet emitted
-  std::int64_t emitted_cycles_ = 0;       // servo cycles whose frames went out
-  int dir_[3] = {1, 1, 1};                // last direction of each axis before hist_[0]
+  int ratio_ = 10;                     // DAQ frames per servo cycle
+  std::vector<Eigen::Vector3d> hist_;  // history + pending cycles (drive positions)
+  std::vector<Eigen::Vector3d> cmd_;   // the commanded positions of the same cycles
+  std::vector<char> filled_;           // per entry of hist_
+  std::size_t pending_ = 0;            // cycles of hist_ not yet emitted
+  std::int64_t emitted_cycles_ = 0;    // servo cycles whose frames went out
+  int dir_[3] = {1, 1, 1};             // last direction of each axis before hist_[0]
   std::uint64_t blocks_ = 0;
-  std::vector<Eigen::Vector3d> window_;   // reused window positions
+  std::vector<Eigen::Vector3d> window_;  // reused window positions
 };
 
 }  // namespace eical::drivers

@@ -2,15 +2,15 @@
 
 #include "drivers/source/stamped_source.hpp"
 
-#include <algorithm>
-#include <cerrno>
-#include <cstring>
 #include <fcntl.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
 
 namespace eical::drivers {
 namespace {
@@ -62,7 +62,7 @@ void DaqStreamSource::open() {
   close();
   frames_.reset();
   const std::string path = options_.path.string();
-  struct stat st{};
+  struct stat st {};
   const bool exists = ::stat(path.c_str(), &st) == 0;
   if (exists && S_ISSOCK(st.st_mode)) {
     fd_ = open_socket(path);
@@ -77,8 +77,8 @@ void DaqStreamSource::open() {
     if (left_ms <= 0 || !pull(static_cast<int>(std::min<std::int64_t>(left_ms, kReadWaitMs)))) {
       if (monotonic_ns() < deadline) continue;
       close();
-      throw SourceError("daq_stream: no DAQ packets on " + path + " within " + std::to_string(options_.connect_timeout_s) +
-                        " s (is the DAQ or its bridge writing it?)");
+      throw SourceError("daq_stream: no DAQ packets on " + path + " within " +
+                        std::to_string(options_.connect_timeout_s) + " s (is the DAQ or its bridge writing it?)");
     }
   }
   last_data_ns_ = monotonic_ns();
@@ -105,8 +105,10 @@ std::size_t DaqStreamSource::read(std::span<dsp::Frame> out) {
   if (frames_.size() < out.size()) {
     if (pull(frames_.size() > 0 ? 0 : kReadWaitMs)) {
       last_data_ns_ = monotonic_ns();
-    } else if (frames_.size() == 0 && monotonic_ns() - last_data_ns_ > static_cast<std::int64_t>(options_.stall_timeout_s * 1e9)) {
-      throw SourceError("daq_stream: no data for " + std::to_string(options_.stall_timeout_s) + " s on " + options_.path.string());
+    } else if (frames_.size() == 0 &&
+               monotonic_ns() - last_data_ns_ > static_cast<std::int64_t>(options_.stall_timeout_s * 1e9)) {
+      throw SourceError("daq_stream: no data for " + std::to_string(options_.stall_timeout_s) + " s on " +
+                        options_.path.string());
     }
   }
   return frames_.pop(out);

@@ -26,13 +26,16 @@ void put_crc(std::vector<std::uint8_t>& p, std::size_t packet_start) {
 
 FrameEncoder::FrameEncoder(int psd_count, int samples_per_packet, int slow_every)
     : channels_(dsp::kAccelChannels + 2 * psd_count), per_packet_(samples_per_packet), slow_every_(slow_every) {
-  if (psd_count < 0 || psd_count > dsp::kMaxPsd) throw std::invalid_argument("FrameEncoder: psd_count must be within 0..4");
-  if (samples_per_packet < 1 || samples_per_packet > kMaxSamplesPerPacket) throw std::invalid_argument("FrameEncoder: 1..64 samples per packet");
+  if (psd_count < 0 || psd_count > dsp::kMaxPsd)
+    throw std::invalid_argument("FrameEncoder: psd_count must be within 0..4");
+  if (samples_per_packet < 1 || samples_per_packet > kMaxSamplesPerPacket)
+    throw std::invalid_argument("FrameEncoder: 1..64 samples per packet");
 }
 
 void FrameEncoder::samples_packet(std::span<const dsp::Frame> frames, std::vector<std::uint8_t>& out) const {
   const std::size_t start = out.size();
-  out.insert(out.end(), {kSync0, kSync1, kVersion, kTypeSamples, static_cast<std::uint8_t>(channels_), static_cast<std::uint8_t>(frames.size())});
+  out.insert(out.end(), {kSync0, kSync1, kVersion, kTypeSamples, static_cast<std::uint8_t>(channels_),
+                         static_cast<std::uint8_t>(frames.size())});
   put_u32(out, static_cast<std::uint32_t>(frames.front().sample_index));
   for (const auto& f : frames) {
     std::uint8_t status = 0;

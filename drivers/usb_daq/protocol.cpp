@@ -7,12 +7,13 @@ namespace eical::drivers::usb_daq {
 namespace {
 
 std::uint32_t u32(const std::uint8_t* p) {
-  return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 | static_cast<std::uint32_t>(p[2]) << 16 |
-         static_cast<std::uint32_t>(p[3]) << 24;
+  return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+         static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
 }
 
 std::int32_t s24(const std::uint8_t* p) {
-  const std::uint32_t v = static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 | static_cast<std::uint32_t>(p[2]) << 16;
+  const std::uint32_t v =
+      static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 | static_cast<std::uint32_t>(p[2]) << 16;
   return static_cast<std::int32_t>(v << 8) >> 8;  // sign-extend 24 → 32 bits
 }
 
@@ -64,9 +65,10 @@ Decoder::Step Decoder::parse_one(dsp::Frame* out, int& n) noexcept {
     }
     if (fill_ < kHeader) return Step::need_more;
     const std::uint8_t version = buf_[2], type = buf_[3], channels = buf_[4], samples = buf_[5];
-    const std::size_t payload = type == kTypeSamples ? static_cast<std::size_t>(samples) * (1 + 3 * static_cast<std::size_t>(channels))
-                                : type == kTypeSlow  ? kSlowPayload
-                                                     : 0;
+    const std::size_t payload = type == kTypeSamples
+                                    ? static_cast<std::size_t>(samples) * (1 + 3 * static_cast<std::size_t>(channels))
+                                : type == kTypeSlow ? kSlowPayload
+                                                    : 0;
     if (version != kVersion || payload == 0 || samples > kMaxSamplesPerPacket || channels > kMaxChannels) {
       ++stats_.unknown_packets;
       drop(2);  // not a packet we understand: look for the next sync
@@ -89,7 +91,8 @@ Decoder::Step Decoder::parse_one(dsp::Frame* out, int& n) noexcept {
       if (p[4] != 0) {
         // Latched at `seq`: unwrapped against the samples seen so far.
         pending_trigger_ = p[4];
-        pending_trigger_index_ = have_seq_ ? next_index_ + static_cast<std::int32_t>(seq - next_seq_) : static_cast<std::int64_t>(seq);
+        pending_trigger_index_ =
+            have_seq_ ? next_index_ + static_cast<std::int32_t>(seq - next_seq_) : static_cast<std::int64_t>(seq);
       }
       drop(total);
       n = 0;
@@ -121,7 +124,8 @@ Decoder::Step Decoder::parse_one(dsp::Frame* out, int& n) noexcept {
       if (k == 0 && gap) f.flags |= dsp::frame_flag::gap_before;
       f.temp_c[0] = temp_c_[0], f.temp_c[1] = temp_c_[1];
       f.flags |= dsp::frame_flag::cmd_missing;  // the NC set-point comes from another source
-      if (pending_trigger_ && f.sample_index >= pending_trigger_index_) f.trigger = pending_trigger_, pending_trigger_ = 0;
+      if (pending_trigger_ && f.sample_index >= pending_trigger_index_)
+        f.trigger = pending_trigger_, pending_trigger_ = 0;
       ++stats_.frames;
     }
     next_seq_ = seq + samples;
@@ -132,15 +136,20 @@ Decoder::Step Decoder::parse_one(dsp::Frame* out, int& n) noexcept {
   }
 }
 
-std::vector<std::uint8_t> encode_samples(std::uint32_t seq, const std::vector<std::array<std::int32_t, 14>>& samples, int channels,
-                                         std::uint8_t status) {
-  std::vector<std::uint8_t> p = {kSync0, kSync1, kVersion, kTypeSamples, static_cast<std::uint8_t>(channels),
+std::vector<std::uint8_t> encode_samples(std::uint32_t seq, const std::vector<std::array<std::int32_t, 14>>& samples,
+                                         int channels, std::uint8_t status) {
+  std::vector<std::uint8_t> p = {kSync0,
+                                 kSync1,
+                                 kVersion,
+                                 kTypeSamples,
+                                 static_cast<std::uint8_t>(channels),
                                  static_cast<std::uint8_t>(samples.size())};
   for (int b = 0; b < 4; ++b) p.push_back(static_cast<std::uint8_t>(seq >> (8 * b)));
   for (const auto& s : samples) {
     p.push_back(status);
     for (int c = 0; c < channels; ++c)
-      for (int b = 0; b < 3; ++b) p.push_back(static_cast<std::uint8_t>(static_cast<std::uint32_t>(s[static_cast<std::size_t>(c)]) >> (8 * b)));
+      for (int b = 0; b < 3; ++b)
+        p.push_back(static_cast<std::uint8_t>(static_cast<std::uint32_t>(s[static_cast<std::size_t>(c)]) >> (8 * b)));
   }
   put_crc(p);
   return p;

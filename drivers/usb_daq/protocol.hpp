@@ -81,7 +81,8 @@ class Decoder {
 };
 
 // The firmware side, for tests and the device simulator: one samples packet.
-std::vector<std::uint8_t> encode_samples(std::uint32_t sequence, const std::vector<std::array<std::int32_t, 14>>& samples, int channels,
+std::vector<std::uint8_t> encode_samples(std::uint32_t sequence,
+                                         const std::vector<std::array<std::int32_t, 14>>& samples, int channels,
                                          std::uint8_t status = 0);
 std::vector<std::uint8_t> encode_slow(std::uint32_t sequence, float temp_table_c, float temp_head_c, int trigger);
 

@@ -11,8 +11,7 @@ UsbDaqOptions parse_usb_id(const std::string& id) {
   UsbDaqOptions o;
   const auto colon = id.find(':');
   unsigned v = 0, p = 0;
-  const bool ok = colon == 4 && id.size() == 9 &&
-                  std::from_chars(id.data(), id.data() + 4, v, 16).ec == std::errc() &&
+  const bool ok = colon == 4 && id.size() == 9 && std::from_chars(id.data(), id.data() + 4, v, 16).ec == std::errc() &&
                   std::from_chars(id.data() + 5, id.data() + 9, p, 16).ec == std::errc();
   if (!ok) throw SourceError("usb_daq: USB id '" + id + "' is not vendor:product in hex (e.g. 1d50:6161)");
   o.vendor_id = static_cast<std::uint16_t>(v);
@@ -48,7 +47,8 @@ void UsbDaqSource::open() {
   close();  // a reopen (after the DAQ failed) starts from scratch
   frames_.reset();
   error_ = 0;
-  if (const int rc = libusb_init(&ctx_); rc != 0) throw SourceError(std::string("usb_daq: libusb_init failed: ") + libusb_error_name(rc));
+  if (const int rc = libusb_init(&ctx_); rc != 0)
+    throw SourceError(std::string("usb_daq: libusb_init failed: ") + libusb_error_name(rc));
   libusb_device** list = nullptr;
   const ssize_t n = libusb_get_device_list(ctx_, &list);
   if (n >= 0) libusb_free_device_list(list, 1);
@@ -67,7 +67,8 @@ void UsbDaqSource::open() {
     if (!t) throw SourceError("usb_daq: cannot allocate a USB transfer");
     transfers_.push_back(t);
     // No timeout on the transfer itself: read() bounds its wait instead.
-    libusb_fill_bulk_transfer(t, handle_, options_.endpoint, buffers_.back().data(), options_.transfer_bytes, &UsbDaqSource::on_transfer, this, 0);
+    libusb_fill_bulk_transfer(t, handle_, options_.endpoint, buffers_.back().data(), options_.transfer_bytes,
+                              &UsbDaqSource::on_transfer, this, 0);
     if (const int rc = libusb_submit_transfer(t); rc != 0)
       throw SourceError(std::string("usb_daq: cannot start reading the DAQ: ") + libusb_error_name(rc));
     ++in_flight_;
@@ -92,7 +93,8 @@ std::size_t UsbDaqSource::read(std::span<dsp::Frame> out) {
     if (rc != 0 && rc != LIBUSB_ERROR_INTERRUPTED) throw SourceError(std::string("usb_daq: ") + libusb_error_name(rc));
     publish_counters();
     // libusb_error_name also names transfer states (LIBUSB_TRANSFER_NO_DEVICE, ...).
-    if (error_ != 0 && frames_.size() == 0) throw SourceError(std::string("usb_daq: bulk transfer failed: ") + libusb_error_name(error_));
+    if (error_ != 0 && frames_.size() == 0)
+      throw SourceError(std::string("usb_daq: bulk transfer failed: ") + libusb_error_name(error_));
   }
   return frames_.pop(out);
 }

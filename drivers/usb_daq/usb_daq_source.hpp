@@ -11,8 +11,8 @@
 
 #include <atomic>
 #include <cstdint>
-#include <vector>
 #include <string>
+#include <vector>
 
 struct libusb_context;
 struct libusb_device_handle;
@@ -23,8 +23,8 @@ namespace eical::drivers {
 struct UsbDaqOptions {
   std::uint16_t vendor_id = 0x1d50, product_id = 0x6161;
   unsigned char endpoint = 0x81;
-  int timeout_ms = 200;      // read() waits at most this long for a transfer to complete
-  int transfers = 4;         // kept in flight: the DAQ never waits for the host
+  int timeout_ms = 200;  // read() waits at most this long for a transfer to complete
+  int transfers = 4;     // kept in flight: the DAQ never waits for the host
   int transfer_bytes = 16384;
 };
 

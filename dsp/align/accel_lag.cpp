@@ -47,7 +47,8 @@ Eigen::Vector3d at_fraction(const std::vector<Eigen::Vector3d>& x, double pos) {
 
 std::vector<Eigen::Vector3d> measured_accel_mps2(const Run& run) {
   const auto& m = run.meta;
-  const StaticComp comp[2] = {StaticComp(m.sensors[0], m.acquisition, m.site), StaticComp(m.sensors[1], m.acquisition, m.site)};
+  const StaticComp comp[2] = {StaticComp(m.sensors[0], m.acquisition, m.site),
+                              StaticComp(m.sensors[1], m.acquisition, m.site)};
   const std::size_t n = run.frames.size();
   std::vector<Eigen::Vector3d> raw(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -74,8 +75,8 @@ std::vector<Eigen::Vector3d> setpoint_accel_mps2(const std::vector<Eigen::Vector
   return a;
 }
 
-LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_in, const std::vector<Eigen::Vector3d>& meas_in, double fs_hz,
-                         const LagOptions& o) {
+LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_in, const std::vector<Eigen::Vector3d>& meas_in,
+                         double fs_hz, const LagOptions& o) {
   LagEstimate r;
   const std::size_t d = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fs_hz / o.rate_hz)));
   const double rate = fs_hz / static_cast<double>(d);

@@ -42,7 +42,7 @@ struct LagOptions {
 };
 
 // cmd and meas on one sample clock (fs_hz), same length.
-LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_mps2, const std::vector<Eigen::Vector3d>& meas_mps2, double fs_hz,
-                         const LagOptions& options = {});
+LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_mps2, const std::vector<Eigen::Vector3d>& meas_mps2,
+                         double fs_hz, const LagOptions& options = {});
 
 }  // namespace eical::dsp::align

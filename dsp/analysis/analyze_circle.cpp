@@ -55,10 +55,12 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
     if (t.code == trigger::segment_mark) marks.push_back(t.sample_index);
   Ranges ccw, cw;
   try {
-    for (const auto& s : eval::find_circle_segments(cmd, m.sample_index, marks, {p.center_mm[0], p.center_mm[1]}, p.arc_deg))
+    for (const auto& s :
+         eval::find_circle_segments(cmd, m.sample_index, marks, {p.center_mm[0], p.center_mm[1]}, p.arc_deg))
       (s.direction == "ccw" ? ccw : cw).emplace_back(s.begin_index, s.end_index);
     if (ccw.empty() && cw.empty())
-      throw InputError("no stretch between two M102 marks sweeps the programmed " + std::to_string(p.arc_deg) + " deg about the programmed centre");
+      throw InputError("no stretch between two M102 marks sweeps the programmed " + std::to_string(p.arc_deg) +
+                       " deg about the programmed centre");
     a.circle = evaluate_channel(p, m.sample_index, pos, ccw, cw);
   } catch (const InputError& e) {
     a.flags.push_back(std::string("circle: ") + e.what());
@@ -66,9 +68,11 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
     return;
   }
   if (p.direction == "both" && (ccw.empty() || cw.empty()))
-    a.flags.push_back(std::string("circle: the program runs both directions but only ") + (ccw.empty() ? "cw" : "ccw") + " was found");
+    a.flags.push_back(std::string("circle: the program runs both directions but only ") + (ccw.empty() ? "cw" : "ccw") +
+                      " was found");
   if (!a.circle->circular_hysteresis_H_um)
-    a.flags.push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions (this run has " + a.circle->direction + " only)");
+    a.flags.push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions (this run has " +
+                      a.circle->direction + " only)");
 
   // The reference instrument (or the simulator's truth) through the same evaluation.
   if (ref_finite && !ref.empty()) {
@@ -113,7 +117,9 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
   try {
     a.diagnostics = eval::diagnose_circle(passes, opt);
     if (!a.diagnostics->servo_and_squareness_separated)
-      a.flags.push_back("diagnostics.servo_mismatch_ms: null, one direction cannot separate servo mismatch from squareness (squareness assumes equal lags)");
+      a.flags.push_back(
+          "diagnostics.servo_mismatch_ms: null, one direction cannot separate servo mismatch from squareness "
+          "(squareness assumes equal lags)");
   } catch (const InputError& e) {
     a.flags.push_back(std::string("diagnostics: null, ") + e.what());
   }

@@ -43,7 +43,8 @@ void evaluate_step_program(const Run& run, Analysis& a) {
     bool repeat = false;
     for (std::size_t i = 0; i < mv.size(); ++i)
       for (std::size_t k = i + 1; k < mv.size(); ++k)
-        repeat |= std::abs(mv[i].to_mm - mv[k].to_mm) < 1e-6 && (mv[i].to_mm > mv[i].from_mm) == (mv[k].to_mm > mv[k].from_mm);
+        repeat |= std::abs(mv[i].to_mm - mv[k].to_mm) < 1e-6 &&
+                  (mv[i].to_mm > mv[i].from_mm) == (mv[k].to_mm > mv[k].from_mm);
     if (!repeat) a.flags.push_back("step.scatter_um: null, no target was approached twice from the same side");
   } catch (const InputError& e) {
     a.flags.push_back(std::string("step: ") + e.what());
@@ -58,8 +59,9 @@ void evaluate_positioning_program(const Run& run, Analysis& a) {
     // ISO 230-2:2014 clause 4.3.2: five runs per target and direction; fewer are evaluated
     // by the same formulas, but the figures are outside the standard (s from < 5 runs).
     if (a.positioning->runs < eval::kIso230_2Runs)
-      a.flags.push_back("positioning: " + std::to_string(a.positioning->runs) + " runs per target and direction, ISO 230-2 asks for " +
-                        std::to_string(eval::kIso230_2Runs) + ": evaluated by its formulas, outside the standard");
+      a.flags.push_back("positioning: " + std::to_string(a.positioning->runs) +
+                        " runs per target and direction, ISO 230-2 asks for " + std::to_string(eval::kIso230_2Runs) +
+                        ": evaluated by its formulas, outside the standard");
   } catch (const InputError& e) {
     a.flags.push_back(std::string("positioning: ") + e.what());
     a.degraded = true;
@@ -157,7 +159,8 @@ void evaluate_measurement(const Run& run, const PipelineConfig& cfg, const Analy
   // run-format.md, "No standstill": a double integral with nothing to hold it is no
   // position. Every positional figure is null with this reason (the verdict: not
   // measurable); eical explain compares such runs in acceleration against the set-point.
-  const std::string unsupported = a.measurement.sample_index.empty() ? std::string() : unsupported_integration(a.measurement);
+  const std::string unsupported =
+      a.measurement.sample_index.empty() ? std::string() : unsupported_integration(a.measurement);
   if (!unsupported.empty()) {
     a.flags.push_back(std::string(kPositionNullFlag) + unsupported);
     a.degraded = true;
@@ -177,12 +180,18 @@ void evaluate_measurement(const Run& run, const PipelineConfig& cfg, const Analy
 void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& options) {
   a.program_kind = run.meta.program.kind;
   const std::string& kind = run.meta.program.kind;
-  if (kind == "circle") detail::evaluate_circle_program(run, a, options);
-  else if (kind == "step") evaluate_step_program(run, a);
-  else if (kind == "positioning") evaluate_positioning_program(run, a);
-  else if (kind == "rectangle") detail::evaluate_rectangle_program(run, a);
-  else if (kind == "freeform") detail::evaluate_freeform_program(run, a);
-  else a.flags.push_back("program kind '" + kind + "': no evaluation in this version");
+  if (kind == "circle")
+    detail::evaluate_circle_program(run, a, options);
+  else if (kind == "step")
+    evaluate_step_program(run, a);
+  else if (kind == "positioning")
+    evaluate_positioning_program(run, a);
+  else if (kind == "rectangle")
+    detail::evaluate_rectangle_program(run, a);
+  else if (kind == "freeform")
+    detail::evaluate_freeform_program(run, a);
+  else
+    a.flags.push_back("program kind '" + kind + "': no evaluation in this version");
 }
 
 }  // namespace eical::dsp

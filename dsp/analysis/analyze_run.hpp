@@ -28,9 +28,9 @@ struct AnalysisOptions {
   DynamicComp dynamic = DynamicComp::two_stage;
   bool zupt = true;
   std::optional<bool> nbs;  // unset: on for rectangles (axis-parallel moves), off otherwise
-  bool coriolis = false;    // (3-6) Earth rate from [site]; real machines: on (simulated runs have it only when injected)
-  bool cupt = true;         // PSD strips as position fixes
-  bool keep_raw = false;    // Measurement::raw (identification, explain, the accuracy bound)
+  bool coriolis = false;  // (3-6) Earth rate from [site]; real machines: on (simulated runs have it only when injected)
+  bool cupt = true;       // PSD strips as position fixes
+  bool keep_raw = false;  // Measurement::raw (identification, explain, the accuracy bound)
   // What the sensors are compensated with beyond run.toml's [sensors.*] (cross terms of a
   // calibration file) and where that model came from: "datasheet", or the calibration's
   // method ("psd", "ref", "explain").
@@ -50,8 +50,8 @@ struct AnalysisOptions {
 // What the program's evaluation may leave out or fix (the uncertainty's draws re-evaluate
 // the same program many times on a perturbed path).
 struct EvaluationOptions {
-  bool reference = true;                   // also evaluate the reference channel
-  std::optional<double> cyclic_pitch_mm;   // diagnostics: this pitch instead of the search
+  bool reference = true;                  // also evaluate the reference channel
+  std::optional<double> cyclic_pitch_mm;  // diagnostics: this pitch instead of the search
 };
 
 struct Analysis {
@@ -59,7 +59,7 @@ struct Analysis {
   DynamicComp dynamic = DynamicComp::two_stage;  // what the pipeline did
   bool nbs = false, coriolis = false;
   std::string sensor_model = "datasheet";
-  std::optional<eval::CircleResult> circle;             // both directions combined when the run has both
+  std::optional<eval::CircleResult> circle;            // both directions combined when the run has both
   std::optional<eval::CircleResult> circle_reference;  // the same evaluation of the reference channel
   std::optional<double> circle_accuracy_rms_um;        // RMS of (measured − reference) radius deviation
   std::optional<eval::CircleDiagnostics> diagnostics;
@@ -69,7 +69,7 @@ struct Analysis {
   std::string step_axis;
   std::optional<eval::RectangleResult> rectangle;
   std::optional<eval::PathDeviation> path;  // free form (and the rectangle's contour)
-  std::vector<eval::RepeatGroup> repeats;  // segments between M102 marks run more than once, averaged
+  std::vector<eval::RepeatGroup> repeats;   // segments between M102 marks run more than once, averaged
   std::string program_kind;
   bool degraded = false;
   std::vector<std::string> flags;  // pipeline quality flags and evaluation failures

@@ -58,14 +58,15 @@ void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const Analy
           if (!(fr.flags & frame_flag::temp_missing) && std::isfinite(fr.temp_c[s])) last[s] = fr.temp_c[s];
       }
     }
-    trace.sample(k, m.sample_index[k], m.pos_mm[k], k < m.vel_mm_s.size() ? m.vel_mm_s[k] : Eigen::Vector3d::Zero(), m.cmd_mm[k],
-                 k < m.ref_mm.size() ? m.ref_mm[k] : Eigen::Vector3d::Constant(NAN), last);
+    trace.sample(k, m.sample_index[k], m.pos_mm[k], k < m.vel_mm_s.size() ? m.vel_mm_s[k] : Eigen::Vector3d::Zero(),
+                 m.cmd_mm[k], k < m.ref_mm.size() ? m.ref_mm[k] : Eigen::Vector3d::Constant(NAN), last);
   }
   trace.finish(run, a);
 }
 
-UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& cfg, const AnalysisOptions& o, const Analysis& a,
-                                   const fusion::SupportSchedule& schedule, std::size_t samples, std::function<std::int64_t(std::size_t)> index_at,
+UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& cfg, const AnalysisOptions& o,
+                                   const Analysis& a, const fusion::SupportSchedule& schedule, std::size_t samples,
+                                   std::function<std::int64_t(std::size_t)> index_at,
                                    const std::vector<bool>* zupt_unused)
     : samples_(samples), draws_(std::max(2, o.uncertainty.draws)), seed_(o.uncertainty.seed) {
   const Measurement& m = a.measurement;
@@ -74,7 +75,8 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& cfg, co
   in.delay_samples = a.dynamic == DynamicComp::none ? 0.0 : cfg.acquisition.daq_group_delay_samples;
   in.model = cfg.fusion;
   in.start_bias_sigma_um_s2 = m.supports.start_bias_sigma_um_s2;
-  in.model_covariance = o.model_covariance ? *o.model_covariance : uncertainty::datasheet_covariance(run.meta.sensors, m.fs_hz);
+  in.model_covariance =
+      o.model_covariance ? *o.model_covariance : uncertainty::datasheet_covariance(run.meta.sensors, m.fs_hz);
   in.sensor_noise_ug_per_rthz[0] = run.meta.sensors[0].noise_ug_per_rthz;
   in.sensor_noise_ug_per_rthz[1] = run.meta.sensors[1].noise_ug_per_rthz;
   in.g_mps2 = run.meta.site.g_mps2;
@@ -88,7 +90,8 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& cfg, co
   fine.index_at = std::move(index_at);
   fine.zupt_unused = zupt_unused;
   if (m.supports.diverged) fine.flag_mask = fusion::schedule_flag::move_start | fusion::schedule_flag::invalid;
-  uncertainty::CoarseSchedule& c = coarse_.emplace(uncertainty::coarsen(fine, in.model, uncertainty::ErrorField::block_for(fine.samples, in.max_coarse)));
+  uncertainty::CoarseSchedule& c = coarse_.emplace(
+      uncertainty::coarsen(fine, in.model, uncertainty::ErrorField::block_for(fine.samples, in.max_coarse)));
   if (m.supports.psd_disagrees) c.schedule.cupt = false;
   if (m.supports.diverged) c.schedule.zupt = c.schedule.cupt = false;
   probe_.emplace(c, in.delay_samples, samples, in.fs_hz);
@@ -101,8 +104,9 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& cfg, co
   nominal_.cmd_mm.reserve(kept), nominal_.ref_mm.reserve(kept);
 }
 
-void UncertaintyTrace::sample(std::size_t k, std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
-                              const Eigen::Vector3d& cmd_mm, const Eigen::Vector3d& ref_mm, const Eigen::Vector2d& temp_c) {
+void UncertaintyTrace::sample(std::size_t k, std::int64_t sample_index, const Eigen::Vector3d& pos_mm,
+                              const Eigen::Vector3d& vel_mm_s, const Eigen::Vector3d& cmd_mm,
+                              const Eigen::Vector3d& ref_mm, const Eigen::Vector2d& temp_c) {
   probe_->sample(k, pos_mm, vel_mm_s, temp_c);
   if (k % q_ != 0 || k >= samples_) return;
   nominal_.sample_index.push_back(sample_index);
@@ -158,7 +162,8 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     }
     return acc;
   };
-  auto add = [](const std::vector<FigureValue>& base, const std::vector<FigureValue>& drawn, std::vector<Accumulator>& acc) {
+  auto add = [](const std::vector<FigureValue>& base, const std::vector<FigureValue>& drawn,
+                std::vector<Accumulator>& acc) {
     for (std::size_t k = 0; k < base.size(); ++k) {
       const FigureValue* v = find_figure(drawn, base[k].key);
       if (!v || v->values.size() != base[k].values.size()) continue;
@@ -177,11 +182,14 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     for (Analysis* base : {&nominal, &ideal}) {
       Analysis x;
       x.measurement = base->measurement;
-      for (std::size_t i = 0; i < err.size() && i < x.measurement.pos_mm.size(); ++i) x.measurement.pos_mm[i] += err[i] / 1000.0;
+      for (std::size_t i = 0; i < err.size() && i < x.measurement.pos_mm.size(); ++i)
+        x.measurement.pos_mm[i] += err[i] / 1000.0;
       x.dynamic = a.dynamic, x.nbs = a.nbs;
       evaluate_program(run, x, eo);
-      if (base == &nominal) add(f0, figures_of(x), acc);
-      else add(g0, figures_of(x), acc_ideal);
+      if (base == &nominal)
+        add(f0, figures_of(x), acc);
+      else
+        add(g0, figures_of(x), acc_ideal);
     }
   }
   // U of element e of figure k of a set of draws (NaN when most draws could not evaluate it).
@@ -212,7 +220,9 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     a.uncertainty_k2[full.key] = u;
   }
   char note[200];
-  std::snprintf(note, sizeof note, "GUM, k = 2: %d Monte Carlo draws of the error field (noise and bias walk between the supports, sensor model: %s, PSD strips), path at %.0f Hz",
+  std::snprintf(note, sizeof note,
+                "GUM, k = 2: %d Monte Carlo draws of the error field (noise and bias walk between the supports, sensor "
+                "model: %s, PSD strips), path at %.0f Hz",
                 draws, a.uncertainty_source.c_str(), m.fs_hz / static_cast<double>(q));
   a.uncertainty_note = note;
 }

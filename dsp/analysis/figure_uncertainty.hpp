@@ -43,15 +43,15 @@ class UncertaintyTrace {
   // pipeline recorded (one flag per trace sample; zupt_unused as uncertainty::FineSchedule);
   // index_at(k): sample index of trace sample k; samples: the trace's length.
   UncertaintyTrace(const Run& run, const PipelineConfig& config, const AnalysisOptions& options, const Analysis& a,
-                   const fusion::SupportSchedule& schedule, std::size_t samples, std::function<std::int64_t(std::size_t)> index_at,
-                   const std::vector<bool>* zupt_unused = nullptr);
+                   const fusion::SupportSchedule& schedule, std::size_t samples,
+                   std::function<std::int64_t(std::size_t)> index_at, const std::vector<bool>* zupt_unused = nullptr);
   UncertaintyTrace(const UncertaintyTrace&) = delete;
   UncertaintyTrace& operator=(const UncertaintyTrace&) = delete;
 
   // Trace sample k (in order from 0) as evaluated: corrected, on the set-point's time;
   // temp_c: the case temperatures of table and head there (the last finite ones).
-  void sample(std::size_t k, std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s, const Eigen::Vector3d& cmd_mm,
-              const Eigen::Vector3d& ref_mm, const Eigen::Vector2d& temp_c);
+  void sample(std::size_t k, std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
+              const Eigen::Vector3d& cmd_mm, const Eigen::Vector3d& ref_mm, const Eigen::Vector2d& temp_c);
 
   // After the last sample, `a` evaluated at full rate: the draws; fills a.uncertainty_k2,
   // its source and note.
@@ -63,7 +63,7 @@ class UncertaintyTrace {
   uncertainty::ErrorFieldInput in_;
   std::optional<uncertainty::CoarseSchedule> coarse_;
   std::optional<uncertainty::CoarsePathProbe> probe_;  // reads coarse_
-  Measurement nominal_;  // every q_-th trace sample
+  Measurement nominal_;                                // every q_-th trace sample
   std::size_t samples_ = 0, q_ = 1;
   int draws_ = 100;
   std::uint64_t seed_ = 0;

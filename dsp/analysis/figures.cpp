@@ -12,7 +12,9 @@ struct Out {
   void scalar(const std::string& key, double v) {
     if (std::isfinite(v)) f.push_back({key, {v}, false, 1});
   }
-  void array(const std::string& key, std::vector<double> v, int columns = 1) { f.push_back({key, std::move(v), true, columns}); }
+  void array(const std::string& key, std::vector<double> v, int columns = 1) {
+    f.push_back({key, std::move(v), true, columns});
+  }
 };
 
 void circle_figures(const Analysis& a, Out& o) {
@@ -30,31 +32,50 @@ void circle_figures(const Analysis& a, Out& o) {
 
 void diagnostics_figures(const Analysis& a, Out& o) {
   const auto& d = *a.diagnostics;
-  const std::pair<const char*, double> f[] = {
-      {"backlash_x_um", d.backlash_x_um},           {"backlash_y_um", d.backlash_y_um},
-      {"reversal_spike_x_um", d.reversal_spike_x_um}, {"reversal_spike_y_um", d.reversal_spike_y_um},
-      {"lateral_play_x_um", d.lateral_play_x_um},   {"lateral_play_y_um", d.lateral_play_y_um},
-      {"cyclic_error_x_um", d.cyclic_error_x_um},   {"cyclic_error_y_um", d.cyclic_error_y_um},
-      {"squareness_urad", d.squareness_urad},       {"scale_mismatch_ppm", d.scale_mismatch_ppm},
-      {"straightness_x_um", d.straightness_x_um},   {"straightness_y_um", d.straightness_y_um},
-      {"stick_slip_um", d.stick_slip_um},           {"vibration_um", d.vibration_um},
-      {"servo_lag_x_ms", d.lag_x_ms},               {"servo_lag_y_ms", d.lag_y_ms},
-      {"model_residual_rms_um", d.residual_rms_um}};
+  const std::pair<const char*, double> f[] = {{"backlash_x_um", d.backlash_x_um},
+                                              {"backlash_y_um", d.backlash_y_um},
+                                              {"reversal_spike_x_um", d.reversal_spike_x_um},
+                                              {"reversal_spike_y_um", d.reversal_spike_y_um},
+                                              {"lateral_play_x_um", d.lateral_play_x_um},
+                                              {"lateral_play_y_um", d.lateral_play_y_um},
+                                              {"cyclic_error_x_um", d.cyclic_error_x_um},
+                                              {"cyclic_error_y_um", d.cyclic_error_y_um},
+                                              {"squareness_urad", d.squareness_urad},
+                                              {"scale_mismatch_ppm", d.scale_mismatch_ppm},
+                                              {"straightness_x_um", d.straightness_x_um},
+                                              {"straightness_y_um", d.straightness_y_um},
+                                              {"stick_slip_um", d.stick_slip_um},
+                                              {"vibration_um", d.vibration_um},
+                                              {"servo_lag_x_ms", d.lag_x_ms},
+                                              {"servo_lag_y_ms", d.lag_y_ms},
+                                              {"model_residual_rms_um", d.residual_rms_um}};
   for (const auto& [k, v] : f) o.scalar(std::string("diagnostics.") + k, v);
   if (d.servo_and_squareness_separated) o.scalar("diagnostics.servo_mismatch_ms", d.servo_mismatch_ms);
 }
 
 void positioning_figures(const Analysis& a, Out& o) {
   const auto& r = *a.positioning;
-  const std::pair<const char*, double> f[] = {{"A_um", r.A_um},         {"A_up_um", r.A_up_um},     {"A_down_um", r.A_down_um},
-                                              {"E_um", r.E_um},         {"E_up_um", r.E_up_um},     {"E_down_um", r.E_down_um},
-                                              {"M_um", r.M_um},         {"R_um", r.R_um},           {"R_up_um", r.R_up_um},
-                                              {"R_down_um", r.R_down_um}, {"B_um", r.B_um},         {"B_mean_um", r.B_mean_um},
-                                              {"vdi3441.P_um", r.vdi.P_um}, {"vdi3441.Pa_um", r.vdi.Pa_um},
-                                              {"vdi3441.U_um", r.vdi.U_um}, {"vdi3441.Ps_um", r.vdi.Ps_um}};
+  const std::pair<const char*, double> f[] = {{"A_um", r.A_um},
+                                              {"A_up_um", r.A_up_um},
+                                              {"A_down_um", r.A_down_um},
+                                              {"E_um", r.E_um},
+                                              {"E_up_um", r.E_up_um},
+                                              {"E_down_um", r.E_down_um},
+                                              {"M_um", r.M_um},
+                                              {"R_um", r.R_um},
+                                              {"R_up_um", r.R_up_um},
+                                              {"R_down_um", r.R_down_um},
+                                              {"B_um", r.B_um},
+                                              {"B_mean_um", r.B_mean_um},
+                                              {"vdi3441.P_um", r.vdi.P_um},
+                                              {"vdi3441.Pa_um", r.vdi.Pa_um},
+                                              {"vdi3441.U_um", r.vdi.U_um},
+                                              {"vdi3441.Ps_um", r.vdi.Ps_um}};
   for (const auto& [k, v] : f) o.scalar(std::string("positioning.") + k, v);
   std::vector<double> mu, md, m, b, rr;
-  for (const auto& t : r.targets) mu.push_back(t.mean_up_um), md.push_back(t.mean_down_um), m.push_back(t.mean_um), b.push_back(t.B_um), rr.push_back(t.R_um);
+  for (const auto& t : r.targets)
+    mu.push_back(t.mean_up_um), md.push_back(t.mean_down_um), m.push_back(t.mean_um), b.push_back(t.B_um),
+        rr.push_back(t.R_um);
   o.array("positioning.per_target.mean_up_um", mu);
   o.array("positioning.per_target.mean_down_um", md);
   o.array("positioning.per_target.mean_um", m);
@@ -67,11 +88,13 @@ void step_figures(const Analysis& a, Out& o) {
   o.scalar("step.end_position_error_um", s.end_position_error_um);
   o.scalar("step.overshoot_um", s.overshoot_um);
   o.scalar("step.noise_um", s.noise_um);
-  if (std::any_of(s.moves.begin(), s.moves.end(), [](const eval::StepMove& m) { return m.settled; })) o.scalar("step.settling_s", s.settling_s);
+  if (std::any_of(s.moves.begin(), s.moves.end(), [](const eval::StepMove& m) { return m.settled; }))
+    o.scalar("step.settling_s", s.settling_s);
   bool repeat = false;
   for (std::size_t i = 0; i < s.moves.size(); ++i)
     for (std::size_t k = i + 1; k < s.moves.size(); ++k)
-      repeat |= std::abs(s.moves[i].to_mm - s.moves[k].to_mm) < 1e-6 && (s.moves[i].to_mm > s.moves[i].from_mm) == (s.moves[k].to_mm > s.moves[k].from_mm);
+      repeat |= std::abs(s.moves[i].to_mm - s.moves[k].to_mm) < 1e-6 &&
+                (s.moves[i].to_mm > s.moves[i].from_mm) == (s.moves[k].to_mm > s.moves[k].from_mm);
   if (repeat) o.scalar("step.scatter_um", s.scatter_um);
   std::vector<double> step, end;
   double largest = 0.0;
@@ -94,7 +117,8 @@ void rectangle_figures(const Analysis& a, Out& o) {
   const auto& r = *a.rectangle;
   std::vector<double> corners, straight, direction;
   double worst = 0.0;
-  for (const auto& e : r.corner_errors_um) corners.push_back(e.x()), corners.push_back(e.y()), worst = std::max(worst, e.norm());
+  for (const auto& e : r.corner_errors_um)
+    corners.push_back(e.x()), corners.push_back(e.y()), worst = std::max(worst, e.norm());
   o.scalar("rectangle.corner_error_max_um", worst);
   o.array("rectangle.corner_errors_um", corners, 2);
   for (const auto& s : r.sides) straight.push_back(s.straightness_um), direction.push_back(s.direction_error_urad);
@@ -121,7 +145,8 @@ std::vector<FigureValue> figures_of(const Analysis& a) {
   if (a.positioning) positioning_figures(a, o);
   if (a.step) step_figures(a, o);
   if (a.rectangle) rectangle_figures(a, o);
-  if (a.path) path_figures(a.rectangle || a.program_kind == "rectangle" ? "rectangle.path_deviation" : "freeform", *a.path, o);
+  if (a.path)
+    path_figures(a.rectangle || a.program_kind == "rectangle" ? "rectangle.path_deviation" : "freeform", *a.path, o);
   return f;
 }
 

@@ -14,8 +14,14 @@ namespace {
 std::string num(double v, const char* unit) {
   char b[64];
   const double a = std::abs(v);
-  if (std::string(unit) == "um" && a >= 1000.0) std::snprintf(b, sizeof b, "%.2f mm", v / 1000.0);
-  else std::snprintf(b, sizeof b, a >= 100.0 ? "%.0f %s" : a >= 10.0 ? "%.1f %s" : "%.2f %s", v, std::string(unit) == "um" ? "µm" : unit);
+  if (std::string(unit) == "um" && a >= 1000.0)
+    std::snprintf(b, sizeof b, "%.2f mm", v / 1000.0);
+  else
+    std::snprintf(b, sizeof b,
+                  a >= 100.0  ? "%.0f %s"
+                  : a >= 10.0 ? "%.1f %s"
+                              : "%.2f %s",
+                  v, std::string(unit) == "um" ? "µm" : unit);
   return b;
 }
 
@@ -25,11 +31,15 @@ bool starts_with(const std::string& s, const char* p) { return s.rfind(p, 0) == 
 
 const std::vector<ResolutionLimit>& resolution_limits() {
   static const std::vector<ResolutionLimit> limits = {
-      {"circle", "circle.circular_deviation_G_um", "circular deviation G", "circle.circular_deviation_G_um", "G", 10.0, "um"},
+      {"circle", "circle.circular_deviation_G_um", "circular deviation G", "circle.circular_deviation_G_um", "G", 10.0,
+       "um"},
       {"positioning", "positioning.A_um", "positioning accuracy A", "positioning.E_um", "E", 5.0, "um"},
-      {"step", "step.largest_step_measured_um", "the measured step", "step.end_position_error_um", "the end-position error", 2.0, "um"},
-      {"rectangle", "rectangle.corner_error_max_um", "the largest corner error", "rectangle.corner_error_max_um", "the corner error", 10.0, "um"},
-      {"freeform", "freeform.contour_error_max_um", "the largest contour error", "freeform.contour_error_max_um", "the contour error", 10.0, "um"},
+      {"step", "step.largest_step_measured_um", "the measured step", "step.end_position_error_um",
+       "the end-position error", 2.0, "um"},
+      {"rectangle", "rectangle.corner_error_max_um", "the largest corner error", "rectangle.corner_error_max_um",
+       "the corner error", 10.0, "um"},
+      {"freeform", "freeform.contour_error_max_um", "the largest contour error", "freeform.contour_error_max_um",
+       "the contour error", 10.0, "um"},
   };
   return limits;
 }
@@ -47,55 +57,69 @@ void judge(const Program& program, Analysis& a) {
   const std::vector<FigureValue> figs = figures_of(a);
   auto u_of = [&](const char* key) -> double {
     const auto it = a.uncertainty_k2.find(key);
-    return it != a.uncertainty_k2.end() && it->second.size() == 1 ? it->second[0] : std::numeric_limits<double>::quiet_NaN();
+    return it != a.uncertainty_k2.end() && it->second.size() == 1 ? it->second[0]
+                                                                  : std::numeric_limits<double>::quiet_NaN();
   };
   if (lim) {
     const FigureValue* h = find_figure(figs, lim->headline);
     const FigureValue* l = find_figure(figs, lim->limited);
-    const auto unsupported = std::find_if(a.flags.begin(), a.flags.end(), [](const std::string& f) { return starts_with(f, kPositionNullFlag); });
+    const auto unsupported = std::find_if(a.flags.begin(), a.flags.end(),
+                                          [](const std::string& f) { return starts_with(f, kPositionNullFlag); });
     if (!h && unsupported != a.flags.end()) {
       // Nothing holds the double integral: no position figure at all, whatever its size.
       not_measurable = true;
-      a.verdict_reasons.push_back(std::string(lim->name) + " is not measurable: " + unsupported->substr(std::string(kPositionNullFlag).size()));
+      a.verdict_reasons.push_back(std::string(lim->name) +
+                                  " is not measurable: " + unsupported->substr(std::string(kPositionNullFlag).size()));
     } else if (!h || !l) {
       a.verdict_reasons.push_back(std::string(lim->name) + " could not be determined (see the flags)");
     } else if (a.uncertainty_k2.empty()) {
-      a.verdict_reasons.push_back("the figures' uncertainty was not estimated" + (a.uncertainty_note.empty() ? "" : ": " + a.uncertainty_note));
+      a.verdict_reasons.push_back("the figures' uncertainty was not estimated" +
+                                  (a.uncertainty_note.empty() ? "" : ": " + a.uncertainty_note));
     } else {
       const double uh = u_of(lim->headline), ul = u_of(lim->limited);
       if (!std::isfinite(ul) || ul > lim->limit) {
         not_measurable = true;
-        a.verdict_reasons.push_back("U(" + std::string(lim->limited_name) + ") = " + (std::isfinite(ul) ? num(ul, lim->unit) : std::string("unknown")) +
-                                    " exceeds the " + num(lim->limit, lim->unit) + " a " + program.kind + " test is meant to resolve");
+        a.verdict_reasons.push_back("U(" + std::string(lim->limited_name) +
+                                    ") = " + (std::isfinite(ul) ? num(ul, lim->unit) : std::string("unknown")) +
+                                    " exceeds the " + num(lim->limit, lim->unit) + " a " + program.kind +
+                                    " test is meant to resolve");
       }
       if (!uncertainty::resolved(h->values[0], uh)) {
         not_measurable = true;
-        a.verdict_reasons.push_back(std::string(lim->name) + " = " + num(h->values[0], lim->unit) + " is not above its uncertainty U = " +
-                                    (std::isfinite(uh) ? num(uh, lim->unit) : std::string("unknown")));
+        a.verdict_reasons.push_back(
+            std::string(lim->name) + " = " + num(h->values[0], lim->unit) +
+            " is not above its uncertainty U = " + (std::isfinite(uh) ? num(uh, lim->unit) : std::string("unknown")));
       }
     }
   }
-  if (not_measurable) a.verdict = "not_measurable";
-  else if (a.degraded || (lim && !a.verdict_reasons.empty())) a.verdict = "degraded";
-  else a.verdict = "ok";
+  if (not_measurable)
+    a.verdict = "not_measurable";
+  else if (a.degraded || (lim && !a.verdict_reasons.empty()))
+    a.verdict = "degraded";
+  else
+    a.verdict = "ok";
   if (a.degraded)
     for (const auto& f : a.flags)
-      if (flag_severity(f) == FlagSeverity::critical && !starts_with(f, kPositionNullFlag)) a.verdict_reasons.push_back(f);
+      if (flag_severity(f) == FlagSeverity::critical && !starts_with(f, kPositionNullFlag))
+        a.verdict_reasons.push_back(f);
 }
 
 FlagSeverity flag_severity(const std::string& f) {
   // The measurement itself is wrong or incomplete.
-  for (const char* p : {"accel_missing", "accel_saturated", "frames_lost", "not_finite", "capacity_exceeded", "fixed_saturated",
-                        "supports_diverged", "psd_disagrees", "no_motion", "interrupted", "source_stopped", kPositionNullFlag})
+  for (const char* p :
+       {"accel_missing", "accel_saturated", "frames_lost", "not_finite", "capacity_exceeded", "fixed_saturated",
+        "supports_diverged", "psd_disagrees", "no_motion", "interrupted", "source_stopped", kPositionNullFlag})
     if (starts_with(f, p)) return FlagSeverity::critical;
   // An evaluation that failed ("circle: …", "positioning: …" without "null").
   for (const char* p : {"circle: ", "step: ", "rectangle: null", "freeform: null"})
     if (starts_with(f, p) && f.find("runs both directions") == std::string::npos) return FlagSeverity::critical;
-  if (starts_with(f, "positioning: ") && f.find("outside the standard") == std::string::npos) return FlagSeverity::critical;
+  if (starts_with(f, "positioning: ") && f.find("outside the standard") == std::string::npos)
+    return FlagSeverity::critical;
   // It limits the measurement.
   for (const char* p : {"no_start_trigger", "no_end_trigger", "short_rest_window", "no_zupt_window"})
     if (starts_with(f, p)) return FlagSeverity::warning;
-  if (f.find("outside the standard") != std::string::npos || f.find("runs both directions") != std::string::npos) return FlagSeverity::warning;
+  if (f.find("outside the standard") != std::string::npos || f.find("runs both directions") != std::string::npos)
+    return FlagSeverity::warning;
   return FlagSeverity::note;
 }
 

@@ -18,12 +18,12 @@
 namespace eical::dsp {
 
 struct ResolutionLimit {
-  const char* program;    // kind
-  const char* headline;   // result key of the headline figure (must exceed its U)
-  const char* name;       // as a user reads it
-  const char* limited;    // result key whose U must stay within `limit_um`
+  const char* program;   // kind
+  const char* headline;  // result key of the headline figure (must exceed its U)
+  const char* name;      // as a user reads it
+  const char* limited;   // result key whose U must stay within `limit_um`
   const char* limited_name;
-  double limit;           // in the limited figure's unit
+  double limit;  // in the limited figure's unit
   const char* unit;
 };
 

@@ -39,12 +39,13 @@ void validate(const AxisTable& t) {
     if (!std::isfinite(t.pos_mm[i]) || !std::isfinite(t.forward_um[i]) || !std::isfinite(t.reverse_um[i]))
       throw InputError(who + ": point " + std::to_string(i + 1) + " is not a finite number");
     if (i > 0 && !(t.pos_mm[i] > t.pos_mm[i - 1]))
-      throw InputError(who + ": positions must increase; point " + std::to_string(i + 1) + " (" + mm(t.pos_mm[i]) + " mm) follows " +
-                       mm(t.pos_mm[i - 1]) + " mm");
+      throw InputError(who + ": positions must increase; point " + std::to_string(i + 1) + " (" + mm(t.pos_mm[i]) +
+                       " mm) follows " + mm(t.pos_mm[i - 1]) + " mm");
   }
 }
 
-AxisTable fold_lost_motion(int axis, const std::vector<double>& pos_mm, const std::vector<double>& mean_um, double lost_motion_um) {
+AxisTable fold_lost_motion(int axis, const std::vector<double>& pos_mm, const std::vector<double>& mean_um,
+                           double lost_motion_um) {
   AxisTable t;
   t.axis = axis;
   t.pos_mm = pos_mm;
@@ -68,8 +69,9 @@ AxisTable resample(const AxisTable& t, double first_mm, double spacing_mm, int p
   for (int k = 0; k < points; ++k) {
     const double p = first_mm + k * spacing_mm;  // no accumulated rounding
     if (p < t.first_mm() - 1e-9 || p > t.last_mm() + 1e-9)
-      throw InputError(std::string("comp: the ") + axis_letter(t.axis) + " grid point " + mm(p) + " mm lies outside the measured " +
-                       mm(t.first_mm()) + " .. " + mm(t.last_mm()) + " mm (eical does not extrapolate a measurement)");
+      throw InputError(std::string("comp: the ") + axis_letter(t.axis) + " grid point " + mm(p) +
+                       " mm lies outside the measured " + mm(t.first_mm()) + " .. " + mm(t.last_mm()) +
+                       " mm (eical does not extrapolate a measurement)");
     r.pos_mm.push_back(p);
     r.forward_um.push_back(t.deviation_um(p, Approach::forward));
     r.reverse_um.push_back(t.deviation_um(p, Approach::reverse));
@@ -81,8 +83,8 @@ void require_coverage(const AxisTable& t, double from_mm, double to_mm, const st
   // 1 µm: a circle's programmed extreme that equals the last target is covered.
   if (from_mm >= t.first_mm() - 1e-3 && to_mm <= t.last_mm() + 1e-3) return;
   const char a = axis_letter(t.axis);
-  throw InputError(std::string("comp: the ") + a + " table covers " + mm(t.first_mm()) + " .. " + mm(t.last_mm()) + " mm, but " + who +
-                   " " + a + " from " + mm(from_mm) + " to " + mm(to_mm) +
+  throw InputError(std::string("comp: the ") + a + " table covers " + mm(t.first_mm()) + " .. " + mm(t.last_mm()) +
+                   " mm, but " + who + " " + a + " from " + mm(from_mm) + " to " + mm(to_mm) +
                    " mm: measure positioning over that range (beyond its ends a control holds the end value)");
 }
 

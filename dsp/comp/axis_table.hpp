@@ -32,7 +32,9 @@ struct AxisTable {
   // Linear interpolation between points; beyond the ends the end value is held (what
   // LinuxCNC and the SINUMERIK tables do; a table is checked to cover the travel first).
   [[nodiscard]] double deviation_um(double at_mm, Approach a) const;
-  [[nodiscard]] double correction_um(double at_mm, Approach a) const { return correction_from_deviation_um(deviation_um(at_mm, a)); }
+  [[nodiscard]] double correction_um(double at_mm, Approach a) const {
+    return correction_from_deviation_um(deviation_um(at_mm, a));
+  }
   [[nodiscard]] double mean_um(std::size_t i) const { return 0.5 * (forward_um[i] + reverse_um[i]); }
   // Mean of reverse − forward over the points: the lost motion b (positive for a play).
   [[nodiscard]] double mean_lost_motion_um() const;
@@ -49,7 +51,8 @@ void validate(const AxisTable& t);
 
 // Both directions from a bidirectional mean and a constant lost motion b (the play folded
 // in): forward = mean − b/2, reverse = mean + b/2.
-AxisTable fold_lost_motion(int axis, const std::vector<double>& pos_mm, const std::vector<double>& mean_um, double lost_motion_um);
+AxisTable fold_lost_motion(int axis, const std::vector<double>& pos_mm, const std::vector<double>& mean_um,
+                           double lost_motion_um);
 
 // Both directions replaced by their mean (the reversal left out).
 AxisTable without_reversal(const AxisTable& t);

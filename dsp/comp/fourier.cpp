@@ -79,14 +79,19 @@ FourierResult fourier_calibration(const std::vector<AngleSeries>& all, const Fou
   std::vector<const AngleSeries*> series;
   const AngleSeries* sweep = nullptr;
   for (const auto& s : all) {
-    if (s.angle_deg.size() != s.deviation_arcsec.size()) throw InputError("fourier: series '" + s.name + "': angles and deviations differ in count");
+    if (s.angle_deg.size() != s.deviation_arcsec.size())
+      throw InputError("fourier: series '" + s.name + "': angles and deviations differ in count");
     for (std::size_t i = 0; i < s.angle_deg.size(); ++i)
       if (!std::isfinite(s.angle_deg[i]) || !std::isfinite(s.deviation_arcsec[i]))
-        throw InputError("fourier: series '" + s.name + "': point " + std::to_string(i + 1) + " is not a finite number");
-    if (!opt.sweep_series.empty() && s.name == opt.sweep_series) sweep = &s;
-    else series.push_back(&s);
+        throw InputError("fourier: series '" + s.name + "': point " + std::to_string(i + 1) +
+                         " is not a finite number");
+    if (!opt.sweep_series.empty() && s.name == opt.sweep_series)
+      sweep = &s;
+    else
+      series.push_back(&s);
   }
-  if (!opt.sweep_series.empty() && !sweep) throw InputError("fourier: no series named '" + opt.sweep_series + "' for the sweep");
+  if (!opt.sweep_series.empty() && !sweep)
+    throw InputError("fourier: no series named '" + opt.sweep_series + "' for the sweep");
   if (series.size() < 2) throw InputError("fourier: need at least 2 interleaved series");
   // n: points per revolution of a series (a closing point at +360° is not counted).
   auto points = [](const AngleSeries& s) {
@@ -99,8 +104,8 @@ FourierResult fourier_calibration(const std::vector<AngleSeries>& all, const Fou
   r.series = static_cast<int>(series.size());
   for (const auto* s : series)
     if (points(*s) != r.points_per_series)
-      throw InputError("fourier: series '" + s->name + "' has " + std::to_string(points(*s)) + " positions, the first has " +
-                       std::to_string(r.points_per_series));
+      throw InputError("fourier: series '" + s->name + "' has " + std::to_string(points(*s)) +
+                       " positions, the first has " + std::to_string(r.points_per_series));
   const int n = r.points_per_series;
   if (n < 3) throw InputError("fourier: a series needs at least 3 positions per revolution");
 
@@ -163,7 +168,8 @@ FourierResult fourier_calibration(const std::vector<AngleSeries>& all, const Fou
     rejected.push_back(term_of(fit, cand[static_cast<std::size_t>(worst)], 1 + 2 * worst, opt.alpha));
     cand.erase(cand.begin() + worst);
   }
-  for (std::size_t l = 0; l < cand.size(); ++l) r.terms.push_back(term_of(fit, cand[l], 1 + 2 * static_cast<Eigen::Index>(l), opt.alpha));
+  for (std::size_t l = 0; l < cand.size(); ++l)
+    r.terms.push_back(term_of(fit, cand[l], 1 + 2 * static_cast<Eigen::Index>(l), opt.alpha));
 
   // u_x: the fitted function's standard uncertainty, RMS over the measured positions.
   double ux2 = 0.0;
@@ -182,10 +188,13 @@ FourierResult fourier_calibration(const std::vector<AngleSeries>& all, const Fou
   // f = k·n from the continuous sweep over one interval, after removing the other terms.
   if (sweep) {
     std::vector<double> sy;
-    for (std::size_t i = 0; i < sweep->angle_deg.size(); ++i) sy.push_back(sweep->deviation_arcsec[i] - r.evaluate(sweep->angle_deg[i]));
+    for (std::size_t i = 0; i < sweep->angle_deg.size(); ++i)
+      sy.push_back(sweep->deviation_arcsec[i] - r.evaluate(sweep->angle_deg[i]));
     const double span = *std::max_element(sweep->angle_deg.begin(), sweep->angle_deg.end()) -
                         *std::min_element(sweep->angle_deg.begin(), sweep->angle_deg.end());
-    if (span < 360.0 / n * 0.95) throw InputError("fourier: the sweep covers " + std::to_string(span) + " deg, less than one interval (" + std::to_string(360.0 / n) + " deg)");
+    if (span < 360.0 / n * 0.95)
+      throw InputError("fourier: the sweep covers " + std::to_string(span) + " deg, less than one interval (" +
+                       std::to_string(360.0 / n) + " deg)");
     std::vector<int> kn(r.lost_frequencies.begin(), r.lost_frequencies.end());
     if (kn.empty()) kn.push_back(n);
     // A sweep moves continuously over the interval: its positions fall on many phases of
@@ -200,19 +209,23 @@ FourierResult fourier_calibration(const std::vector<AngleSeries>& all, const Fou
     }
     const std::size_t needed = 2 * kn.size() + 2;
     if (phases.size() < needed)
-      throw InputError("fourier: series '" + sweep->name + "' is not a sweep: its " + std::to_string(sweep->angle_deg.size()) +
-                       " positions fall on " + std::to_string(phases.size()) + " phase(s) of the " + std::to_string(interval) +
-                       " deg interval; a sweep moves continuously over one interval (at least " + std::to_string(needed) + " phases for " +
-                       std::to_string(kn.size()) + " frequencies k*n)");
+      throw InputError("fourier: series '" + sweep->name + "' is not a sweep: its " +
+                       std::to_string(sweep->angle_deg.size()) + " positions fall on " + std::to_string(phases.size()) +
+                       " phase(s) of the " + std::to_string(interval) +
+                       " deg interval; a sweep moves continuously over one interval (at least " +
+                       std::to_string(needed) + " phases for " + std::to_string(kn.size()) + " frequencies k*n)");
     const Fit sf = lsq(sweep->angle_deg, sy, kn, true);
     for (Eigen::Index i = 0; i < sf.coef.size(); ++i)
       if (!std::isfinite(sf.coef(i)) || !(sf.cov(i, i) >= 0.0) || !std::isfinite(sf.cov(i, i)))
-        throw InputError("fourier: the sweep '" + sweep->name + "' does not determine the f = k*n terms (singular fit): spread it over the interval");
+        throw InputError("fourier: the sweep '" + sweep->name +
+                         "' does not determine the f = k*n terms (singular fit): spread it over the interval");
     for (std::size_t l = 0; l < kn.size(); ++l) {
       FourierTerm t = term_of(sf, kn[l], 1 + 2 * static_cast<Eigen::Index>(l), opt.alpha);
       t.from_sweep = true;
-      if (t.significant) r.terms.push_back(t);
-      else rejected.push_back(t);
+      if (t.significant)
+        r.terms.push_back(t);
+      else
+        rejected.push_back(t);
     }
   }
   std::sort(r.terms.begin(), r.terms.end(), [](const auto& a, const auto& b) { return a.frequency < b.frequency; });

@@ -23,29 +23,29 @@ struct AngleSeries {
 };
 
 struct FourierOptions {
-  double alpha = 0.05;                 // significance level of each term
-  int max_frequency = 0;               // highest candidate (per revolution); 0 = Nyquist of the combined grid
-  double candidate_sigma = 2.0;        // spectrum lines above this many noise σ become candidates
+  double alpha = 0.05;                    // significance level of each term
+  int max_frequency = 0;                  // highest candidate (per revolution); 0 = Nyquist of the combined grid
+  double candidate_sigma = 2.0;           // spectrum lines above this many noise σ become candidates
   double positioning_bound_arcsec = 0.0;  // ±a of the axis' positioning deviation (type B)
-  std::string sweep_series;            // name of the continuous sweep over one interval ("" = none)
+  std::string sweep_series;               // name of the continuous sweep over one interval ("" = none)
 };
 
 struct FourierTerm {
-  int frequency = 0;          // per revolution
+  int frequency = 0;  // per revolution
   double amplitude_arcsec = 0.0;
   double phase_deg = 0.0;
   double u_amplitude_arcsec = 0.0;  // standard uncertainty
   double test_statistic = 0.0;      // F value of the pair
   bool significant = false;
-  bool from_sweep = false;          // f = k·n, recovered from the sweep
+  bool from_sweep = false;  // f = k·n, recovered from the sweep
 };
 
 struct FourierResult {
-  int points_per_series = 0;        // n
+  int points_per_series = 0;  // n
   int series = 0;
   std::vector<double> series_offset_arcsec;  // S̄_m − S̄_1 removed from each series
-  std::vector<FourierTerm> terms;   // significant terms (and the tested rejects, flagged)
-  std::vector<int> lost_frequencies;  // k·n up to the highest candidate: removed by centring
+  std::vector<FourierTerm> terms;            // significant terms (and the tested rejects, flagged)
+  std::vector<int> lost_frequencies;         // k·n up to the highest candidate: removed by centring
   double residual_rms_arcsec = 0.0;
   double u_x_arcsec = 0.0, u_p_arcsec = 0.0, expanded_U_arcsec = 0.0;  // k = 2
   // F at x (deg) from the significant terms.

@@ -53,22 +53,27 @@ LinCompResult piecewise_linear(const ErrorCurve& c, const LinCompOptions& o) {
     if (!std::isfinite(c.pos_mm[i]) || !std::isfinite(c.error_um[i]))
       throw InputError("lincomp: point " + std::to_string(i + 1) + " is not a finite number");
     if (i > 0 && c.pos_mm[i] == c.pos_mm[i - 1])
-      throw InputError("lincomp: duplicate position " + std::to_string(c.pos_mm[i]) + " mm (point " + std::to_string(i + 1) + ")");
+      throw InputError("lincomp: duplicate position " + std::to_string(c.pos_mm[i]) + " mm (point " +
+                       std::to_string(i + 1) + ")");
     if (i > 0 && c.pos_mm[i] < c.pos_mm[i - 1])
-      throw InputError("lincomp: positions must increase; point " + std::to_string(i + 1) + " (" + std::to_string(c.pos_mm[i]) +
-                       " mm) comes after " + std::to_string(c.pos_mm[i - 1]) + " mm");
+      throw InputError("lincomp: positions must increase; point " + std::to_string(i + 1) + " (" +
+                       std::to_string(c.pos_mm[i]) + " mm) comes after " + std::to_string(c.pos_mm[i - 1]) + " mm");
   }
   const double travel = c.pos_mm.back() - c.pos_mm.front();
   if (!(o.spacing_mm > 0.0)) throw InputError("lincomp: spacing must be positive");
   if (o.spacing_mm > travel)
-    throw InputError("lincomp: spacing " + std::to_string(o.spacing_mm) + " mm is larger than the travel " + std::to_string(travel) + " mm");
-  if (!(o.shift_step_mm > 0.0) || o.shift_step_mm > o.spacing_mm) throw InputError("lincomp: shift step must be in (0, spacing]");
+    throw InputError("lincomp: spacing " + std::to_string(o.spacing_mm) + " mm is larger than the travel " +
+                     std::to_string(travel) + " mm");
+  if (!(o.shift_step_mm > 0.0) || o.shift_step_mm > o.spacing_mm)
+    throw InputError("lincomp: shift step must be in (0, spacing]");
   if (travel / o.spacing_mm + 1.0 > kMaxCorrectionPoints)
-    throw InputError("lincomp: the travel " + std::to_string(travel) + " mm at spacing " + std::to_string(o.spacing_mm) + " mm needs more than " +
-                     std::to_string(kMaxCorrectionPoints) + " correction points (positions in mm?)");
+    throw InputError("lincomp: the travel " + std::to_string(travel) + " mm at spacing " +
+                     std::to_string(o.spacing_mm) + " mm needs more than " + std::to_string(kMaxCorrectionPoints) +
+                     " correction points (positions in mm?)");
   if (o.spacing_mm / o.shift_step_mm > kMaxGridShifts)
-    throw InputError("lincomp: spacing " + std::to_string(o.spacing_mm) + " mm / shift step " + std::to_string(o.shift_step_mm) + " mm is more than " +
-                     std::to_string(kMaxGridShifts) + " grid shifts");
+    throw InputError("lincomp: spacing " + std::to_string(o.spacing_mm) + " mm / shift step " +
+                     std::to_string(o.shift_step_mm) + " mm is more than " + std::to_string(kMaxGridShifts) +
+                     " grid shifts");
   if (!(o.period_error_um >= 0.0)) throw InputError("lincomp: period error u must not be negative");
 
   LinCompResult r;

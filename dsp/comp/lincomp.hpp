@@ -29,11 +29,11 @@ struct CorrectionTable {
 
 struct LinCompResult {
   double spacing_mm = 0.0;
-  double max_residual_um = 0.0;   // F_rest: worst over all grid shifts
+  double max_residual_um = 0.0;  // F_rest: worst over all grid shifts
   double worst_shift_mm = 0.0;
-  double total_um = 0.0;          // F_rest + u
+  double total_um = 0.0;  // F_rest + u
   double residual_unshifted_um = 0.0;
-  CorrectionTable table;          // grid starting at the first curve position (shift 0)
+  CorrectionTable table;                     // grid starting at the first curve position (shift 0)
   std::vector<double> residual_by_shift_um;  // per shift, for the report
 };
 

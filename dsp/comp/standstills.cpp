@@ -8,7 +8,9 @@ namespace eical::dsp::comp {
 std::vector<Standstill> standstills(const Measurement& m) {
   std::vector<Standstill> out;
   const std::size_t n = m.cmd_mm.size();
-  auto at_rest = [&](std::size_t i, std::size_t j) { return (m.cmd_mm[i] - m.cmd_mm[j]).cwiseAbs().maxCoeff() < 1e-6; };  // 1 nm
+  auto at_rest = [&](std::size_t i, std::size_t j) {
+    return (m.cmd_mm[i] - m.cmd_mm[j]).cwiseAbs().maxCoeff() < 1e-6;
+  };  // 1 nm
   for (const auto& t : m.triggers) {
     if (t.code != trigger::segment_mark) continue;
     const auto it = std::lower_bound(m.sample_index.begin(), m.sample_index.end(), t.sample_index);

@@ -26,18 +26,20 @@ void validate(const VolumetricModel& m) {
     const auto& t = m.component[k];
     const std::string name = kVolumetricComponents[k];
     if (t.pos_mm.empty()) throw InputError("volumetric: component '" + name + "' is missing");
-    if (t.pos_mm.size() != t.values.size()) throw InputError("volumetric: component '" + name + "': positions and values differ in count");
+    if (t.pos_mm.size() != t.values.size())
+      throw InputError("volumetric: component '" + name + "': positions and values differ in count");
     for (std::size_t i = 0; i < t.pos_mm.size(); ++i) {
       if (!std::isfinite(t.pos_mm[i]) || !std::isfinite(t.values[i]))
-        throw InputError("volumetric: component '" + name + "': support point " + std::to_string(i + 1) + " is not finite");
+        throw InputError("volumetric: component '" + name + "': support point " + std::to_string(i + 1) +
+                         " is not finite");
       if (i > 0 && t.pos_mm[i] <= t.pos_mm[i - 1])
-        throw InputError("volumetric: component '" + name + "': positions must increase strictly (point " + std::to_string(i + 1) +
-                         (t.pos_mm[i] == t.pos_mm[i - 1] ? ", duplicate)" : ")"));
+        throw InputError("volumetric: component '" + name + "': positions must increase strictly (point " +
+                         std::to_string(i + 1) + (t.pos_mm[i] == t.pos_mm[i - 1] ? ", duplicate)" : ")"));
     }
     const int a = k / 6;
     if (t.pos_mm.front() > m.range_mm[a][0] + 1e-9 || t.pos_mm.back() < m.range_mm[a][1] - 1e-9)
-      throw InputError("volumetric: component '" + name + "' does not cover the axis range [" + std::to_string(m.range_mm[a][0]) + ", " +
-                       std::to_string(m.range_mm[a][1]) + "] mm");
+      throw InputError("volumetric: component '" + name + "' does not cover the axis range [" +
+                       std::to_string(m.range_mm[a][0]) + ", " + std::to_string(m.range_mm[a][1]) + "] mm");
   }
 }
 
@@ -58,7 +60,7 @@ VolumetricResult volumetric_deviation(const VolumetricModel& m, const Eigen::Vec
   const Eigen::Vector3d eT(c[xtx] + c[ytx] + c[ztx], c[xty] + c[yty] + c[zty], c[xtz] + c[ytz] + c[ztz]);
   Eigen::Matrix3d ER;
   ER << 0.0, -m.xwy_urad - c[xrz], m.xwz_urad + c[xry] + c[yry],  //
-      0.0, 0.0, -m.ywz_urad - c[xrx] - c[yrx],                     //
+      0.0, 0.0, -m.ywz_urad - c[xrx] - c[yrx],                    //
       0.0, c[xrx], 0.0;
   const double rx = c[xrx] + c[yrx] + c[zrx], ry = c[xry] + c[yry] + c[zry], rz = c[xrz] + c[yrz] + c[zrz];
   Eigen::Matrix3d EP;

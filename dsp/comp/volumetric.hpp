@@ -16,8 +16,9 @@
 namespace eical::dsp::comp {
 
 // The 18 error functions in a fixed order: axis (x, y, z) × (tx, ty, tz, rx, ry, rz).
-inline constexpr std::array<const char*, 18> kVolumetricComponents = {
-    "xtx", "xty", "xtz", "xrx", "xry", "xrz", "ytx", "yty", "ytz", "yrx", "yry", "yrz", "ztx", "zty", "ztz", "zrx", "zry", "zrz"};
+inline constexpr std::array<const char*, 18> kVolumetricComponents = {"xtx", "xty", "xtz", "xrx", "xry", "xrz",
+                                                                      "ytx", "yty", "ytz", "yrx", "yry", "yrz",
+                                                                      "ztx", "zty", "ztz", "zrx", "zry", "zrz"};
 
 struct SupportTable {
   std::vector<double> pos_mm;  // strictly increasing, covering the axis range
@@ -39,7 +40,8 @@ struct VolumetricResult {
   [[nodiscard]] bool ok() const { return out_of_range_axis < 0; }
 };
 
-VolumetricResult volumetric_deviation(const VolumetricModel& model, const Eigen::Vector3d& x_mm, const Eigen::Vector3d& tool_mm);
+VolumetricResult volumetric_deviation(const VolumetricModel& model, const Eigen::Vector3d& x_mm,
+                                      const Eigen::Vector3d& tool_mm);
 
 // The 18 component values at a position (µm / µrad), in kVolumetricComponents order.
 std::array<double, 18> component_values(const VolumetricModel& model, const Eigen::Vector3d& x_mm);

@@ -56,7 +56,8 @@ Channel channel_of(const AxisPass& p, int c) {
       dof += static_cast<int>(v.size()) - 1;
     }
   if (dof < 1)
-    throw InputError("volumetric: the " + letter(p.axis) + " run " + p.source + " has no target reached twice from one side: no scatter, no uncertainty");
+    throw InputError("volumetric: the " + letter(p.axis) + " run " + p.source +
+                     " has no target reached twice from one side: no scatter, no uncertainty");
   const double s = std::sqrt(ss / dof);
   Channel ch;
   for (const auto& [k, dirs] : by_target) {
@@ -113,7 +114,8 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
   for (const auto& p : passes)
     for (const auto& s : p.stops)
       for (int a = 0; a < 3; ++a)
-        if (a != p.axis) still_sum[static_cast<std::size_t>(a)] += s.cmd_mm[a], still_n[static_cast<std::size_t>(a)] += 1.0;
+        if (a != p.axis)
+          still_sum[static_cast<std::size_t>(a)] += s.cmd_mm[a], still_n[static_cast<std::size_t>(a)] += 1.0;
   std::array<std::optional<AxisPass>, 3> merged;
   for (int a = 0; a < 3; ++a) {
     const auto ai = static_cast<std::size_t>(a);
@@ -133,7 +135,7 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
   if (!merged[0] && !merged[1] && !merged[2]) throw InputError("volumetric: no positioning run to fit the model from");
 
   std::array<std::vector<std::pair<double, double>>, 3> square_est;  // (µrad, U) per slot
-  std::array<std::array<std::optional<Line>, 3>, 3> slope;             // [moving axis][channel]
+  std::array<std::array<std::optional<Line>, 3>, 3> slope;           // [moving axis][channel]
   for (int a = 0; a < 3; ++a) {
     const auto ai = static_cast<std::size_t>(a);
     for (int c = 0; c < 3; ++c) {
@@ -141,7 +143,9 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
       auto& comp = f.component[static_cast<std::size_t>(k)];
       if (!merged[ai]) continue;
       Channel ch = channel_of(*merged[ai], c);
-      if (ch.pos_mm.size() < 2) throw InputError("volumetric: the " + letter(a) + " run " + merged[ai]->source + " reached fewer than 2 targets");
+      if (ch.pos_mm.size() < 2)
+        throw InputError("volumetric: the " + letter(a) + " run " + merged[ai]->source +
+                         " reached fewer than 2 targets");
       f.model.range_mm[ai] = {ch.pos_mm.front(), ch.pos_mm.back()};
       std::string note = "positioning run " + merged[ai]->source + ", channel " + letter(c);
       if (c != a) {
@@ -170,7 +174,8 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
     const auto& ba = slope[b][a];  // b's run seen in a's channel
     const auto& ab = slope[a][b];
     if (ba && ab)
-      square_est[sl].emplace_back(kPairs[sl].sign * (ba->slope + ab->slope) * 1e3, 2.0 * std::hypot(ba->u_slope, ab->u_slope) * 1e3);
+      square_est[sl].emplace_back(kPairs[sl].sign * (ba->slope + ab->slope) * 1e3,
+                                  2.0 * std::hypot(ba->u_slope, ab->u_slope) * 1e3);
   }
   for (const auto& c : circles) {
     const auto slot = static_cast<std::size_t>(c.pair);
@@ -184,7 +189,8 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
   for (std::size_t s = 0; s < 3; ++s) {
     auto& sq = f.squareness[s];
     if (square_est[s].empty()) {
-      sq.note = std::string(names[s]) + ": not observed (needs positioning runs of both axes of the pair, or a circle in its plane with an "
+      sq.note = std::string(names[s]) +
+                ": not observed (needs positioning runs of both axes of the pair, or a circle in its plane with an "
                 "uncertainty)";
       continue;
     }
@@ -207,7 +213,8 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
       const auto& rg = f.model.range_mm[ai];
       f.model.component[static_cast<std::size_t>(k)] =
           rg[0] < rg[1] ? SupportTable{{rg[0], rg[1]}, {0.0, 0.0}} : SupportTable{{rg[0]}, {0.0}};
-      comp.note = k >= 6 * a + kRx ? "not observable: a rotation of the carriage moves eical's one measuring point like a translation; it needs a "
+      comp.note = k >= 6 * a + kRx ? "not observable: a rotation of the carriage moves eical's one measuring point "
+                                     "like a translation; it needs a "
                                      "second measuring point at a known lever or an angle reference"
                                    : "not measured: no positioning run moves " + letter(a);
     }

@@ -46,8 +46,8 @@ struct SquarenessFigure {
 
 struct ComponentFit {
   bool observed = false;
-  std::string note;            // where it comes from, or why it is not observed
-  std::vector<double> u_k2;    // per support point (observed components)
+  std::string note;          // where it comes from, or why it is not observed
+  std::vector<double> u_k2;  // per support point (observed components)
 };
 
 struct SquarenessFit {

@@ -54,7 +54,7 @@ struct SensorSpec {
 };
 
 struct PsdSpec {
-  std::string measures = "x";      // relative-position axis it measures
+  std::string measures = "x";        // relative-position axis it measures
   double center_mm[2] = {0.0, 0.0};  // (x, y) of the strip centre, relative coordinates
   double length_mm = 10.0;
   double width_mm = 0.5;

@@ -20,7 +20,8 @@ class Spill {
   // Appends bytes (whole records; the caller's record size).
   virtual void write(const void* data, std::size_t bytes) = 0;
   // Everything written, from the start, in blocks that are whole multiples of record_bytes.
-  virtual void read(std::size_t record_bytes, const std::function<void(const void* data, std::size_t bytes)>& block) = 0;
+  virtual void read(std::size_t record_bytes,
+                    const std::function<void(const void* data, std::size_t bytes)>& block) = 0;
   // `bytes` from `offset` (within what was written) into out.
   virtual void read_at(std::size_t offset, void* out, std::size_t bytes) = 0;
   [[nodiscard]] virtual std::size_t bytes() const = 0;

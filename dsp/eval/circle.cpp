@@ -85,7 +85,8 @@ void CircleAccumulator::put(const Eigen::Vector2d& d, double dev_um) {
 void CircleAccumulator::add(std::int64_t sample_index, const Eigen::Vector2d& pos_mm) {
   const bool arc = o_.arc_deg < 360.0;
   if (!pos_mm.allFinite())
-    throw InputError(std::string(arc ? "arc" : "circle") + " evaluation: non-finite position at sample " + std::to_string(sample_index));
+    throw InputError(std::string(arc ? "arc" : "circle") + " evaluation: non-finite position at sample " +
+                     std::to_string(sample_index));
   if (!arc) {
     pts_.push_back(pos_mm);
     return;
@@ -100,13 +101,17 @@ void CircleAccumulator::end() {
   const int k = open_;
   open_ = -1;
   if (o_.arc_deg < 360.0) {
-    if (n_here_ < 20) throw InputError("arc evaluation: arc " + std::to_string(k + 1) + " has only " + std::to_string(n_here_) + " samples");
+    if (n_here_ < 20)
+      throw InputError("arc evaluation: arc " + std::to_string(k + 1) + " has only " + std::to_string(n_here_) +
+                       " samples");
     r_.centers_mm.push_back(o_.center_mm);
     r_.radii_mm.push_back(o_.radius_mm + sum_here_ / static_cast<double>(n_here_) / 1000.0);  // mean radius of the arc
     ++r_.revolutions;
     return;
   }
-  if (pts_.size() < 100) throw InputError("circle evaluation: revolution " + std::to_string(k + 1) + " has only " + std::to_string(pts_.size()) + " samples");
+  if (pts_.size() < 100)
+    throw InputError("circle evaluation: revolution " + std::to_string(k + 1) + " has only " +
+                     std::to_string(pts_.size()) + " samples");
   const CircleFit fit = fit_circle(pts_);
   r_.centers_mm.push_back(fit.center);
   r_.radii_mm.push_back(fit.radius);
@@ -133,7 +138,8 @@ CircleResult CircleAccumulator::result() const {
 }
 
 CircleResult evaluate_circle(const CircleInput& in) {
-  if (in.pos_mm.size() != in.sample_index.size()) throw InputError("circle evaluation: positions and sample indices differ in length");
+  if (in.pos_mm.size() != in.sample_index.size())
+    throw InputError("circle evaluation: positions and sample indices differ in length");
   if (!(in.radius_mm > 0.0)) throw InputError("circle evaluation: nominal radius must be positive");
   std::vector<std::pair<std::int64_t, std::int64_t>> ranges = in.segments;
   if (ranges.empty()) {
@@ -144,12 +150,14 @@ CircleResult evaluate_circle(const CircleInput& in) {
     for (std::size_t k = 0; k + 1 < marks.size(); ++k) ranges.emplace_back(marks[k], marks[k + 1]);
   }
   if (ranges.empty())
-    throw InputError("circle evaluation: fewer than two M102 marks inside the measurement (a circle program marks each revolution)");
+    throw InputError(
+        "circle evaluation: fewer than two M102 marks inside the measurement (a circle program marks each revolution)");
   CircleAccumulator acc({in.center_mm, in.radius_mm, in.direction, 360.0, 1, 0});
   for (const auto& range : ranges) {
     acc.begin();
     for (std::size_t i = 0; i < in.sample_index.size(); ++i)
-      if (in.sample_index[i] >= range.first && in.sample_index[i] < range.second) acc.add(in.sample_index[i], in.pos_mm[i]);
+      if (in.sample_index[i] >= range.first && in.sample_index[i] < range.second)
+        acc.add(in.sample_index[i], in.pos_mm[i]);
     acc.end();
   }
   return acc.result();

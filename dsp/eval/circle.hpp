@@ -18,8 +18,8 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
-#include <utility>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace eical::dsp::eval {
@@ -33,15 +33,15 @@ struct CircleInput {
   // between the directions that is no revolution).
   std::vector<std::pair<std::int64_t, std::int64_t>> segments;
   Eigen::Vector2d center_mm = Eigen::Vector2d::Zero();  // nominal
-  double radius_mm = 10.0;                  // nominal
+  double radius_mm = 10.0;                              // nominal
   std::string direction = "ccw";
 };
 
 struct CircleTrace {
-  std::vector<double> angle_deg;            // 0..360 about the revolution's centre
+  std::vector<double> angle_deg;  // 0..360 about the revolution's centre
   std::vector<double> radius_deviation_um;
-  std::vector<std::string> direction;       // per point, for combined traces
-  std::vector<int> revolution;             // revolution or arc index within its direction
+  std::vector<std::string> direction;  // per point, for combined traces
+  std::vector<int> revolution;         // revolution or arc index within its direction
   // 1: every point. n > 1: the points whose index in the (combined) trace is a multiple
   // of n (long runs evaluated as they stream keep only what the plots show).
   std::size_t stride = 1;
@@ -110,7 +110,7 @@ class CircleAccumulator {
   CircleResult r_;
   std::vector<Eigen::Vector2d> pts_;  // the open revolution (full circles)
   std::vector<double> last_dev_;
-  std::size_t n_here_ = 0;            // samples of the open arc
+  std::size_t n_here_ = 0;  // samples of the open arc
   double sum_here_ = 0.0, sum_dev_ = 0.0, dmax_ = -INFINITY, dmin_ = INFINITY;
   int open_ = -1;  // index of the open revolution, -1 when none
 };

@@ -9,12 +9,14 @@
 namespace eical::dsp::eval {
 
 CircleResult evaluate_arc(const CircleInput& in, double arc_deg) {
-  if (in.pos_mm.size() != in.sample_index.size()) throw InputError("arc evaluation: positions and sample indices differ in length");
+  if (in.pos_mm.size() != in.sample_index.size())
+    throw InputError("arc evaluation: positions and sample indices differ in length");
   if (!(in.radius_mm > 0.0)) throw InputError("arc evaluation: nominal radius must be positive");
   if (!(arc_deg > 0.0 && arc_deg <= 360.0)) throw InputError("arc evaluation: arc_deg must be in (0, 360]");
   if (in.segments.empty()) throw InputError("arc evaluation: no evaluated arc between two M102 marks");
   // 360 here would fit centres: an arc of the full circle is still about the programmed one.
-  CircleAccumulator acc({in.center_mm, in.radius_mm, in.direction, std::min(arc_deg, std::nextafter(360.0, 0.0)), 1, 0});
+  CircleAccumulator acc(
+      {in.center_mm, in.radius_mm, in.direction, std::min(arc_deg, std::nextafter(360.0, 0.0)), 1, 0});
   for (const auto& seg : in.segments) {
     acc.begin();
     for (std::size_t i = 0; i < in.sample_index.size(); ++i)

@@ -3,8 +3,8 @@
 
 #include "dsp/core/error.hpp"
 
-#include <Eigen/QR>
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
 
 #include <algorithm>
 #include <array>
@@ -56,18 +56,23 @@ void walk(PassReplay& replay, std::size_t window, F&& f) {
   auto close_pass = [&] {
     if (cur == SIZE_MAX || got == 0) return;
     // The last sample: its velocity from the one before it (or none, alone).
-    if (got == 1) emit(cmd, cmd, 0);
-    else emit(prev_cmd, cmd, 1);
+    if (got == 1)
+      emit(cmd, cmd, 0);
+    else
+      emit(prev_cmd, cmd, 1);
   };
   replay.replay([&](std::size_t pass, const Eigen::Vector2d& c, const Eigen::Vector2d& m) {
     if (pass != cur) {
       close_pass();
       cur = pass, i = 0, got = 0, last[0] = last[1] = 0, until[0] = until[1] = 0;
     }
-    if (!c.allFinite() || !m.allFinite()) throw InputError("circle diagnostics: non-finite position at sample " + std::to_string(got));
+    if (!c.allFinite() || !m.allFinite())
+      throw InputError("circle diagnostics: non-finite position at sample " + std::to_string(got));
     if (got >= 1) {  // the buffered sample's next one has come
-      if (got == 1) emit(cmd, c, 1);
-      else emit(prev_cmd, c, 2);
+      if (got == 1)
+        emit(cmd, c, 1);
+      else
+        emit(prev_cmd, c, 2);
       prev_cmd = cmd;
     }
     cmd = c, meas = m;
@@ -78,7 +83,7 @@ void walk(PassReplay& replay, std::size_t window, F&& f) {
 
 // The rows of one axis' model for given settings (pitch, the play of the backlash operator).
 struct AxisModel {
-  int a = 0;              // 0 = x, 1 = y
+  int a = 0;  // 0 = x, 1 = y
   DiagnosticsOptions opt;
   std::vector<double> pitches_mm;  // the cyclic columns' pitches (one each: sin, cos)
   double play_mm = 0.0;            // > 0: the play operator; else the step −sgn(v)/2
@@ -150,7 +155,10 @@ struct AxisGram {
   Eigen::MatrixXd block;
   std::size_t fill = 0, fill_pass = 0;
   static constexpr std::size_t kBlock = 256;
-  AxisGram(std::size_t n_pass, std::size_t pitches) : width(9 + 2 * pitches + 1), m(n_pass, Eigen::MatrixXd::Zero(9 + 2 * pitches + 1, 9 + 2 * pitches + 1)), rows(n_pass, 0) {
+  AxisGram(std::size_t n_pass, std::size_t pitches)
+      : width(9 + 2 * pitches + 1),
+        m(n_pass, Eigen::MatrixXd::Zero(9 + 2 * pitches + 1, 9 + 2 * pitches + 1)),
+        rows(n_pass, 0) {
     block.resize(static_cast<Eigen::Index>(kBlock), static_cast<Eigen::Index>(width));
   }
   double* next_row(std::size_t pass) {
@@ -168,19 +176,21 @@ struct AxisGram {
     if (cyc > 0) {
       g.bottomLeftCorner(cyc, head).noalias() += f.rightCols(cyc).transpose() * f.leftCols(head);
       for (Eigen::Index k = 0; k < cyc; k += 2)
-        g.block(head + k, head + k, 2, 2).noalias() += f.middleCols(head + k, 2).transpose() * f.middleCols(head + k, 2);
+        g.block(head + k, head + k, 2, 2).noalias() +=
+            f.middleCols(head + k, 2).transpose() * f.middleCols(head + k, 2);
     }
     fill = 0;
   }
   [[nodiscard]] double at(std::size_t pass, std::size_t r, std::size_t c) const {
     const auto& g = m[pass];
-    return r >= c ? g(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) : g(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(r));
+    return r >= c ? g(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c))
+                  : g(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(r));
   }
 };
 
 struct AxisFit {
-  Eigen::VectorXd coef;  // fixed columns only (n_cols)
-  Eigen::VectorXd x;     // every unknown (polynomials per pass, then the used fixed columns)
+  Eigen::VectorXd coef;     // fixed columns only (n_cols)
+  Eigen::VectorXd x;        // every unknown (polynomials per pass, then the used fixed columns)
   std::vector<int> col_of;  // unknown index of each fixed column, −1 when not used
   double rms_mm = 0.0;
 };
@@ -222,10 +232,14 @@ AxisFit solve_axis(const AxisGram& g, std::size_t k, const std::array<bool, n_co
     for (Eigen::Index v = 0; v <= u; ++v) {
       const Where& wv = where[static_cast<std::size_t>(v)];
       double val = 0.0;
-      if (wu.pass != SIZE_MAX && wv.pass != SIZE_MAX) val = wu.pass == wv.pass ? g.at(wu.pass, wu.col, wv.col) : 0.0;
-      else if (wu.pass != SIZE_MAX) val = g.at(wu.pass, wu.col, wv.col);
-      else if (wv.pass != SIZE_MAX) val = g.at(wv.pass, wv.col, wu.col);
-      else val = sum(wu, wv.col);
+      if (wu.pass != SIZE_MAX && wv.pass != SIZE_MAX)
+        val = wu.pass == wv.pass ? g.at(wu.pass, wu.col, wv.col) : 0.0;
+      else if (wu.pass != SIZE_MAX)
+        val = g.at(wu.pass, wu.col, wv.col);
+      else if (wv.pass != SIZE_MAX)
+        val = g.at(wv.pass, wv.col, wu.col);
+      else
+        val = sum(wu, wv.col);
       G(u, v) = G(v, u) = val;
     }
     // Target + L·v with the lag column −v: Σ a·(t + L·v) = Σ a·t − L·Σ a·lag.
@@ -233,7 +247,9 @@ AxisFit solve_axis(const AxisGram& g, std::size_t k, const std::array<bool, n_co
   }
   double tt = 0.0, t_lag = 0.0, lag_lag = 0.0;
   std::size_t rows = 0;
-  for (std::size_t p = 0; p < n_pass; ++p) tt += g.at(p, tgt, tgt), t_lag += g.at(p, tgt, gcol[lag]), lag_lag += g.at(p, gcol[lag], gcol[lag]), rows += g.rows[p];
+  for (std::size_t p = 0; p < n_pass; ++p)
+    tt += g.at(p, tgt, tgt), t_lag += g.at(p, tgt, gcol[lag]), lag_lag += g.at(p, gcol[lag], gcol[lag]),
+        rows += g.rows[p];
   tt += -2.0 * fixed_lag_s * t_lag + fixed_lag_s * fixed_lag_s * lag_lag;
   // Column scaling keeps the solution well conditioned (mm, mm/s and ±0.5 columns differ a lot).
   Eigen::VectorXd norm = G.diagonal().cwiseMax(0.0).cwiseSqrt();
@@ -244,20 +260,24 @@ AxisFit solve_axis(const AxisGram& g, std::size_t k, const std::array<bool, n_co
   fit.x = Gs.colPivHouseholderQr().solve(inv.cwiseProduct(b)).cwiseQuotient(norm);
   fit.coef = Eigen::VectorXd::Zero(n_cols);
   for (int c = 0; c < n_cols; ++c)
-    if (fit.col_of[static_cast<std::size_t>(c)] >= 0) fit.coef(c) = fit.x(n_poly + fit.col_of[static_cast<std::size_t>(c)]);
+    if (fit.col_of[static_cast<std::size_t>(c)] >= 0)
+      fit.coef(c) = fit.x(n_poly + fit.col_of[static_cast<std::size_t>(c)]);
   const double rss = tt - 2.0 * fit.x.dot(b) + fit.x.dot(G * fit.x);
   fit.rms_mm = rows > 0 ? std::sqrt(std::max(rss, 0.0) / static_cast<double>(rows)) : 0.0;
   return fit;
 }
 
 // The fit's residual at a sample (target − model), rows as AxisModel makes them.
-double residual(const AxisFit& fit, const double* common9, const double* cyc, double target, std::size_t pass, double fixed_lag_s, double v_a) {
-  const std::size_t n_poly = fit.x.size() - static_cast<Eigen::Index>(std::count_if(fit.col_of.begin(), fit.col_of.end(), [](int c) { return c >= 0; }));
+double residual(const AxisFit& fit, const double* common9, const double* cyc, double target, std::size_t pass,
+                double fixed_lag_s, double v_a) {
+  const std::size_t n_poly = fit.x.size() - static_cast<Eigen::Index>(std::count_if(
+                                                fit.col_of.begin(), fit.col_of.end(), [](int c) { return c >= 0; }));
   double model = 0.0;
   for (std::size_t j = 0; j < 3; ++j) model += fit.x(static_cast<Eigen::Index>(3 * pass + j)) * common9[j];
   const double fixed[n_cols] = {common9[3], common9[4], common9[5], common9[6], common9[7], cyc[0], cyc[1], common9[8]};
   for (int c = 0; c < n_cols; ++c)
-    if (fit.col_of[static_cast<std::size_t>(c)] >= 0) model += fit.x(static_cast<Eigen::Index>(n_poly) + fit.col_of[static_cast<std::size_t>(c)]) * fixed[c];
+    if (fit.col_of[static_cast<std::size_t>(c)] >= 0)
+      model += fit.x(static_cast<Eigen::Index>(n_poly) + fit.col_of[static_cast<std::size_t>(c)]) * fixed[c];
   return target + fixed_lag_s * v_a - model;
 }
 
@@ -282,7 +302,8 @@ class StoredPasses final : public PassReplay {
 
 CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& opt) {
   for (const auto& p : passes)
-    if (p.cmd_mm.size() != p.meas_mm.size()) throw InputError("circle diagnostics: commanded and measured traces differ in length");
+    if (p.cmd_mm.size() != p.meas_mm.size())
+      throw InputError("circle diagnostics: commanded and measured traces differ in length");
   StoredPasses replay(passes);
   return diagnose_circle(replay, opt);
 }
@@ -387,8 +408,10 @@ CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& 
   fits[0] = both_directions ? solve_axis(gram2[0], 0, use, 0.0) : solve_axis(gram2[0], 0, use_x, fixed_lag_x);
   if (!both_directions) fits[0].coef(lag) = fits[1].coef(lag);
 
-  if (both_directions) d.servo_and_squareness_separated = true;
-  else d.notes.push_back("one direction only: servo mismatch cannot be separated from squareness; equal lags assumed");
+  if (both_directions)
+    d.servo_and_squareness_separated = true;
+  else
+    d.notes.push_back("one direction only: servo mismatch cannot be separated from squareness; equal lags assumed");
   const Eigen::VectorXd& cx = fits[0].coef;
   const Eigen::VectorXd& cy = fits[1].coef;
   d.backlash_x_um = cx(backlash) * kUmPerMm;
@@ -467,9 +490,11 @@ CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& 
       // Creep feed: the fast residual of each axis is its slide sticking and slipping — a
       // sawtooth (or triangle) between 0 and the lag A, whose RMS is A/(2√3). Its mean lag
       // A/2 against the direction of motion reads as backlash A.
-      const double ax = std::sqrt(ss_axis[0] / static_cast<double>(n)), ay = std::sqrt(ss_axis[1] / static_cast<double>(n));
+      const double ax = std::sqrt(ss_axis[0] / static_cast<double>(n)),
+                   ay = std::sqrt(ss_axis[1] / static_cast<double>(n));
       d.stick_slip_um = 2.0 * std::sqrt(3.0) * std::max(ax, ay) * kUmPerMm;
-      d.notes.push_back("creep feed: the fast residual is reported as stick-slip (its mean lag also reads as backlash)");
+      d.notes.push_back(
+          "creep feed: the fast residual is reported as stick-slip (its mean lag also reads as backlash)");
     } else {
       d.vibration_um = std::sqrt(ss_rad / static_cast<double>(n)) * kUmPerMm;
     }

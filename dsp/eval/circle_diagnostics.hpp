@@ -59,8 +59,9 @@ struct CircleDiagnostics {
   double squareness_urad = 0;
   double scale_mismatch_ppm = 0;
   double straightness_x_um = 0, straightness_y_um = 0;  // bow of the axis' path at mid-travel vs its ends
-  double stick_slip_um = 0;   // creep feed only: peak-to-peak lag per axis, 2√3 × the fast residual RMS (sawtooth/triangle)
-  double vibration_um = 0;    // above the creep feed: radial residual RMS above the model (fast components)
+  double stick_slip_um =
+      0;  // creep feed only: peak-to-peak lag per axis, 2√3 × the fast residual RMS (sawtooth/triangle)
+  double vibration_um = 0;            // above the creep feed: radial residual RMS above the model (fast components)
   double lag_x_ms = 0, lag_y_ms = 0;  // each axis' lag behind the set-point (common servo lag)
   double residual_rms_um = 0;         // what the model leaves
   bool servo_and_squareness_separated = false;  // needs both directions
@@ -82,7 +83,8 @@ class PassReplay {
   virtual ~PassReplay() = default;
   [[nodiscard]] virtual const std::vector<Pass>& passes() const = 0;
   // Every sample of every pass, pass by pass, in order.
-  virtual void replay(const std::function<void(std::size_t pass, const Eigen::Vector2d& cmd_mm, const Eigen::Vector2d& meas_mm)>& sample) = 0;
+  virtual void replay(const std::function<void(std::size_t pass, const Eigen::Vector2d& cmd_mm,
+                                               const Eigen::Vector2d& meas_mm)>& sample) = 0;
 };
 
 // The same fit over replayed passes; memory independent of their length. (The least

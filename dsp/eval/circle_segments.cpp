@@ -8,7 +8,8 @@
 
 namespace eical::dsp::eval {
 
-CircleSegmentFinder::CircleSegmentFinder(const Eigen::Vector2d& center_mm, double arc_deg) : centre_(center_mm), arc_deg_(arc_deg) {
+CircleSegmentFinder::CircleSegmentFinder(const Eigen::Vector2d& center_mm, double arc_deg)
+    : centre_(center_mm), arc_deg_(arc_deg) {
   if (!(arc_deg > 0.0 && arc_deg <= 360.0)) throw InputError("circle segments: arc_deg must be in (0, 360]");
 }
 
@@ -16,7 +17,7 @@ void CircleSegmentFinder::add(std::int64_t sample_index, const Eigen::Vector2d& 
   constexpr double tol_deg = 2.0;         // the trigger sits on the nearest sample: far below 2°
   constexpr double back_step_deg = 1e-3;  // a set-point step against the sweep larger than this breaks monotonicity
   const double a = std::atan2(cmd.y() - centre_.y(), cmd.x() - centre_.x());
-  if (open_) {  // this sample belongs to the open stretch (the one that closes it too)
+  if (open_) {             // this sample belongs to the open stretch (the one that closes it too)
     double d = a - prev_;  // unwrap
     if (d > std::numbers::pi) d -= 2 * std::numbers::pi;
     if (d < -std::numbers::pi) d += 2 * std::numbers::pi;
@@ -40,8 +41,8 @@ void CircleSegmentFinder::add(std::int64_t sample_index, const Eigen::Vector2d& 
 
 std::vector<CircleSegment> find_circle_segments(const std::vector<Eigen::Vector2d>& cmd,
                                                 const std::vector<std::int64_t>& idx,
-                                                const std::vector<std::int64_t>& marks_in, const Eigen::Vector2d& centre,
-                                                double arc_deg) {
+                                                const std::vector<std::int64_t>& marks_in,
+                                                const Eigen::Vector2d& centre, double arc_deg) {
   if (cmd.size() != idx.size()) throw InputError("circle segments: set-point and sample indices differ in length");
   CircleSegmentFinder finder(centre, arc_deg);
   std::vector<std::int64_t> marks = marks_in;

@@ -18,12 +18,12 @@ struct PathDeviationOptions {
 };
 
 struct PathDeviation {
-  std::vector<double> arc_length_mm;       // along the commanded path, per evaluated sample
-  std::vector<double> normal_um;           // signed by the side: positive left of the travel direction (xy)
-  std::vector<double> normal_magnitude_um; // |normal component| (3-D)
-  std::vector<double> tangential_um;       // positive = ahead of the set-point
-  std::vector<std::size_t> sample;         // which input sample each entry came from
-  double contour_error_max_um = 0.0;       // max |normal|
+  std::vector<double> arc_length_mm;        // along the commanded path, per evaluated sample
+  std::vector<double> normal_um;            // signed by the side: positive left of the travel direction (xy)
+  std::vector<double> normal_magnitude_um;  // |normal component| (3-D)
+  std::vector<double> tangential_um;        // positive = ahead of the set-point
+  std::vector<std::size_t> sample;          // which input sample each entry came from
+  double contour_error_max_um = 0.0;        // max |normal|
   double contour_error_rms_um = 0.0;
   double tangential_rms_um = 0.0;
 };

@@ -10,15 +10,18 @@ namespace eical::dsp::eval {
 PositioningResult evaluate_positioning(const PositioningInput& in) {
   const std::size_t m = in.targets_mm.size();
   if (m < 2) throw InputError("ISO 230-2: at least 2 targets are needed");
-  if (in.up_um.size() < 2 || in.down_um.size() < 2) throw InputError("ISO 230-2: at least 2 runs per direction are needed");
-  if (in.up_um.size() != in.down_um.size()) throw InputError("ISO 230-2: the two directions have different numbers of runs");
+  if (in.up_um.size() < 2 || in.down_um.size() < 2)
+    throw InputError("ISO 230-2: at least 2 runs per direction are needed");
+  if (in.up_um.size() != in.down_um.size())
+    throw InputError("ISO 230-2: the two directions have different numbers of runs");
   for (const auto* dir : {&in.up_um, &in.down_um})
     for (std::size_t j = 0; j < dir->size(); ++j) {
       if ((*dir)[j].size() != m)
         throw InputError("ISO 230-2: run " + std::to_string(j + 1) + (dir == &in.up_um ? " up" : " down") + " has " +
                          std::to_string((*dir)[j].size()) + " deviations for " + std::to_string(m) + " targets");
       for (double v : (*dir)[j])
-        if (!std::isfinite(v)) throw InputError("ISO 230-2: run " + std::to_string(j + 1) + " holds a non-finite deviation");
+        if (!std::isfinite(v))
+          throw InputError("ISO 230-2: run " + std::to_string(j + 1) + " holds a non-finite deviation");
     }
   const auto n = static_cast<double>(in.up_um.size());
   PositioningResult r;
@@ -32,9 +35,9 @@ PositioningResult evaluate_positioning(const PositioningInput& in) {
     for (const auto& run : d) ss += (run[i] - mean) * (run[i] - mean);
     s = std::sqrt(ss / (n - 1.0));
   };
-  double hi_up = -INFINITY, lo_up = INFINITY, hi_dn = -INFINITY, lo_dn = INFINITY;          // x̄ ± 2s
-  double max_mu = -INFINITY, min_mu = INFINITY, max_md = -INFINITY, min_md = INFINITY;      // x̄↑, x̄↓
-  double max_m = -INFINITY, min_m = INFINITY;                                               // x̄i
+  double hi_up = -INFINITY, lo_up = INFINITY, hi_dn = -INFINITY, lo_dn = INFINITY;      // x̄ ± 2s
+  double max_mu = -INFINITY, min_mu = INFINITY, max_md = -INFINITY, min_md = INFINITY;  // x̄↑, x̄↓
+  double max_m = -INFINITY, min_m = INFINITY;                                           // x̄i
   double vdi_hi = -INFINITY, vdi_lo = INFINITY;
   double sum_b = 0.0;
   for (std::size_t i = 0; i < m; ++i) {
@@ -48,7 +51,8 @@ PositioningResult evaluate_positioning(const PositioningInput& in) {
     t.R_down_um = 4.0 * t.s_down_um;
     t.R_um = std::max({2.0 * t.s_up_um + 2.0 * t.s_down_um + std::abs(t.B_um), t.R_up_um, t.R_down_um});
     hi_up = std::max(hi_up, t.mean_up_um + 2 * t.s_up_um), lo_up = std::min(lo_up, t.mean_up_um - 2 * t.s_up_um);
-    hi_dn = std::max(hi_dn, t.mean_down_um + 2 * t.s_down_um), lo_dn = std::min(lo_dn, t.mean_down_um - 2 * t.s_down_um);
+    hi_dn = std::max(hi_dn, t.mean_down_um + 2 * t.s_down_um),
+    lo_dn = std::min(lo_dn, t.mean_down_um - 2 * t.s_down_um);
     max_mu = std::max(max_mu, t.mean_up_um), min_mu = std::min(min_mu, t.mean_up_um);
     max_md = std::max(max_md, t.mean_down_um), min_md = std::min(min_md, t.mean_down_um);
     max_m = std::max(max_m, t.mean_um), min_m = std::min(min_m, t.mean_um);

@@ -44,7 +44,8 @@ RectangleResult evaluate_rectangle(const std::vector<Eigen::Vector2d>& cmd, cons
     if (j - i >= min_stop) stops.emplace_back(i, j);
     i = j;
   }
-  if (stops.size() < 3) throw InputError("rectangle: fewer than 3 stops of the set-point (is the program run with G61?)");
+  if (stops.size() < 3)
+    throw InputError("rectangle: fewer than 3 stops of the set-point (is the program run with G61?)");
 
   RectangleResult r;
   for (const auto& [b, e] : stops) {
@@ -84,7 +85,8 @@ RectangleResult evaluate_rectangle(const std::vector<Eigen::Vector2d>& cmd, cons
   for (std::size_t k = 0; k + 1 < r.sides.size(); ++k) {
     const Eigen::Vector2d c0 = (r.sides[k].to_mm - r.sides[k].from_mm).normalized();
     const Eigen::Vector2d c1 = (r.sides[k + 1].to_mm - r.sides[k + 1].from_mm).normalized();
-    r.corner_angle_error_urad.push_back((signed_angle(measured_dirs[k], measured_dirs[k + 1]) - signed_angle(c0, c1)) * 1e6);
+    r.corner_angle_error_urad.push_back((signed_angle(measured_dirs[k], measured_dirs[k + 1]) - signed_angle(c0, c1)) *
+                                        1e6);
   }
   return r;
 }

@@ -5,7 +5,9 @@
 
 namespace eical::dsp::eval {
 
-RepeatFinder::RepeatFinder(std::vector<std::int64_t> marks) : marks_(std::move(marks)) { std::sort(marks_.begin(), marks_.end()); }
+RepeatFinder::RepeatFinder(std::vector<std::int64_t> marks) : marks_(std::move(marks)) {
+  std::sort(marks_.begin(), marks_.end());
+}
 
 void RepeatFinder::open(std::size_t position, std::int64_t sample_index) {
   open_ = Segment{};
@@ -53,7 +55,7 @@ bool RepeatFinder::same_path(const Segment& a, const Segment& b, std::size_t len
 void RepeatFinder::close(std::size_t position) {
   has_open_ = false;
   Segment s = std::move(open_);
-  (void)position;  // s.len samples were added: the segment is [begin, position)
+  (void)position;                           // s.len samples were added: the segment is [begin, position)
   if (s.len <= 1 || !s.contiguous) return;  // too short, or lost frames inside
   for (Leader& l : leaders_) {
     const std::size_t len = l.len, lj = s.len;
@@ -93,7 +95,9 @@ RepeatAverager::RepeatAverager(std::vector<RepeatFinder::Group> groups, std::uni
     mean_.emplace_back(groups_[g].len, Eigen::Vector3d::Zero());
     for (std::size_t m = 0; m < groups_[g].begin.size(); ++m) order_.emplace_back(g, m);
   }
-  std::sort(order_.begin(), order_.end(), [&](const auto& x, const auto& y) { return groups_[x.first].begin[x.second] < groups_[y.first].begin[y.second]; });
+  std::sort(order_.begin(), order_.end(), [&](const auto& x, const auto& y) {
+    return groups_[x.first].begin[x.second] < groups_[y.first].begin[y.second];
+  });
 }
 
 void RepeatAverager::add(std::size_t position, const Eigen::Vector3d& pos, const Eigen::Vector3d& cmd) {
@@ -151,7 +155,8 @@ std::vector<RepeatGroup> RepeatAverager::result() {
     std::vector<Eigen::Vector3d>().swap(mean_[gi]);
     out.push_back(std::move(g));
   }
-  std::sort(out.begin(), out.end(), [](const RepeatGroup& a, const RepeatGroup& b) { return a.repeats() > b.repeats(); });
+  std::sort(out.begin(), out.end(),
+            [](const RepeatGroup& a, const RepeatGroup& b) { return a.repeats() > b.repeats(); });
   return out;
 }
 

@@ -23,11 +23,11 @@ struct RepeatGroup {
   // Per sample of the segment, or every `stride`-th one (long runs evaluated as they
   // stream keep what a plot shows; the RMS figures are over every sample).
   std::vector<Eigen::Vector3d> mean_deviation_um;
-  std::vector<Eigen::Vector3d> spread_um;          // sample standard deviation across the repeats
+  std::vector<Eigen::Vector3d> spread_um;  // sample standard deviation across the repeats
   std::size_t stride = 1;
   bool axis_moves[3] = {false, false, false};  // the set-point moves along it in the segment
-  double scatter_rms_um = 0.0;   // RMS over the segment of the spread, over the moving axes
-  double mean_rms_um = 0.0;      // RMS of the mean deviation, over the moving axes
+  double scatter_rms_um = 0.0;                 // RMS over the segment of the spread, over the moving axes
+  double mean_rms_um = 0.0;                    // RMS of the mean deviation, over the moving axes
   [[nodiscard]] int repeats() const noexcept { return static_cast<int>(first_index.size()); }
 };
 
@@ -35,7 +35,7 @@ struct RepeatInput {
   const std::vector<std::int64_t>* sample_index = nullptr;
   const std::vector<Eigen::Vector3d>* pos_mm = nullptr;  // measured
   const std::vector<Eigen::Vector3d>* cmd_mm = nullptr;  // commanded
-  std::vector<std::int64_t> marks;                        // M102 sample indices
+  std::vector<std::int64_t> marks;                       // M102 sample indices
   double fs_hz = 10000.0;
 };
 
@@ -54,9 +54,9 @@ class RepeatFinder {
   void finish();  // the trace ended (segments still open are not covered by it)
 
   struct Group {
-    std::vector<std::size_t> begin;          // trace position of each repeat, in order
-    std::vector<std::int64_t> first_index;   // its sample index
-    std::size_t len = 0;                     // common length
+    std::vector<std::size_t> begin;         // trace position of each repeat, in order
+    std::vector<std::int64_t> first_index;  // its sample index
+    std::size_t len = 0;                    // common length
     bool axis_moves[3] = {false, false, false};
   };
   // Groups of at least two, in the order of their first segment.
@@ -75,7 +75,7 @@ class RepeatFinder {
   };
   struct Leader {
     Segment seg;
-    std::size_t len = 0;  // the group's common length so far
+    std::size_t len = 0;           // the group's common length so far
     std::vector<Segment> members;  // after the leader (only begin, first_index used)
   };
   void close(std::size_t position);

@@ -27,8 +27,10 @@ struct SupportTally {
   std::size_t accepted = 0, rejected = 0;
   double nis_sum = 0.0;  // of the accepted ones (≈ accepted when the model fits)
   void add(const UpdateRecord& r) noexcept {
-    if (r.accepted) ++accepted, nis_sum += r.nis;
-    else ++rejected;
+    if (r.accepted)
+      ++accepted, nis_sum += r.nis;
+    else
+      ++rejected;
   }
 };
 

@@ -10,23 +10,32 @@
 
 namespace eical::dsp::fusion {
 
-CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const SmootherSettings& settings, std::size_t segment_samples,
-                                           SegmentSink* sink)
-    : track_(track), settings_(settings), seg_(std::max<std::size_t>(1, segment_samples)), nominal_(discretise(settings.model, 1.0 / settings.fs_hz)) {
+CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const SmootherSettings& settings,
+                                           std::size_t segment_samples, SegmentSink* sink)
+    : track_(track),
+      settings_(settings),
+      seg_(std::max<std::size_t>(1, segment_samples)),
+      nominal_(discretise(settings.model, 1.0 / settings.fs_hz)) {
   if (!track.schedule) throw InputError("smoother: no schedule");
   const std::size_t n = track.n;
   if (track.schedule->flags.size() != n) throw InputError("smoother: trace, velocity and schedule differ in length");
-  if (track.fix_pos_mm.size() != track.schedule->fixes.size()) throw InputError("smoother: a PSD fix without its integrated position");
+  if (track.fix_pos_mm.size() != track.schedule->fixes.size())
+    throw InputError("smoother: a PSD fix without its integrated position");
   std::size_t reads = 0;
   for (const std::uint8_t f : track.schedule->flags) reads += reads_velocity(f) ? 1 : 0;
-  if (track.support_vel_mm_s.size() != reads) throw InputError("smoother: trace, velocity and schedule differ in length");
+  if (track.support_vel_mm_s.size() != reads)
+    throw InputError("smoother: trace, velocity and schedule differ in length");
   // Fixes and window means in sample order, whatever the caller's (stable: equal k keep theirs).
   std::vector<std::size_t> order(track.schedule->fixes.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return track.schedule->fixes[a].k < track.schedule->fixes[b].k; });
-  for (const std::size_t i : order) fixes_.push_back(track.schedule->fixes[i]), fix_pos_mm_.push_back(track.fix_pos_mm[i]);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return track.schedule->fixes[a].k < track.schedule->fixes[b].k;
+  });
+  for (const std::size_t i : order)
+    fixes_.push_back(track.schedule->fixes[i]), fix_pos_mm_.push_back(track.fix_pos_mm[i]);
   means_ = track.schedule->velocity_means;
-  std::stable_sort(means_.begin(), means_.end(), [](const VelocityMean& a, const VelocityMean& b) { return a.k < b.k; });
+  std::stable_sort(means_.begin(), means_.end(),
+                   [](const VelocityMean& a, const VelocityMean& b) { return a.k < b.k; });
   if (sink) sink->restart();
   if (n == 0) return;
   SmoothedSegment out;
@@ -96,17 +105,21 @@ void CheckpointedSmoother::forward(Checkpoint& c, std::size_t first, std::size_t
     std::int64_t gap = 1;
     if (k > 0) {
       gap = gap_into(k, c.next_gap);
-      fwd.predict(gap == 1 ? nominal_ : discretise(m, static_cast<double>(gap) / settings_.fs_hz), (flags[k] & schedule_flag::move_start) != 0, m);
+      fwd.predict(gap == 1 ? nominal_ : discretise(m, static_cast<double>(gap) / settings_.fs_hz),
+                  (flags[k] & schedule_flag::move_start) != 0, m);
     }
     Vec3 vel = Vec3::Zero();  // read only where the flags say so
     if (reads_velocity(flags[k])) vel = track_.support_vel_mm_s[c.next_vel++];
-    const double zupt_sigma = k < zs.size() ? static_cast<double>(zs[k]) : (k < track_.zupt_unused.size() && track_.zupt_unused[k] ? -1.0 : 0.0);
+    const double zupt_sigma = k < zs.size() ? static_cast<double>(zs[k])
+                                            : (k < track_.zupt_unused.size() && track_.zupt_unused[k] ? -1.0 : 0.0);
     fwd.velocity_supports(flags[k], vel * 1000.0, m, zupt_sigma, sch.zupt);
     for (; c.next_mean < means_.size() && means_[c.next_mean].k <= k; ++c.next_mean)
       if (means_[c.next_mean].k == k) fwd.velocity_mean(means_[c.next_mean], m, sch.zupt);
     for (; c.next_fix < fixes_.size() && fixes_[c.next_fix].k == k; ++c.next_fix) {
       const PositionFix& f = fixes_[c.next_fix];
-      if (sch.cupt) fwd.position_fix(f.axis, fix_pos_mm_[c.next_fix] * 1000.0, f.position_um, std::hypot(f.sigma_um, f.model_sigma_um), m);
+      if (sch.cupt)
+        fwd.position_fix(f.axis, fix_pos_mm_[c.next_fix] * 1000.0, f.position_um,
+                         std::hypot(f.sigma_um, f.model_sigma_um), m);
     }
     if (states) {
       states->gap[k - first] = gap;
@@ -139,7 +152,9 @@ void CheckpointedSmoother::backward(SegmentStates& s, std::size_t last, const st
     const auto& extra = extra_[a];
     // Entries at or below `last`: the recursion at k reads those at k + 1 ≤ last.
     std::size_t next_extra = static_cast<std::size_t>(
-        std::upper_bound(extra.begin(), extra.end(), last, [](std::size_t v, const std::pair<std::size_t, Vec3>& x) { return v < x.first; }) - extra.begin());
+        std::upper_bound(extra.begin(), extra.end(), last,
+                         [](std::size_t v, const std::pair<std::size_t, Vec3>& x) { return v < x.first; }) -
+        extra.begin());
     for (std::size_t k = e_next ? last : last - 1; k-- > first;) {
       const std::size_t i = k - first;
       const bool at_top = k + 1 == last;
@@ -167,7 +182,8 @@ void CheckpointedSmoother::segment(std::size_t j, SmoothedSegment& out, bool kee
   const std::size_t first = s.first, last = first + s.gap.size();
   if (!settings_.forward_only) {
     const bool top = j + 1 == checkpoints_.size();
-    backward(s, last, top ? nullptr : &smoothed_e_[j + 1], top ? nullptr : &smoothed_p_[j + 1], keep_gains ? &out.gain : nullptr);
+    backward(s, last, top ? nullptr : &smoothed_e_[j + 1], top ? nullptr : &smoothed_p_[j + 1],
+             keep_gains ? &out.gain : nullptr);
   } else if (keep_gains) {
     for (int a = 0; a < 3; ++a) out.gain[a].assign(last - first, Mat3::Zero());
   }

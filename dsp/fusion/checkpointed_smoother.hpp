@@ -33,7 +33,7 @@ constexpr bool reads_velocity(std::uint8_t flags) {
 
 // What the smoother reads of a measurement's trace, without the trace.
 struct SmootherTrack {
-  std::size_t n = 0;                     // samples
+  std::size_t n = 0;                          // samples
   const SupportSchedule* schedule = nullptr;  // flags and zupt σ per sample (n of each), fixes, window means
   // (k, samples) where the step into trace sample k is not one sample (lost frames), ascending k.
   std::vector<std::pair<std::size_t, std::int64_t>> gaps;
@@ -80,8 +80,8 @@ class CheckpointedSmoother {
   // outlive the smoother (segment() reads it again). Throws InputError when the track's
   // arrays do not match its length. (segment_samples: tests check that the split changes
   // nothing.)
-  CheckpointedSmoother(const SmootherTrack& track, const SmootherSettings& settings, std::size_t segment_samples = kSegment,
-                       SegmentSink* sink = nullptr);
+  CheckpointedSmoother(const SmootherTrack& track, const SmootherSettings& settings,
+                       std::size_t segment_samples = kSegment, SegmentSink* sink = nullptr);
   [[nodiscard]] std::size_t segment_samples() const noexcept { return seg_; }
 
   [[nodiscard]] std::size_t segments() const noexcept { return checkpoints_.size(); }
@@ -116,17 +116,17 @@ class CheckpointedSmoother {
   // The backward recursion over the segment's states (filtered in, smoothed out), from the
   // smoothed state of sample `last` (the next segment's first; none for the last segment,
   // whose last sample is smoothed as filtered); the gains when asked.
-  void backward(SegmentStates& s, std::size_t last, const std::array<Vec3, 3>* e_next, const std::array<Mat3, 3>* p_next,
-                std::array<std::vector<Mat3>, 3>* gains) const;
+  void backward(SegmentStates& s, std::size_t last, const std::array<Vec3, 3>* e_next,
+                const std::array<Mat3, 3>* p_next, std::array<std::vector<Mat3>, 3>* gains) const;
 
   const SmootherTrack& track_;
   SmootherSettings settings_;
   std::size_t seg_ = kSegment;
   Discrete nominal_;
-  std::vector<PositionFix> fixes_;      // sorted by k (stable), with their integrated position
+  std::vector<PositionFix> fixes_;  // sorted by k (stable), with their integrated position
   std::vector<double> fix_pos_mm_;
-  std::vector<VelocityMean> means_;     // sorted by k (stable)
-  std::vector<Checkpoint> checkpoints_;  // one per segment
+  std::vector<VelocityMean> means_;              // sorted by k (stable)
+  std::vector<Checkpoint> checkpoints_;          // one per segment
   std::vector<std::array<Vec3, 3>> smoothed_e_;  // smoothed state at each segment's first sample
   std::vector<std::array<Mat3, 3>> smoothed_p_;
   // Per axis: (sample, added process noise) of each covariance reset, ascending sample.

@@ -7,10 +7,10 @@
 
 namespace eical::dsp::fusion {
 
-ErrorCovariance::ErrorCovariance(const SupportSchedule& schedule, const std::vector<std::int64_t>& sample_index, double fs_hz,
-                                 ErrorModel model, const Vec3& start_bias_sigma_um_s2) {
-  model.gate_nis = 1e300;           // the covariance of the supports as scheduled
-  model.start_position_um = 0.0;    // measured from where it starts
+ErrorCovariance::ErrorCovariance(const SupportSchedule& schedule, const std::vector<std::int64_t>& sample_index,
+                                 double fs_hz, ErrorModel model, const Vec3& start_bias_sigma_um_s2) {
+  model.gate_nis = 1e300;         // the covariance of the supports as scheduled
+  model.start_position_um = 0.0;  // measured from where it starts
   model.reset_after_rejections = 1 << 30;
   const std::size_t n = sample_index.size();
   SupportSchedule noise_only = schedule;  // the strips' own noise: the bound is the sensors'

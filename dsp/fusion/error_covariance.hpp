@@ -24,8 +24,8 @@ namespace eical::dsp::fusion {
 class ErrorCovariance {
  public:
   // The schedule's trace: sample indices (gaps widen a step), fs.
-  ErrorCovariance(const SupportSchedule& schedule, const std::vector<std::int64_t>& sample_index, double fs_hz, ErrorModel model,
-                  const Vec3& start_bias_sigma_um_s2);
+  ErrorCovariance(const SupportSchedule& schedule, const std::vector<std::int64_t>& sample_index, double fs_hz,
+                  ErrorModel model, const Vec3& start_bias_sigma_um_s2);
 
   // Position error covariance (µm²) of `axis` between every pair of the given trace
   // positions (ascending).

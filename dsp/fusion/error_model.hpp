@@ -23,22 +23,22 @@ using Mat3 = Eigen::Matrix3d;
 // What the filter assumes about the sensors and the supports; defaults are the data
 // sheet's (SF3000L, ch. 6.2) and what the thesis measured (ch. 8.3.2).
 struct ErrorModel {
-  double accel_noise_um_s2_rthz = 5.55;   // relative, two-sided: √2 · 0.4 µg/√Hz · g
-  double bias_walk_um_s2_rts = 2.0;       // relative bias random walk, ≈ 0.2 µg/√s
+  double accel_noise_um_s2_rthz = 5.55;  // relative, two-sided: √2 · 0.4 µg/√Hz · g
+  double bias_walk_um_s2_rts = 2.0;      // relative bias random walk, ≈ 0.2 µg/√s
   // Each partial move has its own offset (ch. 8.3.2): at every start of a move the bias
   // may jump by this much (σ) from what the rest before it showed.
-  double bias_step_um_s2 = 20.0;          // ≈ 2 µg
-  double start_position_um = 2.0;         // σ of the start position against the set-point
-  double start_velocity_um_s = 1.0;       // σ of the velocity at the start (at rest)
-  double zupt_sigma_um_s = 2.0;           // σ of the velocity at a standstill (vibration, creep)
-  double zupt_onset_skip_s = 0.1;         // offline: a standstill's first 0.1 s (settling) unused
-  double nbs_sigma_um_s = 5.0;            // σ of a held axis' velocity (straightness, vibration)
-  double psd_floor_um = 0.05;             // added to every PSD fix's σ (model error of the strip)
+  double bias_step_um_s2 = 20.0;     // ≈ 2 µg
+  double start_position_um = 2.0;    // σ of the start position against the set-point
+  double start_velocity_um_s = 1.0;  // σ of the velocity at the start (at rest)
+  double zupt_sigma_um_s = 2.0;      // σ of the velocity at a standstill (vibration, creep)
+  double zupt_onset_skip_s = 0.1;    // offline: a standstill's first 0.1 s (settling) unused
+  double nbs_sigma_um_s = 5.0;       // σ of a held axis' velocity (straightness, vibration)
+  double psd_floor_um = 0.05;        // added to every PSD fix's σ (model error of the strip)
   // The sensors' scale and mounting are known to this (relative, data sheet: a few 1e-4;
   // identified on site: a few 1e-5): a PSD fix d mm from where the integration started
   // cannot be trusted closer than this times d — the error there is no wandering bias.
   double scale_uncertainty = 3e-4;
-  double gate_nis = 25.0;                 // innovation test: reject beyond 5 σ
+  double gate_nis = 25.0;  // innovation test: reject beyond 5 σ
   // A standstill whose velocity the filter keeps rejecting means the model was too sure
   // (a bias jump it did not expect): after this many rejections in a row (per-sample
   // ZUPT; a window mean counts 100) the covariance is opened by what was unexplained.

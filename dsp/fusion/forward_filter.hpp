@@ -28,8 +28,8 @@ struct CovarianceReset {
 struct ForwardFilter {
   AxisFilter axis[3];
   std::array<std::array<SupportTally, kSupportKinds>, 3> tally{};
-  std::size_t k = 0;                              // the sample being processed
-  std::vector<CovarianceReset>* resets = nullptr; // where resets are recorded (within its capacity)
+  std::size_t k = 0;                               // the sample being processed
+  std::vector<CovarianceReset>* resets = nullptr;  // where resets are recorded (within its capacity)
   std::size_t reset_count = 0;
 
   void start(const ErrorModel& m, const Vec3& start_bias_sigma_um_s2) noexcept {
@@ -64,7 +64,8 @@ struct ForwardFilter {
       if (flags & schedule_flag::rest) {
         if (zupt_on) velocity_update(a, Eigen::RowVector3d(0.0, 1.0, 0.0), vel_um_s[a], sz * sz, m, 1);
       } else if (flags & nbs_flag(a)) {
-        tally[a][static_cast<int>(Support::nbs)].add(axis[a].update(1, vel_um_s[a], m.nbs_sigma_um_s * m.nbs_sigma_um_s, m.gate_nis));
+        tally[a][static_cast<int>(Support::nbs)].add(
+            axis[a].update(1, vel_um_s[a], m.nbs_sigma_um_s * m.nbs_sigma_um_s, m.gate_nis));
       }
     }
   }
@@ -73,13 +74,15 @@ struct ForwardFilter {
   void velocity_mean(const VelocityMean& v, const ErrorModel& m, bool zupt_on = true) noexcept {
     if (!zupt_on) return;
     const double s = std::max(m.zupt_sigma_um_s, v.sigma_um_s);
-    for (int a = 0; a < 3; ++a) velocity_update(a, Eigen::RowVector3d(0.0, 1.0, -v.lag_s), v.mean_um_s[a], s * s, m, 100);
+    for (int a = 0; a < 3; ++a)
+      velocity_update(a, Eigen::RowVector3d(0.0, 1.0, -v.lag_s), v.mean_um_s[a], s * s, m, 100);
   }
 
   // CUPT: the integrated position minus the PSD's is the position error.
   // A strip the filter keeps rejecting is reset to like a standstill (the position error is
   // ν; the bias that would have made it since the last position support, 2ν/T²).
-  UpdateRecord position_fix(int a, double ins_pos_um, double fix_pos_um, double sigma_um, const ErrorModel& m) noexcept {
+  UpdateRecord position_fix(int a, double ins_pos_um, double fix_pos_um, double sigma_um,
+                            const ErrorModel& m) noexcept {
     const double s = sigma_um * sigma_um + m.psd_floor_um * m.psd_floor_um;
     UpdateRecord r = axis[a].update(0, ins_pos_um - fix_pos_um, s, m.gate_nis);
     if (!r.accepted && std::isfinite(r.innovation) && std::abs(r.innovation) < 1e9) {
@@ -101,7 +104,8 @@ struct ForwardFilter {
   }
 
  private:
-  void velocity_update(int a, const Eigen::RowVector3d& h, double z, double r, const ErrorModel& m, int weight) noexcept {
+  void velocity_update(int a, const Eigen::RowVector3d& h, double z, double r, const ErrorModel& m,
+                       int weight) noexcept {
     UpdateRecord rec = axis[a].update_row(h, z, r, m.gate_nis);
     if (!rec.accepted && std::isfinite(rec.innovation) && std::abs(rec.innovation) < 1e9) {  // 1 km/s: never a bias
       rejections_[a] += weight;

@@ -5,8 +5,9 @@
 
 namespace eical::dsp::fusion {
 
-SmootherTrack smoother_track(const std::vector<std::int64_t>& sample_index, const std::vector<Eigen::Vector3d>& vel_mm_s,
-                             const std::vector<Eigen::Vector3d>& pos_mm, const SupportSchedule& schedule) {
+SmootherTrack smoother_track(const std::vector<std::int64_t>& sample_index,
+                             const std::vector<Eigen::Vector3d>& vel_mm_s, const std::vector<Eigen::Vector3d>& pos_mm,
+                             const SupportSchedule& schedule) {
   const std::size_t n = sample_index.size();
   if (vel_mm_s.size() != n || pos_mm.size() != n || schedule.flags.size() != n)
     throw InputError("smoother: trace, velocity and schedule differ in length");
@@ -24,7 +25,8 @@ SmootherTrack smoother_track(const std::vector<std::int64_t>& sample_index, cons
 // The checkpointed smoother's segments gathered into whole-measurement arrays (the same
 // numbers; memory for all of them).
 SmootherOutput smooth(const SmootherInput& in) {
-  if (!in.sample_index || !in.vel_mm_s || !in.pos_mm || !in.schedule) throw InputError("smoother: input arrays missing");
+  if (!in.sample_index || !in.vel_mm_s || !in.pos_mm || !in.schedule)
+    throw InputError("smoother: input arrays missing");
   const SmootherTrack track = smoother_track(*in.sample_index, *in.vel_mm_s, *in.pos_mm, *in.schedule);
   SmootherOutput out;
   const std::size_t n = track.n;
@@ -43,12 +45,15 @@ SmootherOutput smooth(const SmootherInput& in) {
     smoother.segment(j, seg, in.keep_gains);
     std::copy(seg.dx_um.begin(), seg.dx_um.end(), out.dx_um.begin() + static_cast<std::ptrdiff_t>(seg.first));
     std::copy(seg.dv_um_s.begin(), seg.dv_um_s.end(), out.dv_um_s.begin() + static_cast<std::ptrdiff_t>(seg.first));
-    std::copy(seg.bias_um_s2.begin(), seg.bias_um_s2.end(), out.bias_um_s2.begin() + static_cast<std::ptrdiff_t>(seg.first));
-    std::copy(seg.sigma_x_um.begin(), seg.sigma_x_um.end(), out.sigma_x_um.begin() + static_cast<std::ptrdiff_t>(seg.first));
+    std::copy(seg.bias_um_s2.begin(), seg.bias_um_s2.end(),
+              out.bias_um_s2.begin() + static_cast<std::ptrdiff_t>(seg.first));
+    std::copy(seg.sigma_x_um.begin(), seg.sigma_x_um.end(),
+              out.sigma_x_um.begin() + static_cast<std::ptrdiff_t>(seg.first));
     if (in.keep_gains)
       for (int a = 0; a < 3; ++a) {
         std::copy(seg.gain[a].begin(), seg.gain[a].end(), out.gain[a].begin() + static_cast<std::ptrdiff_t>(seg.first));
-        std::copy(seg.p_smoothed[a].begin(), seg.p_smoothed[a].end(), out.p_smoothed[a].begin() + static_cast<std::ptrdiff_t>(seg.first));
+        std::copy(seg.p_smoothed[a].begin(), seg.p_smoothed[a].end(),
+                  out.p_smoothed[a].begin() + static_cast<std::ptrdiff_t>(seg.first));
       }
   }
   return out;

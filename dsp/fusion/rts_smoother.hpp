@@ -30,14 +30,14 @@ struct SmootherInput {
   double fs_hz = 10000.0;
   ErrorModel model;
   Vec3 start_bias_sigma_um_s2 = Vec3::Constant(20.0);  // σ of the rest-window bias per axis
-  bool keep_gains = false;  // keep C_k (for cross-time covariances: the accuracy bound)
-  bool forward_only = false;  // the live filter's causal result, no backward pass
+  bool keep_gains = false;                             // keep C_k (for cross-time covariances: the accuracy bound)
+  bool forward_only = false;                           // the live filter's causal result, no backward pass
 };
 
 struct SmootherOutput {
-  std::vector<Eigen::Vector3d> dx_um, dv_um_s;  // smoothed error per sample (subtract it)
-  std::vector<Eigen::Vector3d> sigma_x_um;      // posterior σ of the position per axis
-  std::vector<Eigen::Vector3d> bias_um_s2;      // smoothed residual bias per axis
+  std::vector<Eigen::Vector3d> dx_um, dv_um_s;                     // smoothed error per sample (subtract it)
+  std::vector<Eigen::Vector3d> sigma_x_um;                         // posterior σ of the position per axis
+  std::vector<Eigen::Vector3d> bias_um_s2;                         // smoothed residual bias per axis
   std::array<std::array<SupportTally, kSupportKinds>, 3> tally{};  // [axis][support]
   std::size_t resets = 0;  // covariance resets of the forward pass (forward_filter.hpp)
   // keep_gains: per axis and sample, C_k and the smoothed covariance P_k|N.
@@ -50,7 +50,8 @@ SmootherOutput smooth(const SmootherInput& in);
 
 struct SmootherTrack;
 // The compact track of a stored trace (what the checkpointed smoother reads).
-SmootherTrack smoother_track(const std::vector<std::int64_t>& sample_index, const std::vector<Eigen::Vector3d>& vel_mm_s,
-                             const std::vector<Eigen::Vector3d>& pos_mm, const SupportSchedule& schedule);
+SmootherTrack smoother_track(const std::vector<std::int64_t>& sample_index,
+                             const std::vector<Eigen::Vector3d>& vel_mm_s, const std::vector<Eigen::Vector3d>& pos_mm,
+                             const SupportSchedule& schedule);
 
 }  // namespace eical::dsp::fusion

@@ -22,9 +22,9 @@ inline constexpr std::uint8_t nbs_flag(int axis) { return static_cast<std::uint8
 struct PositionFix {
   std::size_t k = 0;
   int axis = 0;
-  double position_um = 0.0;  // in the trace's frame (the set-point at the start)
-  double sigma_um = 0.0;      // the strip's own noise
-  int strip = 0;              // which PSD strip
+  double position_um = 0.0;     // in the trace's frame (the set-point at the start)
+  double sigma_um = 0.0;        // the strip's own noise
+  int strip = 0;                // which PSD strip
   double model_sigma_um = 0.0;  // what the sensor model's uncertainty adds there (scale × distance)
 };
 
@@ -45,8 +45,8 @@ struct SupportSchedule {
   // (their swings are correlated) but through velocity_means.
   std::vector<float> zupt_sigma_um_s;
   std::vector<VelocityMean> velocity_means;  // ascending k
-  bool zupt = true;  // off: standstills are found and reported, not used
-  bool cupt = true;  // off: PSD fixes are recorded, not used
+  bool zupt = true;                          // off: standstills are found and reported, not used
+  bool cupt = true;                          // off: PSD fixes are recorded, not used
 };
 
 }  // namespace eical::dsp::fusion

@@ -5,8 +5,8 @@
 
 namespace eical::dsp::identify {
 
-AugmentedFilter::AugmentedFilter(const fusion::ErrorModel& model, const Eigen::Vector3d& start_sigma, const Eigen::VectorXd& prior_sigma,
-                                 const Eigen::VectorXd& prior_mean)
+AugmentedFilter::AugmentedFilter(const fusion::ErrorModel& model, const Eigen::Vector3d& start_sigma,
+                                 const Eigen::VectorXd& prior_sigma, const Eigen::VectorXd& prior_mean)
     : model_(model) {
   const Eigen::Index n = 3 + prior_sigma.size();
   x_ = Eigen::VectorXd::Zero(n);
@@ -54,7 +54,8 @@ double AugmentedFilter::update(const Eigen::RowVectorXd& row, double z, double s
   return nu * nu / s;
 }
 
-void AugmentedFilter::predict_observation(const Eigen::RowVectorXd& row, double z, double sigma, double& innovation, double& variance) const {
+void AugmentedFilter::predict_observation(const Eigen::RowVectorXd& row, double z, double sigma, double& innovation,
+                                          double& variance) const {
   innovation = z - row.dot(x_);
   variance = row.dot(p_ * row.transpose()) + sigma * sigma;
 }

@@ -22,8 +22,8 @@ namespace eical::dsp::identify {
 class AugmentedFilter {
  public:
   // `prior_sigma`: σ of each parameter, `prior_mean` its mean (empty: 0); `start` the INS error's.
-  AugmentedFilter(const fusion::ErrorModel& model, const Eigen::Vector3d& start_sigma, const Eigen::VectorXd& prior_sigma,
-                  const Eigen::VectorXd& prior_mean = {});
+  AugmentedFilter(const fusion::ErrorModel& model, const Eigen::Vector3d& start_sigma,
+                  const Eigen::VectorXd& prior_sigma, const Eigen::VectorXd& prior_mean = {});
 
   [[nodiscard]] int parameters() const noexcept { return static_cast<int>(x_.size()) - 3; }
   // One step of h seconds; `accel_gain[j]` = g_j averaged over the step (0 for parameters
@@ -32,7 +32,8 @@ class AugmentedFilter {
   // z = row·state + noise (row has 3 + p entries); returns the normalised innovation².
   double update(const Eigen::RowVectorXd& row, double z, double sigma);
   // The innovation and its variance of an observation, without updating (held-out data).
-  void predict_observation(const Eigen::RowVectorXd& row, double z, double sigma, double& innovation, double& variance) const;
+  void predict_observation(const Eigen::RowVectorXd& row, double z, double sigma, double& innovation,
+                           double& variance) const;
   // ln of the innovation's density of the last update (for likelihoods).
   [[nodiscard]] double last_log_density() const noexcept { return last_log_density_; }
   [[nodiscard]] double last_innovation() const noexcept { return last_innovation_; }

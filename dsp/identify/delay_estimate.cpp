@@ -8,9 +8,7 @@
 #include <cmath>
 
 namespace eical::dsp::identify {
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayReference against) {
   DelayEstimate d;
@@ -35,7 +33,8 @@ DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayRef
     const double pos = static_cast<double>(fx.k) - d0;
     if (pos < 1.0 || pos + 2.0 >= static_cast<double>(c.size())) continue;
     const double ref = interpolate_at(c, pos, fx.axis);
-    const double v = (interpolate_at(c, pos + 1.0, fx.axis) - interpolate_at(c, pos - 1.0, fx.axis)) / 2.0 * fs;  // mm/s
+    const double v =
+        (interpolate_at(c, pos + 1.0, fx.axis) - interpolate_at(c, pos - 1.0, fx.axis)) / 2.0 * fs;  // mm/s
     if (!std::isfinite(ref) || !std::isfinite(v) || std::abs(v) < 1.0) continue;
     std::vector<double> r(static_cast<std::size_t>(p), 0.0);
     r[static_cast<std::size_t>(2 * fx.strip)] = 1.0;
@@ -47,7 +46,8 @@ DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayRef
   }
   const auto n = static_cast<Eigen::Index>(ys.size());
   if (n < p + 4 || passes < 2) return d;
-  const Eigen::MatrixXd a = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(rows.data(), n, p);
+  const Eigen::MatrixXd a =
+      Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(rows.data(), n, p);
   const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(ys.data(), n);
   // Only the columns that vary (a strip never crossed leaves its offset empty).
   // Only what this run's crossings can tell apart. A strip crossed at one speed one way (a
@@ -91,7 +91,8 @@ DelayEstimate estimate_delay(const Measurement& m, const RunMeta& meta, DelayRef
   }
   const double dof = static_cast<double>(n - au.cols());
   const Eigen::MatrixXd white = bread * (res.squaredNorm() / dof);
-  const Eigen::MatrixXd clustered = bread * meat * bread * (clusters > 1 ? static_cast<double>(clusters) / (clusters - 1) : 1.0);
+  const Eigen::MatrixXd clustered =
+      bread * meat * bread * (clusters > 1 ? static_cast<double>(clusters) / (clusters - 1) : 1.0);
   const Eigen::Index iv = au.cols() - 1;
   d.samples = d0 - beta[iv] * fs;
   d.sigma = std::sqrt(std::max({0.0, white(iv, iv), clustered(iv, iv)})) * fs;

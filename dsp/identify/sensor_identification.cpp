@@ -66,7 +66,9 @@ PassResult fit_pass(const Run& run, const RunMeta& meta, const IdentifyOptions& 
   r.m = pipe.finish();
   const Measurement& m = r.m;
   const RawTrace& raw = m.raw;
-  if (raw.empty()) throw InputError("identify: the run has no motion to identify from (" + std::string(m.flags.empty() ? "" : m.flags.front()) + ")");
+  if (raw.empty())
+    throw InputError("identify: the run has no motion to identify from (" +
+                     std::string(m.flags.empty() ? "" : m.flags.front()) + ")");
   const std::size_t n = raw.pos_mm.size();
   const auto& flags = raw.schedule.flags;
   if (flags.size() != n) throw InputError("identify: the support schedule does not cover the trace");
@@ -76,14 +78,18 @@ PassResult fit_pass(const Run& run, const RunMeta& meta, const IdentifyOptions& 
   std::vector<std::pair<std::size_t, std::size_t>> rests;
   for (std::size_t k = 0; k < n; ++k) {
     if (!(flags[k] & sf::rest)) continue;
-    if (rests.empty() || rests.back().second + 1 != k) rests.push_back({k, k});
-    else rests.back().second = k;
+    if (rests.empty() || rests.back().second + 1 != k)
+      rests.push_back({k, k});
+    else
+      rests.back().second = k;
   }
   r.standstills = rests.size();
   if (rests.empty()) throw InputError("identify: no standstill in the run (the program must rest between its moves)");
   if (rests.size() < 2)
-    throw InputError("identify: the run rests only once in its motion: the set-point at the standstills between moves is what ties the scale "
-                     "down (run the identification program, eical gen-nc identify)");
+    throw InputError(
+        "identify: the run rests only once in its motion: the set-point at the standstills between moves is what ties "
+        "the scale "
+        "down (run the identification program, eical gen-nc identify)");
 
   for (int j = 0; j < 3; ++j) {
     double lo = 1e300, hi = -1e300;
@@ -112,7 +118,8 @@ PassResult fit_pass(const Run& run, const RunMeta& meta, const IdentifyOptions& 
       L.x0 = static_cast<int>(prior.size()), prior.push_back(kPriorOffsetUm);  // the reference's zero
     }
     L.count = static_cast<int>(prior.size());
-    AugmentedFilter f(model, Eigen::Vector3d(kPriorOffsetUm, 1.0, 20.0), Eigen::Map<Eigen::VectorXd>(prior.data(), L.count));
+    AugmentedFilter f(model, Eigen::Vector3d(kPriorOffsetUm, 1.0, 20.0),
+                      Eigen::Map<Eigen::VectorXd>(prior.data(), L.count));
     const int np = L.count;
     auto row = [&] { return Eigen::RowVectorXd::Zero(3 + np).eval(); };
 
@@ -222,7 +229,8 @@ Agreement agreement(const Run& run, const RunMeta& meta) {
   std::vector<std::vector<double>> per_strip(meta.psd.size());
   for (const auto& fx : m.raw.schedule.fixes) {
     if (fx.strip < 0 || static_cast<std::size_t>(fx.strip) >= per_strip.size()) continue;
-    const double pos = interpolate_at(m.pos_mm, static_cast<double>(fx.k) - d, fx.axis);  // the trace is on the set-point's time
+    const double pos =
+        interpolate_at(m.pos_mm, static_cast<double>(fx.k) - d, fx.axis);  // the trace is on the set-point's time
     per_strip[static_cast<std::size_t>(fx.strip)].push_back(pos * 1000.0 - fx.position_um);
   }
   double ss = 0.0;
@@ -244,7 +252,8 @@ Agreement agreement(const Run& run, const RunMeta& meta) {
     std::size_t e = k;
     while (e + 1 < flags.size() && (flags[e + 1] & sf::rest)) ++e;
     const double mid = static_cast<double>(k + e) / 2.0 - d;
-    for (int i = 0; i < 3; ++i) per_axis[i].push_back((interpolate_at(m.pos_mm, mid, i) - interpolate_at(m.cmd_mm, mid, i)) * 1000.0);
+    for (int i = 0; i < 3; ++i)
+      per_axis[i].push_back((interpolate_at(m.pos_mm, mid, i) - interpolate_at(m.cmd_mm, mid, i)) * 1000.0);
     k = e + 1;
   }
   ss = 0.0, n = 0;
@@ -295,14 +304,19 @@ void check_crossings(const Measurement& m, const RunMeta& meta, Identification& 
   for (std::size_t s = 0; s < open.size(); ++s) close(s);
   std::sort(speeds.begin(), speeds.end());
   for (double v : speeds)
-    if (id.crossing_speeds_mm_s.empty() || v > 1.25 * id.crossing_speeds_mm_s.back()) id.crossing_speeds_mm_s.push_back(v);
+    if (id.crossing_speeds_mm_s.empty() || v > 1.25 * id.crossing_speeds_mm_s.back())
+      id.crossing_speeds_mm_s.push_back(v);
   if (id.crossing_speeds_mm_s.size() < 2) {
     char b[160];
-    std::snprintf(b, sizeof b, "%zu strip crossings, %s", id.strip_crossings,
-                  speeds.empty() ? "none while moving" : ("all at " + std::to_string(static_cast<int>(std::lround(speeds.front() * 60.0))) + " mm/min").c_str());
-    throw InputError(std::string("identify: the run crosses its PSD strips at one speed at most (") + b +
-                     "): a scale error and a 2ζ/ω0 error look alike there; run the identification program (eical gen-nc identify), "
-                     "which crosses every strip at 2, 4 and 6.5 m/min");
+    std::snprintf(
+        b, sizeof b, "%zu strip crossings, %s", id.strip_crossings,
+        speeds.empty()
+            ? "none while moving"
+            : ("all at " + std::to_string(static_cast<int>(std::lround(speeds.front() * 60.0))) + " mm/min").c_str());
+    throw InputError(
+        std::string("identify: the run crosses its PSD strips at one speed at most (") + b +
+        "): a scale error and a 2ζ/ω0 error look alike there; run the identification program (eical gen-nc identify), "
+        "which crosses every strip at 2, 4 and 6.5 m/min");
   }
 }
 
@@ -315,7 +329,8 @@ void check_crossings(const Measurement& m, const RunMeta& meta, Identification& 
 // 1.46 σ rms, the cross terms by 0.9 σ (tests/accuracy); the calibration carries
 // σ × kSigmaMargin.
 constexpr double kSigmaMargin = 1.5;
-uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const Identification& id, const RunMeta& meta) {
+uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const Identification& id,
+                                                 const RunMeta& meta) {
   uncertainty::SensorModelCovariance c = uncertainty::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
   c.source = id.method;
   for (int i = 0; i < 3; ++i) {
@@ -328,21 +343,25 @@ uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const I
         const int pk = af.layout.e[k];
         const int sk = owner(meta, k);
         if (pk < 0 || sk < 0) continue;
-        c.covariance(uncertainty::error_index(sj, i, j), uncertainty::error_index(sk, i, k)) = kSigmaMargin * kSigmaMargin * af.cov(pj, pk);
+        c.covariance(uncertainty::error_index(sj, i, j), uncertainty::error_index(sk, i, k)) =
+            kSigmaMargin * kSigmaMargin * af.cov(pj, pk);
       }
     }
   }
   // The strips' nonlinearity, which the filter takes for the truth: a scale error of the
   // axes they measure (sensor_model_covariance.hpp), added to each fitted scale term.
   for (int i = 0; i < 3 && id.method == "psd"; ++i) {
-    const bool measured = std::any_of(meta.psd.begin(), meta.psd.end(), [&](const PsdSpec& strip) { return axis_index(strip.measures) == i; });
+    const bool measured = std::any_of(meta.psd.begin(), meta.psd.end(),
+                                      [&](const PsdSpec& strip) { return axis_index(strip.measures) == i; });
     const int s = owner(meta, i);
     if (!measured || s < 0 || last.axis[i].layout.e[i] < 0) continue;
-    c.covariance(uncertainty::error_index(s, i, i), uncertainty::error_index(s, i, i)) += uncertainty::strip_nonlinearity_scale_variance();
+    c.covariance(uncertainty::error_index(s, i, i), uncertainty::error_index(s, i, i)) +=
+        uncertainty::strip_nonlinearity_scale_variance();
   }
   for (int s = 0; s < 2; ++s)
     if (id.sensor[s].damping_s.fitted)
-      c.covariance(uncertainty::damping_index(s), uncertainty::damping_index(s)) = std::pow(kSigmaMargin * id.sensor[s].damping_s.sigma, 2);
+      c.covariance(uncertainty::damping_index(s), uncertainty::damping_index(s)) =
+          std::pow(kSigmaMargin * id.sensor[s].damping_s.sigma, 2);
   const auto& dl = id.delay_reference.valid ? id.delay_reference : id.delay_setpoint;
   if (id.delay_identified && dl.valid) {
     const double u = kSigmaMargin * dl.sigma / meta.acquisition.fs_hz;
@@ -353,7 +372,8 @@ uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const I
 
 }  // namespace
 
-std::vector<std::string> less_certain_than_datasheet(const Identification& id, const uncertainty::SensorModelCovariance& ds) {
+std::vector<std::string> less_certain_than_datasheet(const Identification& id,
+                                                     const uncertainty::SensorModelCovariance& ds) {
   // What the calibration would carry (its covariance, margins included) against the data sheet.
   std::vector<std::string> out;
   char b[200];
@@ -364,14 +384,16 @@ std::vector<std::string> less_certain_than_datasheet(const Identification& id, c
         const int p = uncertainty::error_index(s, i, j);
         const double u = id.covariance.sigma(p), lim = ds.sigma(p);
         if (e.fitted && !(u <= lim)) {
-          std::snprintf(b, sizeof b, "%s (%+.0f ± %.0f ppm, the data sheet ± %.0f ppm)", uncertainty::parameter_name(p).c_str(), e.value * 1e6, u * 1e6, lim * 1e6);
+          std::snprintf(b, sizeof b, "%s (%+.0f ± %.0f ppm, the data sheet ± %.0f ppm)",
+                        uncertainty::parameter_name(p).c_str(), e.value * 1e6, u * 1e6, lim * 1e6);
           out.emplace_back(b);
         }
       }
     const int p = uncertainty::damping_index(s);
     const double u = id.covariance.sigma(p), lim = ds.sigma(p);
     if (id.sensor[s].damping_s.fitted && !(u <= lim)) {
-      std::snprintf(b, sizeof b, "%s (± %.2f µs, the data sheet ± %.2f µs)", uncertainty::parameter_name(p).c_str(), u * 1e6, lim * 1e6);
+      std::snprintf(b, sizeof b, "%s (± %.2f µs, the data sheet ± %.2f µs)", uncertainty::parameter_name(p).c_str(),
+                    u * 1e6, lim * 1e6);
       out.emplace_back(b);
     }
   }
@@ -388,8 +410,10 @@ Identification identify_sensors(const Run& run, const IdentifyOptions& o) {
   // the scale barely better than the data sheet (a step without strips: E_xx ± 170 ppm
   // against the data sheet's ± 260): refused like a run that crosses them at one speed.
   if (!o.against_reference && run.meta.psd.empty())
-    throw InputError("identify: run '" + run.meta.id + "' has no PSD strips: the sensors are identified from strip crossings at several speeds "
-                     "(run the identification program, eical gen-nc identify, or identify against a reference, --compare-reference)");
+    throw InputError("identify: run '" + run.meta.id +
+                     "' has no PSD strips: the sensors are identified from strip crossings at several speeds "
+                     "(run the identification program, eical gen-nc identify, or identify against a reference, "
+                     "--compare-reference)");
   RunMeta meta = run.meta;
   const Eigen::Matrix3d to_machine_ds[2] = {run.meta.sensors[0].to_machine, run.meta.sensors[1].to_machine};
   PassResult last;
@@ -427,7 +451,8 @@ Identification identify_sensors(const Run& run, const IdentifyOptions& o) {
   // Report: the total error against the data sheet, with the last pass's σ.
   for (int s = 0; s < 2; ++s) {
     SensorEstimate& se = id.sensor[s];
-    const Eigen::Matrix3d e_total = to_machine_ds[s] * meta.sensors[s].to_machine.inverse() - Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d e_total =
+        to_machine_ds[s] * meta.sensors[s].to_machine.inverse() - Eigen::Matrix3d::Identity();
     double wsum = 0.0;
     for (int j = 0; j < 3; ++j) {
       if (owner(meta, j) != s || !last.moved[j]) continue;
@@ -441,8 +466,11 @@ Identification identify_sensors(const Run& run, const IdentifyOptions& o) {
       if (own.layout.damping >= 0 && own.sigma[own.layout.damping] < 0.5 * kPriorDampingMs)
         wsum += 1.0 / std::pow(own.sigma[own.layout.damping] * 1e-3, 2);
     }
-    if (wsum > 0.0) se.damping_s = {damping_total[s], 1.0 / std::sqrt(wsum), true};
-    else if (se.moved) id.notes.push_back(std::string(s == 0 ? "table" : "head") + " sensor: 2ζ/ω0 not identified (no PSD strip along its axes): data sheet kept");
+    if (wsum > 0.0)
+      se.damping_s = {damping_total[s], 1.0 / std::sqrt(wsum), true};
+    else if (se.moved)
+      id.notes.push_back(std::string(s == 0 ? "table" : "head") +
+                         " sensor: 2ζ/ω0 not identified (no PSD strip along its axes): data sheet kept");
     // Bias at the first standstill (sensor axes, gravity removed): what the rest window took out.
     const double g = meta.site.g_mps2;
     const Eigen::Vector3d gravity(0.0, 0.0, g);
@@ -465,15 +493,19 @@ Identification identify_sensors(const Run& run, const IdentifyOptions& o) {
 
   // The DAQ delay: PSD readings behind the set-point (with servo lag) and the reference.
   id.delay_setpoint = estimate_delay(last.m, meta, DelayReference::setpoint);
-  if (run.channels.ref[0] || run.channels.ref[1]) id.delay_reference = estimate_delay(last.m, meta, DelayReference::reference);
+  if (run.channels.ref[0] || run.channels.ref[1])
+    id.delay_reference = estimate_delay(last.m, meta, DelayReference::reference);
   id.daq_group_delay_samples = run.meta.acquisition.daq_group_delay_samples;
   if (id.delay_reference.valid) {
     id.daq_group_delay_samples = id.delay_reference.samples, id.delay_identified = true;
   } else if (o.delay_from_setpoint && id.delay_setpoint.valid) {
     id.daq_group_delay_samples = id.delay_setpoint.samples, id.delay_identified = true;
-    id.notes.push_back("DAQ delay taken from the PSD readings against the set-point: it includes the axes' mean servo lag");
+    id.notes.push_back(
+        "DAQ delay taken from the PSD readings against the set-point: it includes the axes' mean servo lag");
   } else if (id.delay_setpoint.valid) {
-    id.notes.push_back("DAQ delay kept at the data sheet's: against the set-point the PSD readings lag by the delay plus the servo lag (no reference in the run)");
+    id.notes.push_back(
+        "DAQ delay kept at the data sheet's: against the set-point the PSD readings lag by the delay plus the servo "
+        "lag (no reference in the run)");
   }
   for (int s = 0; s < 2; ++s) id.sensors[s] = meta.sensors[s];
   if (!id.sensor[0].moved && !id.sensor[1].moved) throw InputError("identify: no axis moved more than 0.5 mm");

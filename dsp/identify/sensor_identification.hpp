@@ -33,9 +33,9 @@
 namespace eical::dsp::identify {
 
 struct IdentifyOptions {
-  double rest_sigma_um = 0.5;    // the machine at a standstill against its set-point (repeatability)
-  int psd_every = 10;            // use every n-th lit PSD sample (they are strongly correlated)
-  int iterations = 2;            // re-run with the estimate, fit what is left
+  double rest_sigma_um = 0.5;        // the machine at a standstill against its set-point (repeatability)
+  int psd_every = 10;                // use every n-th lit PSD sample (they are strongly correlated)
+  int iterations = 2;                // re-run with the estimate, fit what is left
   bool delay_from_setpoint = false;  // accept the PSD-vs-set-point delay (includes servo lag)
   bool against_reference = false;    // fit to the reference instrument instead (comparison)
   int reference_every = 50;
@@ -48,9 +48,9 @@ struct Estimate {
 };
 
 struct SensorEstimate {
-  bool moved = false;                   // it carried an axis that moved: something to identify
-  Estimate error[3][3];                 // E_ij: measured = (I + E) · true, machine axes (columns: its own axes)
-  Estimate damping_s;                   // Δ(2ζ/ω0) = data sheet − identified, s
+  bool moved = false;    // it carried an axis that moved: something to identify
+  Estimate error[3][3];  // E_ij: measured = (I + E) · true, machine axes (columns: its own axes)
+  Estimate damping_s;    // Δ(2ζ/ω0) = data sheet − identified, s
   Eigen::Vector3d rest_bias_g = Eigen::Vector3d::Zero();  // bias at the first standstill, sensor axes, gravity removed
 };
 
@@ -59,11 +59,11 @@ struct DelayEstimate {
   double samples = 0.0, sigma = 0.0;  // identified delay (DAQ delay for "reference"; + servo lag for "set-point")
   std::string against;                // "set-point" | "reference"
   int fixes = 0;
-  bool mounting_assumed = false;      // a strip crossed at one speed one way: taken where run.toml puts it
+  bool mounting_assumed = false;  // a strip crossed at one speed one way: taken where run.toml puts it
 };
 
 struct Identification {
-  SensorEstimate sensor[2];           // table, head
+  SensorEstimate sensor[2];  // table, head
   Estimate rest_offset_um[3], backlash_um[3];
   std::vector<Estimate> psd_offset_um;  // per strip
   DelayEstimate delay_setpoint, delay_reference;
@@ -97,7 +97,8 @@ Identification identify_sensors(const Run& run, const IdentifyOptions& options =
 // The parameters an identification fitted less certainly than the data sheet promises
 // (the σ its covariance carries above the data sheet's u): a calibration with them would
 // be worse than none.
-std::vector<std::string> less_certain_than_datasheet(const Identification& id, const uncertainty::SensorModelCovariance& datasheet);
+std::vector<std::string> less_certain_than_datasheet(const Identification& id,
+                                                     const uncertainty::SensorModelCovariance& datasheet);
 
 // The run's metadata with an identification applied (what the pipeline then uses).
 void apply_identification(const Identification& id, RunMeta& meta, PipelineConfig* config = nullptr);

@@ -24,10 +24,12 @@ Eigen::MatrixXd smooth(const Eigen::MatrixXd& x, int len) {
     const Eigen::MatrixXd in = out;
     for (Eigen::Index c = 0; c < x.cols(); ++c) {
       std::vector<double> cum(static_cast<std::size_t>(n) + 1, 0.0);
-      for (Eigen::Index i = 0; i < n; ++i) cum[static_cast<std::size_t>(i) + 1] = cum[static_cast<std::size_t>(i)] + in(i, c);
+      for (Eigen::Index i = 0; i < n; ++i)
+        cum[static_cast<std::size_t>(i) + 1] = cum[static_cast<std::size_t>(i)] + in(i, c);
       for (Eigen::Index i = 0; i < n; ++i) {
         const Eigen::Index lo = std::max<Eigen::Index>(0, i - len / 2), hi = std::min<Eigen::Index>(n, lo + len);
-        out(i, c) = (cum[static_cast<std::size_t>(hi)] - cum[static_cast<std::size_t>(lo)]) / static_cast<double>(hi - lo);
+        out(i, c) =
+            (cum[static_cast<std::size_t>(hi)] - cum[static_cast<std::size_t>(lo)]) / static_cast<double>(hi - lo);
       }
     }
   }
@@ -53,12 +55,15 @@ Eigen::MatrixXd shifted(const Eigen::MatrixXd& x, double lag) {
 struct LagFit {
   double lag = 0.0, sigma = 0.0;
 };
-LagFit fit_lag(const Eigen::MatrixXd& y, const Eigen::VectorXd& x, int max_k, Eigen::Index from, Eigen::Index to, const std::vector<Eigen::Index>& block_of,
-               int blocks) {
+LagFit fit_lag(const Eigen::MatrixXd& y, const Eigen::VectorXd& x, int max_k, Eigen::Index from, Eigen::Index to,
+               const std::vector<Eigen::Index>& block_of, int blocks) {
   const int nk = 2 * max_k + 1;
   // sums[b][j][k]
   std::vector<double> sums(static_cast<std::size_t>(blocks) * 3 * static_cast<std::size_t>(nk), 0.0);
-  auto at = [&](int b, int j, int k) -> double& { return sums[(static_cast<std::size_t>(b) * 3 + static_cast<std::size_t>(j)) * static_cast<std::size_t>(nk) + static_cast<std::size_t>(k)]; };
+  auto at = [&](int b, int j, int k) -> double& {
+    return sums[(static_cast<std::size_t>(b) * 3 + static_cast<std::size_t>(j)) * static_cast<std::size_t>(nk) +
+                static_cast<std::size_t>(k)];
+  };
   for (Eigen::Index i = from; i < to; ++i) {
     const int b = static_cast<int>(block_of[static_cast<std::size_t>(i - from)]);
     for (int k = -max_k; k <= max_k; ++k) {
@@ -77,10 +82,12 @@ LagFit fit_lag(const Eigen::MatrixXd& y, const Eigen::VectorXd& x, int max_k, Ei
           for (int k = 0; k < nk; ++k) tot[static_cast<std::size_t>(j * nk + k)] += at(b, j, k);
     for (int j = 0; j < 3; ++j)
       for (int k = 0; k < nk; ++k)
-        if (std::abs(tot[static_cast<std::size_t>(j * nk + k)]) > best) best = std::abs(tot[static_cast<std::size_t>(j * nk + k)]), bk = k, bj = j;
+        if (std::abs(tot[static_cast<std::size_t>(j * nk + k)]) > best)
+          best = std::abs(tot[static_cast<std::size_t>(j * nk + k)]), bk = k, bj = j;
     double lag = bk - max_k;
     if (bk > 0 && bk < nk - 1) {
-      bestv[0] = std::abs(tot[static_cast<std::size_t>(bj * nk + bk - 1)]), bestv[1] = best, bestv[2] = std::abs(tot[static_cast<std::size_t>(bj * nk + bk + 1)]);
+      bestv[0] = std::abs(tot[static_cast<std::size_t>(bj * nk + bk - 1)]), bestv[1] = best,
+      bestv[2] = std::abs(tot[static_cast<std::size_t>(bj * nk + bk + 1)]);
       const double den = bestv[0] - 2.0 * bestv[1] + bestv[2];
       if (den < 0.0) lag += 0.5 * (bestv[0] - bestv[2]) / den;
     }
@@ -121,7 +128,8 @@ AccelerationComparison compare_accelerations(const RunResiduals& rr, double cuto
   }
   // Inputs: commanded axes with acceleration in the band.
   Eigen::Vector3d rms = Eigen::Vector3d::Zero();
-  for (int i = 0; i < 3; ++i) rms[i] = std::sqrt(x.col(i).segment(from, to - from).squaredNorm() / static_cast<double>(to - from));
+  for (int i = 0; i < 3; ++i)
+    rms[i] = std::sqrt(x.col(i).segment(from, to - from).squaredNorm() / static_cast<double>(to - from));
   const double top = rms.maxCoeff();
   int dominant = 0;
   for (int i = 0; i < 3; ++i) {
@@ -137,7 +145,8 @@ AccelerationComparison compare_accelerations(const RunResiduals& rr, double cuto
   const Eigen::Index block_len = std::max<Eigen::Index>({static_cast<Eigen::Index>(fs), 4 * len, rows / 40});
   c.blocks = static_cast<int>(rows / block_len);
   std::vector<Eigen::Index> block_of(static_cast<std::size_t>(rows));
-  for (Eigen::Index i = 0; i < rows; ++i) block_of[static_cast<std::size_t>(i)] = std::min<Eigen::Index>(i / block_len, std::max(0, c.blocks - 1));
+  for (Eigen::Index i = 0; i < rows; ++i)
+    block_of[static_cast<std::size_t>(i)] = std::min<Eigen::Index>(i / block_len, std::max(0, c.blocks - 1));
   const int blocks = std::max(1, c.blocks);
 
   const LagFit lf = fit_lag(y, x.col(dominant), max_k, from, to, block_of, blocks);
@@ -170,7 +179,8 @@ AccelerationComparison compare_accelerations(const RunResiduals& rr, double cuto
     c.why = "the commanded axes' accelerations are not independent in the band";
     return c;
   }
-  for (std::size_t k = 0; k < cols.size(); ++k) c.gain.col(cols[k]) = beta.row(static_cast<Eigen::Index>(k)).transpose();
+  for (std::size_t k = 0; k < cols.size(); ++k)
+    c.gain.col(cols[k]) = beta.row(static_cast<Eigen::Index>(k)).transpose();
   c.bias_mm_s2 = beta.row(p - 1).transpose();
   if (blocks >= 4) {
     Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(p, 3), sq = Eigen::MatrixXd::Zero(p, 3);
@@ -180,7 +190,8 @@ AccelerationComparison compare_accelerations(const RunResiduals& rr, double cuto
     }
     mean /= blocks, sq /= blocks;
     const Eigen::MatrixXd var = ((sq - mean.cwiseProduct(mean)) * static_cast<double>(blocks - 1)).cwiseMax(0.0);
-    for (std::size_t k = 0; k < cols.size(); ++k) c.gain_sigma.col(cols[k]) = var.row(static_cast<Eigen::Index>(k)).transpose().cwiseSqrt();
+    for (std::size_t k = 0; k < cols.size(); ++k)
+      c.gain_sigma.col(cols[k]) = var.row(static_cast<Eigen::Index>(k)).transpose().cwiseSqrt();
     c.bias_sigma_mm_s2 = var.row(p - 1).transpose().cwiseSqrt();
   }
   // How much of the measured band-limited acceleration the comparison accounts for.
@@ -199,7 +210,8 @@ AccelerationComparison compare_accelerations(const RunResiduals& rr, double cuto
 }
 
 std::optional<MountingFit> gross_mounting(const RunResiduals& rr, const AccelerationComparison& c) {
-  if (!c.valid || c.explained_fraction < 0.2) return std::nullopt;  // MEMS noise and a sweep leave little below the modes; the columns decide
+  if (!c.valid || c.explained_fraction < 0.2)
+    return std::nullopt;  // MEMS noise and a sweep leave little below the modes; the columns decide
   Eigen::Matrix3d p = Eigen::Matrix3d::Zero();
   std::array<bool, 3> row_used{}, decided{};
   bool wrong = false;
@@ -218,8 +230,8 @@ std::optional<MountingFit> gross_mounting(const RunResiduals& rr, const Accelera
     if (row_used[static_cast<std::size_t>(j)]) return std::nullopt;  // two inputs onto one axis: no mounting does that
     p(j, i) = sign, row_used[static_cast<std::size_t>(j)] = true, decided[static_cast<std::size_t>(i)] = true;
     char b[160];
-    std::snprintf(b, sizeof b, "%scommanded %c is measured as %s%c (gain %.3f +- %.3f)", detail.empty() ? "" : "; ", kAxis[i], sign < 0 ? "-" : "",
-                  kAxis[j], col[j], c.gain_sigma(j, i));
+    std::snprintf(b, sizeof b, "%scommanded %c is measured as %s%c (gain %.3f +- %.3f)", detail.empty() ? "" : "; ",
+                  kAxis[i], sign < 0 ? "-" : "", kAxis[j], col[j], c.gain_sigma(j, i));
     detail += b;
     if (j != i || sign < 0.0) {
       wrong = true;
@@ -253,7 +265,8 @@ std::optional<MountingFit> gross_mounting(const RunResiduals& rr, const Accelera
   }
   std::string unmoved;
   for (int i = 0; i < 3; ++i)
-    if (!decided[static_cast<std::size_t>(i)]) unmoved += std::string(unmoved.empty() ? "" : ", ") + std::string(1, kAxis[i]);
+    if (!decided[static_cast<std::size_t>(i)])
+      unmoved += std::string(unmoved.empty() ? "" : ", ") + std::string(1, kAxis[i]);
   m.evidence = detail + " (band below " + std::to_string(static_cast<int>(std::lround(c.cutoff_hz))) + " Hz)" +
                (unmoved.empty() ? std::string() : "; " + unmoved + " not moved: taken as configured where free");
   return m;

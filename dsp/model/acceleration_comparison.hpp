@@ -16,13 +16,14 @@ namespace eical::dsp::model {
 
 struct AccelerationComparison {
   bool valid = false;
-  std::string why;                     // when not valid
-  double cutoff_hz = 0.0;              // the band compared: below this
-  std::array<bool, 3> input{};         // commanded axes with acceleration in the band
-  Eigen::Matrix3d gain = Eigen::Matrix3d::Zero(), gain_sigma = Eigen::Matrix3d::Zero();  // measured row per commanded column
+  std::string why;              // when not valid
+  double cutoff_hz = 0.0;       // the band compared: below this
+  std::array<bool, 3> input{};  // commanded axes with acceleration in the band
+  Eigen::Matrix3d gain = Eigen::Matrix3d::Zero(),
+                  gain_sigma = Eigen::Matrix3d::Zero();  // measured row per commanded column
   Eigen::Vector3d bias_mm_s2 = Eigen::Vector3d::Zero(), bias_sigma_mm_s2 = Eigen::Vector3d::Zero();
   double lag_s = 0.0, lag_sigma_s = 0.0;
-  double explained_fraction = 0.0;     // of the measured band-limited variance on the moving axes
+  double explained_fraction = 0.0;  // of the measured band-limited variance on the moving axes
   int blocks = 0;
 };
 
@@ -34,9 +35,9 @@ AccelerationComparison compare_accelerations(const RunResiduals& rr, double cuto
 // on the moving axes. `to_machine` is the mounting that fits (axes not moved stay as
 // configured, or take the machine axis left over).
 struct MountingFit {
-  int sensor = 1;                      // 0 table, 1 head
+  int sensor = 1;  // 0 table, 1 head
   Eigen::Matrix3d to_machine = Eigen::Matrix3d::Identity();
-  std::string axes_map;                // to_machine = map · run.toml's (Klipper's notation), e.g. "-x,y,z"
+  std::string axes_map;  // to_machine = map · run.toml's (Klipper's notation), e.g. "-x,y,z"
   std::string evidence;
 };
 std::optional<MountingFit> gross_mounting(const RunResiduals& rr, const AccelerationComparison& c);

@@ -4,7 +4,6 @@
 
 #include <Eigen/QR>
 
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -31,7 +30,6 @@ Eigen::MatrixXd on_axis(const Eigen::VectorXd& v, int a) {
   c.col(a) = v;
   return c;
 }
-
 
 double hint_corr(const Eigen::MatrixXd& hint, const Eigen::VectorXd& col, int axis) {
   if (hint.rows() != col.size()) return 0.0;
@@ -93,7 +91,7 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
   if (moving.empty()) return out;
   const double g = r.meta.site.g_mps2;
   const Eigen::MatrixXd a_drv = driven_acceleration(r);  // mm/s²
-  const Eigen::MatrixXd a_um = a_drv * 1000.0;            // µm/s²
+  const Eigen::MatrixXd a_um = a_drv * 1000.0;           // µm/s²
   auto param = [](std::string name, int axis, bool accel, Eigen::VectorXd input, double prior) {
     AxisParam p;
     p.name = std::move(name), p.axis = axis, p.accel = accel, p.input = std::move(input), p.prior_sigma = prior;
@@ -115,7 +113,8 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
     ParamGroup gp{"nonlinearity", {}};
     for (int j : moving) {
       const Eigen::VectorXd ag = a_drv.col(j) / (1000.0 * g);  // in g
-      const double sign = r.owner[j] == 0 ? -1.0 : 1.0;         // the table sees −a: its square term changes sign in head − table
+      const double sign =
+          r.owner[j] == 0 ? -1.0 : 1.0;  // the table sees −a: its square term changes sign in head − table
       gp.params.push_back(param("k2_" + ax(j) + "_1e-6_per_g", j, true, sign * ag.array().square().matrix() * g, 1e4));
       gp.params.push_back(param("k3_" + ax(j) + "_1e-6_per_g2", j, true, ag.array().cube().matrix() * g, 1e4));
     }
@@ -125,7 +124,8 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
     // Against the set-point alone an axis' timing is its servo's (the base model's lag).
     ParamGroup gp{"timing", {}};
     for (int j : moving)
-      if (r.axis_reference[static_cast<std::size_t>(j)] != "cmd") gp.params.push_back(param("timing_" + ax(j) + "_us", j, false, r.v_meas.col(j) * 1e-3, 300.0));
+      if (r.axis_reference[static_cast<std::size_t>(j)] != "cmd")
+        gp.params.push_back(param("timing_" + ax(j) + "_us", j, false, r.v_meas.col(j) * 1e-3, 300.0));
     if (!gp.params.empty()) out.push_back(gp);
   }
   {
@@ -158,7 +158,8 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
     // site, one gain per axis it reaches (1: the site's prediction).
     const Eigen::Vector3d two_w = 2.0 * earth_rate_machine_radps(r.meta.site);
     Eigen::MatrixXd acc_um(r.n, 3);
-    for (Eigen::Index s = 0; s < r.n; ++s) acc_um.row(s) = two_w.cross(Eigen::Vector3d(r.v_meas.row(s).transpose())).transpose() * 1000.0;  // mm/s → µm/s²
+    for (Eigen::Index s = 0; s < r.n; ++s)
+      acc_um.row(s) = two_w.cross(Eigen::Vector3d(r.v_meas.row(s).transpose())).transpose() * 1000.0;  // mm/s → µm/s²
     ParamGroup gp{"coriolis", {}};
     for (int i = 0; i < 3; ++i)
       if (acc_um.col(i).cwiseAbs().maxCoeff() > kCoriolisFloorUmS2) {
@@ -178,9 +179,12 @@ std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
     const double range = std::max(r.temp_c.col(0).cwiseAbs().maxCoeff(), r.temp_c.col(1).cwiseAbs().maxCoeff());
     if (range > 0.02) {
       ParamGroup gp{"scale_temperature", {}};
-      for (int j : moving) gp.params.push_back(param("scale_tc_" + ax(j) + "_ppm_per_c", j, true, r.temp_c.col(std::max(0, r.owner[j])).cwiseProduct(a_um.col(j)) * 1e-6, 1e4));
+      for (int j : moving)
+        gp.params.push_back(param("scale_tc_" + ax(j) + "_ppm_per_c", j, true,
+                                  r.temp_c.col(std::max(0, r.owner[j])).cwiseProduct(a_um.col(j)) * 1e-6, 1e4));
       const Eigen::VectorXd mean_t = 0.5 * (r.temp_c.col(0) + r.temp_c.col(1));
-      for (int i = 0; i < 3; ++i) gp.params.push_back(param("bias_tc_" + ax(i) + "_ug_per_c", i, true, mean_t * g, 1e3));
+      for (int i = 0; i < 3; ++i)
+        gp.params.push_back(param("bias_tc_" + ax(i) + "_ug_per_c", i, true, mean_t * g, 1e3));
       out.push_back(gp);
     }
   }
@@ -195,7 +199,8 @@ double largest_abs(const std::map<std::string, double>& v) {
 }
 }  // namespace
 
-std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std::string& group, const std::map<std::string, double>& v) {
+std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std::string& group,
+                                                const std::map<std::string, double>& v) {
   std::vector<Attribution> out;
   auto attr = [](const char* name, double mag, double tol, const char* unit, const char* reg) {
     Attribution a;
@@ -215,8 +220,10 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     // too), unless the rotation clearly dominates (3×); a moving axis' response on an axis
     // that does not move (a tilt) goes with what its sensor's pairs show, mounting when
     // the sensor has no pair (the two are one effect then, and the evidence says so).
-    Attribution mis = attr("sensor.misalignment", 0.0, 1.0, "mrad", "the other axes' doubly integrated acceleration, antisymmetric");
-    Attribution cross = attr("sensor.cross_coupling", 0.0, 500.0, "ppm", "the other axes' doubly integrated acceleration, symmetric");
+    Attribution mis =
+        attr("sensor.misalignment", 0.0, 1.0, "mrad", "the other axes' doubly integrated acceleration, antisymmetric");
+    Attribution cross =
+        attr("sensor.cross_coupling", 0.0, 500.0, "ppm", "the other axes' doubly integrated acceleration, symmetric");
     double rot_max[2] = {0.0, 0.0}, sym_max[2] = {0.0, 0.0}, tilt_max[2] = {0.0, 0.0};
     bool has_pair[2] = {false, false};
     for (int j = 0; j < 3; ++j)
@@ -248,11 +255,13 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
         mis.magnitude = std::max({mis.magnitude, rot_max[s], tilt_max[s]});
       }
     }
-    if (!has_pair[0] && !has_pair[1]) mis.regressor += " (one moving axis per sensor: mounting and cross coupling are one effect here)";
+    if (!has_pair[0] && !has_pair[1])
+      mis.regressor += " (one moving axis per sensor: mounting and cross coupling are one effect here)";
     out.push_back(mis), out.push_back(cross);
   } else if (group == "nonlinearity") {
     const double m = largest_abs(v);
-    Attribution a = attr("sensor.nonlinearity", m, 200.0, "1e-6/g", "the doubly integrated square and cube of the acceleration");
+    Attribution a =
+        attr("sensor.nonlinearity", m, 200.0, "1e-6/g", "the doubly integrated square and cube of the acceleration");
     a.params = v;
     out.push_back(a);
   } else if (group == "timing") {
@@ -265,7 +274,8 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
       // Against the set-point alone the axis' servo lag is unknown: its timing says
       // nothing about the sensor.
       for (int j = 0; j < 3; ++j)
-        if (r.moving[j] && r.owner[j] == s && r.axis_reference[static_cast<std::size_t>(j)] != "cmd") sum += get(v, "timing_" + ax(j) + "_us"), ++n;
+        if (r.moving[j] && r.owner[j] == s && r.axis_reference[static_cast<std::size_t>(j)] != "cmd")
+          sum += get(v, "timing_" + ax(j) + "_us"), ++n;
       if (n == 0) continue;
       const double mean = sum / n;
       dyn.params[std::string("damping_term_error_us_") + (s == 0 ? "table" : "head")] = mean;
@@ -274,7 +284,8 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     out.push_back(dyn);
   } else if (group == "damping_amplitude") {
     const double m = largest_abs(v);
-    Attribution a = attr("sensor.damping_amplitude", m, 0.2, "1/g", "the integral of a·|a| (damping growing with the acceleration)");
+    Attribution a = attr("sensor.damping_amplitude", m, 0.2, "1/g",
+                         "the integral of a·|a| (damping growing with the acceleration)");
     a.params = v;
     out.push_back(a);
   } else if (group == "coriolis") {
@@ -286,9 +297,11 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     for (int i = 0; i < 3; ++i) {
       if (v.find("coriolis_gain_" + ax(i)) == v.end()) continue;
       for (Eigen::Index s2 = 0; s2 < r.n; ++s2)
-        peak_ug = std::max(peak_ug, std::abs(two_w.cross(Eigen::Vector3d(r.v_meas.row(s2).transpose()))[i]) * 1e-3 / (r.meta.site.g_mps2 * 1e-6));
+        peak_ug = std::max(peak_ug, std::abs(two_w.cross(Eigen::Vector3d(r.v_meas.row(s2).transpose()))[i]) * 1e-3 /
+                                        (r.meta.site.g_mps2 * 1e-6));
     }
-    Attribution a = attr("site.coriolis", peak_ug, 1.0, "ug", "the Earth rate's 2ω×v of the motion (3-6), from the site");
+    Attribution a =
+        attr("site.coriolis", peak_ug, 1.0, "ug", "the Earth rate's 2ω×v of the motion (3-6), from the site");
     a.params = v;
     a.params["peak_ug"] = peak_ug;
     out.push_back(a);
@@ -301,7 +314,8 @@ std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std
     const double range = std::max(r.temp_c.col(0).cwiseAbs().maxCoeff(), r.temp_c.col(1).cwiseAbs().maxCoeff());
     double m = 0.0;
     for (const auto& [k, x] : v) m = std::max(m, std::abs(x) * range * (k.rfind("bias", 0) == 0 ? 50.0 : 1.0));
-    Attribution a = attr("sensor.scale_temperature", m, 50.0, "ppm over the run (1 ug as 50 ppm)", "the temperature change times the acceleration, and alone");
+    Attribution a = attr("sensor.scale_temperature", m, 50.0, "ppm over the run (1 ug as 50 ppm)",
+                         "the temperature change times the acceleration, and alone");
     a.params = v;
     a.params["temperature_change_c"] = range;
     out.push_back(a);
@@ -336,7 +350,8 @@ std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::Mat
       }
       e.params.push_back("backlash_" + ax(a) + "_um"), e.columns.push_back(on_axis(best, a));
     }
-    e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "half the play against the direction of the last motion";
+    e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um",
+    e.regressor = "half the play against the direction of the last motion";
     if (!e.params.empty()) out.push_back(e);
   }
   {
@@ -370,7 +385,8 @@ std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::Mat
     EffectModel e = effect("machine.servo_mismatch");
     for (std::size_t i = 1; i < moving.size(); ++i) {
       const int a = moving[i];
-      e.params.push_back("lag_" + ax(a) + "_minus_" + ax(moving[0]) + "_ms"), e.columns.push_back(on_axis(lag.velocity.col(a), a));
+      e.params.push_back("lag_" + ax(a) + "_minus_" + ax(moving[0]) + "_ms"),
+          e.columns.push_back(on_axis(lag.velocity.col(a), a));
     }
     e.magnitude = max_abs;
     e.tolerance = 0.05, e.unit = "ms", e.regressor = "an axis' commanded velocity (lag) beyond the others'";
@@ -379,7 +395,8 @@ std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::Mat
   {
     EffectModel e = effect("machine.scale_mismatch");
     for (int a : moving)
-      e.params.push_back("scale_" + ax(a) + "_ppm"), e.columns.push_back(on_axis((r.cmd.col(a).array() - r.cmd.col(a).mean()).matrix() * 1e-3, a));
+      e.params.push_back("scale_" + ax(a) + "_ppm"),
+          e.columns.push_back(on_axis((r.cmd.col(a).array() - r.cmd.col(a).mean()).matrix() * 1e-3, a));
     e.magnitude = [](const Eigen::VectorXd& p) { return p.size() > 1 ? p.maxCoeff() - p.minCoeff() : std::abs(p[0]); };
     e.tolerance = 10.0, e.unit = "ppm", e.regressor = "the commanded position along the axis";
     out.push_back(e);
@@ -395,7 +412,8 @@ std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::Mat
         c.col(j) = -0.5e-3 * (r.cmd.col(i).array() - r.cmd.col(i).mean()).matrix();
         e.columns.push_back(c);
       }
-    e.magnitude = max_abs, e.tolerance = 10.0, e.unit = "urad", e.regressor = "each axis' commanded position on the other";
+    e.magnitude = max_abs, e.tolerance = 10.0, e.unit = "urad",
+    e.regressor = "each axis' commanded position on the other";
     if (!e.params.empty()) out.push_back(e);
   }
   {
@@ -435,7 +453,8 @@ std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::Mat
       Eigen::VectorXd bow = (1.0 - u.array().square()).matrix();
       bow.array() -= bow.mean();
       for (int j = 0; j < 3; ++j)
-        if (j != i) e.params.push_back("bow_of_" + ax(i) + "_in_" + ax(j) + "_um"), e.columns.push_back(on_axis(bow, j));
+        if (j != i)
+          e.params.push_back("bow_of_" + ax(i) + "_in_" + ax(j) + "_um"), e.columns.push_back(on_axis(bow, j));
     }
     e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "a bow over the axis' travel, sideways";
     if (!e.params.empty()) out.push_back(e);
@@ -455,7 +474,7 @@ LagColumns common_lag_columns(const RunResiduals& r, const std::array<double, 3>
       const double h = s > 0 ? r.t_s[s] - r.t_s[s - 1] : 0.0;
       const double k = tau_s > 0.0 ? 1.0 - std::exp(-h / tau_s) : 1.0;  // exact for a held input
       v += (r.v_cmd(s, a) - v) * (s == 0 ? 1.0 : k), acc += (r.a_cmd(s, a) - acc) * (s == 0 ? 1.0 : k);
-      c.velocity(s, a) = -v;             // mm/s × ms = µm
+      c.velocity(s, a) = -v;              // mm/s × ms = µm
       c.acceleration(s, a) = acc * 1e-3;  // mm/s² × ms² = 1e-3 µm
     }
   }
@@ -465,7 +484,8 @@ LagColumns common_lag_columns(const RunResiduals& r, const std::array<double, 3>
 namespace {
 // Per axis: offset, LP(v) and LP(a) by least squares on the rows where the hint is known;
 // the residual of those rows (none below 20 rows).
-std::pair<std::vector<Eigen::Index>, Eigen::VectorXd> lag_fit_residual(const Eigen::MatrixXd& hint, const LagColumns& c, int a) {
+std::pair<std::vector<Eigen::Index>, Eigen::VectorXd> lag_fit_residual(const Eigen::MatrixXd& hint, const LagColumns& c,
+                                                                       int a) {
   std::vector<Eigen::Index> rows;
   for (Eigen::Index s = 0; s < hint.rows(); ++s)
     if (std::isfinite(hint(s, a))) rows.push_back(s);
@@ -535,7 +555,8 @@ ParamGroup as_group(const EffectModel& e, const std::array<bool, 3>& axes) {
   ParamGroup g{e.name, {}};
   for (std::size_t p = 0; p < e.params.size(); ++p) {
     int used = 0;
-    for (int a = 0; a < 3; ++a) used += axes[static_cast<std::size_t>(a)] && e.columns[p].col(a).cwiseAbs().maxCoeff() > 0.0;
+    for (int a = 0; a < 3; ++a)
+      used += axes[static_cast<std::size_t>(a)] && e.columns[p].col(a).cwiseAbs().maxCoeff() > 0.0;
     for (int a = 0; a < 3; ++a) {
       if (!axes[static_cast<std::size_t>(a)] || e.columns[p].col(a).cwiseAbs().maxCoeff() <= 0.0) continue;
       AxisParam ap;

@@ -80,6 +80,7 @@ struct Attribution {
 // The named effects a sensor group's fit stands for (the cross-axis group splits into
 // mounting rotation and non-orthogonality, the timing group into the sensors' own timing
 // and — against the set-point only — the axes' servo mismatch).
-std::vector<Attribution> attribute_sensor_group(const RunResiduals& run, const std::string& group, const std::map<std::string, double>& values);
+std::vector<Attribution> attribute_sensor_group(const RunResiduals& run, const std::string& group,
+                                                const std::map<std::string, double>& values);
 
 }  // namespace eical::dsp::model

@@ -26,7 +26,9 @@ Eigen::VectorXd rows(const Eigen::VectorXd& v, const std::vector<Eigen::Index>& 
   return out;
 }
 
-double rms(const Eigen::VectorXd& v) { return v.size() ? std::sqrt(v.squaredNorm() / static_cast<double>(v.size())) : 0.0; }
+double rms(const Eigen::VectorXd& v) {
+  return v.size() ? std::sqrt(v.squaredNorm() / static_cast<double>(v.size())) : 0.0;
+}
 
 // Least squares with column scaling (regressors differ by orders of magnitude).
 Eigen::VectorXd solve(const Eigen::MatrixXd& A, const Eigen::VectorXd& y) {
@@ -70,7 +72,8 @@ Eigen::VectorXd jackknife_sigma(const Eigen::MatrixXd& A, const Eigen::VectorXd&
     Eigen::MatrixXd m = ata;
     Eigen::VectorXd v = aty;
     for (Eigen::Index i = 0; i < As.rows(); ++i)
-      if (block[static_cast<std::size_t>(i)] == b) m -= As.row(i).transpose() * As.row(i), v -= As.row(i).transpose() * y[i];
+      if (block[static_cast<std::size_t>(i)] == b)
+        m -= As.row(i).transpose() * As.row(i), v -= As.row(i).transpose() * y[i];
     est.push_back(m.completeOrthogonalDecomposition().solve(v).cwiseQuotient(norm));
   }
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(p), var = Eigen::VectorXd::Zero(p);
@@ -106,14 +109,17 @@ double integrated_autocorrelation_time(const Eigen::VectorXd& x, int max_lag) {
 SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vector<Candidate>& candidates,
                                const std::vector<bool>& heldout, const SelectionOptions& opt) {
   const Eigen::Index n = residual.size();
-  if (static_cast<Eigen::Index>(heldout.size()) != n) throw InputError("effect selection: held-out mask size differs from the residual");
+  if (static_cast<Eigen::Index>(heldout.size()) != n)
+    throw InputError("effect selection: held-out mask size differs from the residual");
   if (!residual.allFinite()) throw InputError("effect selection: residual holds non-finite values");
   Split s;
   for (Eigen::Index i = 0; i < n; ++i) (heldout[static_cast<std::size_t>(i)] ? s.check : s.fit).push_back(i);
   if (s.fit.size() < 10 || s.check.empty()) throw InputError("effect selection: need fitting and held-out samples");
   for (const auto& c : candidates) {
-    if (c.regressors.rows() != n) throw InputError("effect selection: candidate '" + c.name + "' has the wrong number of rows");
-    if (!c.regressors.allFinite()) throw InputError("effect selection: candidate '" + c.name + "' has non-finite regressors");
+    if (c.regressors.rows() != n)
+      throw InputError("effect selection: candidate '" + c.name + "' has the wrong number of rows");
+    if (!c.regressors.allFinite())
+      throw InputError("effect selection: candidate '" + c.name + "' has non-finite regressors");
   }
 
   const Eigen::VectorXd y_fit = rows(residual, s.fit), y_chk = rows(residual, s.check);
@@ -127,11 +133,14 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
   {
     Eigen::MatrixXd all(static_cast<Eigen::Index>(s.fit.size()), 0);
     for (const auto& c : candidates) all = hcat(all, rows(c.regressors, s.fit));
-    const Eigen::VectorXd noise = all.cols() > 0 && all.cols() < static_cast<Eigen::Index>(s.fit.size()) / 4 ? Eigen::VectorXd(y_fit - all * solve(all, y_fit)) : y_fit;
+    const Eigen::VectorXd noise = all.cols() > 0 && all.cols() < static_cast<Eigen::Index>(s.fit.size()) / 4
+                                      ? Eigen::VectorXd(y_fit - all * solve(all, y_fit))
+                                      : y_fit;
     out.n_eff = nf / integrated_autocorrelation_time(noise);
   }
 
-  Eigen::MatrixXd accepted_fit(static_cast<Eigen::Index>(s.fit.size()), 0), accepted_chk(static_cast<Eigen::Index>(s.check.size()), 0);
+  Eigen::MatrixXd accepted_fit(static_cast<Eigen::Index>(s.fit.size()), 0),
+      accepted_chk(static_cast<Eigen::Index>(s.check.size()), 0);
   Eigen::MatrixXd accepted_all(n, 0);
   std::vector<bool> done(candidates.size(), false);
   auto bic = [&](double rss, Eigen::Index p) {
@@ -156,7 +165,8 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
       v.rms_before = rms(cur_fit), v.rms_after = rms(rf);
       v.heldout_rms_before = rms(cur_chk), v.heldout_rms_after = rms(rc);
       for (Eigen::Index c = 0; c < candidates[k].regressors.cols(); ++c)
-        v.correlation = std::max(v.correlation, abs_corr(cur_fit, rows(Eigen::VectorXd(candidates[k].regressors.col(c)), s.fit)));
+        v.correlation =
+            std::max(v.correlation, abs_corr(cur_fit, rows(Eigen::VectorXd(candidates[k].regressors.col(c)), s.fit)));
       v.param_names = candidates[k].param_names;
       v.params = x.tail(candidates[k].regressors.cols());
       // Only an extension that also predicts the held-out data better may be taken.
@@ -181,8 +191,9 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
     const Eigen::VectorXd x = solve(accepted_fit, y_fit);
     // cov = (AᵀA)⁻¹ · RSS / n_eff: the residual's variance counted per independent sample.
     const Eigen::MatrixXd ata = accepted_fit.transpose() * accepted_fit;
-    const Eigen::VectorXd var = ata.completeOrthogonalDecomposition().pseudoInverse().diagonal() *
-                                ((y_fit - accepted_fit * x).squaredNorm() / std::max(out.n_eff - static_cast<double>(x.size()), 1.0));
+    const Eigen::VectorXd var =
+        ata.completeOrthogonalDecomposition().pseudoInverse().diagonal() *
+        ((y_fit - accepted_fit * x).squaredNorm() / std::max(out.n_eff - static_cast<double>(x.size()), 1.0));
     std::vector<int> fit_blocks;
     if (!opt.block.empty())
       for (Eigen::Index i : s.fit) fit_blocks.push_back(opt.block[static_cast<std::size_t>(i)]);
@@ -190,8 +201,10 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
     Eigen::Index off = 0;
     for (auto& e : out.effects) {
       e.params = x.segment(off, static_cast<Eigen::Index>(e.param_names.size()));
-      e.param_sigma = var.segment(off, static_cast<Eigen::Index>(e.param_names.size())).cwiseMax(0.0).cwiseSqrt().cwiseMax(
-          jack.segment(off, static_cast<Eigen::Index>(e.param_names.size())));
+      e.param_sigma = var.segment(off, static_cast<Eigen::Index>(e.param_names.size()))
+                          .cwiseMax(0.0)
+                          .cwiseSqrt()
+                          .cwiseMax(jack.segment(off, static_cast<Eigen::Index>(e.param_names.size())));
       off += static_cast<Eigen::Index>(e.param_names.size());
     }
     out.final_residual = residual - accepted_all * x;
@@ -215,7 +228,8 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
     v.param_names = candidates[k].param_names;
     v.params = x.tail(candidates[k].regressors.cols());
     for (Eigen::Index c = 0; c < candidates[k].regressors.cols(); ++c)
-      v.correlation = std::max(v.correlation, abs_corr(cur_fit, rows(Eigen::VectorXd(candidates[k].regressors.col(c)), s.fit)));
+      v.correlation =
+          std::max(v.correlation, abs_corr(cur_fit, rows(Eigen::VectorXd(candidates[k].regressors.col(c)), s.fit)));
     rejected.push_back(v);
   }
   std::sort(rejected.begin(), rejected.end(), [](const auto& a, const auto& b) { return a.bic_drop > b.bic_drop; });

@@ -39,21 +39,22 @@ struct SelectionOptions {
 struct EffectVerdict {
   std::string name;
   bool significant = false;
-  double bic_drop = 0.0;        // when tested (against the model accepted so far)
-  double rms_before = 0.0, rms_after = 0.0;                // fitting samples
+  double bic_drop = 0.0;                                     // when tested (against the model accepted so far)
+  double rms_before = 0.0, rms_after = 0.0;                  // fitting samples
   double heldout_rms_before = 0.0, heldout_rms_after = 0.0;  // held-out samples
-  double correlation = 0.0;     // |corr| of the residual with the block's best single regressor
+  double correlation = 0.0;  // |corr| of the residual with the block's best single regressor
   std::vector<std::string> param_names;
-  Eigen::VectorXd params;       // fitted with the accepted model (all samples of the fitting set)
-  Eigen::VectorXd param_sigma;  // their standard errors: the larger of residual variance per effective sample and block jackknife
+  Eigen::VectorXd params;  // fitted with the accepted model (all samples of the fitting set)
+  Eigen::VectorXd
+      param_sigma;  // their standard errors: the larger of residual variance per effective sample and block jackknife
 };
 
 struct SelectionResult {
   std::vector<EffectVerdict> effects;  // every candidate; significant ones first, in order of acceptance
   double rms_nominal = 0.0, rms_final = 0.0;
   double heldout_rms_nominal = 0.0, heldout_rms_final = 0.0;
-  double n_eff = 0.0;                  // effective independent samples of the fitting set
-  Eigen::VectorXd final_residual;      // all samples, after the accepted effects
+  double n_eff = 0.0;              // effective independent samples of the fitting set
+  Eigen::VectorXd final_residual;  // all samples, after the accepted effects
 };
 
 // `heldout[i]` true marks a sample used only for checking. Throws InputError when sizes

@@ -43,13 +43,13 @@ enum class EffectSide { sensor, daq, site, machine };
 
 struct EffectInfo {
   Effect id;
-  std::string_view name;         // run-format.md
-  std::string_view unit;         // of the size explain reports
-  double tolerance;              // background band, in `unit`
-  double bound;                  // physical bound, in `unit` (servo-class sensors, machine tools)
-  double bound_mems;             // the same for MEMS sensors (noise ≥ 20 µg/√Hz)
+  std::string_view name;  // run-format.md
+  std::string_view unit;  // of the size explain reports
+  double tolerance;       // background band, in `unit`
+  double bound;           // physical bound, in `unit` (servo-class sensors, machine tools)
+  double bound_mems;      // the same for MEMS sensors (noise ≥ 20 µg/√Hz)
   EffectSide side;
-  bool compensable;              // the pipeline can take it into its model (sensor calibration)
+  bool compensable;  // the pipeline can take it into its model (sensor calibration)
   std::string_view bound_reason;
 };
 

@@ -25,7 +25,7 @@ namespace eical::dsp::model {
 struct ExplainedEffect {
   std::string name;
   bool significant = false;
-  std::string channel;       // "sensor" | "machine" | "total" | "spectrum" | "standstills" | "psd"
+  std::string channel;  // "sensor" | "machine" | "total" | "spectrum" | "standstills" | "psd"
   std::string evidence;
   std::map<std::string, double> params;
   double magnitude = 0.0, tolerance = 0.0;
@@ -33,7 +33,7 @@ struct ExplainedEffect {
   double bic_drop = 0.0, correlation = 0.0;
   double residual_rms_before_um = 0.0, residual_rms_after_um = 0.0;  // fitting samples, this effect alone
   double heldout_rms_before_um = 0.0, heldout_rms_after_um = 0.0;
-  double importance_um = 0.0;  // the residual RMS it explains (ranking)
+  double importance_um = 0.0;     // the residual RMS it explains (ranking)
   bool taken_into_model = false;  // a sensor-side extension the pipeline now compensates with
   std::string group;              // the model group it was fitted as (other.residual_like_<group>)
   std::string resembles;          // what its regressor is, in words

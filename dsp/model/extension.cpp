@@ -42,7 +42,8 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
     } else if (ef.name == "sensor.cross_coupling") {
       for (const auto& [k, v] : p) {
         int i = 0, j = 0;
-        if (two_axes(k, "cross_", i, j) && owner(meta, i) >= 0) e[owner(meta, i)](i, j) += v * 1e-6, e[owner(meta, i)](j, i) += v * 1e-6;
+        if (two_axes(k, "cross_", i, j) && owner(meta, i) >= 0)
+          e[owner(meta, i)](i, j) += v * 1e-6, e[owner(meta, i)](j, i) += v * 1e-6;
       }
     } else if (ef.name == "sensor.nonlinearity") {
       for (const auto& [k, v] : p) {
@@ -64,7 +65,8 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
       }
       x.notes.push_back("sensor.dynamics: 2ζ/ω0 into ζ (f0 kept)");
     } else if (ef.name == "daq.group_delay") {
-      if (auto it = p.find("group_delay_samples"); it != p.end()) x.daq_group_delay_samples = it->second, x.delay_changed = true;
+      if (auto it = p.find("group_delay_samples"); it != p.end())
+        x.daq_group_delay_samples = it->second, x.delay_changed = true;
       if (auto it = p.find("skew_head_samples"); it != p.end() && std::abs(it->second) > 0.3)
         x.daq_skew_head_samples += it->second, x.skew_changed = true;
     } else if (ef.name == "sensor.damping_amplitude") {
@@ -87,7 +89,8 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
       int bias_n = 0, k1_n[2] = {0, 0};
       for (const auto& [k, v] : p) {
         if (!p.count("model_group_accepted")) break;  // the standstills alone: no coefficient per axis
-        if (k.size() == 18 && k.rfind("bias_tc_", 0) == 0) {  // bias_tc_<a>_ug_per_c, of the moving axes (they have a scale term)
+        if (k.size() == 18 &&
+            k.rfind("bias_tc_", 0) == 0) {  // bias_tc_<a>_ug_per_c, of the moving axes (they have a scale term)
           const int a = axis_index(k[8]);
           std::string scale_key = "scale_tc_";
           scale_key.append(1, k[8]).append("_ppm_per_c");
@@ -100,16 +103,20 @@ Extension extend_sensors(const RunMeta& meta, const std::vector<ExplainedEffect>
       // A coefficient beyond what a sensor can have (900 µg/°C, 500 ppm/°C) has absorbed a
       // drift that only looks like the warming: not taken over.
       constexpr double kMaxBiasTc = 900.0, kMaxScaleTc = 500.0;
-      if (bias_n && std::abs(bias_sum / bias_n) <= kMaxBiasTc) x.sensors[s].tc_bias_ug_per_c += (s == 1 ? 1.0 : -1.0) * bias_sum / bias_n;
-      else if (bias_n) x.notes.push_back("sensor.scale_temperature: bias coefficient beyond a sensor's (not taken over)");
+      if (bias_n && std::abs(bias_sum / bias_n) <= kMaxBiasTc)
+        x.sensors[s].tc_bias_ug_per_c += (s == 1 ? 1.0 : -1.0) * bias_sum / bias_n;
+      else if (bias_n)
+        x.notes.push_back("sensor.scale_temperature: bias coefficient beyond a sensor's (not taken over)");
       for (int k = 0; k < 2; ++k)
-        if (k1_n[k] && std::abs(k1_sum[k] / k1_n[k]) <= kMaxScaleTc) x.sensors[k].tc_k1_ppm_per_c += k1_sum[k] / k1_n[k];
+        if (k1_n[k] && std::abs(k1_sum[k] / k1_n[k]) <= kMaxScaleTc)
+          x.sensors[k].tc_k1_ppm_per_c += k1_sum[k] / k1_n[k];
     } else if (ef.name.rfind("sensor.", 0) == 0 || ef.name == "site.coriolis") {
       x.notes.push_back(ef.name + ": found; the pipeline does not compensate it from a calibration (yet)");
     }
   }
   for (int s = 0; s < 2; ++s)
-    if (e[s].cwiseAbs().maxCoeff() > 0.0) x.sensors[s].to_machine = (Eigen::Matrix3d::Identity() + e[s]).inverse() * x.sensors[s].to_machine;
+    if (e[s].cwiseAbs().maxCoeff() > 0.0)
+      x.sensors[s].to_machine = (Eigen::Matrix3d::Identity() + e[s]).inverse() * x.sensors[s].to_machine;
   return x;
 }
 

@@ -17,7 +17,8 @@ std::size_t segment_for(std::size_t n, double fs_hz, double df_hz, int min_avera
   return seg;
 }
 
-FrequencyResponse frequency_response(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double fs_hz, std::size_t segment) {
+FrequencyResponse frequency_response(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double fs_hz,
+                                     std::size_t segment) {
   FrequencyResponse out;
   std::size_t seg = 64;
   while (seg * 2 <= segment) seg *= 2;
@@ -25,7 +26,8 @@ FrequencyResponse frequency_response(const Eigen::VectorXd& u, const Eigen::Vect
   if (n < seg || seg < 64) return out;
   const std::size_t nb = seg / 2 + 1;
   std::vector<double> win(seg);
-  for (std::size_t i = 0; i < seg; ++i) win[i] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(seg));
+  for (std::size_t i = 0; i < seg; ++i)
+    win[i] = 0.5 - 0.5 * std::cos(2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(seg));
   std::vector<double> suu(nb, 0.0), syy(nb, 0.0);
   std::vector<std::complex<double>> syu(nb, 0.0);
   Eigen::FFT<double> fft;
@@ -33,7 +35,8 @@ FrequencyResponse frequency_response(const Eigen::VectorXd& u, const Eigen::Vect
   std::vector<std::complex<double>> fu, fy;
   for (std::size_t s0 = 0; s0 + seg <= n; s0 += seg / 2) {
     double mu = 0.0, my = 0.0;
-    for (std::size_t i = 0; i < seg; ++i) mu += u[static_cast<Eigen::Index>(s0 + i)], my += y[static_cast<Eigen::Index>(s0 + i)];
+    for (std::size_t i = 0; i < seg; ++i)
+      mu += u[static_cast<Eigen::Index>(s0 + i)], my += y[static_cast<Eigen::Index>(s0 + i)];
     mu /= static_cast<double>(seg), my /= static_cast<double>(seg);
     for (std::size_t i = 0; i < seg; ++i) {
       bu[i] = (u[static_cast<Eigen::Index>(s0 + i)] - mu) * win[i];

@@ -4,8 +4,8 @@
 #include "dsp/model/effect_selection.hpp"
 
 #include <algorithm>
-#include <numbers>
 #include <cmath>
+#include <numbers>
 
 namespace eical::dsp::model {
 namespace {
@@ -22,13 +22,16 @@ struct AxisFit {
   std::vector<double> innovations;  // of the fitting observations (for the effective count)
 };
 
-AxisFit fit_axis(const AxisTrack& t, const std::vector<const AxisParam*>& ps, const fusion::ErrorModel& model, double zupt_sigma, bool keep_innov) {
+AxisFit fit_axis(const AxisTrack& t, const std::vector<const AxisParam*>& ps, const fusion::ErrorModel& model,
+                 double zupt_sigma, bool keep_innov) {
   const auto p = static_cast<Eigen::Index>(ps.size());
   Eigen::VectorXd prior(p + t.tags);
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(p + t.tags);
-  for (Eigen::Index j = 0; j < p; ++j) prior[j] = ps[static_cast<std::size_t>(j)]->prior_sigma, mean[j] = ps[static_cast<std::size_t>(j)]->prior_mean;
+  for (Eigen::Index j = 0; j < p; ++j)
+    prior[j] = ps[static_cast<std::size_t>(j)]->prior_sigma, mean[j] = ps[static_cast<std::size_t>(j)]->prior_mean;
   for (int k = 0; k < t.tags; ++k) prior[p + k] = kTagPrior;
-  identify::AugmentedFilter f(model, Eigen::Vector3d(50.0, 1.0, std::hypot(model.bias_step_um_s2, t.start_bias_sigma_um_s2)), prior, mean);
+  identify::AugmentedFilter f(
+      model, Eigen::Vector3d(50.0, 1.0, std::hypot(model.bias_step_um_s2, t.start_bias_sigma_um_s2)), prior, mean);
   const Eigen::Index n = t.h_s.size();
   Eigen::VectorXd g = Eigen::VectorXd::Zero(p + t.tags);
   Eigen::RowVectorXd zrow = Eigen::RowVectorXd::Zero(3 + p + t.tags);
@@ -63,7 +66,8 @@ AxisFit fit_axis(const AxisTrack& t, const std::vector<const AxisParam*>& ps, co
         out.held_lpd += -0.5 * (std::log(2.0 * std::numbers::pi * var) + nu * nu / var);
         // A strip not yet seen in the fitting observations has an unknown mounting: its
         // prediction says nothing about the model (the score above weighs it by its variance).
-        if (o.tag < 0 || tag_seen[static_cast<std::size_t>(o.tag)]) out.held_ss += nu * nu, out.held_var += var, ++out.held_n;
+        if (o.tag < 0 || tag_seen[static_cast<std::size_t>(o.tag)])
+          out.held_ss += nu * nu, out.held_var += var, ++out.held_n;
       } else {
         if (o.tag >= 0) tag_seen[static_cast<std::size_t>(o.tag)] = true;
         f.update(row, o.z_um, o.sigma_um);
@@ -74,7 +78,8 @@ AxisFit fit_axis(const AxisTrack& t, const std::vector<const AxisParam*>& ps, co
     }
   }
   out.value.resize(p), out.sigma.resize(p);
-  for (Eigen::Index j = 0; j < p; ++j) out.value[j] = f.parameter(static_cast<int>(j)), out.sigma[j] = f.parameter_sigma(static_cast<int>(j));
+  for (Eigen::Index j = 0; j < p; ++j)
+    out.value[j] = f.parameter(static_cast<int>(j)), out.sigma[j] = f.parameter_sigma(static_cast<int>(j));
   return out;
 }
 
@@ -91,8 +96,9 @@ double rms(double ss, std::size_t n) { return n ? std::sqrt(ss / static_cast<dou
 
 }  // namespace
 
-KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::vector<ParamGroup>& groups, const fusion::ErrorModel& model,
-                             const KfSelectionOptions& o, const std::vector<AxisParam>& base) {
+KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::vector<ParamGroup>& groups,
+                             const fusion::ErrorModel& model, const KfSelectionOptions& o,
+                             const std::vector<AxisParam>& base) {
   KfSelection out;
   auto fit = [&](int a, const std::vector<const AxisParam*>& ps, bool keep = false) {
     return tracks[a].present ? fit_axis(tracks[a], ps, model, o.zupt_sigma_um_s, keep) : AxisFit{};
@@ -113,7 +119,8 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
   sums(cur, fs, fn, hs, hn);
   out.fit_rms_nominal_um = rms(fs, fn), out.held_rms_nominal_um = rms(hs, hn);
   if (fn < 20) return out;
-  const Eigen::VectorXd bi = Eigen::Map<const Eigen::VectorXd>(base_innov.data(), static_cast<Eigen::Index>(base_innov.size()));
+  const Eigen::VectorXd bi =
+      Eigen::Map<const Eigen::VectorXd>(base_innov.data(), static_cast<Eigen::Index>(base_innov.size()));
   out.n_eff = static_cast<double>(fn) / integrated_autocorrelation_time(bi, 2000);
   const double ln_n = std::log(std::max(out.n_eff, 2.0));
   // The log-likelihood of correlated innovations counts each of them too often: scale it
@@ -142,7 +149,9 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
     for (int a = 0; a < 3; ++a)
       for (std::size_t j = 0; j < after.params[a].size(); ++j)
         for (const auto& p : gp.params)
-          if (&p == after.params[a][j]) v.value[p.name] = after.fit[a].value[static_cast<Eigen::Index>(j)], v.sigma[p.name] = after.fit[a].sigma[static_cast<Eigen::Index>(j)];
+          if (&p == after.params[a][j])
+            v.value[p.name] = after.fit[a].value[static_cast<Eigen::Index>(j)],
+            v.sigma[p.name] = after.fit[a].sigma[static_cast<Eigen::Index>(j)];
     return v;
   };
   std::vector<bool> done(groups.size(), false);
@@ -222,7 +231,9 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
   for (int a = 0; a < 3; ++a)
     for (std::size_t j = 0; j < cur.params[a].size(); ++j)
       for (const auto& p : base)
-        if (&p == cur.params[a][j]) out.base_value[p.name] = cur.fit[a].value[static_cast<Eigen::Index>(j)], out.base_sigma[p.name] = cur.fit[a].sigma[static_cast<Eigen::Index>(j)];
+        if (&p == cur.params[a][j])
+          out.base_value[p.name] = cur.fit[a].value[static_cast<Eigen::Index>(j)],
+          out.base_sigma[p.name] = cur.fit[a].sigma[static_cast<Eigen::Index>(j)];
   std::vector<GroupVerdict> rest;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     if (done[g] || groups[g].params.empty()) continue;

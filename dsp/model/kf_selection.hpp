@@ -42,19 +42,19 @@ struct ParamGroup {
 
 struct AxisTrack {
   bool present = false;
-  Eigen::VectorXd h_s;                   // step into each sample
-  std::vector<std::uint8_t> bias_step;   // a move starts here (ch. 8.3.2)
-  std::vector<std::uint8_t> zupt;        // the velocity is zero here
-  Eigen::VectorXd v_um_s;                // the integrated velocity (ZUPT's observation)
+  Eigen::VectorXd h_s;                  // step into each sample
+  std::vector<std::uint8_t> bias_step;  // a move starts here (ch. 8.3.2)
+  std::vector<std::uint8_t> zupt;       // the velocity is zero here
+  Eigen::VectorXd v_um_s;               // the integrated velocity (ZUPT's observation)
   struct Obs {
     int sample = 0;
-    double z_um = 0.0, sigma_um = 0.0;   // integrated position minus the reference
+    double z_um = 0.0, sigma_um = 0.0;  // integrated position minus the reference
     bool heldout = false;
-    int tag = -1;                        // ≥ 0: an offset of its own (a PSD strip's mounting)
+    int tag = -1;  // ≥ 0: an offset of its own (a PSD strip's mounting)
   };
-  std::vector<Obs> obs;                  // ascending sample
+  std::vector<Obs> obs;  // ascending sample
   int tags = 0;
-  double start_bias_sigma_um_s2 = 0.0;   // how well the rest before the motion fixed the bias
+  double start_bias_sigma_um_s2 = 0.0;  // how well the rest before the motion fixed the bias
 };
 
 struct GroupVerdict {
@@ -94,7 +94,8 @@ struct KfSelectionOptions {
 
 // `base`: parameters every model carries (nuisances such as the servo lag of an axis seen
 // against its set-point only); not selected, not counted in the BIC.
-KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::vector<ParamGroup>& groups, const fusion::ErrorModel& model,
-                             const KfSelectionOptions& options = {}, const std::vector<AxisParam>& base = {});
+KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::vector<ParamGroup>& groups,
+                             const fusion::ErrorModel& model, const KfSelectionOptions& options = {},
+                             const std::vector<AxisParam>& base = {});
 
 }  // namespace eical::dsp::model

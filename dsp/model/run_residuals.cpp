@@ -15,7 +15,8 @@ namespace {
 // out every other side would fit x and predict y).
 constexpr double kHeldOutBlockS = 0.25;
 
-void add_row(Channel& c, int sample, int axis, double r_um, double sigma_um, std::vector<double>& r, std::vector<double>& s) {
+void add_row(Channel& c, int sample, int axis, double r_um, double sigma_um, std::vector<double>& r,
+             std::vector<double>& s) {
   c.sample.push_back(sample), c.axis.push_back(axis);
   r.push_back(r_um), s.push_back(sigma_um);
 }
@@ -40,7 +41,8 @@ RunResiduals build_residuals(const Run& run) {
   for (const auto& f : run.frames) pipe.step(f);
   d.measurement = pipe.finish();
   const Measurement& m = d.measurement;
-  if (m.sample_index.size() < 100 || m.raw.empty()) throw InputError("explain: run '" + run.meta.id + "' has no motion to explain");
+  if (m.sample_index.size() < 100 || m.raw.empty())
+    throw InputError("explain: run '" + run.meta.id + "' has no motion to explain");
   d.fs_hz = m.fs_hz;
   d.delay_samples = run.meta.acquisition.daq_group_delay_samples;
   const std::size_t n_full = m.sample_index.size();
@@ -59,7 +61,8 @@ RunResiduals build_residuals(const Run& run) {
   for (std::size_t k = 0; k < n_full; ++k) {
     const auto lo = static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, static_cast<std::ptrdiff_t>(k) - q));
     const auto hi = std::min(n_full - 1, k + static_cast<std::size_t>(q));
-    if (hi - k < static_cast<std::size_t>(q) || k - lo < static_cast<std::size_t>(q)) continue;  // the ends stay at rest
+    if (hi - k < static_cast<std::size_t>(q) || k - lo < static_cast<std::size_t>(q))
+      continue;  // the ends stay at rest
     v_cmd[k] = (m.cmd_mm[hi] - m.cmd_mm[lo]) / (2.0 * hq);
     a_cmd[k] = (m.cmd_mm[hi] - 2.0 * m.cmd_mm[k] + m.cmd_mm[lo]) / (hq * hq);
   }
@@ -71,7 +74,8 @@ RunResiduals build_residuals(const Run& run) {
     for (std::ptrdiff_t j = -q / 2; j < q - q / 2; ++j) sum += interpolate_at(x, pos + static_cast<double>(j), a);
     return sum / static_cast<double>(q);
   };
-  d.cmd.resize(n, 3), d.v_cmd.resize(n, 3), d.a_cmd.resize(n, 3), d.x_meas.resize(n, 3), d.v_meas.resize(n, 3), d.a_meas.resize(n, 3);
+  d.cmd.resize(n, 3), d.v_cmd.resize(n, 3), d.a_cmd.resize(n, 3), d.x_meas.resize(n, 3), d.v_meas.resize(n, 3),
+      d.a_meas.resize(n, 3);
   d.temp_c.resize(n, 2);
   d.t_s.resize(n);
   d.segment.assign(static_cast<std::size_t>(n), 0);
@@ -93,10 +97,12 @@ RunResiduals build_residuals(const Run& run) {
       d.a_meas(s, a) = (box(m.raw.head_mps2, ks, a) - box(m.raw.table_mps2, ks, a)) * 1000.0;  // mm/s²
     }
     d.t_s[s] = static_cast<double>(m.sample_index[k] - m.sample_index.front()) / m.fs_hz;
-    const auto fi = static_cast<std::size_t>(std::clamp<std::int64_t>(m.sample_index[k] - first_frame, 0, static_cast<std::int64_t>(run.frames.size()) - 1));
+    const auto fi = static_cast<std::size_t>(
+        std::clamp<std::int64_t>(m.sample_index[k] - first_frame, 0, static_cast<std::int64_t>(run.frames.size()) - 1));
     for (int sn = 0; sn < 2; ++sn) {
       if (std::isnan(t0[sn])) t0[sn] = run.frames[fi].temp_c[sn];
-      d.temp_c(s, sn) = std::isfinite(run.frames[fi].temp_c[sn]) ? static_cast<double>(run.frames[fi].temp_c[sn] - t0[sn]) : 0.0;
+      d.temp_c(s, sn) =
+          std::isfinite(run.frames[fi].temp_c[sn]) ? static_cast<double>(run.frames[fi].temp_c[sn] - t0[sn]) : 0.0;
     }
     d.segment[static_cast<std::size_t>(s)] =
         static_cast<int>(std::upper_bound(marks.begin(), marks.end(), m.sample_index[k]) - marks.begin());
@@ -106,7 +112,8 @@ RunResiduals build_residuals(const Run& run) {
     d.owner[a] = axis_owner(run.meta.machine, a);
     d.moving[a] = hi - lo > 0.5 && d.owner[a] >= 0;
     bool finite = run.channels.ref[a];
-    for (Eigen::Index s = 0; s < n && finite; ++s) finite = std::isfinite(m.ref_mm[d.trace[static_cast<std::size_t>(s)]][a]);
+    for (Eigen::Index s = 0; s < n && finite; ++s)
+      finite = std::isfinite(m.ref_mm[d.trace[static_cast<std::size_t>(s)]][a]);
     d.has_ref[a] = finite;
   }
   for (const auto& p : run.meta.psd) {
@@ -133,9 +140,12 @@ RunResiduals build_residuals(const Run& run) {
   std::size_t prev_k = 0;
   for (Eigen::Index s = 0; s < n; ++s) {
     const double ks = sensor_pos(s);
-    for (int a = 0; a < 3; ++a) x_ins[static_cast<std::size_t>(s)][a] = interpolate_at(m.raw.pos_mm, ks, a), v_ins[static_cast<std::size_t>(s)][a] = interpolate_at(m.raw.vel_mm_s, ks, a);
+    for (int a = 0; a < 3; ++a)
+      x_ins[static_cast<std::size_t>(s)][a] = interpolate_at(m.raw.pos_mm, ks, a),
+      v_ins[static_cast<std::size_t>(s)][a] = interpolate_at(m.raw.vel_mm_s, ks, a);
     const auto k = static_cast<std::size_t>(std::clamp(std::round(ks), 0.0, ns - 1.0));
-    zupt[static_cast<std::size_t>(s)] = (sched.flags[k] & sf::rest) && k < sched.zupt_sigma_um_s.size() && sched.zupt_sigma_um_s[k] == 0.0F;
+    zupt[static_cast<std::size_t>(s)] =
+        (sched.flags[k] & sf::rest) && k < sched.zupt_sigma_um_s.size() && sched.zupt_sigma_um_s[k] == 0.0F;
     for (std::size_t j = s == 0 ? k : prev_k + 1; j <= k && j < sched.flags.size(); ++j)
       if (sched.flags[j] & sf::move_start) bias_step[static_cast<std::size_t>(s)] = 1;
     prev_k = k;
@@ -155,7 +165,9 @@ RunResiduals build_residuals(const Run& run) {
     t.present = true;
     t.h_s = Eigen::VectorXd::Constant(n, d.dt_s);
     for (Eigen::Index s = 1; s < n; ++s)
-      t.h_s[s] = static_cast<double>(m.sample_index[d.trace[static_cast<std::size_t>(s)]] - m.sample_index[d.trace[static_cast<std::size_t>(s - 1)]]) / m.fs_hz;
+      t.h_s[s] = static_cast<double>(m.sample_index[d.trace[static_cast<std::size_t>(s)]] -
+                                     m.sample_index[d.trace[static_cast<std::size_t>(s - 1)]]) /
+                 m.fs_hz;
     t.bias_step = bias_step, t.zupt = zupt;
     t.start_bias_sigma_um_s2 = m.supports.start_bias_sigma_um_s2[a];
     t.v_um_s.resize(n);
@@ -165,7 +177,8 @@ RunResiduals build_residuals(const Run& run) {
       for (Eigen::Index s = 0; s < n; ++s) {
         const std::size_t k = d.trace[static_cast<std::size_t>(s)];
         const double ref = m.ref_mm[k][a];
-        t.obs.push_back({static_cast<int>(s), (x_ins[static_cast<std::size_t>(s)][a] - ref) * 1000.0, 0.1, d.heldout[static_cast<std::size_t>(s)], -1});
+        t.obs.push_back({static_cast<int>(s), (x_ins[static_cast<std::size_t>(s)][a] - ref) * 1000.0, 0.1,
+                         d.heldout[static_cast<std::size_t>(s)], -1});
         add_row(d.machine, static_cast<int>(s), a, (ref - m.cmd_mm[k][a]) * 1000.0, 0.2, mr, ms);
         add_row(d.pipeline, static_cast<int>(s), a, (m.pos_mm[k][a] - ref) * 1000.0, 1.0, pr, ps);
       }
@@ -178,7 +191,8 @@ RunResiduals build_residuals(const Run& run) {
         if (s < 0 || s >= n) continue;
         auto& tag = tag_of[static_cast<std::size_t>(fx->strip)];
         if (tag < 0) tag = t.tags++;
-        t.obs.push_back({s, m.raw.pos_mm[fx->k][a] * 1000.0 - fx->position_um, std::hypot(fx->sigma_um, 0.05), d.heldout[static_cast<std::size_t>(s)], tag});
+        t.obs.push_back({s, m.raw.pos_mm[fx->k][a] * 1000.0 - fx->position_um, std::hypot(fx->sigma_um, 0.05),
+                         d.heldout[static_cast<std::size_t>(s)], tag});
         const double c = interpolate_at(m.cmd_mm, pos, a) * 1000.0;
         add_row(d.machine, s, a, fx->position_um - c, std::hypot(fx->sigma_um, 0.2), mr, ms);
         add_row(d.pipeline, s, a, interpolate_at(m.pos_mm, pos, a) * 1000.0 - fx->position_um, 1.0, pr, ps);
@@ -188,7 +202,8 @@ RunResiduals build_residuals(const Run& run) {
       d.axis_reference[static_cast<std::size_t>(a)] = "cmd";
       for (Eigen::Index s = 0; s < n; ++s) {
         const std::size_t k = d.trace[static_cast<std::size_t>(s)];
-        t.obs.push_back({static_cast<int>(s), (x_ins[static_cast<std::size_t>(s)][a] - m.cmd_mm[k][a]) * 1000.0, 0.5, d.heldout[static_cast<std::size_t>(s)], -1});
+        t.obs.push_back({static_cast<int>(s), (x_ins[static_cast<std::size_t>(s)][a] - m.cmd_mm[k][a]) * 1000.0, 0.5,
+                         d.heldout[static_cast<std::size_t>(s)], -1});
         add_row(d.pipeline, static_cast<int>(s), a, (m.pos_mm[k][a] - m.cmd_mm[k][a]) * 1000.0, 1.0, pr, ps);
       }
     }

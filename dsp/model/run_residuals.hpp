@@ -24,27 +24,27 @@
 namespace eical::dsp::model {
 
 struct Channel {
-  std::string name;                  // "sensor" | "machine" | "total"
-  std::vector<int> sample, axis;     // each row: decimated sample and machine axis
-  Eigen::VectorXd residual_um;       // per row
-  Eigen::VectorXd sigma_um;          // per row: the noise the row carries (weights)
+  std::string name;               // "sensor" | "machine" | "total"
+  std::vector<int> sample, axis;  // each row: decimated sample and machine axis
+  Eigen::VectorXd residual_um;    // per row
+  Eigen::VectorXd sigma_um;       // per row: the noise the row carries (weights)
   [[nodiscard]] Eigen::Index rows() const { return residual_um.size(); }
 };
 
 struct RunResiduals {
-  std::string run_id, reference;     // "ref" | "psd" | "cmd"
+  std::string run_id, reference;  // "ref" | "psd" | "cmd"
   double fs_hz = 10000.0, dt_s = 1e-3;
-  int n = 0;                          // decimated samples
-  std::vector<std::size_t> trace;     // decimated → aligned trace position
+  int n = 0;                       // decimated samples
+  std::vector<std::size_t> trace;  // decimated → aligned trace position
   std::array<bool, 3> moving{}, has_ref{}, has_psd{};
   std::array<std::string, 3> axis_reference{};  // per axis: "ref" | "psd" | "cmd"
-  std::array<int, 3> owner{{-1, -1, -1}};  // sensor moving each axis: 0 table, 1 head
+  std::array<int, 3> owner{{-1, -1, -1}};       // sensor moving each axis: 0 table, 1 head
   // Decimated kinematics on the set-point's time (mm, mm/s, mm/s²) and the measurement.
   Eigen::MatrixXd cmd, v_cmd, a_cmd, x_meas, v_meas, a_meas;
-  Eigen::MatrixXd temp_c;             // n × 2: case temperature minus its start, table, head
-  Eigen::VectorXd t_s;                // time from the start of the motion
-  std::vector<int> segment;           // per sample: which stretch between M102 marks
-  std::vector<bool> heldout;          // per sample: held out of the fits (every other stretch or half second)
+  Eigen::MatrixXd temp_c;     // n × 2: case temperature minus its start, table, head
+  Eigen::VectorXd t_s;        // time from the start of the motion
+  std::vector<int> segment;   // per sample: which stretch between M102 marks
+  std::vector<bool> heldout;  // per sample: held out of the fits (every other stretch or half second)
   // The integrated motion against each axis' reference, for the augmented filters
   // (kf_selection.hpp): where the reference is, at the standstills, the moves' starts.
   std::array<AxisTrack, 3> tracks;
@@ -54,9 +54,9 @@ struct RunResiduals {
   // The pipeline's path (ZUPT, smoother, no PSD fixes) minus each axis' reference: what
   // the report plots and the gain is measured on.
   Channel pipeline;
-  Measurement measurement;            // nominal pipeline (keep_raw)
+  Measurement measurement;  // nominal pipeline (keep_raw)
   RunMeta meta;
-  double delay_samples = 38.8;        // what the pipeline removed
+  double delay_samples = 38.8;  // what the pipeline removed
 };
 
 // Throws InputError when the run has no motion to explain.

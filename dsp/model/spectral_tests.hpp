@@ -15,8 +15,8 @@ namespace eical::dsp::model {
 
 struct SpectralLine {
   double freq_hz = 0.0;
-  double excess = 0.0;        // power over the floor (ratio)
-  double amp_mg = 0.0;        // equivalent sine amplitude over the line's bins
+  double excess = 0.0;  // power over the floor (ratio)
+  double amp_mg = 0.0;  // equivalent sine amplitude over the line's bins
 };
 
 struct VibrationFinding {
@@ -30,7 +30,7 @@ struct VibrationFinding {
 
 struct VibrationTests {
   VibrationFinding common, differential;
-  double floor_ug_per_rthz = 0.0;   // the noise floor assumed (data sheet)
+  double floor_ug_per_rthz = 0.0;  // the noise floor assumed (data sheet)
   double seconds_used = 0.0;
 };
 

@@ -13,14 +13,14 @@
 namespace eical::dsp::model {
 namespace {
 
-constexpr double kSettleS = 0.2;         // the position loop's creep (1/kv ≈ 30 ms) is gone
-constexpr double kTailS = 0.02;          // the next move's first jerk may sit in the DAQ filter
+constexpr double kSettleS = 0.2;  // the position loop's creep (1/kv ≈ 30 ms) is gone
+constexpr double kTailS = 0.02;   // the next move's first jerk may sit in the DAQ filter
 constexpr double kMinLateS = 0.08;
 constexpr double kWalkUgPerRtS = 0.3;    // data-sheet bias walk per sensor: tolerated
 constexpr double kMaxTempCoeff = 900.0;  // µg/°C of head − table: two sensors' 450 (bias, and scale × 1 g)
 constexpr double kTempPrior = 300.0;     // µg/°C: the prior σ of each coefficient
 constexpr int kBatches = 8;
-constexpr double kBlockS = 0.1;          // a still-ringing mode of 10 Hz or more shows in its spread
+constexpr double kBlockS = 0.1;  // a still-ringing mode of 10 Hz or more shows in its spread
 constexpr double kRingingFactor = 1.5;
 
 // Weight of sample i of n in a Hann-weighted mean.
@@ -32,8 +32,8 @@ double hann_weight(std::size_t i, std::size_t n) {
 // factor is `l`; returns χ² of the residual.
 // With prior_sigma > 0 each coefficient has a zero-mean Gaussian prior of that σ (its
 // penalty is part of the χ²): collinear regressors then share the fit plausibly.
-double gls_chi2(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Eigen::MatrixXd& l, Eigen::VectorXd* beta = nullptr,
-                double prior_sigma = 0.0) {
+double gls_chi2(const Eigen::MatrixXd& x, const Eigen::VectorXd& y, const Eigen::MatrixXd& l,
+                Eigen::VectorXd* beta = nullptr, double prior_sigma = 0.0) {
   const Eigen::VectorXd yw = l.triangularView<Eigen::Lower>().solve(y);
   if (x.cols() == 0) return yw.squaredNorm();
   Eigen::MatrixXd xw = l.triangularView<Eigen::Lower>().solve(x);
@@ -67,7 +67,8 @@ StandstillBias standstill_bias(const RunResiduals& r) {
   auto spread = [&](std::int64_t from) {
     Eigen::Vector3d s1 = Eigen::Vector3d::Zero(), s2 = Eigen::Vector3d::Zero();
     for (std::int64_t i = from; i < from + block; ++i) {
-      const Eigen::Vector3d rel = m.raw.head_mps2[static_cast<std::size_t>(i)] - m.raw.table_mps2[static_cast<std::size_t>(i)];
+      const Eigen::Vector3d rel =
+          m.raw.head_mps2[static_cast<std::size_t>(i)] - m.raw.table_mps2[static_cast<std::size_t>(i)];
       s1 += rel, s2 += rel.cwiseAbs2();
     }
     const auto nb = static_cast<double>(block);
@@ -89,7 +90,8 @@ StandstillBias standstill_bias(const RunResiduals& r) {
   std::vector<double> spreads;
   for (const auto& w : m.supports.rest_windows) {
     const std::int64_t a = w.first_index - i0 + static_cast<std::int64_t>(kSettleS * fs);
-    const std::int64_t b = std::min<std::int64_t>(w.last_index - i0 - static_cast<std::int64_t>(kTailS * fs), n_raw - 1);
+    const std::int64_t b =
+        std::min<std::int64_t>(w.last_index - i0 - static_cast<std::int64_t>(kTailS * fs), n_raw - 1);
     if (a < 0 || b - a < static_cast<std::int64_t>(kMinLateS * fs)) continue;
     spans.emplace_back(a, b);
     for (std::int64_t c = a; c + block <= b; c += block) spreads.push_back(spread(c));
@@ -108,11 +110,12 @@ StandstillBias standstill_bias(const RunResiduals& r) {
     StandstillBias::Window win;
     win.t_s = 0.5 * static_cast<double>(a + b) / fs;
     win.settle_s = static_cast<double>(a - opened) / fs, win.length_s = static_cast<double>(b - a + 1) / fs;
-    const auto ds = static_cast<Eigen::Index>(std::clamp(std::lround(win.t_s / std::max(r.dt_s, 1e-9)), 0L, static_cast<long>(r.n) - 1));
+    const auto ds = static_cast<Eigen::Index>(
+        std::clamp(std::lround(win.t_s / std::max(r.dt_s, 1e-9)), 0L, static_cast<long>(r.n) - 1));
     for (int s = 0; s < 2; ++s) win.temp_c[s] = r.temp_c(ds, s);
     const std::int64_t len = (b - a + 1) / kBatches;
     Eigen::Vector3d batch[kBatches], plain = Eigen::Vector3d::Zero(), mean = Eigen::Vector3d::Zero(),
-        own[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+                                     own[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     // The window's mean is Hann-weighted: a machine's tones (a spindle, a structural mode
     // still ringing) leak into a plain mean by 1/(2πfT), into a tapered one by ~1/(2πfT)³.
     // White noise costs the taper a factor 1.5 in variance.
@@ -138,7 +141,8 @@ StandstillBias standstill_bias(const RunResiduals& r) {
     const double white = noise_rel * std::sqrt(1.5 * fs / static_cast<double>(n_used));
     for (int ax = 0; ax < 3; ++ax) {
       win.bias_ug[ax] = mean[ax] / g_ug;
-      win.sigma_ug[ax] = std::sqrt(std::max(var[ax] / (g_ug * g_ug), white * white) + 2.0 * kWalkUgPerRtS * kWalkUgPerRtS * win.t_s);
+      win.sigma_ug[ax] =
+          std::sqrt(std::max(var[ax] / (g_ug * g_ug), white * white) + 2.0 * kWalkUgPerRtS * kWalkUgPerRtS * win.t_s);
       for (int s = 0; s < 2; ++s) win.sensor_ug[s][ax] = own[s][ax] / static_cast<double>(len * kBatches) / g_ug;
     }
     out.windows.push_back(win);
@@ -187,7 +191,8 @@ StandstillBias standstill_bias(const RunResiduals& r) {
     Eigen::MatrixXd xd(k, 1), xs(k, 2), xt(k, 2);
     for (Eigen::Index i = 0; i < k; ++i) {
       const auto& w = out.windows[static_cast<std::size_t>(i)];
-      xd(i, 0) = w.t_s, xs(i, 0) = 1.0, xs(i, 1) = i % 2 == 0 ? 1.0 : -1.0, xt(i, 0) = w.temp_c[1], xt(i, 1) = -w.temp_c[0];
+      xd(i, 0) = w.t_s, xs(i, 0) = 1.0, xs(i, 1) = i % 2 == 0 ? 1.0 : -1.0, xt(i, 0) = w.temp_c[1],
+            xt(i, 1) = -w.temp_c[0];
     }
     Eigen::VectorXd bd, bs, bt;
     bic_drift += gls_chi2(xd, y, chol[ax], &bd) + ln_n;
@@ -225,17 +230,22 @@ StandstillBias standstill_bias(const RunResiduals& r) {
   const double bic_best = std::min({bic_drift, bic_steps, temp_plausible ? bic_temp : 1e300});
   if (out.chi2 - bic_best > 10.0 && out.largest_change_ug > 1.0) out.changed = true;
   // The case temperature is a measured cause: it wins unless a pattern in time fits clearly better.
-  if (temp_plausible && bic_temp <= bic_drift + 2.0 && bic_temp <= bic_steps + 2.0) out.pattern = "temperature";
-  else if (std::min(bic_drift, bic_steps) < out.chi2 - 2.0 * ln_n) out.pattern = bic_steps < bic_drift ? "steps" : "drift";
-  else out.pattern = "walk";
+  if (temp_plausible && bic_temp <= bic_drift + 2.0 && bic_temp <= bic_steps + 2.0)
+    out.pattern = "temperature";
+  else if (std::min(bic_drift, bic_steps) < out.chi2 - 2.0 * ln_n)
+    out.pattern = bic_steps < bic_drift ? "steps" : "drift";
+  else
+    out.pattern = "walk";
   static const char* kSensor[2] = {"table", "head"};
   static const char* kAx[3] = {"x", "y", "z"};
   char buf[512];
   std::snprintf(buf, sizeof buf,
-                "head - table at %d standstills differs from the rest before the motion by up to %.2f ug (%s, mostly the %s; chi2 %.0f for %d dof); "
+                "head - table at %d standstills differs from the rest before the motion by up to %.2f ug (%s, mostly "
+                "the %s; chi2 %.0f for %d dof); "
                 "pattern: %s (drift %.3f ug/s, steps %.2f ug, %.1f ug/degC over %.2f degC)",
-                static_cast<int>(k), out.largest_change_ug, out.axis >= 0 ? kAx[out.axis] : "-", out.sensor >= 0 ? kSensor[out.sensor] : "-", out.chi2,
-                out.dof, out.pattern.c_str(), out.drift_ug_per_s, out.step_ug, out.temp_coeff_ug_per_c, out.temperature_change_c);
+                static_cast<int>(k), out.largest_change_ug, out.axis >= 0 ? kAx[out.axis] : "-",
+                out.sensor >= 0 ? kSensor[out.sensor] : "-", out.chi2, out.dof, out.pattern.c_str(), out.drift_ug_per_s,
+                out.step_ug, out.temp_coeff_ug_per_c, out.temperature_change_c);
   out.evidence = buf;
   return out;
 }

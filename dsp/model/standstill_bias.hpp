@@ -22,22 +22,22 @@ namespace eical::dsp::model {
 
 struct StandstillBias {
   struct Window {
-    double t_s = 0.0;                   // mid of the late part, from the start of the motion
+    double t_s = 0.0;                       // mid of the late part, from the start of the motion
     double settle_s = 0.0, length_s = 0.0;  // the late part: from this long after the rest opened, this long
-    double temp_c[2] = {0.0, 0.0};      // case temperature change since the start, table/head
-    double bias_ug[3] = {};             // change of the mean relative reading per machine axis
-    double sigma_ug[3] = {};            // its standard error (noise and tolerated walk)
-    double sensor_ug[2][3] = {};        // each sensor's own change (attribution only)
+    double temp_c[2] = {0.0, 0.0};          // case temperature change since the start, table/head
+    double bias_ug[3] = {};                 // change of the mean relative reading per machine axis
+    double sigma_ug[3] = {};                // its standard error (noise and tolerated walk)
+    double sensor_ug[2][3] = {};            // each sensor's own change (attribution only)
   };
   std::vector<Window> windows;
   double chi2 = 0.0;
   int dof = 0;
-  bool changed = false;                 // χ² beyond z = 5 and a change above 1 µg
+  bool changed = false;  // χ² beyond z = 5 and a change above 1 µg
   double largest_change_ug = 0.0;
-  std::string pattern = "none";         // "drift" | "steps" | "temperature" | "walk"
+  std::string pattern = "none";                                           // "drift" | "steps" | "temperature" | "walk"
   double drift_ug_per_s = 0.0, step_ug = 0.0, temp_coeff_ug_per_c = 0.0;  // of the axis with the largest change
-  int temp_coeff_sensor = -1;           // whose bias coefficient temp_coeff_ug_per_c is (0 table, 1 head)
-  int sensor = -1, axis = -1;           // where the largest change is (sensor: the one whose own mean moved more)
+  int temp_coeff_sensor = -1;  // whose bias coefficient temp_coeff_ug_per_c is (0 table, 1 head)
+  int sensor = -1, axis = -1;  // where the largest change is (sensor: the one whose own mean moved more)
   double temperature_change_c = 0.0;
   std::string evidence;
 };

@@ -24,7 +24,8 @@ StickSlipFinding stick_slip_test(const RunResiduals& r) {
   const std::size_t n = std::min({m.raw.head_mps2.size(), m.raw.table_mps2.size(), m.cmd_mm.size()});
   if (n < 1000) return out;
   const double fs = m.fs_hz;
-  const auto shift = static_cast<std::ptrdiff_t>(std::lround(r.delay_samples));  // raw (sensor time) k ↔ set-point k − shift
+  const auto shift =
+      static_cast<std::ptrdiff_t>(std::lround(r.delay_samples));  // raw (sensor time) k ↔ set-point k − shift
   const auto half = static_cast<std::ptrdiff_t>(std::max(1.0, std::round(kHalfWindowS * fs)));
   static const char* kAx[3] = {"x", "y", "z"};
   double best_per_zone = -1.0;
@@ -43,7 +44,9 @@ StickSlipFinding stick_slip_test(const RunResiduals& r) {
     for (std::size_t k = 1; k + 1 < n; ++k) {
       const std::ptrdiff_t c = static_cast<std::ptrdiff_t>(k) - shift;
       if (c < 1 || c + 1 >= static_cast<std::ptrdiff_t>(n)) continue;
-      const double v = std::abs(m.cmd_mm[static_cast<std::size_t>(c + 1)][a] - m.cmd_mm[static_cast<std::size_t>(c - 1)][a]) * fs / 2.0;
+      const double v =
+          std::abs(m.cmd_mm[static_cast<std::size_t>(c + 1)][a] - m.cmd_mm[static_cast<std::size_t>(c - 1)][a]) * fs /
+          2.0;
       zone[k] = v >= kCreepMmS ? 2 : v > kStillMmS ? 1 : 0;
     }
     // Noise: the robust spread of the high-passed signal where the axis moves fast (what
@@ -77,15 +80,18 @@ StickSlipFinding stick_slip_test(const RunResiduals& r) {
       if (zone[k] == 0) continue;
       if (std::abs(hp[k]) > kBurstSigma * sigma && static_cast<std::ptrdiff_t>(k) - last_burst >= half) {
         last_burst = static_cast<std::ptrdiff_t>(k);
-        if (creeping) ++in_creep, ++zone_bursts;
-        else ++elsewhere;
+        if (creeping)
+          ++in_creep, ++zone_bursts;
+        else
+          ++elsewhere;
       }
     }
     if (in_zone) per_zone.push_back(zone_bursts), ++zone_count;
     const double mz = dsp::median(per_zone, 0.0);
     if (mz > best_per_zone) {
       best_per_zone = mz;
-      out.axis = a, out.creep_zones = zone_count, out.bursts_in_creep = in_creep, out.bursts_elsewhere = elsewhere, out.bursts_per_zone = mz;
+      out.axis = a, out.creep_zones = zone_count, out.bursts_in_creep = in_creep, out.bursts_elsewhere = elsewhere,
+      out.bursts_per_zone = mz;
       out.creep_seconds = creep_s, out.other_seconds = other_s;
     }
   }
@@ -112,17 +118,19 @@ StickSlipFinding stick_slip_test(const RunResiduals& r) {
     for (std::size_t k = static_cast<std::size_t>(w); k + static_cast<std::size_t>(w) + 1 < nr; ++k) {
       const double v = std::abs(m.cmd_mm[k + 1][out.axis] - m.cmd_mm[k - 1][out.axis]) * fs / 2.0;
       if (!(v > kStillMmS && v < kCreepMmS) || !std::isfinite(e[k])) continue;
-      const double mean = (pre[k + static_cast<std::size_t>(w) + 1] - pre[k - static_cast<std::size_t>(w)]) / static_cast<double>(2 * w + 1);
+      const double mean = (pre[k + static_cast<std::size_t>(w) + 1] - pre[k - static_cast<std::size_t>(w)]) /
+                          static_cast<double>(2 * w + 1);
       ss += (e[k] - mean) * (e[k] - mean), ++cnt;
     }
     if (cnt > 0) out.slip_um = std::sqrt(ss / static_cast<double>(cnt)) * 1000.0 * std::sqrt(12.0);
   }
   char buf[400];
   std::snprintf(buf, sizeof buf,
-                "%d bursts of relative acceleration beyond %.0f sigma while %s creeps (below %.0f mm/s; median %.0f per creep zone over %d zones, %.2f s) "
+                "%d bursts of relative acceleration beyond %.0f sigma while %s creeps (below %.0f mm/s; median %.0f "
+                "per creep zone over %d zones, %.2f s) "
                 "against %d over %.2f s of faster motion%s",
-                out.bursts_in_creep, kBurstSigma, kAx[out.axis], kCreepMmS, out.bursts_per_zone, out.creep_zones, out.creep_seconds, out.bursts_elsewhere,
-                out.other_seconds, "");
+                out.bursts_in_creep, kBurstSigma, kAx[out.axis], kCreepMmS, out.bursts_per_zone, out.creep_zones,
+                out.creep_seconds, out.bursts_elsewhere, out.other_seconds, "");
   out.evidence = buf;
   if (out.slip_um > 0.0) {
     char b2[96];

@@ -14,11 +14,11 @@ namespace eical::dsp::model {
 
 struct StickSlipFinding {
   bool found = false;
-  int axis = -1;                 // the axis with the most bursts per creep zone
+  int axis = -1;  // the axis with the most bursts per creep zone
   int creep_zones = 0, bursts_in_creep = 0, bursts_elsewhere = 0;
   double bursts_per_zone = 0.0;  // median over the zones of that axis
   double creep_seconds = 0.0, other_seconds = 0.0;
-  double slip_um = 0.0;          // sawtooth size from the reference (0 without one)
+  double slip_um = 0.0;  // sawtooth size from the reference (0 without one)
   std::string evidence;
 };
 

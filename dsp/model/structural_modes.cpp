@@ -9,22 +9,22 @@
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <complex>
 #include <cstdio>
 #include <numbers>
+#include <optional>
 
 namespace eical::dsp::model {
 namespace {
 
 using cd = std::complex<double>;
 
-constexpr double kTargetDfHz = 0.25;      // resolves ζ ≈ 0.01 at 15 Hz (half-power band 2ζf)
+constexpr double kTargetDfHz = 0.25;  // resolves ζ ≈ 0.01 at 15 Hz (half-power band 2ζf)
 constexpr int kMinAverages = 4;
-constexpr double kMinCoherence = 0.5;     // at a candidate peak: the input drives it
-constexpr double kProminence = 1.08;      // |H| over its neighbourhood's median
-constexpr double kMinAmplification = 0.1; // the mode adds 10 % at its peak
-constexpr double kZ = 5.0;                // χ² threshold
+constexpr double kMinCoherence = 0.5;      // at a candidate peak: the input drives it
+constexpr double kProminence = 1.08;       // |H| over its neighbourhood's median
+constexpr double kMinAmplification = 0.1;  // the mode adds 10 % at its peak
+constexpr double kZ = 5.0;                 // χ² threshold
 constexpr double kZetaMin = 0.002, kZetaMax = 0.4;
 // What the mode adds to this run must stand out of the sensors' own noise: 0.1 mg is ten
 // times a servo accelerometer's noise over the band searched (0.4 µg/√Hz over 300 Hz), or
@@ -34,7 +34,7 @@ constexpr double kMaterialUm = 0.1, kMaterialMg = 0.1;
 // ζ 0.01–0.1). A broader shape the fit finds is the drive's or the sensors' own transient
 // (a reversal, backlash taken up) which every run holds at tolerance level.
 constexpr double kZetaStructuralMax = 0.1;
-constexpr double kMmS2PerMg = 9.80665e-3 * 1000.0;     // 1 mg in mm/s²
+constexpr double kMmS2PerMg = 9.80665e-3 * 1000.0;  // 1 mg in mm/s²
 
 // Least squares of every output on the nuisance columns (offset, each input's commanded
 // acceleration and its rate: the servo's gain and lag) and, with a mode, its response to
@@ -49,7 +49,8 @@ class TimeModel {
  public:
   TimeModel(const Eigen::MatrixXd& e, const std::vector<Eigen::VectorXd>& nuisance) {
     Eigen::MatrixXd x(e.rows(), static_cast<Eigen::Index>(nuisance.size()));
-    for (std::size_t c = 0; c < nuisance.size(); ++c) x.col(static_cast<Eigen::Index>(c)) = nuisance[c] / std::max(nuisance[c].norm(), 1e-300);
+    for (std::size_t c = 0; c < nuisance.size(); ++c)
+      x.col(static_cast<Eigen::Index>(c)) = nuisance[c] / std::max(nuisance[c].norm(), 1e-300);
     const Eigen::HouseholderQR<Eigen::MatrixXd> qr(x);
     q_ = qr.householderQ() * Eigen::MatrixXd::Identity(x.rows(), x.cols());
     e_ = project(e);
@@ -94,7 +95,9 @@ std::vector<PeakCandidate> peaks(const FrequencyResponse& fr, int input, double 
   // over every bin searched, a 1 % chance of one false peak.
   std::size_t searched = 0;
   for (std::size_t k = 0; k < nb; ++k) searched += fr.f_hz[k] >= f_min && fr.f_hz[k] <= f_max;
-  const double c_min = std::max(kMinCoherence, 1.0 - std::pow(0.01 / static_cast<double>(std::max<std::size_t>(searched, 1)), 1.0 / std::max(1, fr.averages - 1)));
+  const double c_min =
+      std::max(kMinCoherence, 1.0 - std::pow(0.01 / static_cast<double>(std::max<std::size_t>(searched, 1)),
+                                             1.0 / std::max(1, fr.averages - 1)));
   for (std::size_t k = 2; k + 2 < nb; ++k) {
     const double f = fr.f_hz[k];
     if (f < f_min || f > f_max || fr.coherence[k] < c_min) continue;
@@ -123,7 +126,8 @@ Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_h
   double norm = (a * h).cwiseAbs().rowwise().sum().maxCoeff();
   while (norm > 0.25) norm /= 2.0, ++squarings;
   const Eigen::Matrix2d ah = a * (h / std::pow(2.0, squarings));
-  Eigen::Matrix2d phi = Eigen::Matrix2d::Identity(), term = Eigen::Matrix2d::Identity(), gam = Eigen::Matrix2d::Identity() * (h / std::pow(2.0, squarings));
+  Eigen::Matrix2d phi = Eigen::Matrix2d::Identity(), term = Eigen::Matrix2d::Identity(),
+                  gam = Eigen::Matrix2d::Identity() * (h / std::pow(2.0, squarings));
   Eigen::Matrix2d gterm = gam;
   for (int k = 1; k <= 10; ++k) {
     term = term * ah / k;
@@ -142,8 +146,8 @@ Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_h
   return y;
 }
 
-ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz, const std::array<bool, 3>& driven,
-                                 double max_hz) {
+ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz,
+                                 const std::array<bool, 3>& driven, double max_hz) {
   ModeSearch out;
   const auto n = static_cast<std::size_t>(std::min(a_meas.rows(), a_cmd.rows()));
   const std::size_t seg = segment_for(n, fs_hz, kTargetDfHz, kMinAverages);
@@ -172,7 +176,8 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
     out.averages = fr[j][j].averages;
     for (const auto& c : peaks(fr[j][j], j, out.f_min_hz, out.f_max_hz)) cands.push_back(c);
   }
-  std::sort(cands.begin(), cands.end(), [](const PeakCandidate& a, const PeakCandidate& b) { return a.prominence > b.prominence; });
+  std::sort(cands.begin(), cands.end(),
+            [](const PeakCandidate& a, const PeakCandidate& b) { return a.prominence > b.prominence; });
   if (cands.size() > kMaxCandidates) cands.resize(kMaxCandidates);
   // The time-domain model: what the measured relative acceleration has beyond the
   // commanded one, on the nuisance columns, then with a mode's response.
@@ -188,7 +193,8 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
     // The drive's own response (a broad second-order lag, not a mode) to second order in
     // frequency: gain, lag and the curvature of its phase and magnitude.
     Eigen::VectorXd snap = Eigen::VectorXd::Zero(nn);
-    for (Eigen::Index k = 1; k + 1 < nn; ++k) snap[k] = (a_cmd(k + 1, j) - 2.0 * a_cmd(k, j) + a_cmd(k - 1, j)) * fs_hz * fs_hz;
+    for (Eigen::Index k = 1; k + 1 < nn; ++k)
+      snap[k] = (a_cmd(k + 1, j) - 2.0 * a_cmd(k, j) + a_cmd(k - 1, j)) * fs_hz * fs_hz;
     nuisance.push_back(a_cmd.col(j).head(nn)), nuisance.push_back(jerk), nuisance.push_back(snap);
   }
   const TimeModel tm(e, nuisance);
@@ -216,7 +222,8 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
     const double fstep = 2.0 * span / 20.0;
     search(best_f - fstep, best_f + fstep, 9, std::max(kZetaMin, best_z / 1.6), std::min(kZetaMax, best_z * 1.6), 9);
     // A last, finer pass: the previous grid's 12 % steps in ζ would bias it by up to 6 %.
-    search(best_f - fstep / 4.0, best_f + fstep / 4.0, 7, std::max(kZetaMin, best_z / 1.13), std::min(kZetaMax, best_z * 1.13), 9);
+    search(best_f - fstep / 4.0, best_f + fstep / 4.0, 7, std::max(kZetaMin, best_z / 1.13),
+           std::min(kZetaMax, best_z * 1.13), 9);
     StructuralMode md;
     md.frequency_hz = best_f, md.damping_ratio = best_z;
     // The residual's effective count (it is no white noise: vibration, the servo's error).
@@ -233,7 +240,8 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
     md.gain = std::abs(best.g(bj, bi));
     md.peak_amplification = md.gain / (2.0 * best_z);
     const double gn = best.g.row(bj).norm(), gref = best.g(bj, md.input_axis);
-    for (int i = 0; i < 3; ++i) md.direction[static_cast<std::size_t>(i)] = gn > 0.0 ? best.g(bj, i) * (gref < 0.0 ? -1.0 : 1.0) / gn : 0.0;
+    for (int i = 0; i < 3; ++i)
+      md.direction[static_cast<std::size_t>(i)] = gn > 0.0 ? best.g(bj, i) * (gref < 0.0 ? -1.0 : 1.0) / gn : 0.0;
     // Profile uncertainty: χ² in effective counts rises by one.
     auto bound = [&](bool freq, double dir) {
       double step = freq ? std::max(1e-4 * best_f, out.df_hz / 100.0) : 0.01 * best_z;
@@ -253,16 +261,18 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
     for (std::size_t k = 0; k < f0.f_hz.size(); ++k)
       if (std::abs(f0.f_hz[k] - best_f) <= out.df_hz) md.coherence = std::max(md.coherence, f0.coherence[k]);
     {
-      const Eigen::VectorXd y = mode_response(a_cmd.col(md.input_axis).head(nn), fs_hz, best_f, best_z, false) * best.g(bj, bi);
+      const Eigen::VectorXd y =
+          mode_response(a_cmd.col(md.input_axis).head(nn), fs_hz, best_f, best_z, false) * best.g(bj, bi);
       md.response_rms_mg = std::sqrt(y.squaredNorm() / static_cast<double>(nn)) / kMmS2PerMg;
       const double om = 2.0 * std::numbers::pi * best_f;
       md.displacement_rms_um = md.response_rms_mg * kMmS2PerMg / (om * om) * 1000.0;
     }
     // The input must drive the response where the fit puts the mode, not only where the
     // candidate was: a broad shape fitted into a band the motion leaves unexcited is none.
-    md.significant = md.chi2_drop > md.chi2_threshold && md.peak_amplification >= kMinAmplification && md.coherence >= kMinCoherence &&
-                     (md.displacement_rms_um >= kMaterialUm || md.response_rms_mg >= kMaterialMg) && best_z > kZetaMin * 1.1 &&
-                     best_z <= kZetaStructuralMax && best_f >= out.f_min_hz && best_f <= out.f_max_hz;
+    md.significant =
+        md.chi2_drop > md.chi2_threshold && md.peak_amplification >= kMinAmplification &&
+        md.coherence >= kMinCoherence && (md.displacement_rms_um >= kMaterialUm || md.response_rms_mg >= kMaterialMg) &&
+        best_z > kZetaMin * 1.1 && best_z <= kZetaStructuralMax && best_f >= out.f_min_hz && best_f <= out.f_max_hz;
     return md;
   };
   // Candidates by prominence, each on a model that holds the modes already found: a strong
@@ -278,7 +288,8 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
     // One mode seen from several inputs: keep its best fit.
     bool merged = false;
     for (auto& o : out.modes)
-      if (std::abs(o.frequency_hz - md.frequency_hz) <= 2.0 * out.df_hz + 2.0 * std::max(o.sigma_frequency_hz, md.sigma_frequency_hz)) {
+      if (std::abs(o.frequency_hz - md.frequency_hz) <=
+          2.0 * out.df_hz + 2.0 * std::max(o.sigma_frequency_hz, md.sigma_frequency_hz)) {
         if (md.chi2_drop > o.chi2_drop) o = md;
         merged = true;
       }
@@ -295,7 +306,8 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
       std::vector<Eigen::VectorXd> with_others = nuisance;
       for (std::size_t o : sig)
         if (o != k)
-          for (auto& col : mode_cols(out.modes[o].frequency_hz, out.modes[o].damping_ratio)) with_others.push_back(std::move(col));
+          for (auto& col : mode_cols(out.modes[o].frequency_hz, out.modes[o].damping_ratio))
+            with_others.push_back(std::move(col));
       PeakCandidate c;
       c.input = out.modes[k].input_axis, c.f_hz = out.modes[k].frequency_hz;
       const StructuralMode md = fit_mode(c, TimeModel(e, with_others));
@@ -317,8 +329,10 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
     return a.chi2_drop > b.chi2_drop;
   });
   char buf[200];
-  std::snprintf(buf, sizeof buf, "frequency response of the measured over the commanded acceleration, %.1f-%.0f Hz in %.2f Hz bins over %d averages", out.f_min_hz,
-                out.f_max_hz, out.df_hz, out.averages);
+  std::snprintf(buf, sizeof buf,
+                "frequency response of the measured over the commanded acceleration, %.1f-%.0f Hz in %.2f Hz bins over "
+                "%d averages",
+                out.f_min_hz, out.f_max_hz, out.df_hz, out.averages);
   out.evidence = buf;
   return out;
 }

@@ -26,9 +26,9 @@ struct StructuralMode {
   int input_axis = 0;                 // the commanded axis that excites it best
   std::array<double, 3> direction{};  // response per axis (|G|, normalised; sign against the input axis)
   double chi2_drop = 0.0, chi2_threshold = 0.0;
-  double coherence = 0.0;             // at the peak
-  double response_rms_mg = 0.0;       // what the mode adds to the measured acceleration over the run
-  double displacement_rms_um = 0.0;   // and to the position (the same over ω²)
+  double coherence = 0.0;            // at the peak
+  double response_rms_mg = 0.0;      // what the mode adds to the measured acceleration over the run
+  double displacement_rms_um = 0.0;  // and to the position (the same over ω²)
   bool significant = false;
 };
 
@@ -39,7 +39,7 @@ struct ModeSearch {
   // The gain of the modes found: measured − commanded acceleration beyond the drive's own
   // response (gain, lag, curvature), RMS over the run without and with them, mg.
   double residual_rms_before_mg = 0.0, residual_rms_after_mg = 0.0;
-  std::string evidence;               // what was searched, or why nothing could be
+  std::string evidence;  // what was searched, or why nothing could be
 };
 
 // A mode's response to its drive u (mm/s²): m'' + 2ζω m' + ω² m = u (base excitation);
@@ -49,7 +49,7 @@ Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_h
 // `a_meas`, `a_cmd`: n × 3 (mm/s², same time base, sample rate fs_hz); `driven`: the axes the
 // set-point moves (the inputs); `max_hz`: the highest frequency a mode may have here (the
 // sensors' own dynamics and the DAQ filter shape the response above it).
-ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz, const std::array<bool, 3>& driven,
-                                 double max_hz);
+ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz,
+                                 const std::array<bool, 3>& driven, double max_hz);
 
 }  // namespace eical::dsp::model

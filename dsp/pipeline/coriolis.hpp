@@ -17,7 +17,7 @@ namespace eical::dsp {
 inline Eigen::Vector3d earth_rate_machine_radps(const Site& site) {
   const double lat_rad = units::deg_to_rad(site.latitude_deg), heading_rad = units::deg_to_rad(site.heading_deg);
   return units::kEarthRateRadps * Eigen::Vector3d(std::cos(lat_rad) * std::cos(heading_rad),
-                                                 std::cos(lat_rad) * std::sin(heading_rad), std::sin(lat_rad));
+                                                  std::cos(lat_rad) * std::sin(heading_rad), std::sin(lat_rad));
 }
 
 struct CoriolisComp {

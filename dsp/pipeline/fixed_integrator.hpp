@@ -38,7 +38,8 @@ struct FixedIntegrator {
 
   // k_samples: samples since the last step (1, more after lost frames; kept within 0..2³⁰).
   void step(const std::int64_t a_q40[3], std::int64_t k_samples, fx::Saturation& sat) noexcept {
-    if (k_samples < 0 || k_samples > (std::int64_t{1} << 30)) sat.hit = true, k_samples = k_samples < 0 ? 0 : std::int64_t{1} << 30;
+    if (k_samples < 0 || k_samples > (std::int64_t{1} << 30))
+      sat.hit = true, k_samples = k_samples < 0 ? 0 : std::int64_t{1} << 30;
     for (int i = 0; i < 3; ++i) {
       const std::int64_t s1_new = fx::sat64((fx::i128(a_q40[i]) + a_prev_q40[i]) * k_samples + s1[i], sat);
       s2[i] = fx::clamp128(s2[i] + (fx::i128(s1[i]) + s1_new) * k_samples, kS2Bound, sat);
@@ -55,7 +56,8 @@ struct FixedIntegrator {
   }
   // Velocity, Q40 m/s, with the first stage c1·a.
   [[nodiscard]] std::int64_t v_q40_mps(int i, fx::Saturation& sat) const noexcept {
-    return fx::add_sat(fx::mul(s1[i], fx::kAccelQ, half_dt_s, kOutQ, sat), fx::mul(a_prev_q40[i], fx::kAccelQ, c1_s, kOutQ, sat), sat);
+    return fx::add_sat(fx::mul(s1[i], fx::kAccelQ, half_dt_s, kOutQ, sat),
+                       fx::mul(a_prev_q40[i], fx::kAccelQ, c1_s, kOutQ, sat), sat);
   }
 };
 

@@ -94,7 +94,8 @@ struct QConst {
 };
 
 // value (Q`in_q`) × c → Q`out_q`, one rounding, saturated to int64.
-[[nodiscard]] inline std::int64_t mul(std::int64_t value, int in_q, const QConst& c, int out_q, Saturation& s) noexcept {
+[[nodiscard]] inline std::int64_t mul(std::int64_t value, int in_q, const QConst& c, int out_q,
+                                      Saturation& s) noexcept {
   return sat64(shift_round(i128(value) * c.mant, c.shift + in_q - out_q, s), s);
 }
 

@@ -4,9 +4,7 @@
 
 namespace eical::dsp {
 
-std::int64_t temp_q24_c(float temp_c) noexcept {
-  return std::llround(std::ldexp(static_cast<double>(temp_c), kTempQ));
-}
+std::int64_t temp_q24_c(float temp_c) noexcept { return std::llround(std::ldexp(static_cast<double>(temp_c), kTempQ)); }
 
 FixedStaticComp::FixedStaticComp(const StaticComp& c)
     : offset_counts(std::llround(c.offset_counts)),
@@ -49,7 +47,8 @@ void FixedStaticComp::set_temperature(std::int64_t temp_q24, fx::Saturation& sat
   }
 }
 
-void FixedStaticComp::apply(const std::int32_t counts[3], std::int64_t temp_q24, std::int64_t out[3], fx::Saturation& sat) noexcept {
+void FixedStaticComp::apply(const std::int32_t counts[3], std::int64_t temp_q24, std::int64_t out[3],
+                            fx::Saturation& sat) noexcept {
   if (temp_q24 != cached_temp_q24_c) set_temperature(temp_q24, sat);
   std::int64_t u[3], v[3];
   for (int i = 0; i < 3; ++i) {
@@ -73,10 +72,12 @@ void FixedStaticComp::apply(const std::int32_t counts[3], std::int64_t temp_q24,
       }
       std::int64_t next[3];
       for (int i = 0; i < 3; ++i) {  // v + (K⁻¹ − diag(s))·r
-        const std::int64_t slope = fx::add_sat(fx::mul(v[i], kSensorQ, two_k2[i], kSensorQ, sat),
-                                               fx::mul(fx::mul_q(v[i], v[i], kSensorQ, sat), kSensorQ, three_k3[i], kSensorQ, sat), sat);
+        const std::int64_t slope =
+            fx::add_sat(fx::mul(v[i], kSensorQ, two_k2[i], kSensorQ, sat),
+                        fx::mul(fx::mul_q(v[i], v[i], kSensorQ, sat), kSensorQ, three_k3[i], kSensorQ, sat), sat);
         std::int64_t d = fx::sub_sat(0, fx::mul_q(slope, r[i], kSensorQ, sat), sat);
-        for (int j = 0; j < 3; ++j) d = fx::add_sat(d, fx::mul(r[j], kSensorQ, cross_inverse[i][j], kSensorQ, sat), sat);
+        for (int j = 0; j < 3; ++j)
+          d = fx::add_sat(d, fx::mul(r[j], kSensorQ, cross_inverse[i][j], kSensorQ, sat), sat);
         next[i] = fx::add_sat(v[i], d, sat);
       }
       for (int i = 0; i < 3; ++i) v[i] = next[i];
@@ -84,7 +85,8 @@ void FixedStaticComp::apply(const std::int32_t counts[3], std::int64_t temp_q24,
   }
   for (int i = 0; i < 3; ++i) {  // (6-18) into machine axes, g → m/s²
     std::int64_t a = 0;
-    for (int j = 0; j < 3; ++j) a = fx::add_sat(a, fx::mul(v[j], kSensorQ, to_machine_mps2_per_g[i][j], fx::kAccelQ, sat), sat);
+    for (int j = 0; j < 3; ++j)
+      a = fx::add_sat(a, fx::mul(v[j], kSensorQ, to_machine_mps2_per_g[i][j], fx::kAccelQ, sat), sat);
     out[i] = a;
   }
 }

@@ -22,15 +22,15 @@
 
 namespace eical::dsp {
 
-inline constexpr int kTempQ = 24;       // °C
-inline constexpr int kSensorQ = 44;     // g, sensor axes
-inline constexpr int kCoeffQ = 60;      // dimensionless series in the temperature terms
+inline constexpr int kTempQ = 24;    // °C
+inline constexpr int kSensorQ = 44;  // g, sensor axes
+inline constexpr int kCoeffQ = 60;   // dimensionless series in the temperature terms
 
 // A float case temperature in Q24 °C (exact for |T| ≥ 0.5 °C).
 [[nodiscard]] std::int64_t temp_q24_c(float temp_c) noexcept;
 
 struct FixedStaticComp {
-  fx::QConst g_per_count[3];        // lsb / k1 at the reference temperature
+  fx::QConst g_per_count[3];  // lsb / k1 at the reference temperature
   std::int64_t offset_counts = 0;
   std::int64_t bias_q44_g[3] = {0, 0, 0};
   fx::QConst tc_k1_per_c, tc_bias_g_per_c;
@@ -47,7 +47,8 @@ struct FixedStaticComp {
   explicit FixedStaticComp(const StaticComp& c);
 
   // Counts and a Q24 temperature → specific force in machine axes, Q40 m/s².
-  void apply(const std::int32_t counts[3], std::int64_t temp_q24, std::int64_t out_q40_mps2[3], fx::Saturation& sat) noexcept;
+  void apply(const std::int32_t counts[3], std::int64_t temp_q24, std::int64_t out_q40_mps2[3],
+             fx::Saturation& sat) noexcept;
 
  private:
   void set_temperature(std::int64_t temp_q24, fx::Saturation& sat) noexcept;

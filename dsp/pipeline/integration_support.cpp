@@ -13,7 +13,8 @@ std::string unsupported_integration(const Measurement& m) {
   const double sigma_um = m.sigma_peak_um;  // over the whole trace (the arrays may keep every n-th sample)
   char buf[240];
   std::snprintf(buf, sizeof buf,
-                "no standstill before or after the motion and no position support: the acceleration integrated twice over %.1f s is no position "
+                "no standstill before or after the motion and no position support: the acceleration integrated twice "
+                "over %.1f s is no position "
                 "(its noise alone: sigma %.3g mm); compare in acceleration (eical explain)",
                 seconds, sigma_um * 1e-3);
   return buf;

@@ -44,7 +44,8 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
       "no_end_trigger: no M103 (103) trigger; the measurement ends with the data",
       "fixed_saturated: the fixed-point path clamped a value outside its Q-format range",
       "supports_diverged: the support fusion met values it cannot take (trace left as integrated, no ZUPT/NBS/CUPT)",
-      "psd_disagrees: the PSD readings contradict the integrated motion beyond their noise (sensor model off? run eical identify); fused without them",
+      "psd_disagrees: the PSD readings contradict the integrated motion beyond their noise (sensor model off? run "
+      "eical identify); fused without them",
   };
   std::vector<std::string> out;
   for (std::uint32_t b = 0; b < std::size(names); ++b)
@@ -54,12 +55,16 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
 
 Pipeline::Pipeline(const PipelineConfig& c)
     : config_(c), fixed_(c.arithmetic == Arithmetic::fixed_q), dt_s_(1.0 / c.acquisition.fs_hz) {
-  if (fixed_ && c.coriolis) throw InputError("pipeline: the fixed-point path has no Coriolis term; use double arithmetic");
+  if (fixed_ && c.coriolis)
+    throw InputError("pipeline: the fixed-point path has no Coriolis term; use double arithmetic");
   if (fixed_ && (c.sensors[0].zeta_per_g != 0.0 || c.sensors[1].zeta_per_g != 0.0))
-    throw InputError("pipeline: the fixed-point path does not compensate damping that grows with the acceleration (zeta_per_g); use double arithmetic");
+    throw InputError(
+        "pipeline: the fixed-point path does not compensate damping that grows with the acceleration (zeta_per_g); use "
+        "double arithmetic");
   if (fixed_ && c.dynamic != DynamicComp::none && c.dynamic != DynamicComp::position_level)
-    throw InputError(std::string("pipeline: the fixed-point path compensates the dynamics at the position level only, not ") +
-                     dynamic_comp_name(c.dynamic));
+    throw InputError(
+        std::string("pipeline: the fixed-point path compensates the dynamics at the position level only, not ") +
+        dynamic_comp_name(c.dynamic));
   // The DAQ delay is not inverted by the series of dynamic_comp.hpp: a pure delay is exact
   // as a re-indexing of the trace (finish()), which also holds for the sharp transients of
   // backlash engagement and stick-slip, where the second-order series errs by c2·A (tens of
@@ -75,7 +80,8 @@ Pipeline::Pipeline(const PipelineConfig& c)
     const double skew_s = s == 1 ? c.acquisition.daq_skew_head_samples * dt_s_ : 0.0;
     const DynamicCoefficients dyn = dynamic_coefficients(c.sensors[s], skew_s, c.dynamic);
     integ_[s] = SensorIntegrator(c.dynamic, dyn, dt_s_);
-    integ_[s].c_amp_s3_per_m = c.sensors[s].zeta * c.sensors[s].zeta_per_g / (2.0 * std::numbers::pi * c.sensors[s].f0_hz * c.site.g_mps2);
+    integ_[s].c_amp_s3_per_m =
+        c.sensors[s].zeta * c.sensors[s].zeta_per_g / (2.0 * std::numbers::pi * c.sensors[s].f0_hz * c.site.g_mps2);
     finteg_[s] = FixedIntegrator(dt_s_, dyn);
     temp_c_[s] = static_cast<float>(c.sensors[s].temp_ref_c);
   }
@@ -164,8 +170,9 @@ void Pipeline::compensate(const Frame& f) noexcept {
     if (!config_.sensor_present[s]) continue;  // absent: stays zero (reset)
     // A field of this sensor missing holds this sensor only; saturation and NaN hold both
     // (the frame's flag does not say which channel).
-    const bool bad = (f.flags & (frame_flag::sensor_missing(s) | frame_flag::accel_saturated | frame_flag::not_finite)) != 0 ||
-                     ((f.flags & frame_flag::accel_missing) && !(f.flags & (frame_flag::table_missing | frame_flag::head_missing)));
+    const bool bad =
+        (f.flags & (frame_flag::sensor_missing(s) | frame_flag::accel_saturated | frame_flag::not_finite)) != 0 ||
+        ((f.flags & frame_flag::accel_missing) && !(f.flags & (frame_flag::table_missing | frame_flag::head_missing)));
     if (fixed_) {
       if (!bad) fcomp_[s].apply(&f.accel_counts[3 * s], temp_q24_c(temp_c_[s]), last_valid_aq_[s], saturation_);
       for (int i = 0; i < 3; ++i) aq_[s][i] = last_valid_aq_[s][i];
@@ -184,7 +191,9 @@ void Pipeline::start_motion() noexcept {
     if (fixed_) {
       std::int64_t as[3];
       for (int i = 0; i < 3; ++i) {
-        fbias_[s][i] = bias_n_ > 0 ? fx::sat64(fx::div_round(fbias_sum_[s][i], static_cast<fx::i128>(bias_n_)), saturation_) : aq_[s][i];
+        fbias_[s][i] = bias_n_ > 0
+                           ? fx::sat64(fx::div_round(fbias_sum_[s][i], static_cast<fx::i128>(bias_n_)), saturation_)
+                           : aq_[s][i];
         as[i] = fx::sub_sat(aq_[s][i], fbias_[s][i], saturation_);
         bias_[s][i] = fx::to_double(fbias_[s][i], fx::kAccelQ);
       }
@@ -192,7 +201,9 @@ void Pipeline::start_motion() noexcept {
     } else {
       bias_[s] = bias_n_ > 0 ? Eigen::Vector3d(bias_sum_[s] / static_cast<double>(bias_n_)) : a_[s];
       Eigen::Vector3d hist[3];
-      for (int k = 0; k < 3; ++k) hist[k] = k < static_cast<int>(bias_n_) ? Eigen::Vector3d(rest_hist_[s][k] - bias_[s]) : Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k)
+        hist[k] =
+            k < static_cast<int>(bias_n_) ? Eigen::Vector3d(rest_hist_[s][k] - bias_[s]) : Eigen::Vector3d::Zero();
       integ_[s].start(a_[s] - bias_[s], hist);
     }
   }
@@ -213,7 +224,8 @@ void Pipeline::integrate(std::int64_t k_samples, double dt, Eigen::Vector3d& pos
       std::int64_t as[3];
       for (int i = 0; i < 3; ++i) as[i] = fx::sub_sat(aq_[s][i], fbias_[s][i], saturation_);
       finteg_[s].step(as, k_samples, saturation_);
-      for (int i = 0; i < 3; ++i) x_q40[s][i] = finteg_[s].x_q40_m(i, saturation_), v_q40[s][i] = finteg_[s].v_q40_mps(i, saturation_);
+      for (int i = 0; i < 3; ++i)
+        x_q40[s][i] = finteg_[s].x_q40_m(i, saturation_), v_q40[s][i] = finteg_[s].v_q40_mps(i, saturation_);
     }
     for (int i = 0; i < 3; ++i) {  // head − table (3-1)
       pos_m[i] = fx::to_double(fx::sub_sat(x_q40[1][i], x_q40[0][i], saturation_), kOutQ);
@@ -268,9 +280,11 @@ void Pipeline::step(const Frame& f) noexcept {
           }
         }
         ++bias_n_;
-        const Eigen::Vector3d rel = fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]);
+        const Eigen::Vector3d rel =
+            fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]);
         if (runs_supports()) supports_.rest_sample(rel);
-        if (config_.keep_raw && m_.raw.rest_rel_mps2.size() < config_.capacity_samples) m_.raw.rest_rel_mps2.push_back(rel);  // within the reserve
+        if (config_.keep_raw && m_.raw.rest_rel_mps2.size() < config_.capacity_samples)
+          m_.raw.rest_rel_mps2.push_back(rel);  // within the reserve
         return;
       }
       start_motion();
@@ -285,7 +299,8 @@ void Pipeline::step(const Frame& f) noexcept {
       phase_ = Phase::moving;
       live_.integrating = true;
       if (runs_supports() && stored_ < config_.capacity_samples)
-        supports_.step({0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(), cmd_valid, cmd_moved, cmd});
+        supports_.step({0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(),
+                        cmd_valid, cmd_moved, cmd});
       store(f, start_pos_mm_, Eigen::Vector3d::Zero());
       return;
     case Phase::moving: {
@@ -296,11 +311,14 @@ void Pipeline::step(const Frame& f) noexcept {
       const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
       const std::size_t k = stored_;
       if (runs_supports() && k < config_.capacity_samples)
-        supports_.step({k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd});
+        supports_.step(
+            {k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd});
       // The live filter's estimate, predicted over the DAQ delay (what finish() re-indexes).
       const Eigen::Vector3d live_pos = pos_mm - supports_.live_dx_mm();
       live_.vel_mm_s = vel_mm_s - supports_.live_dv_mm_s();
-      live_.pos_mm = config_.dynamic == DynamicComp::none ? live_pos : Eigen::Vector3d(live_pos + live_.vel_mm_s * (delay_samples_ * dt_s_));
+      live_.pos_mm = config_.dynamic == DynamicComp::none
+                         ? live_pos
+                         : Eigen::Vector3d(live_pos + live_.vel_mm_s * (delay_samples_ * dt_s_));
       store(f, pos_mm, vel_mm_s);  // frames after M103 belong to the rest (ZUPT) window too
       return;
     }
@@ -345,8 +363,10 @@ void Pipeline::apply_supports(Measurement& m) {
   Eigen::Vector3d v_rest = Eigen::Vector3d::Zero();
   if (!m.supports.rest_windows.empty()) {
     const RestWindow& last = m.supports.rest_windows.back();
-    const auto first = static_cast<std::size_t>(std::lower_bound(m.sample_index.begin(), m.sample_index.end(), last.first_index) - m.sample_index.begin());
-    const auto end = static_cast<std::size_t>(std::upper_bound(m.sample_index.begin(), m.sample_index.end(), last.last_index) - m.sample_index.begin());
+    const auto first = static_cast<std::size_t>(
+        std::lower_bound(m.sample_index.begin(), m.sample_index.end(), last.first_index) - m.sample_index.begin());
+    const auto end = static_cast<std::size_t>(
+        std::upper_bound(m.sample_index.begin(), m.sample_index.end(), last.last_index) - m.sample_index.begin());
     if (end > first) {
       const auto [v, cnt] = supports_.recorded_velocity_sum(first, end - 1);
       if (cnt > 0) v_rest = v / static_cast<double>(cnt);
@@ -412,13 +432,16 @@ Pipeline::Tracked Pipeline::finish_track(fusion::SegmentSink* sink) {
     const std::int64_t first = first_stored_;
     const SupportStage& stage = supports_;
     t.first_index = first;
-    m.supports = supports_.finish_track(stored_, [&](std::size_t k) { return stage.trace_index(first, k); }, t.correction, sink);
+    m.supports = supports_.finish_track(
+        stored_, [&](std::size_t k) { return stage.trace_index(first, k); }, t.correction, sink);
     Eigen::Vector3d v_rest = Eigen::Vector3d::Zero();
     if (!m.supports.rest_windows.empty() && t.correction) {
       // Rest windows in trace positions again (they are consecutive samples of the trace).
       const RestWindow& last = m.supports.rest_windows.back();
-      const std::size_t a = t.correction->position_of(first, last.first_index), b = t.correction->position_of(first, last.last_index);
-      const auto [v, cnt] = support_velocity_sum(t.correction->schedule.flags, t.correction->track.support_vel_mm_s, a, b);
+      const std::size_t a = t.correction->position_of(first, last.first_index),
+                        b = t.correction->position_of(first, last.last_index);
+      const auto [v, cnt] =
+          support_velocity_sum(t.correction->schedule.flags, t.correction->track.support_vel_mm_s, a, b);
       if (cnt > 0) v_rest = v / static_cast<double>(cnt);
     }
     rest_windows_done(m, v_rest);

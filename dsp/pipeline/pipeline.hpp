@@ -50,7 +50,7 @@ enum class TraceKeeping {
 // A trace sample as integrated: before the supports' corrections and the delay alignment.
 struct TraceSample {
   std::int64_t sample_index = 0;
-  std::int32_t trigger = 0;  // the frame's NC trigger code (0: none)
+  std::int32_t trigger = 0;        // the frame's NC trigger code (0: none)
   float temp_c[2] = {0.0F, 0.0F};  // the frame's case temperatures (table, head)
   std::uint32_t frame_flags = 0;   // the frame's frame_flag bits
   Eigen::Vector3d pos_mm = Eigen::Vector3d::Zero(), vel_mm_s = Eigen::Vector3d::Zero();
@@ -74,13 +74,13 @@ struct PipelineConfig {
   Site site;
   SensorSpec sensors[2];
   bool sensor_present[2] = {true, true};  // an absent sensor reads zero (single-sensor runs)
-  StaticCalibration calibration[2];  // cross terms and mounting (6-4, 6-18); default: data sheet
-  std::vector<PsdSpec> psd;          // the run's PSD strips (CUPT)
-  std::size_t capacity_samples = 0;  // longest measurement the trace can hold
+  StaticCalibration calibration[2];       // cross terms and mounting (6-4, 6-18); default: data sheet
+  std::vector<PsdSpec> psd;               // the run's PSD strips (CUPT)
+  std::size_t capacity_samples = 0;       // longest measurement the trace can hold
   // Of the supports' per-sample records, how much to reserve up front (SIZE_MAX: the capacity).
   std::size_t reserve_samples = SIZE_MAX;
   DynamicComp dynamic = DynamicComp::two_stage;
-  StaticCompOptions static_comp;     // temperature (6-16) and nonlinearity (6-17) on/off
+  StaticCompOptions static_comp;  // temperature (6-16) and nonlinearity (6-17) on/off
   // (3-6) Earth-rate Coriolis from [site]. Off by default: the simulator's built-in runs
   // leave it out (sc.coriolis), and correcting a term that is absent adds it. Real runs: on.
   bool coriolis = false;
@@ -90,11 +90,11 @@ struct PipelineConfig {
   // its integrated drift there is removed (and so is any real motion of it: straightness of
   // the moving axis is no longer seen). For rectangles and other axis-parallel programs.
   bool nbs = false;
-  bool cupt = true;    // PSD strips as position fixes (when the run has [[psd]])
-  bool smooth = true;  // RTS pass in finish() (off: the forward filter's causal result)
-  fusion::ErrorModel fusion;  // pipeline_config() sets the noise from the sensors' data sheet
-  bool keep_raw = false;      // Measurement::raw (identification, explain; offline only)
-  bool keep_schedule = false; // Measurement::raw.schedule alone (the uncertainty of the figures)
+  bool cupt = true;            // PSD strips as position fixes (when the run has [[psd]])
+  bool smooth = true;          // RTS pass in finish() (off: the forward filter's causal result)
+  fusion::ErrorModel fusion;   // pipeline_config() sets the noise from the sensors' data sheet
+  bool keep_raw = false;       // Measurement::raw (identification, explain; offline only)
+  bool keep_schedule = false;  // Measurement::raw.schedule alone (the uncertainty of the figures)
   TraceKeeping trace = TraceKeeping::whole;
   TraceSink* sink = nullptr;  // track and replay: where the stored samples go (may be none)
   supports::StandstillOptions standstill;
@@ -148,19 +148,19 @@ struct Measurement {
   double fs_hz = 0.0;
   std::vector<std::int64_t> sample_index;  // from the start of the motion to the end
   std::vector<Eigen::Vector3d> pos_mm, vel_mm_s, cmd_mm, ref_mm;
-  std::vector<TriggerMark> triggers;       // all triggers seen, on the DAQ clock
-  std::int64_t start_index = -1;           // first sample of the motion (integration start)
-  std::int64_t motion_end_index = -1;      // last sample where the set-point moved
+  std::vector<TriggerMark> triggers;   // all triggers seen, on the DAQ clock
+  std::int64_t start_index = -1;       // first sample of the motion (integration start)
+  std::int64_t motion_end_index = -1;  // last sample where the set-point moved
   bool degraded = false;
   std::vector<std::string> flags;
-  Eigen::Vector3d rest_bias_rel_mps2 = Eigen::Vector3d::Zero();  // head − table, incl. gravity
+  Eigen::Vector3d rest_bias_rel_mps2 = Eigen::Vector3d::Zero();        // head − table, incl. gravity
   Eigen::Vector3d zupt_velocity_error_mm_s = Eigen::Vector3d::Zero();  // integrated velocity at the last standstill
   std::size_t rest_window_samples = 0, zupt_window_samples = 0;
-  std::vector<Eigen::Vector3d> sigma_um;   // posterior σ of pos_mm per axis (after finish())
+  std::vector<Eigen::Vector3d> sigma_um;  // posterior σ of pos_mm per axis (after finish())
   // Long runs analysed as they stream (dsp/stream) keep every decimation-th sample of the
   // trace in the arrays above (and its last); the figures are computed from every sample.
   std::size_t decimation = 1;
-  std::size_t trace_samples = 0;           // samples of the whole trace
+  std::size_t trace_samples = 0;  // samples of the whole trace
   // Over the whole trace: the largest posterior σ per axis among samples whose σ is finite,
   // and the largest of any axis (NaN ignored) — what the result and the integration check quote.
   Eigen::Vector3d sigma_max_um = Eigen::Vector3d::Zero();
@@ -169,7 +169,7 @@ struct Measurement {
   // last finite ones), what the uncertainty reads from the frames otherwise.
   std::vector<Eigen::Vector2d> temp_c;
   SupportSummary supports;
-  RawTrace raw;                            // only with PipelineConfig::keep_raw
+  RawTrace raw;  // only with PipelineConfig::keep_raw
 };
 
 // Folds σ of trace samples into Measurement::sigma_max_um and sigma_peak_um.
@@ -187,8 +187,8 @@ class Pipeline {
   // TraceKeeping::track: the measurement without its per-sample arrays, and the smoothed
   // corrections to apply to the replayed trace (none when nothing moved).
   struct Tracked {
-    Measurement measurement;   // every field but the per-sample arrays
-    std::size_t samples = 0;   // trace samples (those a replay stores)
+    Measurement measurement;       // every field but the per-sample arrays
+    std::size_t samples = 0;       // trace samples (those a replay stores)
     std::int64_t first_index = 0;  // sample index of the trace's first sample
     std::unique_ptr<SmoothedCorrection> correction;
     double delay_samples = 0.0;  // to re-index by (0: none, DynamicComp::none)
@@ -223,7 +223,7 @@ class Pipeline {
   SupportStage supports_;
   fx::Saturation saturation_;
   double dt_s_;
-  double delay_samples_ = 0.0;  // DAQ group delay, removed by re-indexing in finish()
+  double delay_samples_ = 0.0;      // DAQ group delay, removed by re-indexing in finish()
   float temp_c_[2] = {0.0F, 0.0F};  // last valid case temperature
   // This frame's compensated acceleration (double path, m/s²; fixed path, Q40 m/s²).
   Eigen::Vector3d a_[2];
@@ -245,9 +245,9 @@ class Pipeline {
   Eigen::Vector3d start_pos_mm_ = Eigen::Vector3d::Zero();
   std::int64_t start_index_ = -1, motion_end_index_ = -1;
   LiveEstimate live_;
-  Measurement m_;  // trace storage, reserved in the constructor
-  std::size_t stored_ = 0;             // trace samples stored (or sent) in this measurement
-  std::int64_t first_stored_ = -1;     // sample index of the first
+  Measurement m_;                   // trace storage, reserved in the constructor
+  std::size_t stored_ = 0;          // trace samples stored (or sent) in this measurement
+  std::int64_t first_stored_ = -1;  // sample index of the first
   std::size_t trigger_capacity_ = 4096;
 };
 

@@ -12,9 +12,10 @@ struct SensorIntegrator {
   DynamicComp mode = DynamicComp::none;
   double c1_s = 0.0, c2_s2 = 0.0;
   double dt_nominal_s = 1e-4;  // the derivatives assume the nominal sampling step
-  Eigen::Vector3d hist_mps2[3] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};  // a[n−1..n−3]
-  Eigen::Vector3d v_mps = Eigen::Vector3d::Zero();         // first integral (of A_kor at the acceleration level)
-  Eigen::Vector3d x_m = Eigen::Vector3d::Zero();           // second integral
+  Eigen::Vector3d hist_mps2[3] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                  Eigen::Vector3d::Zero()};  // a[n−1..n−3]
+  Eigen::Vector3d v_mps = Eigen::Vector3d::Zero();           // first integral (of A_kor at the acceleration level)
+  Eigen::Vector3d x_m = Eigen::Vector3d::Zero();             // second integral
   Eigen::Vector3d integrand1_prev = Eigen::Vector3d::Zero(), integrand2_prev = Eigen::Vector3d::Zero();
   Eigen::Vector3d x_out_m = Eigen::Vector3d::Zero(), v_out_mps = Eigen::Vector3d::Zero();  // compensated
   // Damping growing with the acceleration, ζ = ζ0 (1 + k|a|/g) (ch. 8.3.1): the sensor
@@ -24,7 +25,8 @@ struct SensorIntegrator {
   Eigen::Vector3d amp_int_m2_s3 = Eigen::Vector3d::Zero(), amp_prev_m2_s4 = Eigen::Vector3d::Zero();
 
   SensorIntegrator() = default;
-  SensorIntegrator(DynamicComp m, const DynamicCoefficients& c, double dt_s) : mode(m), c1_s(c.c1_s), c2_s2(c.c2_s2), dt_nominal_s(dt_s) {}
+  SensorIntegrator(DynamicComp m, const DynamicCoefficients& c, double dt_s)
+      : mode(m), c1_s(c.c1_s), c2_s2(c.c2_s2), dt_nominal_s(dt_s) {}
 
   // Second-order backward differences (exact for quadratics: no half-sample lag).
   [[nodiscard]] Eigen::Vector3d d1(const Eigen::Vector3d& a) const noexcept {
@@ -40,7 +42,8 @@ struct SensorIntegrator {
     for (int k = 0; k < 3; ++k) hist_mps2[k] = history[k];
     v_mps.setZero(), x_m.setZero();
     integrand1_prev = mode == DynamicComp::acceleration_level ? Eigen::Vector3d(a + c1_s * d1(a) + c2_s2 * d2(a)) : a;
-    integrand2_prev = mode == DynamicComp::velocity_level ? Eigen::Vector3d(c1_s * a + c2_s2 * d1(a)) : Eigen::Vector3d::Zero();
+    integrand2_prev =
+        mode == DynamicComp::velocity_level ? Eigen::Vector3d(c1_s * a + c2_s2 * d1(a)) : Eigen::Vector3d::Zero();
     x_out_m.setZero(), v_out_mps = integrand2_prev;
     amp_int_m2_s3.setZero(), amp_prev_m2_s4 = a.cwiseProduct(a.cwiseAbs());
     if (mode != DynamicComp::none) v_out_mps += c_amp_s3_per_m * amp_prev_m2_s4;
@@ -49,16 +52,18 @@ struct SensorIntegrator {
 
   void step(const Eigen::Vector3d& a, double dt_s) noexcept {
     // First integral: A_s, or A_kor = A_s + c1·Ȧ + c2·Ä at the acceleration level (6-33).
-    const Eigen::Vector3d i1 = mode == DynamicComp::acceleration_level ? Eigen::Vector3d(a + c1_s * d1(a) + c2_s2 * d2(a)) : a;
+    const Eigen::Vector3d i1 =
+        mode == DynamicComp::acceleration_level ? Eigen::Vector3d(a + c1_s * d1(a) + c2_s2 * d2(a)) : a;
     v_mps += 0.5 * (i1 + integrand1_prev) * dt_s;
     integrand1_prev = i1;
     // Second integral: V, or V_kor = V_s + c1·A_s + c2·Ȧ_s at the velocity level (6-34).
-    const Eigen::Vector3d i2 = mode == DynamicComp::velocity_level ? Eigen::Vector3d(v_mps + c1_s * a + c2_s2 * d1(a)) : v_mps;
+    const Eigen::Vector3d i2 =
+        mode == DynamicComp::velocity_level ? Eigen::Vector3d(v_mps + c1_s * a + c2_s2 * d1(a)) : v_mps;
     x_m += 0.5 * (i2 + integrand2_prev) * dt_s;
     integrand2_prev = i2;
     if (mode == DynamicComp::position_level) {
       x_out_m = x_m + c1_s * v_mps + c2_s2 * a;  // (6-38)
-      v_out_mps = v_mps + c1_s * a;  // the c2·jerk term is left out of the velocity: it is noise there
+      v_out_mps = v_mps + c1_s * a;              // the c2·jerk term is left out of the velocity: it is noise there
     } else {
       x_out_m = x_m;
       v_out_mps = i2;

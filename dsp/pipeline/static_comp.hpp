@@ -44,13 +44,13 @@ struct StaticComp {
   Eigen::Vector3d g_per_count = Eigen::Vector3d::Ones();  // lsb / k1 at the reference temperature
   double offset_counts = 0.0;
   Eigen::Vector3d bias_g = Eigen::Vector3d::Zero();
-  double tc_k1_per_c = 0.0;   // α_k
+  double tc_k1_per_c = 0.0;      // α_k
   double tc_bias_g_per_c = 0.0;  // α_b
   double temp_ref_c = 20.0;
   Eigen::Vector3d k2_g_per_g2 = Eigen::Vector3d::Zero(), k3_g_per_g3 = Eigen::Vector3d::Zero();
   Eigen::Matrix3d cross_g_per_g = Eigen::Matrix3d::Zero(), cross2_g_per_g2 = Eigen::Matrix3d::Zero();
-  Eigen::Matrix3d cross_inverse = Eigen::Matrix3d::Identity();  // (I + kx)⁻¹
-  bool iterate = false;  // any nonlinear or cross term to invert
+  Eigen::Matrix3d cross_inverse = Eigen::Matrix3d::Identity();          // (I + kx)⁻¹
+  bool iterate = false;                                                 // any nonlinear or cross term to invert
   Eigen::Matrix3d to_machine_mps2_per_g = Eigen::Matrix3d::Identity();  // to_machine · mounting · g
 
   StaticComp() = default;
@@ -63,7 +63,8 @@ struct StaticComp {
     const double inv_scale = 1.0 / (1.0 + tc_k1_per_c * dt_c);
     Eigen::Vector3d u;
     for (int i = 0; i < 3; ++i)
-      u[i] = (static_cast<double>(counts[i]) - offset_counts) * g_per_count[i] * inv_scale - (bias_g[i] + tc_bias_g_per_c * dt_c);
+      u[i] = (static_cast<double>(counts[i]) - offset_counts) * g_per_count[i] * inv_scale -
+             (bias_g[i] + tc_bias_g_per_c * dt_c);
     return u;
   }
 
@@ -85,7 +86,8 @@ struct StaticComp {
     Eigen::Vector3d v = u;
     for (int it = 0; it < kStaticCompIterations; ++it) {
       const Eigen::Vector3d r = u - model(v);
-      const Eigen::Vector3d slope = 2.0 * k2_g_per_g2.cwiseProduct(v) + 3.0 * k3_g_per_g3.cwiseProduct(v.cwiseProduct(v));
+      const Eigen::Vector3d slope =
+          2.0 * k2_g_per_g2.cwiseProduct(v) + 3.0 * k3_g_per_g3.cwiseProduct(v.cwiseProduct(v));
       v += cross_inverse * r - slope.cwiseProduct(r);
     }
     return v;

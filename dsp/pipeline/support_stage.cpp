@@ -10,10 +10,13 @@ constexpr std::size_t kMaxRestWindows = 4096;
 
 }  // namespace
 
-SupportStage::SupportStage(const SupportConfig& c, const Acquisition& acq, const std::vector<PsdSpec>& psd, double noise_var_m2ps4,
-                           std::size_t capacity, std::size_t reserve)
-    : cfg_(c), fs_hz_(acq.fs_hz), step_(fusion::discretise(c.model, 1.0 / acq.fs_hz)),
-      detector_(c.standstill, acq.fs_hz, acq.daq_group_delay_samples, noise_var_m2ps4), capacity_(capacity) {
+SupportStage::SupportStage(const SupportConfig& c, const Acquisition& acq, const std::vector<PsdSpec>& psd,
+                           double noise_var_m2ps4, std::size_t capacity, std::size_t reserve)
+    : cfg_(c),
+      fs_hz_(acq.fs_hz),
+      step_(fusion::discretise(c.model, 1.0 / acq.fs_hz)),
+      detector_(c.standstill, acq.fs_hz, acq.daq_group_delay_samples, noise_var_m2ps4),
+      capacity_(capacity) {
   for (const auto& s : psd) {
     if (psd_.size() >= static_cast<std::size_t>(kMaxPsd)) break;
     psd_.emplace_back(s, acq);
@@ -76,7 +79,8 @@ void SupportStage::rest_sample(const Eigen::Vector3d& a) noexcept {
   ++rest_n_;
   block_sum_ += a;
   if (++block_n_ == block_len_) {
-    if (block_means_.size() < block_means_.capacity()) block_means_.push_back(block_sum_ / static_cast<double>(block_len_));
+    if (block_means_.size() < block_means_.capacity())
+      block_means_.push_back(block_sum_ / static_cast<double>(block_len_));
     block_sum_.setZero();
     block_n_ = 0;
   }
@@ -99,7 +103,8 @@ void SupportStage::start() noexcept {
       start_bias_sigma_ = start_bias_sigma_.cwiseMax((vb / static_cast<double>(nb)).cwiseSqrt() * 1e6);
     }
   } else {
-    start_bias_sigma_ = Eigen::Vector3d::Constant(std::sqrt(detector_.noise_var() / std::max<double>(1.0, static_cast<double>(rest_n_))) * 1e6);
+    start_bias_sigma_ = Eigen::Vector3d::Constant(
+        std::sqrt(detector_.noise_var() / std::max<double>(1.0, static_cast<double>(rest_n_))) * 1e6);
   }
   live_.start(cfg_.model, start_bias_sigma_);
   started_ = true;
@@ -119,8 +124,10 @@ void SupportStage::close_rest_window() noexcept {
   if (open_.samples == 0) return;
   open_.table_mps2 /= static_cast<double>(open_.samples);
   open_.head_mps2 /= static_cast<double>(open_.samples);
-  if (rests_.size() < kMaxRestWindows) rests_.push_back(open_);
-  else ++rests_dropped_;
+  if (rests_.size() < kMaxRestWindows)
+    rests_.push_back(open_);
+  else
+    ++rests_dropped_;
   open_ = RestWindow{};
 }
 
@@ -141,8 +148,9 @@ SupportStage::RestDecision SupportStage::find_rest(const SupportSample& s) noexc
   double pvv = 0.0;
   for (const auto& f : live_.axis) pvv = std::max(pvv, f.P(1, 1));
   RestDecision r;
-  r.det = detector_.step(s.accel_valid ? Eigen::Vector3d(s.a_head_mps2 - s.a_table_mps2) : Eigen::Vector3d::Constant(NAN), s.vel_mm_s, live_dv_mm_s(),
-                         std::sqrt(pvv) / 1000.0, s.cmd_valid, s.cmd_moved);
+  r.det =
+      detector_.step(s.accel_valid ? Eigen::Vector3d(s.a_head_mps2 - s.a_table_mps2) : Eigen::Vector3d::Constant(NAN),
+                     s.vel_mm_s, live_dv_mm_s(), std::sqrt(pvv) / 1000.0, s.cmd_valid, s.cmd_moved);
   r.rest = s.accel_valid && r.det.rest;  // found and reported even when ZUPT is off
   return r;
 }
@@ -183,10 +191,13 @@ std::uint8_t SupportStage::schedule_flags(const SupportSample& s, const RestDeci
   return flags;
 }
 
-void SupportStage::predict_and_support_velocity(const SupportSample& s, const RestDecision& r, std::uint8_t flags) noexcept {
+void SupportStage::predict_and_support_velocity(const SupportSample& s, const RestDecision& r,
+                                                std::uint8_t flags) noexcept {
   const bool move_start = (flags & fusion::schedule_flag::move_start) != 0;
   if (s.k > 0)
-    live_.predict(s.gap_samples == 1 ? step_ : fusion::discretise(cfg_.model, static_cast<double>(s.gap_samples) / fs_hz_), move_start, cfg_.model);
+    live_.predict(
+        s.gap_samples == 1 ? step_ : fusion::discretise(cfg_.model, static_cast<double>(s.gap_samples) / fs_hz_),
+        move_start, cfg_.model);
   live_.velocity_supports(flags, s.vel_mm_s * 1000.0, cfg_.model, r.zupt_sigma_um_s, cfg_.zupt);
   if (r.mean_update) {
     live_.velocity_mean(r.mean, cfg_.model, cfg_.zupt);
@@ -205,7 +216,8 @@ void SupportStage::position_fixes(const SupportSample& s, const Eigen::Vector3d&
     // The lock-in output lags the spot by its time constant: add τ·v.
     const double fix_um = (psd_[p].centre_mm() + r.u_mm + psd_[p].lockin_tau_s() * vel_corr[ax]) * 1000.0;
     const double model_um = cfg_.model.scale_uncertainty * (s.pos_mm - start_pos_mm_).norm() * 1000.0;
-    if (cfg_.cupt) live_.position_fix(ax, s.pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model);
+    if (cfg_.cupt)
+      live_.position_fix(ax, s.pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model);
     if (schedule_.fixes.size() < capacity_) {
       schedule_.fixes.push_back({s.k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(p), model_um});
       fix_pos_mm_.push_back(s.pos_mm[ax]);
@@ -295,7 +307,8 @@ SupportSummary SupportStage::refine(std::size_t n, const std::function<std::int6
   return sum;
 }
 
-std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, SupportSummary& sum, bool hand_over, fusion::SegmentSink* sink) {
+std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, SupportSummary& sum, bool hand_over,
+                                                               fusion::SegmentSink* sink) {
   auto c = std::make_unique<SmoothedCorrection>();
   c->track.n = n;
   c->track.schedule = &c->schedule;
@@ -320,7 +333,8 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   fusion::SmootherSettings st;
   st.fs_hz = fs_hz_, st.model = cfg_.model, st.start_bias_sigma_um_s2 = start_bias_sigma_;
   st.forward_only = !cfg_.smooth;
-  c->smoother = std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
+  c->smoother =
+      std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
   // PSD readings the integration cannot follow — its strip resets, or rejections of more
   // than 5 % — mean the sensor model is off (uncalibrated scale or mounting: the error is
   // then no slowly wandering bias, and pulling the trace to the strips would bend it far
@@ -334,7 +348,8 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
     sum.psd_disagrees = true;
     sum.psd_rejected = cupt_bad;
     c->schedule.cupt = false;  // for good: segments are recomputed from this schedule
-    c->smoother = std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
+    c->smoother =
+        std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
   }
   c->apply = c->smoother->finite();
   if (!c->apply) {  // an input the model cannot take (a saturated channel): leave the trace as integrated
@@ -382,8 +397,8 @@ SupportSummary SupportStage::finish_track(std::size_t samples, const std::functi
 }
 
 std::pair<Eigen::Vector3d, std::size_t> support_velocity_sum(const std::vector<std::uint8_t>& flags,
-                                                             const std::vector<Eigen::Vector3d>& support_vel_mm_s, std::size_t first,
-                                                             std::size_t last) {
+                                                             const std::vector<Eigen::Vector3d>& support_vel_mm_s,
+                                                             std::size_t first, std::size_t last) {
   Eigen::Vector3d v = Eigen::Vector3d::Zero();
   std::size_t count = 0, next = 0;
   for (std::size_t k = 0; k < flags.size() && k <= last; ++k) {

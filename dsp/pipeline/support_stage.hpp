@@ -54,21 +54,23 @@ struct SupportSummary {
   std::array<std::array<fusion::SupportTally, fusion::kSupportKinds>, 3> tally{};  // [axis][zupt|cupt|nbs]
   std::vector<RestWindow> rest_windows;
   std::size_t psd_fixes = 0, psd_fixes_dropped = 0;
-  std::size_t resets = 0;  // covariance resets (a standstill the model could not explain)
-  bool psd_disagrees = false;   // the PSD readings contradicted the integration: not used
+  std::size_t resets = 0;      // covariance resets (a standstill the model could not explain)
+  bool psd_disagrees = false;  // the PSD readings contradicted the integration: not used
   std::size_t psd_rejected = 0;
   bool smoothed = false;
-  bool diverged = false;   // the fusion met values it cannot take: trace left as integrated
+  bool diverged = false;  // the fusion met values it cannot take: trace left as integrated
   Eigen::Vector3d start_bias_sigma_um_s2 = Eigen::Vector3d::Zero();  // how well the first rest fixed the bias
 };
 
 // One sample of the motion as the supports see it (sensor time base).
 struct SupportSample {
-  std::size_t k = 0;               // trace index (the motion starts at 0)
-  std::int64_t gap_samples = 1;    // samples since the previous one (lost frames)
+  std::size_t k = 0;             // trace index (the motion starts at 0)
+  std::int64_t gap_samples = 1;  // samples since the previous one (lost frames)
   bool accel_valid = true;
-  Eigen::Vector3d a_table_mps2 = Eigen::Vector3d::Zero(), a_head_mps2 = Eigen::Vector3d::Zero();  // bias-free, machine axes
-  Eigen::Vector3d pos_mm = Eigen::Vector3d::Zero(), vel_mm_s = Eigen::Vector3d::Zero();         // the integrated relative motion
+  Eigen::Vector3d a_table_mps2 = Eigen::Vector3d::Zero(),
+                  a_head_mps2 = Eigen::Vector3d::Zero();  // bias-free, machine axes
+  Eigen::Vector3d pos_mm = Eigen::Vector3d::Zero(),
+                  vel_mm_s = Eigen::Vector3d::Zero();  // the integrated relative motion
   bool cmd_valid = false, cmd_moved = false;
   Eigen::Vector3d cmd_mm = Eigen::Vector3d::Zero();
 };
@@ -92,8 +94,8 @@ struct SmoothedCorrection {
 // The recorded integrated velocities (mm/s) of trace samples [first, last] that the
 // smoother reads (fusion::reads_velocity), summed, and how many.
 std::pair<Eigen::Vector3d, std::size_t> support_velocity_sum(const std::vector<std::uint8_t>& flags,
-                                                             const std::vector<Eigen::Vector3d>& support_vel_mm_s, std::size_t first,
-                                                             std::size_t last);
+                                                             const std::vector<Eigen::Vector3d>& support_vel_mm_s,
+                                                             std::size_t first, std::size_t last);
 
 class SupportStage {
  public:
@@ -130,7 +132,8 @@ class SupportStage {
                               std::unique_ptr<SmoothedCorrection>& correction, fusion::SegmentSink* sink = nullptr);
   // The integrated velocity (mm/s, as recorded) of trace samples [first, last], summed
   // over those the smoother reads; and how many (what ZUPT takes out at a standstill).
-  [[nodiscard]] std::pair<Eigen::Vector3d, std::size_t> recorded_velocity_sum(std::size_t first, std::size_t last) const {
+  [[nodiscard]] std::pair<Eigen::Vector3d, std::size_t> recorded_velocity_sum(std::size_t first,
+                                                                              std::size_t last) const {
     return support_velocity_sum(schedule_.flags, support_vel_mm_s_, first, last);
   }
   // Sample index of trace sample k, the first at first_index (the recorded steps).
@@ -161,7 +164,8 @@ class SupportStage {
   SupportSummary refine(std::size_t n, const std::function<std::int64_t(std::size_t)>& index_at);
   // The smoother over the recorded track (its second half); CUPT is dropped when the strips
   // disagree. hand_over: the recorded schedule and track move into the result.
-  std::unique_ptr<SmoothedCorrection> smooth_track(std::size_t n, SupportSummary& sum, bool hand_over, fusion::SegmentSink* sink = nullptr);
+  std::unique_ptr<SmoothedCorrection> smooth_track(std::size_t n, SupportSummary& sum, bool hand_over,
+                                                   fusion::SegmentSink* sink = nullptr);
 
   SupportConfig cfg_;
   double fs_hz_ = 10000.0;

@@ -16,8 +16,10 @@ void MeasurementRecorder::push(const Frame& f) noexcept {
     // A finished recording waits to be taken; frames meanwhile keep the pre-trigger
     // ring warm for the next measurement.
   } else if (recording_) {
-    if (buffer_.size() < capacity_) buffer_.push_back(f);  // within reserve: no allocation
-    else ++overflow_;
+    if (buffer_.size() < capacity_)
+      buffer_.push_back(f);  // within reserve: no allocation
+    else
+      ++overflow_;
     if (stopping_ && post_left_-- == 0) {
       recording_ = false;
       complete_ = true;

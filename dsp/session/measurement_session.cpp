@@ -74,7 +74,8 @@ void MeasurementSession::on_frame(const Frame& in) noexcept {
   }
   pending_count_ = keep;
   if (f.trigger == 0 && external != 0) f.trigger = external;
-  if (f.trigger == trigger::program_start) apply_trigger(trigger::program_start);  // start before the push: the M101 frame is recorded
+  if (f.trigger == trigger::program_start)
+    apply_trigger(trigger::program_start);  // start before the push: the M101 frame is recorded
   recorder_.push(f);
   if (f.trigger != trigger::none && f.trigger != trigger::program_start) apply_trigger(f.trigger);
   if (external != 0 && in.trigger != 0 && external != in.trigger) {

@@ -23,10 +23,10 @@ struct SessionConfig {
 
 struct SessionCounters {
   std::uint64_t frames = 0;
-  std::uint64_t frames_lost = 0;        // frames marked gap_before (the DAQ/driver lost some)
-  std::uint64_t frames_flagged = 0;     // frames with any quality flag
-  std::uint64_t triggers_refused = 0;   // triggers the state machine did not accept
-  std::uint64_t triggers_late = 0;      // external triggers that arrived after their sample
+  std::uint64_t frames_lost = 0;       // frames marked gap_before (the DAQ/driver lost some)
+  std::uint64_t frames_flagged = 0;    // frames with any quality flag
+  std::uint64_t triggers_refused = 0;  // triggers the state machine did not accept
+  std::uint64_t triggers_late = 0;     // external triggers that arrived after their sample
   std::uint64_t trigger_queue_full = 0;
   std::uint64_t measurements_started = 0;
   std::uint64_t measurements_completed = 0;

@@ -41,11 +41,13 @@ const std::array<std::array<std::string, kEvents>, kStates> kRefusals = [] {
   std::array<std::array<std::string, kEvents>, kStates> t;
   for (int s = 0; s < kStates; ++s)
     for (int e = 0; e < kEvents; ++e)
-      t[static_cast<std::size_t>(s)][static_cast<std::size_t>(e)] =
-          std::string(to_string(static_cast<Event>(e))) + " is not allowed in state " + std::string(to_string(static_cast<State>(s)));
+      t[static_cast<std::size_t>(s)][static_cast<std::size_t>(e)] = std::string(to_string(static_cast<Event>(e))) +
+                                                                    " is not allowed in state " +
+                                                                    std::string(to_string(static_cast<State>(s)));
   // The one refusal an NC meets in normal operation says what happens next.
   t[static_cast<std::size_t>(State::measuring)][static_cast<std::size_t>(Event::program_start)] =
-      "program_start (M101) is not allowed in state MEASURING: the running measurement continues untouched (M103 ends it, abort drops it)";
+      "program_start (M101) is not allowed in state MEASURING: the running measurement continues untouched (M103 ends "
+      "it, abort drops it)";
   return t;
 }();
 
@@ -63,9 +65,7 @@ Transition MeasurementState::handle(Event e, std::string_view reason) {
     state_ = to;
     return Transition{from, to, a, true, msg};
   };
-  auto refuse = [&] {
-    return Transition{from, from, Action::none, false, refusal(from, e)};
-  };
+  auto refuse = [&] { return Transition{from, from, Action::none, false, refusal(from, e)}; };
 
   if (e == Event::fault) {
     fault_reason_ = reason.empty() ? "unspecified fault" : std::string(reason);

@@ -29,7 +29,8 @@ class Scout final : public TraceSink {
     ref_finite = run.channels.ref[ia] && run.channels.ref[ib];
     if (!circle) return;
     try {
-      segments.emplace(Eigen::Vector2d(run.meta.program.center_mm[0], run.meta.program.center_mm[1]), run.meta.program.arc_deg);
+      segments.emplace(Eigen::Vector2d(run.meta.program.center_mm[0], run.meta.program.center_mm[1]),
+                       run.meta.program.arc_deg);
     } catch (const InputError& e) {
       segment_error = std::string(e.what());
     }
@@ -44,9 +45,10 @@ class Scout final : public TraceSink {
   }
   void sample(const TraceSample& s) override {
     if (trace)
-      trace->put({{static_cast<double>(s.sample_index), static_cast<double>(s.trigger), s.pos_mm[0], s.pos_mm[1], s.pos_mm[2], s.vel_mm_s[0],
-                   s.vel_mm_s[1], s.vel_mm_s[2], s.cmd_mm[0], s.cmd_mm[1], s.cmd_mm[2], s.ref_mm[0], s.ref_mm[1], s.ref_mm[2],
-                   static_cast<double>(s.temp_c[0]), static_cast<double>(s.temp_c[1]), static_cast<double>(s.frame_flags)}});
+      trace->put({{static_cast<double>(s.sample_index), static_cast<double>(s.trigger), s.pos_mm[0], s.pos_mm[1],
+                   s.pos_mm[2], s.vel_mm_s[0], s.vel_mm_s[1], s.vel_mm_s[2], s.cmd_mm[0], s.cmd_mm[1], s.cmd_mm[2],
+                   s.ref_mm[0], s.ref_mm[1], s.ref_mm[2], static_cast<double>(s.temp_c[0]),
+                   static_cast<double>(s.temp_c[1]), static_cast<double>(s.frame_flags)}});
     if (circle_) {
       repeats.add(n, s.sample_index, s.cmd_mm);
       // A mark counts at the trace sample it falls on (or, between samples, at the next
@@ -62,7 +64,7 @@ class Scout final : public TraceSink {
     ++n;
   }
 
-  std::size_t n = 0;  // trace samples
+  std::size_t n = 0;                          // trace samples
   SpillWriter<Doubles<17>>* trace = nullptr;  // the integrated trace, for the second pass
   bool circle_;
   eval::RepeatFinder repeats;
@@ -91,7 +93,8 @@ class CorrectionSpill final : public fusion::SegmentSink {
     where_[j] = {bytes_, s.first, s.size()};
     buf_.resize(s.size());
     for (std::size_t i = 0; i < s.size(); ++i)
-      for (int a = 0; a < 3; ++a) buf_[i].v[a] = s.dx_um[i][a], buf_[i].v[3 + a] = s.dv_um_s[i][a], buf_[i].v[6 + a] = s.sigma_x_um[i][a];
+      for (int a = 0; a < 3; ++a)
+        buf_[i].v[a] = s.dx_um[i][a], buf_[i].v[3 + a] = s.dv_um_s[i][a], buf_[i].v[6 + a] = s.sigma_x_um[i][a];
     spill_->write(buf_.data(), buf_.size() * sizeof(Doubles<9>));
     bytes_ += buf_.size() * sizeof(Doubles<9>);
   }
@@ -103,7 +106,8 @@ class CorrectionSpill final : public fusion::SegmentSink {
     out.first = w.first;
     out.dx_um.resize(w.size), out.dv_um_s.resize(w.size), out.sigma_x_um.resize(w.size);
     for (std::size_t i = 0; i < w.size; ++i)
-      for (int a = 0; a < 3; ++a) out.dx_um[i][a] = buf_[i].v[a], out.dv_um_s[i][a] = buf_[i].v[3 + a], out.sigma_x_um[i][a] = buf_[i].v[6 + a];
+      for (int a = 0; a < 3; ++a)
+        out.dx_um[i][a] = buf_[i].v[a], out.dv_um_s[i][a] = buf_[i].v[3 + a], out.sigma_x_um[i][a] = buf_[i].v[6 + a];
   }
 
  private:
@@ -131,7 +135,11 @@ struct Corrected {
 class Emitter final : public TraceSink {
  public:
   Emitter(const Pipeline::Tracked& t, CorrectionSpill* kept, std::function<void(const Corrected&)> out)
-      : n_(t.samples), correction_(t.correction.get()), kept_(kept), d_(t.delay_samples), align_(t.delay_samples > 0.0 && t.samples >= 2),
+      : n_(t.samples),
+        correction_(t.correction.get()),
+        kept_(kept),
+        d_(t.delay_samples),
+        align_(t.delay_samples > 0.0 && t.samples >= 2),
         out_(std::move(out)) {}
 
   void sample(const TraceSample& s) override {
@@ -145,8 +153,10 @@ class Emitter final : public TraceSink {
       const auto& sm = *correction_->smoother;
       if (c.k >= seg_.first + seg_.size() || !loaded_) {
         const std::size_t j = c.k / sm.segment_samples();
-        if (kept_ && kept_->has(j)) kept_->load(j, seg_);
-        else sm.segment(j, seg_);
+        if (kept_ && kept_->has(j))
+          kept_->load(j, seg_);
+        else
+          sm.segment(j, seg_);
         loaded_ = true;
       }
       const std::size_t i = c.k - seg_.first;
@@ -163,7 +173,9 @@ class Emitter final : public TraceSink {
     flush();
   }
   void finish() {
-    if (seen_ != n_) throw InputError("the run changed between two readings (" + std::to_string(seen_) + " trace samples, then " + std::to_string(n_) + ")");
+    if (seen_ != n_)
+      throw InputError("the run changed between two readings (" + std::to_string(seen_) + " trace samples, then " +
+                       std::to_string(n_) + ")");
     flush();
   }
 
@@ -212,7 +224,8 @@ fusion::SupportSchedule schedule_as_fused(const SmoothedCorrection& c, const Pip
   fusion::SupportSchedule s = c.schedule;
   if (s.zupt_sigma_um_s.empty() && !c.track.zupt_unused.empty()) {
     s.zupt_sigma_um_s.resize(c.track.zupt_unused.size());
-    for (std::size_t k = 0; k < s.zupt_sigma_um_s.size(); ++k) s.zupt_sigma_um_s[k] = c.track.zupt_unused[k] ? -1.0F : 0.0F;
+    for (std::size_t k = 0; k < s.zupt_sigma_um_s.size(); ++k)
+      s.zupt_sigma_um_s[k] = c.track.zupt_unused[k] ? -1.0F : 0.0F;
   }
   s.cupt = cfg.cupt;
   return s;
@@ -232,9 +245,11 @@ void keep(Measurement& m, const Corrected& c, std::size_t q, std::size_t n, cons
 
 }  // namespace
 
-Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOptions& options, const StreamOptions& stream) {
+Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOptions& options,
+                        const StreamOptions& stream) {
   if (!(header.meta.acquisition.fs_hz > 0.0)) throw InputError("run '" + header.meta.id + "': fs_hz must be positive");
-  if (options.keep_raw) throw InputError("analysis: the raw trace (keep_raw) needs the whole run in memory (analyze_run)");
+  if (options.keep_raw)
+    throw InputError("analysis: the raw trace (keep_raw) needs the whole run in memory (analyze_run)");
   const bool circle = header.meta.program.kind == "circle";
 
   // First pass: the pipeline keeping what the smoother reads; what the set-point decides.
@@ -279,15 +294,18 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   // A run short enough keeps its whole trace and is evaluated as analyze_run() does; a
   // longer circle is evaluated as it streams.
   const bool whole = !circle || n <= stream.materialize_samples;
-  const std::size_t q = whole ? 1 : std::max<std::size_t>(1, (n + stream.measurement_points - 1) / std::max<std::size_t>(1, stream.measurement_points));
-  if (whole && options.uncertainty.enabled && t.correction) a.measurement.raw.schedule = schedule_as_fused(*t.correction, cfg);
+  const std::size_t q = whole ? 1
+                              : std::max<std::size_t>(1, (n + stream.measurement_points - 1) /
+                                                             std::max<std::size_t>(1, stream.measurement_points));
+  if (whole && options.uncertainty.enabled && t.correction)
+    a.measurement.raw.schedule = schedule_as_fused(*t.correction, cfg);
   Measurement& m = a.measurement;
   m.decimation = q;
   std::optional<CircleStream> circle_eval;
   std::optional<eval::RepeatAverager> repeats;
   if (!whole) {
-    circle_eval.emplace(header, scout.segments ? scout.segments->segments() : std::vector<eval::CircleSegment>{}, scout.segment_error,
-                        scout.ref_finite, stream.spills);
+    circle_eval.emplace(header, scout.segments ? scout.segments->segments() : std::vector<eval::CircleSegment>{},
+                        scout.segment_error, scout.ref_finite, stream.spills);
     repeats.emplace(scout.repeats.groups(), stream.spills(), stream.measurement_points);
   }
   // A circle evaluated as it streams: the uncertainty reads what it needs of the trace as
@@ -296,12 +314,14 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   if (!whole && options.uncertainty.enabled && t.correction) {
     const SmoothedCorrection* c = t.correction.get();
     const std::int64_t first = t.first_index;
-    uncertainty.emplace(header, cfg, options, a, c->schedule, n, [c, first](std::size_t k) { return c->sample_index_of(first, k); },
-                        &c->track.zupt_unused);
+    uncertainty.emplace(
+        header, cfg, options, a, c->schedule, n, [c, first](std::size_t k) { return c->sample_index_of(first, k); },
+        &c->track.zupt_unused);
   }
   scout = Scout(header, false);  // what it decided is out; its set-point records can go
   scout.trace = nullptr;
-  Eigen::Vector2d temp(header.meta.sensors[0].temp_ref_c, header.meta.sensors[1].temp_ref_c);  // the last finite case temperatures
+  Eigen::Vector2d temp(header.meta.sensors[0].temp_ref_c,
+                       header.meta.sensors[1].temp_ref_c);  // the last finite case temperatures
   Emitter emitter(t, kept ? &*kept : nullptr, [&](const Corrected& c) {
     for (int i = 0; i < 2; ++i)
       if (!(c.frame_flags & frame_flag::temp_missing) && std::isfinite(c.temp_c[i])) temp[i] = c.temp_c[i];
@@ -348,8 +368,10 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
     circle_eval->finish(a);
     circle_eval.reset();
     a.repeats = repeats->result();
-    if (uncertainty) uncertainty->finish(header, a);
-    else if (options.uncertainty.enabled) a.uncertainty_note = "no support schedule: the uncertainty was not estimated";
+    if (uncertainty)
+      uncertainty->finish(header, a);
+    else if (options.uncertainty.enabled)
+      a.uncertainty_note = "no support schedule: the uncertainty was not estimated";
   }
   judge(header.meta.program, a);
   return a;

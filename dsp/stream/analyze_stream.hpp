@@ -41,6 +41,7 @@ struct StreamOptions {
 
 // header: the run's metadata and channels (its frames are not read; `frames` is).
 // Throws InputError as analyze_run() does, and on bad input met while reading.
-Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOptions& options, const StreamOptions& stream = {});
+Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOptions& options,
+                        const StreamOptions& stream = {});
 
 }  // namespace eical::dsp

@@ -19,7 +19,9 @@ class SpilledPasses final : public eval::PassReplay {
   [[nodiscard]] const std::vector<Pass>& passes() const override { return info_; }
   void replay(const std::function<void(std::size_t, const Eigen::Vector2d&, const Eigen::Vector2d&)>& f) override {
     for (std::size_t k = 0; k < spills_.size(); ++k)
-      for_each_record<Doubles<4>>(*spills_[k], [&](const Doubles<4>& r) { f(k, Eigen::Vector2d(r.v[0], r.v[1]), Eigen::Vector2d(r.v[2], r.v[3])); });
+      for_each_record<Doubles<4>>(*spills_[k], [&](const Doubles<4>& r) {
+        f(k, Eigen::Vector2d(r.v[0], r.v[1]), Eigen::Vector2d(r.v[2], r.v[3]));
+      });
   }
 
  private:
@@ -29,8 +31,8 @@ class SpilledPasses final : public eval::PassReplay {
 
 }  // namespace
 
-CircleStream::CircleStream(const Run& run, std::vector<eval::CircleSegment> segments, std::optional<std::string> segment_error,
-                           bool reference, const SpillFactory& spills)
+CircleStream::CircleStream(const Run& run, std::vector<eval::CircleSegment> segments,
+                           std::optional<std::string> segment_error, bool reference, const SpillFactory& spills)
     : run_(run), segment_error_(std::move(segment_error)), reference_(reference) {
   const Program& p = run.meta.program;
   std::tie(ia_, ib_) = plane_axes(p.plane);
@@ -43,7 +45,8 @@ CircleStream::CircleStream(const Run& run, std::vector<eval::CircleSegment> segm
     n_dir[r.dir] += s.samples;
   }
   if (ranges_.empty()) {
-    segment_error_ = "no stretch between two M102 marks sweeps the programmed " + std::to_string(p.arc_deg) + " deg about the programmed centre";
+    segment_error_ = "no stretch between two M102 marks sweeps the programmed " + std::to_string(p.arc_deg) +
+                     " deg about the programmed centre";
     return;
   }
   // The trace keeps the points the result's plot shows (every n/3600-th of the combined
@@ -95,7 +98,8 @@ void CircleStream::leave(const Range& r) {
   }
 }
 
-void CircleStream::sample(std::int64_t idx, const Eigen::Vector3d& pos, const Eigen::Vector3d& cmd, const Eigen::Vector3d& ref) {
+void CircleStream::sample(std::int64_t idx, const Eigen::Vector3d& pos, const Eigen::Vector3d& cmd,
+                          const Eigen::Vector3d& ref) {
   if (segment_error_) return;
   // Ranges that have ended (also one that no sample fell in: its too few samples are its error).
   while (next_ < ranges_.size() && idx >= ranges_[next_].second) {
@@ -155,9 +159,11 @@ void CircleStream::finish(Analysis& a) {
     return;
   }
   if (p.direction == "both" && (by_dir_[0].empty() || by_dir_[1].empty()))
-    a.flags.push_back(std::string("circle: the program runs both directions but only ") + (by_dir_[0].empty() ? "cw" : "ccw") + " was found");
+    a.flags.push_back(std::string("circle: the program runs both directions but only ") +
+                      (by_dir_[0].empty() ? "cw" : "ccw") + " was found");
   if (!a.circle->circular_hysteresis_H_um)
-    a.flags.push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions (this run has " + a.circle->direction + " only)");
+    a.flags.push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions (this run has " +
+                      a.circle->direction + " only)");
 
   // The reference instrument (or the simulator's truth) through the same evaluation.
   if (reference_) {
@@ -189,7 +195,9 @@ void CircleStream::finish(Analysis& a) {
   try {
     a.diagnostics = eval::diagnose_circle(passes, opt);
     if (!a.diagnostics->servo_and_squareness_separated)
-      a.flags.push_back("diagnostics.servo_mismatch_ms: null, one direction cannot separate servo mismatch from squareness (squareness assumes equal lags)");
+      a.flags.push_back(
+          "diagnostics.servo_mismatch_ms: null, one direction cannot separate servo mismatch from squareness "
+          "(squareness assumes equal lags)");
   } catch (const InputError& e) {
     a.flags.push_back(std::string("diagnostics: null, ") + e.what());
   }

@@ -22,13 +22,13 @@ class CircleStream {
  public:
   // From the first pass: the stretches found (or why none could be), whether the
   // reference channel is usable (present and finite over the trace).
-  CircleStream(const Run& run, std::vector<eval::CircleSegment> segments, std::optional<std::string> segment_error, bool reference,
-               const SpillFactory& spills);
+  CircleStream(const Run& run, std::vector<eval::CircleSegment> segments, std::optional<std::string> segment_error,
+               bool reference, const SpillFactory& spills);
   // Every corrected trace sample, in order.
-  void sample(std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& cmd_mm, const Eigen::Vector3d& ref_mm);
+  void sample(std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& cmd_mm,
+              const Eigen::Vector3d& ref_mm);
   // The figures and flags into the analysis (as evaluate_circle_program() puts them).
   void finish(Analysis& a);
-
 
  private:
   struct Range {
@@ -45,7 +45,7 @@ class CircleStream {
 
   const Run& run_;
   int ia_ = 0, ib_ = 1;
-  std::vector<Range> ranges_;          // time order
+  std::vector<Range> ranges_;  // time order
   std::vector<Range> by_dir_[2];
   std::optional<std::string> segment_error_;
   bool reference_ = false;

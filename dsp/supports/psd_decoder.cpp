@@ -16,9 +16,12 @@ constexpr double kD2PerSigma = 1.954;  // E|i[k] − 2i[k−1] + i[k−2]| = √
 }  // namespace
 
 PsdDecoder::PsdDecoder(const PsdSpec& s, const Acquisition& acq) {
-  if (s.measures == "x") axis_ = 0, cross_ = 1;
-  else if (s.measures == "y") axis_ = 1, cross_ = 0;
-  else throw InputError("psd: measures must be \"x\" or \"y\", got \"" + s.measures + "\"");
+  if (s.measures == "x")
+    axis_ = 0, cross_ = 1;
+  else if (s.measures == "y")
+    axis_ = 1, cross_ = 0;
+  else
+    throw InputError("psd: measures must be \"x\" or \"y\", got \"" + s.measures + "\"");
   if (!(s.length_mm > 0.0)) throw InputError("psd: length_mm must be positive");
   centre_mm_ = s.center_mm[axis_];
   half_length_mm_ = s.length_mm / 2.0;
@@ -37,7 +40,8 @@ void PsdDecoder::reset() noexcept {
 PsdReading PsdDecoder::step(std::int32_t c1, std::int32_t c2, bool missing) noexcept {
   PsdReading r;
   if (missing) return r;
-  const double i[2] = {(static_cast<double>(c1) - offset_counts_) * lsb_v_, (static_cast<double>(c2) - offset_counts_) * lsb_v_};
+  const double i[2] = {(static_cast<double>(c1) - offset_counts_) * lsb_v_,
+                       (static_cast<double>(c2) - offset_counts_) * lsb_v_};
   // Electrode noise from second differences (robust: each clipped at 4× the running mean).
   if (seen_ >= 2) {
     for (int e = 0; e < 2; ++e) {

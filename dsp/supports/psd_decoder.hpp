@@ -30,7 +30,7 @@ class PsdDecoder {
   // Throws InputError for a strip that measures neither x nor y or has no length.
   PsdDecoder(const PsdSpec& spec, const Acquisition& acquisition);
 
-  [[nodiscard]] int axis() const noexcept { return axis_; }          // machine axis measured
+  [[nodiscard]] int axis() const noexcept { return axis_; }  // machine axis measured
   [[nodiscard]] int cross_axis() const noexcept { return cross_; }
   [[nodiscard]] double centre_mm() const noexcept { return centre_mm_; }  // of the strip along axis()
   [[nodiscard]] double lockin_tau_s() const noexcept { return tau_s_; }

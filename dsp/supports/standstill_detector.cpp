@@ -9,7 +9,8 @@ StandstillDetector::StandstillDetector(const StandstillOptions& o, double fs_hz,
     : opt_(o), var_(var > 0.0 ? var : 1.0), datasheet_var_(var_), fs_hz_(fs_hz) {
   const auto w = static_cast<std::size_t>(std::max(8.0, std::round(o.window_s * fs_hz)));
   ring_.assign(w, 0.0);
-  vring_.assign(std::max(w, static_cast<std::size_t>(std::round(o.vibration_window_s * fs_hz))), Eigen::Vector3d::Zero());
+  vring_.assign(std::max(w, static_cast<std::size_t>(std::round(o.vibration_window_s * fs_hz))),
+                Eigen::Vector3d::Zero());
   gamma_ = 1.0 + o.z * std::sqrt(2.0 / (3.0 * static_cast<double>(w)));
   cmd_needed_ = static_cast<std::int64_t>(w) + static_cast<std::int64_t>(std::ceil(std::max(delay_samples, 0.0)));
 }
@@ -25,17 +26,21 @@ void StandstillDetector::reset() noexcept {
 }
 
 StandstillDetector::Decision StandstillDetector::step(const Eigen::Vector3d& a, const Eigen::Vector3d& v_mm_s,
-                                                     const Eigen::Vector3d& v_correction_mm_s, double v_sigma_mm_s, bool cmd_valid,
-                                                     bool cmd_moved) noexcept {
+                                                      const Eigen::Vector3d& v_correction_mm_s, double v_sigma_mm_s,
+                                                      bool cmd_valid, bool cmd_moved) noexcept {
   Decision d;
   if (ring_.empty()) return d;
   // A bad sample (−1 in the ring) holds rest off for a whole window.
   const double e = a.allFinite() ? a.squaredNorm() : -1.0;
   const double old = ring_[head_];
-  if (old < 0.0) --bad_;
-  else sum_ -= old;
-  if (e < 0.0) ++bad_;
-  else sum_ += e;
+  if (old < 0.0)
+    --bad_;
+  else
+    sum_ -= old;
+  if (e < 0.0)
+    ++bad_;
+  else
+    sum_ += e;
   ring_[head_] = e;
   head_ = (head_ + 1) % ring_.size();
   filled_ = std::min(filled_ + 1, ring_.size());

@@ -49,18 +49,19 @@ class StandstillDetector {
 
   struct Decision {
     bool rest = false;
-    bool quiet = false;             // test 1 passed (a confirmed, tight standstill)
+    bool quiet = false;                 // test 1 passed (a confirmed, tight standstill)
     double velocity_spread_mm_s = 0.0;  // spread of the integrated velocity over the detector's window
     double vibration_sigma_mm_s = 0.0;  // ... over the vibration window (a ringing standstill's σ)
     Eigen::Vector3d window_mean_mm_s = Eigen::Vector3d::Zero();  // its mean there
-    double window_lag_s = 0.0;          // from the window's mean time to this sample
+    double window_lag_s = 0.0;                                   // from the window's mean time to this sample
   };
   // One sample: the bias-free relative acceleration (m/s²), the integrated velocity as
   // integrated (mm/s: its window statistics), the filter's correction of it and the σ of
   // what is left (mm/s: the glide test), whether the set-point moved at this sample
   // (cmd_valid false: no set-point).
-  Decision step(const Eigen::Vector3d& accel_mps2, const Eigen::Vector3d& vel_mm_s, const Eigen::Vector3d& vel_correction_mm_s,
-                double vel_sigma_mm_s, bool cmd_valid, bool cmd_moved) noexcept;
+  Decision step(const Eigen::Vector3d& accel_mps2, const Eigen::Vector3d& vel_mm_s,
+                const Eigen::Vector3d& vel_correction_mm_s, double vel_sigma_mm_s, bool cmd_valid,
+                bool cmd_moved) noexcept;
   void reset() noexcept;
 
   [[nodiscard]] double statistic() const noexcept { return t_; }

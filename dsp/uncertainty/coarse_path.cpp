@@ -38,7 +38,8 @@ CoarsePathProbe::Read CoarsePathProbe::read_at(double position) const noexcept {
   return r;
 }
 
-void CoarsePathProbe::sample(std::size_t k, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s, const Eigen::Vector2d& temp_c) noexcept {
+void CoarsePathProbe::sample(std::size_t k, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
+                             const Eigen::Vector2d& temp_c) noexcept {
   while (next_ < need_.size() && need_[next_] < k) ++next_;
   if (next_ >= need_.size() || need_[next_] != k) return;
   pos_[next_] = pos_mm, vel_[next_] = vel_mm_s, temp_[next_] = temp_c;
@@ -75,12 +76,14 @@ CoarsePath CoarsePathProbe::path(bool with_temp) const {
   return p;
 }
 
-CoarsePath coarse_path(const CoarseSchedule& coarse, double delay_samples, double fs_hz, const std::vector<Eigen::Vector3d>& pos_mm,
-                       const std::vector<Eigen::Vector3d>& vel_mm_s, const std::vector<Eigen::Vector2d>* temp_c) {
+CoarsePath coarse_path(const CoarseSchedule& coarse, double delay_samples, double fs_hz,
+                       const std::vector<Eigen::Vector3d>& pos_mm, const std::vector<Eigen::Vector3d>& vel_mm_s,
+                       const std::vector<Eigen::Vector2d>* temp_c) {
   const std::size_t n = std::min(pos_mm.size(), vel_mm_s.size());
   const bool with_temp = temp_c && temp_c->size() >= n;
   CoarsePathProbe probe(coarse, delay_samples, n, fs_hz);
-  for (std::size_t k = 0; k < n; ++k) probe.sample(k, pos_mm[k], vel_mm_s[k], with_temp ? (*temp_c)[k] : Eigen::Vector2d::Zero());
+  for (std::size_t k = 0; k < n; ++k)
+    probe.sample(k, pos_mm[k], vel_mm_s[k], with_temp ? (*temp_c)[k] : Eigen::Vector2d::Zero());
   return probe.path(with_temp);
 }
 

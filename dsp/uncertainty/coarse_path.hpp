@@ -16,7 +16,7 @@ namespace eical::dsp::uncertainty {
 
 struct CoarsePath {
   std::vector<Eigen::Vector3d> pos_mm, vel_mm_s, acc_mm_s2;  // per coarse sample; pos since the trace's start
-  std::vector<Eigen::Vector2d> temp_c;                        // table, head since the start; empty: none
+  std::vector<Eigen::Vector2d> temp_c;                       // table, head since the start; empty: none
 };
 
 class CoarsePathProbe {
@@ -26,7 +26,8 @@ class CoarsePathProbe {
   CoarsePathProbe(const CoarseSchedule& coarse, double delay_samples, std::size_t samples, double fs_hz);
 
   // Trace sample k, in order from 0: aligned position and velocity, case temperatures.
-  void sample(std::size_t k, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s, const Eigen::Vector2d& temp_c) noexcept;
+  void sample(std::size_t k, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
+              const Eigen::Vector2d& temp_c) noexcept;
 
   // After the trace's last sample. with_temp: the temperatures were given.
   [[nodiscard]] CoarsePath path(bool with_temp) const;
@@ -53,7 +54,8 @@ class CoarsePathProbe {
 };
 
 // The same from a trace in memory (temp_c may be null: no temperatures).
-CoarsePath coarse_path(const CoarseSchedule& coarse, double delay_samples, double fs_hz, const std::vector<Eigen::Vector3d>& pos_mm,
-                       const std::vector<Eigen::Vector3d>& vel_mm_s, const std::vector<Eigen::Vector2d>* temp_c);
+CoarsePath coarse_path(const CoarseSchedule& coarse, double delay_samples, double fs_hz,
+                       const std::vector<Eigen::Vector3d>& pos_mm, const std::vector<Eigen::Vector3d>& vel_mm_s,
+                       const std::vector<Eigen::Vector2d>* temp_c);
 
 }  // namespace eical::dsp::uncertainty

@@ -7,8 +7,8 @@
 
 namespace eical::dsp::uncertainty {
 
-CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& idx, const fusion::ErrorModel& model,
-                       std::size_t q) {
+CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& idx,
+                       const fusion::ErrorModel& model, std::size_t q) {
   FineSchedule f;
   f.schedule = &fine;
   f.samples = std::min(fine.flags.size(), idx.size());

@@ -19,12 +19,12 @@
 namespace eical::dsp::uncertainty {
 
 struct CoarseSchedule {
-  std::size_t block = 1;                 // q
+  std::size_t block = 1;  // q
   std::vector<std::int64_t> sample_index;
-  std::vector<std::size_t> fine_end;     // fine (sensor-time) trace position of each coarse sample
+  std::vector<std::size_t> fine_end;  // fine (sensor-time) trace position of each coarse sample
   fusion::SupportSchedule schedule;
-  std::vector<double> fix_noise_um;      // per coarse fix: its strips' own noise (without the model's share)
-  fusion::ErrorModel model;              // the pipeline's, with the per-sample σ folded into the schedule
+  std::vector<double> fix_noise_um;  // per coarse fix: its strips' own noise (without the model's share)
+  fusion::ErrorModel model;          // the pipeline's, with the per-sample σ folded into the schedule
 };
 
 // The schedule the pipeline used, as coarsen() reads it: also without the trace's sample
@@ -42,7 +42,7 @@ struct FineSchedule {
 CoarseSchedule coarsen(const FineSchedule& fine, const fusion::ErrorModel& model, std::size_t block);
 
 // `fine`: the schedule the pipeline used (one flag per trace sample); `block` ≥ 1.
-CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& sample_index, const fusion::ErrorModel& model,
-                       std::size_t block);
+CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& sample_index,
+                       const fusion::ErrorModel& model, std::size_t block);
 
 }  // namespace eical::dsp::uncertainty

@@ -54,15 +54,19 @@ std::size_t ErrorField::block_for(std::size_t n, std::size_t max_coarse) noexcep
 }
 
 ErrorField::ErrorField(const ErrorFieldInput& in) {
-  if (!in.schedule || !in.sample_index || !in.pos_mm || !in.vel_mm_s) throw InputError("uncertainty: input arrays missing");
-  const std::size_t n = std::min({in.schedule->flags.size(), in.sample_index->size(), in.pos_mm->size(), in.vel_mm_s->size()});
+  if (!in.schedule || !in.sample_index || !in.pos_mm || !in.vel_mm_s)
+    throw InputError("uncertainty: input arrays missing");
+  const std::size_t n =
+      std::min({in.schedule->flags.size(), in.sample_index->size(), in.pos_mm->size(), in.vel_mm_s->size()});
   if (n < 2) throw InputError("uncertainty: the measurement holds fewer than 2 samples");
   coarse_ = coarsen(*in.schedule, *in.sample_index, in.model, block_for(n, in.max_coarse));
   const bool have_temp = in.temp_c && in.temp_c->size() >= n;
-  build(in, coarse_path(coarse_, in.delay_samples, in.fs_hz, *in.pos_mm, *in.vel_mm_s, have_temp ? in.temp_c : nullptr));
+  build(in,
+        coarse_path(coarse_, in.delay_samples, in.fs_hz, *in.pos_mm, *in.vel_mm_s, have_temp ? in.temp_c : nullptr));
 }
 
-ErrorField::ErrorField(const ErrorFieldInput& in, CoarseSchedule coarse, const CoarsePath& path) : coarse_(std::move(coarse)) {
+ErrorField::ErrorField(const ErrorFieldInput& in, CoarseSchedule coarse, const CoarsePath& path)
+    : coarse_(std::move(coarse)) {
   if (coarse_.sample_index.size() < 2) throw InputError("uncertainty: the measurement holds fewer than 2 samples");
   build(in, path);
 }
@@ -77,7 +81,9 @@ void ErrorField::build(const ErrorFieldInput& in, const CoarsePath& path) {
   truth_ = coarse_.model;
   const double per_sensor = in.noise.bias_walk_ug_per_rts * 1e-6 * in.g_mps2 * 1e6;  // µm/s²/√s
   truth_.bias_walk_um_s2_rts = std::max(in.model.bias_walk_um_s2_rts, std::sqrt(2.0) * per_sensor);
-  truth_.accel_noise_um_s2_rthz = std::max(in.model.accel_noise_um_s2_rthz, in.noise.noise_factor * std::hypot(in.sensor_noise_ug_per_rthz[0], in.sensor_noise_ug_per_rthz[1]) * in.g_mps2);
+  truth_.accel_noise_um_s2_rthz = std::max(
+      in.model.accel_noise_um_s2_rthz,
+      in.noise.noise_factor * std::hypot(in.sensor_noise_ug_per_rthz[0], in.sensor_noise_ug_per_rthz[1]) * in.g_mps2);
 
   const std::size_t nc = coarse_.sample_index.size();
   const std::vector<Eigen::Vector3d>& p = path.pos_mm;
@@ -88,7 +94,8 @@ void ErrorField::build(const ErrorFieldInput& in, const CoarsePath& path) {
   if (p.size() != nc || v.size() != nc || acc.size() != nc || (have_temp && temp.size() != nc))
     throw InputError("uncertainty: the coarse path does not match its schedule");
   // One smoother pass over pseudo-data: what is left of a unit error after the supports.
-  auto respond = [&](const std::vector<Eigen::Vector3d>& dx_mm, const std::vector<Eigen::Vector3d>& dv_mm_s, int strip, double unit) {
+  auto respond = [&](const std::vector<Eigen::Vector3d>& dx_mm, const std::vector<Eigen::Vector3d>& dv_mm_s, int strip,
+                     double unit) {
     fusion::SupportSchedule sched = coarse_.schedule;
     for (auto& f : sched.fixes) f.position_um = f.strip == strip ? 1.0 : 0.0;
     for (auto& m : sched.velocity_means) {
@@ -117,7 +124,8 @@ void ErrorField::build(const ErrorFieldInput& in, const CoarsePath& path) {
     column_moves_[ju] = hi - lo > 1e-3 && owner_[ju] >= 0;
     if (!column_moves_[ju]) continue;
     std::vector<Eigen::Vector3d> dx(nc), dv(nc);
-    for (std::size_t k = 0; k < nc; ++k) dx[k] = Eigen::Vector3d::Constant(p[k][j] * kUnitE), dv[k] = Eigen::Vector3d::Constant(v[k][j] * kUnitE);
+    for (std::size_t k = 0; k < nc; ++k)
+      dx[k] = Eigen::Vector3d::Constant(p[k][j] * kUnitE), dv[k] = Eigen::Vector3d::Constant(v[k][j] * kUnitE);
     response_e_[ju] = respond(dx, dv, -1, kUnitE);
   }
   {
@@ -144,7 +152,8 @@ void ErrorField::build(const ErrorFieldInput& in, const CoarsePath& path) {
     for (const auto& f : coarse_.schedule.fixes) strips.insert(f.strip);
     for (int s : strips) {
       if (s < 0) continue;
-      if (response_strip_.size() <= static_cast<std::size_t>(s)) response_strip_.resize(static_cast<std::size_t>(s) + 1);
+      if (response_strip_.size() <= static_cast<std::size_t>(s))
+        response_strip_.resize(static_cast<std::size_t>(s) + 1);
       // The strip reads 1 µm too far: the (error-free) trace is pulled towards it.
       response_strip_[static_cast<std::size_t>(s)] = respond(zero, zero, s, 1.0);
     }
@@ -163,7 +172,8 @@ std::vector<Eigen::Vector3d> ErrorField::noise_draw(std::mt19937_64& rng) const 
   std::vector<Eigen::Vector3d> ex(nc), ev(nc), eb(nc);
   const fusion::Mat3 p0 = fusion::initial_covariance(truth_, 0.0);
   for (int a = 0; a < 3; ++a) {
-    fusion::Vec3 e(0.0, std::sqrt(p0(1, 1)) * g(rng), std::hypot(start_bias_sigma_[a], truth_.bias_step_um_s2) * g(rng));
+    fusion::Vec3 e(0.0, std::sqrt(p0(1, 1)) * g(rng),
+                   std::hypot(start_bias_sigma_[a], truth_.bias_step_um_s2) * g(rng));
     fusion::Discrete d;
     std::int64_t last_gap = 0;
     Eigen::LLT<fusion::Mat3> llt;
@@ -187,7 +197,8 @@ std::vector<Eigen::Vector3d> ErrorField::noise_draw(std::mt19937_64& rng) const 
     pos[k] = ex[k] / 1000.0;
     Eigen::Vector3d v = ev[k];
     // A standstill's true velocity is not exactly zero, a held axis' not either.
-    const double s = flags[k] & sf::rest ? std::max(0.0, static_cast<double>(coarse_.schedule.zupt_sigma_um_s[k])) : coarse_.model.nbs_sigma_um_s;
+    const double s = flags[k] & sf::rest ? std::max(0.0, static_cast<double>(coarse_.schedule.zupt_sigma_um_s[k]))
+                                         : coarse_.model.nbs_sigma_um_s;
     for (int a = 0; a < 3; ++a) v[a] += s * g(rng);
     vel[k] = v / 1000.0;
   }
@@ -209,7 +220,8 @@ std::vector<Eigen::Vector3d> ErrorField::noise_draw(std::mt19937_64& rng) const 
   return r;
 }
 
-void ErrorField::draw(std::mt19937_64& rng, const std::vector<double>& at_pos, std::vector<Eigen::Vector3d>& error_um) const {
+void ErrorField::draw(std::mt19937_64& rng, const std::vector<double>& at_pos,
+                      std::vector<Eigen::Vector3d>& error_um) const {
   std::normal_distribution<double> g;
   const std::vector<Eigen::Vector3d> noise = noise_draw(rng);
   Eigen::VectorXd z(kModelParameters);

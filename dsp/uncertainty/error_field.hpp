@@ -34,14 +34,14 @@ namespace eical::dsp::uncertainty {
 
 struct ErrorFieldInput {
   // The trace (the first constructor; the second takes it coarsened and leaves these null).
-  const fusion::SupportSchedule* schedule = nullptr;       // as the pipeline used it (sensor time)
+  const fusion::SupportSchedule* schedule = nullptr;  // as the pipeline used it (sensor time)
   const std::vector<std::int64_t>* sample_index = nullptr;
-  const std::vector<Eigen::Vector3d>* pos_mm = nullptr;    // the measured path, aligned to the set-point
+  const std::vector<Eigen::Vector3d>* pos_mm = nullptr;  // the measured path, aligned to the set-point
   const std::vector<Eigen::Vector3d>* vel_mm_s = nullptr;
-  const std::vector<Eigen::Vector2d>* temp_c = nullptr;    // case temperature of table, head per trace sample (optional)
+  const std::vector<Eigen::Vector2d>* temp_c = nullptr;  // case temperature of table, head per trace sample (optional)
   double fs_hz = 10000.0;
-  double delay_samples = 0.0;        // aligned position = sensor position − delay
-  fusion::ErrorModel model;          // the pipeline's fusion model
+  double delay_samples = 0.0;  // aligned position = sensor position − delay
+  fusion::ErrorModel model;    // the pipeline's fusion model
   Eigen::Vector3d start_bias_sigma_um_s2 = Eigen::Vector3d::Constant(20.0);
   double sensor_noise_ug_per_rthz[2] = {0.4, 0.4};  // the data sheet's, per sensor
   double g_mps2 = 9.81;
@@ -74,7 +74,7 @@ class ErrorField {
 
   CoarseSchedule coarse_;
   double delay_ = 0.0, fs_hz_ = 10000.0;
-  fusion::ErrorModel truth_;            // what the draws simulate
+  fusion::ErrorModel truth_;  // what the draws simulate
   Eigen::Vector3d start_bias_sigma_ = Eigen::Vector3d::Zero();
   // Model responses per coarse sample, µm per unit parameter: per column j of E (all rows
   // i at once), the timing term (v·τ), per sensor its α_b, per PSD strip its offset.

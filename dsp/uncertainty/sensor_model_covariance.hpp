@@ -38,7 +38,7 @@ using ModelMatrix = Eigen::Matrix<double, kModelParameters, kModelParameters>;
 
 struct SensorModelCovariance {
   ModelMatrix covariance = ModelMatrix::Zero();  // standard uncertainties², units of the parameters
-  std::string source = "datasheet";                 // "datasheet" or the calibration's method
+  std::string source = "datasheet";              // "datasheet" or the calibration's method
   // A PSD strip's own systematic error (nonlinearity, the spot's shape): µm, σ per strip.
   double psd_offset_sigma_um = 0.1;
   [[nodiscard]] double sigma(int p) const { return std::sqrt(std::max(0.0, covariance(p, p))); }
@@ -50,15 +50,16 @@ struct SensorModelCovariance {
 // errors: k_zx·a_z·a_x and k_zy·a_z·a_y act on x and y as a scale of k_zx·g, and on the
 // vertical axis k2, k3 act as a scale of 2·k2·g and 3·k3·g² (their slope at 1 g).
 struct DatasheetTolerance {
-  double scale = 400e-6;         // k1 per axis, relative
+  double scale = 400e-6;          // k1 per axis, relative
   double cross2_g_per_g2 = 2e-4;  // k_zx, k_zy: on x and y a scale error with gravity
-  double k2_k3_relative = 0.05;  // k2, k3 within 5 % of the data sheet's
-  double cross_g_per_g = 2e-4;   // cross-axis sensitivity
-  double mounting_rad = 3e-4;    // mounting rotation about each axis
-  double f0_relative = 0.01;     // resonance
-  double zeta = 0.01;            // damping
-  double delay_samples = 0.0;    // the DAQ's linear-phase FIR: its delay is exact by design
-  double tc_bias_ug_per_c = 210.0;  // ±100 µg/°C of unknown sign, 85–110 per unit: compensating with +100 errs by up to 210
+  double k2_k3_relative = 0.05;   // k2, k3 within 5 % of the data sheet's
+  double cross_g_per_g = 2e-4;    // cross-axis sensitivity
+  double mounting_rad = 3e-4;     // mounting rotation about each axis
+  double f0_relative = 0.01;      // resonance
+  double zeta = 0.01;             // damping
+  double delay_samples = 0.0;     // the DAQ's linear-phase FIR: its delay is exact by design
+  double tc_bias_ug_per_c =
+      210.0;  // ±100 µg/°C of unknown sign, 85–110 per unit: compensating with +100 errs by up to 210
   // A PSD strip's own nonlinearity, u_meas = u (1 + nl (2u/L)²), |nl| within this (relative
   // at the strip's end, 0.5 µm on a 10 mm strip; what `eical simulate --background` draws).
   double psd_nonlinearity = 1e-4;
@@ -83,6 +84,7 @@ struct DatasheetNoise {
 };
 
 // The covariance the data sheet gives (independent parameters).
-SensorModelCovariance datasheet_covariance(const SensorSpec sensors[2], double fs_hz, const DatasheetTolerance& tolerance = {});
+SensorModelCovariance datasheet_covariance(const SensorSpec sensors[2], double fs_hz,
+                                           const DatasheetTolerance& tolerance = {});
 
 }  // namespace eical::dsp::uncertainty

@@ -100,7 +100,8 @@ void remove_stale() {
   for (const auto& e : fs::directory_iterator(fs::temp_directory_path(), ec)) {
     if (!e.is_directory() || e.path().filename().string().rfind(kPrefix, 0) != 0) continue;
     if (alive(e.path() / "data" / "postmaster.pid")) continue;
-    if (fs::exists(e.path() / "owner.pid") ? alive(e.path() / "owner.pid") : now - fs::last_write_time(e.path(), ec) < std::chrono::hours(1))
+    if (fs::exists(e.path() / "owner.pid") ? alive(e.path() / "owner.pid")
+                                           : now - fs::last_write_time(e.path(), ec) < std::chrono::hours(1))
       continue;
     fs::remove_all(e.path(), ec);
   }
@@ -128,7 +129,8 @@ ScratchServer::ScratchServer(ServerOptions options) : options_(options), bindir_
                              "': install Debian's postgresql (scripts/deps.sh test) and re-run cmake");
   remove_stale();
   std::string tmpl = (fs::temp_directory_path() / (std::string(kPrefix) + "XXXXXX")).string();
-  if (!::mkdtemp(tmpl.data())) throw std::runtime_error("pg_scratch: cannot create a temporary directory: " + std::string(std::strerror(errno)));
+  if (!::mkdtemp(tmpl.data()))
+    throw std::runtime_error("pg_scratch: cannot create a temporary directory: " + std::string(std::strerror(errno)));
   dir_ = tmpl;
   std::ofstream(dir_ + "/owner.pid") << ::getpid() << "\n";
   const RunAs who = run_as();
@@ -139,8 +141,8 @@ ScratchServer::ScratchServer(ServerOptions options) : options_(options), bindir_
   }
   ::chmod(dir_.c_str(), 0755);
   const std::string log = dir_ + "/initdb.log";
-  const pid_t pid = spawn({bindir_ + "/initdb", "-D", dir_ + "/data", "-U", "eical", "-A", "trust", "-E", "UTF8", "--locale=C", "--no-sync",
-                           "--no-instructions"},
+  const pid_t pid = spawn({bindir_ + "/initdb", "-D", dir_ + "/data", "-U", "eical", "-A", "trust", "-E", "UTF8",
+                           "--locale=C", "--no-sync", "--no-instructions"},
                           log, who, SIGKILL);
   const int rc = wait_for(pid, 120s);
   if (rc != 0) {

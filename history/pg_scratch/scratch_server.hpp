@@ -9,8 +9,8 @@
 // initdb and postgres refuse to run as root: started by root, the server runs as the
 // unprivileged user `nobody` (privileges dropped in the child before exec; the temporary
 // directory is handed to that user). Otherwise it runs as the calling user.
-#include <string>
 #include <sys/types.h>
+#include <string>
 
 namespace eical::history::pg_scratch {
 

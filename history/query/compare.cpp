@@ -23,7 +23,8 @@ std::map<std::string, std::string> setup_of(const std::string& document) {
     if (!obj.is_object()) continue;
     for (const auto& [key, v] : obj.items()) {
       const std::string name = section + "." + key;
-      if ((v.is_number() && is_program_parameter(name)) || ((key == "plane" || key == "axis" || key == "direction") && v.is_string()))
+      if ((v.is_number() && is_program_parameter(name)) ||
+          ((key == "plane" || key == "axis" || key == "direction") && v.is_string()))
         out[name] = v.is_string() ? v.get<std::string>() : v.dump();
     }
   }
@@ -60,7 +61,8 @@ Comparison compare(const Record& before, const Record& after) {
       fc.difference = *fc.after - *fc.before;
       if (fc.u_before && fc.u_after) {
         fc.uncertainty_k2 = std::hypot(*fc.u_before, *fc.u_after);
-        fc.judgement = std::abs(*fc.difference) > *fc.uncertainty_k2 ? Judgement::significant : Judgement::within_uncertainty;
+        fc.judgement =
+            std::abs(*fc.difference) > *fc.uncertainty_k2 ? Judgement::significant : Judgement::within_uncertainty;
       } else {
         fc.judgement = Judgement::not_judged;
       }
@@ -69,7 +71,8 @@ Comparison compare(const Record& before, const Record& after) {
   }
   const auto a = setup_of(before.document), b = setup_of(after.document);
   for (const auto& [k, v] : a)
-    if (auto it = b.find(k); it != b.end() && it->second != v) c.not_comparable.push_back(k + ": " + v + " → " + it->second);
+    if (auto it = b.find(k); it != b.end() && it->second != v)
+      c.not_comparable.push_back(k + ": " + v + " → " + it->second);
   if (before.machine != after.machine) c.not_comparable.push_back("machine: " + before.machine + " → " + after.machine);
   return c;
 }

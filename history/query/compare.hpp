@@ -18,15 +18,15 @@ struct FigureChange {
   std::string name;
   std::optional<double> before, after;  // nullopt: not determined / not in that result
   std::optional<double> u_before, u_after;
-  std::optional<double> difference;     // after − before
+  std::optional<double> difference;      // after − before
   std::optional<double> uncertainty_k2;  // of the difference
   Judgement judgement = Judgement::missing;
 };
 
 struct Comparison {
   Summary before, after;
-  std::vector<FigureChange> figures;       // every figure of either result, by name
-  std::vector<std::string> not_comparable; // e.g. "circle.feed_mm_min: 2500 → 1000 (a different test)"
+  std::vector<FigureChange> figures;        // every figure of either result, by name
+  std::vector<std::string> not_comparable;  // e.g. "circle.feed_mm_min: 2500 → 1000 (a different test)"
 };
 
 Comparison compare(const Record& before, const Record& after);

@@ -1,9 +1,9 @@
 #include "history/query/trend_stats.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <algorithm>
 #include <map>
 
 namespace eical::history {
@@ -41,8 +41,10 @@ std::optional<std::pair<double, double>> fit_slope(const std::vector<double>& t,
   }
   const double dof = static_cast<double>(n) - 2.0;
   double var = 1.0 / stt;  // weights are 1/σ²
-  if (!weights_are_uncertainties) var = dof > 0 ? chi2 / dof / stt : std::nan("");
-  else if (dof > 0 && chi2 / dof > 1.0) var *= chi2 / dof;
+  if (!weights_are_uncertainties)
+    var = dof > 0 ? chi2 / dof / stt : std::nan("");
+  else if (dof > 0 && chi2 / dof > 1.0)
+    var *= chi2 / dof;
   if (!std::isfinite(var)) return std::nullopt;
   return std::make_pair(slope, std::sqrt(var));
 }
@@ -73,7 +75,8 @@ std::vector<TrendSummary> summarize(const std::vector<TrendPoint>& points) {
       w.push_back(has_u ? 1.0 / std::pow(*p->uncertainty_k2 / 2.0, 2) : 1.0);
     }
     if (!all_u) std::fill(w.begin(), w.end(), 1.0);
-    if (!t.empty()) s.span_days = (*std::max_element(t.begin(), t.end()) - *std::min_element(t.begin(), t.end())) * 30.0;
+    if (!t.empty())
+      s.span_days = (*std::max_element(t.begin(), t.end()) - *std::min_element(t.begin(), t.end())) * 30.0;
     if (s.span_days < kMinDriftSpanDays) {
       out.push_back(std::move(s));
       continue;

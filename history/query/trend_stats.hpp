@@ -17,11 +17,11 @@ namespace eical::history {
 
 struct TrendSummary {
   std::string machine;
-  std::size_t points = 0, determined = 0;          // results, of which with a value
-  std::optional<TrendPoint> first, last;           // the first and last with a value
+  std::size_t points = 0, determined = 0;           // results, of which with a value
+  std::optional<TrendPoint> first, last;            // the first and last with a value
   std::optional<double> slope_per_30d, slope_u_k2;  // figure unit per 30 days
   bool drift_significant = false;
-  double span_days = 0.0;                          // first to last result with a value
+  double span_days = 0.0;  // first to last result with a value
 };
 
 inline constexpr double kMinDriftSpanDays = 1.0;

@@ -11,14 +11,14 @@ namespace {
 
 // Longest suffix first ("_mm_min" before "_min"-less "_mm").
 constexpr std::array<std::pair<const char*, const char*>, 9> kUnits = {{{"_mm_min", "mm/min"},
-                                                                           {"_urad", "µrad"},
-                                                                           {"_ppm", "ppm"},
-                                                                           {"_deg", "°"},
-                                                                           {"_um", "µm"},
-                                                                           {"_mm", "mm"},
-                                                                           {"_ms", "ms"},
-                                                                           {"_hz", "Hz"},
-                                                                           {"_s", "s"}}};
+                                                                        {"_urad", "µrad"},
+                                                                        {"_ppm", "ppm"},
+                                                                        {"_deg", "°"},
+                                                                        {"_um", "µm"},
+                                                                        {"_mm", "mm"},
+                                                                        {"_ms", "ms"},
+                                                                        {"_hz", "Hz"},
+                                                                        {"_s", "s"}}};
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
@@ -44,7 +44,8 @@ std::string label_of(const std::string& figure) {
   while (start <= key.size()) {
     const std::size_t end = std::min(key.find('_', start), key.size());
     std::string word = key.substr(start, end - start);
-    if (word == "x" || word == "y" || word == "z") word[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(word[0])));
+    if (word == "x" || word == "y" || word == "z")
+      word[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(word[0])));
     if (!word.empty()) out += (out.empty() ? "" : " ") + word;
     start = end + 1;
   }
@@ -54,7 +55,8 @@ std::string label_of(const std::string& figure) {
 std::string utc_rfc3339(const std::string& text) {
   int y = 0, mo = 0, d = 0, h = 0, mi = 0, s = 0, n = 0;
   char sep = 0;
-  if (std::sscanf(text.c_str(), "%4d-%2d-%2d%c%2d:%2d%n", &y, &mo, &d, &sep, &h, &mi, &n) != 6 || (sep != 'T' && sep != 't' && sep != ' '))
+  if (std::sscanf(text.c_str(), "%4d-%2d-%2d%c%2d:%2d%n", &y, &mo, &d, &sep, &h, &mi, &n) != 6 ||
+      (sep != 'T' && sep != 't' && sep != ' '))
     return "";
   std::size_t i = static_cast<std::size_t>(n);
   if (i < text.size() && text[i] == ':') {

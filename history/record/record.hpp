@@ -14,17 +14,17 @@ struct Figure {
 };
 
 struct Record {
-  std::string machine;                     // [machine] name
+  std::string machine;  // [machine] name
   std::string run_id;
-  std::string program;                     // circle, step, positioning, rectangle, freeform
-  std::string measured_at;                 // RFC 3339 UTC, "2026-11-12T09:11:00Z"
-  std::optional<std::string> verdict;      // quality.verdict; nullopt for results without one
-  bool degraded = false;                   // quality.degraded
-  std::string run_path;                    // the run directory (on the PC that measured)
+  std::string program;                          // circle, step, positioning, rectangle, freeform
+  std::string measured_at;                      // RFC 3339 UTC, "2026-11-12T09:11:00Z"
+  std::optional<std::string> verdict;           // quality.verdict; nullopt for results without one
+  bool degraded = false;                        // quality.degraded
+  std::string run_path;                         // the run directory (on the PC that measured)
   std::optional<std::string> software_version;  // "eical 0.1.0"; nullopt when unknown
-  std::string sensor_calibration;          // "datasheet" or "<method>: <file> (run <id>)"
-  std::vector<Figure> figures;             // sorted by name
-  std::string document;                    // the eical-result/1 JSON, plot traces thinned
+  std::string sensor_calibration;               // "datasheet" or "<method>: <file> (run <id>)"
+  std::vector<Figure> figures;                  // sorted by name
+  std::string document;                         // the eical-result/1 JSON, plot traces thinned
 
   [[nodiscard]] const Figure* figure(const std::string& name) const;
 };

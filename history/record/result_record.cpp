@@ -16,8 +16,9 @@ namespace {
 constexpr std::array<const char*, 4> kNotSections = {"quality", "uncertainty_k2", "sensor_model", "pipeline"};
 
 // What the program was asked to do, not what was measured: not a figure of the history.
-constexpr std::array<const char*, 6> kProgramParameters = {"circle.radius_nominal_mm", "circle.feed_mm_min", "circle.revolutions",
-                                                           "circle.arc_deg", "circle.arc_start_deg", "positioning.runs"};
+constexpr std::array<const char*, 6> kProgramParameters = {"circle.radius_nominal_mm", "circle.feed_mm_min",
+                                                           "circle.revolutions",       "circle.arc_deg",
+                                                           "circle.arc_start_deg",     "positioning.runs"};
 
 bool is_section(const std::string& key) {
   return std::none_of(kNotSections.begin(), kNotSections.end(), [&](const char* s) { return key == s; });
@@ -104,17 +105,20 @@ std::vector<Figure> figures_of(const nlohmann::json& doc) {
 }
 
 Record record_from_result(const nlohmann::json& doc, const Provenance& p) {
-  if (!doc.is_object() || doc.value("format", "") != "eical-result/1") throw std::invalid_argument("not an eical-result/1 document (format)");
+  if (!doc.is_object() || doc.value("format", "") != "eical-result/1")
+    throw std::invalid_argument("not an eical-result/1 document (format)");
   if (!doc.contains("run_id") || !doc["run_id"].is_string() || doc["run_id"].get<std::string>().empty())
     throw std::invalid_argument("eical-result/1 document without run_id");
-  if (p.machine.empty()) throw std::invalid_argument("result " + doc["run_id"].get<std::string>() + ": no machine name");
+  if (p.machine.empty())
+    throw std::invalid_argument("result " + doc["run_id"].get<std::string>() + ": no machine name");
   Record r;
   r.machine = p.machine;
   r.run_id = doc["run_id"].get<std::string>();
   r.program = doc.value("program", "");
   r.measured_at = utc_rfc3339(p.measured_at);
   if (r.measured_at.empty())
-    throw std::invalid_argument("result " + r.run_id + ": measurement time '" + p.measured_at + "' is not an RFC 3339 date-time");
+    throw std::invalid_argument("result " + r.run_id + ": measurement time '" + p.measured_at +
+                                "' is not an RFC 3339 date-time");
   const auto q = doc.find("quality");
   if (q != doc.end() && q->is_object()) {
     if (q->contains("verdict") && (*q)["verdict"].is_string()) r.verdict = (*q)["verdict"].get<std::string>();
@@ -122,7 +126,8 @@ Record record_from_result(const nlohmann::json& doc, const Provenance& p) {
   }
   r.run_path = p.run_path;
   r.software_version = p.software_version;
-  if (!r.software_version && doc.contains("software") && doc["software"].is_string()) r.software_version = doc["software"].get<std::string>();
+  if (!r.software_version && doc.contains("software") && doc["software"].is_string())
+    r.software_version = doc["software"].get<std::string>();
   r.sensor_calibration = p.sensor_calibration;
   if (r.sensor_calibration.empty()) {
     const auto sm = doc.find("sensor_model");

@@ -17,10 +17,10 @@ namespace eical::history {
 // What the document does not say: where and when it was measured, with what.
 struct Provenance {
   std::string machine;
-  std::string measured_at;                     // RFC 3339, any offset (stored as UTC)
+  std::string measured_at;  // RFC 3339, any offset (stored as UTC)
   std::string run_path;
-  std::optional<std::string> software_version; // nullopt: the document's "software" key, if any
-  std::string sensor_calibration;              // "": the document's sensor_model.source
+  std::optional<std::string> software_version;  // nullopt: the document's "software" key, if any
+  std::string sensor_calibration;               // "": the document's sensor_model.source
 };
 
 // At most this many points per trace are kept in the stored document (the polar and

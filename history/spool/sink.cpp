@@ -20,7 +20,8 @@ std::string seconds(double s) {
 
 Sink::Sink(SinkConfig config, Log log) : config_(std::move(config)), log_(std::move(log)), spool_(config_.spool_dir) {
   waiting_ = spool_.waiting().size();
-  if (waiting_ > 0) log_(Level::info, "history: " + std::to_string(waiting_) + " results from before wait in " + spool_.dir().string());
+  if (waiting_ > 0)
+    log_(Level::info, "history: " + std::to_string(waiting_) + " results from before wait in " + spool_.dir().string());
   thread_ = std::thread([this] { writer(); });
 }
 
@@ -32,7 +33,9 @@ Sink::~Sink() {
   cv_.notify_all();
   thread_.join();
   if (!memory_.empty())
-    log_(Level::error, "history: " + std::to_string(memory_.size()) + " results could neither be spooled nor stored; their run directories keep result.json (eical history add RUN)");
+    log_(Level::error, "history: " + std::to_string(memory_.size()) +
+                           " results could neither be spooled nor stored; their run directories keep result.json "
+                           "(eical history add RUN)");
 }
 
 void Sink::submit(const Record& r) {
@@ -49,7 +52,9 @@ void Sink::submit(const Record& r) {
     ++waiting_;
     wake_ = true;
   }
-  if (!error.empty()) log_(Level::error, "history: cannot spool result " + r.run_id + " (" + error + "); held in memory until the store takes it");
+  if (!error.empty())
+    log_(Level::error,
+         "history: cannot spool result " + r.run_id + " (" + error + "); held in memory until the store takes it");
   cv_.notify_all();
 }
 
@@ -91,8 +96,8 @@ void Sink::set_problem(const std::string& p) {
     problem_ = p;
     waiting = waiting_;
     changed = recovered ? "history: store " + sql::redact_uri(config_.location) + " is taking results again"
-                        : "history: " + p + "; " + std::to_string(waiting) + " results wait in " + spool_.dir().string() +
-                              ", tried again every " + seconds(config_.retry_s) + " s";
+                        : "history: " + p + "; " + std::to_string(waiting) + " results wait in " +
+                              spool_.dir().string() + ", tried again every " + seconds(config_.retry_s) + " s";
   }
   log_(p.empty() ? Level::info : Level::error, changed);
 }
@@ -119,7 +124,8 @@ bool Sink::flush() {
     std::size_t from_memory = 0;
     {
       std::lock_guard lk(mu_);
-      for (; from_memory < memory_.size() && batch.size() < kBatch; ++from_memory) batch.push_back(memory_[from_memory].second);
+      for (; from_memory < memory_.size() && batch.size() < kBatch; ++from_memory)
+        batch.push_back(memory_[from_memory].second);
     }
     if (batch.empty()) {
       std::lock_guard lk(mu_);

@@ -27,10 +27,10 @@ namespace eical::history {
 class Store;
 
 struct SinkConfig {
-  std::string location;                  // SQLite file or postgresql:// URI
+  std::string location;  // SQLite file or postgresql:// URI
   std::filesystem::path spool_dir;
-  double retry_s = 30.0;                 // a failed store is tried again after this
-  bool create = true;                    // create the store (file / schema) when missing
+  double retry_s = 30.0;  // a failed store is tried again after this
+  bool create = true;     // create the store (file / schema) when missing
 };
 
 class Sink {

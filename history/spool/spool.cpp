@@ -69,11 +69,14 @@ void write_durable(const fs::path& file, const std::string& text) {
 fs::path Spool::put(const Record& r) {
   std::error_code ec;
   fs::create_directories(dir_, ec);
-  if (!fs::is_directory(dir_)) throw std::runtime_error(dir_.string() + ": cannot create the spool directory" + (ec ? ": " + ec.message() : ""));
+  if (!fs::is_directory(dir_))
+    throw std::runtime_error(dir_.string() + ": cannot create the spool directory" + (ec ? ": " + ec.message() : ""));
   static std::atomic<unsigned> seq{0};
-  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  const auto ns =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
   char name[80];
-  std::snprintf(name, sizeof name, "%020lld-%d-%u.json", static_cast<long long>(ns), static_cast<int>(::getpid()), seq++);
+  std::snprintf(name, sizeof name, "%020lld-%d-%u.json", static_cast<long long>(ns), static_cast<int>(::getpid()),
+                seq++);
   const fs::path file = dir_ / name;
   write_durable(file, nlohmann::json{{"format", kFormat}, {"record", record_json(r)}}.dump() + "\n");
   return file;

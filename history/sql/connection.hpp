@@ -23,7 +23,7 @@ class SqlError : public std::runtime_error {
 enum class Dialect { sqlite, postgresql };
 
 using Value = std::variant<std::monostate, std::int64_t, double, std::string>;  // monostate = NULL
-using Cell = std::optional<std::string>;                                          // nullopt = NULL
+using Cell = std::optional<std::string>;                                        // nullopt = NULL
 using Row = std::vector<Cell>;
 using Rows = std::vector<Row>;
 

@@ -62,15 +62,18 @@ class PgConnection final : public Connection {
     for (std::size_t i = 0; i < params.size(); ++i) {
       const Value& v = params[i];
       if (std::holds_alternative<std::monostate>(v)) continue;
-      if (const auto* n = std::get_if<std::int64_t>(&v)) text[i] = std::to_string(*n);
+      if (const auto* n = std::get_if<std::int64_t>(&v))
+        text[i] = std::to_string(*n);
       else if (const auto* d = std::get_if<double>(&v)) {
         char b[40];
         std::snprintf(b, sizeof b, "%.17g", *d);
         text[i] = b;
-      } else text[i] = std::get<std::string>(v);
+      } else
+        text[i] = std::get<std::string>(v);
       ptrs[i] = text[i].c_str();
     }
-    PGresult* r = PQexecPrepared(conn_, name.c_str(), static_cast<int>(params.size()), ptrs.data(), nullptr, nullptr, 0);
+    PGresult* r =
+        PQexecPrepared(conn_, name.c_str(), static_cast<int>(params.size()), ptrs.data(), nullptr, nullptr, 0);
     check(r);
     Rows rows;
     const int n = PQntuples(r), m = PQnfields(r);
@@ -78,7 +81,9 @@ class PgConnection final : public Connection {
     for (int i = 0; i < n; ++i) {
       Row row(static_cast<std::size_t>(m));
       for (int c = 0; c < m; ++c)
-        if (!PQgetisnull(r, i, c)) row[static_cast<std::size_t>(c)] = std::string(PQgetvalue(r, i, c), static_cast<std::size_t>(PQgetlength(r, i, c)));
+        if (!PQgetisnull(r, i, c))
+          row[static_cast<std::size_t>(c)] =
+              std::string(PQgetvalue(r, i, c), static_cast<std::size_t>(PQgetlength(r, i, c)));
       rows.push_back(std::move(row));
     }
     PQclear(r);

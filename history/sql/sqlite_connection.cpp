@@ -90,7 +90,8 @@ class SqliteConnection final : public Connection {
     if (auto it = cache_.find(sql); it != cache_.end()) return it->second;
     sqlite3_stmt* st = nullptr;
     const std::string text = sqlite_placeholders(sql);
-    if (sqlite3_prepare_v3(db_, text.c_str(), static_cast<int>(text.size()), SQLITE_PREPARE_PERSISTENT, &st, nullptr) != SQLITE_OK)
+    if (sqlite3_prepare_v3(db_, text.c_str(), static_cast<int>(text.size()), SQLITE_PREPARE_PERSISTENT, &st, nullptr) !=
+        SQLITE_OK)
       fail(sqlite3_errmsg(db_));
     cache_.emplace(sql, st);
     return st;
@@ -98,9 +99,12 @@ class SqliteConnection final : public Connection {
 
   void bind(sqlite3_stmt* st, int i, const Value& v) {
     int rc = SQLITE_OK;
-    if (std::holds_alternative<std::monostate>(v)) rc = sqlite3_bind_null(st, i);
-    else if (const auto* n = std::get_if<std::int64_t>(&v)) rc = sqlite3_bind_int64(st, i, *n);
-    else if (const auto* d = std::get_if<double>(&v)) rc = sqlite3_bind_double(st, i, *d);
+    if (std::holds_alternative<std::monostate>(v))
+      rc = sqlite3_bind_null(st, i);
+    else if (const auto* n = std::get_if<std::int64_t>(&v))
+      rc = sqlite3_bind_int64(st, i, *n);
+    else if (const auto* d = std::get_if<double>(&v))
+      rc = sqlite3_bind_double(st, i, *d);
     else {
       const auto& s = std::get<std::string>(v);
       rc = sqlite3_bind_text(st, i, s.data(), static_cast<int>(s.size()), SQLITE_TRANSIENT);
@@ -110,10 +114,8 @@ class SqliteConnection final : public Connection {
 
   static Cell cell(sqlite3_stmt* st, int c) {
     switch (sqlite3_column_type(st, c)) {
-      case SQLITE_NULL:
-        return std::nullopt;
-      case SQLITE_INTEGER:
-        return std::to_string(sqlite3_column_int64(st, c));
+      case SQLITE_NULL: return std::nullopt;
+      case SQLITE_INTEGER: return std::to_string(sqlite3_column_int64(st, c));
       case SQLITE_FLOAT: {
         char b[40];
         std::snprintf(b, sizeof b, "%.17g", sqlite3_column_double(st, c));

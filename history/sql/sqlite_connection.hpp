@@ -10,8 +10,8 @@
 namespace eical::history::sql {
 
 struct SqliteOptions {
-  bool create = false;          // create the file when missing (its directory must exist)
-  int busy_timeout_ms = 2000;   // wait this long for a lock held by another process
+  bool create = false;         // create the file when missing (its directory must exist)
+  int busy_timeout_ms = 2000;  // wait this long for a lock held by another process
 };
 
 // Throws SqlError naming the file and the cause: no such file, missing directory, not a

@@ -18,35 +18,48 @@ const std::vector<Migration>& migrations() {
       // and trends read few pages whatever the documents weigh (14 kB each for a circle).
       {1,
        "results, their figures and documents",
-       {"CREATE TABLE results (id INTEGER PRIMARY KEY, machine TEXT NOT NULL, run_id TEXT NOT NULL, program TEXT NOT NULL, "
-        "measured_at TEXT NOT NULL, verdict TEXT, degraded INTEGER NOT NULL, run_path TEXT NOT NULL, software_version TEXT, "
+       {"CREATE TABLE results (id INTEGER PRIMARY KEY, machine TEXT NOT NULL, run_id TEXT NOT NULL, program TEXT NOT "
+        "NULL, "
+        "measured_at TEXT NOT NULL, verdict TEXT, degraded INTEGER NOT NULL, run_path TEXT NOT NULL, software_version "
+        "TEXT, "
         "sensor_calibration TEXT NOT NULL, added_at TEXT NOT NULL, UNIQUE (machine, run_id))",
-        "CREATE TABLE figures (result_id INTEGER NOT NULL REFERENCES results (id) ON DELETE CASCADE, name TEXT NOT NULL, "
+        "CREATE TABLE figures (result_id INTEGER NOT NULL REFERENCES results (id) ON DELETE CASCADE, name TEXT NOT "
+        "NULL, "
         "value REAL, uncertainty_k2 REAL, PRIMARY KEY (result_id, name)) WITHOUT ROWID",
-        "CREATE TABLE documents (result_id INTEGER PRIMARY KEY REFERENCES results (id) ON DELETE CASCADE, document TEXT NOT NULL)"},
+        "CREATE TABLE documents (result_id INTEGER PRIMARY KEY REFERENCES results (id) ON DELETE CASCADE, document "
+        "TEXT NOT NULL)"},
        // COLLATE "C": text sorts and compares byte-wise, as in SQLite, whatever the server's locale.
-       {"CREATE TABLE results (id BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY, machine TEXT COLLATE \"C\" NOT NULL, "
-        "run_id TEXT COLLATE \"C\" NOT NULL, program TEXT COLLATE \"C\" NOT NULL, measured_at TEXT COLLATE \"C\" NOT NULL, "
-        "verdict TEXT, degraded INTEGER NOT NULL, run_path TEXT NOT NULL, software_version TEXT, sensor_calibration TEXT NOT NULL, "
+       {"CREATE TABLE results (id BIGINT GENERATED ALWAYS AS IDENTITY PRIMARY KEY, machine TEXT COLLATE \"C\" NOT "
+        "NULL, "
+        "run_id TEXT COLLATE \"C\" NOT NULL, program TEXT COLLATE \"C\" NOT NULL, measured_at TEXT COLLATE \"C\" NOT "
+        "NULL, "
+        "verdict TEXT, degraded INTEGER NOT NULL, run_path TEXT NOT NULL, software_version TEXT, sensor_calibration "
+        "TEXT NOT NULL, "
         "added_at TEXT NOT NULL, UNIQUE (machine, run_id))",
-        "CREATE TABLE figures (result_id BIGINT NOT NULL REFERENCES results (id) ON DELETE CASCADE, name TEXT COLLATE \"C\" NOT NULL, "
+        "CREATE TABLE figures (result_id BIGINT NOT NULL REFERENCES results (id) ON DELETE CASCADE, name TEXT COLLATE "
+        "\"C\" NOT NULL, "
         "value DOUBLE PRECISION, uncertainty_k2 DOUBLE PRECISION, PRIMARY KEY (result_id, name))",
-        "CREATE TABLE documents (result_id BIGINT PRIMARY KEY REFERENCES results (id) ON DELETE CASCADE, document TEXT NOT NULL)"}},
+        "CREATE TABLE documents (result_id BIGINT PRIMARY KEY REFERENCES results (id) ON DELETE CASCADE, document TEXT "
+        "NOT NULL)"}},
       // Trend and list queries: a machine's results in time order, one figure over the fleet.
       {2,
        "indexes for the list and trend queries",
        {"CREATE INDEX results_by_machine_time ON results (machine, measured_at)",
-        "CREATE INDEX results_by_time ON results (measured_at)", "CREATE INDEX figures_by_name ON figures (name, result_id)"},
+        "CREATE INDEX results_by_time ON results (measured_at)",
+        "CREATE INDEX figures_by_name ON figures (name, result_id)"},
        {"CREATE INDEX results_by_machine_time ON results (machine, measured_at)",
-        "CREATE INDEX results_by_time ON results (measured_at)", "CREATE INDEX figures_by_name ON figures (name, result_id)"}},
+        "CREATE INDEX results_by_time ON results (measured_at)",
+        "CREATE INDEX figures_by_name ON figures (name, result_id)"}},
   };
   return m;
 }
 
 bool schema_table_exists(sql::Connection& c) {
-  const auto rows = c.dialect() == sql::Dialect::sqlite
-                        ? c.query("SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name = 'eical_schema'")
-                        : c.query("SELECT count(*) FROM pg_tables WHERE schemaname = current_schema() AND tablename = 'eical_schema'");
+  const auto rows =
+      c.dialect() == sql::Dialect::sqlite
+          ? c.query("SELECT count(*) FROM sqlite_master WHERE type = 'table' AND name = 'eical_schema'")
+          : c.query(
+                "SELECT count(*) FROM pg_tables WHERE schemaname = current_schema() AND tablename = 'eical_schema'");
   return sql::to_int(rows.at(0).at(0)) > 0;
 }
 

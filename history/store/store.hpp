@@ -23,7 +23,7 @@ enum class AddOutcome { added, duplicate };
 struct Filter {
   std::string machine = {}, program = {};
   std::string since = {}, until = {};  // measured_at >= since, measured_at < until (until: exclusive)
-  std::size_t limit = 0;     // the newest `limit`, shown oldest first
+  std::size_t limit = 0;               // the newest `limit`, shown oldest first
 };
 
 struct TrendPoint {

@@ -11,7 +11,8 @@
 
 namespace eical::sim {
 
-DecimationFilter::DecimationFilter(int oversample, double delay_samples, double passband_fs, double design_delay_samples)
+DecimationFilter::DecimationFilter(int oversample, double delay_samples, double passband_fs,
+                                   double design_delay_samples)
     : ov_(oversample) {
   if (oversample < 1) throw dsp::InputError("DAQ filter: oversample must be >= 1");
   if (!(delay_samples >= 0.0)) throw dsp::InputError("DAQ filter: delay must not be negative");
@@ -28,7 +29,8 @@ DecimationFilter::DecimationFilter(int oversample, double delay_samples, double 
   // Kaiser design: transition width from the length and the attenuation (Kaiser's formula),
   // cut-off half a transition above the pass-band edge.
   const double atten_db = 90.0, beta = 0.1102 * (atten_db - 8.7);
-  const double transition_out = (atten_db - 8.0) / (2.285 * 2.0 * std::numbers::pi * static_cast<double>(2 * m)) * oversample;
+  const double transition_out =
+      (atten_db - 8.0) / (2.285 * 2.0 * std::numbers::pi * static_cast<double>(2 * m)) * oversample;
   const double fc = (passband_fs + transition_out / 2.0) / oversample;  // cycles per internal sample
   const double i0_beta = std::cyl_bessel_i(0.0, beta);
   double sum = 0.0;
@@ -85,7 +87,8 @@ void DecimationFilter::apply(const std::vector<double>& in, double* out, std::si
     } else if (c - m >= 0 && c + m < n_in) {
       out[n] = filter_at(x.data() + c);
     } else {  // near the ends: the held values in a small copy
-      for (long j = -m; j <= m; ++j) edge[static_cast<std::size_t>(j + m)] = x[static_cast<std::size_t>(std::clamp(c + j, 0L, n_in - 1))];
+      for (long j = -m; j <= m; ++j)
+        edge[static_cast<std::size_t>(j + m)] = x[static_cast<std::size_t>(std::clamp(c + j, 0L, n_in - 1))];
       out[n] = filter_at(edge.data() + m);
     }
   }
@@ -100,7 +103,8 @@ double DecimationFilter::output_at(const std::vector<double>& x, long c) const {
   return y;
 }
 
-void DecimationFilter::apply_at(const std::vector<double>& in, const double* positions, double* out, std::size_t n_out) const {
+void DecimationFilter::apply_at(const std::vector<double>& in, const double* positions, double* out,
+                                std::size_t n_out) const {
   if (in.empty()) throw dsp::InputError("DAQ filter: no input");
   std::vector<double> shifted;
   if (frac_ != 0.0) {

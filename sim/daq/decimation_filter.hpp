@@ -15,7 +15,8 @@ namespace eical::sim {
 class DecimationFilter {
  public:
   // delay_samples at the output rate; design_delay_samples sets the FIR length.
-  DecimationFilter(int oversample, double delay_samples, double passband_fs = 0.4863, double design_delay_samples = 38.8);
+  DecimationFilter(int oversample, double delay_samples, double passband_fs = 0.4863,
+                   double design_delay_samples = 38.8);
 
   // in[k] at t = k/(oversample·fs), k < n_in; out[n] = filtered signal at t = n/fs,
   // delayed. Before t = 0 the input is held at in[0] (the sensor rested), after the end
@@ -37,8 +38,8 @@ class DecimationFilter {
   [[nodiscard]] double output_at(const std::vector<double>& x, long c) const;
 
   int ov_;
-  long shift_;     // integer part of the delay, internal samples
-  double frac_;    // fractional part
+  long shift_;                     // integer part of the delay, internal samples
+  double frac_;                    // fractional part
   std::vector<double> taps_half_;  // h[0..M]; h[−j] = h[j]
 };
 

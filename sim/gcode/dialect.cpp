@@ -34,14 +34,19 @@ Line split(const std::string& raw, int line_no) {
       ++i;
     } else if (c == '(') {
       const auto e = raw.find(')', i);
-      if (e == std::string::npos) throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": unclosed comment");
+      if (e == std::string::npos)
+        throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": unclosed comment");
       l.comment += (l.comment.empty() ? "" : " ") + raw.substr(i + 1, e - i - 1);
       i = e + 1;
     } else if (std::isalpha(static_cast<unsigned char>(c))) {
       WrittenWord w{static_cast<char>(std::toupper(static_cast<unsigned char>(c))), ""};
       ++i;
-      while (i < raw.size() && (std::isdigit(static_cast<unsigned char>(raw[i])) || raw[i] == '.' || raw[i] == '-' || raw[i] == '+')) w.text += raw[i++];
-      if (w.text.empty()) throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": word '" + std::string(1, w.letter) + "' without a number");
+      while (i < raw.size() &&
+             (std::isdigit(static_cast<unsigned char>(raw[i])) || raw[i] == '.' || raw[i] == '-' || raw[i] == '+'))
+        w.text += raw[i++];
+      if (w.text.empty())
+        throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": word '" + std::string(1, w.letter) +
+                              "' without a number");
       l.words.push_back(w);
     } else {
       throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": unexpected '" + std::string(1, c) + "'");
@@ -57,11 +62,11 @@ std::string upper(std::string s) {
   return s;
 }
 
-
 // Canonical G4 P<seconds> → the dwell value in the dialect's unit.
 std::string dwell(const Line& l, int line_no, bool millis) {
   for (const auto& w : l.words)
-    if (w.letter == 'P') return millis ? std::to_string(std::llround(w.value() * 1000.0)) : format_number("%.3f", w.value());
+    if (w.letter == 'P')
+      return millis ? std::to_string(std::llround(w.value() * 1000.0)) : format_number("%.3f", w.value());
   throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": G4 without P");
 }
 
@@ -108,9 +113,12 @@ std::string sinumerik(const std::vector<Line>& lines, const ProgramIdentity& id)
       parts = {"G4", "F" + dwell(l, static_cast<int>(n + 1), false)};
     } else {
       for (const auto& w : l.words) {
-        if (is_g(w, 21)) parts.push_back("G71");       // metric
-        else if (is_g(w, 61)) parts.push_back("G60");  // exact stop, modal
-        else parts.push_back(std::string(1, w.letter) + w.text);
+        if (is_g(w, 21))
+          parts.push_back("G71");  // metric
+        else if (is_g(w, 61))
+          parts.push_back("G60");  // exact stop, modal
+        else
+          parts.push_back(std::string(1, w.letter) + w.text);
       }
     }
     if (!l.comment.empty()) parts.push_back("; " + l.comment);
@@ -144,12 +152,19 @@ std::string heidenhain(const std::vector<Line>& lines, const ProgramIdentity& id
     for (const auto& w : l.words) {
       if (w.letter == 'G') {
         const int g = static_cast<int>(std::lround(w.value()));
-        if (g >= 0 && g <= 3) motion = g;
-        else if (g == 90) absolute = true, parts.push_back("G90");
-        else if (g == 91) absolute = false, parts.push_back("G91");
-        else if (g == 17 || g == 18 || g == 19) plane = g, parts.push_back("G" + std::to_string(g));
-        else if (g == 21 || g == 61 || g == 64) continue;  // mm is in the begin line; no modal exact stop on the TNC
-        else throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": G" + w.text + " has no HEIDENHAIN ISO form here");
+        if (g >= 0 && g <= 3)
+          motion = g;
+        else if (g == 90)
+          absolute = true, parts.push_back("G90");
+        else if (g == 91)
+          absolute = false, parts.push_back("G91");
+        else if (g == 17 || g == 18 || g == 19)
+          plane = g, parts.push_back("G" + std::to_string(g));
+        else if (g == 21 || g == 61 || g == 64)
+          continue;  // mm is in the begin line; no modal exact stop on the TNC
+        else
+          throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": G" + w.text +
+                                " has no HEIDENHAIN ISO form here");
       } else if (w.letter >= 'X' && w.letter <= 'Z') {
         target[static_cast<std::size_t>(w.letter - 'X')] = w.value();
       } else if (w.letter >= 'I' && w.letter <= 'K') {
@@ -157,25 +172,34 @@ std::string heidenhain(const std::vector<Line>& lines, const ProgramIdentity& id
       } else if (w.letter == 'F' || w.letter == 'M') {
         continue;  // after the motion words
       } else {
-        throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": word '" + std::string(1, w.letter) + "' has no HEIDENHAIN ISO form here");
+        throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": word '" + std::string(1, w.letter) +
+                              "' has no HEIDENHAIN ISO form here");
       }
     }
     std::array<double, 3> end = pos;
     for (int a = 0; a < 3; ++a)
-      if (target[static_cast<std::size_t>(a)]) end[static_cast<std::size_t>(a)] = absolute ? *target[static_cast<std::size_t>(a)] : pos[static_cast<std::size_t>(a)] + *target[static_cast<std::size_t>(a)];
+      if (target[static_cast<std::size_t>(a)])
+        end[static_cast<std::size_t>(a)] =
+            absolute ? *target[static_cast<std::size_t>(a)]
+                     : pos[static_cast<std::size_t>(a)] + *target[static_cast<std::size_t>(a)];
     if (motion == 2 || motion == 3) {
-      if (!absolute) throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": an incremental arc has no HEIDENHAIN ISO form here");
+      if (!absolute)
+        throw dsp::InputError("dialect: line " + std::to_string(line_no) +
+                              ": an incremental arc has no HEIDENHAIN ISO form here");
       // The circle centre in a block of its own, absolute: canonical I/J/K are offsets
       // from the arc's start (LinuxCNC's default G91.1).
       const int u = plane == 17 ? 0 : plane == 18 ? 2 : 1, v = plane == 17 ? 1 : plane == 18 ? 0 : 2;
       std::vector<std::string> cc;
       for (int a : {u, v})
-        cc.push_back(std::string(1, static_cast<char>('I' + a)) + signed_num(pos[static_cast<std::size_t>(a)] + centre_offset[static_cast<std::size_t>(a)].value_or(0.0)));
+        cc.push_back(
+            std::string(1, static_cast<char>('I' + a)) +
+            signed_num(pos[static_cast<std::size_t>(a)] + centre_offset[static_cast<std::size_t>(a)].value_or(0.0)));
       emit(cc);
     }
     if (motion >= 0) parts.push_back("G0" + std::to_string(motion));
     for (int a = 0; a < 3; ++a)
-      if (target[static_cast<std::size_t>(a)]) parts.push_back(std::string(1, static_cast<char>('X' + a)) + signed_num(*target[static_cast<std::size_t>(a)]));
+      if (target[static_cast<std::size_t>(a)])
+        parts.push_back(std::string(1, static_cast<char>('X' + a)) + signed_num(*target[static_cast<std::size_t>(a)]));
     for (const auto& w : l.words)
       if (w.letter == 'F' || w.letter == 'M') parts.push_back(std::string(1, w.letter) + w.text);
     if (!parts.empty()) emit(parts);

@@ -40,9 +40,9 @@ Dialect dialect_from_name(const std::string& name);
 const char* dialect_name(Dialect d) noexcept;
 
 struct ProgramIdentity {
-  int number = 1000;            // FANUC O-number
-  std::string name = "EICAL";   // SINUMERIK / HEIDENHAIN program name (letters, digits, _)
-  std::string title;            // one line saying what the program is
+  int number = 1000;           // FANUC O-number
+  std::string name = "EICAL";  // SINUMERIK / HEIDENHAIN program name (letters, digits, _)
+  std::string title;           // one line saying what the program is
 };
 
 // The canonical program as a complete program for the dialect. InputError naming the

@@ -12,9 +12,9 @@ namespace eical::sim::gcode {
 namespace {
 
 struct PlaneWords {
-  const char* g;       // G17 / G18 / G19
-  char a, b;           // the two plane axes, counter-clockwise order seen from +normal
-  char ia, ib;         // their centre-offset words
+  const char* g;  // G17 / G18 / G19
+  char a, b;      // the two plane axes, counter-clockwise order seen from +normal
+  char ia, ib;    // their centre-offset words
 };
 
 PlaneWords plane_axes(const std::string& plane) {
@@ -35,7 +35,8 @@ std::string header(const char* mode_comment, const std::string& plane_g, bool ex
 }
 
 std::string start(const RestTimes& r) {
-  return "G4 P" + format_number("%.3g", r.before_start_s) + "\nM101\nG4 P" + format_number("%.3g", r.after_start_s) + "\n";
+  return "G4 P" + format_number("%.3g", r.before_start_s) + "\nM101\nG4 P" + format_number("%.3g", r.after_start_s) +
+         "\n";
 }
 std::string finish(const RestTimes& r) {
   return "G4 P" + format_number("%.3g", r.before_end_s) + "\nM103\nG4 P" + format_number("%.3g", r.after_end_s) + "\n";
@@ -65,7 +66,8 @@ std::string circle_program(const dsp::Program& p, const RestTimes& rest) {
   const bool partial = p.arc_deg < 360.0;
   // A partial arc needs room for its ramp arcs outside the evaluated arc (feed constant
   // over the whole evaluated arc).
-  require(!partial || partial_arc_ramp_deg(p) >= 10.0, "a partial arc must leave at least 20 deg for the ramps (arc_deg <= 340)");
+  require(!partial || partial_arc_ramp_deg(p) >= 10.0,
+          "a partial arc must leave at least 20 deg for the ramps (arc_deg <= 340)");
   const PlaneWords ax = plane_axes(p.plane);
   const double r = p.radius_mm, c0 = p.center_mm[0], c1 = p.center_mm[1];
   constexpr double deg = std::numbers::pi / 180.0;
@@ -94,8 +96,10 @@ std::string circle_program(const dsp::Program& p, const RestTimes& rest) {
     };
     const auto [sa, sb] = pt(a0);
     g += std::string("G0 ") + ax.a + num(sa) + " " + ax.b + num(sb) + "\n" + start(rest);
-    if (p.direction == "both") g += revolutions(true, a0) + reversal + revolutions(false, a0 + 2 * q);
-    else g += revolutions(p.direction == "ccw", a0);
+    if (p.direction == "both")
+      g += revolutions(true, a0) + reversal + revolutions(false, a0 + 2 * q);
+    else
+      g += revolutions(p.direction == "ccw", a0);
     return g + finish(rest);
   }
   // Partial arc (ISO 230-4 allows arcs below 360°): ramp-in arc, M102, the evaluated arc,
@@ -106,17 +110,20 @@ std::string circle_program(const dsp::Program& p, const RestTimes& rest) {
            arc(true, s1, s1 + ramp, "ramp-out", false);
   };
   auto sweep_cw = [&](bool feed) {
-    return arc(false, s1 + ramp, s1, "ramp-in", feed) + "M102\n" + arc(false, s1, s0, "evaluated arc", false) + "M102\n" +
-           arc(false, s0, s0 - ramp, "ramp-out", false);
+    return arc(false, s1 + ramp, s1, "ramp-in", feed) + "M102\n" + arc(false, s1, s0, "evaluated arc", false) +
+           "M102\n" + arc(false, s0, s0 - ramp, "ramp-out", false);
   };
   const bool cw_first = p.direction == "cw";
   const auto [sa, sb] = pt(cw_first ? s1 + ramp : s0 - ramp);
   g += std::string("G0 ") + ax.a + num(sa) + " " + ax.b + num(sb) + "\n" + start(rest);
   for (int k = 0; k < p.repeats; ++k) {
     if (k > 0) g += reversal;
-    if (p.direction == "both") g += sweep_ccw(k == 0) + reversal + sweep_cw(false);
-    else if (cw_first) g += sweep_cw(k == 0) + (k + 1 < p.repeats ? reversal + arc(true, s0 - ramp, s1 + ramp, "back", false) : "");
-    else g += sweep_ccw(k == 0) + (k + 1 < p.repeats ? reversal + arc(false, s1 + ramp, s0 - ramp, "back", false) : "");
+    if (p.direction == "both")
+      g += sweep_ccw(k == 0) + reversal + sweep_cw(false);
+    else if (cw_first)
+      g += sweep_cw(k == 0) + (k + 1 < p.repeats ? reversal + arc(true, s0 - ramp, s1 + ramp, "back", false) : "");
+    else
+      g += sweep_ccw(k == 0) + (k + 1 < p.repeats ? reversal + arc(false, s1 + ramp, s0 - ramp, "back", false) : "");
   }
   return g + finish(rest);
 }
@@ -172,7 +179,9 @@ std::string rectangle_program(const dsp::Program& p, const RestTimes& rest) {
   const double x0 = p.corner_mm[0], y0 = p.corner_mm[1], x1 = x0 + p.size_mm[0], y1 = y0 + p.size_mm[1];
   const std::string f = " F" + format_number("%.0f", p.feed_mm_min);
   const std::string dwell = "G4 P" + format_number("%.3g", p.dwell_s > 0 ? p.dwell_s : 0.2) + "\n";
-  auto go = [&](double a, double b) { return std::string("G1 ") + ax.a + num(a) + " " + ax.b + num(b) + f + "\nM102\n" + dwell; };
+  auto go = [&](double a, double b) {
+    return std::string("G1 ") + ax.a + num(a) + " " + ax.b + num(b) + f + "\nM102\n" + dwell;
+  };
   std::string g = header("rectangle, exact stop at the corners", ax.g, true);
   g += std::string("G0 ") + ax.a + num(x0) + " " + ax.b + num(y0) + "\n";
   g += start(rest);
@@ -198,7 +207,8 @@ std::string identify_program(const IdentifyPlan& plan, const RestTimes& rest) {
   };
   bool started = false;
   for (const auto& strip : plan.psd) {
-    require(strip.measures == "x" || strip.measures == "y", "identify: a PSD strip measures x or y, not '" + strip.measures + "'");
+    require(strip.measures == "x" || strip.measures == "y",
+            "identify: a PSD strip measures x or y, not '" + strip.measures + "'");
     const char along = axis_letter(strip.measures);
     const char cross = along == 'X' ? 'Y' : 'X';
     const double c_along = strip.center_mm[along == 'X' ? 0 : 1], c_cross = strip.center_mm[cross == 'X' ? 0 : 1];
@@ -245,7 +255,8 @@ std::string program_gcode(const dsp::Program& p) {
   if (p.kind == "step") return step_program(p);
   if (p.kind == "rectangle") return rectangle_program(p);
   if (p.kind == "identify") return identify_program(p);
-  throw dsp::InputError("program kind '" + p.kind + "' has no generator (circle, positioning, step, rectangle, identify)");
+  throw dsp::InputError("program kind '" + p.kind +
+                        "' has no generator (circle, positioning, step, rectangle, identify)");
 }
 
 }  // namespace eical::sim::gcode

@@ -54,10 +54,10 @@ std::string rectangle_program(const dsp::Program& p, const RestTimes& rest = {})
 // dwell (ZUPT, and the set-point as a position at rest) and M102. Exact stop.
 struct IdentifyPlan {
   std::vector<dsp::PsdSpec> psd;
-  std::vector<std::string> axes;                        // swung without a strip
-  double swing_mm = 50.0;                               // peak to peak (the scale's lever)
+  std::vector<std::string> axes;  // swung without a strip
+  double swing_mm = 50.0;         // peak to peak (the scale's lever)
   std::vector<double> feeds_mm_min = {2000.0, 4000.0, 6500.0};
-  double dwell_s = 0.5;                                 // the position loop settles, then ZUPT
+  double dwell_s = 0.5;  // the position loop settles, then ZUPT
 };
 std::string identify_program(const IdentifyPlan& plan, const RestTimes& rest = {});
 // The Program form (kind "identify"): one strip along `axis` centred at targets_mm[0],

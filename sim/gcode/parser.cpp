@@ -42,7 +42,8 @@ class LineParser {
   LineParser(std::string_view name, int line) : name_(name), line_(line) {}
 
   [[noreturn]] void fail(int column, const std::string& what) const {
-    throw dsp::InputError(std::string(name_) + ":" + std::to_string(line_) + ":" + std::to_string(column) + ": " + what);
+    throw dsp::InputError(std::string(name_) + ":" + std::to_string(line_) + ":" + std::to_string(column) + ": " +
+                          what);
   }
 
   // Splits one line into words, dropping comments, block delete and '%'.
@@ -94,7 +95,9 @@ class LineParser {
       if (letter == 'O') {  // a program number; LinuxCNC's O-word subroutines and loops are not
         skip_space();
         if (i < text.size() && std::isalpha(static_cast<unsigned char>(text[i])))
-          fail(static_cast<int>(i) + 1, "O-word control flow (sub, call, if, while, ...) is not supported; O<n> is read as a program number only");
+          fail(static_cast<int>(i) + 1,
+               "O-word control flow (sub, call, if, while, ...) is not supported; O<n> is read as a program number "
+               "only");
       }
     }
     return out;
@@ -143,8 +146,18 @@ Program parse(std::string_view text, std::string_view name, const ParseOptions& 
         case 'M': mcodes.push_back(w); break;
         case 'N': break;  // line number
         case 'O': break;  // program number (FANUC O1000)
-        case 'S': case 'T': break;  // spindle speed, tool number: no effect on the path (M3/M5/M6 below)
-        case 'X': case 'Y': case 'Z': case 'I': case 'J': case 'K': case 'R': case 'F': case 'P': case 'Q': {
+        case 'S':
+        case 'T': break;  // spindle speed, tool number: no effect on the path (M3/M5/M6 below)
+        case 'X':
+        case 'Y':
+        case 'Z':
+        case 'I':
+        case 'J':
+        case 'K':
+        case 'R':
+        case 'F':
+        case 'P':
+        case 'Q': {
           auto& slot = value[static_cast<std::size_t>(w.letter - 'A')];
           if (slot) lp.fail(w.column, "word '" + std::string(1, w.letter) + "' appears twice in one block");
           slot = w;
@@ -162,18 +175,30 @@ Program parse(std::string_view text, std::string_view name, const ParseOptions& 
       if (is_code(c, 0) || is_code(c, 1) || is_code(c, 2) || is_code(c, 3)) {
         if (block_motion >= 0) lp.fail(g.column, "two motion G-codes in one block");
         block_motion = static_cast<int>(std::lround(c));
-      } else if (is_code(c, 4)) dwell = true;
-      else if (is_code(c, 17)) plane = Plane::xy;
-      else if (is_code(c, 18)) plane = Plane::zx;
-      else if (is_code(c, 19)) plane = Plane::yz;
-      else if (is_code(c, 20)) unit_mm = 25.4;
-      else if (is_code(c, 21)) unit_mm = 1.0;
-      else if (is_code(c, 61) || is_code(c, 61.1)) program.exact_stop = true;
-      else if (is_code(c, 64)) program.exact_stop = false;
-      else if (is_code(c, 90)) absolute = true;
-      else if (is_code(c, 91)) absolute = false;
-      else if (is_code(c, 90.1)) arc_absolute = true;
-      else if (is_code(c, 91.1)) arc_absolute = false;
+      } else if (is_code(c, 4))
+        dwell = true;
+      else if (is_code(c, 17))
+        plane = Plane::xy;
+      else if (is_code(c, 18))
+        plane = Plane::zx;
+      else if (is_code(c, 19))
+        plane = Plane::yz;
+      else if (is_code(c, 20))
+        unit_mm = 25.4;
+      else if (is_code(c, 21))
+        unit_mm = 1.0;
+      else if (is_code(c, 61) || is_code(c, 61.1))
+        program.exact_stop = true;
+      else if (is_code(c, 64))
+        program.exact_stop = false;
+      else if (is_code(c, 90))
+        absolute = true;
+      else if (is_code(c, 91))
+        absolute = false;
+      else if (is_code(c, 90.1))
+        arc_absolute = true;
+      else if (is_code(c, 91.1))
+        arc_absolute = false;
       else if (is_code(c, 94)) {  // units per minute feed: the only feed mode supported
       } else if (is_code(c, 40) || is_code(c, 49) || is_code(c, 80)) {
         // Cutter radius, tool length and canned cycle CANCEL, from a part program's safety
@@ -196,15 +221,15 @@ Program parse(std::string_view text, std::string_view name, const ParseOptions& 
       const int code = static_cast<int>(std::lround(m.value));
       if (!is_code(m.value, code)) lp.fail(m.column, "M-code must be an integer");
       if (code >= 100 && code <= 199) {
-        program.blocks.emplace_back(Trigger{code, word('P') ? word('P')->value : kNaN, word('Q') ? word('Q')->value : kNaN});
+        program.blocks.emplace_back(
+            Trigger{code, word('P') ? word('P')->value : kNaN, word('Q') ? word('Q')->value : kNaN});
         program.source.push_back({line_no});
       } else if (std::find(options.ignored_m.begin(), options.ignored_m.end(), code) == options.ignored_m.end()) {
         lp.fail(m.column, "unsupported M-code M" + std::to_string(code));
       }
     }
-    const bool trigger_in_block = std::any_of(mcodes.begin(), mcodes.end(), [](const Word& m) {
-      return m.value >= 100 && m.value < 200;
-    });
+    const bool trigger_in_block =
+        std::any_of(mcodes.begin(), mcodes.end(), [](const Word& m) { return m.value >= 100 && m.value < 200; });
     if (dwell) {
       const auto& p = word('P');
       if (!p) lp.fail(gcodes.front().column, "G4 needs P<seconds>");
@@ -225,7 +250,8 @@ Program parse(std::string_view text, std::string_view name, const ParseOptions& 
 
     Eigen::Vector3d target = pos;
     for (int a = 0; a < 3; ++a) {
-      if (const auto& w = word(static_cast<char>('X' + a))) target[a] = absolute ? w->value * unit_mm : pos[a] + w->value * unit_mm;
+      if (const auto& w = word(static_cast<char>('X' + a)))
+        target[a] = absolute ? w->value * unit_mm : pos[a] + w->value * unit_mm;
     }
     if (motion == 0 || motion == 1) {
       if (has_arc_words) {
@@ -252,7 +278,8 @@ Program parse(std::string_view text, std::string_view name, const ParseOptions& 
       const Eigen::Vector2d chord = e - s;
       const double d = chord.norm();
       if (d < 1e-12) lp.fail(r->column, "R-form arc needs distinct start and end points");
-      if (d / 2.0 > radius + options.arc_radius_tolerance_mm) lp.fail(r->column, "arc radius R is smaller than half the chord");
+      if (d / 2.0 > radius + options.arc_radius_tolerance_mm)
+        lp.fail(r->column, "arc radius R is smaller than half the chord");
       const double h = std::sqrt(std::max(0.0, radius * radius - d * d / 4.0));
       const Eigen::Vector2d left(-chord.y() / d, chord.x() / d);  // unit normal to the left of the chord
       // Short arc (R > 0): centre left of the chord for ccw, right for cw; R < 0 flips.

@@ -23,8 +23,8 @@ struct Arc {
   Eigen::Vector3d to_mm;
   Eigen::Vector3d center_mm;  // centre in the arc plane; the helical axis keeps `from`'s value
   Plane plane;
-  bool clockwise;       // G2 (viewed from the positive axis normal to the plane)
-  double sweep_rad;     // signed: positive counter-clockwise; |sweep| in (0, 2π]
+  bool clockwise;    // G2 (viewed from the positive axis normal to the plane)
+  double sweep_rad;  // signed: positive counter-clockwise; |sweep| in (0, 2π]
   double feed_mm_min;
 };
 

@@ -20,7 +20,7 @@ struct Draw {
   std::mt19937_64 rng;
   explicit Draw(std::uint64_t seed) : rng(seed) {}
   double u(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); }
-  double pm(double a) { return u(-a, a); }                          // ±a, uniform
+  double pm(double a) { return u(-a, a); }                                               // ±a, uniform
   double mag(double lo, double hi) { return (u(0, 1) < 0.5 ? -1.0 : 1.0) * u(lo, hi); }  // ±[lo, hi]
   int pick(int n) { return std::uniform_int_distribution<int>(0, n - 1)(rng); }
 };
@@ -76,7 +76,8 @@ void program(Scenario& sc, const std::string& kind, Draw& d, bool fast) {
 
 void background(Scenario& sc, Draw& d) {
   if (d.pick(2) == 1) sc.meta.machine.table_axes = {"x"}, sc.meta.machine.head_axes = {"y", "z"};
-  sc.meta.site.latitude_deg = d.u(47.0, 54.0), sc.meta.site.heading_deg = d.u(0.0, 360.0), sc.meta.site.g_mps2 = d.u(9.806, 9.813);
+  sc.meta.site.latitude_deg = d.u(47.0, 54.0), sc.meta.site.heading_deg = d.u(0.0, 360.0),
+  sc.meta.site.g_mps2 = d.u(9.806, 9.813);
   for (int s = 0; s < 2; ++s) background_sensor(sc.truth[s], sc.meta.sensors[s], d);
   sc.coriolis = true;
   const double kv = d.u(31.0, 35.0);
@@ -103,17 +104,19 @@ void background(Scenario& sc, Draw& d) {
     sc.reference.interp_nm[a][0] = d.u(5.0, 20.0), sc.reference.interp_nm[a][1] = d.u(1.0, 4.5);
     sc.reference.interp_phase_deg[a][0] = d.u(0.0, 360.0), sc.reference.interp_phase_deg[a][1] = d.u(0.0, 360.0);
   }
-  sc.effects_background = {"sensor.scale", "sensor.nonlinearity", "sensor.cross_coupling", "sensor.misalignment", "sensor.dynamics",
-                           "sensor.bias_drift", "sensor.scale_temperature", "site.coriolis", "machine.backlash", "machine.reversal_spike",
-                           "machine.servo_mismatch", "machine.squareness", "machine.scale_mismatch", "machine.cyclic_error",
-                           "machine.straightness"};
+  sc.effects_background = {
+      "sensor.scale",           "sensor.nonlinearity",    "sensor.cross_coupling",    "sensor.misalignment",
+      "sensor.dynamics",        "sensor.bias_drift",      "sensor.scale_temperature", "site.coriolis",
+      "machine.backlash",       "machine.reversal_spike", "machine.servo_mismatch",   "machine.squareness",
+      "machine.scale_mismatch", "machine.cyclic_error",   "machine.straightness"};
 }
 
 // The sensor an effect goes into: one that moves an axis of the program.
 int moving_sensor(const Scenario& sc, Draw& d) {
-  const bool head_moves = std::find(sc.meta.machine.head_axes.begin(), sc.meta.machine.head_axes.end(), "y") != sc.meta.machine.head_axes.end();
+  const bool head_moves = std::find(sc.meta.machine.head_axes.begin(), sc.meta.machine.head_axes.end(), "y") !=
+                          sc.meta.machine.head_axes.end();
   const bool circle = sc.meta.program.kind == "circle";
-  const int pick = d.pick(2);  // drawn always: the sizes after it do not depend on the program
+  const int pick = d.pick(2);              // drawn always: the sizes after it do not depend on the program
   return circle && head_moves ? pick : 0;  // x (and y) are the table's otherwise
 }
 
@@ -126,11 +129,14 @@ void inject(Scenario& sc, const std::string& e, Draw& d) {
   auto& m = sc.machine;
   if (e == "sensor.scale") {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
-    for (int i = 0; i < 3; ++i) t.spec.k1_v_per_g[i] = sc.meta.sensors[&t - sc.truth].k1_v_per_g[i] * (1.0 + d.mag(2000e-6, 5000e-6));
+    for (int i = 0; i < 3; ++i)
+      t.spec.k1_v_per_g[i] = sc.meta.sensors[&t - sc.truth].k1_v_per_g[i] * (1.0 + d.mag(2000e-6, 5000e-6));
   } else if (e == "sensor.bias_drift") {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
-    if (sc.meta.program.kind == "step") t.bias_step_ug = d.u(6.0, 15.0);
-    else t.bias_drift_ug_per_s = d.mag(0.3, 1.0);
+    if (sc.meta.program.kind == "step")
+      t.bias_step_ug = d.u(6.0, 15.0);
+    else
+      t.bias_drift_ug_per_s = d.mag(0.3, 1.0);
   } else if (e == "sensor.nonlinearity") {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
     for (int i = 0; i < 3; ++i) t.spec.k2_g_per_g2[i] += d.mag(2e-3, 4e-3), t.spec.k3_g_per_g3[i] += d.mag(2e-3, 4e-3);
@@ -172,17 +178,21 @@ void inject(Scenario& sc, const std::string& e, Draw& d) {
   } else if (e == "machine.common_vibration") {
     auto& v = sc.common_vibration;
     Tone drive;
-    drive.freq_hz = 100.0, drive.amp_mg = Eigen::Vector3d(d.u(1.0, 4.0), d.u(1.0, 3.0), d.u(0.5, 1.5)), drive.phase_deg = d.u(0, 360);
+    drive.freq_hz = 100.0, drive.amp_mg = Eigen::Vector3d(d.u(1.0, 4.0), d.u(1.0, 3.0), d.u(0.5, 1.5)),
+    drive.phase_deg = d.u(0, 360);
     Tone floor;
-    floor.freq_hz = d.u(15.0, 40.0), floor.amp_mg = Eigen::Vector3d(d.u(0.1, 0.4), d.u(0.1, 0.4), d.u(0.05, 0.2)), floor.phase_deg = d.u(0, 360);
+    floor.freq_hz = d.u(15.0, 40.0), floor.amp_mg = Eigen::Vector3d(d.u(0.1, 0.4), d.u(0.1, 0.4), d.u(0.05, 0.2)),
+    floor.phase_deg = d.u(0, 360);
     v.tones = {drive, floor};
     v.broadband_rms_mg = Eigen::Vector3d(d.u(0.4, 1.5), d.u(0.4, 1.5), d.u(0.4, 1.5));
-    v.mode.freq_hz = d.u(8.0, 11.0), v.mode.zeta = d.u(0.03, 0.05), v.mode.gain = Eigen::Vector3d::Constant(d.u(0.005, 0.015));
+    v.mode.freq_hz = d.u(8.0, 11.0), v.mode.zeta = d.u(0.03, 0.05),
+    v.mode.gain = Eigen::Vector3d::Constant(d.u(0.005, 0.015));
   } else if (e == "machine.differential_vibration") {
     sc.differential_vibration.freq_hz = d.u(12.0, 25.0), sc.differential_vibration.zeta = d.u(0.03, 0.06);
     sc.differential_vibration.gain = Eigen::Vector3d::Constant(d.u(0.01, 0.03));
     Tone t;
-    t.freq_hz = d.u(30.0, 60.0), t.amp_mg = Eigen::Vector3d(d.u(0.5, 1.5), d.u(0.5, 1.5), d.u(0.2, 0.5)), t.phase_deg = d.u(0, 360);
+    t.freq_hz = d.u(30.0, 60.0), t.amp_mg = Eigen::Vector3d(d.u(0.5, 1.5), d.u(0.5, 1.5), d.u(0.2, 0.5)),
+    t.phase_deg = d.u(0, 360);
     sc.differential_tones = {t};
   } else if (e == "machine.backlash") {
     m.backlash_um[moving_axis(sc, d)] = d.u(3.0, 10.0);
@@ -199,8 +209,10 @@ void inject(Scenario& sc, const std::string& e, Draw& d) {
     m.cyclic[moving_axis(sc, d)] = CyclicError{d.u(1.0, 3.0), d.pick(2) ? 5.0 : 10.0, d.u(0.0, 360.0)};
   } else if (e == "machine.straightness") {
     const int a = moving_axis(sc, d);
-    const double span = sc.meta.program.kind == "circle" ? sc.meta.program.radius_mm : sc.meta.program.targets_mm.back();
-    m.straightness[a] = Straightness{a == 0 ? 1 : 0, d.mag(2.0, 5.0), {sc.meta.program.kind == "circle" ? -span : 0.0, span}};
+    const double span =
+        sc.meta.program.kind == "circle" ? sc.meta.program.radius_mm : sc.meta.program.targets_mm.back();
+    m.straightness[a] =
+        Straightness{a == 0 ? 1 : 0, d.mag(2.0, 5.0), {sc.meta.program.kind == "circle" ? -span : 0.0, span}};
   } else if (e == "machine.stick_slip") {
     m.stick_slip[moving_axis(sc, d)] = StickSlip{d.u(1.0, 3.0), d.u(100.0, 200.0), 2.0};
   } else if (e == "machine.resonance") {
@@ -212,7 +224,8 @@ void inject(Scenario& sc, const std::string& e, Draw& d) {
     mode.frequency_hz = d.u(30.0, 120.0), mode.damping_ratio = d.u(0.01, 0.05), mode.gain = d.u(0.05, 0.2);
     mode.direction = Eigen::Vector3d::Unit(a);
     sc.resonance.modes = {mode};
-    sc.resonance.part = std::find(head.begin(), head.end(), std::string(1, static_cast<char>('x' + a))) != head.end() ? 1 : 0;
+    sc.resonance.part =
+        std::find(head.begin(), head.end(), std::string(1, static_cast<char>('x' + a))) != head.end() ? 1 : 0;
   } else {
     throw dsp::InputError("hidden effects: unknown effect '" + e + "'");
   }
@@ -229,9 +242,16 @@ const std::vector<std::string>& hidden_programs() {
 const std::vector<std::string>& hideable_effects() { return effect_names(); }
 
 std::string program_for(const std::string& e) {
-  static const std::vector<std::string> step = {"sensor.scale", "sensor.bias_drift", "sensor.nonlinearity", "sensor.dynamics",
-                                                "sensor.damping_amplitude", "sensor.scale_temperature", "machine.common_vibration",
-                                                "machine.differential_vibration", "machine.scale_mismatch", "site.coriolis",
+  static const std::vector<std::string> step = {"sensor.scale",
+                                                "sensor.bias_drift",
+                                                "sensor.nonlinearity",
+                                                "sensor.dynamics",
+                                                "sensor.damping_amplitude",
+                                                "sensor.scale_temperature",
+                                                "machine.common_vibration",
+                                                "machine.differential_vibration",
+                                                "machine.scale_mismatch",
+                                                "site.coriolis",
                                                 "machine.resonance"};
   return std::find(step.begin(), step.end(), e) != step.end() ? "step" : "circle";
 }
@@ -255,21 +275,23 @@ Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const s
   program(sc, kind, dp, has("sensor.damping_amplitude") || has("sensor.nonlinearity"));
   background(sc, d);
   // Cross coupling differs from a rotated mounting only where one sensor moves two axes.
-  if (has("sensor.cross_coupling"))
-    sc.meta.machine.table_axes = {"x", "y"}, sc.meta.machine.head_axes = {"z"};
+  if (has("sensor.cross_coupling")) sc.meta.machine.table_axes = {"x", "y"}, sc.meta.machine.head_axes = {"z"};
   for (const auto& e : effects) {
     // Each effect from its own stream: its size does not depend on what else is hidden.
     const auto& names = hideable_effects();
-    Draw de(stream_seed(seed, 7100 + static_cast<std::uint64_t>(std::find(names.begin(), names.end(), e) - names.begin())));
+    Draw de(
+        stream_seed(seed, 7100 + static_cast<std::uint64_t>(std::find(names.begin(), names.end(), e) - names.begin())));
     inject(sc, e, de);
     sc.effects_present.push_back(e);
-    sc.effects_background.erase(std::remove(sc.effects_background.begin(), sc.effects_background.end(), e), sc.effects_background.end());
+    sc.effects_background.erase(std::remove(sc.effects_background.begin(), sc.effects_background.end(), e),
+                                sc.effects_background.end());
   }
   std::string name = effects.empty() ? "baseline" : effects.front();
   for (std::size_t i = 1; i < effects.size(); ++i) name += "+" + effects[i];
   sc.name = name;
   sc.meta.id = "hidden-" + name + "-" + kind + "-s" + std::to_string(seed);
-  sc.description = (effects.empty() ? std::string("no effect") : name) + " hidden among tolerance-level deviations, " + kind + " program";
+  sc.description = (effects.empty() ? std::string("no effect") : name) + " hidden among tolerance-level deviations, " +
+                   kind + " program";
   return sc;
 }
 

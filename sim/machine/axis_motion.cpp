@@ -21,8 +21,8 @@ AxisMotion::AxisMotion(const MachineErrors& e, int axis, double step_s, double s
       prev_vel_mm_s_(0.0),
       // The play starts taken up in + (the last approach was in the positive direction).
       slide_mm_(start_mm - backlash_mm_ / 2.0) {
-  active_ = servo_.kv_per_s > 0.0 || backlash_mm_ != 0.0 || spike_mm_ != 0.0 || cyclic_.amp_um != 0.0 || scale_ != 0.0 ||
-            ss_.amp_um != 0.0;
+  active_ = servo_.kv_per_s > 0.0 || backlash_mm_ != 0.0 || spike_mm_ != 0.0 || cyclic_.amp_um != 0.0 ||
+            scale_ != 0.0 || ss_.amp_um != 0.0;
   if (servo_.kv_per_s > 0.0) exp_kv_h_ = std::exp(-servo_.kv_per_s * h_);
 }
 
@@ -73,7 +73,8 @@ double AxisMotion::stick_slip(double vel) noexcept {
     if (ss_slip_t_s_ >= T) ss_slipping_ = false;
   } else if (creeping) {
     ss_lag_mm_ += vel * h_;
-    if (std::abs(ss_lag_mm_) >= amp) ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_v_mm_s_ = vel, ss_slip_t_s_ = 0.0;
+    if (std::abs(ss_lag_mm_) >= amp)
+      ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_v_mm_s_ = vel, ss_slip_t_s_ = 0.0;
   } else if (ss_lag_mm_ != 0.0) {
     ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_v_mm_s_ = vel, ss_slip_t_s_ = 0.0;  // fast: breaks free
   }
@@ -105,7 +106,8 @@ double AxisMotion::step(double cmd, double vel) noexcept {
   if (ss_.amp_um != 0.0) dev += stick_slip(vel);
   if (scale_ != 0.0) dev += scale_ * cmd;
   if (cyclic_.amp_um != 0.0)
-    dev += cyclic_.amp_um * 1e-3 * std::sin(2.0 * std::numbers::pi * cmd / cyclic_.pitch_mm + cyclic_.phase_deg * std::numbers::pi / 180.0);
+    dev += cyclic_.amp_um * 1e-3 *
+           std::sin(2.0 * std::numbers::pi * cmd / cyclic_.pitch_mm + cyclic_.phase_deg * std::numbers::pi / 180.0);
   return dev;
 }
 

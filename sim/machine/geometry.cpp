@@ -19,7 +19,8 @@ Eigen::Vector3d geometric_deviation_mm(const MachineErrors& e, int axis, const E
 
 bool has_geometric_errors(const MachineErrors& e) noexcept {
   for (int i = 0; i < 3; ++i)
-    if (e.squareness_urad[i] != 0.0 || (e.straightness[i].direction >= 0 && e.straightness[i].bow_um != 0.0)) return true;
+    if (e.squareness_urad[i] != 0.0 || (e.straightness[i].direction >= 0 && e.straightness[i].bow_um != 0.0))
+      return true;
   return false;
 }
 

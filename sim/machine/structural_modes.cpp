@@ -10,7 +10,8 @@ StructuralModesResponse::StructuralModesResponse(const std::vector<StructuralMod
   for (const StructuralMode& m : modes) {
     if (m.gain == 0.0) continue;
     if (!(m.frequency_hz > 0.0) || !(m.damping_ratio > 0.0) || !(m.direction.norm() > 0.0))
-      throw dsp::InputError("machine.resonance: a mode needs a positive frequency, a positive damping ratio and a direction");
+      throw dsp::InputError(
+          "machine.resonance: a mode needs a positive frequency, a positive damping ratio and a direction");
     const double w = 2.0 * std::numbers::pi * m.frequency_hz;
     modes_.push_back({m.direction.normalized(), -m.gain / (w * w), Pt2(m.frequency_hz, m.damping_ratio, h)});
   }

@@ -40,7 +40,8 @@ Biquad Biquad::highpass(double fc, double fs) {
   return b;
 }
 
-CommonAcceleration::CommonAcceleration(const CommonVibration& vib, double g, double h, int decimation, std::uint64_t seed)
+CommonAcceleration::CommonAcceleration(const CommonVibration& vib, double g, double h, int decimation,
+                                       std::uint64_t seed)
     : vib_(vib), g_(g), rng_(seed), decimation_(std::max(1, decimation)) {
   for (const auto& tone : vib.tones) {
     const double ph = tone.phase_deg * std::numbers::pi / 180.0, dph = 2.0 * std::numbers::pi * tone.freq_hz * h;

@@ -68,7 +68,8 @@ std::vector<AccelSegment> current_segments(const KlipperTest& k) {
     last_t = e.t_end_s;
   }
   // run_test: "Decelerate to a stop, continuing in the direction of motion" at max_accel.
-  if (std::abs(v) > 1e-6) seg.push_back({std::abs(v) / k.stop_accel_mm_s2, v > 0.0 ? -k.stop_accel_mm_s2 : k.stop_accel_mm_s2});
+  if (std::abs(v) > 1e-6)
+    seg.push_back({std::abs(v) / k.stop_accel_mm_s2, v > 0.0 ? -k.stop_accel_mm_s2 : k.stop_accel_mm_s2});
   return seg;
 }
 
@@ -105,9 +106,11 @@ std::string KlipperTest::invalid_reason() const {
   if (!(freq_end_hz <= 300.0)) return "freq_end must not exceed 300 Hz (Klipper's limit)";
   if (!(accel_per_hz > 0.0)) return "accel_per_hz must be positive";
   if (!(hz_per_sec > 0.0 && hz_per_sec <= 2.0)) return "hz_per_sec must be in (0, 2] (Klipper's limit)";
-  if (!(sweeping_accel_mm_s2 >= 0.0) || !(sweeping_period_s >= 0.0)) return "sweeping_accel and sweeping_period must not be negative";
+  if (!(sweeping_accel_mm_s2 >= 0.0) || !(sweeping_period_s >= 0.0))
+    return "sweeping_accel and sweeping_period must not be negative";
   if (!(stop_accel_mm_s2 > 0.0)) return "the stop acceleration (max_accel) must be positive";
-  if (legacy_moves && sweeping_accel_mm_s2 > 0.0 && sweeping_period_s > 0.0) return "the older Klipper test has no sweeping";
+  if (legacy_moves && sweeping_accel_mm_s2 > 0.0 && sweeping_period_s > 0.0)
+    return "the older Klipper test has no sweeping";
   return "";
 }
 
@@ -121,12 +124,15 @@ AccelProfileSetPoint::AccelProfileSetPoint(std::vector<AccelSegment> segments, c
                                            const Eigen::Vector3d& start_mm, double lead_in_s, double tail_s)
     : segments_(std::move(segments)), start_mm_(start_mm), lead_in_(lead_in_s) {
   if (segments_.empty()) throw dsp::InputError("acceleration profile: no segments");
-  if (!(direction.norm() > 0.0) || !direction.allFinite()) throw dsp::InputError("acceleration profile: the direction must be a non-zero vector");
-  if (!(lead_in_s >= 0.0) || !(tail_s >= 0.0)) throw dsp::InputError("acceleration profile: lead-in and tail must not be negative");
+  if (!(direction.norm() > 0.0) || !direction.allFinite())
+    throw dsp::InputError("acceleration profile: the direction must be a non-zero vector");
+  if (!(lead_in_s >= 0.0) || !(tail_s >= 0.0))
+    throw dsp::InputError("acceleration profile: lead-in and tail must not be negative");
   dir_ = direction.normalized();
   double t = 0.0, x = 0.0, v = 0.0;
   for (const AccelSegment& s : segments_) {
-    if (!(s.duration_s > 0.0) || !std::isfinite(s.accel_mm_s2)) throw dsp::InputError("acceleration profile: a segment has no duration or no finite acceleration");
+    if (!(s.duration_s > 0.0) || !std::isfinite(s.accel_mm_s2))
+      throw dsp::InputError("acceleration profile: a segment has no duration or no finite acceleration");
     t_start_.push_back(t), x_start_mm_.push_back(x), v_start_mm_s_.push_back(v);
     x += v * s.duration_s + 0.5 * s.accel_mm_s2 * s.duration_s * s.duration_s;
     v += s.accel_mm_s2 * s.duration_s;
@@ -168,7 +174,9 @@ double AccelProfileSetPoint::accel_mm_s2(double t_s) const {
   return segments_[segment_at(tau)].accel_mm_s2;
 }
 
-std::vector<std::pair<double, double>> AccelProfileSetPoint::move_spans_s() const { return {{lead_in_, lead_in_ + motion_s()}}; }
+std::vector<std::pair<double, double>> AccelProfileSetPoint::move_spans_s() const {
+  return {{lead_in_, lead_in_ + motion_s()}};
+}
 
 Eigen::Vector3d test_direction(const std::string& axis, const std::string& what) {
   if (axis == "x" || axis == "X") return Eigen::Vector3d::UnitX();

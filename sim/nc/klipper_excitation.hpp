@@ -36,12 +36,12 @@ struct AccelSegment {
 struct KlipperTest {
   double freq_start_hz = 5.0;
   double freq_end_hz = 200.0;
-  double accel_per_hz = 60.0;            // mm/s² per Hz
+  double accel_per_hz = 60.0;  // mm/s² per Hz
   double hz_per_sec = 1.0;
-  double sweeping_accel_mm_s2 = 400.0;   // 0 (or a period of 0): no slow sweep
+  double sweeping_accel_mm_s2 = 400.0;  // 0 (or a period of 0): no slow sweep
   double sweeping_period_s = 1.2;
-  bool legacy_moves = false;             // the older executor (triangle moves out and back)
-  double stop_accel_mm_s2 = 5000.0;      // the printer's max_accel: the final stop after a sweep
+  bool legacy_moves = false;         // the older executor (triangle moves out and back)
+  double stop_accel_mm_s2 = 5000.0;  // the printer's max_accel: the final stop after a sweep
 
   // Klipper's defaults today, and those of the older releases (see above).
   static KlipperTest current();
@@ -59,8 +59,8 @@ std::vector<AccelSegment> klipper_segments(const KlipperTest& test);
 // M101 at t = 0 and M103 at the end.
 class AccelProfileSetPoint final : public SetPoint {
  public:
-  AccelProfileSetPoint(std::vector<AccelSegment> segments, const Eigen::Vector3d& direction, const Eigen::Vector3d& start_mm,
-                       double lead_in_s = 0.0, double tail_s = 0.0);
+  AccelProfileSetPoint(std::vector<AccelSegment> segments, const Eigen::Vector3d& direction,
+                       const Eigen::Vector3d& start_mm, double lead_in_s = 0.0, double tail_s = 0.0);
 
   [[nodiscard]] MotionState at(double t_s) const override;
   [[nodiscard]] const std::vector<TimedTrigger>& triggers() const override { return triggers_; }
@@ -69,7 +69,9 @@ class AccelProfileSetPoint final : public SetPoint {
 
   // Acceleration along the direction (mm/s²) at t: the commanded excitation.
   [[nodiscard]] double accel_mm_s2(double t_s) const;
-  [[nodiscard]] double motion_s() const { return t_start_.empty() ? 0.0 : t_start_.back() + segments_.back().duration_s; }
+  [[nodiscard]] double motion_s() const {
+    return t_start_.empty() ? 0.0 : t_start_.back() + segments_.back().duration_s;
+  }
   [[nodiscard]] double lead_in_s() const { return lead_in_; }
   [[nodiscard]] const Eigen::Vector3d& direction() const { return dir_; }
 

@@ -7,8 +7,8 @@
 
 namespace eical::sim::nc {
 
-SampledSetPoint::SampledSetPoint(std::vector<Eigen::Vector3d> pos_mm, double rate_hz, std::vector<TimedTrigger> triggers, double t0_s,
-                                 double still_mm)
+SampledSetPoint::SampledSetPoint(std::vector<Eigen::Vector3d> pos_mm, double rate_hz,
+                                 std::vector<TimedTrigger> triggers, double t0_s, double still_mm)
     : p_(std::move(pos_mm)), rate_(rate_hz), t0_(t0_s), triggers_(std::move(triggers)) {
   if (p_.size() < 2) throw dsp::InputError("sampled set-point: need at least 2 positions");
   if (!(rate_hz > 0.0)) throw dsp::InputError("sampled set-point: rate must be positive");
@@ -44,7 +44,8 @@ SampledSetPoint::SampledSetPoint(std::vector<Eigen::Vector3d> pos_mm, double rat
     if (!step && moving) moving = false, spans_.emplace_back(start, t);
   }
   if (moving) spans_.emplace_back(start, duration_);
-  std::sort(triggers_.begin(), triggers_.end(), [](const TimedTrigger& a, const TimedTrigger& b) { return a.t_s < b.t_s; });
+  std::sort(triggers_.begin(), triggers_.end(),
+            [](const TimedTrigger& a, const TimedTrigger& b) { return a.t_s < b.t_s; });
 }
 
 MotionState SampledSetPoint::at(double t_s) const {

@@ -13,8 +13,8 @@ namespace eical::sim::nc {
 class SampledSetPoint final : public SetPoint {
  public:
   // pos_mm[k] at t = t0_s + k / rate_hz; at least 2 samples. Triggers on the same clock.
-  SampledSetPoint(std::vector<Eigen::Vector3d> pos_mm, double rate_hz, std::vector<TimedTrigger> triggers, double t0_s = 0.0,
-                  double still_mm = 1e-7);
+  SampledSetPoint(std::vector<Eigen::Vector3d> pos_mm, double rate_hz, std::vector<TimedTrigger> triggers,
+                  double t0_s = 0.0, double still_mm = 1e-7);
 
   [[nodiscard]] MotionState at(double t_s) const override;
   [[nodiscard]] const std::vector<TimedTrigger>& triggers() const override { return triggers_; }

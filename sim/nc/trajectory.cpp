@@ -41,7 +41,8 @@ Eigen::Vector3d PathElement::curvature(double s) const {
   return k;
 }
 
-void PathElement::state(double s, double v, double a, Eigen::Vector3d& pos, Eigen::Vector3d& vel, Eigen::Vector3d& acc) const {
+void PathElement::state(double s, double v, double a, Eigen::Vector3d& pos, Eigen::Vector3d& vel,
+                        Eigen::Vector3d& acc) const {
   if (!is_arc) {
     const Eigen::Vector3d t = length_mm > 0 ? Eigen::Vector3d((to_mm - from_mm) / length_mm) : Eigen::Vector3d::Zero();
     pos = from_mm + t * s;
@@ -63,7 +64,8 @@ void PathElement::state(double s, double v, double a, Eigen::Vector3d& pos, Eige
   acc[axis_a] = ta * a + ka * v * v, acc[axis_b] = tb * a + kb * v * v, acc[axis_n] = dn * a;
 }
 
-Trajectory::Trajectory(std::vector<Move> moves, std::vector<TimedTrigger> triggers, Eigen::Vector3d start_mm, double duration_s)
+Trajectory::Trajectory(std::vector<Move> moves, std::vector<TimedTrigger> triggers, Eigen::Vector3d start_mm,
+                       double duration_s)
     : moves_(std::move(moves)), triggers_(std::move(triggers)), start_mm_(start_mm), duration_(duration_s) {}
 
 std::vector<std::pair<double, double>> Trajectory::move_spans_s() const {
@@ -82,8 +84,8 @@ MotionState Trajectory::at(double t) const {
   }
   const Move& m = *(it - 1);
   const PathState ps = m.profile.at(t - m.t0_s);
-  const auto k = static_cast<std::size_t>(
-      std::upper_bound(m.s_start_mm.begin(), m.s_start_mm.end(), ps.s) - m.s_start_mm.begin() - 1);
+  const auto k = static_cast<std::size_t>(std::upper_bound(m.s_start_mm.begin(), m.s_start_mm.end(), ps.s) -
+                                          m.s_start_mm.begin() - 1);
   const PathElement& e = m.elements[std::min(k, m.elements.size() - 1)];
   const double s = ps.s - m.s_start_mm[std::min(k, m.elements.size() - 1)];
   e.state(s, ps.v, ps.a, st.pos_mm, st.vel_mm_s, st.acc_mm_s2);
@@ -132,7 +134,7 @@ Trajectory interpolate(const gcode::Program& program, const Eigen::Vector3d& sta
 
   // The open chain of blended elements and the triggers waiting for their path position.
   std::vector<PathElement> chain;
-  double chain_feed = 0.0;  // mm/s, the lowest feed and arc speed limit in the chain
+  double chain_feed = 0.0;                             // mm/s, the lowest feed and arc speed limit in the chain
   std::vector<std::pair<double, int>> chain_triggers;  // (path position, code)
   double chain_len = 0.0;
 
@@ -173,8 +175,10 @@ Trajectory interpolate(const gcode::Program& program, const Eigen::Vector3d& sta
       continue;
     }
     if (const auto* tr = std::get_if<gcode::Trigger>(&block)) {
-      if (chain.empty()) triggers.push_back({t, tr->code});
-      else chain_triggers.emplace_back(chain_len, tr->code);
+      if (chain.empty())
+        triggers.push_back({t, tr->code});
+      else
+        chain_triggers.emplace_back(chain_len, tr->code);
       continue;
     }
     PathElement e;
@@ -188,7 +192,8 @@ Trajectory interpolate(const gcode::Program& program, const Eigen::Vector3d& sta
       // Centripetal acceleration v²/r must stay within the machine's limit.
       feed_mm_s = std::min(a.feed_mm_min / 60.0, std::sqrt(lim.a_max_mm_s2 * e.radius_mm));
     }
-    if (!(feed_mm_s > 0.0)) throw dsp::InputError("interpolator: a move without feed (F word missing) at block " + std::to_string(i + 1));
+    if (!(feed_mm_s > 0.0))
+      throw dsp::InputError("interpolator: a move without feed (F word missing) at block " + std::to_string(i + 1));
     if (e.length_mm <= 1e-12) continue;  // e.g. the G0 to where the machine already is
     // Blend into the open chain only in G64 and where the path is tangent-continuous.
     if (!chain.empty()) {

@@ -18,10 +18,14 @@ double covered(double lo, double hi, double sigma) {
 }  // namespace
 
 PsdStrip::PsdStrip(const dsp::PsdSpec& spec, const PsdTruth& truth, double h) : spec_(spec), truth_(truth) {
-  if (spec.measures == "x") along_ = 0, across_ = 1;
-  else if (spec.measures == "y") along_ = 1, across_ = 0;
-  else throw dsp::InputError("psd: measures must be \"x\" or \"y\", got \"" + spec.measures + "\"");
-  if (!(spec.length_mm > 0.0) || !(spec.width_mm > 0.0)) throw dsp::InputError("psd: length_mm and width_mm must be positive");
+  if (spec.measures == "x")
+    along_ = 0, across_ = 1;
+  else if (spec.measures == "y")
+    along_ = 1, across_ = 0;
+  else
+    throw dsp::InputError("psd: measures must be \"x\" or \"y\", got \"" + spec.measures + "\"");
+  if (!(spec.length_mm > 0.0) || !(spec.width_mm > 0.0))
+    throw dsp::InputError("psd: length_mm and width_mm must be positive");
   sigma_mm_ = std::max(truth.spot_mm, 1e-6) / 4.0;  // 1/e² diameter = 4σ
   alpha_ = spec.lockin_tau_s > 0.0 ? 1.0 - std::exp(-h / spec.lockin_tau_s) : 1.0;
   h_ = h;

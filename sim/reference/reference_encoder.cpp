@@ -10,7 +10,8 @@ double reference_reading_mm(const ReferenceTruth& ref, int axis, double p_mm) no
   const double phase = 2.0 * std::numbers::pi * p_mm * 1e3 / ref.signal_period_um;
   for (int h = 0; h < 2; ++h)
     if (ref.interp_nm[axis][h] != 0.0)
-      nm += ref.interp_nm[axis][h] * std::sin((h + 1) * phase + ref.interp_phase_deg[axis][h] * std::numbers::pi / 180.0);
+      nm +=
+          ref.interp_nm[axis][h] * std::sin((h + 1) * phase + ref.interp_phase_deg[axis][h] * std::numbers::pi / 180.0);
   if (ref.resolution_nm > 0.0) nm = std::round(nm / ref.resolution_nm) * ref.resolution_nm;
   return nm * 1e-6;
 }

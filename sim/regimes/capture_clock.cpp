@@ -11,8 +11,10 @@ namespace eical::sim {
 
 CaptureSamples capture_samples(const CaptureClock& c, std::size_t n, double fs) {
   if (!(fs > 0.0) || n < 2) throw dsp::InputError("capture clock: need at least two samples and a positive rate");
-  if (c.batch < 1 || c.lost_batches < 0) throw dsp::InputError("capture clock: batch must be >= 1 and lost_batches >= 0");
-  if (!(c.jitter_rms_s >= 0.0) || !std::isfinite(c.offset_s)) throw dsp::InputError("capture clock: jitter must not be negative, the offset finite");
+  if (c.batch < 1 || c.lost_batches < 0)
+    throw dsp::InputError("capture clock: batch must be >= 1 and lost_batches >= 0");
+  if (!(c.jitter_rms_s >= 0.0) || !std::isfinite(c.offset_s))
+    throw dsp::InputError("capture clock: jitter must not be negative, the offset finite");
   const std::size_t batch = static_cast<std::size_t>(c.batch), n_batches = (n + batch - 1) / batch;
   std::mt19937_64 rng(stream_seed(c.seed, 9001));
   std::vector<bool> lost_batch(n_batches, false);
@@ -20,7 +22,8 @@ CaptureSamples capture_samples(const CaptureClock& c, std::size_t n, double fs) 
     std::vector<std::size_t> inner(n_batches - 2);
     for (std::size_t b = 0; b < inner.size(); ++b) inner[b] = b + 1;
     std::shuffle(inner.begin(), inner.end(), rng);
-    for (std::size_t k = 0; k < std::min<std::size_t>(inner.size(), static_cast<std::size_t>(c.lost_batches)); ++k) lost_batch[inner[k]] = true;
+    for (std::size_t k = 0; k < std::min<std::size_t>(inner.size(), static_cast<std::size_t>(c.lost_batches)); ++k)
+      lost_batch[inner[k]] = true;
   }
   std::normal_distribution<double> unit(0.0, 1.0);
   const double clip = 0.4 / fs;
@@ -30,7 +33,8 @@ CaptureSamples capture_samples(const CaptureClock& c, std::size_t n, double fs) 
   double sum2 = 0.0;
   std::size_t kept = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    const double j = std::clamp(c.jitter_rms_s * unit(rng), -clip, clip);  // drawn for every frame: a lost batch shifts no other draw
+    const double j = std::clamp(c.jitter_rms_s * unit(rng), -clip,
+                                clip);  // drawn for every frame: a lost batch shifts no other draw
     // The first and last sample stay on the grid: the capture spans the run exactly.
     out.jitter_s[k] = (k == 0 || k + 1 == n) ? 0.0 : j;
     out.kept[k] = !lost_batch[k / batch];

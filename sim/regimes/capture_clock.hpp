@@ -24,7 +24,7 @@ struct CaptureSamples {
   std::vector<double> jitter_s;  // per frame: true sampling time − n/fs (0 at the ends)
   std::vector<bool> kept;        // false: lost with its batch
   std::size_t lost = 0;
-  double jitter_rms_s = 0.0;     // rms of the jitter of the kept samples
+  double jitter_rms_s = 0.0;  // rms of the jitter of the kept samples
   [[nodiscard]] double stamp_s(std::size_t n, double fs_hz, const CaptureClock& clock) const {
     return clock.offset_s + static_cast<double>(n) / fs_hz + jitter_s[n];
   }

@@ -24,8 +24,9 @@ struct ChipRate {
   const char* chip;
   double fs_hz;
 };
-constexpr ChipRate kChipRates[] = {{"adxl345", 3200.0}, {"adxl345", 1600.0}, {"adxl345", 800.0}, {"adxl345", 400.0}, {"lis2dw", 1600.0},
-                                   {"lis2dw", 800.0},   {"lis2dw", 400.0},   {"mpu6050", 1000.0}, {"mpu6050", 400.0}};
+constexpr ChipRate kChipRates[] = {{"adxl345", 3200.0}, {"adxl345", 1600.0}, {"adxl345", 800.0},
+                                   {"adxl345", 400.0},  {"lis2dw", 1600.0},  {"lis2dw", 800.0},
+                                   {"lis2dw", 400.0},   {"mpu6050", 1000.0}, {"mpu6050", 400.0}};
 
 // Mountings a user can state wrongly: a 180° turn about z, a swap (mirror), one axis
 // negated (mirror), a 90° turn about z, the board upside down (180° about x).
@@ -41,7 +42,8 @@ const std::vector<std::string>& klipper_like_effects() {
 Scenario klipper_like_scenario(const std::vector<std::string>& effects, std::uint64_t seed) {
   for (const auto& e : effects)
     if (std::find(klipper_like_effects().begin(), klipper_like_effects().end(), e) == klipper_like_effects().end())
-      throw dsp::InputError(std::string("regime ") + kKlipperLike + ": cannot hide '" + e + "' (it hides machine.resonance and sensor.misalignment)");
+      throw dsp::InputError(std::string("regime ") + kKlipperLike + ": cannot hide '" + e +
+                            "' (it hides machine.resonance and sensor.misalignment)");
   Draw d(stream_seed(seed, 8001));
   const bool legacy = d.pick(2) == 0;
   nc::KlipperTest test = legacy ? nc::KlipperTest::legacy() : nc::KlipperTest::current();
@@ -55,7 +57,8 @@ Scenario klipper_like_scenario(const std::vector<std::string>& effects, std::uin
   sc.meta.site.latitude_deg = d.u(35.0, 60.0), sc.meta.site.heading_deg = d.u(0.0, 360.0);
   sc.coriolis = true;
   const ChipRate cr = kChipRates[d.pick(static_cast<int>(std::size(kChipRates)))];
-  apply_mems(sc, mems_chip(cr.chip), cr.fs_hz, Eigen::Vector3d(d.mag(1e-3, 5e-3), d.mag(1e-3, 5e-3), d.mag(1e-3, 5e-3)));
+  apply_mems(sc, mems_chip(cr.chip), cr.fs_hz,
+             Eigen::Vector3d(d.mag(1e-3, 5e-3), d.mag(1e-3, 5e-3), d.mag(1e-3, 5e-3)));
   set_sensors_present(sc, "head");
   // Each hideable effect from its own stream: its draw does not depend on the other.
   auto has = [&](const char* e) { return std::find(effects.begin(), effects.end(), e) != effects.end(); };
@@ -79,8 +82,16 @@ Scenario klipper_like_scenario(const std::vector<std::string>& effects, std::uin
   // Appended piecewise: GCC 12 at -O2 warns falsely (-Warray-bounds) on chained operator+.
   sc.name = std::string(kKlipperLike).append(":").append(name);
   sc.meta.id = std::string(kKlipperLike).append("-").append(name).append("-s").append(std::to_string(seed));
-  sc.description = std::string(kKlipperLike).append(" regime: ").append(cr.chip).append(" at ").append(std::to_string(static_cast<int>(cr.fs_hz)));
-  sc.description.append(" Hz on the head, ").append(legacy ? "older" : "current").append(" Klipper test on ").append(axis == 0 ? "x, " : "y, ").append(name);
+  sc.description = std::string(kKlipperLike)
+                       .append(" regime: ")
+                       .append(cr.chip)
+                       .append(" at ")
+                       .append(std::to_string(static_cast<int>(cr.fs_hz)));
+  sc.description.append(" Hz on the head, ")
+      .append(legacy ? "older" : "current")
+      .append(" Klipper test on ")
+      .append(axis == 0 ? "x, " : "y, ")
+      .append(name);
   return sc;
 }
 

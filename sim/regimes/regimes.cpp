@@ -24,8 +24,10 @@ void set_daq_rate(Scenario& sc, double fs_hz) {
 void apply_mems(Scenario& sc, const MemsChip& chip, double fs_hz, const Eigen::Vector3d& bias_g) {
   const double fs = fs_hz > 0.0 ? fs_hz : chip.fs_hz;
   if (!(fs >= 100.0 && fs <= 51200.0)) throw dsp::InputError("MEMS: the output data rate must be 100 Hz .. 51.2 kHz");
-  if (chip.bits < 8 || chip.bits > 24 || !(chip.range_g > 0.0) || !(chip.bandwidth_hz > 0.0) || !(chip.noise_ug_per_rthz >= 0.0))
-    throw dsp::InputError("MEMS chip '" + chip.name + "': bits 8..24, a positive range and bandwidth and a noise density are needed");
+  if (chip.bits < 8 || chip.bits > 24 || !(chip.range_g > 0.0) || !(chip.bandwidth_hz > 0.0) ||
+      !(chip.noise_ug_per_rthz >= 0.0))
+    throw dsp::InputError("MEMS chip '" + chip.name +
+                          "': bits 8..24, a positive range and bandwidth and a noise density are needed");
   auto& acq = sc.meta.acquisition;
   acq.fs_hz = fs;
   acq.adc_bits = chip.bits;
@@ -64,8 +66,8 @@ Scenario sweep_scenario(const nc::KlipperTest& test, const Eigen::Vector3d& dire
   Scenario sc;
   sc.name = "sweep";
   sc.seed = seed;
-  sc.description = "Klipper resonance test " + std::to_string(test.freq_start_hz) + " .. " + std::to_string(test.freq_end_hz) +
-                   " Hz, no standstill, ideal machine";
+  sc.description = "Klipper resonance test " + std::to_string(test.freq_start_hz) + " .. " +
+                   std::to_string(test.freq_end_hz) + " Hz, no standstill, ideal machine";
   sc.meta.id = "sim-sweep-s" + std::to_string(seed);
   sc.meta.program.kind = "freeform";
   // The test's peak speed as the program's feed (run.toml needs a positive one).

@@ -22,10 +22,11 @@ void set_daq_rate(Scenario& scenario, double fs_hz);
 // (k1 = 1 V/g; the ADC counts are the chip's own LSBs of range/2^(bits−1) g), no DAQ
 // anti-alias filter and no group delay, noise and bandwidth from the chip, sampled at
 // fs_hz (0: the chip's own rate; the corner where the chip puts it at that rate: ODR/2
-// for adxl345 and lis2dw, 260 Hz for the mpu6050, which at 400 Hz lies above Nyquist). The true bias is the data sheet's 0 plus
-// `bias_g` (a few mg on a real chip). Oversampling keeps the internal grid ≥ 20× the
-// corner so the aliasing is the chip's, not the simulator's.
-void apply_mems(Scenario& scenario, const MemsChip& chip, double fs_hz = 0.0, const Eigen::Vector3d& bias_g = Eigen::Vector3d::Zero());
+// for adxl345 and lis2dw, 260 Hz for the mpu6050, which at 400 Hz lies above Nyquist). The true bias is the data
+// sheet's 0 plus `bias_g` (a few mg on a real chip). Oversampling keeps the internal grid ≥ 20× the corner so the
+// aliasing is the chip's, not the simulator's.
+void apply_mems(Scenario& scenario, const MemsChip& chip, double fs_hz = 0.0,
+                const Eigen::Vector3d& bias_g = Eigen::Vector3d::Zero());
 
 // Sensor `sensor` (0 table, 1 head) is truly mounted as `axes_map` (Klipper notation,
 // sim/sensor/axes_map) applied to what run.toml states: a sign flip, a swap, a mirror.

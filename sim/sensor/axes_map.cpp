@@ -21,7 +21,8 @@ Eigen::Matrix3d axes_map_matrix(std::string_view map, const std::string& what) {
     while (!item.empty() && item.front() == ' ') item.remove_prefix(1);
     while (!item.empty() && item.back() == ' ') item.remove_suffix(1);
     double sign = 1.0;
-    if (!item.empty() && (item.front() == '-' || item.front() == '+')) sign = item.front() == '-' ? -1.0 : 1.0, item.remove_prefix(1);
+    if (!item.empty() && (item.front() == '-' || item.front() == '+'))
+      sign = item.front() == '-' ? -1.0 : 1.0, item.remove_prefix(1);
     if (item.size() != 1 || item[0] < 'x' || item[0] > 'z') return fail("'" + std::string(item) + "' is not x, y or z");
     const int col = item[0] - 'x';
     if (used[col]) return fail(std::string(1, item[0]) + " appears twice");

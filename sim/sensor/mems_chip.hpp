@@ -23,11 +23,11 @@ namespace eical::sim {
 
 struct MemsChip {
   std::string name;
-  double fs_hz = 0.0;              // output data rate Klipper runs it at
-  int bits = 16;                   // resolution over ±range_g
+  double fs_hz = 0.0;  // output data rate Klipper runs it at
+  int bits = 16;       // resolution over ±range_g
   double range_g = 16.0;
-  double noise_ug_per_rthz = 0.0;  // two-sided (run-format.md)
-  double bandwidth_hz = 0.0;       // internal low-pass corner at fs_hz
+  double noise_ug_per_rthz = 0.0;      // two-sided (run-format.md)
+  double bandwidth_hz = 0.0;           // internal low-pass corner at fs_hz
   bool bandwidth_follows_odr = false;  // the corner is ODR/2 at any rate (adxl345, lis2dw)
   [[nodiscard]] double lsb_g() const { return 2.0 * range_g / static_cast<double>(1LL << bits); }
   // The corner when the chip runs at `odr_hz`.

@@ -48,8 +48,10 @@ void sense(std::array<std::vector<double>, 3>& a, const SensorTruth& s, double h
   if (a[1].size() != a[0].size() || a[2].size() != a[0].size() || a[0].empty())
     throw dsp::InputError("sensor model: the three axes need the same, non-zero number of samples");
   for (auto& axis : a) {
-    if (s.zeta_per_g != 0.0) pt2_amplitude_damped(axis, s.spec.f0_hz, s.spec.zeta, s.zeta_per_g, h);
-    else pt2_constant(axis, s.spec.f0_hz, s.spec.zeta, h);
+    if (s.zeta_per_g != 0.0)
+      pt2_amplitude_damped(axis, s.spec.f0_hz, s.spec.zeta, s.zeta_per_g, h);
+    else
+      pt2_constant(axis, s.spec.f0_hz, s.spec.zeta, h);
   }
   // (6-4) without bias and noise: a_i + k2 a_i² + k3 a_i³ + Σ_j kx_ij a_j + Σ_j kxx_ij a_i a_j.
   const Eigen::Vector3d& k2 = s.spec.k2_g_per_g2;

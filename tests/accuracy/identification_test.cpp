@@ -20,7 +20,8 @@ namespace {
 // u = k1_true (I + kx) T_true⁻¹ a, compensated with the data sheet (k1, T).
 Eigen::Matrix3d true_error(const sim::SensorTruth& t, const dsp::SensorSpec& sheet) {
   const Eigen::Vector3d ratio = t.spec.k1_v_per_g.cwiseQuotient(sheet.k1_v_per_g);
-  return sheet.to_machine * ratio.asDiagonal() * (Eigen::Matrix3d::Identity() + t.k_cross_g_per_g) * t.spec.to_machine.inverse() -
+  return sheet.to_machine * ratio.asDiagonal() * (Eigen::Matrix3d::Identity() + t.k_cross_g_per_g) *
+             t.spec.to_machine.inverse() -
          Eigen::Matrix3d::Identity();
 }
 
@@ -30,7 +31,9 @@ TEST(Identification, RecoversScaleMountingCrossTermsAndDampingWithinTheirUncerta
   sim::Scenario sc = sim::identify_scenario(sim::psd_config_b(10.0), {"z"}, 4);
   auto& t = sc.truth[0];
   t.spec.k1_v_per_g[0] *= 1.004, t.spec.k1_v_per_g[1] *= 0.997;
-  t.spec.to_machine = (Eigen::AngleAxisd(0.004, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.002, Eigen::Vector3d::UnitX())).toRotationMatrix();
+  t.spec.to_machine =
+      (Eigen::AngleAxisd(0.004, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.002, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   t.k_cross_g_per_g(0, 1) = 1e-3;
   t.spec.f0_hz = 920.0, t.spec.zeta = 0.6;
   sc.truth[1].spec.k1_v_per_g[2] *= 1.003;
@@ -47,7 +50,8 @@ TEST(Identification, RecoversScaleMountingCrossTermsAndDampingWithinTheirUncerta
         const auto& est = se.error[i][j];
         if (!est.fitted) continue;
         ++fitted;
-        EXPECT_NEAR(est.value, e(i, j), std::max(4.0 * est.sigma, 30e-6)) << "sensor " << s << " E(" << i << "," << j << ")";
+        EXPECT_NEAR(est.value, e(i, j), std::max(4.0 * est.sigma, 30e-6))
+            << "sensor " << s << " E(" << i << "," << j << ")";
         EXPECT_LT(est.sigma, 1e-4);
       }
     EXPECT_EQ(fitted, s == 0 ? 6 : 3);  // the table carries x and y, the head z
@@ -120,11 +124,13 @@ TEST(Identification, TheCalibrationCarriesACovarianceWithinTheDataSheetsToleranc
   // measures, the strips' nonlinearity), well below the data sheet's.
   const int xx = dsp::uncertainty::error_index(0, 0, 0), xy = dsp::uncertainty::error_index(0, 0, 1);
   EXPECT_NEAR(id.covariance.sigma(xy), 1.5 * id.sensor[0].error[0][1].sigma, 1e-12);
-  EXPECT_NEAR(id.covariance.covariance(xx, xx), std::pow(1.5 * id.sensor[0].error[0][0].sigma, 2) + dsp::uncertainty::strip_nonlinearity_scale_variance(),
+  EXPECT_NEAR(id.covariance.covariance(xx, xx),
+              std::pow(1.5 * id.sensor[0].error[0][0].sigma, 2) + dsp::uncertainty::strip_nonlinearity_scale_variance(),
               1e-18);
   EXPECT_LT(id.covariance.sigma(xx), 0.2 * ds.sigma(xx));
   // Terms it did not fit keep the data sheet's.
-  EXPECT_DOUBLE_EQ(id.covariance.sigma(dsp::uncertainty::error_index(1, 0, 0)), ds.sigma(dsp::uncertainty::error_index(1, 0, 0)));
+  EXPECT_DOUBLE_EQ(id.covariance.sigma(dsp::uncertainty::error_index(1, 0, 0)),
+                   ds.sigma(dsp::uncertainty::error_index(1, 0, 0)));
   // A fitted term as uncertain as the circle's E_zx is reported as worse than the data sheet.
   dsp::identify::Identification bad = id;
   bad.sensor[0].error[2][0] = {-3778e-6, 14106e-6, true};

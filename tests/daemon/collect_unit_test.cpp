@@ -31,7 +31,8 @@ TEST(CollectUnit, RestartsAndSpoolsWhereItMayWrite) {
 }
 
 TEST(CollectUnit, PassesSystemdAnalyzeVerify) {
-  ASSERT_EQ(std::system("command -v systemd-analyze >/dev/null 2>&1"), 0) << "systemd-analyze not installed (scripts/deps.sh test)";
+  ASSERT_EQ(std::system("command -v systemd-analyze >/dev/null 2>&1"), 0)
+      << "systemd-analyze not installed (scripts/deps.sh test)";
   const fs::path dir = fs::temp_directory_path() / ("eical-collect-unit-" + std::to_string(std::random_device{}()));
   fs::create_directories(dir);
   std::string unit = read_file(kUnit);

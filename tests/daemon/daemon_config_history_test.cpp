@@ -31,7 +31,10 @@ std::string error_of(const std::string& text, eical::daemon::DaemonConfig* out =
 
 TEST(DaemonConfigHistory, EveryKeyIsRead) {
   eical::daemon::DaemonConfig c;
-  ASSERT_EQ(error_of("[history]\nenabled = true\ndb = \"postgresql://eical@server/eical\"\nspool_dir = \"/tmp/s\"\nretry_s = 5.0\n", &c), "");
+  ASSERT_EQ(error_of("[history]\nenabled = true\ndb = \"postgresql://eical@server/eical\"\nspool_dir = "
+                     "\"/tmp/s\"\nretry_s = 5.0\n",
+                     &c),
+            "");
   EXPECT_TRUE(c.history.enabled);
   EXPECT_EQ(c.history.db, "postgresql://eical@server/eical");
   EXPECT_EQ(c.history.spool_dir, "/tmp/s");
@@ -46,7 +49,8 @@ TEST(DaemonConfigHistory, BadValuesAreRefusedNamingTheKey) {
   EXPECT_NE(error_of("[history]\nspool_dir = \"\"\n").find("spool_dir"), std::string::npos);
   EXPECT_NE(error_of("[history]\nenable = true\n").find("enable"), std::string::npos);  // a typo is not ignored
   EXPECT_NE(error_of("[history]\nenabled = \"yes\"\n").find("enabled"), std::string::npos);
-  EXPECT_NE(error_of("[machine]\nname = \"\"\n[history]\nenabled = true\n").find("[machine] name is required"), std::string::npos);
+  EXPECT_NE(error_of("[machine]\nname = \"\"\n[history]\nenabled = true\n").find("[machine] name is required"),
+            std::string::npos);
 }
 
 TEST(DaemonConfigHistory, TheInstalledExampleKeepsAHistoryWhereTheServiceMayWrite) {

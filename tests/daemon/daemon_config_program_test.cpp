@@ -29,9 +29,12 @@ std::string load_error(const fs::path& cfg) {
 }
 
 TEST(DaemonConfigProgram, ReadsTheGenNcProgramTableWithItsGcode) {
-  const auto prog = temp("p.toml", "[program]\nkind = \"circle\"\nplane = \"xy\"\nfeed_mm_min = 2000.0\ncenter_mm = [0.0, 0.0]\n"
-                                   "radius_mm = 7.5\ndirection = \"cw\"\nrepeats = 3\ngcode = \"\"\"\nG17 G21 G90\nM101\nM103\nM2\n\"\"\"\n");
-  const auto cfg = temp("c.toml", "[source.sim]\nprogram_file = \"" + prog.string() + "\"\n[source.fault]\ngap_at_s = 2.5\ngap_frames = 10\n");
+  const auto prog =
+      temp("p.toml",
+           "[program]\nkind = \"circle\"\nplane = \"xy\"\nfeed_mm_min = 2000.0\ncenter_mm = [0.0, 0.0]\n"
+           "radius_mm = 7.5\ndirection = \"cw\"\nrepeats = 3\ngcode = \"\"\"\nG17 G21 G90\nM101\nM103\nM2\n\"\"\"\n");
+  const auto cfg = temp("c.toml", "[source.sim]\nprogram_file = \"" + prog.string() +
+                                      "\"\n[source.fault]\ngap_at_s = 2.5\ngap_frames = 10\n");
   const auto c = eical::daemon::load_daemon_config(cfg);
   ASSERT_TRUE(c.source.sim_program_loaded);
   EXPECT_EQ(c.source.sim_program_loaded->kind, "circle");

@@ -99,8 +99,8 @@ TEST(DaemonConfig, EveryKeyOfTheExampleIsRecognised) {
     std::string typo = text;
     typo.insert(eq, "_typo");
     const auto msg = error_of(typo);
-    const bool refused = msg.find("unknown key") != std::string::npos ||
-                         msg.find("required key is missing") != std::string::npos;
+    const bool refused =
+        msg.find("unknown key") != std::string::npos || msg.find("required key is missing") != std::string::npos;
     EXPECT_TRUE(refused) << "key at offset " << pos << ": " << msg;
     ++checked;
   }

@@ -114,7 +114,8 @@ TEST(FrameLoopRealTime, WholeMeasurementsAllocateNothingOnTheDspThread) {
     }
     // The evaluator returns the storage long before the next program ends in real time
     // (a swap of two vectors against seconds of 10 kHz frames); free-running, wait for it.
-    for (int i = 0; i < 2000 && returned.load() < jobs.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    for (int i = 0; i < 2000 && returned.load() < jobs.load(); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   t_counting = false;
   const std::size_t allocations = t_allocations;

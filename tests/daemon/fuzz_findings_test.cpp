@@ -28,7 +28,8 @@ std::string error_of(const std::string& input) {
 // gpio_lines = [1e10, ...]: the offset was converted to int before its range was checked,
 // undefined behaviour (UBSan: float-cast-overflow); the range is checked on the double now.
 TEST(DaemonConfigFuzz, GpioLineBeyondIntIsRefusedBeforeConversion) {
-  EXPECT_NE(error_of("review-gpio-line-beyond-int").find(":2: triggers.gpio_lines: line offsets must be integers within 0..65535"),
+  EXPECT_NE(error_of("review-gpio-line-beyond-int")
+                .find(":2: triggers.gpio_lines: line offsets must be integers within 0..65535"),
             std::string::npos);
 }
 

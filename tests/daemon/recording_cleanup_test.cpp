@@ -21,9 +21,9 @@ TEST(RecordingCleanup, TemporariesGoRunsStayAndUnevaluatedRunsAreListed) {
   const fs::path dir = fs::temp_directory_path() / ("eicald-cleanup-" + std::to_string(std::random_device{}()));
   file(dir / "eicald-A-0" / "run.toml");
   file(dir / "eicald-A-0" / "result.json");
-  file(dir / "eicald-B-5" / "run.toml");           // written, not evaluated
-  file(dir / "eicald-B-5" / "result.json.tmp");    // its result was being written
-  file(dir / ".eicald-C-9.tmp-123" / "run.toml");  // a run being written
+  file(dir / "eicald-B-5" / "run.toml");                    // written, not evaluated
+  file(dir / "eicald-B-5" / "result.json.tmp");             // its result was being written
+  file(dir / ".eicald-C-9.tmp-123" / "run.toml");           // a run being written
   file(dir / ".eicald-D-7.old-456" / "run.toml", "old D");  // moved aside, no replacement
   file(dir / ".eicald-D-7.old-456" / "result.json");
   file(dir / "eicald-E-3" / "run.toml");

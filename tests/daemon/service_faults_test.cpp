@@ -10,8 +10,8 @@
 #include "sim/scenario.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <sys/resource.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -50,7 +50,8 @@ DaemonConfig base_config(const fs::path& dir) {
 // Middle of the measurement (between M101 and M103) of the configured circle, in s.
 double mid_measurement_s(const DaemonConfig& c) {
   const auto sc = eical::sim::circle_scenario(c.source.sim_radius_mm, c.source.sim_feed_mm_min, c.source.sim_repeats);
-  const auto tr = eical::sim::nc::interpolate_gcode(eical::sim::gcode::program_gcode(sc.meta.program), "circle", sc.limits);
+  const auto tr =
+      eical::sim::nc::interpolate_gcode(eical::sim::gcode::program_gcode(sc.meta.program), "circle", sc.limits);
   double t101 = -1, t103 = -1;
   for (const auto& t : tr.triggers()) {
     if (t.code == 101 && t101 < 0) t101 = t.t_s;
@@ -69,7 +70,9 @@ std::vector<fs::path> runs_in(const fs::path& dir) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(dir, ec))
     if (e.is_directory() && e.path().filename().string()[0] != '.') out.push_back(e.path());
-  auto index = [](const fs::path& p) { return std::stoll(p.filename().string().substr(p.filename().string().rfind('-') + 1)); };
+  auto index = [](const fs::path& p) {
+    return std::stoll(p.filename().string().substr(p.filename().string().rfind('-') + 1));
+  };
   std::sort(out.begin(), out.end(), [&](const fs::path& a, const fs::path& b) { return index(a) < index(b); });
   return out;
 }

@@ -1,8 +1,8 @@
 // eicald's service loop with the simulated backend, free-running: one measurement is
 // recorded, written atomically with its result, and the result equals a fresh analysis
 // of the recorded run (what `eical analyze` prints).
-#include "daemon/config/daemon_config.hpp"
 #include "daemon/service/service.hpp"
+#include "daemon/config/daemon_config.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 

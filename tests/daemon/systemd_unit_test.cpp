@@ -12,8 +12,8 @@
 #include <random>
 #include <set>
 #include <sstream>
-#include <vector>
 #include <string>
+#include <vector>
 
 namespace {
 

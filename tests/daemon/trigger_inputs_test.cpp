@@ -60,7 +60,7 @@ TEST(GpioTrigger, LinesBecomeMCodesRisingEdgesOnlyAndBounceIsIgnored) {
   ScriptedGpio& gpio = *events;
   drivers::GpioTriggerInput in(std::move(events), {17, 27, 22}, 5'000'000);
   gpio.push({27, true, 1'000'000'000});
-  gpio.push({27, true, 1'002'000'000});  // 2 ms later: bounce
+  gpio.push({27, true, 1'002'000'000});   // 2 ms later: bounce
   gpio.push({17, false, 1'003'000'000});  // falling edge
   gpio.push({5, true, 1'004'000'000});    // a line that is not ours
   gpio.push({22, true, 1'010'000'000});

@@ -45,12 +45,23 @@ TEST(DdsBus, StatusAndLiveRoundTrip) {
   s.temp_table_c = 21.5f;
   s.time_ns = 42;
   // Every counter travels (each a different value: a swapped field shows).
-  std::uint64_t StatusMsg::*const counters[] = {
-      &StatusMsg::bad_frames,       &StatusMsg::live_overruns,          &StatusMsg::stamp_overruns,    &StatusMsg::dds_write_errors,
-      &StatusMsg::triggers_accepted, &StatusMsg::triggers_refused,      &StatusMsg::triggers_late,     &StatusMsg::trigger_events_ignored,
-      &StatusMsg::recorder_overflow, &StatusMsg::handoffs_deferred,     &StatusMsg::source_decode_errors, &StatusMsg::source_lost_samples,
-      &StatusMsg::source_dropped_frames, &StatusMsg::setpoint_samples,  &StatusMsg::setpoint_missing,  &StatusMsg::frames_flagged,
-      &StatusMsg::commands};
+  std::uint64_t StatusMsg::*const counters[] = {&StatusMsg::bad_frames,
+                                                &StatusMsg::live_overruns,
+                                                &StatusMsg::stamp_overruns,
+                                                &StatusMsg::dds_write_errors,
+                                                &StatusMsg::triggers_accepted,
+                                                &StatusMsg::triggers_refused,
+                                                &StatusMsg::triggers_late,
+                                                &StatusMsg::trigger_events_ignored,
+                                                &StatusMsg::recorder_overflow,
+                                                &StatusMsg::handoffs_deferred,
+                                                &StatusMsg::source_decode_errors,
+                                                &StatusMsg::source_lost_samples,
+                                                &StatusMsg::source_dropped_frames,
+                                                &StatusMsg::setpoint_samples,
+                                                &StatusMsg::setpoint_missing,
+                                                &StatusMsg::frames_flagged,
+                                                &StatusMsg::commands};
   std::uint64_t value = 1000;
   for (auto c : counters) s.*c = ++value;
   // Reliable + volatile: publish until the reader has matched and taken one.

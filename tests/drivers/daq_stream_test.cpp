@@ -78,7 +78,8 @@ void expect_same_frames(const dsp::Run& run, const std::vector<dsp::Frame>& got)
     const dsp::Frame& b = got[i];
     ASSERT_EQ(b.sample_index, a.sample_index);
     for (int c = 0; c < 6; ++c) ASSERT_EQ(b.accel_counts[c], a.accel_counts[c]) << "sample " << i << " channel " << c;
-    for (std::size_t c = 0; c < 2 * run.meta.psd.size(); ++c) ASSERT_EQ(b.psd_counts[c], a.psd_counts[c]) << "sample " << i;
+    for (std::size_t c = 0; c < 2 * run.meta.psd.size(); ++c)
+      ASSERT_EQ(b.psd_counts[c], a.psd_counts[c]) << "sample " << i;
     ASSERT_EQ(b.trigger, a.trigger) << "sample " << i;
     triggers += a.trigger != 0;
     ASSERT_NEAR(b.temp_c[0], a.temp_c[0], 0.006f);  // 1/100 °C on the wire

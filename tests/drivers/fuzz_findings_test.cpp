@@ -56,7 +56,9 @@ TEST(DriversFuzz, AdcBitsBeyondIntIsRefusedNotNarrowed) {
   TempDir tmp;
   const fs::path dir = run_dir_of("review-adc-bits-beyond-int", tmp);
   const std::string what = error_of([&] { (void)eical::drivers::read_run(dir); });
-  EXPECT_NE(what.find((dir / "run.toml").string() + ":7: acquisition.adc_bits: integer 4294967312 is out of range"), std::string::npos) << what;
+  EXPECT_NE(what.find((dir / "run.toml").string() + ":7: acquisition.adc_bits: integer 4294967312 is out of range"),
+            std::string::npos)
+      << what;
 }
 
 // A PSD current of 1e300 V became llround(1e300 / lsb): an unspecified value cut to 32 bits,
@@ -65,10 +67,13 @@ TEST(DriversFuzz, AdcBitsBeyondIntIsRefusedNotNarrowed) {
 TEST(DriversFuzz, SampleValuesBeyondWhatTheDaqRecordsAreRefused) {
   TempDir tmp;
   std::string what = error_of([&] { (void)eical::drivers::read_run(run_dir_of("review-psd-beyond-adc", tmp)); });
-  EXPECT_NE(what.find("samples.csv:3: column 'psd0_i1': PSD value beyond the ADC's 32-bit range ('1e300')"), std::string::npos) << what;
+  EXPECT_NE(what.find("samples.csv:3: column 'psd0_i1': PSD value beyond the ADC's 32-bit range ('1e300')"),
+            std::string::npos)
+      << what;
   TempDir tmp2;
   what = error_of([&] { (void)eical::drivers::read_run(run_dir_of("review-temperature-beyond-float", tmp2)); });
-  EXPECT_NE(what.find("samples.csv:4: column 'table_temp': temperature beyond +-1000 C ('-1e300')"), std::string::npos) << what;
+  EXPECT_NE(what.find("samples.csv:4: column 'table_temp': temperature beyond +-1000 C ('-1e300')"), std::string::npos)
+      << what;
 }
 
 // An nc_csv input as fuzz/nc_csv.cpp reads it (byte 0: options; 1 = columns t, x, y, z by
@@ -93,14 +98,17 @@ std::string nc_trace_error(const std::string& input, const TempDir& tmp) {
 TEST(DriversFuzz, NcTraceWithAGapOfAGigasecondIsRefused) {
   TempDir tmp;
   const std::string what = nc_trace_error("review-gap-1e9-s", tmp);
-  EXPECT_NE(what.find("a gap of 999999999.997000 s after sample 4 loses more samples than the 5 recorded"), std::string::npos) << what;
+  EXPECT_NE(what.find("a gap of 999999999.997000 s after sample 4 loses more samples than the 5 recorded"),
+            std::string::npos)
+      << what;
 }
 
 // Two gaps of 5e18 samples each: the grid index overflowed int64 (UBSan: signed overflow).
 TEST(DriversFuzz, GapsWhoseIndicesWouldOverflowAreRefused) {
   TempDir tmp;
   const std::string what = nc_trace_error("review-gaps-overflow-index", tmp);
-  EXPECT_NE(what.find("loses more samples than the 7 recorded (time stamps in another unit?)"), std::string::npos) << what;
+  EXPECT_NE(what.find("loses more samples than the 7 recorded (time stamps in another unit?)"), std::string::npos)
+      << what;
 }
 
 }  // namespace

@@ -21,7 +21,9 @@ TEST(HardwareAbsent, UsbDaqSaysWhichDeviceIsMissing) {
   } catch (const SourceError& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("usb_daq"), std::string::npos) << m;
-    EXPECT_TRUE(m.find("no DAQ with USB id 1d50:6161") != std::string::npos || m.find("libusb_init") != std::string::npos) << m;
+    EXPECT_TRUE(m.find("no DAQ with USB id 1d50:6161") != std::string::npos ||
+                m.find("libusb_init") != std::string::npos)
+        << m;
   }
   EXPECT_THROW((void)parse_usb_id("1d50-6161"), SourceError);
 }
@@ -33,7 +35,9 @@ TEST(HardwareAbsent, CanSaysWhatIsMissing) {
   } catch (const std::runtime_error& e) {
     const std::string m = e.what();
     EXPECT_EQ(m.rfind("can: ", 0), 0u) << m;
-    EXPECT_TRUE(m.find("SocketCAN is not available") != std::string::npos || m.find("no CAN interface 'can0'") != std::string::npos) << m;
+    EXPECT_TRUE(m.find("SocketCAN is not available") != std::string::npos ||
+                m.find("no CAN interface 'can0'") != std::string::npos)
+        << m;
   }
 }
 

@@ -1,8 +1,8 @@
 // The program set-point (M101 P names a program; eical's interpolator reconstructs its
 // set-point) on simulated runs whose set-point was removed and whose marks were moved:
 // the alignment finds the motion again, and the cross-correlation finds a known lag.
-#include "drivers/setpoint/program_catalog.hpp"
 #include "drivers/setpoint/program_setpoint.hpp"
+#include "drivers/setpoint/program_catalog.hpp"
 #include "dsp/align/accel_lag.hpp"
 #include "dsp/core/error.hpp"
 #include "sim/simulate.hpp"
@@ -36,7 +36,8 @@ Pair circle_without_setpoint(int repeats = 2) {
 double max_cmd_error_um(const dsp::Run& a, const dsp::Run& b) {
   double worst = 0.0;
   for (std::size_t i = 0; i < a.frames.size(); ++i)
-    for (int k = 0; k < 3; ++k) worst = std::max(worst, std::abs(a.frames[i].cmd_mm[k] - b.frames[i].cmd_mm[k]) * 1000.0);
+    for (int k = 0; k < 3; ++k)
+      worst = std::max(worst, std::abs(a.frames[i].cmd_mm[k] - b.frames[i].cmd_mm[k]) * 1000.0);
   return worst;
 }
 
@@ -71,7 +72,8 @@ TEST(AccelLag, ASetPointLinearBetweenServoCyclesHasNoLag) {
     const double u = k1 > k0 ? (static_cast<double>(i) - static_cast<double>(k0)) / static_cast<double>(k1 - k0) : 0.0;
     servo[i] = exact[std::min(k0, exact.size() - 1)] * (1.0 - u) + exact[k1] * u;
   }
-  const auto lag = dsp::align::estimate_lag(dsp::align::setpoint_accel_mps2(servo, run.fs_hz()), dsp::align::measured_accel_mps2(run), run.fs_hz());
+  const auto lag = dsp::align::estimate_lag(dsp::align::setpoint_accel_mps2(servo, run.fs_hz()),
+                                            dsp::align::measured_accel_mps2(run), run.fs_hz());
   ASSERT_TRUE(lag.valid);
   EXPECT_NEAR(lag.lag_s, 0.0, 5e-5) << "the decimation keeps the pulses where they are";
 }
@@ -116,13 +118,16 @@ TEST(ProgramSetPoint, AnotherProgramIsFlaggedByItsResidual) {
 
 TEST(ProgramSetPoint, McodeStopsAddAZeroDwellAfterTheTriggersOnly) {
   const std::string g = "G0 X1\nM101 (start)\nG1 X2 F100 (M102 in a comment)\nm102\nM5\nM103 ; end\n";
-  EXPECT_EQ(with_mcode_stops(g), "G0 X1\nM101 (start)\nG4 P0\nG1 X2 F100 (M102 in a comment)\nm102\nG4 P0\nM5\nM103 ; end\nG4 P0\n");
+  EXPECT_EQ(with_mcode_stops(g),
+            "G0 X1\nM101 (start)\nG4 P0\nG1 X2 F100 (M102 in a comment)\nm102\nG4 P0\nM5\nM103 ; end\nG4 P0\n");
 }
 
 TEST(ProgramCatalog, NamesTheMissingProgramFile) {
-  const auto dir = std::filesystem::temp_directory_path() / ("eical-programs-" + std::to_string(std::random_device{}()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("eical-programs-" + std::to_string(std::random_device{}()));
   std::filesystem::create_directories(dir);
-  std::ofstream(dir / "7.toml") << "[program]\nkind = \"circle\"\nradius_mm = 10.0\ngcode = \"\"\"\nG0 X10\nM101\nG1 X0 F100\nM103\n\"\"\"\n";
+  std::ofstream(dir / "7.toml")
+      << "[program]\nkind = \"circle\"\nradius_mm = 10.0\ngcode = \"\"\"\nG0 X10\nM101\nG1 X0 F100\nM103\n\"\"\"\n";
   const ProgramCatalog catalog(dir);
   EXPECT_EQ(catalog.program(7).kind, "circle");
   try {

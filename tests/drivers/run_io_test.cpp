@@ -5,11 +5,11 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <random>
-#include <unistd.h>
 
 namespace eical::drivers {
 namespace {
@@ -18,7 +18,9 @@ namespace fs = std::filesystem;
 
 struct TempDir {
   fs::path path;
-  TempDir() : path(fs::temp_directory_path() / ("eical-runio-" + std::to_string(std::random_device{}()))) { fs::create_directories(path); }
+  TempDir() : path(fs::temp_directory_path() / ("eical-runio-" + std::to_string(std::random_device{}()))) {
+    fs::create_directories(path);
+  }
   ~TempDir() { fs::remove_all(path); }
 };
 
@@ -48,7 +50,9 @@ dsp::Run small_run() {
     if (i == 30)
       f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::table_missing | dsp::frame_flag::head_missing,
           std::fill(std::begin(f.accel_counts), std::end(f.accel_counts), 0);
-    if (i == 31) f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::head_missing, std::fill(std::begin(f.accel_counts) + 3, std::end(f.accel_counts), 0);
+    if (i == 31)
+      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::head_missing,
+          std::fill(std::begin(f.accel_counts) + 3, std::end(f.accel_counts), 0);
     r.frames.push_back(f);
   }
   r.truth_toml = "generator = \"unit\"\n";
@@ -95,13 +99,17 @@ TEST(RunIo, SingleSensorRunKeepsTheOtherSensorsData) {
   TempDir tmp;
   dsp::Run run = small_run();
   run.meta.sensor_present[0] = false;
-  for (auto& f : run.frames) f.flags &= ~(dsp::frame_flag::table_missing | dsp::frame_flag::head_missing | dsp::frame_flag::accel_missing);
+  for (auto& f : run.frames)
+    f.flags &= ~(dsp::frame_flag::table_missing | dsp::frame_flag::head_missing | dsp::frame_flag::accel_missing);
   write_run(run, tmp.path / "one", {});
   const dsp::Run back = read_run(tmp.path / "one");
   EXPECT_FALSE(back.meta.sensor_present[0]);
   EXPECT_TRUE(back.meta.sensor_present[1]);
   for (std::size_t i = 0; i < back.frames.size(); ++i) {
-    ASSERT_EQ(back.frames[i].flags & (dsp::frame_flag::accel_missing | dsp::frame_flag::table_missing | dsp::frame_flag::head_missing), 0u) << i;
+    ASSERT_EQ(back.frames[i].flags &
+                  (dsp::frame_flag::accel_missing | dsp::frame_flag::table_missing | dsp::frame_flag::head_missing),
+              0u)
+        << i;
     for (int c = 3; c < 6; ++c) ASSERT_EQ(back.frames[i].accel_counts[c], run.frames[i].accel_counts[c]) << i;
   }
   // Both triplexes empty: no accelerometer at all is an error naming the cause.

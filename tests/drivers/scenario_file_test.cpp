@@ -28,7 +28,8 @@ TEST(ScenarioFile, EveryEffectOfTheRunFormatCanBeSwitchedOn) {
   EXPECT_EQ(sc.meta.psd.size(), 2u);
   const dsp::Run run = sim::simulate(sc);
   ASSERT_TRUE(run.truth_toml.has_value());
-  for (const auto& name : l.present) EXPECT_NE(run.truth_toml->find("[effects.\"" + name + "\"]"), std::string::npos) << name;
+  for (const auto& name : l.present)
+    EXPECT_NE(run.truth_toml->find("[effects.\"" + name + "\"]"), std::string::npos) << name;
   EXPECT_EQ(run.channels.psd_count, 2);
   // Both strips are crossed by the R10 circle: light reaches each at some time.
   for (int c = 0; c < 4; ++c) {
@@ -46,9 +47,10 @@ TEST(ScenarioFile, BacklashExampleMatchesItsTruth) {
 }
 
 TEST(ScenarioFile, AnEffectOnSeveralAxesIsAnArrayOfTables) {
-  const std::string text = "format = \"eical-scenario/1\"\n[program]\nkind = \"circle\"\nradius_mm = 10.0\n"
-                           "[[effects.\"machine.backlash\"]]\naxis = \"x\"\nvalue_um = 3\n"
-                           "[[effects.\"machine.backlash\"]]\naxis = \"y\"\nvalue_um = 1.5\n";
+  const std::string text =
+      "format = \"eical-scenario/1\"\n[program]\nkind = \"circle\"\nradius_mm = 10.0\n"
+      "[[effects.\"machine.backlash\"]]\naxis = \"x\"\nvalue_um = 3\n"
+      "[[effects.\"machine.backlash\"]]\naxis = \"y\"\nvalue_um = 1.5\n";
   const sim::Scenario sc = drivers::read_scenario_file(write_tmp("eical-scenario-axes.toml", text));
   EXPECT_DOUBLE_EQ(sc.machine.backlash_um[0], 3.0);
   EXPECT_DOUBLE_EQ(sc.machine.backlash_um[1], 1.5);
@@ -66,14 +68,21 @@ TEST(ScenarioFile, UnknownEffectKeyAndTypeAreNamedWithTheLine) {
     return std::string("no error");
   };
   EXPECT_NE(error_of("[effects.\"machine.backlsh\"]\naxis = \"x\"\nvalue_um = 3\n").find(":5:"), std::string::npos);
-  EXPECT_NE(error_of("[effects.\"machine.backlsh\"]\naxis = \"x\"\nvalue_um = 3\n").find("unknown effect"), std::string::npos);
+  EXPECT_NE(error_of("[effects.\"machine.backlsh\"]\naxis = \"x\"\nvalue_um = 3\n").find("unknown effect"),
+            std::string::npos);
   // A misspelt required key is reported missing; a misspelt optional one as unknown, with its line.
-  EXPECT_NE(error_of("[effects.\"machine.backlash\"]\naxis = \"x\"\nvalu_um = 3\n").find("value_um: required key is missing"), std::string::npos);
-  EXPECT_NE(error_of("[effects.\"machine.reversal_spike\"]\naxis = \"x\"\namp_um = 3\ntau_mss = 9\n").find(":8: effects.machine.reversal_spike.tau_mss: unknown key"),
-            std::string::npos) << error_of("[effects.\"machine.reversal_spike\"]\naxis = \"x\"\namp_um = 3\ntau_mss = 9\n");
+  EXPECT_NE(
+      error_of("[effects.\"machine.backlash\"]\naxis = \"x\"\nvalu_um = 3\n").find("value_um: required key is missing"),
+      std::string::npos);
+  EXPECT_NE(error_of("[effects.\"machine.reversal_spike\"]\naxis = \"x\"\namp_um = 3\ntau_mss = 9\n")
+                .find(":8: effects.machine.reversal_spike.tau_mss: unknown key"),
+            std::string::npos)
+      << error_of("[effects.\"machine.reversal_spike\"]\naxis = \"x\"\namp_um = 3\ntau_mss = 9\n");
   EXPECT_NE(error_of("[effects.\"machine.backlash\"]\naxis = \"w\"\nvalue_um = 3\n").find("axis"), std::string::npos);
   EXPECT_NE(error_of("[effects.\"sensor.dynamics\"]\nf0_hz = -5\n").find("f0_hz: must be positive"), std::string::npos);
-  EXPECT_NE(error_of("[effects.\"machine.straightness\"]\naxis = \"x\"\ndirection = \"x\"\nbow_um = 1\n").find("direction"), std::string::npos);
+  EXPECT_NE(
+      error_of("[effects.\"machine.straightness\"]\naxis = \"x\"\ndirection = \"x\"\nbow_um = 1\n").find("direction"),
+      std::string::npos);
   EXPECT_EQ(error_of(""), "no error");
 }
 

@@ -4,15 +4,17 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 namespace {
 namespace fs = std::filesystem;
 using eical::drivers::SensorCalibration;
 
-fs::path temp_file(const std::string& name) { return fs::temp_directory_path() / ("eical_cal_" + name + "_" + std::to_string(::getpid()) + ".toml"); }
+fs::path temp_file(const std::string& name) {
+  return fs::temp_directory_path() / ("eical_cal_" + name + "_" + std::to_string(::getpid()) + ".toml");
+}
 
 void write_text(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
 
@@ -108,12 +110,15 @@ TEST(SensorCalibration, TyposAndWrongFormatAreErrorsNamingTheKey) {
     }
     return "no error";
   };
-  EXPECT_NE(message("format = \"eical-sensor-cal/1\"\n[sensors.head]\nf0_Hz = 900.0\n").find("f0_Hz"), std::string::npos);
+  EXPECT_NE(message("format = \"eical-sensor-cal/1\"\n[sensors.head]\nf0_Hz = 900.0\n").find("f0_Hz"),
+            std::string::npos);
   EXPECT_NE(message("format = \"eical-run/1\"\n").find("format"), std::string::npos);
   EXPECT_NE(message("format = \"eical-sensor-cal/1\"\n[sensors.table]\nzeta = -1.0\n").find("zeta"), std::string::npos);
-  EXPECT_NE(message("format = \"eical-sensor-cal/1\"\n[sensors.table]\ncross_g_per_g = [[0,0],[0,0],[0,0]]\n").find("cross_g_per_g"),
+  EXPECT_NE(message("format = \"eical-sensor-cal/1\"\n[sensors.table]\ncross_g_per_g = [[0,0],[0,0],[0,0]]\n")
+                .find("cross_g_per_g"),
             std::string::npos);
-  EXPECT_NE(message("format = \"eical-sensor-cal/1\"\n[acquisition]\ndaq_group_delay_samples = nan\n").find("daq_group_delay_samples"),
+  EXPECT_NE(message("format = \"eical-sensor-cal/1\"\n[acquisition]\ndaq_group_delay_samples = nan\n")
+                .find("daq_group_delay_samples"),
             std::string::npos);
   fs::remove(p);
 }
@@ -153,7 +158,8 @@ TEST(SensorCalibration, CovarianceRoundTripsAndIsApplied) {
   eical::dsp::AnalysisOptions opt2;
   eical::drivers::apply_calibration(eical::drivers::read_sensor_calibration(p, meta), meta, opt2);
   ASSERT_TRUE(opt2.model_covariance.has_value());
-  EXPECT_DOUBLE_EQ(opt2.model_covariance->covariance(xx, xx), u::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz).covariance(xx, xx));
+  EXPECT_DOUBLE_EQ(opt2.model_covariance->covariance(xx, xx),
+                   u::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz).covariance(xx, xx));
   EXPECT_NE(opt2.model_covariance->source.find("data sheet"), std::string::npos);
   fs::remove(p);
 }
@@ -164,11 +170,14 @@ TEST(SensorCalibration, CovarianceIsReadStrictly) {
   struct Case {
     std::string body, cause;
   };
-  for (const auto& c : {Case{"parameters = [\"table.E_xq\"]\nmatrix = [[1e-10]]\n", "unknown parameter 'table.E_xq'"},
-                        Case{"parameters = [\"table.E_xx\", \"table.E_xy\"]\nmatrix = [[1e-10, 2e-11], [0.0, 1e-10]]\n", "not symmetric"},
-                        Case{"parameters = [\"table.E_xx\", \"table.E_xy\"]\nmatrix = [[1e-10, 2e-10], [2e-10, 1e-10]]\n", "positive semi-definite"},
-                        Case{"parameters = [\"table.E_xx\", \"table.E_xx\"]\nmatrix = [[1e-10, 0.0], [0.0, 1e-10]]\n", "listed twice"},
-                        Case{"parameters = [\"table.E_xx\"]\nmatrix = [[1e-10]]\npsd_offset = 0.1\n", "psd_offset"}}) {
+  for (const auto& c :
+       {Case{"parameters = [\"table.E_xq\"]\nmatrix = [[1e-10]]\n", "unknown parameter 'table.E_xq'"},
+        Case{"parameters = [\"table.E_xx\", \"table.E_xy\"]\nmatrix = [[1e-10, 2e-11], [0.0, 1e-10]]\n",
+             "not symmetric"},
+        Case{"parameters = [\"table.E_xx\", \"table.E_xy\"]\nmatrix = [[1e-10, 2e-10], [2e-10, 1e-10]]\n",
+             "positive semi-definite"},
+        Case{"parameters = [\"table.E_xx\", \"table.E_xx\"]\nmatrix = [[1e-10, 0.0], [0.0, 1e-10]]\n", "listed twice"},
+        Case{"parameters = [\"table.E_xx\"]\nmatrix = [[1e-10]]\npsd_offset = 0.1\n", "psd_offset"}}) {
     const fs::path p = temp_file("strict");
     write_text(p, head + c.body);
     try {

@@ -40,15 +40,16 @@ TEST(ServoSetPoint, TheServoStreamBecomesTheFramesSetPointOnTheDaqClock) {
   auto cmd_at = [&](double t, int a) {
     const double x = std::clamp(t * fs, 0.0, static_cast<double>(truth->frames.size() - 1) - 1e-9);
     const auto k = static_cast<std::size_t>(x);
-    return truth->frames[k].cmd_mm[a] + (truth->frames[k + 1].cmd_mm[a] - truth->frames[k].cmd_mm[a]) * (x - static_cast<double>(k));
+    return truth->frames[k].cmd_mm[a] +
+           (truth->frames[k + 1].cmd_mm[a] - truth->frames[k].cmd_mm[a]) * (x - static_cast<double>(k));
   };
 
   ServoSetPointOptions o;
   o.stream.fifo = dir / "servo.fifo";
   o.hold_s = 0.1;
   ServoSetPointSource src(std::make_unique<ReplaySource>(daq, Pacing::realtime), o);
-  const std::int64_t n0 = 734512;     // LinuxCNC's cycle count since the sampler loaded
-  const double delta_s = 0.0037;      // cycle n0 happens 3.7 ms after DAQ sample 0
+  const std::int64_t n0 = 734512;  // LinuxCNC's cycle count since the sampler loaded
+  const double delta_s = 0.0037;   // cycle n0 happens 3.7 ms after DAQ sample 0
   src.open();
   // The replayed DAQ's sample clock starts at the first read: sample 0 is now.
   std::array<dsp::Frame, 256> block;
@@ -61,7 +62,8 @@ TEST(ServoSetPoint, TheServoStreamBecomesTheFramesSetPointOnTheDaqClock) {
   }
   std::atomic<bool> stop{false};
   std::thread linuxcnc([&] {
-    for (int i = 0; i < 500 && !fs::is_fifo(o.stream.fifo); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    for (int i = 0; i < 500 && !fs::is_fifo(o.stream.fifo); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
     const int fd = ::open(o.stream.fifo.c_str(), O_WRONLY);
     if (fd < 0) return;
     for (std::int64_t k = 0; !stop.load() && k < 2600; k += 10) {
@@ -72,8 +74,8 @@ TEST(ServoSetPoint, TheServoStreamBecomesTheFramesSetPointOnTheDaqClock) {
       for (std::int64_t j = k; j < k + 10; ++j) {
         const double t = delta_s + static_cast<double>(j) * 1e-3;
         char line[200];
-        std::snprintf(line, sizeof line, "%lld %.6f %.6f %.6f %.6f %.6f %.6f 0\n", static_cast<long long>(n0 + j), cmd_at(t, 0), cmd_at(t, 1),
-                      cmd_at(t, 2), cmd_at(t, 0), cmd_at(t, 1), cmd_at(t, 2));
+        std::snprintf(line, sizeof line, "%lld %.6f %.6f %.6f %.6f %.6f %.6f 0\n", static_cast<long long>(n0 + j),
+                      cmd_at(t, 0), cmd_at(t, 1), cmd_at(t, 2), cmd_at(t, 0), cmd_at(t, 1), cmd_at(t, 2));
         burst += line;
       }
       if (::write(fd, burst.data(), burst.size()) < 0) break;
@@ -107,11 +109,12 @@ TEST(ServoSetPoint, TheServoStreamBecomesTheFramesSetPointOnTheDaqClock) {
   for (std::size_t i = 0; i < got.size(); ++i) {
     if (got[i].flags & dsp::frame_flag::cmd_missing) continue;  // before the first servo line
     ++with_setpoint;
-    for (int k = 0; k < 3; ++k) worst_um = std::max(worst_um, std::abs(got[i].cmd_mm[k] - truth->frames[i].cmd_mm[k]) * 1e3);
+    for (int k = 0; k < 3; ++k)
+      worst_um = std::max(worst_um, std::abs(got[i].cmd_mm[k] - truth->frames[i].cmd_mm[k]) * 1e3);
   }
   EXPECT_GT(with_setpoint, 20000u);
-  std::printf("servo cycle at DAQ sample 0: %.3f (true %.3f); set-point error at most %.2f um over %zu frames\n", a.servo_cycle_at_sample0,
-              static_cast<double>(n0) - delta_s * 1e3, worst_um, with_setpoint);
+  std::printf("servo cycle at DAQ sample 0: %.3f (true %.3f); set-point error at most %.2f um over %zu frames\n",
+              a.servo_cycle_at_sample0, static_cast<double>(n0) - delta_s * 1e3, worst_um, with_setpoint);
   // 0.5 ms at 41.7 mm/s is 21 µm.
   EXPECT_LT(worst_um, 22.0);
   if (test::allocations_counted()) {

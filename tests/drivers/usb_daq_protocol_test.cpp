@@ -14,7 +14,8 @@ namespace {
 std::vector<std::array<std::int32_t, 14>> samples(int n, int base) {
   std::vector<std::array<std::int32_t, 14>> v(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k)
-    for (int c = 0; c < 10; ++c) v[static_cast<std::size_t>(k)][static_cast<std::size_t>(c)] = (base + k) * (c % 2 ? -1 : 1) * 1000 + c;
+    for (int c = 0; c < 10; ++c)
+      v[static_cast<std::size_t>(k)][static_cast<std::size_t>(c)] = (base + k) * (c % 2 ? -1 : 1) * 1000 + c;
   v[0][5] = -(1 << 23);  // full negative scale survives the 24-bit packing
   v[0][4] = (1 << 23) - 1;
   return v;
@@ -51,8 +52,8 @@ TEST(UsbDaqProtocol, FramesSurviveArbitraryChunking) {
   EXPECT_EQ(out[0].accel_counts[5], -(1 << 23));
   EXPECT_EQ(out[0].accel_counts[4], (1 << 23) - 1);
   EXPECT_EQ(out[9].accel_counts[1], -9 * 1000 + 1);  // channel 1: -(sample) * 1000 + 1
-  EXPECT_EQ(out[9].psd_counts[3], -9 * 1000 + 9);   // channel 9
-  EXPECT_EQ(out[32].trigger, 101);  // the slow packet's trigger lands on the next sample
+  EXPECT_EQ(out[9].psd_counts[3], -9 * 1000 + 9);    // channel 9
+  EXPECT_EQ(out[32].trigger, 101);                   // the slow packet's trigger lands on the next sample
   EXPECT_FLOAT_EQ(out[40].temp_c[0], 21.55f);
   EXPECT_EQ(d.stats().crc_errors, 0u);
 }

@@ -14,7 +14,7 @@ TEST(AxisTable, CorrectionIsMinusTheDeviationAndTheFoldedPlayGivesISO230_2sB) {
   EXPECT_DOUBLE_EQ(t.forward_um[1], -1.0);
   EXPECT_DOUBLE_EQ(t.reverse_um[1], 3.0);
   EXPECT_DOUBLE_EQ(t.mean_lost_motion_um(), 4.0);
-  EXPECT_DOUBLE_EQ(t.correction_um(5.0, Approach::forward), 1.5);   // −(0.5 − 2)
+  EXPECT_DOUBLE_EQ(t.correction_um(5.0, Approach::forward), 1.5);    // −(0.5 − 2)
   EXPECT_DOUBLE_EQ(t.correction_um(-5.0, Approach::reverse), -2.0);  // held beyond the end
   EXPECT_DOUBLE_EQ(residual_after_um(t, t), 0.0);
   EXPECT_DOUBLE_EQ(residual_after_um(t, without_reversal(t)), 2.0);  // the play left: ±b/2
@@ -30,7 +30,8 @@ TEST(AxisTable, ResampleNeverExtrapolatesAndCoverageNamesTheGap) {
     FAIL();
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              "comp: the y table covers 0 .. 40 mm, but circle run c1 measured y from -10 to 10 mm: measure positioning over that range (beyond "
+              "comp: the y table covers 0 .. 40 mm, but circle run c1 measured y from -10 to 10 mm: measure "
+              "positioning over that range (beyond "
               "its ends a control holds the end value)");
   }
   EXPECT_NO_THROW(require_coverage(t, 0.0, 40.0, "x"));
@@ -42,7 +43,9 @@ TEST(AxisTable, ValidateNamesThePoint) {
     validate(t);
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("z table: positions must increase; point 3 (5 mm) follows 5 mm"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("z table: positions must increase; point 3 (5 mm) follows 5 mm"),
+              std::string::npos)
+        << e.what();
   }
 }
 

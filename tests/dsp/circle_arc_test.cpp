@@ -1,8 +1,8 @@
 // Partial-arc circular test (ISO 230-4 with an arc below 360°) on synthetic paths with
 // known radius errors: evaluated over the arc only, about the programmed centre, both
 // directions combined for H; and the segment finder that picks the arcs from the set-point.
-#include "dsp/core/error.hpp"
 #include "dsp/eval/circle_arc.hpp"
+#include "dsp/core/error.hpp"
 #include "dsp/eval/circle_segments.hpp"
 
 #include <gtest/gtest.h>
@@ -38,8 +38,8 @@ void sweep(Recording& r, const Eigen::Vector2d& centre, double radius_mm, double
     const double err_um = inside ? radius_error_um(th) : 50.0;
     const Eigen::Vector2d u(std::cos(th * kDeg), std::sin(th * kDeg));
     const std::int64_t i = r.idx.empty() ? 0 : r.idx.back() + 1;
-    if (inside && !was_inside) r.marks.push_back(i);              // M102 where the arc begins
-    if (!inside && was_inside) r.marks.push_back(last_inside);    // and where it ends
+    if (inside && !was_inside) r.marks.push_back(i);            // M102 where the arc begins
+    if (!inside && was_inside) r.marks.push_back(last_inside);  // and where it ends
     if (inside) last_inside = i;
     was_inside = inside;
     r.idx.push_back(i);
@@ -107,8 +107,10 @@ TEST(CircleArc, FormErrorAndHysteresisFromBothDirections) {
   // ccw: δ + h/2 + A·cos 2θ, cw: δ − h/2 + A·cos 2θ (the same form, shifted by the reversal).
   const double delta_um = -2.0, h_um = 1.5, lobe_um = 0.8;
   Recording r;
-  sweep(r, kCentre, kRadius, kFrom, kArc, true, [&](double th) { return delta_um + h_um / 2 + lobe_um * std::cos(2 * th * kDeg); });
-  sweep(r, kCentre, kRadius, kFrom, kArc, false, [&](double th) { return delta_um - h_um / 2 + lobe_um * std::cos(2 * th * kDeg); });
+  sweep(r, kCentre, kRadius, kFrom, kArc, true,
+        [&](double th) { return delta_um + h_um / 2 + lobe_um * std::cos(2 * th * kDeg); });
+  sweep(r, kCentre, kRadius, kFrom, kArc, false,
+        [&](double th) { return delta_um - h_um / 2 + lobe_um * std::cos(2 * th * kDeg); });
   const CircleResult a = evaluate_arc(input_for(r, kCentre, kRadius, "ccw", kArc), kArc);
   const CircleResult b = evaluate_arc(input_for(r, kCentre, kRadius, "cw", kArc), kArc);
   const CircleResult c = combine(a, b);
@@ -153,7 +155,8 @@ TEST(CircleArc, BadInputNamesTheCause) {
     EXPECT_NE(std::string(e.what()).find("no evaluated arc"), std::string::npos) << e.what();
   }
   EXPECT_THROW((void)evaluate_arc(in, 0.0), InputError);
-  EXPECT_THROW((void)find_circle_segments({Eigen::Vector2d::Zero()}, {}, {}, Eigen::Vector2d::Zero(), 220.0), InputError);
+  EXPECT_THROW((void)find_circle_segments({Eigen::Vector2d::Zero()}, {}, {}, Eigen::Vector2d::Zero(), 220.0),
+               InputError);
 }
 
 }  // namespace

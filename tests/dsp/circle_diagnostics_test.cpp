@@ -1,8 +1,8 @@
 // Each ballbar-class diagnostic is injected alone into a synthetic two-direction circular
 // test; the fit must recover it (±15 % or ±0.5 µm, the tolerance) and report ≈ 0
 // for every diagnostic that was not injected.
-#include "dsp/core/error.hpp"
 #include "dsp/eval/circle_diagnostics.hpp"
+#include "dsp/core/error.hpp"
 
 #include <gtest/gtest.h>
 
@@ -59,8 +59,8 @@ CirclePass make_pass(int direction, const Injected& in, std::uint64_t seed) {
     }
     e.x() = in.scale_x_ppm * 1e-6 * c.x() - in.squareness_urad * 1e-6 * c.y() - in.lag_x_ms * 1e-3 * v.x() + lost_x +
             in.lateral_x_um * 1e-3 / 2 * sy +
-            in.cyclic_x_um * 1e-3 * std::sin(2 * std::numbers::pi * c.x() / in.pitch_mm + 0.3)
-            - in.spike_x_um * 1e-3 * sx * std::exp(-since_rev_s / 0.008);
+            in.cyclic_x_um * 1e-3 * std::sin(2 * std::numbers::pi * c.x() / in.pitch_mm + 0.3) -
+            in.spike_x_um * 1e-3 * sx * std::exp(-since_rev_s / 0.008);
     e.y() = in.scale_y_ppm * 1e-6 * c.y() - in.lag_y_ms * 1e-3 * v.y() - in.backlash_y_um * 1e-3 / 2 * sy +
             in.straightness_x_um * 1e-3 * (1.0 - (c.x() / kR) * (c.x() / kR));
     // Integration drift: an offset and a slow quadratic per pass.

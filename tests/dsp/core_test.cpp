@@ -24,10 +24,10 @@ TEST(Interpolate, BetweenSamplesClampedAtTheEndsAndNaNWhenEmpty) {
   const std::vector<double> pos = {0.5, 1.25, -3.0, 7.0, 1e300, NAN};
   EXPECT_DOUBLE_EQ(interpolate_at(x, pos[0], 0), 0.5);
   EXPECT_DOUBLE_EQ(interpolate_at(x, pos[1], 1), 25.0);
-  EXPECT_DOUBLE_EQ(interpolate_at(x, pos[2], 1), 10.0);  // before the first sample: the first
-  EXPECT_DOUBLE_EQ(interpolate_at(x, pos[3], 0), 3.0);   // past the last: the last
-  EXPECT_DOUBLE_EQ(interpolate_at(x, pos[4], 0), 3.0);   // far past it: no cast to an index
-  EXPECT_DOUBLE_EQ(interpolate_at(x, pos[5], 0), 0.0);   // no position: the first, never a wild index
+  EXPECT_DOUBLE_EQ(interpolate_at(x, pos[2], 1), 10.0);    // before the first sample: the first
+  EXPECT_DOUBLE_EQ(interpolate_at(x, pos[3], 0), 3.0);     // past the last: the last
+  EXPECT_DOUBLE_EQ(interpolate_at(x, pos[4], 0), 3.0);     // far past it: no cast to an index
+  EXPECT_DOUBLE_EQ(interpolate_at(x, pos[5], 0), 0.0);     // no position: the first, never a wild index
   EXPECT_TRUE(std::isnan(interpolate_at({}, pos[0], 0)));  // nothing to interpolate
 }
 

@@ -1,5 +1,5 @@
-#include "dsp/core/error.hpp"
 #include "dsp/model/effect_selection.hpp"
+#include "dsp/core/error.hpp"
 #include "dsp/model/effects.hpp"
 
 #include <gtest/gtest.h>
@@ -7,9 +7,9 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
-#include <string>
 #include <numbers>
 #include <random>
+#include <string>
 
 namespace eical::dsp::model {
 namespace {
@@ -71,8 +71,9 @@ TEST(EffectSelection, SpuriousCorrelationOfRedNoiseIsNotSignificant) {
   // would accept the regressor. The effective sample count and the held-out check must not.
   int accepted = 0;
   for (std::uint64_t seed = 10; seed < 20; ++seed) {
-    const auto r = select_effects(red_noise(seed, 1.0, 0.999), {single("other.random_walk", red_noise(seed + 100, 1.0, 0.999))},
-                                  every_other_block(2000));
+    const auto r =
+        select_effects(red_noise(seed, 1.0, 0.999), {single("other.random_walk", red_noise(seed + 100, 1.0, 0.999))},
+                       every_other_block(2000));
     accepted += r.effects[0].significant;
   }
   EXPECT_LE(accepted, 1);
@@ -117,11 +118,13 @@ TEST(EffectCatalogue, TheReadmeBoundsTableIsTheCatalogue) {
   auto grouped = [](double v) {
     if (v >= 1e9) return std::string("none");
     std::string digits = std::to_string(static_cast<long long>(std::llround(v))), out;
-    for (std::size_t i = 0; i < digits.size(); ++i) out += (i && (digits.size() - i) % 3 == 0 ? " " : "") + std::string(1, digits[i]);
+    for (std::size_t i = 0; i < digits.size(); ++i)
+      out += (i && (digits.size() - i) % 3 == 0 ? " " : "") + std::string(1, digits[i]);
     return out;
   };
   for (const auto& e : eical::dsp::model::effect_catalogue()) {
-    const std::string row = "| `" + std::string(e.name) + "` | " + std::string(e.unit) + " | " + grouped(e.bound) + " | " + grouped(e.bound_mems) + " | ";
+    const std::string row = "| `" + std::string(e.name) + "` | " + std::string(e.unit) + " | " + grouped(e.bound) +
+                            " | " + grouped(e.bound_mems) + " | ";
     EXPECT_NE(readme.find(row), std::string::npos) << row;
   }
 }

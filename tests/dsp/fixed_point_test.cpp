@@ -1,7 +1,7 @@
 // Q-format primitives and the fixed-point stages: rounding, saturation instead of
 // wrap-around, the sticky flag, and agreement of FixedStaticComp with StaticComp.
-#include "dsp/pipeline/fixed_integrator.hpp"
 #include "dsp/pipeline/fixed_point.hpp"
+#include "dsp/pipeline/fixed_integrator.hpp"
 #include "dsp/pipeline/fixed_static_comp.hpp"
 
 #include <gtest/gtest.h>

@@ -15,7 +15,8 @@ struct Harmonic {
   int f;
   double a_arcsec, phase_deg;
 };
-const std::vector<Harmonic> kTruth = {{1, 3.0, 20.0}, {3, 1.5, -70.0}, {7, 0.8, 130.0}, {12, 1.0, 45.0}, {24, 0.5, -10.0}};
+const std::vector<Harmonic> kTruth = {
+    {1, 3.0, 20.0}, {3, 1.5, -70.0}, {7, 0.8, 130.0}, {12, 1.0, 45.0}, {24, 0.5, -10.0}};
 
 double truth(double x_deg) {
   double s = 0.0;
@@ -123,7 +124,9 @@ TEST(Fourier, ASweepThatIsNotASweepIsAClearError) {
     (void)fourier_calibration(series, o);
     FAIL() << "a grid series was taken for a sweep";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("series 'series3' is not a sweep: its 12 positions fall on 1 phase(s) of the 30"), std::string::npos)
+    EXPECT_NE(
+        std::string(e.what()).find("series 'series3' is not a sweep: its 12 positions fall on 1 phase(s) of the 30"),
+        std::string::npos)
         << e.what();
   }
 }

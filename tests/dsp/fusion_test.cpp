@@ -80,7 +80,8 @@ Batch batch_posterior(const ErrorModel& m, double h, const Vec3& bias0, const Su
   p[0] = initial_covariance(m, bias0[axis]);
   for (Eigen::Index k = 1; k < n; ++k) {
     p[static_cast<std::size_t>(k)] = d.F * p[static_cast<std::size_t>(k - 1)] * d.F.transpose() + d.Q;
-    if (sch.flags[static_cast<std::size_t>(k)] & schedule_flag::move_start) p[static_cast<std::size_t>(k)](2, 2) += m.bias_step_um_s2 * m.bias_step_um_s2;
+    if (sch.flags[static_cast<std::size_t>(k)] & schedule_flag::move_start)
+      p[static_cast<std::size_t>(k)](2, 2) += m.bias_step_um_s2 * m.bias_step_um_s2;
   }
   Eigen::MatrixXd sigma(3 * n, 3 * n);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -96,11 +97,16 @@ Batch batch_posterior(const ErrorModel& m, double h, const Vec3& bias0, const Su
   std::vector<double> z, r;
   for (Eigen::Index k = 0; k < n; ++k) {
     const auto f = sch.flags[static_cast<std::size_t>(k)];
-    if (f & schedule_flag::rest) rows.push_back(3 * k + 1), z.push_back(vel[static_cast<std::size_t>(k)][axis] * 1000), r.push_back(m.zupt_sigma_um_s * m.zupt_sigma_um_s);
-    else if (f & nbs_flag(axis)) rows.push_back(3 * k + 1), z.push_back(vel[static_cast<std::size_t>(k)][axis] * 1000), r.push_back(m.nbs_sigma_um_s * m.nbs_sigma_um_s);
+    if (f & schedule_flag::rest)
+      rows.push_back(3 * k + 1), z.push_back(vel[static_cast<std::size_t>(k)][axis] * 1000),
+          r.push_back(m.zupt_sigma_um_s * m.zupt_sigma_um_s);
+    else if (f & nbs_flag(axis))
+      rows.push_back(3 * k + 1), z.push_back(vel[static_cast<std::size_t>(k)][axis] * 1000),
+          r.push_back(m.nbs_sigma_um_s * m.nbs_sigma_um_s);
     for (const auto& fx : sch.fixes)
       if (static_cast<Eigen::Index>(fx.k) == k && fx.axis == axis)
-        rows.push_back(3 * k), z.push_back(pos[fx.k][axis] * 1000 - fx.position_um), r.push_back(fx.sigma_um * fx.sigma_um + m.psd_floor_um * m.psd_floor_um);
+        rows.push_back(3 * k), z.push_back(pos[fx.k][axis] * 1000 - fx.position_um),
+            r.push_back(fx.sigma_um * fx.sigma_um + m.psd_floor_um * m.psd_floor_um);
   }
   const auto nz = static_cast<Eigen::Index>(rows.size());
   Eigen::MatrixXd hs(nz, 3 * n);  // H Σ
@@ -111,7 +117,8 @@ Batch batch_posterior(const ErrorModel& m, double h, const Vec3& bias0, const Su
     zv[i] = z[static_cast<std::size_t>(i)];
   }
   for (Eigen::Index i = 0; i < nz; ++i)
-    for (Eigen::Index j = 0; j < nz; ++j) s(i, j) = hs(i, rows[static_cast<std::size_t>(j)]) + (i == j ? r[static_cast<std::size_t>(i)] : 0.0);
+    for (Eigen::Index j = 0; j < nz; ++j)
+      s(i, j) = hs(i, rows[static_cast<std::size_t>(j)]) + (i == j ? r[static_cast<std::size_t>(i)] : 0.0);
   const Eigen::LDLT<Eigen::MatrixXd> ls(s);
   Batch b;
   b.mean = hs.transpose() * ls.solve(zv);
@@ -199,17 +206,20 @@ TEST(CheckpointedSmoother, TheSplitIntoSegmentsChangesNoBit) {
   for (std::size_t k = 0; k < 40; ++k) sch.flags[k] = schedule_flag::rest;
   sch.flags[40] |= schedule_flag::move_start;
   for (std::size_t k = 100; k < 180; ++k) sch.flags[k] = nbs_flag(2);
-  for (std::size_t k = 250; k < 330; ++k) sch.flags[k] = schedule_flag::rest, sch.zupt_sigma_um_s[k] = k < 280 ? -1.0F : 0.0F;
+  for (std::size_t k = 250; k < 330; ++k)
+    sch.flags[k] = schedule_flag::rest, sch.zupt_sigma_um_s[k] = k < 280 ? -1.0F : 0.0F;
   sch.flags[260] |= schedule_flag::invalid;
   for (std::size_t k = 450; k < n; ++k) sch.flags[k] = schedule_flag::rest;
-  for (std::size_t k : {63u, 64u, 128u, 255u, 256u, 400u}) sch.fixes.push_back({k, static_cast<int>(k % 3), g(rng) * 5.0, 0.3});
+  for (std::size_t k : {63u, 64u, 128u, 255u, 256u, 400u})
+    sch.fixes.push_back({k, static_cast<int>(k % 3), g(rng) * 5.0, 0.3});
   sch.velocity_means.push_back({264, {1.0, -2.0, 0.5}, 3.0, 0.01});
   sch.velocity_means.push_back({256, {0.5, 0.2, -0.1}, 3.0, 0.01});
   std::vector<Eigen::Vector3d> vel(n), pos(n);
   std::vector<std::int64_t> idx(n);
   std::int64_t t = 0;
   for (std::size_t k = 0; k < n; ++k) {
-    vel[k] = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.05 + Eigen::Vector3d::Constant(k > 450 ? 0.2 : 0.0);  // a bias jump at the end
+    vel[k] = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.05 +
+             Eigen::Vector3d::Constant(k > 450 ? 0.2 : 0.0);  // a bias jump at the end
     pos[k] = Eigen::Vector3d(g(rng), g(rng), g(rng)) * 0.01;
     t += (k == 64 || k == 300) ? 3 : 1;  // lost frames, one on a boundary of the 64-sample split
     idx[k] = t;

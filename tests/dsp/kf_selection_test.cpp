@@ -2,8 +2,8 @@
 // synthetic axis whose position error is a known acceleration-level effect, the true
 // group is accepted with its value inside its uncertainty and a decoy is not; on an axis
 // with noise alone nothing is accepted.
-#include "dsp/core/run_meta.hpp"
 #include "dsp/model/kf_selection.hpp"
+#include "dsp/core/run_meta.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 
 #include <gtest/gtest.h>

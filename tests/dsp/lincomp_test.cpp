@@ -18,7 +18,8 @@ ErrorCurve sample_curve(double travel_mm = 500.0) {
   for (int i = 0; i <= static_cast<int>(travel_mm); ++i) {
     const double x = i;
     c.pos_mm.push_back(x);
-    c.error_um.push_back(2.0 * std::sin(std::numbers::pi * x / travel_mm) + 0.6 * std::sin(2 * std::numbers::pi * x / 37.0) + n(rng));
+    c.error_um.push_back(2.0 * std::sin(std::numbers::pi * x / travel_mm) +
+                         0.6 * std::sin(2 * std::numbers::pi * x / 37.0) + n(rng));
   }
   return c;
 }
@@ -40,8 +41,11 @@ double brute_force_residual(const ErrorCurve& c, double first, double A) {
     double corr;
     const double k = std::floor((x - first) / A);
     const double x0 = c.pos_mm.front(), last_p = first + last * A;
-    if (x <= first) corr = first > x0 ? err_at(x0) + (x - x0) / (first - x0) * (err_at(first) - err_at(x0)) : err_at(first);
-    else if (k >= last) corr = end > last_p ? err_at(last_p) + (x - last_p) / (end - last_p) * (err_at(end) - err_at(last_p)) : err_at(end);
+    if (x <= first)
+      corr = first > x0 ? err_at(x0) + (x - x0) / (first - x0) * (err_at(first) - err_at(x0)) : err_at(first);
+    else if (k >= last)
+      corr =
+          end > last_p ? err_at(last_p) + (x - last_p) / (end - last_p) * (err_at(end) - err_at(last_p)) : err_at(end);
     else {
       const double a = first + k * A, b = a + A;
       corr = err_at(a) + (x - a) / A * (err_at(b) - err_at(a));

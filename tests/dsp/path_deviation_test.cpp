@@ -1,5 +1,5 @@
-#include "dsp/core/error.hpp"
 #include "dsp/eval/path_deviation.hpp"
+#include "dsp/core/error.hpp"
 
 #include <gtest/gtest.h>
 

@@ -44,7 +44,8 @@ TEST(StaticComp, InvertsTheForwardModelWithTemperatureCrossTermsAndMounting) {
     worst_g = std::max(worst_g, (a - expected).cwiseAbs().maxCoeff() / site.g_mps2);
     EXPECT_LT((a - expected).cwiseAbs().maxCoeff() / site.g_mps2, quantisation_g.maxCoeff()) << "sample " << k;
   }
-  std::printf("static model inverse over +-2 g, 10..50 C: worst error %.2e g (ADC step %.1e g)\n", worst_g, acq.adc_lsb_volt / 1.235);
+  std::printf("static model inverse over +-2 g, 10..50 C: worst error %.2e g (ADC step %.1e g)\n", worst_g,
+              acq.adc_lsb_volt / 1.235);
 }
 
 TEST(StaticComp, IterationGoesBeyondTheThesisFirstOrderFormula) {
@@ -54,7 +55,8 @@ TEST(StaticComp, IterationGoesBeyondTheThesisFirstOrderFormula) {
   const StaticComp comp(spec, Acquisition{}, Site{}, cal);
   const Eigen::Vector3d v(0.5, -0.3, 1.0);
   const Eigen::Vector3d u = static_model_g(v, spec, cal);
-  const Eigen::Vector3d first_order = u.array() - spec.k2_g_per_g2.array() * u.array().square() - spec.k3_g_per_g3.array() * u.array().cube();
+  const Eigen::Vector3d first_order =
+      u.array() - spec.k2_g_per_g2.array() * u.array().square() - spec.k3_g_per_g3.array() * u.array().cube();
   const Eigen::Vector3d iterated = comp.invert_model(u);
   EXPECT_GT((first_order - v).cwiseAbs().maxCoeff(), 1e-6);
   EXPECT_LT((iterated - v).cwiseAbs().maxCoeff(), 1e-11);

@@ -1,5 +1,5 @@
-#include "dsp/core/error.hpp"
 #include "dsp/eval/step_response.hpp"
+#include "dsp/core/error.hpp"
 
 #include <gtest/gtest.h>
 
@@ -17,8 +17,7 @@ void move(std::vector<double>& cmd, double to_mm, double move_s, double rest_s) 
   const double from = cmd.empty() ? 0.0 : cmd.back();
   for (int i = 0; i < static_cast<int>(rest_s * kFs); ++i) cmd.push_back(from);
   const int n = static_cast<int>(move_s * kFs);
-  for (int i = 1; i <= n; ++i)
-    cmd.push_back(from + (to_mm - from) * 0.5 * (1 - std::cos(std::numbers::pi * i / n)));
+  for (int i = 1; i <= n; ++i) cmd.push_back(from + (to_mm - from) * 0.5 * (1 - std::cos(std::numbers::pi * i / n)));
 }
 
 TEST(StepResponse, OvershootSettlingAndEndErrorOfADampedOscillation) {
@@ -35,7 +34,8 @@ TEST(StepResponse, OvershootSettlingAndEndErrorOfADampedOscillation) {
     const bool moving = i > 0 && cmd[i] != cmd[i - 1];
     if (moving) since = -1.0 / kFs, dir = cmd[i] > cmd[i - 1] ? 1.0 : -1.0;
     since += 1.0 / kFs;
-    const double ring = since >= 0 && !moving ? amp_um * std::exp(-since / tau_s) * std::cos(2 * std::numbers::pi * f_hz * since) : 0.0;
+    const double ring =
+        since >= 0 && !moving ? amp_um * std::exp(-since / tau_s) * std::cos(2 * std::numbers::pi * f_hz * since) : 0.0;
     meas[i] = cmd[i] + (end_um + dir * ring) * 1e-3;
   }
   StepOptions opt;

@@ -25,7 +25,8 @@ struct Strip {
     std::normal_distribution<double> g(0.0, noise_v);
     const double i1 = light * 2.0 * (0.5 + u / spec.length_mm) + g(rng);
     const double i2 = light * 2.0 * (0.5 - u / spec.length_mm) + g(rng);
-    return {static_cast<std::int32_t>(std::lround(i1 / acq.adc_lsb_volt)), static_cast<std::int32_t>(std::lround(i2 / acq.adc_lsb_volt))};
+    return {static_cast<std::int32_t>(std::lround(i1 / acq.adc_lsb_volt)),
+            static_cast<std::int32_t>(std::lround(i2 / acq.adc_lsb_volt))};
   }
 };
 
@@ -52,10 +53,10 @@ TEST(PsdDecoder, RecoversPositionAndNoiseAndIgnoresDarkAndEnds) {
   }
   const double rms = std::sqrt(sum_sq / n);
   EXPECT_LT(std::abs(sum_err / n), 3.0 * rms / std::sqrt(n));  // unbiased
-  EXPECT_NEAR(sigma / n, rms, 0.2 * rms);                        // σ as propagated
-  const auto [e1, e2] = s.counts(4.95, 1.0, noise_v, rng);       // within 2 % of the end
+  EXPECT_NEAR(sigma / n, rms, 0.2 * rms);                      // σ as propagated
+  const auto [e1, e2] = s.counts(4.95, 1.0, noise_v, rng);     // within 2 % of the end
   EXPECT_FALSE(d.step(e1, e2, false).valid);
-  const auto [f1, f2] = s.counts(1.0, 0.05, noise_v, rng);        // hardly lit: below 30 % of the peak
+  const auto [f1, f2] = s.counts(1.0, 0.05, noise_v, rng);  // hardly lit: below 30 % of the peak
   EXPECT_FALSE(d.step(f1, f2, false).valid);
   EXPECT_FALSE(d.step(0, 0, true).valid);  // missing channel
 }
@@ -78,21 +79,24 @@ TEST(StandstillDetector, RestAfterItsWindowNotDuringMotionNorAtConstantSpeed) {
     if (det.step(noise(), still, still, 0.0, true, false).rest && first_rest < 0) first_rest = k;
   EXPECT_EQ(first_rest, static_cast<int>(det.window()) + 38);  // window plus the DAQ delay for the set-point
   // Motion: 20 mg for 0.1 s while the set-point moves.
-  for (int k = 0; k < 1000; ++k) EXPECT_FALSE(det.step(noise() + Eigen::Vector3d(0.2, 0, 0), still, still, 0.0, true, true).rest);
+  for (int k = 0; k < 1000; ++k)
+    EXPECT_FALSE(det.step(noise() + Eigen::Vector3d(0.2, 0, 0), still, still, 0.0, true, true).rest);
   // The set-point stopped but the machine rings (5 mg at 9 Hz): a standstill, with the
   // velocity such a vibration keeps, not a quiet one.
   StandstillDetector::Decision ringing;
   const double w = 2 * M_PI * 9.0, amp = 0.05;
   for (int k = 0; k < 5000; ++k) {
     const double t = k / fs;
-    ringing = det.step(noise() + Eigen::Vector3d(amp * std::sin(w * t), 0, 0), Eigen::Vector3d(-amp / w * std::cos(w * t) * 1000.0, 0, 0),
-                       still, 0.0, true, false);
+    ringing = det.step(noise() + Eigen::Vector3d(amp * std::sin(w * t), 0, 0),
+                       Eigen::Vector3d(-amp / w * std::cos(w * t) * 1000.0, 0, 0), still, 0.0, true, false);
   }
   EXPECT_TRUE(ringing.rest);
   EXPECT_FALSE(ringing.quiet);
-  EXPECT_NEAR(ringing.vibration_sigma_mm_s, amp / w / std::sqrt(2.0) * 1000.0, 0.15 * amp / w * 1000.0);  // the sine's rms velocity
+  EXPECT_NEAR(ringing.vibration_sigma_mm_s, amp / w / std::sqrt(2.0) * 1000.0,
+              0.15 * amp / w * 1000.0);  // the sine's rms velocity
   // Constant speed (no acceleration, set-point unknown): the velocity says it moves.
-  for (int k = 0; k < 2000; ++k) EXPECT_FALSE(det.step(noise(), Eigen::Vector3d(50.0, 0, 0), still, 0.001, false, false).rest);
+  for (int k = 0; k < 2000; ++k)
+    EXPECT_FALSE(det.step(noise(), Eigen::Vector3d(50.0, 0, 0), still, 0.001, false, false).rest);
   // At rest on pure noise for 10 s the test seldom says "moving" (a missed ZUPT sample).
   StandstillDetector quiet({}, fs, 38.8, sigma * sigma);
   int rest = 0;
@@ -102,8 +106,11 @@ TEST(StandstillDetector, RestAfterItsWindowNotDuringMotionNorAtConstantSpeed) {
 
 TEST(StandstillDetector, ANaNSampleIsNeverRest) {
   StandstillDetector det({}, 10000.0, 0.0, 1e-6);
-  for (int k = 0; k < 500; ++k) (void)det.step(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, false, false);
-  EXPECT_FALSE(det.step(Eigen::Vector3d::Constant(NAN), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, false, false).rest);
+  for (int k = 0; k < 500; ++k)
+    (void)det.step(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, false, false);
+  EXPECT_FALSE(
+      det.step(Eigen::Vector3d::Constant(NAN), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, false, false)
+          .rest);
 }
 
 }  // namespace

@@ -30,8 +30,10 @@ TEST(SensorModelCovariance, NamesRoundTripAndTheDataSheetIsUniformWithinItsToler
   const DatasheetTolerance t;
   const SensorModelCovariance c = datasheet_covariance(sheet, 10000.0, t);
   // x, y scale: k1 and the gravity cross term k_zx·g, each uniform: u² = (a² + b²)/3.
-  EXPECT_NEAR(c.sigma(error_index(0, 0, 0)), std::sqrt((t.scale * t.scale + t.cross2_g_per_g2 * t.cross2_g_per_g2) / 3.0), 1e-12);
-  EXPECT_NEAR(c.sigma(error_index(1, 0, 1)), std::sqrt((t.cross_g_per_g * t.cross_g_per_g + t.mounting_rad * t.mounting_rad) / 3.0), 1e-12);
+  EXPECT_NEAR(c.sigma(error_index(0, 0, 0)),
+              std::sqrt((t.scale * t.scale + t.cross2_g_per_g2 * t.cross2_g_per_g2) / 3.0), 1e-12);
+  EXPECT_NEAR(c.sigma(error_index(1, 0, 1)),
+              std::sqrt((t.cross_g_per_g * t.cross_g_per_g + t.mounting_rad * t.mounting_rad) / 3.0), 1e-12);
   // 2ζ/ω0 = 225 µs; ±0.01 of ζ and ±1 % of f0 make about 2 µs.
   EXPECT_GT(c.sigma(damping_index(0)), 1e-6);
   EXPECT_LT(c.sigma(damping_index(0)), 3e-6);
@@ -127,8 +129,10 @@ TEST(ErrorField, NoiseDrawsSpreadAsTheSmoothersPosteriorWhenTheTruthIsItsModel) 
   fusion::ErrorModel mc = m;
   const fusion::ErrorCovariance cov(t.schedule, t.idx, 1000.0, mc, in.start_bias_sigma_um_s2);
   for (int i = 0; i < 3; ++i) {
-    const double sigma = std::sqrt(ss[i] / draws), expected = cov.sigma_um(static_cast<std::size_t>(at[static_cast<std::size_t>(i)]), 0);
-    std::printf("trace sample %.0f: draws σ %.3f µm, posterior σ %.3f µm\n", at[static_cast<std::size_t>(i)], sigma, expected);
+    const double sigma = std::sqrt(ss[i] / draws),
+                 expected = cov.sigma_um(static_cast<std::size_t>(at[static_cast<std::size_t>(i)]), 0);
+    std::printf("trace sample %.0f: draws σ %.3f µm, posterior σ %.3f µm\n", at[static_cast<std::size_t>(i)], sigma,
+                expected);
     EXPECT_NEAR(sigma / expected, 1.0, 0.15) << "at " << at[static_cast<std::size_t>(i)];
   }
 }

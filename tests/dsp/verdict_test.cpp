@@ -31,7 +31,8 @@ TEST(Verdict, NotMeasurableWhenTheUncertaintyExceedsTheLimitOrTheFigure) {
   judge(p, big);
   EXPECT_EQ(big.verdict, "not_measurable");
   ASSERT_EQ(big.verdict_reasons.size(), 2u);
-  EXPECT_NE(big.verdict_reasons[0].find("exceeds the 10.0 µm a circle test is meant to resolve"), std::string::npos) << big.verdict_reasons[0];
+  EXPECT_NE(big.verdict_reasons[0].find("exceeds the 10.0 µm a circle test is meant to resolve"), std::string::npos)
+      << big.verdict_reasons[0];
   EXPECT_NE(big.verdict_reasons[1].find("not above its uncertainty"), std::string::npos) << big.verdict_reasons[1];
   Analysis small = circle(1.0, 4.0);  // a machine better than the test can tell
   judge(p, small);
@@ -41,7 +42,8 @@ TEST(Verdict, NotMeasurableWhenTheUncertaintyExceedsTheLimitOrTheFigure) {
 TEST(Verdict, DegradedByACriticalFlagAndNotMeasurableOverridesIt) {
   Program p;
   Analysis a = circle(12.0, 3.0, true);
-  a.flags = {"psd_disagrees: the PSD readings contradict the integrated motion", "circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions"};
+  a.flags = {"psd_disagrees: the PSD readings contradict the integrated motion",
+             "circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions"};
   judge(p, a);
   EXPECT_EQ(a.verdict, "degraded");
   ASSERT_EQ(a.verdict_reasons.size(), 1u);
@@ -63,11 +65,14 @@ TEST(Verdict, WithoutUncertaintyTheResultIsDegraded) {
 TEST(FlagSeverity, CriticalWarningAndNote) {
   EXPECT_EQ(flag_severity("psd_disagrees: the PSD readings contradict"), FlagSeverity::critical);
   EXPECT_EQ(flag_severity("frames_lost: the DAQ lost frames"), FlagSeverity::critical);
-  EXPECT_EQ(flag_severity("circle: no stretch between two M102 marks sweeps the programmed arc"), FlagSeverity::critical);
+  EXPECT_EQ(flag_severity("circle: no stretch between two M102 marks sweeps the programmed arc"),
+            FlagSeverity::critical);
   EXPECT_EQ(flag_severity("no_zupt_window: no rest after the motion"), FlagSeverity::warning);
-  EXPECT_EQ(flag_severity("positioning: 3 runs per target and direction, ISO 230-2 asks for 5: evaluated by its formulas, outside the standard"),
+  EXPECT_EQ(flag_severity("positioning: 3 runs per target and direction, ISO 230-2 asks for 5: evaluated by its "
+                          "formulas, outside the standard"),
             FlagSeverity::warning);
-  EXPECT_EQ(flag_severity("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions"), FlagSeverity::note);
+  EXPECT_EQ(flag_severity("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions"),
+            FlagSeverity::note);
   EXPECT_STREQ(severity_name(FlagSeverity::critical), "critical");
 }
 

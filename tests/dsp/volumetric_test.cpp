@@ -4,8 +4,8 @@
 #include "dsp/comp/volumetric.hpp"
 #include "dsp/core/error.hpp"
 
-#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include <cmath>
 #include <random>
@@ -37,8 +37,8 @@ VolumetricModel machine(std::uint64_t seed, const Eigen::Vector3d& travel) {
 // to first order by superposition: the chain is evaluated with one error parameter at a
 // time (exactly linear in it) and the changes are summed — the model's own assumption
 // that the error motions do not interact.
-Eigen::Vector3d chain(const Eigen::Vector3d& x, const Eigen::Vector3d& xp, const std::array<double, 18>& c, double xwy, double xwz,
-                      double ywz) {
+Eigen::Vector3d chain(const Eigen::Vector3d& x, const Eigen::Vector3d& xp, const std::array<double, 18>& c, double xwy,
+                      double xwz, double ywz) {
   auto skew = [](double a, double b, double g) {
     Eigen::Matrix3d s;
     s << 0, -g, b, g, 0, -a, -b, a, 0;
@@ -107,8 +107,9 @@ TEST(Volumetric, AgreesWithAnIndependentFormulationBelowOneNanometre) {
       worst_nm = std::max(worst_nm, d_nm);
     }
   }
-  std::printf("volumetric: %d points, max deviation from the independent formulation %.2e nm, %d/%d range violations flagged\n",
-              points, worst_nm, flagged, violations);
+  std::printf(
+      "volumetric: %d points, max deviation from the independent formulation %.2e nm, %d/%d range violations flagged\n",
+      points, worst_nm, flagged, violations);
   EXPECT_EQ(points, 138);
   EXPECT_LT(worst_nm, 1.0);
   EXPECT_EQ(flagged, violations);

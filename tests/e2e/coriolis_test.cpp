@@ -35,9 +35,10 @@ TEST(Coriolis, FedBackVelocityRemovesTheEarthRateError) {
   // (3-5) and (4-3) for the thesis' example (10 m/min at 50°, 1 s) and for this site.
   const double v_mps = units::mm_per_min_to_mps(10000.0);
   const double thesis_um = 0.5 * 2.0 * units::kEarthRateRadps * v_mps * std::sin(units::deg_to_rad(50.0)) * 1e6;
-  std::printf("Coriolis, 200 mm at 10 m/min (latitude %.1f): max y error without correction %.2f um, with %.4f um "
-              "(thesis example, 1 s at 10 m/min, 50 deg: %.2f um by (3-5))\n",
-              sc.meta.site.latitude_deg, e_without, e_with, thesis_um);
+  std::printf(
+      "Coriolis, 200 mm at 10 m/min (latitude %.1f): max y error without correction %.2f um, with %.4f um "
+      "(thesis example, 1 s at 10 m/min, 50 deg: %.2f um by (3-5))\n",
+      sc.meta.site.latitude_deg, e_without, e_with, thesis_um);
   EXPECT_GT(e_without, thesis_um);  // 1.2 s at 51.3° is longer and further north
   EXPECT_LT(e_with, 0.01 * e_without);
   // With ZUPT the velocity left at the end is removed, not the error inside the move.

@@ -28,11 +28,13 @@ void check_variants_agree(const sim::Scenario& sc, const char* what) {
   const double e_two_stage = max_error_um(two_stage, sr.true_mm);
   std::printf("%s: max error vs truth: uncompensated %.1f um, two-stage (6-38) %.4f um\n", what, e_none, e_two_stage);
   EXPECT_LT(e_two_stage, 0.01 * e_none);
-  for (auto mode : {dsp::DynamicComp::acceleration_level, dsp::DynamicComp::velocity_level, dsp::DynamicComp::position_level}) {
+  for (auto mode :
+       {dsp::DynamicComp::acceleration_level, dsp::DynamicComp::velocity_level, dsp::DynamicComp::position_level}) {
     cfg.dynamic = mode;
     const auto m = run_pipeline(sr.run, cfg);
     const double agree = max_difference_um(m, two_stage), err = max_error_um(m, sr.true_mm);
-    std::printf("  %-34s max |x - x_two_stage| %.2e um, max error vs truth %.4f um\n", dsp::dynamic_comp_name(mode), agree, err);
+    std::printf("  %-34s max |x - x_two_stage| %.2e um, max error vs truth %.4f um\n", dsp::dynamic_comp_name(mode),
+                agree, err);
     ASSERT_EQ(m.pos_mm.size(), two_stage.pos_mm.size());
     // Same result: the variants differ by their discrete derivatives only (transients at
     // the jerk steps), far below the common residual of the second-order inverse (d³/6·Δjerk).

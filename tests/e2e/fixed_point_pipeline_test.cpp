@@ -77,7 +77,8 @@ TEST(FixedPointPipeline, OverflowSaturatesAndFlagsTheResult) {
   EXPECT_TRUE(named);
   // Saturated, not wrapped: the position runs one way and stays finite.
   for (const auto& x : m.pos_mm) EXPECT_TRUE(x.allFinite());
-  EXPECT_GT(std::abs(m.pos_mm.back()[0] - m.pos_mm.front()[0]), 1000.0);  // clamped far away (mm), not wrapped to small values
+  EXPECT_GT(std::abs(m.pos_mm.back()[0] - m.pos_mm.front()[0]),
+            1000.0);  // clamped far away (mm), not wrapped to small values
 }
 
 }  // namespace

@@ -42,9 +42,11 @@ TEST(StaticCompEffects, TemperatureCompensationRemovesTheWarmingBiasDrift) {
   cfg.static_comp.temperature = cfg_zupt.static_comp.temperature = false;
   const double e_without = effect_um(run, run_ref, cfg);
   const auto without_zupt = run_pipeline(run, cfg_zupt);
-  std::printf("table warming 0.5 C/s: position error from it (no ZUPT): (6-16) off %.2f um, on %.4f um; velocity at the "
-              "final rest off %.3f um/s, on %.5f um/s\n",
-              e_without, e_with, without_zupt.zupt_velocity_error_mm_s.norm() * 1e3, with_zupt.zupt_velocity_error_mm_s.norm() * 1e3);
+  std::printf(
+      "table warming 0.5 C/s: position error from it (no ZUPT): (6-16) off %.2f um, on %.4f um; velocity at the "
+      "final rest off %.3f um/s, on %.5f um/s\n",
+      e_without, e_with, without_zupt.zupt_velocity_error_mm_s.norm() * 1e3,
+      with_zupt.zupt_velocity_error_mm_s.norm() * 1e3);
   EXPECT_GT(e_without, 10.0);  // 50 µg/s over seconds: ½·ḃ·t³/3 is tens of µm and more
   EXPECT_LT(e_with, 0.02 * e_without);
   EXPECT_LT(with_zupt.zupt_velocity_error_mm_s.norm(), 0.02 * without_zupt.zupt_velocity_error_mm_s.norm());
@@ -69,7 +71,8 @@ TEST(StaticCompEffects, NonlinearityCompensationRemovesTheSquareTerm) {
   const double e_with = effect_um(run, run_ref, cfg);
   cfg.static_comp.nonlinearity = false;
   const double e_without = effect_um(run, run_ref, cfg);
-  std::printf("k2 = 5e-3/g, 100 mm at 6.5 m/min: position error from it (no ZUPT): (6-17) off %.3f um, on %.5f um\n", e_without, e_with);
+  std::printf("k2 = 5e-3/g, 100 mm at 6.5 m/min: position error from it (no ZUPT): (6-17) off %.3f um, on %.5f um\n",
+              e_without, e_with);
   EXPECT_GT(e_without, 1.0);
   EXPECT_LT(e_with, 0.001 * e_without);
 }
@@ -93,9 +96,10 @@ TEST(StaticCompEffects, CorrectionMatrixRemovesCrossAxisAndMisalignment) {
   const double e_mounting = testutil::max_difference_um(run_pipeline(run, cfg), reference);
   cfg.calibration[0].cross_g_per_g = sc.truth[0].k_cross_g_per_g;
   const double e_full = testutil::max_difference_um(run_pipeline(run, cfg), reference);
-  std::printf("R10 circle, 5 mrad + cross-axis: position error from them: data sheet %.3f um, mounting corrected %.3f um, "
-              "mounting and cross-axis %.5f um\n",
-              e_data_sheet, e_mounting, e_full);
+  std::printf(
+      "R10 circle, 5 mrad + cross-axis: position error from them: data sheet %.3f um, mounting corrected %.3f um, "
+      "mounting and cross-axis %.5f um\n",
+      e_data_sheet, e_mounting, e_full);
   EXPECT_GT(e_data_sheet, 10.0);  // 5 mrad of a 10 mm radius is 50 µm of rotation
   EXPECT_LT(e_mounting, e_data_sheet);
   EXPECT_LT(e_full, 0.001 * e_data_sheet);

@@ -4,6 +4,7 @@
 // PSD strips, lost and bad frames, the other programs; from memory and read from disk as
 // eical analyze reads a run (samples.csv and .gz, a sensor absent, spills in files), and
 // with the per-sample arrays thinned as for a long run.
+#include "dsp/stream/analyze_stream.hpp"
 #include "drivers/results/result_json.hpp"
 #include "drivers/run_io/file_spill.hpp"
 #include "drivers/run_io/run_reader.hpp"
@@ -11,16 +12,15 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/core/error.hpp"
-#include "dsp/stream/analyze_stream.hpp"
 #include "sim/simulate.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <filesystem>
 #include <string>
 
 namespace eical {
@@ -62,7 +62,8 @@ void expect_same(const nlohmann::json& a, const nlohmann::json& b, const std::st
       ++differences;
       return;
     }
-    for (std::size_t i = 0; i < a.size(); ++i) expect_same(a[i], b[i], path + "[" + std::to_string(i) + "]", differences);
+    for (std::size_t i = 0; i < a.size(); ++i)
+      expect_same(a[i], b[i], path + "[" + std::to_string(i) + "]", differences);
     return;
   }
   if (a != b) ADD_FAILURE() << path << ": " << a.dump() << " vs " << b.dump(), ++differences;
@@ -102,7 +103,8 @@ sim::Scenario circle(double radius, double feed, int repeats, const std::string&
 TEST(AnalyzeStream, CircleBothDirectionsEqualsTheWholeTraceAnalysis) {
   const dsp::Run run = sim::simulate(circle(10.0, 2500.0, 3, "both"));
   const dsp::Analysis whole = whole_trace(run);
-  ASSERT_TRUE(whole.circle && whole.diagnostics && whole.circle_accuracy_rms_um) << (whole.flags.empty() ? "" : whole.flags.front());
+  ASSERT_TRUE(whole.circle && whole.diagnostics && whole.circle_accuracy_rms_um)
+      << (whole.flags.empty() ? "" : whole.flags.front());
   ASSERT_EQ(whole.repeats.size(), 2u);  // three revolutions each way
   const dsp::Analysis s = streamed(run);
   expect_same_result(run, whole, s);
@@ -143,7 +145,8 @@ TEST(AnalyzeStream, LostAndBadFramesAndRunsWithoutTriggers) {
   dsp::Run run = sim::simulate(circle(10.0, 2500.0, 2, "both"));
   // Lost frames inside a revolution and across a segment boundary, a saturated sample,
   // a NaN temperature.
-  for (std::size_t k : {40000u, 40001u, 40002u, 61234u}) run.frames.erase(run.frames.begin() + static_cast<std::ptrdiff_t>(k));
+  for (std::size_t k : {40000u, 40001u, 40002u, 61234u})
+    run.frames.erase(run.frames.begin() + static_cast<std::ptrdiff_t>(k));
   for (std::size_t k = 40000; k < 40002; ++k) run.frames[k].flags |= dsp::frame_flag::gap_before;
   run.frames[50000].flags |= dsp::frame_flag::accel_saturated;
   run.frames[50010].temp_c[0] = NAN;
@@ -155,7 +158,8 @@ TEST(AnalyzeStream, LostAndBadFramesAndRunsWithoutTriggers) {
 }
 
 TEST(AnalyzeStream, OtherProgramsAreEvaluatedOverTheirWholeTrace) {
-  for (const auto& sc : {sim::step_scenario(), sim::positioning_scenario({0.0, 10.0, 20.0}, 2), sim::rectangle_scenario(20.0, 10.0)}) {
+  for (const auto& sc :
+       {sim::step_scenario(), sim::positioning_scenario({0.0, 10.0, 20.0}, 2), sim::rectangle_scenario(20.0, 10.0)}) {
     const dsp::Run run = sim::simulate(sc);
     const dsp::Analysis whole = whole_trace(run);
     const dsp::Analysis s = streamed(run);

@@ -56,8 +56,9 @@ TEST(CircleAccuracy, NoiseFreeTwoStageCompensationIsExact) {
   none.dynamic = dsp::DynamicComp::none;
   const auto b = dsp::analyze_run(run, none);
   const double uncompensated = position_rms_um(b.measurement);
-  std::printf("position error RMS on the R10 circle: two-stage %.4f um (steady revolutions %.4f um), uncompensated %.1f um\n",
-              position_rms_um(a.measurement), position_rms_um(a.measurement, true), uncompensated);
+  std::printf(
+      "position error RMS on the R10 circle: two-stage %.4f um (steady revolutions %.4f um), uncompensated %.1f um\n",
+      position_rms_um(a.measurement), position_rms_um(a.measurement, true), uncompensated);
   // The thesis reports about 150 µm uncompensated on this circle (Bild 7-14): the delay
   // of 3.9 ms alone is 160 µm at 41.7 mm/s.
   EXPECT_GT(uncompensated, 50.0);

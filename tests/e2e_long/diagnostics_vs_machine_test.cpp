@@ -63,8 +63,8 @@ void expect_diagnostics(const sim::Scenario& sc, const std::map<std::string, dou
     const double expect = it == truth.end() ? 0.0 : it->second;
     const double tol = std::max(0.15 * std::abs(expect), value_tol.second);
     if (it != truth.end())
-      std::printf("%-22s true %9.3f  reported %9.3f  error %8.3f  (tolerance %.3f)\n", name.c_str(), expect, value_tol.first,
-                  value_tol.first - expect, tol);
+      std::printf("%-22s true %9.3f  reported %9.3f  error %8.3f  (tolerance %.3f)\n", name.c_str(), expect,
+                  value_tol.first, value_tol.first - expect, tol);
     EXPECT_NEAR(value_tol.first, expect, tol) << name << (it == truth.end() ? " (absent: should be ~0)" : "");
   }
 }

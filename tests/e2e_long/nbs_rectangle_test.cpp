@@ -52,8 +52,11 @@ TEST(NbsRectangle, HoldingTheStillAxisRemovesItsDrift) {
   ASSERT_TRUE(with.rectangle && without.rectangle);
   EXPECT_TRUE(with.nbs);  // on by default for rectangles
   const double w = still_axis_drift_um(with.measurement), wo = still_axis_drift_um(without.measurement);
-  std::printf("3 ug bias step per move, 50 mm rectangle at 6.5 m/min: still axis drift along a side without NBS %.2f um, with %.2f um; "
-              "worst corner %.2f / %.2f um\n", wo, w, worst_corner_um(without), worst_corner_um(with));
+  std::printf(
+      "3 ug bias step per move, 50 mm rectangle at 6.5 m/min: still axis drift along a side without NBS %.2f um, with "
+      "%.2f um; "
+      "worst corner %.2f / %.2f um\n",
+      wo, w, worst_corner_um(without), worst_corner_um(with));
   EXPECT_LT(w, 0.25 * wo);
   EXPECT_LT(w, 0.05);
   EXPECT_LT(worst_corner_um(with), 1.5 * worst_corner_um(without) + 0.5);  // the corners stay ZUPT's

@@ -44,7 +44,8 @@ void expect_arc_structure(const dsp::Analysis& a) {
   EXPECT_LT(a.circle_reference->circular_deviation_G_um, 0.2);
   // Partial arcs carry no diagnostics, and say so.
   EXPECT_FALSE(a.diagnostics);
-  EXPECT_TRUE(std::any_of(a.flags.begin(), a.flags.end(), [](const std::string& f) { return f.rfind("diagnostics: null", 0) == 0; }));
+  EXPECT_TRUE(std::any_of(a.flags.begin(), a.flags.end(),
+                          [](const std::string& f) { return f.rfind("diagnostics: null", 0) == 0; }));
 }
 
 TEST(PartialArcRun, GeneratedXyArcBothDirectionsAgreesWithTheTruth) {
@@ -62,7 +63,8 @@ TEST(PartialArcRun, GeneratedYzArcBothDirectionsIsFoundAndEvaluatedOverTheArc) {
   // pipeline's business, not the evaluation's): a regression guard only.
   EXPECT_LT(*a.circle_accuracy_rms_um, 2.0);
   std::printf("220 deg arc, noise-free: measured vs truth radius deviation RMS %.3f um, G %.3f um (truth G %.3f um)\n",
-              *a.circle_accuracy_rms_um, a.circle->circular_deviation_G_um, a.circle_reference->circular_deviation_G_um);
+              *a.circle_accuracy_rms_um, a.circle->circular_deviation_G_um,
+              a.circle_reference->circular_deviation_G_um);
 }
 
 TEST(PartialArcRun, FullCircleBothDirectionsGivesHysteresisAndSeparatesServoMismatch) {

@@ -16,8 +16,8 @@ TEST(PositioningRun, SimulatedCycleEvaluatesAllRunsAndTargets) {
   ASSERT_TRUE(a.positioning) << (a.flags.empty() ? "" : a.flags.front());
   EXPECT_EQ(a.positioning->runs, 3);
   EXPECT_EQ(a.positioning->targets.size(), 4u);
-  std::printf("ideal machine, 0.4 ug/sqrt(Hz): A %.2f um, R %.2f um, B %.2f um\n", a.positioning->A_um, a.positioning->R_um,
-              a.positioning->B_um);
+  std::printf("ideal machine, 0.4 ug/sqrt(Hz): A %.2f um, R %.2f um, B %.2f um\n", a.positioning->A_um,
+              a.positioning->R_um, a.positioning->B_um);
   // The machine is ideal: what A shows is the measurement's own noise after the ZUPTs.
   EXPECT_LT(a.positioning->A_um, 25.0);
   EXPECT_GT(a.measurement.zupt_window_samples, 0u);

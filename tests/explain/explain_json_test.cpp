@@ -26,8 +26,8 @@ TEST(ExplainJson, KeysOfResultsMdAndNamesOfTheEffectTable) {
   EXPECT_EQ(j.at("format"), "eical-explain/1");
   ASSERT_EQ(j.at("runs").size(), 2u);
   EXPECT_EQ(j.at("reference"), "ref");  // both runs carry a reference encoder
-  for (const char* k : {"nominal_residual_rms_um", "final_residual_rms_um", "heldout_nominal_residual_rms_um", "heldout_final_residual_rms_um",
-                        "runtime_s_per_run"})
+  for (const char* k : {"nominal_residual_rms_um", "final_residual_rms_um", "heldout_nominal_residual_rms_um",
+                        "heldout_final_residual_rms_um", "runtime_s_per_run"})
     EXPECT_TRUE(j.at(k).is_number()) << k;
   std::vector<std::string_view> names;
   for (const auto& i : dsp::model::effect_catalogue()) names.push_back(i.name);
@@ -35,11 +35,15 @@ TEST(ExplainJson, KeysOfResultsMdAndNamesOfTheEffectTable) {
   bool seen_insignificant = false;
   for (const auto& e : j.at("effects")) {
     const std::string name = e.at("name");
-    EXPECT_TRUE(std::find(names.begin(), names.end(), std::string_view(name)) != names.end() || name.rfind("other.", 0) == 0) << name;
+    EXPECT_TRUE(std::find(names.begin(), names.end(), std::string_view(name)) != names.end() ||
+                name.rfind("other.", 0) == 0)
+        << name;
     EXPECT_TRUE(e.at("significant").is_boolean());
     EXPECT_TRUE(e.at("evidence").is_string() && !e.at("evidence").get<std::string>().empty()) << name;
     EXPECT_TRUE(e.at("params").is_object());
-    for (const char* k : {"residual_rms_before_um", "residual_rms_after_um", "heldout_rms_before_um", "heldout_rms_after_um"}) EXPECT_TRUE(e.at(k).is_number()) << name << "." << k;
+    for (const char* k :
+         {"residual_rms_before_um", "residual_rms_after_um", "heldout_rms_before_um", "heldout_rms_after_um"})
+      EXPECT_TRUE(e.at(k).is_number()) << name << "." << k;
     if (!e.at("significant")) seen_insignificant = true;
     // Significant ones come first.
     if (e.at("significant")) {

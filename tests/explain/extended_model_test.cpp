@@ -2,6 +2,7 @@
 // (told: the run's data sheet; truth: the extended sensors) simulates a run that shows
 // what the recorded one showed, and the calibration it writes removes the effect from the
 // pipeline's result.
+#include "tools/explain/extended_model.hpp"
 #include "drivers/config/scenario_file.hpp"
 #include "drivers/config/sensor_calibration.hpp"
 #include "dsp/model/explain.hpp"
@@ -9,14 +10,13 @@
 #include "sim/hidden/hidden_effects.hpp"
 #include "sim/regimes/regimes.hpp"
 #include "sim/simulate.hpp"
-#include "tools/explain/extended_model.hpp"
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <unistd.h>
 
 namespace eical {
 namespace {
@@ -28,7 +28,8 @@ double pipeline_rms_um(const dsp::Run& run) {
   double s = 0.0;
   Eigen::Index n = 0;
   for (Eigen::Index i = 0; i < rr.pipeline.rows(); ++i)
-    if (rr.moving[rr.pipeline.axis[static_cast<std::size_t>(i)]]) s += rr.pipeline.residual_um[i] * rr.pipeline.residual_um[i], ++n;
+    if (rr.moving[rr.pipeline.axis[static_cast<std::size_t>(i)]])
+      s += rr.pipeline.residual_um[i] * rr.pipeline.residual_um[i], ++n;
   return n ? std::sqrt(s / static_cast<double>(n)) : 0.0;
 }
 
@@ -49,8 +50,10 @@ TEST(ExtendedModel, ScenarioReproducesTheRunAndTheCalibrationRemovesTheEffect) {
   drivers::apply_calibration(cal, calibrated.meta);
   const double after = pipeline_rms_um(calibrated);
   fs::remove_all(dir);
-  std::printf("sensor.scale hidden, step seed 101: pipeline residual recorded %.2f um, reproduced by the scenario %.2f um, "
-              "recorded with the calibration %.2f um\n", recorded, reproduced, after);
+  std::printf(
+      "sensor.scale hidden, step seed 101: pipeline residual recorded %.2f um, reproduced by the scenario %.2f um, "
+      "recorded with the calibration %.2f um\n",
+      recorded, reproduced, after);
   EXPECT_GT(recorded, 10.0);
   EXPECT_NEAR(reproduced, recorded, 0.2 * recorded);
   EXPECT_LT(after, 0.1 * recorded);
@@ -69,7 +72,8 @@ TEST(ExtendedModel, AnEffectOnTwoAxesRoundTripsThroughTheScenario) {
   tools::explain::write_extended_model(model, dir / "cal.toml", dir / "scenario.toml");
   const sim::Scenario back = drivers::read_scenario_file((dir / "scenario.toml").string());
   fs::remove_all(dir);
-  std::printf("backlash x %.2f y %.2f um read back from the written scenario\n", back.machine.backlash_um[0], back.machine.backlash_um[1]);
+  std::printf("backlash x %.2f y %.2f um read back from the written scenario\n", back.machine.backlash_um[0],
+              back.machine.backlash_um[1]);
   EXPECT_NEAR(back.machine.backlash_um[0], 6.0, 1.5);
   EXPECT_NEAR(back.machine.backlash_um[1], 4.0, 1.5);
 }
@@ -82,7 +86,8 @@ double mode_near(const dsp::model::RunExplanation& ex, double f_hz, double& zeta
     double best = INFINITY;
     for (int k = 0; e.params.count("mode" + std::to_string(k) + "_frequency_hz"); ++k) {
       const double f = e.params.at("mode" + std::to_string(k) + "_frequency_hz");
-      if (std::abs(f - f_hz) < std::abs(best - f_hz)) best = f, zeta = e.params.at("mode" + std::to_string(k) + "_damping_ratio");
+      if (std::abs(f - f_hz) < std::abs(best - f_hz))
+        best = f, zeta = e.params.at("mode" + std::to_string(k) + "_damping_ratio");
     }
     return best;
   }
@@ -108,8 +113,10 @@ TEST(ExtendedModel, TheModesFoundAreSimulatedAgainAndFoundAgain) {
   const auto again = dsp::model::explain_run(sim::simulate(back));
   double z1 = NAN, z2 = NAN;
   const double f1 = mode_near(ex, 45.0, z1), f2 = mode_near(again, 45.0, z2);
-  std::printf("mode 45 Hz zeta 0.030 gain 0.15: found %.2f Hz zeta %.4f; written gain %.3f; the written scenario simulated: %.2f Hz zeta %.4f\n", f1, z1,
-              back.resonance.modes[0].gain, f2, z2);
+  std::printf(
+      "mode 45 Hz zeta 0.030 gain 0.15: found %.2f Hz zeta %.4f; written gain %.3f; the written scenario simulated: "
+      "%.2f Hz zeta %.4f\n",
+      f1, z1, back.resonance.modes[0].gain, f2, z2);
   EXPECT_NEAR(f1, 45.0, 2.0);
   EXPECT_NEAR(z1, 0.03, 0.009);
   EXPECT_NEAR(back.resonance.modes[0].gain, 0.15, 0.045);

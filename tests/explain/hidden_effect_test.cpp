@@ -32,7 +32,8 @@ std::string joined(const std::vector<std::string>& v) {
   return s.empty() ? "none" : s;
 }
 
-dsp::model::RunExplanation explain_hidden(const std::vector<std::string>& effects, const std::string& program, std::uint64_t seed) {
+dsp::model::RunExplanation explain_hidden(const std::vector<std::string>& effects, const std::string& program,
+                                          std::uint64_t seed) {
   const dsp::Run run = sim::simulate(sim::hidden_effect_scenario(effects, program, seed));
   const auto t0 = std::chrono::steady_clock::now();
   auto ex = dsp::model::explain_run(run);
@@ -50,8 +51,9 @@ TEST_P(HiddenEffect, IsNamedFirstInMostSeeds) {
     const auto sig = significant(ex);
     const bool first = !sig.empty() && sig.front() == effect;
     named_first += first ? 1 : 0;
-    std::printf("%-32s seed %llu: %s (significant: %s; %.2f s)\n", effect.c_str(), static_cast<unsigned long long>(seed), first ? "named first" : "MISSED",
-                joined(sig).c_str(), ex.seconds);
+    std::printf("%-32s seed %llu: %s (significant: %s; %.2f s)\n", effect.c_str(),
+                static_cast<unsigned long long>(seed), first ? "named first" : "MISSED", joined(sig).c_str(),
+                ex.seconds);
   }
   // Two of three: a hidden size drawn near the tolerance can stay within the noise. Damping
   // that grows with |a| shows in the step program at one acceleration level, where it is
@@ -83,7 +85,8 @@ class Baseline : public ::testing::TestWithParam<std::string> {};
 TEST_P(Baseline, ShowsNoSignificantEffect) {
   for (std::uint64_t seed : kSeeds) {
     const auto sig = significant(explain_hidden({}, GetParam(), seed));
-    std::printf("baseline %s seed %llu: %s\n", GetParam().c_str(), static_cast<unsigned long long>(seed), joined(sig).c_str());
+    std::printf("baseline %s seed %llu: %s\n", GetParam().c_str(), static_cast<unsigned long long>(seed),
+                joined(sig).c_str());
     EXPECT_TRUE(sig.empty()) << GetParam() << " seed " << seed << ": " << joined(sig);
   }
 }
@@ -96,17 +99,18 @@ TEST_P(TwoEffects, BothNamed) {
   const auto& pair = GetParam();
   const auto sig = significant(explain_hidden(pair, sim::program_for(pair), kSeeds.front()));
   std::printf("%s + %s: %s\n", pair[0].c_str(), pair[1].c_str(), joined(sig).c_str());
-  for (const auto& e : pair) EXPECT_NE(std::find(sig.begin(), sig.end(), e), sig.end()) << e << " not named; significant: " << joined(sig);
+  for (const auto& e : pair)
+    EXPECT_NE(std::find(sig.begin(), sig.end(), e), sig.end()) << e << " not named; significant: " << joined(sig);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Pairs, TwoEffects,
-    // A sensor and a machine effect each, a spectral and a geometric one. (Measured and
-    // left out: bias drift + squareness and scale temperature + straightness at seed 101
-    // — the drift was missed, the warming named as drift; see the issue note.)
-    ::testing::Values(std::vector<std::string>{"machine.backlash", "sensor.scale"},
-                      std::vector<std::string>{"machine.common_vibration", "machine.servo_mismatch"},
-                      std::vector<std::string>{"sensor.dynamics", "machine.reversal_spike"}));
+INSTANTIATE_TEST_SUITE_P(Pairs, TwoEffects,
+                         // A sensor and a machine effect each, a spectral and a geometric one. (Measured and
+                         // left out: bias drift + squareness and scale temperature + straightness at seed 101
+                         // — the drift was missed, the warming named as drift; see the issue note.)
+                         ::testing::Values(std::vector<std::string>{"machine.backlash", "sensor.scale"},
+                                           std::vector<std::string>{"machine.common_vibration",
+                                                                    "machine.servo_mismatch"},
+                                           std::vector<std::string>{"sensor.dynamics", "machine.reversal_spike"}));
 
 }  // namespace
 }  // namespace eical

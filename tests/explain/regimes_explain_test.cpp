@@ -55,8 +55,8 @@ TEST_P(KlipperLikeModes, EachTrueModeFoundWithinTwoHertzAndThirtyPercentDamping)
       if (std::abs(f->second - truth.frequency_hz) < std::abs(best_df))
         best_df = f->second - truth.frequency_hz, zeta = res->params.at("mode" + std::to_string(k) + "_damping_ratio");
     }
-    std::printf("seed %d: true mode %.2f Hz zeta %.4f; found %+.2f Hz, zeta %.4f (%+.0f %%)\n", GetParam(), truth.frequency_hz, truth.damping_ratio, best_df, zeta,
-                100.0 * (zeta / truth.damping_ratio - 1.0));
+    std::printf("seed %d: true mode %.2f Hz zeta %.4f; found %+.2f Hz, zeta %.4f (%+.0f %%)\n", GetParam(),
+                truth.frequency_hz, truth.damping_ratio, best_df, zeta, 100.0 * (zeta / truth.damping_ratio - 1.0));
     EXPECT_LE(std::abs(best_df), 2.0) << "mode at " << truth.frequency_hz << " Hz";
     EXPECT_NEAR(zeta, truth.damping_ratio, 0.3 * truth.damping_ratio) << "mode at " << truth.frequency_hz << " Hz";
   }
@@ -80,7 +80,8 @@ TEST_P(KlipperLikeMounting, AWrongMountingIsNamedFirstWithTheMapThatFits) {
     }
   ASSERT_NE(first, nullptr);
   const std::string& map = sc.truth[1].axes_map;
-  std::printf("seed %d: head mounted as %s; explain: %s\n", GetParam(), map.c_str(), first->evidence.substr(0, 240).c_str());
+  std::printf("seed %d: head mounted as %s; explain: %s\n", GetParam(), map.c_str(),
+              first->evidence.substr(0, 240).c_str());
   EXPECT_EQ(first->name, "sensor.misalignment");
   EXPECT_FALSE(map.empty());
   // The mounting that fits, on the axis the test moves (the others are not moved), is the
@@ -90,7 +91,9 @@ TEST_P(KlipperLikeMounting, AWrongMountingIsNamedFirstWithTheMapThatFits) {
   dir.maxCoeff(&moved);
   // (the moved machine axis is a row of to_machine: which sensor axis lies along it)
   for (int c = 0; c < 3; ++c)
-    EXPECT_NEAR(first->params.at("to_machine_" + std::to_string(moved) + std::to_string(c)), sc.truth[1].spec.to_machine(moved, c), 1e-9) << map << " column " << c;
+    EXPECT_NEAR(first->params.at("to_machine_" + std::to_string(moved) + std::to_string(c)),
+                sc.truth[1].spec.to_machine(moved, c), 1e-9)
+        << map << " column " << c;
   expect_within_bounds(ex, "seed " + std::to_string(seed));
 }
 

@@ -39,15 +39,18 @@ TEST(SharedRuns, ExplainNamesWhatTheirTruthSaysIsPresent) {
       if (e.significant) sig.push_back(e.name);
     std::string list;
     for (const auto& s : sig) list += s + " ";
-    std::printf("%-36s present: %zu, significant: %s(%.2f s)\n", entry.path().filename().string().c_str(), present.size(), list.c_str(), seconds);
+    std::printf("%-36s present: %zu, significant: %s(%.2f s)\n", entry.path().filename().string().c_str(),
+                present.size(), list.c_str(), seconds);
     ++runs;
     if (present.empty()) {
       EXPECT_TRUE(sig.empty()) << "a run without effects shows " << list;
       continue;
     }
-    for (const auto& p : present) EXPECT_NE(std::find(sig.begin(), sig.end(), p), sig.end()) << p << " not named; significant: " << list;
+    for (const auto& p : present)
+      EXPECT_NE(std::find(sig.begin(), sig.end(), p), sig.end()) << p << " not named; significant: " << list;
     ASSERT_FALSE(sig.empty());
-    EXPECT_NE(std::find(present.begin(), present.end(), sig.front()), present.end()) << "first named " << sig.front() << " is not present";
+    EXPECT_NE(std::find(present.begin(), present.end(), sig.front()), present.end())
+        << "first named " << sig.front() << " is not present";
   }
   EXPECT_GT(runs, 0) << "no run with a truth.toml in " << data;
 }

@@ -18,9 +18,11 @@ namespace eical::faults {
 namespace {
 
 void print(const FaultOutcome& o) {
-  std::printf("%s -> %s | alive %d flagged %d clean %d | runs before %zu intact %zu after %zu | recovery %.2f s | data lost %s\n",
-              o.fault.c_str(), o.outcome.c_str(), o.service_alive, o.flagged, o.clean, o.runs_before, o.runs_intact, o.runs_after,
-              o.recovery_s, o.data_lost.c_str());
+  std::printf(
+      "%s -> %s | alive %d flagged %d clean %d | runs before %zu intact %zu after %zu | recovery %.2f s | data lost "
+      "%s\n",
+      o.fault.c_str(), o.outcome.c_str(), o.service_alive, o.flagged, o.clean, o.runs_before, o.runs_intact,
+      o.runs_after, o.recovery_s, o.data_lost.c_str());
 }
 
 // What every case must show, whatever the fault.
@@ -117,7 +119,8 @@ TEST(Faults, ARunLeftWithoutResultIsEvaluatedAtTheNextStart) {
   ASSERT_TRUE(fs::exists(result));
   const auto j = nlohmann::json::parse(slurp(result));
   EXPECT_TRUE(j["quality"]["degraded"].get<bool>());
-  EXPECT_NE(j["quality"]["flags"].dump().find("evaluated_after_restart"), std::string::npos) << j["quality"]["flags"].dump();
+  EXPECT_NE(j["quality"]["flags"].dump().find("evaluated_after_restart"), std::string::npos)
+      << j["quality"]["flags"].dump();
   EXPECT_TRUE(j["circle"].is_object()) << "the circle was not evaluated";
 }
 

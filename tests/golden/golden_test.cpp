@@ -3,9 +3,10 @@
 // tests/golden/tolerances.toml. A failure lists every changed key, old → new.
 // EICAL_GOLDEN_UPDATE=1 rewrites the expected documents instead (read the diff, commit both).
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <toml++/toml.h>
+#include <nlohmann/json.hpp>
 
+#include <sys/wait.h>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -15,7 +16,6 @@
 #include <set>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 namespace {
@@ -30,7 +30,7 @@ constexpr std::size_t kSummariseAbove = 32;  // numeric arrays longer than this:
 struct Case {
   std::string command;  // analyze | explain
   fs::path run;
-  std::string name;     // the run directory's name
+  std::string name;  // the run directory's name
 };
 
 // ctest's test list shows the command and the run, not the parameter's bytes.
@@ -102,7 +102,10 @@ json canonical(const json& j, const Tolerances& tol) {
         const double x = v.get<double>();
         lo = std::min(lo, x), hi = std::max(hi, x), ss += x * x, ++n;
       }
-      return json{{"summary_n", j.size()}, {"summary_nulls", nulls}, {"summary_min", n ? json(lo) : json()}, {"summary_max", n ? json(hi) : json()},
+      return json{{"summary_n", j.size()},
+                  {"summary_nulls", nulls},
+                  {"summary_min", n ? json(lo) : json()},
+                  {"summary_max", n ? json(hi) : json()},
                   {"summary_rms", n ? json(std::sqrt(ss / static_cast<double>(n))) : json()}};
     }
     json a = json::array();
@@ -172,8 +175,10 @@ void diff(const json& a, const json& b, const std::string& path, const Tolerance
       }
       return;
     }
-    if (a.size() != b.size()) out.push_back(path + ": " + std::to_string(a.size()) + " entries -> " + std::to_string(b.size()));
-    for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) diff(a[i], b[i], path + "[" + std::to_string(i) + "]", tol, out);
+    if (a.size() != b.size())
+      out.push_back(path + ": " + std::to_string(a.size()) + " entries -> " + std::to_string(b.size()));
+    for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i)
+      diff(a[i], b[i], path + "[" + std::to_string(i) + "]", tol, out);
     return;
   }
   if (a != b) out.push_back(path + ": " + shown(a) + " -> " + shown(b));
@@ -202,7 +207,8 @@ TEST_P(Golden, OutputEqualsTheCommittedOneWithinTolerance) {
   try {
     doc = json::parse(text);
   } catch (const json::parse_error& e) {
-    FAIL() << "eical " << c.command << " " << c.run << " printed no JSON document (exit " << exit_code << "): " << e.what();
+    FAIL() << "eical " << c.command << " " << c.run << " printed no JSON document (exit " << exit_code
+           << "): " << e.what();
   }
   json now = canonical(doc, tol);
   now["exit_code"] = exit_code;
@@ -220,8 +226,9 @@ TEST_P(Golden, OutputEqualsTheCommittedOneWithinTolerance) {
   diff(before, now, "", tol, changes);
   std::ostringstream msg;
   for (const auto& l : changes) msg << "  " << l << "\n";
-  EXPECT_TRUE(changes.empty()) << "eical " << c.command << " " << c.name << ": " << changes.size() << " changed keys (old -> new):\n"
-                               << msg.str() << "If the change is meant: EICAL_GOLDEN_UPDATE=1 ctest -L golden, read the diff, commit it.";
+  EXPECT_TRUE(changes.empty())
+      << "eical " << c.command << " " << c.name << ": " << changes.size() << " changed keys (old -> new):\n"
+      << msg.str() << "If the change is meant: EICAL_GOLDEN_UPDATE=1 ctest -L golden, read the diff, commit it.";
 }
 
 // The diff itself: a figure moved beyond its tolerance is named with both values; one within
@@ -231,7 +238,8 @@ TEST(GoldenDiff, NamesAChangedFigureAndOnlyIt) {
   tol.fallback = {1e-9, 1e-9};
   tol.rules.push_back({"uncertainty_k2.", {1e-3, 0.0}});
   const json a = {{"circle", {{"G_um", 5.0}, {"F_um", 1.0}}}, {"uncertainty_k2", {{"circle.G_um", 10.0}}}, {"gone", 1}};
-  const json b = {{"circle", {{"G_um", 5.1}, {"F_um", 1.0}}}, {"uncertainty_k2", {{"circle.G_um", 10.005}}}, {"new", 2}};
+  const json b = {
+      {"circle", {{"G_um", 5.1}, {"F_um", 1.0}}}, {"uncertainty_k2", {{"circle.G_um", 10.005}}}, {"new", 2}};
   std::vector<std::string> out;
   diff(a, b, "", tol, out);
   ASSERT_EQ(out.size(), 3u);

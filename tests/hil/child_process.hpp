@@ -2,14 +2,14 @@
 // A child process for hardware-in-the-loop tests: started with fork/exec, output to a log
 // file, always reaped. Every wait has a timeout, and the destructor kills a child that is
 // still running (SIGKILL), so a hanging eicald cannot hang the test.
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
-#include <fcntl.h>
 #include <optional>
 #include <string>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <vector>
 
 namespace eical::test {
@@ -64,7 +64,8 @@ class ChildProcess {
 };
 
 // Runs a command to completion (timeout, then killed) and returns its standard output.
-inline std::optional<std::string> run_capture(const std::vector<std::string>& argv, std::chrono::milliseconds timeout, int* exit_code = nullptr) {
+inline std::optional<std::string> run_capture(const std::vector<std::string>& argv, std::chrono::milliseconds timeout,
+                                              int* exit_code = nullptr) {
   char tmpl[] = "/tmp/eical-hil-out-XXXXXX";
   const int fd = ::mkstemp(tmpl);
   if (fd < 0) return std::nullopt;

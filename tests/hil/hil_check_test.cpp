@@ -2,8 +2,8 @@
 // every problem is one line naming its cause (absent DAQ, absent trigger devices, an
 // unwritable recording path, a missing DDS configuration, a missing program directory),
 // exit 3; a sound configuration says so, exit 0.
-#include "hil_support.hpp"
 #include "child_process.hpp"
+#include "hil_support.hpp"
 
 namespace eical::test {
 namespace {
@@ -21,15 +21,19 @@ std::pair<std::optional<int>, std::string> check(const fs::path& config) {
 TEST(HilCheck, NamesEveryProblemOfTheMachine) {
   const fs::path dir = scratch_dir("check-bad");
   std::ofstream(dir / "eicald.toml") << "[source]\nkind = \"usb_daq\"\n"
-                                     << "[setpoint]\nsource = \"program\"\n[setpoint.program]\ndirectory = \"" << (dir / "no-programs").string() << "\"\n"
-                                     << "[triggers]\ninputs = [\"frame\", \"gpio\", \"can\"]\ngpio_chip = \"gpiochip-absent\"\ncan_interface = \"can-absent\"\n"
+                                     << "[setpoint]\nsource = \"program\"\n[setpoint.program]\ndirectory = \""
+                                     << (dir / "no-programs").string() << "\"\n"
+                                     << "[triggers]\ninputs = [\"frame\", \"gpio\", \"can\"]\ngpio_chip = "
+                                        "\"gpiochip-absent\"\ncan_interface = \"can-absent\"\n"
                                      << "[dds]\nconfig_uri = \"file://" << (dir / "missing.xml").string() << "\"\n"
                                      << "[recording]\ndir = \"/proc/nope/runs\"\n";
   const auto [rc, out] = check(dir / "eicald.toml");
   EXPECT_EQ(rc, std::optional<int>(3)) << out;
-  for (const std::string& want : {std::string("usb_daq: no DAQ with USB id 1d50:6161"), std::string("gpio: cannot open gpiochip-absent"),
-                                   std::string("can: "), std::string("/proc/nope/runs"), (dir / "missing.xml").string() + " ([dds] config_uri) does not exist",
-                                   "the program directory " + (dir / "no-programs").string() + " does not exist"})
+  for (const std::string& want :
+       {std::string("usb_daq: no DAQ with USB id 1d50:6161"), std::string("gpio: cannot open gpiochip-absent"),
+        std::string("can: "), std::string("/proc/nope/runs"),
+        (dir / "missing.xml").string() + " ([dds] config_uri) does not exist",
+        "the program directory " + (dir / "no-programs").string() + " does not exist"})
     EXPECT_NE(out.find(want), std::string::npos) << "missing: " << want << "\n" << out;
   fs::remove_all(dir);
 }

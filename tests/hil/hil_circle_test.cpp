@@ -3,8 +3,8 @@
 // the NC and the HMI. The test sends M101/M102/M103 over the Command topic at the NC
 // program's times, receives Result and Trace, and checks that the Result equals
 // `eical analyze --json` on the run eicald recorded.
-#include "hil_support.hpp"
 #include "child_process.hpp"
+#include "hil_support.hpp"
 #include "sim/nc/trajectory.hpp"
 
 #include <nlohmann/json.hpp>
@@ -41,7 +41,8 @@ void expect_same(const nlohmann::json& a, const nlohmann::json& b, const std::st
       }
     }
     for (auto it = b.begin(); it != b.end(); ++it)
-      if (!a.contains(it.key())) ADD_FAILURE() << path << "/" << it.key() << " missing in the DDS Result", ++differences;
+      if (!a.contains(it.key()))
+        ADD_FAILURE() << path << "/" << it.key() << " missing in the DDS Result", ++differences;
   } else if (a.is_array()) {
     if (a.size() != b.size()) {
       ADD_FAILURE() << path << ": " << a.size() << " vs " << b.size() << " elements";
@@ -102,7 +103,8 @@ TEST(Hil, DdsTriggeredCircleResultEqualsAnalyzeOfTheRecording) {
   while (!result && std::chrono::steady_clock::now() < end) result = nc.bus().take_result(200ms);
   ASSERT_TRUE(result) << "no Result; log:\n" << slurp(dir / "eicald.log");
   std::optional<drivers::dds::TraceMsg> trace;
-  for (int i = 0; i < 50 && !(trace && trace->program_id == result->program_id); ++i) trace = nc.bus().take_trace(200ms);
+  for (int i = 0; i < 50 && !(trace && trace->program_id == result->program_id); ++i)
+    trace = nc.bus().take_trace(200ms);
 
   eicald.signal(SIGTERM);
   EXPECT_EQ(eicald.wait_exit(15s), std::optional<int>(0)) << "eicald did not stop cleanly on SIGTERM";

@@ -10,7 +10,6 @@
 //       NC dwelling 37 ms longer after M101 than the program says (an M-code's dead time).
 // Each recorded run's set-point equals the simulated one, and the circle result equals
 // `eical analyze` of the simulated run within the tolerance below.
-#include "hil_support.hpp"
 #include "child_process.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_writer.hpp"
@@ -18,6 +17,7 @@
 #include "drivers/source/stamped_source.hpp"
 #include "drivers/usb_daq/frame_encoder.hpp"
 #include "dsp/analysis/analyze_run.hpp"
+#include "hil_support.hpp"
 #include "sim/simulate.hpp"
 
 #include <fcntl.h>
@@ -35,14 +35,14 @@ namespace {
 constexpr double kFs = 10000.0;
 constexpr std::int64_t kServoCycle0 = 734512;  // LinuxCNC's cycle count at the servo stream's start
 constexpr double kServoOffsetS = 0.0037;       // servo cycle kServoCycle0 happens 3.7 ms after DAQ sample 0
-constexpr std::int64_t kDeadTimeFrames = 370;   // (b): the NC rests 37 ms longer after M101
+constexpr std::int64_t kDeadTimeFrames = 370;  // (b): the NC rests 37 ms longer after M101
 
 // The simulated run as the machine produced it, and the frames the DAQ streams: rest before
 // and after (eicald starts, the pre-trigger window fills), optionally extra rest after M101.
 struct Stream {
-  dsp::Run sim;                        // the simulated run (written for `eical analyze`)
-  std::vector<dsp::Frame> frames;      // what the DAQ sends, indices from 0
-  std::vector<std::int64_t> origin;    // frame k shows the simulated run's frame origin[k]
+  dsp::Run sim;                      // the simulated run (written for `eical analyze`)
+  std::vector<dsp::Frame> frames;    // what the DAQ sends, indices from 0
+  std::vector<std::int64_t> origin;  // frame k shows the simulated run's frame origin[k]
 };
 
 Stream make_stream(const fs::path& program_file, std::int64_t dead_time_frames) {
@@ -52,7 +52,8 @@ Stream make_stream(const fs::path& program_file, std::int64_t dead_time_frames) 
   s.sim = sim::simulate(sc);
   const auto lead = static_cast<std::int64_t>(2.5 * kFs), tail = static_cast<std::int64_t>(1.5 * kFs);
   auto add = [&](std::int64_t j, bool trigger) {
-    dsp::Frame f = s.sim.frames[static_cast<std::size_t>(std::clamp<std::int64_t>(j, 0, static_cast<std::int64_t>(s.sim.frames.size()) - 1))];
+    dsp::Frame f = s.sim.frames[static_cast<std::size_t>(
+        std::clamp<std::int64_t>(j, 0, static_cast<std::int64_t>(s.sim.frames.size()) - 1))];
     f.sample_index = static_cast<std::int64_t>(s.frames.size());
     if (!trigger) f.trigger = 0;
     for (double& c : f.cmd_mm) c = 0.0;  // a DAQ knows no set-point
@@ -75,10 +76,12 @@ fs::path write_daq_config(const fs::path& dir, int domain, const std::string& in
   const fs::path file = dir / "eicald.toml";
   std::ofstream os(file);
   os << "[source]\nkind = \"daq_stream\"\nretry_s = 0.5\n"
-     << "[source.daq_stream]\npath = \"" << (dir / "daq.fifo").string() << "\"\nconnect_timeout_s = 30.0\nstall_timeout_s = 2.0\n"
+     << "[source.daq_stream]\npath = \"" << (dir / "daq.fifo").string()
+     << "\"\nconnect_timeout_s = 30.0\nstall_timeout_s = 2.0\n"
      << setpoint << "\n"
      << "[triggers]\ninputs = " << inputs << "\n"
-     << "[dds]\ndomain_id = " << domain << "\nconfig_uri = \"file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml\"\n"
+     << "[dds]\ndomain_id = " << domain
+     << "\nconfig_uri = \"file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml\"\n"
      << "[recording]\ndir = \"" << (dir / "runs").string() << "\"\ngzip = false\n"
      << "[limits]\nmax_measurement_s = 60.0\n"
      << "[realtime]\nsched_fifo_priority = 0\nmlockall = false\n";
@@ -89,7 +92,8 @@ fs::path write_daq_config(const fs::path& dir, int domain, const std::string& in
 // 10 kHz (a packet of 32 samples when its last sample is due). t0_ns: sample 0's time.
 class DaqDevice {
  public:
-  DaqDevice(const fs::path& fifo, const std::vector<dsp::Frame>& frames) : ignore_sigpipe_(std::signal(SIGPIPE, SIG_IGN)), thread_([this, fifo, &frames] { run(fifo, frames); }) {}
+  DaqDevice(const fs::path& fifo, const std::vector<dsp::Frame>& frames)
+      : ignore_sigpipe_(std::signal(SIGPIPE, SIG_IGN)), thread_([this, fifo, &frames] { run(fifo, frames); }) {}
   ~DaqDevice() {
     stop_ = true;
     thread_.join();
@@ -137,7 +141,8 @@ class DaqDevice {
 // LinuxCNC's side of the servo stream: the set-point of the frames as halsampler lines.
 class ServoStreamWriter {
  public:
-  ServoStreamWriter(const fs::path& fifo, const Stream& s, const DaqDevice& daq) : thread_([this, fifo, &s, &daq] { run(fifo, s, daq); }) {}
+  ServoStreamWriter(const fs::path& fifo, const Stream& s, const DaqDevice& daq)
+      : thread_([this, fifo, &s, &daq] { run(fifo, s, daq); }) {}
   ~ServoStreamWriter() {
     stop_ = true;
     thread_.join();
@@ -145,7 +150,8 @@ class ServoStreamWriter {
 
  private:
   void run(const fs::path& fifo, const Stream& s, const DaqDevice& daq) {
-    for (int i = 0; i < 3000 && !(fs::is_fifo(fifo) && daq.t0_ns() != 0) && !stop_; ++i) std::this_thread::sleep_for(10ms);
+    for (int i = 0; i < 3000 && !(fs::is_fifo(fifo) && daq.t0_ns() != 0) && !stop_; ++i)
+      std::this_thread::sleep_for(10ms);
     const int fd = ::open(fifo.c_str(), O_WRONLY);
     if (fd < 0) return;
     const std::int64_t t0 = daq.t0_ns();
@@ -158,15 +164,17 @@ class ServoStreamWriter {
       return f0.cmd_mm[a] + (f1.cmd_mm[a] - f0.cmd_mm[a]) * (x - static_cast<double>(k));
     };
     // Cycles from now on (the machine ran before; the stream starts when eicald listens).
-    std::int64_t k = std::max<std::int64_t>(0, static_cast<std::int64_t>((static_cast<double>(drivers::monotonic_ns() - t0) * 1e-9 - kServoOffsetS) * 1e3));
+    std::int64_t k = std::max<std::int64_t>(
+        0, static_cast<std::int64_t>((static_cast<double>(drivers::monotonic_ns() - t0) * 1e-9 - kServoOffsetS) * 1e3));
     for (; !stop_; k += 10) {
       sleep_until_ns(t0 + static_cast<std::int64_t>((kServoOffsetS + static_cast<double>(k + 9) * 1e-3) * 1e9));
       std::string burst;
       for (std::int64_t j = k; j < k + 10; ++j) {
         const double t = kServoOffsetS + static_cast<double>(j) * 1e-3;
         char line[200];
-        std::snprintf(line, sizeof line, "%lld %.6f %.6f %.6f %.6f %.6f %.6f 0\n", static_cast<long long>(kServoCycle0 + j), cmd_at(t, 0),
-                      cmd_at(t, 1), cmd_at(t, 2), cmd_at(t, 0), cmd_at(t, 1), cmd_at(t, 2));
+        std::snprintf(line, sizeof line, "%lld %.6f %.6f %.6f %.6f %.6f %.6f 0\n",
+                      static_cast<long long>(kServoCycle0 + j), cmd_at(t, 0), cmd_at(t, 1), cmd_at(t, 2), cmd_at(t, 0),
+                      cmd_at(t, 1), cmd_at(t, 2));
         burst += line;
       }
       if (::write(fd, burst.data(), burst.size()) < 0) break;
@@ -201,7 +209,8 @@ Outcome collect(const fs::path& dir, const Stream& s, ChildProcess& eicald) {
   int rc = -1;
   // --no-suggest: no simulated variants; the exit status is the verdict's (0 ok, 2 degraded,
   // 3 not measurable), 1 an error.
-  const auto analyzed = run_capture({EICAL_CLI, "analyze", (dir / "simulated").string(), "--json", "--no-suggest"}, 120s, &rc);
+  const auto analyzed =
+      run_capture({EICAL_CLI, "analyze", (dir / "simulated").string(), "--json", "--no-suggest"}, 120s, &rc);
   const bool ok = analyzed && (rc == 0 || rc == 2 || rc == 3);
   EXPECT_TRUE(ok) << "eical analyze failed with " << rc;
   if (ok) o.reference = nlohmann::json::parse(*analyzed);
@@ -271,8 +280,10 @@ void expect_same_circle(const Outcome& o, const fs::path& program_file) {
     const double got = o.result["circle"][key].get<double>(), want = o.reference["circle"][key].get<double>();
     const double tol = std::string(key) == "circular_deviation_G_um" ? t.g_um : t.r_um;
     EXPECT_NEAR(got, want, tol) << key;
-    std::printf("  %s: eicald %.4f um, eical analyze of the simulated run %.4f um, difference %+.4f um (tolerance %.3f um, %s)\n", key, got,
-                want, got - want, tol, t.basis.c_str());
+    std::printf(
+        "  %s: eicald %.4f um, eical analyze of the simulated run %.4f um, difference %+.4f um (tolerance %.3f um, "
+        "%s)\n",
+        key, got, want, got - want, tol, t.basis.c_str());
   }
 }
 
@@ -287,10 +298,11 @@ TEST(HilDaqStream, ServoStreamSetPointBesideTheDaq) {
   const Stream s = make_stream(dir / "programs" / "7.toml", 0);
   const int domain = hil_domain(6);
   // The triggers on the DAQ's input carry no P word: the program evaluated is the default.
-  const fs::path cfg = write_daq_config(dir, domain, "[\"frame\"]",
-                                        "[setpoint]\nsource = \"servo_stream\"\n[setpoint.servo_stream]\nfifo = \"" + (dir / "servo.fifo").string() +
-                                            "\"\nhold_ms = 300.0\n[setpoint.program]\ndirectory = \"" + (dir / "programs").string() +
-                                            "\"\ndefault_program = 7\n");
+  const fs::path cfg =
+      write_daq_config(dir, domain, "[\"frame\"]",
+                       "[setpoint]\nsource = \"servo_stream\"\n[setpoint.servo_stream]\nfifo = \"" +
+                           (dir / "servo.fifo").string() + "\"\nhold_ms = 300.0\n[setpoint.program]\ndirectory = \"" +
+                           (dir / "programs").string() + "\"\ndefault_program = 7\n");
   ChildProcess eicald({EICALD_BIN, "--config", cfg.string()}, (dir / "eicald.log").string());
   Outcome o;
   {
@@ -305,12 +317,15 @@ TEST(HilDaqStream, ServoStreamSetPointBesideTheDaq) {
   EXPECT_EQ(sp.source, "servo_stream");
   EXPECT_EQ(sp.program_number, 7);
   EXPECT_EQ(run.meta.program.kind, "circle");
-  const double true_cycle = static_cast<double>(kServoCycle0) + (static_cast<double>(run.frames.front().sample_index) / kFs - kServoOffsetS) * 1e3;
+  const double true_cycle = static_cast<double>(kServoCycle0) +
+                            (static_cast<double>(run.frames.front().sample_index) / kFs - kServoOffsetS) * 1e3;
   const double err_um = setpoint_error_um(run, s);
-  std::printf("(a) servo stream: servo cycle at the first sample %.3f (true %.3f, %+.3f ms); set-point within %.2f um of the simulated one;\n"
-              "    cross-correlation: measured lags the set-point by %+.3f ms, correlation %.4f, residual %.2f %%\n",
-              sp.servo_cycle_at_first_sample, true_cycle, (sp.servo_cycle_at_first_sample - true_cycle), err_um, sp.lag_s * 1e3, sp.correlation,
-              sp.residual_ratio * 100.0);
+  std::printf(
+      "(a) servo stream: servo cycle at the first sample %.3f (true %.3f, %+.3f ms); set-point within %.2f um of the "
+      "simulated one;\n"
+      "    cross-correlation: measured lags the set-point by %+.3f ms, correlation %.4f, residual %.2f %%\n",
+      sp.servo_cycle_at_first_sample, true_cycle, (sp.servo_cycle_at_first_sample - true_cycle), err_um, sp.lag_s * 1e3,
+      sp.correlation, sp.residual_ratio * 100.0);
   EXPECT_NEAR(sp.servo_cycle_at_first_sample, true_cycle, 0.5) << "the clocks' offset within 0.5 ms";
   EXPECT_LT(err_um, 25.0);
   EXPECT_NEAR(sp.lag_s, 0.0, 5e-4);
@@ -330,8 +345,9 @@ TEST(HilDaqStream, ProgramSetPointNamedByM101BesideTheDaq) {
   ASSERT_EQ(rc, 0);
   const Stream s = make_stream(dir / "programs" / "7.toml", kDeadTimeFrames);
   const int domain = hil_domain(7);
-  const fs::path cfg = write_daq_config(dir, domain, "[\"dds\"]",
-                                        "[setpoint]\nsource = \"program\"\n[setpoint.program]\ndirectory = \"" + (dir / "programs").string() + "\"\n");
+  const fs::path cfg = write_daq_config(
+      dir, domain, "[\"dds\"]",
+      "[setpoint]\nsource = \"program\"\n[setpoint.program]\ndirectory = \"" + (dir / "programs").string() + "\"\n");
   ChildProcess eicald({EICALD_BIN, "--config", cfg.string()}, (dir / "eicald.log").string());
   Outcome o;
   {
@@ -359,11 +375,13 @@ TEST(HilDaqStream, ProgramSetPointNamedByM101BesideTheDaq) {
   EXPECT_EQ(run.meta.program.kind, "circle");
   EXPECT_FALSE(run.meta.program.gcode.empty()) << "the program travels with the run";
   const double err_um = setpoint_error_um(run, s);
-  std::printf("(b) program 7: marks offset %+.3f ms, after the cross-correlation %+.3f ms (the NC's 37 ms dead time after M101: %+.3f ms "
-              "expected from the marks); %d motion block(s); set-point within %.2f um of the simulated one;\n"
-              "    measured lags the set-point by %+.3f ms, correlation %.4f, residual %.2f %%\n",
-              sp.marks_offset_s * 1e3, sp.offset_s * 1e3, static_cast<double>(kDeadTimeFrames) / kFs * 1e3, sp.blocks, err_um, sp.lag_s * 1e3,
-              sp.correlation, sp.residual_ratio * 100.0);
+  std::printf(
+      "(b) program 7: marks offset %+.3f ms, after the cross-correlation %+.3f ms (the NC's 37 ms dead time after "
+      "M101: %+.3f ms "
+      "expected from the marks); %d motion block(s); set-point within %.2f um of the simulated one;\n"
+      "    measured lags the set-point by %+.3f ms, correlation %.4f, residual %.2f %%\n",
+      sp.marks_offset_s * 1e3, sp.offset_s * 1e3, static_cast<double>(kDeadTimeFrames) / kFs * 1e3, sp.blocks, err_um,
+      sp.lag_s * 1e3, sp.correlation, sp.residual_ratio * 100.0);
   // The motion starts 37 ms later than the M101 mark says: the cross-correlation finds it.
   EXPECT_NEAR((sp.offset_s - sp.marks_offset_s) * 1e3, static_cast<double>(kDeadTimeFrames) / kFs * 1e3, 8.0)
       << "the 37 ms within the DDS mark's latency";

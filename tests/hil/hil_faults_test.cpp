@@ -2,9 +2,9 @@
 // recorded so far is saved and flagged `interrupted`, never a half-written directory) and
 // an HMI that disappears and returns (the Result of what was measured meanwhile still
 // arrives: transient-local).
-#include "hil_support.hpp"
 #include "child_process.hpp"
 #include "drivers/run_io/run_reader.hpp"
+#include "hil_support.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -22,15 +22,16 @@ Daemon start_daemon(const std::string& tag, int salt) {
   Daemon d;
   d.dir = scratch_dir(tag);
   int rc = -1;
-  const auto out = run_capture({EICAL_CLI, "gen-nc", "circle", "--radius", "10", "--feed", "2500", "--repeats", "2", "-o",
-                                (d.dir / "circle.ngc").string(), "--meta", (d.dir / "circle.toml").string()},
+  const auto out = run_capture({EICAL_CLI, "gen-nc", "circle", "--radius", "10", "--feed", "2500", "--repeats", "2",
+                                "-o", (d.dir / "circle.ngc").string(), "--meta", (d.dir / "circle.toml").string()},
                                30s, &rc);
   EXPECT_TRUE(out && rc == 0) << "eical gen-nc failed";
   d.hc.domain = hil_domain(salt);
   d.hc.program_file = d.dir / "circle.toml";
   d.hc.recording_dir = d.dir / "runs";
   const fs::path cfg = write_config(d.dir, d.hc);
-  d.process = std::make_unique<ChildProcess>(std::vector<std::string>{EICALD_BIN, "--config", cfg.string()}, (d.dir / "eicald.log").string());
+  d.process = std::make_unique<ChildProcess>(std::vector<std::string>{EICALD_BIN, "--config", cfg.string()},
+                                             (d.dir / "eicald.log").string());
   return d;
 }
 
@@ -91,7 +92,8 @@ TEST(HilFaults, HmiThatLeftAndReturnsGetsTheResultMeasuredMeanwhile) {
   const auto until = std::chrono::steady_clock::now() + 20s;
   while (!(result && result->program_id == run.filename().string()) && std::chrono::steady_clock::now() < until)
     result = hmi.take_result(200ms);
-  ASSERT_TRUE(result && result->program_id == run.filename().string()) << "the returning HMI did not get " << run.filename();
+  ASSERT_TRUE(result && result->program_id == run.filename().string())
+      << "the returning HMI did not get " << run.filename();
   EXPECT_EQ(nlohmann::json::parse(result->json)["format"], "eical-result/1");
   d.process->signal(SIGTERM);
   EXPECT_EQ(d.process->wait_exit(20s), std::optional<int>(0));

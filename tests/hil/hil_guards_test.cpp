@@ -2,9 +2,9 @@
 // a measurement is refused with its reason on Reply and the measurement goes on untouched
 // (one recording, one M101 mark, not degraded); `eical hmi` never shows a result count
 // below a result it printed; without a daemon it says so and exits non-zero.
-#include "hil_support.hpp"
 #include "child_process.hpp"
 #include "drivers/run_io/run_reader.hpp"
+#include "hil_support.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -28,11 +28,13 @@ TEST(HilGuards, M101DuringAMeasurementIsRefusedOnReplyAndTheMeasurementContinues
   ChildProcess eicald({EICALD_BIN, "--config", cfg.string()}, (dir / "eicald.log").string());
   // The HMI, as a machine operator runs it, from before the first result.
   // It listens 12 s: the result arrives after about 4 s, and Status (1 Hz) keeps coming.
-  ChildProcess hmi({EICAL_CLI, "hmi", "--domain", std::to_string(hc.domain), "--timeout", "12"}, (dir / "hmi.log").string());
+  ChildProcess hmi({EICAL_CLI, "hmi", "--domain", std::to_string(hc.domain), "--timeout", "12"},
+                   (dir / "hmi.log").string());
   NcOnBus nc(hc.domain);
   ASSERT_TRUE(nc.handshake(30s)) << slurp(dir / "eicald.log");
   ASSERT_TRUE(nc.trigger(101, now_ns()));
-  ASSERT_TRUE(nc.status(10s, [](const drivers::dds::StatusMsg& s) { return s.state == "MEASURING"; })) << slurp(dir / "eicald.log");
+  ASSERT_TRUE(nc.status(10s, [](const drivers::dds::StatusMsg& s) { return s.state == "MEASURING"; }))
+      << slurp(dir / "eicald.log");
   const auto refused = nc.trigger_reply(101, now_ns(), 3.0);
   ASSERT_TRUE(refused) << "no Reply to the second M101";
   EXPECT_FALSE(refused->ok);
@@ -77,7 +79,8 @@ TEST(HilGuards, M101DuringAMeasurementIsRefusedOnReplyAndTheMeasurementContinues
     if (line.rfind("result ", 0) == 0) after_result = true;
     unsigned long long n = 0;
     const auto at = line.find(" lost, ");
-    if (after_result && line.rfind("status ", 0) == 0 && at != std::string::npos && std::sscanf(line.c_str() + at, " lost, %llu results", &n) == 1) {
+    if (after_result && line.rfind("status ", 0) == 0 && at != std::string::npos &&
+        std::sscanf(line.c_str() + at, " lost, %llu results", &n) == 1) {
       EXPECT_GE(n, 1u) << line;
       ++status_after;
     }

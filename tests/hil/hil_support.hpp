@@ -39,17 +39,19 @@ struct HilConfig {
   fs::path program_file;  // [program] TOML from eical gen-nc --meta
   fs::path recording_dir;
   double idle_s = 1.0;
-  std::string extra;      // more TOML (e.g. a [source.fault] table)
+  std::string extra;  // more TOML (e.g. a [source.fault] table)
 };
 
 inline fs::path write_config(const fs::path& dir, const HilConfig& c) {
   const fs::path file = dir / "eicald.toml";
   std::ofstream os(file);
   os << "[source]\nkind = \"sim\"\npacing = \"realtime\"\nretry_s = 0.5\n"
-     << "[source.sim]\nprogram_file = \"" << c.program_file.string() << "\"\nidle_s = " << c.idle_s << "\nrepeat_program = true\n"
+     << "[source.sim]\nprogram_file = \"" << c.program_file.string() << "\"\nidle_s = " << c.idle_s
+     << "\nrepeat_program = true\n"
      << c.extra << "\n"
      << "[triggers]\ninputs = [\"dds\"]\n"
-     << "[dds]\ndomain_id = " << c.domain << "\nconfig_uri = \"file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml\"\n"
+     << "[dds]\ndomain_id = " << c.domain
+     << "\nconfig_uri = \"file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml\"\n"
      << "[recording]\ndir = \"" << c.recording_dir.string() << "\"\ngzip = false\n"
      << "[limits]\nmax_measurement_s = 60.0\n"
      << "[realtime]\nsched_fifo_priority = 0\nmlockall = false\n";
@@ -95,7 +97,8 @@ class NcOnBus {
     return r && r->ok;
   }
 
-  std::optional<drivers::dds::StatusMsg> status(std::chrono::milliseconds timeout, bool (*want)(const drivers::dds::StatusMsg&)) {
+  std::optional<drivers::dds::StatusMsg> status(std::chrono::milliseconds timeout,
+                                                bool (*want)(const drivers::dds::StatusMsg&)) {
     const auto end = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < end)
       if (auto s = bus_.take_status(200ms); s && want(*s)) return s;

@@ -12,7 +12,8 @@ namespace {
 using history::Judgement;
 
 history::Record rec(const std::string& run, const CircleFigures& f, const std::string& machine = "maho-1") {
-  return history::record_from_result(circle_result(run, f), {machine, "2026-11-12T09:11:00Z", "/runs/" + run, std::nullopt, ""});
+  return history::record_from_result(circle_result(run, f),
+                                     {machine, "2026-11-12T09:11:00Z", "/runs/" + run, std::nullopt, ""});
 }
 
 const history::FigureChange& change(const history::Comparison& c, const std::string& name) {

@@ -87,7 +87,8 @@ TEST_P(EicaldHistory, EachEvaluatedResultEntersTheStore) {
   fs::remove_all(dir);
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, EicaldHistory, ::testing::Values(Backend::sqlite, Backend::postgresql), backend_name);
+INSTANTIATE_TEST_SUITE_P(Backends, EicaldHistory, ::testing::Values(Backend::sqlite, Backend::postgresql),
+                         backend_name);
 
 TEST(EicaldHistoryFaults, WithTheDatabaseAwayTheResultWaitsAndEntersWhenItIsBack) {
   const fs::path dir = scratch("eicald-away");
@@ -97,7 +98,9 @@ TEST(EicaldHistoryFaults, WithTheDatabaseAwayTheResultWaitsAndEntersWhenItIsBack
   std::atomic<bool> stop{false};
   std::vector<std::string> faults;
   ::testing::internal::CaptureStderr();
-  daemon::Service(one_measurement(dir, db)).run(stop, [&](const daemon::ServiceStatus& st) { faults.push_back(st.fault); });
+  daemon::Service(one_measurement(dir, db)).run(stop, [&](const daemon::ServiceStatus& st) {
+    faults.push_back(st.fault);
+  });
   const std::string log = ::testing::internal::GetCapturedStderr();
   // Recorded and evaluated as always.
   const fs::path run = the_run(dir / "runs");

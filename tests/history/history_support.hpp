@@ -8,12 +8,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <random>
 #include <string>
-#include <unistd.h>
 
 namespace eical::test {
 
@@ -45,7 +45,8 @@ inline std::string backend_name(const ::testing::TestParamInfo<Backend>& info) {
 }
 
 inline fs::path scratch(const std::string& tag) {
-  const fs::path d = fs::temp_directory_path() / ("eical-history-" + tag + "-" + std::to_string(std::random_device{}()));
+  const fs::path d =
+      fs::temp_directory_path() / ("eical-history-" + tag + "-" + std::to_string(std::random_device{}()));
   fs::create_directories(d);
   return d;
 }
@@ -69,7 +70,9 @@ struct CircleFigures {
 // A circle result as results.md describes it (issue 16's uncertainty_k2 and verdict when
 // asked for), with a trace long enough to be thinned for the store.
 inline nlohmann::json circle_result(const std::string& run_id, const CircleFigures& f = {}) {
-  nlohmann::json trace = {{"angle_deg", nlohmann::json::array()}, {"radius_deviation_um", nlohmann::json::array()}, {"direction", nlohmann::json::array()}};
+  nlohmann::json trace = {{"angle_deg", nlohmann::json::array()},
+                          {"radius_deviation_um", nlohmann::json::array()},
+                          {"direction", nlohmann::json::array()}};
   for (int i = 0; i < f.trace_points; ++i) {
     const double a = 720.0 * i / f.trace_points;
     trace["angle_deg"].push_back(std::fmod(a, 360.0));
@@ -84,20 +87,33 @@ inline nlohmann::json circle_result(const std::string& run_id, const CircleFigur
       {"quality", {{"degraded", false}, {"flags", nlohmann::json::array()}}},
       {"sensor_model", {{"identified", false}, {"source", "datasheet"}}},
       {"circle",
-       {{"plane", "xy"}, {"radius_nominal_mm", 10.0}, {"feed_mm_min", 2500.0}, {"direction", "both"}, {"revolutions", 2},
-        {"arc_deg", 360.0}, {"radius_mean_deviation_um", f.mean_um}, {"circular_deviation_G_um", f.g_um},
-        {"circular_hysteresis_H_um", nullptr}, {"radial_deviation_F_max_um", 3.4}, {"radial_deviation_F_min_um", -2.9},
+       {{"plane", "xy"},
+        {"radius_nominal_mm", 10.0},
+        {"feed_mm_min", 2500.0},
+        {"direction", "both"},
+        {"revolutions", 2},
+        {"arc_deg", 360.0},
+        {"radius_mean_deviation_um", f.mean_um},
+        {"circular_deviation_G_um", f.g_um},
+        {"circular_hysteresis_H_um", nullptr},
+        {"radial_deviation_F_max_um", 3.4},
+        {"radial_deviation_F_min_um", -2.9},
         {"trace", trace}}},
       {"diagnostics",
-       {{"backlash_x_um", f.backlash_x_um}, {"backlash_y_um", 0.3}, {"squareness_urad", 12.5}, {"servo_mismatch_ms", nullptr},
+       {{"backlash_x_um", f.backlash_x_um},
+        {"backlash_y_um", 0.3},
+        {"squareness_urad", 12.5},
+        {"servo_mismatch_ms", nullptr},
         {"notes", nlohmann::json::array()}}},
       {"pipeline", {{"rest_window_samples", 1000}, {"supports", {{"standstills", 4}}}}},
   };
   j["quality"]["flags"].push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions");
   if (f.verdict) j["quality"]["verdict"] = f.verdict_text;
   if (f.uncertainty)
-    j["uncertainty_k2"] = {{"circle.radius_mean_deviation_um", f.u_mean_um}, {"circle.circular_deviation_G_um", f.u_g_um},
-                           {"diagnostics.backlash_x_um", f.u_backlash_x_um}, {"diagnostics.backlash_y_um", 0.4},
+    j["uncertainty_k2"] = {{"circle.radius_mean_deviation_um", f.u_mean_um},
+                           {"circle.circular_deviation_G_um", f.u_g_um},
+                           {"diagnostics.backlash_x_um", f.u_backlash_x_um},
+                           {"diagnostics.backlash_y_um", 0.4},
                            {"diagnostics.squareness_urad", 3.0}};
   return j;
 }

@@ -34,10 +34,11 @@ TEST(HistoryRecord, FiguresCarryTheirUncertaintyAndNullsStayNull) {
   const auto* h = r.figure("circle.circular_hysteresis_H_um");  // null in the result: not determined
   ASSERT_NE(h, nullptr);
   EXPECT_FALSE(h->value);
-  EXPECT_EQ(r.figure("circle.radius_nominal_mm"), nullptr);      // what the program was asked to do
+  EXPECT_EQ(r.figure("circle.radius_nominal_mm"), nullptr);  // what the program was asked to do
   EXPECT_EQ(r.figure("circle.revolutions"), nullptr);
   EXPECT_EQ(r.figure("pipeline.rest_window_samples"), nullptr);  // bookkeeping, not a figure
-  EXPECT_TRUE(std::is_sorted(r.figures.begin(), r.figures.end(), [](const auto& x, const auto& y) { return x.name < y.name; }));
+  EXPECT_TRUE(
+      std::is_sorted(r.figures.begin(), r.figures.end(), [](const auto& x, const auto& y) { return x.name < y.name; }));
 }
 
 TEST(HistoryRecord, ResultsWithoutUncertaintyOrVerdictStoreNulls) {

@@ -2,10 +2,10 @@
 // an earlier eical left is upgraded in place with its results intact; a store of a newer
 // schema is refused with a clear message and left untouched; SQLite files that are not a
 // store (missing, corrupt) are named with the cause.
-#include "history/record/result_record.hpp"
-#include "history/sql/sqlite_connection.hpp"
-#include "history/sql/pg_connection.hpp"
 #include "history/store/schema.hpp"
+#include "history/record/result_record.hpp"
+#include "history/sql/pg_connection.hpp"
+#include "history/sql/sqlite_connection.hpp"
 #include "history/store/store.hpp"
 #include "history_support.hpp"
 
@@ -22,7 +22,8 @@ std::unique_ptr<history::sql::Connection> connect(Backend b, const std::string& 
 }
 
 history::Record sample(const std::string& run) {
-  return history::record_from_result(circle_result(run), {"maho-1", "2026-11-12T09:11:00Z", "/runs/" + run, std::nullopt, ""});
+  return history::record_from_result(circle_result(run),
+                                     {"maho-1", "2026-11-12T09:11:00Z", "/runs/" + run, std::nullopt, ""});
 }
 
 class SchemaTest : public ::testing::TestWithParam<Backend> {

@@ -2,9 +2,9 @@
 // and enter the store; when it is missing, locked, corrupt, of a newer schema, or the
 // database goes away, they wait in the spool with one message naming the cause, and enter
 // the store when it is back — also after a restart of the process.
+#include "history/spool/sink.hpp"
 #include "history/record/result_record.hpp"
 #include "history/sql/sqlite_connection.hpp"
-#include "history/spool/sink.hpp"
 #include "history/store/store.hpp"
 #include "history_support.hpp"
 
@@ -19,7 +19,8 @@ using namespace std::chrono_literals;
 using history::Sink;
 
 history::Record sample(const std::string& run) {
-  return history::record_from_result(circle_result(run), {"maho-1", "2026-11-12T09:11:00Z", "/runs/" + run, std::nullopt, ""});
+  return history::record_from_result(circle_result(run),
+                                     {"maho-1", "2026-11-12T09:11:00Z", "/runs/" + run, std::nullopt, ""});
 }
 
 // Collects the sink's messages.
@@ -46,7 +47,8 @@ std::size_t stored(const std::string& location) { return history::Store::open(lo
 // Until `pred` or 20 s.
 template <class P>
 bool eventually(P pred) {
-  for (auto end = std::chrono::steady_clock::now() + 20s; std::chrono::steady_clock::now() < end; std::this_thread::sleep_for(20ms))
+  for (auto end = std::chrono::steady_clock::now() + 20s; std::chrono::steady_clock::now() < end;
+       std::this_thread::sleep_for(20ms))
     if (pred()) return true;
   return pred();
 }
@@ -84,7 +86,9 @@ TEST_P(SinkTest, AStoreOfANewerSchemaKeepsResultsSpooledAndSaysWhy) {
   Sink sink(config(), msg.log());
   sink.submit(sample("a"));
   // The problem is set before its message is logged: wait for both.
-  ASSERT_TRUE(eventually([&] { return !sink.problem().empty() && msg.errors().find("results wait in") != std::string::npos; })) << msg.errors();
+  ASSERT_TRUE(eventually([&] {
+    return !sink.problem().empty() && msg.errors().find("results wait in") != std::string::npos;
+  })) << msg.errors();
   EXPECT_NE(sink.problem().find("schema version 99"), std::string::npos) << sink.problem();
   EXPECT_NE(msg.errors().find("1 results wait in " + (dir_ / "spool").string()), std::string::npos) << msg.errors();
   EXPECT_EQ(history::Spool(dir_ / "spool").waiting().size(), 1u);

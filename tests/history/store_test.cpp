@@ -1,9 +1,9 @@
 // The store against both backends, the same tests: what goes in comes out exactly, a
 // result is keyed by machine and run id, listings and trends filter and order alike, and
 // SQLite and PostgreSQL give identical answers for the same results.
+#include "history/store/store.hpp"
 #include "history/record/result_record.hpp"
 #include "history/store/schema.hpp"
-#include "history/store/store.hpp"
 #include "history_support.hpp"
 
 namespace eical::test {
@@ -14,7 +14,8 @@ using history::Filter;
 using history::Record;
 using history::Store;
 
-Record record(const std::string& machine, const std::string& run, const std::string& time, const CircleFigures& f = {}) {
+Record record(const std::string& machine, const std::string& run, const std::string& time,
+              const CircleFigures& f = {}) {
   return history::record_from_result(circle_result(run, f), {machine, time, "/runs/" + run, std::nullopt, ""});
 }
 
@@ -76,18 +77,21 @@ TEST_P(StoreTest, AResultIsKeyedByMachineAndRunId) {
   other.backlash_x_um = 99.0;
   EXPECT_EQ(store_->add(record("maho-1", "r1", "2026-11-12T09:00:00Z", other)), AddOutcome::duplicate);
   EXPECT_EQ(store_->find("r1").at(0).figure("diagnostics.backlash_x_um")->value.value(), 6.1);  // the first stays
-  EXPECT_EQ(store_->add(record("hermle-2", "r1", "2026-11-12T09:00:00Z")), AddOutcome::added);  // same run id, other machine
+  EXPECT_EQ(store_->add(record("hermle-2", "r1", "2026-11-12T09:00:00Z")),
+            AddOutcome::added);  // same run id, other machine
   EXPECT_EQ(store_->count(), 2u);
   EXPECT_EQ(store_->find("r1").size(), 2u);
   EXPECT_EQ(store_->find("r1", "hermle-2").size(), 1u);
-  const auto outcomes = store_->add_many({record("maho-1", "r1", "2026-11-12T09:00:00Z"), record("maho-1", "r2", "2026-11-13T09:00:00Z")});
+  const auto outcomes = store_->add_many(
+      {record("maho-1", "r1", "2026-11-12T09:00:00Z"), record("maho-1", "r2", "2026-11-13T09:00:00Z")});
   EXPECT_EQ(outcomes, (std::vector<AddOutcome>{AddOutcome::duplicate, AddOutcome::added}));
   EXPECT_EQ(store_->count(), 3u);
 }
 
 TEST_P(StoreTest, ListAndTrendFilterAndOrderByTime) {
   // Added out of time order; two machines.
-  const char* times[] = {"2026-03-01T08:00:00Z", "2026-01-01T08:00:00Z", "2026-02-01T08:00:00Z", "2026-04-01T08:00:00Z"};
+  const char* times[] = {"2026-03-01T08:00:00Z", "2026-01-01T08:00:00Z", "2026-02-01T08:00:00Z",
+                         "2026-04-01T08:00:00Z"};
   for (int i = 0; i < 4; ++i) {
     CircleFigures f;
     f.backlash_x_um = 1.0 + i, f.u_backlash_x_um = 0.1 * (i + 1);
@@ -131,7 +135,8 @@ TEST(StoreBackends, SQLiteAndPostgreSQLGiveTheSameAnswers) {
   std::vector<Record> rs;
   for (int i = 0; i < 40; ++i) {
     CircleFigures f;
-    f.backlash_x_um = u(rng), f.u_backlash_x_um = u(rng) / 10, f.g_um = u(rng), f.verdict = i % 3 != 0, f.uncertainty = i % 5 != 0;
+    f.backlash_x_um = u(rng), f.u_backlash_x_um = u(rng) / 10, f.g_um = u(rng), f.verdict = i % 3 != 0,
+    f.uncertainty = i % 5 != 0;
     char t[32];
     std::snprintf(t, sizeof t, "2026-%02d-%02dT%02d:00:00Z", 1 + i % 12, 1 + i % 28, i % 24);
     rs.push_back(record(i % 2 ? "maho-1" : "Hermle-2", "run-" + std::to_string(i % 17) + (i >= 17 ? "b" : ""), t, f));
@@ -152,7 +157,8 @@ TEST(StoreBackends, SQLiteAndPostgreSQLGiveTheSameAnswers) {
   same_list({.machine = "maho-1"});
   same_list({.since = "2026-03", .until = "2026-09-15"});
   same_list({.limit = 7});
-  for (const char* fig : {"diagnostics.backlash_x_um", "circle.circular_deviation_G_um", "circle.circular_hysteresis_H_um"}) {
+  for (const char* fig :
+       {"diagnostics.backlash_x_um", "circle.circular_deviation_G_um", "circle.circular_hysteresis_H_um"}) {
     for (const std::string m : {"", "maho-1"}) {
       const auto x = a->trend(fig, {.machine = m}), y = b->trend(fig, {.machine = m});
       ASSERT_EQ(x.size(), y.size());

@@ -14,8 +14,8 @@ namespace eical::test {
 
 // A run directory as eicald leaves it (run.toml + result.json; no samples are needed to
 // add a run that has its result).
-inline fs::path write_run_dir(const fs::path& parent, const std::string& machine, const std::string& run_id, const std::string& created,
-                              const CircleFigures& f) {
+inline fs::path write_run_dir(const fs::path& parent, const std::string& machine, const std::string& run_id,
+                              const std::string& created, const CircleFigures& f) {
   const fs::path dir = parent / run_id;
   fs::create_directories(dir);
   dsp::RunMeta meta = sim::circle_scenario(10.0, 2500.0, 2).meta;

@@ -29,7 +29,8 @@ fs::path daemon_config(const fs::path& dir, const std::string& machine, int doma
      << "[source.sim]\nprogram = \"circle\"\nradius_mm = 5.0\nfeed_mm_min = 3000.0\nrepeats = 1\nseed = " << seed
      << "\nidle_s = 0.5\nrepeat_program = true\n"
      << "[triggers]\ninputs = [\"frame\"]\n"
-     << "[dds]\ndomain_id = " << domain << "\nconfig_uri = \"file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml\"\nlive_rate_hz = 10.0\n"
+     << "[dds]\ndomain_id = " << domain
+     << "\nconfig_uri = \"file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml\"\nlive_rate_hz = 10.0\n"
      << "[recording]\ndir = \"" << (dir / machine).string() << "\"\ngzip = false\n"
      << "[limits]\nmax_measurement_s = 60.0\n"
      << "[realtime]\nsched_fifo_priority = 0\nmlockall = false\n"
@@ -61,7 +62,8 @@ std::set<Key> stored(const std::string& db) {
 
 template <class P>
 bool wait_until(P pred, std::chrono::seconds timeout) {
-  for (auto end = std::chrono::steady_clock::now() + timeout; std::chrono::steady_clock::now() < end; std::this_thread::sleep_for(250ms))
+  for (auto end = std::chrono::steady_clock::now() + timeout; std::chrono::steady_clock::now() < end;
+       std::this_thread::sleep_for(250ms))
     if (pred()) return true;
   return pred();
 }
@@ -75,13 +77,15 @@ TEST(Fleet, ThreeEicaldOneCollectorIntoPostgresqlWithoutLossOrDuplicates) {
   const std::string db = pg().create_database("fleet_" + std::to_string(::getpid()));
   ::setenv("CYCLONEDDS_URI", "file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml", 1);
   const int domain = drivers::dds::claim_free_domain();
-  const std::vector<std::string> collect = {EICAL_CLI, "collect", "--db", db, "--domain", std::to_string(domain), "--spool",
-                                            (dir / "spool").string(), "--retry-s", "0.5"};
+  const std::vector<std::string> collect = {
+      EICAL_CLI,   "collect", "--db", db, "--domain", std::to_string(domain), "--spool", (dir / "spool").string(),
+      "--retry-s", "0.5"};
   auto collector = std::make_unique<ChildProcess>(collect, (dir / "collect-1.log").string());
   std::vector<std::unique_ptr<ChildProcess>> daemons;
   for (std::size_t i = 0; i < kMachines.size(); ++i)
     daemons.push_back(std::make_unique<ChildProcess>(
-        std::vector<std::string>{EICALD_BIN, "--config", daemon_config(dir, kMachines[i], domain, static_cast<int>(i + 1)).string()},
+        std::vector<std::string>{EICALD_BIN, "--config",
+                                 daemon_config(dir, kMachines[i], domain, static_cast<int>(i + 1)).string()},
         (dir / (kMachines[i] + ".log")).string()));
   auto logs = [&] {
     std::string s = "\ncollect-1:\n" + slurp(dir / "collect-1.log") + "\ncollect-2:\n" + slurp(dir / "collect-2.log");
@@ -133,7 +137,9 @@ TEST(Fleet, ThreeEicaldOneCollectorIntoPostgresqlWithoutLossOrDuplicates) {
   const auto summary = second.find("collect: ");
   ASSERT_NE(summary, std::string::npos) << second;
   unsigned received = 0, added = 0, again = 0;
-  ASSERT_EQ(std::sscanf(second.c_str() + summary, "collect: %u results received, %u stored, %u already stored", &received, &added, &again), 3)
+  ASSERT_EQ(std::sscanf(second.c_str() + summary, "collect: %u results received, %u stored, %u already stored",
+                        &received, &added, &again),
+            3)
       << second;
   EXPECT_GE(again, had.size()) << second;
   EXPECT_GE(added, 1u) << second;
@@ -158,8 +164,9 @@ TEST(Fleet, ThreeEicaldOneCollectorIntoPostgresqlWithoutLossOrDuplicates) {
     }
   }
   for (const auto& m : kMachines) EXPECT_GE(count_of(keys, m), 2u) << m;
-  std::printf("fleet: %zu results of %zu machines stored; the restarted collector received %u, stored %u, %u already stored\n", rows.size(),
-              kMachines.size(), received, added, again);
+  std::printf(
+      "fleet: %zu results of %zu machines stored; the restarted collector received %u, stored %u, %u already stored\n",
+      rows.size(), kMachines.size(), received, added, again);
   fs::remove_all(dir);
 }
 

@@ -23,13 +23,15 @@ Fixture make(Backend b) {
   Fixture fx;
   fx.dir = scratch("cli");
   fx.db = fresh_store(b, fx.dir);
-  const char* times[] = {"2026-10-01T08:00:00Z", "2026-10-15T08:00:00Z", "2026-11-01T08:00:00Z", "2026-11-15T08:00:00Z"};
+  const char* times[] = {"2026-10-01T08:00:00Z", "2026-10-15T08:00:00Z", "2026-11-01T08:00:00Z",
+                         "2026-11-15T08:00:00Z"};
   const double backlash[] = {6.1, 6.3, 0.8, 0.8};
   for (int i = 0; i < 4; ++i) {
     CircleFigures f;
     f.backlash_x_um = backlash[i];
     f.u_backlash_x_um = 0.4;
-    fx.runs.push_back(write_run_dir(fx.dir / "runs", "maho-1", "circle-" + std::to_string(i + 1), times[i], f).string());
+    fx.runs.push_back(
+        write_run_dir(fx.dir / "runs", "maho-1", "circle-" + std::to_string(i + 1), times[i], f).string());
   }
   fx.runs.push_back(write_run_dir(fx.dir / "other", "hermle-2", "circle-1", "2026-10-02T08:00:00Z", {}).string());
   return fx;
@@ -50,7 +52,8 @@ TEST_P(HistoryCli, AddListShowTrendCompare) {
   add.insert(add.end(), {"--db", fx.db});
   auto r = eical_cli(add);
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("added maho-1 circle-1 (circle, 2026-10-01 08:00:00 UTC, verdict ok)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("added maho-1 circle-1 (circle, 2026-10-01 08:00:00 UTC, verdict ok)"), std::string::npos)
+      << r.out;
   r = eical_cli(add);  // again: nothing twice
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("already stored: maho-1 circle-4"), std::string::npos) << r.out;
@@ -85,10 +88,12 @@ TEST_P(HistoryCli, AddListShowTrendCompare) {
   EXPECT_TRUE(found);
 
   const fs::path trend_html = fx.dir / "trend.html";
-  r = eical_cli({"history", "trend", "diagnostics.backlash_x_um", "--machine", "maho-1", "--db", fx.db, "--html", trend_html.string()});
+  r = eical_cli({"history", "trend", "diagnostics.backlash_x_um", "--machine", "maho-1", "--db", fx.db, "--html",
+                 trend_html.string()});
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("6.1 ± 0.4 µm"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("maho-1: 6.1 ± 0.4 µm (2026-10-01) → 0.8 ± 0.4 µm (2026-11-15), drift"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("maho-1: 6.1 ± 0.4 µm (2026-10-01) → 0.8 ± 0.4 µm (2026-11-15), drift"), std::string::npos)
+      << r.out;
   EXPECT_NE(r.out.find("(significant)"), std::string::npos) << r.out;
   EXPECT_NE(slurp(trend_html).find("<svg"), std::string::npos);
   const auto trend = parse(eical_cli({"history", "trend", "diagnostics.backlash_x_um", "--db", fx.db, "--json"}));
@@ -97,17 +102,22 @@ TEST_P(HistoryCli, AddListShowTrendCompare) {
   EXPECT_EQ(trend["unit"], "µm");
 
   const fs::path cmp_html = fx.dir / "compare.html";
-  r = eical_cli({"history", "compare", "circle-1@maho-1", "circle-4@maho-1", "--db", fx.db, "--html", cmp_html.string()});
+  r = eical_cli(
+      {"history", "compare", "circle-1@maho-1", "circle-4@maho-1", "--db", fx.db, "--html", cmp_html.string()});
   ASSERT_EQ(r.code, 0) << r.out;
-  EXPECT_NE(r.out.find("backlash X went from 6.1 ± 0.4 to 0.8 ± 0.4 µm: -5.3 ± 0.6 µm, significant"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("circular deviation G went from 6.3 ± 1.1 to 6.3 ± 1.1 µm: 0.0 ± 1.6 µm, within the uncertainty"), std::string::npos)
+  EXPECT_NE(r.out.find("backlash X went from 6.1 ± 0.4 to 0.8 ± 0.4 µm: -5.3 ± 0.6 µm, significant"), std::string::npos)
+      << r.out;
+  EXPECT_NE(
+      r.out.find("circular deviation G went from 6.3 ± 1.1 to 6.3 ± 1.1 µm: 0.0 ± 1.6 µm, within the uncertainty"),
+      std::string::npos)
       << r.out;
   const std::string page = slurp(cmp_html);
   EXPECT_NE(page.find("Polar plots overlaid"), std::string::npos);
   EXPECT_NE(page.find("before: circle-1 (2026-10-01)"), std::string::npos);
   EXPECT_NE(page.find("after: circle-4 (2026-11-15)"), std::string::npos);
   EXPECT_NE(page.find("Trends of the changed figures"), std::string::npos);
-  const auto cmp = parse(eical_cli({"history", "compare", "circle-1", "circle-4", "--machine", "maho-1", "--db", fx.db, "--json"}));
+  const auto cmp =
+      parse(eical_cli({"history", "compare", "circle-1", "circle-4", "--machine", "maho-1", "--db", fx.db, "--json"}));
   for (const auto& f : cmp["figures"]) {
     if (f["name"] == "diagnostics.backlash_x_um") {
       EXPECT_EQ(f["judgement"], "significant");
@@ -175,7 +185,8 @@ TEST(HistoryCliSqlite, AnalysesARunWithoutResultAndRefusesAMissingStore) {
   r = eical_cli({"history", "add", (dir / "sim").string(), "--machine", "bench-1", "--db", (dir / "h.db").string()});
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_NE(r.out.find("added bench-1"), std::string::npos) << r.out;
-  const auto shown = parse(eical_cli({"history", "show", "sim-circle-r10-f2500-s1", "--db", (dir / "h.db").string(), "--json"}));
+  const auto shown =
+      parse(eical_cli({"history", "show", "sim-circle-r10-f2500-s1", "--db", (dir / "h.db").string(), "--json"}));
   EXPECT_EQ(shown["software_version"], "eical 0.1.0");
   EXPECT_TRUE(shown["document"]["circle"]["circular_deviation_G_um"].is_number());
   r = eical_cli({"history", "list", "--db", (dir / "none.db").string()}, true);

@@ -40,7 +40,8 @@ TEST(HistorySinkThreads, ConcurrentSubmitsWhileTheStoreIsLockedAllEnterOnce) {
   holder->exec("BEGIN IMMEDIATE");
   std::atomic<int> messages{0};
   {
-    eical::history::Sink sink({db, dir / "spool", 0.05, true}, [&](eical::history::Sink::Level, const std::string&) { ++messages; });
+    eical::history::Sink sink({db, dir / "spool", 0.05, true},
+                              [&](eical::history::Sink::Level, const std::string&) { ++messages; });
     constexpr int kThreads = 4, kEach = 25;
     std::vector<std::thread> producers;
     for (int t = 0; t < kThreads; ++t)
@@ -53,7 +54,8 @@ TEST(HistorySinkThreads, ConcurrentSubmitsWhileTheStoreIsLockedAllEnterOnce) {
       });
     for (auto& p : producers) p.join();
     // The lock outlasts SQLite's busy timeout: the writer reports it, the results wait.
-    for (auto end = std::chrono::steady_clock::now() + 30s; sink.problem().empty() && std::chrono::steady_clock::now() < end;)
+    for (auto end = std::chrono::steady_clock::now() + 30s;
+         sink.problem().empty() && std::chrono::steady_clock::now() < end;)
       std::this_thread::sleep_for(20ms);
     EXPECT_NE(sink.problem().find("database is locked"), std::string::npos) << sink.problem();
     EXPECT_GT(sink.waiting(), 0u);

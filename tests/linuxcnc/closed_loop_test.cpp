@@ -26,7 +26,8 @@ constexpr double kSquarenessUrad = 40.0;
 std::string machine() {
   return "[servo.x]\nkv_per_s = 33.3\nfeedforward = 0.99\n[servo.y]\nkv_per_s = 33.3\nfeedforward = 0.99\n"
          "[effects.\"machine.backlash\"]\naxis = \"x\"\nvalue_um = " +
-         std::to_string(kBacklashXUm) + "\n[effects.\"machine.scale_mismatch\"]\naxis = \"x\"\nvalue_ppm = " + std::to_string(kScaleXPpm) +
+         std::to_string(kBacklashXUm) +
+         "\n[effects.\"machine.scale_mismatch\"]\naxis = \"x\"\nvalue_ppm = " + std::to_string(kScaleXPpm) +
          "\n[effects.\"machine.squareness\"]\nplane = \"xy\"\nvalue_urad = " + std::to_string(kSquarenessUrad) +
          "\n"
          // The instrument as the embedded calibrator has it: a PSD strip on x at the origin
@@ -36,12 +37,14 @@ std::string machine() {
 }
 
 // ISO 230-2 over the circle's x travel and beyond, 5 runs; a circle both ways.
-const std::vector<std::string> kPositioning = {"positioning", "--axis", "x", "--targets", "-20,-10,0,10,20", "--runs", "5",
-                                               "--feed", "2000", "--dwell", "0.3"};
-const std::vector<std::string> kCircle = {"circle", "--radius", "10", "--feed", "2500", "--repeats", "2", "--direction", "both"};
+const std::vector<std::string> kPositioning = {
+    "positioning", "--axis", "x", "--targets", "-20,-10,0,10,20", "--runs", "5", "--feed", "2000", "--dwell", "0.3"};
+const std::vector<std::string> kCircle = {"circle",    "--radius", "10",          "--feed", "2500",
+                                          "--repeats", "2",        "--direction", "both"};
 
 struct Figures {
-  double A_um = std::nan(""), B_um = std::nan(""), B_mean_um = std::nan(""), backlash_x_um = std::nan(""), backlash_y_um = std::nan(""), squareness_urad = std::nan("");
+  double A_um = std::nan(""), B_um = std::nan(""), B_mean_um = std::nan(""), backlash_x_um = std::nan(""),
+         backlash_y_um = std::nan(""), squareness_urad = std::nan("");
 };
 
 ProgramOutcome run(const std::string& tag, const std::vector<std::string>& gen, const fs::path& config) {
@@ -55,7 +58,8 @@ ProgramOutcome run(const std::string& tag, const std::vector<std::string>& gen, 
 }
 
 double number(const nlohmann::json& j, const char* section, const char* key) {
-  return j.contains(section) && j[section].contains(key) && j[section][key].is_number() ? j[section][key].get<double>() : std::nan("");
+  return j.contains(section) && j[section].contains(key) && j[section][key].is_number() ? j[section][key].get<double>()
+                                                                                        : std::nan("");
 }
 
 // `eical analyze RUN --json` → file: what the user hands to eical comp.
@@ -78,16 +82,18 @@ TEST(LinuxcncClosedLoop, CompensationFromEicalCompDropsIso230_2AandBandTheCircle
   const ProgramOutcome pos0 = run("pos-before", kPositioning, work / "machine");
   const ProgramOutcome circ0 = run("circle-before", kCircle, work / "machine");
   ASSERT_FALSE(pos0.run_dir.empty() || circ0.run_dir.empty()) << "a run was not recorded";
-  const fs::path pos0_json = analyze(pos0, work / "pos-before.json"), circ0_json = analyze(circ0, work / "circle-before.json");
+  const fs::path pos0_json = analyze(pos0, work / "pos-before.json"),
+                 circ0_json = analyze(circ0, work / "circle-before.json");
 
   // eical comp: LinuxCNC files merged into the machine's INI.
   // --skip-unresolved, as a user told so by eical comp: y has no backlash, and its circle
   // figure (about 1 um against a U of 1.5 um) is not resolved; the x terms compensated here are
   // far above their uncertainty. Never --allow-unresolved.
   int rc = -1;
-  const auto comp_out = run_capture({EICAL_CLI, "comp", pos0_json.string(), circ0_json.string(), "-o", (work / "comp").string(), "--merge-ini",
-                                     (work / "machine" / "eical-sim3.ini").string(), "--skip-unresolved"},
-                                    60s, &rc);
+  const auto comp_out =
+      run_capture({EICAL_CLI, "comp", pos0_json.string(), circ0_json.string(), "-o", (work / "comp").string(),
+                   "--merge-ini", (work / "machine" / "eical-sim3.ini").string(), "--skip-unresolved"},
+                  60s, &rc);
   ASSERT_TRUE(comp_out && rc == 0) << "eical comp failed:\n" << comp_out.value_or("");
   std::printf("%s", comp_out->c_str());
   // The compensated machine: its folder with eical comp's LinuxCNC files copied in as
@@ -101,7 +107,8 @@ TEST(LinuxcncClosedLoop, CompensationFromEicalCompDropsIso230_2AandBandTheCircle
     bool in_joint = false;
     for (std::string l; std::getline(ini, l);) {
       if (!l.empty() && l[0] == '[') in_joint = l.rfind("[JOINT_", 0) == 0;
-      if (in_joint && (l.find("COMP") != std::string::npos || l.find("BACKLASH") != std::string::npos || l[0] == '[' || l[0] == '#'))
+      if (in_joint && (l.find("COMP") != std::string::npos || l.find("BACKLASH") != std::string::npos || l[0] == '[' ||
+                       l[0] == '#'))
         std::printf("  %s\n", l.c_str());
     }
   }
@@ -123,15 +130,18 @@ TEST(LinuxcncClosedLoop, CompensationFromEicalCompDropsIso230_2AandBandTheCircle
   };
   const Figures b = figures(pos0, circ0), a = figures(pos1, circ1);
   auto drop = [](double before, double after) { return 100.0 * (1.0 - std::abs(after) / std::abs(before)); };
-  std::printf("closed loop on LinuxCNC (x: %.0f um backlash, %.0f ppm pitch error; xy squareness %.0f urad)\n", kBacklashXUm, kScaleXPpm,
-              kSquarenessUrad);
+  std::printf("closed loop on LinuxCNC (x: %.0f um backlash, %.0f ppm pitch error; xy squareness %.0f urad)\n",
+              kBacklashXUm, kScaleXPpm, kSquarenessUrad);
   std::printf("  figure                     before      after    drop\n");
   std::printf("  ISO 230-2 A (um)         %8.2f   %8.2f   %5.1f %%\n", b.A_um, a.A_um, drop(b.A_um, a.A_um));
   std::printf("  ISO 230-2 B (um)         %8.2f   %8.2f   %5.1f %%\n", b.B_um, a.B_um, drop(b.B_um, a.B_um));
-  std::printf("  ISO 230-2 mean B (um)    %8.2f   %8.2f   %5.1f %%\n", b.B_mean_um, a.B_mean_um, drop(b.B_mean_um, a.B_mean_um));
-  std::printf("  circle backlash x (um)   %8.2f   %8.2f   %5.1f %%\n", b.backlash_x_um, a.backlash_x_um, drop(b.backlash_x_um, a.backlash_x_um));
+  std::printf("  ISO 230-2 mean B (um)    %8.2f   %8.2f   %5.1f %%\n", b.B_mean_um, a.B_mean_um,
+              drop(b.B_mean_um, a.B_mean_um));
+  std::printf("  circle backlash x (um)   %8.2f   %8.2f   %5.1f %%\n", b.backlash_x_um, a.backlash_x_um,
+              drop(b.backlash_x_um, a.backlash_x_um));
   std::printf("  circle backlash y (um)   %8.2f   %8.2f   (none injected)\n", b.backlash_y_um, a.backlash_y_um);
-  std::printf("  squareness xy (urad)     %8.1f   %8.1f   (injected %.0f; not compensable with trivkins)\n", b.squareness_urad, a.squareness_urad, kSquarenessUrad);
+  std::printf("  squareness xy (urad)     %8.1f   %8.1f   (injected %.0f; not compensable with trivkins)\n",
+              b.squareness_urad, a.squareness_urad, kSquarenessUrad);
   EXPECT_GE(drop(b.A_um, a.A_um), 80.0);
   EXPECT_GE(drop(b.B_um, a.B_um), 80.0);
   EXPECT_GE(drop(b.backlash_x_um, a.backlash_x_um), 80.0);

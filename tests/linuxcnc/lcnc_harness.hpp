@@ -19,9 +19,11 @@ namespace eical::test {
 inline std::string kit() { return EICAL_SOURCE_DIR "/integrations/linuxcnc"; }
 
 inline void require_linuxcnc() {
-  if (const char* s = std::getenv("EICAL_SKIP_LINUXCNC"); s && std::string(s) == "1") GTEST_SKIP() << "EICAL_SKIP_LINUXCNC=1";
+  if (const char* s = std::getenv("EICAL_SKIP_LINUXCNC"); s && std::string(s) == "1")
+    GTEST_SKIP() << "EICAL_SKIP_LINUXCNC=1";
   if (std::system("command -v linuxcnc >/dev/null 2>&1") != 0)
-    FAIL() << "LinuxCNC is not installed: run scripts/deps.sh test (installs linuxcnc-uspace), or set EICAL_SKIP_LINUXCNC=1";
+    FAIL() << "LinuxCNC is not installed: run scripts/deps.sh test (installs linuxcnc-uspace), or set "
+              "EICAL_SKIP_LINUXCNC=1";
 }
 
 struct LcncProgram {
@@ -30,7 +32,7 @@ struct LcncProgram {
   std::string machine;                // the simulated machine: scenario TOML without [program]
   fs::path config;                    // LinuxCNC configuration folder (copied); default: the kit
   std::string ini = "eical-sim3.ini";
-  std::string drive = "command";      // eicald [source.linuxcnc] drive: command or feedback
+  std::string drive = "command";  // eicald [source.linuxcnc] drive: command or feedback
 };
 
 struct TriggerTiming {
@@ -62,7 +64,8 @@ inline std::vector<TriggerTiming> trigger_timing(const dsp::Run& run) {
     while (a > 1 && !moved(a)) --a;
     while (b < f.size() && !moved(b)) ++b;
     const double none = std::nan("");
-    out.push_back({f[n].trigger, a > 1 ? static_cast<double>(n - a) * ms : none, b < f.size() ? static_cast<double>(b - n) * ms : none});
+    out.push_back({f[n].trigger, a > 1 ? static_cast<double>(n - a) * ms : none,
+                   b < f.size() ? static_cast<double>(b - n) * ms : none});
   }
   return out;
 }
@@ -78,8 +81,8 @@ inline ProgramOutcome run_program(const LcncProgram& prog) {
   const std::string uri = "file://" EICAL_SOURCE_DIR "/config/cyclonedds-loopback.xml";
   {
     std::ofstream env(cfg / "eical.env");
-    env << "EICAL=" EICAL_CLI "\nEICAL_FIFO=" << fifo.string() << "\nEICAL_DOMAIN=" << domain << "\nEICAL_DDS_CONFIG=" << uri
-        << "\nEICAL_MARK=1\n";
+    env << "EICAL=" EICAL_CLI "\nEICAL_FIFO=" << fifo.string() << "\nEICAL_DOMAIN=" << domain
+        << "\nEICAL_DDS_CONFIG=" << uri << "\nEICAL_MARK=1\n";
   }
   std::vector<std::string> gen = {EICAL_CLI, "gen-nc"};
   gen.insert(gen.end(), prog.gen_args.begin(), prog.gen_args.end());
@@ -88,15 +91,18 @@ inline ProgramOutcome run_program(const LcncProgram& prog) {
   EXPECT_TRUE(run_capture(gen, 20s, &rc) && rc == 0) << "eical gen-nc failed";
   {
     std::ofstream sc(dir / "machine.toml");
-    sc << "format = \"eical-scenario/1\"\nname = \"lcnc-" << prog.tag << "\"\n" << prog.machine << "\n"
+    sc << "format = \"eical-scenario/1\"\nname = \"lcnc-" << prog.tag << "\"\n"
+       << prog.machine << "\n"
        << slurp(dir / "program.toml");  // a scenario file names its program
   }
   {
     std::ofstream c(dir / "eicald.toml");
-    c << "[source]\nkind = \"linuxcnc\"\nretry_s = 0.5\n[source.linuxcnc]\nfifo = \"" << fifo.string() << "\"\nprogram_file = \""
-      << (dir / "program.toml").string() << "\"\nscenario_file = \"" << (dir / "machine.toml").string() << "\"\ndrive = \"" << prog.drive
-      << "\"\nconnect_timeout_s = 10\n[triggers]\ninputs = [\"dds\"]\n[dds]\ndomain_id = " << domain << "\nconfig_uri = \"" << uri
-      << "\"\n[recording]\ndir = \"" << rec.string() << "\"\ngzip = false\n[limits]\nmax_measurement_s = 300.0\n"
+    c << "[source]\nkind = \"linuxcnc\"\nretry_s = 0.5\n[source.linuxcnc]\nfifo = \"" << fifo.string()
+      << "\"\nprogram_file = \"" << (dir / "program.toml").string() << "\"\nscenario_file = \""
+      << (dir / "machine.toml").string() << "\"\ndrive = \"" << prog.drive
+      << "\"\nconnect_timeout_s = 10\n[triggers]\ninputs = [\"dds\"]\n[dds]\ndomain_id = " << domain
+      << "\nconfig_uri = \"" << uri << "\"\n[recording]\ndir = \"" << rec.string()
+      << "\"\ngzip = false\n[limits]\nmax_measurement_s = 300.0\n"
       << "[realtime]\nsched_fifo_priority = 0\nmlockall = false\n";
   }
   NcOnBus hmi(domain);
@@ -107,7 +113,8 @@ inline ProgramOutcome run_program(const LcncProgram& prog) {
     ADD_FAILURE() << "eicald did not start:\n" << slurp(dir / "eicald.log");
     return o;
   }
-  ChildProcess lcnc({"/bin/bash", (cfg / "run-headless").string(), (cfg / prog.ini).string(), (cfg / "nc/prog.ngc").string(), "400", "1.5"},
+  ChildProcess lcnc({"/bin/bash", (cfg / "run-headless").string(), (cfg / prog.ini).string(),
+                     (cfg / "nc/prog.ngc").string(), "400", "1.5"},
                     (dir / "run-headless.log").string());
   auto lrc = lcnc.wait_exit(450s);
   if (!lrc) {
@@ -115,21 +122,25 @@ inline ProgramOutcome run_program(const LcncProgram& prog) {
     lcnc.signal(SIGTERM);
     lrc = lcnc.wait_exit(40s);
   }
-  EXPECT_EQ(lrc.value_or(-1), 0) << "LinuxCNC run failed:\n" << slurp(dir / "run-headless.log") << slurp(cfg / "linuxcnc.log");
+  EXPECT_EQ(lrc.value_or(-1), 0) << "LinuxCNC run failed:\n"
+                                 << slurp(dir / "run-headless.log") << slurp(cfg / "linuxcnc.log");
   std::optional<drivers::dds::ResultMsg> r;
   const auto end = std::chrono::steady_clock::now() + 90s;
   while (!r && std::chrono::steady_clock::now() < end) r = hmi.bus().take_result(500ms);
   eicald.signal(SIGTERM);
   EXPECT_TRUE(eicald.wait_exit(20s)) << "eicald did not stop";
   const std::string log = slurp(dir / "eicald.log");
-  EXPECT_TRUE(r) << "no Result over DDS; eicald log:\n" << log << "\nrun-headless:\n" << slurp(dir / "run-headless.log");
+  EXPECT_TRUE(r) << "no Result over DDS; eicald log:\n"
+                 << log << "\nrun-headless:\n"
+                 << slurp(dir / "run-headless.log");
   if (!r) return o;
   o.result = nlohmann::json::parse(r->json);
   // "M-code marker <code·100000 + pid> at servo cycle <n> = sample <k>" (no std::regex: GCC 12
   // warns falsely inside it under -O2 with sanitizers).
   for (std::size_t at = log.find("M-code marker "); at != std::string::npos; at = log.find("M-code marker ", at + 1)) {
     long long id = 0, cycle = 0, sample = 0;
-    if (std::sscanf(log.c_str() + at, "M-code marker %lld at servo cycle %lld = sample %lld", &id, &cycle, &sample) == 3)
+    if (std::sscanf(log.c_str() + at, "M-code marker %lld at servo cycle %lld = sample %lld", &id, &cycle, &sample) ==
+        3)
       o.markers.emplace_back(static_cast<int>(id / 100000), sample);
   }
   if (log.find("<6>linuxcnc: ") != std::string::npos) {

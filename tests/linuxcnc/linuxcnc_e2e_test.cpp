@@ -36,12 +36,15 @@ void check_and_print_timing(const std::string& what, const ProgramOutcome& o) {
   std::printf("%s: %s\n", what.c_str(), o.stream_stats.c_str());
   double lo = 1e9, hi = 0;
   for (const auto& t : o.triggers) {
-    std::printf("  M%d: %.1f ms after motion stopped, %.1f ms before the next motion\n", t.code, t.after_stop_ms, t.before_move_ms);
+    std::printf("  M%d: %.1f ms after motion stopped, %.1f ms before the next motion\n", t.code, t.after_stop_ms,
+                t.before_move_ms);
     EXPECT_FALSE(t.after_stop_ms == 0.0) << "M" << t.code << " landed inside a move";
     EXPECT_FALSE(t.before_move_ms <= 0.0) << "M" << t.code << " landed inside a move";
-    if (t.code == 102 && std::isfinite(t.after_stop_ms)) lo = std::min(lo, t.after_stop_ms), hi = std::max(hi, t.after_stop_ms);
+    if (t.code == 102 && std::isfinite(t.after_stop_ms))
+      lo = std::min(lo, t.after_stop_ms), hi = std::max(hi, t.after_stop_ms);
   }
-  std::printf("  trigger latency (M102, motion stop -> eical trigger's time on the DAQ clock): %.1f .. %.1f ms\n", lo, hi);
+  std::printf("  trigger latency (M102, motion stop -> eical trigger's time on the DAQ clock): %.1f .. %.1f ms\n", lo,
+              hi);
   // Alignment: the script's marker in the servo stream against the trigger eicald placed
   // from eical trigger's CLOCK_MONOTONIC time and the servo clock.
   std::size_t k = 0;
@@ -67,9 +70,12 @@ TEST(LinuxcncE2E, CircleBothDirectionsAndIso230_2OnLinuxCncMatchTheInjectedBackl
     ASSERT_TRUE(o.result.contains("circle")) << o.result.dump();
     const auto& c = o.result["circle"];
     const auto& d = o.result["diagnostics"];
-    std::printf("circle %s on LinuxCNC: G %.2f um, mean radius deviation %.2f um, backlash x %.2f um (injected %.1f), backlash y %.2f um (injected 0), degraded %d\n",
-                dir, c["circular_deviation_G_um"].get<double>(), c["radius_mean_deviation_um"].get<double>(),
-                d["backlash_x_um"].get<double>(), kBacklashXUm, d["backlash_y_um"].get<double>(), o.result["quality"]["degraded"].get<bool>());
+    std::printf(
+        "circle %s on LinuxCNC: G %.2f um, mean radius deviation %.2f um, backlash x %.2f um (injected %.1f), backlash "
+        "y %.2f um (injected 0), degraded %d\n",
+        dir, c["circular_deviation_G_um"].get<double>(), c["radius_mean_deviation_um"].get<double>(),
+        d["backlash_x_um"].get<double>(), kBacklashXUm, d["backlash_y_um"].get<double>(),
+        o.result["quality"]["degraded"].get<bool>());
     check_and_print_timing(std::string("circle ") + dir, o);
     // The ballbar-style fit of the play on x; its residual is the model's own scatter.
     // Measured here: 2.2..3.4 um for 4 um injected, |y| <= 1.2 um (4 runs). Tolerance:
@@ -79,19 +85,23 @@ TEST(LinuxcncE2E, CircleBothDirectionsAndIso230_2OnLinuxCncMatchTheInjectedBackl
     EXPECT_NEAR(d["backlash_y_um"].get<double>(), 0.0, tol);
     EXPECT_FALSE(o.result["quality"]["degraded"].get<bool>()) << o.result["quality"].dump();
   }
-  const auto p = run_program("positioning", {"positioning", "--axis", "x", "--targets", "0,10,20,30", "--runs", "2", "--feed", "2000", "--dwell", "0.3"});
+  const auto p = run_program("positioning", {"positioning", "--axis", "x", "--targets", "0,10,20,30", "--runs", "2",
+                                             "--feed", "2000", "--dwell", "0.3"});
   ASSERT_TRUE(p.result.contains("positioning")) << p.result.dump();
   const auto& pos = p.result["positioning"];
-  std::printf("ISO 230-2 on LinuxCNC: B %.2f um, mean B %.2f um (injected backlash %.1f um), E %.2f um, M %.2f um, R %.2f um, A %.2f um\n",
-              pos["B_um"].get<double>(), pos["B_mean_um"].get<double>(), kBacklashXUm, pos["E_um"].get<double>(), pos["M_um"].get<double>(),
-              pos["R_um"].get<double>(), pos["A_um"].get<double>());
+  std::printf(
+      "ISO 230-2 on LinuxCNC: B %.2f um, mean B %.2f um (injected backlash %.1f um), E %.2f um, M %.2f um, R %.2f um, "
+      "A %.2f um\n",
+      pos["B_um"].get<double>(), pos["B_mean_um"].get<double>(), kBacklashXUm, pos["E_um"].get<double>(),
+      pos["M_um"].get<double>(), pos["R_um"].get<double>(), pos["A_um"].get<double>());
   check_and_print_timing("positioning", p);
   // ISO 230-2 B = mean up - mean down; the play shifts every approach from below by -b.
   // Tolerance from this run's own scatter: one reading has s ~ R/4, B_mean averages
   // targets x runs readings per direction; 3 sigma.
   const double n = static_cast<double>(pos["targets_mm"].size() * pos["runs"].get<std::size_t>());
   const double tol_b = 3.0 * pos["R_um"].get<double>() / 4.0 * std::sqrt(2.0 / n);
-  std::printf("ISO 230-2: mean B %.2f um, expected %.2f +- %.2f um (3 sigma from R)\n", pos["B_mean_um"].get<double>(), -kBacklashXUm, tol_b);
+  std::printf("ISO 230-2: mean B %.2f um, expected %.2f +- %.2f um (3 sigma from R)\n", pos["B_mean_um"].get<double>(),
+              -kBacklashXUm, tol_b);
   EXPECT_NEAR(pos["B_mean_um"].get<double>(), -kBacklashXUm, tol_b);
 }
 

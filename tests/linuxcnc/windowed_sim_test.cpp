@@ -1,7 +1,7 @@
 // The block-wise simulation of a servo-rate set-point against the batch simulation of
 // the same set-point: what the windows change must stay far below the sensor noise.
-#include "drivers/source/source.hpp"
 #include "drivers/source/windowed_sim.hpp"
+#include "drivers/source/source.hpp"
 #include "sim/nc/sampled_set_point.hpp"
 #include "sim/simulate.hpp"
 
@@ -36,7 +36,8 @@ std::vector<Eigen::Vector3d> servo_trajectory() {
   auto rest = [&](int n) { p.insert(p.end(), static_cast<std::size_t>(n), p.back()); };
   auto move_x = [&](double dist_mm) {
     const Eigen::Vector3d p0 = p.back();
-    for (double s : trapezoid(std::abs(dist_mm), 40, 1000)) p.push_back(p0 + Eigen::Vector3d(dist_mm > 0 ? s : -s, 0, 0));
+    for (double s : trapezoid(std::abs(dist_mm), 40, 1000))
+      p.push_back(p0 + Eigen::Vector3d(dist_mm > 0 ? s : -s, 0, 0));
   };
   move_x(20);
   rest(300);
@@ -44,7 +45,8 @@ std::vector<Eigen::Vector3d> servo_trajectory() {
   rest(200);
   const double r = 10;
   const Eigen::Vector3d c = p.back() - Eigen::Vector3d(r, 0, 0);
-  for (double s : trapezoid(r * std::numbers::pi / 2, 41.667, 250)) p.push_back(c + r * Eigen::Vector3d(std::cos(s / r), std::sin(s / r), 0));
+  for (double s : trapezoid(r * std::numbers::pi / 2, 41.667, 250))
+    p.push_back(c + r * Eigen::Vector3d(std::cos(s / r), std::sin(s / r), 0));
   rest(500);
   return p;
 }
@@ -69,7 +71,8 @@ TEST(WindowedSim, FramesMatchTheBatchSimulationWellBelowTheSensorNoise) {
   std::vector<dsp::Frame> block(w.frames_per_block() + 100);
   for (std::size_t k = 0; k < traj.size(); ++k) {
     w.push(traj[k]);
-    if (w.block_ready()) out.insert(out.end(), block.begin(), block.begin() + static_cast<std::ptrdiff_t>(w.simulate_block(block)));
+    if (w.block_ready())
+      out.insert(out.end(), block.begin(), block.begin() + static_cast<std::ptrdiff_t>(w.simulate_block(block)));
   }
   out.insert(out.end(), block.begin(), block.begin() + static_cast<std::ptrdiff_t>(w.simulate_block(block, true)));
   ASSERT_EQ(out.size(), batch.frames.size()) << "one frame per DAQ sample of the trajectory, none twice";
@@ -83,12 +86,14 @@ TEST(WindowedSim, FramesMatchTheBatchSimulationWellBelowTheSensorNoise) {
       const double d = std::abs(out[n].accel_counts[c] - batch.frames[n].accel_counts[c]) / k1;
       if (d > worst_g) worst_g = d, worst_at = n;
     }
-    for (int a = 0; a < 3; ++a) worst_cmd_mm = std::max(worst_cmd_mm, std::abs(out[n].cmd_mm[a] - batch.frames[n].cmd_mm[a]));
+    for (int a = 0; a < 3; ++a)
+      worst_cmd_mm = std::max(worst_cmd_mm, std::abs(out[n].cmd_mm[a] - batch.frames[n].cmd_mm[a]));
   }
   // Sensor noise per sample at the data-sheet density and 10 kHz.
   const double noise_g = sc.truth[0].spec.noise_ug_per_rthz * 1e-6 * std::sqrt(sc.meta.acquisition.fs_hz);
-  std::printf("windowed vs batch: worst accel difference %.3g ug at frame %zu (noise per sample %.3g ug); set-point %.3g um\n",
-              worst_g * 1e6, worst_at, noise_g * 1e6, worst_cmd_mm * 1e3);
+  std::printf(
+      "windowed vs batch: worst accel difference %.3g ug at frame %zu (noise per sample %.3g ug); set-point %.3g um\n",
+      worst_g * 1e6, worst_at, noise_g * 1e6, worst_cmd_mm * 1e3);
   EXPECT_LT(worst_g, 0.1 * noise_g) << "block boundaries must not show in the accelerations";
   // Linear (frames) against cubic (batch) interpolation between servo samples: a·h²/8 for
   // the linear part, and the spline rounds the acceleration steps by as much again.

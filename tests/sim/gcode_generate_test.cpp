@@ -106,7 +106,8 @@ TEST(GcodeGenerate, PositioningVisitsEveryTargetInBothDirectionsEachRun) {
     const auto& mv = std::get<Linear>(prog.blocks[i - 1]);
     const bool up = (k / 4) % 2 == 0;
     EXPECT_EQ(mv.to_mm.y() > mv.from_mm.y(), up) << "trigger " << k;
-    const double target = up ? p.targets_mm[static_cast<std::size_t>(k % 4)] : p.targets_mm[3 - static_cast<std::size_t>(k % 4)];
+    const double target =
+        up ? p.targets_mm[static_cast<std::size_t>(k % 4)] : p.targets_mm[3 - static_cast<std::size_t>(k % 4)];
     EXPECT_NEAR(mv.to_mm.y(), target, 1e-9);
     ++k;
   }

@@ -150,7 +150,7 @@ TEST(GcodeParser, RealPartProgramsAreRead) {
 
 TEST(GcodeParser, PartProgramsStillRefuseWhatTheyCannotSimulate) {
   EXPECT_EQ(error_of("%\nO1\nN10 G81 X1 Y1 Z-2 R1 F100"), "t.ngc:3:5: unsupported G-code G81");  // canned cycle
-  EXPECT_EQ(error_of("G0 X0\nG43 H1 Z50"), "t.ngc:2:5: unsupported word 'H'");                      // tool length offset
+  EXPECT_EQ(error_of("G0 X0\nG43 H1 Z50"), "t.ngc:2:5: unsupported word 'H'");                   // tool length offset
   EXPECT_EQ(error_of("G28"), "t.ngc:1:1: unsupported G-code G28");
   EXPECT_EQ(error_of("G55"), "t.ngc:1:1: unsupported G-code G55");
   EXPECT_NE(error_of("o100 sub").find("t.ngc:1:6: O-word control flow"), std::string::npos) << error_of("o100 sub");

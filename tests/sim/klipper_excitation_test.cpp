@@ -1,6 +1,6 @@
 // Klipper's resonance test as eical reconstructs and simulates it (sim/nc/klipper_excitation).
-#include "dsp/core/error.hpp"
 #include "sim/nc/klipper_excitation.hpp"
+#include "dsp/core/error.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,8 +20,9 @@ TEST(KlipperExcitation, SweepMatchesKlipperGenTestWorkedByHand) {
   k.freq_start_hz = 10.0, k.freq_end_hz = 10.2, k.accel_per_hz = 50.0, k.hz_per_sec = 2.0;
   k.sweeping_accel_mm_s2 = 100.0, k.sweeping_period_s = 0.2, k.stop_accel_mm_s2 = 5000.0;
   const auto seg = klipper_segments(k);
-  const double expected[][2] = {{0.025, 600.0},          {0.010355339, -400.0},      {0.014644661, -600.0},      {0.024752475, -605.0},
-                                {0.024752475, 405.0},    {0.021205728, 409.950495},  {0.003306456, 609.950495},  {0.024512183, -409.950495}};
+  const double expected[][2] = {
+      {0.025, 600.0},       {0.010355339, -400.0},     {0.014644661, -600.0},     {0.024752475, -605.0},
+      {0.024752475, 405.0}, {0.021205728, 409.950495}, {0.003306456, 609.950495}, {0.024512183, -409.950495}};
   ASSERT_EQ(seg.size(), 9u);  // eight entries and the stop at max_accel
   for (std::size_t i = 0; i < 8; ++i) {
     EXPECT_NEAR(seg[i].duration_s, expected[i][0], 1e-8) << i;

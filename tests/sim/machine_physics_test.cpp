@@ -34,7 +34,10 @@ TEST(MachinePhysics, ServoLagIsFeedforwardShortfallOverKv) {
   // Mid-move at constant feed: lag = (1 − ff) v / Kv = 0.1 · 50 mm/s / 30 /s = 166.7 µm.
   std::size_t mid = 0;
   for (std::size_t n = 0; n < run.frames.size(); ++n)
-    if (run.frames[n].cmd_mm[0] > 25.0) { mid = n; break; }
+    if (run.frames[n].cmd_mm[0] > 25.0) {
+      mid = n;
+      break;
+    }
   EXPECT_NEAR(-deviation_um(run, truth, 0)[mid], 0.1 * 50.0 / 30.0 * 1e3, 0.5);
   // There and back: it settles at the start position again.
   EXPECT_NEAR(truth.back().x(), 0.0, 1e-6);
@@ -48,7 +51,8 @@ TEST(MachinePhysics, BacklashIsLostMotionAtReversal) {
   const auto dx = deviation_um(run, truth, 0), dy = deviation_um(run, truth, 1);
   const auto [lo, hi] = std::minmax_element(dx.begin(), dx.end());
   EXPECT_NEAR(*hi - *lo, 5.0, 1e-6);
-  EXPECT_NEAR(*std::max_element(dy.begin(), dy.end(), [](double a, double b) { return std::abs(a) < std::abs(b); }), 0.0, 1e-9);
+  EXPECT_NEAR(*std::max_element(dy.begin(), dy.end(), [](double a, double b) { return std::abs(a) < std::abs(b); }),
+              0.0, 1e-9);
 }
 
 TEST(MachinePhysics, SquarenessTiltsYIntoMinusX) {
@@ -69,7 +73,8 @@ TEST(MachinePhysics, CyclicAndScaleErrorsFollowThePosition) {
   const auto dx = deviation_um(run, truth, 0);
   for (std::size_t n = 0; n < truth.size(); n += 733) {
     const double x = run.frames[n].cmd_mm[0];
-    const double expect = 40e-6 * x * 1e3 + 1.5 * std::sin(2 * std::numbers::pi * x / 10.0 + 30.0 * std::numbers::pi / 180.0);
+    const double expect =
+        40e-6 * x * 1e3 + 1.5 * std::sin(2 * std::numbers::pi * x / 10.0 + 30.0 * std::numbers::pi / 180.0);
     EXPECT_NEAR(dx[n], expect, 1e-9);
   }
 }
@@ -82,8 +87,8 @@ TEST(MachinePhysics, StraightnessBowsTheOtherAxis) {
   const auto dy = deviation_um(run, truth, 1);
   double peak = 0.0;
   for (double v : dy) peak = std::max(peak, v);
-  EXPECT_NEAR(peak, 3.0, 1e-3);                        // at mid-span
-  EXPECT_NEAR(dy.front(), 0.0, 1e-9);                  // at the span's ends
+  EXPECT_NEAR(peak, 3.0, 1e-3);        // at mid-span
+  EXPECT_NEAR(dy.front(), 0.0, 1e-9);  // at the span's ends
   EXPECT_NEAR(dy.back(), 0.0, 1e-9);
 }
 
@@ -120,13 +125,15 @@ TEST(MachinePhysics, StickSlipIsASawtoothBelowTheCreepFeed) {
 
 TEST(MachinePhysics, DifferentialModeIsRealRelativeMotionCommonModeIsNot) {
   Scenario base = quiet(step_scenario(0.0, 50.0, 3250.0, 1));
-  for (auto& t : base.truth) t.spec.k2_g_per_g2.setZero(), t.spec.k3_g_per_g3.setZero();  // no mixing of motion and vibration
+  for (auto& t : base.truth)
+    t.spec.k2_g_per_g2.setZero(), t.spec.k3_g_per_g3.setZero();  // no mixing of motion and vibration
   Scenario diff = base, common = base;
   diff.differential_vibration = DriveMode{9.0, 0.03, Eigen::Vector3d(0.01, 0.0, 0.0)};
   common.common_vibration.mode = DriveMode{9.0, 0.03, Eigen::Vector3d(0.01, 0.0, 0.0)};
   common.common_vibration.tones.push_back({100.0, Eigen::Vector3d(3.0, 0.0, 0.0), 0.0});
   std::vector<Eigen::Vector3d> t_base, t_diff, t_common;
-  const dsp::Run r_base = simulate(base, &t_base), r_diff = simulate(diff, &t_diff), r_common = simulate(common, &t_common);
+  const dsp::Run r_base = simulate(base, &t_base), r_diff = simulate(diff, &t_diff),
+                 r_common = simulate(common, &t_common);
   double diff_peak = 0.0, common_peak = 0.0, table_change = 0.0, rel_change = 0.0;
   for (std::size_t n = 0; n < t_base.size(); ++n) {
     diff_peak = std::max(diff_peak, std::abs(t_diff[n].x() - t_base[n].x()) * 1e3);

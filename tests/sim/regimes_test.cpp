@@ -1,10 +1,10 @@
 // Realistic regimes of runs measured by other systems (sim/regimes): each regime's physics
 // against what was put in — the mode's frequency and damping, the chip's noise density and
 // quantisation step, aliasing above Nyquist, a mirrored mounting, one sensor, 51.2 kHz.
+#include "sim/regimes/regimes.hpp"
 #include "dsp/core/error.hpp"
 #include "sim/regimes/capture_clock.hpp"
 #include "sim/regimes/klipper_like.hpp"
-#include "sim/regimes/regimes.hpp"
 #include "sim/simulate.hpp"
 
 #include <gtest/gtest.h>
@@ -23,7 +23,8 @@ constexpr double kPi = std::numbers::pi;
 double decode_g(const dsp::Run& run, std::size_t n, int channel) {
   const auto& acq = run.meta.acquisition;
   const auto& s = run.meta.sensors[channel / 3];
-  return static_cast<double>(run.frames[n].accel_counts[channel] - acq.adc_offset_counts) * acq.adc_lsb_volt / s.k1_v_per_g[channel % 3];
+  return static_cast<double>(run.frames[n].accel_counts[channel] - acq.adc_offset_counts) * acq.adc_lsb_volt /
+         s.k1_v_per_g[channel % 3];
 }
 
 // A machine whose head moves every axis, with ideal sensors: no noise, a 32-bit ADC, no
@@ -78,7 +79,8 @@ TEST(Regimes, ModeFrequencyAndDampingFromItsFreeDecay) {
   const auto n_peaks = static_cast<double>(peak_t.size());
   for (std::size_t k = 0; k < peak_t.size(); ++k) mt += peak_t[k] / n_peaks, ml += peak_ln[k] / n_peaks;
   double stt = 0, stl = 0;
-  for (std::size_t k = 0; k < peak_t.size(); ++k) stt += (peak_t[k] - mt) * (peak_t[k] - mt), stl += (peak_t[k] - mt) * (peak_ln[k] - ml);
+  for (std::size_t k = 0; k < peak_t.size(); ++k)
+    stt += (peak_t[k] - mt) * (peak_t[k] - mt), stl += (peak_t[k] - mt) * (peak_ln[k] - ml);
   const double sigma = -stl / stt, wn = std::hypot(wd, sigma);
   const double f_hz = wn / (2 * kPi), zeta = sigma / wn;
   std::printf("mode put in: 45 Hz, zeta 0.02; free decay of the simulated head: %.3f Hz, zeta %.4f\n", f_hz, zeta);
@@ -142,8 +144,10 @@ TEST(Regimes, ModeShowsInTheSweptResponseOfAMemsHeadSensor) {
       for (std::size_t b = b0; b < b1; ++b) ss += std::norm(h[b] - 1.0 - gain * shape[b - b0]);
       if (ss < best) best = ss, f_fit = fn, zeta_fit = z, gain_fit = gain;
     }
-  std::printf("mode put in: 42 Hz, zeta 0.03, gain 0.15; adxl345 at 3200 Hz, swept 20-70 Hz, measured/commanded fitted: %.2f Hz, zeta %.4f, gain %.3f\n",
-              f_fit, zeta_fit, gain_fit);
+  std::printf(
+      "mode put in: 42 Hz, zeta 0.03, gain 0.15; adxl345 at 3200 Hz, swept 20-70 Hz, measured/commanded fitted: %.2f "
+      "Hz, zeta %.4f, gain %.3f\n",
+      f_fit, zeta_fit, gain_fit);
   EXPECT_NEAR(f_fit, 42.0, 0.2);
   EXPECT_NEAR(zeta_fit, 0.03, 0.1 * 0.03);
   EXPECT_NEAR(gain_fit, 0.15, 0.1 * 0.15);
@@ -172,8 +176,10 @@ TEST(Regimes, MemsChipHasItsNoiseDensityAndQuantisationStep) {
       sum += v, sum2 += v * v;
     }
     const double mean = sum / n, density = std::sqrt(sum2 / n - mean * mean) / std::sqrt(fs);
-    std::printf("mpu6050 axis %d: noise put in %.1f ug/rtHz (two-sided), measured %.1f ug/rtHz; mean %.3f mg (bias %.3f mg%s)\n", a + 1,
-                chip.noise_ug_per_rthz, density * 1e6, mean * 1e3, bias[a] * 1e3, a == 2 ? " + 1 g" : "");
+    std::printf(
+        "mpu6050 axis %d: noise put in %.1f ug/rtHz (two-sided), measured %.1f ug/rtHz; mean %.3f mg (bias %.3f "
+        "mg%s)\n",
+        a + 1, chip.noise_ug_per_rthz, density * 1e6, mean * 1e3, bias[a] * 1e3, a == 2 ? " + 1 g" : "");
     EXPECT_NEAR(density, chip.noise_ug_per_rthz * 1e-6, 0.05 * chip.noise_ug_per_rthz * 1e-6);
     EXPECT_NEAR(mean, bias[a] + (a == 2 ? 1.0 : 0.0), 4.0 * chip.noise_ug_per_rthz * 1e-6 * std::sqrt(fs / n));
   }
@@ -183,7 +189,8 @@ TEST(Regimes, MemsChipHasItsNoiseDensityAndQuantisationStep) {
   for (int a = 0; a < 3; ++a) {
     const double f = bias[a] + (a == 2 ? 1.0 : 0.0);
     const auto expected = static_cast<std::int32_t>(std::llround(f / chip.lsb_g()));
-    for (std::size_t k = 0; k < quiet.frames.size(); k += 97) ASSERT_EQ(quiet.frames[k].accel_counts[3 + a], expected) << a;
+    for (std::size_t k = 0; k < quiet.frames.size(); k += 97)
+      ASSERT_EQ(quiet.frames[k].accel_counts[3 + a], expected) << a;
   }
 }
 
@@ -194,7 +201,8 @@ double amplitude_at(const dsp::Run& run, int channel, double f_hz, double second
   const double fs = run.fs_hz();
   const auto n0 = run.frames.size() - static_cast<std::size_t>(std::llround(seconds * fs));
   for (std::size_t n = n0; n < run.frames.size(); ++n)
-    acc += decode_g(run, n, channel) * std::exp(std::complex<double>(0.0, -2 * kPi * f_hz * static_cast<double>(n) / fs));
+    acc +=
+        decode_g(run, n, channel) * std::exp(std::complex<double>(0.0, -2 * kPi * f_hz * static_cast<double>(n) / fs));
   return 2.0 * std::abs(acc) / static_cast<double>(run.frames.size() - n0);
 }
 
@@ -216,8 +224,11 @@ TEST(Regimes, MemsChipAliasesWhatLiesAboveNyquistTheDaqFilterDoesNot) {
   set_daq_rate(daq, 400.0);
   daq.meta.acquisition.adc_bits = 32, daq.meta.acquisition.adc_lsb_volt = 1e-9;
   const double filtered = amplitude_at(simulate(daq), 3, 50.0, 1.5);
-  std::printf("350 Hz tone, 10 mg, sampled at 400 Hz: mpu6050 (corner 260 Hz, no anti-alias filter) shows %.3f mg at 50 Hz (expected 10 mg x |H(350 Hz)| = %.3f mg); "
-              "the DAQ's anti-alias filter leaves %.2e mg\n", alias * 1e3, 10.0 * h350, filtered * 1e3);
+  std::printf(
+      "350 Hz tone, 10 mg, sampled at 400 Hz: mpu6050 (corner 260 Hz, no anti-alias filter) shows %.3f mg at 50 Hz "
+      "(expected 10 mg x |H(350 Hz)| = %.3f mg); "
+      "the DAQ's anti-alias filter leaves %.2e mg\n",
+      alias * 1e3, 10.0 * h350, filtered * 1e3);
   // The chip quantises at 0.49 mg: a 0.1 mg agreement is what its resolution allows.
   EXPECT_NEAR(alias, 10e-3 * h350, 0.1e-3);
   EXPECT_LT(filtered, 1e-6);
@@ -244,14 +255,15 @@ TEST(Regimes, WrongMountingShowsInTheDataAsPutIn) {
     double sxx = 0;
     for (std::size_t n = 0; n < run.frames.size(); ++n) {
       const double x = sp->at(static_cast<double>(n) / run.fs_hz()).acc_mm_s2.x() / 1000.0 / sc.meta.site.g_mps2;
-      for (int a = 0; a < 3; ++a) sxy[a] += x * (decode_g(run, n, 3 + a) - (m.row(2)[a]));  // less gravity along that sensor axis
+      for (int a = 0; a < 3; ++a)
+        sxy[a] += x * (decode_g(run, n, 3 + a) - (m.row(2)[a]));  // less gravity along that sensor axis
       sxx += x * x;
     }
     const Eigen::Vector3d slope = sxy / sxx;
     // The sensor axes see machine x through the true mounting: sensor = to_machineᵀ · machine.
     const Eigen::Vector3d expected = m.transpose() * Eigen::Vector3d::UnitX();
-    std::printf("mounting %s: sensor axes respond to commanded x with [%.4f, %.4f, %.4f] (put in [%.0f, %.0f, %.0f])\n", map, slope.x(), slope.y(), slope.z(),
-                expected.x(), expected.y(), expected.z());
+    std::printf("mounting %s: sensor axes respond to commanded x with [%.4f, %.4f, %.4f] (put in [%.0f, %.0f, %.0f])\n",
+                map, slope.x(), slope.y(), slope.z(), expected.x(), expected.y(), expected.z());
     EXPECT_LT((slope - expected).norm(), 0.01) << map;
     EXPECT_NE(run.truth_toml->find(std::string("axes_map = \"") + map + "\""), std::string::npos);
   }
@@ -280,7 +292,8 @@ TEST(Regimes, DaqAt51k2HzKeepsTheNoiseDensity) {
     sum += v, sum2 += v * v;
   }
   const double density = std::sqrt(sum2 / n - (sum / n) * (sum / n)) / std::sqrt(run.fs_hz());
-  std::printf("51.2 kHz DAQ: noise put in 0.40 ug/rtHz, measured %.3f ug/rtHz over %zu samples\n", density * 1e6, run.frames.size());
+  std::printf("51.2 kHz DAQ: noise put in 0.40 ug/rtHz, measured %.3f ug/rtHz over %zu samples\n", density * 1e6,
+              run.frames.size());
   EXPECT_NEAR(density, 0.4e-6, 0.02e-6);
 }
 
@@ -305,7 +318,8 @@ TEST(Regimes, KlipperLikeRegimeDrawsWhatItPromises) {
     const Scenario mounted = klipper_like_scenario({"sensor.misalignment"}, seed);
     EXPECT_TRUE(mounted.resonance.modes.empty());
     EXPECT_FALSE(mounted.truth[1].axes_map.empty());
-    EXPECT_EQ(klipper_like_scenario({"machine.resonance"}, seed).resonance.modes[0].frequency_hz, sc.resonance.modes[0].frequency_hz);
+    EXPECT_EQ(klipper_like_scenario({"machine.resonance"}, seed).resonance.modes[0].frequency_hz,
+              sc.resonance.modes[0].frequency_hz);
     const CaptureClock c = klipper_like_capture_clock(seed, sc.meta.acquisition.fs_hz);
     EXPECT_GE(c.jitter_rms_s * sc.meta.acquisition.fs_hz, 0.02);
     EXPECT_LE(c.jitter_rms_s * sc.meta.acquisition.fs_hz, 0.10);

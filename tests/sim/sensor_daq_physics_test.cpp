@@ -26,11 +26,13 @@ TEST(DaqFilter, DelaysASineByTheTrueDelayIncludingFractions) {
     const DecimationFilter f(10, d);
     const double freq = 50.0, fs = 10000.0;
     std::vector<double> in(200000);
-    for (std::size_t k = 0; k < in.size(); ++k) in[k] = std::sin(2 * std::numbers::pi * freq * static_cast<double>(k) / (10 * fs));
+    for (std::size_t k = 0; k < in.size(); ++k)
+      in[k] = std::sin(2 * std::numbers::pi * freq * static_cast<double>(k) / (10 * fs));
     std::vector<double> out(20000);
     f.apply(in, out.data(), out.size());
     for (std::size_t n = 1000; n < 19000; n += 1234)
-      EXPECT_NEAR(out[n], std::sin(2 * std::numbers::pi * freq * (static_cast<double>(n) - d) / fs), 2e-5) << d << " " << n;
+      EXPECT_NEAR(out[n], std::sin(2 * std::numbers::pi * freq * (static_cast<double>(n) - d) / fs), 2e-5)
+          << d << " " << n;
   }
 }
 
@@ -56,10 +58,13 @@ TEST(SensingElement, StaticModelWithCrossTerms) {
   SensorTruth s;
   s.k_cross_g_per_g(0, 1) = 2e-4;
   s.k_cross2_g_per_g2(0, 2) = 1e-4;
-  std::array<std::vector<double>, 3> a{std::vector<double>(10, 0.3), std::vector<double>(10, -0.2), std::vector<double>(10, 1.0)};
+  std::array<std::vector<double>, 3> a{std::vector<double>(10, 0.3), std::vector<double>(10, -0.2),
+                                       std::vector<double>(10, 1.0)};
   sense(a, s, 1e-5);
   const double x = 0.3;
-  EXPECT_NEAR(a[0].back(), x + s.spec.k2_g_per_g2[0] * x * x + s.spec.k3_g_per_g3[0] * x * x * x + 2e-4 * -0.2 + 1e-4 * x * 1.0, 1e-12);
+  EXPECT_NEAR(a[0].back(),
+              x + s.spec.k2_g_per_g2[0] * x * x + s.spec.k3_g_per_g3[0] * x * x * x + 2e-4 * -0.2 + 1e-4 * x * 1.0,
+              1e-12);
 }
 
 TEST(PsdStrip, SharesTheLightByPositionAndIsDarkOffTheStrip) {
@@ -101,7 +106,8 @@ TEST(Reference, ReadsWithScaleInterpolationErrorAndOneNanometre) {
   EXPECT_NEAR(reference_reading_mm(r, 0, 10.0), 10.00001, 1e-12);
   r.scale_ppm[0] = 0.0;
   r.interp_nm[0][0] = 8.0;
-  EXPECT_NEAR(reference_reading_mm(r, 0, 0.001), 0.001 + 8e-6 * std::sin(2 * std::numbers::pi * 0.25), 1e-12);  // 1 µm = ¼ period
+  EXPECT_NEAR(reference_reading_mm(r, 0, 0.001), 0.001 + 8e-6 * std::sin(2 * std::numbers::pi * 0.25),
+              1e-12);                                                           // 1 µm = ¼ period
   EXPECT_DOUBLE_EQ(reference_reading_mm(ReferenceTruth{}, 0, 1.0000004), 1.0);  // 1 nm resolution
 }
 
@@ -123,7 +129,8 @@ TEST(SimulateChain, TemperatureChannelAndSkewedHeadChannels) {
   auto first_above = [&](int ch, double sign) {
     const double rest = r.frames[0].accel_counts[ch];
     for (std::size_t n = 1; n < r.frames.size(); ++n) {
-      const double a0 = sign * (r.frames[n - 1].accel_counts[ch] - rest), a1 = sign * (r.frames[n].accel_counts[ch] - rest);
+      const double a0 = sign * (r.frames[n - 1].accel_counts[ch] - rest),
+                   a1 = sign * (r.frames[n].accel_counts[ch] - rest);
       if (a1 > 1e5 && a0 <= 1e5) return static_cast<double>(n - 1) + (1e5 - a0) / (a1 - a0);
     }
     return -1.0;

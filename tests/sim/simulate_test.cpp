@@ -33,8 +33,8 @@ TEST(Simulate, AtRestSensorsReadBiasPlusGravityWithTheRightNoise) {
     // (6-16): scale and bias at the case temperature (the head's case is 0.5 °C above 20 °C).
     const double dT = sc.truth[ch / 3].temperature.t0_c - s.temp_ref_c;
     const double k1_ratio = 1.0 + s.tc_k1_ppm_per_c * 1e-6 * dT;
-    const double expected =
-        k1_ratio * (a + s.bias_g[ax] + s.tc_bias_ug_per_c * 1e-6 * dT + s.k2_g_per_g2[ax] * a * a + s.k3_g_per_g3[ax] * a * a * a);
+    const double expected = k1_ratio * (a + s.bias_g[ax] + s.tc_bias_ug_per_c * 1e-6 * dT + s.k2_g_per_g2[ax] * a * a +
+                                        s.k3_g_per_g3[ax] * a * a * a);
     EXPECT_NEAR(mean, expected, 3e-6) << "channel " << ch;
     // Two-sided density n: per-sample std = n·√fs = 40 µg (quantisation adds 0.28 µg rms).
     EXPECT_NEAR(sd, 0.4e-6 * std::sqrt(10000.0), 0.05 * 40e-6) << "channel " << ch;
@@ -61,7 +61,7 @@ TEST(Simulate, DaqDelayShowsUpAsThatManySamples) {
   Scenario sc = circle_scenario(10.0, 2500.0, 1);
   sc.noise = false;
   sc.meta.acquisition.adc_bits = 32;
-  sc.meta.acquisition.adc_lsb_volt = 1e-9;  // near-ideal ADC
+  sc.meta.acquisition.adc_lsb_volt = 1e-9;          // near-ideal ADC
   for (auto& t : sc.truth) t.spec.f0_hz = 20000.0;  // sensor dynamics far above the signal
   sc.daq.group_delay_samples = 38.8;
   const dsp::Run run = simulate(sc);
@@ -94,7 +94,8 @@ TEST(Simulate, TriggersAndSetPointFollowTheProgram) {
   EXPECT_EQ(run.frames[at[1]].trigger, 102);
   EXPECT_NEAR(std::hypot(run.frames[30000].cmd_mm[0], run.frames[30000].cmd_mm[1]), 10.0, 1e-4);
   ASSERT_TRUE(run.truth_toml.has_value());
-  for (const char* key : {"generator", "[effects]", "present", "[sensors.table]", "[sensors.head]", "[daq]", "[nc]", "moves_s", "triggers"})
+  for (const char* key : {"generator", "[effects]", "present", "[sensors.table]", "[sensors.head]", "[daq]", "[nc]",
+                          "moves_s", "triggers"})
     EXPECT_NE(run.truth_toml->find(key), std::string::npos) << key;
 }
 

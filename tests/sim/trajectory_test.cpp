@@ -1,9 +1,9 @@
 // The interpolator against the sample runs' truth (their NC timing is known to 1e-9 s)
 // and against its own limits.
+#include "sim/nc/trajectory.hpp"
 #include "sim/gcode/generate.hpp"
 #include "sim/gcode/parser.hpp"
 #include "sim/nc/sampled_set_point.hpp"
-#include "sim/nc/trajectory.hpp"
 
 #include <gtest/gtest.h>
 
@@ -63,7 +63,7 @@ TEST(Trajectory, CircleRunsOnTheRadiusAtFeedWithinTheLimits) {
   }
   EXPECT_LE(max_acc, 2000.0 * (1 + 1e-9));
   EXPECT_NEAR(tr.at(3.0).vel_mm_s.norm(), feed, 1e-9);
-  EXPECT_EQ(tr.at(0.45).vel_mm_s.norm(), 0.0);                 // at rest before the move
+  EXPECT_EQ(tr.at(0.45).vel_mm_s.norm(), 0.0);                    // at rest before the move
   EXPECT_EQ(tr.at(tr.duration_s() - 0.05).vel_mm_s.norm(), 0.0);  // and after
 }
 
@@ -94,7 +94,8 @@ TEST(Trajectory, PerAxisLimitsHoldOnADiagonalMove) {
   lim.axis_v_mm_min[0] = 1500.0;
   lim.axis_a_mm_s2[0] = 500.0;
   lim.axis_j_mm_s3[0] = 10000.0;
-  const Trajectory tr = interpolate_gcode("G90 G21 G17 G61\nG0 X0 Y0\nG4 P0.1\nG1 X43.3013 Y25 F6000\nG4 P0.1\n", "diag", lim);
+  const Trajectory tr =
+      interpolate_gcode("G90 G21 G17 G61\nG0 X0 Y0\nG4 P0.1\nG1 X43.3013 Y25 F6000\nG4 P0.1\n", "diag", lim);
   double vx = 0.0, ax = 0.0, jx = 0.0, vy = 0.0;
   const double h = 1e-4;
   for (double t = h; t < tr.duration_s(); t += h) {
@@ -105,7 +106,7 @@ TEST(Trajectory, PerAxisLimitsHoldOnADiagonalMove) {
     jx = std::max(jx, std::abs(s.acc_mm_s2.x() - p.acc_mm_s2.x()) / h);
   }
   EXPECT_LE(vx, 1500.0 * (1 + 1e-6));
-  EXPECT_GT(vx, 1500.0 * 0.999);  // the limit is reached, not undercut
+  EXPECT_GT(vx, 1500.0 * 0.999);                                  // the limit is reached, not undercut
   EXPECT_NEAR(vy, 1500.0 * std::tan(std::numbers::pi / 6), 1.0);  // y follows the path direction
   EXPECT_LE(ax, 500.0 * (1 + 1e-6));
   EXPECT_LE(jx, 10000.0 * 1.01);
@@ -126,9 +127,9 @@ TEST(SampledSetPoint, SplineThroughServoSamplesRecoversMotion) {
     vel = std::max(vel, (a.vel_mm_s - b.vel_mm_s).norm());
     acc = std::max(acc, (a.acc_mm_s2 - b.acc_mm_s2).norm());
   }
-  EXPECT_LT(pos, 1e-6);   // mm
-  EXPECT_LT(vel, 1e-3);   // mm/s
-  EXPECT_LT(acc, 30.0);   // mm/s² (jerk 50 m/s³ over half a servo period)
+  EXPECT_LT(pos, 1e-6);  // mm
+  EXPECT_LT(vel, 1e-3);  // mm/s
+  EXPECT_LT(acc, 30.0);  // mm/s² (jerk 50 m/s³ over half a servo period)
   ASSERT_EQ(sp.move_spans_s().size(), 1u);
   EXPECT_NEAR(sp.move_spans_s()[0].first, tr.moves()[0].t0_s, 2e-3);
   EXPECT_EQ(sp.triggers().size(), tr.triggers().size());

@@ -104,7 +104,8 @@ TEST_F(CliErrors, HelpWorks) {
       EXPECT_NE(out.find("--calibration"), std::string::npos) << args << ": " << out;
     } else {  // the command list: every command, not the help of `help`
       for (const char* c : {"simulate", "analyze", "plan", "identify", "report", "comp", "help"})
-        EXPECT_NE(out.find(std::string("  ") + c + " "), std::string::npos) << args << " does not list " << c << ": " << out;
+        EXPECT_NE(out.find(std::string("  ") + c + " "), std::string::npos)
+            << args << " does not list " << c << ": " << out;
     }
   }
   expect_one_line_error(eical("help no-such-command"), "no command 'no-such-command'");
@@ -118,7 +119,9 @@ TEST_F(CliErrors, IdentifyRefusesACircleAndWritesNoCalibration) {
   EXPECT_FALSE(fs::exists(cal));
 }
 
-TEST_F(CliErrors, MissingRun) { expect_one_line_error(eical("analyze " + (dir_ / "nope").string()), "not a run directory"); }
+TEST_F(CliErrors, MissingRun) {
+  expect_one_line_error(eical("analyze " + (dir_ / "nope").string()), "not a run directory");
+}
 
 TEST_F(CliErrors, MissingColumn) {
   edit("samples.csv", "head_az", "head_azz");

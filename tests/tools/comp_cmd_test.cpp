@@ -40,10 +40,12 @@ nlohmann::json positioning_result(double u, const std::string& axis = "x", doubl
     per.push_back({{"target_mm", x}, {"mean_up_um", pitch - 3.0}, {"mean_down_um", pitch + 3.0}});
     lo = std::min(lo, pitch), hi = std::max(hi, pitch);
   }
-  nlohmann::json j = {{"format", "eical-result/1"},
-                      {"run_id", "pos-" + axis},
-                      {"program", "positioning"},
-                      {"positioning", {{"axis", axis}, {"A_um", 12.0}, {"M_um", hi - lo}, {"B_um", -6.0}, {"B_mean_um", -6.0}, {"per_target", per}}}};
+  nlohmann::json j = {
+      {"format", "eical-result/1"},
+      {"run_id", "pos-" + axis},
+      {"program", "positioning"},
+      {"positioning",
+       {{"axis", axis}, {"A_um", 12.0}, {"M_um", hi - lo}, {"B_um", -6.0}, {"B_mean_um", -6.0}, {"per_target", per}}}};
   if (u >= 0) j["uncertainty_k2"] = {{"positioning.M_um", u}, {"positioning.B_mean_um", u}};
   return j;
 }
@@ -54,9 +56,14 @@ nlohmann::json circle_result(double u, double backlash_y = 4.0) {
                       {"run_id", "circle"},
                       {"program", "circle"},
                       {"circle", {{"plane", "xy"}, {"center_mm", {0.0, 0.0}}, {"radius_nominal_mm", 10.0}}},
-                      {"diagnostics", {{"backlash_x_um", 5.0}, {"backlash_y_um", backlash_y}, {"squareness_urad", 30.0}, {"scale_mismatch_ppm", 100.0}}}};
+                      {"diagnostics",
+                       {{"backlash_x_um", 5.0},
+                        {"backlash_y_um", backlash_y},
+                        {"squareness_urad", 30.0},
+                        {"scale_mismatch_ppm", 100.0}}}};
   if (u >= 0)
-    j["uncertainty_k2"] = {{"diagnostics.backlash_x_um", u}, {"diagnostics.backlash_y_um", u}, {"diagnostics.squareness_urad", 5.0}};
+    j["uncertainty_k2"] = {
+        {"diagnostics.backlash_x_um", u}, {"diagnostics.backlash_y_um", u}, {"diagnostics.squareness_urad", 5.0}};
   return j;
 }
 
@@ -72,15 +79,18 @@ const char* kMachineIni =
 
 TEST(CompCmd, ResolvedFiguresGiveOneSectionPerJointWithTheReversalFoldedIntoTheTable) {
   Tmp t;
-  const auto pos = write(t.dir / "pos.json", positioning_result(0.5)), circ = write(t.dir / "circle.json", circle_result(0.5));
+  const auto pos = write(t.dir / "pos.json", positioning_result(0.5)),
+             circ = write(t.dir / "circle.json", circle_result(0.5));
   std::ofstream(t.dir / "machine.ini") << kMachineIni;
-  run_cli({"comp", pos.string(), circ.string(), "-o", (t.dir / "out").string(), "--merge-ini", (t.dir / "machine.ini").string(), "--control", "all"});
+  run_cli({"comp", pos.string(), circ.string(), "-o", (t.dir / "out").string(), "--merge-ini",
+           (t.dir / "machine.ini").string(), "--control", "all"});
   // The snippet: one section per joint; x has the table and no BACKLASH, y the circle's backlash.
   const std::string snippet = slurp(t.dir / "out/linuxcnc/eical-comp.ini");
   EXPECT_EQ(snippet.find("[JOINT_0]"), snippet.rfind("[JOINT_0]"));
   EXPECT_NE(snippet.find("COMP_FILE = eical_joint0.comp"), std::string::npos) << snippet;
   EXPECT_NE(snippet.find("BACKLASH = 0.0040000"), std::string::npos) << snippet;  // y from the circle
-  const std::string joint0 = snippet.substr(snippet.find("[JOINT_0]"), snippet.find("[JOINT_1]") - snippet.find("[JOINT_0]"));
+  const std::string joint0 =
+      snippet.substr(snippet.find("[JOINT_0]"), snippet.find("[JOINT_1]") - snippet.find("[JOINT_0]"));
   EXPECT_EQ(joint0.find("\nBACKLASH"), std::string::npos) << joint0;
   // The merged INI: the machine's other keys kept, one [JOINT_0], its BACKLASH set to 0.
   const std::string merged = slurp(t.dir / "out/linuxcnc/machine.ini");
@@ -99,8 +109,9 @@ TEST(CompCmd, ResolvedFiguresGiveOneSectionPerJointWithTheReversalFoldedIntoTheT
   }
   EXPECT_EQ(rows, 5);
   // Every control's files, and comp.json naming each figure and what it was used for.
-  for (const char* file : {"sinumerik/AX_EEC.INI", "sinumerik/backlash.txt", "fanuc/parameters.txt", "fanuc/pitch_error_table.txt", "heidenhain/X.COM",
-                        "heidenhain/CONFIG.CMA", "heidenhain/backlash.txt"})
+  for (const char* file :
+       {"sinumerik/AX_EEC.INI", "sinumerik/backlash.txt", "fanuc/parameters.txt", "fanuc/pitch_error_table.txt",
+        "heidenhain/X.COM", "heidenhain/CONFIG.CMA", "heidenhain/backlash.txt"})
     EXPECT_TRUE(fs::exists(t.dir / "out" / file)) << file;
   const auto j = nlohmann::json::parse(slurp(t.dir / "out/comp.json"));
   EXPECT_EQ(j["format"], "eical-comp/1");
@@ -136,7 +147,7 @@ TEST(CompCmd, UnresolvedFiguresAreRefusedByNameUnlessSkippedOrAllowed) {
   Tmp t;
   const auto pos = write(t.dir / "pos.json", positioning_result(0.5));
   const auto circ = write(t.dir / "circle.json", circle_result(0.5, 0.3));  // backlash y 0.3 ± 0.5 µm
-  const auto bare = write(t.dir / "bare.json", positioning_result(-1.0));    // no uncertainty_k2 at all
+  const auto bare = write(t.dir / "bare.json", positioning_result(-1.0));   // no uncertainty_k2 at all
   const std::string out = (t.dir / "out").string();
   try {
     run_cli({"comp", pos.string(), circ.string(), "-o", out});
@@ -164,7 +175,8 @@ TEST(CompCmd, UnresolvedFiguresAreRefusedByNameUnlessSkippedOrAllowed) {
     const auto left = nlohmann::json::parse(slurp(t.dir / "out/comp.json"));
     ASSERT_TRUE(left.contains("left_out_unresolved_figures")) << "what was left out is said";
     ASSERT_EQ(left["left_out_unresolved_figures"].size(), 1u);
-    EXPECT_NE(left["left_out_unresolved_figures"][0].get<std::string>().find("diagnostics.backlash_y_um"), std::string::npos);
+    EXPECT_NE(left["left_out_unresolved_figures"][0].get<std::string>().find("diagnostics.backlash_y_um"),
+              std::string::npos);
   }
   // --allow-unresolved: proposed and said so in comp.json.
   run_cli({"comp", bare.string(), "-o", (t.dir / "out3").string(), "--allow-unresolved"});
@@ -181,10 +193,12 @@ TEST(CompCmd, ATableThatDoesNotCoverTheMeasuredTravelIsRefused) {
     run_cli({"comp", pos.string(), circ.string(), "-o", (t.dir / "out").string()});
     FAIL() << "accepted a table that does not cover the circle";
   } catch (const eical::dsp::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("the x table covers 0 .. 40 mm, but circle run"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("the x table covers 0 .. 40 mm, but circle run"), std::string::npos)
+        << e.what();
   }
   EXPECT_FALSE(fs::exists(t.dir / "out"));
-  EXPECT_THROW(run_cli({"comp", pos.string(), "--travel", "x:0,100", "-o", (t.dir / "out").string()}), eical::dsp::InputError);
+  EXPECT_THROW(run_cli({"comp", pos.string(), "--travel", "x:0,100", "-o", (t.dir / "out").string()}),
+               eical::dsp::InputError);
   EXPECT_FALSE(fs::exists(t.dir / "out"));
 }
 
@@ -193,8 +207,10 @@ TEST(CompCmd, RunDirectoriesAreAnalysedAndTheirProgramNamesTheTravel) {
   eical::drivers::write_run(eical::sim::simulate(eical::sim::positioning_scenario({-12, 0, 12}, 2)), t.dir / "pos");
   eical::drivers::write_run(eical::sim::simulate(eical::sim::circle_scenario(10, 2500, 2)), t.dir / "circle");
   // No uncertainty_k2 in today's results: refused without the override.
-  EXPECT_THROW(run_cli({"comp", (t.dir / "pos").string(), (t.dir / "circle").string(), "-o", (t.dir / "out").string()}), eical::dsp::InputError);
-  run_cli({"comp", (t.dir / "pos").string(), (t.dir / "circle").string(), "-o", (t.dir / "out").string(), "--allow-unresolved"});
+  EXPECT_THROW(run_cli({"comp", (t.dir / "pos").string(), (t.dir / "circle").string(), "-o", (t.dir / "out").string()}),
+               eical::dsp::InputError);
+  run_cli({"comp", (t.dir / "pos").string(), (t.dir / "circle").string(), "-o", (t.dir / "out").string(),
+           "--allow-unresolved"});
   const auto j = nlohmann::json::parse(slurp(t.dir / "out/comp.json"));
   EXPECT_EQ(j["axes"]["x"]["table"].size(), 3u);
   EXPECT_TRUE(fs::exists(t.dir / "out/linuxcnc/eical_joint0.comp"));

@@ -109,13 +109,16 @@ ControlModel sinumerik_model(const std::string& eec, const std::string& axis, do
     int n;
     double v;
     char name[16];
-    if (std::sscanf(l.c_str(), "$AA_ENC_COMP[0,%d,%15[^]]]=%lf", &n, name, &v) == 3 && axis == name) values[n] = v * 1e3;
+    if (std::sscanf(l.c_str(), "$AA_ENC_COMP[0,%d,%15[^]]]=%lf", &n, name, &v) == 3 && axis == name)
+      values[n] = v * 1e3;
     if (l.rfind("$AA_ENC_COMP_STEP[0," + axis + "]=", 0) == 0) step = std::stod(l.substr(l.find('=') + 1));
     if (l.rfind("$AA_ENC_COMP_MIN[0," + axis + "]=", 0) == 0) min = std::stod(l.substr(l.find('=') + 1));
   }
   std::vector<double> x, v;
   for (const auto& [n, val] : values) x.push_back(min + n * step), v.push_back(val);
-  return [=](double at, Approach a) { return -interp(x, v, at) + (a == Approach::forward ? 0.5 : -0.5) * backlash_mm * 1e3; };
+  return [=](double at, Approach a) {
+    return -interp(x, v, at) + (a == Approach::forward ? 0.5 : -0.5) * backlash_mm * 1e3;
+  };
 }
 
 // FANUC: the amount is 0 at the reference point (No. 3620) and changes by each point's
@@ -128,7 +131,8 @@ ControlModel fanuc_model(const std::string& tape, const std::string& table, doub
     const auto at = tape.find(key);
     return at == std::string::npos ? 0LL : std::stoll(tape.substr(at + std::strlen(key)));
   };
-  const long long ref = param(3620), lo = param(3621), hi = param(3622), step_units = param(3624), b_units = param(1851);
+  const long long ref = param(3620), lo = param(3621), hi = param(3622), step_units = param(3624),
+                  b_units = param(1851);
   std::map<long long, long long> value;
   std::istringstream is(table);
   for (std::string l; std::getline(is, l);) {
@@ -159,7 +163,8 @@ ControlModel heidenhain_model(const std::string& com) {
   for (std::string l; std::getline(is, l);) {
     int nr;
     double p, f, r;
-    if (std::sscanf(l.c_str(), "%d %lf %lf %lf", &nr, &p, &f, &r) == 4) x.push_back(p), fwd.push_back(f * 1e3), rev.push_back(r * 1e3);
+    if (std::sscanf(l.c_str(), "%d %lf %lf %lf", &nr, &p, &f, &r) == 4)
+      x.push_back(p), fwd.push_back(f * 1e3), rev.push_back(r * 1e3);
   }
   return [=](double at, Approach a) { return -interp(x, a == Approach::forward ? fwd : rev, at); };
 }
@@ -175,19 +180,24 @@ TEST(CompExports, EveryControlsTableAppliedToTheMeasuredDeviationLeavesZero) {
   const double b_x_mm = t.mean_lost_motion_um() * 1e-3;
   const double sinu = worst_residual_um(t, sinumerik_model(*find(sin, "sinumerik/AX_EEC.INI"), "X1", b_x_mm));
   const auto fan = fanuc_outputs(props, {{10.0}, 1.0, 0.0, 0});
-  const double fanu = worst_residual_um(t, fanuc_model(*find(fan, "fanuc/parameters.txt"), *find(fan, "fanuc/pitch_error_table.txt"), 1.0));
+  const double fanu = worst_residual_um(
+      t, fanuc_model(*find(fan, "fanuc/parameters.txt"), *find(fan, "fanuc/pitch_error_table.txt"), 1.0));
   const auto hei = heidenhain_outputs(props, {});
   const double heid = worst_residual_um(t, heidenhain_model(*find(hei, "heidenhain/X.COM")));
-  std::printf("residual after applying each export to the deviations: LinuxCNC COMP_FILE %.2g um, BACKLASH %.2g um, SINUMERIK %.2g um, "
-              "FANUC %.2g um (1 um detection unit), HEIDENHAIN %.2g um\n",
-              lcnc, lcnc_b, sinu, fanu, heid);
+  std::printf(
+      "residual after applying each export to the deviations: LinuxCNC COMP_FILE %.2g um, BACKLASH %.2g um, SINUMERIK "
+      "%.2g um, "
+      "FANUC %.2g um (1 um detection unit), HEIDENHAIN %.2g um\n",
+      lcnc, lcnc_b, sinu, fanu, heid);
   EXPECT_LT(lcnc, 1e-3);  // 0.1 nm printed
   EXPECT_LT(lcnc_b, 1e-3);
-  EXPECT_LT(sinu, 1e-3);  // 1 nm printed
+  EXPECT_LT(sinu, 1e-3);        // 1 nm printed
   EXPECT_LE(fanu, 0.5 + 1e-9);  // half a detection unit
   EXPECT_LT(heid, 1e-3);
   // And the opposite sign in any of them would leave twice the deviation.
-  EXPECT_GT(worst_residual_um(t, [&](double x, Approach a) { return -linuxcnc_model(linuxcnc_comp_file(t, "t"))(x, a); }), 10.0);
+  EXPECT_GT(
+      worst_residual_um(t, [&](double x, Approach a) { return -linuxcnc_model(linuxcnc_comp_file(t, "t"))(x, a); }),
+      10.0);
 }
 
 TEST(CompExports, ABacklashWithoutTableIsLinuxCncsBacklashKeyAndTheOthersMachineData) {
@@ -195,7 +205,8 @@ TEST(CompExports, ABacklashWithoutTableIsLinuxCncsBacklashKeyAndTheOthersMachine
   const auto sin = sinumerik_outputs(props, {});
   EXPECT_NE(find(sin, "sinumerik/backlash.txt")->find("$MA_BACKLASH[0,Y1]=0.004000"), std::string::npos);
   const auto fan = fanuc_outputs(props, {{10.0}, 1.0, 0.0, 0});
-  EXPECT_NE(find(fan, "fanuc/parameters.txt")->find("N01851A1P6A2P4"), std::string::npos) << *find(fan, "fanuc/parameters.txt");
+  EXPECT_NE(find(fan, "fanuc/parameters.txt")->find("N01851A1P6A2P4"), std::string::npos)
+      << *find(fan, "fanuc/parameters.txt");
   const auto hei = heidenhain_outputs(props, {});
   EXPECT_NE(find(hei, "heidenhain/backlash.txt")->find("Y: MP_backLash = 0.004000"), std::string::npos);
 }
@@ -207,7 +218,8 @@ TEST(CompExports, GoldenFiles) {
   std::vector<OutputFile> all;
   std::vector<JointSettings> joints = {{0, 'x', std::nullopt, std::string("eical_joint0.comp"), {"x: test table"}},
                                        {1, 'y', 0.004, std::nullopt, {"y: test backlash"}}};
-  all.push_back({"linuxcnc/eical_joint0.comp", linuxcnc_comp_file(sample_table(), "eical comp, joint 0 (x): test table")});
+  all.push_back(
+      {"linuxcnc/eical_joint0.comp", linuxcnc_comp_file(sample_table(), "eical comp, joint 0 (x): test table")});
   all.push_back({"linuxcnc/eical-comp.ini", linuxcnc_ini_snippet(joints, "# eical comp test\n")});
   for (auto& f : sinumerik_outputs(props, {})) all.push_back(f);
   for (auto& f : fanuc_outputs(props, {{10.0}, 1.0, 0.0, 0})) all.push_back(f);
@@ -229,17 +241,21 @@ TEST(CompExports, GoldenFiles) {
 }
 
 TEST(CompExports, MergingKeepsTheMachinesIniAndRefusesWhatItCannotMap) {
-  const std::string ini = "[KINS]\nKINEMATICS = trivkins coordinates=XZ\n[JOINT_0]\nBACKLASH = 0.01\n# keep me\n[JOINT_1]\nFERROR = 1\n";
+  const std::string ini =
+      "[KINS]\nKINEMATICS = trivkins coordinates=XZ\n[JOINT_0]\nBACKLASH = 0.01\n# keep me\n[JOINT_1]\nFERROR = 1\n";
   const auto map = joint_map(ini, "lathe.ini");
   EXPECT_EQ(map.at('x'), 0);
   EXPECT_EQ(map.at('z'), 1);
   EXPECT_EQ(map.count('y'), 0u);
   const std::string merged = merge_linuxcnc_ini(ini, "lathe.ini", {{1, 'z', 0.003, std::nullopt, {"z"}}});
   EXPECT_NE(merged.find("# keep me"), std::string::npos);
-  EXPECT_NE(merged.find("[JOINT_1]\nFERROR = 1\n# eical comp (z):\n# z\nBACKLASH = 0.0030000"), std::string::npos) << merged;
+  EXPECT_NE(merged.find("[JOINT_1]\nFERROR = 1\n# eical comp (z):\n# z\nBACKLASH = 0.0030000"), std::string::npos)
+      << merged;
   EXPECT_THROW((void)joint_map("[KINS]\nKINEMATICS = 5axiskins\n", "m.ini"), dsp::InputError);
-  EXPECT_THROW((void)merge_linuxcnc_ini("[JOINT_0]\n[JOINT_0]\n", "m.ini", {{0, 'x', 0.001, std::nullopt, {}}}), dsp::InputError);
-  EXPECT_THROW((void)linuxcnc_ini_snippet({{0, 'x', 0.001, std::string("a.comp"), {}}}, ""), dsp::InputError);  // BACKLASH and COMP_FILE
+  EXPECT_THROW((void)merge_linuxcnc_ini("[JOINT_0]\n[JOINT_0]\n", "m.ini", {{0, 'x', 0.001, std::nullopt, {}}}),
+               dsp::InputError);
+  EXPECT_THROW((void)linuxcnc_ini_snippet({{0, 'x', 0.001, std::string("a.comp"), {}}}, ""),
+               dsp::InputError);  // BACKLASH and COMP_FILE
 }
 
 TEST(CompExports, AtMost256PointsForLinuxCnc) {

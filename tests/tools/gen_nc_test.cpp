@@ -136,7 +136,8 @@ TEST(GenNc, DialectsHaveTheirDwellUnitsProgramNumbersAndEndCodes) {
   EXPECT_TRUE(approach.rapid);
   EXPECT_NEAR(approach.to_mm.x(), 10.0, 1e-12);
 
-  const std::string fanuc = gen({"gen-nc", "step", "--targets", "10,60", "--runs", "1", "--dialect", "fanuc", "--program-number", "4711"});
+  const std::string fanuc =
+      gen({"gen-nc", "step", "--targets", "10,60", "--runs", "1", "--dialect", "fanuc", "--program-number", "4711"});
   EXPECT_EQ(fanuc.rfind("%\nO4711 (EICAL STEP", 0), 0u) << fanuc;
   EXPECT_NE(fanuc.find("G04 P400\nM101\nG04 P100"), std::string::npos) << fanuc;  // milliseconds
   EXPECT_EQ(fanuc.substr(fanuc.size() - 6), "M30\n%\n");
@@ -147,10 +148,12 @@ TEST(GenNc, DialectsHaveTheirDwellUnitsProgramNumbersAndEndCodes) {
   EXPECT_NE(sin.find("G4 F0.400\nM101"), std::string::npos) << sin;  // seconds
   EXPECT_EQ(sin.substr(sin.size() - 4), "M30\n");
 
-  const std::string tnc = gen({"gen-nc", "circle", "--repeats", "1", "--center", "5,0", "--dialect", "heidenhain-iso", "--program-name", "CAL1"});
+  const std::string tnc = gen({"gen-nc", "circle", "--repeats", "1", "--center", "5,0", "--dialect", "heidenhain-iso",
+                               "--program-name", "CAL1"});
   EXPECT_EQ(tnc.rfind("%CAL1 G71 *\n", 0), 0u) << tnc;
   EXPECT_NE(tnc.find("G04 F0.400 *\nN40 M101 *"), std::string::npos) << tnc;
-  EXPECT_NE(tnc.find(" I+5.0000 J+0.0000 *\nN70 G03 X-2.0711 Y+7.0711 F2500 *"), std::string::npos) << tnc;  // absolute centre
+  EXPECT_NE(tnc.find(" I+5.0000 J+0.0000 *\nN70 G03 X-2.0711 Y+7.0711 F2500 *"), std::string::npos)
+      << tnc;  // absolute centre
   const std::string tnc_end = "\nN99999999 %CAL1 G71 *\n";
   EXPECT_EQ(tnc.substr(tnc.size() - tnc_end.size()), tnc_end);
 
@@ -159,8 +162,10 @@ TEST(GenNc, DialectsHaveTheirDwellUnitsProgramNumbersAndEndCodes) {
   for (const char* d : {"linuxcnc", "fanuc", "sinumerik", "heidenhain-iso"})
     for (const char* kind : {"circle", "positioning"}) {
       std::vector<std::string> args = {"gen-nc", kind, "--dialect", d};
-      if (std::string(kind) == "circle") args.insert(args.end(), {"--repeats", "1", "--direction", "both"});
-      else args.insert(args.end(), {"--targets", "0,10", "--runs", "1"});
+      if (std::string(kind) == "circle")
+        args.insert(args.end(), {"--repeats", "1", "--direction", "both"});
+      else
+        args.insert(args.end(), {"--targets", "0,10", "--runs", "1"});
       const std::string text = gen(args);
       const fs::path p = golden / (std::string(d) + "-" + kind + ".nc");
       if (update) {

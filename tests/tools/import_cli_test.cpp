@@ -27,7 +27,8 @@ Outcome eical(const std::string& args, const fs::path& dir) {
   while (p && std::fgets(buf, sizeof buf, p)) out += buf;
   const int status = p ? ::pclose(p) : -1;
   std::ifstream is(err);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), out, std::string(std::istreambuf_iterator<char>(is), {})};
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), out,
+          std::string(std::istreambuf_iterator<char>(is), {})};
 }
 
 class ImportCli : public ::testing::Test {
@@ -40,8 +41,9 @@ class ImportCli : public ::testing::Test {
 
 TEST_F(ImportCli, SimulatedKlipperTestExportedAndImportedBack) {
   const std::string test = " --freq-start 30 --freq-end 45 --hz-per-sec 2";
-  const Outcome sim = eical("simulate --program sweep --sensors head --mems adxl345 --fs 1600" + test + " --resonance 38,0.03,0.1,x -o " + at("sim") +
-                                " --export klipper " + at("raw.csv") + " --export-offset-s 812.5",
+  const Outcome sim = eical("simulate --program sweep --sensors head --mems adxl345 --fs 1600" + test +
+                                " --resonance 38,0.03,0.1,x -o " + at("sim") + " --export klipper " + at("raw.csv") +
+                                " --export-offset-s 812.5",
                             dir_);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   EXPECT_NE(sim.out.find("exported"), std::string::npos);
@@ -67,11 +69,12 @@ TEST_F(ImportCli, BadInputIsOneLineNamingTheCause) {
   EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
   EXPECT_NE(o.err.find("no such file"), std::string::npos) << o.err;
   // A capture of another motion than the one described: refused, not aligned to noise.
-  ASSERT_EQ(eical("simulate --program sweep --sensors head --mems adxl345 --freq-start 30 --freq-end 40 --hz-per-sec 2 -o " + at("sim") +
-                      " --export klipper " + at("raw.csv"),
-                  dir_)
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      eical("simulate --program sweep --sensors head --mems adxl345 --freq-start 30 --freq-end 40 --hz-per-sec 2 -o " +
+                at("sim") + " --export klipper " + at("raw.csv"),
+            dir_)
+          .exit_code,
+      0);
   o = eical("import klipper " + at("raw.csv") + " --axis x --freq-start 100 --freq-end 110 -o " + at("run"), dir_);
   EXPECT_EQ(o.exit_code, 1);
   EXPECT_NE(o.err.find("the commanded acceleration is not found in the measured one"), std::string::npos) << o.err;

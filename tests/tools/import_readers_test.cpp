@@ -45,15 +45,25 @@ TEST(ImportReaders, KlipperCaptureRowsAreCheckedOneByOne) {
   EXPECT_NE(klipper("norows", kHeader).find("no samples after the header"), std::string::npos);
   const std::string nan = klipper("nan", std::string("##stats\n") + kHeader + "1.000000,1,2,3\n1.000312,nan,2,3\n");
   EXPECT_NE(nan.find(":4: column 'accel_x': NaN or Inf"), std::string::npos) << nan;
-  EXPECT_NE(klipper("word", std::string(kHeader) + "1.0,1,abc,3\n").find(":2: column 'accel_y': expected a number, got 'abc'"), std::string::npos);
-  EXPECT_NE(klipper("back", std::string(kHeader) + "1.0,1,2,3\n1.1,1,2,3\n1.05,1,2,3\n").find(":4: column 'time': time does not increase"), std::string::npos);
-  EXPECT_NE(klipper("same", std::string(kHeader) + "1.0,1,2,3\n1.0,1,2,3\n").find(":3: column 'time': time does not increase"), std::string::npos);
-  EXPECT_NE(klipper("fields", std::string(kHeader) + "1.0,1,2,3\n1.1,1,2\n").find(":3: wrong number of fields (3, header has 4)"), std::string::npos);
-  EXPECT_NE(klipper("blank", std::string(kHeader) + "1.0,1,2,3\n\n1.1,1,2,3\n").find(":3: blank line inside the data"), std::string::npos);
+  EXPECT_NE(klipper("word", std::string(kHeader) + "1.0,1,abc,3\n")
+                .find(":2: column 'accel_y': expected a number, got 'abc'"),
+            std::string::npos);
+  EXPECT_NE(klipper("back", std::string(kHeader) + "1.0,1,2,3\n1.1,1,2,3\n1.05,1,2,3\n")
+                .find(":4: column 'time': time does not increase"),
+            std::string::npos);
+  EXPECT_NE(klipper("same", std::string(kHeader) + "1.0,1,2,3\n1.0,1,2,3\n")
+                .find(":3: column 'time': time does not increase"),
+            std::string::npos);
+  EXPECT_NE(klipper("fields", std::string(kHeader) + "1.0,1,2,3\n1.1,1,2\n")
+                .find(":3: wrong number of fields (3, header has 4)"),
+            std::string::npos);
+  EXPECT_NE(klipper("blank", std::string(kHeader) + "1.0,1,2,3\n\n1.1,1,2,3\n").find(":3: blank line inside the data"),
+            std::string::npos);
   EXPECT_NE(klipper("cut", std::string(kHeader) + "1.0,1,2,3\n1.1,1,2").find("truncated file"), std::string::npos);
   EXPECT_NE(error_of([] { read_klipper_capture("/nonexistent/raw.csv"); }).find("no such file"), std::string::npos);
   // A good one, CRLF line ends and a trailing blank line allowed; mm/s² to m/s².
-  const std::string good = file_with("good", std::string("#time,accel_x,accel_y,accel_z\r\n") + "10.000000,-1.5,2.25,9806.65\r\n10.000312,0,0,9806.65\r\n\n");
+  const std::string good = file_with("good", std::string("#time,accel_x,accel_y,accel_z\r\n") +
+                                                 "10.000000,-1.5,2.25,9806.65\r\n10.000312,0,0,9806.65\r\n\n");
   const StampedAccel a = read_klipper_capture(good);
   ASSERT_EQ(a.t_s.size(), 2u);
   EXPECT_DOUBLE_EQ(a.accel_mps2[0].x(), -1.5e-3);
@@ -63,11 +73,16 @@ TEST(ImportReaders, KlipperCaptureRowsAreCheckedOneByOne) {
 TEST(ImportReaders, GenericCsvAndNcTracesNameWhatIsWrong) {
   CsvColumns named{"t", {"ax", "ay", "az"}, 1.0};
   const std::string missing = file_with("missing", "t,ax,ay\n0,1,2\n");
-  EXPECT_NE(error_of([&] { read_accel_csv(missing, named, AccelUnit::g); }).find(":1: no column 'az' (the header has: t, ax, ay)"), std::string::npos);
+  EXPECT_NE(error_of([&] {
+              read_accel_csv(missing, named, AccelUnit::g);
+            }).find(":1: no column 'az' (the header has: t, ax, ay)"),
+            std::string::npos);
   const std::string twice = file_with("twice", "t,ax,ay,az,ax\n0,1,2,3,4\n");
-  EXPECT_NE(error_of([&] { read_accel_csv(twice, named, AccelUnit::g); }).find("column 'ax' appears twice"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_accel_csv(twice, named, AccelUnit::g); }).find("column 'ax' appears twice"),
+            std::string::npos);
   const std::string inf = file_with("inf", "t,ax,ay,az\n0,1,2,3\n0.001,1,inf,3\n");
-  EXPECT_NE(error_of([&] { read_accel_csv(inf, named, AccelUnit::g); }).find(":3: column 'ay': NaN or Inf"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_accel_csv(inf, named, AccelUnit::g); }).find(":3: column 'ay': NaN or Inf"),
+            std::string::npos);
   const std::string ok = file_with("ok", "\"time\",\"z\",\"x\",\"y\"\n0.5,3,1,2\n0.6,3,1,2\n");
   const StampedAccel a = read_accel_csv(ok, {"time", {"x", "y", "z"}, 1.0}, AccelUnit::g);
   EXPECT_DOUBLE_EQ(a.accel_mps2[0].x(), kStandardGravity_mps2);
@@ -80,7 +95,8 @@ TEST(ImportReaders, GenericCsvAndNcTracesNameWhatIsWrong) {
   const std::string short_line = file_with("halshort", "100 1.0 2.0\n");
   EXPECT_NE(error_of([&] { read_halsampler(short_line, 0.001); }).find(":1: column 4"), std::string::npos);
   const std::string back = file_with("halback", "100 1 2 3 1 2 3 0\n99 1 2 3 1 2 3 0\n");
-  EXPECT_NE(error_of([&] { read_halsampler(back, 0.001); }).find(":2: sample number 99 does not increase"), std::string::npos);
+  EXPECT_NE(error_of([&] { read_halsampler(back, 0.001); }).find(":2: sample number 99 does not increase"),
+            std::string::npos);
   const std::string nc = file_with("nc", "t,x,y,z\n0,0,0,0\n0.001,0,0\n");
   EXPECT_NE(error_of([&] { read_nc_csv(nc, {}); }).find(":3: wrong number of fields"), std::string::npos);
 }
@@ -96,9 +112,11 @@ TEST(ImportReaders, UniformClockFromMicrosecondStampsWithJitterAndAGap) {
     t.push_back(std::round(stamp * 1e6) / 1e6);  // Klipper prints %.6f
   }
   const UniformClock c = fit_uniform_clock(t, "stamps");
-  std::printf("stamps at 3187.3 Hz printed to 1 us with 20 us jitter: median dt %.1f us (fs %.2f Hz from it), fitted fs %.5f Hz, jitter %.2f us, "
-              "%zu lost frames in %zu gaps\n",
-              c.median_dt_s * 1e6, 1.0 / c.median_dt_s, c.fs_hz, c.jitter_rms_s * 1e6, c.lost_frames, c.gaps);
+  std::printf(
+      "stamps at 3187.3 Hz printed to 1 us with 20 us jitter: median dt %.1f us (fs %.2f Hz from it), fitted fs %.5f "
+      "Hz, jitter %.2f us, "
+      "%zu lost frames in %zu gaps\n",
+      c.median_dt_s * 1e6, 1.0 / c.median_dt_s, c.fs_hz, c.jitter_rms_s * 1e6, c.lost_frames, c.gaps);
   EXPECT_NEAR(c.fs_hz, fs, 1e-3);
   EXPECT_EQ(c.lost_frames, 40u);
   EXPECT_EQ(c.gaps, 1u);
@@ -131,8 +149,10 @@ TEST(ImportReaders, UniformClockCountsEverySingleLostSample) {
     t.push_back(std::round((7.25 + k / fs + jitter * unit(rng)) * 1e6) / 1e6);
   }
   const UniformClock c = fit_uniform_clock(t, "stamps");
-  std::printf("%zu single samples lost at 3187.3 Hz, 20 us jitter: %zu lost frames in %zu gaps found, jitter %.2f us, fs %.4f Hz\n", lost,
-              c.lost_frames, c.gaps, c.jitter_rms_s * 1e6, c.fs_hz);
+  std::printf(
+      "%zu single samples lost at 3187.3 Hz, 20 us jitter: %zu lost frames in %zu gaps found, jitter %.2f us, fs %.4f "
+      "Hz\n",
+      lost, c.lost_frames, c.gaps, c.jitter_rms_s * 1e6, c.fs_hz);
   EXPECT_EQ(c.lost_frames, lost);
   EXPECT_EQ(c.gaps, lost);
   EXPECT_EQ(c.index.back(), 99999);

@@ -61,8 +61,8 @@ double unresampled_rms_g(const Simulated& s, int part) {
     if (!s.samples.kept[n]) continue;
     for (int a = 0; a < 3; ++a) {
       const auto c = static_cast<std::size_t>(3 * part + a);
-      const double d = static_cast<double>(s.jittered.counts[n][c] - s.run.frames[n].accel_counts[c]) * s.run.meta.acquisition.adc_lsb_volt /
-                       s.run.meta.sensors[part].k1_v_per_g[a];
+      const double d = static_cast<double>(s.jittered.counts[n][c] - s.run.frames[n].accel_counts[c]) *
+                       s.run.meta.acquisition.adc_lsb_volt / s.run.meta.sensors[part].k1_v_per_g[a];
       ss += d * d;
     }
     ++n_kept;
@@ -82,9 +82,12 @@ Comparison compare(const dsp::Run& imported, int part, const Simulated& truth, d
   double ss = 0.0, signal = 0.0;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (std::size_t n = 0; n < truth.run.frames.size(); ++n)
-    for (int a = 0; a < 3; ++a) mean[a] += decode_g(truth.run, n, 3 * part + a) / static_cast<double>(truth.run.frames.size());
+    for (int a = 0; a < 3; ++a)
+      mean[a] += decode_g(truth.run, n, 3 * part + a) / static_cast<double>(truth.run.frames.size());
   for (std::size_t n = 1; n < truth.run.frames.size(); ++n)
-    for (int a = 0; a < 3; ++a) c.v_max_mm_s = std::max(c.v_max_mm_s, std::abs(truth.run.frames[n].cmd_mm[a] - truth.run.frames[n - 1].cmd_mm[a]) * fs);
+    for (int a = 0; a < 3; ++a)
+      c.v_max_mm_s =
+          std::max(c.v_max_mm_s, std::abs(truth.run.frames[n].cmd_mm[a] - truth.run.frames[n - 1].cmd_mm[a]) * fs);
   for (const auto& f : imported.frames) {
     const double t_true = t0_s + static_cast<double>(f.sample_index) / imported.fs_hz() - true_offset_s;
     const auto n = static_cast<std::size_t>(std::llround(t_true * fs));
@@ -95,7 +98,8 @@ Comparison compare(const dsp::Run& imported, int part, const Simulated& truth, d
       signal += (decode_g(truth.run, n, 3 * part + a) - mean[a]) * (decode_g(truth.run, n, 3 * part + a) - mean[a]);
     }
     if (!(f.flags & dsp::frame_flag::cmd_missing))
-      for (int a = 0; a < 3; ++a) c.cmd_max_um = std::max(c.cmd_max_um, 1e3 * std::abs(f.cmd_mm[a] - truth.run.frames[n].cmd_mm[a]));
+      for (int a = 0; a < 3; ++a)
+        c.cmd_max_um = std::max(c.cmd_max_um, 1e3 * std::abs(f.cmd_mm[a] - truth.run.frames[n].cmd_mm[a]));
     ++c.matched;
   }
   c.accel_rms_g = std::sqrt(ss / (3.0 * static_cast<double>(c.matched)));
@@ -120,7 +124,8 @@ TEST(ImportRoundTrip, KlipperCaptureWithJitterGapsAndAnUnknownStart) {
   clock.offset_s = 523.25, clock.jitter_rms_s = 0.05 / 3200.0, clock.batch = 16, clock.lost_batches = 3, clock.seed = 5;
   const Simulated truth = simulate_capture(sc, clock);
   const fs::path file = dir.path / "raw_data_x.csv";
-  drivers::write_klipper_capture(file, drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 1, file.string()));
+  drivers::write_klipper_capture(
+      file, drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 1, file.string()));
 
   drivers::KlipperImport k;
   k.test = sc.sweep.test;
@@ -131,12 +136,15 @@ TEST(ImportRoundTrip, KlipperCaptureWithJitterGapsAndAnUnknownStart) {
   const auto& ck = r.report.accel_clock;
   const Comparison c = compare(r.run, 1, truth, clock.offset_s, ck.t0_s);
   const double unresampled = unresampled_rms_g(truth, 1);
-  std::printf("klipper round trip (adxl345, 3200 Hz, 20-50 Hz): offset %.7f s (truth %.7f, error %+.2f us, u %.2f us k=1); "
-              "fs %.4f Hz; jitter %.2f us (truth %.2f); %zu lost frames in %zu gaps (truth %zu); acceleration %.3f mg rms from the truth "
-              "(%.3f mg without resampling; noise %.2f mg, signal %.1f mg rms); set-point within %.4f um (peak speed %.0f mm/s)\n",
-              off.offset_s, clock.offset_s, (off.offset_s - clock.offset_s) * 1e6, off.u_s * 1e6, ck.fs_hz, ck.jitter_rms_s * 1e6,
-              truth.samples.jitter_rms_s * 1e6, ck.lost_frames, ck.gaps, truth.samples.lost, c.accel_rms_g * 1e3, unresampled * 1e3, c.noise_g * 1e3,
-              c.signal_rms_g * 1e3, c.cmd_max_um, c.v_max_mm_s);
+  std::printf(
+      "klipper round trip (adxl345, 3200 Hz, 20-50 Hz): offset %.7f s (truth %.7f, error %+.2f us, u %.2f us k=1); "
+      "fs %.4f Hz; jitter %.2f us (truth %.2f); %zu lost frames in %zu gaps (truth %zu); acceleration %.3f mg rms from "
+      "the truth "
+      "(%.3f mg without resampling; noise %.2f mg, signal %.1f mg rms); set-point within %.4f um (peak speed %.0f "
+      "mm/s)\n",
+      off.offset_s, clock.offset_s, (off.offset_s - clock.offset_s) * 1e6, off.u_s * 1e6, ck.fs_hz,
+      ck.jitter_rms_s * 1e6, truth.samples.jitter_rms_s * 1e6, ck.lost_frames, ck.gaps, truth.samples.lost,
+      c.accel_rms_g * 1e3, unresampled * 1e3, c.noise_g * 1e3, c.signal_rms_g * 1e3, c.cmd_max_um, c.v_max_mm_s);
   EXPECT_LE(std::abs(off.offset_s - clock.offset_s), 3.0 * off.u_s + 1e-7);
   EXPECT_LT(off.u_s, 0.05 / 3200.0);  // a twentieth of a sample
   EXPECT_GT(off.explained, 0.9);
@@ -178,7 +186,8 @@ TEST(ImportRoundTrip, OlderKlipperTestThroughTwoModes) {
   clock.offset_s = 77.125, clock.jitter_rms_s = 0.08 / 1600.0, clock.batch = 24, clock.lost_batches = 2, clock.seed = 6;
   const Simulated truth = simulate_capture(sc, clock);
   const fs::path file = dir.path / "raw.csv";
-  drivers::write_klipper_capture(file, drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 1, file.string()));
+  drivers::write_klipper_capture(
+      file, drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 1, file.string()));
   drivers::KlipperImport k;
   k.test = sc.sweep.test;
   k.setup.chip = "lis2dw";
@@ -187,11 +196,14 @@ TEST(ImportRoundTrip, OlderKlipperTestThroughTwoModes) {
   const auto& off = r.report.offset;
   const Comparison c = compare(r.run, 1, truth, clock.offset_s, r.report.accel_clock.t0_s);
   const double unresampled = unresampled_rms_g(truth, 1);
-  std::printf("older Klipper test through modes at 38 and 61 Hz (lis2dw, 1600 Hz): offset error %+.2f us, u %.2f us (k=1), the command explains %.1f %%; "
-              "acceleration %.3f mg rms from the truth (%.3f mg without resampling; noise %.2f mg, signal %.1f mg rms); set-point within %.4f um "
-              "(peak speed %.0f mm/s)\n",
-              (off.offset_s - clock.offset_s) * 1e6, off.u_s * 1e6, 100.0 * off.explained, c.accel_rms_g * 1e3, unresampled * 1e3, c.noise_g * 1e3,
-              c.signal_rms_g * 1e3, c.cmd_max_um, c.v_max_mm_s);
+  std::printf(
+      "older Klipper test through modes at 38 and 61 Hz (lis2dw, 1600 Hz): offset error %+.2f us, u %.2f us (k=1), the "
+      "command explains %.1f %%; "
+      "acceleration %.3f mg rms from the truth (%.3f mg without resampling; noise %.2f mg, signal %.1f mg rms); "
+      "set-point within %.4f um "
+      "(peak speed %.0f mm/s)\n",
+      (off.offset_s - clock.offset_s) * 1e6, off.u_s * 1e6, 100.0 * off.explained, c.accel_rms_g * 1e3,
+      unresampled * 1e3, c.noise_g * 1e3, c.signal_rms_g * 1e3, c.cmd_max_um, c.v_max_mm_s);
   // The modes' phase moves the correlation peak: a tenth of a sample is what is asked here.
   EXPECT_LT(std::abs(off.offset_s - clock.offset_s), 0.1 / 1600.0);
   // Square-wave edges through an 800 Hz corner sampled at 1600 Hz put content up to
@@ -212,7 +224,9 @@ TEST(ImportRoundTrip, AccelerometerCsvWithAHalsamplerTrace) {
   clock.offset_s = 16.75, clock.jitter_rms_s = 0.05 / 1000.0, clock.batch = 8, clock.lost_batches = 2, clock.seed = 7;
   const Simulated truth = simulate_capture(sc, clock);
   const fs::path accel = dir.path / "accel.csv", nc = dir.path / "nc.txt";
-  drivers::write_accel_csv(accel, drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 0, accel.string()), drivers::AccelUnit::mps2);
+  drivers::write_accel_csv(
+      accel, drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 0, accel.string()),
+      drivers::AccelUnit::mps2);
   const double nc_offset = 1234.5678;
   const drivers::NcTrace trace = drivers::exported_nc_trace(*truth.set_point, 0.001, nc_offset, nc.string());
   drivers::write_halsampler(nc, trace, std::llround(trace.t_s.front() / 0.001));
@@ -225,10 +239,13 @@ TEST(ImportRoundTrip, AccelerometerCsvWithAHalsamplerTrace) {
   const auto& off = r.report.offset;
   const double true_offset = clock.offset_s - nc_offset;
   const Comparison c = compare(r.run, 0, truth, clock.offset_s, r.report.accel_clock.t0_s);
-  std::printf("accel CSV + halsampler (mpu6050, 1000 Hz, free-form contour): offset %.7f s (truth %.7f, error %+.2f us, u %.2f us k=1); "
-              "acceleration %.3f mg rms from the truth (noise %.2f mg, signal %.1f mg rms); set-point within %.4f um (peak speed %.0f mm/s)\n",
-              off.offset_s, true_offset, (off.offset_s - true_offset) * 1e6, off.u_s * 1e6, c.accel_rms_g * 1e3, c.noise_g * 1e3, c.signal_rms_g * 1e3,
-              c.cmd_max_um, c.v_max_mm_s);
+  std::printf(
+      "accel CSV + halsampler (mpu6050, 1000 Hz, free-form contour): offset %.7f s (truth %.7f, error %+.2f us, u %.2f "
+      "us k=1); "
+      "acceleration %.3f mg rms from the truth (noise %.2f mg, signal %.1f mg rms); set-point within %.4f um (peak "
+      "speed %.0f mm/s)\n",
+      off.offset_s, true_offset, (off.offset_s - true_offset) * 1e6, off.u_s * 1e6, c.accel_rms_g * 1e3,
+      c.noise_g * 1e3, c.signal_rms_g * 1e3, c.cmd_max_um, c.v_max_mm_s);
   // A jerk-limited contour has no sharp edges: its offset is known to a fraction of a sample.
   EXPECT_LE(std::abs(off.offset_s - true_offset), 3.0 * off.u_s + 1e-7);
   EXPECT_LT(off.u_s, 1.0 / 1000.0);
@@ -246,7 +263,8 @@ TEST(ImportRoundTrip, NcCsvWithJitteredStampsAndNamedColumns) {
   clock.offset_s = 3.5, clock.jitter_rms_s = 0.03 / 1600.0, clock.seed = 8;
   const Simulated truth = simulate_capture(sc, clock);
   // The accelerometer CSV in mm/s² with the time in ms and its columns in another order.
-  const drivers::StampedAccel cap = drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 0, "accel");
+  const drivers::StampedAccel cap =
+      drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 0, "accel");
   std::string text = "az_mmps2,time_ms,ax_mmps2,ay_mmps2\n";
   char buf[160];
   for (std::size_t k = 0; k < cap.t_s.size(); ++k) {
@@ -278,10 +296,12 @@ TEST(ImportRoundTrip, NcCsvWithJitteredStampsAndNamedColumns) {
   const auto& off = r.report.offset;
   const double true_offset = clock.offset_s - nc_offset;
   const Comparison c = compare(r.run, 0, truth, clock.offset_s, r.report.accel_clock.t0_s);
-  std::printf("accel CSV (mm/s2, ms) + jittered NC CSV (500 Hz, 40 us): offset error %+.2f us, u %.2f us (k=1); NC clock %.4f Hz, jitter %.1f us; "
-              "acceleration %.3f mg rms from the truth (noise %.2f mg); set-point within %.3f um\n",
-              (off.offset_s - true_offset) * 1e6, off.u_s * 1e6, r.report.nc_clock->fs_hz, r.report.nc_clock->jitter_rms_s * 1e6, c.accel_rms_g * 1e3,
-              c.noise_g * 1e3, c.cmd_max_um);
+  std::printf(
+      "accel CSV (mm/s2, ms) + jittered NC CSV (500 Hz, 40 us): offset error %+.2f us, u %.2f us (k=1); NC clock %.4f "
+      "Hz, jitter %.1f us; "
+      "acceleration %.3f mg rms from the truth (noise %.2f mg); set-point within %.3f um\n",
+      (off.offset_s - true_offset) * 1e6, off.u_s * 1e6, r.report.nc_clock->fs_hz,
+      r.report.nc_clock->jitter_rms_s * 1e6, c.accel_rms_g * 1e3, c.noise_g * 1e3, c.cmd_max_um);
   EXPECT_LE(std::abs(off.offset_s - true_offset), 3.0 * off.u_s + 1e-7);
   EXPECT_NEAR(r.report.nc_clock->fs_hz, 500.0, 0.01);
   EXPECT_LT(c.accel_rms_g, 0.2 * c.noise_g);

@@ -56,7 +56,8 @@ TEST(Iso2302Inputs, EcmcAndDeviationCsvGiveTheSameFigures) {
     EXPECT_GE(ra.B_um + 1e-12, std::abs(ra.B_mean_um)) << e.path();
     EXPECT_GE(ra.A_um + 1e-12, std::max(ra.A_up_um, ra.A_down_um)) << e.path();
     EXPECT_EQ(ra.runs, 5);
-    std::printf("%s: A %.3f E %.3f M %.3f R %.3f B %.3f um\n", e.path().filename().c_str(), ra.A_um, ra.E_um, ra.M_um, ra.R_um, ra.B_um);
+    std::printf("%s: A %.3f E %.3f M %.3f R %.3f B %.3f um\n", e.path().filename().c_str(), ra.A_um, ra.E_um, ra.M_um,
+                ra.R_um, ra.B_um);
   }
 }
 
@@ -75,7 +76,8 @@ TEST(Iso2302Inputs, BadTablesAreRefusedWithTheLine) {
   EXPECT_NE(error(h + "0,1,up,1\n0,1,sideways,1\n").find(":3: column 'direction'"), std::string::npos);
   EXPECT_NE(error(h + "0,1,up,nan\n").find("column 'deviation_um'"), std::string::npos);
   EXPECT_NE(error(h + "0,1,up,1\n0,1,down,1\n10,1,up,1\n10,1,down,1\n").find("at least 2 runs"), std::string::npos);
-  EXPECT_NE(error(h + "0,1,up,1\n0,1,down,1\n0,2,up,1\n0,2,down,1\n10,1,up,1\n10,1,down,1\n10,2,up,1\n").find("no deviation for target 10"),
+  EXPECT_NE(error(h + "0,1,up,1\n0,1,down,1\n0,2,up,1\n0,2,down,1\n10,1,up,1\n10,1,down,1\n10,2,up,1\n")
+                .find("no deviation for target 10"),
             std::string::npos);
   fs::remove(csv);
 }

@@ -4,10 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <array>
 #include <random>
 
 namespace {
@@ -22,7 +22,6 @@ struct Tmp {
 
 using eical::tools::testing::run_cli;
 
-
 TEST(LinCompCmd, WritesLinuxCncAndCsvTables) {
   Tmp t;
   {
@@ -30,8 +29,8 @@ TEST(LinCompCmd, WritesLinuxCncAndCsvTables) {
     os << "pos_mm,error_um\n";
     for (int i = 0; i <= 200; ++i) os << i << "," << 0.02 * i << "\n";  // 20 µm/m
   }
-  run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "50", "--linuxcnc", (t.dir / "x.comp").string(), "--csv",
-       (t.dir / "x.csv").string()});
+  run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "50", "--linuxcnc",
+           (t.dir / "x.comp").string(), "--csv", (t.dir / "x.csv").string()});
   // COMP_FILE_TYPE 0 (LinuxCNC usrmotLoadComp): "nominal actual-moving-up actual-moving-down",
   // data from the first line (a comment above it would stop LinuxCNC reading).
   std::ifstream is(t.dir / "x.comp");
@@ -55,14 +54,15 @@ TEST(LinCompCmd, WritesLinuxCncAndCsvTables) {
   // A second run does not replace the tables without --force, and writes neither file.
   const auto before = fs::last_write_time(t.dir / "x.comp");
   try {
-    run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "25", "--linuxcnc", (t.dir / "x.comp").string(), "--csv",
-             (t.dir / "x.csv").string()});
+    run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "25", "--linuxcnc",
+             (t.dir / "x.comp").string(), "--csv", (t.dir / "x.csv").string()});
     FAIL() << "overwrote x.comp without --force";
   } catch (const eical::dsp::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos) << e.what();
   }
   EXPECT_EQ(fs::last_write_time(t.dir / "x.comp"), before);
-  run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "25", "--linuxcnc", (t.dir / "x.comp").string(), "--force"});
+  run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "25", "--linuxcnc",
+           (t.dir / "x.comp").string(), "--force"});
   std::ifstream again(t.dir / "x.comp");
   std::size_t n_rows = 0;
   while (again >> n >> f >> r) ++n_rows;
@@ -73,8 +73,8 @@ TEST(LinCompCmd, ACurveThatDoesNotCoverTheTravelWritesNothing) {
   Tmp t;
   std::ofstream(t.dir / "c.csv") << "pos_mm,error_um\n0,0\n50,1\n100,2\n";
   try {
-    run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "50", "--travel-mm", "0,300", "--linuxcnc",
-             (t.dir / "x.comp").string()});
+    run_cli({"lincomp", "--curve", (t.dir / "c.csv").string(), "--spacing-mm", "50", "--travel-mm", "0,300",
+             "--linuxcnc", (t.dir / "x.comp").string()});
     FAIL() << "accepted a table over 0..100 mm for a 0..300 mm travel";
   } catch (const eical::dsp::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("covers 0 .. 100 mm"), std::string::npos) << e.what();
@@ -85,7 +85,8 @@ TEST(LinCompCmd, ACurveThatDoesNotCoverTheTravelWritesNothing) {
 TEST(LinCompCmd, BadCurveWritesNothing) {
   Tmp t;
   std::ofstream(t.dir / "bad.csv") << "pos_mm,error_um\n0,1\n10,2\n10,3\n20,4\n";
-  EXPECT_THROW(run_cli({"lincomp", "--curve", (t.dir / "bad.csv").string(), "--spacing-mm", "5", "--linuxcnc", (t.dir / "x.comp").string()}),
+  EXPECT_THROW(run_cli({"lincomp", "--curve", (t.dir / "bad.csv").string(), "--spacing-mm", "5", "--linuxcnc",
+                        (t.dir / "x.comp").string()}),
                eical::dsp::InputError);
   EXPECT_FALSE(fs::exists(t.dir / "x.comp"));
   std::ofstream(t.dir / "nan.csv") << "pos_mm,error_um\n0,1\n10,nan\n20,4\n";

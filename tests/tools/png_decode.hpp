@@ -25,14 +25,16 @@ inline Image decode_png(const std::string& file) {
   static const std::uint8_t sig[8] = {137, 80, 78, 71, 13, 10, 26, 10};
   if (d.size() < 8 || !std::equal(sig, sig + 8, d.begin())) throw std::runtime_error(file + ": not a PNG");
   auto be32 = [&](std::size_t i) {
-    return static_cast<std::uint32_t>(d[i]) << 24 | static_cast<std::uint32_t>(d[i + 1]) << 16 | static_cast<std::uint32_t>(d[i + 2]) << 8 | d[i + 3];
+    return static_cast<std::uint32_t>(d[i]) << 24 | static_cast<std::uint32_t>(d[i + 1]) << 16 |
+           static_cast<std::uint32_t>(d[i + 2]) << 8 | d[i + 3];
   };
   Image img;
   int channels = 0;
   std::vector<std::uint8_t> z;
   for (std::size_t i = 8; i + 8 <= d.size();) {
     const std::uint32_t len = be32(i);
-    const std::string type(d.begin() + static_cast<std::ptrdiff_t>(i + 4), d.begin() + static_cast<std::ptrdiff_t>(i + 8));
+    const std::string type(d.begin() + static_cast<std::ptrdiff_t>(i + 4),
+                           d.begin() + static_cast<std::ptrdiff_t>(i + 8));
     if (i + 12 + len > d.size()) throw std::runtime_error(file + ": truncated chunk " + type);
     const std::size_t body = i + 8;
     if (type == "IHDR") {
@@ -42,7 +44,8 @@ inline Image decode_png(const std::string& file) {
         throw std::runtime_error(file + ": only 8-bit RGB/RGBA non-interlaced PNG is supported");
       channels = color == 2 ? 3 : 4;
     } else if (type == "IDAT") {
-      z.insert(z.end(), d.begin() + static_cast<std::ptrdiff_t>(body), d.begin() + static_cast<std::ptrdiff_t>(body + len));
+      z.insert(z.end(), d.begin() + static_cast<std::ptrdiff_t>(body),
+               d.begin() + static_cast<std::ptrdiff_t>(body + len));
     } else if (type == "IEND") {
       break;
     }
@@ -60,7 +63,8 @@ inline Image decode_png(const std::string& file) {
     const std::uint8_t* row = &raw[y * (stride + 1)];
     const int filter = row[0];
     for (std::size_t x = 0; x < stride; ++x) {
-      const int a = x >= static_cast<std::size_t>(channels) ? cur[x - static_cast<std::size_t>(channels)] : 0, b = prev[x],
+      const int a = x >= static_cast<std::size_t>(channels) ? cur[x - static_cast<std::size_t>(channels)] : 0,
+                b = prev[x],
                 c = x >= static_cast<std::size_t>(channels) ? prev[x - static_cast<std::size_t>(channels)] : 0;
       int pred = 0;
       switch (filter) {
@@ -78,7 +82,9 @@ inline Image decode_png(const std::string& file) {
       cur[x] = static_cast<std::uint8_t>(row[1 + x] + pred);
     }
     for (std::uint32_t x = 0; x < img.width; ++x)
-      for (int k = 0; k < 3; ++k) img.rgb[(static_cast<std::size_t>(y) * img.width + x) * 3 + static_cast<std::size_t>(k)] = cur[x * static_cast<std::size_t>(channels) + static_cast<std::size_t>(k)];
+      for (int k = 0; k < 3; ++k)
+        img.rgb[(static_cast<std::size_t>(y) * img.width + x) * 3 + static_cast<std::size_t>(k)] =
+            cur[x * static_cast<std::size_t>(channels) + static_cast<std::size_t>(k)];
     std::swap(cur, prev);
   }
   return img;

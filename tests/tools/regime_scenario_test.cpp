@@ -64,11 +64,15 @@ TEST(RegimeScenarios, BadRegimeKeysAreNamedWithTheLine) {
   EXPECT_NE(error_of("[sweep]\naxis = \"w\"\n").find("axis"), std::string::npos);
   EXPECT_NE(error_of("sensors_present = \"none\"\n[sweep]\n").find("sensors_present"), std::string::npos);
   EXPECT_NE(error_of("[sweep]\n[effects.\"machine.resonance\"]\npart = \"head\"\n").find("modes"), std::string::npos);
-  const std::string zeta = error_of("[sweep]\n[effects.\"machine.resonance\"]\n[[effects.\"machine.resonance\".modes]]\nfrequency_hz = 40.0\ndamping_ratio = 1.5\ngain = 0.1\n");
+  const std::string zeta = error_of(
+      "[sweep]\n[effects.\"machine.resonance\"]\n[[effects.\"machine.resonance\".modes]]\nfrequency_hz = "
+      "40.0\ndamping_ratio = 1.5\ngain = 0.1\n");
   EXPECT_NE(zeta.find(":6:"), std::string::npos) << zeta;
   EXPECT_NE(zeta.find("damping_ratio"), std::string::npos) << zeta;
-  EXPECT_NE(error_of("[sweep]\n[effects.\"sensor.misalignment\"]\naxes_map = \"x,x,z\"\n").find("x appears twice"), std::string::npos);
-  EXPECT_NE(error_of("[sweep]\n[program]\nkind = \"freeform\"\ngcode_file = \"a.ngc\"\n").find("runs Klipper's test"), std::string::npos);
+  EXPECT_NE(error_of("[sweep]\n[effects.\"sensor.misalignment\"]\naxes_map = \"x,x,z\"\n").find("x appears twice"),
+            std::string::npos);
+  EXPECT_NE(error_of("[sweep]\n[program]\nkind = \"freeform\"\ngcode_file = \"a.ngc\"\n").find("runs Klipper's test"),
+            std::string::npos);
   EXPECT_NE(error_of("[mems]\nchip = \"lis2dw\"\nfrequency = 3\n[sweep]\n").find("frequency"), std::string::npos);
   std::filesystem::remove(file);
 }

@@ -8,16 +8,16 @@
 #include "png_decode.hpp"
 #include "sim/simulate.hpp"
 #include "tools/report/run_report.hpp"
-#include "tools/sim_programs.hpp"
 #include "tools/run_files.hpp"
+#include "tools/sim_programs.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <random>
 #include <fstream>
+#include <random>
 #include <set>
 #include <sstream>
 
@@ -44,11 +44,12 @@ std::string find_chromium() {
   return {};
 }
 
-std::string chromium_cmd(const std::string& chromium, const fs::path& profile, const std::string& action, const fs::path& html) {
+std::string chromium_cmd(const std::string& chromium, const fs::path& profile, const std::string& action,
+                         const fs::path& html) {
   return "timeout 180 " + chromium +
          " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run --disable-background-networking"
-         " --disable-component-update --disable-sync --hide-scrollbars --user-data-dir=" + profile.string() + " " + action +
-         " --window-size=1280,2000 file://" + html.string() + " 2>/dev/null";
+         " --disable-component-update --disable-sync --hide-scrollbars --user-data-dir=" +
+         profile.string() + " " + action + " --window-size=1280,2000 file://" + html.string() + " 2>/dev/null";
 }
 
 struct Rendered {
@@ -59,7 +60,9 @@ struct Rendered {
 // Simulates `sc`, writes its report into a fresh folder and renders it.
 Rendered render(const sim::Scenario& sc, const std::string& tag) {
   const std::string chromium = find_chromium();
-  if (chromium.empty()) throw std::runtime_error("chromium not found in PATH: install it with scripts/deps.sh test (Debian package 'chromium')");
+  if (chromium.empty())
+    throw std::runtime_error(
+        "chromium not found in PATH: install it with scripts/deps.sh test (Debian package 'chromium')");
   Rendered r;
   r.dir = fs::temp_directory_path() / ("eical-report-" + tag + "-" + std::to_string(std::random_device{}()));
   const dsp::Run run = sim::simulate(sc);
@@ -100,8 +103,8 @@ PixelStats stats(const testing::Image& img) {
   }
   s.ink_fraction = static_cast<double>(ink) / static_cast<double>(n - below_header);
   s.colours = colours.size();
-  std::printf("screenshot: %.4f of the page below the header is ink, %zu colours, %zu blue, %zu red pixels\n", s.ink_fraction,
-              s.colours, s.blue, s.red);
+  std::printf("screenshot: %.4f of the page below the header is ink, %zu colours, %zu blue, %zu red pixels\n",
+              s.ink_fraction, s.colours, s.blue, s.red);
   return s;
 }
 
@@ -171,7 +174,8 @@ TEST(ReportScreenshot, CircleReportPrintsToA4Pdf) {
   const fs::path html = fs::absolute(tools::report::write_run_report(run, a, dir / "report"));
   const fs::path pdf = dir / "report.pdf";
   int st = 0;
-  (void)run_capture(chromium_cmd(chromium, dir / "profile-pdf", "--no-pdf-header-footer --print-to-pdf=" + pdf.string(), html), st);
+  (void)run_capture(
+      chromium_cmd(chromium, dir / "profile-pdf", "--no-pdf-header-footer --print-to-pdf=" + pdf.string(), html), st);
   EXPECT_EQ(st, 0) << "chromium --print-to-pdf failed";
   ASSERT_TRUE(fs::exists(pdf));
   std::ifstream is(pdf, std::ios::binary);
@@ -191,13 +195,15 @@ TEST(ReportScreenshot, CircleReportPrintsToA4Pdf) {
   EXPECT_GE(pages, 1u);
   EXPECT_LE(pages, 6u) << "the print layout spreads one test over too many pages";
   EXPECT_EQ(a4, pages);
-  if (const char* keep = std::getenv("EICAL_SCREENSHOT_DIR")) fs::copy_file(pdf, fs::path(keep) / "report-circle.pdf", fs::copy_options::overwrite_existing);
+  if (const char* keep = std::getenv("EICAL_SCREENSHOT_DIR"))
+    fs::copy_file(pdf, fs::path(keep) / "report-circle.pdf", fs::copy_options::overwrite_existing);
   fs::remove_all(dir);
 }
 
 TEST(ReportScreenshot, RectangleAndFreeFormReportsShowThePathAndItsDeviation) {
-  for (const auto& [sc, tag] : {std::pair{sim::rectangle_scenario(20.0, 10.0, 1500.0, "xy", 1, 1), std::string("rectangle")},
-                                std::pair{tools::freeform_scenario(1500.0, 1), std::string("freeform")}}) {
+  for (const auto& [sc, tag] :
+       {std::pair{sim::rectangle_scenario(20.0, 10.0, 1500.0, "xy", 1, 1), std::string("rectangle")},
+        std::pair{tools::freeform_scenario(1500.0, 1), std::string("freeform")}}) {
     SCOPED_TRACE(tag);
     const Rendered r = render(sc, tag);
     ASSERT_TRUE(fs::exists(r.png));
@@ -208,8 +214,10 @@ TEST(ReportScreenshot, RectangleAndFreeFormReportsShowThePathAndItsDeviation) {
     expect_contains(r.dom, "Deviation along the path");
     expect_contains(r.dom, "path length (mm)");
     expect_contains(r.dom, "Contour error (max)");
-    if (tag == "rectangle") expect_contains(r.dom, "Corners (in the order visited");
-    else expect_contains(r.dom, "Free-form contour report");
+    if (tag == "rectangle")
+      expect_contains(r.dom, "Corners (in the order visited");
+    else
+      expect_contains(r.dom, "Free-form contour report");
     fs::remove_all(r.dir);
   }
 }

@@ -23,13 +23,16 @@ using nlohmann::json;
 
 // results.md, object by object.
 const std::map<std::string, std::vector<std::string>> kSpecKeys = {
-    {"circle", {"plane", "radius_nominal_mm", "feed_mm_min", "radius_mean_deviation_um", "circular_deviation_G_um",
-                "circular_hysteresis_H_um", "radial_deviation_F_max_um", "radial_deviation_F_min_um", "trace"}},
-    {"diagnostics", {"backlash_x_um", "backlash_y_um", "reversal_spike_x_um", "reversal_spike_y_um", "lateral_play_x_um",
-                     "lateral_play_y_um", "cyclic_error_x_um", "cyclic_error_y_um", "servo_mismatch_ms", "squareness_urad",
-                     "scale_mismatch_ppm", "straightness_x_um", "straightness_y_um", "stick_slip_um", "vibration_um"}},
-    {"positioning", {"axis", "targets_mm", "runs", "A_um", "A_up_um", "A_down_um", "E_um", "M_um", "R_um", "R_up_um", "R_down_um",
-                     "B_um", "B_mean_um", "deviation_um"}},
+    {"circle",
+     {"plane", "radius_nominal_mm", "feed_mm_min", "radius_mean_deviation_um", "circular_deviation_G_um",
+      "circular_hysteresis_H_um", "radial_deviation_F_max_um", "radial_deviation_F_min_um", "trace"}},
+    {"diagnostics",
+     {"backlash_x_um", "backlash_y_um", "reversal_spike_x_um", "reversal_spike_y_um", "lateral_play_x_um",
+      "lateral_play_y_um", "cyclic_error_x_um", "cyclic_error_y_um", "servo_mismatch_ms", "squareness_urad",
+      "scale_mismatch_ppm", "straightness_x_um", "straightness_y_um", "stick_slip_um", "vibration_um"}},
+    {"positioning",
+     {"axis", "targets_mm", "runs", "A_um", "A_up_um", "A_down_um", "E_um", "M_um", "R_um", "R_up_um", "R_down_um",
+      "B_um", "B_mean_um", "deviation_um"}},
     {"step", {"axis", "end_position_error_um", "scatter_um", "overshoot_um", "settling_s"}},
     {"rectangle", {"corners_mm", "corner_errors_um"}},
 };
@@ -37,13 +40,15 @@ const std::map<std::string, std::vector<std::string>> kSpecKeys = {
 // Which objects each program kind must carry.
 const std::map<std::string, std::vector<std::string>> kObjectsOfKind = {
     {"circle", {"circle", "diagnostics"}}, {"positioning", {"positioning"}}, {"step", {"step"}},
-    {"rectangle", {"rectangle"}},         {"freeform", {"freeform"}},
+    {"rectangle", {"rectangle"}},          {"freeform", {"freeform"}},
 };
 
 // A number-valued key must say its unit: one of these suffixes, or be a count.
 bool has_unit(const std::string& key) {
   for (const char* u : {"_um", "_mm", "_ms", "_urad", "_ppm", "_s", "_mm_min", "_deg", "_hz"})
-    if (key.size() > std::string(u).size() && key.compare(key.size() - std::string(u).size(), std::string::npos, u) == 0) return true;
+    if (key.size() > std::string(u).size() &&
+        key.compare(key.size() - std::string(u).size(), std::string::npos, u) == 0)
+      return true;
   return key == "runs" || key == "revolutions";
 }
 
@@ -57,8 +62,8 @@ bool flag_explains(const json& doc, const std::string& object, const std::string
 
 // Settings and choices among candidates: numbers that are not figures (no uncertainty).
 bool is_setting(const std::string& key) {
-  for (const char* k : {"radius_nominal_mm", "feed_mm_min", "arc_deg", "arc_start_deg", "revolutions", "runs", "cyclic_pitch_mm",
-                        "smallest_step_resolved_um", "path_length_mm"})
+  for (const char* k : {"radius_nominal_mm", "feed_mm_min", "arc_deg", "arc_start_deg", "revolutions", "runs",
+                        "cyclic_pitch_mm", "smallest_step_resolved_um", "path_length_mm"})
     if (key == k) return true;
   return false;
 }
@@ -157,7 +162,8 @@ TEST(ResultKeys, Positioning) {
   // Fewer than 5 runs: evaluated, and said to be outside ISO 230-2.
   EXPECT_FALSE(doc["positioning"]["within_standard"].get<bool>());
   bool flagged = false;
-  for (const auto& f : doc["quality"]["flags"]) flagged |= f.get<std::string>().find("outside the standard") != std::string::npos;
+  for (const auto& f : doc["quality"]["flags"])
+    flagged |= f.get<std::string>().find("outside the standard") != std::string::npos;
   EXPECT_TRUE(flagged);
   EXPECT_EQ(doc["uncertainty_k2"]["positioning.per_target.mean_um"].size(), 3u);
   EXPECT_EQ(doc["positioning"]["deviation_um"]["up"][0].size(), 3u);

@@ -16,8 +16,8 @@ TEST(Svg, PolarScaleCoversTheLargestDeviationForAnyAmplitude) {
     ASSERT_NE(at, std::string::npos);
     const auto from = svg.rfind('>', at) + 1;
     const double scale = std::stod(svg.substr(from, at - from));
-    EXPECT_GE(scale * 3, amp) << amp;       // three rings outside the reference circle
-    EXPECT_LT(scale, amp) << amp;           // and not absurdly coarse
+    EXPECT_GE(scale * 3, amp) << amp;  // three rings outside the reference circle
+    EXPECT_LT(scale, amp) << amp;      // and not absurdly coarse
   }
 }
 

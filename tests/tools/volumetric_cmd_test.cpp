@@ -17,7 +17,6 @@ const fs::path kModel = fs::path(EICAL_SOURCE_DIR) / "config" / "examples" / "vo
 
 using eical::tools::testing::run_cli;
 
-
 std::string slurp(const fs::path& p) {
   std::ifstream is(p);
   return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
@@ -27,7 +26,8 @@ TEST(VolumetricCmd, ExampleModelGivesDeviationsAndFlagsRanges) {
   const fs::path dir = fs::temp_directory_path() / ("vol-" + std::to_string(std::random_device{}()));
   fs::create_directories(dir);
   std::ofstream(dir / "p.csv") << "x,y,z,xp,yp,zp\n0,0,0,0,0,0\n400,250,200,0,0,100\n-1,0,0,0,0,0\n0,0,401,0,0,0\n";
-  run_cli({"volumetric", "--model", kModel.string(), "--points", (dir / "p.csv").string(), "--out", (dir / "o.csv").string()});
+  run_cli({"volumetric", "--model", kModel.string(), "--points", (dir / "p.csv").string(), "--out",
+           (dir / "o.csv").string()});
   const std::string out = slurp(dir / "o.csv");
   EXPECT_NE(out.find(",ok\n"), std::string::npos) << out;
   EXPECT_NE(out.find("out_of_range:x"), std::string::npos) << out;
@@ -41,7 +41,8 @@ TEST(VolumetricCmd, ExampleModelGivesDeviationsAndFlagsRanges) {
   std::ofstream(dir / "bad.toml") << model;
   fs::remove(dir / "o.csv");
   try {
-    run_cli({"volumetric", "--model", (dir / "bad.toml").string(), "--points", (dir / "p.csv").string(), "--out", (dir / "o.csv").string()});
+    run_cli({"volumetric", "--model", (dir / "bad.toml").string(), "--points", (dir / "p.csv").string(), "--out",
+             (dir / "o.csv").string()});
     FAIL() << "accepted an unknown component";
   } catch (const eical::dsp::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("yrq"), std::string::npos) << e.what();

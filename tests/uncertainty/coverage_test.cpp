@@ -23,7 +23,8 @@ TEST(UncertaintyCoverage, HeadlineFiguresAreCoveredAndUIsNotInflated) {
   ASSERT_GE(r.headline.cases, 30u);
   EXPECT_GE(r.headline.coverage(), 0.85);
   EXPECT_LE(r.headline.median_u(), 3.0 * r.headline.rms_error());
-  for (const char* key : {"circle.circular_deviation_G_um", "positioning.E_um", "step.end_position_error_um", "rectangle.corner_error_max_um"})
+  for (const char* key : {"circle.circular_deviation_G_um", "positioning.E_um", "step.end_position_error_um",
+                          "rectangle.corner_error_max_um"})
     EXPECT_EQ(r.figures.count(key), 1u) << key << " was not evaluated";
 }
 

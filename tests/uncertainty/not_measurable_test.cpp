@@ -8,8 +8,8 @@
 #include "tools/plan/test_plan.hpp"
 
 #include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
 #include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
 #include <cstdio>
 #include <filesystem>
@@ -45,7 +45,8 @@ TEST(NotMeasurable, BallbarSizeCircleWithoutSupportsSaysSoAndNamesAMeasurableTes
 }
 
 TEST(NotMeasurable, AnalyzeExitsThreeAndPlanPrintsTheNearestMeasurableVariant) {
-  const auto dir = std::filesystem::temp_directory_path() / ("not-measurable-" + std::to_string(std::random_device{}()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("not-measurable-" + std::to_string(std::random_device{}()));
   // A short circle without strips on data-sheet sensors: U(G) above 10 µm.
   drivers::write_run(sim::simulate(sim::circle_scenario(25.0, 2500.0, 2, "ccw")), dir / "run", {});
   int status = 0;

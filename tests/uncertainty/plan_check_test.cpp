@@ -32,7 +32,8 @@ TEST_P(PlanCheck, PredictedUncertaintyMatchesTheSpreadOfSimulatedRepeats) {
   ASSERT_FALSE(rows.empty());
   for (const auto& r : rows) {
     EXPECT_EQ(r.repeats, kRepeats) << r.program << ": repeats degraded or not evaluated";
-    EXPECT_NEAR(r.ratio(), 1.0, kBound) << r.program << " " << r.key << ": U plan " << r.predicted_u << ", U sim " << r.empirical_u;
+    EXPECT_NEAR(r.ratio(), 1.0, kBound) << r.program << " " << r.key << ": U plan " << r.predicted_u << ", U sim "
+                                        << r.empirical_u;
   }
 }
 

@@ -24,7 +24,8 @@ std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
 }
 
 // The sensors as they really are: data sheet ± the tolerances, drawn per seed.
-void draw_sensor(sim::SensorTruth& t, const dsp::SensorSpec& sheet, std::mt19937_64& rng, const char* name, std::vector<std::string>& text) {
+void draw_sensor(sim::SensorTruth& t, const dsp::SensorSpec& sheet, std::mt19937_64& rng, const char* name,
+                 std::vector<std::string>& text) {
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   t.spec = sheet;
   Eigen::Vector3d scale;
@@ -32,13 +33,15 @@ void draw_sensor(sim::SensorTruth& t, const dsp::SensorSpec& sheet, std::mt19937
   t.spec.f0_hz *= 1.0 + 0.1 * u(rng);
   t.spec.zeta = 0.65 + 0.15 * u(rng);
   const Eigen::Vector3d r = Eigen::Vector3d(u(rng), u(rng), u(rng)) * 5e-3;
-  const Eigen::Matrix3d rot = (Eigen::AngleAxisd(r[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r[1], Eigen::Vector3d::UnitY()) *
-                               Eigen::AngleAxisd(r[0], Eigen::Vector3d::UnitX()))
-                                  .toRotationMatrix();
+  const Eigen::Matrix3d rot =
+      (Eigen::AngleAxisd(r[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r[1], Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(r[0], Eigen::Vector3d::UnitX()))
+          .toRotationMatrix();
   t.spec.to_machine = sheet.to_machine * rot;
   t.bias_rw_ug_per_rts = 0.15;
-  text.push_back(std::string(name) + ": scale " + fmt("%+.0f %+.0f ", scale[0] * 1e6, scale[1] * 1e6) + fmt("%+.0f ppm, ", scale[2] * 1e6) +
-                 fmt("f0 %.0f Hz, zeta %.3f, ", t.spec.f0_hz, t.spec.zeta) + fmt("rotation %+.2f %+.2f ", r[0] * 1e3, r[1] * 1e3) +
+  text.push_back(std::string(name) + ": scale " + fmt("%+.0f %+.0f ", scale[0] * 1e6, scale[1] * 1e6) +
+                 fmt("%+.0f ppm, ", scale[2] * 1e6) + fmt("f0 %.0f Hz, zeta %.3f, ", t.spec.f0_hz, t.spec.zeta) +
+                 fmt("rotation %+.2f %+.2f ", r[0] * 1e3, r[1] * 1e3) +
                  fmt("%+.2f mrad, bias walk 0.15 ug/rt(s)", r[2] * 1e3));
 }
 
@@ -55,14 +58,18 @@ struct Machine {
 };
 
 std::string step_gcode() {
-  std::string g = "G90 G21 G17 G61 (1-D move 50 mm at 6.5 m/min, 5 runs, across the x strip)\nG0 X-25 Y-10\nG4 P0.4\nM101\nG4 P0.1\n";
+  std::string g =
+      "G90 G21 G17 G61 (1-D move 50 mm at 6.5 m/min, 5 runs, across the x strip)\nG0 X-25 Y-10\nG4 P0.4\nM101\nG4 "
+      "P0.1\n";
   for (int r = 0; r < 5; ++r) g += "G1 X25 F6500\nM102\nG4 P0.5\nG1 X-25 F6500\nM102\nG4 P0.5\n";
   return g + "G4 P0.4\nM103\nG4 P0.1\n";
 }
 
 std::string rectangle_gcode() {
-  std::string g = "G90 G21 G17 G61 (rectangle 50 mm at 6.5 m/min across both strips)\nG0 X-40 Y-10\nG4 P0.4\nM101\nG4 P0.1\n";
-  for (const char* c : {"X10 Y-10", "X10 Y40", "X-40 Y40", "X-40 Y-10"}) g += std::string("G1 ") + c + " F6500\nM102\nG4 P0.5\n";
+  std::string g =
+      "G90 G21 G17 G61 (rectangle 50 mm at 6.5 m/min across both strips)\nG0 X-40 Y-10\nG4 P0.4\nM101\nG4 P0.1\n";
+  for (const char* c : {"X10 Y-10", "X10 Y40", "X-40 Y40", "X-40 Y-10"})
+    g += std::string("G1 ") + c + " F6500\nM102\nG4 P0.5\n";
   return g + "G4 P0.4\nM103\nG4 P0.1\n";
 }
 
@@ -104,7 +111,8 @@ Analysed analyse(const sim::Scenario& sc, const Report& rep) {
   r.a = dsp::analyze_run(r.run, o);
   const auto& m = r.a.measurement;
   const dsp::PipelineConfig cfg = dsp::pipeline_config(r.run.meta, r.run.frames.size());
-  r.cov = std::make_unique<dsp::fusion::ErrorCovariance>(m.raw.schedule, m.sample_index, m.fs_hz, cfg.fusion, m.supports.start_bias_sigma_um_s2);
+  r.cov = std::make_unique<dsp::fusion::ErrorCovariance>(m.raw.schedule, m.sample_index, m.fs_hz, cfg.fusion,
+                                                         m.supports.start_bias_sigma_um_s2);
   r.shift = static_cast<std::ptrdiff_t>(std::lround(r.run.meta.acquisition.daq_group_delay_samples));
   return r;
 }
@@ -126,7 +134,8 @@ std::vector<std::pair<std::size_t, std::size_t>> dwell_windows(const dsp::Measur
 }
 
 // Sensor-time grid points of a dwell window (every 10th sample) and the averaging row.
-void dwell_grid(const std::pair<std::size_t, std::size_t>& w, std::ptrdiff_t shift, std::size_t limit, std::vector<std::size_t>& grid) {
+void dwell_grid(const std::pair<std::size_t, std::size_t>& w, std::ptrdiff_t shift, std::size_t limit,
+                std::vector<std::size_t>& grid) {
   for (std::size_t k = w.first; k <= w.second; k += 10) {
     const auto s = static_cast<std::ptrdiff_t>(k) + shift;
     if (s >= 0 && static_cast<std::size_t>(s) < limit) grid.push_back(static_cast<std::size_t>(s));
@@ -190,7 +199,8 @@ void circle_figures(const Machine& mach, Report& rep) {
   const auto n = static_cast<Eigen::Index>(grid.size());
   const Eigen::MatrixXd cx = r.cov->position(grid, 0), cy = r.cov->position(grid, 1);
   Eigen::VectorXd cs(n), sn(n);
-  for (Eigen::Index i = 0; i < n; ++i) cs[i] = std::cos(theta[static_cast<std::size_t>(i)]), sn[i] = std::sin(theta[static_cast<std::size_t>(i)]);
+  for (Eigen::Index i = 0; i < n; ++i)
+    cs[i] = std::cos(theta[static_cast<std::size_t>(i)]), sn[i] = std::sin(theta[static_cast<std::size_t>(i)]);
   const Eigen::MatrixXd ce = cs.asDiagonal() * cx * cs.asDiagonal() + sn.asDiagonal() * cy * sn.asDiagonal();
   Eigen::MatrixXd proj = Eigen::MatrixXd::Zero(n, n);  // block-diagonal: I − B(BᵀB)⁻¹Bᵀ per revolution
   const int revs = static_cast<int>(segs.size());
@@ -200,10 +210,12 @@ void circle_figures(const Machine& mach, Report& rep) {
       if (rev[static_cast<std::size_t>(i)] == s) idx.push_back(i);
     const auto ni = static_cast<Eigen::Index>(idx.size());
     Eigen::MatrixXd bm(ni, 2);
-    for (Eigen::Index i = 0; i < ni; ++i) bm(i, 0) = cs[idx[static_cast<std::size_t>(i)]], bm(i, 1) = sn[idx[static_cast<std::size_t>(i)]];
+    for (Eigen::Index i = 0; i < ni; ++i)
+      bm(i, 0) = cs[idx[static_cast<std::size_t>(i)]], bm(i, 1) = sn[idx[static_cast<std::size_t>(i)]];
     const Eigen::MatrixXd p = Eigen::MatrixXd::Identity(ni, ni) - bm * (bm.transpose() * bm).inverse() * bm.transpose();
     for (Eigen::Index i = 0; i < ni; ++i)
-      for (Eigen::Index j = 0; j < ni; ++j) proj(idx[static_cast<std::size_t>(i)], idx[static_cast<std::size_t>(j)]) = p(i, j);
+      for (Eigen::Index j = 0; j < ni; ++j)
+        proj(idx[static_cast<std::size_t>(i)], idx[static_cast<std::size_t>(j)]) = p(i, j);
   }
   const Eigen::MatrixXd cp = proj * ce * proj.transpose();
   const double bound_rms = std::sqrt(cp.trace() / static_cast<double>(n));
@@ -212,10 +224,14 @@ void circle_figures(const Machine& mach, Report& rep) {
   for (Eigen::Index i = 0; i < n; ++i) avg(i % per_rev, i) = 1.0 / revs;
   const Eigen::MatrixXd ca = avg * cp * avg.transpose();
   const double bound_avg = std::sqrt(ca.trace() / per_rev);
-  rep.figures.push_back({"circle R10 2.5 m/min x5: radius deviation error RMS (every revolution)", "um", rms, bound_rms, 1.5});
-  rep.figures.push_back({"circle R10 2.5 m/min x5: radius deviation error peak (every revolution)", "um", peak, expected_peak(cp, rep.seed), 3.0});
-  rep.figures.push_back({"circle R10 2.5 m/min x5: mean of the 5 revolutions, error RMS", "um", rms_avg, bound_avg, 1.5});
-  rep.figures.push_back({"circle R10 2.5 m/min x5: mean of the 5 revolutions, error peak", "um", peak_avg, expected_peak(ca, rep.seed + 1), 3.0});
+  rep.figures.push_back(
+      {"circle R10 2.5 m/min x5: radius deviation error RMS (every revolution)", "um", rms, bound_rms, 1.5});
+  rep.figures.push_back({"circle R10 2.5 m/min x5: radius deviation error peak (every revolution)", "um", peak,
+                         expected_peak(cp, rep.seed), 3.0});
+  rep.figures.push_back(
+      {"circle R10 2.5 m/min x5: mean of the 5 revolutions, error RMS", "um", rms_avg, bound_avg, 1.5});
+  rep.figures.push_back({"circle R10 2.5 m/min x5: mean of the 5 revolutions, error peak", "um", peak_avg,
+                         expected_peak(ca, rep.seed + 1), 3.0});
 }
 
 void step_figures(const Machine& mach, Report& rep) {
@@ -256,22 +272,27 @@ void step_figures(const Machine& mach, Report& rep) {
   const Eigen::MatrixXd c = r.cov->position(grid, 0);
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(spans.size()), c.rows());
   for (std::size_t i = 0; i < spans.size(); ++i)
-    for (Eigen::Index j = spans[i].first; j < spans[i].second; ++j) a(static_cast<Eigen::Index>(i), j) = 1.0 / static_cast<double>(spans[i].second - spans[i].first);
+    for (Eigen::Index j = spans[i].first; j < spans[i].second; ++j)
+      a(static_cast<Eigen::Index>(i), j) = 1.0 / static_cast<double>(spans[i].second - spans[i].first);
   const Eigen::MatrixXd ce = a * c * a.transpose();
   const Eigen::RowVectorXd mean_row = Eigen::RowVectorXd::Constant(ce.rows(), 1.0 / static_cast<double>(ce.rows()));
   const double bound_mean = std::sqrt((mean_row * ce * mean_row.transpose())(0));
   // Scatter of the arrivals about their mean: E[Σ(e_i − ē)²/(n−1)] = (tr C − 1ᵀC1/n)/(n−1).
   const double nn = static_cast<double>(ce.rows());
   const double bound_scatter = 2.0 * std::sqrt(std::max(0.0, (ce.trace() - ce.sum() / nn) / (nn - 1.0)));
-  rep.figures.push_back({"1-D move 50 mm 6.5 m/min x5: end-position error |mean| at the far end", "um", std::abs(mean), bound_mean, 2.0});
-  rep.figures.push_back({"1-D move 50 mm 6.5 m/min x5: scatter of the end positions (2 sigma)", "um", scatter, bound_scatter, 2.0});
-  rep.figures.push_back({"1-D move 50 mm 6.5 m/min x5: largest error of any arrival", "um", worst, expected_peak(ce, rep.seed + 2), 3.0});
+  rep.figures.push_back(
+      {"1-D move 50 mm 6.5 m/min x5: end-position error |mean| at the far end", "um", std::abs(mean), bound_mean, 2.0});
+  rep.figures.push_back(
+      {"1-D move 50 mm 6.5 m/min x5: scatter of the end positions (2 sigma)", "um", scatter, bound_scatter, 2.0});
+  rep.figures.push_back(
+      {"1-D move 50 mm 6.5 m/min x5: largest error of any arrival", "um", worst, expected_peak(ce, rep.seed + 2), 3.0});
 }
 
 void rectangle_figures(const Machine& mach, Report& rep) {
   sim::Scenario sc = sim::gcode_scenario(rectangle_gcode(), "rectangle", rep.seed);
   auto& p = sc.meta.program;
-  p.corner_mm[0] = -40.0, p.corner_mm[1] = -10.0, p.size_mm[0] = 50.0, p.size_mm[1] = 50.0, p.feed_mm_min = 6500.0, p.dwell_s = 0.5;
+  p.corner_mm[0] = -40.0, p.corner_mm[1] = -10.0, p.size_mm[0] = 50.0, p.size_mm[1] = 50.0, p.feed_mm_min = 6500.0,
+  p.dwell_s = 0.5;
   mach.apply(sc, true);
   const Analysed r = analyse(sc, rep);
   const auto& m = r.a.measurement;
@@ -296,8 +317,10 @@ void rectangle_figures(const Machine& mach, Report& rep) {
   Eigen::MatrixXd a = Eigen::MatrixXd::Zero(nc, static_cast<Eigen::Index>(grid.size()));
   for (Eigen::Index i = 0; i < nc; ++i)
     for (Eigen::Index j = spans[static_cast<std::size_t>(i)].first; j < spans[static_cast<std::size_t>(i)].second; ++j)
-      a(i, j) = 1.0 / static_cast<double>(spans[static_cast<std::size_t>(i)].second - spans[static_cast<std::size_t>(i)].first);
-  const Eigen::MatrixXd cx = a * r.cov->position(grid, 0) * a.transpose(), cy = a * r.cov->position(grid, 1) * a.transpose();
+      a(i, j) = 1.0 / static_cast<double>(spans[static_cast<std::size_t>(i)].second -
+                                          spans[static_cast<std::size_t>(i)].first);
+  const Eigen::MatrixXd cx = a * r.cov->position(grid, 0) * a.transpose(),
+                        cy = a * r.cov->position(grid, 1) * a.transpose();
   Eigen::MatrixXd joint = Eigen::MatrixXd::Zero(2 * nc, 2 * nc);
   joint.topLeftCorner(nc, nc) = cx, joint.bottomRightCorner(nc, nc) = cy;
   // Expected largest corner error |(ex, ey)| by drawing the pair per corner.
@@ -346,19 +369,25 @@ Report run(const Options& o) {
 
 std::string table(const Report& r) {
   std::string o = "accuracy campaign, seed " + std::to_string(r.seed) +
-                  (r.oracle ? ", the true sensor parameters (oracle)" : r.calibrated ? ", sensors identified on site" : ", data-sheet sensors") + "\n";
+                  (r.oracle       ? ", the true sensor parameters (oracle)"
+                   : r.calibrated ? ", sensors identified on site"
+                                  : ", data-sheet sensors") +
+                  "\n";
   for (const auto& t : r.truth) o += "  true " + t + "\n";
   if (r.calibrated) {
     const auto& id = r.identification;
-    o += fmt("  identification: agreement with the PSD readings %.2f -> %.2f um RMS, ", id.psd_rms_before_um, id.psd_rms_after_um) +
-         fmt("DAQ delay %.3f samples ", id.daq_group_delay_samples) + (id.delay_identified ? "(identified)\n" : "(data sheet kept)\n");
+    o += fmt("  identification: agreement with the PSD readings %.2f -> %.2f um RMS, ", id.psd_rms_before_um,
+             id.psd_rms_after_um) +
+         fmt("DAQ delay %.3f samples ", id.daq_group_delay_samples) +
+         (id.delay_identified ? "(identified)\n" : "(data sheet kept)\n");
   }
   char line[256];
   std::snprintf(line, sizeof line, "  %-72s %9s %9s %7s %7s\n", "figure", "measured", "bound", "ratio", "target");
   o += line;
   for (const auto& f : r.figures) {
-    std::snprintf(line, sizeof line, "  %-72s %6.2f %s %6.2f %s %7.2f %5.1f %s%s\n", f.name.c_str(), f.measured, f.unit.c_str(), f.bound, f.unit.c_str(), f.ratio(),
-                  f.target, f.unit.c_str(), f.within() ? "" : "  OVER");
+    std::snprintf(line, sizeof line, "  %-72s %6.2f %s %6.2f %s %7.2f %5.1f %s%s\n", f.name.c_str(), f.measured,
+                  f.unit.c_str(), f.bound, f.unit.c_str(), f.ratio(), f.target, f.unit.c_str(),
+                  f.within() ? "" : "  OVER");
     o += line;
   }
   o += fmt("  campaign wall time %.1f s\n", r.seconds);

@@ -38,11 +38,11 @@ struct Figure {
 
 struct Report {
   std::uint64_t seed = 0;
-  std::vector<std::string> truth;       // the drawn sensor deviations, as text
+  std::vector<std::string> truth;  // the drawn sensor deviations, as text
   dsp::identify::Identification identification;
   bool calibrated = false, oracle = false;
   std::vector<Figure> figures;
-  double seconds = 0.0;                 // wall time of the campaign
+  double seconds = 0.0;  // wall time of the campaign
 };
 
 Report run(const Options& options);

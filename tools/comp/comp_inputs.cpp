@@ -62,12 +62,16 @@ CompInput load_comp_input(const std::string& path) {
 bool Figure::resolved() const { return u_k2 && dsp::uncertainty::resolved(value, *u_k2); }
 
 std::string Figure::describe() const {
-  std::string s = key + " = " + num(value) + (u_k2 ? " (U = " + num(*u_k2) + ", k = 2)" : " (no uncertainty)") + " in " + input;
+  std::string s =
+      key + " = " + num(value) + (u_k2 ? " (U = " + num(*u_k2) + ", k = 2)" : " (no uncertainty)") + " in " + input;
   return s;
 }
 
 nlohmann::json Figure::to_json() const {
-  return {{"figure", key}, {"input", input}, {"value", value}, {"U_k2", u_k2 ? nlohmann::json(*u_k2) : nlohmann::json(nullptr)},
+  return {{"figure", key},
+          {"input", input},
+          {"value", value},
+          {"U_k2", u_k2 ? nlohmann::json(*u_k2) : nlohmann::json(nullptr)},
           {"resolved", resolved()}};
 }
 
@@ -95,8 +99,10 @@ Figure combined(const std::vector<Figure>& figures) {
   c.input.clear();
   for (const auto& f : figures) {
     sum += f.value;
-    if (f.u_k2) u2 += *f.u_k2 * *f.u_k2;
-    else all_u = false;
+    if (f.u_k2)
+      u2 += *f.u_k2 * *f.u_k2;
+    else
+      all_u = false;
     c.input += (c.input.empty() ? "" : " + ") + f.input;
   }
   const auto n = static_cast<double>(figures.size());

@@ -33,11 +33,13 @@ PositioningData positioning_of(const CompInput& in) {
   d.table.axis = dsp::axis_index(p.value("axis", std::string()));
   if (d.table.axis < 0) throw dsp::InputError(in.name + ": positioning.axis is not x, y or z");
   if (!p.contains("per_target") || !p["per_target"].is_array())
-    throw dsp::InputError(in.name + ": positioning.per_target is missing (a result older than eical comp's input format)");
+    throw dsp::InputError(in.name +
+                          ": positioning.per_target is missing (a result older than eical comp's input format)");
   for (const auto& t : p["per_target"]) {
     if (!t.value("target_mm", nlohmann::json()).is_number() || !t.value("mean_up_um", nlohmann::json()).is_number() ||
         !t.value("mean_down_um", nlohmann::json()).is_number())
-      throw dsp::InputError(in.name + ": positioning.per_target has a target without target_mm, mean_up_um or mean_down_um");
+      throw dsp::InputError(in.name +
+                            ": positioning.per_target has a target without target_mm, mean_up_um or mean_down_um");
     d.table.pos_mm.push_back(t["target_mm"].get<double>());
     d.table.forward_um.push_back(t["mean_up_um"].get<double>());
     d.table.reverse_um.push_back(t["mean_down_um"].get<double>());
@@ -62,37 +64,45 @@ Plan build_plan(const std::vector<CompInput>& inputs, const PlanOptions& o) {
     bool used = false;
     if (has_numbers(r, "positioning", "A_um")) {
       PositioningData d = positioning_of(in);
-      travel.push_back({d.table.axis, d.table.first_mm(), d.table.last_mm(), "positioning run " + in.name + " measured"});
+      travel.push_back(
+          {d.table.axis, d.table.first_mm(), d.table.last_mm(), "positioning run " + in.name + " measured"});
       pos[static_cast<std::size_t>(d.table.axis)].push_back(std::move(d));
       used = true;
     }
     if (has_numbers(r, "diagnostics", "backlash_x_um") && r.contains("circle") && r["circle"].is_object()) {
       const auto [u, v] = plane_axes(r["circle"].value("plane", std::string("xy")));
       backlash[static_cast<std::size_t>(u)].push_back(figure(in, "diagnostics.backlash_x_um"));
-      if (has_numbers(r, "diagnostics", "backlash_y_um")) backlash[static_cast<std::size_t>(v)].push_back(figure(in, "diagnostics.backlash_y_um"));
+      if (has_numbers(r, "diagnostics", "backlash_y_um"))
+        backlash[static_cast<std::size_t>(v)].push_back(figure(in, "diagnostics.backlash_y_um"));
       for (const char* k : {"diagnostics.squareness_urad", "diagnostics.scale_mismatch_ppm"})
         if (has_numbers(r, "diagnostics", std::string(k).substr(12).c_str())) {
           nlohmann::json j = figure(in, k).to_json();
-          j["reason"] = std::string("no axis table holds it: LinuxCNC's trivkins has no such term; SINUMERIK, FANUC and HEIDENHAIN need "
-                                    "cross-axis tables eical does not write; it enters the volumetric model (eical volumetric --fit)");
+          j["reason"] = std::string(
+              "no axis table holds it: LinuxCNC's trivkins has no such term; SINUMERIK, FANUC and HEIDENHAIN need "
+              "cross-axis tables eical does not write; it enters the volumetric model (eical volumetric --fit)");
           plan.not_compensated.push_back(j);
         }
       // The circle's travel on its two axes: centre ± radius.
       std::optional<std::array<double, 2>> centre;
-      if (r["circle"].contains("center_mm") && r["circle"]["center_mm"].is_array() && r["circle"]["center_mm"].size() == 2)
-        centre = std::array<double, 2>{r["circle"]["center_mm"][0].get<double>(), r["circle"]["center_mm"][1].get<double>()};
+      if (r["circle"].contains("center_mm") && r["circle"]["center_mm"].is_array() &&
+          r["circle"]["center_mm"].size() == 2)
+        centre =
+            std::array<double, 2>{r["circle"]["center_mm"][0].get<double>(), r["circle"]["center_mm"][1].get<double>()};
       else if (in.program)
         centre = std::array<double, 2>{in.program->center_mm[0], in.program->center_mm[1]};
       const double radius = r["circle"].value("radius_nominal_mm", 0.0);
-      if (!centre) throw dsp::InputError(in.name + ": circle.center_mm is missing: give the run directory (its run.toml names the centre)");
+      if (!centre)
+        throw dsp::InputError(in.name +
+                              ": circle.center_mm is missing: give the run directory (its run.toml names the centre)");
       travel.push_back({u, (*centre)[0] - radius, (*centre)[0] + radius, "circle run " + in.name + " measured"});
       travel.push_back({v, (*centre)[1] - radius, (*centre)[1] + radius, "circle run " + in.name + " measured"});
       used = true;
     }
     if (!used)
-      plan.skipped.push_back({{"input", in.name},
-                              {"reason", "program '" + r.value("program", std::string("?")) +
-                                             "' gives no compensation terms (positioning runs give tables, circles backlash)"}});
+      plan.skipped.push_back(
+          {{"input", in.name},
+           {"reason", "program '" + r.value("program", std::string("?")) +
+                          "' gives no compensation terms (positioning runs give tables, circles backlash)"}});
   }
 
   std::vector<std::string> refused;
@@ -114,8 +124,8 @@ Plan build_plan(const std::vector<CompInput>& inputs, const PlanOptions& o) {
   for (int a = 0; a < 3; ++a) {
     const auto ai = static_cast<std::size_t>(a);
     if (pos[ai].size() > 1)
-      throw dsp::InputError("comp: " + std::to_string(pos[ai].size()) + " positioning runs measure " + letter(a) + " (" + pos[ai][0].in->name +
-                            ", " + pos[ai][1].in->name + "): give one per axis");
+      throw dsp::InputError("comp: " + std::to_string(pos[ai].size()) + " positioning runs measure " + letter(a) +
+                            " (" + pos[ai][0].in->name + ", " + pos[ai][1].in->name + "): give one per axis");
     std::optional<Figure> circle_b;
     if (!backlash[ai].empty()) circle_b = combined(backlash[ai]);
     AxisProposal p;
@@ -142,16 +152,20 @@ Plan build_plan(const std::vector<CompInput>& inputs, const PlanOptions& o) {
       for (std::size_t i = 0; i < d.table.pos_mm.size(); ++i) mean.push_back(d.table.mean_um(i));
       const std::string src = "positioning run " + d.in->name + (d.in->run_id.empty() ? "" : " (" + d.in->run_id + ")");
       if (pitch) {
-        if (reversal == run) p.table = d.table, p.source = src + ", reversal as measured";
+        if (reversal == run)
+          p.table = d.table, p.source = src + ", reversal as measured";
         else if (reversal == circle)
-          p.table = dsp::comp::fold_lost_motion(a, d.table.pos_mm, mean, circle_b->value), p.source = src + ", backlash of " + circle_b->input + " folded in";
-        else p.table = dsp::comp::without_reversal(d.table), p.source = src + ", no reversal (not resolved)";
+          p.table = dsp::comp::fold_lost_motion(a, d.table.pos_mm, mean, circle_b->value),
+          p.source = src + ", backlash of " + circle_b->input + " folded in";
+        else
+          p.table = dsp::comp::without_reversal(d.table), p.source = src + ", no reversal (not resolved)";
       } else if (reversal != none) {
         p.lost_motion_um = reversal == run ? -bm.value : circle_b->value;  // ISO 230-2 B of a play is −b
         p.source = reversal == run ? src + ", mean reversal only" : "backlash of " + circle_b->input;
       }
     } else if (circle_b) {
-      if (usable(*circle_b, letter(a) + " backlash")) p.lost_motion_um = circle_b->value, p.source = "backlash of " + circle_b->input;
+      if (usable(*circle_b, letter(a) + " backlash"))
+        p.lost_motion_um = circle_b->value, p.source = "backlash of " + circle_b->input;
     }
     if (p.table) {
       for (const auto& t : travel)
@@ -160,9 +174,12 @@ Plan build_plan(const std::vector<CompInput>& inputs, const PlanOptions& o) {
     if (p.table || p.lost_motion_um) plan.axes.push_back(p);
   }
   if (!refused.empty()) {
-    std::string msg = "comp: no compensation from figures that are not resolved (|value| must exceed U, k = 2); nothing written:";
+    std::string msg =
+        "comp: no compensation from figures that are not resolved (|value| must exceed U, k = 2); nothing written:";
     for (const auto& r : refused) msg += "\n  " + r;
-    msg += "\n  measure again (more runs or revolutions), --skip-unresolved to leave these terms out, or --allow-unresolved to propose them anyway";
+    msg +=
+        "\n  measure again (more runs or revolutions), --skip-unresolved to leave these terms out, or "
+        "--allow-unresolved to propose them anyway";
     throw dsp::InputError(msg);
   }
   if (plan.axes.empty() && plan.figures.empty())

@@ -34,12 +34,12 @@ struct PlanOptions {
 };
 
 struct Plan {
-  std::vector<AxisProposal> axes;  // ascending axis, only axes with a proposal
-  nlohmann::json figures = nlohmann::json::array();       // every figure looked at, with its use
+  std::vector<AxisProposal> axes;                    // ascending axis, only axes with a proposal
+  nlohmann::json figures = nlohmann::json::array();  // every figure looked at, with its use
   nlohmann::json not_compensated = nlohmann::json::array();
-  nlohmann::json skipped = nlohmann::json::array();       // inputs that give no compensation terms
-  std::vector<std::string> unresolved_used;               // proposed anyway (allow)
-  std::vector<std::string> unresolved_skipped;            // left out (skip)
+  nlohmann::json skipped = nlohmann::json::array();  // inputs that give no compensation terms
+  std::vector<std::string> unresolved_used;          // proposed anyway (allow)
+  std::vector<std::string> unresolved_skipped;       // left out (skip)
 };
 
 Plan build_plan(const std::vector<CompInput>& inputs, const PlanOptions& o);

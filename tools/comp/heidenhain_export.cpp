@@ -26,10 +26,12 @@ std::vector<OutputFile> heidenhain_outputs(const std::vector<AxisProposal>& axes
       const std::string name = std::string(1, up) + ".COM";
       char line[160];
       std::string t = "BEGIN " + name + " MM\n";
-      std::snprintf(line, sizeof line, "%-6s %-14s %-14s %-14s\n", "NR", "AXISPOS", std::string(1, up).c_str(), "BACKLASH");
+      std::snprintf(line, sizeof line, "%-6s %-14s %-14s %-14s\n", "NR", "AXISPOS", std::string(1, up).c_str(),
+                    "BACKLASH");
       t += rtrim(line);
       for (std::size_t i = 0; i < g.pos_mm.size(); ++i) {
-        std::snprintf(line, sizeof line, "%-6zu %+-14.4f %+-14.6f %+-14.6f\n", i, g.pos_mm[i], g.forward_um[i] * 1e-3, g.reverse_um[i] * 1e-3);
+        std::snprintf(line, sizeof line, "%-6zu %+-14.4f %+-14.6f %+-14.6f\n", i, g.pos_mm[i], g.forward_um[i] * 1e-3,
+                      g.reverse_um[i] * 1e-3);
         t += rtrim(line);
       }
       t += "[END]\n";
@@ -47,7 +49,8 @@ std::vector<OutputFile> heidenhain_outputs(const std::vector<AxisProposal>& axes
     std::string c = "BEGIN CONFIG.CMA\n";
     std::snprintf(line, sizeof line, "%-6s %-10s %-10s %-10s %-6s\n", "NR", "X", "Y", "Z", "ACTIVE");
     c += rtrim(line);
-    std::snprintf(line, sizeof line, "%-6d %-10s %-10s %-10s %-6s\n", 0, cma_cols[0].c_str(), cma_cols[1].c_str(), cma_cols[2].c_str(), "*");
+    std::snprintf(line, sizeof line, "%-6d %-10s %-10s %-10s %-6s\n", 0, cma_cols[0].c_str(), cma_cols[1].c_str(),
+                  cma_cols[2].c_str(), "*");
     c += rtrim(line);
     out.push_back({"heidenhain/CONFIG.CMA", c + "[END]\n"});
   }

@@ -72,10 +72,12 @@ std::vector<std::string> key_lines(const JointSettings& j, bool with_comments) {
 void check(const std::vector<JointSettings>& joints) {
   std::set<int> seen;
   for (const auto& j : joints) {
-    if (!seen.insert(j.joint).second) throw dsp::InputError("comp: joint " + std::to_string(j.joint) + " has two proposals");
+    if (!seen.insert(j.joint).second)
+      throw dsp::InputError("comp: joint " + std::to_string(j.joint) + " has two proposals");
     if (j.backlash_mm && j.comp_file)
-      throw dsp::InputError("comp: joint " + std::to_string(j.joint) +
-                            " would get BACKLASH and COMP_FILE; LinuxCNC ignores BACKLASH with a COMP_FILE (fold it into the table)");
+      throw dsp::InputError(
+          "comp: joint " + std::to_string(j.joint) +
+          " would get BACKLASH and COMP_FILE; LinuxCNC ignores BACKLASH with a COMP_FILE (fold it into the table)");
   }
 }
 
@@ -84,7 +86,8 @@ void check(const std::vector<JointSettings>& joints) {
 std::string linuxcnc_comp_file(const dsp::comp::AxisTable& t, const std::string& comment) {
   dsp::comp::validate(t);
   if (t.pos_mm.size() > kLinuxcncMaxCompPoints)
-    throw dsp::InputError(std::string("comp: the ") + dsp::comp::axis_letter(t.axis) + " table has " + std::to_string(t.pos_mm.size()) +
+    throw dsp::InputError(std::string("comp: the ") + dsp::comp::axis_letter(t.axis) + " table has " +
+                          std::to_string(t.pos_mm.size()) +
                           " points; LinuxCNC takes at most 256 per joint (give a larger --spacing-mm)");
   // usrmotLoadComp reads triplets until the first line that is not three numbers and stops
   // there: a comment above the data would leave the joint without compensation, so the
@@ -93,10 +96,12 @@ std::string linuxcnc_comp_file(const dsp::comp::AxisTable& t, const std::string&
   for (std::size_t i = 0; i < t.pos_mm.size(); ++i) {
     char line[128];
     const double nominal = std::round(t.pos_mm[i] * 1e6) * 1e-6;  // as printed: the actuals refer to it
-    std::snprintf(line, sizeof line, "%.6f %.7f %.7f\n", nominal, nominal + t.forward_um[i] * 1e-3, nominal + t.reverse_um[i] * 1e-3);
+    std::snprintf(line, sizeof line, "%.6f %.7f %.7f\n", nominal, nominal + t.forward_um[i] * 1e-3,
+                  nominal + t.reverse_um[i] * 1e-3);
     text += line;
   }
-  text += "# " + comment + "\n# COMP_FILE_TYPE = 0: nominal, actual moving +, actual moving - (mm); actual = nominal + deviation\n";
+  text += "# " + comment +
+          "\n# COMP_FILE_TYPE = 0: nominal, actual moving +, actual moving - (mm); actual = nominal + deviation\n";
   return text;
 }
 
@@ -117,16 +122,19 @@ std::map<char, int> joint_map(const std::string& ini_text, const std::string& in
   ks >> module;
   if (module != "trivkins")
     throw dsp::InputError(ini_name + ": [KINS] KINEMATICS = " + kins +
-                          ": eical merges trivkins configurations only (one joint per axis letter); write the snippet with the joint numbers by hand");
+                          ": eical merges trivkins configurations only (one joint per axis letter); write the snippet "
+                          "with the joint numbers by hand");
   for (std::string p; ks >> p;)
     if (p.rfind("coordinates=", 0) == 0) coords = p.substr(12);
   std::string letters;
   for (char c : coords)
-    if (std::isalpha(static_cast<unsigned char>(c))) letters += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (std::isalpha(static_cast<unsigned char>(c)))
+      letters += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (letters.empty()) letters = "xyz";
   std::map<char, int> m;
   for (std::size_t j = 0; j < letters.size(); ++j)
-    if (!m.count(letters[j])) m[letters[j]] = static_cast<int>(j);  // trivkins: a repeated letter is a gantry; the first joint leads
+    if (!m.count(letters[j]))
+      m[letters[j]] = static_cast<int>(j);  // trivkins: a repeated letter is a gantry; the first joint leads
   return m;
 }
 
@@ -142,7 +150,8 @@ std::string linuxcnc_ini_snippet(const std::vector<JointSettings>& joints, const
   return text;
 }
 
-std::string merge_linuxcnc_ini(const std::string& ini_text, const std::string& ini_name, const std::vector<JointSettings>& joints) {
+std::string merge_linuxcnc_ini(const std::string& ini_text, const std::string& ini_name,
+                               const std::vector<JointSettings>& joints) {
   check(joints);
   const std::vector<std::string> in = lines_of(ini_text);
   std::map<std::string, const JointSettings*> by_section;
@@ -150,7 +159,8 @@ std::string merge_linuxcnc_ini(const std::string& ini_text, const std::string& i
   std::map<std::string, int> seen;
   for (const auto& l : in)
     if (const std::string s = section_of(l); !s.empty() && ++seen[s] > 1 && by_section.count(s))
-      throw dsp::InputError(ini_name + ": section [" + s + "] appears twice: eical cannot tell which one LinuxCNC reads");
+      throw dsp::InputError(ini_name + ": section [" + s +
+                            "] appears twice: eical cannot tell which one LinuxCNC reads");
 
   static const std::set<std::string> kManaged = {"BACKLASH", "COMP_FILE", "COMP_FILE_TYPE"};
   std::vector<std::string> out;

@@ -35,9 +35,9 @@ std::string linuxcnc_comp_file(const dsp::comp::AxisTable& t, const std::string&
 struct JointSettings {
   int joint = 0;
   char axis = 'x';
-  std::optional<double> backlash_mm;   // BACKLASH (only without a COMP_FILE)
+  std::optional<double> backlash_mm;     // BACKLASH (only without a COMP_FILE)
   std::optional<std::string> comp_file;  // COMP_FILE (type 0), relative to the INI's folder
-  std::vector<std::string> comments;   // written above the keys
+  std::vector<std::string> comments;     // written above the keys
 };
 
 // Which joint moves which axis letter in a machine INI: trivkins only (its coordinates=
@@ -52,6 +52,7 @@ std::string linuxcnc_ini_snippet(const std::vector<JointSettings>& joints, const
 // lines are kept as comments, a BACKLASH next to a new COMP_FILE is set to 0 (LinuxCNC
 // would ignore it anyway; 0 says so), missing keys go to the end of their section, a
 // missing section to the end of the file. Everything else is copied byte for byte.
-std::string merge_linuxcnc_ini(const std::string& ini_text, const std::string& ini_name, const std::vector<JointSettings>& joints);
+std::string merge_linuxcnc_ini(const std::string& ini_text, const std::string& ini_name,
+                               const std::vector<JointSettings>& joints);
 
 }  // namespace eical::tools::comp

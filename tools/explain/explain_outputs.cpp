@@ -6,10 +6,10 @@
 
 #include <unsupported/Eigen/FFT>
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <cstdio>
-#include <algorithm>
 #include <map>
 
 namespace eical::tools::explain {
@@ -57,13 +57,17 @@ nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector
   std::vector<dsp::model::ExplainedEffect> merged;
   double before = 0.0, after = 0.0, hb = 0.0, ha = 0.0, seconds = 0.0;
   for (const auto& r : ex) {
-    before += r.nominal_residual_rms_um * r.nominal_residual_rms_um, after += r.final_residual_rms_um * r.final_residual_rms_um;
+    before += r.nominal_residual_rms_um * r.nominal_residual_rms_um,
+        after += r.final_residual_rms_um * r.final_residual_rms_um;
     hb += r.heldout_nominal_rms_um * r.heldout_nominal_rms_um, ha += r.heldout_final_rms_um * r.heldout_final_rms_um;
     seconds += r.seconds;
     for (const auto& e : r.effects) {
       auto it = std::find_if(merged.begin(), merged.end(), [&](const auto& m) { return m.name == e.name; });
-      if (it == merged.end()) merged.push_back(e);
-      else if ((e.significant && !it->significant) || (e.significant == it->significant && e.importance_um > it->importance_um)) *it = e;
+      if (it == merged.end())
+        merged.push_back(e);
+      else if ((e.significant && !it->significant) ||
+               (e.significant == it->significant && e.importance_um > it->importance_um))
+        *it = e;
     }
   }
   std::stable_sort(merged.begin(), merged.end(), [](const auto& a, const auto& b) {
@@ -91,7 +95,8 @@ nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector
                          {"runtime_s", r.seconds}};
     if (!r.position_not_compared.empty()) pr["position_not_compared"] = r.position_not_compared;
     pr["correlations"] = nlohmann::json::array();
-    for (const auto& c : r.correlations) pr["correlations"].push_back({{"axis", std::string(1, "xyz"[c.axis])}, {"regressor", c.regressor}, {"r", c.r}});
+    for (const auto& c : r.correlations)
+      pr["correlations"].push_back({{"axis", std::string(1, "xyz"[c.axis])}, {"regressor", c.regressor}, {"r", c.r}});
     pr["significant"] = nlohmann::json::array();
     for (const auto& e : r.effects)
       if (e.significant) pr["significant"].push_back(e.name);
@@ -100,21 +105,27 @@ nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector
   // Held out across runs: each run's extension applied to the other runs.
   j["heldout_runs"] = nlohmann::json::array();
   for (const auto& t : transfers)
-    j["heldout_runs"].push_back({{"model_from", t.from_run}, {"applied_to", t.to_run}, {"residual_rms_before_um", t.before_um}, {"residual_rms_after_um", t.after_um}});
+    j["heldout_runs"].push_back({{"model_from", t.from_run},
+                                 {"applied_to", t.to_run},
+                                 {"residual_rms_before_um", t.before_um},
+                                 {"residual_rms_after_um", t.after_um}});
   return j;
 }
 
-std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex, const std::vector<dsp::model::TransferGain>& transfers) {
+std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex,
+                         const std::vector<dsp::model::TransferGain>& transfers) {
   std::string o;
   char b[512];
   for (const auto& r : ex) {
     if (!r.position_not_compared.empty())
-      std::snprintf(b, sizeof b, "%s (compared with: %s): no position compared: %s; %.1f s\n", r.run_id.c_str(), r.reference.c_str(),
-                    r.position_not_compared.c_str(), r.seconds);
+      std::snprintf(b, sizeof b, "%s (compared with: %s): no position compared: %s; %.1f s\n", r.run_id.c_str(),
+                    r.reference.c_str(), r.position_not_compared.c_str(), r.seconds);
     else
-      std::snprintf(b, sizeof b, "%s (compared with: %s): pipeline residual %.3f um RMS -> %.3f um with the extended model; model prediction at held-out points %.3f -> %.3f um; %.1f s\n",
-                    r.run_id.c_str(), r.reference.c_str(), r.nominal_residual_rms_um, r.final_residual_rms_um, r.heldout_nominal_rms_um,
-                    r.heldout_final_rms_um, r.seconds);
+      std::snprintf(b, sizeof b,
+                    "%s (compared with: %s): pipeline residual %.3f um RMS -> %.3f um with the extended model; model "
+                    "prediction at held-out points %.3f -> %.3f um; %.1f s\n",
+                    r.run_id.c_str(), r.reference.c_str(), r.nominal_residual_rms_um, r.final_residual_rms_um,
+                    r.heldout_nominal_rms_um, r.heldout_final_rms_um, r.seconds);
     o += b;
     int sig = 0;
     for (const auto& e : r.effects) {
@@ -123,17 +134,19 @@ std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex, cons
       std::snprintf(b, sizeof b, "  %d. %s  [%s]  %s\n", sig, e.name.c_str(), e.channel.c_str(), e.evidence.c_str());
       o += b;
     }
-    if (sig == 0) o += "  no significant effect: the nominal model explains the run within its noise and the tolerance bands\n";
+    if (sig == 0)
+      o += "  no significant effect: the nominal model explains the run within its noise and the tolerance bands\n";
   }
   for (const auto& t : transfers) {
-    std::snprintf(b, sizeof b, "held out: %s with the model extended on %s: pipeline residual %.3f -> %.3f um RMS\n", t.to_run.c_str(), t.from_run.c_str(),
-                  t.before_um, t.after_um);
+    std::snprintf(b, sizeof b, "held out: %s with the model extended on %s: pipeline residual %.3f -> %.3f um RMS\n",
+                  t.to_run.c_str(), t.from_run.c_str(), t.before_um, t.after_um);
     o += b;
   }
   return o;
 }
 
-void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex, const std::filesystem::path& dir) {
+void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex,
+                          const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
   for (std::size_t i = 0; i < runs.size() && i < ex.size(); ++i) {
     const auto& r = ex[i];
@@ -142,26 +155,34 @@ void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<d
     page.run_id = r.run_id;
     page.program = runs[i].meta.program.kind;
     page.context = {{"compared with", r.reference},
-                    {"pipeline residual RMS, extended model", report_fmt(r.nominal_residual_rms_um) + " -> " + report_fmt(r.final_residual_rms_um) + " um"},
-                    {"prediction at held-out reference points", report_fmt(r.heldout_nominal_rms_um) + " -> " + report_fmt(r.heldout_final_rms_um) + " um"}};
+                    {"pipeline residual RMS, extended model",
+                     report_fmt(r.nominal_residual_rms_um) + " -> " + report_fmt(r.final_residual_rms_um) + " um"},
+                    {"prediction at held-out reference points",
+                     report_fmt(r.heldout_nominal_rms_um) + " -> " + report_fmt(r.heldout_final_rms_um) + " um"}};
     // The effects, significant first.
     report::Section table;
     table.heading = "Effects tested";
-    table.lead = "each effect of the run format as a model extension: BIC with an effective sample count, a held-out guard, and the tolerance band";
+    table.lead =
+        "each effect of the run format as a model extension: BIC with an effective sample count, a held-out guard, and "
+        "the tolerance band";
     report::Grid g;
     g.header = {"", "effect", "size", "tolerance", "residual RMS before -> after (um)", "evidence"};
     for (const auto& e : r.effects)
-      g.rows.push_back({e.significant ? "significant" : "", e.name, report_fmt(e.magnitude) + " " + e.unit, report_fmt(e.tolerance),
-                        report_fmt(e.residual_rms_before_um) + " -> " + report_fmt(e.residual_rms_after_um), e.evidence});
+      g.rows.push_back(
+          {e.significant ? "significant" : "", e.name, report_fmt(e.magnitude) + " " + e.unit, report_fmt(e.tolerance),
+           report_fmt(e.residual_rms_before_um) + " -> " + report_fmt(e.residual_rms_after_um), e.evidence});
     table.grids.push_back(g);
     page.sections.push_back(table);
     if (!r.correlations.empty()) {
       report::Section cs;
       cs.heading = "Residual against the candidate regressors";
-      cs.lead = "Pearson r of the nominal model's residual with each regressor, per moving axis (|r| near 1: the residual follows it)";
+      cs.lead =
+          "Pearson r of the nominal model's residual with each regressor, per moving axis (|r| near 1: the residual "
+          "follows it)";
       report::Grid cg;
       cg.header = {"axis", "regressor", "r"};
-      for (const auto& c : r.correlations) cg.rows.push_back({std::string(1, "xyz"[c.axis]), c.regressor, report_fmt(c.r)});
+      for (const auto& c : r.correlations)
+        cg.rows.push_back({std::string(1, "xyz"[c.axis]), c.regressor, report_fmt(c.r)});
       cs.grids.push_back(cg);
       page.sections.push_back(cs);
     }
@@ -171,8 +192,9 @@ void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<d
       report::Section s;
       s.heading = "Residual, " + tr.channel;
       s.lead = tr.channel == "ref" ? "the pipeline's path minus the reference instrument, each axis' offset out"
-               : tr.channel == "psd" ? "the pipeline's path minus the PSD readings, each axis' offset out"
-                                     : "the pipeline's path minus the set-point (sensor and machine together), each axis' offset out";
+               : tr.channel == "psd"
+                   ? "the pipeline's path minus the PSD readings, each axis' offset out"
+                   : "the pipeline's path minus the set-point (sensor and machine together), each axis' offset out";
       for (int a = 0; a < 3; ++a) {
         report::LineSeries before, after;
         before.label = "nominal model", before.color = report::kRed;
@@ -184,7 +206,8 @@ void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<d
           after.x.push_back(tr.t_s[k]), after.y.push_back(tr.after_um[k]);
         }
         if (before.x.size() < 16) continue;
-        s.svgs.push_back(report::line_plot({before, after}, std::string(axes[a]) + ": residual in time", "time (s)", "residual (um)"));
+        s.svgs.push_back(report::line_plot({before, after}, std::string(axes[a]) + ": residual in time", "time (s)",
+                                           "residual (um)"));
         // Amplitude spectrum of both (the samples are at ~1 kHz, not exactly uniform where thinned).
         const std::size_t m = before.y.size();
         std::size_t nfft = 1;
@@ -203,14 +226,17 @@ void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<d
             dst.y.push_back(2.0 * std::abs(out[f]) / static_cast<double>(nfft));
           }
         }
-        s.svgs.push_back(report::line_plot({sb, sa}, std::string(axes[a]) + ": residual amplitude spectrum", "frequency (Hz)", "amplitude (um)"));
+        s.svgs.push_back(report::line_plot({sb, sa}, std::string(axes[a]) + ": residual amplitude spectrum",
+                                           "frequency (Hz)", "amplitude (um)"));
       }
       page.sections.push_back(s);
     }
     const auto model = extended_model(runs[i], r);
     report::Section ext;
     ext.heading = "The extended model";
-    ext.lead = "the significant sensor effects as a sensor calibration, the machine effects as a scenario the simulator reproduces the run with";
+    ext.lead =
+        "the significant sensor effects as a sensor calibration, the machine effects as a scenario the simulator "
+        "reproduces the run with";
     ext.notes = model.notes;
     page.files.push_back(r.run_id + "-calibration.toml");
     page.files.push_back(r.run_id + "-scenario.toml");

@@ -18,7 +18,9 @@ namespace eical::tools::explain {
 // `transfers`: each run's extension applied to the other runs (held out across runs).
 nlohmann::json explain_json(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex,
                             const std::vector<dsp::model::TransferGain>& transfers = {});
-std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex, const std::vector<dsp::model::TransferGain>& transfers = {});
-void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex, const std::filesystem::path& dir);
+std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex,
+                         const std::vector<dsp::model::TransferGain>& transfers = {});
+void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex,
+                          const std::filesystem::path& dir);
 
 }  // namespace eical::tools::explain

@@ -37,13 +37,15 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
     } else if (x.name == "machine.backlash") {
       for (const auto& [k, v] : p)
         if (k.rfind("backlash_", 0) == 0)
-          effects_toml += "\n[[effects.\"machine.backlash\"]]\naxis = \"" + std::string(1, k[9]) + "\"\nvalue_um = " + drivers::toml_number(std::abs(v)) + "\n";
+          effects_toml += "\n[[effects.\"machine.backlash\"]]\naxis = \"" + std::string(1, k[9]) +
+                          "\"\nvalue_um = " + drivers::toml_number(std::abs(v)) + "\n";
     } else if (x.name == "machine.reversal_spike") {
       for (const auto& [k, v] : p)
         if (k.rfind("spike_", 0) == 0) {
           const auto tau = k.find("tau_");
           const double tau_ms = tau == std::string::npos ? 15.0 : std::atof(k.c_str() + tau + 4);
-          effects_toml += "\n[[effects.\"machine.reversal_spike\"]]\naxis = \"" + std::string(1, k[6]) + "\"\namp_um = " + drivers::toml_number(std::abs(v)) +
+          effects_toml += "\n[[effects.\"machine.reversal_spike\"]]\naxis = \"" + std::string(1, k[6]) +
+                          "\"\namp_um = " + drivers::toml_number(std::abs(v)) +
                           "\ntau_ms = " + drivers::toml_number(tau_ms) + "\n";
         }
     } else if (x.name == "machine.squareness") {
@@ -51,12 +53,14 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
         int i = 0, j = 0;
         if (!dsp::two_axes(k, "squareness_", i, j)) continue;
         const char* plane = (i == 0 && j == 1) ? "xy" : (i == 1 && j == 2) ? "yz" : "zx";
-        effects_toml += "\n[[effects.\"machine.squareness\"]]\nplane = \"" + std::string(plane) + "\"\nvalue_urad = " + drivers::toml_number(v) + "\n";
+        effects_toml += "\n[[effects.\"machine.squareness\"]]\nplane = \"" + std::string(plane) +
+                        "\"\nvalue_urad = " + drivers::toml_number(v) + "\n";
       }
     } else if (x.name == "machine.scale_mismatch") {
       for (const auto& [k, v] : p)
         if (k.rfind("scale_", 0) == 0)
-          effects_toml += "\n[[effects.\"machine.scale_mismatch\"]]\naxis = \"" + std::string(1, k[6]) + "\"\nvalue_ppm = " + drivers::toml_number(v) + "\n";
+          effects_toml += "\n[[effects.\"machine.scale_mismatch\"]]\naxis = \"" + std::string(1, k[6]) +
+                          "\"\nvalue_ppm = " + drivers::toml_number(v) + "\n";
     } else if (x.name == "machine.cyclic_error") {
       for (const auto& [k, v] : p) {
         if (k.rfind("cyclic_", 0) != 0 || k.find("_sin_um") == std::string::npos) continue;
@@ -65,8 +69,10 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
         const double cs = c == p.end() ? 0.0 : c->second;
         const auto pos = base.find("pitch_");
         const double pitch = pos == std::string::npos ? 10.0 : std::atof(base.c_str() + pos + 6);
-        effects_toml += "\n[[effects.\"machine.cyclic_error\"]]\naxis = \"" + std::string(1, k[7]) + "\"\namp_um = " + drivers::toml_number(std::hypot(v, cs)) +
-                        "\npitch_mm = " + drivers::toml_number(pitch) + "\nphase_deg = " + drivers::toml_number(std::atan2(cs, v) * 180.0 / std::numbers::pi) + "\n";
+        effects_toml += "\n[[effects.\"machine.cyclic_error\"]]\naxis = \"" + std::string(1, k[7]) +
+                        "\"\namp_um = " + drivers::toml_number(std::hypot(v, cs)) +
+                        "\npitch_mm = " + drivers::toml_number(pitch) +
+                        "\nphase_deg = " + drivers::toml_number(std::atan2(cs, v) * 180.0 / std::numbers::pi) + "\n";
       }
     } else if (x.name == "machine.resonance") {
       // The simulator's mode: m'' + 2ζω m' + ω² m = −gain (d·a_drive) along d, so the
@@ -78,16 +84,23 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
         if (!(d.norm() > 0.0)) continue;
         d.normalize();
         const double in = d.cwiseAbs().maxCoeff();
-        modes += "\n[[effects.\"machine.resonance\".modes]]\nfrequency_hz = " + drivers::toml_number(p.at(pre + "frequency_hz")) +
-                 "\ndamping_ratio = " + drivers::toml_number(p.at(pre + "damping_ratio")) + "\ngain = " + drivers::toml_number(p.at(pre + "gain") / (in * in)) +
-                 "\ndirection = [" + drivers::toml_number(d.x()) + ", " + drivers::toml_number(d.y()) + ", " + drivers::toml_number(d.z()) + "]\n";
+        modes += "\n[[effects.\"machine.resonance\".modes]]\nfrequency_hz = " +
+                 drivers::toml_number(p.at(pre + "frequency_hz")) +
+                 "\ndamping_ratio = " + drivers::toml_number(p.at(pre + "damping_ratio")) +
+                 "\ngain = " + drivers::toml_number(p.at(pre + "gain") / (in * in)) + "\ndirection = [" +
+                 drivers::toml_number(d.x()) + ", " + drivers::toml_number(d.y()) + ", " + drivers::toml_number(d.z()) +
+                 "]\n";
       }
       if (run.meta.program.kind == "freeform" && run.meta.program.gcode.empty())
-        m.notes.push_back("machine.resonance: into the scenario; the run's program (a recorded set-point, no G-code) has no generator: add a [sweep] or a gcode_file to simulate it");
+        m.notes.push_back(
+            "machine.resonance: into the scenario; the run's program (a recorded set-point, no G-code) has no "
+            "generator: add a [sweep] or a gcode_file to simulate it");
       if (!modes.empty())
-        effects_toml += std::string("\n[effects.\"machine.resonance\"]\npart = \"") + (run.meta.sensor_present[1] ? "head" : "table") + "\"\n" + modes;
+        effects_toml += std::string("\n[effects.\"machine.resonance\"]\npart = \"") +
+                        (run.meta.sensor_present[1] ? "head" : "table") + "\"\n" + modes;
     } else {
-      m.notes.push_back(x.name + ": found; not taken into the scenario (its shape is not one of the simulator's tables)");
+      m.notes.push_back(x.name +
+                        ": found; not taken into the scenario (its shape is not one of the simulator's tables)");
     }
     if (x.name.rfind("machine.", 0) == 0) m.notes.push_back(x.name + ": into the scenario");
   }
@@ -95,11 +108,16 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
   for (const auto& x : ex.effects)
     if (x.name == "machine.servo_mismatch")
       for (const auto& [k, v] : x.params)
-        if (k.rfind("lag_", 0) == 0 && v > 1e-4) servo_toml += "\n[servo." + std::string(1, k[4]) + "]\nkv_per_s = " + drivers::toml_number(0.01 / (v * 1e-3)) + "\nfeedforward = 0.99\n";
+        if (k.rfind("lag_", 0) == 0 && v > 1e-4)
+          servo_toml += "\n[servo." + std::string(1, k[4]) +
+                        "]\nkv_per_s = " + drivers::toml_number(0.01 / (v * 1e-3)) + "\nfeedforward = 0.99\n";
   // The scenario: what eical is told = the run's own data sheet, the truth = the extended
   // sensors and DAQ ([truth.*]): simulated, it shows what the recorded run showed.
-  std::string truth_toml = "\n[truth.daq]\ngroup_delay_samples = " + drivers::toml_number(cal.daq_group_delay_samples.value_or(meta.acquisition.daq_group_delay_samples)) +
-                           "\nskew_head_samples = " + drivers::toml_number(cal.daq_skew_head_samples.value_or(meta.acquisition.daq_skew_head_samples)) + "\n";
+  std::string truth_toml =
+      "\n[truth.daq]\ngroup_delay_samples = " +
+      drivers::toml_number(cal.daq_group_delay_samples.value_or(meta.acquisition.daq_group_delay_samples)) +
+      "\nskew_head_samples = " +
+      drivers::toml_number(cal.daq_skew_head_samples.value_or(meta.acquisition.daq_skew_head_samples)) + "\n";
   for (int s = 0; s < 2; ++s) {
     std::string sec = drivers::sensor_section_toml(s == 0 ? "table" : "head", cal.sensors[s]);
     sec.replace(sec.find("[sensors."), 9, "[truth.sensors.");
@@ -108,16 +126,21 @@ ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanati
   std::string text = drivers::run_toml_text(meta);
   const auto eol = text.find('\n');
   // A run of one sensor is simulated with that sensor only (the other's columns empty).
-  const std::string present = meta.sensor_present[0] && meta.sensor_present[1] ? "" : meta.sensor_present[1] ? "\nsensors_present = \"head\"" : "\nsensors_present = \"table\"";
-  text = "format = \"eical-scenario/1\"\nname = \"explained-" + meta.id + "\"\ndescription = \"what eical explain found in " + meta.id + "\"" + present +
-         text.substr(eol);
+  const std::string present = meta.sensor_present[0] && meta.sensor_present[1] ? ""
+                              : meta.sensor_present[1]                         ? "\nsensors_present = \"head\""
+                                                                               : "\nsensors_present = \"table\"";
+  text = "format = \"eical-scenario/1\"\nname = \"explained-" + meta.id +
+         "\"\ndescription = \"what eical explain found in " + meta.id + "\"" + present + text.substr(eol);
   if (const auto c = text.find("\ncreated = "); c != std::string::npos) text.erase(c, text.find('\n', c + 1) - c);
-  m.scenario_toml = "# Written by eical explain: the run's program with the effects it found; eical simulate --scenario this-file -o RUN\n" + text +
-                    servo_toml + effects_toml + truth_toml;
+  m.scenario_toml =
+      "# Written by eical explain: the run's program with the effects it found; eical simulate --scenario this-file -o "
+      "RUN\n" +
+      text + servo_toml + effects_toml + truth_toml;
   return m;
 }
 
-void write_extended_model(const ExtendedModel& m, const std::filesystem::path& calibration_file, const std::filesystem::path& scenario_file) {
+void write_extended_model(const ExtendedModel& m, const std::filesystem::path& calibration_file,
+                          const std::filesystem::path& scenario_file) {
   drivers::write_sensor_calibration(m.calibration, calibration_file);
   drivers::write_text_atomic(scenario_file, m.scenario_toml);
 }

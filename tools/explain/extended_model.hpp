@@ -21,6 +21,7 @@ struct ExtendedModel {
 };
 
 ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanation& explanation);
-void write_extended_model(const ExtendedModel& model, const std::filesystem::path& calibration_file, const std::filesystem::path& scenario_file);
+void write_extended_model(const ExtendedModel& model, const std::filesystem::path& calibration_file,
+                          const std::filesystem::path& scenario_file);
 
 }  // namespace eical::tools::explain

@@ -83,17 +83,21 @@ std::string when(const std::string& t) {
 std::string list_text(const std::vector<history::Summary>& rows) {
   if (rows.empty()) return "no results\n";
   std::size_t wm = 7, wr = 3, wp = 7;
-  for (const auto& r : rows) wm = std::max(wm, r.machine.size()), wr = std::max(wr, r.run_id.size()), wp = std::max(wp, r.program.size());
-  std::string out = pad("measured (UTC)", 21) + pad("machine", wm + 2) + pad("program", wp + 2) + pad("run", wr + 2) + "verdict\n";
   for (const auto& r : rows)
-    out += pad(when(r.measured_at), 21) + pad(r.machine, wm + 2) + pad(r.program, wp + 2) + pad(r.run_id, wr + 2) + verdict_of(r.verdict, r.degraded) + "\n";
+    wm = std::max(wm, r.machine.size()), wr = std::max(wr, r.run_id.size()), wp = std::max(wp, r.program.size());
+  std::string out =
+      pad("measured (UTC)", 21) + pad("machine", wm + 2) + pad("program", wp + 2) + pad("run", wr + 2) + "verdict\n";
+  for (const auto& r : rows)
+    out += pad(when(r.measured_at), 21) + pad(r.machine, wm + 2) + pad(r.program, wp + 2) + pad(r.run_id, wr + 2) +
+           verdict_of(r.verdict, r.degraded) + "\n";
   out += std::to_string(rows.size()) + " result" + (rows.size() == 1 ? "" : "s") + "\n";
   return out;
 }
 
 std::string record_text(const history::Record& r) {
   std::string out = r.machine + " " + r.run_id + " (" + r.program + "), measured " + when(r.measured_at) + " UTC\n";
-  out += "  verdict             " + verdict_of(r.verdict, r.degraded) + (r.verdict ? "" : " (the result gives none)") + "\n";
+  out += "  verdict             " + verdict_of(r.verdict, r.degraded) + (r.verdict ? "" : " (the result gives none)") +
+         "\n";
   out += "  run directory       " + r.run_path + "\n";
   out += "  software            " + r.software_version.value_or("unknown") + "\n";
   out += "  sensor calibration  " + r.sensor_calibration + "\n";
@@ -101,33 +105,36 @@ std::string record_text(const history::Record& r) {
   for (const auto& f : r.figures) w = std::max(w, f.name.size());
   out += "  " + pad("figure", w + 2) + "value ± U (k = 2)\n";
   for (const auto& f : r.figures)
-    out += "  " + pad(f.name, w + 2) + pad(measure(f.value, f.uncertainty_k2, history::unit_of(f.name)), 24) + history::label_of(f.name) +
-           (f.value ? "" : " (not determined)") + "\n";
+    out += "  " + pad(f.name, w + 2) + pad(measure(f.value, f.uncertainty_k2, history::unit_of(f.name)), 24) +
+           history::label_of(f.name) + (f.value ? "" : " (not determined)") + "\n";
   return out;
 }
 
 std::string trend_text(const std::string& figure, const std::vector<history::TrendPoint>& points,
                        const std::vector<history::TrendSummary>& summaries) {
   const std::string unit = history::unit_of(figure);
-  std::string out = figure + " (" + history::label_of(figure) + (unit.empty() ? "" : ", " + unit) + "): " + std::to_string(points.size()) +
-                    " result" + (points.size() == 1 ? "" : "s") + "\n";
+  std::string out = figure + " (" + history::label_of(figure) + (unit.empty() ? "" : ", " + unit) +
+                    "): " + std::to_string(points.size()) + " result" + (points.size() == 1 ? "" : "s") + "\n";
   if (points.empty()) return out;
   std::size_t wm = 7, wr = 3;
   for (const auto& p : points) wm = std::max(wm, p.machine.size()), wr = std::max(wr, p.run_id.size());
-  out += pad("measured (UTC)", 21) + pad("machine", wm + 2) + pad("run", wr + 2) + pad("value ± U (k = 2)", 24) + "verdict\n";
+  out += pad("measured (UTC)", 21) + pad("machine", wm + 2) + pad("run", wr + 2) + pad("value ± U (k = 2)", 24) +
+         "verdict\n";
   for (const auto& p : points)
-    out += pad(when(p.measured_at), 21) + pad(p.machine, wm + 2) + pad(p.run_id, wr + 2) + pad(measure(p.value, p.uncertainty_k2, unit), 24) +
-           verdict_of(p.verdict, p.degraded) + "\n";
+    out += pad(when(p.measured_at), 21) + pad(p.machine, wm + 2) + pad(p.run_id, wr + 2) +
+           pad(measure(p.value, p.uncertainty_k2, unit), 24) + verdict_of(p.verdict, p.degraded) + "\n";
   for (const auto& s : summaries) {
     out += s.machine + ": ";
     if (!s.first) {
       out += "not determined in any of its " + std::to_string(s.points) + " results\n";
       continue;
     }
-    out += measure(s.first->value, s.first->uncertainty_k2, unit) + " (" + when(s.first->measured_at).substr(0, 10) + ") → " +
-           measure(s.last->value, s.last->uncertainty_k2, unit) + " (" + when(s.last->measured_at).substr(0, 10) + ")";
+    out += measure(s.first->value, s.first->uncertainty_k2, unit) + " (" + when(s.first->measured_at).substr(0, 10) +
+           ") → " + measure(s.last->value, s.last->uncertainty_k2, unit) + " (" +
+           when(s.last->measured_at).substr(0, 10) + ")";
     if (s.slope_per_30d && s.slope_u_k2)
-      out += ", drift " + measure(s.slope_per_30d, s.slope_u_k2, unit) + " per 30 days (" + (s.drift_significant ? "significant" : "within its uncertainty") + ")";
+      out += ", drift " + measure(s.slope_per_30d, s.slope_u_k2, unit) + " per 30 days (" +
+             (s.drift_significant ? "significant" : "within its uncertainty") + ")";
     else if (s.span_days < history::kMinDriftSpanDays)
       out += ", drift: the results span less than a day";
     else
@@ -147,29 +154,30 @@ std::string change_sentence(const FigureChange& c) {
              (c.after ? measure(c.after, c.u_after, unit) : "not determined");
     case Judgement::not_judged: {
       const std::string d = plain(*c.difference);
-      return label + " went from " + measure(c.before, c.u_before, unit) + " to " + measure(c.after, c.u_after, unit) + ": " +
-             (*c.difference > 0 ? "+" : "") + d + tail + " (no uncertainty on both sides: not judged)";
+      return label + " went from " + measure(c.before, c.u_before, unit) + " to " + measure(c.after, c.u_after, unit) +
+             ": " + (*c.difference > 0 ? "+" : "") + d + tail + " (no uncertainty on both sides: not judged)";
     }
     default: {
       // Both values at the decimals of the larger uncertainty: "from 6.1 ± 0.4 to 0.8 ± 0.4 µm".
       const int d = decimals_for(std::max(*c.u_before, *c.u_after));
       const int dd = decimals_for(*c.uncertainty_k2);
-      return label + " went from " + fixed(*c.before, d) + " ± " + fixed(*c.u_before, d) + " to " + fixed(*c.after, d) + " ± " +
-             fixed(*c.u_after, d) + tail + ": " + (*c.difference > 0 ? "+" : "") + fixed(*c.difference, dd) + " ± " +
-             fixed(*c.uncertainty_k2, dd) + tail + ", " +
+      return label + " went from " + fixed(*c.before, d) + " ± " + fixed(*c.u_before, d) + " to " + fixed(*c.after, d) +
+             " ± " + fixed(*c.u_after, d) + tail + ": " + (*c.difference > 0 ? "+" : "") + fixed(*c.difference, dd) +
+             " ± " + fixed(*c.uncertainty_k2, dd) + tail + ", " +
              (c.judgement == Judgement::significant ? "significant" : "within the uncertainty");
     }
   }
 }
 
 std::string compare_text(const history::Comparison& c) {
-  std::string out = "before: " + c.before.machine + " " + c.before.run_id + " (" + c.before.program + ", " + when(c.before.measured_at) +
-                    " UTC, " + verdict_of(c.before.verdict, c.before.degraded) + ")\n";
-  out += "after:  " + c.after.machine + " " + c.after.run_id + " (" + c.after.program + ", " + when(c.after.measured_at) + " UTC, " +
-         verdict_of(c.after.verdict, c.after.degraded) + ")\n";
+  std::string out = "before: " + c.before.machine + " " + c.before.run_id + " (" + c.before.program + ", " +
+                    when(c.before.measured_at) + " UTC, " + verdict_of(c.before.verdict, c.before.degraded) + ")\n";
+  out += "after:  " + c.after.machine + " " + c.after.run_id + " (" + c.after.program + ", " +
+         when(c.after.measured_at) + " UTC, " + verdict_of(c.after.verdict, c.after.degraded) + ")\n";
   for (const auto& n : c.not_comparable) out += "not the same test: " + n + "\n";
   auto sorted = c.figures;
-  std::stable_sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return rank(a.judgement) < rank(b.judgement); });
+  std::stable_sort(sorted.begin(), sorted.end(),
+                   [](const auto& a, const auto& b) { return rank(a.judgement) < rank(b.judgement); });
   std::size_t significant = 0;
   for (const auto& f : sorted) {
     significant += f.judgement == Judgement::significant;
@@ -190,8 +198,13 @@ nlohmann::json trend_json(const std::string& figure, const std::vector<history::
                           const std::vector<history::TrendSummary>& summaries) {
   nlohmann::json pts = nlohmann::json::array(), sums = nlohmann::json::array();
   for (const auto& p : points)
-    pts.push_back({{"machine", p.machine}, {"run_id", p.run_id}, {"measured_at", p.measured_at}, {"value", opt(p.value)},
-                   {"uncertainty_k2", opt(p.uncertainty_k2)}, {"verdict", opt(p.verdict)}, {"degraded", p.degraded}});
+    pts.push_back({{"machine", p.machine},
+                   {"run_id", p.run_id},
+                   {"measured_at", p.measured_at},
+                   {"value", opt(p.value)},
+                   {"uncertainty_k2", opt(p.uncertainty_k2)},
+                   {"verdict", opt(p.verdict)},
+                   {"degraded", p.degraded}});
   for (const auto& s : summaries)
     sums.push_back({{"machine", s.machine},
                     {"results", s.points},
@@ -201,8 +214,8 @@ nlohmann::json trend_json(const std::string& figure, const std::vector<history::
                     {"drift_per_30d", opt(s.slope_per_30d)},
                     {"drift_uncertainty_k2", opt(s.slope_u_k2)},
                     {"drift_significant", s.drift_significant}});
-  return {{"format", "eical-history-trend/1"}, {"figure", figure}, {"label", history::label_of(figure)}, {"unit", history::unit_of(figure)},
-          {"points", pts}, {"machines", sums}};
+  return {{"format", "eical-history-trend/1"}, {"figure", figure}, {"label", history::label_of(figure)},
+          {"unit", history::unit_of(figure)},  {"points", pts},    {"machines", sums}};
 }
 
 nlohmann::json compare_json(const history::Comparison& c) {

@@ -12,8 +12,8 @@
 namespace eical::tools {
 
 struct AddOptions {
-  std::string machine;                    // "": run.toml's [machine] name
-  std::filesystem::path calibration;      // eical-sensor-cal/1, or empty
+  std::string machine;                // "": run.toml's [machine] name
+  std::filesystem::path calibration;  // eical-sensor-cal/1, or empty
 };
 
 // Throws naming the run and the cause (no run.toml, malformed result.json, ...).

@@ -40,8 +40,8 @@ CsvTable::CsvTable(const std::filesystem::path& file, const std::vector<std::str
     }
     auto f = split(line);
     if (f.size() != header_.size())
-      throw dsp::InputError(file_ + ":" + std::to_string(no) + ": " + std::to_string(f.size()) + " fields, the header has " +
-                            std::to_string(header_.size()));
+      throw dsp::InputError(file_ + ":" + std::to_string(no) + ": " + std::to_string(f.size()) +
+                            " fields, the header has " + std::to_string(header_.size()));
     cells_.push_back(std::move(f));
     line_.push_back(no);
   }
@@ -64,7 +64,8 @@ double CsvTable::number(std::size_t row, const std::string& column) const {
   const std::string& s = cells_[row][index(column)];
   double v = 0.0;
   const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || ec != std::errc() || p != s.data() + s.size()) throw dsp::InputError(where(row, column) + ": expected a number, got '" + s + "'");
+  if (s.empty() || ec != std::errc() || p != s.data() + s.size())
+    throw dsp::InputError(where(row, column) + ": expected a number, got '" + s + "'");
   if (!std::isfinite(v)) throw dsp::InputError(where(row, column) + ": NaN or Inf");
   return v;
 }
@@ -73,10 +74,13 @@ long long CsvTable::integer(std::size_t row, const std::string& column) const {
   const std::string& s = cells_[row][index(column)];
   long long v = 0;
   const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || ec != std::errc() || p != s.data() + s.size()) throw dsp::InputError(where(row, column) + ": expected an integer, got '" + s + "'");
+  if (s.empty() || ec != std::errc() || p != s.data() + s.size())
+    throw dsp::InputError(where(row, column) + ": expected an integer, got '" + s + "'");
   return v;
 }
 
-const std::string& CsvTable::text(std::size_t row, const std::string& column) const { return cells_[row][index(column)]; }
+const std::string& CsvTable::text(std::size_t row, const std::string& column) const {
+  return cells_[row][index(column)];
+}
 
 }  // namespace eical::tools

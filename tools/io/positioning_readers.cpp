@@ -15,9 +15,12 @@ namespace {
 // What ISO 230-2 needs of a table (evaluate_positioning checks it again, without a file
 // to name).
 void require_table(const std::string& file, std::size_t targets, long long runs, const char* what) {
-  if (targets < 2) throw dsp::InputError(file + ": at least 2 targets are needed for ISO 230-2 (the file has " + std::to_string(targets) + ")");
+  if (targets < 2)
+    throw dsp::InputError(file + ": at least 2 targets are needed for ISO 230-2 (the file has " +
+                          std::to_string(targets) + ")");
   if (runs < 2)
-    throw dsp::InputError(file + ": at least 2 " + what + " per direction are needed for ISO 230-2 (the file has " + std::to_string(runs) + ")");
+    throw dsp::InputError(file + ": at least 2 " + what + " per direction are needed for ISO 230-2 (the file has " +
+                          std::to_string(runs) + ")");
 }
 
 }  // namespace
@@ -32,12 +35,14 @@ dsp::eval::PositioningInput read_deviation_csv(const std::string& file) {
     const long long run = t.integer(r, "run");
     if (run < 1) throw dsp::InputError(t.where(r, "run") + ": runs are numbered from 1");
     const std::string& d = t.text(r, "direction");
-    if (d != "up" && d != "down") throw dsp::InputError(t.where(r, "direction") + ": expected up or down, got '" + d + "'");
+    if (d != "up" && d != "down")
+      throw dsp::InputError(t.where(r, "direction") + ": expected up or down, got '" + d + "'");
     const double dev = t.number(r, "deviation_um");
     const long long key = std::llround(target * 1e6);
     target_of[key] = target;
     if (!value.emplace(std::tuple{key, run, d == "up" ? 0 : 1}, dev).second)
-      throw dsp::InputError(t.where(r, "run") + ": target " + std::to_string(target) + " mm, run " + std::to_string(run) + ", " + d + " appears twice");
+      throw dsp::InputError(t.where(r, "run") + ": target " + std::to_string(target) + " mm, run " +
+                            std::to_string(run) + ", " + d + " appears twice");
     max_run = std::max(max_run, run);
   }
   require_table(file, target_of.size(), max_run, "runs");
@@ -51,7 +56,8 @@ dsp::eval::PositioningInput read_deviation_csv(const std::string& file) {
       for (int dir = 0; dir < 2; ++dir) {
         const auto it = value.find({k, run, dir});
         if (it == value.end())
-          throw dsp::InputError(file + ": no deviation for target " + std::to_string(v) + " mm, run " + std::to_string(run) + ", " + (dir ? "down" : "up"));
+          throw dsp::InputError(file + ": no deviation for target " + std::to_string(v) + " mm, run " +
+                                std::to_string(run) + ", " + (dir ? "down" : "up"));
         (dir ? in.down_um : in.up_um).back().push_back(it->second);
       }
   }
@@ -81,7 +87,8 @@ dsp::eval::PositioningInput read_ecmc_dat(const std::string& file) {
     for (char ch : line)
       if (ch != ' ' && ch != '\t') t += ch;
     const auto open = t.find('['), close = t.find(']'), eq = t.find('=');
-    if (open == std::string::npos || close == std::string::npos || eq == std::string::npos || !(open < close && close < eq))
+    if (open == std::string::npos || close == std::string::npos || eq == std::string::npos ||
+        !(open < close && close < eq))
       throw dsp::InputError(file + ":" + std::to_string(no) + ": not a TGT_DATA or REF_DATA line: '" + line + "'");
     const std::string name = t.substr(0, open), index = t.substr(open + 1, close - open - 1), value = t.substr(eq + 1);
     auto int_of = [&](const std::string& s) {
@@ -95,10 +102,13 @@ dsp::eval::PositioningInput read_ecmc_dat(const std::string& file) {
       targets[int_of(index)] = number(value);
     } else if (name == "REF_DATA_FWD" || name == "REF_DATA_BWD") {
       const auto comma = index.find(',');
-      if (comma == std::string::npos) throw dsp::InputError(file + ":" + std::to_string(no) + ": " + name + " needs [target,cycle]");
-      refs[{name == "REF_DATA_FWD" ? 0 : 1, int_of(index.substr(0, comma)), int_of(index.substr(comma + 1))}] = number(value);
+      if (comma == std::string::npos)
+        throw dsp::InputError(file + ":" + std::to_string(no) + ": " + name + " needs [target,cycle]");
+      refs[{name == "REF_DATA_FWD" ? 0 : 1, int_of(index.substr(0, comma)), int_of(index.substr(comma + 1))}] =
+          number(value);
     } else {
-      throw dsp::InputError(file + ":" + std::to_string(no) + ": unknown name '" + name + "' (TGT_DATA, REF_DATA_FWD, REF_DATA_BWD)");
+      throw dsp::InputError(file + ":" + std::to_string(no) + ": unknown name '" + name +
+                            "' (TGT_DATA, REF_DATA_FWD, REF_DATA_BWD)");
     }
   }
   if (targets.empty()) throw dsp::InputError(file + ": no TGT_DATA lines");
@@ -113,7 +123,8 @@ dsp::eval::PositioningInput read_ecmc_dat(const std::string& file) {
       for (int dir = 0; dir < 2; ++dir) {
         const auto it = refs.find({dir, i, j});
         if (it == refs.end())
-          throw dsp::InputError(file + ": REF_DATA_" + (dir ? "BWD" : "FWD") + "[" + std::to_string(i) + "," + std::to_string(j) + "] is missing");
+          throw dsp::InputError(file + ": REF_DATA_" + (dir ? "BWD" : "FWD") + "[" + std::to_string(i) + "," +
+                                std::to_string(j) + "] is missing");
         (dir ? in.down_um : in.up_um).back().push_back((it->second - t) * 1000.0);  // REF − TGT, µm
       }
   }

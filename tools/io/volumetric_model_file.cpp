@@ -104,9 +104,12 @@ std::string volumetric_model_toml(const dsp::comp::VolumetricFit& f, const std::
   for (int k = 0; k < 18; ++k) {
     const auto& c = f.component[k];
     t += "\n[[component]]\nname = \"" + std::string(kVolumetricComponents[k]) + "\"\n";
-    t += "positions_mm = " + numbers(m.component[k].pos_mm) + "\nvalues = " + numbers(m.component[k].values, "%.4f") + "\n";
-    if (c.observed) t += "u_k2 = " + numbers(c.u_k2, "%.4f") + "\n";
-    else t += "observed = false\n";
+    t += "positions_mm = " + numbers(m.component[k].pos_mm) + "\nvalues = " + numbers(m.component[k].values, "%.4f") +
+         "\n";
+    if (c.observed)
+      t += "u_k2 = " + numbers(c.u_k2, "%.4f") + "\n";
+    else
+      t += "observed = false\n";
     t += "note = " + toml_string(c.note) + "\n";
   }
   return t;

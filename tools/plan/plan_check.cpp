@@ -75,7 +75,8 @@ std::vector<CheckRow> check_plan(const TestProgram& p, int repeats, int draws) {
     for (std::size_t k = 0; k < keys.size(); ++k) {
       const auto* m = dsp::find_figure(measured, keys[k]);
       const auto* t = dsp::find_figure(true_figs, keys[k]);
-      if (m && t && !m->values.empty() && m->values.size() == t->values.size()) errors[k].push_back(m->values[0] - t->values[0]);
+      if (m && t && !m->values.empty() && m->values.size() == t->values.size())
+        errors[k].push_back(m->values[0] - t->values[0]);
     }
   }
   std::vector<CheckRow> rows;
@@ -101,15 +102,19 @@ std::vector<CheckRow> check_plan(const TestProgram& p, int repeats, int draws) {
 std::string check_table(const std::vector<CheckRow>& rows) {
   std::string o;
   char b[320];
-  std::snprintf(b, sizeof b, "  %-58s %-34s %9s %9s %7s %9s %9s %8s\n", "program", "figure", "U plan", "U sim", "ratio", "mean err", "sd err", "repeats");
+  std::snprintf(b, sizeof b, "  %-58s %-34s %9s %9s %7s %9s %9s %8s\n", "program", "figure", "U plan", "U sim", "ratio",
+                "mean err", "sd err", "repeats");
   o += b;
   for (const auto& r : rows) {
-    std::snprintf(b, sizeof b, "  %-58s %-34s %9.3f %9.3f %7.2f %9.3f %9.3f %4d (+%d)%s\n", r.program.substr(0, 58).c_str(), r.key.c_str(), r.predicted_u,
-                  r.empirical_u, r.ratio(), r.mean_error, r.sd_error, r.repeats, r.degraded, std::abs(r.ratio() - 1.0) <= 0.3 ? "" : "  OUT");
+    std::snprintf(b, sizeof b, "  %-58s %-34s %9.3f %9.3f %7.2f %9.3f %9.3f %4d (+%d)%s\n",
+                  r.program.substr(0, 58).c_str(), r.key.c_str(), r.predicted_u, r.empirical_u, r.ratio(), r.mean_error,
+                  r.sd_error, r.repeats, r.degraded, std::abs(r.ratio() - 1.0) <= 0.3 ? "" : "  OUT");
     o += b;
   }
-  o += "  (U plan: predicted before the test; U sim: |mean error| + 2 sd over the repeats against the truth; within 30 % is the target;\n"
-       "   repeats: runs compared (+ degraded runs left out: the strips disagreed with the data sheet's sensors, flagged, with their own U))\n";
+  o += "  (U plan: predicted before the test; U sim: |mean error| + 2 sd over the repeats against the truth; within 30 "
+       "% is the target;\n"
+       "   repeats: runs compared (+ degraded runs left out: the strips disagreed with the data sheet's sensors, "
+       "flagged, with their own U))\n";
   return o;
 }
 

@@ -37,17 +37,20 @@ double feed_cap(const TestProgram& p) {
 std::string describe(const TestProgram& p) {
   std::string s;
   if (p.kind == "circle") {
-    s = "circle R" + g(p.radius_mm) + " F" + g(p.feed_mm_min) + " " + p.direction + " x" + std::to_string(p.repeats) + " in " + p.plane;
+    s = "circle R" + g(p.radius_mm) + " F" + g(p.feed_mm_min) + " " + p.direction + " x" + std::to_string(p.repeats) +
+        " in " + p.plane;
     if (p.arc_deg < 360.0) s += ", " + g(p.arc_deg) + " deg arc";
   } else if (p.kind == "positioning") {
-    s = "positioning x " + g(p.targets_mm.front()) + ".." + g(p.targets_mm.back()) + " mm, " + std::to_string(p.targets_mm.size()) + " targets, " +
-        std::to_string(p.runs) + " runs, F" + g(p.feed_mm_min);
+    s = "positioning x " + g(p.targets_mm.front()) + ".." + g(p.targets_mm.back()) + " mm, " +
+        std::to_string(p.targets_mm.size()) + " targets, " + std::to_string(p.runs) + " runs, F" + g(p.feed_mm_min);
   } else if (p.kind == "step") {
-    s = "step x " + g(p.from_mm) + " -> " + g(p.to_mm) + " mm, " + std::to_string(p.runs) + " pairs, F" + g(p.feed_mm_min);
+    s = "step x " + g(p.from_mm) + " -> " + g(p.to_mm) + " mm, " + std::to_string(p.runs) + " pairs, F" +
+        g(p.feed_mm_min);
   } else {
     s = "rectangle " + g(p.size_mm[0]) + " x " + g(p.size_mm[1]) + " mm in " + p.plane + ", F" + g(p.feed_mm_min);
   }
-  s += p.psd.empty() ? ", no PSD strips" : ", " + std::to_string(p.psd.size()) + " PSD strip" + (p.psd.size() > 1 ? "s" : "");
+  s += p.psd.empty() ? ", no PSD strips"
+                     : ", " + std::to_string(p.psd.size()) + " PSD strip" + (p.psd.size() > 1 ? "s" : "");
   if (p.identified) s += ", sensors identified on site first (eical gen-nc identify, eical identify)";
   return s;
 }
@@ -117,7 +120,8 @@ sim::Scenario scenario_on_drawn_machine(const TestProgram& p, std::uint64_t seed
   sc.meta.machine = bg.meta.machine;
   for (int s = 0; s < 2; ++s) {
     sc.truth[s] = bg.truth[s];
-    sc.truth[s].spec.noise_ug_per_rthz = p.noise_ug_per_rthz * bg.truth[s].spec.noise_ug_per_rthz / bg.meta.sensors[s].noise_ug_per_rthz;
+    sc.truth[s].spec.noise_ug_per_rthz =
+        p.noise_ug_per_rthz * bg.truth[s].spec.noise_ug_per_rthz / bg.meta.sensors[s].noise_ug_per_rthz;
   }
   sc.daq = bg.daq;
   sc.machine = bg.machine;
@@ -131,7 +135,8 @@ std::vector<sim::PsdTruth> drawn_strips(const std::vector<dsp::PsdSpec>& psd, st
   const double bound = dsp::uncertainty::DatasheetTolerance{}.psd_nonlinearity;
   for (const dsp::PsdSpec& s : psd) {
     // Keyed by the strip's place: the identification and the test cross the same strip.
-    const std::string key = s.measures + ":" + std::to_string(std::llround(s.center_mm[0] * 1000.0)) + "," + std::to_string(std::llround(s.center_mm[1] * 1000.0));
+    const std::string key = s.measures + ":" + std::to_string(std::llround(s.center_mm[0] * 1000.0)) + "," +
+                            std::to_string(std::llround(s.center_mm[1] * 1000.0));
     std::mt19937_64 rng(seed ^ std::hash<std::string>{}(key));
     sim::PsdTruth t;
     t.nonlinearity = std::uniform_real_distribution<double>(-bound, bound)(rng);
@@ -154,10 +159,13 @@ dsp::uncertainty::SensorModelCovariance typical_identification(const TestProgram
 }
 
 double duration_s(const dsp::Run& run) {
-  return run.frames.empty() ? 0.0 : static_cast<double>(run.frames.back().sample_index - run.frames.front().sample_index) / run.fs_hz();
+  return run.frames.empty()
+             ? 0.0
+             : static_cast<double>(run.frames.back().sample_index - run.frames.front().sample_index) / run.fs_hz();
 }
 
-Prediction predict(const TestProgram& p, std::uint64_t seed, int draws, const std::optional<dsp::uncertainty::SensorModelCovariance>& identified) {
+Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
+                   const std::optional<dsp::uncertainty::SensorModelCovariance>& identified) {
   const dsp::Run run = sim::simulate(scenario_of(p, seed));
   dsp::AnalysisOptions o;
   o.uncertainty.draws = draws;
@@ -217,7 +225,8 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
     }
   } else if (p.kind == "step" || p.kind == "positioning") {
     TestProgram t = s;
-    if (p.kind == "step") t.to_mm = t.from_mm + 0.5 * (t.to_mm - t.from_mm);
+    if (p.kind == "step")
+      t.to_mm = t.from_mm + 0.5 * (t.to_mm - t.from_mm);
     else
       for (auto& x : t.targets_mm) x = t.targets_mm.front() + 0.5 * (x - t.targets_mm.front());
     t.psd = strips_for(t);
@@ -236,10 +245,14 @@ std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_du
   for (const TestProgram& t : variants(p)) {
     // A rough duration first (the set-point's time), so that long variants are not simulated.
     double path_mm = 0.0;
-    if (t.kind == "circle") path_mm = 2.0 * 3.14159265358979 * t.radius_mm * t.arc_deg / 360.0 * t.repeats * (t.direction == "both" ? 2 : 1);
-    else if (t.kind == "step") path_mm = 2.0 * std::abs(t.to_mm - t.from_mm) * t.runs;
-    else if (t.kind == "positioning") path_mm = 2.0 * std::abs(t.targets_mm.back() - t.targets_mm.front()) * t.runs;
-    else path_mm = 2.0 * (t.size_mm[0] + t.size_mm[1]) * std::max(1, t.repeats);
+    if (t.kind == "circle")
+      path_mm = 2.0 * 3.14159265358979 * t.radius_mm * t.arc_deg / 360.0 * t.repeats * (t.direction == "both" ? 2 : 1);
+    else if (t.kind == "step")
+      path_mm = 2.0 * std::abs(t.to_mm - t.from_mm) * t.runs;
+    else if (t.kind == "positioning")
+      path_mm = 2.0 * std::abs(t.targets_mm.back() - t.targets_mm.front()) * t.runs;
+    else
+      path_mm = 2.0 * (t.size_mm[0] + t.size_mm[1]) * std::max(1, t.repeats);
     if (path_mm / (t.feed_mm_min / 60.0) > max_duration_s) continue;
     if (t.identified && !identified) identified = typical_identification(t);
     Prediction r = predict(t, 1, draws, identified);
@@ -256,10 +269,13 @@ void suggest_measurable_test(const dsp::Run& run, dsp::Analysis& a) {
   const dsp::ResolutionLimit* lim = dsp::resolution_limit(run.meta.program.kind);
   if (!lim) return;
   if (a.measurement.supports.psd_disagrees)
-    a.verdict_reasons.push_back("the PSD readings disagree with the data sheet's sensor model: identify the sensors (eical gen-nc identify, eical identify)");
+    a.verdict_reasons.push_back(
+        "the PSD readings disagree with the data sheet's sensor model: identify the sensors (eical gen-nc identify, "
+        "eical identify)");
   const auto it = a.uncertainty_k2.find(lim->limited);
   if (it == a.uncertainty_k2.end() || it->second.size() != 1 || !(it->second[0] > lim->limit)) {
-    a.verdict_reasons.push_back("the test resolves what it is meant to: the machine's figure is within the test's uncertainty");
+    a.verdict_reasons.push_back(
+        "the test resolves what it is meant to: the machine's figure is within the test's uncertainty");
     return;
   }
   TestProgram p;
@@ -272,8 +288,8 @@ void suggest_measurable_test(const dsp::Run& run, dsp::Analysis& a) {
   }
   char b[256];
   if (const auto best = nearest_measurable(p, 30.0, 60)) {
-    std::snprintf(b, sizeof b, "a test that would be measurable (eical plan): %s, predicted U(%s) = %.2f µm", describe(best->program).c_str(),
-                  lim->limited_name, best->limited_u);
+    std::snprintf(b, sizeof b, "a test that would be measurable (eical plan): %s, predicted U(%s) = %.2f µm",
+                  describe(best->program).c_str(), lim->limited_name, best->limited_u);
     a.verdict_reasons.push_back(b);
   } else {
     a.verdict_reasons.push_back("no nearby variant of this test is measurable (eical plan lists what was tried)");

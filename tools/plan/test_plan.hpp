@@ -21,18 +21,18 @@
 namespace eical::tools::plan {
 
 struct TestProgram {
-  std::string kind = "circle";   // circle | positioning | step | rectangle
+  std::string kind = "circle";  // circle | positioning | step | rectangle
   std::string plane = "xy", direction = "ccw";
   double radius_mm = 10.0, feed_mm_min = 2500.0, arc_deg = 360.0;
-  int repeats = 5;                                   // circle revolutions, rectangle laps
+  int repeats = 5;                                              // circle revolutions, rectangle laps
   std::vector<double> targets_mm{0.0, 10.0, 20.0, 30.0, 40.0};  // positioning
-  int runs = 5;                                      // positioning runs, step pairs
-  double from_mm = 0.0, to_mm = 50.0;                // step
-  double size_mm[2] = {50.0, 50.0};                  // rectangle
-  std::vector<dsp::PsdSpec> psd;                     // the strips on the machine
-  double noise_ug_per_rthz = 0.4;                    // each sensor, two-sided
-  double fs_hz = 10000.0;                            // the DAQ's rate
-  bool identified = false;                           // sensors identified on site first (eical identify)
+  int runs = 5;                                                 // positioning runs, step pairs
+  double from_mm = 0.0, to_mm = 50.0;                           // step
+  double size_mm[2] = {50.0, 50.0};                             // rectangle
+  std::vector<dsp::PsdSpec> psd;                                // the strips on the machine
+  double noise_ug_per_rthz = 0.4;                               // each sensor, two-sided
+  double fs_hz = 10000.0;                                       // the DAQ's rate
+  bool identified = false;                                      // sensors identified on site first (eical identify)
 };
 
 // "circle R10 F2500 ccw ×5 in xy, 2 PSD strips".
@@ -65,7 +65,7 @@ struct Prediction {
   std::map<std::string, double> u_k2;  // scalar figures
   std::string headline, limited;       // result keys (verdict.hpp)
   double limited_u = 0.0, limit = 0.0;
-  bool measurable = false;             // U(limited) within what the test is meant to resolve
+  bool measurable = false;  // U(limited) within what the test is meant to resolve
   double duration_s = 0.0;
 };
 

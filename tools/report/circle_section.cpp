@@ -12,9 +12,11 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
   const auto [na, nb] = plane_axis_names(p.plane);
   const bool partial = c.arc_deg < 360.0;
   Section s;
-  s.heading = partial ? "Circular test (ISO 230-4), " + fmt("%.0f", c.arc_deg) + "° partial arc" : "Circular test (ISO 230-4)";
-  s.lead = "Radius deviation along the path, both directions where measured; plot magnified about the reference circle as "
-           "on a ballbar plot.";
+  s.heading =
+      partial ? "Circular test (ISO 230-4), " + fmt("%.0f", c.arc_deg) + "° partial arc" : "Circular test (ISO 230-4)";
+  s.lead =
+      "Radius deviation along the path, both directions where measured; plot magnified about the reference circle as "
+      "on a ballbar plot.";
   // One trace per revolution and direction, each its own colour, closed when it is a full
   // revolution, a marker where it begins.
   const FigureRows fr(a);
@@ -28,7 +30,8 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
         if (c.trace.direction[i] == dir && c.trace.revolution[i] == rev)
           t.angle_deg.push_back(c.trace.angle_deg[i]), t.deviation_um.push_back(c.trace.radius_deviation_um[i]);
       if (t.angle_deg.empty()) continue;
-      t.label = std::string(ccw ? "ccw (G3)" : "cw (G2)") + (partial ? ", arc " : ", revolution ") + std::to_string(rev + 1);
+      t.label =
+          std::string(ccw ? "ccw (G3)" : "cw (G2)") + (partial ? ", arc " : ", revolution ") + std::to_string(rev + 1);
       t.closed = !partial;
       t.start_marker = true;
       polar.push_back(std::move(t));
@@ -42,8 +45,10 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
     };
     subtitle = "G ccw " + g("circle.circular_deviation_G_ccw_um") + ",  G cw " + g("circle.circular_deviation_G_cw_um");
   } else {
-    subtitle = "G " + fmt("%.2f", c.circular_deviation_G_um) + (fr.u("circle.circular_deviation_G_um") ? " ± " + fmt("%.2f", *fr.u("circle.circular_deviation_G_um")) : "") + " µm, " +
-               (c.direction == "cw" ? "clockwise" : "counter-clockwise");
+    subtitle =
+        "G " + fmt("%.2f", c.circular_deviation_G_um) +
+        (fr.u("circle.circular_deviation_G_um") ? " ± " + fmt("%.2f", *fr.u("circle.circular_deviation_G_um")) : "") +
+        " µm, " + (c.direction == "cw" ? "clockwise" : "counter-clockwise");
   }
   s.svgs.push_back(polar_plot(polar, "Radius deviation, " + p.plane + " plane", "+" + na, "+" + nb, 0.0, subtitle));
   Table iso{"ISO 230-4 figures (± U, k = 2)", {}};
@@ -52,12 +57,14 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
               {partial ? "Arcs evaluated" : "Revolutions evaluated", static_cast<double>(c.revolutions), "", 0,
                c.direction == "both" ? "both directions" : c.direction},
               fr.row("circle.radius_mean_deviation_um", "Mean radius deviation", "µm", 2, "measured − nominal"),
-              fr.row("circle.circular_deviation_G_um", "Circular deviation G", "µm", 2, partial ? "about the programmed centre" : "about the LSQ centre")};
+              fr.row("circle.circular_deviation_G_um", "Circular deviation G", "µm", 2,
+                     partial ? "about the programmed centre" : "about the LSQ centre")};
   if (c.direction == "both") {
     iso.rows.push_back(fr.row("circle.circular_deviation_G_ccw_um", "G, counter-clockwise", "µm", 2));
     iso.rows.push_back(fr.row("circle.circular_deviation_G_cw_um", "G, clockwise", "µm", 2));
   }
-  Figure h = fr.row("circle.circular_hysteresis_H_um", "Circular hysteresis H", "µm", 2, c.circular_hysteresis_H_um ? "max over 1° bins" : "needs both directions");
+  Figure h = fr.row("circle.circular_hysteresis_H_um", "Circular hysteresis H", "µm", 2,
+                    c.circular_hysteresis_H_um ? "max over 1° bins" : "needs both directions");
   iso.rows.push_back(h);
   iso.rows.push_back(fr.row("circle.radial_deviation_F_max_um", "Radial deviation F max", "µm", 2));
   iso.rows.push_back(fr.row("circle.radial_deviation_F_min_um", "Radial deviation F min", "µm", 2));
@@ -72,9 +79,11 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
                fr.row("diagnostics.reversal_spike_y_um", "Reversal spike " + nb, "µm", 2),
                fr.row("diagnostics.lateral_play_x_um", "Lateral play " + na, "µm", 2),
                fr.row("diagnostics.lateral_play_y_um", "Lateral play " + nb, "µm", 2),
-               fr.row("diagnostics.cyclic_error_x_um", "Cyclic error " + na, "µm", 2, "pitch " + fmt("%.1f mm", d.cyclic_pitch_mm)),
+               fr.row("diagnostics.cyclic_error_x_um", "Cyclic error " + na, "µm", 2,
+                      "pitch " + fmt("%.1f mm", d.cyclic_pitch_mm)),
                fr.row("diagnostics.cyclic_error_y_um", "Cyclic error " + nb, "µm", 2),
-               fr.row("diagnostics.servo_mismatch_ms", "Servo mismatch", "ms", 3, sep ? na + " lag − " + nb + " lag" : "needs both directions"),
+               fr.row("diagnostics.servo_mismatch_ms", "Servo mismatch", "ms", 3,
+                      sep ? na + " lag − " + nb + " lag" : "needs both directions"),
                fr.row("diagnostics.squareness_urad", "Squareness", "µrad", 1, "+: angle above 90°"),
                fr.row("diagnostics.scale_mismatch_ppm", "Scale mismatch", "ppm", 1, na + " − " + nb),
                fr.row("diagnostics.straightness_x_um", "Straightness " + na, "µm", 2),
@@ -83,17 +92,20 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
                fr.row("diagnostics.vibration_um", "Vibration", "µm", 2, "radial, fast")};
     s.tables.push_back(dt);
     for (const auto& n : d.notes) s.notes.push_back(n);
-    s.notes.push_back("A diagnostic whose magnitude is not above its uncertainty U is marked \"not resolved\": the measurement cannot tell it "
-                      "from zero, and eical comp never compensates it.");
+    s.notes.push_back(
+        "A diagnostic whose magnitude is not above its uncertainty U is marked \"not resolved\": the measurement "
+        "cannot tell it "
+        "from zero, and eical comp never compensates it.");
   } else {
     s.notes.push_back(partial ? "Diagnostics: not evaluated on a partial arc (they need full revolutions)."
                               : "Diagnostics: could not be determined (see the flags above).");
   }
-  s.notes.push_back(partial ? "Partial arc: the radius is measured from the programmed centre (as a ballbar measures from its "
-                              "pivot), because a centre fitted to a partial arc trades off against the radius. A real centre "
-                              "offset therefore shows as a once-per-revolution term and enters G and F."
-                            : "Each revolution is evaluated about its own least-squares centre (the integration drift of an "
-                              "inertial measurement moves the centre slowly; a ballbar's pivot does the same job).");
+  s.notes.push_back(
+      partial ? "Partial arc: the radius is measured from the programmed centre (as a ballbar measures from its "
+                "pivot), because a centre fitted to a partial arc trades off against the radius. A real centre "
+                "offset therefore shows as a once-per-revolution term and enters G and F."
+              : "Each revolution is evaluated about its own least-squares centre (the integration drift of an "
+                "inertial measurement moves the centre slowly; a ballbar's pivot does the same job).");
   if (a.circle_reference && a.circle_accuracy_rms_um) {
     Table r{"Against the reference (" + (run.meta.reference ? run.meta.reference->kind : std::string("ref")) + ")", {}};
     r.rows = {{"Radius deviation error (RMS)", *a.circle_accuracy_rms_um, "µm", 3, "eical − reference"},

@@ -16,14 +16,16 @@ namespace {
 
 namespace hv = history_view;
 
-constexpr std::array<const char*, 8> kPalette = {kBlue, kRed, kGreen, "#8e44ad", "#d35400", "#16a085", "#2c3e50", kGrey};
+constexpr std::array<const char*, 8> kPalette = {kBlue,     kRed,      kGreen,    "#8e44ad",
+                                                 "#d35400", "#16a085", "#2c3e50", kGrey};
 
 // The stored circle trace as polylines: one per stretch of one direction, split where the
 // angle wraps (a new revolution), so no line is drawn across the plot.
 std::vector<PolarTrace> polar_traces(const history::Record& r, const std::string& label, const char* color) {
   std::vector<PolarTrace> out;
   const auto doc = nlohmann::json::parse(r.document, nullptr, false);
-  if (!doc.is_object() || !doc.contains("circle") || !doc["circle"].is_object() || !doc["circle"].contains("trace")) return out;
+  if (!doc.is_object() || !doc.contains("circle") || !doc["circle"].is_object() || !doc["circle"].contains("trace"))
+    return out;
   const auto& t = doc["circle"]["trace"];
   if (!t.contains("angle_deg") || !t.contains("radius_deviation_um")) return out;
   const auto& ang = t["angle_deg"];
@@ -58,11 +60,13 @@ std::string judgement_text(history::Judgement j) {
 
 }  // namespace
 
-std::string trend_plot(const std::string& figure, const std::vector<history::TrendPoint>& points, const std::vector<std::string>& marked) {
+std::string trend_plot(const std::string& figure, const std::vector<history::TrendPoint>& points,
+                       const std::vector<std::string>& marked) {
   std::optional<double> t0;
   std::string first_day;
   for (const auto& p : points)
-    if (const auto s = history::epoch_s(p.measured_at); s && (!t0 || *s < *t0)) t0 = *s, first_day = short_date(p.measured_at);
+    if (const auto s = history::epoch_s(p.measured_at); s && (!t0 || *s < *t0))
+      t0 = *s, first_day = short_date(p.measured_at);
   std::map<std::string, std::size_t> machine_index;
   for (const auto& p : points) machine_index.emplace(p.machine, machine_index.size());
   std::vector<LineSeries> series;
@@ -84,16 +88,18 @@ std::string trend_plot(const std::string& figure, const std::vector<history::Tre
     d.x.push_back(x), d.y.push_back(*p.value);
     const double u = p.uncertainty_k2.value_or(NAN);
     d.y_lo.push_back(*p.value - u), d.y_hi.push_back(*p.value + u);
-    if (std::find(marked.begin(), marked.end(), p.run_id) != marked.end()) ring.x.push_back(x), ring.y.push_back(*p.value);
+    if (std::find(marked.begin(), marked.end(), p.run_id) != marked.end())
+      ring.x.push_back(x), ring.y.push_back(*p.value);
   }
   if (!ring.x.empty()) series.push_back(ring);
   const std::string unit = history::unit_of(figure);
-  return line_plot(series, history::label_of(figure) + " over time (bars: ± U, k = 2)", "days since " + (first_day.empty() ? "the first result" : first_day),
+  return line_plot(series, history::label_of(figure) + " over time (bars: ± U, k = 2)",
+                   "days since " + (first_day.empty() ? "the first result" : first_day),
                    history::label_of(figure) + (unit.empty() ? "" : " (" + unit + ")"), 760, 320);
 }
 
-Page trend_page(const std::string& figure, const std::vector<history::TrendPoint>& points, const std::vector<history::TrendSummary>& summaries,
-                const std::string& store) {
+Page trend_page(const std::string& figure, const std::vector<history::TrendPoint>& points,
+                const std::vector<history::TrendSummary>& summaries, const std::string& store) {
   Page page;
   page.title = "Calibration history: trend";
   page.run_id = figure;
@@ -108,9 +114,9 @@ Page trend_page(const std::string& figure, const std::vector<history::TrendPoint
   for (const auto& m : summaries)
     drift.rows.push_back({m.machine, m.first ? hv::measure(m.first->value, m.first->uncertainty_k2, unit) : "n/a",
                           m.last ? hv::measure(m.last->value, m.last->uncertainty_k2, unit) : "n/a",
-                          m.slope_per_30d                             ? hv::measure(m.slope_per_30d, m.slope_u_k2, unit)
+                          m.slope_per_30d                            ? hv::measure(m.slope_per_30d, m.slope_u_k2, unit)
                           : m.span_days < history::kMinDriftSpanDays ? "results span less than a day"
-                                                                      : "too few results",
+                                                                     : "too few results",
                           m.slope_per_30d ? (m.drift_significant ? "significant" : "within its uncertainty") : ""});
   s.grids.push_back(drift);
   Grid all{"Results", {"measured (UTC)", "machine", "run", "value ± U (k = 2)", "verdict"}, {}};
@@ -118,18 +124,23 @@ Page trend_page(const std::string& figure, const std::vector<history::TrendPoint
     all.rows.push_back({hv::when(p.measured_at), p.machine, p.run_id, hv::measure(p.value, p.uncertainty_k2, unit),
                         p.verdict.value_or("-") + (p.degraded ? " (degraded)" : "")});
   s.grids.push_back(all);
-  s.notes.push_back("Drift: a straight line through the results weighted by their uncertainty (σ = U/2), its uncertainty enlarged by √(χ²/dof) "
-                    "when they scatter more than their uncertainties allow; significant when the slope exceeds its expanded uncertainty.");
+  s.notes.push_back(
+      "Drift: a straight line through the results weighted by their uncertainty (σ = U/2), its uncertainty enlarged by "
+      "√(χ²/dof) "
+      "when they scatter more than their uncertainties allow; significant when the slope exceeds its expanded "
+      "uncertainty.");
   page.sections.push_back(std::move(s));
   return page;
 }
 
 Page compare_page(const history::Comparison& c, const history::Record& before, const history::Record& after,
-                  const std::vector<std::pair<std::string, std::vector<history::TrendPoint>>>& trends, const std::string& store) {
+                  const std::vector<std::pair<std::string, std::vector<history::TrendPoint>>>& trends,
+                  const std::string& store) {
   Page page;
   page.title = "Calibration history: comparison";
   page.run_id = before.run_id + " → " + after.run_id;
-  page.program = before.machine == after.machine ? before.machine + ", " + before.program : before.machine + " → " + after.machine;
+  page.program =
+      before.machine == after.machine ? before.machine + ", " + before.program : before.machine + " → " + after.machine;
   page.context = {{"before", hv::when(before.measured_at) + " UTC, " + before.verdict.value_or("no verdict")},
                   {"after", hv::when(after.measured_at) + " UTC, " + after.verdict.value_or("no verdict")},
                   {"store", store}};
@@ -145,20 +156,29 @@ Page compare_page(const history::Comparison& c, const history::Record& before, c
   if (both_circles) {
     const auto doc = nlohmann::json::parse(after.document, nullptr, false);
     const std::string plane = doc.is_object() && doc.contains("circle") ? doc["circle"].value("plane", "xy") : "xy";
-    const std::string a = plane == "zx" ? "Z" : plane == "yz" ? "Y" : "X", b = plane == "zx" ? "X" : plane == "yz" ? "Z" : "Y";
+    const std::string a = plane == "zx"   ? "Z"
+                          : plane == "yz" ? "Y"
+                                          : "X",
+                      b = plane == "zx"   ? "X"
+                          : plane == "yz" ? "Z"
+                                          : "Y";
     p.svgs.push_back(polar_plot(polar, "Radius deviation, " + plane + " plane", "+" + a, "+" + b));
   } else {
-    p.notes.push_back("Polar plots need two circular tests with their traces; these results are " + before.program + " and " + after.program + ".");
+    p.notes.push_back("Polar plots need two circular tests with their traces; these results are " + before.program +
+                      " and " + after.program + ".");
   }
   Grid sig{"Significant changes", {"figure", "before", "after", "difference"}, {}};
   for (const auto& f : c.figures)
     if (f.judgement == history::Judgement::significant) {
       const std::string unit = history::unit_of(f.name);
-      sig.rows.push_back({history::label_of(f.name), hv::measure(f.before, f.u_before, unit), hv::measure(f.after, f.u_after, unit),
-                          hv::measure(f.difference, f.uncertainty_k2, unit)});
+      sig.rows.push_back({history::label_of(f.name), hv::measure(f.before, f.u_before, unit),
+                          hv::measure(f.after, f.u_after, unit), hv::measure(f.difference, f.uncertainty_k2, unit)});
     }
-  if (sig.rows.empty()) p.notes.push_back("No figure changed significantly: every change is within its uncertainty or could not be judged.");
-  else p.grids.push_back(sig);
+  if (sig.rows.empty())
+    p.notes.push_back(
+        "No figure changed significantly: every change is within its uncertainty or could not be judged.");
+  else
+    p.grids.push_back(sig);
   page.sections.push_back(std::move(p));
 
   Section f;
@@ -167,8 +187,10 @@ Page compare_page(const history::Comparison& c, const history::Record& before, c
   Grid g{"", {"figure", "before", "after", "difference", "judgement"}, {}};
   for (const auto& fc : c.figures) {
     const std::string unit = history::unit_of(fc.name);
-    g.rows.push_back({history::label_of(fc.name) + " (" + fc.name + ")", hv::measure(fc.before, fc.u_before, unit), hv::measure(fc.after, fc.u_after, unit),
-                      fc.difference ? hv::measure(fc.difference, fc.uncertainty_k2, unit) : "-", judgement_text(fc.judgement)});
+    g.rows.push_back({history::label_of(fc.name) + " (" + fc.name + ")", hv::measure(fc.before, fc.u_before, unit),
+                      hv::measure(fc.after, fc.u_after, unit),
+                      fc.difference ? hv::measure(fc.difference, fc.uncertainty_k2, unit) : "-",
+                      judgement_text(fc.judgement)});
   }
   f.grids.push_back(g);
   page.sections.push_back(std::move(f));

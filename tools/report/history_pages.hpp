@@ -24,6 +24,7 @@ Page trend_page(const std::string& figure, const std::vector<history::TrendPoint
 
 // `trends`: figure name → its points on the machine (for the significantly changed figures).
 Page compare_page(const history::Comparison& c, const history::Record& before, const history::Record& after,
-                  const std::vector<std::pair<std::string, std::vector<history::TrendPoint>>>& trends, const std::string& store);
+                  const std::vector<std::pair<std::string, std::vector<history::TrendPoint>>>& trends,
+                  const std::string& store);
 
 }  // namespace eical::tools::report

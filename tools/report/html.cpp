@@ -93,7 +93,9 @@ std::string format_value(const Figure& f) {
   return out;
 }
 
-bool not_resolved(const Figure& f) { return f.value && f.u && std::isfinite(*f.value) && std::isfinite(*f.u) && !(std::abs(*f.value) > *f.u); }
+bool not_resolved(const Figure& f) {
+  return f.value && f.u && std::isfinite(*f.value) && std::isfinite(*f.u) && !(std::abs(*f.value) > *f.u);
+}
 
 std::string cell_class(const std::string& text) {
   if (text == "pass" || text == "fail" || text == "undecided") return text;
@@ -114,7 +116,8 @@ std::string grid_html(const Grid& g) {
   out += "</tr>\n";
   for (const auto& r : g.rows) {
     out += "<tr>";
-    for (std::size_t i = 0; i < r.size(); ++i) out += (i ? "<td class=\"" + cell_class(r[i]) + "\">" : "<td>") + xml_escape(r[i]) + "</td>";
+    for (std::size_t i = 0; i < r.size(); ++i)
+      out += (i ? "<td class=\"" + cell_class(r[i]) + "\">" : "<td>") + xml_escape(r[i]) + "</td>";
     out += "</tr>\n";
   }
   return out + "</table>\n";
@@ -125,13 +128,16 @@ std::string grid_html(const Grid& g) {
 std::string render_html(const Page& page) {
   std::string out;
   out.reserve(256 * 1024);
-  out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" + xml_escape(page.title + " — " + page.run_id) +
-         "</title>\n<style>" + kStyle + "</style></head><body>\n<header>\n<div class=\"brand\">eical · inertial machine-tool calibration</div>\n";
+  out += "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" +
+         xml_escape(page.title + " — " + page.run_id) + "</title>\n<style>" + kStyle +
+         "</style></head><body>\n<header>\n<div class=\"brand\">eical · inertial machine-tool calibration</div>\n";
   out += "<h1>" + xml_escape(page.title) + "</h1>\n";
-  out += "<div class=\"prog\">Run <span class=\"runid\">" + xml_escape(page.run_id) + "</span> &nbsp;·&nbsp; " + xml_escape(page.program) + "</div>\n";
+  out += "<div class=\"prog\">Run <span class=\"runid\">" + xml_escape(page.run_id) + "</span> &nbsp;·&nbsp; " +
+         xml_escape(page.program) + "</div>\n";
   if (!page.context.empty()) {
     out += "<dl class=\"ctx\">";
-    for (const auto& [k, v] : page.context) out += "<div><dt>" + xml_escape(k) + "</dt><dd>" + xml_escape(v) + "</dd></div>";
+    for (const auto& [k, v] : page.context)
+      out += "<div><dt>" + xml_escape(k) + "</dt><dd>" + xml_escape(v) + "</dd></div>";
     out += "</dl>\n";
   }
   out += "</header>\n<main>\n";
@@ -147,7 +153,8 @@ std::string render_html(const Page& page) {
   for (const auto& g : page.summary) out += "<section>" + grid_html(g) + "</section>\n";
   for (const char* sev : {"critical", "warning", "note"})
     for (const auto& f : page.flags)
-      if (f.severity == sev) out += std::string("<div class=\"flag ") + sev + "\"><b>" + sev + "</b> " + xml_escape(f.text) + "</div>\n";
+      if (f.severity == sev)
+        out += std::string("<div class=\"flag ") + sev + "\"><b>" + sev + "</b> " + xml_escape(f.text) + "</div>\n";
   for (const auto& w : page.warnings) out += "<div class=\"warn\">" + xml_escape(w) + "</div>\n";
   for (const auto& s : page.sections) {
     out += "<section><h2>" + xml_escape(s.heading) + "</h2>\n";
@@ -164,8 +171,10 @@ std::string render_html(const Page& page) {
         out += "<table>";
         if (!t.caption.empty()) out += "<caption>" + xml_escape(t.caption) + "</caption>";
         for (const auto& f : t.rows)
-          out += "<tr><td>" + xml_escape(f.label) + "</td><td class=\"v\">" + format_value(f) + "</td><td class=\"u\">" +
-                 xml_escape(f.unit) + "</td><td class=\"n\">" + (not_resolved(f) ? "<span class=\"nr\">not resolved</span>" + std::string(f.note.empty() ? "" : "; ") : "") +
+          out += "<tr><td>" + xml_escape(f.label) + "</td><td class=\"v\">" + format_value(f) +
+                 "</td><td class=\"u\">" + xml_escape(f.unit) + "</td><td class=\"n\">" +
+                 (not_resolved(f) ? "<span class=\"nr\">not resolved</span>" + std::string(f.note.empty() ? "" : "; ")
+                                  : "") +
                  xml_escape(f.note) + "</td></tr>\n";
         out += "</table>\n";
       }
@@ -179,7 +188,8 @@ std::string render_html(const Page& page) {
   if (!page.files.empty()) {
     out += "<footer>Every trace behind the plots, as CSV: ";
     for (std::size_t i = 0; i < page.files.size(); ++i)
-      out += std::string(i ? ", " : "") + "<a href=\"" + xml_escape(page.files[i]) + "\">" + xml_escape(page.files[i]) + "</a>";
+      out += std::string(i ? ", " : "") + "<a href=\"" + xml_escape(page.files[i]) + "\">" + xml_escape(page.files[i]) +
+             "</a>";
     out += ". Machine-readable figures: <a href=\"result.json\">result.json</a> (eical-result/1).";
     if (!page.files_note.empty()) out += " " + xml_escape(page.files_note);
     out += "</footer>\n";

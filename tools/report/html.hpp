@@ -16,7 +16,8 @@ struct Figure {
   std::string unit;
   int decimals = 1;
   std::string note;  // e.g. the reason a figure is missing or a convention
-  std::optional<double> u = std::nullopt;  // expanded uncertainty (k = 2): shown as "value ± U", "not resolved" when |value| <= U
+  std::optional<double> u =
+      std::nullopt;  // expanded uncertainty (k = 2): shown as "value ± U", "not resolved" when |value| <= U
 };
 
 struct Table {
@@ -50,16 +51,16 @@ struct Flag {
 struct Page {
   std::string title;
   std::string run_id;
-  std::string program;                 // e.g. "circle R 10 mm, F 2500 mm/min, XY, both directions"
+  std::string program;  // e.g. "circle R 10 mm, F 2500 mm/min, XY, both directions"
   std::vector<std::pair<std::string, std::string>> context;  // label → value under the header
-  std::vector<std::string> warnings;   // shown at the top, never hidden
-  std::vector<Flag> flags;             // quality flags, critical first
-  std::string verdict;                 // "ok", "degraded", "not_measurable" (a banner when set)
+  std::vector<std::string> warnings;                         // shown at the top, never hidden
+  std::vector<Flag> flags;                                   // quality flags, critical first
+  std::string verdict;                                       // "ok", "degraded", "not_measurable" (a banner when set)
   std::vector<std::string> verdict_reasons;
-  std::vector<Grid> summary;           // right under the banner (e.g. against the tolerances)
+  std::vector<Grid> summary;  // right under the banner (e.g. against the tolerances)
   std::vector<Section> sections;
-  std::vector<std::string> files;      // CSV files next to the report (linked at the end)
-  std::string files_note;              // e.g. how the CSV traces were thinned
+  std::vector<std::string> files;  // CSV files next to the report (linked at the end)
+  std::string files_note;          // e.g. how the CSV traces were thinned
 };
 
 std::string render_html(const Page& page);

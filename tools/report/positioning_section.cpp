@@ -14,7 +14,8 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
   s.heading = "Positioning accuracy and repeatability (ISO 230-2), axis " + r.axis;
   s.lead = std::to_string(r.runs) + " bidirectional runs over " + std::to_string(r.targets.size()) +
            " targets; deviation = measured − target at each stop.";
-  LineSeries up{"mean ↑ ± 2s", kBlue, {}, {}, {}, {}, false, false, 1.6}, down{"mean ↓ ± 2s", kRed, {}, {}, {}, {}, false, false, 1.6};
+  LineSeries up{"mean ↑ ± 2s", kBlue, {}, {}, {}, {}, false, false, 1.6},
+      down{"mean ↓ ± 2s", kRed, {}, {}, {}, {}, false, false, 1.6};
   LineSeries up_pts{"runs ↑", kBlue, {}, {}, {}, {}, true}, down_pts{"runs ↓", kRed, {}, {}, {}, {}, true};
   for (const auto& t : r.targets) {
     up.x.push_back(t.target_mm), up.y.push_back(t.mean_up_um);
@@ -27,8 +28,8 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
       up_pts.x.push_back(in.targets_mm[i]), up_pts.y.push_back(in.up_um[j][i]);
       down_pts.x.push_back(in.targets_mm[i]), down_pts.y.push_back(in.down_um[j][i]);
     }
-  s.svgs.push_back(line_plot({up, down, up_pts, down_pts}, "Positioning deviation, axis " + r.axis, "target position (mm)",
-                             "deviation (µm)", 680, 340));
+  s.svgs.push_back(line_plot({up, down, up_pts, down_pts}, "Positioning deviation, axis " + r.axis,
+                             "target position (mm)", "deviation (µm)", 680, 340));
   LineSeries b{"reversal value B", kGreen, {}, {}};
   for (const auto& t : r.targets) b.x.push_back(t.target_mm), b.y.push_back(t.B_um);
   s.svgs.push_back(line_plot({b}, "Reversal value per target", "target position (mm)", "B (µm)", 680, 220));
@@ -55,31 +56,42 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
             fr.row("positioning.vdi3441.Ps_um", "Position scatter Ps", "µm", 2)};
   s.tables.push_back(v);
   if (!within)
-    s.notes.push_back(std::to_string(r.runs) + " runs per target and direction: ISO 230-2 asks for " + std::to_string(dsp::eval::kIso230_2Runs) +
-                      ". The figures are evaluated by its formulas but are outside the standard (s from fewer runs is less certain).");
+    s.notes.push_back(std::to_string(r.runs) + " runs per target and direction: ISO 230-2 asks for " +
+                      std::to_string(dsp::eval::kIso230_2Runs) +
+                      ". The figures are evaluated by its formulas but are outside the standard (s from fewer runs is "
+                      "less certain).");
   auto pm = [&](const char* key, std::size_t i) {
     const auto val = fr.value(key, i), unc = fr.u(key, i);
     return (val ? fmt("%.2f", *val) : std::string("n/a")) + (unc ? " ± " + fmt("%.2f", *unc) : "");
   };
-  Grid g{"Per target (± U, k = 2)", {"target (mm)", "x̄↑ (µm)", "x̄↓ (µm)", "2s↑ (µm)", "2s↓ (µm)", "Bi (µm)", "Ri (µm)"}, {}};
+  Grid g{"Per target (± U, k = 2)",
+         {"target (mm)", "x̄↑ (µm)", "x̄↓ (µm)", "2s↑ (µm)", "2s↓ (µm)", "Bi (µm)", "Ri (µm)"},
+         {}};
   for (std::size_t i = 0; i < r.targets.size(); ++i) {
     const auto& tg = r.targets[i];
-    g.rows.push_back({fmt("%.3f", tg.target_mm), pm("positioning.per_target.mean_up_um", i), pm("positioning.per_target.mean_down_um", i), fmt("%.2f", 2 * tg.s_up_um),
-                      fmt("%.2f", 2 * tg.s_down_um), pm("positioning.per_target.B_um", i), pm("positioning.per_target.R_um", i)});
+    g.rows.push_back({fmt("%.3f", tg.target_mm), pm("positioning.per_target.mean_up_um", i),
+                      pm("positioning.per_target.mean_down_um", i), fmt("%.2f", 2 * tg.s_up_um),
+                      fmt("%.2f", 2 * tg.s_down_um), pm("positioning.per_target.B_um", i),
+                      pm("positioning.per_target.R_um", i)});
   }
   s.grids.push_back(g);
   page.sections.push_back(std::move(s));
   std::vector<double> tg, run_no, dir, dev;
   for (std::size_t j = 0; j < in.up_um.size(); ++j)
     for (std::size_t i = 0; i < in.targets_mm.size(); ++i) {
-      tg.push_back(in.targets_mm[i]), run_no.push_back(static_cast<double>(j + 1)), dir.push_back(1.0), dev.push_back(in.up_um[j][i]);
-      tg.push_back(in.targets_mm[i]), run_no.push_back(static_cast<double>(j + 1)), dir.push_back(-1.0), dev.push_back(in.down_um[j][i]);
+      tg.push_back(in.targets_mm[i]), run_no.push_back(static_cast<double>(j + 1)), dir.push_back(1.0),
+          dev.push_back(in.up_um[j][i]);
+      tg.push_back(in.targets_mm[i]), run_no.push_back(static_cast<double>(j + 1)), dir.push_back(-1.0),
+          dev.push_back(in.down_um[j][i]);
     }
-  csv.write("trace_positioning.csv", {"target_mm", "run", "direction_up1_down-1", "deviation_um"}, {tg, run_no, dir, dev});
+  csv.write("trace_positioning.csv", {"target_mm", "run", "direction_up1_down-1", "deviation_um"},
+            {tg, run_no, dir, dev});
   std::vector<double> t_mm, mu, md, su, sd;
   for (const auto& x : r.targets)
-    t_mm.push_back(x.target_mm), mu.push_back(x.mean_up_um), md.push_back(x.mean_down_um), su.push_back(x.s_up_um), sd.push_back(x.s_down_um);
-  csv.write("trace_positioning_targets.csv", {"target_mm", "mean_up_um", "mean_down_um", "s_up_um", "s_down_um"}, {t_mm, mu, md, su, sd});
+    t_mm.push_back(x.target_mm), mu.push_back(x.mean_up_um), md.push_back(x.mean_down_um), su.push_back(x.s_up_um),
+        sd.push_back(x.s_down_um);
+  csv.write("trace_positioning_targets.csv", {"target_mm", "mean_up_um", "mean_down_um", "s_up_um", "s_down_um"},
+            {t_mm, mu, md, su, sd});
 }
 
 }  // namespace eical::tools::report

@@ -1,7 +1,7 @@
 #include "tools/report/run_report.hpp"
 
-#include "dsp/analysis/verdict.hpp"
 #include "drivers/results/software_version.hpp"
+#include "dsp/analysis/verdict.hpp"
 
 #include "tools/report/html.hpp"
 #include "tools/report/sections.hpp"
@@ -27,7 +27,8 @@ std::pair<std::string, std::string> plane_axis_names(const std::string& plane) {
   return {"X", "Y"};
 }
 
-void CsvFiles::write(const std::string& name, const std::vector<std::string>& header, const std::vector<std::vector<double>>& cols) {
+void CsvFiles::write(const std::string& name, const std::vector<std::string>& header,
+                     const std::vector<std::vector<double>>& cols) {
   const fs::path file = dir_ / name;
   std::ofstream os(file, std::ios::trunc);
   if (!os) throw std::runtime_error(file.string() + ": cannot write");
@@ -60,7 +61,8 @@ std::optional<double> FigureRows::u(const std::string& key, std::size_t i) const
   return it->second[i];
 }
 
-Figure FigureRows::row(const std::string& key, std::string label, std::string unit, int decimals, std::string note, double scale) const {
+Figure FigureRows::row(const std::string& key, std::string label, std::string unit, int decimals, std::string note,
+                       double scale) const {
   Figure f{std::move(label), value(key), std::move(unit), decimals, std::move(note), u(key)};
   if (f.value) *f.value *= scale;
   if (f.u) *f.u *= scale;
@@ -73,7 +75,8 @@ namespace {
 std::string program_line(const dsp::Program& p) {
   const auto [na, nb] = plane_axis_names(p.plane);
   if (p.kind == "circle") {
-    std::string s = "circular test R " + fmt("%g", p.radius_mm) + " mm, F " + fmt("%g", p.feed_mm_min) + " mm/min, " + na + nb + " plane, ";
+    std::string s = "circular test R " + fmt("%g", p.radius_mm) + " mm, F " + fmt("%g", p.feed_mm_min) + " mm/min, " +
+                    na + nb + " plane, ";
     s += p.direction == "both" ? "both directions" : p.direction == "cw" ? "clockwise" : "counter-clockwise";
     if (p.arc_deg < 360.0) s += ", " + fmt("%g", p.arc_deg) + "° partial arc";
     return s;
@@ -85,7 +88,8 @@ std::string program_line(const dsp::Program& p) {
     return s + " mm, " + std::to_string(p.runs) + " runs, F " + fmt("%g", p.feed_mm_min) + " mm/min";
   }
   if (p.kind == "rectangle")
-    return "rectangle " + fmt("%g", p.size_mm[0]) + " × " + fmt("%g", p.size_mm[1]) + " mm in " + na + nb + ", F " + fmt("%g", p.feed_mm_min) + " mm/min";
+    return "rectangle " + fmt("%g", p.size_mm[0]) + " × " + fmt("%g", p.size_mm[1]) + " mm in " + na + nb + ", F " +
+           fmt("%g", p.feed_mm_min) + " mm/min";
   if (p.kind == "freeform") return "free-form path (G-code of the run), F " + fmt("%g", p.feed_mm_min) + " mm/min";
   return p.kind + " program";
 }
@@ -104,25 +108,36 @@ void measurement_section(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
   Section p;
   p.heading = "Measurement";
   p.lead = "How the relative path head − table was obtained from the two accelerometers.";
-  p.tables.push_back({"Supports", {{"Rest window before the motion", static_cast<double>(m.rest_window_samples) / m.fs_hz, "s", 3, "bias reference (M101 → motion)"},
-                                   {"ZUPT window after the motion", static_cast<double>(m.zupt_window_samples) / m.fs_hz, "s", 3, ""},
-                                   {"Velocity error removed by ZUPT, x", m.zupt_velocity_error_mm_s.x() * 1000.0, "µm/s", 2, ""},
-                                   {"Velocity error removed by ZUPT, y", m.zupt_velocity_error_mm_s.y() * 1000.0, "µm/s", 2, ""},
-                                   {"Velocity error removed by ZUPT, z", m.zupt_velocity_error_mm_s.z() * 1000.0, "µm/s", 2, ""}}});
-  p.notes.push_back("Pipeline: " + std::string(a.sensor_model == "datasheet" ? "data-sheet" : "calibrated (" + a.sensor_model + ")") +
-                    " static compensation, rest-window bias, trapezoid double integration, " + (a.dynamic == dsp::DynamicComp::none ? "no" : "two-stage") +
-                    " dynamic compensation (6-38) and the DAQ group delay, ZUPT at the standstills" + (a.nbs ? ", NBS on held axes" : "") +
-                    ", CUPT at the PSD strips, Rauch–Tung–Striebel smoother.");
+  p.tables.push_back(
+      {"Supports",
+       {{"Rest window before the motion", static_cast<double>(m.rest_window_samples) / m.fs_hz, "s", 3,
+         "bias reference (M101 → motion)"},
+        {"ZUPT window after the motion", static_cast<double>(m.zupt_window_samples) / m.fs_hz, "s", 3, ""},
+        {"Velocity error removed by ZUPT, x", m.zupt_velocity_error_mm_s.x() * 1000.0, "µm/s", 2, ""},
+        {"Velocity error removed by ZUPT, y", m.zupt_velocity_error_mm_s.y() * 1000.0, "µm/s", 2, ""},
+        {"Velocity error removed by ZUPT, z", m.zupt_velocity_error_mm_s.z() * 1000.0, "µm/s", 2, ""}}});
+  p.notes.push_back(
+      "Pipeline: " + std::string(a.sensor_model == "datasheet" ? "data-sheet" : "calibrated (" + a.sensor_model + ")") +
+      " static compensation, rest-window bias, trapezoid double integration, " +
+      (a.dynamic == dsp::DynamicComp::none ? "no" : "two-stage") +
+      " dynamic compensation (6-38) and the DAQ group delay, ZUPT at the standstills" +
+      (a.nbs ? ", NBS on held axes" : "") + ", CUPT at the PSD strips, Rauch–Tung–Striebel smoother.");
   if (!a.uncertainty_note.empty())
-    p.notes.push_back("Uncertainty (every ± in this report): " + a.uncertainty_note +
-                      ". A figure is resolved when its magnitude exceeds U; one that is not is marked \"not resolved\".");
+    p.notes.push_back(
+        "Uncertainty (every ± in this report): " + a.uncertainty_note +
+        ". A figure is resolved when its magnitude exceeds U; one that is not is marked \"not resolved\".");
   page.sections.push_back(std::move(p));
   std::vector<std::vector<double>> cols(7);
   for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
     cols[0].push_back(static_cast<double>(m.sample_index[i]) / m.fs_hz);
-    for (int k = 0; k < 3; ++k) cols[1 + static_cast<std::size_t>(k)].push_back(m.cmd_mm[i][k]), cols[4 + static_cast<std::size_t>(k)].push_back(m.pos_mm[i][k]);
+    for (int k = 0; k < 3; ++k)
+      cols[1 + static_cast<std::size_t>(k)].push_back(m.cmd_mm[i][k]),
+          cols[4 + static_cast<std::size_t>(k)].push_back(m.pos_mm[i][k]);
   }
-  csv.write("trace_measurement.csv", {"t_s", "setpoint_x_mm", "setpoint_y_mm", "setpoint_z_mm", "measured_x_mm", "measured_y_mm", "measured_z_mm"}, cols);
+  csv.write(
+      "trace_measurement.csv",
+      {"t_s", "setpoint_x_mm", "setpoint_y_mm", "setpoint_z_mm", "measured_x_mm", "measured_y_mm", "measured_z_mm"},
+      cols);
 }
 
 // Case temperatures over the run: "table 22.10–22.11 °C, head 24.29 °C".
@@ -132,18 +147,22 @@ std::string temperatures(const dsp::Run& run) {
   for (int s = 0; s < 2; ++s) {
     double lo = INFINITY, hi = -INFINITY;
     for (const auto& f : run.frames)
-      if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s])) lo = std::min(lo, static_cast<double>(f.temp_c[s])), hi = std::max(hi, static_cast<double>(f.temp_c[s]));
+      if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s]))
+        lo = std::min(lo, static_cast<double>(f.temp_c[s])), hi = std::max(hi, static_cast<double>(f.temp_c[s]));
     if (!std::isfinite(lo)) continue;
-    out += std::string(out.empty() ? "" : ", ") + names[s] + " " + fmt("%.2f", lo) + (hi - lo >= 0.005 ? "–" + fmt("%.2f", hi) : "") + " °C";
+    out += std::string(out.empty() ? "" : ", ") + names[s] + " " + fmt("%.2f", lo) +
+           (hi - lo >= 0.005 ? "–" + fmt("%.2f", hi) : "") + " °C";
   }
   return out.empty() ? "not recorded" : out;
 }
 
 std::string settings(const dsp::Run& run, const dsp::Analysis& a) {
   std::string s = fmt("%.0f Hz", run.meta.acquisition.fs_hz) + ", " + std::to_string(run.frames.size()) + " samples, " +
-                  std::to_string(run.meta.psd.size()) + " PSD strip" + (run.meta.psd.size() == 1 ? "" : "s") + ", sensor model " +
-                  (a.sensor_model == "datasheet" ? std::string("data sheet") : "identified (" + a.sensor_model + ")") + ", dynamic compensation " +
-                  (a.dynamic == dsp::DynamicComp::none ? "off" : "two-stage") + (a.coriolis ? ", Earth rate corrected" : "");
+                  std::to_string(run.meta.psd.size()) + " PSD strip" + (run.meta.psd.size() == 1 ? "" : "s") +
+                  ", sensor model " +
+                  (a.sensor_model == "datasheet" ? std::string("data sheet") : "identified (" + a.sensor_model + ")") +
+                  ", dynamic compensation " + (a.dynamic == dsp::DynamicComp::none ? "off" : "two-stage") +
+                  (a.coriolis ? ", Earth rate corrected" : "");
   return s;
 }
 
@@ -173,9 +192,12 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs:
   page.verdict = a.verdict;
   page.verdict_reasons = a.verdict_reasons;
   if (opt.tolerances) {
-    Grid g{"Against the tolerances (ISO 14253-1 with U, k = 2)", {"figure", "measured (µm)", "U (µm)", "tolerance (µm)", "decision"}, {}};
+    Grid g{"Against the tolerances (ISO 14253-1 with U, k = 2)",
+           {"figure", "measured (µm)", "U (µm)", "tolerance (µm)", "decision"},
+           {}};
     for (const auto& d : decide(a, tol))
-      g.rows.push_back({d.figure, fmt("%.2f", d.value), d.u ? fmt("%.2f", *d.u) : std::string("unknown"), fmt("%.2f", d.tolerance), d.decision});
+      g.rows.push_back({d.figure, fmt("%.2f", d.value), d.u ? fmt("%.2f", *d.u) : std::string("unknown"),
+                        fmt("%.2f", d.tolerance), d.decision});
     if (g.rows.empty()) g.rows.push_back({"(no toleranced figure in this test)", "", "", "", ""});
     page.summary.push_back(g);
   }
@@ -186,7 +208,9 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs:
   if (p.kind == "freeform") freeform_sections(run, a, page, csv);
   measurement_section(a, page, csv);
   page.files = csv.names();
-  if (csv.thinned()) page.files_note = "Long traces are thinned to at most " + std::to_string(CsvFiles::kMaxRows) + " rows per file (the run holds every sample).";
+  if (csv.thinned())
+    page.files_note = "Long traces are thinned to at most " + std::to_string(CsvFiles::kMaxRows) +
+                      " rows per file (the run holds every sample).";
   const fs::path file = dir / "report.html";
   write_html(page, file);
   return file;

@@ -18,7 +18,7 @@ struct ReportOptions {
 };
 
 // Writes <dir>/report.html and <dir>/trace_*.csv; returns the path of the HTML file.
-std::filesystem::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, const std::filesystem::path& dir,
-                                       const ReportOptions& options = {});
+std::filesystem::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis,
+                                       const std::filesystem::path& dir, const ReportOptions& options = {});
 
 }  // namespace eical::tools::report

@@ -22,7 +22,8 @@ class CsvFiles {
   // thinned to every q-th row (the run itself holds every sample): one test's CSV stays
   // a few MB, not the 180 MB a ballbar-size circle at 10 kHz would make.
   static constexpr std::size_t kMaxRows = 50000;
-  void write(const std::string& name, const std::vector<std::string>& header, const std::vector<std::vector<double>>& cols);
+  void write(const std::string& name, const std::vector<std::string>& header,
+             const std::vector<std::vector<double>>& cols);
   [[nodiscard]] bool thinned() const { return thinned_; }
   [[nodiscard]] const std::vector<std::string>& names() const { return names_; }
 
@@ -40,7 +41,8 @@ class FigureRows {
   [[nodiscard]] std::optional<double> value(const std::string& key, std::size_t i = 0) const;
   [[nodiscard]] std::optional<double> u(const std::string& key, std::size_t i = 0) const;
   // Value (n/a when absent) ± U; `scale` converts the unit (e.g. s → ms).
-  [[nodiscard]] Figure row(const std::string& key, std::string label, std::string unit, int decimals, std::string note = "", double scale = 1.0) const;
+  [[nodiscard]] Figure row(const std::string& key, std::string label, std::string unit, int decimals,
+                           std::string note = "", double scale = 1.0) const;
 
  private:
   const dsp::Analysis& a_;

@@ -16,7 +16,8 @@ void step_sections(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
   const int ax = a.step_axis == "y" ? 1 : a.step_axis == "z" ? 2 : 0;
   Section s;
   s.heading = "Step response (axis " + a.step_axis + ")";
-  s.lead = std::to_string(st.moves.size()) + " moves; each judged from its arrival at the target to the end of its dwell.";
+  s.lead =
+      std::to_string(st.moves.size()) + " moves; each judged from its arrival at the target to the end of its dwell.";
   std::vector<double> t, pos, cmd, err;
   for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
     t.push_back(static_cast<double>(m.sample_index[i]) / m.fs_hz);
@@ -26,7 +27,8 @@ void step_sections(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
   }
   s.svgs.push_back(line_plot({{"set-point", kGrey, t, cmd, {}, {}, false, true, 1.4}, {"measured", kBlue, t, pos}},
                              "Position over time", "time (s)", "position " + a.step_axis + " (mm)", 680, 250));
-  s.svgs.push_back(line_plot({{"measured − set-point", kBlue, t, err}}, "Following error", "time (s)", "error (µm)", 680, 220));
+  s.svgs.push_back(
+      line_plot({{"measured − set-point", kBlue, t, err}}, "Following error", "time (s)", "error (µm)", 680, 220));
   // Arrivals overlaid, from the moment the set-point stops to the end of the dwell: what
   // remains is the machine settling (and the measurement), not the move itself.
   const char* colors[] = {kBlue, kRed, kGreen, "#8e44ad", "#d35400", "#16a085", "#2c3e50", "#b7950b"};
@@ -35,7 +37,8 @@ void step_sections(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
     const auto& mv = st.moves[k];
     LineSeries ls{fmt("%.3f", mv.from_mm) + " → " + fmt("%.3f", mv.to_mm) + " mm", colors[k], {}, {}};
     for (std::size_t i = mv.arrive; i < mv.end && i < pos.size(); ++i) {
-      ls.x.push_back(static_cast<double>(static_cast<std::int64_t>(i) - static_cast<std::int64_t>(mv.arrive)) / m.fs_hz);
+      ls.x.push_back(static_cast<double>(static_cast<std::int64_t>(i) - static_cast<std::int64_t>(mv.arrive)) /
+                     m.fs_hz);
       ls.y.push_back((pos[i] - mv.to_mm) * 1000.0);
     }
     arrivals.push_back(std::move(ls));
@@ -49,15 +52,19 @@ void step_sections(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
             fr.row("step.overshoot_um", "Overshoot (max)", "µm", 2),
             fr.row("step.settling_s", "Settling time (max)", "ms", 1, "into ±1 µm of the end value", 1000.0),
             fr.row("step.noise_um", "Noise in the dwell", "µm", 3, "RMS, median over dwells"),
-            {"Smallest step resolved", st.smallest_step_resolved_um > 0 ? std::optional<double>(st.smallest_step_resolved_um) : std::nullopt,
+            {"Smallest step resolved",
+             st.smallest_step_resolved_um > 0 ? std::optional<double>(st.smallest_step_resolved_um) : std::nullopt,
              "µm", 1, st.smallest_step_resolved_um > 0 ? "" : "no step resolved"}};
   s.tables.push_back(f);
-  Grid g{"Per move", {"move", "from → to (mm)", "step measured (µm)", "end error (µm)", "overshoot (µm)", "settling (ms)", "resolved"}, {}};
+  Grid g{
+      "Per move",
+      {"move", "from → to (mm)", "step measured (µm)", "end error (µm)", "overshoot (µm)", "settling (ms)", "resolved"},
+      {}};
   for (std::size_t k = 0; k < st.moves.size(); ++k) {
     const auto& mv = st.moves[k];
-    g.rows.push_back({std::to_string(k + 1), fmt("%.3f", mv.from_mm) + " → " + fmt("%.3f", mv.to_mm), fmt("%.2f", mv.step_measured_um),
-                      fmt("%.2f", mv.end_error_um), fmt("%.2f", mv.overshoot_um), mv.settled ? fmt("%.1f", mv.settling_s * 1000.0) : "not settled",
-                      mv.resolved ? "yes" : "no"});
+    g.rows.push_back({std::to_string(k + 1), fmt("%.3f", mv.from_mm) + " → " + fmt("%.3f", mv.to_mm),
+                      fmt("%.2f", mv.step_measured_um), fmt("%.2f", mv.end_error_um), fmt("%.2f", mv.overshoot_um),
+                      mv.settled ? fmt("%.1f", mv.settling_s * 1000.0) : "not settled", mv.resolved ? "yes" : "no"});
   }
   s.grids.push_back(g);
   page.sections.push_back(std::move(s));

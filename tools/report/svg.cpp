@@ -25,12 +25,13 @@ std::string tick_label(double v, double step) {
 }
 
 std::string svg_open(double w, double h) {
-  return "<svg xmlns='http://www.w3.org/2000/svg' class='plot' viewBox='0 0 " + num(w) + " " + num(h) + "' width='" + num(w) +
-         "' height='" + num(h) + "' font-family='inherit' font-size='11' fill='#1d2330'>";
+  return "<svg xmlns='http://www.w3.org/2000/svg' class='plot' viewBox='0 0 " + num(w) + " " + num(h) + "' width='" +
+         num(w) + "' height='" + num(h) + "' font-family='inherit' font-size='11' fill='#1d2330'>";
 }
 
 std::string text(double x, double y, const std::string& s, const std::string& extra = "") {
-  return "<text x='" + num(x) + "' y='" + num(y) + "'" + (extra.empty() ? "" : " " + extra) + ">" + xml_escape(s) + "</text>";
+  return "<text x='" + num(x) + "' y='" + num(y) + "'" + (extra.empty() ? "" : " " + extra) + ">" + xml_escape(s) +
+         "</text>";
 }
 
 // Every `stride`-th point so that a trace has at most `max_points` (plots need no more).
@@ -81,7 +82,8 @@ double nice_step(double span, int target_ticks) {
 }
 
 const char* revolution_colour(bool ccw, int revolution) {
-  static const char* const blues[] = {kBlue, "#0e8fa3", "#6a3fb5", "#2c4f8a", "#3aa35d", "#7d93d9", "#0b5563", "#9b59b6"};
+  static const char* const blues[] = {kBlue,     "#0e8fa3", "#6a3fb5", "#2c4f8a",
+                                      "#3aa35d", "#7d93d9", "#0b5563", "#9b59b6"};
   static const char* const reds[] = {kRed, "#e67e22", "#a93270", "#8a4b08", "#d4a017", "#e0766a", "#6e2c00", "#c2185b"};
   const int n = 8;
   const int i = ((revolution % n) + n) % n;
@@ -118,14 +120,15 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
   // Grid first: rings and spokes under the traces.
   for (int k = -divisions; k <= divisions; ++k) {
     const double r = r0 + k * ring;
-    s += "<circle cx='" + num(c) + "' cy='" + num(cy) + "' r='" + num(r) + "' fill='none' stroke='" + (k == 0 ? "#8a93a3" : "#d5d9e0") +
-         "' stroke-width='" + (k == 0 ? "1.1" : "0.8") + (k == 0 ? "'" : "' stroke-dasharray='3,3'") + "/>";
+    s += "<circle cx='" + num(c) + "' cy='" + num(cy) + "' r='" + num(r) + "' fill='none' stroke='" +
+         (k == 0 ? "#8a93a3" : "#d5d9e0") + "' stroke-width='" + (k == 0 ? "1.1" : "0.8") +
+         (k == 0 ? "'" : "' stroke-dasharray='3,3'") + "/>";
   }
   const double r1 = r0 - divisions * ring, r2 = r0 + divisions * ring + 4;
   for (int a = 0; a < 360; a += 30) {
     const double th = a * kPi / 180.0;
-    s += "<line x1='" + num(c + r1 * std::cos(th)) + "' y1='" + num(cy - r1 * std::sin(th)) + "' x2='" + num(c + r2 * std::cos(th)) +
-         "' y2='" + num(cy - r2 * std::sin(th)) + "' stroke='#e6e9ee'/>";
+    s += "<line x1='" + num(c + r1 * std::cos(th)) + "' y1='" + num(cy - r1 * std::sin(th)) + "' x2='" +
+         num(c + r2 * std::cos(th)) + "' y2='" + num(cy - r2 * std::sin(th)) + "' stroke='#e6e9ee'/>";
   }
   // Traces: one polyline per revolution, closed where it is a full one, a marker at its start.
   std::string markers;
@@ -138,8 +141,10 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
     for (std::size_t i = 0; i < n; i += stride) {
       if (!std::isfinite(t.deviation_um[i]) || !std::isfinite(t.angle_deg[i])) continue;
       // A jump in angle (a gap in the data) starts a new polyline.
-      if (std::isfinite(prev_ang) && std::abs(t.angle_deg[i] - prev_ang) > 5.0 && std::abs(std::abs(t.angle_deg[i] - prev_ang) - 360.0) > 5.0) {
-        s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" + pts + "'/>";
+      if (std::isfinite(prev_ang) && std::abs(t.angle_deg[i] - prev_ang) > 5.0 &&
+          std::abs(std::abs(t.angle_deg[i] - prev_ang) - 360.0) > 5.0) {
+        s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" +
+             pts + "'/>";
         pts.clear();
       }
       prev_ang = t.angle_deg[i];
@@ -150,10 +155,12 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
       px(t.angle_deg[0], t.deviation_um[0], x, y);
       pts += num(x) + "," + num(y) + " ";
     }
-    s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" + pts + "'/>";
+    s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" + pts +
+         "'/>";
     if (t.start_marker) {
       px(t.angle_deg[0], t.deviation_um[0], x, y);
-      markers += "<circle cx='" + num(x) + "' cy='" + num(y) + "' r='3.6' fill='#ffffff' stroke='" + t.color + "' stroke-width='1.8'/>";
+      markers += "<circle cx='" + num(x) + "' cy='" + num(y) + "' r='3.6' fill='#ffffff' stroke='" + t.color +
+                 "' stroke-width='1.8'/>";
     }
   }
   s += markers;
@@ -161,7 +168,8 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
   for (int k = -divisions; k <= divisions; ++k)
     if (k != 0) {
       const double r = r0 + k * ring;
-      s += text(c + 3, cy - r - 2, (k > 0 ? "+" : "") + tick_label(k * scale_um_per_div, scale_um_per_div), "fill='#6b7385' font-size='9'" + halo);
+      s += text(c + 3, cy - r - 2, (k > 0 ? "+" : "") + tick_label(k * scale_um_per_div, scale_um_per_div),
+                "fill='#6b7385' font-size='9'" + halo);
     }
   for (int a = 0; a < 360; a += 30) {
     const double th = a * kPi / 180.0;
@@ -182,8 +190,11 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
     if (k % 2 == 1) ly += 15;
     ++k;
   }
-  s += "<circle cx='" + num(14) + "' cy='" + num(h - 9) + "' r='3.6' fill='#ffffff' stroke='#4a5366' stroke-width='1.8'/>" + text(24, h - 5, "start of a revolution", "fill='#4a5366' font-size='10'");
-  s += text(w - 10, h - 21, tick_label(scale_um_per_div, scale_um_per_div) + " µm / division", "text-anchor='end' fill='#4a5366'");
+  s += "<circle cx='" + num(14) + "' cy='" + num(h - 9) +
+       "' r='3.6' fill='#ffffff' stroke='#4a5366' stroke-width='1.8'/>" +
+       text(24, h - 5, "start of a revolution", "fill='#4a5366' font-size='10'");
+  s += text(w - 10, h - 21, tick_label(scale_um_per_div, scale_um_per_div) + " µm / division",
+            "text-anchor='end' fill='#4a5366'");
   s += text(w - 10, h - 5, "reference circle = 0 µm", "text-anchor='end' fill='#6b7385' font-size='10'");
   return s + "</svg>";
 }
@@ -217,23 +228,26 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
   s += text(w / 2, 17, title, "text-anchor='middle' font-size='13' font-weight='600'");
   const double xs = nice_step(xmax - xmin, 8), ys = nice_step(ymax - ymin, 6);
   for (double x : ticks(xmin, xmax, xs))
-    s += "<line x1='" + num(X(x)) + "' y1='" + num(top) + "' x2='" + num(X(x)) + "' y2='" + num(h - bottom) + "' stroke='#edf0f4'/>" +
-         text(X(x), h - bottom + 15, tick_label(x, xs), "text-anchor='middle' fill='#4a5366'");
+    s += "<line x1='" + num(X(x)) + "' y1='" + num(top) + "' x2='" + num(X(x)) + "' y2='" + num(h - bottom) +
+         "' stroke='#edf0f4'/>" + text(X(x), h - bottom + 15, tick_label(x, xs), "text-anchor='middle' fill='#4a5366'");
   for (double y : ticks(ymin, ymax, ys))
-    s += "<line x1='" + num(left) + "' y1='" + num(Y(y)) + "' x2='" + num(w - right) + "' y2='" + num(Y(y)) + "' stroke='" +
-         (std::abs(y) < ys * 1e-6 ? "#9aa3b2" : "#edf0f4") + "'/>" + text(left - 5, Y(y) + 4, tick_label(y, ys), "text-anchor='end' fill='#4a5366'");
-  s += "<rect x='" + num(left) + "' y='" + num(top) + "' width='" + num(w - left - right) + "' height='" + num(h - top - bottom) +
-       "' fill='none' stroke='#8a93a3'/>";
+    s += "<line x1='" + num(left) + "' y1='" + num(Y(y)) + "' x2='" + num(w - right) + "' y2='" + num(Y(y)) +
+         "' stroke='" + (std::abs(y) < ys * 1e-6 ? "#9aa3b2" : "#edf0f4") + "'/>" +
+         text(left - 5, Y(y) + 4, tick_label(y, ys), "text-anchor='end' fill='#4a5366'");
+  s += "<rect x='" + num(left) + "' y='" + num(top) + "' width='" + num(w - left - right) + "' height='" +
+       num(h - top - bottom) + "' fill='none' stroke='#8a93a3'/>";
   s += text((left + w - right) / 2, h - 8, x_label, "text-anchor='middle'");
-  s += "<text transform='translate(15," + num((top + h - bottom) / 2) + ") rotate(-90)' text-anchor='middle'>" + xml_escape(y_label) + "</text>";
+  s += "<text transform='translate(15," + num((top + h - bottom) / 2) + ") rotate(-90)' text-anchor='middle'>" +
+       xml_escape(y_label) + "</text>";
   // Bands first, so that lines stay on top.
   for (const auto& ser : series) {
     const std::size_t n = std::min({ser.x.size(), ser.y_lo.size(), ser.y_hi.size()});
     if (ser.error_bars) {
       for (std::size_t i = 0; i < n; ++i)
         if (std::isfinite(ser.x[i]) && std::isfinite(ser.y_lo[i]) && std::isfinite(ser.y_hi[i]))
-          s += "<line x1='" + num(X(ser.x[i])) + "' y1='" + num(Y(ser.y_lo[i])) + "' x2='" + num(X(ser.x[i])) + "' y2='" +
-               num(Y(ser.y_hi[i])) + "' stroke='" + ser.color + "' stroke-opacity='0.6' stroke-width='1.2'/>";
+          s += "<line x1='" + num(X(ser.x[i])) + "' y1='" + num(Y(ser.y_lo[i])) + "' x2='" + num(X(ser.x[i])) +
+               "' y2='" + num(Y(ser.y_hi[i])) + "' stroke='" + ser.color +
+               "' stroke-opacity='0.6' stroke-width='1.2'/>";
       continue;
     }
     if (n < 2) continue;
@@ -252,17 +266,20 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
     if (ser.markers) {
       for (std::size_t i = 0; i < n; i += stride)
         if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i]))
-          s += "<circle cx='" + num(X(ser.x[i])) + "' cy='" + num(Y(ser.y[i])) + "' r='2.2' fill='" + ser.color + "' fill-opacity='0.7'/>";
+          s += "<circle cx='" + num(X(ser.x[i])) + "' cy='" + num(Y(ser.y[i])) + "' r='2.2' fill='" + ser.color +
+               "' fill-opacity='0.7'/>";
     } else {
       std::string pts;
       for (std::size_t i = 0; i < n; i += stride)
         if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i])) pts += num(X(ser.x[i])) + "," + num(Y(ser.y[i])) + " ";
-      s += "<polyline fill='none' stroke='" + ser.color + "' stroke-width='" + num(ser.width) + "' stroke-linejoin='round'" +
-           (ser.dashed ? " stroke-dasharray='5,3'" : "") + " points='" + pts + "'/>";
+      s += "<polyline fill='none' stroke='" + ser.color + "' stroke-width='" + num(ser.width) +
+           "' stroke-linejoin='round'" + (ser.dashed ? " stroke-dasharray='5,3'" : "") + " points='" + pts + "'/>";
     }
     if (ser.label.empty()) continue;
-    legend += ser.markers ? "<circle cx='" + num(w - right - 176) + "' cy='" + num(ly - 4) + "' r='2.5' fill='" + ser.color + "'/>"
-                          : "<rect x='" + num(w - right - 184) + "' y='" + num(ly - 5) + "' width='16' height='3' fill='" + ser.color + "'/>";
+    legend += ser.markers ? "<circle cx='" + num(w - right - 176) + "' cy='" + num(ly - 4) + "' r='2.5' fill='" +
+                                ser.color + "'/>"
+                          : "<rect x='" + num(w - right - 184) + "' y='" + num(ly - 5) +
+                                "' width='16' height='3' fill='" + ser.color + "'/>";
     legend += text(w - right - 162, ly, ser.label, "fill='#1d2330'");
     ly += 14;
   }
@@ -272,15 +289,18 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
   return s + "</svg>";
 }
 
-std::string path_plot(const PathView& v, const std::string& title, const std::string& axis_a, const std::string& axis_b) {
+std::string path_plot(const PathView& v, const std::string& title, const std::string& axis_a,
+                      const std::string& axis_b) {
   const double w = 460, pad = 46, top = 28, max_plot_h = 400;
   double amin = INFINITY, amax = -INFINITY, bmin = INFINITY, bmax = -INFINITY, dmax_um = 0.0;
   for (std::size_t i = 0; i < v.cmd_a_mm.size(); ++i) {
     amin = std::min(amin, v.cmd_a_mm[i]), amax = std::max(amax, v.cmd_a_mm[i]);
     bmin = std::min(bmin, v.cmd_b_mm[i]), bmax = std::max(bmax, v.cmd_b_mm[i]);
   }
-  for (std::size_t i = 0; i < v.dev_a_um.size(); ++i) dmax_um = std::max(dmax_um, std::hypot(v.dev_a_um[i], v.dev_b_um[i]));
-  for (std::size_t i = 0; i < v.arrow_da_um.size(); ++i) dmax_um = std::max(dmax_um, std::hypot(v.arrow_da_um[i], v.arrow_db_um[i]));
+  for (std::size_t i = 0; i < v.dev_a_um.size(); ++i)
+    dmax_um = std::max(dmax_um, std::hypot(v.dev_a_um[i], v.dev_b_um[i]));
+  for (std::size_t i = 0; i < v.arrow_da_um.size(); ++i)
+    dmax_um = std::max(dmax_um, std::hypot(v.arrow_da_um[i], v.arrow_db_um[i]));
   if (!std::isfinite(amin)) amin = bmin = 0, amax = bmax = 1;
   const double span_mm = std::max({amax - amin, bmax - bmin, 1e-3});
   // Magnify so that the largest deviation shows as about 8 % of the path's extent.
@@ -297,40 +317,48 @@ std::string path_plot(const PathView& v, const std::string& title, const std::st
   s += text(w / 2, 17, title, "text-anchor='middle' font-size='13' font-weight='600'");
   const double step = nice_step(std::max(amax - amin, bmax - bmin), 6);
   for (double a : ticks(amin, amax, step))
-    s += "<line x1='" + num(X(a)) + "' y1='" + num(Y(bmin)) + "' x2='" + num(X(a)) + "' y2='" + num(Y(bmax)) + "' stroke='#edf0f4'/>" +
-         text(X(a), Y(bmin) + 14, tick_label(a, step), "text-anchor='middle' fill='#4a5366'");
+    s += "<line x1='" + num(X(a)) + "' y1='" + num(Y(bmin)) + "' x2='" + num(X(a)) + "' y2='" + num(Y(bmax)) +
+         "' stroke='#edf0f4'/>" + text(X(a), Y(bmin) + 14, tick_label(a, step), "text-anchor='middle' fill='#4a5366'");
   for (double b : ticks(bmin, bmax, step))
-    s += "<line x1='" + num(X(amin)) + "' y1='" + num(Y(b)) + "' x2='" + num(X(amax)) + "' y2='" + num(Y(b)) + "' stroke='#edf0f4'/>" +
-         text(X(amin) - 4, Y(b) + 4, tick_label(b, step), "text-anchor='end' fill='#4a5366'");
-  s += "<rect x='" + num(X(amin)) + "' y='" + num(Y(bmax)) + "' width='" + num((amax - amin) * px_per_mm) + "' height='" +
-       num((bmax - bmin) * px_per_mm) + "' fill='none' stroke='#8a93a3'/>";
+    s += "<line x1='" + num(X(amin)) + "' y1='" + num(Y(b)) + "' x2='" + num(X(amax)) + "' y2='" + num(Y(b)) +
+         "' stroke='#edf0f4'/>" + text(X(amin) - 4, Y(b) + 4, tick_label(b, step), "text-anchor='end' fill='#4a5366'");
+  s += "<rect x='" + num(X(amin)) + "' y='" + num(Y(bmax)) + "' width='" + num((amax - amin) * px_per_mm) +
+       "' height='" + num((bmax - bmin) * px_per_mm) + "' fill='none' stroke='#8a93a3'/>";
   s += text(cx, Y(bmin) + 30, axis_a + " (mm)", "text-anchor='middle'");
-  s += "<text transform='translate(" + num(X(amin) - 34) + "," + num(cy) + ") rotate(-90)' text-anchor='middle'>" + xml_escape(axis_b + " (mm)") + "</text>";
+  s += "<text transform='translate(" + num(X(amin) - 34) + "," + num(cy) + ") rotate(-90)' text-anchor='middle'>" +
+       xml_escape(axis_b + " (mm)") + "</text>";
   std::string cmd, meas;
   const std::size_t n = v.cmd_a_mm.size(), stride = stride_for(n, 3000);
   for (std::size_t i = 0; i < n; i += stride) cmd += num(X(v.cmd_a_mm[i])) + "," + num(Y(v.cmd_b_mm[i])) + " ";
   const std::size_t nd = std::min(v.base_a_mm.size(), v.dev_a_um.size()), sd = stride_for(nd, 3000);
-  s += "<polyline fill='none' stroke='" + std::string(kGrey) + "' stroke-width='1' stroke-dasharray='4,3' points='" + cmd + "'/>";
+  s += "<polyline fill='none' stroke='" + std::string(kGrey) + "' stroke-width='1' stroke-dasharray='4,3' points='" +
+       cmd + "'/>";
   for (std::size_t i = 0; i < nd; i += sd) {
     // A gap in the evaluated samples (a stop, a corner) starts a new polyline.
-    if (i > 0 && std::hypot(v.base_a_mm[i] - v.base_a_mm[i - sd], v.base_b_mm[i] - v.base_b_mm[i - sd]) > 0.03 * span_mm) {
+    if (i > 0 &&
+        std::hypot(v.base_a_mm[i] - v.base_a_mm[i - sd], v.base_b_mm[i] - v.base_b_mm[i - sd]) > 0.03 * span_mm) {
       s += "<polyline fill='none' stroke='" + std::string(kBlue) + "' stroke-width='1.3' points='" + meas + "'/>";
       meas.clear();
     }
-    meas += num(X(v.base_a_mm[i] + mag * v.dev_a_um[i] * 1e-3)) + "," + num(Y(v.base_b_mm[i] + mag * v.dev_b_um[i] * 1e-3)) + " ";
+    meas += num(X(v.base_a_mm[i] + mag * v.dev_a_um[i] * 1e-3)) + "," +
+            num(Y(v.base_b_mm[i] + mag * v.dev_b_um[i] * 1e-3)) + " ";
   }
-  if (!meas.empty()) s += "<polyline fill='none' stroke='" + std::string(kBlue) + "' stroke-width='1.3' points='" + meas + "'/>";
+  if (!meas.empty())
+    s += "<polyline fill='none' stroke='" + std::string(kBlue) + "' stroke-width='1.3' points='" + meas + "'/>";
   for (std::size_t i = 0; i < v.arrow_a_mm.size(); ++i) {
     const double x1 = X(v.arrow_a_mm[i]), y1 = Y(v.arrow_b_mm[i]);
-    const double x2 = X(v.arrow_a_mm[i] + mag * v.arrow_da_um[i] * 1e-3), y2 = Y(v.arrow_b_mm[i] + mag * v.arrow_db_um[i] * 1e-3);
-    s += "<line x1='" + num(x1) + "' y1='" + num(y1) + "' x2='" + num(x2) + "' y2='" + num(y2) + "' stroke='" + kRed + "' stroke-width='2'/>";
-    s += "<circle cx='" + num(x2) + "' cy='" + num(y2) + "' r='3' fill='" + kRed + "'/><circle cx='" + num(x1) + "' cy='" + num(y1) +
-         "' r='2' fill='#333'/>";
+    const double x2 = X(v.arrow_a_mm[i] + mag * v.arrow_da_um[i] * 1e-3),
+                 y2 = Y(v.arrow_b_mm[i] + mag * v.arrow_db_um[i] * 1e-3);
+    s += "<line x1='" + num(x1) + "' y1='" + num(y1) + "' x2='" + num(x2) + "' y2='" + num(y2) + "' stroke='" + kRed +
+         "' stroke-width='2'/>";
+    s += "<circle cx='" + num(x2) + "' cy='" + num(y2) + "' r='3' fill='" + kRed + "'/><circle cx='" + num(x1) +
+         "' cy='" + num(y1) + "' r='2' fill='#333'/>";
   }
   char buf[96];
   std::snprintf(buf, sizeof buf, "deviation magnified ×%g (1 µm → %.3g mm)", mag, mag * 1e-3);
   s += text(w - 10, h - 6, buf, "text-anchor='end' fill='#4a5366'");
-  s += "<rect x='10' y='" + num(h - 12) + "' width='16' height='3' fill='" + kBlue + "'/>" + text(30, h - 8, "measured (contour)", "");
+  s += "<rect x='10' y='" + num(h - 12) + "' width='16' height='3' fill='" + kBlue + "'/>" +
+       text(30, h - 8, "measured (contour)", "");
   return s + "</svg>";
 }
 

@@ -7,9 +7,9 @@
 namespace eical::tools::report {
 
 // Colours shared by all plots so that a direction keeps its colour across a report.
-inline constexpr const char* kBlue = "#1f5fbf";    // ccw, ↑ (positive approach), measured
-inline constexpr const char* kRed = "#c0392b";     // cw, ↓ (negative approach)
-inline constexpr const char* kGrey = "#7b8494";    // set-point, reference
+inline constexpr const char* kBlue = "#1f5fbf";  // ccw, ↑ (positive approach), measured
+inline constexpr const char* kRed = "#c0392b";   // cw, ↓ (negative approach)
+inline constexpr const char* kGrey = "#7b8494";  // set-point, reference
 inline constexpr const char* kGreen = "#1e8449";
 
 // One trace of a polar radius-deviation plot, e.g. one revolution of one direction.
@@ -30,8 +30,9 @@ const char* revolution_colour(bool ccw, int revolution);
 // `axis_b` name the plane's axes at 0° and 90° (e.g. "+X", "+Y"). Labels are drawn above
 // the traces (with a white halo) so that no trace hides them; `subtitle` (e.g. G per
 // direction) is printed under the title.
-std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title, const std::string& axis_a = "0°",
-                       const std::string& axis_b = "90°", double scale_um_per_div = 0.0, const std::string& subtitle = "");
+std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title,
+                       const std::string& axis_a = "0°", const std::string& axis_b = "90°",
+                       double scale_um_per_div = 0.0, const std::string& subtitle = "");
 
 struct LineSeries {
   std::string label = {};
@@ -39,7 +40,7 @@ struct LineSeries {
   std::vector<double> x = {};
   std::vector<double> y = {};
   std::vector<double> y_lo = {}, y_hi = {};  // optional band (same length as x), drawn shaded
-  bool markers = false;            // points instead of a line
+  bool markers = false;                      // points instead of a line
   bool dashed = false;
   double width = 1.4;
   bool error_bars = false;  // y_lo..y_hi as a bar at each point (separate measurements) instead of a band

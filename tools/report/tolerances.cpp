@@ -74,7 +74,8 @@ std::vector<ToleranceDecision> decide(const dsp::Analysis& a, const Tolerances& 
     const auto fmax = get("circle.radial_deviation_F_max_um"), fmin = get("circle.radial_deviation_F_min_um");
     if (fmax && fmin) {
       const auto& f = fmax->first >= fmin->first ? *fmax : *fmin;
-      out.push_back({"Radial deviation F (ISO 230-4)", f.first, f.second, *t.F_um, decision(f.first, f.second, *t.F_um)});
+      out.push_back(
+          {"Radial deviation F (ISO 230-4)", f.first, f.second, *t.F_um, decision(f.first, f.second, *t.F_um)});
     }
   }
   add("Accuracy A (ISO 230-2)", "positioning.A_um", t.A_um);

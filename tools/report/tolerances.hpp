@@ -43,7 +43,7 @@ struct ToleranceDecision {
   double value = 0.0;       // the magnitude compared
   std::optional<double> u;  // its U (k = 2)
   double tolerance = 0.0;
-  std::string decision;     // pass | fail | undecided
+  std::string decision;  // pass | fail | undecided
 };
 
 // Every toleranced figure the analysis has.

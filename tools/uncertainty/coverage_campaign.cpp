@@ -21,8 +21,10 @@ sim::Scenario scenario(const std::string& program, std::uint64_t seed) {
   if (program == "circle" || program == "step") return sim::hidden_effect_scenario({}, program, seed);
   plan::TestProgram p;
   p.kind = program;
-  if (program == "positioning") p.targets_mm = {0.0, 10.0, 20.0, 30.0}, p.runs = 3, p.feed_mm_min = 3000.0;
-  else p.size_mm[0] = 40.0, p.size_mm[1] = 30.0, p.feed_mm_min = 4000.0;
+  if (program == "positioning")
+    p.targets_mm = {0.0, 10.0, 20.0, 30.0}, p.runs = 3, p.feed_mm_min = 3000.0;
+  else
+    p.size_mm[0] = 40.0, p.size_mm[1] = 30.0, p.feed_mm_min = 4000.0;
   p.psd = plan::strips_for(p);
   sim::Scenario sc = plan::scenario_on_drawn_machine(p, seed);
   sc.meta.id = "coverage-" + program + "-s" + std::to_string(seed);
@@ -44,7 +46,8 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vector<Eigen::Vector3d>& truth, const dsp::Analysis& a) {
+std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vector<Eigen::Vector3d>& truth,
+                                           const dsp::Analysis& a) {
   dsp::Analysis t;
   t.measurement = a.measurement;
   const std::int64_t first = run.frames.front().sample_index;
@@ -64,15 +67,21 @@ double FigureCoverage::median_u() const { return median(u); }
 double FigureCoverage::rms_error() const {
   double ss = 0.0;
   for (double e : abs_error) ss += e * e;
-  return abs_error.empty() ? std::numeric_limits<double>::quiet_NaN() : std::sqrt(ss / static_cast<double>(abs_error.size()));
+  return abs_error.empty() ? std::numeric_limits<double>::quiet_NaN()
+                           : std::sqrt(ss / static_cast<double>(abs_error.size()));
 }
 
 const std::vector<std::string>& headline_keys() {
-  static const std::vector<std::string> keys = {
-      "circle.radius_mean_deviation_um", "circle.circular_deviation_G_um", "circle.radial_deviation_F_max_um",
-      "circle.radial_deviation_F_min_um", "step.end_position_error_um",     "positioning.A_um",
-      "positioning.E_um",                "positioning.M_um",                "positioning.B_um",
-      "rectangle.corner_error_max_um"};
+  static const std::vector<std::string> keys = {"circle.radius_mean_deviation_um",
+                                                "circle.circular_deviation_G_um",
+                                                "circle.radial_deviation_F_max_um",
+                                                "circle.radial_deviation_F_min_um",
+                                                "step.end_position_error_um",
+                                                "positioning.A_um",
+                                                "positioning.E_um",
+                                                "positioning.M_um",
+                                                "positioning.B_um",
+                                                "rectangle.corner_error_max_um"};
   return keys;
 }
 
@@ -85,7 +94,8 @@ CampaignResult run_campaign(const CampaignOptions& o) {
       const sim::Scenario sc = scenario(program, seed);
       std::vector<Eigen::Vector3d> truth;
       const dsp::Run run = sim::simulate(sc, &truth);
-      if (!o.write_runs.empty()) drivers::write_run(run, std::filesystem::path(o.write_runs) / sc.meta.id, {.gzip = false, .overwrite = true});
+      if (!o.write_runs.empty())
+        drivers::write_run(run, std::filesystem::path(o.write_runs) / sc.meta.id, {.gzip = false, .overwrite = true});
       dsp::AnalysisOptions ao;
       ao.coriolis = sc.coriolis;
       ao.uncertainty.draws = o.draws;
@@ -95,13 +105,16 @@ CampaignResult run_campaign(const CampaignOptions& o) {
       // The same evaluation of the true relative path.
       const auto measured = dsp::figures_of(a), true_figs = true_figures(run, truth, a);
       if (measured.empty()) {
-        r.failures.push_back(sc.meta.id + ": no figures (" + (a.flags.empty() ? std::string("?") : a.flags.front()) + ")");
+        r.failures.push_back(sc.meta.id + ": no figures (" + (a.flags.empty() ? std::string("?") : a.flags.front()) +
+                             ")");
         continue;
       }
       for (const auto& f : measured) {
         const dsp::FigureValue* tf = dsp::find_figure(true_figs, f.key);
         const auto u = a.uncertainty_k2.find(f.key);
-        if (!tf || tf->values.size() != f.values.size() || u == a.uncertainty_k2.end() || u->second.size() != f.values.size()) continue;
+        if (!tf || tf->values.size() != f.values.size() || u == a.uncertainty_k2.end() ||
+            u->second.size() != f.values.size())
+          continue;
         FigureCoverage& c = r.figures[f.key];
         c.key = f.key;
         const bool headline = std::find(headline_keys().begin(), headline_keys().end(), f.key) != headline_keys().end();
@@ -122,14 +135,16 @@ std::string coverage_table(const CampaignResult& r) {
   char b[256];
   std::snprintf(b, sizeof b, "uncertainty coverage campaign: %zu runs, %.0f s\n", r.runs, r.seconds);
   o += b;
-  std::snprintf(b, sizeof b, "  %-44s %6s %9s %11s %11s %8s\n", "figure", "cases", "coverage", "median U", "RMS error", "U/RMS");
+  std::snprintf(b, sizeof b, "  %-44s %6s %9s %11s %11s %8s\n", "figure", "cases", "coverage", "median U", "RMS error",
+                "U/RMS");
   o += b;
   auto row = [&](const FigureCoverage& c, const char* mark) {
-    std::snprintf(b, sizeof b, "  %-44s %6zu %8.1f%% %11.3f %11.3f %8.2f%s\n", c.key.c_str(), c.cases, 100.0 * c.coverage(), c.median_u(), c.rms_error(),
-                  c.median_u() / c.rms_error(), mark);
+    std::snprintf(b, sizeof b, "  %-44s %6zu %8.1f%% %11.3f %11.3f %8.2f%s\n", c.key.c_str(), c.cases,
+                  100.0 * c.coverage(), c.median_u(), c.rms_error(), c.median_u() / c.rms_error(), mark);
     o += b;
   };
-  for (const auto& [k, c] : r.figures) row(c, std::find(headline_keys().begin(), headline_keys().end(), k) != headline_keys().end() ? "  *" : "");
+  for (const auto& [k, c] : r.figures)
+    row(c, std::find(headline_keys().begin(), headline_keys().end(), k) != headline_keys().end() ? "  *" : "");
   row(r.headline, "  <- 90-99 %, U/RMS <= 3");
   for (const auto& f : r.failures) o += "  failed: " + f + "\n";
   o += "  (* headline figure; coverage: |measured - true| <= U; U/RMS: median U over the RMS error)\n";

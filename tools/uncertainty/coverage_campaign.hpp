@@ -32,21 +32,24 @@ struct FigureCoverage {
   std::string key;
   std::size_t cases = 0, covered = 0;
   std::vector<double> u, abs_error;  // per case
-  [[nodiscard]] double coverage() const { return cases ? static_cast<double>(covered) / static_cast<double>(cases) : 0.0; }
+  [[nodiscard]] double coverage() const {
+    return cases ? static_cast<double>(covered) / static_cast<double>(cases) : 0.0;
+  }
   [[nodiscard]] double median_u() const;
   [[nodiscard]] double rms_error() const;
 };
 
 struct CampaignResult {
   std::size_t runs = 0;
-  std::vector<std::string> failures;          // runs that could not be analysed, why
+  std::vector<std::string> failures;  // runs that could not be analysed, why
   std::map<std::string, FigureCoverage> figures;
-  FigureCoverage headline;                     // all headline figures pooled
+  FigureCoverage headline;  // all headline figures pooled
   double seconds = 0.0;
 };
 
 // The figures of the same evaluation of the simulator's true relative path (per frame).
-std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vector<Eigen::Vector3d>& truth, const dsp::Analysis& measured);
+std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vector<Eigen::Vector3d>& truth,
+                                           const dsp::Analysis& measured);
 
 // The headline figures of each program (the ones the campaign must cover).
 const std::vector<std::string>& headline_keys();

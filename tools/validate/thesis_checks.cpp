@@ -59,7 +59,8 @@ std::vector<double> channel_g(const dsp::Run& run, const Scenario& sc, int chann
   const double bias = t.bias_g[ax] + t.tc_bias_ug_per_c * 1e-6 * dT;
   std::vector<double> g(run.frames.size());
   for (std::size_t n = 0; n < g.size(); ++n)
-    g[n] = static_cast<double>(run.frames[n].accel_counts[channel] - acq.adc_offset_counts) * acq.adc_lsb_volt / k1 - bias;
+    g[n] =
+        static_cast<double>(run.frames[n].accel_counts[channel] - acq.adc_offset_counts) * acq.adc_lsb_volt / k1 - bias;
   return g;
 }
 
@@ -92,7 +93,9 @@ double windowed_sigma_um(const std::vector<std::vector<double>>& signals, double
 ThesisCheck dynamic_circle() {
   ThesisCheck c{"uncompensated dynamic error, R10 circle 2.5 m/min", "Bild 7-14", "um", 150.0, 0.0, 0.75, 1.25, ""};
   c.simulated = peak_dynamic_error_um(deterministic(circle_scenario(10.0, 2500.0, 2)), {0, 1}, dsp::DynamicComp::none);
-  c.how = "peak |p_meas - p_true| in XY during the motion; data-sheet PT2 (1 kHz, 0.707) + 38.8-sample DAQ filter, pipeline without dynamic compensation";
+  c.how =
+      "peak |p_meas - p_true| in XY during the motion; data-sheet PT2 (1 kHz, 0.707) + 38.8-sample DAQ filter, "
+      "pipeline without dynamic compensation";
   return c;
 }
 
@@ -105,7 +108,14 @@ ThesisCheck dynamic_step() {
 
 ThesisCheck white_noise(const ValidationOptions& o) {
   const double n_ug = 0.44, T = 1.2;
-  ThesisCheck c{"double-integrated white noise 0.44 ug/rtHz over 1.2 s", "(6-25)..(6-28): n T^1.5 / sqrt(3)", "um", 0.0, 0.0, 0.9, 1.1, ""};
+  ThesisCheck c{"double-integrated white noise 0.44 ug/rtHz over 1.2 s",
+                "(6-25)..(6-28): n T^1.5 / sqrt(3)",
+                "um",
+                0.0,
+                0.0,
+                0.9,
+                1.1,
+                ""};
   Scenario sc = rest_scenario(T * o.monte_carlo_windows / 4.0 + 0.1, o.seed);
   for (auto& t : sc.truth) t.spec.noise_ug_per_rthz = n_ug;
   const dsp::Run run = simulate(sc);
@@ -115,13 +125,15 @@ ThesisCheck white_noise(const ValidationOptions& o) {
   for (int channel : {0, 1, 3, 4}) ch.push_back(channel_g(run, sc, channel));
   c.thesis = n_ug * kUg * g * std::pow(T, 1.5) / std::sqrt(3.0) * 1e6;
   c.simulated = windowed_sigma_um(ch, T, fs, g);
-  c.how = "Monte Carlo over " + std::to_string(o.monte_carlo_windows) + " windows of the simulated sensor output (true bias removed), trapezoid double integral";
+  c.how = "Monte Carlo over " + std::to_string(o.monte_carlo_windows) +
+          " windows of the simulated sensor output (true bias removed), trapezoid double integral";
   return c;
 }
 
 ThesisCheck quantisation(const ValidationOptions& o) {
   const double T = 1.2;
-  ThesisCheck c{"quantisation, 23 effective bits, over 1.2 s", "ch. 7.1: 0.56 ug rms -> 0.04 um", "um", 0.04, 0.0, 0.8, 1.25, ""};
+  ThesisCheck c{
+      "quantisation, 23 effective bits, over 1.2 s", "ch. 7.1: 0.56 ug rms -> 0.04 um", "um", 0.04, 0.0, 0.8, 1.25, ""};
   Scenario sc = rest_scenario(T * o.monte_carlo_windows / 4.0 + 0.1, o.seed + 1);
   Scenario ideal = sc;
   sc.meta.acquisition.adc_bits = 23;
@@ -183,7 +195,8 @@ ThesisCheck common_vibration(double& relative_peak_um) {
   auto peak_x_error = [](const dsp::Run& r) {
     const dsp::Measurement m = dsp::analyze_run(r).measurement;
     double peak = 0.0;
-    for (std::size_t i = 0; i < m.pos_mm.size(); ++i) peak = std::max(peak, std::abs(m.pos_mm[i].x() - m.ref_mm[i].x()) * 1e3);
+    for (std::size_t i = 0; i < m.pos_mm.size(); ++i)
+      peak = std::max(peak, std::abs(m.pos_mm[i].x() - m.ref_mm[i].x()) * 1e3);
     return peak;
   };
   relative_peak_um = peak_x_error(run);
@@ -191,8 +204,17 @@ ThesisCheck common_vibration(double& relative_peak_um) {
   dsp::Run head_only = run;
   for (auto& f : head_only.frames)
     for (int ch = 0; ch < 3; ++ch) f.accel_counts[ch] = run.frames[0].accel_counts[ch];
-  ThesisCheck c{"single head sensor under common vibration", "ch. 8.3.1 (HERMLE: +-20 um)", "um", 20.0, peak_x_error(head_only), 0.5, 2.0, ""};
-  c.how = "peak |x_meas - x_true| of a 50 mm move, 8.8 Hz machine rocking + tones + broadband common to head and table, head sensor alone";
+  ThesisCheck c{"single head sensor under common vibration",
+                "ch. 8.3.1 (HERMLE: +-20 um)",
+                "um",
+                20.0,
+                peak_x_error(head_only),
+                0.5,
+                2.0,
+                ""};
+  c.how =
+      "peak |x_meas - x_true| of a 50 mm move, 8.8 Hz machine rocking + tones + broadband common to head and table, "
+      "head sensor alone";
   return c;
 }
 
@@ -206,13 +228,26 @@ std::vector<ThesisCheck> validate_against_thesis(const ValidationOptions& o) {
   rows.push_back(quantisation(o));
   double coriolis_um = 0.0;
   rows.push_back(coriolis_acceleration(coriolis_um));
-  ThesisCheck cp{"Coriolis position error after 1 s", "(3-6)", "um", 9.3, coriolis_um, 0.95, 1.05,
+  ThesisCheck cp{"Coriolis position error after 1 s",
+                 "(3-6)",
+                 "um",
+                 9.3,
+                 coriolis_um,
+                 0.95,
+                 1.05,
                  "double integral of the simulated Coriolis acceleration over 1 s of cruise"};
   rows.push_back(cp);
   double relative_um = 0.0;
   rows.push_back(common_vibration(relative_um));
-  ThesisCheck rel{"relative measurement (head - table) under the same vibration", "ch. 8.3.1 (KGM: +-1 um)", "um", 1.0, relative_um, 0.2, 3.0,
-                  "the same run through eical's relative pipeline (two sensors): the common vibration cancels; what is left is sensor noise"};
+  ThesisCheck rel{"relative measurement (head - table) under the same vibration",
+                  "ch. 8.3.1 (KGM: +-1 um)",
+                  "um",
+                  1.0,
+                  relative_um,
+                  0.2,
+                  3.0,
+                  "the same run through eical's relative pipeline (two sensors): the common vibration cancels; what is "
+                  "left is sensor noise"};
   rows.push_back(rel);
   return rows;
 }

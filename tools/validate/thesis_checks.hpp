@@ -10,13 +10,13 @@
 namespace eical::tools {
 
 struct ThesisCheck {
-  std::string name;       // what is compared
-  std::string source;     // where the thesis figure comes from
+  std::string name;    // what is compared
+  std::string source;  // where the thesis figure comes from
   std::string unit;
-  double thesis = 0.0;    // the thesis' figure (or the closed form it gives)
+  double thesis = 0.0;  // the thesis' figure (or the closed form it gives)
   double simulated = 0.0;
   double ratio_min = 0.0, ratio_max = 0.0;  // accepted simulated/thesis
-  std::string how;        // how the simulated figure was obtained
+  std::string how;                          // how the simulated figure was obtained
   [[nodiscard]] double ratio() const { return simulated / thesis; }
   [[nodiscard]] bool within() const { return ratio() >= ratio_min && ratio() <= ratio_max; }
 };

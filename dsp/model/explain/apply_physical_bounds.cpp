@@ -19,7 +19,8 @@ bool mems(const RunMeta& meta) {
 
 // A drift the standstills contradict: the fit would move the bias between the first and
 // the last standstill by far more than they show.
-bool contradicted_by_standstills(const ExplainedEffect& drift, const RunResiduals& rr, double& predicted_ug, double& shown_ug) {
+bool contradicted_by_standstills(const ExplainedEffect& drift, const RunResiduals& rr, double& predicted_ug,
+                                 double& shown_ug) {
   const auto change = drift.params.find("largest_bias_change_ug");
   const auto count = drift.params.find("standstills");
   const auto changed = drift.params.find("standstills_changed");
@@ -32,7 +33,8 @@ bool contradicted_by_standstills(const ExplainedEffect& drift, const RunResidual
 
 // A drift the standstills show themselves: they changed, and by what the fit predicts (within
 // a factor of three).
-bool shown_at_standstills(const ExplainedEffect& drift, const RunResiduals& rr, double& predicted_ug, double& shown_ug) {
+bool shown_at_standstills(const ExplainedEffect& drift, const RunResiduals& rr, double& predicted_ug,
+                          double& shown_ug) {
   const auto change = drift.params.find("largest_bias_change_ug");
   const auto changed = drift.params.find("standstills_changed");
   if (change == drift.params.end() || changed == drift.params.end() || changed->second <= 0.0 || rr.n < 2) return false;
@@ -51,8 +53,8 @@ ExplainedEffect outside_table(const ExplainedEffect& x, const std::string& why) 
   // at the held-out points is no finding.
   other.significant = std::max(explained, x.importance_um) >= kMaterialUm;
   other.magnitude = std::max(explained, x.importance_um), other.tolerance = kMaterialUm, other.unit = "um explained";
-  other.evidence = "a residual shaped like " + (x.resembles.empty() ? std::string(x.name) : x.resembles) + " but " + why +
-                   fmt("; it explains %.3g um RMS at the held-out points", explained);
+  other.evidence = "a residual shaped like " + (x.resembles.empty() ? std::string(x.name) : x.resembles) + " but " +
+                   why + fmt("; it explains %.3g um RMS at the held-out points", explained);
   return other;
 }
 
@@ -68,14 +70,22 @@ void apply_physical_bounds(ExplainState& st) {
     const double bound = is_mems ? i.bound_mems : i.bound;
     std::string why;
     if (x.unit == i.unit && x.magnitude > bound)
-      why = fmt("%.3g ", x.magnitude) + x.unit + std::string(" (") + (i.side == EffectSide::machine ? "a machine tool" : is_mems ? "a MEMS sensor" : "a servo accelerometer") + fmt(" has at most %.3g: ", bound) + std::string(i.bound_reason) + ")";
+      why = fmt("%.3g ", x.magnitude) + x.unit + std::string(" (") +
+            (i.side == EffectSide::machine ? "a machine tool"
+             : is_mems                     ? "a MEMS sensor"
+                                           : "a servo accelerometer") +
+            fmt(" has at most %.3g: ", bound) + std::string(i.bound_reason) + ")";
     double predicted = 0.0, shown = 0.0;
     if (*id == Effect::sensor_bias_drift && x.unit == i.unit && contradicted_by_standstills(x, st.rr, predicted, shown))
-      why = fmt("%.3g ug/s would move the bias by %.0f ug over the run, and its standstills agree to %.1f ug", x.magnitude, predicted, shown);
+      why = fmt("%.3g ug/s would move the bias by %.0f ug over the run, and its standstills agree to %.1f ug",
+                x.magnitude, predicted, shown);
     else if (*id == Effect::sensor_bias_drift && x.unit == i.unit && shown_at_standstills(x, st.rr, predicted, shown)) {
       // The sensor itself shows the bias moving this much at rest: a size observed directly
       // is no impossible size, whatever drives it (a sensor warming faster than its kind).
-      x.evidence += fmt("; beyond the %.3g ug/s a sensor of its kind drifts, but its standstills show the bias moving by %.0f ug (the drift predicts %.0f)", bound, shown, predicted);
+      x.evidence +=
+          fmt("; beyond the %.3g ug/s a sensor of its kind drifts, but its standstills show the bias moving by %.0f ug "
+              "(the drift predicts %.0f)",
+              bound, shown, predicted);
       why.clear();
     }
     if (why.empty()) continue;

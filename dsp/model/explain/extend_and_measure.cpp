@@ -1,7 +1,6 @@
 // Stage: the extended model and what it gains.
 #include "dsp/model/explain/stages.hpp"
 
-
 #include <algorithm>
 #include <cmath>
 
@@ -27,14 +26,17 @@ void extend_and_measure(ExplainState& st) {
       Eigen::VectorXd pred = Eigen::VectorXd::Zero(ch.rows());
       for (const auto& e : all) {
         if (!e.significant || e.channel != "total") continue;
-        const auto it = std::find_if(machine.begin(), machine.end(), [&](const EffectModel& m) { return m.name == e.name; });
+        const auto it =
+            std::find_if(machine.begin(), machine.end(), [&](const EffectModel& m) { return m.name == e.name; });
         if (it == machine.end()) continue;
         Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(it->params.size()));
         for (std::size_t p = 0; p < it->params.size(); ++p)
-          if (auto f = e.params.find(it->params[p]); f != e.params.end()) full[static_cast<Eigen::Index>(p)] = f->second;
+          if (auto f = e.params.find(it->params[p]); f != e.params.end())
+            full[static_cast<Eigen::Index>(p)] = f->second;
         const Eigen::MatrixXd cols = columns_on(*it, ch);
         for (Eigen::Index i = 0; i < ch.rows(); ++i)
-          if (cmd_axes[static_cast<std::size_t>(ch.axis[static_cast<std::size_t>(i)])]) pred[i] += cols.row(i).dot(full);
+          if (cmd_axes[static_cast<std::size_t>(ch.axis[static_cast<std::size_t>(i)])])
+            pred[i] += cols.row(i).dot(full);
       }
       return pred;
     };
@@ -49,13 +51,16 @@ void extend_and_measure(ExplainState& st) {
     Channel after_ch = rr.pipeline;
     after_ch.residual_um -= machine_prediction(after_ch);
     double best = moving_rms(offsets_out(after_ch), after_ch);
-    static const char* kPipelineSide[] = {"sensor.scale", "sensor.misalignment", "sensor.cross_coupling", "sensor.nonlinearity", "sensor.dynamics",
-                                          "sensor.damping_amplitude", "sensor.scale_temperature", "daq.group_delay"};
+    static const char* kPipelineSide[] = {
+        "sensor.scale",    "sensor.misalignment",      "sensor.cross_coupling",    "sensor.nonlinearity",
+        "sensor.dynamics", "sensor.damping_amplitude", "sensor.scale_temperature", "daq.group_delay"};
     std::vector<std::size_t> order;
     for (std::size_t k = 0; k < all.size(); ++k)
-      if (all[k].significant && std::any_of(std::begin(kPipelineSide), std::end(kPipelineSide), [&](const char* n) { return all[k].name == n; }))
+      if (all[k].significant && std::any_of(std::begin(kPipelineSide), std::end(kPipelineSide),
+                                            [&](const char* n) { return all[k].name == n; }))
         order.push_back(k);
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return all[a].importance_um > all[b].importance_um; });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return all[a].importance_um > all[b].importance_um; });
     std::vector<ExplainedEffect> taken;
     for (std::size_t k : order) {
       std::vector<ExplainedEffect> trial = taken;
@@ -66,7 +71,9 @@ void extend_and_measure(ExplainState& st) {
         best = r, after_ch = std::move(ch), taken = std::move(trial);
         all[k].taken_into_model = true;
       } else {
-        all[k].evidence += fmt("; not taken into the model: the pipeline with it follows the reference no better (%.3f -> %.3f um)", best, r);
+        all[k].evidence +=
+            fmt("; not taken into the model: the pipeline with it follows the reference no better (%.3f -> %.3f um)",
+                best, r);
       }
     }
     const Eigen::VectorXd after_v = offsets_out(after_ch);

@@ -23,15 +23,18 @@ void servo_mismatch_from_base(ExplainState& st, const KfSelection& ks) {
   double sure = 0.0;
   for (std::size_t i = 0; i < lags.size(); ++i)
     for (std::size_t j = i + 1; j < lags.size(); ++j) {
-      const double d = lags[j].second.first - lags[i].second.first, sd = std::hypot(lags[i].second.second, lags[j].second.second);
+      const double d = lags[j].second.first - lags[i].second.first,
+                   sd = std::hypot(lags[i].second.second, lags[j].second.second);
       x.params["lag_" + axis_letter(lags[j].first) + "_minus_" + axis_letter(lags[i].first) + "_ms"] = d;
       x.magnitude = std::max(x.magnitude, std::abs(d)), sure = std::max(sure, std::abs(d) - 2.0 * sd);
     }
   for (const auto& [a, l] : lags) x.params["lag_" + axis_letter(a) + "_ms"] = l.first;
   x.significant = sure > x.tolerance;
   x.importance_um = x.significant ? x.magnitude * st.rr.v_cmd.cwiseAbs().maxCoeff() : 0.0;
-  x.evidence = fmt("the axes' servo lags against the set-point (the integrated motion's base model) differ by %.3g ms (%.3g at 2 sigma) against a tolerance of %.3g ms",
-                   x.magnitude, sure, x.tolerance);
+  x.evidence =
+      fmt("the axes' servo lags against the set-point (the integrated motion's base model) differ by %.3g ms (%.3g at "
+          "2 sigma) against a tolerance of %.3g ms",
+          x.magnitude, sure, x.tolerance);
   st.merge(std::move(x));
 }
 
@@ -41,20 +44,23 @@ Attribution machine_attribution(const EffectModel& m, const std::map<std::string
   a.name = m.name, a.tolerance = m.tolerance, a.unit = m.unit, a.regressor = m.regressor;
   Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.params.size()));
   for (std::size_t p = 0; p < m.params.size(); ++p)
-    if (const auto mean = axes_mean(value, m.params[p])) full[static_cast<Eigen::Index>(p)] = *mean, a.params[m.params[p]] = *mean;
+    if (const auto mean = axes_mean(value, m.params[p]))
+      full[static_cast<Eigen::Index>(p)] = *mean, a.params[m.params[p]] = *mean;
   a.magnitude = m.magnitude(full);
   return a;
 }
 
 // The effects one group's verdict stands for, at its fitted values and 2σ towards zero.
-bool attributions(const ExplainState& st, const GroupVerdict& v, bool is_sensor, std::vector<Attribution>& atts, std::vector<Attribution>& sure) {
+bool attributions(const ExplainState& st, const GroupVerdict& v, bool is_sensor, std::vector<Attribution>& atts,
+                  std::vector<Attribution>& sure) {
   const std::map<std::string, double> sure_value = toward_zero(v.value, v.sigma);
   if (is_sensor) {
     atts = attribute_sensor_group(st.rr, v.name, v.value);
     sure = attribute_sensor_group(st.rr, v.name, sure_value);
     return true;
   }
-  const auto it = std::find_if(st.machine.begin(), st.machine.end(), [&](const EffectModel& e) { return e.name == v.name; });
+  const auto it =
+      std::find_if(st.machine.begin(), st.machine.end(), [&](const EffectModel& e) { return e.name == v.name; });
   if (it == st.machine.end()) return false;
   atts = {machine_attribution(*it, v.value)};
   sure = {machine_attribution(*it, sure_value)};
@@ -62,7 +68,8 @@ bool attributions(const ExplainState& st, const GroupVerdict& v, bool is_sensor,
 }
 
 // One attributed effect of a group's verdict.
-ExplainedEffect explained(const ExplainState& st, const GroupVerdict& v, bool is_sensor, const Attribution& at, double sure_magnitude, double share) {
+ExplainedEffect explained(const ExplainState& st, const GroupVerdict& v, bool is_sensor, const Attribution& at,
+                          double sure_magnitude, double share) {
   ExplainedEffect x;
   x.name = at.name, x.params = at.params, x.magnitude = at.magnitude, x.tolerance = at.tolerance, x.unit = at.unit;
   x.group = v.name, x.resembles = at.regressor;
@@ -73,10 +80,12 @@ ExplainedEffect explained(const ExplainState& st, const GroupVerdict& v, bool is
   x.heldout_rms_before_um = v.held_rms_before_um, x.heldout_rms_after_um = v.held_rms_after_um;
   x.importance_um = std::max(0.0, v.held_rms_before_um - v.held_rms_after_um) * share;
   x.significant = v.accepted && sure_magnitude > x.tolerance;
-  x.evidence = "the integrated motion against the " + st.rr.reference + " follows " + at.regressor + " (model group '" + v.name + "')" +
-               fmt("; BIC drop %.0f; prediction error at the held-out samples %.3f -> %.3f um; size %.3g (%.3g at 2 sigma) ", v.bic_drop, v.held_rms_before_um,
-                   v.held_rms_after_um, x.magnitude, sure_magnitude) +
-               x.unit + fmt(" against a tolerance of %.3g ", x.tolerance) + x.unit;
+  x.evidence =
+      "the integrated motion against the " + st.rr.reference + " follows " + at.regressor + " (model group '" + v.name +
+      "')" +
+      fmt("; BIC drop %.0f; prediction error at the held-out samples %.3f -> %.3f um; size %.3g (%.3g at 2 sigma) ",
+          v.bic_drop, v.held_rms_before_um, v.held_rms_after_um, x.magnitude, sure_magnitude) +
+      x.unit + fmt(" against a tolerance of %.3g ", x.tolerance) + x.unit;
   if (v.accepted && !x.significant) x.evidence += " (not clearly outside the tolerance: background)";
   // Known from the site, not fitted: named when it matters for the motion and the run
   // agrees with it better than without it.
@@ -96,7 +105,8 @@ void fit_integrated_motion(ExplainState& st) {
   std::vector<ParamGroup> groups = sensor_groups(rr);
   const std::size_t n_sensor_groups = groups.size();
   for (const auto& e : st.machine) {
-    if (e.name == name(Effect::machine_servo_mismatch)) continue;  // the servos of set-point-only axes are the base model's
+    if (e.name == name(Effect::machine_servo_mismatch))
+      continue;  // the servos of set-point-only axes are the base model's
     ParamGroup g = as_group(e, st.cmd_axes);
     if (!g.params.empty()) groups.push_back(std::move(g));
   }
@@ -122,7 +132,8 @@ void fit_integrated_motion(ExplainState& st) {
       double sure_magnitude = 0.0;
       for (const auto& sa : sure_atts)
         if (sa.name == at.name) sure_magnitude = sa.magnitude;
-      const double share = atts.size() > 1 && excess_sum > 0.0 && at.tolerance > 0.0 ? at.magnitude / at.tolerance / excess_sum : 1.0;
+      const double share =
+          atts.size() > 1 && excess_sum > 0.0 && at.tolerance > 0.0 ? at.magnitude / at.tolerance / excess_sum : 1.0;
       st.merge(explained(st, v, is_sensor, at, sure_magnitude, share));
     }
   }

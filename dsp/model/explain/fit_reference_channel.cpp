@@ -1,9 +1,9 @@
 // Stage 2: reference minus set-point — the machine effects of the axes with a reference, by
 // generalised least squares with the base model (offsets, loop lags, the reference's
 // rotation) projected out.
-#include "dsp/model/explain/stages.hpp"
 #include "dsp/core/median.hpp"
 #include "dsp/model/effect_selection.hpp"
+#include "dsp/model/explain/stages.hpp"
 
 #include <Eigen/QR>
 
@@ -12,7 +12,6 @@
 
 namespace eical::dsp::model::stage {
 namespace {
-
 
 struct ChannelResult {
   std::vector<ExplainedEffect> effects;
@@ -44,11 +43,15 @@ Eigen::MatrixXd base_columns(const RunResiduals& rr, const Channel& ch, const La
     add(offset), add(acc);
   }
   Eigen::VectorXd lag_rows(rows);
-  for (Eigen::Index i = 0; i < rows; ++i) lag_rows[i] = lag.velocity(ch.sample[static_cast<std::size_t>(i)], ch.axis[static_cast<std::size_t>(i)]) / ch.sigma_um[i];
+  for (Eigen::Index i = 0; i < rows; ++i)
+    lag_rows[i] =
+        lag.velocity(ch.sample[static_cast<std::size_t>(i)], ch.axis[static_cast<std::size_t>(i)]) / ch.sigma_um[i];
   add(lag_rows);
   for (int i = 0; i < 3; ++i)
     for (int j = i + 1; j < 3; ++j) {
-      if (rr.axis_reference[static_cast<std::size_t>(i)] != "ref" || rr.axis_reference[static_cast<std::size_t>(j)] != "ref" || !rr.moving[i] || !rr.moving[j]) continue;
+      if (rr.axis_reference[static_cast<std::size_t>(i)] != "ref" ||
+          rr.axis_reference[static_cast<std::size_t>(j)] != "ref" || !rr.moving[i] || !rr.moving[j])
+        continue;
       Eigen::VectorXd c(rows);
       const double mi = rr.cmd.col(i).mean(), mj = rr.cmd.col(j).mean();
       for (Eigen::Index k = 0; k < rows; ++k) {
@@ -74,8 +77,8 @@ Eigen::VectorXd without_all(const Eigen::VectorXd& y, const std::vector<Candidat
   return y - x * x.colPivHouseholderQr().solve(y);
 }
 
-ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const std::vector<EffectModel>& catalog, const LagColumns& lag,
-                              const ExplainOptions& o) {
+ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const std::vector<EffectModel>& catalog,
+                              const LagColumns& lag, const ExplainOptions& o) {
   ChannelResult out;
   const Eigen::Index rows = ch.rows();
   const Eigen::MatrixXd nu = base_columns(rr, ch, lag);
@@ -108,14 +111,18 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
     models.push_back(&e);
   }
   out.heldout.resize(static_cast<std::size_t>(rows));
-  for (Eigen::Index i = 0; i < rows; ++i) out.heldout[static_cast<std::size_t>(i)] = rr.heldout[static_cast<std::size_t>(ch.sample[static_cast<std::size_t>(i)])];
+  for (Eigen::Index i = 0; i < rows; ++i)
+    out.heldout[static_cast<std::size_t>(i)] =
+        rr.heldout[static_cast<std::size_t>(ch.sample[static_cast<std::size_t>(i)])];
   out.before_um = y.cwiseProduct(ch.sigma_um);  // the base model's residual (offsets and common lag out), µm
   out.after_um = out.before_um;
   if (cands.empty() || rows < 50) return out;
   SelectionOptions so;
   so.min_bic_drop = o.min_bic_drop, so.min_heldout_gain = o.min_heldout_gain, so.max_effects = 10;
   so.block.resize(static_cast<std::size_t>(rows));
-  for (Eigen::Index i = 0; i < rows; ++i) so.block[static_cast<std::size_t>(i)] = static_cast<int>(rr.t_s[ch.sample[static_cast<std::size_t>(i)]] / kJackknifeBlockS);
+  for (Eigen::Index i = 0; i < rows; ++i)
+    so.block[static_cast<std::size_t>(i)] =
+        static_cast<int>(rr.t_s[ch.sample[static_cast<std::size_t>(i)]] / kJackknifeBlockS);
   const SelectionResult sel = select_effects(y, cands, out.heldout, so);
   out.unexplained_um = without_all(y, cands).cwiseProduct(ch.sigma_um);
 
@@ -137,7 +144,8 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
     for (std::size_t p = 0; p < v.param_names.size(); ++p) {
       x.params[v.param_names[p]] = v.params[static_cast<Eigen::Index>(p)];
       for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
-        if (e.params[q2] == v.param_names[p]) full[static_cast<Eigen::Index>(q2)] = v.params[static_cast<Eigen::Index>(p)];
+        if (e.params[q2] == v.param_names[p])
+          full[static_cast<Eigen::Index>(q2)] = v.params[static_cast<Eigen::Index>(p)];
     }
     x.magnitude = e.magnitude(full), x.tolerance = e.tolerance, x.unit = e.unit;
     // Outside the tolerance with confidence: each parameter moved 2σ towards zero.
@@ -156,16 +164,17 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
     x.heldout_rms_before_um = split_rms(out.before_um, true), x.heldout_rms_after_um = split_rms(after, true);
     x.importance_um = x.residual_rms_before_um - x.residual_rms_after_um;
     x.significant = v.significant && sure_magnitude > x.tolerance;
-    x.evidence = "residual correlates with " + e.regressor + fmt(" (r = %.2f); BIC drop %.0f; held-out RMS %.3f -> %.3f um; ", v.correlation, v.bic_drop,
-                                                              x.heldout_rms_before_um, x.heldout_rms_after_um) +
-                 fmt("size %.3g (%.3g at 2 sigma) ", x.magnitude, sure_magnitude) + x.unit + fmt(" against a tolerance of %.3g ", x.tolerance) + x.unit;
+    x.evidence = "residual correlates with " + e.regressor +
+                 fmt(" (r = %.2f); BIC drop %.0f; held-out RMS %.3f -> %.3f um; ", v.correlation, v.bic_drop,
+                     x.heldout_rms_before_um, x.heldout_rms_after_um) +
+                 fmt("size %.3g (%.3g at 2 sigma) ", x.magnitude, sure_magnitude) + x.unit +
+                 fmt(" against a tolerance of %.3g ", x.tolerance) + x.unit;
     if (v.significant && !x.significant) x.evidence += " (not clearly outside the tolerance: background)";
     if (x.significant) out.after_um -= pred;
     out.effects.push_back(std::move(x));
   }
   return out;
 }
-
 
 }  // namespace
 

@@ -13,7 +13,8 @@ ExplainState prepare(const Run& run, const ExplainOptions& options) {
   const RunResiduals& rr = st.rr;
   st.ex.run_id = rr.run_id, st.ex.reference = rr.reference;
   // A reference instrument holds the integration as a standstill does.
-  st.integration_supported = unsupported_integration(rr.measurement).empty() || rr.has_ref[0] || rr.has_ref[1] || rr.has_ref[2];
+  st.integration_supported =
+      unsupported_integration(rr.measurement).empty() || rr.has_ref[0] || rr.has_ref[1] || rr.has_ref[2];
   if (!st.integration_supported) {
     st.ex.position_not_compared = unsupported_integration(rr.measurement);
     st.ex.nominal_residual_rms_um = st.ex.final_residual_rms_um = NAN;
@@ -24,11 +25,13 @@ ExplainState prepare(const Run& run, const ExplainOptions& options) {
   Eigen::MatrixXd hint = Eigen::MatrixXd::Constant(rr.n, 3, NAN);
   for (const Channel* hc : {&rr.pipeline, &rr.machine})
     for (Eigen::Index i = 0; i < hc->rows(); ++i)
-      if (hc == &rr.machine || rr.axis_reference[static_cast<std::size_t>(hc->axis[static_cast<std::size_t>(i)])] == "cmd")
+      if (hc == &rr.machine ||
+          rr.axis_reference[static_cast<std::size_t>(hc->axis[static_cast<std::size_t>(i)])] == "cmd")
         hint(hc->sample[static_cast<std::size_t>(i)], hc->axis[static_cast<std::size_t>(i)]) = hc->residual_um[i];
   st.lag = common_lag_columns(rr, loop_time_constant_s(rr, hint));
   st.machine = machine_effects(rr, without_lag(hint, st.lag), st.lag);
-  for (int a = 0; a < 3; ++a) st.cmd_axes[static_cast<std::size_t>(a)] = rr.axis_reference[static_cast<std::size_t>(a)] == "cmd" && rr.moving[a];
+  for (int a = 0; a < 3; ++a)
+    st.cmd_axes[static_cast<std::size_t>(a)] = rr.axis_reference[static_cast<std::size_t>(a)] == "cmd" && rr.moving[a];
   return st;
 }
 

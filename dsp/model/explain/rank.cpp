@@ -1,7 +1,6 @@
 // Stage: the effects in the order a reader needs them.
 #include "dsp/model/explain/stages.hpp"
 
-
 #include <algorithm>
 #include <cmath>
 
@@ -19,7 +18,6 @@ void rank(ExplainState& st) {
     if (a.significant) return a.importance_um > b.importance_um;
     return a.bic_drop > b.bic_drop;
   });
-
 }
 
 }  // namespace eical::dsp::model::stage

@@ -40,15 +40,18 @@ void where(const std::vector<double>& t_s, const std::vector<double>& r, double&
   freq_hz = static_cast<double>(best) / (static_cast<double>(n) * dt);
 }
 
-ExplainedEffect unexplained(const std::string& channel, double rms_um, double noise_um, const std::string& what, double at_s, double freq_hz) {
+ExplainedEffect unexplained(const std::string& channel, double rms_um, double noise_um, const std::string& what,
+                            double at_s, double freq_hz) {
   ExplainedEffect x;
   x.name = "other.unexplained", x.channel = channel, x.unit = "um", x.tolerance = kMaterialUm;
   x.magnitude = rms_um;
-  x.params["residual_rms_um"] = rms_um, x.params["noise_rms_um"] = noise_um, x.params["largest_at_s"] = at_s, x.params["strongest_hz"] = freq_hz;
+  x.params["residual_rms_um"] = rms_um, x.params["noise_rms_um"] = noise_um, x.params["largest_at_s"] = at_s,
+  x.params["strongest_hz"] = freq_hz;
   x.significant = rms_um > kMargin * noise_um && rms_um - noise_um >= kMaterialUm;
   x.importance_um = x.significant ? rms_um - noise_um : 0.0;
   x.evidence = what + fmt(" leaves %.3g um RMS where its noise explains %.3g um", rms_um, noise_um) +
-               (x.significant ? fmt("; largest at t = %.2f s, strongest at %.2f Hz", at_s, freq_hz) : std::string(": within its noise"));
+               (x.significant ? fmt("; largest at t = %.2f s, strongest at %.2f Hz", at_s, freq_hz)
+                              : std::string(": within its noise"));
   return x;
 }
 
@@ -69,7 +72,8 @@ std::vector<Eigen::VectorXd> mode_columns(const ExplainState& st, const Channel&
       for (int a = 0; a < 3; ++a) {
         Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
         for (Eigen::Index i = 0; i < n; ++i)
-          if (rows.axis[static_cast<std::size_t>(i)] == a) c[i] = m_mm[rows.sample[static_cast<std::size_t>(i)]] * 1000.0;
+          if (rows.axis[static_cast<std::size_t>(i)] == a)
+            c[i] = m_mm[rows.sample[static_cast<std::size_t>(i)]] * 1000.0;
         if (c.norm() > 0.0) cols.push_back(c);
       }
     }
@@ -123,8 +127,9 @@ void report_unexplained(ExplainState& st) {
   if (lo.held_expected_rms_um > 0.0) {
     double at = 0.0, hz = 0.0;
     if (!st.ex.traces.empty()) where(st.ex.traces.front().t_s, st.ex.traces.front().after_um, at, hz);
-    found.push_back(unexplained(st.rr.reference, lo.held_rms_um, lo.held_expected_rms_um,
-                                "the integrated motion with every effect of the table, predicted at the held-out points,", at, hz));
+    found.push_back(
+        unexplained(st.rr.reference, lo.held_rms_um, lo.held_expected_rms_um,
+                    "the integrated motion with every effect of the table, predicted at the held-out points,", at, hz));
   }
   if (lo.machine_rows && lo.machine_residual.size() == lo.machine_rows->rows()) {
     const Eigen::VectorXd left = without_modes(st, lo.machine_residual, *lo.machine_rows);
@@ -135,19 +140,22 @@ void report_unexplained(ExplainState& st) {
     double at = 0.0, hz = 0.0;
     where(t, r, at, hz);
     const double rms = std::sqrt(left.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, left.size())));
-    found.push_back(unexplained("machine", rms, lo.machine_noise_um,
-                                st.modes.empty() ? "reference - set-point after the base model and every effect of the table"
-                                                 : "reference - set-point after the base model, every effect of the table and the modes found",
-                                at, hz));
+    found.push_back(unexplained(
+        "machine", rms, lo.machine_noise_um,
+        st.modes.empty() ? "reference - set-point after the base model and every effect of the table"
+                         : "reference - set-point after the base model, every effect of the table and the modes found",
+        at, hz));
   }
   // A bias that wanders more than the data sheet says (named from the standstills) makes
   // the integrated motion's held-out predictions worse than its noise model expects: that
   // excess is the named effect, not an unexplained one.
   for (const Effect noise_like : {Effect::sensor_bias_drift, Effect::sensor_scale_temperature})
-    if (const ExplainedEffect* e = st.find(name(noise_like)); e && e->significant && !found.empty() && found.front().channel == st.rr.reference &&
-                                                               found.front().significant) {
+    if (const ExplainedEffect* e = st.find(name(noise_like)); e && e->significant && !found.empty() &&
+                                                              found.front().channel == st.rr.reference &&
+                                                              found.front().significant) {
       found.front().significant = false, found.front().importance_um = 0.0;
-      found.front().evidence += "; that excess is the " + e->name + " named above (not in the integration's noise model)";
+      found.front().evidence +=
+          "; that excess is the " + e->name + " named above (not in the integration's noise model)";
     }
   // One finding: the larger excess.
   if (found.empty()) return;

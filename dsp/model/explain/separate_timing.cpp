@@ -1,6 +1,6 @@
 // Stage: the sensors' timing against the DAQ delay the PSD strips show.
-#include "dsp/model/explain/stages.hpp"
 #include "dsp/identify/delay_estimate.hpp"
+#include "dsp/model/explain/stages.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -22,18 +22,22 @@ void separate_timing(ExplainState& st) {
   ExplainedEffect* dyn = find("sensor.dynamics");
   ExplainedEffect* del = find("daq.group_delay");
   if (rr.reference == "ref" && has_psd) {
-    const identify::DelayEstimate de = identify::estimate_delay(rr.measurement, rr.meta, identify::DelayReference::reference);
+    const identify::DelayEstimate de =
+        identify::estimate_delay(rr.measurement, rr.meta, identify::DelayReference::reference);
     if (de.valid) {
       ExplainedEffect d;
       d.name = "daq.group_delay", d.channel = "psd", d.unit = "samples", d.tolerance = 0.3;
       const double dd = de.samples - rr.delay_samples;
-      d.params["group_delay_samples"] = de.samples, d.params["delay_error_samples"] = dd, d.params["sigma_samples"] = de.sigma;
+      d.params["group_delay_samples"] = de.samples, d.params["delay_error_samples"] = dd,
+      d.params["sigma_samples"] = de.sigma;
       d.magnitude = std::abs(dd);
       d.significant = std::abs(dd) > d.tolerance && std::abs(dd) > 3.0 * de.sigma;
       d.importance_um = std::abs(dd) / rr.fs_hz * rr.v_cmd.cwiseAbs().maxCoeff() * 1000.0 / std::sqrt(2.0);
       d.bic_drop = de.sigma > 0.0 ? (dd / de.sigma) * (dd / de.sigma) : 0.0;
-      d.evidence = fmt("the PSD readings (through the DAQ filter, not the sensors) lag the reference by %.3f +- %.3f samples against %.3f nominal", de.samples,
-                       de.sigma, rr.delay_samples);
+      d.evidence =
+          fmt("the PSD readings (through the DAQ filter, not the sensors) lag the reference by %.3f +- %.3f samples "
+              "against %.3f nominal",
+              de.samples, de.sigma, rr.delay_samples);
       if (de.mounting_assumed) d.evidence += " (strips crossed at one speed: taken where run.toml puts them)";
       // What each sensor's own timing is once the delay is known. Both sensors off by the
       // same: their dynamics (2ζ/ω0); the head off against the table: the DAQ's skew between
@@ -44,7 +48,8 @@ void separate_timing(ExplainState& st) {
         const double delay_us = -dd * 1e6 / rr.fs_hz;
         double own[2] = {NAN, NAN};
         for (int s2 = 0; s2 < 2; ++s2)
-          if (auto it = dyn->params.find(std::string("damping_term_error_us_") + (s2 == 0 ? "table" : "head")); it != dyn->params.end())
+          if (auto it = dyn->params.find(std::string("damping_term_error_us_") + (s2 == 0 ? "table" : "head"));
+              it != dyn->params.end())
             own[s2] = it->second - delay_us;
         double base = std::isfinite(own[0]) ? own[0] : own[1];
         if (std::isfinite(own[0]) && std::isfinite(own[1])) {
@@ -66,8 +71,10 @@ void separate_timing(ExplainState& st) {
         dyn->significant = dyn->bic_drop > o.min_bic_drop && std::abs(base) > dyn->tolerance;
         dyn->evidence += fmt("; %.1f us of it is the DAQ delay the PSD readings show", delay_us);
       }
-      if (del) *del = d;
-      else all.push_back(d);
+      if (del)
+        *del = d;
+      else
+        all.push_back(d);
     }
   } else if (del) {  // without strips and a reference the two are one shift: name the sensor's
     if (del->significant) {

@@ -18,7 +18,8 @@ void ExplainState::merge(ExplainedEffect e) { stage::merge(effects, std::move(e)
 void merge(std::vector<ExplainedEffect>& all, ExplainedEffect e) {
   for (auto& a : all) {
     if (a.name != e.name) continue;
-    const bool take = (e.significant && !a.significant) || (e.significant == a.significant && e.importance_um > a.importance_um);
+    const bool take =
+        (e.significant && !a.significant) || (e.significant == a.significant && e.importance_um > a.importance_um);
     for (const auto& [k, v] : (take ? a : e).params) (take ? e : a).params.emplace(k, v);
     if (take) a = std::move(e);
     return;
@@ -33,10 +34,12 @@ ExplainedEffect effect_of(Effect e) {
   return x;
 }
 
-std::map<std::string, double> toward_zero(const std::map<std::string, double>& value, const std::map<std::string, double>& sigma, double k) {
+std::map<std::string, double> toward_zero(const std::map<std::string, double>& value,
+                                          const std::map<std::string, double>& sigma, double k) {
   std::map<std::string, double> out = value;
   for (auto& [name, x] : out)
-    if (const auto sg = sigma.find(name); sg != sigma.end()) x = std::abs(x) > k * sg->second ? x - std::copysign(k * sg->second, x) : 0.0;
+    if (const auto sg = sigma.find(name); sg != sigma.end())
+      x = std::abs(x) > k * sg->second ? x - std::copysign(k * sg->second, x) : 0.0;
   return out;
 }
 
@@ -53,10 +56,11 @@ std::optional<double> axes_mean(const std::map<std::string, double>& value, cons
 Eigen::MatrixXd columns_on(const EffectModel& e, const Channel& ch) {
   Eigen::MatrixXd m(ch.rows(), static_cast<Eigen::Index>(e.columns.size()));
   for (std::size_t p = 0; p < e.columns.size(); ++p)
-    for (Eigen::Index i = 0; i < ch.rows(); ++i) m(i, static_cast<Eigen::Index>(p)) = e.columns[p](ch.sample[static_cast<std::size_t>(i)], ch.axis[static_cast<std::size_t>(i)]);
+    for (Eigen::Index i = 0; i < ch.rows(); ++i)
+      m(i, static_cast<Eigen::Index>(p)) =
+          e.columns[p](ch.sample[static_cast<std::size_t>(i)], ch.axis[static_cast<std::size_t>(i)]);
   return m;
 }
-
 
 // A channel's residual with each axis' offset taken out (the reference's zero is arbitrary).
 Eigen::VectorXd offsets_out(const Channel& ch) {

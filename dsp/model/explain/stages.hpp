@@ -44,7 +44,7 @@ struct ExplainState {
   std::array<bool, 3> cmd_axes{};    // moving axes with the set-point as their only reference
   std::vector<ExplainedEffect> effects;
   RunExplanation ex;
-  std::vector<StructuralMode> modes;   // significant modes the motion drives (test_vibration)
+  std::vector<StructuralMode> modes;  // significant modes the motion drives (test_vibration)
   bool integration_supported = true;  // a rest or a position support holds the double integral
   // What the accepted effects leave, for the unexplained-residual test.
   struct Leftover {
@@ -78,7 +78,8 @@ std::string fmt(const char* f, Num... v) {
 
 // Each value moved k standard errors towards zero (to zero when within them): the size that
 // lies outside a band with confidence.
-std::map<std::string, double> toward_zero(const std::map<std::string, double>& value, const std::map<std::string, double>& sigma, double k = 2.0);
+std::map<std::string, double> toward_zero(const std::map<std::string, double>& value,
+                                          const std::map<std::string, double>& sigma, double k = 2.0);
 
 // A parameter fitted per axis ("name@x", "name@y") as one value: their mean (nullopt: none).
 std::optional<double> axes_mean(const std::map<std::string, double>& value, const std::string& name);
@@ -94,21 +95,23 @@ Run extended_run(const Run& run, const std::vector<ExplainedEffect>& taken);
 
 // The stages, in the order explain_run calls them.
 ExplainState prepare(const Run& run, const ExplainOptions& options);
-void fit_integrated_motion(ExplainState& st);   // sensor effects (and set-point-only machine ones) through the integration's filter
-void fit_reference_channel(ExplainState& st);   // machine effects on reference − set-point
-void separate_timing(ExplainState& st);         // the sensors' dynamics against the DAQ delay
-void report_earth_rate(ExplainState& st);       // site.coriolis from the site
-void test_standstill_bias(ExplainState& st);    // bias steps, drift, temperature at the standstills
+void fit_integrated_motion(
+    ExplainState& st);  // sensor effects (and set-point-only machine ones) through the integration's filter
+void fit_reference_channel(ExplainState& st);  // machine effects on reference − set-point
+void separate_timing(ExplainState& st);        // the sensors' dynamics against the DAQ delay
+void report_earth_rate(ExplainState& st);      // site.coriolis from the site
+void test_standstill_bias(ExplainState& st);   // bias steps, drift, temperature at the standstills
 void test_stick_slip(ExplainState& st);
-void test_vibration(ExplainState& st);          // spectra and structural modes
-void compare_accelerations(ExplainState& st);   // runs nothing holds: mounting angle, scale, lag and bias in acceleration
+void test_vibration(ExplainState& st);  // spectra and structural modes
+void compare_accelerations(
+    ExplainState& st);  // runs nothing holds: mounting angle, scale, lag and bias in acceleration
 // A sensor mounted otherwise than run.toml says (flip, swap, mirror): explain_run then
 // explains the run with the mounting that fits, the finding first.
 std::optional<MountingFit> wrong_mounting(const ExplainState& st);
 ExplainedEffect mounting_effect(const MountingFit& m);
-void apply_physical_bounds(ExplainState& st);   // a size no sensor or machine can have is not that effect
-void report_unexplained(ExplainState& st);      // a residual beyond the noise that no effect explains
-void extend_and_measure(ExplainState& st);      // take the sensor side into the model, measure the gain
-void rank(ExplainState& st);                    // significant first, then by importance
+void apply_physical_bounds(ExplainState& st);  // a size no sensor or machine can have is not that effect
+void report_unexplained(ExplainState& st);     // a residual beyond the noise that no effect explains
+void extend_and_measure(ExplainState& st);     // take the sensor side into the model, measure the gain
+void rank(ExplainState& st);                   // significant first, then by importance
 
 }  // namespace eical::dsp::model::stage

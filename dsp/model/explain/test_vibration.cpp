@@ -15,18 +15,23 @@ void test_vibration(ExplainState& st) {
   {
     const VibrationTests v = vibration_tests(rr);
     ExplainedEffect c, d;
-    c.name = "machine.common_vibration", c.channel = "spectrum", c.unit = "mg", c.tolerance = 0.05, c.magnitude = v.common.rms_mg;
+    c.name = "machine.common_vibration", c.channel = "spectrum", c.unit = "mg", c.tolerance = 0.05,
+    c.magnitude = v.common.rms_mg;
     c.params["rms_mg"] = v.common.rms_mg, c.params["coherence"] = v.common.coherence;
-    for (std::size_t i = 0; i < v.common.lines.size(); ++i) c.params["line" + std::to_string(i) + "_hz"] = v.common.lines[i].freq_hz;
+    for (std::size_t i = 0; i < v.common.lines.size(); ++i)
+      c.params["line" + std::to_string(i) + "_hz"] = v.common.lines[i].freq_hz;
     c.significant = v.common.found && v.common.rms_mg > c.tolerance;
     c.importance_um = c.significant ? 1.0 + v.common.rms_mg : 0.0;
     c.evidence = v.common.evidence;
-    d.name = "machine.differential_vibration", d.channel = "spectrum", d.unit = "um", d.tolerance = 0.1, d.magnitude = v.differential.displacement_um;
+    d.name = "machine.differential_vibration", d.channel = "spectrum", d.unit = "um", d.tolerance = 0.1,
+    d.magnitude = v.differential.displacement_um;
     d.params["rms_mg"] = v.differential.rms_mg, d.params["displacement_um"] = v.differential.displacement_um;
-    for (std::size_t i = 0; i < v.differential.lines.size(); ++i) d.params["line" + std::to_string(i) + "_hz"] = v.differential.lines[i].freq_hz;
+    for (std::size_t i = 0; i < v.differential.lines.size(); ++i)
+      d.params["line" + std::to_string(i) + "_hz"] = v.differential.lines[i].freq_hz;
     // Relative motion that matters for the position (0.1 µm), or an acceleration ten times
     // the sensors' own noise over the band (0.3 mg RMS) that a light structure shows.
-    d.significant = v.differential.found && (v.differential.displacement_um > d.tolerance || v.differential.rms_mg > 0.3);
+    d.significant =
+        v.differential.found && (v.differential.displacement_um > d.tolerance || v.differential.rms_mg > 0.3);
     d.importance_um = d.significant ? v.differential.displacement_um : 0.0;
     d.evidence = v.differential.evidence;
     // Modes the motion drives (machine.resonance, run-format.md): the frequency response of
@@ -40,22 +45,27 @@ void test_vibration(ExplainState& st) {
     double f0_min = INFINITY;
     for (int sn = 0; sn < 2; ++sn)
       if (rr.meta.sensor_present[sn]) f0_min = std::min(f0_min, rr.meta.sensors[sn].f0_hz);
-    const ModeSearch ms = find_structural_modes(rr.a_meas, rr.a_cmd, 1.0 / rr.dt_s, rr.moving, std::min(kModeMaxHz, f0_min / 3.0));
+    const ModeSearch ms =
+        find_structural_modes(rr.a_meas, rr.a_cmd, 1.0 / rr.dt_s, rr.moving, std::min(kModeMaxHz, f0_min / 3.0));
     int k = 0;
     double largest = 0.0;
     for (const auto& md : ms.modes) {
       if (!md.significant) continue;
       st.modes.push_back(md);
       const std::string pre = "mode" + std::to_string(k++) + "_";
-      res.params[pre + "frequency_hz"] = md.frequency_hz, res.params[pre + "sigma_frequency_hz"] = md.sigma_frequency_hz;
-      res.params[pre + "damping_ratio"] = md.damping_ratio, res.params[pre + "sigma_damping_ratio"] = md.sigma_damping_ratio;
+      res.params[pre + "frequency_hz"] = md.frequency_hz,
+                       res.params[pre + "sigma_frequency_hz"] = md.sigma_frequency_hz;
+      res.params[pre + "damping_ratio"] = md.damping_ratio,
+                       res.params[pre + "sigma_damping_ratio"] = md.sigma_damping_ratio;
       res.params[pre + "gain"] = md.gain, res.params[pre + "peak_amplification"] = md.peak_amplification;
       for (int a = 0; a < 3; ++a) res.params[pre + "direction_" + "xyz"[a]] = md.direction[static_cast<std::size_t>(a)];
       res.params[pre + "displacement_rms_um"] = md.displacement_rms_um;
-      res.evidence += fmt("; a mode at %.2f +- %.2f Hz, damping %.3f +- %.3f, ", md.frequency_hz, md.sigma_frequency_hz, md.damping_ratio, md.sigma_damping_ratio) +
-                      fmt("gain %.3f (x%.2f at its peak), driven along ", md.gain, 1.0 + md.peak_amplification) + std::string(1, "xyz"[md.input_axis]) +
-                      fmt(", %.2f mg / %.3f um RMS in this run; chi2 drop %.0f against %.0f, coherence %.2f", md.response_rms_mg, md.displacement_rms_um, md.chi2_drop,
-                          md.chi2_threshold, md.coherence);
+      res.evidence += fmt("; a mode at %.2f +- %.2f Hz, damping %.3f +- %.3f, ", md.frequency_hz, md.sigma_frequency_hz,
+                          md.damping_ratio, md.sigma_damping_ratio) +
+                      fmt("gain %.3f (x%.2f at its peak), driven along ", md.gain, 1.0 + md.peak_amplification) +
+                      std::string(1, "xyz"[md.input_axis]) +
+                      fmt(", %.2f mg / %.3f um RMS in this run; chi2 drop %.0f against %.0f, coherence %.2f",
+                          md.response_rms_mg, md.displacement_rms_um, md.chi2_drop, md.chi2_threshold, md.coherence);
       largest = std::max(largest, md.peak_amplification);
     }
     std::string modes = res.evidence;  // "; a mode at …; a mode at …"
@@ -63,9 +73,12 @@ void test_vibration(ExplainState& st) {
     if (k > 0) {
       res.significant = true;
       res.magnitude = largest, res.importance_um = 1.0 + largest;
-      res.params["residual_rms_before_mg"] = ms.residual_rms_before_mg, res.params["residual_rms_after_mg"] = ms.residual_rms_after_mg;
-      res.evidence = (rr.meta.sensor_present[0] && rr.meta.sensor_present[1] ? "head against table: " : "") + modes + "; " + ms.evidence +
-                     fmt("; with the modes, measured - commanded acceleration beyond the drive's own response falls from %.3g to %.3g mg RMS",
+      res.params["residual_rms_before_mg"] = ms.residual_rms_before_mg,
+      res.params["residual_rms_after_mg"] = ms.residual_rms_after_mg;
+      res.evidence = (rr.meta.sensor_present[0] && rr.meta.sensor_present[1] ? "head against table: " : "") + modes +
+                     "; " + ms.evidence +
+                     fmt("; with the modes, measured - commanded acceleration beyond the drive's own response falls "
+                         "from %.3g to %.3g mg RMS",
                          ms.residual_rms_before_mg, ms.residual_rms_after_mg);
     } else {
       res.evidence = ms.evidence + ": no mode stands out";

@@ -135,8 +135,10 @@ FaultOutcome command_flood() {
   const auto t1 = Clock::now();
   cmd.request_id = ++id, cmd.action = "ping", cmd.code = 0;
   hmi.send(cmd);
-  if (wait_reply(replies, id, 5s)) o.recovery_s = std::chrono::duration<double>(Clock::now() - t1).count();
-  else o.problem("no Reply right after the flood");
+  if (wait_reply(replies, id, 5s))
+    o.recovery_s = std::chrono::duration<double>(Clock::now() - t1).count();
+  else
+    o.problem("no Reply right after the flood");
   std::this_thread::sleep_for(1s);
   const auto answered_now = replies.replies();
   std::size_t answered = 0;
@@ -147,22 +149,27 @@ FaultOutcome command_flood() {
   svc.stop();
   const std::string log = journal.restore();
   const std::size_t lines = count(log, "command from flooding-hmi");
-  const std::uint64_t overruns = after.overruns - before.overruns, commands = after.counters.commands - before.counters.commands;
+  const std::uint64_t overruns = after.overruns - before.overruns,
+                      commands = after.counters.commands - before.counters.commands;
   o.flagged = false;
   o.clean = temporaries(dir).empty() && overruns == 0;
   if (overruns > 0) o.problem(std::to_string(overruns) + " frames overran the ring during the flood");
-  if (answered < sent / 2) o.problem("only " + std::to_string(answered) + " of " + std::to_string(sent) + " commands answered");
+  if (answered < sent / 2)
+    o.problem("only " + std::to_string(answered) + " of " + std::to_string(sent) + " commands answered");
   if (lines > 20) o.problem(std::to_string(lines) + " journal lines for the flood");
   char b[300];
-  std::snprintf(b, sizeof b, "%zu sent in %.1f s, %llu received, %zu answered; ring overruns %llu; %zu journal lines (then counted)", sent,
-                flood_s, static_cast<unsigned long long>(commands), answered, static_cast<unsigned long long>(overruns), lines);
+  std::snprintf(b, sizeof b,
+                "%zu sent in %.1f s, %llu received, %zu answered; ring overruns %llu; %zu journal lines (then counted)",
+                sent, flood_s, static_cast<unsigned long long>(commands), answered,
+                static_cast<unsigned long long>(overruns), lines);
   o.outcome = b;
   o.runs_after = completed_runs(dir).size();
   for (const auto& r : completed_runs(dir)) {
     std::string why;
     if (!readable_with_result(r, &why)) o.problem("not readable: " + why);
   }
-  o.measurements_lost = static_cast<std::int64_t>(svc.last().measurements) - static_cast<std::int64_t>(svc.last().results_written);
+  o.measurements_lost =
+      static_cast<std::int64_t>(svc.last().measurements) - static_cast<std::int64_t>(svc.last().results_written);
   o.data_lost = o.measurements_lost == 0 ? "0" : std::to_string(o.measurements_lost) + " measurements not recorded";
   return o;
 }
@@ -228,7 +235,9 @@ FaultOutcome malformed_commands() {
   nc.send(m101);
   const bool got101 = wait_reply(replies, id, 3s);
   const bool ok101 = got101 && replies.replies().at(id).ok;
-  if (!ok101) o.problem("the NC's M101 after the malformed commands was refused: " + (got101 ? replies.replies().at(id).message : std::string("no Reply")));
+  if (!ok101)
+    o.problem("the NC's M101 after the malformed commands was refused: " +
+              (got101 ? replies.replies().at(id).message : std::string("no Reply")));
   std::this_thread::sleep_for(1s);
   m103.time_ns = clock_ns(CLOCK_MONOTONIC), m103.request_id = ++id;
   nc.send(m103);
@@ -246,10 +255,12 @@ FaultOutcome malformed_commands() {
   if (longest > 2000) o.problem("a journal line of " + std::to_string(longest) + " bytes");
   o.flagged = refused == bad.size();  // each one refused, with its reason in the Reply
   o.clean = temporaries(dir).empty();
-  o.outcome = std::to_string(refused) + " of " + std::to_string(bad.size()) + " refused with a Reply; longest journal line " + std::to_string(longest) +
+  o.outcome = std::to_string(refused) + " of " + std::to_string(bad.size()) +
+              " refused with a Reply; longest journal line " + std::to_string(longest) +
               " bytes; the NC's next M101/M103 measured";
   o.runs_after = completed_runs(dir).size();
-  o.measurements_lost = static_cast<std::int64_t>(svc.last().measurements) - static_cast<std::int64_t>(svc.last().results_written);
+  o.measurements_lost =
+      static_cast<std::int64_t>(svc.last().measurements) - static_cast<std::int64_t>(svc.last().results_written);
   o.data_lost = o.measurements_lost == 0 ? "0" : std::to_string(o.measurements_lost) + " measurements not recorded";
   return o;
 }

@@ -16,7 +16,9 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-std::int64_t now_ns() { return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count(); }
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+}
 
 dsp::Frame as_daq(dsp::Frame f) {
   for (double& c : f.cmd_mm) c = 0.0;  // a DAQ knows no set-point
@@ -93,13 +95,15 @@ void DaqFeeder::run() {
     started_ns_[p] = t0;
     const FeedPhase& ph = phases_[p];
     if (ph.frames.empty()) {
-      while (!stop_ && now_ns() - t0 < static_cast<std::int64_t>(ph.silence_s * 1e9)) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      while (!stop_ && now_ns() - t0 < static_cast<std::int64_t>(ph.silence_s * 1e9))
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
       continue;
     }
     std::vector<dsp::Frame> block;
     for (std::size_t i = 0; i < ph.frames.size() && !stop_; i += 32) {
       const std::size_t n = std::min<std::size_t>(32, ph.frames.size() - i);
-      block.assign(ph.frames.begin() + static_cast<std::ptrdiff_t>(i), ph.frames.begin() + static_cast<std::ptrdiff_t>(i + n));
+      block.assign(ph.frames.begin() + static_cast<std::ptrdiff_t>(i),
+                   ph.frames.begin() + static_cast<std::ptrdiff_t>(i + n));
       for (auto& f : block) f.sample_index = index++;
       // A packet leaves when its last sample is taken (at `pace` times the real rate).
       const auto due = t0 + static_cast<std::int64_t>(static_cast<double>(i + n) * 1e9 / (fs_hz_ * ph.pace));

@@ -29,7 +29,8 @@ fs::path write_eicald_config(const fs::path& dir, const fs::path& recording_dir,
   return file;
 }
 
-EicaldProcess::EicaldProcess(const fs::path& config, const fs::path& log_file, const std::vector<std::pair<std::string, std::string>>& env)
+EicaldProcess::EicaldProcess(const fs::path& config, const fs::path& log_file,
+                             const std::vector<std::pair<std::string, std::string>>& env)
     : log_file_(log_file) {
   pid_ = ::fork();
   if (pid_ == 0) {

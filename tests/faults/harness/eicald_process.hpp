@@ -22,7 +22,8 @@ fs::path write_eicald_config(const fs::path& dir, const fs::path& recording_dir,
 
 class EicaldProcess {
  public:
-  EicaldProcess(const fs::path& config, const fs::path& log_file, const std::vector<std::pair<std::string, std::string>>& env = {});
+  EicaldProcess(const fs::path& config, const fs::path& log_file,
+                const std::vector<std::pair<std::string, std::string>>& env = {});
   ~EicaldProcess();  // SIGKILL when still running
   EicaldProcess(const EicaldProcess&) = delete;
   EicaldProcess& operator=(const EicaldProcess&) = delete;

@@ -72,15 +72,20 @@ FaultOutcome kill9_during_write() {
   const auto end = Clock::now() + 60s;
   while (Clock::now() < end && again.running() && !(temporaries(dir).empty() && runs_with_result(dir) >= o.runs_before))
     std::this_thread::sleep_for(10ms);
-  if (temporaries(dir).empty() && runs_with_result(dir) >= o.runs_before) o.recovery_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  else o.problem("after the restart: " + std::to_string(temporaries(dir).size()) + " temporaries, " + std::to_string(runs_with_result(dir)) + " of " +
-                 std::to_string(o.runs_before) + " runs with a result");
+  if (temporaries(dir).empty() && runs_with_result(dir) >= o.runs_before)
+    o.recovery_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  else
+    o.problem("after the restart: " + std::to_string(temporaries(dir).size()) + " temporaries, " +
+              std::to_string(runs_with_result(dir)) + " of " + std::to_string(o.runs_before) + " runs with a result");
   // Measuring again: a run beyond those of the first start.
-  while (Clock::now() < end + 30s && again.running() && completed_runs(dir).size() <= o.runs_before) std::this_thread::sleep_for(20ms);
+  while (Clock::now() < end + 30s && again.running() && completed_runs(dir).size() <= o.runs_before)
+    std::this_thread::sleep_for(20ms);
   o.service_alive = completed_runs(dir).size() > o.runs_before;
   again.signal(SIGTERM);
   const auto rc = again.wait_exit(20s);
-  if (rc != 0) o.problem("eicald did not stop cleanly after SIGTERM: " + (rc ? std::to_string(*rc) : std::string("still running")));
+  if (rc != 0)
+    o.problem("eicald did not stop cleanly after SIGTERM: " +
+              (rc ? std::to_string(*rc) : std::string("still running")));
   o.runs_intact = intact_runs(before, dir);
   o.runs_after = completed_runs(dir).size() - o.runs_before;
   o.clean = temporaries(dir).empty();
@@ -90,8 +95,11 @@ FaultOutcome kill9_during_write() {
   }
   const std::string log2 = again.log();
   o.flagged = unevaluated == 0 || log2.find("evaluated now") != std::string::npos;
-  o.outcome = "no torn run directory; the next start removed " + std::to_string(temps_left) + " temporar" + (temps_left == 1 ? "y" : "ies") +
-              (unevaluated ? " and evaluated " + std::to_string(unevaluated) + " run(s) left without result (flagged evaluated_after_restart)" : "");
+  o.outcome = "no torn run directory; the next start removed " + std::to_string(temps_left) + " temporar" +
+              (temps_left == 1 ? "y" : "ies") +
+              (unevaluated ? " and evaluated " + std::to_string(unevaluated) +
+                                 " run(s) left without result (flagged evaluated_after_restart)"
+                           : "");
   o.measurements_lost = 1;
   o.data_lost = "the measurement being written (in the killed process's memory); no completed run";
   return o;

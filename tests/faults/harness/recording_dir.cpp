@@ -41,7 +41,8 @@ std::vector<fs::path> temporaries(const fs::path& recording_dir) {
   for (const auto& e : fs::directory_iterator(recording_dir, ec)) {
     const std::string name = e.path().filename().string();
     if (name == ".eicald-state") continue;  // eicald's own record of how it last ended
-    if (name[0] == '.') out.push_back(e.path());
+    if (name[0] == '.')
+      out.push_back(e.path());
     else if (e.is_directory())
       for (const auto& f : fs::directory_iterator(e.path(), ec))
         if (f.path().extension() == ".tmp") out.push_back(f.path());
@@ -88,7 +89,9 @@ std::size_t intact_runs(const Snapshot& before, const fs::path& recording_dir) {
   }
   std::size_t intact = 0;
   for (const auto& run : runs)
-    if (!broken.count(run) && (!fs::exists(recording_dir / run / "run.toml") || readable_with_result(recording_dir / run))) ++intact;
+    if (!broken.count(run) &&
+        (!fs::exists(recording_dir / run / "run.toml") || readable_with_result(recording_dir / run)))
+      ++intact;
   return intact;
 }
 

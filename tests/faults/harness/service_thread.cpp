@@ -55,7 +55,8 @@ std::optional<std::string> ServiceThread::error() const {
   return error_;
 }
 
-bool ServiceThread::wait_for(const std::function<bool(const daemon::ServiceStatus&)>& want, std::chrono::milliseconds timeout) const {
+bool ServiceThread::wait_for(const std::function<bool(const daemon::ServiceStatus&)>& want,
+                             std::chrono::milliseconds timeout) const {
   const auto end = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < end) {
     if (want(last())) return true;

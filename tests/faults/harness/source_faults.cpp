@@ -69,23 +69,33 @@ FaultOutcome source_faster_than_real_time() {
   ServiceThread svc(daq_config(s.dir));
   // 3x: 6 s of wall time at rest (the rate window fills), a circle; then real time: rest
   // (the window empties of the fast samples) and a circle.
-  DaqFeeder daq(s.dir / "daq.fifo", {{daq_rest(18.0), 3.0}, {daq_circle(1.0), 3.0}, {daq_rest(5.0), 1.0}, {daq_circle(1.0), 1.0}, {daq_rest(1.0), 1.0}});
+  DaqFeeder daq(s.dir / "daq.fifo", {{daq_rest(18.0), 3.0},
+                                     {daq_circle(1.0), 3.0},
+                                     {daq_rest(5.0), 1.0},
+                                     {daq_circle(1.0), 1.0},
+                                     {daq_rest(1.0), 1.0}});
   svc.watch([](const auto& st) { return st.fault.find("source_rate") != std::string::npos; });
-  if (!svc.wait_for([&](const auto&) { return daq.phase() >= 2; }, 60s)) o.problem("the feeder did not get to real time");
+  if (!svc.wait_for([&](const auto&) { return daq.phase() >= 2; }, 60s))
+    o.problem("the feeder did not get to real time");
   // Back at its rate from phase 2 on: when Status.fault no longer says source_rate.
   if (svc.wait_for([](const auto& st) { return st.fault.find("source_rate") == std::string::npos; }, 20s))
     o.recovery_s = std::chrono::duration<double>(Clock::now() - daq.phase_started(2)).count();
   if (!svc.wait_for([&](const auto&) { return daq.done(); }, 60s)) o.problem("the feeder did not finish");
   svc.wait_for([](const auto& st) { return st.results_written >= 2; }, 30s);
   const auto rs = results(dir);
-  o.flagged = svc.seen() && !rs.empty() && has_flag(rs.front(), "source_rate") && rs.front()["quality"]["degraded"].get<bool>();
+  o.flagged =
+      svc.seen() && !rs.empty() && has_flag(rs.front(), "source_rate") && rs.front()["quality"]["degraded"].get<bool>();
   if (!svc.seen()) o.problem("Status.fault never said source_rate");
-  if (rs.size() < 2) o.problem("expected two measurements, got " + std::to_string(rs.size()));
+  if (rs.size() < 2)
+    o.problem("expected two measurements, got " + std::to_string(rs.size()));
   else if (!rs.front()["quality"]["flags"].dump().empty() && !has_flag(rs.front(), "source_rate"))
     o.problem("the fast measurement is not flagged source_rate: " + rs.front()["quality"]["flags"].dump());
   o.service_alive = rs.size() >= 2 && !has_flag(rs.back(), "source_rate");
-  if (rs.size() >= 2 && has_flag(rs.back(), "source_rate")) o.problem("the measurement at the right rate is flagged source_rate too");
-  o.outcome = "Status.fault source_rate (x3), the measurement flagged source_rate, degraded; the next one at the right rate unflagged";
+  if (rs.size() >= 2 && has_flag(rs.back(), "source_rate"))
+    o.problem("the measurement at the right rate is flagged source_rate too");
+  o.outcome =
+      "Status.fault source_rate (x3), the measurement flagged source_rate, degraded; the next one at the right rate "
+      "unflagged";
   finish(o, svc, dir);
   if (o.recovery_s == o.recovery_s) o.outcome += " (Status clear after the 4 s rate window)";
   return o;
@@ -98,10 +108,12 @@ FaultOutcome source_stalls() {
   const fs::path dir = s.dir / "runs";
   ServiceThread svc(daq_config(s.dir));
   std::vector<dsp::Frame> circle = daq_circle(1.0);
-  const std::vector<dsp::Frame> first_half(circle.begin(), circle.begin() + static_cast<std::ptrdiff_t>(circle.size() / 2));
+  const std::vector<dsp::Frame> first_half(circle.begin(),
+                                           circle.begin() + static_cast<std::ptrdiff_t>(circle.size() / 2));
   DaqFeeder daq(s.dir / "daq.fifo", {{first_half, 1.0}, {{}, 1.0, 2.0}, {daq_circle(1.0), 1.0}, {daq_rest(1.0), 1.0}});
   svc.watch([](const auto& st) { return st.state == "FAULT"; });
-  if (!svc.wait_for([&](const auto&) { return daq.phase() >= 2; }, 60s)) o.problem("the feeder did not get past the stall");
+  if (!svc.wait_for([&](const auto&) { return daq.phase() >= 2; }, 60s))
+    o.problem("the feeder did not get past the stall");
   // Measuring again once the DAQ is back: the state leaves FAULT.
   if (svc.wait_for([](const auto& st) { return st.state != "FAULT"; }, 30s))
     o.recovery_s = std::chrono::duration<double>(Clock::now() - daq.phase_started(2)).count();
@@ -110,10 +122,14 @@ FaultOutcome source_stalls() {
   const auto rs = results(dir);
   if (!svc.seen()) o.problem("Status never showed FAULT");
   if (rs.size() < 2) o.problem("expected two measurements, got " + std::to_string(rs.size()));
-  o.flagged = svc.seen() && !rs.empty() && has_flag(rs.front(), "source_stopped") && rs.front()["quality"]["degraded"].get<bool>();
-  if (!rs.empty() && !has_flag(rs.front(), "source_stopped")) o.problem("the cut measurement is not flagged: " + rs.front()["quality"]["flags"].dump());
+  o.flagged = svc.seen() && !rs.empty() && has_flag(rs.front(), "source_stopped") &&
+              rs.front()["quality"]["degraded"].get<bool>();
+  if (!rs.empty() && !has_flag(rs.front(), "source_stopped"))
+    o.problem("the cut measurement is not flagged: " + rs.front()["quality"]["flags"].dump());
   o.service_alive = rs.size() >= 2 && !has_flag(rs.back(), "source_stopped");
-  o.outcome = "FAULT (no bytes for 0.5 s), the source reopened every 0.2 s; the cut measurement recorded, flagged source_stopped";
+  o.outcome =
+      "FAULT (no bytes for 0.5 s), the source reopened every 0.2 s; the cut measurement recorded, flagged "
+      "source_stopped";
   finish(o, svc, dir);
   return o;
 }

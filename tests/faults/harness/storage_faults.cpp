@@ -99,16 +99,20 @@ FaultOutcome disk_full_mid_recording() {
     freed = Clock::now();
   }
   const std::uint64_t results_at_fault = at_fault.results_written;
-  if (wait_for_new_run(dir, o.runs_before, 30s)) o.recovery_s = seconds_since(freed);
-  else o.problem("the held measurement was not written after space was freed");
-  if (!svc.wait_for([&](const auto& st) { return st.fault.empty(); }, 10s)) o.problem("Status.fault not cleared: " + svc.last().fault);
+  if (wait_for_new_run(dir, o.runs_before, 30s))
+    o.recovery_s = seconds_since(freed);
+  else
+    o.problem("the held measurement was not written after space was freed");
+  if (!svc.wait_for([&](const auto& st) { return st.fault.empty(); }, 10s))
+    o.problem("Status.fault not cleared: " + svc.last().fault);
   o.service_alive = svc.wait_for([&](const auto& st) { return st.results_written > results_at_fault + 1; }, 60s);
   // The system's reason, as Status.fault gives it after the path ("...: File too large; retried ...").
   const std::string& f = at_fault.fault;
   const auto retried = f.find("; retried");
   const auto reason = f.rfind(": ", retried);
   o.outcome = "Status.fault \"recording ...: " + (reason == std::string::npos ? f : f.substr(reason + 2)) +
-              "\"; written when space returned; " + std::to_string(svc.last().counters.triggers_refused - at_fault.counters.triggers_refused) +
+              "\"; written when space returned; " +
+              std::to_string(svc.last().counters.triggers_refused - at_fault.counters.triggers_refused) +
               " M-codes refused (with a Reply) meanwhile";
   svc.stop();
   if (svc.error()) o.problem("the service ended with: " + *svc.error());
@@ -136,7 +140,8 @@ FaultOutcome recording_dir_removed() {
   o.service_alive = svc.wait_for([&](const auto& st) { return st.results_written > results + 1; }, 60s);
   const daemon::ServiceStatus st = svc.last();
   o.flagged = false;  // nothing to flag: the next run goes into the directory made again
-  o.outcome = "the directory is made again; the next measurement is written into it" + (st.fault.empty() ? std::string() : "; Status.fault: " + st.fault);
+  o.outcome = "the directory is made again; the next measurement is written into it" +
+              (st.fault.empty() ? std::string() : "; Status.fault: " + st.fault);
   svc.stop();
   if (svc.error()) o.problem("the service ended with: " + *svc.error());
   o.runs_after = completed_runs(dir).size();  // the runs removed were the operator's to remove

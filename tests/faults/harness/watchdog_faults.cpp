@@ -51,7 +51,8 @@ class NotifySocket {
       const auto now = Clock::now();
       if (msg.find("WATCHDOG=1") != std::string::npos) last_ping = now, ++pings;
       if (msg.find("READY=1") != std::string::npos) ready = true, ready_at = now;
-      if (const auto at = msg.find("STATUS="); at != std::string::npos) status = msg.substr(at + 7, msg.find('\n', at) - at - 7);
+      if (const auto at = msg.find("STATUS="); at != std::string::npos)
+        status = msg.substr(at + 7, msg.find('\n', at) - at - 7);
     }
   }
   bool ready = false;
@@ -65,7 +66,8 @@ class NotifySocket {
 };
 
 std::vector<std::pair<std::string, std::string>> systemd_env(const fs::path& socket) {
-  return {{"NOTIFY_SOCKET", socket.string()}, {"WATCHDOG_USEC", std::to_string(std::chrono::microseconds(kWatchdog).count())}};
+  return {{"NOTIFY_SOCKET", socket.string()},
+          {"WATCHDOG_USEC", std::to_string(std::chrono::microseconds(kWatchdog).count())}};
 }
 
 }  // namespace
@@ -100,19 +102,22 @@ FaultOutcome dsp_thread_hung() {
       if (systemd.pings > 0 && Clock::now() - systemd.last_ping > kWatchdog) break;
     }
     if (!(systemd.pings > 0 && Clock::now() - systemd.last_ping > kWatchdog)) {
-      o.problem("the watchdog was fed on (" + std::to_string(systemd.pings) + " pings) or never: eicald did not stall it");
+      o.problem("the watchdog was fed on (" + std::to_string(systemd.pings) +
+                " pings) or never: eicald did not stall it");
       return o;
     }
     before = snapshot(dir);
     eicald.signal(SIGABRT);
     killed = Clock::now();
     const auto rc = eicald.wait_exit(10s);
-    if (rc != 128 + SIGABRT) o.problem("eicald did not end by SIGABRT: " + (rc ? std::to_string(*rc) : std::string("still running")));
+    if (rc != 128 + SIGABRT)
+      o.problem("eicald did not end by SIGABRT: " + (rc ? std::to_string(*rc) : std::string("still running")));
     first_log = eicald.log();
   }
   o.runs_before = runs_in(before);
   if (o.runs_before == 0) o.problem("no measurement was completed before the hang");
-  if (first_log.find("the DSP thread has handled no frame") == std::string::npos) o.problem("the hung eicald did not log the stall");
+  if (first_log.find("the DSP thread has handled no frame") == std::string::npos)
+    o.problem("the hung eicald did not log the stall");
   // systemd's Restart=on-failure: the same unit again (RestartSec=2s not waited here).
   systemd.ready = false, systemd.status.clear();
   EicaldProcess again(normal, s.dir / "eicald-2.log", systemd_env(s.dir / "notify"));
@@ -129,13 +134,15 @@ FaultOutcome dsp_thread_hung() {
   const auto stop_end = Clock::now() + 20s;
   while (Clock::now() < stop_end && again.running()) systemd.poll();
   if (const auto rc = again.wait_exit(1s); rc != 0)
-    o.problem("the restarted eicald did not stop cleanly (" + (rc ? "exit " + std::to_string(*rc) : std::string("still running")) + "): " +
-              again.log().substr(again.log().size() > 600 ? again.log().size() - 600 : 0));
+    o.problem("the restarted eicald did not stop cleanly (" +
+              (rc ? "exit " + std::to_string(*rc) : std::string("still running")) +
+              "): " + again.log().substr(again.log().size() > 600 ? again.log().size() - 600 : 0));
   o.runs_intact = intact_runs(before, dir);
   o.runs_after = completed_runs(dir).size() - o.runs_before;
   o.clean = temporaries(dir).empty();
   const auto at = said.find("the DSP thread");
-  o.outcome = "watchdog starved, SIGABRT; the next start's STATUS: \"" + (at == std::string::npos ? said : said.substr(at, 60)) + "...\"";
+  o.outcome = "watchdog starved, SIGABRT; the next start's STATUS: \"" +
+              (at == std::string::npos ? said : said.substr(at, 60)) + "...\"";
   o.measurements_lost = 1;
   o.data_lost = "at most the measurement under way at the hang (in the hung process's memory)";
   return o;
