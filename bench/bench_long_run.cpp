@@ -19,6 +19,7 @@
 //   bench_long_run [--minutes 1,10,30] [--dir DIR] [--keep] [--no-daemon]
 #include "drivers/run_io/file_spill.hpp"
 #include "drivers/run_io/run_reader.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "dsp/stream/analyze_stream.hpp"
 
 #include <sys/resource.h>
@@ -90,7 +91,7 @@ double peak_mb() {
   std::string line;
   while (std::getline(is, line))
     if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
-  return NAN;
+  return eical::kNaN;
 }
 
 // Resets VmHWM to the current resident size (Linux ≥ 4.0: clear_refs 5): the peak of what
@@ -189,7 +190,7 @@ int main(int argc, char** argv) {
       int fd[2];
       if (::pipe(fd) != 0) return 1;
       struct Inside {
-        double frames_mb = NAN, peak_mb = NAN, wall_s = NAN, cpu_s = NAN;
+        double frames_mb = eical::kNaN, peak_mb = eical::kNaN, wall_s = eical::kNaN, cpu_s = eical::kNaN;
         int status = 1;
       };
       const Usage ev = in_child(

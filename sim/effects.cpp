@@ -1,4 +1,5 @@
 #include "sim/effects.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -59,7 +60,7 @@ std::vector<std::string> effects_in(const Scenario& sc) {
     add("machine.stick_slip", m.stick_slip[i].amp_um != 0.0);
   }
   // Servo mismatch: the lags (1 − ff)/Kv of the axes differ.
-  double lag_min = INFINITY, lag_max = -INFINITY;
+  double lag_min = kInf, lag_max = -kInf;
   for (int i = 0; i < 3; ++i) {
     const double lag = m.servo[i].kv_per_s > 0.0 ? (1.0 - m.servo[i].feedforward) / m.servo[i].kv_per_s : 0.0;
     lag_min = std::min(lag_min, lag), lag_max = std::max(lag_max, lag);

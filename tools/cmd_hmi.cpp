@@ -2,6 +2,7 @@
 // Status and every Result and Trace it receives (a late HMI still gets the last Result and
 // Trace per program: transient-local) and can save the traces as CSV; `trigger` sends an M-code (101 tare + start, 102
 // segment, 103 stop) as an NC user M-function would, and waits for the daemon's Reply.
+#include "dsp/core/float_limits.hpp"
 #include "tools/commands.hpp"
 
 #if EICAL_HAVE_DDS
@@ -78,7 +79,7 @@ void register_hmi(CLI::App& app) {
     double timeout_s = 0.0, connect_timeout_s = 10.0;
     std::string uri;
     int code = 0;
-    double p = NAN, q = NAN;
+    double p = kNaN, q = kNaN;
   };
   auto o = std::make_shared<Opt>();
   auto* hmi = app.add_subcommand("hmi", "Reference HMI: print eicald's status and results from the DDS bus");

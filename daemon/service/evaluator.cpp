@@ -14,6 +14,7 @@
 #include "drivers/source/servo_setpoint_source.hpp"
 #include "dsp/align/accel_lag.hpp"
 #include "dsp/analysis/verdict.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "dsp/stream/analyze_stream.hpp"
 
 #include <algorithm>
@@ -45,7 +46,7 @@ std::vector<std::string> temperature_flags(const dsp::Run& run, const Limits& li
   const char* names[2] = {"table", "head"};
   for (int s = 0; s < 2; ++s) {
     if (!run.meta.sensor_present[s]) continue;
-    float lo = INFINITY, hi = -INFINITY;
+    float lo = kInf, hi = -kInf;
     for (const auto& f : run.frames)
       if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s]))
         lo = std::min(lo, f.temp_c[s]), hi = std::max(hi, f.temp_c[s]);

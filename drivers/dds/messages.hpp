@@ -1,6 +1,8 @@
 #pragma once
 // Plain C++ forms of the DDS topics (drivers/dds/eical.idl): the rest of eical never
 // touches generated C types or dds_* calls.
+#include "dsp/core/float_limits.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -12,7 +14,7 @@ namespace eical::drivers::dds {
 struct StatusMsg {
   std::string daemon, state, fault;
   std::uint64_t frames = 0, overruns = 0, frames_lost = 0, measurements = 0, results = 0;
-  float temp_table_c = NAN, temp_head_c = NAN;
+  float temp_table_c = kNaN, temp_head_c = kNaN;
   std::int64_t time_ns = 0;
   std::int64_t sample_index = 0, sample_time_ns = 0;  // DAQ clock ↔ CLOCK_MONOTONIC
   // Every counter of the service (eical.idl says what each one counts).
@@ -35,7 +37,7 @@ struct LiveMsg {
 struct ResultMsg {
   std::string machine, program_id, program;  // key: machine + program_id (the run id)
   bool degraded = false;
-  double circular_deviation_G_um = NAN, radius_mean_deviation_um = NAN;
+  double circular_deviation_G_um = kNaN, radius_mean_deviation_um = kNaN;
   std::uint64_t results = 0;  // the daemon's result count, this one included
   std::string json;
   std::string measured_at, run_path, software_version, sensor_calibration;  // provenance (history)
@@ -54,7 +56,7 @@ struct CommandMsg {
   std::uint32_t request_id = 0;
   std::string action;  // trigger | arm | abort | reset
   std::int32_t code = 0;
-  double p = NAN, q = NAN;
+  double p = kNaN, q = kNaN;
   std::int64_t time_ns = 0;
 };
 

@@ -53,7 +53,8 @@ std::vector<Eigen::Vector3d> measured_accel_mps2(const Run& run) {
   std::vector<Eigen::Vector3d> raw(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Frame& f = run.frames[i];
-    raw[i] = comp[1].apply(&f.accel_counts[3], f.temp_c[1]) - comp[0].apply(&f.accel_counts[0], f.temp_c[0]);
+    raw[i] = comp[1].apply(&f.accel_counts[3], static_cast<double>(f.temp_c[1])) -
+             comp[0].apply(&f.accel_counts[0], static_cast<double>(f.temp_c[0]));
   }
   // Sample i of the sensors shows the motion of time i − delay: read it `delay` later.
   double pt2_s = 0.0;

@@ -3,6 +3,7 @@
 #include "dsp/analysis/figure_uncertainty.hpp"
 #include "dsp/analysis/program_evaluations.hpp"
 #include "dsp/analysis/verdict.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "dsp/pipeline/integration_support.hpp"
 
 #include "dsp/core/error.hpp"
@@ -82,7 +83,7 @@ eval::PositioningInput positioning_deviations(const Measurement& m, const Progra
     const auto it = std::lower_bound(m.sample_index.begin(), m.sample_index.end(), idx);
     return it == m.sample_index.end() ? -1 : it - m.sample_index.begin();
   };
-  std::vector<double> up_run(in.targets_mm.size(), NAN), down_run(in.targets_mm.size(), NAN);
+  std::vector<double> up_run(in.targets_mm.size(), kNaN), down_run(in.targets_mm.size(), kNaN);
   auto flush_if_complete = [&] {
     const auto full = [](const std::vector<double>& v) {
       return std::all_of(v.begin(), v.end(), [](double d) { return std::isfinite(d); });
@@ -90,8 +91,8 @@ eval::PositioningInput positioning_deviations(const Measurement& m, const Progra
     if (full(up_run) && full(down_run)) {
       in.up_um.push_back(up_run);
       in.down_um.push_back(down_run);
-      std::fill(up_run.begin(), up_run.end(), NAN);
-      std::fill(down_run.begin(), down_run.end(), NAN);
+      std::fill(up_run.begin(), up_run.end(), kNaN);
+      std::fill(down_run.begin(), down_run.end(), kNaN);
     }
   };
   for (const auto& t : m.triggers) {

@@ -3,6 +3,7 @@
 #include "dsp/analysis/figures.hpp"
 #include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "dsp/uncertainty/error_field.hpp"
 
 #include <algorithm>
@@ -28,7 +29,7 @@ struct Accumulator {
 }  // namespace
 
 double expanded_uncertainty(double mean_offset, double sd, int n) {
-  if (n < 2) return NAN;
+  if (n < 2) return kNaN;
   const double mc = 2.0 * sd / std::sqrt(static_cast<double>(n));
   const double bias = std::max(0.0, std::abs(mean_offset) - mc);
   return 2.0 * sd + bias / (std::numbers::sqrt2 - 1.0);
@@ -55,11 +56,12 @@ void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const Analy
       if (f < run.frames.size()) {
         const Frame& fr = run.frames[f];
         for (int s = 0; s < 2; ++s)
-          if (!(fr.flags & frame_flag::temp_missing) && std::isfinite(fr.temp_c[s])) last[s] = fr.temp_c[s];
+          if (!(fr.flags & frame_flag::temp_missing) && std::isfinite(fr.temp_c[s]))
+            last[s] = static_cast<double>(fr.temp_c[s]);
       }
     }
     trace.sample(k, m.sample_index[k], m.pos_mm[k], k < m.vel_mm_s.size() ? m.vel_mm_s[k] : Eigen::Vector3d::Zero(),
-                 m.cmd_mm[k], k < m.ref_mm.size() ? m.ref_mm[k] : Eigen::Vector3d::Constant(NAN), last);
+                 m.cmd_mm[k], k < m.ref_mm.size() ? m.ref_mm[k] : Eigen::Vector3d::Constant(kNaN), last);
   }
   trace.finish(run, a);
 }

@@ -1,6 +1,7 @@
 #include "dsp/comp/fourier.hpp"
 
 #include "dsp/core/error.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <Eigen/Dense>
 
@@ -159,7 +160,7 @@ FourierResult fourier_calibration(const std::vector<AngleSeries>& all, const Fou
     fit = lsq(x, y, cand, true);
     if (cand.empty()) break;
     int worst = -1;
-    double worst_stat = INFINITY;
+    double worst_stat = kInf;
     for (std::size_t l = 0; l < cand.size(); ++l) {
       const FourierTerm t = term_of(fit, cand[l], 1 + 2 * static_cast<Eigen::Index>(l), opt.alpha);
       if (!t.significant && t.test_statistic < worst_stat) worst_stat = t.test_statistic, worst = static_cast<int>(l);

@@ -1,6 +1,8 @@
 #pragma once
 // Linear interpolation of one column of a trace at a fractional sample position, clamped to
 // the trace's ends (NaN for an empty trace: nothing to interpolate, never a read past it).
+#include "dsp/core/float_limits.hpp"
+
 #include <Eigen/Core>
 
 #include <cmath>
@@ -10,7 +12,7 @@
 namespace eical::dsp {
 
 inline double interpolate_at(const std::vector<Eigen::Vector3d>& x, double pos, int axis) {
-  if (x.empty()) return NAN;
+  if (x.empty()) return kNaN;
   if (!(pos > 0.0)) return x.front()[axis];
   // Compared as doubles before the cast: a position beyond size_t is no index.
   if (pos >= static_cast<double>(x.size() - 1)) return x.back()[axis];

@@ -12,6 +12,8 @@
 // revolutions: mean radius deviation, G = max − min of the radius deviation (LSQ
 // reference, ISO 230-4 circular deviation), F_max / F_min (radial deviation from the
 // nominal radius). Hysteresis H needs both directions (combine()).
+#include "dsp/core/float_limits.hpp"
+
 #include <Eigen/Core>
 
 #include <array>
@@ -61,7 +63,7 @@ struct CircleResult {
   std::size_t points = 0;  // radius deviations evaluated (all, whatever the trace keeps)
   // The largest and smallest radius deviation of each direction's own points (counter-
   // clockwise, clockwise; ±inf: not run): G per direction, whatever the trace keeps.
-  std::array<double, 2> direction_F_max_um{-INFINITY, -INFINITY}, direction_F_min_um{INFINITY, INFINITY};
+  std::array<double, 2> direction_F_max_um{-kInf, -kInf}, direction_F_min_um{kInf, kInf};
   // Sum and count of the radius deviations per 1° of angle (H of combine()).
   std::array<double, 360> deviation_sum_by_deg{}, points_by_deg{};
 };
@@ -111,7 +113,7 @@ class CircleAccumulator {
   std::vector<Eigen::Vector2d> pts_;  // the open revolution (full circles)
   std::vector<double> last_dev_;
   std::size_t n_here_ = 0;  // samples of the open arc
-  double sum_here_ = 0.0, sum_dev_ = 0.0, dmax_ = -INFINITY, dmin_ = INFINITY;
+  double sum_here_ = 0.0, sum_dev_ = 0.0, dmax_ = -kInf, dmin_ = kInf;
   int open_ = -1;  // index of the open revolution, -1 when none
 };
 

@@ -1,4 +1,5 @@
 #include "dsp/eval/circle_diagnostics.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "dsp/core/units.hpp"
 
 #include "dsp/core/error.hpp"
@@ -365,7 +366,7 @@ CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& 
   // Y first: its lag is identifiable from one direction (v_y follows cos θ, squareness
   // sits in the x equation only), and a single-direction x fit borrows it.
   std::size_t best = 0;
-  double best_rms = INFINITY;
+  double best_rms = kInf;
   for (std::size_t k = 0; k < pitches.size(); ++k) {
     const double rms = solve_axis(gram[1], k, use, 0.0).rms_mm + solve_axis(gram[0], k, use, 0.0).rms_mm;
     if (rms < best_rms) best_rms = rms, best = k;

@@ -1,6 +1,7 @@
 #include "dsp/eval/path_deviation.hpp"
 
 #include "dsp/core/error.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <Eigen/Geometry>
 
@@ -33,7 +34,7 @@ PathDeviation path_deviation(const std::vector<Eigen::Vector3d>& cmd, const std:
     // Closest point on the polyline segments within the window.
     const std::size_t lo = i > window ? i - window : 0;
     const std::size_t hi = std::min(n - 1, i + window);
-    double best_d2 = INFINITY, best_s = 0.0;
+    double best_d2 = kInf, best_s = 0.0;
     Eigen::Vector3d best_p = cmd[i], best_t = local_dir.normalized();
     for (std::size_t k = lo; k < hi; ++k) {
       const Eigen::Vector3d seg = cmd[k + 1] - cmd[k];

@@ -1,6 +1,7 @@
 #include "dsp/eval/positioning.hpp"
 
 #include "dsp/core/error.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -35,10 +36,10 @@ PositioningResult evaluate_positioning(const PositioningInput& in) {
     for (const auto& run : d) ss += (run[i] - mean) * (run[i] - mean);
     s = std::sqrt(ss / (n - 1.0));
   };
-  double hi_up = -INFINITY, lo_up = INFINITY, hi_dn = -INFINITY, lo_dn = INFINITY;      // x̄ ± 2s
-  double max_mu = -INFINITY, min_mu = INFINITY, max_md = -INFINITY, min_md = INFINITY;  // x̄↑, x̄↓
-  double max_m = -INFINITY, min_m = INFINITY;                                           // x̄i
-  double vdi_hi = -INFINITY, vdi_lo = INFINITY;
+  double hi_up = -kInf, lo_up = kInf, hi_dn = -kInf, lo_dn = kInf;      // x̄ ± 2s
+  double max_mu = -kInf, min_mu = kInf, max_md = -kInf, min_md = kInf;  // x̄↑, x̄↓
+  double max_m = -kInf, min_m = kInf;                                   // x̄i
+  double vdi_hi = -kInf, vdi_lo = kInf;
   double sum_b = 0.0;
   for (std::size_t i = 0; i < m; ++i) {
     PositioningTarget t;

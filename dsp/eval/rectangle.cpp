@@ -1,6 +1,7 @@
 #include "dsp/eval/rectangle.hpp"
 
 #include "dsp/core/error.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -72,7 +73,7 @@ RectangleResult evaluate_rectangle(const std::vector<Eigen::Vector2d>& cmd, cons
     auto [c, dir] = fit_line(pts);
     if (dir.dot(cmd_dir) < 0) dir = -dir;
     const Eigen::Vector2d normal(-dir.y(), dir.x());
-    double lo = INFINITY, hi = -INFINITY;
+    double lo = kInf, hi = -kInf;
     for (const auto& p : pts) {
       const double d = (p - c).dot(normal);
       lo = std::min(lo, d), hi = std::max(hi, d);

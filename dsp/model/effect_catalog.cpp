@@ -1,5 +1,6 @@
 #include "dsp/model/effect_catalog.hpp"
 
+#include "dsp/core/float_limits.hpp"
 #include "dsp/pipeline/coriolis.hpp"
 
 #include <Eigen/QR>
@@ -522,7 +523,7 @@ std::array<double, 3> loop_time_constant_s(const RunResiduals& r, const Eigen::M
       t[static_cast<std::size_t>(a)] = tau_s;
       return lag_fit_residual(hint, common_lag_columns(r, t), a).second.squaredNorm();
     };
-    double best_rss = INFINITY, tau = 0.0;
+    double best_rss = kInf, tau = 0.0;
     for (double tau_ms = 0.0; tau_ms <= 100.0; tau_ms += tau_ms < 60.0 ? 2.0 : 10.0)
       if (const double q = rss_at(tau_ms * 1e-3); q < best_rss) best_rss = q, tau = tau_ms * 1e-3;
     // Golden-section refinement within one grid step either side.

@@ -1,6 +1,7 @@
 #include "dsp/model/effect_selection.hpp"
 
 #include "dsp/core/error.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <Eigen/QR>
 
@@ -151,7 +152,7 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
 
   for (int round = 0; round < opt.max_effects; ++round) {
     int best = -1;
-    double best_drop = -INFINITY;
+    double best_drop = -kInf;
     EffectVerdict best_v;
     for (std::size_t k = 0; k < candidates.size(); ++k) {
       if (done[k]) continue;

@@ -1,5 +1,6 @@
 #include "dsp/model/kf_selection.hpp"
 
+#include "dsp/core/float_limits.hpp"
 #include "dsp/identify/augmented_filter.hpp"
 #include "dsp/model/effect_selection.hpp"
 
@@ -162,7 +163,7 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
       Model m;
     };
     std::vector<Trial> trials;
-    double top_bic = -INFINITY;
+    double top_bic = -kInf;
     for (std::size_t g = 0; g < groups.size(); ++g) {
       if (done[g] || groups[g].params.empty() || groups[g].known) continue;
       Model m = with(cur, groups[g]);

@@ -2,6 +2,7 @@
 
 #include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "dsp/core/interpolate.hpp"
 
 #include <algorithm>
@@ -84,7 +85,7 @@ RunResiduals build_residuals(const Run& run) {
     if (t.code == trigger::segment_mark) marks.push_back(t.sample_index);
   const std::int64_t first_frame = run.frames.front().sample_index;
   const double dly = d.delay_samples;
-  float t0[2] = {NAN, NAN};
+  float t0[2] = {kNaN, kNaN};
   for (Eigen::Index s = 0; s < n; ++s) {
     const std::size_t k = d.trace[static_cast<std::size_t>(s)];
     const double ks = static_cast<double>(k) + dly;  // the same moment in the sensors' time

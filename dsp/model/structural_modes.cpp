@@ -1,6 +1,7 @@
 #include "dsp/model/structural_modes.hpp"
 
 #include "dsp/core/chi2.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "dsp/core/median.hpp"
 #include "dsp/model/effect_selection.hpp"
 #include "dsp/model/frequency_response.hpp"
@@ -41,7 +42,7 @@ constexpr double kMmS2PerMg = 9.80665e-3 * 1000.0;  // 1 mg in mm/s²
 // each input. The nuisance is projected out once (an orthonormal basis); each trial of a
 // mode then solves only for its own gains. RSS summed over the outputs; G per (input, output).
 struct Fit {
-  double rss = INFINITY;
+  double rss = kInf;
   Eigen::MatrixXd g;  // inputs × 3
 };
 

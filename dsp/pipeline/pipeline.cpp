@@ -44,8 +44,8 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
       "no_end_trigger: no M103 (103) trigger; the measurement ends with the data",
       "fixed_saturated: the fixed-point path clamped a value outside its Q-format range",
       "supports_diverged: the support fusion met values it cannot take (trace left as integrated, no ZUPT/NBS/CUPT)",
-      "psd_disagrees: the PSD readings contradict the integrated motion beyond their noise (sensor model off? run "
-      "eical identify); fused without them",
+      ("psd_disagrees: the PSD readings contradict the integrated motion beyond their noise (sensor model off? run "
+       "eical identify); fused without them"),
   };
   std::vector<std::string> out;
   for (std::uint32_t b = 0; b < std::size(names); ++b)
@@ -177,7 +177,7 @@ void Pipeline::compensate(const Frame& f) noexcept {
       if (!bad) fcomp_[s].apply(&f.accel_counts[3 * s], temp_q24_c(temp_c_[s]), last_valid_aq_[s], saturation_);
       for (int i = 0; i < 3; ++i) aq_[s][i] = last_valid_aq_[s][i];
     } else {
-      if (!bad) last_valid_a_[s] = comp_[s].apply(&f.accel_counts[3 * s], temp_c_[s]);
+      if (!bad) last_valid_a_[s] = comp_[s].apply(&f.accel_counts[3 * s], static_cast<double>(temp_c_[s]));
       a_[s] = last_valid_a_[s];
     }
   }

@@ -1,4 +1,5 @@
 #include "dsp/pipeline/support_stage.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -109,7 +110,7 @@ void SupportStage::start() noexcept {
   live_.start(cfg_.model, start_bias_sigma_);
   started_ = true;
   at_rest_ = false;
-  start_pos_mm_ = Eigen::Vector3d::Constant(NAN);
+  start_pos_mm_ = Eigen::Vector3d::Constant(kNaN);
 }
 
 Eigen::Vector3d SupportStage::live_dx_mm() const noexcept {
@@ -149,7 +150,7 @@ SupportStage::RestDecision SupportStage::find_rest(const SupportSample& s) noexc
   for (const auto& f : live_.axis) pvv = std::max(pvv, f.P(1, 1));
   RestDecision r;
   r.det =
-      detector_.step(s.accel_valid ? Eigen::Vector3d(s.a_head_mps2 - s.a_table_mps2) : Eigen::Vector3d::Constant(NAN),
+      detector_.step(s.accel_valid ? Eigen::Vector3d(s.a_head_mps2 - s.a_table_mps2) : Eigen::Vector3d::Constant(kNaN),
                      s.vel_mm_s, live_dv_mm_s(), std::sqrt(pvv) / 1000.0, s.cmd_valid, s.cmd_moved);
   r.rest = s.accel_valid && r.det.rest;  // found and reported even when ZUPT is off
   return r;
@@ -370,7 +371,7 @@ SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::v
   pos_mm.resize(n), vel_mm_s.resize(n);
   const std::unique_ptr<SmoothedCorrection> c = smooth_track(n, sum, false);
   if (!c->apply) {
-    sigma_x_um.assign(n, Eigen::Vector3d::Constant(NAN));
+    sigma_x_um.assign(n, Eigen::Vector3d::Constant(kNaN));
     return sum;
   }
   sigma_x_um.resize(n);

@@ -324,7 +324,8 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
                        header.meta.sensors[1].temp_ref_c);  // the last finite case temperatures
   Emitter emitter(t, kept ? &*kept : nullptr, [&](const Corrected& c) {
     for (int i = 0; i < 2; ++i)
-      if (!(c.frame_flags & frame_flag::temp_missing) && std::isfinite(c.temp_c[i])) temp[i] = c.temp_c[i];
+      if (!(c.frame_flags & frame_flag::temp_missing) && std::isfinite(c.temp_c[i]))
+        temp[i] = static_cast<double>(c.temp_c[i]);
     keep(m, c, q, n, temp);
     if (c.sigma_um.allFinite()) m.sigma_max_um = m.sigma_max_um.cwiseMax(c.sigma_um);
     m.sigma_peak_um = std::max(m.sigma_peak_um, c.sigma_um.maxCoeff());

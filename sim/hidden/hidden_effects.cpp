@@ -8,13 +8,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <random>
 
 namespace eical::sim {
 namespace {
-
-constexpr double kPi = std::numbers::pi;
 
 struct Draw {
   std::mt19937_64 rng;

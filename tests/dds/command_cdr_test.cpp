@@ -2,6 +2,7 @@
 // sends decodes to the same command in every plain encoding; malformed bytes are refused
 // with a reason, never read past (the fuzz target fuzz/dds_command.cpp drives the rest).
 #include "drivers/dds/command_cdr.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +20,7 @@ CommandMsg sample() {
   m.action = "trigger";
   m.code = 102;
   m.p = 2.5;
-  m.q = NAN;
+  m.q = kNaN;
   m.time_ns = 123456789012;
   return m;
 }

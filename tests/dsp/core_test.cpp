@@ -1,3 +1,4 @@
+#include "dsp/core/float_limits.hpp"
 #include "dsp/core/frame.hpp"
 #include "dsp/core/interpolate.hpp"
 #include "dsp/core/units.hpp"
@@ -21,7 +22,7 @@ TEST(Interpolate, BetweenSamplesClampedAtTheEndsAndNaNWhenEmpty) {
   const std::vector<Eigen::Vector3d> x = {{0.0, 10.0, 0.0}, {1.0, 20.0, 0.0}, {3.0, 40.0, 0.0}};
   // Positions read at run time: folded as constants, GCC 12 warns of the branches the clamps
   // never take (-Warray-bounds).
-  const std::vector<double> pos = {0.5, 1.25, -3.0, 7.0, 1e300, NAN};
+  const std::vector<double> pos = {0.5, 1.25, -3.0, 7.0, 1e300, kNaN};
   EXPECT_DOUBLE_EQ(interpolate_at(x, pos[0], 0), 0.5);
   EXPECT_DOUBLE_EQ(interpolate_at(x, pos[1], 1), 25.0);
   EXPECT_DOUBLE_EQ(interpolate_at(x, pos[2], 1), 10.0);    // before the first sample: the first

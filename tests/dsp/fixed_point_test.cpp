@@ -93,7 +93,7 @@ TEST(FixedPoint, StaticCompMatchesTheDoublePathToItsLsb) {
     const float t = temp(rng);
     std::int64_t out[3];
     q.apply(c, temp_q24_c(t), out, s);
-    const Eigen::Vector3d a = d.apply(c, t);
+    const Eigen::Vector3d a = d.apply(c, static_cast<double>(t));
     for (int i = 0; i < 3; ++i) worst = std::max(worst, std::abs(fx::to_double(out[i], fx::kAccelQ) - a[i]));
   }
   EXPECT_FALSE(s.hit);

@@ -2,6 +2,7 @@
 // its noise, stays silent in the dark and at the strip's ends; the standstill detector
 // finds rest after its window, not during motion, not at constant speed, and rarely
 // raises a false alarm on noise.
+#include "dsp/core/float_limits.hpp"
 #include "dsp/supports/psd_decoder.hpp"
 #include "dsp/supports/standstill_detector.hpp"
 
@@ -109,7 +110,7 @@ TEST(StandstillDetector, ANaNSampleIsNeverRest) {
   for (int k = 0; k < 500; ++k)
     (void)det.step(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, false, false);
   EXPECT_FALSE(
-      det.step(Eigen::Vector3d::Constant(NAN), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, false, false)
+      det.step(Eigen::Vector3d::Constant(kNaN), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 0.0, false, false)
           .rest);
 }
 

@@ -4,6 +4,7 @@
 // responses, the expanded uncertainty of linear and range-like figures, and the one rule
 // of when a figure is resolved.
 #include "dsp/analysis/figure_uncertainty.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "dsp/fusion/error_covariance.hpp"
 #include "dsp/uncertainty/coarse_schedule.hpp"
 #include "dsp/uncertainty/error_field.hpp"
@@ -47,8 +48,8 @@ TEST(ResolvedRule, MagnitudeAboveTheExpandedUncertainty) {
   EXPECT_TRUE(resolved(-2.0, 1.0));
   EXPECT_FALSE(resolved(1.0, 1.0));
   EXPECT_FALSE(resolved(0.5, 1.0));
-  EXPECT_FALSE(resolved(NAN, 1.0));
-  EXPECT_FALSE(resolved(5.0, NAN));
+  EXPECT_FALSE(resolved(kNaN, 1.0));
+  EXPECT_FALSE(resolved(5.0, kNaN));
 }
 
 TEST(ExpandedUncertainty, LinearFigureIsTwoSigmaAndARangeCarriesItsBias) {

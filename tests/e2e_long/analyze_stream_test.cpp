@@ -12,6 +12,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "sim/simulate.hpp"
 
 #include <gtest/gtest.h>
@@ -149,7 +150,7 @@ TEST(AnalyzeStream, LostAndBadFramesAndRunsWithoutTriggers) {
     run.frames.erase(run.frames.begin() + static_cast<std::ptrdiff_t>(k));
   for (std::size_t k = 40000; k < 40002; ++k) run.frames[k].flags |= dsp::frame_flag::gap_before;
   run.frames[50000].flags |= dsp::frame_flag::accel_saturated;
-  run.frames[50010].temp_c[0] = NAN;
+  run.frames[50010].temp_c[0] = kNaN;
   const dsp::Analysis whole = whole_trace(run);
   expect_same_result(run, whole, streamed(run));
   dsp::Run bare = sim::simulate(circle(10.0, 2500.0, 1, "ccw"));

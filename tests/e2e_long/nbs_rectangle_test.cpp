@@ -3,6 +3,7 @@
 // during the side; holding that axis removes it. The corners are ZUPT's business. The
 // machine is ideal, so every error is measurement error.
 #include "dsp/analysis/analyze_run.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "sim/simulate.hpp"
 
 #include <gtest/gtest.h>
@@ -31,7 +32,7 @@ double still_axis_drift_um(const dsp::Measurement& m) {
       ++k;
       continue;
     }
-    double lo = INFINITY, hi = -INFINITY;
+    double lo = kInf, hi = -kInf;
     for (; k < m.pos_mm.size() && (m.cmd_mm[k] - m.cmd_mm[k - 1])[1 - still] != 0.0; ++k) {
       const double e = (m.pos_mm[k][still] - m.ref_mm[k][still]) * 1e3;
       lo = std::min(lo, e), hi = std::max(hi, e);

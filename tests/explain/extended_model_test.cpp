@@ -5,6 +5,7 @@
 #include "tools/explain/extended_model.hpp"
 #include "drivers/config/scenario_file.hpp"
 #include "drivers/config/sensor_calibration.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "dsp/model/explain.hpp"
 #include "dsp/model/run_residuals.hpp"
 #include "sim/hidden/hidden_effects.hpp"
@@ -83,7 +84,7 @@ TEST(ExtendedModel, AnEffectOnTwoAxesRoundTripsThroughTheScenario) {
 double mode_near(const dsp::model::RunExplanation& ex, double f_hz, double& zeta) {
   for (const auto& e : ex.effects) {
     if (e.name != "machine.resonance" || !e.significant) continue;
-    double best = INFINITY;
+    double best = kInf;
     for (int k = 0; e.params.count("mode" + std::to_string(k) + "_frequency_hz"); ++k) {
       const double f = e.params.at("mode" + std::to_string(k) + "_frequency_hz");
       if (std::abs(f - f_hz) < std::abs(best - f_hz))
@@ -91,7 +92,7 @@ double mode_near(const dsp::model::RunExplanation& ex, double f_hz, double& zeta
     }
     return best;
   }
-  return INFINITY;
+  return kInf;
 }
 
 TEST(ExtendedModel, TheModesFoundAreSimulatedAgainAndFoundAgain) {
@@ -111,7 +112,7 @@ TEST(ExtendedModel, TheModesFoundAreSimulatedAgainAndFoundAgain) {
   fs::remove_all(dir);
   ASSERT_EQ(back.resonance.modes.size(), 1u);
   const auto again = dsp::model::explain_run(sim::simulate(back));
-  double z1 = NAN, z2 = NAN;
+  double z1 = kNaN, z2 = kNaN;
   const double f1 = mode_near(ex, 45.0, z1), f2 = mode_near(again, 45.0, z2);
   std::printf(
       "mode 45 Hz zeta 0.030 gain 0.15: found %.2f Hz zeta %.4f; written gain %.3f; the written scenario simulated: "

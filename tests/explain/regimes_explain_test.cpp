@@ -3,6 +3,7 @@
 // sensor at 400 Hz–3.2 kHz, no standstill, two modes 30–80 Hz), a wrong mounting. Each
 // true mode within ±2 Hz and its damping within ±30 %; the mounting named with the map
 // that fits; no significant figure outside its physical bound.
+#include "dsp/core/float_limits.hpp"
 #include "dsp/model/effects.hpp"
 #include "dsp/model/explain.hpp"
 #include "sim/regimes/klipper_like.hpp"
@@ -48,7 +49,7 @@ TEST_P(KlipperLikeModes, EachTrueModeFoundWithinTwoHertzAndThirtyPercentDamping)
   EXPECT_TRUE(res->significant);
   ASSERT_GE(sc.resonance.modes.size(), 1u);
   for (const auto& truth : sc.resonance.modes) {
-    double best_df = INFINITY, zeta = NAN;
+    double best_df = kInf, zeta = kNaN;
     for (int k = 0; k < 6; ++k) {
       const auto f = res->params.find("mode" + std::to_string(k) + "_frequency_hz");
       if (f == res->params.end()) break;

@@ -2,6 +2,8 @@
 // run in ../shared/data diffed against tests/golden/expected with the per-key tolerances of
 // tests/golden/tolerances.toml. A failure lists every changed key, old → new.
 // EICAL_GOLDEN_UPDATE=1 rewrites the expected documents instead (read the diff, commit both).
+#include "dsp/core/float_limits.hpp"
+
 #include <gtest/gtest.h>
 #include <toml++/toml.h>
 #include <nlohmann/json.hpp>
@@ -92,7 +94,7 @@ json canonical(const json& j, const Tolerances& tol) {
     bool numeric = j.size() > kSummariseAbove;
     for (const auto& v : j) numeric = numeric && (v.is_number() || v.is_null());
     if (numeric) {
-      double lo = INFINITY, hi = -INFINITY, ss = 0.0;
+      double lo = eical::kInf, hi = -eical::kInf, ss = 0.0;
       std::size_t n = 0, nulls = 0;
       for (const auto& v : j) {
         if (v.is_null()) {

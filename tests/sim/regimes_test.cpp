@@ -3,6 +3,7 @@
 // quantisation step, aliasing above Nyquist, a mirrored mounting, one sensor, 51.2 kHz.
 #include "sim/regimes/regimes.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/float_limits.hpp"
 #include "sim/regimes/capture_clock.hpp"
 #include "sim/regimes/klipper_like.hpp"
 #include "sim/simulate.hpp"
@@ -127,7 +128,7 @@ TEST(Regimes, ModeShowsInTheSweptResponseOfAMemsHeadSensor) {
   const double df = fs / static_cast<double>(seg);
   // The mode's own response, H = 1 + gain·ω²/(ωn² − ω² + 2iζωnω), fitted to 30–55 Hz
   // (gain by least squares for each fn, ζ of a grid).
-  double best = INFINITY, f_fit = 0, zeta_fit = 0, gain_fit = 0;
+  double best = kInf, f_fit = 0, zeta_fit = 0, gain_fit = 0;
   const auto b0 = static_cast<std::size_t>(30.0 / df), b1 = static_cast<std::size_t>(55.0 / df);
   for (double fn = 38.0; fn <= 46.0; fn += 0.02)
     for (double z = 0.01; z <= 0.06; z += 0.0005) {

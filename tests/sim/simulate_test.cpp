@@ -1,4 +1,5 @@
 #include "sim/simulate.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <gtest/gtest.h>
 
@@ -67,7 +68,7 @@ TEST(Simulate, DaqDelayShowsUpAsThatManySamples) {
   const dsp::Run run = simulate(sc);
   // The table x channel reads −a_x(t − d/fs) (table moves against the relative motion).
   const nc::Trajectory tr = nc::interpolate_gcode(run.meta.program.gcode, "c", sc.limits);
-  double best_d = 0, best_err = INFINITY;
+  double best_d = 0, best_err = kInf;
   for (double d = 37.0; d <= 40.6; d += 0.05) {
     double err = 0;
     for (std::size_t n = 4000; n < run.frames.size(); n += 7) {

@@ -1,5 +1,6 @@
 #include "tools/report/history_pages.hpp"
 
+#include "dsp/core/float_limits.hpp"
 #include "history/record/figure_names.hpp"
 #include "tools/history/history_format.hpp"
 #include "tools/report/svg.hpp"
@@ -86,7 +87,7 @@ std::string trend_plot(const std::string& figure, const std::vector<history::Tre
     series[line_of[p.machine]].x.push_back(x), series[line_of[p.machine]].y.push_back(*p.value);
     auto& d = series[dots_of[p.machine]];
     d.x.push_back(x), d.y.push_back(*p.value);
-    const double u = p.uncertainty_k2.value_or(NAN);
+    const double u = p.uncertainty_k2.value_or(kNaN);
     d.y_lo.push_back(*p.value - u), d.y_hi.push_back(*p.value + u);
     if (std::find(marked.begin(), marked.end(), p.run_id) != marked.end())
       ring.x.push_back(x), ring.y.push_back(*p.value);

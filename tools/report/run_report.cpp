@@ -2,6 +2,7 @@
 
 #include "drivers/results/software_version.hpp"
 #include "dsp/analysis/verdict.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include "tools/report/html.hpp"
 #include "tools/report/sections.hpp"
@@ -145,7 +146,7 @@ std::string temperatures(const dsp::Run& run) {
   std::string out;
   const char* names[2] = {"table", "head"};
   for (int s = 0; s < 2; ++s) {
-    double lo = INFINITY, hi = -INFINITY;
+    double lo = kInf, hi = -kInf;
     for (const auto& f : run.frames)
       if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s]))
         lo = std::min(lo, static_cast<double>(f.temp_c[s])), hi = std::max(hi, static_cast<double>(f.temp_c[s]));

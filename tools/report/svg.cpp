@@ -1,4 +1,5 @@
 #include "tools/report/svg.hpp"
+#include "dsp/core/float_limits.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -137,7 +138,7 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
     if (n == 0) continue;
     const std::size_t stride = stride_for(n, 1500);
     std::string pts;
-    double prev_ang = NAN, x = 0, y = 0;
+    double prev_ang = kNaN, x = 0, y = 0;
     for (std::size_t i = 0; i < n; i += stride) {
       if (!std::isfinite(t.deviation_um[i]) || !std::isfinite(t.angle_deg[i])) continue;
       // A jump in angle (a gap in the data) starts a new polyline.
@@ -292,7 +293,7 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
 std::string path_plot(const PathView& v, const std::string& title, const std::string& axis_a,
                       const std::string& axis_b) {
   const double w = 460, pad = 46, top = 28, max_plot_h = 400;
-  double amin = INFINITY, amax = -INFINITY, bmin = INFINITY, bmax = -INFINITY, dmax_um = 0.0;
+  double amin = kInf, amax = -kInf, bmin = kInf, bmax = -kInf, dmax_um = 0.0;
   for (std::size_t i = 0; i < v.cmd_a_mm.size(); ++i) {
     amin = std::min(amin, v.cmd_a_mm[i]), amax = std::max(amax, v.cmd_a_mm[i]);
     bmin = std::min(bmin, v.cmd_b_mm[i]), bmax = std::max(bmax, v.cmd_b_mm[i]);

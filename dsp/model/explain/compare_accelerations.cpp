@@ -3,6 +3,7 @@
 // nothing holds (no rest, no position support) this is where its sensors are judged: scale
 // and mounting angle per moving axis, the lag and the bias by regression — never a double
 // integral over the run called a position error (run-format.md, "No standstill").
+#include "dsp/core/float_limits.hpp"
 #include "dsp/model/acceleration_comparison.hpp"
 #include "dsp/model/explain/stages.hpp"
 
@@ -43,7 +44,7 @@ ExplainedEffect mounting_effect(const MountingFit& m) {
   x.unit = "axes map", x.magnitude = 1.0, x.tolerance = 0.5;
   x.channel = "acceleration";
   x.significant = true;
-  x.importance_um = INFINITY;  // first: every other finding is explained with this mounting
+  x.importance_um = kInf;  // first: every other finding is explained with this mounting
   x.resembles = "the commanded acceleration on another measured axis or with the other sign";
   x.evidence = std::string("the ") + sensor_name(m.sensor) + " sensor is not mounted as run.toml says: " + m.evidence +
                "; the mounting that fits is the axes map " + m.axes_map + " applied to run.toml's to_machine" +

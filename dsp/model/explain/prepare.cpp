@@ -1,5 +1,6 @@
 // Stage 0: the run's residuals against the nominal model, each axis' loop and the machine
 // effects' columns with their shapes chosen on this run.
+#include "dsp/core/float_limits.hpp"
 #include "dsp/model/explain/stages.hpp"
 
 #include "dsp/pipeline/integration_support.hpp"
@@ -17,12 +18,12 @@ ExplainState prepare(const Run& run, const ExplainOptions& options) {
       unsupported_integration(rr.measurement).empty() || rr.has_ref[0] || rr.has_ref[1] || rr.has_ref[2];
   if (!st.integration_supported) {
     st.ex.position_not_compared = unsupported_integration(rr.measurement);
-    st.ex.nominal_residual_rms_um = st.ex.final_residual_rms_um = NAN;
-    st.ex.heldout_nominal_rms_um = st.ex.heldout_final_rms_um = NAN;
+    st.ex.nominal_residual_rms_um = st.ex.final_residual_rms_um = kNaN;
+    st.ex.heldout_nominal_rms_um = st.ex.heldout_final_rms_um = kNaN;
   }
   // Shapes (spike time constant, cyclic pitch) are chosen on the residual that shows
   // machine effects: reference minus set-point, else the pipeline against the set-point.
-  Eigen::MatrixXd hint = Eigen::MatrixXd::Constant(rr.n, 3, NAN);
+  Eigen::MatrixXd hint = Eigen::MatrixXd::Constant(rr.n, 3, kNaN);
   for (const Channel* hc : {&rr.pipeline, &rr.machine})
     for (Eigen::Index i = 0; i < hc->rows(); ++i)
       if (hc == &rr.machine ||

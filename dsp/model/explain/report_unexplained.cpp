@@ -1,6 +1,7 @@
 // Stage: a residual that the accepted effects leave beyond the noise is reported
 // (other.unexplained, run-format.md): its size against the noise and where it sits in time
 // and frequency. "Within its noise" is said only when it is true.
+#include "dsp/core/float_limits.hpp"
 #include "dsp/model/explain/stages.hpp"
 
 #include <unsupported/Eigen/FFT>
@@ -106,7 +107,7 @@ Eigen::VectorXd without_modes(const ExplainState& st, const Eigen::VectorXd& r, 
   for (std::size_t m = 0; m < fz.size(); ++m) {
     const auto others = all_cols(m);
     const auto [f0, z0] = fz[m];
-    double best = INFINITY;
+    double best = kInf;
     for (int fi = -3; fi <= 3; ++fi)
       for (int zi = -3; zi <= 3; ++zi) {
         const double f = f0 * (1.0 + 0.005 * fi), z = z0 * std::pow(1.12, zi);

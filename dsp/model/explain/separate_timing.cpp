@@ -1,4 +1,5 @@
 // Stage: the sensors' timing against the DAQ delay the PSD strips show.
+#include "dsp/core/float_limits.hpp"
 #include "dsp/identify/delay_estimate.hpp"
 #include "dsp/model/explain/stages.hpp"
 
@@ -46,7 +47,7 @@ void separate_timing(ExplainState& st) {
       // sensor's own dynamics.
       if (dyn) {
         const double delay_us = -dd * 1e6 / rr.fs_hz;
-        double own[2] = {NAN, NAN};
+        double own[2] = {kNaN, kNaN};
         for (int s2 = 0; s2 < 2; ++s2)
           if (auto it = dyn->params.find(std::string("damping_term_error_us_") + (s2 == 0 ? "table" : "head"));
               it != dyn->params.end())

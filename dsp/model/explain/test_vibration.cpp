@@ -1,4 +1,5 @@
 // Stage: vibration in the spectra and modes the motion drives.
+#include "dsp/core/float_limits.hpp"
 #include "dsp/model/explain/stages.hpp"
 #include "dsp/model/spectral_tests.hpp"
 #include "dsp/model/structural_modes.hpp"
@@ -42,7 +43,7 @@ void test_vibration(ExplainState& st) {
     res.name = "machine.resonance", res.channel = "frequency response", res.unit = "amplification", res.tolerance = 0.1;
     // Up to a third of the slowest sensor's natural frequency: above it the sensor's own
     // dynamics (what explain tests as sensor.dynamics) and the DAQ filter shape the response.
-    double f0_min = INFINITY;
+    double f0_min = kInf;
     for (int sn = 0; sn < 2; ++sn)
       if (rr.meta.sensor_present[sn]) f0_min = std::min(f0_min, rr.meta.sensors[sn].f0_hz);
     const ModeSearch ms =
