@@ -172,8 +172,9 @@ std::vector<Eigen::Vector3d> ErrorField::noise_draw(std::mt19937_64& rng) const 
   std::vector<Eigen::Vector3d> ex(nc), ev(nc), eb(nc);
   const fusion::Mat3 p0 = fusion::initial_covariance(truth_, 0.0);
   for (int a = 0; a < 3; ++a) {
-    fusion::Vec3 e(0.0, std::sqrt(p0(1, 1)) * g(rng),
-                   std::hypot(start_bias_sigma_[a], truth_.bias_step_um_s2) * g(rng));
+    // Drawn one by one, the bias first (see below: a call's arguments have no order).
+    const double z_bias = g(rng), z_vel = g(rng);
+    fusion::Vec3 e(0.0, std::sqrt(p0(1, 1)) * z_vel, std::hypot(start_bias_sigma_[a], truth_.bias_step_um_s2) * z_bias);
     fusion::Discrete d;
     std::int64_t last_gap = 0;
     Eigen::LLT<fusion::Mat3> llt;
@@ -185,7 +186,10 @@ std::vector<Eigen::Vector3d> ErrorField::noise_draw(std::mt19937_64& rng) const 
           llt.compute(d.Q + 1e-18 * fusion::Mat3::Identity());
           last_gap = gap;
         }
-        e = d.F * e + llt.matrixL() * fusion::Vec3(g(rng), g(rng), g(rng));
+        // Drawn one by one (last component first, the order these runs were made with): the
+        // arguments of a call have no order, and another compiler would draw another field.
+        const double w2 = g(rng), w1 = g(rng), w0 = g(rng);
+        e = d.F * e + llt.matrixL() * fusion::Vec3(w0, w1, w2);
         if (flags[k] & sf::move_start) e[2] += truth_.bias_step_um_s2 * g(rng);
       }
       ex[k][a] = e[0], ev[k][a] = e[1], eb[k][a] = e[2];

@@ -32,7 +32,8 @@ void draw_sensor(sim::SensorTruth& t, const dsp::SensorSpec& sheet, std::mt19937
   for (int i = 0; i < 3; ++i) scale[i] = 0.005 * u(rng), t.spec.k1_v_per_g[i] *= 1.0 + scale[i];
   t.spec.f0_hz *= 1.0 + 0.1 * u(rng);
   t.spec.zeta = 0.65 + 0.15 * u(rng);
-  const Eigen::Vector3d r = Eigen::Vector3d(u(rng), u(rng), u(rng)) * 5e-3;
+  const double r2 = u(rng), r1 = u(rng), r0 = u(rng);  // in order: a call's arguments have none
+  const Eigen::Vector3d r = Eigen::Vector3d(r0, r1, r2) * 5e-3;
   const Eigen::Matrix3d rot =
       (Eigen::AngleAxisd(r[2], Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(r[1], Eigen::Vector3d::UnitY()) *
        Eigen::AngleAxisd(r[0], Eigen::Vector3d::UnitX()))
