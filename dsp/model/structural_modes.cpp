@@ -147,48 +147,65 @@ Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_h
   return y;
 }
 
-ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz,
-                                 const std::array<bool, 3>& driven, double max_hz) {
-  ModeSearch out;
-  const auto n = static_cast<std::size_t>(std::min(a_meas.rows(), a_cmd.rows()));
-  const std::size_t seg = segment_for(n, fs_hz, kTargetDfHz, kMinAverages);
-  if (n < 4 * 128 || seg < 128) {
-    out.evidence = "too short a run for a frequency response (" + std::to_string(n) + " samples)";
-    return out;
-  }
-  // fr[j][i]: response of axis i to the commanded acceleration along j.
-  std::array<std::array<FrequencyResponse, 3>, 3> fr;
+namespace {
+
+// fr[j][i]: response of axis i to the commanded acceleration along j.
+using Responses = std::array<std::array<FrequencyResponse, 3>, 3>;
+
+// What every mode fit reads: the commanded acceleration and the responses (for the
+// coherence at a mode), the band searched, and the time-domain model: what the measured
+// relative acceleration has beyond the commanded one and the nuisance columns.
+struct ModeProblem {
+  const Eigen::MatrixXd& a_cmd;
+  double fs_hz = 0.0;
+  Eigen::Index n = 0;
+  const Responses& fr;
+  double df_hz = 0.0, f_min_hz = 0.0, f_max_hz = 0.0;
+  std::vector<int> inputs;  // the commanded axes with a response
+  Eigen::MatrixXd e;        // measured − commanded acceleration, n × 3
+  std::vector<Eigen::VectorXd> nuisance;
+};
+
+// The response of every driven axis that moves; the number of such inputs.
+int frequency_responses(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz,
+                        const std::array<bool, 3>& driven, std::size_t seg, Responses& fr) {
   int inputs = 0;
   for (int j = 0; j < 3; ++j) {
     if (!driven[static_cast<std::size_t>(j)] || a_cmd.col(j).cwiseAbs().maxCoeff() <= 0.0) continue;
     ++inputs;
     for (int i = 0; i < 3; ++i) fr[j][i] = frequency_response(a_cmd.col(j), a_meas.col(i), fs_hz, seg);
   }
-  if (inputs == 0) {
-    out.evidence = "no commanded acceleration to excite a mode";
-    return out;
-  }
-  out.df_hz = fs_hz / static_cast<double>(seg);
-  out.f_min_hz = std::max(2.0, 4.0 * out.df_hz);
-  out.f_max_hz = std::min(0.4 * fs_hz, max_hz);
+  return inputs;
+}
+
+// The most prominent peaks of the inputs' own responses (`averages`: the responses').
+std::vector<PeakCandidate> peak_candidates(const Responses& fr, double f_min_hz, double f_max_hz, int& averages) {
   std::vector<PeakCandidate> cands;
   for (int j = 0; j < 3; ++j) {
     if (fr[j][j].f_hz.empty()) continue;
-    out.averages = fr[j][j].averages;
-    for (const auto& c : peaks(fr[j][j], j, out.f_min_hz, out.f_max_hz)) cands.push_back(c);
+    averages = fr[j][j].averages;
+    for (const auto& c : peaks(fr[j][j], j, f_min_hz, f_max_hz)) cands.push_back(c);
   }
   std::sort(cands.begin(), cands.end(),
             [](const PeakCandidate& a, const PeakCandidate& b) { return a.prominence > b.prominence; });
   if (cands.size() > kMaxCandidates) cands.resize(kMaxCandidates);
-  // The time-domain model: what the measured relative acceleration has beyond the
-  // commanded one, on the nuisance columns, then with a mode's response.
-  std::vector<int> inputs_used;
+  return cands;
+}
+
+// The commanded axes with a response: the inputs of the time-domain model.
+std::vector<int> input_axes(const Responses& fr) {
+  std::vector<int> inputs;
   for (int j = 0; j < 3; ++j)
-    if (!fr[j][j].f_hz.empty()) inputs_used.push_back(j);
-  const auto nn = static_cast<Eigen::Index>(n);
-  Eigen::MatrixXd e = a_meas.topRows(nn) - a_cmd.topRows(nn);
+    if (!fr[j][j].f_hz.empty()) inputs.push_back(j);
+  return inputs;
+}
+
+// The nuisance columns of the time-domain model: the offset and, per input, its commanded
+// acceleration, jerk and snap.
+std::vector<Eigen::VectorXd> nuisance_columns(const Eigen::MatrixXd& a_cmd, double fs_hz, Eigen::Index nn,
+                                              const std::vector<int>& inputs) {
   std::vector<Eigen::VectorXd> nuisance{Eigen::VectorXd::Ones(nn)};
-  for (int j : inputs_used) {
+  for (int j : inputs) {
     Eigen::VectorXd jerk = Eigen::VectorXd::Zero(nn);
     for (Eigen::Index k = 1; k + 1 < nn; ++k) jerk[k] = (a_cmd(k + 1, j) - a_cmd(k - 1, j)) * fs_hz / 2.0;
     // The drive's own response (a broad second-order lag, not a mode) to second order in
@@ -198,143 +215,235 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
       snap[k] = (a_cmd(k + 1, j) - 2.0 * a_cmd(k, j) + a_cmd(k - 1, j)) * fs_hz * fs_hz;
     nuisance.push_back(a_cmd.col(j).head(nn)), nuisance.push_back(jerk), nuisance.push_back(snap);
   }
-  const TimeModel tm(e, nuisance);
-  auto mode_cols = [&](double f, double z) {
-    std::vector<Eigen::VectorXd> cols;
-    for (int j : inputs_used) cols.push_back(mode_response(a_cmd.col(j).head(nn), fs_hz, f, z, false));
-    return cols;
-  };
-  // One mode's fit on a model whose nuisance holds the base columns (and, in the second
-  // pass, the other modes found).
-  auto fit_mode = [&](const PeakCandidate& c, const TimeModel& model) {
-    double best_f = c.f_hz, best_z = 0.05;
-    Fit best;
-    auto search = [&](double f_lo, double f_hi, int f_n, double z_lo, double z_hi, int z_n) {
-      for (int fi = 0; fi < f_n; ++fi)
-        for (int zi = 0; zi < z_n; ++zi) {
-          const double f = f_lo + (f_hi - f_lo) * fi / std::max(1, f_n - 1);
-          const double z = z_lo * std::pow(z_hi / z_lo, static_cast<double>(zi) / std::max(1, z_n - 1));
-          Fit t = model.fit(mode_cols(f, z));
-          if (t.rss < best.rss) best = std::move(t), best_f = f, best_z = z;
-        }
-    };
-    const double span = std::max(2.0 * out.df_hz, 0.1 * c.f_hz);
-    search(c.f_hz - span, c.f_hz + span, 21, kZetaMin, kZetaMax, 14);
-    const double fstep = 2.0 * span / 20.0;
-    search(best_f - fstep, best_f + fstep, 9, std::max(kZetaMin, best_z / 1.6), std::min(kZetaMax, best_z * 1.6), 9);
-    // A last, finer pass: the previous grid's 12 % steps in ζ would bias it by up to 6 %.
-    search(best_f - fstep / 4.0, best_f + fstep / 4.0, 7, std::max(kZetaMin, best_z / 1.13),
-           std::min(kZetaMax, best_z * 1.13), 9);
-    StructuralMode md;
-    md.frequency_hz = best_f, md.damping_ratio = best_z;
-    // The residual's effective count (it is no white noise: vibration, the servo's error).
-    const Eigen::Index ax_in = inputs_used.empty() ? 0 : inputs_used[0];
-    const Eigen::VectorXd resid = model.residual(mode_cols(best_f, best_z), best).col(ax_in);
-    const double n_eff = static_cast<double>(nn) / integrated_autocorrelation_time(resid, 2000);
-    md.chi2_drop = n_eff * 3.0 * std::log(model.base_rss() / best.rss);
-    const int dof = 2 + 3 * static_cast<int>(inputs_used.size());
-    md.chi2_threshold = chi2_quantile(dof, kZ);
-    // The strongest path: input j to output i.
-    Eigen::Index bj = 0, bi = 0;
-    best.g.cwiseAbs().maxCoeff(&bj, &bi);
-    md.input_axis = inputs_used[static_cast<std::size_t>(bj)];
-    md.gain = std::abs(best.g(bj, bi));
-    md.peak_amplification = md.gain / (2.0 * best_z);
-    const double gn = best.g.row(bj).norm(), gref = best.g(bj, md.input_axis);
-    for (int i = 0; i < 3; ++i)
-      md.direction[static_cast<std::size_t>(i)] = gn > 0.0 ? best.g(bj, i) * (gref < 0.0 ? -1.0 : 1.0) / gn : 0.0;
-    // Profile uncertainty: χ² in effective counts rises by one.
-    auto bound = [&](bool freq, double dir) {
-      double step = freq ? std::max(1e-4 * best_f, out.df_hz / 100.0) : 0.01 * best_z;
-      double x = freq ? best_f : best_z;
-      for (int it = 0; it < 200; ++it) {
-        x += dir * step;
-        if (x <= 0.0) break;
-        const Fit t = model.fit(mode_cols(freq ? x : best_f, freq ? best_z : x));
-        if (n_eff * 3.0 * std::log(t.rss / best.rss) > 1.0) return std::abs(x - (freq ? best_f : best_z));
-        step *= 1.3;
-      }
-      return std::abs(x - (freq ? best_f : best_z));
-    };
-    md.sigma_frequency_hz = 0.5 * (bound(true, -1.0) + bound(true, 1.0));
-    md.sigma_damping_ratio = 0.5 * (bound(false, -1.0) + bound(false, 1.0));
-    const FrequencyResponse& f0 = fr[static_cast<std::size_t>(md.input_axis)][static_cast<std::size_t>(md.input_axis)];
-    for (std::size_t k = 0; k < f0.f_hz.size(); ++k)
-      if (std::abs(f0.f_hz[k] - best_f) <= out.df_hz) md.coherence = std::max(md.coherence, f0.coherence[k]);
-    {
-      const Eigen::VectorXd y =
-          mode_response(a_cmd.col(md.input_axis).head(nn), fs_hz, best_f, best_z, false) * best.g(bj, bi);
-      md.response_rms_mg = std::sqrt(y.squaredNorm() / static_cast<double>(nn)) / kMmS2PerMg;
-      const double om = 2.0 * std::numbers::pi * best_f;
-      md.displacement_rms_um = md.response_rms_mg * kMmS2PerMg / (om * om) * 1000.0;
+  return nuisance;
+}
+
+// A mode's response to each input: the columns of its gains.
+std::vector<Eigen::VectorXd> mode_columns(const ModeProblem& p, double f, double z) {
+  std::vector<Eigen::VectorXd> cols;
+  for (int j : p.inputs) cols.push_back(mode_response(p.a_cmd.col(j).head(p.n), p.fs_hz, f, z, false));
+  return cols;
+}
+
+struct BestMode {
+  double f_hz = 0.0, zeta = 0.05;
+  Fit fit;
+};
+
+// A grid over frequency (linear) and damping (logarithmic); the best fit so far kept.
+void grid_search(const ModeProblem& p, const TimeModel& model, double f_lo, double f_hi, int f_n, double z_lo,
+                 double z_hi, int z_n, BestMode& best) {
+  for (int fi = 0; fi < f_n; ++fi)
+    for (int zi = 0; zi < z_n; ++zi) {
+      const double f = f_lo + (f_hi - f_lo) * fi / std::max(1, f_n - 1);
+      const double z = z_lo * std::pow(z_hi / z_lo, static_cast<double>(zi) / std::max(1, z_n - 1));
+      Fit t = model.fit(mode_columns(p, f, z));
+      if (t.rss < best.fit.rss) best.fit = std::move(t), best.f_hz = f, best.zeta = z;
     }
-    // The input must drive the response where the fit puts the mode, not only where the
-    // candidate was: a broad shape fitted into a band the motion leaves unexcited is none.
-    md.significant =
-        md.chi2_drop > md.chi2_threshold && md.peak_amplification >= kMinAmplification &&
-        md.coherence >= kMinCoherence && (md.displacement_rms_um >= kMaterialUm || md.response_rms_mg >= kMaterialMg) &&
-        best_z > kZetaMin * 1.1 && best_z <= kZetaStructuralMax && best_f >= out.f_min_hz && best_f <= out.f_max_hz;
-    return md;
-  };
-  // Candidates by prominence, each on a model that holds the modes already found: a strong
-  // mode's response left in the residual would drag a weaker one's fit onto its own.
-  std::vector<Eigen::VectorXd> found_cols = nuisance;
+}
+
+// Coarse about the candidate, then two finer grids about the best.
+BestMode search_mode(const ModeProblem& p, const TimeModel& model, const PeakCandidate& c) {
+  BestMode best;
+  best.f_hz = c.f_hz;
+  const double span = std::max(2.0 * p.df_hz, 0.1 * c.f_hz);
+  grid_search(p, model, c.f_hz - span, c.f_hz + span, 21, kZetaMin, kZetaMax, 14, best);
+  const double fstep = 2.0 * span / 20.0;
+  grid_search(p, model, best.f_hz - fstep, best.f_hz + fstep, 9, std::max(kZetaMin, best.zeta / 1.6),
+              std::min(kZetaMax, best.zeta * 1.6), 9, best);
+  // A last, finer pass: the previous grid's 12 % steps in ζ would bias it by up to 6 %.
+  grid_search(p, model, best.f_hz - fstep / 4.0, best.f_hz + fstep / 4.0, 7, std::max(kZetaMin, best.zeta / 1.13),
+              std::min(kZetaMax, best.zeta * 1.13), 9, best);
+  return best;
+}
+
+// Profile uncertainty of the frequency (`freq`) or the damping, one side (`dir`): χ² in
+// effective counts rises by one.
+double profile_bound(const ModeProblem& p, const TimeModel& model, const BestMode& best, double n_eff, bool freq,
+                     double dir) {
+  double step = freq ? std::max(1e-4 * best.f_hz, p.df_hz / 100.0) : 0.01 * best.zeta;
+  double x = freq ? best.f_hz : best.zeta;
+  for (int it = 0; it < 200; ++it) {
+    x += dir * step;
+    if (x <= 0.0) break;
+    const Fit t = model.fit(mode_columns(p, freq ? x : best.f_hz, freq ? best.zeta : x));
+    if (n_eff * 3.0 * std::log(t.rss / best.fit.rss) > 1.0) return std::abs(x - (freq ? best.f_hz : best.zeta));
+    step *= 1.3;
+  }
+  return std::abs(x - (freq ? best.f_hz : best.zeta));
+}
+
+// The strongest path of a fitted mode (input j to output i): its input axis, gain,
+// amplification at the peak and direction.
+void strongest_path(const ModeProblem& p, const BestMode& best, StructuralMode& md, Eigen::Index& bj,
+                    Eigen::Index& bi) {
+  best.fit.g.cwiseAbs().maxCoeff(&bj, &bi);
+  md.input_axis = p.inputs[static_cast<std::size_t>(bj)];
+  md.gain = std::abs(best.fit.g(bj, bi));
+  md.peak_amplification = md.gain / (2.0 * best.zeta);
+  const double gn = best.fit.g.row(bj).norm(), gref = best.fit.g(bj, md.input_axis);
+  for (int i = 0; i < 3; ++i)
+    md.direction[static_cast<std::size_t>(i)] = gn > 0.0 ? best.fit.g(bj, i) * (gref < 0.0 ? -1.0 : 1.0) / gn : 0.0;
+}
+
+// What the mode adds to this run: the coherence at its frequency, its acceleration and
+// displacement RMS over the run.
+void mode_footprint(const ModeProblem& p, const BestMode& best, Eigen::Index bj, Eigen::Index bi, StructuralMode& md) {
+  const FrequencyResponse& f0 = p.fr[static_cast<std::size_t>(md.input_axis)][static_cast<std::size_t>(md.input_axis)];
+  for (std::size_t k = 0; k < f0.f_hz.size(); ++k)
+    if (std::abs(f0.f_hz[k] - best.f_hz) <= p.df_hz) md.coherence = std::max(md.coherence, f0.coherence[k]);
+  const Eigen::VectorXd y =
+      mode_response(p.a_cmd.col(md.input_axis).head(p.n), p.fs_hz, best.f_hz, best.zeta, false) * best.fit.g(bj, bi);
+  md.response_rms_mg = std::sqrt(y.squaredNorm() / static_cast<double>(p.n)) / kMmS2PerMg;
+  const double om = 2.0 * std::numbers::pi * best.f_hz;
+  md.displacement_rms_um = md.response_rms_mg * kMmS2PerMg / (om * om) * 1000.0;
+}
+
+// One mode's fit on a model whose nuisance holds the base columns (and, in the second
+// pass, the other modes found).
+StructuralMode fit_mode(const ModeProblem& p, const PeakCandidate& c, const TimeModel& model) {
+  const BestMode best = search_mode(p, model, c);
+  StructuralMode md;
+  md.frequency_hz = best.f_hz, md.damping_ratio = best.zeta;
+  // The residual's effective count (it is no white noise: vibration, the servo's error).
+  const Eigen::Index ax_in = p.inputs.empty() ? 0 : p.inputs[0];
+  const Eigen::VectorXd resid = model.residual(mode_columns(p, best.f_hz, best.zeta), best.fit).col(ax_in);
+  const double n_eff = static_cast<double>(p.n) / integrated_autocorrelation_time(resid, 2000);
+  md.chi2_drop = n_eff * 3.0 * std::log(model.base_rss() / best.fit.rss);
+  const int dof = 2 + 3 * static_cast<int>(p.inputs.size());
+  md.chi2_threshold = chi2_quantile(dof, kZ);
+  Eigen::Index bj = 0, bi = 0;
+  strongest_path(p, best, md, bj, bi);
+  md.sigma_frequency_hz =
+      0.5 * (profile_bound(p, model, best, n_eff, true, -1.0) + profile_bound(p, model, best, n_eff, true, 1.0));
+  md.sigma_damping_ratio =
+      0.5 * (profile_bound(p, model, best, n_eff, false, -1.0) + profile_bound(p, model, best, n_eff, false, 1.0));
+  mode_footprint(p, best, bj, bi, md);
+  // The input must drive the response where the fit puts the mode, not only where the
+  // candidate was: a broad shape fitted into a band the motion leaves unexcited is none.
+  md.significant =
+      md.chi2_drop > md.chi2_threshold && md.peak_amplification >= kMinAmplification && md.coherence >= kMinCoherence &&
+      (md.displacement_rms_um >= kMaterialUm || md.response_rms_mg >= kMaterialMg) && best.zeta > kZetaMin * 1.1 &&
+      best.zeta <= kZetaStructuralMax && best.f_hz >= p.f_min_hz && best.f_hz <= p.f_max_hz;
+  return md;
+}
+
+// Candidates by prominence, each on a model that holds the modes already found: a strong
+// mode's response left in the residual would drag a weaker one's fit onto its own.
+std::vector<StructuralMode> fit_candidates(const ModeProblem& p, const std::vector<PeakCandidate>& cands,
+                                           const TimeModel& tm) {
+  std::vector<StructuralMode> modes;
+  std::vector<Eigen::VectorXd> found_cols = p.nuisance;
   std::optional<TimeModel> with_found;
   for (const PeakCandidate& c : cands) {
-    const StructuralMode md = fit_mode(c, with_found ? *with_found : tm);
+    const StructuralMode md = fit_mode(p, c, with_found ? *with_found : tm);
     if (md.significant) {
-      for (auto& col : mode_cols(md.frequency_hz, md.damping_ratio)) found_cols.push_back(std::move(col));
-      with_found.emplace(e, found_cols);
+      for (auto& col : mode_columns(p, md.frequency_hz, md.damping_ratio)) found_cols.push_back(std::move(col));
+      with_found.emplace(p.e, found_cols);
     }
     // One mode seen from several inputs: keep its best fit.
     bool merged = false;
-    for (auto& o : out.modes)
+    for (auto& o : modes)
       if (std::abs(o.frequency_hz - md.frequency_hz) <=
-          2.0 * out.df_hz + 2.0 * std::max(o.sigma_frequency_hz, md.sigma_frequency_hz)) {
+          2.0 * p.df_hz + 2.0 * std::max(o.sigma_frequency_hz, md.sigma_frequency_hz)) {
         if (md.chi2_drop > o.chi2_drop) o = md;
         merged = true;
       }
-    if (!merged) out.modes.push_back(md);
+    if (!merged) modes.push_back(md);
   }
-  // Modes close together bias each other's damping when fitted one at a time: each
-  // significant mode once more with the others' responses as nuisance (one backfitting pass).
+  return modes;
+}
+
+// Modes close together bias each other's damping when fitted one at a time: each
+// significant mode once more with the others' responses as nuisance (one backfitting pass).
+void backfit_modes(const ModeProblem& p, std::vector<StructuralMode>& modes) {
   std::vector<std::size_t> sig;
-  for (std::size_t k = 0; k < out.modes.size(); ++k)
-    if (out.modes[k].significant) sig.push_back(k);
-  if (sig.size() >= 2) {
-    std::vector<StructuralMode> refit = out.modes;
-    for (std::size_t k : sig) {
-      std::vector<Eigen::VectorXd> with_others = nuisance;
-      for (std::size_t o : sig)
-        if (o != k)
-          for (auto& col : mode_cols(out.modes[o].frequency_hz, out.modes[o].damping_ratio))
-            with_others.push_back(std::move(col));
-      PeakCandidate c;
-      c.input = out.modes[k].input_axis, c.f_hz = out.modes[k].frequency_hz;
-      const StructuralMode md = fit_mode(c, TimeModel(e, with_others));
-      if (md.significant) refit[k] = md;
-    }
-    out.modes = std::move(refit);
+  for (std::size_t k = 0; k < modes.size(); ++k)
+    if (modes[k].significant) sig.push_back(k);
+  if (sig.size() < 2) return;
+  std::vector<StructuralMode> refit = modes;
+  for (std::size_t k : sig) {
+    std::vector<Eigen::VectorXd> with_others = p.nuisance;
+    for (std::size_t o : sig)
+      if (o != k)
+        for (auto& col : mode_columns(p, modes[o].frequency_hz, modes[o].damping_ratio))
+          with_others.push_back(std::move(col));
+    PeakCandidate c;
+    c.input = modes[k].input_axis, c.f_hz = modes[k].frequency_hz;
+    const StructuralMode md = fit_mode(p, c, TimeModel(p.e, with_others));
+    if (md.significant) refit[k] = md;
   }
-  {
-    std::vector<Eigen::VectorXd> cols;
-    for (const auto& md : out.modes)
-      if (md.significant)
-        for (auto& col : mode_cols(md.frequency_hz, md.damping_ratio)) cols.push_back(std::move(col));
-    const double per = 1.0 / (static_cast<double>(nn) * 3.0);
-    out.residual_rms_before_mg = out.residual_rms_after_mg = std::sqrt(tm.base_rss() * per) / kMmS2PerMg;
-    if (!cols.empty()) out.residual_rms_after_mg = std::sqrt(tm.fit(cols).rss * per) / kMmS2PerMg;
-  }
-  std::sort(out.modes.begin(), out.modes.end(), [](const StructuralMode& a, const StructuralMode& b) {
+  modes = std::move(refit);
+}
+
+// The gain of the modes found: the residual RMS without and with them.
+void residual_gain(const ModeProblem& p, const TimeModel& tm, ModeSearch& out) {
+  std::vector<Eigen::VectorXd> cols;
+  for (const auto& md : out.modes)
+    if (md.significant)
+      for (auto& col : mode_columns(p, md.frequency_hz, md.damping_ratio)) cols.push_back(std::move(col));
+  const double per = 1.0 / (static_cast<double>(p.n) * 3.0);
+  out.residual_rms_before_mg = out.residual_rms_after_mg = std::sqrt(tm.base_rss() * per) / kMmS2PerMg;
+  if (!cols.empty()) out.residual_rms_after_mg = std::sqrt(tm.fit(cols).rss * per) / kMmS2PerMg;
+}
+
+// Significant modes first, each group by its χ² drop.
+void sort_modes(std::vector<StructuralMode>& modes) {
+  std::sort(modes.begin(), modes.end(), [](const StructuralMode& a, const StructuralMode& b) {
     if (a.significant != b.significant) return a.significant;
     return a.chi2_drop > b.chi2_drop;
   });
+}
+
+std::string describe_search(const ModeSearch& out) {
   char buf[200];
   std::snprintf(buf, sizeof buf,
                 "frequency response of the measured over the commanded acceleration, %.1f-%.0f Hz in %.2f Hz bins over "
                 "%d averages",
                 out.f_min_hz, out.f_max_hz, out.df_hz, out.averages);
-  out.evidence = buf;
+  return buf;
+}
+
+}  // namespace
+
+ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz,
+                                 const std::array<bool, 3>& driven, double max_hz) {
+  ModeSearch out;
+  const auto n = static_cast<std::size_t>(std::min(a_meas.rows(), a_cmd.rows()));
+  const std::size_t seg = segment_for(n, fs_hz, kTargetDfHz, kMinAverages);
+  if (n < 4 * 128 || seg < 128) {
+    out.evidence = "too short a run for a frequency response (" + std::to_string(n) + " samples)";
+    return out;
+  }
+  Responses fr;
+  if (frequency_responses(a_meas, a_cmd, fs_hz, driven, seg, fr) == 0) {
+    out.evidence = "no commanded acceleration to excite a mode";
+    return out;
+  }
+  out.df_hz = fs_hz / static_cast<double>(seg);
+  out.f_min_hz = std::max(2.0, 4.0 * out.df_hz);
+  out.f_max_hz = std::min(0.4 * fs_hz, max_hz);
+  const std::vector<PeakCandidate> cands = peak_candidates(fr, out.f_min_hz, out.f_max_hz, out.averages);
+  // The time-domain model: what the measured relative acceleration has beyond the
+  // commanded one, on the nuisance columns, then with a mode's response.
+  const auto nn = static_cast<Eigen::Index>(n);
+  const std::vector<int> inputs = input_axes(fr);
+  const ModeProblem p{.a_cmd = a_cmd,
+                      .fs_hz = fs_hz,
+                      .n = nn,
+                      .fr = fr,
+                      .df_hz = out.df_hz,
+                      .f_min_hz = out.f_min_hz,
+                      .f_max_hz = out.f_max_hz,
+                      .inputs = inputs,
+                      .e = a_meas.topRows(nn) - a_cmd.topRows(nn),
+                      .nuisance = nuisance_columns(a_cmd, fs_hz, nn, inputs)};
+  const TimeModel tm(p.e, p.nuisance);
+  out.modes = fit_candidates(p, cands, tm);
+  backfit_modes(p, out.modes);
+  residual_gain(p, tm, out);
+  sort_modes(out.modes);
+  out.evidence = describe_search(out);
   return out;
 }
 
