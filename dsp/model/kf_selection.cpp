@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 namespace eical::dsp::model {
 namespace {
@@ -95,152 +96,226 @@ double total_held_lpd(const Model& m) { return m.fit[0].held_lpd + m.fit[1].held
 
 double rms(double ss, std::size_t n) { return n ? std::sqrt(ss / static_cast<double>(n)) : 0.0; }
 
-}  // namespace
+// A model's squared innovations and counts, fitting and held-out observations summed over the axes.
+struct InnovationSums {
+  double fit_ss = 0.0, held_ss = 0.0;
+  std::size_t fit_n = 0, held_n = 0;
+};
 
-KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::vector<ParamGroup>& groups,
-                             const fusion::ErrorModel& model, const KfSelectionOptions& o,
-                             const std::vector<AxisParam>& base) {
-  KfSelection out;
-  auto fit = [&](int a, const std::vector<const AxisParam*>& ps, bool keep = false) {
-    return tracks[a].present ? fit_axis(tracks[a], ps, model, o.zupt_sigma_um_s, keep) : AxisFit{};
-  };
+InnovationSums innovation_sums(const Model& m) {
+  InnovationSums s;
+  for (const auto& f : m.fit) s.fit_ss += f.fit_ss, s.fit_n += f.fit_n, s.held_ss += f.held_ss, s.held_n += f.held_n;
+  return s;
+}
+
+// The sum of a model's held-out predictive variances.
+double held_variance(const Model& m) {
+  double var = 0.0;
+  for (const auto& f : m.fit) var += f.held_var;
+  return var;
+}
+
+// Axis a's track through the filter with parameters ps (an axis without a track: no fit).
+AxisFit fit_track(const std::array<AxisTrack, 3>& tracks, const fusion::ErrorModel& model, const KfSelectionOptions& o,
+                  int a, const std::vector<const AxisParam*>& ps, bool keep = false) {
+  return tracks[a].present ? fit_axis(tracks[a], ps, model, o.zupt_sigma_um_s, keep) : AxisFit{};
+}
+
+// What every model of the selection is fitted and scored with.
+struct Selector {
+  const std::array<AxisTrack, 3>& tracks;
+  const fusion::ErrorModel& model;
+  const KfSelectionOptions& o;
+  // The log-likelihood of correlated innovations counts each of them too often: it is
+  // scaled by the effective count, as the BIC's penalty (ln n_eff) is.
+  double scale = 1.0, ln_n = 0.0;
+
+  [[nodiscard]] AxisFit fit(int a, const std::vector<const AxisParam*>& ps) const {
+    return fit_track(tracks, model, o, a, ps);
+  }
+};
+
+// `from` with a group's parameters added, the axes it touches refitted.
+Model with_group(const Selector& sel, const Model& from, const ParamGroup& gp) {
+  Model m = from;
+  std::array<bool, 3> touched{};
+  for (const auto& p : gp.params) m.params[p.axis].push_back(&p), touched[p.axis] = true, ++m.k;
+  for (int a = 0; a < 3; ++a)
+    if (touched[a]) m.fit[a] = sel.fit(a, m.params[a]);
+  return m;
+}
+
+// What a group gains from `before` to `after`: BIC drop, RMS, held-out score, its values.
+GroupVerdict verdict(const Selector& sel, const Model& before, const Model& after, const ParamGroup& gp) {
+  GroupVerdict v;
+  v.name = gp.name;
+  v.loglik_gain = 2.0 * sel.scale * (total_logl(after) - total_logl(before));
+  v.bic_drop = v.loglik_gain - static_cast<double>(after.k - before.k) * sel.ln_n;
+  const InnovationSums b = innovation_sums(before), a = innovation_sums(after);
+  v.fit_rms_before_um = rms(b.fit_ss, b.fit_n), v.fit_rms_after_um = rms(a.fit_ss, a.fit_n);
+  v.held_rms_before_um = rms(b.held_ss, b.held_n), v.held_rms_after_um = rms(a.held_ss, a.held_n);
+  v.held_score_gain = sel.scale * (total_held_lpd(after) - total_held_lpd(before));
+  for (int ax = 0; ax < 3; ++ax)
+    for (std::size_t j = 0; j < after.params[ax].size(); ++j)
+      for (const auto& p : gp.params)
+        if (&p == after.params[ax][j])
+          v.value[p.name] = after.fit[ax].value[static_cast<Eigen::Index>(j)],
+          v.sigma[p.name] = after.fit[ax].sigma[static_cast<Eigen::Index>(j)];
+  return v;
+}
+
+// The base model (its parameters on every axis), fitted; the innovations it leaves.
+Model base_model(const std::array<AxisTrack, 3>& tracks, const fusion::ErrorModel& model, const KfSelectionOptions& o,
+                 const std::vector<AxisParam>& base, std::vector<double>& base_innov) {
   Model cur;
   for (const auto& p : base) cur.params[static_cast<std::size_t>(p.axis)].push_back(&p);
-  std::vector<double> base_innov;
   for (int a = 0; a < 3; ++a) {
-    cur.fit[a] = fit(a, cur.params[static_cast<std::size_t>(a)], true);
+    cur.fit[a] = fit_track(tracks, model, o, a, cur.params[static_cast<std::size_t>(a)], true);
     base_innov.insert(base_innov.end(), cur.fit[a].innovations.begin(), cur.fit[a].innovations.end());
   }
-  auto sums = [](const Model& m, double& fs, std::size_t& fn, double& hs, std::size_t& hn) {
-    fs = hs = 0.0, fn = hn = 0;
-    for (const auto& f : m.fit) fs += f.fit_ss, fn += f.fit_n, hs += f.held_ss, hn += f.held_n;
-  };
-  double fs = 0.0, hs = 0.0;
-  std::size_t fn = 0, hn = 0;
-  sums(cur, fs, fn, hs, hn);
-  out.fit_rms_nominal_um = rms(fs, fn), out.held_rms_nominal_um = rms(hs, hn);
-  if (fn < 20) return out;
-  const Eigen::VectorXd bi =
-      Eigen::Map<const Eigen::VectorXd>(base_innov.data(), static_cast<Eigen::Index>(base_innov.size()));
-  out.n_eff = static_cast<double>(fn) / integrated_autocorrelation_time(bi, 2000);
-  const double ln_n = std::log(std::max(out.n_eff, 2.0));
-  // The log-likelihood of correlated innovations counts each of them too often: scale it
-  // by the effective count, as the BIC's penalty is.
-  const double scale = out.n_eff / static_cast<double>(fn);
+  return cur;
+}
 
-  auto with = [&](const Model& from, const ParamGroup& gp) {
-    Model m = from;
-    std::array<bool, 3> touched{};
-    for (const auto& p : gp.params) m.params[p.axis].push_back(&p), touched[p.axis] = true, ++m.k;
-    for (int a = 0; a < 3; ++a)
-      if (touched[a]) m.fit[a] = fit(a, m.params[a]);
-    return m;
-  };
-  auto verdict = [&](const Model& before, const Model& after, const ParamGroup& gp) {
-    GroupVerdict v;
-    v.name = gp.name;
-    v.loglik_gain = 2.0 * scale * (total_logl(after) - total_logl(before));
-    v.bic_drop = v.loglik_gain - static_cast<double>(after.k - before.k) * ln_n;
-    double a_fs, a_hs, b_fs, b_hs;
-    std::size_t a_fn, a_hn, b_fn, b_hn;
-    sums(before, b_fs, b_fn, b_hs, b_hn), sums(after, a_fs, a_fn, a_hs, a_hn);
-    v.fit_rms_before_um = rms(b_fs, b_fn), v.fit_rms_after_um = rms(a_fs, a_fn);
-    v.held_rms_before_um = rms(b_hs, b_hn), v.held_rms_after_um = rms(a_hs, a_hn);
-    v.held_score_gain = scale * (total_held_lpd(after) - total_held_lpd(before));
-    for (int a = 0; a < 3; ++a)
-      for (std::size_t j = 0; j < after.params[a].size(); ++j)
-        for (const auto& p : gp.params)
-          if (&p == after.params[a][j])
-            v.value[p.name] = after.fit[a].value[static_cast<Eigen::Index>(j)],
-            v.sigma[p.name] = after.fit[a].sigma[static_cast<Eigen::Index>(j)];
-    return v;
-  };
-  std::vector<bool> done(groups.size(), false);
-  for (int round = 0; round < o.max_groups; ++round) {
-    struct Trial {
-      std::size_t g;
-      GroupVerdict v;
-      Model m;
-    };
-    std::vector<Trial> trials;
-    double top_bic = -kInf;
-    for (std::size_t g = 0; g < groups.size(); ++g) {
-      if (done[g] || groups[g].params.empty() || groups[g].known) continue;
-      Model m = with(cur, groups[g]);
-      GroupVerdict v = verdict(cur, m, groups[g]);
-      // Only an extension that also predicts the held-out data better may be taken.
-      // The score is the held-out observations' log predictive density (in effective
-      // counts, as the BIC): it weighs each prediction by how well it could be known.
-      const bool gain = v.held_score_gain > o.min_heldout_score_gain;
-      if (!gain) continue;
-      top_bic = std::max(top_bic, v.bic_drop);
-      trials.push_back({g, std::move(v), std::move(m)});
-    }
-    // Groups the BIC cannot tell apart (within kTieBic: less than "strong" evidence for
-    // one over the other — ζ(|a|) and a constant ζ error in a move of one acceleration
-    // level) are decided by what predicts the held-out observations better.
-    const Trial* pick = nullptr;
-    for (const auto& t : trials)
-      if (t.v.bic_drop >= top_bic - kTieBic && (!pick || t.v.held_rms_after_um < pick->v.held_rms_after_um)) pick = &t;
-    if (!pick || pick->v.bic_drop < o.min_bic_drop) break;
-    const int best = static_cast<int>(pick->g);
-    GroupVerdict best_v = pick->v;
-    Model best_m = pick->m;
-    best_v.accepted = true;
-    done[static_cast<std::size_t>(best)] = true;
-    cur = std::move(best_m);
-    out.groups.push_back(best_v);
+// One round of the forward selection: the group to take, if any. Only an extension that
+// also predicts the held-out data better may be taken; groups the BIC cannot tell apart
+// are decided by the held-out prediction.
+struct Trial {
+  std::size_t g = 0;
+  GroupVerdict v;
+  Model m;
+};
+
+std::optional<Trial> best_trial(const Selector& sel, const std::vector<ParamGroup>& groups, const Model& cur,
+                                const std::vector<bool>& done) {
+  std::vector<Trial> trials;
+  double top_bic = -kInf;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (done[g] || groups[g].params.empty() || groups[g].known) continue;
+    Model m = with_group(sel, cur, groups[g]);
+    GroupVerdict v = verdict(sel, cur, m, groups[g]);
+    // The score is the held-out observations' log predictive density (in effective
+    // counts, as the BIC): it weighs each prediction by how well it could be known.
+    const bool gain = v.held_score_gain > sel.o.min_heldout_score_gain;
+    if (!gain) continue;
+    top_bic = std::max(top_bic, v.bic_drop);
+    trials.push_back({g, std::move(v), std::move(m)});
   }
-  // Known groups the run shows join the final model: their size is not a free choice, so
-  // no BIC penalty is charged, only the evidence that the run carries them.
+  // Groups the BIC cannot tell apart (within kTieBic: less than "strong" evidence for
+  // one over the other — ζ(|a|) and a constant ζ error in a move of one acceleration
+  // level) are decided by what predicts the held-out observations better.
+  const Trial* pick = nullptr;
+  for (const auto& t : trials)
+    if (t.v.bic_drop >= top_bic - kTieBic && (!pick || t.v.held_rms_after_um < pick->v.held_rms_after_um)) pick = &t;
+  if (!pick || pick->v.bic_drop < sel.o.min_bic_drop) return std::nullopt;
+  return *pick;
+}
+
+// Forward selection: the best group per round into the model while the BIC says so.
+void select_forward(const Selector& sel, const std::vector<ParamGroup>& groups, Model& cur, std::vector<bool>& done,
+                    KfSelection& out) {
+  for (int round = 0; round < sel.o.max_groups; ++round) {
+    std::optional<Trial> pick = best_trial(sel, groups, cur, done);
+    if (!pick) break;
+    pick->v.accepted = true;
+    done[pick->g] = true;
+    cur = std::move(pick->m);
+    out.groups.push_back(std::move(pick->v));
+  }
+}
+
+// Known groups the run shows join the final model: their size is not a free choice, so
+// no BIC penalty is charged, only the evidence that the run carries them.
+void add_known_groups(const Selector& sel, const std::vector<ParamGroup>& groups, Model& cur, std::vector<bool>& done,
+                      KfSelection& out) {
   for (std::size_t g = 0; g < groups.size(); ++g) {
     if (done[g] || groups[g].params.empty() || !groups[g].known) continue;
-    Model m = with(cur, groups[g]);
-    GroupVerdict v = verdict(cur, m, groups[g]);
-    if (v.loglik_gain < o.known_min_loglik_gain || v.held_score_gain < 0.0) continue;
+    Model m = with_group(sel, cur, groups[g]);
+    GroupVerdict v = verdict(sel, cur, m, groups[g]);
+    if (v.loglik_gain < sel.o.known_min_loglik_gain || v.held_score_gain < 0.0) continue;
     v.accepted = true;
     done[g] = true;
     cur = std::move(m);
     out.groups.push_back(std::move(v));
   }
-  // The accepted groups' final values (fitted together), then every other group once more
-  // against the final model.
-  for (auto& v : out.groups)
+}
+
+// The accepted groups' final values (fitted together).
+void final_values(const Model& cur, std::vector<GroupVerdict>& accepted) {
+  for (auto& v : accepted)
     for (int a = 0; a < 3; ++a)
       for (std::size_t j = 0; j < cur.params[a].size(); ++j)
         if (v.value.count(cur.params[a][j]->name)) {
           v.value[cur.params[a][j]->name] = cur.fit[a].value[static_cast<Eigen::Index>(j)];
           v.sigma[cur.params[a][j]->name] = cur.fit[a].sigma[static_cast<Eigen::Index>(j)];
         }
-  sums(cur, fs, fn, hs, hn);
-  out.fit_rms_final_um = rms(fs, fn), out.held_rms_final_um = rms(hs, hn);
-  {
-    double var = 0.0;
-    for (const auto& f : cur.fit) var += f.held_var;
-    out.held_expected_rms_final_um = rms(var, hn);
-  }
-  {
-    Model all = cur;
-    for (std::size_t g = 0; g < groups.size(); ++g)
-      if (!done[g] && !groups[g].params.empty() && !groups[g].known) all = with(all, groups[g]);
-    double afs, ahs, var = 0.0;
-    std::size_t afn, ahn;
-    sums(all, afs, afn, ahs, ahn);
-    for (const auto& f : all.fit) var += f.held_var;
-    out.held_rms_all_um = rms(ahs, ahn), out.held_expected_rms_all_um = rms(var, ahn);
-  }
+}
+
+// The held-out RMS with every group of the table in the model at once, and what that
+// model expects there.
+void all_groups_rms(const Selector& sel, const std::vector<ParamGroup>& groups, const Model& cur,
+                    const std::vector<bool>& done, KfSelection& out) {
+  Model all = cur;
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    if (!done[g] && !groups[g].params.empty() && !groups[g].known) all = with_group(sel, all, groups[g]);
+  const InnovationSums s = innovation_sums(all);
+  out.held_rms_all_um = rms(s.held_ss, s.held_n), out.held_expected_rms_all_um = rms(held_variance(all), s.held_n);
+}
+
+// The base parameters' values in the final model.
+void base_values(const Model& cur, const std::vector<AxisParam>& base, KfSelection& out) {
   for (int a = 0; a < 3; ++a)
     for (std::size_t j = 0; j < cur.params[a].size(); ++j)
       for (const auto& p : base)
         if (&p == cur.params[a][j])
           out.base_value[p.name] = cur.fit[a].value[static_cast<Eigen::Index>(j)],
           out.base_sigma[p.name] = cur.fit[a].sigma[static_cast<Eigen::Index>(j)];
+}
+
+// Every group not taken, once more against the final model, by BIC drop.
+std::vector<GroupVerdict> rest_verdicts(const Selector& sel, const std::vector<ParamGroup>& groups, const Model& cur,
+                                        const std::vector<bool>& done) {
   std::vector<GroupVerdict> rest;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     if (done[g] || groups[g].params.empty()) continue;
-    rest.push_back(verdict(cur, with(cur, groups[g]), groups[g]));
+    rest.push_back(verdict(sel, cur, with_group(sel, cur, groups[g]), groups[g]));
   }
   std::sort(rest.begin(), rest.end(), [](const auto& a, const auto& b) { return a.bic_drop > b.bic_drop; });
+  return rest;
+}
+
+}  // namespace
+
+KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::vector<ParamGroup>& groups,
+                             const fusion::ErrorModel& model, const KfSelectionOptions& o,
+                             const std::vector<AxisParam>& base) {
+  KfSelection out;
+  std::vector<double> base_innov;
+  Model cur = base_model(tracks, model, o, base, base_innov);
+  const InnovationSums nominal = innovation_sums(cur);
+  out.fit_rms_nominal_um = rms(nominal.fit_ss, nominal.fit_n);
+  out.held_rms_nominal_um = rms(nominal.held_ss, nominal.held_n);
+  if (nominal.fit_n < 20) return out;
+  const Eigen::VectorXd bi =
+      Eigen::Map<const Eigen::VectorXd>(base_innov.data(), static_cast<Eigen::Index>(base_innov.size()));
+  out.n_eff = static_cast<double>(nominal.fit_n) / integrated_autocorrelation_time(bi, 2000);
+  const Selector sel{.tracks = tracks,
+                     .model = model,
+                     .o = o,
+                     .scale = out.n_eff / static_cast<double>(nominal.fit_n),
+                     .ln_n = std::log(std::max(out.n_eff, 2.0))};
+
+  std::vector<bool> done(groups.size(), false);
+  select_forward(sel, groups, cur, done, out);
+  add_known_groups(sel, groups, cur, done, out);
+  // The accepted groups' final values, then every other group once more against the final model.
+  final_values(cur, out.groups);
+  const InnovationSums final_sums = innovation_sums(cur);
+  out.fit_rms_final_um = rms(final_sums.fit_ss, final_sums.fit_n);
+  out.held_rms_final_um = rms(final_sums.held_ss, final_sums.held_n);
+  out.held_expected_rms_final_um = rms(held_variance(cur), final_sums.held_n);
+  all_groups_rms(sel, groups, cur, done, out);
+  base_values(cur, base, out);
+  const std::vector<GroupVerdict> rest = rest_verdicts(sel, groups, cur, done);
   out.groups.insert(out.groups.end(), rest.begin(), rest.end());
   return out;
 }
