@@ -84,382 +84,480 @@ void axis_directions(const RunResiduals& r, int axis, Eigen::VectorXd& dir, std:
   }
 }
 
-std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
-  std::vector<ParamGroup> out;
+namespace {
+
+// The axes the program moves.
+std::vector<int> moving_axes(const RunResiduals& r) {
   std::vector<int> moving;
   for (int a = 0; a < 3; ++a)
     if (r.moving[a]) moving.push_back(a);
-  if (moving.empty()) return out;
+  return moving;
+}
+
+// The largest case temperature change of either sensor over the run.
+double temperature_range_c(const RunResiduals& r) {
+  return std::max(r.temp_c.col(0).cwiseAbs().maxCoeff(), r.temp_c.col(1).cwiseAbs().maxCoeff());
+}
+
+AxisParam axis_param(std::string name, int axis, bool accel, Eigen::VectorXd input, double prior) {
+  AxisParam p;
+  p.name = std::move(name), p.axis = axis, p.accel = accel, p.input = std::move(input), p.prior_sigma = prior;
+  return p;
+}
+
+// a_um: the driven acceleration, µm/s².
+ParamGroup scale_group(const std::vector<int>& moving, const Eigen::MatrixXd& a_um) {
+  ParamGroup gp{"scale", {}};
+  for (int j : moving) gp.params.push_back(axis_param("scale_" + ax(j) + "_ppm", j, true, a_um.col(j) * 1e-6, 5e3));
+  return gp;
+}
+
+ParamGroup cross_axis_group(const std::vector<int>& moving, const Eigen::MatrixXd& a_um) {
+  ParamGroup gp{"cross_axis", {}};
+  for (int j : moving)
+    for (int i = 0; i < 3; ++i)
+      if (i != j) gp.params.push_back(axis_param("E_" + ax(i) + ax(j) + "_ppm", i, true, a_um.col(j) * 1e-6, 2e4));
+  return gp;
+}
+
+// a_drv: the driven acceleration, mm/s².
+ParamGroup nonlinearity_group(const RunResiduals& r, const std::vector<int>& moving, const Eigen::MatrixXd& a_drv) {
   const double g = r.meta.site.g_mps2;
+  ParamGroup gp{"nonlinearity", {}};
+  for (int j : moving) {
+    const Eigen::VectorXd ag = a_drv.col(j) / (1000.0 * g);  // in g
+    const double sign =
+        r.owner[j] == 0 ? -1.0 : 1.0;  // the table sees −a: its square term changes sign in head − table
+    gp.params.push_back(
+        axis_param("k2_" + ax(j) + "_1e-6_per_g", j, true, sign * ag.array().square().matrix() * g, 1e4));
+    gp.params.push_back(axis_param("k3_" + ax(j) + "_1e-6_per_g2", j, true, ag.array().cube().matrix() * g, 1e4));
+  }
+  return gp;
+}
+
+// Against the set-point alone an axis' timing is its servo's (the base model's lag).
+ParamGroup timing_group(const RunResiduals& r, const std::vector<int>& moving) {
+  ParamGroup gp{"timing", {}};
+  for (int j : moving)
+    if (r.axis_reference[static_cast<std::size_t>(j)] != "cmd")
+      gp.params.push_back(axis_param("timing_" + ax(j) + "_us", j, false, r.v_meas.col(j) * 1e-3, 300.0));
+  return gp;
+}
+
+// ζ = ζ0 (1 + k |a|/g) (ch. 8.3.1): the PT2 drops (2ζ/ω0)·ȧ, so the extra damping
+// drops −(2ζ0 k/(ω0 g))·|a|·ȧ = −(ζ0 k/(ω0 g))·d(a|a|)/dt of acceleration, i.e.
+// −(ζ0 k/(ω0 g))·∫ a|a| dt of position — a plateau over a move's cruise that its
+// deceleration takes back; on a circle, odd harmonics a constant 2ζ/ω0 does not have.
+ParamGroup damping_amplitude_group(const RunResiduals& r, const std::vector<int>& moving,
+                                   const Eigen::MatrixXd& a_drv) {
+  const double g = r.meta.site.g_mps2;
+  ParamGroup gp{"damping_amplitude", {}};
+  for (int j : moving) {
+    const dsp::SensorSpec& sp = r.meta.sensors[std::max(0, r.owner[j])];
+    const double k = -sp.zeta / (2.0 * kPi * sp.f0_hz * g) * 1e6;  // µm per (m²/s³) of ∫a|a|dt
+    Eigen::VectorXd col(r.n);
+    double acc = 0.0, prev = 0.0;
+    for (Eigen::Index s = 0; s < r.n; ++s) {
+      const double a = a_drv(s, j) / 1000.0, cur = a * std::abs(a);
+      if (s > 0) acc += 0.5 * (cur + prev) * (r.t_s[s] - r.t_s[s - 1]);
+      prev = cur, col[s] = k * acc;
+    }
+    gp.params.push_back(axis_param("zeta_per_g_" + ax(j), j, false, col, 10.0));
+  }
+  return gp;
+}
+
+ParamGroup coriolis_group(const RunResiduals& r) {
+  // An axis whose Coriolis acceleration stays below 0.1 µg (1 µm/s²) has no say in it.
+  constexpr double kCoriolisFloorUmS2 = 1.0;
+  // The Earth rate is known: the group is the site's prediction (gain 1, held there),
+  // tested against the final model, not selected.
+  constexpr double kCoriolisGainSigma = 1e-3;
+  // Earth-rate Coriolis (3-6): the sensors measure 2ω×v on top of the motion; ω from the
+  // site, one gain per axis it reaches (1: the site's prediction).
+  const Eigen::Vector3d two_w = 2.0 * earth_rate_machine_radps(r.meta.site);
+  Eigen::MatrixXd acc_um(r.n, 3);
+  for (Eigen::Index s = 0; s < r.n; ++s)
+    acc_um.row(s) = two_w.cross(Eigen::Vector3d(r.v_meas.row(s).transpose())).transpose() * 1000.0;  // mm/s → µm/s²
+  ParamGroup gp{"coriolis", {}};
+  for (int i = 0; i < 3; ++i)
+    if (acc_um.col(i).cwiseAbs().maxCoeff() > kCoriolisFloorUmS2) {
+      AxisParam cp = axis_param("coriolis_gain_" + ax(i), i, true, acc_um.col(i), kCoriolisGainSigma);
+      cp.prior_mean = 1.0;  // the site's Earth rate
+      gp.params.push_back(std::move(cp));
+    }
+  gp.known = true;
+  return gp;
+}
+
+ParamGroup bias_drift_group(const RunResiduals& r) {
+  const double g = r.meta.site.g_mps2;
+  ParamGroup gp{"bias_drift", {}};
+  for (int i = 0; i < 3; ++i)
+    gp.params.push_back(axis_param("drift_" + ax(i) + "_ug_per_s", i, true, r.t_s * g, 100.0));
+  return gp;
+}
+
+ParamGroup scale_temperature_group(const RunResiduals& r, const std::vector<int>& moving, const Eigen::MatrixXd& a_um) {
+  const double g = r.meta.site.g_mps2;
+  ParamGroup gp{"scale_temperature", {}};
+  for (int j : moving)
+    gp.params.push_back(axis_param("scale_tc_" + ax(j) + "_ppm_per_c", j, true,
+                                   r.temp_c.col(std::max(0, r.owner[j])).cwiseProduct(a_um.col(j)) * 1e-6, 1e4));
+  const Eigen::VectorXd mean_t = 0.5 * (r.temp_c.col(0) + r.temp_c.col(1));
+  for (int i = 0; i < 3; ++i)
+    gp.params.push_back(axis_param("bias_tc_" + ax(i) + "_ug_per_c", i, true, mean_t * g, 1e3));
+  return gp;
+}
+
+}  // namespace
+
+std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
+  std::vector<ParamGroup> out;
+  const std::vector<int> moving = moving_axes(r);
+  if (moving.empty()) return out;
   const Eigen::MatrixXd a_drv = driven_acceleration(r);  // mm/s²
   const Eigen::MatrixXd a_um = a_drv * 1000.0;           // µm/s²
-  auto param = [](std::string name, int axis, bool accel, Eigen::VectorXd input, double prior) {
-    AxisParam p;
-    p.name = std::move(name), p.axis = axis, p.accel = accel, p.input = std::move(input), p.prior_sigma = prior;
-    return p;
-  };
-  {
-    ParamGroup gp{"scale", {}};
-    for (int j : moving) gp.params.push_back(param("scale_" + ax(j) + "_ppm", j, true, a_um.col(j) * 1e-6, 5e3));
-    out.push_back(gp);
-  }
-  {
-    ParamGroup gp{"cross_axis", {}};
-    for (int j : moving)
-      for (int i = 0; i < 3; ++i)
-        if (i != j) gp.params.push_back(param("E_" + ax(i) + ax(j) + "_ppm", i, true, a_um.col(j) * 1e-6, 2e4));
-    out.push_back(gp);
-  }
-  {
-    ParamGroup gp{"nonlinearity", {}};
-    for (int j : moving) {
-      const Eigen::VectorXd ag = a_drv.col(j) / (1000.0 * g);  // in g
-      const double sign =
-          r.owner[j] == 0 ? -1.0 : 1.0;  // the table sees −a: its square term changes sign in head − table
-      gp.params.push_back(param("k2_" + ax(j) + "_1e-6_per_g", j, true, sign * ag.array().square().matrix() * g, 1e4));
-      gp.params.push_back(param("k3_" + ax(j) + "_1e-6_per_g2", j, true, ag.array().cube().matrix() * g, 1e4));
-    }
-    out.push_back(gp);
-  }
-  {
-    // Against the set-point alone an axis' timing is its servo's (the base model's lag).
-    ParamGroup gp{"timing", {}};
-    for (int j : moving)
-      if (r.axis_reference[static_cast<std::size_t>(j)] != "cmd")
-        gp.params.push_back(param("timing_" + ax(j) + "_us", j, false, r.v_meas.col(j) * 1e-3, 300.0));
-    if (!gp.params.empty()) out.push_back(gp);
-  }
-  {
-    // ζ = ζ0 (1 + k |a|/g) (ch. 8.3.1): the PT2 drops (2ζ/ω0)·ȧ, so the extra damping
-    // drops −(2ζ0 k/(ω0 g))·|a|·ȧ = −(ζ0 k/(ω0 g))·d(a|a|)/dt of acceleration, i.e.
-    // −(ζ0 k/(ω0 g))·∫ a|a| dt of position — a plateau over a move's cruise that its
-    // deceleration takes back; on a circle, odd harmonics a constant 2ζ/ω0 does not have.
-    ParamGroup gp{"damping_amplitude", {}};
-    for (int j : moving) {
-      const dsp::SensorSpec& sp = r.meta.sensors[std::max(0, r.owner[j])];
-      const double k = -sp.zeta / (2.0 * kPi * sp.f0_hz * g) * 1e6;  // µm per (m²/s³) of ∫a|a|dt
-      Eigen::VectorXd col(r.n);
-      double acc = 0.0, prev = 0.0;
-      for (Eigen::Index s = 0; s < r.n; ++s) {
-        const double a = a_drv(s, j) / 1000.0, cur = a * std::abs(a);
-        if (s > 0) acc += 0.5 * (cur + prev) * (r.t_s[s] - r.t_s[s - 1]);
-        prev = cur, col[s] = k * acc;
-      }
-      gp.params.push_back(param("zeta_per_g_" + ax(j), j, false, col, 10.0));
-    }
-    out.push_back(gp);
-  }
-  {
-    // An axis whose Coriolis acceleration stays below 0.1 µg (1 µm/s²) has no say in it.
-    constexpr double kCoriolisFloorUmS2 = 1.0;
-    // The Earth rate is known: the group is the site's prediction (gain 1, held there),
-    // tested against the final model, not selected.
-    constexpr double kCoriolisGainSigma = 1e-3;
-    // Earth-rate Coriolis (3-6): the sensors measure 2ω×v on top of the motion; ω from the
-    // site, one gain per axis it reaches (1: the site's prediction).
-    const Eigen::Vector3d two_w = 2.0 * earth_rate_machine_radps(r.meta.site);
-    Eigen::MatrixXd acc_um(r.n, 3);
-    for (Eigen::Index s = 0; s < r.n; ++s)
-      acc_um.row(s) = two_w.cross(Eigen::Vector3d(r.v_meas.row(s).transpose())).transpose() * 1000.0;  // mm/s → µm/s²
-    ParamGroup gp{"coriolis", {}};
-    for (int i = 0; i < 3; ++i)
-      if (acc_um.col(i).cwiseAbs().maxCoeff() > kCoriolisFloorUmS2) {
-        AxisParam cp = param("coriolis_gain_" + ax(i), i, true, acc_um.col(i), kCoriolisGainSigma);
-        cp.prior_mean = 1.0;  // the site's Earth rate
-        gp.params.push_back(std::move(cp));
-      }
-    gp.known = true;
-    if (!gp.params.empty()) out.push_back(gp);
-  }
-  {
-    ParamGroup gp{"bias_drift", {}};
-    for (int i = 0; i < 3; ++i) gp.params.push_back(param("drift_" + ax(i) + "_ug_per_s", i, true, r.t_s * g, 100.0));
-    out.push_back(gp);
-  }
-  {
-    const double range = std::max(r.temp_c.col(0).cwiseAbs().maxCoeff(), r.temp_c.col(1).cwiseAbs().maxCoeff());
-    if (range > 0.02) {
-      ParamGroup gp{"scale_temperature", {}};
-      for (int j : moving)
-        gp.params.push_back(param("scale_tc_" + ax(j) + "_ppm_per_c", j, true,
-                                  r.temp_c.col(std::max(0, r.owner[j])).cwiseProduct(a_um.col(j)) * 1e-6, 1e4));
-      const Eigen::VectorXd mean_t = 0.5 * (r.temp_c.col(0) + r.temp_c.col(1));
-      for (int i = 0; i < 3; ++i)
-        gp.params.push_back(param("bias_tc_" + ax(i) + "_ug_per_c", i, true, mean_t * g, 1e3));
-      out.push_back(gp);
-    }
-  }
+  out.push_back(scale_group(moving, a_um));
+  out.push_back(cross_axis_group(moving, a_um));
+  out.push_back(nonlinearity_group(r, moving, a_drv));
+  if (ParamGroup gp = timing_group(r, moving); !gp.params.empty()) out.push_back(std::move(gp));
+  out.push_back(damping_amplitude_group(r, moving, a_drv));
+  if (ParamGroup gp = coriolis_group(r); !gp.params.empty()) out.push_back(std::move(gp));
+  out.push_back(bias_drift_group(r));
+  if (temperature_range_c(r) > 0.02) out.push_back(scale_temperature_group(r, moving, a_um));
   return out;
 }
 
 namespace {
+
 double largest_abs(const std::map<std::string, double>& v) {
   double m = 0.0;
   for (const auto& [k, x] : v) m = std::max(m, std::abs(x));
   return m;
 }
+
+Attribution attribution(const char* name, double mag, double tol, const char* unit, const char* reg) {
+  Attribution a;
+  a.name = name, a.magnitude = mag, a.tolerance = tol, a.unit = unit, a.regressor = reg;
+  return a;
+}
+
+// An effect sized by its largest parameter, the parameters as fitted.
+Attribution sized_by_largest(const char* name, double tol, const char* unit, const char* reg,
+                             const std::map<std::string, double>& v) {
+  Attribution a = attribution(name, largest_abs(v), tol, unit, reg);
+  a.params = v;
+  return a;
+}
+
+// Per sensor: the largest rotation (mrad), symmetric term (ppm) and tilt (mrad) of its
+// cross-axis terms, and whether it has a pair of moving axes.
+struct CrossAxisParts {
+  double rot_max[2] = {0.0, 0.0}, sym_max[2] = {0.0, 0.0}, tilt_max[2] = {0.0, 0.0};
+  bool has_pair[2] = {false, false};
+};
+
+// Each pair of a sensor's moving axes split into rotation (antisymmetric) and cross
+// coupling (symmetric); a moving axis' response on one that does not move is a tilt.
+CrossAxisParts split_cross_axis(const RunResiduals& r, const std::map<std::string, double>& v, Attribution& mis,
+                                Attribution& cross) {
+  CrossAxisParts parts;
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) {
+      if (i == j || !r.moving[j] || r.owner[j] < 0) continue;
+      const int s = r.owner[j];
+      const double eij = get(v, "E_" + ax(i) + ax(j) + "_ppm");
+      if (r.moving[i] && r.owner[i] == s) {
+        if (i < j) continue;
+        const double eji = get(v, "E_" + ax(j) + ax(i) + "_ppm");
+        const double rot = 0.5 * (eij - eji) / 1000.0, sym = 0.5 * (eij + eji);
+        mis.params["rotation_" + ax(j) + ax(i) + "_mrad"] = rot;
+        cross.params["cross_" + ax(j) + ax(i) + "_ppm"] = sym;
+        parts.rot_max[s] = std::max(parts.rot_max[s], std::abs(rot));
+        parts.sym_max[s] = std::max(parts.sym_max[s], std::abs(sym));
+        parts.has_pair[s] = true;
+      } else {
+        mis.params["tilt_" + ax(j) + "_into_" + ax(i) + "_mrad"] = eij / 1000.0;
+        parts.tilt_max[s] = std::max(parts.tilt_max[s], std::abs(eij) / 1000.0);
+      }
+    }
+  return parts;
+}
+
+// Two moving axes of one sensor: the antisymmetric part of their pair is a rotation of
+// the mounting, the symmetric part axes that are not square to each other or respond
+// across (cross coupling) — a rotation cannot make it. A sensor whose pairs show cross
+// coupling is named for it alone (a general cross-axis matrix explains the rotation
+// too), unless the rotation clearly dominates (3×); a moving axis' response on an axis
+// that does not move (a tilt) goes with what its sensor's pairs show, mounting when
+// the sensor has no pair (the two are one effect then, and the evidence says so).
+std::vector<Attribution> attribute_cross_axis(const RunResiduals& r, const std::map<std::string, double>& v) {
+  Attribution mis = attribution("sensor.misalignment", 0.0, 1.0, "mrad",
+                                "the other axes' doubly integrated acceleration, antisymmetric");
+  Attribution cross = attribution("sensor.cross_coupling", 0.0, 500.0, "ppm",
+                                  "the other axes' doubly integrated acceleration, symmetric");
+  const CrossAxisParts p = split_cross_axis(r, v, mis, cross);
+  for (int s = 0; s < 2; ++s) {
+    const bool crossed = p.has_pair[s] && p.sym_max[s] > cross.tolerance && p.rot_max[s] < 3.0 * p.sym_max[s] * 1e-3;
+    if (crossed) {
+      // Rotation and tilts are cross-axis terms of this sensor too: sized in ppm with it.
+      cross.magnitude = std::max({cross.magnitude, p.sym_max[s], p.rot_max[s] * 1000.0, p.tilt_max[s] * 1000.0});
+      mis.params[std::string("included_in_cross_coupling_") + (s == 0 ? "table" : "head")] = 1.0;
+    } else {
+      cross.magnitude = std::max(cross.magnitude, p.sym_max[s]);
+      mis.magnitude = std::max({mis.magnitude, p.rot_max[s], p.tilt_max[s]});
+    }
+  }
+  if (!p.has_pair[0] && !p.has_pair[1])
+    mis.regressor += " (one moving axis per sensor: mounting and cross coupling are one effect here)";
+  return {mis, cross};
+}
+
+// Per sensor the common shift (2ζ/ω0, or a delay); against the set-point only, what the
+// axes differ by is their position loops'.
+Attribution attribute_timing(const RunResiduals& r, const std::map<std::string, double>& v) {
+  Attribution dyn = attribution("sensor.dynamics", 0.0, 15.0, "us", "the velocity (2ζ/ω0 · v, (6-38))");
+  for (int s = 0; s < 2; ++s) {
+    double sum = 0.0;
+    int n = 0;
+    // Against the set-point alone the axis' servo lag is unknown: its timing says
+    // nothing about the sensor.
+    for (int j = 0; j < 3; ++j)
+      if (r.moving[j] && r.owner[j] == s && r.axis_reference[static_cast<std::size_t>(j)] != "cmd")
+        sum += get(v, "timing_" + ax(j) + "_us"), ++n;
+    if (n == 0) continue;
+    const double mean = sum / n;
+    dyn.params[std::string("damping_term_error_us_") + (s == 0 ? "table" : "head")] = mean;
+    dyn.magnitude = std::max(dyn.magnitude, std::abs(mean));
+  }
+  return dyn;
+}
+
+// The site's prediction, held at gain 1: its size is the peak Coriolis acceleration of
+// the motion. Within one move it acts like a bias; a run shows it where it changes sign
+// with the direction of motion — the filter's likelihood decides that, not its size.
+Attribution attribute_coriolis(const RunResiduals& r, const std::map<std::string, double>& v) {
+  const Eigen::Vector3d two_w = 2.0 * earth_rate_machine_radps(r.meta.site);
+  double peak_ug = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    if (v.find("coriolis_gain_" + ax(i)) == v.end()) continue;
+    for (Eigen::Index s2 = 0; s2 < r.n; ++s2)
+      peak_ug = std::max(peak_ug, std::abs(two_w.cross(Eigen::Vector3d(r.v_meas.row(s2).transpose()))[i]) * 1e-3 /
+                                      (r.meta.site.g_mps2 * 1e-6));
+  }
+  Attribution a =
+      attribution("site.coriolis", peak_ug, 1.0, "ug", "the Earth rate's 2ω×v of the motion (3-6), from the site");
+  a.params = v;
+  a.params["peak_ug"] = peak_ug;
+  return a;
+}
+
+Attribution attribute_scale_temperature(const RunResiduals& r, const std::map<std::string, double>& v) {
+  const double range = temperature_range_c(r);
+  double m = 0.0;
+  for (const auto& [k, x] : v) m = std::max(m, std::abs(x) * range * (k.rfind("bias", 0) == 0 ? 50.0 : 1.0));
+  Attribution a = attribution("sensor.scale_temperature", m, 50.0, "ppm over the run (1 ug as 50 ppm)",
+                              "the temperature change times the acceleration, and alone");
+  a.params = v;
+  a.params["temperature_change_c"] = range;
+  return a;
+}
+
 }  // namespace
 
 std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std::string& group,
                                                 const std::map<std::string, double>& v) {
-  std::vector<Attribution> out;
-  auto attr = [](const char* name, double mag, double tol, const char* unit, const char* reg) {
-    Attribution a;
-    a.name = name, a.magnitude = mag, a.tolerance = tol, a.unit = unit, a.regressor = reg;
-    return a;
-  };
-  if (group == "scale") {
-    const double m = largest_abs(v);
-    Attribution a = attr("sensor.scale", m, 1000.0, "ppm", "the doubly integrated acceleration along the axis");
-    a.params = v;
-    out.push_back(a);
-  } else if (group == "cross_axis") {
-    // Two moving axes of one sensor: the antisymmetric part of their pair is a rotation of
-    // the mounting, the symmetric part axes that are not square to each other or respond
-    // across (cross coupling) — a rotation cannot make it. A sensor whose pairs show cross
-    // coupling is named for it alone (a general cross-axis matrix explains the rotation
-    // too), unless the rotation clearly dominates (3×); a moving axis' response on an axis
-    // that does not move (a tilt) goes with what its sensor's pairs show, mounting when
-    // the sensor has no pair (the two are one effect then, and the evidence says so).
-    Attribution mis =
-        attr("sensor.misalignment", 0.0, 1.0, "mrad", "the other axes' doubly integrated acceleration, antisymmetric");
-    Attribution cross =
-        attr("sensor.cross_coupling", 0.0, 500.0, "ppm", "the other axes' doubly integrated acceleration, symmetric");
-    double rot_max[2] = {0.0, 0.0}, sym_max[2] = {0.0, 0.0}, tilt_max[2] = {0.0, 0.0};
-    bool has_pair[2] = {false, false};
-    for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) {
-        if (i == j || !r.moving[j] || r.owner[j] < 0) continue;
-        const int s = r.owner[j];
-        const double eij = get(v, "E_" + ax(i) + ax(j) + "_ppm");
-        if (r.moving[i] && r.owner[i] == s) {
-          if (i < j) continue;
-          const double eji = get(v, "E_" + ax(j) + ax(i) + "_ppm");
-          const double rot = 0.5 * (eij - eji) / 1000.0, sym = 0.5 * (eij + eji);
-          mis.params["rotation_" + ax(j) + ax(i) + "_mrad"] = rot;
-          cross.params["cross_" + ax(j) + ax(i) + "_ppm"] = sym;
-          rot_max[s] = std::max(rot_max[s], std::abs(rot)), sym_max[s] = std::max(sym_max[s], std::abs(sym));
-          has_pair[s] = true;
-        } else {
-          mis.params["tilt_" + ax(j) + "_into_" + ax(i) + "_mrad"] = eij / 1000.0;
-          tilt_max[s] = std::max(tilt_max[s], std::abs(eij) / 1000.0);
-        }
-      }
-    for (int s = 0; s < 2; ++s) {
-      const bool crossed = has_pair[s] && sym_max[s] > cross.tolerance && rot_max[s] < 3.0 * sym_max[s] * 1e-3;
-      if (crossed) {
-        // Rotation and tilts are cross-axis terms of this sensor too: sized in ppm with it.
-        cross.magnitude = std::max({cross.magnitude, sym_max[s], rot_max[s] * 1000.0, tilt_max[s] * 1000.0});
-        mis.params[std::string("included_in_cross_coupling_") + (s == 0 ? "table" : "head")] = 1.0;
-      } else {
-        cross.magnitude = std::max(cross.magnitude, sym_max[s]);
-        mis.magnitude = std::max({mis.magnitude, rot_max[s], tilt_max[s]});
-      }
-    }
-    if (!has_pair[0] && !has_pair[1])
-      mis.regressor += " (one moving axis per sensor: mounting and cross coupling are one effect here)";
-    out.push_back(mis), out.push_back(cross);
-  } else if (group == "nonlinearity") {
-    const double m = largest_abs(v);
-    Attribution a =
-        attr("sensor.nonlinearity", m, 200.0, "1e-6/g", "the doubly integrated square and cube of the acceleration");
-    a.params = v;
-    out.push_back(a);
-  } else if (group == "timing") {
-    // Per sensor the common shift (2ζ/ω0, or a delay); against the set-point only, what the
-    // axes differ by is their position loops'.
-    Attribution dyn = attr("sensor.dynamics", 0.0, 15.0, "us", "the velocity (2ζ/ω0 · v, (6-38))");
-    for (int s = 0; s < 2; ++s) {
-      double sum = 0.0;
-      int n = 0;
-      // Against the set-point alone the axis' servo lag is unknown: its timing says
-      // nothing about the sensor.
-      for (int j = 0; j < 3; ++j)
-        if (r.moving[j] && r.owner[j] == s && r.axis_reference[static_cast<std::size_t>(j)] != "cmd")
-          sum += get(v, "timing_" + ax(j) + "_us"), ++n;
-      if (n == 0) continue;
-      const double mean = sum / n;
-      dyn.params[std::string("damping_term_error_us_") + (s == 0 ? "table" : "head")] = mean;
-      dyn.magnitude = std::max(dyn.magnitude, std::abs(mean));
-    }
-    out.push_back(dyn);
-  } else if (group == "damping_amplitude") {
-    const double m = largest_abs(v);
-    Attribution a = attr("sensor.damping_amplitude", m, 0.2, "1/g",
-                         "the integral of a·|a| (damping growing with the acceleration)");
-    a.params = v;
-    out.push_back(a);
-  } else if (group == "coriolis") {
-    // The site's prediction, held at gain 1: its size is the peak Coriolis acceleration of
-    // the motion. Within one move it acts like a bias; a run shows it where it changes sign
-    // with the direction of motion — the filter's likelihood decides that, not its size.
-    const Eigen::Vector3d two_w = 2.0 * earth_rate_machine_radps(r.meta.site);
-    double peak_ug = 0.0;
-    for (int i = 0; i < 3; ++i) {
-      if (v.find("coriolis_gain_" + ax(i)) == v.end()) continue;
-      for (Eigen::Index s2 = 0; s2 < r.n; ++s2)
-        peak_ug = std::max(peak_ug, std::abs(two_w.cross(Eigen::Vector3d(r.v_meas.row(s2).transpose()))[i]) * 1e-3 /
-                                        (r.meta.site.g_mps2 * 1e-6));
-    }
-    Attribution a =
-        attr("site.coriolis", peak_ug, 1.0, "ug", "the Earth rate's 2ω×v of the motion (3-6), from the site");
-    a.params = v;
-    a.params["peak_ug"] = peak_ug;
-    out.push_back(a);
-  } else if (group == "bias_drift") {
-    const double m = largest_abs(v);
-    Attribution a = attr("sensor.bias_drift", m, 0.3, "ug/s", "the doubly integrated time (a linear bias drift)");
-    a.params = v;
-    out.push_back(a);
-  } else if (group == "scale_temperature") {
-    const double range = std::max(r.temp_c.col(0).cwiseAbs().maxCoeff(), r.temp_c.col(1).cwiseAbs().maxCoeff());
-    double m = 0.0;
-    for (const auto& [k, x] : v) m = std::max(m, std::abs(x) * range * (k.rfind("bias", 0) == 0 ? 50.0 : 1.0));
-    Attribution a = attr("sensor.scale_temperature", m, 50.0, "ppm over the run (1 ug as 50 ppm)",
-                         "the temperature change times the acceleration, and alone");
-    a.params = v;
-    a.params["temperature_change_c"] = range;
-    out.push_back(a);
-  }
-  return out;
+  if (group == "scale")
+    return {sized_by_largest("sensor.scale", 1000.0, "ppm", "the doubly integrated acceleration along the axis", v)};
+  if (group == "cross_axis") return attribute_cross_axis(r, v);
+  if (group == "nonlinearity")
+    return {sized_by_largest("sensor.nonlinearity", 200.0, "1e-6/g",
+                             "the doubly integrated square and cube of the acceleration", v)};
+  if (group == "timing") return {attribute_timing(r, v)};
+  if (group == "damping_amplitude")
+    return {sized_by_largest("sensor.damping_amplitude", 0.2, "1/g",
+                             "the integral of a·|a| (damping growing with the acceleration)", v)};
+  if (group == "coriolis") return {attribute_coriolis(r, v)};
+  if (group == "bias_drift")
+    return {sized_by_largest("sensor.bias_drift", 0.3, "ug/s", "the doubly integrated time (a linear bias drift)", v)};
+  if (group == "scale_temperature") return {attribute_scale_temperature(r, v)};
+  return {};
 }
+
+namespace {
+
+// Lost motion as a play operator on the commanded position: after a reversal the slide
+// stands while the command crosses the play, so near a circle's quadrant, where the
+// axis reverses slowly, the play is taken up over milliseconds, not in a step. The
+// play's width shapes the column; the fitted coefficient is its size.
+EffectModel backlash_effect(const RunResiduals& r, const Eigen::MatrixXd& hint, const std::vector<int>& moving,
+                            const std::vector<int> (&rev)[3]) {
+  EffectModel e = effect("machine.backlash");
+  for (int a : moving) {
+    if (rev[a].empty()) continue;
+    Eigen::VectorXd best;
+    double best_c = -1.0;
+    for (double play_um : {0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 15.0, 20.0, 30.0}) {
+      const Eigen::VectorXd col = play_operator_column(r.cmd.col(a), play_um);
+      const double c = hint_corr(hint, col, a);
+      if (c > best_c) best_c = c, best = col;
+    }
+    e.params.push_back("backlash_" + ax(a) + "_um"), e.columns.push_back(on_axis(best, a));
+  }
+  e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um",
+  e.regressor = "half the play against the direction of the last motion";
+  return e;
+}
+
+// Friction holds the slide as the axis reverses: the lag grows from zero like t²
+// (position and velocity continuous), peaks at tau with the given size, decays.
+Eigen::VectorXd reversal_spike_column(const RunResiduals& r, const Eigen::VectorXd& dir, const std::vector<int>& rev,
+                                      double tau_ms) {
+  const Eigen::Index n = r.n;
+  Eigen::VectorXd col = Eigen::VectorXd::Zero(n);
+  for (int s0 : rev) {
+    const double sign = -dir[s0];  // the slide lags behind its new direction
+    for (Eigen::Index s = s0; s < n; ++s) {
+      const double t = (r.t_s[s] - r.t_s[s0]) / (tau_ms * 1e-3);
+      if (t > 12.0) break;
+      col[s] += sign * t * t * std::exp(2.0 * (1.0 - t));
+    }
+  }
+  return col;
+}
+
+EffectModel reversal_spike_effect(const RunResiduals& r, const Eigen::MatrixXd& hint, const std::vector<int>& moving,
+                                  const Eigen::VectorXd (&dir)[3], const std::vector<int> (&rev)[3]) {
+  EffectModel e = effect("machine.reversal_spike");
+  for (int a : moving) {
+    if (rev[a].empty()) continue;
+    Eigen::VectorXd best;
+    double best_c = -1.0, best_tau = 0.0;
+    for (double tau_ms : {5.0, 8.0, 12.0, 16.0, 20.0, 25.0, 30.0, 40.0, 50.0}) {
+      Eigen::VectorXd col = reversal_spike_column(r, dir[a], rev[a], tau_ms);
+      const double c = hint_corr(hint, col, a);
+      if (c > best_c) best_c = c, best = col, best_tau = tau_ms;
+    }
+    e.params.push_back("spike_" + ax(a) + "_um_tau_" + std::to_string(static_cast<int>(best_tau)) + "ms");
+    e.columns.push_back(on_axis(best, a));
+  }
+  e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "a lag peaking tau after each reversal";
+  return e;
+}
+
+// The common lag is the base model's (machine_base_columns); this is what axes differ by.
+EffectModel servo_mismatch_effect(const std::vector<int>& moving, const LagColumns& lag) {
+  EffectModel e = effect("machine.servo_mismatch");
+  for (std::size_t i = 1; i < moving.size(); ++i) {
+    const int a = moving[i];
+    e.params.push_back("lag_" + ax(a) + "_minus_" + ax(moving[0]) + "_ms"),
+        e.columns.push_back(on_axis(lag.velocity.col(a), a));
+  }
+  e.magnitude = max_abs;
+  e.tolerance = 0.05, e.unit = "ms", e.regressor = "an axis' commanded velocity (lag) beyond the others'";
+  return e;
+}
+
+EffectModel scale_mismatch_effect(const RunResiduals& r, const std::vector<int>& moving) {
+  EffectModel e = effect("machine.scale_mismatch");
+  for (int a : moving)
+    e.params.push_back("scale_" + ax(a) + "_ppm"),
+        e.columns.push_back(on_axis((r.cmd.col(a).array() - r.cmd.col(a).mean()).matrix() * 1e-3, a));
+  e.magnitude = [](const Eigen::VectorXd& p) { return p.size() > 1 ? p.maxCoeff() - p.minCoeff() : std::abs(p[0]); };
+  e.tolerance = 10.0, e.unit = "ppm", e.regressor = "the commanded position along the axis";
+  return e;
+}
+
+EffectModel squareness_effect(const RunResiduals& r, const std::vector<int>& moving) {
+  const Eigen::Index n = r.n;
+  EffectModel e = effect("machine.squareness");
+  for (std::size_t p = 0; p < moving.size(); ++p)
+    for (std::size_t q = p + 1; q < moving.size(); ++q) {
+      const int i = moving[p], j = moving[q];
+      e.params.push_back("squareness_" + ax(i) + ax(j) + "_urad");
+      Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, 3);
+      c.col(i) = -0.5e-3 * (r.cmd.col(j).array() - r.cmd.col(j).mean()).matrix();
+      c.col(j) = -0.5e-3 * (r.cmd.col(i).array() - r.cmd.col(i).mean()).matrix();
+      e.columns.push_back(c);
+    }
+  e.magnitude = max_abs, e.tolerance = 10.0, e.unit = "urad",
+  e.regressor = "each axis' commanded position on the other";
+  return e;
+}
+
+// The ball-screw pitch (of a few standard ones, at most 2/3 of the travel) whose sine and
+// cosine the hint follows best; 0 when none fits in the travel.
+double cyclic_pitch_mm(const RunResiduals& r, const Eigen::MatrixXd& hint, int a) {
+  const double span = r.cmd.col(a).maxCoeff() - r.cmd.col(a).minCoeff();
+  double best_c = -1.0, best_p = 0.0;
+  for (double pitch : {1.0, 2.0, 2.5, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0}) {
+    if (pitch > span / 1.5) continue;
+    const Eigen::VectorXd sn = (2.0 * kPi * r.cmd.col(a).array() / pitch).sin().matrix();
+    const Eigen::VectorXd cs = (2.0 * kPi * r.cmd.col(a).array() / pitch).cos().matrix();
+    const double c = std::hypot(hint_corr(hint, sn, a), hint_corr(hint, cs, a));
+    if (c > best_c) best_c = c, best_p = pitch;
+  }
+  return best_p;
+}
+
+EffectModel cyclic_error_effect(const RunResiduals& r, const Eigen::MatrixXd& hint, const std::vector<int>& moving) {
+  EffectModel e = effect("machine.cyclic_error");
+  for (int a : moving) {
+    const double best_p = cyclic_pitch_mm(r, hint, a);
+    if (best_p <= 0.0) continue;
+    char name[64];
+    std::snprintf(name, sizeof name, "cyclic_%s_pitch_%gmm", kAxis[a], best_p);
+    e.params.push_back(std::string(name) + "_sin_um");
+    e.columns.push_back(on_axis((2.0 * kPi * r.cmd.col(a).array() / best_p).sin().matrix(), a));
+    e.params.push_back(std::string(name) + "_cos_um");
+    e.columns.push_back(on_axis((2.0 * kPi * r.cmd.col(a).array() / best_p).cos().matrix(), a));
+  }
+  e.magnitude = [](const Eigen::VectorXd& p) {
+    double m = 0.0;
+    for (Eigen::Index i = 0; i + 1 < p.size(); i += 2) m = std::max(m, std::hypot(p[i], p[i + 1]));
+    return m;
+  };
+  e.tolerance = 0.5, e.unit = "um", e.regressor = "a sine of the commanded position (ball-screw pitch)";
+  return e;
+}
+
+EffectModel straightness_effect(const RunResiduals& r, const std::vector<int>& moving) {
+  EffectModel e = effect("machine.straightness");
+  for (int i : moving) {
+    const double lo = r.cmd.col(i).minCoeff(), hi = r.cmd.col(i).maxCoeff();
+    if (hi - lo < 5.0) continue;
+    const Eigen::VectorXd u = ((2.0 * r.cmd.col(i).array() - lo - hi) / (hi - lo)).matrix();
+    Eigen::VectorXd bow = (1.0 - u.array().square()).matrix();
+    bow.array() -= bow.mean();
+    for (int j = 0; j < 3; ++j)
+      if (j != i) e.params.push_back("bow_of_" + ax(i) + "_in_" + ax(j) + "_um"), e.columns.push_back(on_axis(bow, j));
+  }
+  e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "a bow over the axis' travel, sideways";
+  return e;
+}
+
+// An effect with columns on this run joins the list.
+void add_if_any(std::vector<EffectModel>& out, EffectModel e) {
+  if (!e.params.empty()) out.push_back(std::move(e));
+}
+
+}  // namespace
 
 std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::MatrixXd& hint, const LagColumns& lag) {
   std::vector<EffectModel> out;
-  const Eigen::Index n = r.n;
-  std::vector<int> moving;
-  for (int a = 0; a < 3; ++a)
-    if (r.moving[a]) moving.push_back(a);
+  const std::vector<int> moving = moving_axes(r);
   if (moving.empty()) return out;
   Eigen::VectorXd dir[3];
   std::vector<int> rev[3];
   for (int a : moving) axis_directions(r, a, dir[a], rev[a]);
-  {
-    // Lost motion as a play operator on the commanded position: after a reversal the slide
-    // stands while the command crosses the play, so near a circle's quadrant, where the
-    // axis reverses slowly, the play is taken up over milliseconds, not in a step. The
-    // play's width shapes the column; the fitted coefficient is its size.
-    EffectModel e = effect("machine.backlash");
-    for (int a : moving) {
-      if (rev[a].empty()) continue;
-      Eigen::VectorXd best;
-      double best_c = -1.0;
-      for (double play_um : {0.5, 1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 11.0, 15.0, 20.0, 30.0}) {
-        const Eigen::VectorXd col = play_operator_column(r.cmd.col(a), play_um);
-        const double c = hint_corr(hint, col, a);
-        if (c > best_c) best_c = c, best = col;
-      }
-      e.params.push_back("backlash_" + ax(a) + "_um"), e.columns.push_back(on_axis(best, a));
-    }
-    e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um",
-    e.regressor = "half the play against the direction of the last motion";
-    if (!e.params.empty()) out.push_back(e);
-  }
-  {
-    EffectModel e = effect("machine.reversal_spike");
-    for (int a : moving) {
-      if (rev[a].empty()) continue;
-      Eigen::VectorXd best;
-      double best_c = -1.0, best_tau = 0.0;
-      for (double tau_ms : {5.0, 8.0, 12.0, 16.0, 20.0, 25.0, 30.0, 40.0, 50.0}) {
-        Eigen::VectorXd col = Eigen::VectorXd::Zero(n);
-        for (int s0 : rev[a]) {
-          const double sign = -dir[a][s0];  // the slide lags behind its new direction
-          // Friction holds the slide as the axis reverses: the lag grows from zero like t²
-          // (position and velocity continuous), peaks at tau with the given size, decays.
-          for (Eigen::Index s = s0; s < n; ++s) {
-            const double t = (r.t_s[s] - r.t_s[s0]) / (tau_ms * 1e-3);
-            if (t > 12.0) break;
-            col[s] += sign * t * t * std::exp(2.0 * (1.0 - t));
-          }
-        }
-        const double c = hint_corr(hint, col, a);
-        if (c > best_c) best_c = c, best = col, best_tau = tau_ms;
-      }
-      e.params.push_back("spike_" + ax(a) + "_um_tau_" + std::to_string(static_cast<int>(best_tau)) + "ms");
-      e.columns.push_back(on_axis(best, a));
-    }
-    e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "a lag peaking tau after each reversal";
-    if (!e.params.empty()) out.push_back(e);
-  }
-  if (moving.size() >= 2) {  // the common lag is the base model's (machine_base_columns); this is what axes differ by
-    EffectModel e = effect("machine.servo_mismatch");
-    for (std::size_t i = 1; i < moving.size(); ++i) {
-      const int a = moving[i];
-      e.params.push_back("lag_" + ax(a) + "_minus_" + ax(moving[0]) + "_ms"),
-          e.columns.push_back(on_axis(lag.velocity.col(a), a));
-    }
-    e.magnitude = max_abs;
-    e.tolerance = 0.05, e.unit = "ms", e.regressor = "an axis' commanded velocity (lag) beyond the others'";
-    out.push_back(e);
-  }
-  {
-    EffectModel e = effect("machine.scale_mismatch");
-    for (int a : moving)
-      e.params.push_back("scale_" + ax(a) + "_ppm"),
-          e.columns.push_back(on_axis((r.cmd.col(a).array() - r.cmd.col(a).mean()).matrix() * 1e-3, a));
-    e.magnitude = [](const Eigen::VectorXd& p) { return p.size() > 1 ? p.maxCoeff() - p.minCoeff() : std::abs(p[0]); };
-    e.tolerance = 10.0, e.unit = "ppm", e.regressor = "the commanded position along the axis";
-    out.push_back(e);
-  }
-  {
-    EffectModel e = effect("machine.squareness");
-    for (std::size_t p = 0; p < moving.size(); ++p)
-      for (std::size_t q = p + 1; q < moving.size(); ++q) {
-        const int i = moving[p], j = moving[q];
-        e.params.push_back("squareness_" + ax(i) + ax(j) + "_urad");
-        Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, 3);
-        c.col(i) = -0.5e-3 * (r.cmd.col(j).array() - r.cmd.col(j).mean()).matrix();
-        c.col(j) = -0.5e-3 * (r.cmd.col(i).array() - r.cmd.col(i).mean()).matrix();
-        e.columns.push_back(c);
-      }
-    e.magnitude = max_abs, e.tolerance = 10.0, e.unit = "urad",
-    e.regressor = "each axis' commanded position on the other";
-    if (!e.params.empty()) out.push_back(e);
-  }
-  {
-    EffectModel e = effect("machine.cyclic_error");
-    for (int a : moving) {
-      const double span = r.cmd.col(a).maxCoeff() - r.cmd.col(a).minCoeff();
-      double best_c = -1.0, best_p = 0.0;
-      for (double pitch : {1.0, 2.0, 2.5, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0}) {
-        if (pitch > span / 1.5) continue;
-        const Eigen::VectorXd sn = (2.0 * kPi * r.cmd.col(a).array() / pitch).sin().matrix();
-        const Eigen::VectorXd cs = (2.0 * kPi * r.cmd.col(a).array() / pitch).cos().matrix();
-        const double c = std::hypot(hint_corr(hint, sn, a), hint_corr(hint, cs, a));
-        if (c > best_c) best_c = c, best_p = pitch;
-      }
-      if (best_p <= 0.0) continue;
-      char name[64];
-      std::snprintf(name, sizeof name, "cyclic_%s_pitch_%gmm", kAxis[a], best_p);
-      e.params.push_back(std::string(name) + "_sin_um");
-      e.columns.push_back(on_axis((2.0 * kPi * r.cmd.col(a).array() / best_p).sin().matrix(), a));
-      e.params.push_back(std::string(name) + "_cos_um");
-      e.columns.push_back(on_axis((2.0 * kPi * r.cmd.col(a).array() / best_p).cos().matrix(), a));
-    }
-    e.magnitude = [](const Eigen::VectorXd& p) {
-      double m = 0.0;
-      for (Eigen::Index i = 0; i + 1 < p.size(); i += 2) m = std::max(m, std::hypot(p[i], p[i + 1]));
-      return m;
-    };
-    e.tolerance = 0.5, e.unit = "um", e.regressor = "a sine of the commanded position (ball-screw pitch)";
-    if (!e.params.empty()) out.push_back(e);
-  }
-  {
-    EffectModel e = effect("machine.straightness");
-    for (int i : moving) {
-      const double lo = r.cmd.col(i).minCoeff(), hi = r.cmd.col(i).maxCoeff();
-      if (hi - lo < 5.0) continue;
-      const Eigen::VectorXd u = ((2.0 * r.cmd.col(i).array() - lo - hi) / (hi - lo)).matrix();
-      Eigen::VectorXd bow = (1.0 - u.array().square()).matrix();
-      bow.array() -= bow.mean();
-      for (int j = 0; j < 3; ++j)
-        if (j != i)
-          e.params.push_back("bow_of_" + ax(i) + "_in_" + ax(j) + "_um"), e.columns.push_back(on_axis(bow, j));
-    }
-    e.magnitude = max_abs, e.tolerance = 1.0, e.unit = "um", e.regressor = "a bow over the axis' travel, sideways";
-    if (!e.params.empty()) out.push_back(e);
-  }
+  add_if_any(out, backlash_effect(r, hint, moving, rev));
+  add_if_any(out, reversal_spike_effect(r, hint, moving, dir, rev));
+  if (moving.size() >= 2) out.push_back(servo_mismatch_effect(moving, lag));
+  out.push_back(scale_mismatch_effect(r, moving));
+  add_if_any(out, squareness_effect(r, moving));
+  add_if_any(out, cyclic_error_effect(r, hint, moving));
+  add_if_any(out, straightness_effect(r, moving));
   return out;
 }
 
