@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace eical::dsp::model {
 namespace {
@@ -107,133 +108,207 @@ double integrated_autocorrelation_time(const Eigen::VectorXd& x, int max_lag) {
   return tau;
 }
 
-SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vector<Candidate>& candidates,
-                               const std::vector<bool>& heldout, const SelectionOptions& opt) {
-  const Eigen::Index n = residual.size();
-  if (static_cast<Eigen::Index>(heldout.size()) != n)
+namespace {
+
+// What the forward selection fits: the candidates, the split of the samples, the residual
+// on each set, and the effective count of the fitting set.
+struct SelectionData {
+  const std::vector<Candidate>& candidates;
+  Split s;
+  Eigen::VectorXd y_fit, y_chk;
+  double nf = 0.0, n_eff = 0.0;
+
+  // BIC = n_eff · ln(RSS/n) + p · ln(n_eff).
+  [[nodiscard]] double bic(double rss, Eigen::Index p) const {
+    return n_eff * std::log(std::max(rss, 1e-300) / nf) + static_cast<double>(p) * std::log(n_eff);
+  }
+};
+
+// The model accepted so far: its regressors (fitting rows, held-out rows, all rows), the
+// residuals it leaves on either set and its BIC.
+struct AcceptedModel {
+  Eigen::MatrixXd fit, chk, all;
+  Eigen::VectorXd cur_fit, cur_chk;
+  double cur_bic = 0.0;
+};
+
+void check_residual(const Eigen::VectorXd& residual, const std::vector<bool>& heldout) {
+  if (static_cast<Eigen::Index>(heldout.size()) != residual.size())
     throw InputError("effect selection: held-out mask size differs from the residual");
   if (!residual.allFinite()) throw InputError("effect selection: residual holds non-finite values");
+}
+
+Split split_samples(const std::vector<bool>& heldout) {
   Split s;
-  for (Eigen::Index i = 0; i < n; ++i) (heldout[static_cast<std::size_t>(i)] ? s.check : s.fit).push_back(i);
+  for (std::size_t i = 0; i < heldout.size(); ++i)
+    (heldout[i] ? s.check : s.fit).push_back(static_cast<Eigen::Index>(i));
   if (s.fit.size() < 10 || s.check.empty()) throw InputError("effect selection: need fitting and held-out samples");
+  return s;
+}
+
+void check_candidates(const std::vector<Candidate>& candidates, Eigen::Index n) {
   for (const auto& c : candidates) {
     if (c.regressors.rows() != n)
       throw InputError("effect selection: candidate '" + c.name + "' has the wrong number of rows");
     if (!c.regressors.allFinite())
       throw InputError("effect selection: candidate '" + c.name + "' has non-finite regressors");
   }
+}
 
-  const Eigen::VectorXd y_fit = rows(residual, s.fit), y_chk = rows(residual, s.check);
-  SelectionResult out;
-  out.rms_nominal = rms(y_fit);
-  out.heldout_rms_nominal = rms(y_chk);
-  const double nf = static_cast<double>(s.fit.size());
-  // The effective count is the noise's: the residual's autocorrelation once every
-  // candidate is fitted (a structured residual — the very effects to be found — is smooth
-  // and would count as a handful of samples, hiding them).
-  {
-    Eigen::MatrixXd all(static_cast<Eigen::Index>(s.fit.size()), 0);
-    for (const auto& c : candidates) all = hcat(all, rows(c.regressors, s.fit));
-    const Eigen::VectorXd noise = all.cols() > 0 && all.cols() < static_cast<Eigen::Index>(s.fit.size()) / 4
-                                      ? Eigen::VectorXd(y_fit - all * solve(all, y_fit))
-                                      : y_fit;
-    out.n_eff = nf / integrated_autocorrelation_time(noise);
-  }
+// The effective count is the noise's: the residual's autocorrelation once every
+// candidate is fitted (a structured residual — the very effects to be found — is smooth
+// and would count as a handful of samples, hiding them).
+double effective_count(const std::vector<Candidate>& candidates, const Split& s, const Eigen::VectorXd& y_fit) {
+  Eigen::MatrixXd all(static_cast<Eigen::Index>(s.fit.size()), 0);
+  for (const auto& c : candidates) all = hcat(all, rows(c.regressors, s.fit));
+  const Eigen::VectorXd noise = all.cols() > 0 && all.cols() < static_cast<Eigen::Index>(s.fit.size()) / 4
+                                    ? Eigen::VectorXd(y_fit - all * solve(all, y_fit))
+                                    : y_fit;
+  return static_cast<double>(s.fit.size()) / integrated_autocorrelation_time(noise);
+}
 
-  Eigen::MatrixXd accepted_fit(static_cast<Eigen::Index>(s.fit.size()), 0),
-      accepted_chk(static_cast<Eigen::Index>(s.check.size()), 0);
-  Eigen::MatrixXd accepted_all(n, 0);
-  std::vector<bool> done(candidates.size(), false);
-  auto bic = [&](double rss, Eigen::Index p) {
-    return out.n_eff * std::log(std::max(rss, 1e-300) / nf) + static_cast<double>(p) * std::log(out.n_eff);
-  };
-  Eigen::VectorXd cur_fit = y_fit, cur_chk = y_chk;
-  double cur_bic = bic(y_fit.squaredNorm(), 0);
+// |corr| of the residual with the candidate's best single regressor (fitting rows).
+double best_correlation(const Eigen::VectorXd& cur_fit, const Candidate& c, const Split& s) {
+  double r = 0.0;
+  for (Eigen::Index col = 0; col < c.regressors.cols(); ++col)
+    r = std::max(r, abs_corr(cur_fit, rows(Eigen::VectorXd(c.regressors.col(col)), s.fit)));
+  return r;
+}
 
-  for (int round = 0; round < opt.max_effects; ++round) {
-    int best = -1;
-    double best_drop = -kInf;
-    EffectVerdict best_v;
-    for (std::size_t k = 0; k < candidates.size(); ++k) {
-      if (done[k]) continue;
-      const Eigen::MatrixXd Af = hcat(accepted_fit, rows(candidates[k].regressors, s.fit));
-      const Eigen::MatrixXd Ac = hcat(accepted_chk, rows(candidates[k].regressors, s.check));
-      const Eigen::VectorXd x = solve(Af, y_fit);
-      const Eigen::VectorXd rf = y_fit - Af * x, rc = y_chk - Ac * x;
-      EffectVerdict v;
-      v.name = candidates[k].name;
-      v.bic_drop = cur_bic - bic(rf.squaredNorm(), Af.cols());
-      v.rms_before = rms(cur_fit), v.rms_after = rms(rf);
-      v.heldout_rms_before = rms(cur_chk), v.heldout_rms_after = rms(rc);
-      for (Eigen::Index c = 0; c < candidates[k].regressors.cols(); ++c)
-        v.correlation =
-            std::max(v.correlation, abs_corr(cur_fit, rows(Eigen::VectorXd(candidates[k].regressors.col(c)), s.fit)));
-      v.param_names = candidates[k].param_names;
-      v.params = x.tail(candidates[k].regressors.cols());
-      // Only an extension that also predicts the held-out data better may be taken.
-      const bool gain = v.heldout_rms_after < (1.0 - opt.min_heldout_gain) * v.heldout_rms_before;
-      if (gain && v.bic_drop > best_drop) best_drop = v.bic_drop, best = static_cast<int>(k), best_v = v;
-    }
-    if (best < 0 || best_v.bic_drop < opt.min_bic_drop) break;
-    best_v.significant = true;
-    done[static_cast<std::size_t>(best)] = true;
-    const auto& cand = candidates[static_cast<std::size_t>(best)];
-    accepted_fit = hcat(accepted_fit, rows(cand.regressors, s.fit));
-    accepted_chk = hcat(accepted_chk, rows(cand.regressors, s.check));
-    accepted_all = hcat(accepted_all, cand.regressors);
-    const Eigen::VectorXd x = solve(accepted_fit, y_fit);
-    cur_fit = y_fit - accepted_fit * x;
-    cur_chk = y_chk - accepted_chk * x;
-    cur_bic = bic(cur_fit.squaredNorm(), accepted_fit.cols());
-    out.effects.push_back(best_v);
-  }
-  // Parameters of the accepted effects from the final joint fit.
-  if (accepted_fit.cols() > 0) {
-    const Eigen::VectorXd x = solve(accepted_fit, y_fit);
-    // cov = (AᵀA)⁻¹ · RSS / n_eff: the residual's variance counted per independent sample.
-    const Eigen::MatrixXd ata = accepted_fit.transpose() * accepted_fit;
-    const Eigen::VectorXd var =
-        ata.completeOrthogonalDecomposition().pseudoInverse().diagonal() *
-        ((y_fit - accepted_fit * x).squaredNorm() / std::max(out.n_eff - static_cast<double>(x.size()), 1.0));
-    std::vector<int> fit_blocks;
-    if (!opt.block.empty())
-      for (Eigen::Index i : s.fit) fit_blocks.push_back(opt.block[static_cast<std::size_t>(i)]);
-    const Eigen::VectorXd jack = jackknife_sigma(accepted_fit, y_fit, fit_blocks);
-    Eigen::Index off = 0;
-    for (auto& e : out.effects) {
-      e.params = x.segment(off, static_cast<Eigen::Index>(e.param_names.size()));
-      e.param_sigma = var.segment(off, static_cast<Eigen::Index>(e.param_names.size()))
-                          .cwiseMax(0.0)
-                          .cwiseSqrt()
-                          .cwiseMax(jack.segment(off, static_cast<Eigen::Index>(e.param_names.size())));
-      off += static_cast<Eigen::Index>(e.param_names.size());
-    }
-    out.final_residual = residual - accepted_all * x;
-  } else {
-    out.final_residual = residual;
-  }
-  out.rms_final = rms(cur_fit);
-  out.heldout_rms_final = rms(cur_chk);
-  // The rejected candidates, tested once more against the final model, most telling first.
-  std::vector<EffectVerdict> rejected;
-  for (std::size_t k = 0; k < candidates.size(); ++k) {
+// A candidate added to the accepted model: what it gains on either set.
+EffectVerdict trial(const SelectionData& d, const AcceptedModel& m, const Candidate& c) {
+  const Eigen::MatrixXd Af = hcat(m.fit, rows(c.regressors, d.s.fit));
+  const Eigen::MatrixXd Ac = hcat(m.chk, rows(c.regressors, d.s.check));
+  const Eigen::VectorXd x = solve(Af, d.y_fit);
+  const Eigen::VectorXd rf = d.y_fit - Af * x, rc = d.y_chk - Ac * x;
+  EffectVerdict v;
+  v.name = c.name;
+  v.bic_drop = m.cur_bic - d.bic(rf.squaredNorm(), Af.cols());
+  v.rms_before = rms(m.cur_fit), v.rms_after = rms(rf);
+  v.heldout_rms_before = rms(m.cur_chk), v.heldout_rms_after = rms(rc);
+  v.correlation = best_correlation(m.cur_fit, c, d.s);
+  v.param_names = c.param_names;
+  v.params = x.tail(c.regressors.cols());
+  return v;
+}
+
+// The candidate with the largest BIC drop among those that also predict the held-out data
+// better (-1: none).
+int best_candidate(const SelectionData& d, const AcceptedModel& m, const std::vector<bool>& done,
+                   const SelectionOptions& opt, EffectVerdict& best_v) {
+  int best = -1;
+  double best_drop = -kInf;
+  for (std::size_t k = 0; k < d.candidates.size(); ++k) {
     if (done[k]) continue;
-    const Eigen::MatrixXd Af = hcat(accepted_fit, rows(candidates[k].regressors, s.fit));
-    const Eigen::MatrixXd Ac = hcat(accepted_chk, rows(candidates[k].regressors, s.check));
-    const Eigen::VectorXd x = solve(Af, y_fit);
+    EffectVerdict v = trial(d, m, d.candidates[k]);
+    // Only an extension that also predicts the held-out data better may be taken.
+    const bool gain = v.heldout_rms_after < (1.0 - opt.min_heldout_gain) * v.heldout_rms_before;
+    if (gain && v.bic_drop > best_drop) best_drop = v.bic_drop, best = static_cast<int>(k), best_v = v;
+  }
+  return best;
+}
+
+// The candidate into the model, which is refitted.
+void accept(const SelectionData& d, const Candidate& cand, AcceptedModel& m) {
+  m.fit = hcat(m.fit, rows(cand.regressors, d.s.fit));
+  m.chk = hcat(m.chk, rows(cand.regressors, d.s.check));
+  m.all = hcat(m.all, cand.regressors);
+  const Eigen::VectorXd x = solve(m.fit, d.y_fit);
+  m.cur_fit = d.y_fit - m.fit * x;
+  m.cur_chk = d.y_chk - m.chk * x;
+  m.cur_bic = d.bic(m.cur_fit.squaredNorm(), m.fit.cols());
+}
+
+// Parameters of the accepted effects from the final joint fit, with their standard errors;
+// the residual of all samples after them.
+void joint_parameters(const SelectionData& d, const AcceptedModel& m, const Eigen::VectorXd& residual,
+                      const SelectionOptions& opt, SelectionResult& out) {
+  if (m.fit.cols() == 0) {
+    out.final_residual = residual;
+    return;
+  }
+  const Eigen::VectorXd x = solve(m.fit, d.y_fit);
+  // cov = (AᵀA)⁻¹ · RSS / n_eff: the residual's variance counted per independent sample.
+  const Eigen::MatrixXd ata = m.fit.transpose() * m.fit;
+  const Eigen::VectorXd var =
+      ata.completeOrthogonalDecomposition().pseudoInverse().diagonal() *
+      ((d.y_fit - m.fit * x).squaredNorm() / std::max(out.n_eff - static_cast<double>(x.size()), 1.0));
+  std::vector<int> fit_blocks;
+  if (!opt.block.empty())
+    for (Eigen::Index i : d.s.fit) fit_blocks.push_back(opt.block[static_cast<std::size_t>(i)]);
+  const Eigen::VectorXd jack = jackknife_sigma(m.fit, d.y_fit, fit_blocks);
+  Eigen::Index off = 0;
+  for (auto& e : out.effects) {
+    e.params = x.segment(off, static_cast<Eigen::Index>(e.param_names.size()));
+    e.param_sigma = var.segment(off, static_cast<Eigen::Index>(e.param_names.size()))
+                        .cwiseMax(0.0)
+                        .cwiseSqrt()
+                        .cwiseMax(jack.segment(off, static_cast<Eigen::Index>(e.param_names.size())));
+    off += static_cast<Eigen::Index>(e.param_names.size());
+  }
+  out.final_residual = residual - m.all * x;
+}
+
+// The rejected candidates, tested once more against the final model, most telling first.
+std::vector<EffectVerdict> rejected_verdicts(const SelectionData& d, const AcceptedModel& m,
+                                             const std::vector<bool>& done) {
+  std::vector<EffectVerdict> rejected;
+  for (std::size_t k = 0; k < d.candidates.size(); ++k) {
+    if (done[k]) continue;
+    const Candidate& c = d.candidates[k];
+    const Eigen::MatrixXd Af = hcat(m.fit, rows(c.regressors, d.s.fit));
+    const Eigen::MatrixXd Ac = hcat(m.chk, rows(c.regressors, d.s.check));
+    const Eigen::VectorXd x = solve(Af, d.y_fit);
     EffectVerdict v;
-    v.name = candidates[k].name;
-    v.bic_drop = cur_bic - bic((y_fit - Af * x).squaredNorm(), Af.cols());
-    v.rms_before = rms(cur_fit), v.rms_after = rms(y_fit - Af * x);
-    v.heldout_rms_before = rms(cur_chk), v.heldout_rms_after = rms(y_chk - Ac * x);
-    v.param_names = candidates[k].param_names;
-    v.params = x.tail(candidates[k].regressors.cols());
-    for (Eigen::Index c = 0; c < candidates[k].regressors.cols(); ++c)
-      v.correlation =
-          std::max(v.correlation, abs_corr(cur_fit, rows(Eigen::VectorXd(candidates[k].regressors.col(c)), s.fit)));
+    v.name = c.name;
+    v.bic_drop = m.cur_bic - d.bic((d.y_fit - Af * x).squaredNorm(), Af.cols());
+    v.rms_before = rms(m.cur_fit), v.rms_after = rms(d.y_fit - Af * x);
+    v.heldout_rms_before = rms(m.cur_chk), v.heldout_rms_after = rms(d.y_chk - Ac * x);
+    v.param_names = c.param_names;
+    v.params = x.tail(c.regressors.cols());
+    v.correlation = best_correlation(m.cur_fit, c, d.s);
     rejected.push_back(v);
   }
   std::sort(rejected.begin(), rejected.end(), [](const auto& a, const auto& b) { return a.bic_drop > b.bic_drop; });
+  return rejected;
+}
+
+}  // namespace
+
+SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vector<Candidate>& candidates,
+                               const std::vector<bool>& heldout, const SelectionOptions& opt) {
+  const Eigen::Index n = residual.size();
+  check_residual(residual, heldout);
+  Split s = split_samples(heldout);
+  check_candidates(candidates, n);
+  Eigen::VectorXd y_fit = rows(residual, s.fit), y_chk = rows(residual, s.check);
+  const double nf = static_cast<double>(s.fit.size()), n_eff = effective_count(candidates, s, y_fit);
+  const SelectionData d{candidates, std::move(s), std::move(y_fit), std::move(y_chk), nf, n_eff};
+  SelectionResult out;
+  out.rms_nominal = rms(d.y_fit);
+  out.heldout_rms_nominal = rms(d.y_chk);
+  out.n_eff = d.n_eff;
+
+  AcceptedModel m{.fit = Eigen::MatrixXd(static_cast<Eigen::Index>(d.s.fit.size()), 0),
+                  .chk = Eigen::MatrixXd(static_cast<Eigen::Index>(d.s.check.size()), 0),
+                  .all = Eigen::MatrixXd(n, 0),
+                  .cur_fit = d.y_fit,
+                  .cur_chk = d.y_chk,
+                  .cur_bic = d.bic(d.y_fit.squaredNorm(), 0)};
+  std::vector<bool> done(candidates.size(), false);
+  for (int round = 0; round < opt.max_effects; ++round) {
+    EffectVerdict best_v;
+    const int best = best_candidate(d, m, done, opt, best_v);
+    if (best < 0 || best_v.bic_drop < opt.min_bic_drop) break;
+    best_v.significant = true;
+    done[static_cast<std::size_t>(best)] = true;
+    accept(d, candidates[static_cast<std::size_t>(best)], m);
+    out.effects.push_back(best_v);
+  }
+  joint_parameters(d, m, residual, opt, out);
+  out.rms_final = rms(m.cur_fit);
+  out.heldout_rms_final = rms(m.cur_chk);
+  const std::vector<EffectVerdict> rejected = rejected_verdicts(d, m, done);
   out.effects.insert(out.effects.end(), rejected.begin(), rejected.end());
   return out;
 }
