@@ -107,104 +107,150 @@ LagFit fit_lag(const Eigen::MatrixXd& y, const Eigen::VectorXd& x, int max_k, Ei
   return f;
 }
 
-}  // namespace
+// The band-limited signals compared (smoothed: measured y, commanded x) and the rows
+// [from, to) clear of the filter's edges and the lag search.
+struct BandSignals {
+  Eigen::MatrixXd y, x;
+  int len = 1, max_k = 1;  // the filter's length, the largest lag searched (samples)
+  Eigen::Index from = 0, to = 0;
+};
 
-AccelerationComparison compare_accelerations(const RunResiduals& rr, double cutoff_hz, double max_lag_s) {
-  AccelerationComparison c;
-  const Eigen::Index n = rr.n;
-  if (n < 200 || !(rr.dt_s > 0.0)) {
-    c.why = "too few samples to compare accelerations";
-    return c;
-  }
-  const double fs = 1.0 / rr.dt_s;
-  c.cutoff_hz = std::min(cutoff_hz, 0.1 * fs);
-  const int len = std::max(1, static_cast<int>(std::lround(fs / c.cutoff_hz)));
-  const Eigen::MatrixXd y = smooth(rr.a_meas, len), x = smooth(rr.a_cmd, len);
-  const int max_k = std::max(1, static_cast<int>(std::lround(max_lag_s * fs)));
-  const Eigen::Index from = 2 * len + max_k, to = n - 2 * len - max_k;
-  if (to - from < 100) {
-    c.why = "the run is too short for the band below " + std::to_string(c.cutoff_hz) + " Hz";
-    return c;
-  }
-  // Inputs: commanded axes with acceleration in the band.
+BandSignals band_signals(const RunResiduals& rr, double fs, double cutoff_hz, double max_lag_s) {
+  BandSignals b;
+  b.len = std::max(1, static_cast<int>(std::lround(fs / cutoff_hz)));
+  b.y = smooth(rr.a_meas, b.len), b.x = smooth(rr.a_cmd, b.len);
+  b.max_k = std::max(1, static_cast<int>(std::lround(max_lag_s * fs)));
+  b.from = 2 * b.len + b.max_k, b.to = rr.n - 2 * b.len - b.max_k;
+  return b;
+}
+
+// Inputs: commanded axes with acceleration in the band (into c.input). Returns the
+// dominant one (-1: not even that one is an input).
+int band_inputs(const BandSignals& b, AccelerationComparison& c) {
   Eigen::Vector3d rms = Eigen::Vector3d::Zero();
   for (int i = 0; i < 3; ++i)
-    rms[i] = std::sqrt(x.col(i).segment(from, to - from).squaredNorm() / static_cast<double>(to - from));
+    rms[i] = std::sqrt(b.x.col(i).segment(b.from, b.to - b.from).squaredNorm() / static_cast<double>(b.to - b.from));
   const double top = rms.maxCoeff();
   int dominant = 0;
   for (int i = 0; i < 3; ++i) {
     c.input[static_cast<std::size_t>(i)] = rms[i] > 0.05 * top && rms[i] > 1.0;  // 1 mm/s² ≈ 0.1 mg
     if (rms[i] > rms[dominant]) dominant = i;
   }
-  if (!c.input[static_cast<std::size_t>(dominant)]) {
-    c.why = "no commanded acceleration below " + std::to_string(c.cutoff_hz) + " Hz";
-    return c;
-  }
-  // Jackknife blocks: a second or four filter lengths, at most 40.
-  const Eigen::Index rows = to - from;
-  const Eigen::Index block_len = std::max<Eigen::Index>({static_cast<Eigen::Index>(fs), 4 * len, rows / 40});
+  return c.input[static_cast<std::size_t>(dominant)] ? dominant : -1;
+}
+
+// Jackknife blocks: a second or four filter lengths, at most 40 (their count into
+// c.blocks). Each row's block.
+std::vector<Eigen::Index> jackknife_blocks(const BandSignals& b, double fs, AccelerationComparison& c) {
+  const Eigen::Index rows = b.to - b.from;
+  const Eigen::Index block_len = std::max<Eigen::Index>({static_cast<Eigen::Index>(fs), 4 * b.len, rows / 40});
   c.blocks = static_cast<int>(rows / block_len);
   std::vector<Eigen::Index> block_of(static_cast<std::size_t>(rows));
   for (Eigen::Index i = 0; i < rows; ++i)
     block_of[static_cast<std::size_t>(i)] = std::min<Eigen::Index>(i / block_len, std::max(0, c.blocks - 1));
+  return block_of;
+}
+
+// a_meas,j = Σ_i G_ji a_cmd,i(t − τ) + b_j: the normal equations per block, the regressors
+// the input columns of xs (the shifted commanded acceleration) and one.
+struct BlockNormals {
+  int p = 0;  // regressors
+  std::vector<Eigen::MatrixXd> xtx, xty;
+};
+
+BlockNormals block_normals(const BandSignals& b, const Eigen::MatrixXd& xs, const std::vector<int>& cols,
+                           const std::vector<Eigen::Index>& block_of, int blocks) {
+  const int p = static_cast<int>(cols.size()) + 1;
+  BlockNormals bn{p, std::vector<Eigen::MatrixXd>(static_cast<std::size_t>(blocks), Eigen::MatrixXd::Zero(p, p)),
+                  std::vector<Eigen::MatrixXd>(static_cast<std::size_t>(blocks), Eigen::MatrixXd::Zero(p, 3))};
+  Eigen::VectorXd r(p);
+  for (Eigen::Index i = b.from; i < b.to; ++i) {
+    for (int k = 0; k + 1 < p; ++k) r[k] = xs(i, cols[static_cast<std::size_t>(k)]);
+    r[p - 1] = 1.0;
+    const auto blk = static_cast<std::size_t>(block_of[static_cast<std::size_t>(i - b.from)]);
+    bn.xtx[blk].noalias() += r * r.transpose();
+    bn.xty[blk].noalias() += r * b.y.row(i);
+  }
+  return bn;
+}
+
+// p × 3: coefficient per regressor, per measured axis, from every block but `skip`.
+Eigen::MatrixXd solve_without(const BlockNormals& bn, int skip) {
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(bn.p, bn.p), bm = Eigen::MatrixXd::Zero(bn.p, 3);
+  for (std::size_t blk = 0; blk < bn.xtx.size(); ++blk)
+    if (static_cast<int>(blk) != skip) a += bn.xtx[blk], bm += bn.xty[blk];
+  return Eigen::MatrixXd(a.ldlt().solve(bm));
+}
+
+// The gains' and the bias' block-jackknife standard errors.
+void gain_jackknife_sigma(const BlockNormals& bn, const std::vector<int>& cols, AccelerationComparison& c) {
+  const int blocks = static_cast<int>(bn.xtx.size()), p = bn.p;
+  Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(p, 3), sq = Eigen::MatrixXd::Zero(p, 3);
+  for (int b = 0; b < blocks; ++b) {
+    const Eigen::MatrixXd bj = solve_without(bn, b);
+    mean += bj, sq += bj.cwiseProduct(bj);
+  }
+  mean /= blocks, sq /= blocks;
+  const Eigen::MatrixXd var = ((sq - mean.cwiseProduct(mean)) * static_cast<double>(blocks - 1)).cwiseMax(0.0);
+  for (std::size_t k = 0; k < cols.size(); ++k)
+    c.gain_sigma.col(cols[k]) = var.row(static_cast<Eigen::Index>(k)).transpose().cwiseSqrt();
+  c.bias_sigma_mm_s2 = var.row(p - 1).transpose().cwiseSqrt();
+}
+
+// How much of the measured band-limited acceleration the comparison accounts for.
+double explained_fraction(const BandSignals& b, const Eigen::MatrixXd& xs, const std::vector<int>& cols,
+                          const AccelerationComparison& c) {
+  double rss = 0.0, tss = 0.0;
+  for (int j = 0; j < 3; ++j) {
+    const double mean = b.y.col(j).segment(b.from, b.to - b.from).mean();
+    for (Eigen::Index i = b.from; i < b.to; ++i) {
+      double pred = c.bias_mm_s2[j];
+      for (int col : cols) pred += c.gain(j, col) * xs(i, col);
+      rss += (b.y(i, j) - pred) * (b.y(i, j) - pred), tss += (b.y(i, j) - mean) * (b.y(i, j) - mean);
+    }
+  }
+  return tss > 0.0 ? 1.0 - rss / tss : 0.0;
+}
+
+}  // namespace
+
+AccelerationComparison compare_accelerations(const RunResiduals& rr, double cutoff_hz, double max_lag_s) {
+  AccelerationComparison c;
+  if (rr.n < 200 || !(rr.dt_s > 0.0)) {
+    c.why = "too few samples to compare accelerations";
+    return c;
+  }
+  const double fs = 1.0 / rr.dt_s;
+  c.cutoff_hz = std::min(cutoff_hz, 0.1 * fs);
+  const BandSignals b = band_signals(rr, fs, c.cutoff_hz, max_lag_s);
+  if (b.to - b.from < 100) {
+    c.why = "the run is too short for the band below " + std::to_string(c.cutoff_hz) + " Hz";
+    return c;
+  }
+  const int dominant = band_inputs(b, c);
+  if (dominant < 0) {
+    c.why = "no commanded acceleration below " + std::to_string(c.cutoff_hz) + " Hz";
+    return c;
+  }
+  const std::vector<Eigen::Index> block_of = jackknife_blocks(b, fs, c);
   const int blocks = std::max(1, c.blocks);
-
-  const LagFit lf = fit_lag(y, x.col(dominant), max_k, from, to, block_of, blocks);
+  const LagFit lf = fit_lag(b.y, b.x.col(dominant), b.max_k, b.from, b.to, block_of, blocks);
   c.lag_s = lf.lag * rr.dt_s, c.lag_sigma_s = lf.sigma * rr.dt_s;
-  const Eigen::MatrixXd xs = shifted(x, lf.lag);
-
-  // a_meas,j = Σ_i G_ji a_cmd,i(t − τ) + b_j, the normal equations per block.
+  const Eigen::MatrixXd xs = shifted(b.x, lf.lag);
   std::vector<int> cols;
   for (int i = 0; i < 3; ++i)
     if (c.input[static_cast<std::size_t>(i)]) cols.push_back(i);
-  const int p = static_cast<int>(cols.size()) + 1;
-  std::vector<Eigen::MatrixXd> xtx(static_cast<std::size_t>(blocks), Eigen::MatrixXd::Zero(p, p));
-  std::vector<Eigen::MatrixXd> xty(static_cast<std::size_t>(blocks), Eigen::MatrixXd::Zero(p, 3));
-  Eigen::VectorXd r(p);
-  for (Eigen::Index i = from; i < to; ++i) {
-    for (int k = 0; k + 1 < p; ++k) r[k] = xs(i, cols[static_cast<std::size_t>(k)]);
-    r[p - 1] = 1.0;
-    const auto b = static_cast<std::size_t>(block_of[static_cast<std::size_t>(i - from)]);
-    xtx[b].noalias() += r * r.transpose();
-    xty[b].noalias() += r * y.row(i);
-  }
-  auto solve = [&](int skip) {
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(p, p), bm = Eigen::MatrixXd::Zero(p, 3);
-    for (int b = 0; b < blocks; ++b)
-      if (b != skip) a += xtx[static_cast<std::size_t>(b)], bm += xty[static_cast<std::size_t>(b)];
-    return Eigen::MatrixXd(a.ldlt().solve(bm));  // p × 3: coefficient per regressor, per measured axis
-  };
-  const Eigen::MatrixXd beta = solve(-1);
+  const BlockNormals bn = block_normals(b, xs, cols, block_of, blocks);
+  const Eigen::MatrixXd beta = solve_without(bn, -1);
   if (!beta.allFinite()) {
     c.why = "the commanded axes' accelerations are not independent in the band";
     return c;
   }
   for (std::size_t k = 0; k < cols.size(); ++k)
     c.gain.col(cols[k]) = beta.row(static_cast<Eigen::Index>(k)).transpose();
-  c.bias_mm_s2 = beta.row(p - 1).transpose();
-  if (blocks >= 4) {
-    Eigen::MatrixXd mean = Eigen::MatrixXd::Zero(p, 3), sq = Eigen::MatrixXd::Zero(p, 3);
-    for (int b = 0; b < blocks; ++b) {
-      const Eigen::MatrixXd bj = solve(b);
-      mean += bj, sq += bj.cwiseProduct(bj);
-    }
-    mean /= blocks, sq /= blocks;
-    const Eigen::MatrixXd var = ((sq - mean.cwiseProduct(mean)) * static_cast<double>(blocks - 1)).cwiseMax(0.0);
-    for (std::size_t k = 0; k < cols.size(); ++k)
-      c.gain_sigma.col(cols[k]) = var.row(static_cast<Eigen::Index>(k)).transpose().cwiseSqrt();
-    c.bias_sigma_mm_s2 = var.row(p - 1).transpose().cwiseSqrt();
-  }
-  // How much of the measured band-limited acceleration the comparison accounts for.
-  double rss = 0.0, tss = 0.0;
-  for (int j = 0; j < 3; ++j) {
-    const double mean = y.col(j).segment(from, rows).mean();
-    for (Eigen::Index i = from; i < to; ++i) {
-      double pred = c.bias_mm_s2[j];
-      for (int col : cols) pred += c.gain(j, col) * xs(i, col);
-      rss += (y(i, j) - pred) * (y(i, j) - pred), tss += (y(i, j) - mean) * (y(i, j) - mean);
-    }
-  }
-  c.explained_fraction = tss > 0.0 ? 1.0 - rss / tss : 0.0;
+  c.bias_mm_s2 = beta.row(bn.p - 1).transpose();
+  if (blocks >= 4) gain_jackknife_sigma(bn, cols, c);
+  c.explained_fraction = explained_fraction(b, xs, cols, c);
   c.valid = true;
   return c;
 }
