@@ -77,19 +77,27 @@ Eigen::VectorXd without_all(const Eigen::VectorXd& y, const std::vector<Candidat
   return y - x * x.colPivHouseholderQr().solve(y);
 }
 
-ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const std::vector<EffectModel>& catalog,
-                              const LagColumns& lag, const ExplainOptions& o) {
-  ChannelResult out;
-  const Eigen::Index rows = ch.rows();
+// The base model's columns projected out (an orthonormal basis of them).
+struct BaseProjection {
+  Eigen::MatrixXd q;
+
+  [[nodiscard]] Eigen::MatrixXd operator()(const Eigen::MatrixXd& m) const {
+    return Eigen::MatrixXd(m - q * (q.transpose() * m));
+  }
+};
+
+BaseProjection base_projection(const RunResiduals& rr, const Channel& ch, const LagColumns& lag) {
   const Eigen::MatrixXd nu = base_columns(rr, ch, lag);
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(nu);
-  const Eigen::MatrixXd q = qr.householderQ() * Eigen::MatrixXd::Identity(rows, nu.cols());
-  auto project = [&](const Eigen::MatrixXd& m) { return Eigen::MatrixXd(m - q * (q.transpose() * m)); };
-  const Eigen::VectorXd w = ch.sigma_um.cwiseInverse();
-  const Eigen::VectorXd y = project(ch.residual_um.cwiseProduct(w));
+  return {qr.householderQ() * Eigen::MatrixXd::Identity(ch.rows(), nu.cols())};
+}
 
+// The catalogue's effects with a footprint on this channel, as weighted candidates with the
+// base model projected out; `models[k]` is candidate k's effect.
+std::vector<Candidate> channel_candidates(const Channel& ch, const std::vector<EffectModel>& catalog,
+                                          const BaseProjection& project, const Eigen::VectorXd& w,
+                                          const Eigen::VectorXd& y, std::vector<const EffectModel*>& models) {
   std::vector<Candidate> cands;
-  std::vector<const EffectModel*> models;
   for (const auto& e : catalog) {
     const Eigen::MatrixXd c = columns_on(e, ch);
     if (c.cwiseAbs().maxCoeff() <= 0.0) continue;  // nothing of it on this channel's axes
@@ -102,7 +110,7 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
       if (cand.regressors.col(p).norm() > 1e-12 * (1.0 + y.norm())) keep.push_back(p);
     if (keep.empty()) continue;
     if (static_cast<Eigen::Index>(keep.size()) < c.cols()) {
-      Eigen::MatrixXd r(rows, static_cast<Eigen::Index>(keep.size()));
+      Eigen::MatrixXd r(ch.rows(), static_cast<Eigen::Index>(keep.size()));
       for (std::size_t k = 0; k < keep.size(); ++k) r.col(static_cast<Eigen::Index>(k)) = cand.regressors.col(keep[k]);
       cand.regressors = r;
     }
@@ -110,6 +118,87 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
     cands.push_back(std::move(cand));
     models.push_back(&e);
   }
+  return cands;
+}
+
+// The selection's options: the explain options' thresholds, jackknife blocks of
+// kJackknifeBlockS by the rows' time.
+SelectionOptions channel_selection_options(const RunResiduals& rr, const Channel& ch, const ExplainOptions& o) {
+  SelectionOptions so;
+  so.min_bic_drop = o.min_bic_drop, so.min_heldout_gain = o.min_heldout_gain, so.max_effects = 10;
+  so.block.resize(static_cast<std::size_t>(ch.rows()));
+  for (Eigen::Index i = 0; i < ch.rows(); ++i)
+    so.block[static_cast<std::size_t>(i)] =
+        static_cast<int>(rr.t_s[ch.sample[static_cast<std::size_t>(i)]] / kJackknifeBlockS);
+  return so;
+}
+
+// RMS over the fitting (held false) or the held-out rows.
+double split_rms(const Eigen::VectorXd& v, const std::vector<bool>& heldout, bool held) {
+  double s = 0.0;
+  std::size_t n = 0;
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (heldout[static_cast<std::size_t>(i)] == held) s += v[i] * v[i], ++n;
+  return n ? std::sqrt(s / static_cast<double>(n)) : 0.0;
+}
+
+// The selected parameters on the effect's full parameter list (the others zero), and the
+// same moved 2σ towards zero: the size outside the tolerance with confidence.
+void full_parameters(const EffectVerdict& v, const EffectModel& e, Eigen::VectorXd& full, Eigen::VectorXd& sure) {
+  full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(e.params.size()));
+  for (std::size_t p = 0; p < v.param_names.size(); ++p)
+    for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
+      if (e.params[q2] == v.param_names[p])
+        full[static_cast<Eigen::Index>(q2)] = v.params[static_cast<Eigen::Index>(p)];
+  sure = full;
+  for (std::size_t p = 0; p < v.param_names.size() && static_cast<Eigen::Index>(p) < v.param_sigma.size(); ++p)
+    for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
+      if (e.params[q2] == v.param_names[p]) {
+        const double a = full[static_cast<Eigen::Index>(q2)], s2 = 2.0 * v.param_sigma[static_cast<Eigen::Index>(p)];
+        sure[static_cast<Eigen::Index>(q2)] = std::abs(a) > s2 ? a - std::copysign(s2, a) : 0.0;
+      }
+}
+
+// One verdict of the selection as an explained effect: its size against its tolerance, and
+// what its own prediction (µm, `pred`) does to the base model's residual.
+ExplainedEffect explained_effect(const EffectVerdict& v, const EffectModel& e, const Channel& ch,
+                                 const BaseProjection& project, const Eigen::VectorXd& w, const ChannelResult& res,
+                                 Eigen::VectorXd& pred) {
+  ExplainedEffect x;
+  x.name = v.name, x.channel = ch.name, x.bic_drop = v.bic_drop, x.correlation = v.correlation;
+  for (std::size_t p = 0; p < v.param_names.size(); ++p)
+    x.params[v.param_names[p]] = v.params[static_cast<Eigen::Index>(p)];
+  Eigen::VectorXd full, sure;
+  full_parameters(v, e, full, sure);
+  x.magnitude = e.magnitude(full), x.tolerance = e.tolerance, x.unit = e.unit;
+  const double sure_magnitude = e.magnitude(sure);
+  // Its own prediction in µm, against the nominal residual (offsets out).
+  pred = project(w.asDiagonal() * (columns_on(e, ch) * full)).cwiseProduct(ch.sigma_um);
+  const Eigen::VectorXd after = res.before_um - pred;
+  x.residual_rms_before_um = split_rms(res.before_um, res.heldout, false);
+  x.residual_rms_after_um = split_rms(after, res.heldout, false);
+  x.heldout_rms_before_um = split_rms(res.before_um, res.heldout, true);
+  x.heldout_rms_after_um = split_rms(after, res.heldout, true);
+  x.importance_um = x.residual_rms_before_um - x.residual_rms_after_um;
+  x.significant = v.significant && sure_magnitude > x.tolerance;
+  x.evidence = "residual correlates with " + e.regressor +
+               fmt(" (r = %.2f); BIC drop %.0f; held-out RMS %.3f -> %.3f um; ", v.correlation, v.bic_drop,
+                   x.heldout_rms_before_um, x.heldout_rms_after_um) +
+               fmt("size %.3g (%.3g at 2 sigma) ", x.magnitude, sure_magnitude) + x.unit +
+               fmt(" against a tolerance of %.3g ", x.tolerance) + x.unit;
+  if (v.significant && !x.significant) x.evidence += " (not clearly outside the tolerance: background)";
+  return x;
+}
+
+ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const std::vector<EffectModel>& catalog,
+                              const LagColumns& lag, const ExplainOptions& o) {
+  ChannelResult out;
+  const Eigen::Index rows = ch.rows();
+  const BaseProjection project = base_projection(rr, ch, lag);
+  const Eigen::VectorXd w = ch.sigma_um.cwiseInverse();
+  const Eigen::VectorXd y = project(ch.residual_um.cwiseProduct(w));
+  std::vector<const EffectModel*> models;
+  const std::vector<Candidate> cands = channel_candidates(ch, catalog, project, w, y, models);
   out.heldout.resize(static_cast<std::size_t>(rows));
   for (Eigen::Index i = 0; i < rows; ++i)
     out.heldout[static_cast<std::size_t>(i)] =
@@ -117,59 +206,14 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
   out.before_um = y.cwiseProduct(ch.sigma_um);  // the base model's residual (offsets and common lag out), µm
   out.after_um = out.before_um;
   if (cands.empty() || rows < 50) return out;
-  SelectionOptions so;
-  so.min_bic_drop = o.min_bic_drop, so.min_heldout_gain = o.min_heldout_gain, so.max_effects = 10;
-  so.block.resize(static_cast<std::size_t>(rows));
-  for (Eigen::Index i = 0; i < rows; ++i)
-    so.block[static_cast<std::size_t>(i)] =
-        static_cast<int>(rr.t_s[ch.sample[static_cast<std::size_t>(i)]] / kJackknifeBlockS);
-  const SelectionResult sel = select_effects(y, cands, out.heldout, so);
+  const SelectionResult sel = select_effects(y, cands, out.heldout, channel_selection_options(rr, ch, o));
   out.unexplained_um = without_all(y, cands).cwiseProduct(ch.sigma_um);
-
-  auto split_rms = [&](const Eigen::VectorXd& v, bool held) {
-    double s = 0.0;
-    std::size_t n = 0;
-    for (Eigen::Index i = 0; i < v.size(); ++i)
-      if (out.heldout[static_cast<std::size_t>(i)] == held) s += v[i] * v[i], ++n;
-    return n ? std::sqrt(s / static_cast<double>(n)) : 0.0;
-  };
   for (const auto& v : sel.effects) {
     std::size_t k = 0;
     while (k < cands.size() && cands[k].name != v.name) ++k;
     if (k == cands.size()) continue;
-    const EffectModel& e = *models[k];
-    ExplainedEffect x;
-    x.name = v.name, x.channel = ch.name, x.bic_drop = v.bic_drop, x.correlation = v.correlation;
-    Eigen::VectorXd full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(e.params.size()));
-    for (std::size_t p = 0; p < v.param_names.size(); ++p) {
-      x.params[v.param_names[p]] = v.params[static_cast<Eigen::Index>(p)];
-      for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
-        if (e.params[q2] == v.param_names[p])
-          full[static_cast<Eigen::Index>(q2)] = v.params[static_cast<Eigen::Index>(p)];
-    }
-    x.magnitude = e.magnitude(full), x.tolerance = e.tolerance, x.unit = e.unit;
-    // Outside the tolerance with confidence: each parameter moved 2σ towards zero.
-    Eigen::VectorXd sure = full;
-    for (std::size_t p = 0; p < v.param_names.size() && static_cast<Eigen::Index>(p) < v.param_sigma.size(); ++p)
-      for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
-        if (e.params[q2] == v.param_names[p]) {
-          const double a = full[static_cast<Eigen::Index>(q2)], s2 = 2.0 * v.param_sigma[static_cast<Eigen::Index>(p)];
-          sure[static_cast<Eigen::Index>(q2)] = std::abs(a) > s2 ? a - std::copysign(s2, a) : 0.0;
-        }
-    const double sure_magnitude = e.magnitude(sure);
-    // Its own prediction in µm, against the nominal residual (offsets out).
-    const Eigen::VectorXd pred = project(w.asDiagonal() * (columns_on(e, ch) * full)).cwiseProduct(ch.sigma_um);
-    const Eigen::VectorXd after = out.before_um - pred;
-    x.residual_rms_before_um = split_rms(out.before_um, false), x.residual_rms_after_um = split_rms(after, false);
-    x.heldout_rms_before_um = split_rms(out.before_um, true), x.heldout_rms_after_um = split_rms(after, true);
-    x.importance_um = x.residual_rms_before_um - x.residual_rms_after_um;
-    x.significant = v.significant && sure_magnitude > x.tolerance;
-    x.evidence = "residual correlates with " + e.regressor +
-                 fmt(" (r = %.2f); BIC drop %.0f; held-out RMS %.3f -> %.3f um; ", v.correlation, v.bic_drop,
-                     x.heldout_rms_before_um, x.heldout_rms_after_um) +
-                 fmt("size %.3g (%.3g at 2 sigma) ", x.magnitude, sure_magnitude) + x.unit +
-                 fmt(" against a tolerance of %.3g ", x.tolerance) + x.unit;
-    if (v.significant && !x.significant) x.evidence += " (not clearly outside the tolerance: background)";
+    Eigen::VectorXd pred;
+    ExplainedEffect x = explained_effect(v, *models[k], ch, project, w, out, pred);
     if (x.significant) out.after_um -= pred;
     out.effects.push_back(std::move(x));
   }
