@@ -62,104 +62,129 @@ std::string sensors_with(const Scenario& sc, bool (*pred)(const Scenario&, int))
   return t && h ? "both" : (t ? "table" : (h ? "head" : "none"));
 }
 
-std::string effect_table(const Scenario& sc, const std::string& name) {
-  std::string o = "\n[effects.\"" + name + "\"]\n";
-  const MachineErrors& m = sc.machine;
-  // The axis with the largest size (the others may carry the same effect at background level).
-  auto per_axis = [&](auto size, auto body) {
-    int best = -1;
-    for (int i = 0; i < 3; ++i)
-      if (size(i) != 0.0 && (best < 0 || std::abs(size(i)) > std::abs(size(best)))) best = i;
-    if (best >= 0) o += "axis = " + str(kAxis[best]) + "\n" + body(best);
-  };
-  if (name.rfind("sensor.", 0) == 0) {
-    bool (*pred)(const Scenario&, int) = nullptr;
-    if (name == "sensor.scale")
-      pred = [](const Scenario& s, int i) {
-        return (s.truth[i].spec.k1_v_per_g - s.meta.sensors[i].k1_v_per_g).norm() > 1e-12;
-      };
-    if (name == "sensor.bias_drift")
-      pred = [](const Scenario& s, int i) {
-        return s.truth[i].bias_rw_ug_per_rts != 0.0 || s.truth[i].bias_step_ug != 0.0 ||
-               s.truth[i].bias_drift_ug_per_s != 0.0;
-      };
-    if (name == "sensor.nonlinearity")
-      pred = [](const Scenario& s, int i) {
-        return (s.truth[i].spec.k2_g_per_g2 - s.meta.sensors[i].k2_g_per_g2).norm() +
-                   (s.truth[i].spec.k3_g_per_g3 - s.meta.sensors[i].k3_g_per_g3).norm() >
-               1e-12;
-      };
-    if (name == "sensor.cross_coupling")
-      pred = [](const Scenario& s, int i) {
-        return s.truth[i].k_cross_g_per_g.squaredNorm() + s.truth[i].k_cross2_g_per_g2.squaredNorm() > 0.0;
-      };
-    if (name == "sensor.misalignment")
-      pred = [](const Scenario& s, int i) {
-        return (s.truth[i].spec.to_machine - s.meta.sensors[i].to_machine).norm() > 1e-12;
-      };
-    if (name == "sensor.dynamics")
-      pred = [](const Scenario& s, int i) {
-        return std::abs(s.truth[i].spec.f0_hz - s.meta.sensors[i].f0_hz) +
-                   std::abs(s.truth[i].spec.zeta - s.meta.sensors[i].zeta) >
-               1e-12;
-      };
-    if (name == "sensor.damping_amplitude")
-      pred = [](const Scenario& s, int i) { return s.truth[i].zeta_per_g != s.meta.sensors[i].zeta_per_g; };
-    if (name == "sensor.scale_temperature")
-      pred = [](const Scenario& s, int i) { return s.truth[i].temperature.rise_c != 0.0; };
-    const std::string which = pred ? sensors_with(sc, pred) : "none";
-    o += "sensor = " + str(which) + "\n";
-    const int s = which == "head" ? 1 : 0;
-    const SensorTruth& st = sc.truth[s];
-    const SensorTruth& t = st;
-    if (name == "sensor.scale") o += "k1_v_per_g = " + vec3(t.spec.k1_v_per_g) + "\n";
-    if (name == "sensor.bias_drift")
-      o += "rw_ug_per_rts = " + num(t.bias_rw_ug_per_rts) + "\nstep_ug = " + num(t.bias_step_ug) +
-           "\ndrift_ug_per_s = " + num(t.bias_drift_ug_per_s) + "\n";
-    if (name == "sensor.nonlinearity")
-      o += "k2_g_per_g2 = " + vec3(t.spec.k2_g_per_g2) + "\nk3_g_per_g3 = " + vec3(t.spec.k3_g_per_g3) + "\n";
-    if (name == "sensor.cross_coupling")
-      o += "k_cross_g_per_g = " + mat3(t.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(t.k_cross2_g_per_g2) + "\n";
-    if (name == "sensor.misalignment") {
-      // A sign flip, swap or mirror is no small rotation: the true matrix says what it is.
-      if (!st.axes_map.empty())
-        o += "axes_map = " + str(st.axes_map) +
-             "\nmounting = " + str(mounting_kind(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
-      else
-        o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
-      o += "to_machine = " + mat3(t.spec.to_machine) + "\n";
-    }
-    if (name == "sensor.dynamics") o += "f0_hz = " + num(t.spec.f0_hz) + "\nzeta = " + num(t.spec.zeta) + "\n";
-    if (name == "sensor.damping_amplitude")
-      o += "zeta0 = " + num(t.spec.zeta) + "\nzeta_per_g = " + num(t.zeta_per_g) + "\n";
-    if (name == "sensor.scale_temperature")
-      o += "rise_c = " + num(t.temperature.rise_c) + "\ntau_s = " + num(t.temperature.tau_s) +
-           "\ntc_k1_ppm_per_c = " + num(t.spec.tc_k1_ppm_per_c) +
-           "\ntc_bias_ug_per_c = " + num(t.spec.tc_bias_ug_per_c) + "\n";
-  } else if (name == "daq.group_delay") {
-    o += "group_delay_samples = " + num(sc.daq.group_delay_samples) +
-         "\nskew_head_samples = " + num(sc.daq.skew_head_samples) + "\n";
-  } else if (name == "site.coriolis") {
-    o += "latitude_deg = " + num(sc.meta.site.latitude_deg) + "\nheading_deg = " + num(sc.meta.site.heading_deg) + "\n";
-  } else if (name == "machine.common_vibration") {
+// Which sensors an effect of the sensor.* family shows in: its test on one sensor.
+using SensorTest = bool (*)(const Scenario&, int);
+
+SensorTest sensor_test(const std::string& name) {
+  if (name == "sensor.scale")
+    return [](const Scenario& s, int i) {
+      return (s.truth[i].spec.k1_v_per_g - s.meta.sensors[i].k1_v_per_g).norm() > 1e-12;
+    };
+  if (name == "sensor.bias_drift")
+    return [](const Scenario& s, int i) {
+      return s.truth[i].bias_rw_ug_per_rts != 0.0 || s.truth[i].bias_step_ug != 0.0 ||
+             s.truth[i].bias_drift_ug_per_s != 0.0;
+    };
+  if (name == "sensor.nonlinearity")
+    return [](const Scenario& s, int i) {
+      return (s.truth[i].spec.k2_g_per_g2 - s.meta.sensors[i].k2_g_per_g2).norm() +
+                 (s.truth[i].spec.k3_g_per_g3 - s.meta.sensors[i].k3_g_per_g3).norm() >
+             1e-12;
+    };
+  if (name == "sensor.cross_coupling")
+    return [](const Scenario& s, int i) {
+      return s.truth[i].k_cross_g_per_g.squaredNorm() + s.truth[i].k_cross2_g_per_g2.squaredNorm() > 0.0;
+    };
+  if (name == "sensor.misalignment")
+    return [](const Scenario& s, int i) {
+      return (s.truth[i].spec.to_machine - s.meta.sensors[i].to_machine).norm() > 1e-12;
+    };
+  if (name == "sensor.dynamics")
+    return [](const Scenario& s, int i) {
+      return std::abs(s.truth[i].spec.f0_hz - s.meta.sensors[i].f0_hz) +
+                 std::abs(s.truth[i].spec.zeta - s.meta.sensors[i].zeta) >
+             1e-12;
+    };
+  if (name == "sensor.damping_amplitude")
+    return [](const Scenario& s, int i) { return s.truth[i].zeta_per_g != s.meta.sensors[i].zeta_per_g; };
+  if (name == "sensor.scale_temperature")
+    return [](const Scenario& s, int i) { return s.truth[i].temperature.rise_c != 0.0; };
+  return nullptr;
+}
+
+// The parameters of a sensor effect in sensor s.
+std::string sensor_effect_params(const Scenario& sc, const std::string& name, int s) {
+  const SensorTruth& st = sc.truth[s];
+  const SensorTruth& t = st;
+  std::string o;
+  if (name == "sensor.scale") o += "k1_v_per_g = " + vec3(t.spec.k1_v_per_g) + "\n";
+  if (name == "sensor.bias_drift")
+    o += "rw_ug_per_rts = " + num(t.bias_rw_ug_per_rts) + "\nstep_ug = " + num(t.bias_step_ug) +
+         "\ndrift_ug_per_s = " + num(t.bias_drift_ug_per_s) + "\n";
+  if (name == "sensor.nonlinearity")
+    o += "k2_g_per_g2 = " + vec3(t.spec.k2_g_per_g2) + "\nk3_g_per_g3 = " + vec3(t.spec.k3_g_per_g3) + "\n";
+  if (name == "sensor.cross_coupling")
+    o += "k_cross_g_per_g = " + mat3(t.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(t.k_cross2_g_per_g2) + "\n";
+  if (name == "sensor.misalignment") {
+    // A sign flip, swap or mirror is no small rotation: the true matrix says what it is.
+    if (!st.axes_map.empty())
+      o += "axes_map = " + str(st.axes_map) +
+           "\nmounting = " + str(mounting_kind(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
+    else
+      o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
+    o += "to_machine = " + mat3(t.spec.to_machine) + "\n";
+  }
+  if (name == "sensor.dynamics") o += "f0_hz = " + num(t.spec.f0_hz) + "\nzeta = " + num(t.spec.zeta) + "\n";
+  if (name == "sensor.damping_amplitude")
+    o += "zeta0 = " + num(t.spec.zeta) + "\nzeta_per_g = " + num(t.zeta_per_g) + "\n";
+  if (name == "sensor.scale_temperature")
+    o += "rise_c = " + num(t.temperature.rise_c) + "\ntau_s = " + num(t.temperature.tau_s) +
+         "\ntc_k1_ppm_per_c = " + num(t.spec.tc_k1_ppm_per_c) + "\ntc_bias_ug_per_c = " + num(t.spec.tc_bias_ug_per_c) +
+         "\n";
+  return o;
+}
+
+// A sensor effect: the sensors it shows in, and its parameters in the head when only the
+// head has it, else in the table.
+std::string sensor_effect_table(const Scenario& sc, const std::string& name) {
+  const SensorTest pred = sensor_test(name);
+  const std::string which = pred ? sensors_with(sc, pred) : "none";
+  return "sensor = " + str(which) + "\n" + sensor_effect_params(sc, name, which == "head" ? 1 : 0);
+}
+
+std::string tones_table(const std::string& name, const std::vector<Tone>& tones) {
+  std::string o;
+  for (const Tone& t : tones)
+    o += "\n[[effects.\"" + name + "\".tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) +
+         "\nphase_deg = " + num(t.phase_deg) + "\n";
+  return o;
+}
+
+std::string vibration_effect_table(const Scenario& sc, const std::string& name) {
+  std::string o;
+  if (name == "machine.common_vibration") {
     const CommonVibration& v = sc.common_vibration;
     o += "broadband_rms_mg = " + vec3(v.broadband_rms_mg) + "\nband_hz = " + arr(v.band_hz, 2) + "\n";
-    for (const Tone& t : v.tones)
-      o += "\n[[effects.\"" + name + "\".tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) +
-           "\nphase_deg = " + num(t.phase_deg) + "\n";
+    o += tones_table(name, v.tones);
     o += "\n[effects.\"" + name + "\".mode]\nfreq_hz = " + num(v.mode.freq_hz) + "\nzeta = " + num(v.mode.zeta) +
          "\ngain = " + vec3(v.mode.gain) + "\n";
-  } else if (name == "machine.differential_vibration") {
+  } else {
     const DriveMode& d = sc.differential_vibration;
     o += "freq_hz = " + num(d.freq_hz) + "\nzeta = " + num(d.zeta) + "\ngain = " + vec3(d.gain) + "\n";
-    for (const Tone& t : sc.differential_tones)
-      o += "\n[[effects.\"" + name + "\".tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) +
-           "\nphase_deg = " + num(t.phase_deg) + "\n";
-  } else if (name == "machine.backlash") {
-    per_axis([&](int i) { return m.backlash_um[i]; },
-             [&](int i) { return "value_um = " + num(m.backlash_um[i]) + "\n"; });
+    o += tones_table(name, sc.differential_tones);
+  }
+  return o;
+}
+
+// "axis = …" and the parameters of the axis with the largest size (the others may carry
+// the same effect at background level); nothing when no axis has it.
+template <class Size, class Body>
+std::string largest_axis(Size size, Body body) {
+  int best = -1;
+  for (int i = 0; i < 3; ++i)
+    if (size(i) != 0.0 && (best < 0 || std::abs(size(i)) > std::abs(size(best)))) best = i;
+  return best >= 0 ? "axis = " + str(kAxis[best]) + "\n" + body(best) : std::string();
+}
+
+// The errors of the axes and between them (machine.*, vibration aside).
+std::string machine_effect_table(const Scenario& sc, const std::string& name) {
+  const MachineErrors& m = sc.machine;
+  std::string o;
+  if (name == "machine.backlash") {
+    o += largest_axis([&](int i) { return m.backlash_um[i]; },
+                      [&](int i) { return "value_um = " + num(m.backlash_um[i]) + "\n"; });
   } else if (name == "machine.reversal_spike") {
-    per_axis(
+    o += largest_axis(
         [&](int i) { return m.spike[i].amp_um; },
         [&](int i) { return "amp_um = " + num(m.spike[i].amp_um) + "\ntau_ms = " + num(m.spike[i].tau_ms) + "\n"; });
   } else if (name == "machine.servo_mismatch") {
@@ -174,18 +199,18 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
   } else if (name == "machine.scale_mismatch") {
     for (int i = 0; i < 3; ++i) o += std::string(kAxis[i]) + "_ppm = " + num(m.scale_ppm[i]) + "\n";
   } else if (name == "machine.cyclic_error") {
-    per_axis([&](int i) { return m.cyclic[i].amp_um; },
-             [&](int i) {
-               return "amp_um = " + num(m.cyclic[i].amp_um) + "\npitch_mm = " + num(m.cyclic[i].pitch_mm) +
-                      "\nphase_deg = " + num(m.cyclic[i].phase_deg) + "\n";
-             });
+    o += largest_axis([&](int i) { return m.cyclic[i].amp_um; },
+                      [&](int i) {
+                        return "amp_um = " + num(m.cyclic[i].amp_um) + "\npitch_mm = " + num(m.cyclic[i].pitch_mm) +
+                               "\nphase_deg = " + num(m.cyclic[i].phase_deg) + "\n";
+                      });
   } else if (name == "machine.straightness") {
-    per_axis([&](int i) { return m.straightness[i].direction >= 0 ? m.straightness[i].bow_um : 0.0; },
-             [&](int i) {
-               return "direction = " + str(kAxis[m.straightness[i].direction]) +
-                      "\nbow_um = " + num(m.straightness[i].bow_um) +
-                      "\nspan_mm = " + arr(m.straightness[i].span_mm, 2) + "\n";
-             });
+    o += largest_axis([&](int i) { return m.straightness[i].direction >= 0 ? m.straightness[i].bow_um : 0.0; },
+                      [&](int i) {
+                        return "direction = " + str(kAxis[m.straightness[i].direction]) +
+                               "\nbow_um = " + num(m.straightness[i].bow_um) +
+                               "\nspan_mm = " + arr(m.straightness[i].span_mm, 2) + "\n";
+                      });
   } else if (name == "machine.resonance") {
     o += "part = " + str(kSensor[sc.resonance.part]) + "\n";
     for (const StructuralMode& md : sc.resonance.modes)
@@ -193,19 +218,36 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
            "\ndamping_ratio = " + num(md.damping_ratio) + "\ngain = " + num(md.gain) +
            "\ndirection = " + vec3(md.direction.normalized()) + "\n";
   } else if (name == "machine.stick_slip") {
-    per_axis([&](int i) { return m.stick_slip[i].amp_um; },
-             [&](int i) {
-               return "amp_um = " + num(m.stick_slip[i].amp_um) +
-                      "\nbelow_mm_min = " + num(m.stick_slip[i].below_mm_min) +
-                      "\nslip_ms = " + num(m.stick_slip[i].slip_ms) + "\n";
-             });
+    o += largest_axis([&](int i) { return m.stick_slip[i].amp_um; },
+                      [&](int i) {
+                        return "amp_um = " + num(m.stick_slip[i].amp_um) +
+                               "\nbelow_mm_min = " + num(m.stick_slip[i].below_mm_min) +
+                               "\nslip_ms = " + num(m.stick_slip[i].slip_ms) + "\n";
+                      });
   }
   return o;
 }
 
-}  // namespace
+// [effects."NAME"]: where an effect present is, with its true parameters.
+std::string effect_table(const Scenario& sc, const std::string& name) {
+  std::string o = "\n[effects.\"" + name + "\"]\n";
+  if (name.rfind("sensor.", 0) == 0)
+    o += sensor_effect_table(sc, name);
+  else if (name == "daq.group_delay")
+    o += "group_delay_samples = " + num(sc.daq.group_delay_samples) +
+         "\nskew_head_samples = " + num(sc.daq.skew_head_samples) + "\n";
+  else if (name == "site.coriolis")
+    o += "latitude_deg = " + num(sc.meta.site.latitude_deg) + "\nheading_deg = " + num(sc.meta.site.heading_deg) + "\n";
+  else if (name == "machine.common_vibration" || name == "machine.differential_vibration")
+    o += vibration_effect_table(sc, name);
+  else
+    o += machine_effect_table(sc, name);
+  return o;
+}
 
-std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
+// The comments, the scenario, the effects present and in the background, and where each
+// present one is.
+std::string header_and_effects(const Scenario& sc) {
   const EffectLists effects = effect_lists(sc);
   std::string o;
   o += "# truth.toml -- synthetic run, true parameters (eical sim 2).\n";
@@ -222,45 +264,56 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
        "\n";
   o += "\n[effects]\npresent = " + list(effects.present) + "\nbackground = " + list(effects.background) + "\n";
   for (const auto& e : effects.present) o += effect_table(sc, e);
+  return o;
+}
 
-  for (int s = 0; s < 2; ++s) {
-    const SensorTruth& st = sc.truth[s];
-    const auto& t = st.spec;
-    o += std::string("\n[sensors.") + kSensor[s] + "]\n";
-    o += "model = " + str(t.model) + "\nto_machine = " + mat3(t.to_machine) + "\n";
-    o += "k1_v_per_g = " + vec3(t.k1_v_per_g) + "\nk2_g_per_g2 = " + vec3(t.k2_g_per_g2) +
-         "\nk3_g_per_g3 = " + vec3(t.k3_g_per_g3) + "\n";
-    o += "bias_g = " + vec3(t.bias_g) + "\ntc_k1_ppm_per_c = " + num(t.tc_k1_ppm_per_c) +
-         "\ntc_bias_ug_per_c = " + num(t.tc_bias_ug_per_c) + "\n";
-    o += "f0_hz = " + num(t.f0_hz) + "\nzeta = " + num(t.zeta) +
-         "\nnoise_ug_per_rthz = " + num(sc.noise ? t.noise_ug_per_rthz : 0.0) + "\n";
-    o += "temp_ref_c = " + num(t.temp_ref_c) + "\n";
-    o += "k_cross_g_per_g = " + mat3(st.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(st.k_cross2_g_per_g2) + "\n";
-    if (st.axes_map.empty())
-      o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.to_machine)) + "\n";
-    else
-      o += "axes_map = " + str(st.axes_map) + "\n";
-    o += "zeta_per_g = " + num(st.zeta_per_g) + "\nbias_rw_ug_per_rts = " + num(st.bias_rw_ug_per_rts) +
-         "\nbias_step_ug = " + num(st.bias_step_ug) + "\nbias_drift_ug_per_s = " + num(st.bias_drift_ug_per_s) + "\n";
-    o += std::string("\n[sensors.") + kSensor[s] + ".temperature]\nt0_c = " + num(st.temperature.t0_c) +
-         "\nrise_c = " + num(st.temperature.rise_c) + "\ntau_s = " + num(st.temperature.tau_s) +
-         "\nstart_c = " + num(st.temperature.at(0.0)) + "\nend_c = " + num(st.temperature.at(tr.duration_s())) + "\n";
-  }
+// [sensors.table] or [sensors.head]: the true sensor and its case temperature.
+std::string sensor_section(const Scenario& sc, int s, double duration_s) {
+  const SensorTruth& st = sc.truth[s];
+  const auto& t = st.spec;
+  std::string o;
+  o += std::string("\n[sensors.") + kSensor[s] + "]\n";
+  o += "model = " + str(t.model) + "\nto_machine = " + mat3(t.to_machine) + "\n";
+  o += "k1_v_per_g = " + vec3(t.k1_v_per_g) + "\nk2_g_per_g2 = " + vec3(t.k2_g_per_g2) +
+       "\nk3_g_per_g3 = " + vec3(t.k3_g_per_g3) + "\n";
+  o += "bias_g = " + vec3(t.bias_g) + "\ntc_k1_ppm_per_c = " + num(t.tc_k1_ppm_per_c) +
+       "\ntc_bias_ug_per_c = " + num(t.tc_bias_ug_per_c) + "\n";
+  o += "f0_hz = " + num(t.f0_hz) + "\nzeta = " + num(t.zeta) +
+       "\nnoise_ug_per_rthz = " + num(sc.noise ? t.noise_ug_per_rthz : 0.0) + "\n";
+  o += "temp_ref_c = " + num(t.temp_ref_c) + "\n";
+  o += "k_cross_g_per_g = " + mat3(st.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(st.k_cross2_g_per_g2) + "\n";
+  if (st.axes_map.empty())
+    o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.to_machine)) + "\n";
+  else
+    o += "axes_map = " + str(st.axes_map) + "\n";
+  o += "zeta_per_g = " + num(st.zeta_per_g) + "\nbias_rw_ug_per_rts = " + num(st.bias_rw_ug_per_rts) +
+       "\nbias_step_ug = " + num(st.bias_step_ug) + "\nbias_drift_ug_per_s = " + num(st.bias_drift_ug_per_s) + "\n";
+  o += std::string("\n[sensors.") + kSensor[s] + ".temperature]\nt0_c = " + num(st.temperature.t0_c) +
+       "\nrise_c = " + num(st.temperature.rise_c) + "\ntau_s = " + num(st.temperature.tau_s) +
+       "\nstart_c = " + num(st.temperature.at(0.0)) + "\nend_c = " + num(st.temperature.at(duration_s)) + "\n";
+  return o;
+}
 
-  const MachineErrors& m = sc.machine;
-  auto axes3 = [&](const char* table, auto get) {
-    o += std::string("\n[machine_errors.") + table + "]\n";
-    for (int i = 0; i < 3; ++i) o += std::string(kAxis[i]) + " = " + num(get(i)) + "\n";
-  };
+// [machine_errors.TABLE] with one value per axis.
+template <class Get>
+std::string axes_table(const char* table, Get get) {
+  std::string o = std::string("\n[machine_errors.") + table + "]\n";
+  for (int i = 0; i < 3; ++i) o += std::string(kAxis[i]) + " = " + num(get(i)) + "\n";
+  return o;
+}
+
+// [machine_errors]: the position loops, then each error per axis.
+std::string machine_errors_section(const MachineErrors& m) {
+  std::string o;
   o += "\n[machine_errors]\n# relative-position sense; an axis' errors are carried by the part that moves it\n";
-  axes3("kv_per_s", [&](int i) { return m.servo[i].kv_per_s; });
-  axes3("feedforward", [&](int i) { return m.servo[i].feedforward; });
-  axes3("velocity_tau_ms", [&](int i) { return m.servo[i].velocity_tau_s * 1e3; });
-  axes3("servo_lag_ms", [&](int i) {
+  o += axes_table("kv_per_s", [&](int i) { return m.servo[i].kv_per_s; });
+  o += axes_table("feedforward", [&](int i) { return m.servo[i].feedforward; });
+  o += axes_table("velocity_tau_ms", [&](int i) { return m.servo[i].velocity_tau_s * 1e3; });
+  o += axes_table("servo_lag_ms", [&](int i) {
     return m.servo[i].kv_per_s > 0 ? 1e3 * (1.0 - m.servo[i].feedforward) / m.servo[i].kv_per_s : 0.0;
   });
-  axes3("backlash_um", [&](int i) { return m.backlash_um[i]; });
-  axes3("scale_ppm", [&](int i) { return m.scale_ppm[i]; });
+  o += axes_table("backlash_um", [&](int i) { return m.backlash_um[i]; });
+  o += axes_table("scale_ppm", [&](int i) { return m.scale_ppm[i]; });
   o += "\n[machine_errors.squareness_urad]\n";
   for (int i = 0; i < 3; ++i) o += std::string(kPair[i]) + " = " + num(m.squareness_urad[i]) + "\n";
   for (int i = 0; i < 3; ++i) {
@@ -275,7 +328,12 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
     o += std::string("\n[machine_errors.stick_slip.") + kAxis[i] + "]\namp_um = " + num(m.stick_slip[i].amp_um) +
          "\nbelow_mm_min = " + num(m.stick_slip[i].below_mm_min) + "\nslip_ms = " + num(m.stick_slip[i].slip_ms) + "\n";
   }
+  return o;
+}
 
+// [daq] and [site].
+std::string daq_and_site_sections(const Scenario& sc) {
+  std::string o;
   o += "\n[daq]\nanti_alias_filter = " + std::string(sc.daq.anti_alias_filter ? "true" : "false") +
        "\ngroup_delay_samples = " + num(sc.daq.group_delay_samples) +
        "\nskew_head_samples = " + num(sc.daq.skew_head_samples) + "\n";
@@ -287,6 +345,12 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
        "\nheading_deg = " + num(sc.meta.site.heading_deg) + "\ng_mps2 = " + num(sc.meta.site.g_mps2) +
        "\ncoriolis = " + (sc.coriolis ? "true" : "false") +
        "\nomega_machine_radps = " + vec3(earth_rate_machine(sc.meta.site)) + "\n";
+  return o;
+}
+
+// [nc]: the limits, when each move runs and each trigger comes; [nc.sweep] for a sweep.
+std::string nc_section(const Scenario& sc, const nc::SetPoint& tr) {
+  std::string o;
   o += "\n[nc]\na_max_mps2 = " + num(sc.limits.a_max_mm_s2 / 1000.0) +
        "\njerk_mps3 = " + num(sc.limits.j_max_mm_s3 / 1000.0) + "\nmoves_s = [";
   const auto spans = tr.move_spans_s();
@@ -306,6 +370,12 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
          "\nstart_mm = " + vec3(sc.sweep.start_mm) + "\nlead_in_s = " + num(sc.sweep.lead_in_s) +
          "\ntail_s = " + num(sc.sweep.tail_s) + "\n";
   }
+  return o;
+}
+
+// [[machine_errors.resonance]], [vibration.common] and [vibration.differential] with their tones.
+std::string modes_and_vibration_sections(const Scenario& sc) {
+  std::string o;
   for (const StructuralMode& md : sc.resonance.modes)
     o += "\n[[machine_errors.resonance]]\npart = " + str(kSensor[sc.resonance.part]) +
          "\nfrequency_hz = " + num(md.frequency_hz) + "\ndamping_ratio = " + num(md.damping_ratio) +
@@ -323,6 +393,12 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
   for (const Tone& t : sc.differential_tones)
     o += "\n[[vibration.differential.tones]]\nfreq_hz = " + num(t.freq_hz) + "\namp_mg = " + vec3(t.amp_mg) +
          "\nphase_deg = " + num(t.phase_deg) + "\n";
+  return o;
+}
+
+// [[psd]] per strip and [reference].
+std::string psd_and_reference_sections(const Scenario& sc) {
+  std::string o;
   for (std::size_t k = 0; k < sc.meta.psd.size(); ++k) {
     const auto& p = sc.meta.psd[k];
     const PsdTruth pt = k < sc.psd.size() ? sc.psd[k] : PsdTruth{};
@@ -340,6 +416,19 @@ std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
          arr(r.interp_phase_deg[0], 2) + ", " + arr(r.interp_phase_deg[1], 2) + ", " + arr(r.interp_phase_deg[2], 2) +
          "]" + "\nsignal_period_um = " + num(r.signal_period_um) + "\nresolution_nm = " + num(r.resolution_nm) + "\n";
   }
+  return o;
+}
+
+}  // namespace
+
+std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
+  std::string o = header_and_effects(sc);
+  for (int s = 0; s < 2; ++s) o += sensor_section(sc, s, tr.duration_s());
+  o += machine_errors_section(sc.machine);
+  o += daq_and_site_sections(sc);
+  o += nc_section(sc, tr);
+  o += modes_and_vibration_sections(sc);
+  o += psd_and_reference_sections(sc);
   return o;
 }
 

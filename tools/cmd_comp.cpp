@@ -30,7 +30,8 @@ namespace fs = std::filesystem;
 using comp::AxisProposal;
 using comp::OutputFile;
 
-struct Opt {
+// What `eical comp` is told.
+struct CompOptions {
   std::vector<std::string> inputs, controls = {"linuxcnc"}, travel, sinumerik_axes = {"X1", "Y1", "Z1"};
   std::string out = "comp", merge_ini;
   double spacing_mm = 0.0, fanuc_unit_um = 1.0, fanuc_reference_mm = 0.0;
@@ -61,7 +62,7 @@ std::string slurp(const std::string& file) {
   return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
 }
 
-std::vector<OutputFile> linuxcnc_outputs(const std::vector<AxisProposal>& axes, const Opt& o,
+std::vector<OutputFile> linuxcnc_outputs(const std::vector<AxisProposal>& axes, const CompOptions& o,
                                          nlohmann::json& axes_json) {
   std::map<char, int> joints = {{'x', 0}, {'y', 1}, {'z', 2}};
   std::string ini_text;
@@ -119,122 +120,149 @@ nlohmann::json axis_json(const AxisProposal& p) {
   return j;
 }
 
-}  // namespace
-
-void register_comp(CLI::App& app) {
-  auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand(
-      "comp",
-      "Propose axis compensation (tables with the reversal folded in, backlash) for the control from measured results");
-  cmd->add_option("inputs", o->inputs,
-                  "eical-result/1 files (eical analyze --json) or run directories: positioning and circle runs")
+void add_comp_options(CLI::App& cmd, CompOptions& o) {
+  cmd.add_option("inputs", o.inputs,
+                 "eical-result/1 files (eical analyze --json) or run directories: positioning and circle runs")
       ->required();
-  cmd->add_option("-o,--out", o->out, "output folder")->default_val("comp");
-  cmd->add_option("--control", o->controls, "linuxcnc, sinumerik, fanuc, heidenhain or all (comma separated)")
+  cmd.add_option("-o,--out", o.out, "output folder")->default_val("comp");
+  cmd.add_option("--control", o.controls, "linuxcnc, sinumerik, fanuc, heidenhain or all (comma separated)")
       ->delimiter(',')
       ->check(CLI::IsMember({"linuxcnc", "sinumerik", "fanuc", "heidenhain", "all"}))
       ->default_str("linuxcnc");
-  cmd->add_option("--merge-ini", o->merge_ini,
-                  "LinuxCNC machine INI: also write it with the [JOINT_n] keys merged (trivkins)")
+  cmd.add_option("--merge-ini", o.merge_ini,
+                 "LinuxCNC machine INI: also write it with the [JOINT_n] keys merged (trivkins)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--spacing-mm", o->spacing_mm,
-                  "interval of the equidistant SINUMERIK/FANUC/HEIDENHAIN tables (default: mean target spacing)")
+  cmd.add_option("--spacing-mm", o.spacing_mm,
+                 "interval of the equidistant SINUMERIK/FANUC/HEIDENHAIN tables (default: mean target spacing)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--travel", o->travel,
-                  "AXIS:MIN,MAX the table must cover (mm), besides what the inputs measured (repeatable)");
-  cmd->add_option("--sinumerik-axes", o->sinumerik_axes, "SINUMERIK machine axis names of x, y, z")
+  cmd.add_option("--travel", o.travel,
+                 "AXIS:MIN,MAX the table must cover (mm), besides what the inputs measured (repeatable)");
+  cmd.add_option("--sinumerik-axes", o.sinumerik_axes, "SINUMERIK machine axis names of x, y, z")
       ->delimiter(',')
       ->expected(3);
-  cmd->add_option("--fanuc-detection-unit-um", o->fanuc_unit_um, "FANUC detection unit")
+  cmd.add_option("--fanuc-detection-unit-um", o.fanuc_unit_um, "FANUC detection unit")
       ->default_val(1.0)
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--fanuc-reference-mm", o->fanuc_reference_mm,
-                  "FANUC reference position (machine coordinate) of No. 3620")
+  cmd.add_option("--fanuc-reference-mm", o.fanuc_reference_mm,
+                 "FANUC reference position (machine coordinate) of No. 3620")
       ->default_val(0.0);
-  cmd->add_flag("--force", o->force, "overwrite existing output files");
-  auto* allow = cmd->add_flag(
-      "--allow-unresolved", o->allow_unresolved,
+  cmd.add_flag("--force", o.force, "overwrite existing output files");
+  auto* allow = cmd.add_flag(
+      "--allow-unresolved", o.allow_unresolved,
       "propose terms from figures not larger than their uncertainty (or without one), marked in comp.json");
-  auto* skip =
-      cmd->add_flag("--skip-unresolved", o->skip_unresolved, "leave out the terms whose figure is not resolved");
+  auto* skip = cmd.add_flag("--skip-unresolved", o.skip_unresolved, "leave out the terms whose figure is not resolved");
   allow->excludes(skip);
-  cmd->callback([o] {
-    std::vector<comp::CompInput> inputs;
-    for (const auto& p : o->inputs) inputs.push_back(comp::load_comp_input(p));
-    comp::PlanOptions po;
-    po.unresolved = o->allow_unresolved  ? comp::Unresolved::allow
-                    : o->skip_unresolved ? comp::Unresolved::skip
-                                         : comp::Unresolved::refuse;
-    for (const auto& t : o->travel) po.travel.push_back(parse_travel(t));
-    const comp::Plan plan = comp::build_plan(inputs, po);
-    if (plan.axes.empty())
-      throw dsp::InputError("comp: no term is left to propose (the unresolved ones were skipped); nothing written");
+}
 
-    std::set<std::string> controls(o->controls.begin(), o->controls.end());
-    if (controls.count("all")) controls = {"linuxcnc", "sinumerik", "fanuc", "heidenhain"};
-    nlohmann::json axes = nlohmann::json::object();
-    for (const auto& p : plan.axes) axes[std::string(1, dsp::comp::axis_letter(p.axis))] = axis_json(p);
-    std::vector<OutputFile> files;
-    const comp::GridOptions grid{o->spacing_mm};
-    if (controls.count("linuxcnc"))
-      for (auto& f : linuxcnc_outputs(plan.axes, *o, axes)) files.push_back(std::move(f));
-    if (controls.count("sinumerik"))
-      for (auto& f : comp::sinumerik_outputs(plan.axes, {grid, o->sinumerik_axes})) files.push_back(std::move(f));
-    if (controls.count("fanuc"))
-      for (auto& f : comp::fanuc_outputs(plan.axes, {grid, o->fanuc_unit_um, o->fanuc_reference_mm, 0}))
-        files.push_back(std::move(f));
-    if (controls.count("heidenhain"))
-      for (auto& f : comp::heidenhain_outputs(plan.axes, {grid})) files.push_back(std::move(f));
+// The inputs' proposal per axis; refuses to go on when no term is left.
+comp::Plan comp_plan(const std::vector<comp::CompInput>& inputs, const CompOptions& o) {
+  comp::PlanOptions po;
+  po.unresolved = o.allow_unresolved  ? comp::Unresolved::allow
+                  : o.skip_unresolved ? comp::Unresolved::skip
+                                      : comp::Unresolved::refuse;
+  for (const auto& t : o.travel) po.travel.push_back(parse_travel(t));
+  comp::Plan plan = comp::build_plan(inputs, po);
+  if (plan.axes.empty())
+    throw dsp::InputError("comp: no term is left to propose (the unresolved ones were skipped); nothing written");
+  return plan;
+}
 
-    nlohmann::json j = {{"format", "eical-comp/1"},
-                        {"sign_convention",
-                         "deviation = actual - nominal; correction = -deviation, what the control adds to the command"},
-                        {"axes", axes},
-                        {"figures", plan.figures},
-                        {"not_compensated", plan.not_compensated},
-                        {"skipped", plan.skipped}};
-    nlohmann::json ins = nlohmann::json::array();
-    for (const auto& in : inputs)
-      ins.push_back(
-          {{"input", in.name}, {"run_id", in.run_id}, {"program", in.result.value("program", std::string())}});
-    j["inputs"] = ins;
-    if (!plan.unresolved_used.empty()) j["proposed_from_unresolved_figures"] = plan.unresolved_used;
-    if (!plan.unresolved_skipped.empty()) j["left_out_unresolved_figures"] = plan.unresolved_skipped;
-    nlohmann::json names = nlohmann::json::array();
-    for (const auto& f : files) names.push_back(f.path);
-    j["files"] = names;
-    files.push_back({"comp.json", j.dump(2) + "\n"});
+// The files of every control asked for; the LinuxCNC joints go into `axes`.
+std::vector<OutputFile> control_files(const comp::Plan& plan, const CompOptions& o, nlohmann::json& axes) {
+  std::set<std::string> controls(o.controls.begin(), o.controls.end());
+  if (controls.count("all")) controls = {"linuxcnc", "sinumerik", "fanuc", "heidenhain"};
+  std::vector<OutputFile> files;
+  const comp::GridOptions grid{o.spacing_mm};
+  if (controls.count("linuxcnc"))
+    for (auto& f : linuxcnc_outputs(plan.axes, o, axes)) files.push_back(std::move(f));
+  if (controls.count("sinumerik"))
+    for (auto& f : comp::sinumerik_outputs(plan.axes, {grid, o.sinumerik_axes})) files.push_back(std::move(f));
+  if (controls.count("fanuc"))
+    for (auto& f : comp::fanuc_outputs(plan.axes, {grid, o.fanuc_unit_um, o.fanuc_reference_mm, 0}))
+      files.push_back(std::move(f));
+  if (controls.count("heidenhain"))
+    for (auto& f : comp::heidenhain_outputs(plan.axes, {grid})) files.push_back(std::move(f));
+  return files;
+}
 
-    // Nothing is written unless everything can be: existing files first.
-    std::vector<std::string> existing;
-    for (const auto& f : files)
-      if (fs::exists(fs::path(o->out) / f.path)) existing.push_back((fs::path(o->out) / f.path).string());
-    if (!existing.empty() && !o->force) {
-      std::string msg = "comp: would overwrite " + std::to_string(existing.size()) +
-                        " existing file(s), nothing written (--force to replace them):";
-      for (const auto& e : existing) msg += "\n  " + e;
-      throw dsp::InputError(msg);
-    }
-    for (const auto& f : files) {
-      const fs::path p = fs::path(o->out) / f.path;
-      fs::create_directories(p.parent_path());
-      write_file_atomic(p, f.text);
-    }
-    for (const auto& p : plan.axes) {
-      const char a = dsp::comp::axis_letter(p.axis);
-      if (p.table)
-        std::printf("comp: %c table, %zu points %.3f .. %.3f mm, lost motion in it %.2f um (%s)\n", a,
-                    p.table->pos_mm.size(), p.table->first_mm(), p.table->last_mm(), p.table->mean_lost_motion_um(),
-                    p.source.c_str());
-      else
-        std::printf("comp: %c backlash %.2f um (%s)\n", a, *p.lost_motion_um, p.source.c_str());
-    }
-    for (const auto& u : plan.unresolved_used)
-      std::printf("comp: WARNING proposed from an unresolved figure (--allow-unresolved): %s\n", u.c_str());
-    for (const auto& u : plan.unresolved_skipped)
-      std::printf("comp: left out, not resolved (--skip-unresolved): %s\n", u.c_str());
-    std::printf("comp: %zu files -> %s\n", files.size(), o->out.c_str());
-  });
+// comp.json: which figure each term comes from, the inputs, the files written.
+nlohmann::json comp_json(const comp::Plan& plan, const nlohmann::json& axes, const std::vector<comp::CompInput>& inputs,
+                         const std::vector<OutputFile>& files) {
+  nlohmann::json j = {{"format", "eical-comp/1"},
+                      {"sign_convention",
+                       "deviation = actual - nominal; correction = -deviation, what the control adds to the command"},
+                      {"axes", axes},
+                      {"figures", plan.figures},
+                      {"not_compensated", plan.not_compensated},
+                      {"skipped", plan.skipped}};
+  nlohmann::json ins = nlohmann::json::array();
+  for (const auto& in : inputs)
+    ins.push_back({{"input", in.name}, {"run_id", in.run_id}, {"program", in.result.value("program", std::string())}});
+  j["inputs"] = ins;
+  if (!plan.unresolved_used.empty()) j["proposed_from_unresolved_figures"] = plan.unresolved_used;
+  if (!plan.unresolved_skipped.empty()) j["left_out_unresolved_figures"] = plan.unresolved_skipped;
+  nlohmann::json names = nlohmann::json::array();
+  for (const auto& f : files) names.push_back(f.path);
+  j["files"] = names;
+  return j;
+}
+
+// Nothing is written unless everything can be: existing files first.
+void write_all_or_nothing(const std::vector<OutputFile>& files, const CompOptions& o) {
+  std::vector<std::string> existing;
+  for (const auto& f : files)
+    if (fs::exists(fs::path(o.out) / f.path)) existing.push_back((fs::path(o.out) / f.path).string());
+  if (!existing.empty() && !o.force) {
+    std::string msg = "comp: would overwrite " + std::to_string(existing.size()) +
+                      " existing file(s), nothing written (--force to replace them):";
+    for (const auto& e : existing) msg += "\n  " + e;
+    throw dsp::InputError(msg);
+  }
+  for (const auto& f : files) {
+    const fs::path p = fs::path(o.out) / f.path;
+    fs::create_directories(p.parent_path());
+    write_file_atomic(p, f.text);
+  }
+}
+
+void print_proposal(const comp::Plan& plan, std::size_t n_files, const CompOptions& o) {
+  for (const auto& p : plan.axes) {
+    const char a = dsp::comp::axis_letter(p.axis);
+    if (p.table)
+      std::printf("comp: %c table, %zu points %.3f .. %.3f mm, lost motion in it %.2f um (%s)\n", a,
+                  p.table->pos_mm.size(), p.table->first_mm(), p.table->last_mm(), p.table->mean_lost_motion_um(),
+                  p.source.c_str());
+    else
+      std::printf("comp: %c backlash %.2f um (%s)\n", a, *p.lost_motion_um, p.source.c_str());
+  }
+  for (const auto& u : plan.unresolved_used)
+    std::printf("comp: WARNING proposed from an unresolved figure (--allow-unresolved): %s\n", u.c_str());
+  for (const auto& u : plan.unresolved_skipped)
+    std::printf("comp: left out, not resolved (--skip-unresolved): %s\n", u.c_str());
+  std::printf("comp: %zu files -> %s\n", n_files, o.out.c_str());
+}
+
+void run_comp(const CompOptions& o) {
+  std::vector<comp::CompInput> inputs;
+  for (const auto& p : o.inputs) inputs.push_back(comp::load_comp_input(p));
+  const comp::Plan plan = comp_plan(inputs, o);
+  nlohmann::json axes = nlohmann::json::object();
+  for (const auto& p : plan.axes) axes[std::string(1, dsp::comp::axis_letter(p.axis))] = axis_json(p);
+  std::vector<OutputFile> files = control_files(plan, o, axes);
+  files.push_back({"comp.json", comp_json(plan, axes, inputs, files).dump(2) + "\n"});
+  write_all_or_nothing(files, o);
+  print_proposal(plan, files.size(), o);
+}
+
+}  // namespace
+
+void register_comp(CLI::App& app) {
+  auto o = std::make_shared<CompOptions>();
+  auto* cmd = app.add_subcommand(
+      "comp",
+      "Propose axis compensation (tables with the reversal folded in, backlash) for the control from measured results");
+  add_comp_options(*cmd, *o);
+  cmd->callback([o] { run_comp(*o); });
 }
 
 }  // namespace eical::tools

@@ -45,90 +45,102 @@ std::string prediction_text(const plan::Prediction& p) {
   return o + b;
 }
 
+// What `eical plan` is told: the test program, its strips, how hard to look.
+struct PlanCommandOptions {
+  plan::TestProgram p;
+  std::string psd = "none";
+  std::vector<std::string> strips;
+  std::vector<double> size{50.0, 50.0};
+  bool json = false;
+  int draws = 100;
+  double max_s = 60.0;
+};
+
+void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
+  cmd.add_option("--program", o.p.kind, "circle, positioning, step or rectangle")
+      ->default_val("circle")
+      ->check(CLI::IsMember({"circle", "positioning", "step", "rectangle"}));
+  cmd.add_option("--radius", o.p.radius_mm, "circle radius, mm")->default_val(10.0)->check(CLI::PositiveNumber);
+  cmd.add_option("--feed", o.p.feed_mm_min, "feed, mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
+  cmd.add_option("--repeats", o.p.repeats, "circle revolutions per direction, rectangle laps")
+      ->default_val(5)
+      ->check(CLI::Range(1, 1000));
+  cmd.add_option("--direction", o.p.direction, "circle: ccw, cw or both")
+      ->default_val("ccw")
+      ->check(CLI::IsMember({"ccw", "cw", "both"}));
+  cmd.add_option("--plane", o.p.plane, "circle, rectangle: xy, zx or yz")
+      ->default_val("xy")
+      ->check(CLI::IsMember({"xy", "zx", "yz"}));
+  cmd.add_option("--arc-deg", o.p.arc_deg, "circle: evaluated arc in deg")
+      ->default_val(360.0)
+      ->check(CLI::Range(1.0, 360.0));
+  cmd.add_option("--targets", o.p.targets_mm, "positioning: targets on x, mm (comma separated)")->delimiter(',');
+  cmd.add_option("--runs", o.p.runs, "positioning: runs; step: there-and-back pairs")
+      ->default_val(5)
+      ->check(CLI::Range(1, 1000));
+  cmd.add_option("--from", o.p.from_mm, "step: start on x, mm")->default_val(0.0);
+  cmd.add_option("--to", o.p.to_mm, "step: end on x, mm")->default_val(50.0);
+  cmd.add_option("--size", o.size, "rectangle: side lengths, mm (two values, comma separated)")
+      ->expected(2)
+      ->delimiter(',');
+  cmd.add_option("--psd", o.psd,
+                 "PSD strips: none, B (configuration B about the circle, one at mid travel, mid sides of a rectangle)")
+      ->default_val("none")
+      ->check(CLI::IsMember({"none", "B"}));
+  cmd.add_option("--strip", o.strips, "a strip on the machine as MEASURES:CX,CY, e.g. x:0,-10 (repeat for each)");
+  cmd.add_option("--noise", o.p.noise_ug_per_rthz, "each sensor's noise density, ug/sqrt(Hz) (two-sided)")
+      ->default_val(0.4)
+      ->check(CLI::PositiveNumber);
+  cmd.add_option("--fs", o.p.fs_hz, "DAQ sampling rate, Hz")->default_val(10000.0)->check(CLI::Range(1000.0, 100000.0));
+  cmd.add_option("--draws", o.draws, "Monte Carlo draws per prediction")
+      ->default_val(100)
+      ->check(CLI::Range(10, 100000));
+  cmd.add_option("--max-duration", o.max_s, "variants that run longer than this (s) are not tried")
+      ->default_val(60.0)
+      ->check(CLI::PositiveNumber);
+  cmd.add_flag("--json", o.json, "print the prediction as JSON");
+}
+
+// The test as asked: its rectangle size and PSD strips.
+plan::TestProgram test_program(const PlanCommandOptions& o) {
+  plan::TestProgram p = o.p;
+  p.size_mm[0] = o.size.at(0), p.size_mm[1] = o.size.at(1);
+  if (o.psd == "B") p.psd = plan::strips_for(p);
+  for (const auto& s : o.strips) p.psd.push_back(parse_psd(s));
+  return p;
+}
+
+void run_plan(const PlanCommandOptions& o) {
+  const plan::TestProgram p = test_program(o);
+  const plan::Prediction r = plan::predict(p, 1, o.draws);
+  std::optional<plan::Prediction> better;
+  if (!r.measurable) better = plan::nearest_measurable(p, o.max_s, o.draws);
+  if (o.json) {
+    nlohmann::json j = {{"format", "eical-plan/1"}, {"prediction", prediction_json(r)}};
+    j["nearest_measurable"] = better ? prediction_json(*better) : nlohmann::json(nullptr);
+    std::printf("%s\n", j.dump(2).c_str());
+    return;
+  }
+  std::string text = prediction_text(r);
+  if (!r.measurable) {
+    if (better)
+      text += "\nnearest measurable variant:\n" + prediction_text(*better);
+    else {
+      text += "\nno variant within " + std::to_string(static_cast<int>(o.max_s)) + " s is measurable; tried:\n";
+      for (const auto& v : plan::variants(p)) text += "  " + plan::describe(v) + "\n";
+    }
+  }
+  std::fputs(text.c_str(), stdout);
+}
+
 }  // namespace
 
 void register_plan(CLI::App& app) {
-  struct Opt {
-    plan::TestProgram p;
-    std::string psd = "none";
-    std::vector<std::string> strips;
-    std::vector<double> size{50.0, 50.0};
-    bool json = false;
-    int draws = 100;
-    double max_s = 60.0;
-  };
-  auto o = std::make_shared<Opt>();
+  auto o = std::make_shared<PlanCommandOptions>();
   auto* cmd = app.add_subcommand(
       "plan", "Predict the uncertainty of a test before it runs; propose the nearest measurable variant");
-  cmd->add_option("--program", o->p.kind, "circle, positioning, step or rectangle")
-      ->default_val("circle")
-      ->check(CLI::IsMember({"circle", "positioning", "step", "rectangle"}));
-  cmd->add_option("--radius", o->p.radius_mm, "circle radius, mm")->default_val(10.0)->check(CLI::PositiveNumber);
-  cmd->add_option("--feed", o->p.feed_mm_min, "feed, mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
-  cmd->add_option("--repeats", o->p.repeats, "circle revolutions per direction, rectangle laps")
-      ->default_val(5)
-      ->check(CLI::Range(1, 1000));
-  cmd->add_option("--direction", o->p.direction, "circle: ccw, cw or both")
-      ->default_val("ccw")
-      ->check(CLI::IsMember({"ccw", "cw", "both"}));
-  cmd->add_option("--plane", o->p.plane, "circle, rectangle: xy, zx or yz")
-      ->default_val("xy")
-      ->check(CLI::IsMember({"xy", "zx", "yz"}));
-  cmd->add_option("--arc-deg", o->p.arc_deg, "circle: evaluated arc in deg")
-      ->default_val(360.0)
-      ->check(CLI::Range(1.0, 360.0));
-  cmd->add_option("--targets", o->p.targets_mm, "positioning: targets on x, mm (comma separated)")->delimiter(',');
-  cmd->add_option("--runs", o->p.runs, "positioning: runs; step: there-and-back pairs")
-      ->default_val(5)
-      ->check(CLI::Range(1, 1000));
-  cmd->add_option("--from", o->p.from_mm, "step: start on x, mm")->default_val(0.0);
-  cmd->add_option("--to", o->p.to_mm, "step: end on x, mm")->default_val(50.0);
-  cmd->add_option("--size", o->size, "rectangle: side lengths, mm (two values, comma separated)")
-      ->expected(2)
-      ->delimiter(',');
-  cmd->add_option("--psd", o->psd,
-                  "PSD strips: none, B (configuration B about the circle, one at mid travel, mid sides of a rectangle)")
-      ->default_val("none")
-      ->check(CLI::IsMember({"none", "B"}));
-  cmd->add_option("--strip", o->strips, "a strip on the machine as MEASURES:CX,CY, e.g. x:0,-10 (repeat for each)");
-  cmd->add_option("--noise", o->p.noise_ug_per_rthz, "each sensor's noise density, ug/sqrt(Hz) (two-sided)")
-      ->default_val(0.4)
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--fs", o->p.fs_hz, "DAQ sampling rate, Hz")
-      ->default_val(10000.0)
-      ->check(CLI::Range(1000.0, 100000.0));
-  cmd->add_option("--draws", o->draws, "Monte Carlo draws per prediction")
-      ->default_val(100)
-      ->check(CLI::Range(10, 100000));
-  cmd->add_option("--max-duration", o->max_s, "variants that run longer than this (s) are not tried")
-      ->default_val(60.0)
-      ->check(CLI::PositiveNumber);
-  cmd->add_flag("--json", o->json, "print the prediction as JSON");
-  cmd->callback([o] {
-    plan::TestProgram p = o->p;
-    p.size_mm[0] = o->size.at(0), p.size_mm[1] = o->size.at(1);
-    if (o->psd == "B") p.psd = plan::strips_for(p);
-    for (const auto& s : o->strips) p.psd.push_back(parse_psd(s));
-    const plan::Prediction r = plan::predict(p, 1, o->draws);
-    std::optional<plan::Prediction> better;
-    if (!r.measurable) better = plan::nearest_measurable(p, o->max_s, o->draws);
-    if (o->json) {
-      nlohmann::json j = {{"format", "eical-plan/1"}, {"prediction", prediction_json(r)}};
-      j["nearest_measurable"] = better ? prediction_json(*better) : nlohmann::json(nullptr);
-      std::printf("%s\n", j.dump(2).c_str());
-      return;
-    }
-    std::string text = prediction_text(r);
-    if (!r.measurable) {
-      if (better)
-        text += "\nnearest measurable variant:\n" + prediction_text(*better);
-      else {
-        text += "\nno variant within " + std::to_string(static_cast<int>(o->max_s)) + " s is measurable; tried:\n";
-        for (const auto& v : plan::variants(p)) text += "  " + plan::describe(v) + "\n";
-      }
-    }
-    std::fputs(text.c_str(), stdout);
-  });
+  add_plan_options(*cmd, *o);
+  cmd->callback([o] { run_plan(*o); });
 }
 
 }  // namespace eical::tools

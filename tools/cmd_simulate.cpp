@@ -17,7 +17,8 @@
 namespace eical::tools {
 namespace {
 
-struct Opt {
+// What `eical simulate` is told (its options, add_*_options below).
+struct SimulateOptions {
   std::string program = "circle", direction = "ccw", plane = "xy", out, scenario, psd = "none";
   double arc_deg = 360.0, radius_mm = 10.0, feed_mm_min = 2500.0, noise_ug = 0.4, from_mm = 0.0, to_mm = 50.0;
   int repeats = 5, runs = 2;
@@ -59,7 +60,7 @@ sim::StructuralMode parse_mode(const std::string& text) {
   return m;
 }
 
-sim::nc::KlipperTest sweep_test(const Opt& o) {
+sim::nc::KlipperTest sweep_test(const SimulateOptions& o) {
   sim::nc::KlipperTest k = o.klipper_legacy ? sim::nc::KlipperTest::legacy() : sim::nc::KlipperTest::current();
   if (o.freq_start > 0.0) k.freq_start_hz = o.freq_start;
   if (o.freq_end > 0.0) k.freq_end_hz = o.freq_end;
@@ -70,7 +71,7 @@ sim::nc::KlipperTest sweep_test(const Opt& o) {
   return k;
 }
 
-sim::Scenario base_scenario(const Opt& o, bool program_given) {
+sim::Scenario base_scenario(const SimulateOptions& o, bool program_given) {
   if (!o.regime.empty()) {
     if (!o.scenario.empty() || program_given)
       throw dsp::InputError("simulate --regime: the regime sets the program (no --scenario or --program)");
@@ -109,7 +110,7 @@ sim::Scenario base_scenario(const Opt& o, bool program_given) {
 
 // The regime flags on top of the scenario: chip and rate first (they set the data sheet),
 // then which sensors, the mounting and the modes.
-void apply_regime_flags(const Opt& o, sim::Scenario& sc) {
+void apply_regime_flags(const SimulateOptions& o, sim::Scenario& sc) {
   const bool fixed = !o.regime.empty();
   if (fixed &&
       (!o.mems.empty() || o.fs_hz > 0.0 || !o.sensors.empty() || !o.wrong_mounting.empty() || !o.resonance.empty()))
@@ -136,11 +137,8 @@ void apply_regime_flags(const Opt& o, sim::Scenario& sc) {
   }
 }
 
-}  // namespace
-
-void register_simulate(CLI::App& app) {
-  auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("simulate", "Simulate a machine and its sensors; write a recorded run (eical-run/1)");
+// --hide, --background, --scenario and the program with its sizes.
+void add_program_options(CLI::App& cmd, SimulateOptions& o) {
   std::string effects_help =
       "hide these effects (comma separated; run-format.md names) among tolerance-level deviations of sensors, machine, "
       "PSD strips and KGM, at the sizes a faulty machine shows (sim/hidden/hidden_effects.cpp); with --program circle "
@@ -148,123 +146,154 @@ void register_simulate(CLI::App& app) {
       "(default: the program the first effect shows best in), --seed; with --regime klipper-like: machine.resonance, "
       "sensor.misalignment. Names:";
   for (const auto& e : sim::hideable_effects()) effects_help += " " + e;
-  cmd->add_option("--hide", o->hide, effects_help)->delimiter(',')->check(CLI::IsMember(sim::hideable_effects()));
-  cmd->add_flag("--background", o->background,
-                "a baseline with the tolerance-level deviations only (no effect hidden)");
-  auto* scenario = cmd->add_option("--scenario", o->scenario,
-                                   "scenario file (eical-scenario/1, config/scenarios/README.md): machine errors, "
-                                   "vibration, sensor truth, every effect")
+  cmd.add_option("--hide", o.hide, effects_help)->delimiter(',')->check(CLI::IsMember(sim::hideable_effects()));
+  cmd.add_flag("--background", o.background, "a baseline with the tolerance-level deviations only (no effect hidden)");
+  auto* scenario = cmd.add_option("--scenario", o.scenario,
+                                  "scenario file (eical-scenario/1, config/scenarios/README.md): machine errors, "
+                                  "vibration, sensor truth, every effect")
                        ->check(CLI::ExistingFile);
-  cmd->add_option(
-         "--program", o->program,
+  cmd.add_option(
+         "--program", o.program,
          "circle, step, positioning, rectangle, freeform, identify or sweep (Klipper's resonance test, no standstill)")
       ->default_val("circle")
       ->check(CLI::IsMember({"circle", "step", "positioning", "rectangle", "freeform", "identify", "sweep"}))
       ->excludes(scenario);
-  cmd->add_option(
-         "--psd", o->psd,
+  cmd.add_option(
+         "--psd", o.psd,
          "PSD strips: B (configuration B of the sample runs, for a circle of --radius), none; identify: B by default")
       ->default_val("none")
       ->check(CLI::IsMember({"B", "none"}));
-  cmd->add_option("--plane", o->plane, "circle, rectangle: xy, zx or yz")
+  cmd.add_option("--plane", o.plane, "circle, rectangle: xy, zx or yz")
       ->default_val("xy")
       ->check(CLI::IsMember({"xy", "zx", "yz"}));
-  cmd->add_option("--arc-deg", o->arc_deg, "circle: evaluated arc in deg (below 360: partial arc, up to 340)")
+  cmd.add_option("--arc-deg", o.arc_deg, "circle: evaluated arc in deg (below 360: partial arc, up to 340)")
       ->default_val(360.0)
       ->check(CLI::Range(1.0, 360.0));
-  cmd->add_option("--targets", o->targets, "positioning: targets on x, mm (comma separated)")->delimiter(',');
-  cmd->add_option("--radius", o->radius_mm, "circle radius, mm")->default_val(10.0)->check(CLI::PositiveNumber);
-  cmd->add_option("--feed", o->feed_mm_min, "feed, mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
-  cmd->add_option("--repeats", o->repeats, "circle revolutions")->default_val(5)->check(CLI::Range(1, 1000));
-  cmd->add_option("--direction", o->direction, "ccw, cw or both")
+  cmd.add_option("--targets", o.targets, "positioning: targets on x, mm (comma separated)")->delimiter(',');
+  cmd.add_option("--radius", o.radius_mm, "circle radius, mm")->default_val(10.0)->check(CLI::PositiveNumber);
+  cmd.add_option("--feed", o.feed_mm_min, "feed, mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
+  cmd.add_option("--repeats", o.repeats, "circle revolutions")->default_val(5)->check(CLI::Range(1, 1000));
+  cmd.add_option("--direction", o.direction, "ccw, cw or both")
       ->default_val("ccw")
       ->check(CLI::IsMember({"ccw", "cw", "both"}));
-  cmd->add_option("--from", o->from_mm, "step: start position on x, mm")->default_val(0.0);
-  cmd->add_option("--to", o->to_mm, "step: end position on x, mm")->default_val(50.0);
-  cmd->add_option("--runs", o->runs, "step: there-and-back pairs")->default_val(2)->check(CLI::Range(1, 1000));
-  cmd->add_option("--noise", o->noise_ug, "sensor noise density, ug/sqrt(Hz) (two-sided)")
+  cmd.add_option("--from", o.from_mm, "step: start position on x, mm")->default_val(0.0);
+  cmd.add_option("--to", o.to_mm, "step: end position on x, mm")->default_val(50.0);
+  cmd.add_option("--runs", o.runs, "step: there-and-back pairs")->default_val(2)->check(CLI::Range(1, 1000));
+}
+
+// The noise, the seed and where the run goes.
+void add_output_options(CLI::App& cmd, SimulateOptions& o) {
+  cmd.add_option("--noise", o.noise_ug, "sensor noise density, ug/sqrt(Hz) (two-sided)")
       ->default_val(0.4)
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--seed", o->seed, "random seed (same seed, same run)")->default_val(1);
-  cmd->add_option("-o,--out", o->out, "run directory to write")->required();
-  cmd->add_flag("--gzip", o->gzip, "write samples.csv.gz");
-  cmd->add_flag("--overwrite", o->overwrite, "replace an existing run");
-  // Regimes of runs measured by other systems (config/scenarios/README.md has the keys).
-  cmd->add_option(
-         "--regime", o->regime,
+  cmd.add_option("--seed", o.seed, "random seed (same seed, same run)")->default_val(1);
+  cmd.add_option("-o,--out", o.out, "run directory to write")->required();
+  cmd.add_flag("--gzip", o.gzip, "write samples.csv.gz");
+  cmd.add_flag("--overwrite", o.overwrite, "replace an existing run");
+}
+
+// Regimes of runs measured by other systems (config/scenarios/README.md has the keys).
+void add_regime_options(CLI::App& cmd, SimulateOptions& o) {
+  cmd.add_option(
+         "--regime", o.regime,
          "klipper-like: a CoreXY head under Klipper's resonance test, head MEMS sensor only (400 Hz .. 3.2 kHz), "
          "two modes 30-80 Hz, per --seed (sim/regimes/klipper_like.hpp); with --hide, --background, --export")
       ->check(CLI::IsMember({sim::kKlipperLike}));
-  cmd->add_option("--sensors", o->sensors, "both, head or table: the absent triplex's columns are written empty")
+  cmd.add_option("--sensors", o.sensors, "both, head or table: the absent triplex's columns are written empty")
       ->check(CLI::IsMember({"both", "head", "table"}));
-  cmd->add_option("--fs", o->fs_hz,
-                  "sample rate, Hz: the DAQ's (100 .. 51200, anti-alias filter kept) or, with --mems, the chip's "
-                  "output data rate")
+  cmd.add_option("--fs", o.fs_hz,
+                 "sample rate, Hz: the DAQ's (100 .. 51200, anti-alias filter kept) or, with --mems, the chip's "
+                 "output data rate")
       ->check(CLI::Range(100.0, 51200.0));
   std::vector<std::string> chips;
   for (const auto& c : sim::mems_chips()) chips.push_back(c.name);
-  cmd->add_option(
-         "--mems", o->mems,
-         "both sensors a digital MEMS chip: its resolution, noise and low-pass, no anti-alias filter (aliasing), "
-         "no DAQ delay (sim/sensor/mems_chip.hpp)")
+  cmd.add_option("--mems", o.mems,
+                 "both sensors a digital MEMS chip: its resolution, noise and low-pass, no anti-alias filter "
+                 "(aliasing), no DAQ delay (sim/sensor/mems_chip.hpp)")
       ->check(CLI::IsMember(chips));
-  cmd->add_option("--wrong-mounting", o->wrong_mounting,
-                  "the (head, else table) sensor truly mounted as this axes map applied to run.toml's "
-                  "to_machine: a sign flip (-x,-y,z), a swap (y,x,z), a mirror (-x,y,z)");
-  cmd->add_option("--resonance", o->resonance,
-                  "a structural mode FREQ_HZ,DAMPING_RATIO,GAIN,AXIS between the drive and the measured point "
-                  "(machine.resonance; repeat for more modes)");
-  cmd->add_option("--sweep-axis", o->sweep_axis, "sweep: Klipper's AXIS (x, y, z or dx,dy[,dz])")->default_val("x");
-  cmd->add_flag("--klipper-legacy", o->klipper_legacy,
-                "sweep: the older Klipper test (max_freq 133.33 Hz, 75 mm/s2 per Hz, no sweeping)");
-  cmd->add_option("--freq-start", o->freq_start, "sweep: FREQ_START, Hz (default 5)");
-  cmd->add_option("--freq-end", o->freq_end, "sweep: FREQ_END, Hz (default 200, legacy 133.33)");
-  cmd->add_option("--hz-per-sec", o->hz_per_sec, "sweep: HZ_PER_SEC (default 1)");
-  cmd->add_option("--accel-per-hz", o->accel_per_hz, "sweep: ACCEL_PER_HZ, mm/s2 per Hz (default 60, legacy 75)");
-  cmd->add_option("--sweeping-accel", o->sweeping_accel, "sweep: SWEEPING_ACCEL, mm/s2 (default 400, legacy 0)");
-  cmd->add_option("--sweeping-period", o->sweeping_period, "sweep: SWEEPING_PERIOD, s (default 1.2, legacy 0)");
-  cmd->add_option("--export", o->export_to,
-                  "also write the run as another system records it, with jittered stamps: 'klipper FILE' (a raw "
-                  "accelerometer capture) or 'csv PREFIX' (PREFIX-accel.csv and an NC trace); truth.toml [export]")
+  cmd.add_option("--wrong-mounting", o.wrong_mounting,
+                 "the (head, else table) sensor truly mounted as this axes map applied to run.toml's "
+                 "to_machine: a sign flip (-x,-y,z), a swap (y,x,z), a mirror (-x,y,z)");
+  cmd.add_option("--resonance", o.resonance,
+                 "a structural mode FREQ_HZ,DAMPING_RATIO,GAIN,AXIS between the drive and the measured point "
+                 "(machine.resonance; repeat for more modes)");
+}
+
+// Klipper's resonance test (--program sweep).
+void add_sweep_options(CLI::App& cmd, SimulateOptions& o) {
+  cmd.add_option("--sweep-axis", o.sweep_axis, "sweep: Klipper's AXIS (x, y, z or dx,dy[,dz])")->default_val("x");
+  cmd.add_flag("--klipper-legacy", o.klipper_legacy,
+               "sweep: the older Klipper test (max_freq 133.33 Hz, 75 mm/s2 per Hz, no sweeping)");
+  cmd.add_option("--freq-start", o.freq_start, "sweep: FREQ_START, Hz (default 5)");
+  cmd.add_option("--freq-end", o.freq_end, "sweep: FREQ_END, Hz (default 200, legacy 133.33)");
+  cmd.add_option("--hz-per-sec", o.hz_per_sec, "sweep: HZ_PER_SEC (default 1)");
+  cmd.add_option("--accel-per-hz", o.accel_per_hz, "sweep: ACCEL_PER_HZ, mm/s2 per Hz (default 60, legacy 75)");
+  cmd.add_option("--sweeping-accel", o.sweeping_accel, "sweep: SWEEPING_ACCEL, mm/s2 (default 400, legacy 0)");
+  cmd.add_option("--sweeping-period", o.sweeping_period, "sweep: SWEEPING_PERIOD, s (default 1.2, legacy 0)");
+}
+
+// The run as another system records it (--export).
+void add_export_options(CLI::App& cmd, SimulateOptions& o) {
+  cmd.add_option("--export", o.export_to,
+                 "also write the run as another system records it, with jittered stamps: 'klipper FILE' (a raw "
+                 "accelerometer capture) or 'csv PREFIX' (PREFIX-accel.csv and an NC trace); truth.toml [export]")
       ->expected(2);
-  cmd->add_option("--export-nc", o->export_nc,
-                  "csv export: NC trace as halsampler (PREFIX-nc.txt) or csv (PREFIX-nc.csv)")
+  cmd.add_option("--export-nc", o.export_nc,
+                 "csv export: NC trace as halsampler (PREFIX-nc.txt) or csv (PREFIX-nc.csv)")
       ->check(CLI::IsMember({"halsampler", "csv"}));
-  cmd->add_option("--export-offset-s", o->export_offset_s,
-                  "export: the capture clock at the run's t = 0, s (klipper-like: drawn)");
-  cmd->add_option("--export-jitter-us", o->export_jitter_us,
-                  "export: stamp jitter rms, us (default 5 % of a sample; klipper-like: drawn)")
+  cmd.add_option("--export-offset-s", o.export_offset_s,
+                 "export: the capture clock at the run's t = 0, s (klipper-like: drawn)");
+  cmd.add_option("--export-jitter-us", o.export_jitter_us,
+                 "export: stamp jitter rms, us (default 5 % of a sample; klipper-like: drawn)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--export-lost-batches", o->export_lost_batches, "export: batches lost (gaps)")
+  cmd.add_option("--export-lost-batches", o.export_lost_batches, "export: batches lost (gaps)")
       ->check(CLI::Range(0, 1000));
-  cmd->add_option("--export-batch", o->export_batch, "export: samples per batch")->check(CLI::Range(1, 4096));
-  cmd->add_option("--export-nc-offset-s", o->export_nc_offset_s, "csv export: the NC clock at the run's t = 0, s");
+  cmd.add_option("--export-batch", o.export_batch, "export: samples per batch")->check(CLI::Range(1, 4096));
+  cmd.add_option("--export-nc-offset-s", o.export_nc_offset_s, "csv export: the NC clock at the run's t = 0, s");
+}
+
+// The capture clock and files of --export: drawn for a regime, else from the flags.
+ExportRequest export_request(const SimulateOptions& o, double fs) {
+  ExportRequest req;
+  req.kind = o.export_to[0], req.target = o.export_to[1], req.nc_format = o.export_nc,
+  req.nc_offset_s = o.export_nc_offset_s;
+  if (!o.regime.empty()) {
+    req.clock = sim::klipper_like_capture_clock(o.seed, fs);
+  } else {
+    req.clock.offset_s = o.export_offset_s;
+    req.clock.jitter_rms_s = o.export_jitter_us >= 0.0 ? o.export_jitter_us * 1e-6 : 0.05 / fs;
+    req.clock.lost_batches = o.export_lost_batches, req.clock.batch = o.export_batch, req.clock.seed = o.seed;
+  }
+  return req;
+}
+
+void run_simulate(const SimulateOptions& o, bool program_given) {
+  sim::Scenario sc = base_scenario(o, program_given);
+  apply_regime_flags(o, sc);
+  if (!o.export_to.empty()) {
+    const double fs = sc.meta.acquisition.fs_hz;
+    const std::string line = simulate_with_export(sc, export_request(o, fs), o.out, o.gzip, o.overwrite);
+    std::printf("wrote %s (program %s, %.0f Hz)\n%s\n", o.out.c_str(), sc.meta.program.kind.c_str(), fs, line.c_str());
+    return;
+  }
+  const dsp::Run run = sim::simulate(sc);
+  drivers::write_run(run, o.out, {.gzip = o.gzip, .overwrite = o.overwrite});
+  std::printf("wrote %s: %zu samples, %.2f s, program %s\n", o.out.c_str(), run.frames.size(),
+              static_cast<double>(run.frames.size()) / run.meta.acquisition.fs_hz, run.meta.program.kind.c_str());
+}
+
+}  // namespace
+
+void register_simulate(CLI::App& app) {
+  auto o = std::make_shared<SimulateOptions>();
+  auto* cmd = app.add_subcommand("simulate", "Simulate a machine and its sensors; write a recorded run (eical-run/1)");
+  add_program_options(*cmd, *o);
+  add_output_options(*cmd, *o);
+  add_regime_options(*cmd, *o);
+  add_sweep_options(*cmd, *o);
+  add_export_options(*cmd, *o);
   auto* program_opt = cmd->get_option("--program");
-  cmd->callback([o, program_opt] {
-    sim::Scenario sc = base_scenario(*o, program_opt->count() > 0);
-    apply_regime_flags(*o, sc);
-    if (!o->export_to.empty()) {
-      ExportRequest req;
-      req.kind = o->export_to[0], req.target = o->export_to[1], req.nc_format = o->export_nc,
-      req.nc_offset_s = o->export_nc_offset_s;
-      const double fs = sc.meta.acquisition.fs_hz;
-      if (!o->regime.empty()) {
-        req.clock = sim::klipper_like_capture_clock(o->seed, fs);
-      } else {
-        req.clock.offset_s = o->export_offset_s;
-        req.clock.jitter_rms_s = o->export_jitter_us >= 0.0 ? o->export_jitter_us * 1e-6 : 0.05 / fs;
-        req.clock.lost_batches = o->export_lost_batches, req.clock.batch = o->export_batch, req.clock.seed = o->seed;
-      }
-      const std::string line = simulate_with_export(sc, req, o->out, o->gzip, o->overwrite);
-      std::printf("wrote %s (program %s, %.0f Hz)\n%s\n", o->out.c_str(), sc.meta.program.kind.c_str(), fs,
-                  line.c_str());
-      return;
-    }
-    const dsp::Run run = sim::simulate(sc);
-    drivers::write_run(run, o->out, {.gzip = o->gzip, .overwrite = o->overwrite});
-    std::printf("wrote %s: %zu samples, %.2f s, program %s\n", o->out.c_str(), run.frames.size(),
-                static_cast<double>(run.frames.size()) / run.meta.acquisition.fs_hz, run.meta.program.kind.c_str());
-  });
+  cmd->callback([o, program_opt] { run_simulate(*o, program_opt->count() > 0); });
 }
 
 }  // namespace eical::tools

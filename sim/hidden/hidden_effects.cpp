@@ -122,8 +122,12 @@ int moving_axis(const Scenario& sc, Draw& d) {
   return sc.meta.program.kind == "circle" ? pick : 0;
 }
 
-void inject(Scenario& sc, const std::string& e, Draw& d) {
-  auto& m = sc.machine;
+[[noreturn]] void unknown_effect(const std::string& e) {
+  throw dsp::InputError("hidden effects: unknown effect '" + e + "'");
+}
+
+// sensor.*: into the sensor that moves an axis of the program (both sensors' cases warm).
+void inject_sensor(Scenario& sc, const std::string& e, Draw& d) {
   if (e == "sensor.scale") {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
     for (int i = 0; i < 3; ++i)
@@ -167,12 +171,14 @@ void inject(Scenario& sc, const std::string& e, Draw& d) {
       t.spec.tc_bias_ug_per_c = sc.meta.sensors[s].tc_bias_ug_per_c + d.mag(100.0, 200.0);
       t.spec.tc_k1_ppm_per_c = sc.meta.sensors[s].tc_k1_ppm_per_c + d.mag(50.0, 150.0);
     }
-  } else if (e == "daq.group_delay") {
-    sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples + d.mag(0.8, 2.0);
-    if (d.pick(2) == 1) sc.daq.skew_head_samples = d.mag(0.3, 1.0);
-  } else if (e == "site.coriolis") {
-    sc.coriolis = true;
-  } else if (e == "machine.common_vibration") {
+  } else {
+    unknown_effect(e);
+  }
+}
+
+// The vibration common to table and head, and the head's against the table.
+void inject_vibration(Scenario& sc, const std::string& e, Draw& d) {
+  if (e == "machine.common_vibration") {
     auto& v = sc.common_vibration;
     Tone drive;
     drive.freq_hz = 100.0, drive.amp_mg = Eigen::Vector3d(d.u(1.0, 4.0), d.u(1.0, 3.0), d.u(0.5, 1.5)),
@@ -191,7 +197,15 @@ void inject(Scenario& sc, const std::string& e, Draw& d) {
     t.freq_hz = d.u(30.0, 60.0), t.amp_mg = Eigen::Vector3d(d.u(0.5, 1.5), d.u(0.5, 1.5), d.u(0.2, 0.5)),
     t.phase_deg = d.u(0, 360);
     sc.differential_tones = {t};
-  } else if (e == "machine.backlash") {
+  } else {
+    unknown_effect(e);
+  }
+}
+
+// The errors of an axis the program moves (squareness: of the xy pair).
+void inject_machine(Scenario& sc, const std::string& e, Draw& d) {
+  auto& m = sc.machine;
+  if (e == "machine.backlash") {
     m.backlash_um[moving_axis(sc, d)] = d.u(3.0, 10.0);
   } else if (e == "machine.reversal_spike") {
     m.spike[moving_axis(sc, d)] = ReversalSpike{d.u(2.0, 6.0), d.u(10.0, 25.0)};
@@ -224,7 +238,23 @@ void inject(Scenario& sc, const std::string& e, Draw& d) {
     sc.resonance.part =
         std::find(head.begin(), head.end(), std::string(1, static_cast<char>('x' + a))) != head.end() ? 1 : 0;
   } else {
-    throw dsp::InputError("hidden effects: unknown effect '" + e + "'");
+    unknown_effect(e);
+  }
+}
+
+// The effect e on top of the background, its sizes drawn from d.
+void inject(Scenario& sc, const std::string& e, Draw& d) {
+  if (e.rfind("sensor.", 0) == 0) {
+    inject_sensor(sc, e, d);
+  } else if (e == "daq.group_delay") {
+    sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples + d.mag(0.8, 2.0);
+    if (d.pick(2) == 1) sc.daq.skew_head_samples = d.mag(0.3, 1.0);
+  } else if (e == "site.coriolis") {
+    sc.coriolis = true;
+  } else if (e == "machine.common_vibration" || e == "machine.differential_vibration") {
+    inject_vibration(sc, e, d);
+  } else {
+    inject_machine(sc, e, d);
   }
 }
 

@@ -125,91 +125,113 @@ PathElement element_of(const gcode::Arc& a) {
   return e;
 }
 
+// The open chain of blended elements and the triggers waiting for their path position.
+struct Chain {
+  std::vector<PathElement> elements;
+  double feed_mm_s = 0.0;                        // the lowest feed and arc speed limit in the chain
+  std::vector<std::pair<double, int>> triggers;  // (path position, code)
+  double length_mm = 0.0;
+};
+
+// What is timed so far: the moves, the triggers, the time they take.
+struct Timeline {
+  std::vector<Move> moves;
+  std::vector<TimedTrigger> triggers;
+  double t_s = 0.0;
+};
+
+// The chain's S-curve: per-axis limits, the largest share of the path speed any axis
+// takes in the chain, lower the path's.
+SCurve chain_profile(const Chain& chain, double length_mm, const MachineLimits& lim) {
+  double v_lim = chain.feed_mm_s, a_lim = lim.a_max_mm_s2, j_lim = lim.j_max_mm_s3;
+  for (const auto& e : chain.elements)
+    for (int i = 0; i < 3; ++i) {
+      const double share = e.is_arc && (i == e.axis_a || i == e.axis_b) ? 1.0 : std::abs(e.tangent(0.0)[i]);
+      if (share <= 1e-12) continue;
+      if (lim.axis_v_mm_min[i] > 0) v_lim = std::min(v_lim, lim.axis_v_mm_min[i] / 60.0 / share);
+      if (lim.axis_a_mm_s2[i] > 0) a_lim = std::min(a_lim, lim.axis_a_mm_s2[i] / share);
+      if (lim.axis_j_mm_s3[i] > 0) j_lim = std::min(j_lim, lim.axis_j_mm_s3[i] / share);
+    }
+  return SCurve(length_mm, v_lim, a_lim, j_lim);
+}
+
+// The open chain becomes one move after what is timed, its triggers at their path
+// positions; the chain is empty after.
+void flush(Chain& chain, const MachineLimits& lim, Timeline& out) {
+  if (chain.elements.empty()) return;
+  Move m;
+  m.t0_s = out.t_s;
+  double s = 0.0;
+  for (const auto& e : chain.elements) {
+    m.s_start_mm.push_back(s);
+    s += e.length_mm;
+  }
+  m.elements = chain.elements;
+  m.profile = chain_profile(chain, s, lim);
+  for (const auto& [pos, code] : chain.triggers) out.triggers.push_back({out.t_s + m.profile.time_at(pos), code});
+  out.t_s += m.profile.duration_s();
+  out.moves.push_back(std::move(m));
+  chain.elements.clear();
+  chain.triggers.clear();
+  chain.length_mm = 0.0;
+}
+
+// A linear or arc block's path element and its feed, mm/s.
+PathElement path_element(const gcode::Block& block, const MachineLimits& lim, double& feed_mm_s) {
+  if (const auto* l = std::get_if<gcode::Linear>(&block)) {
+    feed_mm_s = (l->rapid ? lim.rapid_mm_min : l->feed_mm_min) / 60.0;
+    return element_of(*l);
+  }
+  const auto& a = std::get<gcode::Arc>(block);
+  const PathElement e = element_of(a);
+  // Centripetal acceleration v²/r must stay within the machine's limit.
+  feed_mm_s = std::min(a.feed_mm_min / 60.0, std::sqrt(lim.a_max_mm_s2 * e.radius_mm));
+  return e;
+}
+
+// Blend into the open chain only in G64 and where the path is tangent-continuous at the
+// same feed.
+bool blends(const Chain& chain, const PathElement& e, double feed_mm_s, bool exact_stop) {
+  const Eigen::Vector3d t_end = chain.elements.back().tangent(chain.elements.back().length_mm).normalized();
+  const Eigen::Vector3d t_start = e.tangent(0.0).normalized();
+  const bool tangent = t_end.dot(t_start) > std::cos(1e-3);
+  return !(exact_stop || !tangent || std::abs(chain.feed_mm_s - feed_mm_s) > 1e-9);
+}
+
 }  // namespace
 
 Trajectory interpolate(const gcode::Program& program, const Eigen::Vector3d& start_mm, const MachineLimits& lim) {
-  std::vector<Move> moves;
-  std::vector<TimedTrigger> triggers;
-  double t = 0.0;
-
-  // The open chain of blended elements and the triggers waiting for their path position.
-  std::vector<PathElement> chain;
-  double chain_feed = 0.0;                             // mm/s, the lowest feed and arc speed limit in the chain
-  std::vector<std::pair<double, int>> chain_triggers;  // (path position, code)
-  double chain_len = 0.0;
-
-  auto flush = [&] {
-    if (chain.empty()) return;
-    Move m;
-    m.t0_s = t;
-    double s = 0.0;
-    for (const auto& e : chain) {
-      m.s_start_mm.push_back(s);
-      s += e.length_mm;
-    }
-    m.elements = chain;
-    // Per-axis limits: the largest share of the path speed any axis takes in this chain.
-    double v_lim = chain_feed, a_lim = lim.a_max_mm_s2, j_lim = lim.j_max_mm_s3;
-    for (const auto& e : chain)
-      for (int i = 0; i < 3; ++i) {
-        const double share = e.is_arc && (i == e.axis_a || i == e.axis_b) ? 1.0 : std::abs(e.tangent(0.0)[i]);
-        if (share <= 1e-12) continue;
-        if (lim.axis_v_mm_min[i] > 0) v_lim = std::min(v_lim, lim.axis_v_mm_min[i] / 60.0 / share);
-        if (lim.axis_a_mm_s2[i] > 0) a_lim = std::min(a_lim, lim.axis_a_mm_s2[i] / share);
-        if (lim.axis_j_mm_s3[i] > 0) j_lim = std::min(j_lim, lim.axis_j_mm_s3[i] / share);
-      }
-    m.profile = SCurve(s, v_lim, a_lim, j_lim);
-    for (const auto& [pos, code] : chain_triggers) triggers.push_back({t + m.profile.time_at(pos), code});
-    t += m.profile.duration_s();
-    moves.push_back(std::move(m));
-    chain.clear();
-    chain_triggers.clear();
-    chain_len = 0.0;
-  };
-
+  Timeline out;
+  Chain chain;
   for (std::size_t i = 0; i < program.blocks.size(); ++i) {
     const auto& block = program.blocks[i];
     if (const auto* d = std::get_if<gcode::Dwell>(&block)) {
-      flush();
-      t += d->duration_s;
+      flush(chain, lim, out);
+      out.t_s += d->duration_s;
       continue;
     }
     if (const auto* tr = std::get_if<gcode::Trigger>(&block)) {
-      if (chain.empty())
-        triggers.push_back({t, tr->code});
+      if (chain.elements.empty())
+        out.triggers.push_back({out.t_s, tr->code});
       else
-        chain_triggers.emplace_back(chain_len, tr->code);
+        chain.triggers.emplace_back(chain.length_mm, tr->code);
       continue;
     }
-    PathElement e;
     double feed_mm_s = 0.0;
-    if (const auto* l = std::get_if<gcode::Linear>(&block)) {
-      e = element_of(*l);
-      feed_mm_s = (l->rapid ? lim.rapid_mm_min : l->feed_mm_min) / 60.0;
-    } else {
-      const auto& a = std::get<gcode::Arc>(block);
-      e = element_of(a);
-      // Centripetal acceleration v²/r must stay within the machine's limit.
-      feed_mm_s = std::min(a.feed_mm_min / 60.0, std::sqrt(lim.a_max_mm_s2 * e.radius_mm));
-    }
+    const PathElement e = path_element(block, lim, feed_mm_s);
     if (!(feed_mm_s > 0.0))
       throw dsp::InputError("interpolator: a move without feed (F word missing) at block " + std::to_string(i + 1));
     if (e.length_mm <= 1e-12) continue;  // e.g. the G0 to where the machine already is
-    // Blend into the open chain only in G64 and where the path is tangent-continuous.
-    if (!chain.empty()) {
-      const Eigen::Vector3d t_end = chain.back().tangent(chain.back().length_mm).normalized();
-      const Eigen::Vector3d t_start = e.tangent(0.0).normalized();
-      const bool tangent = t_end.dot(t_start) > std::cos(1e-3);
-      if (program.exact_stop || !tangent || std::abs(chain_feed - feed_mm_s) > 1e-9) flush();
-    }
-    if (chain.empty()) chain_feed = feed_mm_s;
-    chain.push_back(e);
-    chain_len += e.length_mm;
-    if (program.exact_stop) flush();
+    if (!chain.elements.empty() && !blends(chain, e, feed_mm_s, program.exact_stop)) flush(chain, lim, out);
+    if (chain.elements.empty()) chain.feed_mm_s = feed_mm_s;
+    chain.elements.push_back(e);
+    chain.length_mm += e.length_mm;
+    if (program.exact_stop) flush(chain, lim, out);
   }
-  flush();
-  std::stable_sort(triggers.begin(), triggers.end(), [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
-  return Trajectory(std::move(moves), std::move(triggers), start_mm, t);
+  flush(chain, lim, out);
+  std::stable_sort(out.triggers.begin(), out.triggers.end(),
+                   [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
+  return Trajectory(std::move(out.moves), std::move(out.triggers), start_mm, out.t_s);
 }
 
 Trajectory interpolate_gcode(std::string_view text, std::string_view name, const MachineLimits& limits) {

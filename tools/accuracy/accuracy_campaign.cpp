@@ -143,15 +143,13 @@ void dwell_grid(const std::pair<std::size_t, std::size_t>& w, std::ptrdiff_t shi
   }
 }
 
-void circle_figures(const Machine& mach, Report& rep) {
-  sim::Scenario sc = sim::circle_scenario(10.0, 2500.0, 5, "ccw", rep.seed);
-  mach.apply(sc, true);
-  const Analysed r = analyse(sc, rep);
-  const auto& a = r.a;
-  if (!a.circle || !a.circle_reference) {
-    rep.figures.push_back({"circle R10: evaluation failed", "um", 1e9, 0.0, 1.5});
-    return;
-  }
+// The radius deviation's error against the reference: over every point, and of the mean
+// over the revolutions (1° bins).
+struct CircleErrors {
+  double rms = 0.0, peak = 0.0, rms_avg = 0.0, peak_avg = 0.0;
+};
+
+CircleErrors circle_errors(const dsp::Analysis& a) {
   const auto& dm = a.circle->trace.radius_deviation_um;
   const auto& dr = a.circle_reference->trace.radius_deviation_um;
   const auto& ang = a.circle->trace.angle_deg;
@@ -171,44 +169,54 @@ void circle_figures(const Machine& mach, Report& rep) {
       ss_avg += e * e, peak_avg = std::max(peak_avg, std::abs(e)), nb += 1.0;
     }
   const double rms_avg = std::sqrt(ss_avg / nb);
+  return {rms, peak, rms_avg, peak_avg};
+}
 
-  // Bound: the radial error at 180 points per revolution, less what each revolution's centre
-  // fit takes out (its cos/sin components), as a quadratic form of the posterior covariance.
-  const auto& m = a.measurement;
+constexpr int kBoundPointsPerRev = 180;
+
+// Where the bound looks: 180 points per revolution (sensor-time trace positions), each
+// with its angle and revolution.
+struct RevolutionGrid {
+  std::vector<std::size_t> grid;
+  std::vector<double> theta;
+  std::vector<int> rev;
+  int revs = 0;
+};
+
+RevolutionGrid revolution_grid(const dsp::Measurement& m, std::ptrdiff_t shift) {
   std::vector<Eigen::Vector2d> cmd;
   for (const auto& c : m.cmd_mm) cmd.emplace_back(c.x(), c.y());
   std::vector<std::int64_t> marks;
   for (const auto& t : m.triggers)
     if (t.code == dsp::trigger::segment_mark) marks.push_back(t.sample_index);
   const auto segs = dsp::eval::find_circle_segments(cmd, m.sample_index, marks, Eigen::Vector2d::Zero(), 360.0);
-  std::vector<std::size_t> grid;
-  std::vector<double> theta;
-  std::vector<int> rev;
-  const int per_rev = 180;
+  RevolutionGrid rg;
+  const int per_rev = kBoundPointsPerRev;
   for (std::size_t s = 0; s < segs.size(); ++s) {
     const auto b = static_cast<std::size_t>(segs[s].begin_index - m.sample_index.front());
     const auto e = static_cast<std::size_t>(segs[s].end_index - m.sample_index.front());
     for (int g = 0; g < per_rev; ++g) {
       const std::size_t k = b + (e - b) * static_cast<std::size_t>(g) / per_rev;
-      const auto ks = static_cast<std::ptrdiff_t>(k) + r.shift;
+      const auto ks = static_cast<std::ptrdiff_t>(k) + shift;
       if (ks < 0 || static_cast<std::size_t>(ks) >= m.raw.schedule.flags.size()) continue;
-      grid.push_back(static_cast<std::size_t>(ks));
-      theta.push_back(std::atan2(m.cmd_mm[k].y(), m.cmd_mm[k].x()));
-      rev.push_back(static_cast<int>(s));
+      rg.grid.push_back(static_cast<std::size_t>(ks));
+      rg.theta.push_back(std::atan2(m.cmd_mm[k].y(), m.cmd_mm[k].x()));
+      rg.rev.push_back(static_cast<int>(s));
     }
   }
-  const auto n = static_cast<Eigen::Index>(grid.size());
-  const Eigen::MatrixXd cx = r.cov->position(grid, 0), cy = r.cov->position(grid, 1);
-  Eigen::VectorXd cs(n), sn(n);
-  for (Eigen::Index i = 0; i < n; ++i)
-    cs[i] = std::cos(theta[static_cast<std::size_t>(i)]), sn[i] = std::sin(theta[static_cast<std::size_t>(i)]);
-  const Eigen::MatrixXd ce = cs.asDiagonal() * cx * cs.asDiagonal() + sn.asDiagonal() * cy * sn.asDiagonal();
-  Eigen::MatrixXd proj = Eigen::MatrixXd::Zero(n, n);  // block-diagonal: I − B(BᵀB)⁻¹Bᵀ per revolution
-  const int revs = static_cast<int>(segs.size());
-  for (int s = 0; s < revs; ++s) {
+  rg.revs = static_cast<int>(segs.size());
+  return rg;
+}
+
+// What each revolution's centre fit takes out (its cos/sin components): block-diagonal
+// I − B(BᵀB)⁻¹Bᵀ per revolution.
+Eigen::MatrixXd centre_fit_projection(const Eigen::VectorXd& cs, const Eigen::VectorXd& sn, const RevolutionGrid& rg) {
+  const auto n = static_cast<Eigen::Index>(rg.grid.size());
+  Eigen::MatrixXd proj = Eigen::MatrixXd::Zero(n, n);
+  for (int s = 0; s < rg.revs; ++s) {
     std::vector<Eigen::Index> idx;
     for (Eigen::Index i = 0; i < n; ++i)
-      if (rev[static_cast<std::size_t>(i)] == s) idx.push_back(i);
+      if (rg.rev[static_cast<std::size_t>(i)] == s) idx.push_back(i);
     const auto ni = static_cast<Eigen::Index>(idx.size());
     Eigen::MatrixXd bm(ni, 2);
     for (Eigen::Index i = 0; i < ni; ++i)
@@ -218,21 +226,56 @@ void circle_figures(const Machine& mach, Report& rep) {
       for (Eigen::Index j = 0; j < ni; ++j)
         proj(idx[static_cast<std::size_t>(i)], idx[static_cast<std::size_t>(j)]) = p(i, j);
   }
+  return proj;
+}
+
+// The noise-limited bound of the radius deviation's error as quadratic forms of the
+// posterior covariance: of every point (cp) and of the mean over the revolutions (ca).
+struct CircleBound {
+  Eigen::MatrixXd cp, ca;
+  double rms = 0.0, rms_avg = 0.0;
+};
+
+CircleBound circle_bound(const Analysed& r) {
+  const RevolutionGrid rg = revolution_grid(r.a.measurement, r.shift);
+  const int per_rev = kBoundPointsPerRev;
+  const auto n = static_cast<Eigen::Index>(rg.grid.size());
+  const Eigen::MatrixXd cx = r.cov->position(rg.grid, 0), cy = r.cov->position(rg.grid, 1);
+  Eigen::VectorXd cs(n), sn(n);
+  for (Eigen::Index i = 0; i < n; ++i)
+    cs[i] = std::cos(rg.theta[static_cast<std::size_t>(i)]), sn[i] = std::sin(rg.theta[static_cast<std::size_t>(i)]);
+  const Eigen::MatrixXd ce = cs.asDiagonal() * cx * cs.asDiagonal() + sn.asDiagonal() * cy * sn.asDiagonal();
+  const Eigen::MatrixXd proj = centre_fit_projection(cs, sn, rg);
   const Eigen::MatrixXd cp = proj * ce * proj.transpose();
   const double bound_rms = std::sqrt(cp.trace() / static_cast<double>(n));
   // The mean over the revolutions at each grid angle.
   Eigen::MatrixXd avg = Eigen::MatrixXd::Zero(per_rev, n);
-  for (Eigen::Index i = 0; i < n; ++i) avg(i % per_rev, i) = 1.0 / revs;
+  for (Eigen::Index i = 0; i < n; ++i) avg(i % per_rev, i) = 1.0 / rg.revs;
   const Eigen::MatrixXd ca = avg * cp * avg.transpose();
   const double bound_avg = std::sqrt(ca.trace() / per_rev);
+  return {cp, ca, bound_rms, bound_avg};
+}
+
+void circle_figures(const Machine& mach, Report& rep) {
+  sim::Scenario sc = sim::circle_scenario(10.0, 2500.0, 5, "ccw", rep.seed);
+  mach.apply(sc, true);
+  const Analysed r = analyse(sc, rep);
+  if (!r.a.circle || !r.a.circle_reference) {
+    rep.figures.push_back({"circle R10: evaluation failed", "um", 1e9, 0.0, 1.5});
+    return;
+  }
+  const CircleErrors e = circle_errors(r.a);
+  // Bound: the radial error at 180 points per revolution, less what each revolution's centre
+  // fit takes out (its cos/sin components), as a quadratic form of the posterior covariance.
+  const CircleBound b = circle_bound(r);
   rep.figures.push_back(
-      {"circle R10 2.5 m/min x5: radius deviation error RMS (every revolution)", "um", rms, bound_rms, 1.5});
-  rep.figures.push_back({"circle R10 2.5 m/min x5: radius deviation error peak (every revolution)", "um", peak,
-                         expected_peak(cp, rep.seed), 3.0});
+      {"circle R10 2.5 m/min x5: radius deviation error RMS (every revolution)", "um", e.rms, b.rms, 1.5});
+  rep.figures.push_back({"circle R10 2.5 m/min x5: radius deviation error peak (every revolution)", "um", e.peak,
+                         expected_peak(b.cp, rep.seed), 3.0});
   rep.figures.push_back(
-      {"circle R10 2.5 m/min x5: mean of the 5 revolutions, error RMS", "um", rms_avg, bound_avg, 1.5});
-  rep.figures.push_back({"circle R10 2.5 m/min x5: mean of the 5 revolutions, error peak", "um", peak_avg,
-                         expected_peak(ca, rep.seed + 1), 3.0});
+      {"circle R10 2.5 m/min x5: mean of the 5 revolutions, error RMS", "um", e.rms_avg, b.rms_avg, 1.5});
+  rep.figures.push_back({"circle R10 2.5 m/min x5: mean of the 5 revolutions, error peak", "um", e.peak_avg,
+                         expected_peak(b.ca, rep.seed + 1), 3.0});
 }
 
 void step_figures(const Machine& mach, Report& rep) {

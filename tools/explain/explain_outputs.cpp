@@ -145,105 +145,132 @@ std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex,
   return o;
 }
 
+namespace {
+
+using Explanation = dsp::model::RunExplanation;
+
+// The effects, significant first.
+report::Section effects_section(const Explanation& r) {
+  report::Section table;
+  table.heading = "Effects tested";
+  table.lead =
+      "each effect of the run format as a model extension: BIC with an effective sample count, a held-out guard, and "
+      "the tolerance band";
+  report::Grid g;
+  g.header = {"", "effect", "size", "tolerance", "residual RMS before -> after (um)", "evidence"};
+  for (const auto& e : r.effects)
+    g.rows.push_back({e.significant ? "significant" : "", e.name, report_fmt(e.magnitude) + " " + e.unit,
+                      report_fmt(e.tolerance),
+                      report_fmt(e.residual_rms_before_um) + " -> " + report_fmt(e.residual_rms_after_um), e.evidence});
+  table.grids.push_back(g);
+  return table;
+}
+
+report::Section correlations_section(const Explanation& r) {
+  report::Section cs;
+  cs.heading = "Residual against the candidate regressors";
+  cs.lead =
+      "Pearson r of the nominal model's residual with each regressor, per moving axis (|r| near 1: the residual "
+      "follows it)";
+  report::Grid cg;
+  cg.header = {"axis", "regressor", "r"};
+  for (const auto& c : r.correlations) cg.rows.push_back({std::string(1, "xyz"[c.axis]), c.regressor, report_fmt(c.r)});
+  cs.grids.push_back(cg);
+  return cs;
+}
+
+// Amplitude spectrum of a series' first power-of-two samples (the samples are at ~1 kHz,
+// not exactly uniform where thinned).
+report::LineSeries amplitude_spectrum(const report::LineSeries& in_time, std::size_t nfft, double dt,
+                                      Eigen::FFT<double>& fft) {
+  report::LineSeries sp;
+  sp.label = in_time.label, sp.color = in_time.color;
+  std::vector<double> in(in_time.y.begin(), in_time.y.begin() + static_cast<std::ptrdiff_t>(nfft));
+  std::vector<std::complex<double>> out;
+  fft.fwd(out, in);
+  for (std::size_t f = 1; f < nfft / 2; ++f) {
+    sp.x.push_back(static_cast<double>(f) / (static_cast<double>(nfft) * dt));
+    sp.y.push_back(2.0 * std::abs(out[f]) / static_cast<double>(nfft));
+  }
+  return sp;
+}
+
+// One axis of one channel: the residual before and after in time and in frequency (none
+// for fewer than 16 samples).
+void residual_plots(const Explanation::Trace& tr, int a, report::Section& s) {
+  const char* axes[3] = {"x", "y", "z"};
+  report::LineSeries before, after;
+  before.label = "nominal model", before.color = report::kRed;
+  after.label = "with the significant effects", after.color = report::kBlue;
+  for (std::size_t k = 0; k < tr.t_s.size(); ++k) {
+    if (tr.axis[k] != a) continue;
+    before.x.push_back(tr.t_s[k]), before.y.push_back(tr.before_um[k]);
+    after.x.push_back(tr.t_s[k]), after.y.push_back(tr.after_um[k]);
+  }
+  if (before.x.size() < 16) return;
+  s.svgs.push_back(
+      report::line_plot({before, after}, std::string(axes[a]) + ": residual in time", "time (s)", "residual (um)"));
+  const std::size_t m = before.y.size();
+  std::size_t nfft = 1;
+  while (nfft * 2 <= m) nfft *= 2;
+  const double dt = (before.x[nfft - 1] - before.x[0]) / static_cast<double>(nfft - 1);
+  Eigen::FFT<double> fft;
+  const report::LineSeries sb = amplitude_spectrum(before, nfft, dt, fft);
+  const report::LineSeries sa = amplitude_spectrum(after, nfft, dt, fft);
+  s.svgs.push_back(report::line_plot({sb, sa}, std::string(axes[a]) + ": residual amplitude spectrum", "frequency (Hz)",
+                                     "amplitude (um)"));
+}
+
+// Residuals before and after, per channel and axis, in time and frequency.
+report::Section residual_section(const Explanation::Trace& tr) {
+  report::Section s;
+  s.heading = "Residual, " + tr.channel;
+  s.lead = tr.channel == "ref" ? "the pipeline's path minus the reference instrument, each axis' offset out"
+           : tr.channel == "psd"
+               ? "the pipeline's path minus the PSD readings, each axis' offset out"
+               : "the pipeline's path minus the set-point (sensor and machine together), each axis' offset out";
+  for (int a = 0; a < 3; ++a) residual_plots(tr, a, s);
+  return s;
+}
+
+report::Section extended_model_section(const ExtendedModel& model) {
+  report::Section ext;
+  ext.heading = "The extended model";
+  ext.lead =
+      "the significant sensor effects as a sensor calibration, the machine effects as a scenario the simulator "
+      "reproduces the run with";
+  ext.notes = model.notes;
+  return ext;
+}
+
+// One run's page and the extended model's two files beside it.
+void write_run_report(const dsp::Run& run, const Explanation& r, const std::filesystem::path& dir) {
+  report::Page page;
+  page.title = "What the simulation gets wrong";
+  page.run_id = r.run_id;
+  page.program = run.meta.program.kind;
+  page.context = {{"compared with", r.reference},
+                  {"pipeline residual RMS, extended model",
+                   report_fmt(r.nominal_residual_rms_um) + " -> " + report_fmt(r.final_residual_rms_um) + " um"},
+                  {"prediction at held-out reference points",
+                   report_fmt(r.heldout_nominal_rms_um) + " -> " + report_fmt(r.heldout_final_rms_um) + " um"}};
+  page.sections.push_back(effects_section(r));
+  if (!r.correlations.empty()) page.sections.push_back(correlations_section(r));
+  for (const auto& tr : r.traces) page.sections.push_back(residual_section(tr));
+  const auto model = extended_model(run, r);
+  page.files.push_back(r.run_id + "-calibration.toml");
+  page.files.push_back(r.run_id + "-scenario.toml");
+  page.sections.push_back(extended_model_section(model));
+  report::write_html(page, dir / (r.run_id + ".html"));
+  write_extended_model(model, dir / (r.run_id + "-calibration.toml"), dir / (r.run_id + "-scenario.toml"));
+}
+
+}  // namespace
+
 void write_explain_report(const std::vector<dsp::Run>& runs, const std::vector<dsp::model::RunExplanation>& ex,
                           const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);
-  for (std::size_t i = 0; i < runs.size() && i < ex.size(); ++i) {
-    const auto& r = ex[i];
-    report::Page page;
-    page.title = "What the simulation gets wrong";
-    page.run_id = r.run_id;
-    page.program = runs[i].meta.program.kind;
-    page.context = {{"compared with", r.reference},
-                    {"pipeline residual RMS, extended model",
-                     report_fmt(r.nominal_residual_rms_um) + " -> " + report_fmt(r.final_residual_rms_um) + " um"},
-                    {"prediction at held-out reference points",
-                     report_fmt(r.heldout_nominal_rms_um) + " -> " + report_fmt(r.heldout_final_rms_um) + " um"}};
-    // The effects, significant first.
-    report::Section table;
-    table.heading = "Effects tested";
-    table.lead =
-        "each effect of the run format as a model extension: BIC with an effective sample count, a held-out guard, and "
-        "the tolerance band";
-    report::Grid g;
-    g.header = {"", "effect", "size", "tolerance", "residual RMS before -> after (um)", "evidence"};
-    for (const auto& e : r.effects)
-      g.rows.push_back(
-          {e.significant ? "significant" : "", e.name, report_fmt(e.magnitude) + " " + e.unit, report_fmt(e.tolerance),
-           report_fmt(e.residual_rms_before_um) + " -> " + report_fmt(e.residual_rms_after_um), e.evidence});
-    table.grids.push_back(g);
-    page.sections.push_back(table);
-    if (!r.correlations.empty()) {
-      report::Section cs;
-      cs.heading = "Residual against the candidate regressors";
-      cs.lead =
-          "Pearson r of the nominal model's residual with each regressor, per moving axis (|r| near 1: the residual "
-          "follows it)";
-      report::Grid cg;
-      cg.header = {"axis", "regressor", "r"};
-      for (const auto& c : r.correlations)
-        cg.rows.push_back({std::string(1, "xyz"[c.axis]), c.regressor, report_fmt(c.r)});
-      cs.grids.push_back(cg);
-      page.sections.push_back(cs);
-    }
-    // Residuals before and after, per channel and axis, in time and frequency.
-    const char* axes[3] = {"x", "y", "z"};
-    for (const auto& tr : r.traces) {
-      report::Section s;
-      s.heading = "Residual, " + tr.channel;
-      s.lead = tr.channel == "ref" ? "the pipeline's path minus the reference instrument, each axis' offset out"
-               : tr.channel == "psd"
-                   ? "the pipeline's path minus the PSD readings, each axis' offset out"
-                   : "the pipeline's path minus the set-point (sensor and machine together), each axis' offset out";
-      for (int a = 0; a < 3; ++a) {
-        report::LineSeries before, after;
-        before.label = "nominal model", before.color = report::kRed;
-        after.label = "with the significant effects", after.color = report::kBlue;
-        std::vector<double> yb;
-        for (std::size_t k = 0; k < tr.t_s.size(); ++k) {
-          if (tr.axis[k] != a) continue;
-          before.x.push_back(tr.t_s[k]), before.y.push_back(tr.before_um[k]);
-          after.x.push_back(tr.t_s[k]), after.y.push_back(tr.after_um[k]);
-        }
-        if (before.x.size() < 16) continue;
-        s.svgs.push_back(report::line_plot({before, after}, std::string(axes[a]) + ": residual in time", "time (s)",
-                                           "residual (um)"));
-        // Amplitude spectrum of both (the samples are at ~1 kHz, not exactly uniform where thinned).
-        const std::size_t m = before.y.size();
-        std::size_t nfft = 1;
-        while (nfft * 2 <= m) nfft *= 2;
-        const double dt = (before.x[nfft - 1] - before.x[0]) / static_cast<double>(nfft - 1);
-        Eigen::FFT<double> fft;
-        report::LineSeries sb, sa;
-        sb.label = before.label, sb.color = before.color, sa.label = after.label, sa.color = after.color;
-        for (auto* pr : {&before, &after}) {
-          std::vector<double> in(pr->y.begin(), pr->y.begin() + static_cast<std::ptrdiff_t>(nfft));
-          std::vector<std::complex<double>> out;
-          fft.fwd(out, in);
-          auto& dst = pr == &before ? sb : sa;
-          for (std::size_t f = 1; f < nfft / 2; ++f) {
-            dst.x.push_back(static_cast<double>(f) / (static_cast<double>(nfft) * dt));
-            dst.y.push_back(2.0 * std::abs(out[f]) / static_cast<double>(nfft));
-          }
-        }
-        s.svgs.push_back(report::line_plot({sb, sa}, std::string(axes[a]) + ": residual amplitude spectrum",
-                                           "frequency (Hz)", "amplitude (um)"));
-      }
-      page.sections.push_back(s);
-    }
-    const auto model = extended_model(runs[i], r);
-    report::Section ext;
-    ext.heading = "The extended model";
-    ext.lead =
-        "the significant sensor effects as a sensor calibration, the machine effects as a scenario the simulator "
-        "reproduces the run with";
-    ext.notes = model.notes;
-    page.files.push_back(r.run_id + "-calibration.toml");
-    page.files.push_back(r.run_id + "-scenario.toml");
-    page.sections.push_back(ext);
-    report::write_html(page, dir / (r.run_id + ".html"));
-    write_extended_model(model, dir / (r.run_id + "-calibration.toml"), dir / (r.run_id + "-scenario.toml"));
-  }
+  for (std::size_t i = 0; i < runs.size() && i < ex.size(); ++i) write_run_report(runs[i], ex[i], dir);
 }
 
 }  // namespace eical::tools::explain

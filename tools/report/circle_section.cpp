@@ -5,21 +5,11 @@
 
 namespace eical::tools::report {
 
-void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv) {
-  if (!a.circle) return;
-  const auto& c = *a.circle;
-  const auto& p = run.meta.program;
-  const auto [na, nb] = plane_axis_names(p.plane);
-  const bool partial = c.arc_deg < 360.0;
-  Section s;
-  s.heading =
-      partial ? "Circular test (ISO 230-4), " + fmt("%.0f", c.arc_deg) + "° partial arc" : "Circular test (ISO 230-4)";
-  s.lead =
-      "Radius deviation along the path, both directions where measured; plot magnified about the reference circle as "
-      "on a ballbar plot.";
-  // One trace per revolution and direction, each its own colour, closed when it is a full
-  // revolution, a marker where it begins.
-  const FigureRows fr(a);
+namespace {
+
+// One trace per revolution and direction, each its own colour, closed when it is a full
+// revolution, a marker where it begins.
+std::vector<PolarTrace> revolution_traces(const dsp::eval::CircleResult& c, bool partial) {
   std::vector<PolarTrace> polar;
   for (const char* dir : {"ccw", "cw"}) {
     const bool ccw = std::string(dir) == "ccw";
@@ -37,20 +27,24 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
       polar.push_back(std::move(t));
     }
   }
-  std::string subtitle;
+  return polar;
+}
+
+// G (per direction when both ran) ± U under the plot's title.
+std::string polar_subtitle(const dsp::eval::CircleResult& c, const FigureRows& fr) {
   if (c.direction == "both") {
     auto g = [&](const char* key) {
       const auto v = fr.value(key), u = fr.u(key);
       return v ? fmt("%.2f", *v) + (u ? " ± " + fmt("%.2f", *u) : "") + " µm" : std::string("n/a");
     };
-    subtitle = "G ccw " + g("circle.circular_deviation_G_ccw_um") + ",  G cw " + g("circle.circular_deviation_G_cw_um");
-  } else {
-    subtitle =
-        "G " + fmt("%.2f", c.circular_deviation_G_um) +
-        (fr.u("circle.circular_deviation_G_um") ? " ± " + fmt("%.2f", *fr.u("circle.circular_deviation_G_um")) : "") +
-        " µm, " + (c.direction == "cw" ? "clockwise" : "counter-clockwise");
+    return "G ccw " + g("circle.circular_deviation_G_ccw_um") + ",  G cw " + g("circle.circular_deviation_G_cw_um");
   }
-  s.svgs.push_back(polar_plot(polar, "Radius deviation, " + p.plane + " plane", "+" + na, "+" + nb, 0.0, subtitle));
+  return "G " + fmt("%.2f", c.circular_deviation_G_um) +
+         (fr.u("circle.circular_deviation_G_um") ? " ± " + fmt("%.2f", *fr.u("circle.circular_deviation_G_um")) : "") +
+         " µm, " + (c.direction == "cw" ? "clockwise" : "counter-clockwise");
+}
+
+Table iso230_4_table(const dsp::eval::CircleResult& c, const dsp::Program& p, const FigureRows& fr, bool partial) {
   Table iso{"ISO 230-4 figures (± U, k = 2)", {}};
   iso.rows = {{"Nominal radius", p.radius_mm, "mm", 3, ""},
               {"Feed", p.feed_mm_min, "mm/min", 0, ""},
@@ -68,52 +62,58 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
   iso.rows.push_back(h);
   iso.rows.push_back(fr.row("circle.radial_deviation_F_max_um", "Radial deviation F max", "µm", 2));
   iso.rows.push_back(fr.row("circle.radial_deviation_F_min_um", "Radial deviation F min", "µm", 2));
-  s.tables.push_back(iso);
-  if (a.diagnostics) {
-    const auto& d = *a.diagnostics;
-    const bool sep = d.servo_and_squareness_separated;
-    Table dt{"Diagnostics (per axis, ± U)", {}};
-    dt.rows = {fr.row("diagnostics.backlash_x_um", "Backlash " + na, "µm", 2),
-               fr.row("diagnostics.backlash_y_um", "Backlash " + nb, "µm", 2),
-               fr.row("diagnostics.reversal_spike_x_um", "Reversal spike " + na, "µm", 2),
-               fr.row("diagnostics.reversal_spike_y_um", "Reversal spike " + nb, "µm", 2),
-               fr.row("diagnostics.lateral_play_x_um", "Lateral play " + na, "µm", 2),
-               fr.row("diagnostics.lateral_play_y_um", "Lateral play " + nb, "µm", 2),
-               fr.row("diagnostics.cyclic_error_x_um", "Cyclic error " + na, "µm", 2,
-                      "pitch " + fmt("%.1f mm", d.cyclic_pitch_mm)),
-               fr.row("diagnostics.cyclic_error_y_um", "Cyclic error " + nb, "µm", 2),
-               fr.row("diagnostics.servo_mismatch_ms", "Servo mismatch", "ms", 3,
-                      sep ? na + " lag − " + nb + " lag" : "needs both directions"),
-               fr.row("diagnostics.squareness_urad", "Squareness", "µrad", 1, "+: angle above 90°"),
-               fr.row("diagnostics.scale_mismatch_ppm", "Scale mismatch", "ppm", 1, na + " − " + nb),
-               fr.row("diagnostics.straightness_x_um", "Straightness " + na, "µm", 2),
-               fr.row("diagnostics.straightness_y_um", "Straightness " + nb, "µm", 2),
-               fr.row("diagnostics.stick_slip_um", "Stick-slip", "µm", 2, "tangential, fast"),
-               fr.row("diagnostics.vibration_um", "Vibration", "µm", 2, "radial, fast")};
-    s.tables.push_back(dt);
-    for (const auto& n : d.notes) s.notes.push_back(n);
-    s.notes.push_back(
-        "A diagnostic whose magnitude is not above its uncertainty U is marked \"not resolved\": the measurement "
-        "cannot tell it "
-        "from zero, and eical comp never compensates it.");
-  } else {
+  return iso;
+}
+
+// The diagnostics per axis with their notes, or why there are none.
+void diagnostics_table(const dsp::Analysis& a, const std::string& na, const std::string& nb, const FigureRows& fr,
+                       bool partial, Section& s) {
+  if (!a.diagnostics) {
     s.notes.push_back(partial ? "Diagnostics: not evaluated on a partial arc (they need full revolutions)."
                               : "Diagnostics: could not be determined (see the flags above).");
+    return;
   }
+  const auto& d = *a.diagnostics;
+  const bool sep = d.servo_and_squareness_separated;
+  Table dt{"Diagnostics (per axis, ± U)", {}};
+  dt.rows = {fr.row("diagnostics.backlash_x_um", "Backlash " + na, "µm", 2),
+             fr.row("diagnostics.backlash_y_um", "Backlash " + nb, "µm", 2),
+             fr.row("diagnostics.reversal_spike_x_um", "Reversal spike " + na, "µm", 2),
+             fr.row("diagnostics.reversal_spike_y_um", "Reversal spike " + nb, "µm", 2),
+             fr.row("diagnostics.lateral_play_x_um", "Lateral play " + na, "µm", 2),
+             fr.row("diagnostics.lateral_play_y_um", "Lateral play " + nb, "µm", 2),
+             fr.row("diagnostics.cyclic_error_x_um", "Cyclic error " + na, "µm", 2,
+                    "pitch " + fmt("%.1f mm", d.cyclic_pitch_mm)),
+             fr.row("diagnostics.cyclic_error_y_um", "Cyclic error " + nb, "µm", 2),
+             fr.row("diagnostics.servo_mismatch_ms", "Servo mismatch", "ms", 3,
+                    sep ? na + " lag − " + nb + " lag" : "needs both directions"),
+             fr.row("diagnostics.squareness_urad", "Squareness", "µrad", 1, "+: angle above 90°"),
+             fr.row("diagnostics.scale_mismatch_ppm", "Scale mismatch", "ppm", 1, na + " − " + nb),
+             fr.row("diagnostics.straightness_x_um", "Straightness " + na, "µm", 2),
+             fr.row("diagnostics.straightness_y_um", "Straightness " + nb, "µm", 2),
+             fr.row("diagnostics.stick_slip_um", "Stick-slip", "µm", 2, "tangential, fast"),
+             fr.row("diagnostics.vibration_um", "Vibration", "µm", 2, "radial, fast")};
+  s.tables.push_back(dt);
+  for (const auto& n : d.notes) s.notes.push_back(n);
   s.notes.push_back(
-      partial ? "Partial arc: the radius is measured from the programmed centre (as a ballbar measures from its "
-                "pivot), because a centre fitted to a partial arc trades off against the radius. A real centre "
-                "offset therefore shows as a once-per-revolution term and enters G and F."
-              : "Each revolution is evaluated about its own least-squares centre (the integration drift of an "
-                "inertial measurement moves the centre slowly; a ballbar's pivot does the same job).");
-  if (a.circle_reference && a.circle_accuracy_rms_um) {
-    Table r{"Against the reference (" + (run.meta.reference ? run.meta.reference->kind : std::string("ref")) + ")", {}};
-    r.rows = {{"Radius deviation error (RMS)", *a.circle_accuracy_rms_um, "µm", 3, "eical − reference"},
-              {"Reference G", a.circle_reference->circular_deviation_G_um, "µm", 2, "same evaluation"},
-              {"Reference mean radius deviation", a.circle_reference->radius_mean_deviation_um, "µm", 2, ""}};
-    s.tables.push_back(r);
-  }
-  page.sections.push_back(std::move(s));
+      "A diagnostic whose magnitude is not above its uncertainty U is marked \"not resolved\": the measurement "
+      "cannot tell it "
+      "from zero, and eical comp never compensates it.");
+}
+
+// The same evaluation of the reference channel, when the run has one.
+void reference_table(const dsp::Run& run, const dsp::Analysis& a, Section& s) {
+  if (!a.circle_reference || !a.circle_accuracy_rms_um) return;
+  Table r{"Against the reference (" + (run.meta.reference ? run.meta.reference->kind : std::string("ref")) + ")", {}};
+  r.rows = {{"Radius deviation error (RMS)", *a.circle_accuracy_rms_um, "µm", 3, "eical − reference"},
+            {"Reference G", a.circle_reference->circular_deviation_G_um, "µm", 2, "same evaluation"},
+            {"Reference mean radius deviation", a.circle_reference->radius_mean_deviation_um, "µm", 2, ""}};
+  s.tables.push_back(r);
+}
+
+// trace_circle.csv: the trace behind the polar plot (and the reference's beside it).
+void circle_csv(const dsp::Analysis& a, CsvFiles& csv) {
+  const auto& c = *a.circle;
   std::vector<double> rev(c.trace.revolution.begin(), c.trace.revolution.end()), dir;
   for (const auto& d : c.trace.direction) dir.push_back(d == "cw" ? -1.0 : 1.0);
   std::vector<std::vector<double>> cols{c.trace.angle_deg, c.trace.radius_deviation_um, dir, rev};
@@ -123,6 +123,36 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
     head.emplace_back("reference_radius_deviation_um");
   }
   csv.write("trace_circle.csv", head, cols);
+}
+
+}  // namespace
+
+void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv) {
+  if (!a.circle) return;
+  const auto& c = *a.circle;
+  const auto& p = run.meta.program;
+  const auto [na, nb] = plane_axis_names(p.plane);
+  const bool partial = c.arc_deg < 360.0;
+  Section s;
+  s.heading =
+      partial ? "Circular test (ISO 230-4), " + fmt("%.0f", c.arc_deg) + "° partial arc" : "Circular test (ISO 230-4)";
+  s.lead =
+      "Radius deviation along the path, both directions where measured; plot magnified about the reference circle as "
+      "on a ballbar plot.";
+  const FigureRows fr(a);
+  s.svgs.push_back(polar_plot(revolution_traces(c, partial), "Radius deviation, " + p.plane + " plane", "+" + na,
+                              "+" + nb, 0.0, polar_subtitle(c, fr)));
+  s.tables.push_back(iso230_4_table(c, p, fr, partial));
+  diagnostics_table(a, na, nb, fr, partial, s);
+  s.notes.push_back(
+      partial ? "Partial arc: the radius is measured from the programmed centre (as a ballbar measures from its "
+                "pivot), because a centre fitted to a partial arc trades off against the radius. A real centre "
+                "offset therefore shows as a once-per-revolution term and enters G and F."
+              : "Each revolution is evaluated about its own least-squares centre (the integration drift of an "
+                "inertial measurement moves the centre slowly; a ballbar's pivot does the same job).");
+  reference_table(run, a, s);
+  page.sections.push_back(std::move(s));
+  circle_csv(a, csv);
 }
 
 }  // namespace eical::tools::report

@@ -5,15 +5,14 @@
 
 namespace eical::tools::report {
 
-void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv) {
-  (void)run;
-  if (!a.positioning || !a.positioning_input) return;
-  const auto& r = *a.positioning;
-  const auto& in = *a.positioning_input;
-  Section s;
-  s.heading = "Positioning accuracy and repeatability (ISO 230-2), axis " + r.axis;
-  s.lead = std::to_string(r.runs) + " bidirectional runs over " + std::to_string(r.targets.size()) +
-           " targets; deviation = measured − target at each stop.";
+namespace {
+
+using dsp::eval::PositioningInput;
+using dsp::eval::PositioningResult;
+
+// The laser interferometer's plot: mean per target and direction with ±2s bands, every
+// run's points.
+std::string deviation_plot(const PositioningResult& r, const PositioningInput& in) {
   LineSeries up{"mean ↑ ± 2s", kBlue, {}, {}, {}, {}, false, false, 1.6},
       down{"mean ↓ ± 2s", kRed, {}, {}, {}, {}, false, false, 1.6};
   LineSeries up_pts{"runs ↑", kBlue, {}, {}, {}, {}, true}, down_pts{"runs ↓", kRed, {}, {}, {}, {}, true};
@@ -28,13 +27,18 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
       up_pts.x.push_back(in.targets_mm[i]), up_pts.y.push_back(in.up_um[j][i]);
       down_pts.x.push_back(in.targets_mm[i]), down_pts.y.push_back(in.down_um[j][i]);
     }
-  s.svgs.push_back(line_plot({up, down, up_pts, down_pts}, "Positioning deviation, axis " + r.axis,
-                             "target position (mm)", "deviation (µm)", 680, 340));
+  return line_plot({up, down, up_pts, down_pts}, "Positioning deviation, axis " + r.axis, "target position (mm)",
+                   "deviation (µm)", 680, 340);
+}
+
+std::string reversal_plot(const PositioningResult& r) {
   LineSeries b{"reversal value B", kGreen, {}, {}};
   for (const auto& t : r.targets) b.x.push_back(t.target_mm), b.y.push_back(t.B_um);
-  s.svgs.push_back(line_plot({b}, "Reversal value per target", "target position (mm)", "B (µm)", 680, 220));
-  const FigureRows fr(a);
-  const bool within = r.runs >= dsp::eval::kIso230_2Runs;
+  return line_plot({b}, "Reversal value per target", "target position (mm)", "B (µm)", 680, 220);
+}
+
+// The ISO 230-2 figures and VDI/DGQ 3441's, each ± U.
+void figure_tables(const FigureRows& fr, Section& s) {
   Table t{"ISO 230-2 figures (± U, k = 2)", {}};
   t.rows = {fr.row("positioning.A_um", "Accuracy A", "µm", 2, "bidirectional"),
             fr.row("positioning.A_up_um", "Accuracy A↑", "µm", 2),
@@ -55,11 +59,9 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
             fr.row("positioning.vdi3441.U_um", "Reversal span U", "µm", 2),
             fr.row("positioning.vdi3441.Ps_um", "Position scatter Ps", "µm", 2)};
   s.tables.push_back(v);
-  if (!within)
-    s.notes.push_back(std::to_string(r.runs) + " runs per target and direction: ISO 230-2 asks for " +
-                      std::to_string(dsp::eval::kIso230_2Runs) +
-                      ". The figures are evaluated by its formulas but are outside the standard (s from fewer runs is "
-                      "less certain).");
+}
+
+Grid per_target_grid(const PositioningResult& r, const FigureRows& fr) {
   auto pm = [&](const char* key, std::size_t i) {
     const auto val = fr.value(key, i), unc = fr.u(key, i);
     return (val ? fmt("%.2f", *val) : std::string("n/a")) + (unc ? " ± " + fmt("%.2f", *unc) : "");
@@ -74,8 +76,12 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
                       fmt("%.2f", 2 * tg.s_down_um), pm("positioning.per_target.B_um", i),
                       pm("positioning.per_target.R_um", i)});
   }
-  s.grids.push_back(g);
-  page.sections.push_back(std::move(s));
+  return g;
+}
+
+// trace_positioning.csv (every run's deviations) and trace_positioning_targets.csv (the
+// means and scatters per target).
+void positioning_csv(const PositioningResult& r, const PositioningInput& in, CsvFiles& csv) {
   std::vector<double> tg, run_no, dir, dev;
   for (std::size_t j = 0; j < in.up_um.size(); ++j)
     for (std::size_t i = 0; i < in.targets_mm.size(); ++i) {
@@ -92,6 +98,31 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
         sd.push_back(x.s_down_um);
   csv.write("trace_positioning_targets.csv", {"target_mm", "mean_up_um", "mean_down_um", "s_up_um", "s_down_um"},
             {t_mm, mu, md, su, sd});
+}
+
+}  // namespace
+
+void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv) {
+  (void)run;
+  if (!a.positioning || !a.positioning_input) return;
+  const auto& r = *a.positioning;
+  const auto& in = *a.positioning_input;
+  Section s;
+  s.heading = "Positioning accuracy and repeatability (ISO 230-2), axis " + r.axis;
+  s.lead = std::to_string(r.runs) + " bidirectional runs over " + std::to_string(r.targets.size()) +
+           " targets; deviation = measured − target at each stop.";
+  s.svgs.push_back(deviation_plot(r, in));
+  s.svgs.push_back(reversal_plot(r));
+  const FigureRows fr(a);
+  figure_tables(fr, s);
+  if (r.runs < dsp::eval::kIso230_2Runs)
+    s.notes.push_back(std::to_string(r.runs) + " runs per target and direction: ISO 230-2 asks for " +
+                      std::to_string(dsp::eval::kIso230_2Runs) +
+                      ". The figures are evaluated by its formulas but are outside the standard (s from fewer runs is "
+                      "less certain).");
+  s.grids.push_back(per_target_grid(r, fr));
+  page.sections.push_back(std::move(s));
+  positioning_csv(r, in, csv);
 }
 
 }  // namespace eical::tools::report

@@ -91,48 +91,67 @@ const char* revolution_colour(bool ccw, int revolution) {
   return ccw ? blues[i] : reds[i];
 }
 
-std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title, const std::string& axis_a,
-                       const std::string& axis_b, double scale_um_per_div, const std::string& subtitle) {
-  // The reference circle (zero deviation) at r0 with `divisions` rings inside and outside,
-  // each `ring` px: the ballbar plot's fixed geometry with a µm-per-division scale.
+namespace {
+
+// The ballbar plot's fixed geometry: the reference circle (zero deviation) at r0 with
+// `divisions` rings inside and outside, each `ring` px, at a µm-per-division scale; spokes
+// from r1 to r2; the legend's rows under it.
+struct PolarGeometry {
+  double w = 500, cy = 276, r0 = 122.0, ring = 28.0, c = w / 2.0;
+  double h = 0.0;
+  int divisions = 3;
+  double scale_um_per_div = 0.0, px_per_um = 0.0;
+  double r1 = 0.0, r2 = 0.0;
+
+  void point(double ang_deg, double dev_um, double& x, double& y) const {
+    const double th = ang_deg * kPi / 180.0;
+    const double r = std::max(0.0, r0 + dev_um * px_per_um);
+    x = c + r * std::cos(th), y = cy - r * std::sin(th);
+  }
+};
+
+// The scale: the one asked for, else a nice step for the largest deviation, raised until
+// every deviation fits inside the outer ring.
+PolarGeometry polar_geometry(const std::vector<PolarTrace>& traces, double scale_um_per_div) {
+  PolarGeometry g;
   std::size_t labelled = 0;
   for (const auto& t : traces) labelled += t.label.empty() ? 0 : 1;
   const double legend_rows = static_cast<double>((labelled + 1) / 2);
-  const double w = 500, cy = 276, r0 = 122.0, ring = 28.0, c = w / 2.0;
-  const double h = cy + 3 * ring + r0 + 34 + 15 * legend_rows + 34;
-  const int divisions = 3;
+  g.h = g.cy + 3 * g.ring + g.r0 + 34 + 15 * legend_rows + 34;
   double max_abs_um = 0.0;
   for (const auto& t : traces)
     for (double d : t.deviation_um)
       if (std::isfinite(d)) max_abs_um = std::max(max_abs_um, std::abs(d));
-  if (scale_um_per_div <= 0.0) scale_um_per_div = nice_step(std::max(max_abs_um, 0.05) * 1.05, divisions);
-  while (scale_um_per_div * divisions < max_abs_um) scale_um_per_div = next_nice(scale_um_per_div);
-  const double px_per_um = ring / scale_um_per_div;
-  const auto px = [&](double ang_deg, double dev_um, double& x, double& y) {
-    const double th = ang_deg * kPi / 180.0;
-    const double r = std::max(0.0, r0 + dev_um * px_per_um);
-    x = c + r * std::cos(th), y = cy - r * std::sin(th);
-  };
-  const std::string halo = " stroke='#ffffff' stroke-width='3' paint-order='stroke' stroke-linejoin='round'";
+  if (scale_um_per_div <= 0.0) scale_um_per_div = nice_step(std::max(max_abs_um, 0.05) * 1.05, g.divisions);
+  while (scale_um_per_div * g.divisions < max_abs_um) scale_um_per_div = next_nice(scale_um_per_div);
+  g.scale_um_per_div = scale_um_per_div;
+  g.px_per_um = g.ring / scale_um_per_div;
+  g.r1 = g.r0 - g.divisions * g.ring, g.r2 = g.r0 + g.divisions * g.ring + 4;
+  return g;
+}
 
-  std::string s = svg_open(w, h);
-  s += text(c, 18, title, "text-anchor='middle' font-size='14' font-weight='600'");
-  if (!subtitle.empty()) s += text(c, 34, subtitle, "text-anchor='middle' font-size='11' fill='#4a5366'");
-  // Grid first: rings and spokes under the traces.
-  for (int k = -divisions; k <= divisions; ++k) {
-    const double r = r0 + k * ring;
+// Rings and spokes, drawn first (under the traces).
+std::string polar_grid(const PolarGeometry& g) {
+  const double c = g.c, cy = g.cy, r1 = g.r1, r2 = g.r2;
+  std::string s;
+  for (int k = -g.divisions; k <= g.divisions; ++k) {
+    const double r = g.r0 + k * g.ring;
     s += "<circle cx='" + num(c) + "' cy='" + num(cy) + "' r='" + num(r) + "' fill='none' stroke='" +
          (k == 0 ? "#8a93a3" : "#d5d9e0") + "' stroke-width='" + (k == 0 ? "1.1" : "0.8") +
          (k == 0 ? "'" : "' stroke-dasharray='3,3'") + "/>";
   }
-  const double r1 = r0 - divisions * ring, r2 = r0 + divisions * ring + 4;
   for (int a = 0; a < 360; a += 30) {
     const double th = a * kPi / 180.0;
     s += "<line x1='" + num(c + r1 * std::cos(th)) + "' y1='" + num(cy - r1 * std::sin(th)) + "' x2='" +
          num(c + r2 * std::cos(th)) + "' y2='" + num(cy - r2 * std::sin(th)) + "' stroke='#e6e9ee'/>";
   }
-  // Traces: one polyline per revolution, closed where it is a full one, a marker at its start.
-  std::string markers;
+  return s;
+}
+
+// Traces: one polyline per revolution, closed where it is a full one, a marker at its start
+// (the markers after every trace, so that none hides under the next).
+std::string polar_traces(const std::vector<PolarTrace>& traces, const PolarGeometry& g) {
+  std::string s, markers;
   for (const auto& t : traces) {
     const std::size_t n = std::min(t.angle_deg.size(), t.deviation_um.size());
     if (n == 0) continue;
@@ -149,27 +168,34 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
         pts.clear();
       }
       prev_ang = t.angle_deg[i];
-      px(t.angle_deg[i], t.deviation_um[i], x, y);
+      g.point(t.angle_deg[i], t.deviation_um[i], x, y);
       pts += num(x) + "," + num(y) + " ";
     }
     if (t.closed && n > 1) {  // back to where it began
-      px(t.angle_deg[0], t.deviation_um[0], x, y);
+      g.point(t.angle_deg[0], t.deviation_um[0], x, y);
       pts += num(x) + "," + num(y) + " ";
     }
     s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" + pts +
          "'/>";
     if (t.start_marker) {
-      px(t.angle_deg[0], t.deviation_um[0], x, y);
+      g.point(t.angle_deg[0], t.deviation_um[0], x, y);
       markers += "<circle cx='" + num(x) + "' cy='" + num(y) + "' r='3.6' fill='#ffffff' stroke='" + t.color +
                  "' stroke-width='1.8'/>";
     }
   }
-  s += markers;
-  // Labels above the traces.
-  for (int k = -divisions; k <= divisions; ++k)
+  return s + markers;
+}
+
+// The rings' µm and the angles (the plane's axes at 0° and 90°), above the traces on a
+// white halo.
+std::string polar_labels(const PolarGeometry& g, const std::string& axis_a, const std::string& axis_b) {
+  const std::string halo = " stroke='#ffffff' stroke-width='3' paint-order='stroke' stroke-linejoin='round'";
+  const double c = g.c, cy = g.cy, r2 = g.r2;
+  std::string s;
+  for (int k = -g.divisions; k <= g.divisions; ++k)
     if (k != 0) {
-      const double r = r0 + k * ring;
-      s += text(c + 3, cy - r - 2, (k > 0 ? "+" : "") + tick_label(k * scale_um_per_div, scale_um_per_div),
+      const double r = g.r0 + k * g.ring;
+      s += text(c + 3, cy - r - 2, (k > 0 ? "+" : "") + tick_label(k * g.scale_um_per_div, g.scale_um_per_div),
                 "fill='#6b7385' font-size='9'" + halo);
     }
   for (int a = 0; a < 360; a += 30) {
@@ -180,8 +206,14 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
     s += text(c + (r2 + 14) * std::cos(th), cy - (r2 + 14) * std::sin(th) + 4, lab,
               "text-anchor='middle' fill='#4a5366'" + std::string(a % 90 == 0 ? " font-weight='600'" : "") + halo);
   }
-  // Legend in two columns under the plot, the scale beside.
-  double ly = cy + r2 + 34;
+  return s;
+}
+
+// Legend in two columns under the plot, the scale beside.
+std::string polar_legend(const std::vector<PolarTrace>& traces, const PolarGeometry& g) {
+  const double w = g.w, h = g.h;
+  std::string s;
+  double ly = g.cy + g.r2 + 34;
   std::size_t k = 0;
   for (const auto& t : traces) {
     if (t.label.empty()) continue;
@@ -194,15 +226,25 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
   s += "<circle cx='" + num(14) + "' cy='" + num(h - 9) +
        "' r='3.6' fill='#ffffff' stroke='#4a5366' stroke-width='1.8'/>" +
        text(24, h - 5, "start of a revolution", "fill='#4a5366' font-size='10'");
-  s += text(w - 10, h - 21, tick_label(scale_um_per_div, scale_um_per_div) + " µm / division",
+  s += text(w - 10, h - 21, tick_label(g.scale_um_per_div, g.scale_um_per_div) + " µm / division",
             "text-anchor='end' fill='#4a5366'");
   s += text(w - 10, h - 5, "reference circle = 0 µm", "text-anchor='end' fill='#6b7385' font-size='10'");
-  return s + "</svg>";
+  return s;
 }
 
-std::string line_plot(const std::vector<LineSeries>& series, const std::string& title, const std::string& x_label,
-                      const std::string& y_label, double w, double h) {
-  const double left = 64, right = 18, top = 30, bottom = 44;
+// A line plot's frame: its margins, the data's ranges (padded) and their mapping to px.
+struct PlotFrame {
+  double w = 0.0, h = 0.0;
+  double left = 64, right = 18, top = 30, bottom = 44;
+  double xmin = 0.0, xmax = 0.0, ymin = 0.0, ymax = 0.0;
+  [[nodiscard]] double X(double x) const { return left + (x - xmin) / (xmax - xmin) * (w - left - right); }
+  [[nodiscard]] double Y(double y) const { return top + (ymax - y) / (ymax - ymin) * (h - top - bottom); }
+};
+
+// The ranges of every finite point and band; a degenerate range widened, y padded by 6 %.
+PlotFrame plot_frame(const std::vector<LineSeries>& series, double w, double h) {
+  PlotFrame f;
+  f.w = w, f.h = h;
   double xmin = std::numeric_limits<double>::infinity(), xmax = -xmin, ymin = xmin, ymax = -xmin;
   auto extend_y = [&](double y) {
     if (std::isfinite(y)) ymin = std::min(ymin, y), ymax = std::max(ymax, y);
@@ -222,43 +264,60 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
   if (ymax <= ymin) ymin -= 0.5, ymax += 0.5;
   const double ypad = 0.06 * (ymax - ymin);
   ymin -= ypad, ymax += ypad;
-  const auto X = [&](double x) { return left + (x - xmin) / (xmax - xmin) * (w - left - right); };
-  const auto Y = [&](double y) { return top + (ymax - y) / (ymax - ymin) * (h - top - bottom); };
+  f.xmin = xmin, f.xmax = xmax, f.ymin = ymin, f.ymax = ymax;
+  return f;
+}
 
-  std::string s = svg_open(w, h);
-  s += text(w / 2, 17, title, "text-anchor='middle' font-size='13' font-weight='600'");
-  const double xs = nice_step(xmax - xmin, 8), ys = nice_step(ymax - ymin, 6);
-  for (double x : ticks(xmin, xmax, xs))
-    s += "<line x1='" + num(X(x)) + "' y1='" + num(top) + "' x2='" + num(X(x)) + "' y2='" + num(h - bottom) +
-         "' stroke='#edf0f4'/>" + text(X(x), h - bottom + 15, tick_label(x, xs), "text-anchor='middle' fill='#4a5366'");
-  for (double y : ticks(ymin, ymax, ys))
-    s += "<line x1='" + num(left) + "' y1='" + num(Y(y)) + "' x2='" + num(w - right) + "' y2='" + num(Y(y)) +
+// Title, grid with tick labels, the frame and the axis labels.
+std::string plot_axes(const PlotFrame& f, const std::string& title, const std::string& x_label,
+                      const std::string& y_label) {
+  const double w = f.w, h = f.h, left = f.left, right = f.right, top = f.top, bottom = f.bottom;
+  std::string s = text(w / 2, 17, title, "text-anchor='middle' font-size='13' font-weight='600'");
+  const double xs = nice_step(f.xmax - f.xmin, 8), ys = nice_step(f.ymax - f.ymin, 6);
+  for (double x : ticks(f.xmin, f.xmax, xs))
+    s += "<line x1='" + num(f.X(x)) + "' y1='" + num(top) + "' x2='" + num(f.X(x)) + "' y2='" + num(h - bottom) +
+         "' stroke='#edf0f4'/>" +
+         text(f.X(x), h - bottom + 15, tick_label(x, xs), "text-anchor='middle' fill='#4a5366'");
+  for (double y : ticks(f.ymin, f.ymax, ys))
+    s += "<line x1='" + num(left) + "' y1='" + num(f.Y(y)) + "' x2='" + num(w - right) + "' y2='" + num(f.Y(y)) +
          "' stroke='" + (std::abs(y) < ys * 1e-6 ? "#9aa3b2" : "#edf0f4") + "'/>" +
-         text(left - 5, Y(y) + 4, tick_label(y, ys), "text-anchor='end' fill='#4a5366'");
+         text(left - 5, f.Y(y) + 4, tick_label(y, ys), "text-anchor='end' fill='#4a5366'");
   s += "<rect x='" + num(left) + "' y='" + num(top) + "' width='" + num(w - left - right) + "' height='" +
        num(h - top - bottom) + "' fill='none' stroke='#8a93a3'/>";
   s += text((left + w - right) / 2, h - 8, x_label, "text-anchor='middle'");
   s += "<text transform='translate(15," + num((top + h - bottom) / 2) + ") rotate(-90)' text-anchor='middle'>" +
        xml_escape(y_label) + "</text>";
-  // Bands first, so that lines stay on top.
+  return s;
+}
+
+// Bands (or error bars), drawn before the lines so that the lines stay on top.
+std::string plot_bands(const std::vector<LineSeries>& series, const PlotFrame& f) {
+  std::string s;
   for (const auto& ser : series) {
     const std::size_t n = std::min({ser.x.size(), ser.y_lo.size(), ser.y_hi.size()});
     if (ser.error_bars) {
       for (std::size_t i = 0; i < n; ++i)
         if (std::isfinite(ser.x[i]) && std::isfinite(ser.y_lo[i]) && std::isfinite(ser.y_hi[i]))
-          s += "<line x1='" + num(X(ser.x[i])) + "' y1='" + num(Y(ser.y_lo[i])) + "' x2='" + num(X(ser.x[i])) +
-               "' y2='" + num(Y(ser.y_hi[i])) + "' stroke='" + ser.color +
+          s += "<line x1='" + num(f.X(ser.x[i])) + "' y1='" + num(f.Y(ser.y_lo[i])) + "' x2='" + num(f.X(ser.x[i])) +
+               "' y2='" + num(f.Y(ser.y_hi[i])) + "' stroke='" + ser.color +
                "' stroke-opacity='0.6' stroke-width='1.2'/>";
       continue;
     }
     if (n < 2) continue;
     std::string pts;
-    for (std::size_t i = 0; i < n; ++i) pts += num(X(ser.x[i])) + "," + num(Y(ser.y_hi[i])) + " ";
-    for (std::size_t i = n; i-- > 0;) pts += num(X(ser.x[i])) + "," + num(Y(ser.y_lo[i])) + " ";
+    for (std::size_t i = 0; i < n; ++i) pts += num(f.X(ser.x[i])) + "," + num(f.Y(ser.y_hi[i])) + " ";
+    for (std::size_t i = n; i-- > 0;) pts += num(f.X(ser.x[i])) + "," + num(f.Y(ser.y_lo[i])) + " ";
     s += "<polygon points='" + pts + "' fill='" + ser.color + "' fill-opacity='0.13' stroke='" + ser.color +
          "' stroke-opacity='0.35' stroke-width='0.7'/>";
   }
-  // The legend is drawn last, on a white panel: a trace may pass under it, never over it.
+  return s;
+}
+
+// The series as lines or markers; the legend is drawn last, on a white panel: a trace may
+// pass under it, never over it.
+std::string plot_lines_and_legend(const std::vector<LineSeries>& series, const PlotFrame& f) {
+  const double w = f.w, right = f.right, top = f.top;
+  std::string s;
   double ly = top + 14;
   std::string legend;
   for (const auto& ser : series) {
@@ -267,12 +326,13 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
     if (ser.markers) {
       for (std::size_t i = 0; i < n; i += stride)
         if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i]))
-          s += "<circle cx='" + num(X(ser.x[i])) + "' cy='" + num(Y(ser.y[i])) + "' r='2.2' fill='" + ser.color +
+          s += "<circle cx='" + num(f.X(ser.x[i])) + "' cy='" + num(f.Y(ser.y[i])) + "' r='2.2' fill='" + ser.color +
                "' fill-opacity='0.7'/>";
     } else {
       std::string pts;
       for (std::size_t i = 0; i < n; i += stride)
-        if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i])) pts += num(X(ser.x[i])) + "," + num(Y(ser.y[i])) + " ";
+        if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i]))
+          pts += num(f.X(ser.x[i])) + "," + num(f.Y(ser.y[i])) + " ";
       s += "<polyline fill='none' stroke='" + ser.color + "' stroke-width='" + num(ser.width) +
            "' stroke-linejoin='round'" + (ser.dashed ? " stroke-dasharray='5,3'" : "") + " points='" + pts + "'/>";
     }
@@ -287,6 +347,31 @@ std::string line_plot(const std::vector<LineSeries>& series, const std::string& 
   if (!legend.empty())
     s += "<rect x='" + num(w - right - 190) + "' y='" + num(top + 2) + "' width='186' height='" + num(ly - top - 4) +
          "' fill='white' fill-opacity='0.85' stroke='#d5dae3' stroke-width='0.6' rx='2'/>" + legend;
+  return s;
+}
+
+}  // namespace
+
+std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title, const std::string& axis_a,
+                       const std::string& axis_b, double scale_um_per_div, const std::string& subtitle) {
+  const PolarGeometry g = polar_geometry(traces, scale_um_per_div);
+  std::string s = svg_open(g.w, g.h);
+  s += text(g.c, 18, title, "text-anchor='middle' font-size='14' font-weight='600'");
+  if (!subtitle.empty()) s += text(g.c, 34, subtitle, "text-anchor='middle' font-size='11' fill='#4a5366'");
+  s += polar_grid(g);
+  s += polar_traces(traces, g);
+  s += polar_labels(g, axis_a, axis_b);
+  s += polar_legend(traces, g);
+  return s + "</svg>";
+}
+
+std::string line_plot(const std::vector<LineSeries>& series, const std::string& title, const std::string& x_label,
+                      const std::string& y_label, double w, double h) {
+  const PlotFrame f = plot_frame(series, w, h);
+  std::string s = svg_open(w, h);
+  s += plot_axes(f, title, x_label, y_label);
+  s += plot_bands(series, f);
+  s += plot_lines_and_legend(series, f);
   return s + "</svg>";
 }
 
