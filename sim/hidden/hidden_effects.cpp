@@ -2,6 +2,7 @@
 
 #include "dsp/core/error.hpp"
 #include "sim/effects.hpp"
+#include "sim/regimes/regimes.hpp"
 #include "sim/simulate.hpp"
 
 #include <Eigen/Geometry>
@@ -237,6 +238,10 @@ void inject_machine(Scenario& sc, const std::string& e, Draw& d) {
     sc.resonance.modes = {mode};
     sc.resonance.part =
         std::find(head.begin(), head.end(), std::string(1, static_cast<char>('x' + a))) != head.end() ? 1 : 0;
+    // Measured by the moving part's sensor alone (a machine with one sensor, as the printers
+    // under Klipper): with both, the same mode is the head moving against the table, which
+    // explain names machine.differential_vibration (run-format.md).
+    set_sensors_present(sc, sc.resonance.part == 1 ? "head" : "table");
   } else {
     unknown_effect(e);
   }

@@ -140,7 +140,10 @@ std::string machine_effects_toml(const dsp::Run& run, const dsp::model::RunExpla
       effects_toml += scale_mismatch_toml(p);
     } else if (x.name == "machine.cyclic_error") {
       effects_toml += cyclic_error_toml(p);
-    } else if (x.name == "machine.resonance") {
+    } else if (x.name == "machine.resonance" ||
+               (x.name == "machine.differential_vibration" && p.count("mode0_frequency_hz"))) {
+      // A driven mode of the head against the table is the simulator's resonance of the
+      // moving part: the same equation of motion.
       effects_toml += resonance_toml(run, p, notes);
     } else {
       notes.push_back(x.name + ": found; not taken into the scenario (its shape is not one of the simulator's tables)");

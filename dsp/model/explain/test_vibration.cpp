@@ -9,6 +9,34 @@
 
 namespace eical::dsp::model::stage {
 
+namespace {
+
+// With both sensors the relative acceleration is head - table: a mode the motion drives in
+// it is the head moving against the table (machine.differential_vibration, run-format.md),
+// whichever part carries it; machine.resonance stays the name of a mode one sensor sees
+// against the commanded motion, where nothing says the motion is relative. The mode's
+// parameters move over with it; its size in µm is the larger of the spectral test's and
+// the modes' relative displacement.
+void name_as_differential(ExplainedEffect& res, ExplainedEffect& d) {
+  double displacement_um = 0.0;
+  for (const auto& [key, value] : res.params) {
+    d.params[key] = value;
+    if (key.size() > 20 && key.compare(key.size() - 20, 20, "_displacement_rms_um") == 0)
+      displacement_um = std::max(displacement_um, value);
+  }
+  d.magnitude = std::max(d.magnitude, displacement_um);
+  d.params["displacement_um"] = d.magnitude;
+  d.significant = true;
+  d.importance_um = std::max(d.importance_um, res.importance_um);
+  d.evidence = "driven by the motion, " + res.evidence + (d.evidence.empty() ? "" : "; spectra: " + d.evidence);
+  res.significant = false, res.importance_um = 0.0;
+  res.evidence =
+      "the mode found is the head moving against the table (both sensors): named "
+      "machine.differential_vibration";
+}
+
+}  // namespace
+
 void test_vibration(ExplainState& st) {
   RunResiduals& rr = st.rr;
   std::vector<ExplainedEffect>& all = st.effects;
@@ -84,6 +112,7 @@ void test_vibration(ExplainState& st) {
     } else {
       res.evidence = ms.evidence + ": no mode stands out";
     }
+    if (k > 0 && rr.meta.sensor_present[0] && rr.meta.sensor_present[1]) name_as_differential(res, d);
     all.push_back(c), all.push_back(d), all.push_back(res);
   }
 }
