@@ -40,9 +40,9 @@ std::string list(const std::vector<std::string>& v) {
   return s + "]";
 }
 
-const char* kAxis[3] = {"x", "y", "z"};
-const char* kPair[3] = {"xy", "yz", "zx"};
-const char* kSensor[2] = {"table", "head"};
+const char* const kAxis[3] = {"x", "y", "z"};
+const char* const kPair[3] = {"xy", "yz", "zx"};
+const char* const kSensor[2] = {"table", "head"};
 
 // Small rotation (mrad) about the sensor axes between nominal and true mounting.
 Eigen::Vector3d misalignment_mrad(const Eigen::Matrix3d& nominal, const Eigen::Matrix3d& truth) {

@@ -17,8 +17,8 @@
 namespace eical::tools {
 namespace {
 
-const char* kAxis[3] = {"x", "y", "z"};
-const char* kSensor[2] = {"table", "head"};
+const char* const kAxis[3] = {"x", "y", "z"};
+const char* const kSensor[2] = {"table", "head"};
 
 nlohmann::json estimate_json(const dsp::identify::Estimate& e) {
   if (!e.fitted) return nullptr;

@@ -41,11 +41,11 @@ void register_iso230_2(CLI::App& app) {
     if (o->vdi)
       std::printf("  VDI/DGQ 3441: P %.3f um, Pa %.3f um, U %.3f um, Ps %.3f um\n", r.vdi.P_um, r.vdi.Pa_um, r.vdi.U_um,
                   r.vdi.Ps_um);
-    if (r.runs < dsp::eval::kIso230_2Runs)
+    if (r.runs < dsp::eval::kRunsPerTargetIso230_2)
       std::printf(
           "  note: %d runs per target and direction, ISO 230-2 asks for %d: evaluated by its formulas, outside the "
           "standard\n",
-          r.runs, dsp::eval::kIso230_2Runs);
+          r.runs, dsp::eval::kRunsPerTargetIso230_2);
   });
 }
 

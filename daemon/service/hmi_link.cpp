@@ -72,13 +72,13 @@ void HmiLink::publisher() {
     const auto rt = make_this_thread_realtime(publisher_priority_, "eicald-pub");
     log(rt.ok ? LogLevel::info : LogLevel::warning, "%s", rt.message.c_str());
   }
-  using clock = std::chrono::steady_clock;
+  using Clock = std::chrono::steady_clock;
   const auto status_period =
-      std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(1.0 / config_.status_rate_hz));
-  auto next_status = clock::now();
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(1.0 / config_.status_rate_hz));
+  auto next_status = Clock::now();
   while (!stop_.load()) {
     // Sleep until a Live sample arrives or the next Status is due.
-    const auto wait_ms = std::chrono::ceil<std::chrono::milliseconds>(next_status - clock::now()).count();
+    const auto wait_ms = std::chrono::ceil<std::chrono::milliseconds>(next_status - Clock::now()).count();
     pollfd p{wake_fd_, POLLIN, 0};
     if (wait_ms > 0 && ::poll(&p, 1, static_cast<int>(wait_ms)) > 0) {
       std::uint64_t n = 0;
@@ -100,7 +100,7 @@ void HmiLink::publisher() {
       m.acquired_ns = latest.acquired_ns;
       (void)bus_->publish(m);
     }
-    if (clock::now() >= next_status) {
+    if (Clock::now() >= next_status) {
       // The newest Status the status thread handed over (its strings are the front
       // buffer's: nothing is copied here).
       (void)status_.update();
@@ -109,7 +109,7 @@ void HmiLink::publisher() {
       st.time_ns = now_ns();
       (void)bus_->publish(st);
       next_status += status_period;
-      if (next_status < clock::now()) next_status = clock::now() + status_period;  // after a stall: no burst
+      if (next_status < Clock::now()) next_status = Clock::now() + status_period;  // after a stall: no burst
     }
   }
 }

@@ -287,7 +287,7 @@ nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp
                       {"deviation_um", {{"up", in.up_um}, {"down", in.down_um}}},
                       {"per_target", targets},
                       {"standard", "ISO 230-2:2014"},
-                      {"within_standard", r.runs >= dsp::eval::kIso230_2Runs}};
+                      {"within_standard", r.runs >= dsp::eval::kRunsPerTargetIso230_2}};
   if (vdi) j["vdi3441"] = {{"P_um", r.vdi.P_um}, {"Pa_um", r.vdi.Pa_um}, {"U_um", r.vdi.U_um}, {"Ps_um", r.vdi.Ps_um}};
   return j;
 }

@@ -59,9 +59,10 @@ void evaluate_positioning_program(const Run& run, Analysis& a) {
     a.positioning = eval::evaluate_positioning(*a.positioning_input);
     // ISO 230-2:2014 clause 4.3.2: five runs per target and direction; fewer are evaluated
     // by the same formulas, but the figures are outside the standard (s from < 5 runs).
-    if (a.positioning->runs < eval::kIso230_2Runs)
+    if (a.positioning->runs < eval::kRunsPerTargetIso230_2)
       a.flags.push_back("positioning: " + std::to_string(a.positioning->runs) +
-                        " runs per target and direction, ISO 230-2 asks for " + std::to_string(eval::kIso230_2Runs) +
+                        " runs per target and direction, ISO 230-2 asks for " +
+                        std::to_string(eval::kRunsPerTargetIso230_2) +
                         ": evaluated by its formulas, outside the standard");
   } catch (const InputError& e) {
     a.flags.push_back(std::string("positioning: ") + e.what());

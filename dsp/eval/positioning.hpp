@@ -14,7 +14,7 @@
 namespace eical::dsp::eval {
 
 // Runs per target and direction the standard asks for (ISO 230-2:2014, 4.3.2).
-inline constexpr int kIso230_2Runs = 5;
+inline constexpr int kRunsPerTargetIso230_2 = 5;
 
 struct PositioningInput {
   std::string axis = "x";

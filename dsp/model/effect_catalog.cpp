@@ -14,7 +14,7 @@ namespace eical::dsp::model {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-const char* kAxis[3] = {"x", "y", "z"};
+const char* const kAxis[3] = {"x", "y", "z"};
 
 std::string ax(int a) { return kAxis[a]; }
 

@@ -40,16 +40,16 @@ std::vector<RunExplanation::Correlation> regressor_correlations(const RunResidua
       x(k, 5) = cross, x(k, 6) = 0.5 * (rr.temp_c(s, 0) + rr.temp_c(s, 1)), x(k, 7) = rr.t_s[s];
       x(k, 8) = tr < other_sig.size() ? other_sig[tr][a] : 0.0, x(k, 9) = direction[s];
     }
-    static const char* kNames[10] = {"position",
-                                     "velocity",
-                                     "acceleration",
-                                     "|a|*v",
-                                     "jerk",
-                                     "other axes' acceleration",
-                                     "temperature",
-                                     "time",
-                                     "the other sensor's signal",
-                                     "direction since the last reversal"};
+    static const char* const kNames[10] = {"position",
+                                           "velocity",
+                                           "acceleration",
+                                           "|a|*v",
+                                           "jerk",
+                                           "other axes' acceleration",
+                                           "temperature",
+                                           "time",
+                                           "the other sensor's signal",
+                                           "direction since the last reversal"};
     const Eigen::VectorXd yc = y.array() - y.mean();
     for (int c = 0; c < 10; ++c) {
       const Eigen::VectorXd xc = x.col(c).array() - x.col(c).mean();

@@ -313,8 +313,8 @@ void choose_pattern(const PatternScores& sc, double ln_n, StandstillBias& out) {
 }
 
 std::string describe_standstills(const StandstillBias& out) {
-  static const char* kSensor[2] = {"table", "head"};
-  static const char* kAx[3] = {"x", "y", "z"};
+  static const char* const kSensor[2] = {"table", "head"};
+  static const char* const kAx[3] = {"x", "y", "z"};
   char buf[512];
   std::snprintf(buf, sizeof buf,
                 "head - table at %d standstills differs from the rest before the motion by up to %.2f ug (%s, mostly "

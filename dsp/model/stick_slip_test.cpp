@@ -147,7 +147,7 @@ double sawtooth_um(const Measurement& m, int axis) {
 }
 
 std::string describe_stick_slip(const StickSlipFinding& out) {
-  static const char* kAx[3] = {"x", "y", "z"};
+  static const char* const kAx[3] = {"x", "y", "z"};
   char buf[400];
   std::snprintf(buf, sizeof buf,
                 "%d bursts of relative acceleration beyond %.0f sigma while %s creeps (below %.0f mm/s; median %.0f "

@@ -10,15 +10,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <complex>
 #include <cstdio>
 #include <numbers>
 #include <optional>
 
 namespace eical::dsp::model {
 namespace {
-
-using cd = std::complex<double>;
 
 constexpr double kTargetDfHz = 0.25;  // resolves ζ ≈ 0.01 at 15 Hz (half-power band 2ζf)
 constexpr int kMinAverages = 4;

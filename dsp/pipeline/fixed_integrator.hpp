@@ -16,12 +16,12 @@
 namespace eical::dsp {
 
 inline constexpr int kOutQ = 40;  // position (m) and velocity (m/s) read-out
-inline constexpr fx::i128 kS2Bound = fx::i128(1) << 75;
+inline constexpr fx::Int128 kS2Bound = fx::Int128(1) << 75;
 
 struct FixedIntegrator {
   std::int64_t a_prev_q40[3] = {0, 0, 0};
   std::int64_t s1[3] = {0, 0, 0};
-  fx::i128 s2[3] = {0, 0, 0};
+  fx::Int128 s2[3] = {0, 0, 0};
   fx::QConst half_dt_s, quarter_dt2_s2, c1_half_dt_s2, c1_s, c2_s2;  // read-out constants
 
   FixedIntegrator() = default;
@@ -41,8 +41,8 @@ struct FixedIntegrator {
     if (k_samples < 0 || k_samples > (std::int64_t{1} << 30))
       sat.hit = true, k_samples = k_samples < 0 ? 0 : std::int64_t{1} << 30;
     for (int i = 0; i < 3; ++i) {
-      const std::int64_t s1_new = fx::sat64((fx::i128(a_q40[i]) + a_prev_q40[i]) * k_samples + s1[i], sat);
-      s2[i] = fx::clamp128(s2[i] + (fx::i128(s1[i]) + s1_new) * k_samples, kS2Bound, sat);
+      const std::int64_t s1_new = fx::sat64((fx::Int128(a_q40[i]) + a_prev_q40[i]) * k_samples + s1[i], sat);
+      s2[i] = fx::clamp128(s2[i] + (fx::Int128(s1[i]) + s1_new) * k_samples, kS2Bound, sat);
       s1[i] = s1_new;
       a_prev_q40[i] = a_q40[i];
     }

@@ -19,7 +19,7 @@
 
 namespace eical::dsp::fx {
 
-__extension__ using i128 = __int128;
+__extension__ using Int128 = __int128;
 
 // The acceleration format between the static compensation and the integrators, m/s²
 // (reasons in fixed_static_comp.hpp).
@@ -33,13 +33,13 @@ struct Saturation {
   bool hit = false;
 };
 
-[[nodiscard]] inline std::int64_t sat64(i128 v, Saturation& s) noexcept {
+[[nodiscard]] inline std::int64_t sat64(Int128 v, Saturation& s) noexcept {
   if (v > kMax64) return s.hit = true, kMax64;
   if (v < kMin64) return s.hit = true, kMin64;
   return static_cast<std::int64_t>(v);
 }
 
-[[nodiscard]] inline i128 clamp128(i128 v, i128 bound, Saturation& s) noexcept {
+[[nodiscard]] inline Int128 clamp128(Int128 v, Int128 bound, Saturation& s) noexcept {
   if (v > bound) return s.hit = true, bound;
   if (v < -bound) return s.hit = true, -bound;
   return v;
@@ -59,13 +59,13 @@ struct Saturation {
 
 // v·2⁻ˢʰⁱᶠᵗ rounded to nearest, ties away from zero; shift ≤ 0 multiplies (saturating at
 // ±2¹²⁶). |v| must stay below 2¹²⁶ (every caller's products do, by their bounds).
-[[nodiscard]] inline i128 shift_round(i128 v, int shift, Saturation& s) noexcept {
+[[nodiscard]] inline Int128 shift_round(Int128 v, int shift, Saturation& s) noexcept {
   if (shift > 0) {
     if (shift >= 127) return 0;
-    const i128 half = i128(1) << (shift - 1);
+    const Int128 half = Int128(1) << (shift - 1);
     return v >= 0 ? (v + half) >> shift : -((-v + half) >> shift);
   }
-  const i128 bound = i128(1) << 126;
+  const Int128 bound = Int128(1) << 126;
   for (int k = 0; k < -shift; ++k) {
     if (v > bound / 2 || v < -bound / 2) return s.hit = true, v > 0 ? bound : -bound;
     v *= 2;
@@ -74,7 +74,7 @@ struct Saturation {
 }
 
 // Rounded quotient num / den (den > 0), ties away from zero.
-[[nodiscard]] inline i128 div_round(i128 num, i128 den) noexcept {
+[[nodiscard]] inline Int128 div_round(Int128 num, Int128 den) noexcept {
   return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
 }
 
@@ -96,17 +96,17 @@ struct QConst {
 // value (Q`in_q`) × c → Q`out_q`, one rounding, saturated to int64.
 [[nodiscard]] inline std::int64_t mul(std::int64_t value, int in_q, const QConst& c, int out_q,
                                       Saturation& s) noexcept {
-  return sat64(shift_round(i128(value) * c.mant, c.shift + in_q - out_q, s), s);
+  return sat64(shift_round(Int128(value) * c.mant, c.shift + in_q - out_q, s), s);
 }
 
 // value (Q`in_q`, a 128-bit accumulator below 2⁷⁵ in magnitude) × c (mantissa < 2⁵⁰) → Q`out_q`.
-[[nodiscard]] inline std::int64_t mul_wide(i128 value, int in_q, const QConst& c, int out_q, Saturation& s) noexcept {
+[[nodiscard]] inline std::int64_t mul_wide(Int128 value, int in_q, const QConst& c, int out_q, Saturation& s) noexcept {
   return sat64(shift_round(value * c.mant, c.shift + in_q - out_q, s), s);
 }
 
 // Two Q`q` signals multiplied, back in Q`q`.
 [[nodiscard]] inline std::int64_t mul_q(std::int64_t a, std::int64_t b, int q, Saturation& s) noexcept {
-  return sat64(shift_round(i128(a) * b, q, s), s);
+  return sat64(shift_round(Int128(a) * b, q, s), s);
 }
 
 [[nodiscard]] inline double to_double(std::int64_t v, int q) noexcept { return std::ldexp(static_cast<double>(v), -q); }

@@ -192,7 +192,7 @@ void Pipeline::start_motion() noexcept {
       std::int64_t as[3];
       for (int i = 0; i < 3; ++i) {
         fbias_[s][i] = bias_n_ > 0
-                           ? fx::sat64(fx::div_round(fbias_sum_[s][i], static_cast<fx::i128>(bias_n_)), saturation_)
+                           ? fx::sat64(fx::div_round(fbias_sum_[s][i], static_cast<fx::Int128>(bias_n_)), saturation_)
                            : aq_[s][i];
         as[i] = fx::sub_sat(aq_[s][i], fbias_[s][i], saturation_);
         bias_[s][i] = fx::to_double(fbias_[s][i], fx::kAccelQ);

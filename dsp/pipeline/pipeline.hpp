@@ -229,7 +229,7 @@ class Pipeline {
   Eigen::Vector3d a_[2];
   std::int64_t aq_[2][3] = {};
   std::int64_t last_valid_aq_[2][3] = {};
-  fx::i128 fbias_sum_[2][3] = {};
+  fx::Int128 fbias_sum_[2][3] = {};
   std::int64_t fbias_[2][3] = {};
   Eigen::Vector3d rest_hist_[2][3];  // the last three rest samples (derivative history)
   Phase phase_ = Phase::wait_start;

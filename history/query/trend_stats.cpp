@@ -18,7 +18,7 @@ std::optional<double> epoch_s(const std::string& utc) {
 
 namespace {
 
-constexpr double k30Days_s = 30.0 * 86400.0;
+constexpr double kMonth_s = 30.0 * 86400.0;  // the trend's time unit: 30 days
 
 // Weighted straight line through (t, y) with weights w; slope and its standard deviation
 // (scaled by √(χ²/dof) when the scatter exceeds the weights, or from the residuals when
@@ -68,7 +68,7 @@ std::vector<TrendSummary> summarize(const std::vector<TrendPoint>& points) {
       ++s.determined;
       if (!s.first) s.first = *p;
       s.last = *p;
-      t.push_back(*ts / k30Days_s);
+      t.push_back(*ts / kMonth_s);
       y.push_back(*p->value);
       const bool has_u = p->uncertainty_k2 && *p->uncertainty_k2 > 0;
       all_u &= has_u;

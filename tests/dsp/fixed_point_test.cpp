@@ -39,10 +39,10 @@ TEST(FixedPoint, SaturatesInsteadOfWrappingAndSetsTheFlag) {
   EXPECT_EQ(fx::mul_q(-(std::int64_t{1} << 62), std::int64_t{1} << 62, 40, s), fx::kMin64);
   EXPECT_TRUE(s.hit);
   s = {};
-  EXPECT_EQ(fx::shift_round(fx::i128(1) << 120, -10, s), fx::i128(1) << 126);
+  EXPECT_EQ(fx::shift_round(fx::Int128(1) << 120, -10, s), fx::Int128(1) << 126);
   EXPECT_TRUE(s.hit);
   s = {};
-  EXPECT_EQ(fx::clamp128(fx::i128(1) << 80, kS2Bound, s), kS2Bound);
+  EXPECT_EQ(fx::clamp128(fx::Int128(1) << 80, kS2Bound, s), kS2Bound);
   EXPECT_TRUE(s.hit);
   s = {};
   EXPECT_EQ(fx::add_sat(5, -7, s), -2);  // in range: exact, no flag

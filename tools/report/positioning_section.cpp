@@ -115,9 +115,9 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
   s.svgs.push_back(reversal_plot(r));
   const FigureRows fr(a);
   figure_tables(fr, s);
-  if (r.runs < dsp::eval::kIso230_2Runs)
+  if (r.runs < dsp::eval::kRunsPerTargetIso230_2)
     s.notes.push_back(std::to_string(r.runs) + " runs per target and direction: ISO 230-2 asks for " +
-                      std::to_string(dsp::eval::kIso230_2Runs) +
+                      std::to_string(dsp::eval::kRunsPerTargetIso230_2) +
                       ". The figures are evaluated by its formulas but are outside the standard (s from fewer runs is "
                       "less certain).");
   s.grids.push_back(per_target_grid(r, fr));

@@ -37,7 +37,7 @@ Channel residual_with(const ExplainState& st, const std::vector<ExplainedEffect>
 
 // The significant effects the pipeline compensates from a calibration, most important first.
 std::vector<std::size_t> pipeline_side_order(const std::vector<ExplainedEffect>& all) {
-  static const char* kPipelineSide[] = {
+  static const char* const kPipelineSide[] = {
       "sensor.scale",    "sensor.misalignment",      "sensor.cross_coupling",    "sensor.nonlinearity",
       "sensor.dynamics", "sensor.damping_amplitude", "sensor.scale_temperature", "daq.group_delay"};
   std::vector<std::size_t> order;
