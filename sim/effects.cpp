@@ -23,14 +23,14 @@ const std::vector<std::string>& effect_names() {
   return names;
 }
 
-std::vector<std::string> effects_in(const Scenario& sc) {
+std::vector<std::string> effects_in(const Scenario& scenario) {
   std::vector<std::string> on;
   auto add = [&](const char* e, bool cond) {
     if (cond && std::find(on.begin(), on.end(), e) == on.end()) on.emplace_back(e);
   };
   for (int s = 0; s < 2; ++s) {
-    const SensorTruth& t = sc.truth[s];
-    const dsp::SensorSpec& n = sc.meta.sensors[s];
+    const SensorTruth& t = scenario.truth[s];
+    const dsp::SensorSpec& n = scenario.meta.sensors[s];
     add("sensor.scale", differs(t.spec.k1_v_per_g, n.k1_v_per_g));
     add("sensor.bias_drift", t.bias_rw_ug_per_rts != 0.0 || t.bias_step_ug != 0.0 || t.bias_drift_ug_per_s != 0.0);
     add("sensor.nonlinearity",
@@ -42,14 +42,14 @@ std::vector<std::string> effects_in(const Scenario& sc) {
     add("sensor.scale_temperature",
         t.temperature.rise_c != 0.0 && (t.spec.tc_k1_ppm_per_c != 0.0 || t.spec.tc_bias_ug_per_c != 0.0));
   }
-  add("daq.group_delay", differs(sc.daq.group_delay_samples, sc.meta.acquisition.daq_group_delay_samples) ||
-                             sc.daq.skew_head_samples != sc.meta.acquisition.daq_skew_head_samples);
-  add("site.coriolis", sc.coriolis);
-  add("machine.common_vibration", sc.common_vibration.on());
+  add("daq.group_delay", differs(scenario.daq.group_delay_samples, scenario.meta.acquisition.daq_group_delay_samples) ||
+                             scenario.daq.skew_head_samples != scenario.meta.acquisition.daq_skew_head_samples);
+  add("site.coriolis", scenario.coriolis);
+  add("machine.common_vibration", scenario.common_vibration.on());
   add("machine.differential_vibration",
-      sc.differential_vibration.gain.squaredNorm() > 0.0 || !sc.differential_tones.empty());
-  add("machine.resonance", sc.resonance.on());
-  const MachineErrors& m = sc.machine;
+      scenario.differential_vibration.gain.squaredNorm() > 0.0 || !scenario.differential_tones.empty());
+  add("machine.resonance", scenario.resonance.on());
+  const MachineErrors& m = scenario.machine;
   for (int i = 0; i < 3; ++i) {
     add("machine.backlash", m.backlash_um[i] != 0.0);
     add("machine.reversal_spike", m.spike[i].amp_um != 0.0);
@@ -72,14 +72,14 @@ std::vector<std::string> effects_in(const Scenario& sc) {
   return ordered;
 }
 
-EffectLists effect_lists(const Scenario& sc) {
+EffectLists effect_lists(const Scenario& scenario) {
   EffectLists l;
-  const std::vector<std::string> found = effects_in(sc);
-  if (sc.effects_present.empty() && sc.effects_background.empty()) {
+  const std::vector<std::string> found = effects_in(scenario);
+  if (scenario.effects_present.empty() && scenario.effects_background.empty()) {
     l.present = found;
     return l;
   }
-  l.present = sc.effects_present;
+  l.present = scenario.effects_present;
   for (const auto& e : found)
     if (std::find(l.present.begin(), l.present.end(), e) == l.present.end()) l.background.push_back(e);
   return l;

@@ -99,10 +99,10 @@ Scenario gcode_scenario(const std::string& gcode, const std::string& kind, std::
   return sc;
 }
 
-std::vector<dsp::PsdSpec> psd_config_b(double r) {
+std::vector<dsp::PsdSpec> psd_config_b(double radius_mm) {
   dsp::PsdSpec x, y;
-  x.measures = "x", x.center_mm[0] = 0.0, x.center_mm[1] = -r;
-  y.measures = "y", y.center_mm[0] = r, y.center_mm[1] = 0.0;
+  x.measures = "x", x.center_mm[0] = 0.0, x.center_mm[1] = -radius_mm;
+  y.measures = "y", y.center_mm[0] = radius_mm, y.center_mm[1] = 0.0;
   return {x, y};
 }
 

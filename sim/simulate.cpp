@@ -419,43 +419,46 @@ std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t purpose) noexcept {
   return z ^ (z >> 31);
 }
 
-std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& sc) {
-  if (sc.sweep.on)
-    return std::make_unique<nc::AccelProfileSetPoint>(nc::klipper_segments(sc.sweep.test), sc.sweep.direction,
-                                                      sc.sweep.start_mm, sc.sweep.lead_in_s, sc.sweep.tail_s);
-  const dsp::Program& p = sc.meta.program;
-  return std::make_unique<nc::Trajectory>(
-      nc::interpolate_gcode(p.gcode.empty() ? gcode::program_gcode(p) : p.gcode, sc.meta.id + ".ngc", sc.limits));
+std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& scenario) {
+  if (scenario.sweep.on)
+    return std::make_unique<nc::AccelProfileSetPoint>(nc::klipper_segments(scenario.sweep.test),
+                                                      scenario.sweep.direction, scenario.sweep.start_mm,
+                                                      scenario.sweep.lead_in_s, scenario.sweep.tail_s);
+  const dsp::Program& p = scenario.meta.program;
+  return std::make_unique<nc::Trajectory>(nc::interpolate_gcode(p.gcode.empty() ? gcode::program_gcode(p) : p.gcode,
+                                                                scenario.meta.id + ".ngc", scenario.limits));
 }
 
-dsp::Run simulate(const Scenario& sc) { return simulate(sc, static_cast<std::vector<Eigen::Vector3d>*>(nullptr)); }
+dsp::Run simulate(const Scenario& scenario) {
+  return simulate(scenario, static_cast<std::vector<Eigen::Vector3d>*>(nullptr));
+}
 
-dsp::Run simulate(const Scenario& sc, std::vector<Eigen::Vector3d>* true_rel_mm, JitteredCapture* capture) {
-  Scenario with_program = sc;
+dsp::Run simulate(const Scenario& scenario, std::vector<Eigen::Vector3d>* true_rel_mm, JitteredCapture* capture) {
+  Scenario with_program = scenario;
   auto& p = with_program.meta.program;
-  if (!sc.sweep.on && p.gcode.empty()) p.gcode = gcode::program_gcode(p);
+  if (!scenario.sweep.on && p.gcode.empty()) p.gcode = gcode::program_gcode(p);
   const auto tr = scenario_set_point(with_program);
   return simulate(with_program, *tr, true_rel_mm, capture);
 }
 
-dsp::Run simulate(const Scenario& sc, const nc::SetPoint& tr, std::vector<Eigen::Vector3d>* true_rel_mm,
+dsp::Run simulate(const Scenario& scenario, const nc::SetPoint& set_point, std::vector<Eigen::Vector3d>* true_rel_mm,
                   JitteredCapture* capture) {
-  check(sc);
-  const SimGrid gr = sim_grid(sc, tr);
+  check(scenario);
+  const SimGrid gr = sim_grid(scenario, set_point);
   check_capture(capture, gr);
   dsp::Run run;
-  run.meta = sc.meta;
+  run.meta = scenario.meta;
   run.meta.format = "eical-run/1";
-  set_point_frames(sc, tr, gr, run);
+  set_point_frames(scenario, set_point, gr, run);
   // Machine, vibration, Earth rate, PSD on the internal grid.
-  InternalChannels ch = internal_channels(sc, gr);
-  simulate_motion(sc, tr, gr, ch, run, true_rel_mm);
+  InternalChannels ch = internal_channels(scenario, gr);
+  simulate_motion(scenario, set_point, gr, ch, run, true_rel_mm);
   // Sensing elements, DAQ filter, slow terms, noise, ADC.
-  DaqStage daq(sc, gr, capture);
+  DaqStage daq(scenario, gr, capture);
   for (int s = 0; s < 2; ++s)
-    if (ch.present[s]) sensor_counts(daq, s, tr, ch.sensor_g[static_cast<std::size_t>(s)], run, capture);
+    if (ch.present[s]) sensor_counts(daq, s, set_point, ch.sensor_g[static_cast<std::size_t>(s)], run, capture);
   if (!ch.psd_v.empty()) psd_counts(daq, ch.psd_v, run);
-  run.truth_toml = truth_toml(sc, tr);
+  run.truth_toml = truth_toml(scenario, set_point);
   return run;
 }
 

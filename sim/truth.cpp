@@ -421,14 +421,14 @@ std::string psd_and_reference_sections(const Scenario& sc) {
 
 }  // namespace
 
-std::string truth_toml(const Scenario& sc, const nc::SetPoint& tr) {
-  std::string o = header_and_effects(sc);
-  for (int s = 0; s < 2; ++s) o += sensor_section(sc, s, tr.duration_s());
-  o += machine_errors_section(sc.machine);
-  o += daq_and_site_sections(sc);
-  o += nc_section(sc, tr);
-  o += modes_and_vibration_sections(sc);
-  o += psd_and_reference_sections(sc);
+std::string truth_toml(const Scenario& scenario, const nc::SetPoint& set_point) {
+  std::string o = header_and_effects(scenario);
+  for (int s = 0; s < 2; ++s) o += sensor_section(scenario, s, set_point.duration_s());
+  o += machine_errors_section(scenario.machine);
+  o += daq_and_site_sections(scenario);
+  o += nc_section(scenario, set_point);
+  o += modes_and_vibration_sections(scenario);
+  o += psd_and_reference_sections(scenario);
   return o;
 }
 

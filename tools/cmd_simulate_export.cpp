@@ -22,16 +22,16 @@ std::size_t gaps_of(const sim::CaptureSamples& s) {
 
 }  // namespace
 
-std::string simulate_with_export(const sim::Scenario& sc, const ExportRequest& req, const std::string& out, bool gzip,
-                                 bool overwrite) {
-  if (req.kind != "klipper" && req.kind != "csv")
-    throw dsp::InputError("simulate --export: '" + req.kind + "' is not klipper or csv");
-  const auto set_point = sim::scenario_set_point(sc);
-  const double fs = sc.meta.acquisition.fs_hz;
+std::string simulate_with_export(const sim::Scenario& scenario, const ExportRequest& request, const std::string& out,
+                                 bool gzip, bool overwrite) {
+  if (request.kind != "klipper" && request.kind != "csv")
+    throw dsp::InputError("simulate --export: '" + request.kind + "' is not klipper or csv");
+  const auto set_point = sim::scenario_set_point(scenario);
+  const double fs = scenario.meta.acquisition.fs_hz;
   const auto n_frames = static_cast<std::size_t>(std::ceil(set_point->duration_s() * fs)) + 1;
-  const sim::CaptureSamples samples = sim::capture_samples(req.clock, n_frames, fs);
+  const sim::CaptureSamples samples = sim::capture_samples(request.clock, n_frames, fs);
   sim::JitteredCapture jittered{samples.jitter_s, {}};
-  dsp::Run run = sim::simulate(sc, *set_point, nullptr, &jittered);
+  dsp::Run run = sim::simulate(scenario, *set_point, nullptr, &jittered);
   const int part = run.meta.sensor_present[1] ? 1 : 0;
 
   std::string files,
@@ -39,35 +39,37 @@ std::string simulate_with_export(const sim::Scenario& sc, const ExportRequest& r
           "\n[export]\n# The run as another system recorded it (eical simulate --export): frame n taken at\n"
           "# n/fs + jitter, stamped offset_s + that time; lost batches left out. offset_s is what\n"
           "# eical import must find: recorder time - set-point time.\n";
-  truth += "format = \"" + req.kind + "\"\nsensor = \"" + std::string(part ? "head" : "table") + "\"\n";
-  const drivers::StampedAccel capture = drivers::exported_capture(run, jittered, samples, req.clock, part, req.target);
-  if (req.kind == "klipper") {
-    drivers::write_klipper_capture(req.target, capture);
-    files = req.target;
-    truth += "file = \"" + req.target + "\"\noffset_s = " + num(req.clock.offset_s) + "\n";
+  truth += "format = \"" + request.kind + "\"\nsensor = \"" + std::string(part ? "head" : "table") + "\"\n";
+  const drivers::StampedAccel capture =
+      drivers::exported_capture(run, jittered, samples, request.clock, part, request.target);
+  if (request.kind == "klipper") {
+    drivers::write_klipper_capture(request.target, capture);
+    files = request.target;
+    truth += "file = \"" + request.target + "\"\noffset_s = " + num(request.clock.offset_s) + "\n";
   } else {
-    const std::string accel_file = req.target + "-accel.csv";
-    const std::string nc_file = req.target + (req.nc_format == "halsampler" ? "-nc.txt" : "-nc.csv");
+    const std::string accel_file = request.target + "-accel.csv";
+    const std::string nc_file = request.target + (request.nc_format == "halsampler" ? "-nc.txt" : "-nc.csv");
     drivers::write_accel_csv(accel_file, capture, drivers::AccelUnit::mps2);
-    const drivers::NcTrace trace = drivers::exported_nc_trace(*set_point, req.servo_period_s, req.nc_offset_s, nc_file);
-    if (req.nc_format == "halsampler")
-      drivers::write_halsampler(nc_file, trace, std::llround(trace.t_s.front() / req.servo_period_s));
+    const drivers::NcTrace trace =
+        drivers::exported_nc_trace(*set_point, request.servo_period_s, request.nc_offset_s, nc_file);
+    if (request.nc_format == "halsampler")
+      drivers::write_halsampler(nc_file, trace, std::llround(trace.t_s.front() / request.servo_period_s));
     else
       drivers::write_nc_csv(nc_file, trace);
     files = accel_file + " and " + nc_file;
-    truth += "file = \"" + accel_file + "\"\nnc_file = \"" + nc_file + "\"\nnc_format = \"" + req.nc_format +
-             "\"\nservo_period_s = " + num(req.servo_period_s) + "\nnc_offset_s = " + num(req.nc_offset_s) +
-             "\ncapture_offset_s = " + num(req.clock.offset_s) +
-             "\noffset_s = " + num(req.clock.offset_s - req.nc_offset_s) + "\n";
+    truth += "file = \"" + accel_file + "\"\nnc_file = \"" + nc_file + "\"\nnc_format = \"" + request.nc_format +
+             "\"\nservo_period_s = " + num(request.servo_period_s) + "\nnc_offset_s = " + num(request.nc_offset_s) +
+             "\ncapture_offset_s = " + num(request.clock.offset_s) +
+             "\noffset_s = " + num(request.clock.offset_s - request.nc_offset_s) + "\n";
   }
-  truth += "jitter_rms_s = " + num(samples.jitter_rms_s) + "\nbatch = " + std::to_string(req.clock.batch) +
+  truth += "jitter_rms_s = " + num(samples.jitter_rms_s) + "\nbatch = " + std::to_string(request.clock.batch) +
            "\nlost_frames = " + std::to_string(samples.lost) + "\ngaps = " + std::to_string(gaps_of(samples)) + "\n";
   if (run.truth_toml) *run.truth_toml += truth;
   drivers::write_run(run, out, {.gzip = gzip, .overwrite = overwrite});
   char line[512];
   std::snprintf(line, sizeof line, "exported %s: %zu samples (%zu lost in %zu gaps), jitter %.1f us rms, offset %.6f s",
                 files.c_str(), capture.t_s.size(), samples.lost, gaps_of(samples), samples.jitter_rms_s * 1e6,
-                req.kind == "klipper" ? req.clock.offset_s : req.clock.offset_s - req.nc_offset_s);
+                request.kind == "klipper" ? request.clock.offset_s : request.clock.offset_s - request.nc_offset_s);
   return line;
 }
 

@@ -28,14 +28,14 @@ std::string figure_label(const std::string& key) {
   return k;
 }
 
-std::string value_with_u(double v, std::optional<double> u, const std::string& unit) {
-  const double scale = std::max(std::abs(v), u ? *u : 0.0);
+std::string value_with_u(double value, std::optional<double> u_k2, const std::string& unit) {
+  const double scale = std::max(std::abs(value), u_k2 ? *u_k2 : 0.0);
   const int d = scale >= 1000.0 ? 0 : scale >= 100.0 ? 1 : scale >= 0.1 ? 2 : 3;
   char b[96];
-  if (u && std::isfinite(*u))
-    std::snprintf(b, sizeof b, "%.*f ± %.*f %s", d, v, d, *u, unit.c_str());
+  if (u_k2 && std::isfinite(*u_k2))
+    std::snprintf(b, sizeof b, "%.*f ± %.*f %s", d, value, d, *u_k2, unit.c_str());
   else
-    std::snprintf(b, sizeof b, "%.*f %s ± ?", d, v, unit.c_str());
+    std::snprintf(b, sizeof b, "%.*f %s ± ?", d, value, unit.c_str());
   return b;
 }
 

@@ -47,28 +47,28 @@ const char* section_title(const std::string& section) {
 
 }  // namespace
 
-std::string summary_text(const dsp::Run& run, const dsp::Analysis& a) {
+std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
   std::string o;
   char b[320];
   std::snprintf(b, sizeof b, "run %s (%s, %zu samples at %.0f Hz)\n", run.meta.id.c_str(),
                 run.meta.program.kind.c_str(), run.frame_count(), run.meta.acquisition.fs_hz);
   o += b;
   std::string section;
-  for (const dsp::FigureValue& f : dsp::figures_of(a)) {
+  for (const dsp::FigureValue& f : dsp::figures_of(analysis)) {
     const std::string sec = f.key.substr(0, f.key.find('.'));
     if (sec != section) {
       section = sec;
       o += std::string("  ") + section_title(sec);
-      if (sec == "circle" && a.circle)
-        o += ", " + std::to_string(a.circle->revolutions) + (a.circle->arc_deg < 360.0 ? " arcs, " : " revolutions, ") +
-             a.circle->direction;
-      if (sec == "positioning" && a.positioning)
-        o += ", axis " + a.positioning->axis + ", " + std::to_string(a.positioning->runs) + " runs";
+      if (sec == "circle" && analysis.circle)
+        o += ", " + std::to_string(analysis.circle->revolutions) +
+             (analysis.circle->arc_deg < 360.0 ? " arcs, " : " revolutions, ") + analysis.circle->direction;
+      if (sec == "positioning" && analysis.positioning)
+        o += ", axis " + analysis.positioning->axis + ", " + std::to_string(analysis.positioning->runs) + " runs";
       o += "\n";
     }
     const std::string unit = figure_unit(f.key);
     if (!f.array) {
-      const auto u = figure_u(a, f.key);
+      const auto u = figure_u(analysis, f.key);
       std::snprintf(b, sizeof b, "    %-34s %s%s\n", figure_label(f.key).c_str(),
                     value_with_u(f.values[0], u, unit).c_str(),
                     u && !dsp::uncertainty::resolved(f.values[0], *u) ? "   not resolved" : "");
@@ -77,7 +77,7 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& a) {
     }
     std::string line = "    " + figure_label(f.key) + " (" + unit + "):";
     for (std::size_t i = 0; i < f.values.size() && i < 24; ++i) {
-      const auto u = figure_u(a, f.key, i);
+      const auto u = figure_u(analysis, f.key, i);
       char e[80];
       if (u)
         std::snprintf(e, sizeof e, " %.2f±%.2f%s", f.values[i], *u,
@@ -93,24 +93,24 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& a) {
     if (f.values.size() > 24) line += " …";
     o += line + "\n";
   }
-  if (a.circle && !a.circle->circular_hysteresis_H_um)
+  if (analysis.circle && !analysis.circle->circular_hysteresis_H_um)
     o += "    circular hysteresis H              n/a (needs both directions)\n";
-  if (a.circle_accuracy_rms_um) {
+  if (analysis.circle_accuracy_rms_um) {
     std::snprintf(b, sizeof b, "  against the reference: %.2f µm RMS of (measured − reference) radius deviation\n",
-                  *a.circle_accuracy_rms_um);
+                  *analysis.circle_accuracy_rms_um);
     o += b;
   }
-  if (!a.uncertainty_note.empty())
-    o += "  uncertainty: " + a.uncertainty_note + (a.uncertainty_k2.empty() ? "" : "; * not resolved (|value| <= U)") +
-         "\n";
+  if (!analysis.uncertainty_note.empty())
+    o += "  uncertainty: " + analysis.uncertainty_note +
+         (analysis.uncertainty_k2.empty() ? "" : "; * not resolved (|value| <= U)") + "\n";
   o += "  verdict: " +
-       std::string(a.verdict == "not_measurable" ? "NOT MEASURABLE"
-                   : a.verdict == "degraded"     ? "DEGRADED"
-                                                 : "ok") +
+       std::string(analysis.verdict == "not_measurable" ? "NOT MEASURABLE"
+                   : analysis.verdict == "degraded"     ? "DEGRADED"
+                                                        : "ok") +
        "\n";
-  for (const auto& r : a.verdict_reasons) o += "    - " + r + "\n";
+  for (const auto& r : analysis.verdict_reasons) o += "    - " + r + "\n";
   bool header = false;
-  for (const auto& f : a.flags) {
+  for (const auto& f : analysis.flags) {
     const auto s = dsp::flag_severity(f);
     if (!header) o += "  flags:\n", header = true;
     o += std::string("    [") + dsp::severity_name(s) + "] " + f + "\n";

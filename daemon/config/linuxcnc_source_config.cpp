@@ -7,21 +7,21 @@
 
 namespace eical::daemon {
 
-std::unique_ptr<drivers::Source> make_linuxcnc_source(const DaemonConfig& c) {
-  const LinuxcncConfig& l = c.source.linuxcnc;
+std::unique_ptr<drivers::Source> make_linuxcnc_source(const DaemonConfig& config) {
+  const LinuxcncConfig& l = config.source.linuxcnc;
   sim::Scenario sc = l.scenario_file.empty() ? sim::gcode_scenario("", "freeform", l.seed)
                                              : drivers::read_scenario_file(l.scenario_file.string());
   const bool truth_from_file = !l.scenario_file.empty();
   sc.seed = l.seed;
   sc.meta.program = *l.program_loaded;
-  sc.meta.acquisition = c.acquisition;
-  sc.meta.site = c.site;
-  sc.meta.machine = c.machine;
-  sc.meta.sensors[0] = c.sensors[0];
-  sc.meta.sensors[1] = c.sensors[1];
+  sc.meta.acquisition = config.acquisition;
+  sc.meta.site = config.site;
+  sc.meta.machine = config.machine;
+  sc.meta.sensors[0] = config.sensors[0];
+  sc.meta.sensors[1] = config.sensors[1];
   // Without a scenario file the sensors are exactly what the configuration says.
   if (!truth_from_file)
-    for (int s = 0; s < 2; ++s) sc.truth[s].spec = c.sensors[s];
+    for (int s = 0; s < 2; ++s) sc.truth[s].spec = config.sensors[s];
   drivers::LinuxcncSourceOptions o;
   o.fifo = l.fifo;
   o.window.servo_rate_hz = l.servo_rate_hz;

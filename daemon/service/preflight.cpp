@@ -49,16 +49,16 @@ std::optional<std::string> dds_config_problem(const DdsConfig& dds) {
   return std::nullopt;
 }
 
-std::optional<std::string> setpoint_problem(const SetPointConfig& sp) {
-  if (sp.source == "none") return std::nullopt;
+std::optional<std::string> setpoint_problem(const SetPointConfig& setpoint) {
+  if (setpoint.source == "none") return std::nullopt;
   // The program set-point needs its programs; beside the servo stream they only name
   // what to evaluate, so a missing directory matters only when a default is set.
-  if (!fs::is_directory(sp.program_dir) && (sp.source == "program" || sp.default_program >= 0))
-    return "setpoint: the program directory " + sp.program_dir.string() +
+  if (!fs::is_directory(setpoint.program_dir) && (setpoint.source == "program" || setpoint.default_program >= 0))
+    return "setpoint: the program directory " + setpoint.program_dir.string() +
            " does not exist ([setpoint.program] directory)";
-  if (sp.default_program >= 0) {
+  if (setpoint.default_program >= 0) {
     try {
-      (void)drivers::ProgramCatalog(sp.program_dir).program(sp.default_program);
+      (void)drivers::ProgramCatalog(setpoint.program_dir).program(setpoint.default_program);
     } catch (const std::exception& e) {
       return std::string("setpoint: default program: ") + e.what();
     }

@@ -14,12 +14,13 @@ int axis_index(const std::string& axis) { return axis == "y" ? 1 : axis == "z" ?
 
 }  // namespace
 
-std::optional<drivers::dds::TraceMsg> make_trace(const dsp::Run& run, const dsp::Analysis& a, std::size_t max_points) {
+std::optional<drivers::dds::TraceMsg> make_trace(const dsp::Run& run, const dsp::Analysis& analysis,
+                                                 std::size_t max_points) {
   drivers::dds::TraceMsg t;
   t.program_id = run.meta.id;
   t.program = run.meta.program.kind;
-  if (a.circle) {
-    const auto& c = a.circle->trace;
+  if (analysis.circle) {
+    const auto& c = analysis.circle->trace;
     const std::size_t n = std::min(c.angle_deg.size(), c.radius_deviation_um.size());
     if (n == 0) return std::nullopt;
     const std::size_t k = stride_for(n, max_points);
@@ -34,7 +35,7 @@ std::optional<drivers::dds::TraceMsg> make_trace(const dsp::Run& run, const dsp:
     t.decimation = static_cast<std::uint32_t>(k);
     return t;
   }
-  const auto& m = a.measurement;
+  const auto& m = analysis.measurement;
   const std::size_t n = std::min({m.sample_index.size(), m.pos_mm.size(), m.cmd_mm.size()});
   if (n == 0 || !(m.fs_hz > 0.0)) return std::nullopt;
   const std::size_t k = stride_for(n, max_points);

@@ -56,24 +56,25 @@ bool wants(const TriggerConfig& c, const char* input) {
 
 }  // namespace
 
-std::unique_ptr<TriggerInput> make_gpio_input(std::unique_ptr<drivers::GpioEventSource> events, const TriggerConfig& c,
-                                              std::string name) {
-  const auto debounce_ns = static_cast<std::int64_t>(std::llround(c.gpio_debounce_ms * 1e6));
-  return std::make_unique<GpioInput>(drivers::GpioTriggerInput(std::move(events), lines_of(c), debounce_ns),
+std::unique_ptr<TriggerInput> make_gpio_input(std::unique_ptr<drivers::GpioEventSource> events,
+                                              const TriggerConfig& config, std::string name) {
+  const auto debounce_ns = static_cast<std::int64_t>(std::llround(config.gpio_debounce_ms * 1e6));
+  return std::make_unique<GpioInput>(drivers::GpioTriggerInput(std::move(events), lines_of(config), debounce_ns),
                                      std::move(name));
 }
 
-std::unique_ptr<TriggerInput> make_can_input_on_socket(int fd, const TriggerConfig& c, std::string name) {
-  return std::make_unique<CanInput>(drivers::CanTriggerInput::from_socket(fd, c.can_id), std::move(name));
+std::unique_ptr<TriggerInput> make_can_input_on_socket(int fd, const TriggerConfig& config, std::string name) {
+  return std::make_unique<CanInput>(drivers::CanTriggerInput::from_socket(fd, config.can_id), std::move(name));
 }
 
-std::vector<std::unique_ptr<TriggerInput>> open_trigger_inputs(const TriggerConfig& c) {
+std::vector<std::unique_ptr<TriggerInput>> open_trigger_inputs(const TriggerConfig& config) {
   std::vector<std::unique_ptr<TriggerInput>> out;
-  if (wants(c, "gpio"))
-    out.push_back(make_gpio_input(drivers::open_gpio_lines(c.gpio_chip, lines_of(c)), c, "gpio " + c.gpio_chip));
-  if (wants(c, "can"))
-    out.push_back(
-        std::make_unique<CanInput>(drivers::CanTriggerInput(c.can_interface, c.can_id), "can " + c.can_interface));
+  if (wants(config, "gpio"))
+    out.push_back(make_gpio_input(drivers::open_gpio_lines(config.gpio_chip, lines_of(config)), config,
+                                  "gpio " + config.gpio_chip));
+  if (wants(config, "can"))
+    out.push_back(std::make_unique<CanInput>(drivers::CanTriggerInput(config.can_interface, config.can_id),
+                                             "can " + config.can_interface));
   return out;
 }
 

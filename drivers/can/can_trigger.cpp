@@ -15,20 +15,21 @@
 
 namespace eical::drivers {
 
-std::optional<CanTrigger> parse_can_trigger(const can_frame& f, std::uint32_t id) {
-  if ((f.can_id & CAN_EFF_FLAG) || (f.can_id & CAN_RTR_FLAG) || (f.can_id & CAN_SFF_MASK) != id || f.len != 8)
+std::optional<CanTrigger> parse_can_trigger(const can_frame& frame, std::uint32_t trigger_id) {
+  if ((frame.can_id & CAN_EFF_FLAG) || (frame.can_id & CAN_RTR_FLAG) || (frame.can_id & CAN_SFF_MASK) != trigger_id ||
+      frame.len != 8)
     return std::nullopt;
-  if (f.data[0] < 1 || f.data[0] > 3) return std::nullopt;
+  if (frame.data[0] < 1 || frame.data[0] > 3) return std::nullopt;
   const auto raw = static_cast<std::int32_t>(
-      static_cast<std::uint32_t>(f.data[2]) | static_cast<std::uint32_t>(f.data[3]) << 8 |
-      static_cast<std::uint32_t>(f.data[4]) << 16 | static_cast<std::uint32_t>(f.data[5]) << 24);
+      static_cast<std::uint32_t>(frame.data[2]) | static_cast<std::uint32_t>(frame.data[3]) << 8 |
+      static_cast<std::uint32_t>(frame.data[4]) << 16 | static_cast<std::uint32_t>(frame.data[5]) << 24);
   const double p = raw == INT32_MIN ? std::nan("") : raw / 1000.0;
-  return CanTrigger{100 + f.data[0], p, f.data[1]};
+  return CanTrigger{100 + frame.data[0], p, frame.data[1]};
 }
 
-can_frame make_can_trigger(std::uint32_t id, int code, std::uint8_t sequence, double p) {
+can_frame make_can_trigger(std::uint32_t trigger_id, int code, std::uint8_t sequence, double p) {
   can_frame f{};
-  f.can_id = id & CAN_SFF_MASK;
+  f.can_id = trigger_id & CAN_SFF_MASK;
   f.len = 8;
   f.data[0] = static_cast<std::uint8_t>(code - 100);
   f.data[1] = sequence;
@@ -37,7 +38,7 @@ can_frame make_can_trigger(std::uint32_t id, int code, std::uint8_t sequence, do
   return f;
 }
 
-CanTriggerInput::CanTriggerInput(const std::string& interface, std::uint32_t id) : id_(id) {
+CanTriggerInput::CanTriggerInput(const std::string& interface, std::uint32_t trigger_id) : id_(trigger_id) {
   fd_ = ::socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
   if (fd_ < 0)
     throw std::runtime_error(std::string("can: SocketCAN is not available in this kernel (socket(PF_CAN): ") +
@@ -48,7 +49,7 @@ CanTriggerInput::CanTriggerInput(const std::string& interface, std::uint32_t id)
     ::close(fd_);
     throw std::runtime_error("can: no CAN interface '" + interface + "' (" + std::strerror(err) + ")");
   }
-  can_filter filter{id & CAN_SFF_MASK, CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG};
+  can_filter filter{trigger_id & CAN_SFF_MASK, CAN_SFF_MASK | CAN_EFF_FLAG | CAN_RTR_FLAG};
   ::setsockopt(fd_, SOL_CAN_RAW, CAN_RAW_FILTER, &filter, sizeof filter);
   const int on = 1;
   (void)::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
@@ -68,9 +69,9 @@ CanTriggerInput CanTriggerInput::from_socket(int fd, std::uint32_t trigger_id) {
   return CanTriggerInput(fd, trigger_id, true);
 }
 
-CanTriggerInput::CanTriggerInput(CanTriggerInput&& o) noexcept
-    : fd_(o.fd_), id_(o.id_), last_seq_(o.last_seq_), ignored_(o.ignored_) {
-  o.fd_ = -1;
+CanTriggerInput::CanTriggerInput(CanTriggerInput&& other) noexcept
+    : fd_(other.fd_), id_(other.id_), last_seq_(other.last_seq_), ignored_(other.ignored_) {
+  other.fd_ = -1;
 }
 
 CanTriggerInput::~CanTriggerInput() {

@@ -140,8 +140,8 @@ void write_lines(const std::filesystem::path& file, const std::string& text) { w
 
 }  // namespace
 
-double accel_unit_in_mps2(AccelUnit u) {
-  switch (u) {
+double accel_unit_in_mps2(AccelUnit unit) {
+  switch (unit) {
     case AccelUnit::mps2: return 1.0;
     case AccelUnit::mmps2: return 1e-3;
     case AccelUnit::g: return kStandardGravity_mps2;
@@ -173,36 +173,36 @@ StampedAccel read_klipper_capture(const std::filesystem::path& file) {
   return out;
 }
 
-void write_klipper_capture(const std::filesystem::path& file, const StampedAccel& c) {
+void write_klipper_capture(const std::filesystem::path& file, const StampedAccel& capture) {
   std::string out = "#time,accel_x,accel_y,accel_z\n";
   char buf[160];
-  for (std::size_t k = 0; k < c.t_s.size(); ++k) {
-    const Eigen::Vector3d a = c.accel_mps2[k] * 1e3;
-    std::snprintf(buf, sizeof buf, "%.6f,%.6f,%.6f,%.6f\n", c.t_s[k], a.x(), a.y(), a.z());
+  for (std::size_t k = 0; k < capture.t_s.size(); ++k) {
+    const Eigen::Vector3d a = capture.accel_mps2[k] * 1e3;
+    std::snprintf(buf, sizeof buf, "%.6f,%.6f,%.6f,%.6f\n", capture.t_s[k], a.x(), a.y(), a.z());
     out += buf;
   }
   write_lines(file, out);
 }
 
-StampedAccel read_accel_csv(const std::filesystem::path& file, const CsvColumns& cols, AccelUnit unit) {
-  Csv csv = read_csv(file, cols, accel_unit_in_mps2(unit));
+StampedAccel read_accel_csv(const std::filesystem::path& file, const CsvColumns& columns, AccelUnit unit) {
+  Csv csv = read_csv(file, columns, accel_unit_in_mps2(unit));
   return {std::move(csv.source), std::move(csv.t), std::move(csv.v)};
 }
 
-void write_accel_csv(const std::filesystem::path& file, const StampedAccel& c, AccelUnit unit) {
+void write_accel_csv(const std::filesystem::path& file, const StampedAccel& capture, AccelUnit unit) {
   std::string out = "t,ax,ay,az\n";
   char buf[160];
   const double per_mps2 = 1.0 / accel_unit_in_mps2(unit);
-  for (std::size_t k = 0; k < c.t_s.size(); ++k) {
-    const Eigen::Vector3d a = c.accel_mps2[k] * per_mps2;
-    std::snprintf(buf, sizeof buf, "%.9f,%.9g,%.9g,%.9g\n", c.t_s[k], a.x(), a.y(), a.z());
+  for (std::size_t k = 0; k < capture.t_s.size(); ++k) {
+    const Eigen::Vector3d a = capture.accel_mps2[k] * per_mps2;
+    std::snprintf(buf, sizeof buf, "%.9f,%.9g,%.9g,%.9g\n", capture.t_s[k], a.x(), a.y(), a.z());
     out += buf;
   }
   write_lines(file, out);
 }
 
-NcTrace read_halsampler(const std::filesystem::path& file, double period_s) {
-  if (!(period_s > 0.0)) throw dsp::InputError(file.string() + ": the servo period must be positive");
+NcTrace read_halsampler(const std::filesystem::path& file, double servo_period_s) {
+  if (!(servo_period_s > 0.0)) throw dsp::InputError(file.string() + ": the servo period must be positive");
   if (!std::filesystem::exists(file)) throw dsp::InputError(file.string() + ": no such file");
   LineSource src(file);
   std::string_view line;
@@ -219,7 +219,7 @@ NcTrace read_halsampler(const std::filesystem::path& file, double period_s) {
       fail(src,
            "sample number " + std::to_string(s.number) + " does not increase (after " + std::to_string(last) + ")");
     last = s.number;
-    out.t_s.push_back(static_cast<double>(s.number) * period_s);
+    out.t_s.push_back(static_cast<double>(s.number) * servo_period_s);
     out.pos_mm.emplace_back(s.cmd_mm[0], s.cmd_mm[1], s.cmd_mm[2]);
   }
   if (out.t_s.empty()) throw dsp::InputError(file.string() + ": empty file (no servo samples)");
@@ -239,8 +239,8 @@ void write_halsampler(const std::filesystem::path& file, const NcTrace& trace, s
   write_lines(file, out);
 }
 
-NcTrace read_nc_csv(const std::filesystem::path& file, const CsvColumns& cols) {
-  Csv csv = read_csv(file, cols, 1.0);
+NcTrace read_nc_csv(const std::filesystem::path& file, const CsvColumns& columns) {
+  Csv csv = read_csv(file, columns, 1.0);
   return {std::move(csv.source), std::move(csv.t), std::move(csv.v)};
 }
 

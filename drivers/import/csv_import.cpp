@@ -9,12 +9,13 @@
 namespace eical::drivers {
 
 ImportResult import_csv(const std::filesystem::path& accel_file, const std::filesystem::path& nc_file,
-                        const CsvImport& o) {
-  const StampedAccel capture = read_accel_csv(accel_file, o.accel_columns, o.unit);
-  const NcTrace nc = o.nc_halsampler ? read_halsampler(nc_file, o.servo_period_s) : read_nc_csv(nc_file, o.nc_columns);
+                        const CsvImport& options) {
+  const StampedAccel capture = read_accel_csv(accel_file, options.accel_columns, options.unit);
+  const NcTrace nc = options.nc_halsampler ? read_halsampler(nc_file, options.servo_period_s)
+                                           : read_nc_csv(nc_file, options.nc_columns);
   const UniformClock clock = fit_uniform_clock(capture.t_s, capture.source);
   UniformSeries accel = resample(capture.t_s, capture.accel_mps2, clock);
-  for (auto& v : accel.values) v /= o.setup.site.g_mps2;  // in g of the site, as run.toml's [site] says
+  for (auto& v : accel.values) v /= options.setup.site.g_mps2;  // in g of the site, as run.toml's [site] says
   const UniformClock nc_clock = fit_uniform_clock(nc.t_s, nc.source);
   const std::vector<Eigen::Vector3d> nc_uniform = bridge_gaps(nc.t_s, nc.pos_mm, nc_clock);
   const std::size_t n_nc = nc_uniform.size();
@@ -30,12 +31,12 @@ ImportResult import_csv(const std::filesystem::path& accel_file, const std::file
   if (ref.moving.sum() == 0.0)
     throw dsp::InputError(nc.source + ": the NC trace does not move (nothing to align the clocks with)");
   ref.accel = [&sp](double t) { return sp.at(t).acc_mm_s2; };
-  const dsp::SensorSpec spec = import_sensor_spec(o.setup, clock.fs_hz);
+  const dsp::SensorSpec spec = import_sensor_spec(options.setup, clock.fs_hz);
   ref.sensor_f0_hz = spec.f0_hz, ref.sensor_zeta = spec.zeta;
   const OffsetEstimate offset = estimate_offset(measured, ref);
   require_alignment(offset, capture.source);
 
-  ImportSetup setup = o.setup;
+  ImportSetup setup = options.setup;
   double v_max = 0.0;
   for (std::size_t i = 0; i < n_nc; ++i)
     v_max = std::max(v_max, sp.at(nc_clock.time_at(static_cast<std::int64_t>(i))).vel_mm_s.norm());
@@ -46,8 +47,8 @@ ImportResult import_csv(const std::filesystem::path& accel_file, const std::file
   r.kind = "csv";
   r.source = capture.source;
   r.nc_source = nc.source;
-  r.excitation =
-      o.nc_halsampler ? "NC trace (LinuxCNC halsampler), natural cubic spline" : "NC trace (CSV), natural cubic spline";
+  r.excitation = options.nc_halsampler ? "NC trace (LinuxCNC halsampler), natural cubic spline"
+                                       : "NC trace (CSV), natural cubic spline";
   r.accel_clock = clock;
   r.nc_clock = nc_clock;
   r.samples = capture.t_s.size();

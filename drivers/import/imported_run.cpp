@@ -9,52 +9,52 @@
 
 namespace eical::drivers {
 
-dsp::SensorSpec import_sensor_spec(const ImportSetup& s, double fs_hz) {
-  dsp::SensorSpec spec = sim::mems_sensor_spec(sim::mems_chip(s.chip), fs_hz);
-  if (s.bandwidth_hz > 0.0) spec.f0_hz = s.bandwidth_hz;
-  if (s.noise_ug_per_rthz >= 0.0) spec.noise_ug_per_rthz = s.noise_ug_per_rthz;
-  spec.to_machine = s.to_machine;
+dsp::SensorSpec import_sensor_spec(const ImportSetup& setup, double fs_hz) {
+  dsp::SensorSpec spec = sim::mems_sensor_spec(sim::mems_chip(setup.chip), fs_hz);
+  if (setup.bandwidth_hz > 0.0) spec.f0_hz = setup.bandwidth_hz;
+  if (setup.noise_ug_per_rthz >= 0.0) spec.noise_ug_per_rthz = setup.noise_ug_per_rthz;
+  spec.to_machine = setup.to_machine;
   return spec;
 }
 
-dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel, const ImportSetup& s,
-                      const ImportSetPoint& sp, double offset_s) {
-  if (accel.values.empty() || accel.values.size() != accel.grid_index.size())
+dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel_g, const ImportSetup& setup,
+                      const ImportSetPoint& set_point, double offset_s) {
+  if (accel_g.values.empty() || accel_g.values.size() != accel_g.grid_index.size())
     throw dsp::InputError("import: no samples");
-  if (s.part != 0 && s.part != 1) throw dsp::InputError("import: the sensor must be on the table or the head");
+  if (setup.part != 0 && setup.part != 1) throw dsp::InputError("import: the sensor must be on the table or the head");
   dsp::Run run;
   dsp::RunMeta& m = run.meta;
-  m.id = s.id;
+  m.id = setup.id;
   m.acquisition.fs_hz = clock.fs_hz;
   m.acquisition.adc_bits = 32;
   m.acquisition.adc_lsb_volt = 1.0 / kImportCountsPerG;  // with k1 = 1 V/g: 1 count = 1 µg
   m.acquisition.adc_offset_counts = 0;
   m.acquisition.daq_group_delay_samples = 0.0;
-  m.site = s.site;
-  m.machine = s.machine;
-  const dsp::SensorSpec spec = import_sensor_spec(s, clock.fs_hz);
+  m.site = setup.site;
+  m.machine = setup.machine;
+  const dsp::SensorSpec spec = import_sensor_spec(setup, clock.fs_hz);
   m.sensors[0] = m.sensors[1] = spec;
-  m.sensor_present[s.part] = true;
-  m.sensor_present[1 - s.part] = false;
+  m.sensor_present[setup.part] = true;
+  m.sensor_present[1 - setup.part] = false;
   m.program.kind = "freeform";
-  m.program.feed_mm_min = std::max(1.0, s.feed_mm_min);
+  m.program.feed_mm_min = std::max(1.0, setup.feed_mm_min);
   m.program.repeats = 1;
-  run.frames.resize(accel.values.size());
+  run.frames.resize(accel_g.values.size());
   const double full = std::ldexp(1.0, 31);
-  for (std::size_t k = 0; k < accel.values.size(); ++k) {
+  for (std::size_t k = 0; k < accel_g.values.size(); ++k) {
     dsp::Frame& f = run.frames[k];
-    f.sample_index = accel.grid_index[k] - accel.grid_index.front();
+    f.sample_index = accel_g.grid_index[k] - accel_g.grid_index.front();
     for (int a = 0; a < 3; ++a) {
-      const double c = std::round(accel.values[k][a] * kImportCountsPerG);
+      const double c = std::round(accel_g.values[k][a] * kImportCountsPerG);
       if (c >= full - 1 || c <= -full) f.flags |= dsp::frame_flag::accel_saturated;
-      f.accel_counts[3 * s.part + a] = static_cast<std::int32_t>(std::clamp(c, -full, full - 1));
+      f.accel_counts[3 * setup.part + a] = static_cast<std::int32_t>(std::clamp(c, -full, full - 1));
     }
     f.flags |= dsp::frame_flag::temp_missing;
-    const double t_sp = clock.time_at(accel.grid_index[k]) - offset_s;
-    if (!sp.hold_outside && (t_sp < sp.t_begin_s || t_sp > sp.t_end_s)) {
+    const double t_sp = clock.time_at(accel_g.grid_index[k]) - offset_s;
+    if (!set_point.hold_outside && (t_sp < set_point.t_begin_s || t_sp > set_point.t_end_s)) {
       f.flags |= dsp::frame_flag::cmd_missing;
     } else {
-      const Eigen::Vector3d p = sp.position_mm(std::clamp(t_sp, sp.t_begin_s, sp.t_end_s));
+      const Eigen::Vector3d p = set_point.position_mm(std::clamp(t_sp, set_point.t_begin_s, set_point.t_end_s));
       for (int a = 0; a < 3; ++a) f.cmd_mm[a] = p[a];
     }
   }
@@ -63,7 +63,7 @@ dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel, con
   return run;
 }
 
-std::string import_report_toml(const ImportReport& r) {
+std::string import_report_toml(const ImportReport& report) {
   auto str = [](const std::string& v) {
     std::string o = "\"";
     for (char c : v) o += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
@@ -79,37 +79,38 @@ std::string import_report_toml(const ImportReport& r) {
       "# (cubic Lagrange onto the uniform clock, drivers/import/uniform_clock.hpp) and the\n"
       "# time offset recorder - set-point by cross-correlation (u: standard uncertainty, k = 1,\n"
       "# block jackknife).\n";
-  o += "format = \"eical-import/1\"\nkind = " + str(r.kind) + "\nsource = " + str(r.source) + "\n";
-  if (!r.nc_source.empty()) o += "nc_source = " + str(r.nc_source) + "\n";
-  o += "excitation = " + str(r.excitation) + "\nsamples = " + std::to_string(r.samples) + "\n";
-  o += clock("accel_clock", r.accel_clock);
-  if (r.nc_clock) o += clock("nc_clock", *r.nc_clock);
-  o += "\n[time_offset]\noffset_s = " + toml_number(r.offset.offset_s) + "\nu_s = " + toml_number(r.offset.u_s) +
-       "\nexplained = " + toml_number(r.offset.explained) +
-       "\npeak_to_median = " + toml_number(r.offset.peak_to_median) + "\nblocks = " + std::to_string(r.offset.blocks) +
-       "\nfine_step_s = " + toml_number(r.offset.fine_step_s) +
+  o += "format = \"eical-import/1\"\nkind = " + str(report.kind) + "\nsource = " + str(report.source) + "\n";
+  if (!report.nc_source.empty()) o += "nc_source = " + str(report.nc_source) + "\n";
+  o += "excitation = " + str(report.excitation) + "\nsamples = " + std::to_string(report.samples) + "\n";
+  o += clock("accel_clock", report.accel_clock);
+  if (report.nc_clock) o += clock("nc_clock", *report.nc_clock);
+  o += "\n[time_offset]\noffset_s = " + toml_number(report.offset.offset_s) +
+       "\nu_s = " + toml_number(report.offset.u_s) + "\nexplained = " + toml_number(report.offset.explained) +
+       "\npeak_to_median = " + toml_number(report.offset.peak_to_median) +
+       "\nblocks = " + std::to_string(report.offset.blocks) +
+       "\nfine_step_s = " + toml_number(report.offset.fine_step_s) +
        "\n# measured (sensor axes) = gain · commanded (machine axes), at the offset\ngain = [";
   for (int i = 0; i < 3; ++i) {
     o += i ? ", [" : "[";
-    for (int j = 0; j < 3; ++j) o += (j ? ", " : "") + toml_number(r.offset.gain(i, j));
+    for (int j = 0; j < 3; ++j) o += (j ? ", " : "") + toml_number(report.offset.gain(i, j));
     o += "]";
   }
   return o + "]\n";
 }
 
-void write_import_report(const std::filesystem::path& dir, const ImportReport& r) {
-  write_text_atomic(dir / "import.toml", import_report_toml(r));
+void write_import_report(const std::filesystem::path& run_dir, const ImportReport& report) {
+  write_text_atomic(run_dir / "import.toml", import_report_toml(report));
 }
 
-void require_alignment(const OffsetEstimate& o, const std::string& source) {
-  if (o.peak_to_median >= kMinPeakToMedian && o.explained >= kMinExplained) return;
+void require_alignment(const OffsetEstimate& offset, const std::string& source) {
+  if (offset.peak_to_median >= kMinPeakToMedian && offset.explained >= kMinExplained) return;
   char buf[320];
   std::snprintf(buf, sizeof buf,
                 ": the commanded acceleration is not found in the measured one (correlation peak %.1f x the median "
                 "over all lags, %.0f needed; "
                 "it explains %.2f %%, %.0f %% needed): wrong test parameters, axis or file, or a sensor on a part that "
                 "does not move?",
-                o.peak_to_median, kMinPeakToMedian, 100.0 * o.explained, 100.0 * kMinExplained);
+                offset.peak_to_median, kMinPeakToMedian, 100.0 * offset.explained, 100.0 * kMinExplained);
   throw dsp::InputError(source + buf);
 }
 

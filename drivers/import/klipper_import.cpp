@@ -9,8 +9,8 @@
 
 namespace eical::drivers {
 
-ImportResult import_klipper(const std::filesystem::path& file, const KlipperImport& o) {
-  const StampedAccel capture = read_klipper_capture(file);
+ImportResult import_klipper(const std::filesystem::path& capture, const KlipperImport& o) {
+  const StampedAccel capture = read_klipper_capture(capture);
   const UniformClock clock = fit_uniform_clock(capture.t_s, capture.source);
   UniformSeries accel = resample(capture.t_s, capture.accel_mps2, clock);
   for (auto& v : accel.values) v /= o.setup.site.g_mps2;  // in g of the site, as run.toml's [site] says

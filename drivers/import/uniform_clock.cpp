@@ -86,69 +86,70 @@ Eigen::Vector3d cubic_in(const std::vector<double>& t, const std::vector<Eigen::
 
 }  // namespace
 
-UniformClock fit_uniform_clock(const std::vector<double>& t, const std::string& source) {
-  if (t.size() < 4)
-    throw dsp::InputError(source + ": " + std::to_string(t.size()) + " samples; at least 4 are needed for a clock");
-  std::vector<double> d(t.size() - 1);
-  for (std::size_t k = 1; k < t.size(); ++k) {
-    d[k - 1] = t[k] - t[k - 1];
+UniformClock fit_uniform_clock(const std::vector<double>& t_s, const std::string& source) {
+  if (t_s.size() < 4)
+    throw dsp::InputError(source + ": " + std::to_string(t_s.size()) + " samples; at least 4 are needed for a clock");
+  std::vector<double> d(t_s.size() - 1);
+  for (std::size_t k = 1; k < t_s.size(); ++k) {
+    d[k - 1] = t_s[k] - t_s[k - 1];
     if (!(d[k - 1] > 0.0))
       throw dsp::InputError(source + ": time stamps do not increase at sample " + std::to_string(k + 1));
   }
   std::nth_element(d.begin(), d.begin() + static_cast<std::ptrdiff_t>(d.size() / 2), d.end());
   UniformClock c;
   c.median_dt_s = d[d.size() / 2];
-  assign_indices(t, c.median_dt_s, c, source);
-  fit_line(t, c);
-  assign_indices(t, 1.0 / c.fs_hz, c, source);  // gaps measured with the fitted rate
-  fit_line(t, c);
+  assign_indices(t_s, c.median_dt_s, c, source);
+  fit_line(t_s, c);
+  assign_indices(t_s, 1.0 / c.fs_hz, c, source);  // gaps measured with the fitted rate
+  fit_line(t_s, c);
   double s2 = 0.0;
-  for (std::size_t k = 0; k < t.size(); ++k) {
-    const double r = t[k] - c.time_at(c.index[k]);
+  for (std::size_t k = 0; k < t_s.size(); ++k) {
+    const double r = t_s[k] - c.time_at(c.index[k]);
     s2 += r * r;
   }
-  c.jitter_rms_s = std::sqrt(s2 / static_cast<double>(t.size()));
+  c.jitter_rms_s = std::sqrt(s2 / static_cast<double>(t_s.size()));
   return c;
 }
 
-UniformSeries resample(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, const UniformClock& c) {
-  if (t.size() != v.size() || t.size() != c.index.size())
+UniformSeries resample(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values,
+                       const UniformClock& clock) {
+  if (t_s.size() != values.size() || t_s.size() != clock.index.size())
     throw dsp::InputError("resample: stamps, values and clock disagree in length");
   UniformSeries out;
-  out.grid_index.reserve(t.size());
-  out.values.reserve(t.size());
+  out.grid_index.reserve(t_s.size());
+  out.values.reserve(t_s.size());
   // Unbroken stretches [lo, hi] between gaps; every sample's own grid point is produced.
   std::size_t lo = 0;
-  while (lo < t.size()) {
+  while (lo < t_s.size()) {
     std::size_t hi = lo;
-    while (hi + 1 < t.size() && c.index[hi + 1] == c.index[hi] + 1) ++hi;
+    while (hi + 1 < t_s.size() && clock.index[hi + 1] == clock.index[hi] + 1) ++hi;
     std::size_t k = lo;
     for (std::size_t s = lo; s <= hi; ++s) {
-      const double at = c.time_at(c.index[s]);
-      while (k < hi && t[k + 1] <= at) ++k;
-      while (k > lo && t[k] > at) --k;
-      out.grid_index.push_back(c.index[s]);
-      out.values.push_back(cubic_in(t, v, lo, hi, k, at));
+      const double at = clock.time_at(clock.index[s]);
+      while (k < hi && t_s[k + 1] <= at) ++k;
+      while (k > lo && t_s[k] > at) --k;
+      out.grid_index.push_back(clock.index[s]);
+      out.values.push_back(cubic_in(t_s, values, lo, hi, k, at));
     }
     lo = hi + 1;
   }
   return out;
 }
 
-std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v,
-                                         const UniformClock& c) {
-  const auto n = static_cast<std::size_t>(c.index.back()) + 1;
+std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values,
+                                         const UniformClock& clock) {
+  const auto n = static_cast<std::size_t>(clock.index.back()) + 1;
   std::vector<Eigen::Vector3d> out(n);
-  for (std::size_t i = 0; i < n; ++i) out[i] = interpolate_at(t, v, c.time_at(static_cast<std::int64_t>(i)));
+  for (std::size_t i = 0; i < n; ++i) out[i] = interpolate_at(t_s, values, clock.time_at(static_cast<std::int64_t>(i)));
   return out;
 }
 
-Eigen::Vector3d interpolate_at(const std::vector<double>& t, const std::vector<Eigen::Vector3d>& v, double at) {
-  if (t.empty()) throw dsp::InputError("interpolate: no samples");
-  if (at <= t.front()) return v.front();
-  if (at >= t.back()) return v.back();
-  const auto k = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), at) - t.begin()) - 1;
-  return cubic_in(t, v, 0, t.size() - 1, k, at);
+Eigen::Vector3d interpolate_at(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, double at) {
+  if (t_s.empty()) throw dsp::InputError("interpolate: no samples");
+  if (at <= t_s.front()) return values.front();
+  if (at >= t_s.back()) return values.back();
+  const auto k = static_cast<std::size_t>(std::upper_bound(t_s.begin(), t_s.end(), at) - t_s.begin()) - 1;
+  return cubic_in(t_s, values, 0, t_s.size() - 1, k, at);
 }
 
 }  // namespace eical::drivers

@@ -51,6 +51,6 @@ std::vector<Eigen::Vector3d> bridge_gaps(const std::vector<double>& t_s, const s
 
 // A stamped series evaluated at arbitrary times (for an NC trace: cubic Lagrange through
 // the four nearest stamps; held at the ends).
-Eigen::Vector3d interpolate_at(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, double t);
+Eigen::Vector3d interpolate_at(const std::vector<double>& t_s, const std::vector<Eigen::Vector3d>& values, double at);
 
 }  // namespace eical::drivers

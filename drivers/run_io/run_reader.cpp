@@ -255,10 +255,10 @@ void read_samples(const fs::path& file, dsp::Run& run) {
 
 }  // namespace
 
-dsp::RunMeta read_run_meta(const fs::path& file) {
-  if (!fs::exists(file)) throw dsp::InputError(file.string() + ": no such file");
-  const toml::table root = StrictTable::parse_file(file.string());
-  StrictTable t(root, file.string(), "");
+dsp::RunMeta read_run_meta(const fs::path& run_toml) {
+  if (!fs::exists(run_toml)) throw dsp::InputError(run_toml.string() + ": no such file");
+  const toml::table root = StrictTable::parse_file(run_toml.string());
+  StrictTable t(root, run_toml.string(), "");
   dsp::RunMeta m;
   m.format = t.string("format");
   if (m.format != "eical-run/1") t.fail("format", "expected \"eical-run/1\", got \"" + m.format + "\"");

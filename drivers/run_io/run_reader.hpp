@@ -26,7 +26,7 @@ class SampleReader {
   SampleReader(const SampleReader&) = delete;
   SampleReader& operator=(const SampleReader&) = delete;
   // The next row; false after the last (an error when there was none).
-  bool next(dsp::Frame& f);
+  bool next(dsp::Frame& out);
   // Whether a row so far held every field of sensor s (table 0, head 1): a sensor that
   // never does is absent (run-format.md, One sensor), its empty fields no loss.
   [[nodiscard]] bool sensor_seen(int s) const noexcept { return seen_[s]; }

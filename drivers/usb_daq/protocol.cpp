@@ -136,15 +136,16 @@ Decoder::Step Decoder::parse_one(dsp::Frame* out, int& n) noexcept {
   }
 }
 
-std::vector<std::uint8_t> encode_samples(std::uint32_t seq, const std::vector<std::array<std::int32_t, 14>>& samples,
-                                         int channels, std::uint8_t status) {
+std::vector<std::uint8_t> encode_samples(std::uint32_t sequence,
+                                         const std::vector<std::array<std::int32_t, 14>>& samples, int channels,
+                                         std::uint8_t status) {
   std::vector<std::uint8_t> p = {kSync0,
                                  kSync1,
                                  kVersion,
                                  kTypeSamples,
                                  static_cast<std::uint8_t>(channels),
                                  static_cast<std::uint8_t>(samples.size())};
-  for (int b = 0; b < 4; ++b) p.push_back(static_cast<std::uint8_t>(seq >> (8 * b)));
+  for (int b = 0; b < 4; ++b) p.push_back(static_cast<std::uint8_t>(sequence >> (8 * b)));
   for (const auto& s : samples) {
     p.push_back(status);
     for (int c = 0; c < channels; ++c)
@@ -155,10 +156,10 @@ std::vector<std::uint8_t> encode_samples(std::uint32_t seq, const std::vector<st
   return p;
 }
 
-std::vector<std::uint8_t> encode_slow(std::uint32_t seq, float t0, float t1, int trigger) {
+std::vector<std::uint8_t> encode_slow(std::uint32_t sequence, float temp_table_c, float temp_head_c, int trigger) {
   std::vector<std::uint8_t> p = {kSync0, kSync1, kVersion, kTypeSlow, 0, 1};
-  for (int b = 0; b < 4; ++b) p.push_back(static_cast<std::uint8_t>(seq >> (8 * b)));
-  for (float t : {t0, t1}) {
+  for (int b = 0; b < 4; ++b) p.push_back(static_cast<std::uint8_t>(sequence >> (8 * b)));
+  for (float t : {temp_table_c, temp_head_c}) {
     const auto v = static_cast<std::int16_t>(std::lround(t * 100.0f));
     p.push_back(static_cast<std::uint8_t>(v & 0xFF));
     p.push_back(static_cast<std::uint8_t>((static_cast<std::uint16_t>(v) >> 8) & 0xFF));

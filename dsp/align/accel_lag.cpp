@@ -76,15 +76,15 @@ std::vector<Eigen::Vector3d> setpoint_accel_mps2(const std::vector<Eigen::Vector
   return a;
 }
 
-LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_in, const std::vector<Eigen::Vector3d>& meas_in,
-                         double fs_hz, const LagOptions& o) {
+LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_mps2, const std::vector<Eigen::Vector3d>& meas_mps2,
+                         double fs_hz, const LagOptions& options) {
   LagEstimate r;
-  const std::size_t d = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fs_hz / o.rate_hz)));
+  const std::size_t d = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(fs_hz / options.rate_hz)));
   const double rate = fs_hz / static_cast<double>(d);
   const std::size_t h = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(0.002 * rate)));  // ±2 ms
   const std::size_t pre = d / 2;  // ≈ d samples, centred: pulses keep their centroid
-  const auto cmd = smooth(decimate(pre > 0 ? smooth(cmd_in, pre) : cmd_in, d), h);
-  auto meas = smooth(decimate(pre > 0 ? smooth(meas_in, pre) : meas_in, d), h);
+  const auto cmd = smooth(decimate(pre > 0 ? smooth(cmd_mps2, pre) : cmd_mps2, d), h);
+  auto meas = smooth(decimate(pre > 0 ? smooth(meas_mps2, pre) : meas_mps2, d), h);
   const std::size_t n = std::min(cmd.size(), meas.size());
   if (n < 10) return r;
 
@@ -94,9 +94,10 @@ LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_in, const std::
   // Motion: the set-point accelerates; dilated by the search range so a lagging
   // measurement still falls inside.
   std::vector<char> moving(n, 0);
-  const auto pad = static_cast<std::size_t>(std::ceil(std::max(std::abs(o.min_lag_s), std::abs(o.max_lag_s)) * rate));
+  const auto pad =
+      static_cast<std::size_t>(std::ceil(std::max(std::abs(options.min_lag_s), std::abs(options.max_lag_s)) * rate));
   for (std::size_t i = 0; i < n; ++i)
-    if (cmd[i].norm() > o.moving_fraction * peak)
+    if (cmd[i].norm() > options.moving_fraction * peak)
       for (std::size_t j = i >= pad ? i - pad : 0; j < std::min(n, i + pad + 1); ++j) moving[j] = 1;
   // Gravity and bias: the mean of the measurement over the samples used.
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -107,8 +108,8 @@ LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_in, const std::
   mean /= static_cast<double>(used);
   for (auto& v : meas) v -= mean;
 
-  const auto lag0 = static_cast<std::ptrdiff_t>(std::floor(o.min_lag_s * rate));
-  const auto lag1 = static_cast<std::ptrdiff_t>(std::ceil(o.max_lag_s * rate));
+  const auto lag0 = static_cast<std::ptrdiff_t>(std::floor(options.min_lag_s * rate));
+  const auto lag1 = static_cast<std::ptrdiff_t>(std::ceil(options.max_lag_s * rate));
   std::vector<double> corr;
   corr.reserve(static_cast<std::size_t>(lag1 - lag0 + 1));
   for (std::ptrdiff_t L = lag0; L <= lag1; ++L) {
@@ -138,7 +139,7 @@ LagEstimate estimate_lag(const std::vector<Eigen::Vector3d>& cmd_in, const std::
   double ss_cmd = 0.0, ss_res = 0.0;
   std::size_t k = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (cmd[i].norm() <= o.moving_fraction * peak) continue;
+    if (cmd[i].norm() <= options.moving_fraction * peak) continue;
     const Eigen::Vector3d m = at_fraction(meas, static_cast<double>(i) + lag_samples);
     if (!m.allFinite()) continue;
     ss_cmd += cmd[i].squaredNorm(), ss_res += (m - cmd[i]).squaredNorm(), ++k;

@@ -157,7 +157,7 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   return a;
 }
 
-void evaluate_measurement(const Run& run, const PipelineConfig& cfg, const AnalysisOptions& options, Analysis& a) {
+void evaluate_measurement(const Run& run, const PipelineConfig& config, const AnalysisOptions& options, Analysis& a) {
   // run-format.md, "No standstill": a double integral with nothing to hold it is no
   // position. Every positional figure is null with this reason (the verdict: not
   // measurable); eical explain compares such runs in acceleration against the set-point.
@@ -174,7 +174,7 @@ void evaluate_measurement(const Run& run, const PipelineConfig& cfg, const Analy
     ri.fs_hz = a.measurement.fs_hz;
     a.repeats = eval::average_repeats(ri);
     evaluate_program(run, a);
-    if (options.uncertainty.enabled) estimate_uncertainty(run, cfg, options, a);
+    if (options.uncertainty.enabled) estimate_uncertainty(run, config, options, a);
   }
   judge(run.meta.program, a);
 }

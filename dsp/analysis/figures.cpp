@@ -129,24 +129,25 @@ void rectangle_figures(const Analysis& a, Out& o) {
 
 }  // namespace
 
-double direction_G_um(const eval::CircleResult& c, const std::string& direction) {
+double direction_G_um(const eval::CircleResult& circle, const std::string& direction) {
   // From every point of the direction (the trace of a long run keeps every n-th only).
   if (direction != "ccw" && direction != "cw") return std::numeric_limits<double>::quiet_NaN();
   const std::size_t d = direction == "cw" ? 1 : 0;
-  const double hi = c.direction_F_max_um[d], lo = c.direction_F_min_um[d];
+  const double hi = circle.direction_F_max_um[d], lo = circle.direction_F_min_um[d];
   return hi >= lo ? hi - lo : std::numeric_limits<double>::quiet_NaN();
 }
 
-std::vector<FigureValue> figures_of(const Analysis& a) {
+std::vector<FigureValue> figures_of(const Analysis& analysis) {
   std::vector<FigureValue> f;
   Out o{f};
-  if (a.circle) circle_figures(a, o);
-  if (a.diagnostics) diagnostics_figures(a, o);
-  if (a.positioning) positioning_figures(a, o);
-  if (a.step) step_figures(a, o);
-  if (a.rectangle) rectangle_figures(a, o);
-  if (a.path)
-    path_figures(a.rectangle || a.program_kind == "rectangle" ? "rectangle.path_deviation" : "freeform", *a.path, o);
+  if (analysis.circle) circle_figures(analysis, o);
+  if (analysis.diagnostics) diagnostics_figures(analysis, o);
+  if (analysis.positioning) positioning_figures(analysis, o);
+  if (analysis.step) step_figures(analysis, o);
+  if (analysis.rectangle) rectangle_figures(analysis, o);
+  if (analysis.path)
+    path_figures(analysis.rectangle || analysis.program_kind == "rectangle" ? "rectangle.path_deviation" : "freeform",
+                 *analysis.path, o);
   return f;
 }
 

@@ -44,9 +44,9 @@ const std::vector<ResolutionLimit>& resolution_limits() {
   return limits;
 }
 
-const ResolutionLimit* resolution_limit(const std::string& kind) {
+const ResolutionLimit* resolution_limit(const std::string& program_kind) {
   for (const auto& l : resolution_limits())
-    if (kind == l.program) return &l;
+    if (program_kind == l.program) return &l;
   return nullptr;
 }
 
@@ -104,21 +104,21 @@ void judge(const Program& program, Analysis& a) {
         a.verdict_reasons.push_back(f);
 }
 
-FlagSeverity flag_severity(const std::string& f) {
+FlagSeverity flag_severity(const std::string& flag) {
   // The measurement itself is wrong or incomplete.
   for (const char* p :
        {"accel_missing", "accel_saturated", "frames_lost", "not_finite", "capacity_exceeded", "fixed_saturated",
         "supports_diverged", "psd_disagrees", "no_motion", "interrupted", "source_stopped", kPositionNullFlag})
-    if (starts_with(f, p)) return FlagSeverity::critical;
+    if (starts_with(flag, p)) return FlagSeverity::critical;
   // An evaluation that failed ("circle: …", "positioning: …" without "null").
   for (const char* p : {"circle: ", "step: ", "rectangle: null", "freeform: null"})
-    if (starts_with(f, p) && f.find("runs both directions") == std::string::npos) return FlagSeverity::critical;
-  if (starts_with(f, "positioning: ") && f.find("outside the standard") == std::string::npos)
+    if (starts_with(flag, p) && flag.find("runs both directions") == std::string::npos) return FlagSeverity::critical;
+  if (starts_with(flag, "positioning: ") && flag.find("outside the standard") == std::string::npos)
     return FlagSeverity::critical;
   // It limits the measurement.
   for (const char* p : {"no_start_trigger", "no_end_trigger", "short_rest_window", "no_zupt_window"})
-    if (starts_with(f, p)) return FlagSeverity::warning;
-  if (f.find("outside the standard") != std::string::npos || f.find("runs both directions") != std::string::npos)
+    if (starts_with(flag, p)) return FlagSeverity::warning;
+  if (flag.find("outside the standard") != std::string::npos || flag.find("runs both directions") != std::string::npos)
     return FlagSeverity::warning;
   return FlagSeverity::note;
 }

@@ -14,16 +14,17 @@ enum C { xtx, xty, xtz, xrx, xry, xrz, ytx, yty, ytz, yrx, yry, yrz, ztx, zty, z
 
 }  // namespace
 
-void validate(const VolumetricModel& m) {
+void validate(const VolumetricModel& model) {
   const char* axes = "xyz";
   for (int a = 0; a < 3; ++a)
     // min == max: the model describes the axis where it stood (a fit from runs that never moved it).
-    if (!(m.range_mm[a][0] <= m.range_mm[a][1]) || !std::isfinite(m.range_mm[a][0]) || !std::isfinite(m.range_mm[a][1]))
+    if (!(model.range_mm[a][0] <= model.range_mm[a][1]) || !std::isfinite(model.range_mm[a][0]) ||
+        !std::isfinite(model.range_mm[a][1]))
       throw InputError(std::string("volumetric: axis ") + axes[a] + " range must be [min, max] with min <= max");
-  for (double w : {m.xwy_urad, m.xwz_urad, m.ywz_urad})
+  for (double w : {model.xwy_urad, model.xwz_urad, model.ywz_urad})
     if (!std::isfinite(w)) throw InputError("volumetric: squareness must be finite");
   for (int k = 0; k < 18; ++k) {
-    const auto& t = m.component[k];
+    const auto& t = model.component[k];
     const std::string name = kVolumetricComponents[k];
     if (t.pos_mm.empty()) throw InputError("volumetric: component '" + name + "' is missing");
     if (t.pos_mm.size() != t.values.size())
@@ -37,30 +38,31 @@ void validate(const VolumetricModel& m) {
                          std::to_string(i + 1) + (t.pos_mm[i] == t.pos_mm[i - 1] ? ", duplicate)" : ")"));
     }
     const int a = k / 6;
-    if (t.pos_mm.front() > m.range_mm[a][0] + 1e-9 || t.pos_mm.back() < m.range_mm[a][1] - 1e-9)
+    if (t.pos_mm.front() > model.range_mm[a][0] + 1e-9 || t.pos_mm.back() < model.range_mm[a][1] - 1e-9)
       throw InputError("volumetric: component '" + name + "' does not cover the axis range [" +
-                       std::to_string(m.range_mm[a][0]) + ", " + std::to_string(m.range_mm[a][1]) + "] mm");
+                       std::to_string(model.range_mm[a][0]) + ", " + std::to_string(model.range_mm[a][1]) + "] mm");
   }
 }
 
-std::array<double, 18> component_values(const VolumetricModel& m, const Eigen::Vector3d& x) {
+std::array<double, 18> component_values(const VolumetricModel& model, const Eigen::Vector3d& x_mm) {
   std::array<double, 18> v{};
-  for (int k = 0; k < 18; ++k) v[k] = interpolate(m.component[k].pos_mm, m.component[k].values, x[k / 6]);
+  for (int k = 0; k < 18; ++k) v[k] = interpolate(model.component[k].pos_mm, model.component[k].values, x_mm[k / 6]);
   return v;
 }
 
-VolumetricResult volumetric_deviation(const VolumetricModel& m, const Eigen::Vector3d& x, const Eigen::Vector3d& xp) {
+VolumetricResult volumetric_deviation(const VolumetricModel& model, const Eigen::Vector3d& x_mm,
+                                      const Eigen::Vector3d& tool_mm) {
   VolumetricResult r;
   for (int a = 0; a < 3; ++a)
-    if (x[a] < m.range_mm[a][0] || x[a] > m.range_mm[a][1]) {
+    if (x_mm[a] < model.range_mm[a][0] || x_mm[a] > model.range_mm[a][1]) {
       r.out_of_range_axis = a;
       return r;  // never extrapolate
     }
-  const auto c = component_values(m, x);
+  const auto c = component_values(model, x_mm);
   const Eigen::Vector3d eT(c[xtx] + c[ytx] + c[ztx], c[xty] + c[yty] + c[zty], c[xtz] + c[ytz] + c[ztz]);
   Eigen::Matrix3d ER;
-  ER << 0.0, -m.xwy_urad - c[xrz], m.xwz_urad + c[xry] + c[yry],  //
-      0.0, 0.0, -m.ywz_urad - c[xrx] - c[yrx],                    //
+  ER << 0.0, -model.xwy_urad - c[xrz], model.xwz_urad + c[xry] + c[yry],  //
+      0.0, 0.0, -model.ywz_urad - c[xrx] - c[yrx],                        //
       0.0, c[xrx], 0.0;
   const double rx = c[xrx] + c[yrx] + c[zrx], ry = c[xry] + c[yry] + c[zry], rz = c[xrz] + c[yrz] + c[zrz];
   Eigen::Matrix3d EP;
@@ -68,7 +70,7 @@ VolumetricResult volumetric_deviation(const VolumetricModel& m, const Eigen::Vec
       rz, 0.0, -rx,    //
       -ry, rx, 0.0;
   // µrad · mm = nm → µm.
-  r.e_um = eT + (ER * x + EP * xp) * 1e-3;
+  r.e_um = eT + (ER * x_mm + EP * tool_mm) * 1e-3;
   return r;
 }
 

@@ -13,10 +13,10 @@ CircleSegmentFinder::CircleSegmentFinder(const Eigen::Vector2d& center_mm, doubl
   if (!(arc_deg > 0.0 && arc_deg <= 360.0)) throw InputError("circle segments: arc_deg must be in (0, 360]");
 }
 
-void CircleSegmentFinder::add(std::int64_t sample_index, const Eigen::Vector2d& cmd, bool mark) {
+void CircleSegmentFinder::add(std::int64_t sample_index, const Eigen::Vector2d& cmd_mm, bool mark) {
   constexpr double tol_deg = 2.0;         // the trigger sits on the nearest sample: far below 2°
   constexpr double back_step_deg = 1e-3;  // a set-point step against the sweep larger than this breaks monotonicity
-  const double a = std::atan2(cmd.y() - centre_.y(), cmd.x() - centre_.x());
+  const double a = std::atan2(cmd_mm.y() - centre_.y(), cmd_mm.x() - centre_.x());
   if (open_) {             // this sample belongs to the open stretch (the one that closes it too)
     double d = a - prev_;  // unwrap
     if (d > std::numbers::pi) d -= 2 * std::numbers::pi;
@@ -39,21 +39,23 @@ void CircleSegmentFinder::add(std::int64_t sample_index, const Eigen::Vector2d& 
   prev_ = a, sweep_ = fwd_ = back_ = 0.0;
 }
 
-std::vector<CircleSegment> find_circle_segments(const std::vector<Eigen::Vector2d>& cmd,
-                                                const std::vector<std::int64_t>& idx,
+std::vector<CircleSegment> find_circle_segments(const std::vector<Eigen::Vector2d>& cmd_mm,
+                                                const std::vector<std::int64_t>& sample_index,
                                                 const std::vector<std::int64_t>& marks_in,
-                                                const Eigen::Vector2d& centre, double arc_deg) {
-  if (cmd.size() != idx.size()) throw InputError("circle segments: set-point and sample indices differ in length");
-  CircleSegmentFinder finder(centre, arc_deg);
+                                                const Eigen::Vector2d& center_mm, double arc_deg) {
+  if (cmd_mm.size() != sample_index.size())
+    throw InputError("circle segments: set-point and sample indices differ in length");
+  CircleSegmentFinder finder(center_mm, arc_deg);
   std::vector<std::int64_t> marks = marks_in;
   std::sort(marks.begin(), marks.end());
   marks.erase(std::unique(marks.begin(), marks.end()), marks.end());
   // A mark between two samples (lost frames) counts at the first sample after it.
   std::size_t next = 0;
-  for (std::size_t i = 0; i < idx.size(); ++i) {
+  for (std::size_t i = 0; i < sample_index.size(); ++i) {
     bool mark = false;
-    for (; next < marks.size() && marks[next] <= idx[i]; ++next) mark = mark || (i > 0 || marks[next] == idx[i]);
-    finder.add(idx[i], cmd[i], mark);
+    for (; next < marks.size() && marks[next] <= sample_index[i]; ++next)
+      mark = mark || (i > 0 || marks[next] == sample_index[i]);
+    finder.add(sample_index[i], cmd_mm[i], mark);
   }
   return finder.segments();
 }

@@ -45,7 +45,7 @@ class CircleSegmentFinder {
 // non-positive arc.
 std::vector<CircleSegment> find_circle_segments(const std::vector<Eigen::Vector2d>& cmd_mm,
                                                 const std::vector<std::int64_t>& sample_index,
-                                                const std::vector<std::int64_t>& marks,
+                                                const std::vector<std::int64_t>& marks_in,
                                                 const Eigen::Vector2d& center_mm, double arc_deg);
 
 }  // namespace eical::dsp::eval

@@ -8,26 +8,26 @@
 
 namespace eical::dsp::eval {
 
-PositioningResult evaluate_positioning(const PositioningInput& in) {
-  const std::size_t m = in.targets_mm.size();
+PositioningResult evaluate_positioning(const PositioningInput& input) {
+  const std::size_t m = input.targets_mm.size();
   if (m < 2) throw InputError("ISO 230-2: at least 2 targets are needed");
-  if (in.up_um.size() < 2 || in.down_um.size() < 2)
+  if (input.up_um.size() < 2 || input.down_um.size() < 2)
     throw InputError("ISO 230-2: at least 2 runs per direction are needed");
-  if (in.up_um.size() != in.down_um.size())
+  if (input.up_um.size() != input.down_um.size())
     throw InputError("ISO 230-2: the two directions have different numbers of runs");
-  for (const auto* dir : {&in.up_um, &in.down_um})
+  for (const auto* dir : {&input.up_um, &input.down_um})
     for (std::size_t j = 0; j < dir->size(); ++j) {
       if ((*dir)[j].size() != m)
-        throw InputError("ISO 230-2: run " + std::to_string(j + 1) + (dir == &in.up_um ? " up" : " down") + " has " +
+        throw InputError("ISO 230-2: run " + std::to_string(j + 1) + (dir == &input.up_um ? " up" : " down") + " has " +
                          std::to_string((*dir)[j].size()) + " deviations for " + std::to_string(m) + " targets");
       for (double v : (*dir)[j])
         if (!std::isfinite(v))
           throw InputError("ISO 230-2: run " + std::to_string(j + 1) + " holds a non-finite deviation");
     }
-  const auto n = static_cast<double>(in.up_um.size());
+  const auto n = static_cast<double>(input.up_um.size());
   PositioningResult r;
-  r.axis = in.axis;
-  r.runs = static_cast<int>(in.up_um.size());
+  r.axis = input.axis;
+  r.runs = static_cast<int>(input.up_um.size());
   auto stats = [&](const std::vector<std::vector<double>>& d, std::size_t i, double& mean, double& s) {
     mean = 0.0;
     for (const auto& run : d) mean += run[i];
@@ -43,9 +43,9 @@ PositioningResult evaluate_positioning(const PositioningInput& in) {
   double sum_b = 0.0;
   for (std::size_t i = 0; i < m; ++i) {
     PositioningTarget t;
-    t.target_mm = in.targets_mm[i];
-    stats(in.up_um, i, t.mean_up_um, t.s_up_um);
-    stats(in.down_um, i, t.mean_down_um, t.s_down_um);
+    t.target_mm = input.targets_mm[i];
+    stats(input.up_um, i, t.mean_up_um, t.s_up_um);
+    stats(input.down_um, i, t.mean_down_um, t.s_down_um);
     t.mean_um = 0.5 * (t.mean_up_um + t.mean_down_um);
     t.B_um = t.mean_up_um - t.mean_down_um;
     t.R_up_um = 4.0 * t.s_up_um;

@@ -29,19 +29,19 @@ double signed_angle(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 
 }  // namespace
 
-RectangleResult evaluate_rectangle(const std::vector<Eigen::Vector2d>& cmd, const std::vector<Eigen::Vector2d>& meas,
-                                   double fs_hz, double min_stop_s) {
-  if (cmd.size() != meas.size()) throw InputError("rectangle: command and measurement differ in length");
+RectangleResult evaluate_rectangle(const std::vector<Eigen::Vector2d>& cmd_mm,
+                                   const std::vector<Eigen::Vector2d>& meas_mm, double fs_hz, double min_stop_s) {
+  if (cmd_mm.size() != meas_mm.size()) throw InputError("rectangle: command and measurement differ in length");
   if (!(fs_hz > 0.0)) throw InputError("rectangle: fs_hz must be positive");
-  for (std::size_t i = 0; i < cmd.size(); ++i)
-    if (!cmd[i].allFinite() || !meas[i].allFinite())
+  for (std::size_t i = 0; i < cmd_mm.size(); ++i)
+    if (!cmd_mm[i].allFinite() || !meas_mm[i].allFinite())
       throw InputError("rectangle: non-finite position at sample " + std::to_string(i));
   const auto min_stop = static_cast<std::size_t>(std::max(1.0, min_stop_s * fs_hz));
 
   std::vector<std::pair<std::size_t, std::size_t>> stops;
-  for (std::size_t i = 0; i < cmd.size();) {
+  for (std::size_t i = 0; i < cmd_mm.size();) {
     std::size_t j = i + 1;
-    while (j < cmd.size() && (cmd[j] - cmd[i]).norm() <= 1e-9) ++j;
+    while (j < cmd_mm.size() && (cmd_mm[j] - cmd_mm[i]).norm() <= 1e-9) ++j;
     if (j - i >= min_stop) stops.emplace_back(i, j);
     i = j;
   }
@@ -51,23 +51,23 @@ RectangleResult evaluate_rectangle(const std::vector<Eigen::Vector2d>& cmd, cons
   RectangleResult r;
   for (const auto& [b, e] : stops) {
     Eigen::Vector2d err = Eigen::Vector2d::Zero();
-    for (std::size_t k = b; k < e; ++k) err += meas[k] - cmd[k];
-    r.corners_mm.push_back(cmd[b]);
+    for (std::size_t k = b; k < e; ++k) err += meas_mm[k] - cmd_mm[k];
+    r.corners_mm.push_back(cmd_mm[b]);
     r.corner_errors_um.push_back(err / static_cast<double>(e - b) * 1000.0);
   }
   std::vector<Eigen::Vector2d> measured_dirs;
   for (std::size_t k = 0; k + 1 < stops.size(); ++k) {
     RectangleSide side;
-    side.from_mm = cmd[stops[k].first];
-    side.to_mm = cmd[stops[k + 1].first];
+    side.from_mm = cmd_mm[stops[k].first];
+    side.to_mm = cmd_mm[stops[k + 1].first];
     const Eigen::Vector2d cmd_dir = (side.to_mm - side.from_mm).normalized();
     // The side proper: the samples between the stops, without the acceleration phases'
     // first and last 10 % of the path (where servo transients dominate).
     std::vector<Eigen::Vector2d> pts;
     const double len = (side.to_mm - side.from_mm).norm();
     for (std::size_t i = stops[k].second; i < stops[k + 1].first; ++i) {
-      const double u = (cmd[i] - side.from_mm).dot(cmd_dir) / len;
-      if (u > 0.1 && u < 0.9) pts.push_back(meas[i]);
+      const double u = (cmd_mm[i] - side.from_mm).dot(cmd_dir) / len;
+      if (u > 0.1 && u < 0.9) pts.push_back(meas_mm[i]);
     }
     if (pts.size() < 3) throw InputError("rectangle: side " + std::to_string(k + 1) + " has too few samples");
     auto [c, dir] = fit_line(pts);

@@ -16,7 +16,7 @@ void RepeatFinder::open(std::size_t position, std::int64_t sample_index) {
   has_open_ = true;
 }
 
-void RepeatFinder::add(std::size_t position, std::int64_t sample_index, const Eigen::Vector3d& cmd) {
+void RepeatFinder::add(std::size_t position, std::int64_t sample_index, const Eigen::Vector3d& cmd_mm) {
   // Every mark at or before this sample starts its segment here (lower_bound) and ends
   // the one before it.
   for (; next_mark_ < marks_.size() && marks_[next_mark_] <= sample_index; ++next_mark_) {
@@ -28,14 +28,14 @@ void RepeatFinder::add(std::size_t position, std::int64_t sample_index, const Ei
   const std::size_t i = s.len++;
   if (i > 0) {
     s.contiguous = s.contiguous && sample_index == prev_index_ + 1;
-    s.max_step.push_back(std::max(s.max_step.back(), (cmd - s.last).norm()));
+    s.max_step.push_back(std::max(s.max_step.back(), (cmd_mm - s.last).norm()));
     for (int a = 0; a < 3; ++a)
-      if (s.first_move[a] == SIZE_MAX && std::abs(cmd[a] - s.every7.front()[a]) > 1e-6) s.first_move[a] = i;
+      if (s.first_move[a] == SIZE_MAX && std::abs(cmd_mm[a] - s.every7.front()[a]) > 1e-6) s.first_move[a] = i;
   } else {
     s.max_step.push_back(0.0);
   }
-  if (i % 7 == 0) s.every7.push_back(cmd);
-  s.last = cmd;
+  if (i % 7 == 0) s.every7.push_back(cmd_mm);
+  s.last = cmd_mm;
   prev_index_ = sample_index;
 }
 
@@ -100,7 +100,7 @@ RepeatAverager::RepeatAverager(std::vector<RepeatFinder::Group> groups, std::uni
   });
 }
 
-void RepeatAverager::add(std::size_t position, const Eigen::Vector3d& pos, const Eigen::Vector3d& cmd) {
+void RepeatAverager::add(std::size_t position, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& cmd_mm) {
   while (next_ < order_.size()) {
     const auto [g, m] = order_[next_];
     const std::size_t begin = groups_[g].begin[m], len = groups_[g].len;
@@ -109,7 +109,7 @@ void RepeatAverager::add(std::size_t position, const Eigen::Vector3d& pos, const
       ++next_;
       continue;
     }
-    const Eigen::Vector3d d = pos - cmd;
+    const Eigen::Vector3d d = pos_mm - cmd_mm;
     const double nr = static_cast<double>(groups_[g].begin.size());
     mean_[g][position - begin] += d * 1000.0 / nr;
     writer_->put({{d[0], d[1], d[2]}});

@@ -16,15 +16,15 @@ AugmentedFilter::AugmentedFilter(const fusion::ErrorModel& model, const Eigen::V
   if (prior_mean.size() == prior_sigma.size()) x_.tail(prior_mean.size()) = prior_mean;
 }
 
-void AugmentedFilter::predict(double h, const Eigen::VectorXd& g, bool bias_step) {
+void AugmentedFilter::predict(double h_s, const Eigen::VectorXd& accel_gain, bool bias_step) {
   // F = I except: δx += h δv + h²/2 (δb + g·θ), δv += h (δb + g·θ). Applied as P ← F P Fᵀ
   // through its two rows (F differs from I only there).
   const Eigen::Index n = x_.size(), p = n - 3;
   Eigen::RowVectorXd fx = Eigen::RowVectorXd::Zero(n), fv = Eigen::RowVectorXd::Zero(n);
-  fx[0] = 1.0, fx[1] = h, fx[2] = 0.5 * h * h;
-  fv[1] = 1.0, fv[2] = h;
-  fx.tail(p) = 0.5 * h * h * g.transpose();
-  fv.tail(p) = h * g.transpose();
+  fx[0] = 1.0, fx[1] = h_s, fx[2] = 0.5 * h_s * h_s;
+  fv[1] = 1.0, fv[2] = h_s;
+  fx.tail(p) = 0.5 * h_s * h_s * accel_gain.transpose();
+  fv.tail(p) = h_s * accel_gain.transpose();
   const double nx = fx.dot(x_), nv = fv.dot(x_);
   x_[0] = nx, x_[1] = nv;
   // Rows 0 and 1 of F·P, then columns 0 and 1 of (F·P)·Fᵀ.
@@ -34,7 +34,7 @@ void AugmentedFilter::predict(double h, const Eigen::VectorXd& g, bool bias_step
   const Eigen::VectorXd c0 = p_ * fx.transpose(), c1 = p_ * fv.transpose();
   p_.col(0) = c0;
   p_.col(1) = c1;
-  if (h != step_.h_s) step_ = fusion::discretise(model_, h);
+  if (h_s != step_.h_s) step_ = fusion::discretise(model_, h_s);
   p_.topLeftCorner<3, 3>() += step_.Q;
   if (bias_step) p_(2, 2) += model_.bias_step_um_s2 * model_.bias_step_um_s2;
   p_ = 0.5 * (p_ + p_.transpose()).eval();

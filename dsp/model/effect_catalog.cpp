@@ -70,11 +70,11 @@ Eigen::MatrixXd driven_acceleration(const RunResiduals& r) { return r.a_cmd; }
 
 }  // namespace
 
-void axis_directions(const RunResiduals& r, int axis, Eigen::VectorXd& dir, std::vector<int>& reversals) {
-  dir = Eigen::VectorXd::Zero(r.n);
+void axis_directions(const RunResiduals& run, int axis, Eigen::VectorXd& dir, std::vector<int>& reversals) {
+  dir = Eigen::VectorXd::Zero(run.n);
   double d = 0.0;
-  for (int s = 0; s < r.n; ++s) {
-    const double v = r.v_cmd(s, axis);
+  for (int s = 0; s < run.n; ++s) {
+    const double v = run.v_cmd(s, axis);
     if (std::abs(v) > 1e-3) {
       const double nd = v > 0.0 ? 1.0 : -1.0;
       if (d != 0.0 && nd != d) reversals.push_back(s);
@@ -212,20 +212,20 @@ ParamGroup scale_temperature_group(const RunResiduals& r, const std::vector<int>
 
 }  // namespace
 
-std::vector<ParamGroup> sensor_groups(const RunResiduals& r) {
+std::vector<ParamGroup> sensor_groups(const RunResiduals& run) {
   std::vector<ParamGroup> out;
-  const std::vector<int> moving = moving_axes(r);
+  const std::vector<int> moving = moving_axes(run);
   if (moving.empty()) return out;
-  const Eigen::MatrixXd a_drv = driven_acceleration(r);  // mm/s²
-  const Eigen::MatrixXd a_um = a_drv * 1000.0;           // µm/s²
+  const Eigen::MatrixXd a_drv = driven_acceleration(run);  // mm/s²
+  const Eigen::MatrixXd a_um = a_drv * 1000.0;             // µm/s²
   out.push_back(scale_group(moving, a_um));
   out.push_back(cross_axis_group(moving, a_um));
-  out.push_back(nonlinearity_group(r, moving, a_drv));
-  if (ParamGroup gp = timing_group(r, moving); !gp.params.empty()) out.push_back(std::move(gp));
-  out.push_back(damping_amplitude_group(r, moving, a_drv));
-  if (ParamGroup gp = coriolis_group(r); !gp.params.empty()) out.push_back(std::move(gp));
-  out.push_back(bias_drift_group(r));
-  if (temperature_range_c(r) > 0.02) out.push_back(scale_temperature_group(r, moving, a_um));
+  out.push_back(nonlinearity_group(run, moving, a_drv));
+  if (ParamGroup gp = timing_group(run, moving); !gp.params.empty()) out.push_back(std::move(gp));
+  out.push_back(damping_amplitude_group(run, moving, a_drv));
+  if (ParamGroup gp = coriolis_group(run); !gp.params.empty()) out.push_back(std::move(gp));
+  out.push_back(bias_drift_group(run));
+  if (temperature_range_c(run) > 0.02) out.push_back(scale_temperature_group(run, moving, a_um));
   return out;
 }
 
@@ -366,22 +366,24 @@ Attribution attribute_scale_temperature(const RunResiduals& r, const std::map<st
 
 }  // namespace
 
-std::vector<Attribution> attribute_sensor_group(const RunResiduals& r, const std::string& group,
-                                                const std::map<std::string, double>& v) {
+std::vector<Attribution> attribute_sensor_group(const RunResiduals& run, const std::string& group,
+                                                const std::map<std::string, double>& values) {
   if (group == "scale")
-    return {sized_by_largest("sensor.scale", 1000.0, "ppm", "the doubly integrated acceleration along the axis", v)};
-  if (group == "cross_axis") return attribute_cross_axis(r, v);
+    return {
+        sized_by_largest("sensor.scale", 1000.0, "ppm", "the doubly integrated acceleration along the axis", values)};
+  if (group == "cross_axis") return attribute_cross_axis(run, values);
   if (group == "nonlinearity")
     return {sized_by_largest("sensor.nonlinearity", 200.0, "1e-6/g",
-                             "the doubly integrated square and cube of the acceleration", v)};
-  if (group == "timing") return {attribute_timing(r, v)};
+                             "the doubly integrated square and cube of the acceleration", values)};
+  if (group == "timing") return {attribute_timing(run, values)};
   if (group == "damping_amplitude")
     return {sized_by_largest("sensor.damping_amplitude", 0.2, "1/g",
-                             "the integral of a·|a| (damping growing with the acceleration)", v)};
-  if (group == "coriolis") return {attribute_coriolis(r, v)};
+                             "the integral of a·|a| (damping growing with the acceleration)", values)};
+  if (group == "coriolis") return {attribute_coriolis(run, values)};
   if (group == "bias_drift")
-    return {sized_by_largest("sensor.bias_drift", 0.3, "ug/s", "the doubly integrated time (a linear bias drift)", v)};
-  if (group == "scale_temperature") return {attribute_scale_temperature(r, v)};
+    return {
+        sized_by_largest("sensor.bias_drift", 0.3, "ug/s", "the doubly integrated time (a linear bias drift)", values)};
+  if (group == "scale_temperature") return {attribute_scale_temperature(run, values)};
   return {};
 }
 
@@ -544,35 +546,35 @@ void add_if_any(std::vector<EffectModel>& out, EffectModel e) {
 
 }  // namespace
 
-std::vector<EffectModel> machine_effects(const RunResiduals& r, const Eigen::MatrixXd& hint, const LagColumns& lag) {
+std::vector<EffectModel> machine_effects(const RunResiduals& run, const Eigen::MatrixXd& hint, const LagColumns& lag) {
   std::vector<EffectModel> out;
-  const std::vector<int> moving = moving_axes(r);
+  const std::vector<int> moving = moving_axes(run);
   if (moving.empty()) return out;
   Eigen::VectorXd dir[3];
   std::vector<int> rev[3];
-  for (int a : moving) axis_directions(r, a, dir[a], rev[a]);
-  add_if_any(out, backlash_effect(r, hint, moving, rev));
-  add_if_any(out, reversal_spike_effect(r, hint, moving, dir, rev));
+  for (int a : moving) axis_directions(run, a, dir[a], rev[a]);
+  add_if_any(out, backlash_effect(run, hint, moving, rev));
+  add_if_any(out, reversal_spike_effect(run, hint, moving, dir, rev));
   if (moving.size() >= 2) out.push_back(servo_mismatch_effect(moving, lag));
-  out.push_back(scale_mismatch_effect(r, moving));
-  add_if_any(out, squareness_effect(r, moving));
-  add_if_any(out, cyclic_error_effect(r, hint, moving));
-  add_if_any(out, straightness_effect(r, moving));
+  out.push_back(scale_mismatch_effect(run, moving));
+  add_if_any(out, squareness_effect(run, moving));
+  add_if_any(out, cyclic_error_effect(run, hint, moving));
+  add_if_any(out, straightness_effect(run, moving));
   return out;
 }
 
-LagColumns common_lag_columns(const RunResiduals& r, const std::array<double, 3>& tau_s_per_axis) {
+LagColumns common_lag_columns(const RunResiduals& run, const std::array<double, 3>& tau_s_per_axis) {
   LagColumns c;
   c.tau_s = tau_s_per_axis;
-  c.velocity = Eigen::MatrixXd::Zero(r.n, 3), c.acceleration = Eigen::MatrixXd::Zero(r.n, 3);
+  c.velocity = Eigen::MatrixXd::Zero(run.n, 3), c.acceleration = Eigen::MatrixXd::Zero(run.n, 3);
   for (int a = 0; a < 3; ++a) {
-    if (!r.moving[a]) continue;
+    if (!run.moving[a]) continue;
     const double tau_s = tau_s_per_axis[static_cast<std::size_t>(a)];
     double v = 0.0, acc = 0.0;
-    for (Eigen::Index s = 0; s < r.n; ++s) {
-      const double h = s > 0 ? r.t_s[s] - r.t_s[s - 1] : 0.0;
+    for (Eigen::Index s = 0; s < run.n; ++s) {
+      const double h = s > 0 ? run.t_s[s] - run.t_s[s - 1] : 0.0;
       const double k = tau_s > 0.0 ? 1.0 - std::exp(-h / tau_s) : 1.0;  // exact for a held input
-      v += (r.v_cmd(s, a) - v) * (s == 0 ? 1.0 : k), acc += (r.a_cmd(s, a) - acc) * (s == 0 ? 1.0 : k);
+      v += (run.v_cmd(s, a) - v) * (s == 0 ? 1.0 : k), acc += (run.a_cmd(s, a) - acc) * (s == 0 ? 1.0 : k);
       c.velocity(s, a) = -v;              // mm/s × ms = µm
       c.acceleration(s, a) = acc * 1e-3;  // mm/s² × ms² = 1e-3 µm
     }
@@ -600,26 +602,26 @@ std::pair<std::vector<Eigen::Index>, Eigen::VectorXd> lag_fit_residual(const Eig
 }
 }  // namespace
 
-Eigen::MatrixXd without_lag(const Eigen::MatrixXd& hint, const LagColumns& c) {
+Eigen::MatrixXd without_lag(const Eigen::MatrixXd& hint, const LagColumns& lag) {
   Eigen::MatrixXd out = hint;
   for (int a = 0; a < 3; ++a) {
-    if (c.velocity.col(a).cwiseAbs().maxCoeff() <= 0.0) continue;
-    const auto [rows, e] = lag_fit_residual(hint, c, a);
+    if (lag.velocity.col(a).cwiseAbs().maxCoeff() <= 0.0) continue;
+    const auto [rows, e] = lag_fit_residual(hint, lag, a);
     for (std::size_t i = 0; i < rows.size(); ++i) out(rows[i], a) = e[static_cast<Eigen::Index>(i)];
   }
   return out;
 }
 
-std::array<double, 3> loop_time_constant_s(const RunResiduals& r, const Eigen::MatrixXd& hint) {
+std::array<double, 3> loop_time_constant_s(const RunResiduals& run, const Eigen::MatrixXd& hint) {
   // Per axis: each axis' loop has its own gain (kv) and so its own time constant; a common
   // one leaves τ·a-shaped residuals that look like scale mismatch on a circle.
   std::array<double, 3> best_tau{};
   for (int a = 0; a < 3; ++a) {
-    if (!r.moving[a]) continue;
+    if (!run.moving[a]) continue;
     auto rss_at = [&](double tau_s) {
       std::array<double, 3> t{};
       t[static_cast<std::size_t>(a)] = tau_s;
-      return lag_fit_residual(hint, common_lag_columns(r, t), a).second.squaredNorm();
+      return lag_fit_residual(hint, common_lag_columns(run, t), a).second.squaredNorm();
     };
     double best_rss = kInf, tau = 0.0;
     for (double tau_ms = 0.0; tau_ms <= 100.0; tau_ms += tau_ms < 60.0 ? 2.0 : 10.0)
@@ -636,10 +638,10 @@ std::array<double, 3> loop_time_constant_s(const RunResiduals& r, const Eigen::M
   return best_tau;
 }
 
-std::vector<AxisParam> servo_base(const RunResiduals& r, const LagColumns& lag) {
+std::vector<AxisParam> servo_base(const RunResiduals& run, const LagColumns& lag) {
   std::vector<AxisParam> out;
   for (int a = 0; a < 3; ++a) {
-    if (!r.moving[a] || r.axis_reference[static_cast<std::size_t>(a)] != "cmd") continue;
+    if (!run.moving[a] || run.axis_reference[static_cast<std::size_t>(a)] != "cmd") continue;
     AxisParam p;
     p.axis = a, p.accel = false;
     p.name = "servo_lag_" + ax(a) + "_ms", p.input = lag.velocity.col(a), p.prior_sigma = 10.0;

@@ -276,7 +276,7 @@ std::vector<EffectVerdict> rejected_verdicts(const SelectionData& d, const Accep
 }  // namespace
 
 SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vector<Candidate>& candidates,
-                               const std::vector<bool>& heldout, const SelectionOptions& opt) {
+                               const std::vector<bool>& heldout, const SelectionOptions& options) {
   const Eigen::Index n = residual.size();
   check_residual(residual, heldout);
   Split s = split_samples(heldout);
@@ -296,16 +296,16 @@ SelectionResult select_effects(const Eigen::VectorXd& residual, const std::vecto
                   .cur_chk = d.y_chk,
                   .cur_bic = d.bic(d.y_fit.squaredNorm(), 0)};
   std::vector<bool> done(candidates.size(), false);
-  for (int round = 0; round < opt.max_effects; ++round) {
+  for (int round = 0; round < options.max_effects; ++round) {
     EffectVerdict best_v;
-    const int best = best_candidate(d, m, done, opt, best_v);
-    if (best < 0 || best_v.bic_drop < opt.min_bic_drop) break;
+    const int best = best_candidate(d, m, done, options, best_v);
+    if (best < 0 || best_v.bic_drop < options.min_bic_drop) break;
     best_v.significant = true;
     done[static_cast<std::size_t>(best)] = true;
     accept(d, candidates[static_cast<std::size_t>(best)], m);
     out.effects.push_back(best_v);
   }
-  joint_parameters(d, m, residual, opt, out);
+  joint_parameters(d, m, residual, options, out);
   out.rms_final = rms(m.cur_fit);
   out.heldout_rms_final = rms(m.cur_chk);
   const std::vector<EffectVerdict> rejected = rejected_verdicts(d, m, done);

@@ -60,9 +60,9 @@ const EffectInfo& info(Effect e) { return effect_catalogue()[static_cast<std::si
 
 std::string_view name(Effect e) { return info(e).name; }
 
-std::optional<Effect> effect_named(std::string_view n) {
+std::optional<Effect> effect_named(std::string_view name) {
   for (const auto& i : effect_catalogue())
-    if (i.name == n) return i.id;
+    if (i.name == name) return i.id;
   return std::nullopt;
 }
 

@@ -286,11 +286,11 @@ std::vector<GroupVerdict> rest_verdicts(const Selector& sel, const std::vector<P
 }  // namespace
 
 KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::vector<ParamGroup>& groups,
-                             const fusion::ErrorModel& model, const KfSelectionOptions& o,
+                             const fusion::ErrorModel& model, const KfSelectionOptions& options,
                              const std::vector<AxisParam>& base) {
   KfSelection out;
   std::vector<double> base_innov;
-  Model cur = base_model(tracks, model, o, base, base_innov);
+  Model cur = base_model(tracks, model, options, base, base_innov);
   const InnovationSums nominal = innovation_sums(cur);
   out.fit_rms_nominal_um = rms(nominal.fit_ss, nominal.fit_n);
   out.held_rms_nominal_um = rms(nominal.held_ss, nominal.held_n);
@@ -300,7 +300,7 @@ KfSelection select_groups_kf(const std::array<AxisTrack, 3>& tracks, const std::
   out.n_eff = static_cast<double>(nominal.fit_n) / integrated_autocorrelation_time(bi, 2000);
   const Selector sel{.tracks = tracks,
                      .model = model,
-                     .o = o,
+                     .o = options,
                      .scale = out.n_eff / static_cast<double>(nominal.fit_n),
                      .ln_n = std::log(std::max(out.n_eff, 2.0))};
 

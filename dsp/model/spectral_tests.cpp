@@ -195,22 +195,22 @@ void report_differential(SpectralFindings& f, bool rest_ok, VibrationFinding& ou
 
 }  // namespace
 
-VibrationTests vibration_tests(const RunResiduals& r) {
+VibrationTests vibration_tests(const RunResiduals& run) {
   VibrationTests out;
-  const auto& raw = r.measurement.raw;
+  const auto& raw = run.measurement.raw;
   const std::size_t n = std::min(raw.schedule.flags.size(), raw.head_mps2.size());
-  const double fs = r.fs_hz;
+  const double fs = run.fs_hz;
   SegmentTransform tr;
   Spectra rest, moving;
   collect_segments(raw, n, fs, tr, rest, moving);
   out.seconds_used = static_cast<double>(rest.segments) * kSeg / 2.0 / fs;
   SpectrumScale sc;
-  sc.fs_hz = fs, sc.w2 = tr.w2, sc.g = r.meta.site.g_mps2;
+  sc.fs_hz = fs, sc.w2 = tr.w2, sc.g = run.meta.site.g_mps2;
   for (int s = 0; s < 2; ++s) {
-    const double n_g = r.meta.sensors[s].noise_ug_per_rthz * 1e-6 * sc.g;
+    const double n_g = run.meta.sensors[s].noise_ug_per_rthz * 1e-6 * sc.g;
     sc.floor[s] = 2.0 * n_g * n_g;
   }
-  out.floor_ug_per_rthz = std::hypot(r.meta.sensors[0].noise_ug_per_rthz, r.meta.sensors[1].noise_ug_per_rthz);
+  out.floor_ug_per_rthz = std::hypot(run.meta.sensors[0].noise_ug_per_rthz, run.meta.sensors[1].noise_ug_per_rthz);
   SpectralFindings f;
   const bool rest_ok = rest.segments >= 2, moving_ok = moving.segments >= 4;
   std::string where;

@@ -328,16 +328,16 @@ std::string describe_standstills(const StandstillBias& out) {
 
 }  // namespace
 
-StandstillBias standstill_bias(const RunResiduals& r) {
+StandstillBias standstill_bias(const RunResiduals& run) {
   StandstillBias out;
-  const Measurement& m = r.measurement;
+  const Measurement& m = run.measurement;
   if (m.sample_index.empty() || m.raw.table_mps2.empty()) return out;
   const WindowInputs in{
-      .run = r,
+      .run = run,
       .m = m,
       .fs_hz = m.fs_hz,
-      .g_ug = r.meta.site.g_mps2 * 1e-6,
-      .noise_rel = std::hypot(r.meta.sensors[0].noise_ug_per_rthz, r.meta.sensors[1].noise_ug_per_rthz),
+      .g_ug = run.meta.site.g_mps2 * 1e-6,
+      .noise_rel = std::hypot(run.meta.sensors[0].noise_ug_per_rthz, run.meta.sensors[1].noise_ug_per_rthz),
       .block = static_cast<std::int64_t>(kBlockS * m.fs_hz),
       .ref_offset = rest_reference_offset(m)};
   out.windows = measure_windows(in, late_spans(in));

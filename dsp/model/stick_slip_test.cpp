@@ -166,12 +166,12 @@ std::string describe_stick_slip(const StickSlipFinding& out) {
 
 }  // namespace
 
-StickSlipFinding stick_slip_test(const RunResiduals& r) {
+StickSlipFinding stick_slip_test(const RunResiduals& run) {
   StickSlipFinding out;
-  const Measurement& m = r.measurement;
+  const Measurement& m = run.measurement;
   const std::size_t n = std::min({m.raw.head_mps2.size(), m.raw.table_mps2.size(), m.cmd_mm.size()});
   if (n < 1000) return out;
-  busiest_axis(r, n, out);
+  busiest_axis(run, n, out);
   if (out.axis < 0) {
     out.evidence = "no moving axis with enough fast motion to measure the noise against";
     return out;
@@ -180,7 +180,7 @@ StickSlipFinding stick_slip_test(const RunResiduals& r) {
   // step of acceleration, ring through the DAQ filter (its impulse response spans ~8 ms)
   // as a handful of peaks a millisecond apart, once per reversal.
   out.found = out.bursts_per_zone >= 8.0 && out.bursts_in_creep >= 20;
-  if (r.has_ref[out.axis]) out.slip_um = sawtooth_um(m, out.axis);
+  if (run.has_ref[out.axis]) out.slip_um = sawtooth_um(m, out.axis);
   out.evidence = describe_stick_slip(out);
   return out;
 }

@@ -47,7 +47,7 @@ void FixedStaticComp::set_temperature(std::int64_t temp_q24, fx::Saturation& sat
   }
 }
 
-void FixedStaticComp::apply(const std::int32_t counts[3], std::int64_t temp_q24, std::int64_t out[3],
+void FixedStaticComp::apply(const std::int32_t counts[3], std::int64_t temp_q24, std::int64_t out_q40_mps2[3],
                             fx::Saturation& sat) noexcept {
   if (temp_q24 != cached_temp_q24_c) set_temperature(temp_q24, sat);
   std::int64_t u[3], v[3];
@@ -87,7 +87,7 @@ void FixedStaticComp::apply(const std::int32_t counts[3], std::int64_t temp_q24,
     std::int64_t a = 0;
     for (int j = 0; j < 3; ++j)
       a = fx::add_sat(a, fx::mul(v[j], kSensorQ, to_machine_mps2_per_g[i][j], fx::kAccelQ, sat), sat);
-    out[i] = a;
+    out_q40_mps2[i] = a;
   }
 }
 

@@ -21,12 +21,12 @@ StaticComp::StaticComp(const SensorSpec& spec, const Acquisition& acq, const Sit
             cross2_g_per_g2.squaredNorm() > 0.0;
 }
 
-Eigen::Vector3d static_model_g(const Eigen::Vector3d& v, const SensorSpec& spec, const StaticCalibration& cal) {
+Eigen::Vector3d static_model_g(const Eigen::Vector3d& v_g, const SensorSpec& spec, const StaticCalibration& cal) {
   Eigen::Vector3d u;
   for (int i = 0; i < 3; ++i) {
-    u[i] = v[i] + spec.k2_g_per_g2[i] * v[i] * v[i] + spec.k3_g_per_g3[i] * v[i] * v[i] * v[i];
+    u[i] = v_g[i] + spec.k2_g_per_g2[i] * v_g[i] * v_g[i] + spec.k3_g_per_g3[i] * v_g[i] * v_g[i] * v_g[i];
     for (int j = 0; j < 3; ++j)
-      if (j != i) u[i] += cal.cross_g_per_g(i, j) * v[j] + cal.cross2_g_per_g2(i, j) * v[i] * v[j];
+      if (j != i) u[i] += cal.cross_g_per_g(i, j) * v_g[j] + cal.cross2_g_per_g2(i, j) * v_g[i] * v_g[j];
   }
   return u;
 }

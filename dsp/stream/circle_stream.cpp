@@ -98,32 +98,32 @@ void CircleStream::leave(const Range& r) {
   }
 }
 
-void CircleStream::sample(std::int64_t idx, const Eigen::Vector3d& pos, const Eigen::Vector3d& cmd,
-                          const Eigen::Vector3d& ref) {
+void CircleStream::sample(std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& cmd_mm,
+                          const Eigen::Vector3d& ref_mm) {
   if (segment_error_) return;
   // Ranges that have ended (also one that no sample fell in: its too few samples are its error).
-  while (next_ < ranges_.size() && idx >= ranges_[next_].second) {
+  while (next_ < ranges_.size() && sample_index >= ranges_[next_].second) {
     if (!inside_) enter(ranges_[next_]);
     leave(ranges_[next_]);
     inside_ = false;
     ++next_;
   }
-  if (next_ < ranges_.size() && idx >= ranges_[next_].first) {
+  if (next_ < ranges_.size() && sample_index >= ranges_[next_].first) {
     const Range& r = ranges_[next_];
     if (!inside_) enter(r), inside_ = true;
-    const Eigen::Vector2d pm(pos[ia_], pos[ib_]), pr(ref[ia_], ref[ib_]);
+    const Eigen::Vector2d pm(pos_mm[ia_], pos_mm[ib_]), pr(ref_mm[ia_], ref_mm[ib_]);
     for (auto [c, p] : {std::pair<Channel*, const Eigen::Vector2d*>{&meas_, &pm}, {&ref_, &pr}}) {
       if (!c->acc[r.dir] || c->error) continue;
       try {
-        c->acc[r.dir]->add(idx, *p);
+        c->acc[r.dir]->add(sample_index, *p);
       } catch (const InputError& e) {
         c->error = e.what();
       }
     }
   }
   for (int d = 0; d < 2; ++d)
-    if (pass_writer_[d] && idx >= by_dir_[d].front().first && idx < by_dir_[d].back().second) {
-      pass_writer_[d]->put({{cmd[ia_], cmd[ib_], pos[ia_], pos[ib_]}});
+    if (pass_writer_[d] && sample_index >= by_dir_[d].front().first && sample_index < by_dir_[d].back().second) {
+      pass_writer_[d]->put({{cmd_mm[ia_], cmd_mm[ib_], pos_mm[ia_], pos_mm[ib_]}});
       ++pass_samples_[d];
     }
 }

@@ -15,20 +15,20 @@ constexpr double kD2PerSigma = 1.954;  // E|i[k] − 2i[k−1] + i[k−2]| = √
 
 }  // namespace
 
-PsdDecoder::PsdDecoder(const PsdSpec& s, const Acquisition& acq) {
-  if (s.measures == "x")
+PsdDecoder::PsdDecoder(const PsdSpec& spec, const Acquisition& acquisition) {
+  if (spec.measures == "x")
     axis_ = 0, cross_ = 1;
-  else if (s.measures == "y")
+  else if (spec.measures == "y")
     axis_ = 1, cross_ = 0;
   else
-    throw InputError("psd: measures must be \"x\" or \"y\", got \"" + s.measures + "\"");
-  if (!(s.length_mm > 0.0)) throw InputError("psd: length_mm must be positive");
-  centre_mm_ = s.center_mm[axis_];
-  half_length_mm_ = s.length_mm / 2.0;
-  margin_mm_ = 0.02 * s.length_mm;  // the spot (tens of µm) clear of the ends, where u clamps
-  tau_s_ = std::max(s.lockin_tau_s, 0.0);
-  lsb_v_ = acq.adc_lsb_volt;
-  offset_counts_ = static_cast<double>(acq.adc_offset_counts);
+    throw InputError("psd: measures must be \"x\" or \"y\", got \"" + spec.measures + "\"");
+  if (!(spec.length_mm > 0.0)) throw InputError("psd: length_mm must be positive");
+  centre_mm_ = spec.center_mm[axis_];
+  half_length_mm_ = spec.length_mm / 2.0;
+  margin_mm_ = 0.02 * spec.length_mm;  // the spot (tens of µm) clear of the ends, where u clamps
+  tau_s_ = std::max(spec.lockin_tau_s, 0.0);
+  lsb_v_ = acquisition.adc_lsb_volt;
+  offset_counts_ = static_cast<double>(acquisition.adc_offset_counts);
 }
 
 void PsdDecoder::reset() noexcept {
@@ -37,11 +37,11 @@ void PsdDecoder::reset() noexcept {
   d2_count_ = 0;
 }
 
-PsdReading PsdDecoder::step(std::int32_t c1, std::int32_t c2, bool missing) noexcept {
+PsdReading PsdDecoder::step(std::int32_t i1_counts, std::int32_t i2_counts, bool missing) noexcept {
   PsdReading r;
   if (missing) return r;
-  const double i[2] = {(static_cast<double>(c1) - offset_counts_) * lsb_v_,
-                       (static_cast<double>(c2) - offset_counts_) * lsb_v_};
+  const double i[2] = {(static_cast<double>(i1_counts) - offset_counts_) * lsb_v_,
+                       (static_cast<double>(i2_counts) - offset_counts_) * lsb_v_};
   // Electrode noise from second differences (robust: each clipped at 4× the running mean).
   if (seen_ >= 2) {
     for (int e = 0; e < 2; ++e) {

@@ -5,13 +5,14 @@
 
 namespace eical::dsp::supports {
 
-StandstillDetector::StandstillDetector(const StandstillOptions& o, double fs_hz, double delay_samples, double var)
-    : opt_(o), var_(var > 0.0 ? var : 1.0), datasheet_var_(var_), fs_hz_(fs_hz) {
-  const auto w = static_cast<std::size_t>(std::max(8.0, std::round(o.window_s * fs_hz)));
+StandstillDetector::StandstillDetector(const StandstillOptions& options, double fs_hz, double delay_samples,
+                                       double noise_var_mps2)
+    : opt_(options), var_(noise_var_mps2 > 0.0 ? noise_var_mps2 : 1.0), datasheet_var_(var_), fs_hz_(fs_hz) {
+  const auto w = static_cast<std::size_t>(std::max(8.0, std::round(options.window_s * fs_hz)));
   ring_.assign(w, 0.0);
-  vring_.assign(std::max(w, static_cast<std::size_t>(std::round(o.vibration_window_s * fs_hz))),
+  vring_.assign(std::max(w, static_cast<std::size_t>(std::round(options.vibration_window_s * fs_hz))),
                 Eigen::Vector3d::Zero());
-  gamma_ = 1.0 + o.z * std::sqrt(2.0 / (3.0 * static_cast<double>(w)));
+  gamma_ = 1.0 + options.z * std::sqrt(2.0 / (3.0 * static_cast<double>(w)));
   cmd_needed_ = static_cast<std::int64_t>(w) + static_cast<std::int64_t>(std::ceil(std::max(delay_samples, 0.0)));
 }
 
@@ -25,13 +26,14 @@ void StandstillDetector::reset() noexcept {
   cmd_still_samples_ = 0;
 }
 
-StandstillDetector::Decision StandstillDetector::step(const Eigen::Vector3d& a, const Eigen::Vector3d& v_mm_s,
-                                                      const Eigen::Vector3d& v_correction_mm_s, double v_sigma_mm_s,
+StandstillDetector::Decision StandstillDetector::step(const Eigen::Vector3d& accel_mps2,
+                                                      const Eigen::Vector3d& vel_mm_s,
+                                                      const Eigen::Vector3d& vel_correction_mm_s, double vel_sigma_mm_s,
                                                       bool cmd_valid, bool cmd_moved) noexcept {
   Decision d;
   if (ring_.empty()) return d;
   // A bad sample (−1 in the ring) holds rest off for a whole window.
-  const double e = a.allFinite() ? a.squaredNorm() : -1.0;
+  const double e = accel_mps2.allFinite() ? accel_mps2.squaredNorm() : -1.0;
   const double old = ring_[head_];
   if (old < 0.0)
     --bad_;
@@ -44,7 +46,7 @@ StandstillDetector::Decision StandstillDetector::step(const Eigen::Vector3d& a, 
   ring_[head_] = e;
   head_ = (head_ + 1) % ring_.size();
   filled_ = std::min(filled_ + 1, ring_.size());
-  const Eigen::Vector3d v = v_mm_s.allFinite() ? v_mm_s : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d v = vel_mm_s.allFinite() ? vel_mm_s : Eigen::Vector3d::Zero();
   // The velocity W samples ago leaves the short window (the vibration ring is longer).
   const std::size_t vn = vring_.size(), w = ring_.size();
   if (vfilled_ >= w) {
@@ -86,8 +88,8 @@ StandstillDetector::Decision StandstillDetector::step(const Eigen::Vector3d& a, 
   }
   // Without a set-point only the integrated velocity tells a glide from a standstill (its
   // spread is no excuse there: it includes the ramp into the glide).
-  const double v_max = opt_.velocity_floor_mm_s + 4.0 * v_sigma_mm_s;
-  d.rest = cmd_valid || (v_mm_s - v_correction_mm_s).cwiseAbs().maxCoeff() <= v_max;
+  const double v_max = opt_.velocity_floor_mm_s + 4.0 * vel_sigma_mm_s;
+  d.rest = cmd_valid || (vel_mm_s - vel_correction_mm_s).cwiseAbs().maxCoeff() <= v_max;
   return d;
 }
 

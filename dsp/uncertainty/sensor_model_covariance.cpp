@@ -29,35 +29,41 @@ int parameter_index(const std::string& name) {
   return -1;
 }
 
-SensorModelCovariance datasheet_covariance(const SensorSpec sensors[2], double fs_hz, const DatasheetTolerance& t) {
+SensorModelCovariance datasheet_covariance(const SensorSpec sensors[2], double fs_hz,
+                                           const DatasheetTolerance& tolerance) {
   SensorModelCovariance c;
   c.source = "datasheet";
   const double third = 1.0 / 3.0;  // uniform within ±a: u² = a²/3
   for (int s = 0; s < 2; ++s) {
     // The vertical axis' slope errors of k2, k3 at 1 g (sensor axis 3 ≈ machine z).
-    const double k2 = 2.0 * t.k2_k3_relative * std::abs(sensors[s].k2_g_per_g2[2]),
-                 k3 = 3.0 * t.k2_k3_relative * std::abs(sensors[s].k3_g_per_g3[2]);
+    const double k2 = 2.0 * tolerance.k2_k3_relative * std::abs(sensors[s].k2_g_per_g2[2]),
+                 k3 = 3.0 * tolerance.k2_k3_relative * std::abs(sensors[s].k3_g_per_g3[2]);
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
-        double v = (t.cross_g_per_g * t.cross_g_per_g + t.mounting_rad * t.mounting_rad) * third;
+        double v =
+            (tolerance.cross_g_per_g * tolerance.cross_g_per_g + tolerance.mounting_rad * tolerance.mounting_rad) *
+            third;
         if (i == j)
-          v = (t.scale * t.scale + (i < 2 ? t.cross2_g_per_g2 * t.cross2_g_per_g2 : k2 * k2 + k3 * k3)) * third;
+          v = (tolerance.scale * tolerance.scale +
+               (i < 2 ? tolerance.cross2_g_per_g2 * tolerance.cross2_g_per_g2 : k2 * k2 + k3 * k3)) *
+              third;
         c.covariance(error_index(s, i, j), error_index(s, i, j)) = v;
       }
     // c1 = 2ζ/ω0 = ζ/(π f0): δc1 = δζ/(π f0) − c1 δf0/f0.
     const double f0 = sensors[s].f0_hz, c1 = sensors[s].zeta / (std::numbers::pi * f0);
-    const double u_zeta = t.zeta / (std::numbers::pi * f0), u_f0 = c1 * t.f0_relative;
+    const double u_zeta = tolerance.zeta / (std::numbers::pi * f0), u_f0 = c1 * tolerance.f0_relative;
     c.covariance(damping_index(s), damping_index(s)) = (u_zeta * u_zeta + u_f0 * u_f0) * third;
     for (int i = 0; i < 3; ++i)
-      c.covariance(tc_bias_index(s, i), tc_bias_index(s, i)) = t.tc_bias_ug_per_c * t.tc_bias_ug_per_c * third;
+      c.covariance(tc_bias_index(s, i), tc_bias_index(s, i)) =
+          tolerance.tc_bias_ug_per_c * tolerance.tc_bias_ug_per_c * third;
   }
-  const double d_s = t.delay_samples / fs_hz;
+  const double d_s = tolerance.delay_samples / fs_hz;
   c.covariance(kDelayIndex, kDelayIndex) = d_s * d_s * third;
   return c;
 }
 
-double strip_nonlinearity_scale_variance(const DatasheetTolerance& t) {
-  const double a = 0.6 * t.psd_nonlinearity;
+double strip_nonlinearity_scale_variance(const DatasheetTolerance& tolerance) {
+  const double a = 0.6 * tolerance.psd_nonlinearity;
   return a * a / 3.0;
 }
 

@@ -273,7 +273,7 @@ const std::vector<std::string>& hidden_programs() {
 // Every effect of the table can be hidden (the simulator's own list of them).
 const std::vector<std::string>& hideable_effects() { return effect_names(); }
 
-std::string program_for(const std::string& e) {
+std::string program_for(const std::string& effect) {
   static const std::vector<std::string> step = {"sensor.scale",
                                                 "sensor.bias_drift",
                                                 "sensor.nonlinearity",
@@ -285,7 +285,7 @@ std::string program_for(const std::string& e) {
                                                 "machine.scale_mismatch",
                                                 "site.coriolis",
                                                 "machine.resonance"};
-  return std::find(step.begin(), step.end(), e) != step.end() ? "step" : "circle";
+  return std::find(step.begin(), step.end(), effect) != step.end() ? "step" : "circle";
 }
 
 std::string program_for(const std::vector<std::string>& effects) {
@@ -294,7 +294,8 @@ std::string program_for(const std::vector<std::string>& effects) {
   return effects.empty() ? "circle" : "step";
 }
 
-Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const std::string& kind, std::uint64_t seed) {
+Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const std::string& program,
+                                std::uint64_t seed) {
   Draw d(stream_seed(seed, 7001));
   Scenario sc;
   sc.seed = seed;
@@ -304,7 +305,7 @@ Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const s
   // The program draws from its own stream: one seed is one machine (sensors, errors),
   // whichever program measures it.
   Draw dp(stream_seed(seed, 7002));
-  program(sc, kind, dp, has("sensor.damping_amplitude") || has("sensor.nonlinearity"));
+  program(sc, program, dp, has("sensor.damping_amplitude") || has("sensor.nonlinearity"));
   background(sc, d);
   // Cross coupling differs from a rotated mounting only where one sensor moves two axes.
   if (has("sensor.cross_coupling")) sc.meta.machine.table_axes = {"x", "y"}, sc.meta.machine.head_axes = {"z"};
@@ -321,9 +322,9 @@ Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const s
   std::string name = effects.empty() ? "baseline" : effects.front();
   for (std::size_t i = 1; i < effects.size(); ++i) name += "+" + effects[i];
   sc.name = name;
-  sc.meta.id = "hidden-" + name + "-" + kind + "-s" + std::to_string(seed);
+  sc.meta.id = "hidden-" + name + "-" + program + "-s" + std::to_string(seed);
   sc.description = (effects.empty() ? std::string("no effect") : name) + " hidden among tolerance-level deviations, " +
-                   kind + " program";
+                   program + " program";
   return sc;
 }
 

@@ -6,14 +6,14 @@
 
 namespace eical::sim {
 
-AxisMotion::AxisMotion(const MachineErrors& e, int axis, double step_s, double start_mm)
-    : servo_(e.servo[axis]),
-      backlash_mm_(e.backlash_um[axis] * 1e-3),
-      spike_mm_(e.spike[axis].amp_um * 1e-3),
-      spike_tau_s_(e.spike[axis].tau_ms * 1e-3),
-      cyclic_(e.cyclic[axis]),
-      scale_(e.scale_ppm[axis] * 1e-6),
-      ss_(e.stick_slip[axis]),
+AxisMotion::AxisMotion(const MachineErrors& errors, int axis, double step_s, double start_mm)
+    : servo_(errors.servo[axis]),
+      backlash_mm_(errors.backlash_um[axis] * 1e-3),
+      spike_mm_(errors.spike[axis].amp_um * 1e-3),
+      spike_tau_s_(errors.spike[axis].tau_ms * 1e-3),
+      cyclic_(errors.cyclic[axis]),
+      scale_(errors.scale_ppm[axis] * 1e-6),
+      ss_(errors.stick_slip[axis]),
       h_(step_s),
       x_mm_(start_mm),
       vx_mm_s_(0.0),
@@ -26,21 +26,21 @@ AxisMotion::AxisMotion(const MachineErrors& e, int axis, double step_s, double s
   if (servo_.kv_per_s > 0.0) exp_kv_h_ = std::exp(-servo_.kv_per_s * h_);
 }
 
-double AxisMotion::servo(double cmd, double vel) noexcept {
-  if (!(servo_.kv_per_s > 0.0)) return cmd;
+double AxisMotion::servo(double cmd_mm, double cmd_vel_mm_s) noexcept {
+  if (!(servo_.kv_per_s > 0.0)) return cmd_mm;
   const double kv = servo_.kv_per_s, ff = servo_.feedforward;
   if (servo_.velocity_tau_s <= 0.0) {
     // e = cmd − x obeys e' = (1 − ff) v − Kv e: exact over the step with v at mid-step.
-    const double v_mid = 0.5 * (vel + prev_vel_mm_s_);
+    const double v_mid = 0.5 * (cmd_vel_mm_s + prev_vel_mm_s_);
     const double e = (prev_cmd_mm_ - x_mm_) * exp_kv_h_ + (1.0 - ff) * v_mid * (1.0 - exp_kv_h_) / kv;
-    x_mm_ = cmd - e;
+    x_mm_ = cmd_mm - e;
   } else {
     // Second-order loop: x' = vx, vx' = (ff v + Kv (cmd − x) − vx)/T; RK4 with the set-point
     // interpolated linearly over the step.
     const double T = servo_.velocity_tau_s;
     auto f = [&](double frac, double x, double vx, double& dx, double& dvx) {
-      const double c = prev_cmd_mm_ + frac * (cmd - prev_cmd_mm_);
-      const double v = prev_vel_mm_s_ + frac * (vel - prev_vel_mm_s_);
+      const double c = prev_cmd_mm_ + frac * (cmd_mm - prev_cmd_mm_);
+      const double v = prev_vel_mm_s_ + frac * (cmd_vel_mm_s - prev_vel_mm_s_);
       dx = vx;
       dvx = (ff * v + kv * (c - x) - vx) / T;
     };
@@ -55,11 +55,11 @@ double AxisMotion::servo(double cmd, double vel) noexcept {
   return x_mm_;
 }
 
-double AxisMotion::stick_slip(double vel) noexcept {
+double AxisMotion::stick_slip(double cmd_vel_mm_s) noexcept {
   // lag = set-point − slide (signed). Below the creep speed static friction holds the slide
   // (the lag follows the set-point) until |lag| reaches amp; above it the slide breaks free.
   const double amp = ss_.amp_um * 1e-3;
-  const bool creeping = std::abs(vel) * 60.0 < ss_.below_mm_min;
+  const bool creeping = std::abs(cmd_vel_mm_s) * 60.0 < ss_.below_mm_min;
   if (ss_slipping_) {
     // The slide breaks free and stops again: its speed u = U (1 − cos 2πt/T)/2 rises and
     // falls back to zero (no velocity step, so no acceleration impulse), covering the lag
@@ -72,27 +72,28 @@ double AxisMotion::stick_slip(double vel) noexcept {
     ss_lag_mm_ = ss_slip_from_mm_ + ss_slip_v_mm_s_ * t - covered;
     if (ss_slip_t_s_ >= T) ss_slipping_ = false;
   } else if (creeping) {
-    ss_lag_mm_ += vel * h_;
+    ss_lag_mm_ += cmd_vel_mm_s * h_;
     if (std::abs(ss_lag_mm_) >= amp)
-      ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_v_mm_s_ = vel, ss_slip_t_s_ = 0.0;
+      ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_v_mm_s_ = cmd_vel_mm_s, ss_slip_t_s_ = 0.0;
   } else if (ss_lag_mm_ != 0.0) {
-    ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_v_mm_s_ = vel, ss_slip_t_s_ = 0.0;  // fast: breaks free
+    ss_slipping_ = true, ss_slip_from_mm_ = ss_lag_mm_, ss_slip_v_mm_s_ = cmd_vel_mm_s,
+    ss_slip_t_s_ = 0.0;  // fast: breaks free
   }
   return -ss_lag_mm_;
 }
 
-double AxisMotion::step(double cmd, double vel) noexcept {
+double AxisMotion::step(double cmd_mm, double cmd_vel_mm_s) noexcept {
   if (!active_) return 0.0;
-  const double motor = servo(cmd, vel);
-  prev_cmd_mm_ = cmd, prev_vel_mm_s_ = vel;
-  double dev = motor - cmd;
+  const double motor = servo(cmd_mm, cmd_vel_mm_s);
+  prev_cmd_mm_ = cmd_mm, prev_vel_mm_s_ = cmd_vel_mm_s;
+  double dev = motor - cmd_mm;
   if (backlash_mm_ != 0.0) {
     // Play operator: the motor drags the slide only at the ends of the play.
     slide_mm_ = std::clamp(slide_mm_, motor - backlash_mm_ / 2.0, motor + backlash_mm_ / 2.0);
     dev += slide_mm_ - motor + backlash_mm_ / 2.0;  // zero while moving in + after the start
   }
   if (spike_mm_ != 0.0) {
-    const int d = vel > 1e-9 ? 1 : (vel < -1e-9 ? -1 : 0);
+    const int d = cmd_vel_mm_s > 1e-9 ? 1 : (cmd_vel_mm_s < -1e-9 ? -1 : 0);
     if (d != 0 && dir_ != 0 && d != dir_) since_reversal_s_ = 0.0;
     if (d != 0) dir_ = d;
     since_reversal_s_ += h_;
@@ -103,11 +104,11 @@ double AxisMotion::step(double cmd, double vel) noexcept {
       dev -= dir_ * spike_mm_ * u * u * std::exp(2.0 * (1.0 - u));
     }
   }
-  if (ss_.amp_um != 0.0) dev += stick_slip(vel);
-  if (scale_ != 0.0) dev += scale_ * cmd;
+  if (ss_.amp_um != 0.0) dev += stick_slip(cmd_vel_mm_s);
+  if (scale_ != 0.0) dev += scale_ * cmd_mm;
   if (cyclic_.amp_um != 0.0)
     dev += cyclic_.amp_um * 1e-3 *
-           std::sin(2.0 * std::numbers::pi * cmd / cyclic_.pitch_mm + cyclic_.phase_deg * std::numbers::pi / 180.0);
+           std::sin(2.0 * std::numbers::pi * cmd_mm / cyclic_.pitch_mm + cyclic_.phase_deg * std::numbers::pi / 180.0);
   return dev;
 }
 

@@ -114,10 +114,10 @@ std::string KlipperTest::invalid_reason() const {
   return "";
 }
 
-std::vector<AccelSegment> klipper_segments(const KlipperTest& k) {
-  const std::string why = k.invalid_reason();
+std::vector<AccelSegment> klipper_segments(const KlipperTest& test) {
+  const std::string why = test.invalid_reason();
   if (!why.empty()) throw dsp::InputError("Klipper resonance test: " + why);
-  return k.legacy_moves ? legacy_segments(k) : current_segments(k);
+  return test.legacy_moves ? legacy_segments(test) : current_segments(test);
 }
 
 AccelProfileSetPoint::AccelProfileSetPoint(std::vector<AccelSegment> segments, const Eigen::Vector3d& direction,
@@ -142,8 +142,8 @@ AccelProfileSetPoint::AccelProfileSetPoint(std::vector<AccelSegment> segments, c
   triggers_ = {{0.0, dsp::trigger::program_start}, {duration_, dsp::trigger::program_end}};
 }
 
-std::size_t AccelProfileSetPoint::segment_at(double tau) const {
-  const auto it = std::upper_bound(t_start_.begin(), t_start_.end(), tau);
+std::size_t AccelProfileSetPoint::segment_at(double tau_s) const {
+  const auto it = std::upper_bound(t_start_.begin(), t_start_.end(), tau_s);
   return static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, (it - t_start_.begin()) - 1));
 }
 

@@ -70,13 +70,13 @@ PathState SCurve::accel_phase(double t) const {
   return {s2 + v2 * u + ap * u * u / 2.0 - j * u * u * u / 6.0, v2 + ap * u - j * u * u / 2.0, ap - j * u, -j};
 }
 
-PathState SCurve::at(double t) const {
-  if (length_ == 0.0 || t <= 0.0) return {};
-  if (t >= duration_) return {length_, 0.0, 0.0, 0.0};
-  if (t <= t_acc_) return accel_phase(t);
-  if (t <= t_acc_ + t_cruise_) return {s_acc_ + v_peak_ * (t - t_acc_), v_peak_, 0.0, 0.0};
+PathState SCurve::at(double t_s) const {
+  if (length_ == 0.0 || t_s <= 0.0) return {};
+  if (t_s >= duration_) return {length_, 0.0, 0.0, 0.0};
+  if (t_s <= t_acc_) return accel_phase(t_s);
+  if (t_s <= t_acc_ + t_cruise_) return {s_acc_ + v_peak_ * (t_s - t_acc_), v_peak_, 0.0, 0.0};
   // Deceleration mirrors the acceleration in time.
-  const PathState m = accel_phase(duration_ - t);
+  const PathState m = accel_phase(duration_ - t_s);
   return {length_ - m.s, m.v, -m.a, m.j};
 }
 

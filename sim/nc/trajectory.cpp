@@ -74,16 +74,16 @@ std::vector<std::pair<double, double>> Trajectory::move_spans_s() const {
   return spans;
 }
 
-MotionState Trajectory::at(double t) const {
+MotionState Trajectory::at(double t_s) const {
   MotionState st;
   // The last move that started at or before t.
-  auto it = std::upper_bound(moves_.begin(), moves_.end(), t, [](double v, const Move& m) { return v < m.t0_s; });
+  auto it = std::upper_bound(moves_.begin(), moves_.end(), t_s, [](double v, const Move& m) { return v < m.t0_s; });
   if (it == moves_.begin()) {
     st.pos_mm = start_mm_;
     return st;
   }
   const Move& m = *(it - 1);
-  const PathState ps = m.profile.at(t - m.t0_s);
+  const PathState ps = m.profile.at(t_s - m.t0_s);
   const auto k = static_cast<std::size_t>(std::upper_bound(m.s_start_mm.begin(), m.s_start_mm.end(), ps.s) -
                                           m.s_start_mm.begin() - 1);
   const PathElement& e = m.elements[std::min(k, m.elements.size() - 1)];
@@ -200,13 +200,13 @@ bool blends(const Chain& chain, const PathElement& e, double feed_mm_s, bool exa
 
 }  // namespace
 
-Trajectory interpolate(const gcode::Program& program, const Eigen::Vector3d& start_mm, const MachineLimits& lim) {
+Trajectory interpolate(const gcode::Program& program, const Eigen::Vector3d& start_mm, const MachineLimits& limits) {
   Timeline out;
   Chain chain;
   for (std::size_t i = 0; i < program.blocks.size(); ++i) {
     const auto& block = program.blocks[i];
     if (const auto* d = std::get_if<gcode::Dwell>(&block)) {
-      flush(chain, lim, out);
+      flush(chain, limits, out);
       out.t_s += d->duration_s;
       continue;
     }
@@ -218,17 +218,17 @@ Trajectory interpolate(const gcode::Program& program, const Eigen::Vector3d& sta
       continue;
     }
     double feed_mm_s = 0.0;
-    const PathElement e = path_element(block, lim, feed_mm_s);
+    const PathElement e = path_element(block, limits, feed_mm_s);
     if (!(feed_mm_s > 0.0))
       throw dsp::InputError("interpolator: a move without feed (F word missing) at block " + std::to_string(i + 1));
     if (e.length_mm <= 1e-12) continue;  // e.g. the G0 to where the machine already is
-    if (!chain.elements.empty() && !blends(chain, e, feed_mm_s, program.exact_stop)) flush(chain, lim, out);
+    if (!chain.elements.empty() && !blends(chain, e, feed_mm_s, program.exact_stop)) flush(chain, limits, out);
     if (chain.elements.empty()) chain.feed_mm_s = feed_mm_s;
     chain.elements.push_back(e);
     chain.length_mm += e.length_mm;
-    if (program.exact_stop) flush(chain, lim, out);
+    if (program.exact_stop) flush(chain, limits, out);
   }
-  flush(chain, lim, out);
+  flush(chain, limits, out);
   std::stable_sort(out.triggers.begin(), out.triggers.end(),
                    [](const auto& a, const auto& b) { return a.t_s < b.t_s; });
   return Trajectory(std::move(out.moves), std::move(out.triggers), start_mm, out.t_s);

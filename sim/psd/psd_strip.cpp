@@ -17,7 +17,7 @@ double covered(double lo, double hi, double sigma) {
 
 }  // namespace
 
-PsdStrip::PsdStrip(const dsp::PsdSpec& spec, const PsdTruth& truth, double h) : spec_(spec), truth_(truth) {
+PsdStrip::PsdStrip(const dsp::PsdSpec& spec, const PsdTruth& truth, double step_s) : spec_(spec), truth_(truth) {
   if (spec.measures == "x")
     along_ = 0, across_ = 1;
   else if (spec.measures == "y")
@@ -27,13 +27,13 @@ PsdStrip::PsdStrip(const dsp::PsdSpec& spec, const PsdTruth& truth, double h) : 
   if (!(spec.length_mm > 0.0) || !(spec.width_mm > 0.0))
     throw dsp::InputError("psd: length_mm and width_mm must be positive");
   sigma_mm_ = std::max(truth.spot_mm, 1e-6) / 4.0;  // 1/e² diameter = 4σ
-  alpha_ = spec.lockin_tau_s > 0.0 ? 1.0 - std::exp(-h / spec.lockin_tau_s) : 1.0;
-  h_ = h;
+  alpha_ = spec.lockin_tau_s > 0.0 ? 1.0 - std::exp(-step_s / spec.lockin_tau_s) : 1.0;
+  h_ = step_s;
 }
 
-void PsdStrip::step(const Eigen::Vector3d& p, double& i1_v, double& i2_v) noexcept {
-  const double u = p[along_] - spec_.center_mm[along_];
-  const double w = p[across_] - spec_.center_mm[across_];
+void PsdStrip::step(const Eigen::Vector3d& rel_mm, double& i1_v, double& i2_v) noexcept {
+  const double u = rel_mm[along_] - spec_.center_mm[along_];
+  const double w = rel_mm[across_] - spec_.center_mm[across_];
   const double half_l = spec_.length_mm / 2.0, half_w = spec_.width_mm / 2.0;
   double target1 = 0.0, target2 = 0.0;
   // Most of the time the spot is far from the strip: the cross direction decides first.

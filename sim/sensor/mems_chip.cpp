@@ -24,18 +24,18 @@ const MemsChip& mems_chip(std::string_view name) {
   throw dsp::InputError("unknown MEMS chip '" + std::string(name) + "' (known: " + known + ")");
 }
 
-dsp::SensorSpec mems_sensor_spec(const MemsChip& c, double odr_hz) {
+dsp::SensorSpec mems_sensor_spec(const MemsChip& chip, double odr_hz) {
   dsp::SensorSpec s;
-  s.model = c.name;
+  s.model = chip.name;
   s.k1_v_per_g = Eigen::Vector3d::Ones();
   s.k2_g_per_g2 = Eigen::Vector3d::Zero();
   s.k3_g_per_g3 = Eigen::Vector3d::Zero();
   s.bias_g = Eigen::Vector3d::Zero();
   s.tc_k1_ppm_per_c = 0.0;
   s.tc_bias_ug_per_c = 0.0;
-  s.f0_hz = c.bandwidth_at(odr_hz);
+  s.f0_hz = chip.bandwidth_at(odr_hz);
   s.zeta = 0.707;
-  s.noise_ug_per_rthz = c.noise_ug_per_rthz;
+  s.noise_ug_per_rthz = chip.noise_ug_per_rthz;
   s.temp_ref_c = 20.0;
   return s;
 }

@@ -6,8 +6,9 @@
 
 namespace eical::sim {
 
-Pt2::Pt2(double f0_hz, double zeta, double h) {
-  if (!(f0_hz > 0.0) || !(zeta > 0.0) || !(h > 0.0)) throw dsp::InputError("PT2: f0, zeta and step must be positive");
+Pt2::Pt2(double f0_hz, double zeta, double step_s) {
+  if (!(f0_hz > 0.0) || !(zeta > 0.0) || !(step_s > 0.0))
+    throw dsp::InputError("PT2: f0, zeta and step must be positive");
   const double w = 2.0 * std::numbers::pi * f0_hz;
   // Augmented system [x; u]' = [A B; 0 0][x; u]: its exponential holds Φ and Γ.
   Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
@@ -15,7 +16,7 @@ Pt2::Pt2(double f0_hz, double zeta, double h) {
   M(1, 0) = -w * w;
   M(1, 1) = -2.0 * zeta * w;
   M(1, 2) = w * w;
-  M *= h;
+  M *= step_s;
   // Scaling and squaring with a Taylor series: ‖M‖ is ~0.1 at 100 kHz, so 2^4 scaling and
   // 16 terms are far below double precision.
   const int squarings = 4;

@@ -44,30 +44,30 @@ void pt2_constant(std::vector<double>& x, double f0_hz, double zeta, double h) {
 
 }  // namespace
 
-void sense(std::array<std::vector<double>, 3>& a, const SensorTruth& s, double h) {
-  if (a[1].size() != a[0].size() || a[2].size() != a[0].size() || a[0].empty())
+void sense(std::array<std::vector<double>, 3>& axes_g, const SensorTruth& sensor, double step_s) {
+  if (axes_g[1].size() != axes_g[0].size() || axes_g[2].size() != axes_g[0].size() || axes_g[0].empty())
     throw dsp::InputError("sensor model: the three axes need the same, non-zero number of samples");
-  for (auto& axis : a) {
-    if (s.zeta_per_g != 0.0)
-      pt2_amplitude_damped(axis, s.spec.f0_hz, s.spec.zeta, s.zeta_per_g, h);
+  for (auto& axis : axes_g) {
+    if (sensor.zeta_per_g != 0.0)
+      pt2_amplitude_damped(axis, sensor.spec.f0_hz, sensor.spec.zeta, sensor.zeta_per_g, step_s);
     else
-      pt2_constant(axis, s.spec.f0_hz, s.spec.zeta, h);
+      pt2_constant(axis, sensor.spec.f0_hz, sensor.spec.zeta, step_s);
   }
   // (6-4) without bias and noise: a_i + k2 a_i² + k3 a_i³ + Σ_j kx_ij a_j + Σ_j kxx_ij a_i a_j.
-  const Eigen::Vector3d& k2 = s.spec.k2_g_per_g2;
-  const Eigen::Vector3d& k3 = s.spec.k3_g_per_g3;
-  const Eigen::Matrix3d& kx = s.k_cross_g_per_g;
-  const Eigen::Matrix3d& kxx = s.k_cross2_g_per_g2;
+  const Eigen::Vector3d& k2 = sensor.spec.k2_g_per_g2;
+  const Eigen::Vector3d& k3 = sensor.spec.k3_g_per_g3;
+  const Eigen::Matrix3d& kx = sensor.k_cross_g_per_g;
+  const Eigen::Matrix3d& kxx = sensor.k_cross2_g_per_g2;
   const bool cross = kx.squaredNorm() > 0.0 || kxx.squaredNorm() > 0.0;
-  const std::size_t n = a[0].size();
+  const std::size_t n = axes_g[0].size();
   for (std::size_t k = 0; k < n; ++k) {
-    const double v[3] = {a[0][k], a[1][k], a[2][k]};
+    const double v[3] = {axes_g[0][k], axes_g[1][k], axes_g[2][k]};
     for (int i = 0; i < 3; ++i) {
       double u = v[i] + k2[i] * v[i] * v[i] + k3[i] * v[i] * v[i] * v[i];
       if (cross)
         for (int j = 0; j < 3; ++j)
           if (j != i) u += kx(i, j) * v[j] + kxx(i, j) * v[i] * v[j];
-      a[static_cast<std::size_t>(i)][k] = u;
+      axes_g[static_cast<std::size_t>(i)][k] = u;
     }
   }
 }

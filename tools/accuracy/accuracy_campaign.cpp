@@ -388,18 +388,18 @@ void rectangle_figures(const Machine& mach, Report& rep) {
 
 }  // namespace
 
-Report run(const Options& o) {
+Report run(const Options& options) {
   const auto t0 = std::chrono::steady_clock::now();
   Report rep;
-  rep.seed = o.seed;
-  std::mt19937_64 rng(sim::stream_seed(o.seed, 900));
+  rep.seed = options.seed;
+  std::mt19937_64 rng(sim::stream_seed(options.seed, 900));
   Machine mach;
   const dsp::RunMeta sheet;
   draw_sensor(mach.truth[0], sheet.sensors[0], rng, "table", rep.truth);
   draw_sensor(mach.truth[1], sheet.sensors[1], rng, "head", rep.truth);
-  rep.oracle = o.oracle;
-  if (o.calibrate && !o.oracle) {  // on site: the identification program, PSD and set-point only
-    sim::Scenario id = sim::identify_scenario(sim::psd_config_b(10.0), {"z"}, o.seed);
+  rep.oracle = options.oracle;
+  if (options.calibrate && !options.oracle) {  // on site: the identification program, PSD and set-point only
+    sim::Scenario id = sim::identify_scenario(sim::psd_config_b(10.0), {"z"}, options.seed);
     mach.apply(id, false);
     rep.identification = dsp::identify::identify_sensors(sim::simulate(id));
     rep.calibrated = true;
@@ -411,15 +411,15 @@ Report run(const Options& o) {
   return rep;
 }
 
-std::string table(const Report& r) {
-  std::string o = "accuracy campaign, seed " + std::to_string(r.seed) +
-                  (r.oracle       ? ", the true sensor parameters (oracle)"
-                   : r.calibrated ? ", sensors identified on site"
-                                  : ", data-sheet sensors") +
+std::string table(const Report& report) {
+  std::string o = "accuracy campaign, seed " + std::to_string(report.seed) +
+                  (report.oracle       ? ", the true sensor parameters (oracle)"
+                   : report.calibrated ? ", sensors identified on site"
+                                       : ", data-sheet sensors") +
                   "\n";
-  for (const auto& t : r.truth) o += "  true " + t + "\n";
-  if (r.calibrated) {
-    const auto& id = r.identification;
+  for (const auto& t : report.truth) o += "  true " + t + "\n";
+  if (report.calibrated) {
+    const auto& id = report.identification;
     o += fmt("  identification: agreement with the PSD readings %.2f -> %.2f um RMS, ", id.psd_rms_before_um,
              id.psd_rms_after_um) +
          fmt("DAQ delay %.3f samples ", id.daq_group_delay_samples) +
@@ -428,13 +428,13 @@ std::string table(const Report& r) {
   char line[256];
   std::snprintf(line, sizeof line, "  %-72s %9s %9s %7s %7s\n", "figure", "measured", "bound", "ratio", "target");
   o += line;
-  for (const auto& f : r.figures) {
+  for (const auto& f : report.figures) {
     std::snprintf(line, sizeof line, "  %-72s %6.2f %s %6.2f %s %7.2f %5.1f %s%s\n", f.name.c_str(), f.measured,
                   f.unit.c_str(), f.bound, f.unit.c_str(), f.ratio(), f.target, f.unit.c_str(),
                   f.within() ? "" : "  OVER");
     o += line;
   }
-  o += fmt("  campaign wall time %.1f s\n", r.seconds);
+  o += fmt("  campaign wall time %.1f s\n", report.seconds);
   return o;
 }
 

@@ -196,23 +196,23 @@ std::string told_tables(const dsp::RunMeta& meta) {
 
 }  // namespace
 
-ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanation& ex) {
+ExtendedModel extended_model(const dsp::Run& run, const dsp::model::RunExplanation& explanation) {
   ExtendedModel m;
-  sensor_calibration(run.meta, ex, m);
-  const std::string effects_toml = machine_effects_toml(run, ex, m.notes);
+  sensor_calibration(run.meta, explanation, m);
+  const std::string effects_toml = machine_effects_toml(run, explanation, m.notes);
   // The scenario: what eical is told = the run's own data sheet, the truth = the extended
   // sensors and DAQ ([truth.*]): simulated, it shows what the recorded run showed.
   m.scenario_toml =
       "# Written by eical explain: the run's program with the effects it found; eical simulate --scenario this-file -o "
       "RUN\n" +
-      told_tables(run.meta) + servo_toml(ex) + effects_toml + truth_tables(m.calibration, run.meta);
+      told_tables(run.meta) + servo_toml(explanation) + effects_toml + truth_tables(m.calibration, run.meta);
   return m;
 }
 
-void write_extended_model(const ExtendedModel& m, const std::filesystem::path& calibration_file,
+void write_extended_model(const ExtendedModel& model, const std::filesystem::path& calibration_file,
                           const std::filesystem::path& scenario_file) {
-  drivers::write_sensor_calibration(m.calibration, calibration_file);
-  drivers::write_text_atomic(scenario_file, m.scenario_toml);
+  drivers::write_sensor_calibration(model.calibration, calibration_file);
+  drivers::write_text_atomic(scenario_file, model.scenario_toml);
 }
 
 }  // namespace eical::tools::explain

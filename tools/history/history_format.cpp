@@ -74,8 +74,8 @@ std::string measure(const std::optional<double>& value, const std::optional<doub
   return fixed(*value, d) + " ± " + fixed(*u_k2, d) + tail;
 }
 
-std::string when(const std::string& t) {
-  std::string s = t;
+std::string when(const std::string& rfc3339) {
+  std::string s = rfc3339;
   if (s.size() == 20 && s[10] == 'T' && s[19] == 'Z') s[10] = ' ', s.pop_back();
   return s;
 }

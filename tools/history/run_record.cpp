@@ -31,29 +31,29 @@ std::string file_time_utc(const fs::path& p) {
 
 }  // namespace
 
-history::Record run_record(const fs::path& run_dir, const AddOptions& o) {
+history::Record run_record(const fs::path& run_dir, const AddOptions& options) {
   const fs::path dir = fs::absolute(run_dir);
   const dsp::RunMeta meta = drivers::read_run_meta(dir / "run.toml");
   nlohmann::json doc;
   std::string calibration, software;
   const fs::path result = dir / "result.json";
-  if (o.calibration.empty() && fs::exists(result)) {
+  if (options.calibration.empty() && fs::exists(result)) {
     std::ifstream is(result);
     doc = nlohmann::json::parse(is, nullptr, false);
     if (doc.is_discarded()) throw std::runtime_error(result.string() + ": not JSON");
   } else {
     dsp::Run run = drivers::read_run(dir);
     dsp::AnalysisOptions opt;
-    if (!o.calibration.empty()) {
-      const auto cal = drivers::read_sensor_calibration(o.calibration, run.meta);
+    if (!options.calibration.empty()) {
+      const auto cal = drivers::read_sensor_calibration(options.calibration, run.meta);
       drivers::apply_calibration(cal, run.meta, opt);
-      calibration = cal.method + ": " + fs::absolute(o.calibration).string() + " (run " + cal.run_id + ")";
+      calibration = cal.method + ": " + fs::absolute(options.calibration).string() + " (run " + cal.run_id + ")";
     }
     doc = drivers::result_json(run, dsp::analyze_run(run, opt));
     software = drivers::software_version();
   }
   history::Provenance p;
-  p.machine = o.machine.empty() ? meta.machine.name : o.machine;
+  p.machine = options.machine.empty() ? meta.machine.name : options.machine;
   p.measured_at = meta.created.empty() ? file_time_utc(dir / "run.toml") : meta.created;
   p.run_path = dir.string();
   if (!software.empty()) p.software_version = software;

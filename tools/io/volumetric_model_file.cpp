@@ -80,8 +80,8 @@ dsp::comp::VolumetricFit read_volumetric_model(const std::string& file) {
   return f;
 }
 
-std::string volumetric_model_toml(const dsp::comp::VolumetricFit& f, const std::vector<std::string>& runs) {
-  const auto& m = f.model;
+std::string volumetric_model_toml(const dsp::comp::VolumetricFit& fit, const std::vector<std::string>& runs) {
+  const auto& m = fit.model;
   std::string t = "# eical-volumetric/1 fitted by eical volumetric --fit from:\n";
   for (const auto& r : runs) t += "#   " + r + "\n";
   t += "# Translations (t) in um, rotations (r) and squareness (w) in urad, positions in mm; u_k2 the expanded\n"
@@ -94,15 +94,15 @@ std::string volumetric_model_toml(const dsp::comp::VolumetricFit& f, const std::
   const double values[3] = {m.xwy_urad, m.ywz_urad, m.xwz_urad};
   for (int s = 0; s < 3; ++s) {
     char b[160];
-    std::snprintf(b, sizeof b, "%s = %.4g  # %s\n", names[s], values[s], f.squareness[s].note.c_str());
+    std::snprintf(b, sizeof b, "%s = %.4g  # %s\n", names[s], values[s], fit.squareness[s].note.c_str());
     t += b;
-    if (f.squareness[s].observed) {
-      std::snprintf(b, sizeof b, "%s_u_k2 = %.4g\n", names[s], f.squareness[s].u_k2_urad);
+    if (fit.squareness[s].observed) {
+      std::snprintf(b, sizeof b, "%s_u_k2 = %.4g\n", names[s], fit.squareness[s].u_k2_urad);
       t += b;
     }
   }
   for (int k = 0; k < 18; ++k) {
-    const auto& c = f.component[k];
+    const auto& c = fit.component[k];
     t += "\n[[component]]\nname = \"" + std::string(kVolumetricComponents[k]) + "\"\n";
     t += "positions_mm = " + numbers(m.component[k].pos_mm) + "\nvalues = " + numbers(m.component[k].values, "%.4f") +
          "\n";

@@ -74,9 +74,9 @@ std::vector<dsp::PsdSpec> strips_for(const TestProgram& p) {
   return {x, y};
 }
 
-TestProgram program_of(const dsp::RunMeta& m) {
+TestProgram program_of(const dsp::RunMeta& meta) {
   TestProgram p;
-  const auto& q = m.program;
+  const auto& q = meta.program;
   p.kind = q.kind;
   p.plane = q.plane, p.direction = q.direction;
   p.radius_mm = q.radius_mm, p.feed_mm_min = q.feed_mm_min, p.arc_deg = q.arc_deg;
@@ -85,9 +85,10 @@ TestProgram program_of(const dsp::RunMeta& m) {
   p.runs = std::max(1, q.runs);
   if (q.kind == "step" && q.targets_mm.size() >= 2) p.from_mm = q.targets_mm[0], p.to_mm = q.targets_mm[1];
   p.size_mm[0] = q.size_mm[0] > 0.0 ? q.size_mm[0] : 50.0, p.size_mm[1] = q.size_mm[1] > 0.0 ? q.size_mm[1] : 50.0;
-  p.psd = m.psd;
-  p.noise_ug_per_rthz = std::hypot(m.sensors[0].noise_ug_per_rthz, m.sensors[1].noise_ug_per_rthz) / std::sqrt(2.0);
-  p.fs_hz = m.acquisition.fs_hz;
+  p.psd = meta.psd;
+  p.noise_ug_per_rthz =
+      std::hypot(meta.sensors[0].noise_ug_per_rthz, meta.sensors[1].noise_ug_per_rthz) / std::sqrt(2.0);
+  p.fs_hz = meta.acquisition.fs_hz;
   return p;
 }
 

@@ -16,9 +16,9 @@
 namespace eical::tools::report {
 namespace fs = std::filesystem;
 
-std::string fmt(const char* f, double v) {
+std::string fmt(const char* format, double v) {
   char b[64];
-  std::snprintf(b, sizeof b, f, v);
+  std::snprintf(b, sizeof b, format, v);
   return b;
 }
 
@@ -169,7 +169,8 @@ std::string settings(const dsp::Run& run, const dsp::Analysis& a) {
 
 }  // namespace
 
-fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs::path& dir, const ReportOptions& opt) {
+fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, const fs::path& dir,
+                          const ReportOptions& options) {
   fs::create_directories(dir);
   CsvFiles csv(dir);
   Page page;
@@ -177,37 +178,37 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& a, const fs:
   page.title = title_for(p.kind);
   page.run_id = run.meta.id;
   page.program = program_line(p);
-  const Tolerances tol = opt.tolerances.value_or(Tolerances{});
+  const Tolerances tol = options.tolerances.value_or(Tolerances{});
   const std::string machine = tol.machine.empty() ? run.meta.machine.name : tol.machine;
-  const std::string serial = !opt.serial.empty() ? opt.serial : tol.serial;
-  const std::string op = !opt.operator_name.empty() ? opt.operator_name : tol.operator_name;
+  const std::string serial = !options.serial.empty() ? options.serial : tol.serial;
+  const std::string op = !options.operator_name.empty() ? options.operator_name : tol.operator_name;
   page.context = {{"machine", machine + (serial.empty() ? ", serial not given" : ", serial " + serial)},
                   {"operator", op.empty() ? "not given" : op},
                   {"run recorded", run.meta.created.empty() ? "not recorded" : run.meta.created},
                   {"temperatures", temperatures(run)},
                   {"software", std::string(drivers::software_version())},
-                  {"test settings", settings(run, a)},
+                  {"test settings", settings(run, analysis)},
                   {"sensors", run.meta.sensors[0].model + " (table), " + run.meta.sensors[1].model + " (head)"}};
   if (run.meta.reference) page.context.emplace_back("reference", run.meta.reference->kind);
-  for (const auto& f : a.flags) page.flags.push_back({f, dsp::severity_name(dsp::flag_severity(f))});
-  page.verdict = a.verdict;
-  page.verdict_reasons = a.verdict_reasons;
-  if (opt.tolerances) {
+  for (const auto& f : analysis.flags) page.flags.push_back({f, dsp::severity_name(dsp::flag_severity(f))});
+  page.verdict = analysis.verdict;
+  page.verdict_reasons = analysis.verdict_reasons;
+  if (options.tolerances) {
     Grid g{"Against the tolerances (ISO 14253-1 with U, k = 2)",
            {"figure", "measured (µm)", "U (µm)", "tolerance (µm)", "decision"},
            {}};
-    for (const auto& d : decide(a, tol))
+    for (const auto& d : decide(analysis, tol))
       g.rows.push_back({d.figure, fmt("%.2f", d.value), d.u ? fmt("%.2f", *d.u) : std::string("unknown"),
                         fmt("%.2f", d.tolerance), d.decision});
     if (g.rows.empty()) g.rows.push_back({"(no toleranced figure in this test)", "", "", "", ""});
     page.summary.push_back(g);
   }
-  circle_sections(run, a, page, csv);
-  positioning_sections(run, a, page, csv);
-  step_sections(a, page, csv);
-  if (p.kind == "rectangle") rectangle_sections(run, a, page, csv);
-  if (p.kind == "freeform") freeform_sections(run, a, page, csv);
-  measurement_section(a, page, csv);
+  circle_sections(run, analysis, page, csv);
+  positioning_sections(run, analysis, page, csv);
+  step_sections(analysis, page, csv);
+  if (p.kind == "rectangle") rectangle_sections(run, analysis, page, csv);
+  if (p.kind == "freeform") freeform_sections(run, analysis, page, csv);
+  measurement_section(analysis, page, csv);
   page.files = csv.names();
   if (csv.thinned())
     page.files_note = "Long traces are thinned to at most " + std::to_string(CsvFiles::kMaxRows) +

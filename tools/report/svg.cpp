@@ -57,10 +57,10 @@ std::vector<double> ticks(double lo, double hi, double step) {
 
 }  // namespace
 
-std::string xml_escape(const std::string& t) {
+std::string xml_escape(const std::string& text) {
   std::string out;
-  out.reserve(t.size());
-  for (char c : t) {
+  out.reserve(text.size());
+  for (char c : text) {
     switch (c) {
       case '&': out += "&amp;"; break;
       case '<': out += "&lt;"; break;
@@ -366,27 +366,27 @@ std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string&
 }
 
 std::string line_plot(const std::vector<LineSeries>& series, const std::string& title, const std::string& x_label,
-                      const std::string& y_label, double w, double h) {
-  const PlotFrame f = plot_frame(series, w, h);
-  std::string s = svg_open(w, h);
+                      const std::string& y_label, double width_px, double height_px) {
+  const PlotFrame f = plot_frame(series, width_px, height_px);
+  std::string s = svg_open(width_px, height_px);
   s += plot_axes(f, title, x_label, y_label);
   s += plot_bands(series, f);
   s += plot_lines_and_legend(series, f);
   return s + "</svg>";
 }
 
-std::string path_plot(const PathView& v, const std::string& title, const std::string& axis_a,
+std::string path_plot(const PathView& view, const std::string& title, const std::string& axis_a,
                       const std::string& axis_b) {
   const double w = 460, pad = 46, top = 28, max_plot_h = 400;
   double amin = kInf, amax = -kInf, bmin = kInf, bmax = -kInf, dmax_um = 0.0;
-  for (std::size_t i = 0; i < v.cmd_a_mm.size(); ++i) {
-    amin = std::min(amin, v.cmd_a_mm[i]), amax = std::max(amax, v.cmd_a_mm[i]);
-    bmin = std::min(bmin, v.cmd_b_mm[i]), bmax = std::max(bmax, v.cmd_b_mm[i]);
+  for (std::size_t i = 0; i < view.cmd_a_mm.size(); ++i) {
+    amin = std::min(amin, view.cmd_a_mm[i]), amax = std::max(amax, view.cmd_a_mm[i]);
+    bmin = std::min(bmin, view.cmd_b_mm[i]), bmax = std::max(bmax, view.cmd_b_mm[i]);
   }
-  for (std::size_t i = 0; i < v.dev_a_um.size(); ++i)
-    dmax_um = std::max(dmax_um, std::hypot(v.dev_a_um[i], v.dev_b_um[i]));
-  for (std::size_t i = 0; i < v.arrow_da_um.size(); ++i)
-    dmax_um = std::max(dmax_um, std::hypot(v.arrow_da_um[i], v.arrow_db_um[i]));
+  for (std::size_t i = 0; i < view.dev_a_um.size(); ++i)
+    dmax_um = std::max(dmax_um, std::hypot(view.dev_a_um[i], view.dev_b_um[i]));
+  for (std::size_t i = 0; i < view.arrow_da_um.size(); ++i)
+    dmax_um = std::max(dmax_um, std::hypot(view.arrow_da_um[i], view.arrow_db_um[i]));
   if (!std::isfinite(amin)) amin = bmin = 0, amax = bmax = 1;
   const double span_mm = std::max({amax - amin, bmax - bmin, 1e-3});
   // Magnify so that the largest deviation shows as about 8 % of the path's extent.
@@ -414,27 +414,27 @@ std::string path_plot(const PathView& v, const std::string& title, const std::st
   s += "<text transform='translate(" + num(X(amin) - 34) + "," + num(cy) + ") rotate(-90)' text-anchor='middle'>" +
        xml_escape(axis_b + " (mm)") + "</text>";
   std::string cmd, meas;
-  const std::size_t n = v.cmd_a_mm.size(), stride = stride_for(n, 3000);
-  for (std::size_t i = 0; i < n; i += stride) cmd += num(X(v.cmd_a_mm[i])) + "," + num(Y(v.cmd_b_mm[i])) + " ";
-  const std::size_t nd = std::min(v.base_a_mm.size(), v.dev_a_um.size()), sd = stride_for(nd, 3000);
+  const std::size_t n = view.cmd_a_mm.size(), stride = stride_for(n, 3000);
+  for (std::size_t i = 0; i < n; i += stride) cmd += num(X(view.cmd_a_mm[i])) + "," + num(Y(view.cmd_b_mm[i])) + " ";
+  const std::size_t nd = std::min(view.base_a_mm.size(), view.dev_a_um.size()), sd = stride_for(nd, 3000);
   s += "<polyline fill='none' stroke='" + std::string(kGrey) + "' stroke-width='1' stroke-dasharray='4,3' points='" +
        cmd + "'/>";
   for (std::size_t i = 0; i < nd; i += sd) {
     // A gap in the evaluated samples (a stop, a corner) starts a new polyline.
-    if (i > 0 &&
-        std::hypot(v.base_a_mm[i] - v.base_a_mm[i - sd], v.base_b_mm[i] - v.base_b_mm[i - sd]) > 0.03 * span_mm) {
+    if (i > 0 && std::hypot(view.base_a_mm[i] - view.base_a_mm[i - sd], view.base_b_mm[i] - view.base_b_mm[i - sd]) >
+                     0.03 * span_mm) {
       s += "<polyline fill='none' stroke='" + std::string(kBlue) + "' stroke-width='1.3' points='" + meas + "'/>";
       meas.clear();
     }
-    meas += num(X(v.base_a_mm[i] + mag * v.dev_a_um[i] * 1e-3)) + "," +
-            num(Y(v.base_b_mm[i] + mag * v.dev_b_um[i] * 1e-3)) + " ";
+    meas += num(X(view.base_a_mm[i] + mag * view.dev_a_um[i] * 1e-3)) + "," +
+            num(Y(view.base_b_mm[i] + mag * view.dev_b_um[i] * 1e-3)) + " ";
   }
   if (!meas.empty())
     s += "<polyline fill='none' stroke='" + std::string(kBlue) + "' stroke-width='1.3' points='" + meas + "'/>";
-  for (std::size_t i = 0; i < v.arrow_a_mm.size(); ++i) {
-    const double x1 = X(v.arrow_a_mm[i]), y1 = Y(v.arrow_b_mm[i]);
-    const double x2 = X(v.arrow_a_mm[i] + mag * v.arrow_da_um[i] * 1e-3),
-                 y2 = Y(v.arrow_b_mm[i] + mag * v.arrow_db_um[i] * 1e-3);
+  for (std::size_t i = 0; i < view.arrow_a_mm.size(); ++i) {
+    const double x1 = X(view.arrow_a_mm[i]), y1 = Y(view.arrow_b_mm[i]);
+    const double x2 = X(view.arrow_a_mm[i] + mag * view.arrow_da_um[i] * 1e-3),
+                 y2 = Y(view.arrow_b_mm[i] + mag * view.arrow_db_um[i] * 1e-3);
     s += "<line x1='" + num(x1) + "' y1='" + num(y1) + "' x2='" + num(x2) + "' y2='" + num(y2) + "' stroke='" + kRed +
          "' stroke-width='2'/>";
     s += "<circle cx='" + num(x2) + "' cy='" + num(y2) + "' r='3' fill='" + kRed + "'/><circle cx='" + num(x1) +

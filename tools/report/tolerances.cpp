@@ -47,10 +47,10 @@ Tolerances read_tolerances(const std::filesystem::path& file) {
   return t;
 }
 
-std::string decision(double value, std::optional<double> u, double tol) {
+std::string decision(double value, std::optional<double> u, double tolerance) {
   const double uu = u && std::isfinite(*u) ? *u : std::numeric_limits<double>::infinity();
-  if (value + uu <= tol) return "pass";
-  if (value - uu > tol) return "fail";
+  if (value + uu <= tolerance) return "pass";
+  if (value - uu > tolerance) return "fail";
   return "undecided";
 }
 

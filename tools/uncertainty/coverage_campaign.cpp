@@ -47,9 +47,9 @@ double median(std::vector<double> v) {
 }  // namespace
 
 std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vector<Eigen::Vector3d>& truth,
-                                           const dsp::Analysis& a) {
+                                           const dsp::Analysis& measured) {
   dsp::Analysis t;
-  t.measurement = a.measurement;
+  t.measurement = measured.measurement;
   const std::int64_t first = run.frames.front().sample_index;
   for (std::size_t k = 0; k < t.measurement.pos_mm.size(); ++k) {
     const auto i = static_cast<std::size_t>(t.measurement.sample_index[k] - first);
@@ -57,7 +57,7 @@ std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vecto
   }
   dsp::EvaluationOptions eo;
   eo.reference = false;
-  if (a.diagnostics) eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
+  if (measured.diagnostics) eo.cyclic_pitch_mm = measured.diagnostics->cyclic_pitch_mm;
   dsp::evaluate_program(run, t, eo);
   return dsp::figures_of(t);
 }
@@ -85,20 +85,21 @@ const std::vector<std::string>& headline_keys() {
   return keys;
 }
 
-CampaignResult run_campaign(const CampaignOptions& o) {
+CampaignResult run_campaign(const CampaignOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   CampaignResult r;
   r.headline.key = "headline figures, pooled";
-  for (const auto seed : o.seeds)
-    for (const auto& program : o.programs) {
+  for (const auto seed : options.seeds)
+    for (const auto& program : options.programs) {
       const sim::Scenario sc = scenario(program, seed);
       std::vector<Eigen::Vector3d> truth;
       const dsp::Run run = sim::simulate(sc, &truth);
-      if (!o.write_runs.empty())
-        drivers::write_run(run, std::filesystem::path(o.write_runs) / sc.meta.id, {.gzip = false, .overwrite = true});
+      if (!options.write_runs.empty())
+        drivers::write_run(run, std::filesystem::path(options.write_runs) / sc.meta.id,
+                           {.gzip = false, .overwrite = true});
       dsp::AnalysisOptions ao;
       ao.coriolis = sc.coriolis;
-      ao.uncertainty.draws = o.draws;
+      ao.uncertainty.draws = options.draws;
       ao.uncertainty.seed = seed;
       const dsp::Analysis a = dsp::analyze_run(run, ao);
       ++r.runs;
@@ -130,10 +131,10 @@ CampaignResult run_campaign(const CampaignOptions& o) {
   return r;
 }
 
-std::string coverage_table(const CampaignResult& r) {
+std::string coverage_table(const CampaignResult& result) {
   std::string o;
   char b[256];
-  std::snprintf(b, sizeof b, "uncertainty coverage campaign: %zu runs, %.0f s\n", r.runs, r.seconds);
+  std::snprintf(b, sizeof b, "uncertainty coverage campaign: %zu runs, %.0f s\n", result.runs, result.seconds);
   o += b;
   std::snprintf(b, sizeof b, "  %-44s %6s %9s %11s %11s %8s\n", "figure", "cases", "coverage", "median U", "RMS error",
                 "U/RMS");
@@ -143,10 +144,10 @@ std::string coverage_table(const CampaignResult& r) {
                   100.0 * c.coverage(), c.median_u(), c.rms_error(), c.median_u() / c.rms_error(), mark);
     o += b;
   };
-  for (const auto& [k, c] : r.figures)
+  for (const auto& [k, c] : result.figures)
     row(c, std::find(headline_keys().begin(), headline_keys().end(), k) != headline_keys().end() ? "  *" : "");
-  row(r.headline, "  <- 90-99 %, U/RMS <= 3");
-  for (const auto& f : r.failures) o += "  failed: " + f + "\n";
+  row(result.headline, "  <- 90-99 %, U/RMS <= 3");
+  for (const auto& f : result.failures) o += "  failed: " + f + "\n";
   o += "  (* headline figure; coverage: |measured - true| <= U; U/RMS: median U over the RMS error)\n";
   return o;
 }

@@ -220,12 +220,12 @@ ThesisCheck common_vibration(double& relative_peak_um) {
 
 }  // namespace
 
-std::vector<ThesisCheck> validate_against_thesis(const ValidationOptions& o) {
+std::vector<ThesisCheck> validate_against_thesis(const ValidationOptions& options) {
   std::vector<ThesisCheck> rows;
   rows.push_back(dynamic_circle());
   rows.push_back(dynamic_step());
-  rows.push_back(white_noise(o));
-  rows.push_back(quantisation(o));
+  rows.push_back(white_noise(options));
+  rows.push_back(quantisation(options));
   double coriolis_um = 0.0;
   rows.push_back(coriolis_acceleration(coriolis_um));
   ThesisCheck cp{"Coriolis position error after 1 s",
