@@ -294,13 +294,9 @@ std::string read_text(const std::filesystem::path& p) {
   return os.str();
 }
 
-}  // namespace
-
-sim::Scenario read_scenario_file(const std::string& path) {
-  const toml::table doc = StrictTable::parse_file(path);
-  StrictTable root(doc, path, "");
+// The file's identity: format, name, seed, oversampling, noise, run id.
+void read_header(StrictTable& root, sim::Scenario& sc) {
   if (root.string("format") != "eical-scenario/1") root.fail("format", "expected \"eical-scenario/1\"");
-  sim::Scenario sc;
   sc.name = root.string("name", "scenario");
   sc.description = root.string("description", "");
   sc.seed = static_cast<std::uint64_t>(root.integer("seed", 1));
@@ -308,6 +304,10 @@ sim::Scenario read_scenario_file(const std::string& path) {
   if (sc.oversample < 1 || sc.oversample > 100) root.fail("oversample", "must be 1..100");
   sc.noise = root.boolean("noise", true);
   sc.meta.id = root.string("id", "sim-" + sc.name + "-s" + std::to_string(sc.seed));
+}
+
+// What eical is told (run.toml's sections); the truth starts from it.
+void read_told(StrictTable& root, sim::Scenario& sc) {
   if (auto t = root.optional_table("acquisition")) sc.meta.acquisition = read_acquisition(*t);
   if (auto t = root.optional_table("site")) sc.meta.site = read_site(*t);
   if (auto t = root.optional_table("machine")) sc.meta.machine = read_machine(*t);
@@ -320,31 +320,32 @@ sim::Scenario read_scenario_file(const std::string& path) {
     sc.truth[s].spec = sc.meta.sensors[s], sc.truth[s].zeta_per_g = sc.meta.sensors[s].zeta_per_g;
   sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples;
   sc.daq.skew_head_samples = sc.meta.acquisition.daq_skew_head_samples;
-  if (auto t = root.optional_table("mems")) read_mems(*t, sc);
-  if (root.has("sensors_present"))
-    sim::set_sensors_present(sc, root.choice("sensors_present", {"both", "head", "table"}, "both"));
-  // [truth.sensors.*] / [truth.daq]: the true sensors and DAQ in full (run.toml's sensor
-  // keys, starting from what eical is told) — what eical explain writes to reproduce a run.
-  if (auto truth = root.optional_table("truth")) {
-    if (auto sensors = truth->optional_table("sensors")) {
-      for (int s = 0; s < 2; ++s)
-        if (auto t = sensors->optional_table(s == 0 ? "table" : "head")) {
-          sc.truth[s].spec = read_sensor(*t, sc.meta.sensors[s]);
-          sc.truth[s].zeta_per_g = sc.truth[s].spec.zeta_per_g;
-        }
-      sensors->finish();
-    }
-    if (auto d = truth->optional_table("daq")) {
-      sc.daq.group_delay_samples = d->number("group_delay_samples", sc.daq.group_delay_samples);
-      sc.daq.skew_head_samples = d->number("skew_head_samples", sc.daq.skew_head_samples);
-      if (!(sc.daq.group_delay_samples >= 0.0)) d->fail("group_delay_samples", "must not be negative");
-      d->finish();
-    }
-    truth->finish();
-  }
+}
 
+// [truth.sensors.*] / [truth.daq]: the true sensors and DAQ in full (run.toml's sensor
+// keys, starting from what eical is told) — what eical explain writes to reproduce a run.
+void read_truth(StrictTable& truth, sim::Scenario& sc) {
+  if (auto sensors = truth.optional_table("sensors")) {
+    for (int s = 0; s < 2; ++s)
+      if (auto t = sensors->optional_table(s == 0 ? "table" : "head")) {
+        sc.truth[s].spec = read_sensor(*t, sc.meta.sensors[s]);
+        sc.truth[s].zeta_per_g = sc.truth[s].spec.zeta_per_g;
+      }
+    sensors->finish();
+  }
+  if (auto d = truth.optional_table("daq")) {
+    sc.daq.group_delay_samples = d->number("group_delay_samples", sc.daq.group_delay_samples);
+    sc.daq.skew_head_samples = d->number("skew_head_samples", sc.daq.skew_head_samples);
+    if (!(sc.daq.group_delay_samples >= 0.0)) d->fail("group_delay_samples", "must not be negative");
+    d->finish();
+  }
+  truth.finish();
+}
+
+// [sweep] and [program]: with a [sweep] the program is the test; [program] may still name
+// its kind. A G-code file is read relative to the scenario's folder.
+void read_motion(StrictTable& root, const std::string& path, sim::Scenario& sc) {
   if (auto t = root.optional_table("sweep")) read_sweep(*t, sc);
-  // With a [sweep] the program is the test; [program] may still name its kind.
   if (auto program = sc.sweep.on ? root.optional_table("program") : std::optional<StrictTable>(root.table("program"))) {
     const std::string gcode_file = program->string("gcode_file", "");
     sc.meta.program = read_program(*program);  // the copy knows gcode_file is used
@@ -356,7 +357,10 @@ sim::Scenario read_scenario_file(const std::string& path) {
   } else {
     sc.meta.program.kind = "freeform";
   }
+}
 
+// [[psd]]: each strip as run.toml has it, and its truth.
+void read_psd_strips(StrictTable& root, sim::Scenario& sc) {
   for (StrictTable p : root.tables("psd")) {
     sim::PsdTruth pt;
     pt.spot_mm = positive(p, "spot_mm", pt.spot_mm);
@@ -368,74 +372,99 @@ sim::Scenario read_scenario_file(const std::string& path) {
   }
   if (sc.meta.psd.size() > static_cast<std::size_t>(dsp::kMaxPsd))
     root.fail("psd", "at most " + std::to_string(dsp::kMaxPsd) + " strips");
+}
 
+// A 3 × 2 matrix key (per axis, per harmonic) into dst when present.
+void read_3x2(StrictTable& r, std::string_view key, double (&dst)[3][2]) {
+  if (!r.has(key)) return;
+  const auto m = r.matrix(key, 3, 2);
+  for (int a = 0; a < 3; ++a)
+    for (int h = 0; h < 2; ++h) dst[a][h] = m[static_cast<std::size_t>(a)][static_cast<std::size_t>(h)];
+}
+
+// [reference]: the reference instrument and its errors.
+void read_reference(StrictTable& r, sim::Scenario& sc) {
+  sc.meta.reference = dsp::Reference{r.string("kind", "KGM182"), r.strings("axes")};
+  if (r.has("scale_ppm")) {
+    const auto v = r.numbers("scale_ppm", 3);
+    std::copy(v.begin(), v.end(), sc.reference.scale_ppm);
+  }
+  read_3x2(r, "interp_nm", sc.reference.interp_nm);
+  read_3x2(r, "interp_phase_deg", sc.reference.interp_phase_deg);
+  sc.reference.signal_period_um = positive(r, "signal_period_um", sc.reference.signal_period_um);
+  sc.reference.resolution_nm = r.number("resolution_nm", sc.reference.resolution_nm);
+  r.finish();
+}
+
+// A per-axis limit key (0 = none) into dst, times unit, when present.
+void read_axis_limits(StrictTable& l, const char* key, double (&dst)[3], double unit) {
+  if (!l.has(key)) return;
+  const auto v = l.numbers(key, 3);
+  for (int i = 0; i < 3; ++i) {
+    if (v[static_cast<std::size_t>(i)] < 0.0) l.fail(key, "limits must not be negative (0 = none)");
+    dst[i] = v[static_cast<std::size_t>(i)] * unit;
+  }
+}
+
+// [limits]: the interpolator's limits.
+void read_limits(StrictTable& l, sim::Scenario& sc) {
+  sc.limits.a_max_mm_s2 = positive(l, "a_max_mps2", sc.limits.a_max_mm_s2 / 1000.0) * 1000.0;
+  sc.limits.j_max_mm_s3 = positive(l, "jerk_mps3", sc.limits.j_max_mm_s3 / 1000.0) * 1000.0;
+  sc.limits.rapid_mm_min = positive(l, "rapid_mm_min", sc.limits.rapid_mm_min);
+  read_axis_limits(l, "axis_v_mm_min", sc.limits.axis_v_mm_min, 1.0);
+  read_axis_limits(l, "axis_a_mps2", sc.limits.axis_a_mm_s2, 1000.0);
+  read_axis_limits(l, "axis_jerk_mps3", sc.limits.axis_j_mm_s3, 1000.0);
+  l.finish();
+}
+
+// [servo.x|y|z]: each axis' position loop.
+void read_servo(StrictTable& servo, sim::Scenario& sc) {
+  for (int a = 0; a < 3; ++a) {
+    const char name[2] = {static_cast<char>('x' + a), 0};
+    if (auto t = servo.optional_table(name)) {
+      sc.machine.servo[a].kv_per_s = positive(*t, "kv_per_s", 30.0);
+      sc.machine.servo[a].feedforward = t->number("feedforward", 0.0);
+      sc.machine.servo[a].velocity_tau_s = t->number("velocity_tau_ms", 0.0) * 1e-3;
+      t->finish();
+    }
+  }
+  servo.finish();
+}
+
+// [effects.*]: every effect the simulator knows, each table (or array of tables) of it.
+void read_effects(StrictTable& effects, sim::Scenario& sc) {
+  const auto& known = sim::effect_names();
+  for (const std::string& name : effects.keys()) {
+    if (std::find(known.begin(), known.end(), name) == known.end()) {
+      std::string list;
+      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      effects.fail(name, "unknown effect (known: " + list + ")");
+    }
+    for (StrictTable& t : effects.table_or_tables(name)) read_effect(name, std::move(t), sc);
+    sc.effects_present.push_back(name);
+  }
+  effects.finish();
+}
+
+}  // namespace
+
+sim::Scenario read_scenario_file(const std::string& path) {
+  const toml::table doc = StrictTable::parse_file(path);
+  StrictTable root(doc, path, "");
+  sim::Scenario sc;
+  read_header(root, sc);
+  read_told(root, sc);
+  if (auto t = root.optional_table("mems")) read_mems(*t, sc);
+  if (root.has("sensors_present"))
+    sim::set_sensors_present(sc, root.choice("sensors_present", {"both", "head", "table"}, "both"));
+  if (auto truth = root.optional_table("truth")) read_truth(*truth, sc);
+  read_motion(root, path, sc);
+  read_psd_strips(root, sc);
   sc.meta.reference.reset();
-  if (auto r = root.optional_table("reference")) {
-    sc.meta.reference = dsp::Reference{r->string("kind", "KGM182"), r->strings("axes")};
-    if (r->has("scale_ppm")) {
-      const auto v = r->numbers("scale_ppm", 3);
-      std::copy(v.begin(), v.end(), sc.reference.scale_ppm);
-    }
-    if (r->has("interp_nm")) {
-      const auto m = r->matrix("interp_nm", 3, 2);
-      for (int a = 0; a < 3; ++a)
-        for (int h = 0; h < 2; ++h)
-          sc.reference.interp_nm[a][h] = m[static_cast<std::size_t>(a)][static_cast<std::size_t>(h)];
-    }
-    if (r->has("interp_phase_deg")) {
-      const auto m = r->matrix("interp_phase_deg", 3, 2);
-      for (int a = 0; a < 3; ++a)
-        for (int h = 0; h < 2; ++h)
-          sc.reference.interp_phase_deg[a][h] = m[static_cast<std::size_t>(a)][static_cast<std::size_t>(h)];
-    }
-    sc.reference.signal_period_um = positive(*r, "signal_period_um", sc.reference.signal_period_um);
-    sc.reference.resolution_nm = r->number("resolution_nm", sc.reference.resolution_nm);
-    r->finish();
-  }
-
-  if (auto l = root.optional_table("limits")) {
-    sc.limits.a_max_mm_s2 = positive(*l, "a_max_mps2", sc.limits.a_max_mm_s2 / 1000.0) * 1000.0;
-    sc.limits.j_max_mm_s3 = positive(*l, "jerk_mps3", sc.limits.j_max_mm_s3 / 1000.0) * 1000.0;
-    sc.limits.rapid_mm_min = positive(*l, "rapid_mm_min", sc.limits.rapid_mm_min);
-    auto per_axis = [&](const char* key, double(&dst)[3], double unit) {
-      if (!l->has(key)) return;
-      const auto v = l->numbers(key, 3);
-      for (int i = 0; i < 3; ++i) {
-        if (v[static_cast<std::size_t>(i)] < 0.0) l->fail(key, "limits must not be negative (0 = none)");
-        dst[i] = v[static_cast<std::size_t>(i)] * unit;
-      }
-    };
-    per_axis("axis_v_mm_min", sc.limits.axis_v_mm_min, 1.0);
-    per_axis("axis_a_mps2", sc.limits.axis_a_mm_s2, 1000.0);
-    per_axis("axis_jerk_mps3", sc.limits.axis_j_mm_s3, 1000.0);
-    l->finish();
-  }
-  if (auto servo = root.optional_table("servo")) {
-    for (int a = 0; a < 3; ++a) {
-      const char name[2] = {static_cast<char>('x' + a), 0};
-      if (auto t = servo->optional_table(name)) {
-        sc.machine.servo[a].kv_per_s = positive(*t, "kv_per_s", 30.0);
-        sc.machine.servo[a].feedforward = t->number("feedforward", 0.0);
-        sc.machine.servo[a].velocity_tau_s = t->number("velocity_tau_ms", 0.0) * 1e-3;
-        t->finish();
-      }
-    }
-    servo->finish();
-  }
-
-  if (auto effects = root.optional_table("effects")) {
-    const auto& known = sim::effect_names();
-    for (const std::string& name : effects->keys()) {
-      if (std::find(known.begin(), known.end(), name) == known.end()) {
-        std::string list;
-        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-        effects->fail(name, "unknown effect (known: " + list + ")");
-      }
-      for (StrictTable& t : effects->table_or_tables(name)) read_effect(name, std::move(t), sc);
-      sc.effects_present.push_back(name);
-    }
-    effects->finish();
-  }
+  if (auto r = root.optional_table("reference")) read_reference(*r, sc);
+  if (auto l = root.optional_table("limits")) read_limits(*l, sc);
+  if (auto servo = root.optional_table("servo")) read_servo(*servo, sc);
+  if (auto effects = root.optional_table("effects")) read_effects(*effects, sc);
   // Effects listed under `background` are in the data at tolerance level, not injected.
   if (root.has("background")) sc.effects_background = root.strings("background");
   std::erase_if(sc.effects_present, [&](const std::string& e) {

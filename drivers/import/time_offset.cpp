@@ -29,9 +29,10 @@ double peak(const std::vector<double>& s) {
   return static_cast<double>(best) + (den < 0.0 ? 0.5 * (a - c) / den : 0.0);
 }
 
-}  // namespace
+using Columns = std::vector<std::vector<double>>;  // per reference column (or axis), its samples
 
-OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal& ref, int F) {
+// Throws on unusable inputs; the machine axes the reference moves (its columns).
+std::vector<int> check_inputs(const MeasuredSeries& y_in, const ReferenceSignal& ref, int F) {
   if (!(y_in.fs_hz > 0.0) || y_in.grid_index.size() != y_in.values.size() || y_in.values.size() < 16)
     throw dsp::InputError("time offset: the measurement needs a rate and at least 16 samples");
   if (!(ref.t_end_s > ref.t_begin_s) || !ref.accel)
@@ -41,56 +42,67 @@ OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal
   for (int j = 0; j < 3; ++j)
     if (ref.moving[j] != 0.0) cols.push_back(j);
   if (cols.empty()) throw dsp::InputError("time offset: the reference moves no axis");
-  const auto nc = static_cast<int>(cols.size());
-  const double fs = y_in.fs_hz, hf = 1.0 / (fs * F);
+  return cols;
+}
 
-  // The reference on the fine grid through the sensor's low-pass, mean removed.
+// The reference on the fine grid (step hf) through the sensor's low-pass, mean removed.
+Columns fine_reference(const ReferenceSignal& ref, const std::vector<int>& cols, double hf) {
   const auto m_fine = static_cast<std::size_t>(std::floor((ref.t_end_s - ref.t_begin_s) / hf)) + 1;
-  std::vector<std::vector<double>> rf(cols.size(), std::vector<double>(m_fine));
-  {
-    std::vector<sim::Pt2> lp;
-    if (ref.sensor_f0_hz > 0.0)
-      for (int c = 0; c < nc; ++c) lp.emplace_back(ref.sensor_f0_hz, ref.sensor_zeta, hf);
-    std::vector<double> prev(cols.size(), 0.0);
-    for (std::size_t m = 0; m < m_fine; ++m) {
-      const Eigen::Vector3d a = ref.accel(ref.t_begin_s + static_cast<double>(m) * hf);
-      for (std::size_t c = 0; c < cols.size(); ++c) {
-        const double x = a[cols[c]];
-        rf[c][m] = lp.empty() ? x : lp[c].step(m == 0 ? x : 0.5 * (prev[c] + x));
-        prev[c] = x;
-      }
-    }
-    for (auto& r : rf) {
-      double mean = 0.0;
-      for (double v : r) mean += v;
-      mean /= static_cast<double>(r.size());
-      for (double& v : r) v -= mean;
+  Columns rf(cols.size(), std::vector<double>(m_fine));
+  std::vector<sim::Pt2> lp;
+  if (ref.sensor_f0_hz > 0.0)
+    for (std::size_t c = 0; c < cols.size(); ++c) lp.emplace_back(ref.sensor_f0_hz, ref.sensor_zeta, hf);
+  std::vector<double> prev(cols.size(), 0.0);
+  for (std::size_t m = 0; m < m_fine; ++m) {
+    const Eigen::Vector3d a = ref.accel(ref.t_begin_s + static_cast<double>(m) * hf);
+    for (std::size_t c = 0; c < cols.size(); ++c) {
+      const double x = a[cols[c]];
+      rf[c][m] = lp.empty() ? x : lp[c].step(m == 0 ? x : 0.5 * (prev[c] + x));
+      prev[c] = x;
     }
   }
-  const std::size_t m_coarse = (m_fine - 1) / static_cast<std::size_t>(F) + 1;
+  for (auto& r : rf) {
+    double mean = 0.0;
+    for (double v : r) mean += v;
+    mean /= static_cast<double>(r.size());
+    for (double& v : r) v -= mean;
+  }
+  return rf;
+}
 
-  // The measurement on its grid, mean removed, lost frames zero.
+// The measurement on its grid, mean removed, lost frames zero.
+struct Grid {
+  Columns y;  // per sensor axis
+  std::vector<bool> valid;
+  double energy = 0.0;  // Σ y²
+  double t0_s = 0.0;    // recorder time of the grid's first sample
+};
+
+Grid measurement_grid(const MeasuredSeries& y_in) {
   const auto n = static_cast<std::size_t>(y_in.grid_index.back() - y_in.grid_index.front()) + 1;
-  std::vector<std::vector<double>> y(3, std::vector<double>(n, 0.0));
-  std::vector<bool> valid(n, false);
+  Grid g;
+  g.y.assign(3, std::vector<double>(n, 0.0));
+  g.valid.assign(n, false);
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const auto& v : y_in.values) mean += v;
   mean /= static_cast<double>(y_in.values.size());
-  double y_energy = 0.0;
   for (std::size_t k = 0; k < y_in.values.size(); ++k) {
     const auto i = static_cast<std::size_t>(y_in.grid_index[k] - y_in.grid_index.front());
-    valid[i] = true;
+    g.valid[i] = true;
     for (int a = 0; a < 3; ++a)
-      y[static_cast<std::size_t>(a)][i] = y_in.values[k][a] - mean[a],
-      y_energy += y[static_cast<std::size_t>(a)][i] * y[static_cast<std::size_t>(a)][i];
+      g.y[static_cast<std::size_t>(a)][i] = y_in.values[k][a] - mean[a],
+      g.energy += g.y[static_cast<std::size_t>(a)][i] * g.y[static_cast<std::size_t>(a)][i];
   }
-  const double t_y0 = y_in.t0_s + static_cast<double>(y_in.grid_index.front()) / fs;
+  g.t0_s = y_in.t0_s + static_cast<double>(y_in.grid_index.front()) / y_in.fs_hz;
+  return g;
+}
 
-  // Coarse: every lag by FFT at the measurement's rate.
-  std::size_t L = 1;
-  while (L < n + m_coarse) L <<= 1;
+// The score at every lag mod L (L ≥ n + m_coarse, a power of 2), by FFT at the
+// measurement's rate (every F-th fine reference sample).
+std::vector<double> coarse_scores(const Columns& y, const Columns& rf, int F, std::size_t m_coarse, std::size_t L) {
+  const auto nc = static_cast<int>(rf.size());
   Eigen::FFT<double> fft;
-  std::vector<std::vector<std::complex<double>>> Y(3), R(cols.size());
+  std::vector<std::vector<std::complex<double>>> Y(3), R(rf.size());
   std::vector<double> buf(L);
   for (int a = 0; a < 3; ++a) {
     std::fill(buf.begin(), buf.end(), 0.0);
@@ -98,11 +110,11 @@ OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal
     fft.fwd(Y[static_cast<std::size_t>(a)], buf);
   }
   Eigen::MatrixXd g_coarse = Eigen::MatrixXd::Zero(nc, nc);
-  for (std::size_t c = 0; c < cols.size(); ++c) {
+  for (std::size_t c = 0; c < rf.size(); ++c) {
     std::fill(buf.begin(), buf.end(), 0.0);
     for (std::size_t m = 0; m < m_coarse; ++m) buf[m] = rf[c][m * static_cast<std::size_t>(F)];
     fft.fwd(R[c], buf);
-    for (std::size_t d = 0; d < cols.size(); ++d)
+    for (std::size_t d = 0; d < rf.size(); ++d)
       for (std::size_t m = 0; m < m_coarse; ++m)
         g_coarse(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(d)) +=
             rf[c][m * static_cast<std::size_t>(F)] * rf[d][m * static_cast<std::size_t>(F)];
@@ -111,88 +123,138 @@ OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal
     throw dsp::InputError("time offset: the commanded acceleration is zero (nothing to correlate with)");
   const Eigen::MatrixXd g_inv = g_coarse.inverse();
   // corr[a][c][lag mod L] = Σ_n y_a[n] r_c[n − lag]
-  std::vector<double> best_score(L, 0.0);
-  {
-    std::vector<std::vector<std::vector<double>>> corr(3, std::vector<std::vector<double>>(cols.size()));
-    std::vector<std::complex<double>> prod(L);
-    for (int a = 0; a < 3; ++a)
-      for (std::size_t c = 0; c < cols.size(); ++c) {
-        for (std::size_t k = 0; k < L; ++k) prod[k] = Y[static_cast<std::size_t>(a)][k] * std::conj(R[c][k]);
-        fft.inv(corr[static_cast<std::size_t>(a)][c], prod);
-      }
-    Eigen::MatrixXd cm(3, nc);
-    for (std::size_t k = 0; k < L; ++k) {
-      for (int a = 0; a < 3; ++a)
-        for (int c = 0; c < nc; ++c) cm(a, c) = corr[static_cast<std::size_t>(a)][static_cast<std::size_t>(c)][k];
-      best_score[k] = score(cm, g_inv);
+  std::vector<std::vector<std::vector<double>>> corr(3, std::vector<std::vector<double>>(rf.size()));
+  std::vector<std::complex<double>> prod(L);
+  for (int a = 0; a < 3; ++a)
+    for (std::size_t c = 0; c < rf.size(); ++c) {
+      for (std::size_t k = 0; k < L; ++k) prod[k] = Y[static_cast<std::size_t>(a)][k] * std::conj(R[c][k]);
+      fft.inv(corr[static_cast<std::size_t>(a)][c], prod);
     }
+  std::vector<double> scores(L, 0.0);
+  Eigen::MatrixXd cm(3, nc);
+  for (std::size_t k = 0; k < L; ++k) {
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < nc; ++c) cm(a, c) = corr[static_cast<std::size_t>(a)][static_cast<std::size_t>(c)][k];
+    scores[k] = score(cm, g_inv);
   }
-  // Lags −(m_coarse − 1) .. n − 1 sit at k = lag mod L.
-  long lag0 = 0;
-  double best = -1.0;
+  return scores;
+}
+
+// The coarse peak over the lags −(m_coarse − 1) .. n − 1 (at k = lag mod L) and the median score.
+struct CoarsePeak {
+  long lag = 0;
+  double best = -1.0, median = 0.0;
+};
+
+CoarsePeak coarse_peak(const std::vector<double>& scores, std::size_t n, std::size_t m_coarse) {
+  const auto L = static_cast<long>(scores.size());
+  CoarsePeak p;
   std::vector<double> all;
   all.reserve(n + m_coarse);
   for (long lag = -static_cast<long>(m_coarse) + 1; lag < static_cast<long>(n); ++lag) {
-    const double s = best_score[static_cast<std::size_t>((lag % static_cast<long>(L) + static_cast<long>(L)) %
-                                                         static_cast<long>(L))];
+    const double s = scores[static_cast<std::size_t>((lag % L + L) % L)];
     all.push_back(s);
-    if (s > best) best = s, lag0 = lag;
+    if (s > p.best) p.best = s, p.lag = lag;
   }
   std::nth_element(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(all.size() / 2), all.end());
-  const double median_score = all[all.size() / 2];
+  p.median = all[all.size() / 2];
+  return p;
+}
 
-  // Fine: ±2 samples on the fine grid, per block for the jackknife.
-  const int span = 2 * F, n_lags = 2 * span + 1;
-  std::vector<Eigen::MatrixXd> cb(static_cast<std::size_t>(kBlocks * n_lags), Eigen::MatrixXd::Zero(3, nc));
+// Fine: the correlations at ±span fine lags about the coarse peak, per block of the
+// measurement (for the jackknife), and the reference's Gram matrix at the peak.
+struct FineCorrelations {
+  int span = 0, n_lags = 0;
+  std::vector<Eigen::MatrixXd> block;  // [b · n_lags + j]: 3 × columns
+  std::vector<Eigen::MatrixXd> total;  // [j]: summed over the blocks
+  Eigen::MatrixXd g_inv;
+};
+
+FineCorrelations fine_correlations(const Grid& grid, const Columns& rf, int F, long lag0) {
+  const auto nc = static_cast<int>(rf.size());
+  const std::size_t n = grid.valid.size(), m_fine = rf.front().size();
+  FineCorrelations fc;
+  fc.span = 2 * F, fc.n_lags = 2 * fc.span + 1;
+  const int span = fc.span, n_lags = fc.n_lags;
+  fc.block.assign(static_cast<std::size_t>(kBlocks * n_lags), Eigen::MatrixXd::Zero(3, nc));
   Eigen::MatrixXd g = Eigen::MatrixXd::Zero(nc, nc);
   const std::size_t block_len = (n + kBlocks - 1) / kBlocks;
   Eigen::VectorXd r(nc);
   for (std::size_t i = 0; i < n; ++i) {
-    if (!valid[i]) continue;
+    if (!grid.valid[i]) continue;
     const auto b = static_cast<std::size_t>(i / block_len);
     const long base = static_cast<long>(F) * (static_cast<long>(i) - lag0);
     for (int j = -span; j <= span; ++j) {
       const long m = base - j;
       if (m < 0 || m >= static_cast<long>(m_fine)) continue;
       for (int c = 0; c < nc; ++c) r[c] = rf[static_cast<std::size_t>(c)][static_cast<std::size_t>(m)];
-      Eigen::MatrixXd& acc = cb[b * static_cast<std::size_t>(n_lags) + static_cast<std::size_t>(j + span)];
-      for (int a = 0; a < 3; ++a) acc.row(a) += y[static_cast<std::size_t>(a)][i] * r.transpose();
+      Eigen::MatrixXd& acc = fc.block[b * static_cast<std::size_t>(n_lags) + static_cast<std::size_t>(j + span)];
+      for (int a = 0; a < 3; ++a) acc.row(a) += grid.y[static_cast<std::size_t>(a)][i] * r.transpose();
       if (j == 0) g += r * r.transpose();
     }
   }
   if (!(g.determinant() > 0.0))
     throw dsp::InputError("time offset: the measurement does not overlap the commanded motion");
-  const Eigen::MatrixXd gi = g.inverse();
-  std::vector<Eigen::MatrixXd> total(static_cast<std::size_t>(n_lags), Eigen::MatrixXd::Zero(3, nc));
+  fc.g_inv = g.inverse();
+  fc.total.assign(static_cast<std::size_t>(n_lags), Eigen::MatrixXd::Zero(3, nc));
   for (int b = 0; b < kBlocks; ++b)
-    for (int j = 0; j < n_lags; ++j) total[static_cast<std::size_t>(j)] += cb[static_cast<std::size_t>(b * n_lags + j)];
-  auto tau_of = [&](double j_peak) {
-    return t_y0 - ref.t_begin_s + static_cast<double>(lag0) / fs + (j_peak - span) * hf;
-  };
-  std::vector<double> s(static_cast<std::size_t>(n_lags));
-  for (int j = 0; j < n_lags; ++j) s[static_cast<std::size_t>(j)] = score(total[static_cast<std::size_t>(j)], gi);
-  const double j_hat = peak(s);
-  OffsetEstimate out;
-  out.peak_to_median = median_score > 0.0 ? best / median_score : std::numeric_limits<double>::infinity();
-  out.offset_s = tau_of(j_hat);
-  out.fine_step_s = hf;
-  out.blocks = kBlocks;
-  const auto j_best = static_cast<std::size_t>(std::lround(j_hat));
-  out.explained = y_energy > 0.0 ? s[j_best] / y_energy : 0.0;
-  const Eigen::MatrixXd gain = total[j_best] * gi;
-  for (int c = 0; c < nc; ++c) out.gain.col(cols[static_cast<std::size_t>(c)]) = gain.col(c);
+    for (int j = 0; j < n_lags; ++j)
+      fc.total[static_cast<std::size_t>(j)] += fc.block[static_cast<std::size_t>(b * n_lags + j)];
+  return fc;
+}
+
+// The offset at a (fractional) fine lag index j_peak: base_s + (j_peak − span)·hf.
+struct LagTime {
+  double base_s = 0.0, hf = 0.0;
+  int span = 0;
+  [[nodiscard]] double operator()(double j_peak) const { return base_s + (j_peak - span) * hf; }
+};
+
+// Block jackknife: the fine peak with each block left out once; u = √((K−1)/K · Σ (τ_−k − τ̄)²).
+double jackknife_u(const FineCorrelations& fc, const LagTime& tau_of) {
+  std::vector<double> s(static_cast<std::size_t>(fc.n_lags));
   std::vector<double> loo(kBlocks);
   double loo_mean = 0.0;
   for (int b = 0; b < kBlocks; ++b) {
-    for (int j = 0; j < n_lags; ++j)
-      s[static_cast<std::size_t>(j)] =
-          score(total[static_cast<std::size_t>(j)] - cb[static_cast<std::size_t>(b * n_lags + j)], gi);
+    for (int j = 0; j < fc.n_lags; ++j)
+      s[static_cast<std::size_t>(j)] = score(
+          fc.total[static_cast<std::size_t>(j)] - fc.block[static_cast<std::size_t>(b * fc.n_lags + j)], fc.g_inv);
     loo[static_cast<std::size_t>(b)] = tau_of(peak(s));
     loo_mean += loo[static_cast<std::size_t>(b)] / kBlocks;
   }
   double ss = 0.0;
   for (double v : loo) ss += (v - loo_mean) * (v - loo_mean);
-  out.u_s = std::sqrt((kBlocks - 1.0) / kBlocks * ss);
+  return std::sqrt((kBlocks - 1.0) / kBlocks * ss);
+}
+
+}  // namespace
+
+OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal& ref, int F) {
+  const std::vector<int> cols = check_inputs(y_in, ref, F);
+  const double fs = y_in.fs_hz, hf = 1.0 / (fs * F);
+  const Columns rf = fine_reference(ref, cols, hf);
+  const std::size_t m_coarse = (rf.front().size() - 1) / static_cast<std::size_t>(F) + 1;
+  const Grid grid = measurement_grid(y_in);
+  const std::size_t n = grid.valid.size();
+  std::size_t L = 1;
+  while (L < n + m_coarse) L <<= 1;
+  const CoarsePeak coarse = coarse_peak(coarse_scores(grid.y, rf, F, m_coarse, L), n, m_coarse);
+  const FineCorrelations fc = fine_correlations(grid, rf, F, coarse.lag);
+  const LagTime tau_of{grid.t0_s - ref.t_begin_s + static_cast<double>(coarse.lag) / fs, hf, fc.span};
+  std::vector<double> s(static_cast<std::size_t>(fc.n_lags));
+  for (int j = 0; j < fc.n_lags; ++j)
+    s[static_cast<std::size_t>(j)] = score(fc.total[static_cast<std::size_t>(j)], fc.g_inv);
+  const double j_hat = peak(s);
+  OffsetEstimate out;
+  out.peak_to_median = coarse.median > 0.0 ? coarse.best / coarse.median : std::numeric_limits<double>::infinity();
+  out.offset_s = tau_of(j_hat);
+  out.fine_step_s = hf;
+  out.blocks = kBlocks;
+  const auto j_best = static_cast<std::size_t>(std::lround(j_hat));
+  out.explained = grid.energy > 0.0 ? s[j_best] / grid.energy : 0.0;
+  const Eigen::MatrixXd gain = fc.total[j_best] * fc.g_inv;
+  for (std::size_t c = 0; c < cols.size(); ++c) out.gain.col(cols[c]) = gain.col(static_cast<Eigen::Index>(c));
+  out.u_s = jackknife_u(fc, tau_of);
   return out;
 }
 

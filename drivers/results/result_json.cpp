@@ -116,63 +116,65 @@ void explain_nulls(nlohmann::json& doc) {
   }
 }
 
-}  // namespace
+constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
-nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
-  nlohmann::json j;
-  const std::string& kind = run.meta.program.kind;
-  j["format"] = "eical-result/1";
-  j["run_id"] = run.meta.id;
-  j["program"] = kind;
-  j["software"] = software_version();
-  j["quality"] = {
+// The verdict, its reasons, the flags and each flag's severity.
+nlohmann::json quality_json(const dsp::Analysis& a) {
+  nlohmann::json q = {
       {"degraded", a.degraded}, {"verdict", a.verdict}, {"verdict_reasons", a.verdict_reasons}, {"flags", a.flags}};
   nlohmann::json severity = nlohmann::json::array();
   for (const auto& f : a.flags) severity.push_back(dsp::severity_name(dsp::flag_severity(f)));
-  j["quality"]["flag_severity"] = severity;
-  j["uncertainty_k2"] = uncertainty_json(a);
-  j["uncertainty"] = {
-      {"coverage_factor", 2},
-      {"sensor_model", a.uncertainty_source},
-      {"method", a.uncertainty_note},
-      {"resolved_rule", "a figure is resolved when |value| > U (k = 2); one that is not is never compensated"}};
-  j["sensor_model"] = {{"identified", a.sensor_model != "datasheet"}, {"source", a.sensor_model}};
+  q["flag_severity"] = severity;
+  return q;
+}
+
+// circle and diagnostics: the evaluation's, or for a circle program whose evaluation failed
+// every key null.
+void add_circle(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
   if (a.circle) {
-    j["circle"] = circle_json(run.meta.program, *a.circle);
-  } else if (kind == "circle") {
+    j["circle"] = circle_json(p, *a.circle);
+  } else if (p.kind == "circle") {
     j["circle"] = all_null({"radius_mean_deviation_um", "circular_deviation_G_um", "circular_hysteresis_H_um",
                             "radial_deviation_F_max_um", "radial_deviation_F_min_um"});
-    j["circle"]["plane"] = run.meta.program.plane;
-    j["circle"]["radius_nominal_mm"] = run.meta.program.radius_mm;
-    j["circle"]["feed_mm_min"] = run.meta.program.feed_mm_min;
-    j["circle"]["arc_deg"] = run.meta.program.arc_deg;
+    j["circle"]["plane"] = p.plane;
+    j["circle"]["radius_nominal_mm"] = p.radius_mm;
+    j["circle"]["feed_mm_min"] = p.feed_mm_min;
+    j["circle"]["arc_deg"] = p.arc_deg;
     j["circle"]["trace"] = {{"angle_deg", nlohmann::json::array()},
                             {"radius_deviation_um", nlohmann::json::array()},
                             {"direction", nlohmann::json::array()}};
   }
   if (a.diagnostics) {
     j["diagnostics"] = diagnostics_json(*a.diagnostics);
-  } else if (kind == "circle") {
+  } else if (p.kind == "circle") {
     j["diagnostics"] =
         all_null({"backlash_x_um", "backlash_y_um", "reversal_spike_x_um", "reversal_spike_y_um", "lateral_play_x_um",
                   "lateral_play_y_um", "cyclic_error_x_um", "cyclic_error_y_um", "servo_mismatch_ms", "squareness_urad",
                   "scale_mismatch_ppm", "straightness_x_um", "straightness_y_um", "stick_slip_um", "vibration_um"});
   }
+}
+
+// step and positioning, likewise.
+void add_step_and_positioning(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
   if (a.step) {
     j["step"] = step_json(a.step_axis, *a.step);
-  } else if (kind == "step") {
+  } else if (p.kind == "step") {
     j["step"] = all_null({"end_position_error_um", "scatter_um", "overshoot_um", "settling_s"});
-    j["step"]["axis"] = run.meta.program.axis;
+    j["step"]["axis"] = p.axis;
   }
   if (a.positioning && a.positioning_input) {
     j["positioning"] = positioning_json(*a.positioning_input, *a.positioning, true);
-  } else if (kind == "positioning") {
+  } else if (p.kind == "positioning") {
     j["positioning"] = all_null({"A_um", "A_up_um", "A_down_um", "E_um", "M_um", "R_um", "R_up_um", "R_down_um", "B_um",
                                  "B_mean_um", "deviation_um"});
-    j["positioning"]["axis"] = run.meta.program.axis;
-    j["positioning"]["targets_mm"] = run.meta.program.targets_mm;
-    j["positioning"]["runs"] = run.meta.program.runs;
+    j["positioning"]["axis"] = p.axis;
+    j["positioning"]["targets_mm"] = p.targets_mm;
+    j["positioning"]["runs"] = p.runs;
   }
+}
+
+// rectangle (with its path deviation) and free form, likewise.
+void add_rectangle_and_freeform(const std::string& kind, const dsp::Analysis& a, nlohmann::json& j) {
   if (a.rectangle) {
     j["rectangle"] = rectangle_json(*a.rectangle);
   } else if (kind == "rectangle") {
@@ -183,32 +185,32 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   if (kind == "freeform")
     j["freeform"] =
         a.path ? path_json(*a.path) : all_null({"contour_error_max_um", "contour_error_rms_um", "tangential_rms_um"});
-  if (a.circle_accuracy_rms_um) {
-    j["reference_comparison"] = {{"reference", run.meta.reference ? run.meta.reference->kind : "ref"},
-                                 {"radius_deviation_error_rms_um", *a.circle_accuracy_rms_um},
-                                 {"reference_circular_deviation_G_um", a.circle_reference->circular_deviation_G_um},
-                                 {"reference_radius_mean_deviation_um", a.circle_reference->radius_mean_deviation_um}};
-  }
+}
+
+// How the pipeline ran: its windows, the dynamic compensation, NBS, Coriolis.
+nlohmann::json pipeline_json(const dsp::Analysis& a) {
   const auto& m = a.measurement;
-  j["pipeline"] = {{"rest_window_samples", m.rest_window_samples},
-                   {"zupt_window_samples", m.zupt_window_samples},
-                   {"zupt_velocity_error_mm_s",
-                    {m.zupt_velocity_error_mm_s.x(), m.zupt_velocity_error_mm_s.y(), m.zupt_velocity_error_mm_s.z()}},
-                   {"dynamic_compensation",
-                    a.dynamic == dsp::DynamicComp::none
-                        ? std::string("none (PT2 and DAQ delay uncompensated)")
-                        : std::string(dsp::dynamic_comp_name(a.dynamic)) + ", DAQ delay removed by re-indexing"},
-                   {"nbs", a.nbs},
-                   {"coriolis", a.coriolis}};
-  // What the supports did: accepted and rejected updates per kind and axis, the
-  // standstills found, the strips' readings, and the measurement's own noise-limited σ.
+  return {{"rest_window_samples", m.rest_window_samples},
+          {"zupt_window_samples", m.zupt_window_samples},
+          {"zupt_velocity_error_mm_s",
+           {m.zupt_velocity_error_mm_s.x(), m.zupt_velocity_error_mm_s.y(), m.zupt_velocity_error_mm_s.z()}},
+          {"dynamic_compensation",
+           a.dynamic == dsp::DynamicComp::none
+               ? std::string("none (PT2 and DAQ delay uncompensated)")
+               : std::string(dsp::dynamic_comp_name(a.dynamic)) + ", DAQ delay removed by re-indexing"},
+          {"nbs", a.nbs},
+          {"coriolis", a.coriolis}};
+}
+
+// What the supports did: accepted and rejected updates per kind and axis, the
+// standstills found, the strips' readings, and the measurement's own noise-limited σ.
+nlohmann::json supports_json(const dsp::Measurement& m) {
   nlohmann::json sup;
-  const char* axes[3] = {"x", "y", "z"};
   for (int k = 0; k < dsp::fusion::kSupportKinds; ++k) {
     nlohmann::json kind_j;
     for (int ax = 0; ax < 3; ++ax) {
       const auto& t = m.supports.tally[ax][k];
-      kind_j[axes[ax]] = {{"accepted", t.accepted}, {"rejected", t.rejected}};
+      kind_j[kAxisNames[ax]] = {{"accepted", t.accepted}, {"rejected", t.rejected}};
     }
     sup[dsp::fusion::support_name(static_cast<dsp::fusion::Support>(k))] = kind_j;
   }
@@ -219,20 +221,53 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
   sup["smoothed"] = m.supports.smoothed;
   const Eigen::Vector3d& worst = m.sigma_max_um;  // over the whole trace
   sup["position_sigma_max_um"] = {worst.x(), worst.y(), worst.z()};
-  j["pipeline"]["supports"] = sup;
-  // Repeats of one segment (between M102 marks) averaged sample by sample (6-44).
+  return sup;
+}
+
+// Repeats of one segment (between M102 marks) averaged sample by sample (6-44).
+nlohmann::json repeats_json(const dsp::Analysis& a) {
   nlohmann::json reps = nlohmann::json::array();
   for (const auto& g : a.repeats) {
     nlohmann::json moving = nlohmann::json::array();
     for (int ax = 0; ax < 3; ++ax)
-      if (g.axis_moves[ax]) moving.push_back(axes[ax]);
+      if (g.axis_moves[ax]) moving.push_back(kAxisNames[ax]);
     reps.push_back({{"repeats", g.repeats()},
                     {"samples", g.samples},
                     {"axes", moving},
                     {"mean_deviation_rms_um", g.mean_rms_um},
                     {"scatter_rms_um", g.scatter_rms_um}});
   }
-  j["repeats"] = reps;
+  return reps;
+}
+
+}  // namespace
+
+nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
+  nlohmann::json j;
+  j["format"] = "eical-result/1";
+  j["run_id"] = run.meta.id;
+  j["program"] = run.meta.program.kind;
+  j["software"] = software_version();
+  j["quality"] = quality_json(a);
+  j["uncertainty_k2"] = uncertainty_json(a);
+  j["uncertainty"] = {
+      {"coverage_factor", 2},
+      {"sensor_model", a.uncertainty_source},
+      {"method", a.uncertainty_note},
+      {"resolved_rule", "a figure is resolved when |value| > U (k = 2); one that is not is never compensated"}};
+  j["sensor_model"] = {{"identified", a.sensor_model != "datasheet"}, {"source", a.sensor_model}};
+  add_circle(run.meta.program, a, j);
+  add_step_and_positioning(run.meta.program, a, j);
+  add_rectangle_and_freeform(run.meta.program.kind, a, j);
+  if (a.circle_accuracy_rms_um) {
+    j["reference_comparison"] = {{"reference", run.meta.reference ? run.meta.reference->kind : "ref"},
+                                 {"radius_deviation_error_rms_um", *a.circle_accuracy_rms_um},
+                                 {"reference_circular_deviation_G_um", a.circle_reference->circular_deviation_G_um},
+                                 {"reference_radius_mean_deviation_um", a.circle_reference->radius_mean_deviation_um}};
+  }
+  j["pipeline"] = pipeline_json(a);
+  j["pipeline"]["supports"] = supports_json(a.measurement);
+  j["repeats"] = repeats_json(a);
   explain_nulls(j);
   return j;
 }

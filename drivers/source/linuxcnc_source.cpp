@@ -176,99 +176,133 @@ void LinuxcncSource::publish(const ServoStreamReader& reader, const LinuxcncStre
   store_max(shared_.max_following_error_mm, local.max_following_error_mm);
 }
 
-void LinuxcncSource::work() {
-  WindowedSim sim(scenario_, options_.window);
-  std::vector<dsp::Frame> frames(sim.frames_per_block() +
-                                 static_cast<std::size_t>(sim.ratio()) * options_.window.lookahead_cycles + 16);
-  bool drop_flag = false;
-  std::uint32_t last_marker = 0;
-  LinuxcncStreamStats local;
-  ServoStreamReader& reader = *reader_;
-  const int stall_ms = static_cast<int>(options_.stall_timeout_s * 1000.0);
-  // Longer than open()'s wait, so open() reports the absent LinuxCNC in its own words.
-  const int connect_ms = static_cast<int>(options_.connect_timeout_s * 2000.0);
-  const auto hold_ns = static_cast<std::int64_t>(options_.hold_s * 1e9);
+// The worker thread (the DAQ card's processor): reads the servo stream, simulates a block
+// whenever one is ready and releases frames once their servo cycle is hold_s old.
+class LinuxcncSource::Worker {
+ public:
+  explicit Worker(LinuxcncSource& src)
+      : src_(src),
+        reader_(*src.reader_),
+        sim_(src.scenario_, src.options_.window),
+        frames_(sim_.frames_per_block() +
+                static_cast<std::size_t>(sim_.ratio()) * src.options_.window.lookahead_cycles + 16),
+        stall_ms_(static_cast<int>(src.options_.stall_timeout_s * 1000.0)),
+        // Longer than open()'s wait, so open() reports the absent LinuxCNC in its own words.
+        connect_ms_(static_cast<int>(src.options_.connect_timeout_s * 2000.0)),
+        hold_ns_(static_cast<std::int64_t>(src.options_.hold_s * 1e9)) {}
+
+  // Reads until stopped, the stream stalls, ends or fails.
+  void run() {
+    using S = ServoStreamReader::Status;
+    for (;;) {
+      const bool before_first = src_.first_number_.load(std::memory_order_relaxed) < 0;
+      const auto status =
+          reader_.read(before_first ? connect_ms_ : stall_ms_, [this](const ServoCycle& c) { on_cycle(c); });
+      if (status == S::woken) break;  // stop_worker()
+      if (status == S::timeout) {
+        src_.fail(before_first ? "no servo samples within the connect timeout"
+                               : "no servo samples for " + std::to_string(src_.options_.stall_timeout_s) +
+                                     " s (LinuxCNC stalled?)");
+        break;
+      }
+      if (status == S::error || status == S::closed) {
+        end_of_stream(status, before_first);
+        break;
+      }
+      release(false);
+    }
+    src_.publish(reader_, local_);
+  }
+
+ private:
+  // One servo cycle: the first one starts the clock, a new marker is logged, the position
+  // drives the simulation, a ready block is simulated.
+  void on_cycle(const ServoCycle& c) {
+    const Eigen::Vector3d cmd(c.cmd_mm[0], c.cmd_mm[1], c.cmd_mm[2]), fb(c.fb_mm[0], c.fb_mm[1], c.fb_mm[2]);
+    const Eigen::Vector3d pos = src_.options_.drive_from_feedback ? fb : cmd;
+    if (!c.filled) local_.max_following_error_mm = std::max(local_.max_following_error_mm, (cmd - fb).norm());
+    if (src_.first_number_.load(std::memory_order_relaxed) < 0) first_line(c.number);
+    if (c.marker != last_marker_ && c.marker != 0)
+      // Diagnostic (EICAL_MARK=1 in the kit): when the M-code script ran, on the DAQ clock.
+      (void)src_.markers_->push_or_drop({c.marker, c.number, (c.number - local_.first_number) * src_.ratio_});
+    last_marker_ = c.marker;
+    sim_.push(pos, cmd, c.filled);
+    if (sim_.block_ready()) {
+      emit(false);
+      src_.publish(reader_, local_);
+    }
+  }
+
+  // The stream's first line: its cycle number is sample 0; open() stops waiting.
+  void first_line(std::int64_t number) {
+    src_.first_number_.store(number, std::memory_order_release);
+    src_.shared_.first_number.store(number, std::memory_order_relaxed);
+    local_.first_number = number;
+    {
+      std::lock_guard lk(src_.mu_);  // once per stream, not per sample
+      src_.first_line_ = true;
+    }
+    src_.cv_.notify_all();
+  }
+
+  // Simulates a block (flush: the last, however short) into the held queue.
+  void emit(bool flush) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::size_t n = sim_.simulate_block(frames_, flush);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    for (std::size_t k = 0; k < n; ++k) {
+      if (src_.held_->full()) release(false);  // never drops: a full queue releases its oldest early
+      (void)src_.held_->push(frames_[k]);
+    }
+    local_.blocks = sim_.blocks();
+    if (ms > local_.max_block_sim_ms) local_.max_block_sim_ms = ms;
+  }
 
   // Frames wait until their servo cycle is hold_s old: a DDS trigger (eical trigger
   // starts a process and a participant first) must reach eicald before its frame does,
-  // or it is clamped onto a later frame. Released as servo lines arrive (every ~10 ms).
-  auto release = [&](bool all) {
+  // or it is clamped onto a later frame. Released as servo lines arrive (every ~10 ms);
+  // `all`: every held frame.
+  void release(bool all) {
+    FixedQueue<dsp::Frame>& held = *src_.held_;
     std::size_t n = 0;
     const std::int64_t now = monotonic_ns();
-    while (!held_->empty() && (all || held_->full() || sample_time_ns(held_->front().sample_index) + hold_ns <= now)) {
-      dsp::Frame f = held_->front();
-      held_->pop();
-      if (drop_flag) f.flags |= dsp::frame_flag::gap_before;
-      drop_flag = !ring_->push_or_drop(f);
-      if (drop_flag) ++local.dropped_frames;
+    while (!held.empty() && (all || held.full() || src_.sample_time_ns(held.front().sample_index) + hold_ns_ <= now)) {
+      dsp::Frame f = held.front();
+      held.pop();
+      if (drop_flag_) f.flags |= dsp::frame_flag::gap_before;
+      drop_flag_ = !src_.ring_->push_or_drop(f);
+      if (drop_flag_) ++local_.dropped_frames;
       ++n;
     }
-    if (n > 0) available_.release();
-  };
-  auto emit = [&](bool flush) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const std::size_t n = sim.simulate_block(frames, flush);
-    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    for (std::size_t k = 0; k < n; ++k) {
-      if (held_->full()) release(false);  // never drops: a full queue releases its oldest early
-      (void)held_->push(frames[k]);
-    }
-    local.blocks = sim.blocks();
-    if (ms > local.max_block_sim_ms) local.max_block_sim_ms = ms;
-  };
-
-  auto on_cycle = [&](const ServoCycle& c) {
-    const Eigen::Vector3d cmd(c.cmd_mm[0], c.cmd_mm[1], c.cmd_mm[2]), fb(c.fb_mm[0], c.fb_mm[1], c.fb_mm[2]);
-    const Eigen::Vector3d pos = options_.drive_from_feedback ? fb : cmd;
-    if (!c.filled) local.max_following_error_mm = std::max(local.max_following_error_mm, (cmd - fb).norm());
-    if (first_number_.load(std::memory_order_relaxed) < 0) {
-      first_number_.store(c.number, std::memory_order_release);
-      shared_.first_number.store(c.number, std::memory_order_relaxed);
-      local.first_number = c.number;
-      {
-        std::lock_guard lk(mu_);  // once per stream, not per sample
-        first_line_ = true;
-      }
-      cv_.notify_all();
-    }
-    if (c.marker != last_marker && c.marker != 0)
-      // Diagnostic (EICAL_MARK=1 in the kit): when the M-code script ran, on the DAQ clock.
-      (void)markers_->push_or_drop({c.marker, c.number, (c.number - local.first_number) * ratio_});
-    last_marker = c.marker;
-    sim.push(pos, cmd, c.filled);
-    if (sim.block_ready()) {
-      emit(false);
-      publish(reader, local);
-    }
-  };
-
-  for (;;) {
-    const bool before_first = first_number_.load(std::memory_order_relaxed) < 0;
-    const auto status = reader.read(before_first ? connect_ms : stall_ms, on_cycle);
-    using S = ServoStreamReader::Status;
-    if (status == S::woken) break;  // stop_worker()
-    if (status == S::timeout) {
-      fail(before_first
-               ? "no servo samples within the connect timeout"
-               : "no servo samples for " + std::to_string(options_.stall_timeout_s) + " s (LinuxCNC stalled?)");
-      break;
-    }
-    if (status == S::error || status == S::closed) {
-      emit(true);  // the cycles before the end or the bad line still become frames
-      release(true);
-      publish(reader, local);
-      if (status == S::error)
-        fail(reader.error());
-      else if (before_first)
-        fail("the servo stream closed before its first line (eical-halsampler failed? see LinuxCNC's log)");
-      else
-        fail("LinuxCNC closed the servo stream after cycle " + std::to_string(reader.stats().last_number) +
-             " (LinuxCNC stopped or eical-halsampler exited)");
-      break;
-    }
-    release(false);
+    if (n > 0) src_.available_.release();
   }
-  publish(reader, local);
-}
+
+  // The stream ended (closed or a bad line): the cycles before it still become frames,
+  // every frame goes out, then the source fails naming why.
+  void end_of_stream(ServoStreamReader::Status status, bool before_first) {
+    emit(true);
+    release(true);
+    src_.publish(reader_, local_);
+    if (status == ServoStreamReader::Status::error)
+      src_.fail(reader_.error());
+    else if (before_first)
+      src_.fail("the servo stream closed before its first line (eical-halsampler failed? see LinuxCNC's log)");
+    else
+      src_.fail("LinuxCNC closed the servo stream after cycle " + std::to_string(reader_.stats().last_number) +
+                " (LinuxCNC stopped or eical-halsampler exited)");
+  }
+
+  LinuxcncSource& src_;
+  ServoStreamReader& reader_;
+  WindowedSim sim_;
+  std::vector<dsp::Frame> frames_;
+  const int stall_ms_, connect_ms_;
+  const std::int64_t hold_ns_;
+  bool drop_flag_ = false;
+  std::uint32_t last_marker_ = 0;
+  LinuxcncStreamStats local_;
+};
+
+void LinuxcncSource::work() { Worker(*this).run(); }
 
 }  // namespace eical::drivers

@@ -89,6 +89,7 @@ class LinuxcncSource final : public Source {
     std::atomic<std::int64_t> first_number{-1}, clock_offset_ns{0};
     std::atomic<double> mean_delay_ms{0.0}, max_delay_ms{0.0}, max_block_sim_ms{0.0}, max_following_error_mm{0.0};
   };
+  class Worker;  // work()'s loop and its stages (linuxcnc_source.cpp)
   void stop_worker();
   void work();
   void fail(const std::string& why);

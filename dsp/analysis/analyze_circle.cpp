@@ -34,68 +34,64 @@ std::optional<eval::CircleResult> evaluate_channel(const Program& p, const std::
   return out;
 }
 
-}  // namespace
-
-void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOptions& options) {
-  const Measurement& m = a.measurement;
-  const Program& p = run.meta.program;
-  const auto [ia, ib] = plane_axes(p.plane);
+// The trace in the program's plane: set-point, measured and (when every sample is finite
+// and asked for) the reference.
+struct PlaneTrace {
   std::vector<Eigen::Vector2d> cmd, pos, ref;
-  bool ref_finite = options.reference && run.channels.ref[ia] && run.channels.ref[ib];
+  bool ref_finite = false;
+};
+
+PlaneTrace plane_trace(const Run& run, const Measurement& m, const EvaluationOptions& options) {
+  const auto [ia, ib] = plane_axes(run.meta.program.plane);
+  PlaneTrace t;
+  t.ref_finite = options.reference && run.channels.ref[ia] && run.channels.ref[ib];
   for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
-    cmd.emplace_back(m.cmd_mm[i][ia], m.cmd_mm[i][ib]);
-    pos.emplace_back(m.pos_mm[i][ia], m.pos_mm[i][ib]);
-    if (ref_finite) {
-      ref.emplace_back(m.ref_mm[i][ia], m.ref_mm[i][ib]);
-      ref_finite = ref.back().allFinite();
+    t.cmd.emplace_back(m.cmd_mm[i][ia], m.cmd_mm[i][ib]);
+    t.pos.emplace_back(m.pos_mm[i][ia], m.pos_mm[i][ib]);
+    if (t.ref_finite) {
+      t.ref.emplace_back(m.ref_mm[i][ia], m.ref_mm[i][ib]);
+      t.ref_finite = t.ref.back().allFinite();
     }
   }
+  return t;
+}
+
+// The evaluated revolutions (arcs) per direction, between the M102 marks; throws when none
+// sweeps the programmed arc.
+void find_segments(const Program& p, const Measurement& m, const std::vector<Eigen::Vector2d>& cmd, Ranges& ccw,
+                   Ranges& cw) {
   std::vector<std::int64_t> marks;
   for (const auto& t : m.triggers)
     if (t.code == trigger::segment_mark) marks.push_back(t.sample_index);
-  Ranges ccw, cw;
+  for (const auto& s :
+       eval::find_circle_segments(cmd, m.sample_index, marks, {p.center_mm[0], p.center_mm[1]}, p.arc_deg))
+    (s.direction == "ccw" ? ccw : cw).emplace_back(s.begin_index, s.end_index);
+  if (ccw.empty() && cw.empty())
+    throw InputError("no stretch between two M102 marks sweeps the programmed " + std::to_string(p.arc_deg) +
+                     " deg about the programmed centre");
+}
+
+// The reference instrument (or the simulator's truth) through the same evaluation, and the
+// RMS of the radius deviation's difference.
+void evaluate_reference(const Program& p, const Measurement& m, const std::vector<Eigen::Vector2d>& ref,
+                        const Ranges& ccw, const Ranges& cw, Analysis& a) {
   try {
-    for (const auto& s :
-         eval::find_circle_segments(cmd, m.sample_index, marks, {p.center_mm[0], p.center_mm[1]}, p.arc_deg))
-      (s.direction == "ccw" ? ccw : cw).emplace_back(s.begin_index, s.end_index);
-    if (ccw.empty() && cw.empty())
-      throw InputError("no stretch between two M102 marks sweeps the programmed " + std::to_string(p.arc_deg) +
-                       " deg about the programmed centre");
-    a.circle = evaluate_channel(p, m.sample_index, pos, ccw, cw);
-  } catch (const InputError& e) {
-    a.flags.push_back(std::string("circle: ") + e.what());
-    a.degraded = true;
-    return;
-  }
-  if (p.direction == "both" && (ccw.empty() || cw.empty()))
-    a.flags.push_back(std::string("circle: the program runs both directions but only ") + (ccw.empty() ? "cw" : "ccw") +
-                      " was found");
-  if (!a.circle->circular_hysteresis_H_um)
-    a.flags.push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions (this run has " +
-                      a.circle->direction + " only)");
-
-  // The reference instrument (or the simulator's truth) through the same evaluation.
-  if (ref_finite && !ref.empty()) {
-    try {
-      a.circle_reference = evaluate_channel(p, m.sample_index, ref, ccw, cw);
-      const auto& dm = a.circle->trace.radius_deviation_um;
-      const auto& dr = a.circle_reference->trace.radius_deviation_um;
-      if (dm.size() == dr.size() && !dm.empty()) {
-        double ss = 0.0;
-        for (std::size_t i = 0; i < dm.size(); ++i) ss += (dm[i] - dr[i]) * (dm[i] - dr[i]);
-        a.circle_accuracy_rms_um = std::sqrt(ss / static_cast<double>(dm.size()));
-      }
-    } catch (const InputError& e) {
-      a.flags.push_back(std::string("circle reference: ") + e.what());
+    a.circle_reference = evaluate_channel(p, m.sample_index, ref, ccw, cw);
+    const auto& dm = a.circle->trace.radius_deviation_um;
+    const auto& dr = a.circle_reference->trace.radius_deviation_um;
+    if (dm.size() == dr.size() && !dm.empty()) {
+      double ss = 0.0;
+      for (std::size_t i = 0; i < dm.size(); ++i) ss += (dm[i] - dr[i]) * (dm[i] - dr[i]);
+      a.circle_accuracy_rms_um = std::sqrt(ss / static_cast<double>(dm.size()));
     }
+  } catch (const InputError& e) {
+    a.flags.push_back(std::string("circle reference: ") + e.what());
   }
+}
 
-  // Diagnostics: one pass per direction over its steady revolutions.
-  if (p.arc_deg < 360.0) {
-    a.flags.push_back("diagnostics: null, the ballbar-class diagnostics need full revolutions (this run is a " +
-                      std::to_string(static_cast<int>(std::lround(p.arc_deg))) + " deg partial arc)");
-    return;
-  }
+// One pass per direction over its steady revolutions.
+std::vector<eval::CirclePass> diagnostic_passes(const Measurement& m, const PlaneTrace& t, const Ranges& ccw,
+                                                const Ranges& cw) {
   std::vector<eval::CirclePass> passes;
   for (const auto* ranges : {&ccw, &cw}) {
     if (ranges->empty()) continue;
@@ -104,11 +100,17 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
     pass.fs_hz = m.fs_hz;
     for (std::size_t i = 0; i < m.sample_index.size(); ++i)
       if (m.sample_index[i] >= ranges->front().first && m.sample_index[i] < ranges->back().second) {
-        pass.cmd_mm.push_back(cmd[i]);
-        pass.meas_mm.push_back(pos[i]);
+        pass.cmd_mm.push_back(t.cmd[i]);
+        pass.meas_mm.push_back(t.pos[i]);
       }
     passes.push_back(std::move(pass));
   }
+  return passes;
+}
+
+// The ballbar-class diagnostics of full circles; a flag instead when they cannot be had.
+void diagnose(const Program& p, const std::vector<eval::CirclePass>& passes, const EvaluationOptions& options,
+              Analysis& a) {
   eval::DiagnosticsOptions opt;
   opt.centre_mm = {p.center_mm[0], p.center_mm[1]};
   opt.radius_mm = p.radius_mm;
@@ -123,6 +125,36 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
   } catch (const InputError& e) {
     a.flags.push_back(std::string("diagnostics: null, ") + e.what());
   }
+}
+
+}  // namespace
+
+void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOptions& options) {
+  const Measurement& m = a.measurement;
+  const Program& p = run.meta.program;
+  const PlaneTrace t = plane_trace(run, m, options);
+  Ranges ccw, cw;
+  try {
+    find_segments(p, m, t.cmd, ccw, cw);
+    a.circle = evaluate_channel(p, m.sample_index, t.pos, ccw, cw);
+  } catch (const InputError& e) {
+    a.flags.push_back(std::string("circle: ") + e.what());
+    a.degraded = true;
+    return;
+  }
+  if (p.direction == "both" && (ccw.empty() || cw.empty()))
+    a.flags.push_back(std::string("circle: the program runs both directions but only ") + (ccw.empty() ? "cw" : "ccw") +
+                      " was found");
+  if (!a.circle->circular_hysteresis_H_um)
+    a.flags.push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions (this run has " +
+                      a.circle->direction + " only)");
+  if (t.ref_finite && !t.ref.empty()) evaluate_reference(p, m, t.ref, ccw, cw, a);
+  if (p.arc_deg < 360.0) {
+    a.flags.push_back("diagnostics: null, the ballbar-class diagnostics need full revolutions (this run is a " +
+                      std::to_string(static_cast<int>(std::lround(p.arc_deg))) + " deg partial arc)");
+    return;
+  }
+  diagnose(p, diagnostic_passes(m, t, ccw, cw), options, a);
 }
 
 }  // namespace eical::dsp::detail

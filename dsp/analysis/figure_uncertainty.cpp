@@ -13,6 +13,7 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <utility>
 
 namespace eical::dsp {
 namespace {
@@ -25,6 +26,124 @@ struct Accumulator {
   std::vector<double> sum, sumsq;
   std::vector<int> count;
 };
+
+// The two paths the draws perturb, evaluated at the draws' rate. The measured one (the
+// plug-in: what the error does to this machine's figures) and the ideal one, the set-point
+// (what the error alone makes of them: for a range, an amplitude or a spread —
+// |f(t + e) − f(t)| ≤ f(e) — a bound whatever the machine).
+struct DrawBases {
+  EvaluationOptions eo;
+  Analysis nominal, ideal;
+  std::vector<FigureValue> f0, g0;  // their figures
+  std::vector<double> at;           // the trace positions the draws perturb
+};
+
+// `decimated`: every q-th sample of the trace (fs/q); the triggers are kept.
+DrawBases evaluate_bases(const Run& run, const Analysis& a, Measurement decimated, std::size_t q, std::size_t samples) {
+  const Measurement& m = a.measurement;
+  DrawBases b;
+  b.eo.reference = false;
+  if (a.diagnostics) b.eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
+  b.nominal.measurement = std::move(decimated);
+  b.nominal.measurement.fs_hz = m.fs_hz / static_cast<double>(q);
+  b.nominal.measurement.triggers = m.triggers;
+  b.nominal.measurement.start_index = m.start_index, b.nominal.measurement.motion_end_index = m.motion_end_index;
+  b.nominal.dynamic = b.ideal.dynamic = a.dynamic, b.nominal.nbs = b.ideal.nbs = a.nbs;
+  b.ideal.measurement = b.nominal.measurement;
+  b.ideal.measurement.pos_mm = b.ideal.measurement.cmd_mm;
+  evaluate_program(run, b.nominal, b.eo);
+  evaluate_program(run, b.ideal, b.eo);
+  b.f0 = figures_of(b.nominal), b.g0 = figures_of(b.ideal);
+  for (std::size_t i = 0; i < samples; i += q) b.at.push_back(static_cast<double>(i));
+  return b;
+}
+
+// Per figure of a base, per element: the sums of the draws' offsets from the base.
+std::vector<Accumulator> accumulators_for(const std::vector<FigureValue>& f) {
+  std::vector<Accumulator> acc(f.size());
+  for (std::size_t k = 0; k < f.size(); ++k) {
+    const std::size_t e = f[k].values.size();
+    acc[k].sum.assign(e, 0.0), acc[k].sumsq.assign(e, 0.0), acc[k].count.assign(e, 0);
+  }
+  return acc;
+}
+
+// A draw's figures into the sums (figures whose shape differs from the base's left out).
+void accumulate(const std::vector<FigureValue>& base, const std::vector<FigureValue>& drawn,
+                std::vector<Accumulator>& acc) {
+  for (std::size_t k = 0; k < base.size(); ++k) {
+    const FigureValue* v = find_figure(drawn, base[k].key);
+    if (!v || v->values.size() != base[k].values.size()) continue;
+    for (std::size_t e = 0; e < v->values.size(); ++e) {
+      const double dv = v->values[e] - base[k].values[e];
+      if (!std::isfinite(dv)) continue;
+      acc[k].sum[e] += dv, acc[k].sumsq[e] += dv * dv, ++acc[k].count[e];
+    }
+  }
+}
+
+// The figures of a base with a draw's error (µm) added to its path.
+std::vector<FigureValue> perturbed_figures(const Run& run, const Analysis& a, const Analysis& base,
+                                           const std::vector<Eigen::Vector3d>& err, const EvaluationOptions& eo) {
+  Analysis x;
+  x.measurement = base.measurement;
+  for (std::size_t i = 0; i < err.size() && i < x.measurement.pos_mm.size(); ++i)
+    x.measurement.pos_mm[i] += err[i] / 1000.0;
+  x.dynamic = a.dynamic, x.nbs = a.nbs;
+  evaluate_program(run, x, eo);
+  return figures_of(x);
+}
+
+struct DrawSums {
+  std::vector<Accumulator> plug, bound;  // on the measured path, on the ideal one
+};
+
+// The seeded draws of the error field, each added to both bases and evaluated.
+DrawSums draw_figures(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
+                      int draws, std::uint64_t seed) {
+  DrawSums s{accumulators_for(b.f0), accumulators_for(b.g0)};
+  std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
+  std::vector<Eigen::Vector3d> err;
+  for (int d = 0; d < draws; ++d) {
+    field.draw(rng, b.at, err);
+    accumulate(b.f0, perturbed_figures(run, a, b.nominal, err, b.eo), s.plug);
+    accumulate(b.g0, perturbed_figures(run, a, b.ideal, err, b.eo), s.bound);
+  }
+  return s;
+}
+
+// U of element e of figure k of a set of draws (NaN when most draws could not evaluate it).
+double u_of(const std::vector<Accumulator>& ac, std::size_t k, std::size_t e, bool plug_in, int draws) {
+  const int c = ac[k].count[e];
+  if (2 * c < draws) return std::numeric_limits<double>::quiet_NaN();
+  const double mean = ac[k].sum[e] / c;
+  const double sd = std::sqrt(std::max(0.0, (ac[k].sumsq[e] - c * mean * mean) / std::max(1, c - 1)));
+  return plug_in ? expanded_uncertainty(mean, sd, c) : std::abs(mean) + 2.0 * sd;
+}
+
+std::size_t index_of(const std::vector<FigureValue>& f, const std::string& key) {
+  std::size_t k = 0;
+  while (k < f.size() && f[k].key != key) ++k;
+  return k;
+}
+
+// Figures of the full-rate analysis: U from the draws where the shapes agree, the larger
+// of the plug-in and the ideal path's bound.
+void assign_uncertainties(const DrawBases& b, const DrawSums& s, int draws, Analysis& a) {
+  for (const FigureValue& full : figures_of(a)) {
+    const std::size_t k = index_of(b.f0, full.key), j = index_of(b.g0, full.key);
+    const bool plug = k < b.f0.size() && b.f0[k].values.size() == full.values.size();
+    const bool bound = j < b.g0.size() && b.g0[j].values.size() == full.values.size();
+    if (!plug && !bound) continue;
+    std::vector<double> u(full.values.size(), std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t e = 0; e < u.size(); ++e) {
+      const double up = plug ? u_of(s.plug, k, e, true, draws) : std::numeric_limits<double>::quiet_NaN();
+      const double ub = bound ? u_of(s.bound, j, e, false, draws) : std::numeric_limits<double>::quiet_NaN();
+      u[e] = std::isfinite(up) && std::isfinite(ub) ? std::max(up, ub) : std::isfinite(up) ? up : ub;
+    }
+    a.uncertainty_k2[full.key] = u;
+  }
+}
 
 }  // namespace
 
@@ -119,7 +238,6 @@ void UncertaintyTrace::sample(std::size_t k, std::int64_t sample_index, const Ei
 }
 
 void UncertaintyTrace::finish(const Run& run, Analysis& a) {
-  const Measurement& m = a.measurement;
   a.uncertainty_source = in_.model_covariance.source;
   std::unique_ptr<uncertainty::ErrorField> field;
   try {
@@ -131,101 +249,14 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     a.uncertainty_note = std::string("the uncertainty was not estimated: ") + e.what();
     return;
   }
-  const std::size_t q = q_;
-  const int draws = draws_;
-
-  // The nominal evaluation at the draws' rate, and the positions the draws perturb. Two
-  // paths: the measured one (the plug-in: what the error does to this machine's figures) and
-  // the ideal one, the set-point (what the error alone makes of them: for a range, an
-  // amplitude or a spread — |f(t + e) − f(t)| ≤ f(e) — a bound whatever the machine).
-  EvaluationOptions eo;
-  eo.reference = false;
-  if (a.diagnostics) eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
-  Analysis nominal, ideal;
-  nominal.measurement = std::move(nominal_);  // every q-th sample (fs/q), the triggers kept
-  nominal_ = Measurement{};
-  nominal.measurement.fs_hz = m.fs_hz / static_cast<double>(q);
-  nominal.measurement.triggers = m.triggers;
-  nominal.measurement.start_index = m.start_index, nominal.measurement.motion_end_index = m.motion_end_index;
-  nominal.dynamic = ideal.dynamic = a.dynamic, nominal.nbs = ideal.nbs = a.nbs;
-  ideal.measurement = nominal.measurement;
-  ideal.measurement.pos_mm = ideal.measurement.cmd_mm;
-  evaluate_program(run, nominal, eo);
-  evaluate_program(run, ideal, eo);
-  const std::vector<FigureValue> f0 = figures_of(nominal), g0 = figures_of(ideal);
-  std::vector<double> at;
-  for (std::size_t i = 0; i < samples_; i += q) at.push_back(static_cast<double>(i));
-
-  auto start = [](const std::vector<FigureValue>& f) {
-    std::vector<Accumulator> acc(f.size());
-    for (std::size_t k = 0; k < f.size(); ++k) {
-      const std::size_t e = f[k].values.size();
-      acc[k].sum.assign(e, 0.0), acc[k].sumsq.assign(e, 0.0), acc[k].count.assign(e, 0);
-    }
-    return acc;
-  };
-  auto add = [](const std::vector<FigureValue>& base, const std::vector<FigureValue>& drawn,
-                std::vector<Accumulator>& acc) {
-    for (std::size_t k = 0; k < base.size(); ++k) {
-      const FigureValue* v = find_figure(drawn, base[k].key);
-      if (!v || v->values.size() != base[k].values.size()) continue;
-      for (std::size_t e = 0; e < v->values.size(); ++e) {
-        const double dv = v->values[e] - base[k].values[e];
-        if (!std::isfinite(dv)) continue;
-        acc[k].sum[e] += dv, acc[k].sumsq[e] += dv * dv, ++acc[k].count[e];
-      }
-    }
-  };
-  std::vector<Accumulator> acc = start(f0), acc_ideal = start(g0);
-  std::mt19937_64 rng(seed_ ^ 0x9e3779b97f4a7c15ULL);
-  std::vector<Eigen::Vector3d> err;
-  for (int d = 0; d < draws; ++d) {
-    field->draw(rng, at, err);
-    for (Analysis* base : {&nominal, &ideal}) {
-      Analysis x;
-      x.measurement = base->measurement;
-      for (std::size_t i = 0; i < err.size() && i < x.measurement.pos_mm.size(); ++i)
-        x.measurement.pos_mm[i] += err[i] / 1000.0;
-      x.dynamic = a.dynamic, x.nbs = a.nbs;
-      evaluate_program(run, x, eo);
-      if (base == &nominal)
-        add(f0, figures_of(x), acc);
-      else
-        add(g0, figures_of(x), acc_ideal);
-    }
-  }
-  // U of element e of figure k of a set of draws (NaN when most draws could not evaluate it).
-  auto u_of = [&](const std::vector<Accumulator>& ac, std::size_t k, std::size_t e, bool plug_in) {
-    const int c = ac[k].count[e];
-    if (2 * c < draws) return std::numeric_limits<double>::quiet_NaN();
-    const double mean = ac[k].sum[e] / c;
-    const double sd = std::sqrt(std::max(0.0, (ac[k].sumsq[e] - c * mean * mean) / std::max(1, c - 1)));
-    return plug_in ? expanded_uncertainty(mean, sd, c) : std::abs(mean) + 2.0 * sd;
-  };
-  auto index_of = [](const std::vector<FigureValue>& f, const std::string& key) {
-    std::size_t k = 0;
-    while (k < f.size() && f[k].key != key) ++k;
-    return k;
-  };
-  // Figures of the full-rate analysis: U from the draws where the shapes agree.
-  for (const FigureValue& full : figures_of(a)) {
-    const std::size_t k = index_of(f0, full.key), j = index_of(g0, full.key);
-    const bool plug = k < f0.size() && f0[k].values.size() == full.values.size();
-    const bool bound = j < g0.size() && g0[j].values.size() == full.values.size();
-    if (!plug && !bound) continue;
-    std::vector<double> u(full.values.size(), std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t e = 0; e < u.size(); ++e) {
-      const double up = plug ? u_of(acc, k, e, true) : std::numeric_limits<double>::quiet_NaN();
-      const double ub = bound ? u_of(acc_ideal, j, e, false) : std::numeric_limits<double>::quiet_NaN();
-      u[e] = std::isfinite(up) && std::isfinite(ub) ? std::max(up, ub) : std::isfinite(up) ? up : ub;
-    }
-    a.uncertainty_k2[full.key] = u;
-  }
+  const DrawBases bases = evaluate_bases(run, a, std::exchange(nominal_, Measurement{}), q_, samples_);
+  const DrawSums sums = draw_figures(run, a, *field, bases, draws_, seed_);
+  assign_uncertainties(bases, sums, draws_, a);
   char note[200];
   std::snprintf(note, sizeof note,
                 "GUM, k = 2: %d Monte Carlo draws of the error field (noise and bias walk between the supports, sensor "
                 "model: %s, PSD strips), path at %.0f Hz",
-                draws, a.uncertainty_source.c_str(), m.fs_hz / static_cast<double>(q));
+                draws_, a.uncertainty_source.c_str(), a.measurement.fs_hz / static_cast<double>(q_));
   a.uncertainty_note = note;
 }
 

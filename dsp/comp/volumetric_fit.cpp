@@ -103,10 +103,11 @@ Line weighted_line(const Channel& ch) {
 
 double reference_of(const std::array<double, 2>& range) { return range[0] <= 0.0 && 0.0 <= range[1] ? 0.0 : range[0]; }
 
-}  // namespace
+using MergedRuns = std::array<std::optional<AxisPass>, 3>;  // per axis: all its positioning runs as one
 
-VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vector<SquarenessFigure>& circles) {
-  VolumetricFit f;
+// Every axis' runs merged into one; the range of each axis no run moved (where it stood,
+// on average) into range_mm. Throws when no axis moved.
+MergedRuns merge_runs(const std::vector<AxisPass>& passes, std::array<std::array<double, 2>, 3>& range_mm) {
   std::array<std::vector<const AxisPass*>, 3> by_axis;
   for (const auto& p : passes) by_axis[static_cast<std::size_t>(p.axis)].push_back(&p);
   // Ranges: a moved axis over its targets; a standing one where it stood.
@@ -116,12 +117,12 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
       for (int a = 0; a < 3; ++a)
         if (a != p.axis)
           still_sum[static_cast<std::size_t>(a)] += s.cmd_mm[a], still_n[static_cast<std::size_t>(a)] += 1.0;
-  std::array<std::optional<AxisPass>, 3> merged;
+  MergedRuns merged;
   for (int a = 0; a < 3; ++a) {
     const auto ai = static_cast<std::size_t>(a);
     if (by_axis[ai].empty()) {
       const double at = still_n[ai] > 0 ? still_sum[ai] / still_n[ai] : 0.0;
-      f.model.range_mm[ai] = {at, at};
+      range_mm[ai] = {at, at};
       continue;
     }
     AxisPass m;
@@ -133,42 +134,51 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
     merged[ai] = m;
   }
   if (!merged[0] && !merged[1] && !merged[2]) throw InputError("volumetric: no positioning run to fit the model from");
+  return merged;
+}
 
-  std::array<std::vector<std::pair<double, double>>, 3> square_est;  // (µrad, U) per slot
-  std::array<std::array<std::optional<Line>, 3>, 3> slope;           // [moving axis][channel]
-  for (int a = 0; a < 3; ++a) {
-    const auto ai = static_cast<std::size_t>(a);
-    for (int c = 0; c < 3; ++c) {
-      const int k = 6 * a + kTx + c;
-      auto& comp = f.component[static_cast<std::size_t>(k)];
-      if (!merged[ai]) continue;
-      Channel ch = channel_of(*merged[ai], c);
-      if (ch.pos_mm.size() < 2)
-        throw InputError("volumetric: the " + letter(a) + " run " + merged[ai]->source +
-                         " reached fewer than 2 targets");
-      f.model.range_mm[ai] = {ch.pos_mm.front(), ch.pos_mm.back()};
-      std::string note = "positioning run " + merged[ai]->source + ", channel " + letter(c);
-      if (c != a) {
-        // A straightness has no slope: that is the frame and the squareness (kPairs).
-        const Line l = weighted_line(ch);
-        slope[ai][static_cast<std::size_t>(c)] = l;
-        for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) ch.value_um[i] -= l.slope * ch.pos_mm[i] + l.intercept;
-        note += " less its slope (frame and squareness)";
-      }
-      // Relative to the machine at the reference point of the axis.
-      const double r = reference_of(f.model.range_mm[ai]);
-      const double v_r = interpolate(ch.pos_mm, ch.value_um, r), u_r = interpolate(ch.pos_mm, ch.u_um, r);
-      comp.u_k2.clear();
-      for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) {
-        ch.value_um[i] -= v_r;
-        const bool at_ref = std::abs(ch.pos_mm[i] - r) < 1e-9;
-        comp.u_k2.push_back(at_ref ? 0.0 : 2.0 * std::hypot(ch.u_um[i], u_r));
-      }
-      f.model.component[static_cast<std::size_t>(k)] = {ch.pos_mm, ch.value_um};
-      comp.observed = true;
-      comp.note = note;
-    }
+using Slopes = std::array<std::array<std::optional<Line>, 3>, 3>;  // [moving axis][channel]
+
+// The translation component of the run's axis a in direction c (positioning for c = a,
+// straightness less its slope, which goes to `slope`, otherwise), relative to the machine at
+// the axis' reference point, with its U; the axis' range from the run's targets.
+void fit_translation(const AxisPass& run, int c, VolumetricFit& f, Slopes& slope) {
+  const int a = run.axis;
+  const auto ai = static_cast<std::size_t>(a);
+  const int k = 6 * a + kTx + c;
+  auto& comp = f.component[static_cast<std::size_t>(k)];
+  Channel ch = channel_of(run, c);
+  if (ch.pos_mm.size() < 2)
+    throw InputError("volumetric: the " + letter(a) + " run " + run.source + " reached fewer than 2 targets");
+  f.model.range_mm[ai] = {ch.pos_mm.front(), ch.pos_mm.back()};
+  std::string note = "positioning run " + run.source + ", channel " + letter(c);
+  if (c != a) {
+    // A straightness has no slope: that is the frame and the squareness (kPairs).
+    const Line l = weighted_line(ch);
+    slope[ai][static_cast<std::size_t>(c)] = l;
+    for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) ch.value_um[i] -= l.slope * ch.pos_mm[i] + l.intercept;
+    note += " less its slope (frame and squareness)";
   }
+  // Relative to the machine at the reference point of the axis.
+  const double r = reference_of(f.model.range_mm[ai]);
+  const double v_r = interpolate(ch.pos_mm, ch.value_um, r), u_r = interpolate(ch.pos_mm, ch.u_um, r);
+  comp.u_k2.clear();
+  for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) {
+    ch.value_um[i] -= v_r;
+    const bool at_ref = std::abs(ch.pos_mm[i] - r) < 1e-9;
+    comp.u_k2.push_back(at_ref ? 0.0 : 2.0 * std::hypot(ch.u_um[i], u_r));
+  }
+  f.model.component[static_cast<std::size_t>(k)] = {ch.pos_mm, ch.value_um};
+  comp.observed = true;
+  comp.note = note;
+}
+
+using SquarenessEstimates = std::array<std::vector<std::pair<double, double>>, 3>;  // (µrad, U) per slot
+
+// Each pair's squareness from the slopes of its two runs (kPairs), and from the circles in
+// its plane that carry an uncertainty.
+SquarenessEstimates squareness_estimates(const Slopes& slope, const std::vector<SquarenessFigure>& circles) {
+  SquarenessEstimates square_est;
   for (std::size_t sl = 0; sl < 3; ++sl) {
     const auto a = static_cast<std::size_t>(kPairs[sl].a), b = static_cast<std::size_t>(kPairs[sl].b);
     const auto& ba = slope[b][a];  // b's run seen in a's channel
@@ -184,6 +194,11 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
     const double value = c.pair == 2 ? -c.urad : c.urad;
     if (c.u_k2_urad && *c.u_k2_urad > 0.0) square_est[slot].emplace_back(value, *c.u_k2_urad);
   }
+  return square_est;
+}
+
+// Each squareness the inverse-variance mean of its estimates; not observed without any.
+void combine_squareness(const SquarenessEstimates& square_est, VolumetricFit& f) {
   const char* names[3] = {"xwy", "ywz", "xwz"};
   double* values[3] = {&f.model.xwy_urad, &f.model.ywz_urad, &f.model.xwz_urad};
   for (std::size_t s = 0; s < 3; ++s) {
@@ -204,7 +219,10 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
     sq.observed = true;
     sq.note = std::to_string(square_est[s].size()) + " estimate(s), inverse-variance mean";
   }
-  // What eical cannot observe, and the axes no run moved.
+}
+
+// What eical cannot observe, and the axes no run moved: zero over the axis' range, and why.
+void mark_unobserved(VolumetricFit& f) {
   for (int a = 0; a < 3; ++a) {
     const auto ai = static_cast<std::size_t>(a);
     for (int k = 6 * a; k < 6 * a + 6; ++k) {
@@ -219,6 +237,19 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
                                    : "not measured: no positioning run moves " + letter(a);
     }
   }
+}
+
+}  // namespace
+
+VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vector<SquarenessFigure>& circles) {
+  VolumetricFit f;
+  const MergedRuns merged = merge_runs(passes, f.model.range_mm);
+  Slopes slope;
+  for (int a = 0; a < 3; ++a)
+    if (merged[static_cast<std::size_t>(a)])
+      for (int c = 0; c < 3; ++c) fit_translation(*merged[static_cast<std::size_t>(a)], c, f, slope);
+  combine_squareness(squareness_estimates(slope, circles), f);
+  mark_unobserved(f);
   return f;
 }
 

@@ -168,6 +168,15 @@ struct AxisGram {
     ++rows[pass];
     return &block(static_cast<Eigen::Index>(fill++), 0);  // column-major: stride kBlock
   }
+  // One sample's row: the common features, the target and n_cyc cyclic columns.
+  void add_row(std::size_t pass, const double* common9, double target, const double* cyc, std::size_t n_cyc) {
+    double* r = next_row(pass);
+    const auto stride = static_cast<std::size_t>(kBlock);
+    for (std::size_t j = 0; j < 9; ++j) r[j * stride] = common9[j];
+    r[kTarget * stride] = target;
+    for (std::size_t j = 0; j < n_cyc; ++j) r[(kCyc + j) * stride] = cyc[j];
+    if (fill == kBlock) flush();
+  }
   void flush() {
     if (fill == 0) return;
     const auto f = block.topRows(static_cast<Eigen::Index>(fill));
@@ -299,6 +308,246 @@ class StoredPasses final : public PassReplay {
   std::vector<Pass> info_;
 };
 
+// Throws when the passes cannot be evaluated; whether they go round in both directions.
+bool check_passes(const std::vector<PassReplay::Pass>& passes, const DiagnosticsOptions& opt) {
+  if (passes.empty()) throw InputError("circle diagnostics: no pass to evaluate");
+  if (!(opt.radius_mm > 0.0)) throw InputError("circle diagnostics: radius must be positive");
+  bool both_directions = false;
+  for (const auto& p : passes) {
+    if (p.samples < 100) throw InputError("circle diagnostics: a pass holds fewer than 100 samples");
+    if (!(p.fs_hz > 0.0)) throw InputError("circle diagnostics: fs_hz must be positive");
+    if (p.direction != passes.front().direction) both_directions = true;
+  }
+  return both_directions;
+}
+
+// The pitches searched for the cyclic error. A pitch is identifiable only with at least two
+// periods over the diameter; longer ones are collinear with scale, offset and bow.
+std::vector<double> candidate_pitches(const DiagnosticsOptions& opt) {
+  if (opt.cyclic_pitch_mm) return {*opt.cyclic_pitch_mm};
+  std::vector<double> pitches;
+  for (double p : {1.0, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0})
+    if (p <= opt.radius_mm) pitches.push_back(p);
+  if (pitches.empty()) pitches = {opt.radius_mm};
+  return pitches;
+}
+
+// Every fixed column, and every one but the lag (a single-direction x fit borrows y's).
+std::array<bool, n_cols> every_column() {
+  std::array<bool, n_cols> use{};
+  use.fill(true);
+  return use;
+}
+std::array<bool, n_cols> every_column_but_lag() {
+  auto use = every_column();
+  use[lag] = false;
+  return use;
+}
+
+// Both axes' models with the backlash as a step, searching `pitches`.
+std::array<AxisModel, 2> step_models(const DiagnosticsOptions& opt, const std::vector<double>& pitches,
+                                     std::size_t n_pass) {
+  std::array<AxisModel, 2> model;
+  for (int a = 0; a < 2; ++a) {
+    model[a].a = a, model[a].opt = opt;
+    model[a].set_pitches(pitches);
+    model[a].d0.assign(n_pass, 0);
+  }
+  return model;
+}
+
+// First replay: the normal equations of both axes over every pitch, outside the reversal
+// windows; records each axis' first direction of motion per pass into its model.
+std::vector<AxisGram> accumulate_every_pitch(PassReplay& replay, std::size_t window, std::array<AxisModel, 2>& model) {
+  const std::size_t n_pitch = model[0].pitches_mm.size();
+  std::vector<AxisGram> gram;
+  for (int a = 0; a < 2; ++a) gram.emplace_back(replay.passes().size(), n_pitch);
+  std::vector<double> cyc(2 * n_pitch);
+  walk(replay, window, [&model, &gram, &cyc](const Walked& w) {
+    for (int a = 0; a < 2; ++a) {
+      if (model[a].d0[w.pass] == 0) model[a].d0[w.pass] = sgn(w.vel[a], 1e-6);
+      if (w.skip[a]) continue;
+      double c9[9], target = 0.0;
+      model[a].row(w, c9, cyc.data(), target);
+      gram[a].add_row(w.pass, c9, target, cyc.data(), cyc.size());
+    }
+  });
+  for (auto& g : gram) g.flush();
+  return gram;
+}
+
+// Second replay: the normal equations of both axes for the one pitch the models hold now.
+std::vector<AxisGram> accumulate_best_pitch(PassReplay& replay, std::size_t window, std::array<AxisModel, 2>& model) {
+  std::vector<AxisGram> gram;
+  for (int a = 0; a < 2; ++a) gram.emplace_back(replay.passes().size(), 1);
+  walk(replay, window, [&model, &gram](const Walked& w) {
+    for (int a = 0; a < 2; ++a) {
+      double c9[9], cyc[2], target = 0.0;
+      model[a].row(w, c9, cyc, target);  // every sample: the play operator runs through the skipped ones too
+      if (w.skip[a]) continue;
+      gram[a].add_row(w.pass, c9, target, cyc, 2);
+    }
+  });
+  for (auto& g : gram) g.flush();
+  return gram;
+}
+
+// The pitch (index) whose fit leaves the least, both axes.
+std::size_t search_pitch(const std::vector<AxisGram>& gram, std::size_t n_pitch) {
+  const auto use = every_column();
+  std::size_t best = 0;
+  double best_rms = kInf;
+  for (std::size_t k = 0; k < n_pitch; ++k) {
+    const double rms = solve_axis(gram[1], k, use, 0.0).rms_mm + solve_axis(gram[0], k, use, 0.0).rms_mm;
+    if (rms < best_rms) best_rms = rms, best = k;
+  }
+  return best;
+}
+
+struct AxisFits {
+  std::array<AxisFit, 2> axis;
+  double fixed_lag_x_s = 0.0;  // moved to x's target (one direction only): y's lag
+};
+
+// Both axes at pitch k. Y first: its lag is identifiable from one direction (v_y follows
+// cos θ, squareness sits in the x equation only), and a single-direction x fit borrows it.
+AxisFits fit_axes(const std::vector<AxisGram>& gram, std::size_t k, bool both_directions) {
+  AxisFits fits;
+  fits.axis[1] = solve_axis(gram[1], k, every_column(), 0.0);
+  fits.fixed_lag_x_s = both_directions ? 0.0 : fits.axis[1].coef(lag);
+  fits.axis[0] = both_directions ? solve_axis(gram[0], k, every_column(), 0.0)
+                                 : solve_axis(gram[0], k, every_column_but_lag(), fits.fixed_lag_x_s);
+  if (!both_directions) fits.axis[0].coef(lag) = fits.axis[1].coef(lag);
+  return fits;
+}
+
+// The fitted machine errors into the diagnostics, in ballbar conventions.
+void report_fit(const AxisFits& fits, double pitch_mm, bool both_directions, CircleDiagnostics& d) {
+  if (both_directions)
+    d.servo_and_squareness_separated = true;
+  else
+    d.notes.push_back("one direction only: servo mismatch cannot be separated from squareness; equal lags assumed");
+  const Eigen::VectorXd& cx = fits.axis[0].coef;
+  const Eigen::VectorXd& cy = fits.axis[1].coef;
+  d.backlash_x_um = cx(backlash) * kUmPerMm;
+  d.backlash_y_um = cy(backlash) * kUmPerMm;
+  d.lateral_play_x_um = cx(lateral) * kUmPerMm;
+  d.lateral_play_y_um = cy(lateral) * kUmPerMm;
+  d.cyclic_error_x_um = std::hypot(cx(cyc_sin), cx(cyc_cos)) * kUmPerMm;
+  d.cyclic_error_y_um = std::hypot(cy(cyc_sin), cy(cyc_cos)) * kUmPerMm;
+  d.cyclic_pitch_mm = pitch_mm;
+  d.lag_x_ms = cx(lag) * 1e3;
+  d.lag_y_ms = cy(lag) * 1e3;
+  d.servo_mismatch_ms = d.lag_x_ms - d.lag_y_ms;
+  d.squareness_urad = cx(square) * 1e6;
+  d.scale_mismatch_ppm = (cx(scale) - cy(scale)) * 1e6;
+  // Bow of X's travel is seen on y, and the other way round; reported as the deviation at
+  // mid-travel relative to the ends of the circle's span (the u² column is zero at mid-travel
+  // and one at the ends, hence the sign).
+  d.straightness_x_um = -cy(bow) * kUmPerMm;
+  d.straightness_y_um = -cx(bow) * kUmPerMm;
+}
+
+// What the final fits leave, summed over the third replay.
+struct ResidualSums {
+  double spike_sum[2] = {0.0, 0.0};  // signed reversal spikes (positive: lagging)
+  int spike_count[2] = {0, 0};
+  double ss_rad = 0.0, ss_axis[2] = {0.0, 0.0};  // outside every reversal window
+  std::size_t n = 0;
+  double ss_fit[2] = {0.0, 0.0};  // outside the axis' own reversal windows
+  std::size_t n_fit[2] = {0, 0};
+};
+
+// The third replay's per-sample work. Reversal spikes (the mean signed peak of the residual
+// in the window after each reversal of the axis, the window within the pass); what the
+// model leaves (RMS over the samples outside the reversal windows): radially the vibration
+// class, per axis the stick-slip class.
+class ResidualMeter {
+ public:
+  ResidualMeter(std::array<AxisModel, 2>& model, const AxisFits& fits, const Eigen::Vector2d& centre_mm,
+                std::size_t window)
+      : model_(model), fits_(fits), centre_mm_(centre_mm), window_(window) {}
+
+  void add(const Walked& w) {
+    if (w.pass != pass_now_) pass_now_ = w.pass, last_[0] = last_[1] = 0, open_[0].clear(), open_[1].clear();
+    double r[2];
+    for (int a = 0; a < 2; ++a) {
+      double c9[9], cyc[2], target = 0.0;
+      model_[a].row(w, c9, cyc, target);
+      r[a] = residual(fits_.axis[a], c9, cyc, target, w.pass, a == 0 ? fits_.fixed_lag_x_s : 0.0, w.vel[a]);
+      if (!w.skip[a]) sums_.ss_fit[a] += r[a] * r[a], ++sums_.n_fit[a];
+      track_spikes(a, w, r[a]);
+    }
+    if (w.skip[0] || w.skip[1]) return;
+    const Eigen::Vector2d res(r[0], r[1]);
+    Eigen::Vector2d radial = w.cmd - centre_mm_;
+    if (radial.norm() <= 0.0) return;
+    radial.normalize();
+    sums_.ss_rad += std::pow(res.dot(radial), 2);
+    sums_.ss_axis[0] += res[0] * res[0], sums_.ss_axis[1] += res[1] * res[1];
+    ++sums_.n;
+  }
+  [[nodiscard]] const ResidualSums& sums() const { return sums_; }
+
+ private:
+  struct Spike {
+    std::size_t end;  // window end (exclusive), within the pass
+    int s;
+    double peak = 0.0;
+  };
+  // A reversal opens a window when the whole window lies within the pass; a window closes
+  // with its peak residual.
+  void track_spikes(int a, const Walked& w, double r) {
+    const int s = sgn(w.vel[a], 1e-6);
+    if (s != 0 && last_[a] != 0 && s != last_[a] && w.i + window_ <= w.n) open_[a].push_back({w.i + window_, s});
+    if (s != 0) last_[a] = s;
+    for (auto it = open_[a].begin(); it != open_[a].end();) {
+      if (std::abs(r) > std::abs(it->peak)) it->peak = r;
+      if (w.i + 1 == it->end) {
+        // Positive when the axis lags behind its new direction (friction holds it at the
+        // reversal, the usual reversal spike); an overshoot is negative.
+        sums_.spike_sum[a] -= it->peak * it->s;
+        ++sums_.spike_count[a];
+        it = open_[a].erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
+
+  std::array<AxisModel, 2>& model_;
+  const AxisFits& fits_;
+  Eigen::Vector2d centre_mm_;
+  std::size_t window_;
+  std::array<std::vector<Spike>, 2> open_;
+  int last_[2] = {0, 0};
+  std::size_t pass_now_ = SIZE_MAX;
+  ResidualSums sums_;
+};
+
+// Reversal spikes, the fast residual (stick-slip at creep feed, else vibration) and the fit's RMS.
+void report_residuals(const ResidualSums& s, const DiagnosticsOptions& opt, CircleDiagnostics& d) {
+  d.reversal_spike_x_um = s.spike_count[0] > 0 ? s.spike_sum[0] / s.spike_count[0] * kUmPerMm : 0.0;
+  d.reversal_spike_y_um = s.spike_count[1] > 0 ? s.spike_sum[1] / s.spike_count[1] * kUmPerMm : 0.0;
+  if (s.n > 0) {
+    if (opt.feed_mm_min > 0.0 && opt.feed_mm_min <= opt.creep_feed_mm_min) {
+      // Creep feed: the fast residual of each axis is its slide sticking and slipping — a
+      // sawtooth (or triangle) between 0 and the lag A, whose RMS is A/(2√3). Its mean lag
+      // A/2 against the direction of motion reads as backlash A.
+      const double ax = std::sqrt(s.ss_axis[0] / static_cast<double>(s.n)),
+                   ay = std::sqrt(s.ss_axis[1] / static_cast<double>(s.n));
+      d.stick_slip_um = 2.0 * std::sqrt(3.0) * std::max(ax, ay) * kUmPerMm;
+      d.notes.push_back(
+          "creep feed: the fast residual is reported as stick-slip (its mean lag also reads as backlash)");
+    } else {
+      d.vibration_um = std::sqrt(s.ss_rad / static_cast<double>(s.n)) * kUmPerMm;
+    }
+  }
+  const double rms_x = s.n_fit[0] > 0 ? std::sqrt(s.ss_fit[0] / static_cast<double>(s.n_fit[0])) : 0.0;
+  const double rms_y = s.n_fit[1] > 0 ? std::sqrt(s.ss_fit[1] / static_cast<double>(s.n_fit[1])) : 0.0;
+  d.residual_rms_um = std::hypot(rms_x, rms_y) * kUmPerMm;
+}
+
 }  // namespace
 
 CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& opt) {
@@ -311,198 +560,32 @@ CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const D
 
 CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& opt) {
   const auto& passes = replay.passes();
-  if (passes.empty()) throw InputError("circle diagnostics: no pass to evaluate");
-  if (!(opt.radius_mm > 0.0)) throw InputError("circle diagnostics: radius must be positive");
-  bool both_directions = false;
-  for (const auto& p : passes) {
-    if (p.samples < 100) throw InputError("circle diagnostics: a pass holds fewer than 100 samples");
-    if (!(p.fs_hz > 0.0)) throw InputError("circle diagnostics: fs_hz must be positive");
-    if (p.direction != passes.front().direction) both_directions = true;
-  }
-  const std::size_t n_pass = passes.size();
+  const bool both_directions = check_passes(passes, opt);
   const auto window = static_cast<std::size_t>(std::lround(opt.spike_window_s * passes.front().fs_hz));
-
-  std::array<bool, n_cols> use{};
-  use.fill(true);
-  // A pitch is identifiable only with at least two periods over the diameter; longer ones
-  // are collinear with scale, offset and bow.
-  std::vector<double> pitches;
-  if (opt.cyclic_pitch_mm) {
-    pitches = {*opt.cyclic_pitch_mm};
-  } else {
-    for (double p : {1.0, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0})
-      if (p <= opt.radius_mm) pitches.push_back(p);
-    if (pitches.empty()) pitches = {opt.radius_mm};
-  }
+  const std::vector<double> pitches = candidate_pitches(opt);
 
   // First replay: every pitch with the backlash as a step, both axes; each axis' first
   // direction of motion per pass (the play operator starts from it).
-  std::array<AxisModel, 2> model;
-  std::vector<AxisGram> gram;
-  for (int a = 0; a < 2; ++a) {
-    model[a].a = a, model[a].opt = opt;
-    model[a].set_pitches(pitches);
-    model[a].d0.assign(n_pass, 0);
-    gram.emplace_back(n_pass, pitches.size());
+  std::array<AxisModel, 2> model = step_models(opt, pitches, passes.size());
+  const std::vector<AxisGram> gram = accumulate_every_pitch(replay, window, model);
+  const std::size_t best = search_pitch(gram, pitches.size());
+  // Round one: the backlash as a step (what the pitch search fitted).
+  const AxisFits round_one = fit_axes(gram, best, both_directions);
+
+  // Second replay, round two: the play operator of the play just found (a sharp step
+  // would leave the play's crossing time as a false reversal spike).
+  for (std::size_t a = 0; a < 2; ++a) {
+    model[a].set_pitches({pitches[best]});
+    model[a].play_mm = std::max(0.0, round_one.axis[a].coef(backlash));
   }
-  std::vector<double> cyc(2 * pitches.size());
-  walk(replay, window, [&](const Walked& w) {
-    for (int a = 0; a < 2; ++a) {
-      if (model[a].d0[w.pass] == 0) model[a].d0[w.pass] = sgn(w.vel[a], 1e-6);
-      if (w.skip[a]) continue;
-      double* r = gram[a].next_row(w.pass);
-      double c9[9], target = 0.0;
-      model[a].row(w, c9, cyc.data(), target);
-      const auto stride = static_cast<std::size_t>(AxisGram::kBlock);
-      for (std::size_t j = 0; j < 9; ++j) r[j * stride] = c9[j];
-      r[AxisGram::kTarget * stride] = target;
-      for (std::size_t j = 0; j < cyc.size(); ++j) r[(AxisGram::kCyc + j) * stride] = cyc[j];
-      if (gram[a].fill == AxisGram::kBlock) gram[a].flush();
-    }
-  });
-  for (auto& g : gram) g.flush();
+  const AxisFits fits = fit_axes(accumulate_best_pitch(replay, window, model), 0, both_directions);
 
   CircleDiagnostics d;
-  // Y first: its lag is identifiable from one direction (v_y follows cos θ, squareness
-  // sits in the x equation only), and a single-direction x fit borrows it.
-  std::size_t best = 0;
-  double best_rms = kInf;
-  for (std::size_t k = 0; k < pitches.size(); ++k) {
-    const double rms = solve_axis(gram[1], k, use, 0.0).rms_mm + solve_axis(gram[0], k, use, 0.0).rms_mm;
-    if (rms < best_rms) best_rms = rms, best = k;
-  }
-  const double best_pitch = pitches[best];
-  auto use_x = use;
-  use_x[lag] = false;
-  // Round one: the backlash as a step (what the pitch search fitted).
-  std::array<AxisFit, 2> fits;
-  fits[1] = solve_axis(gram[1], best, use, 0.0);
-  fits[0] = both_directions ? solve_axis(gram[0], best, use, 0.0) : solve_axis(gram[0], best, use_x, fits[1].coef(lag));
-  if (!both_directions) fits[0].coef(lag) = fits[1].coef(lag);
-  // Round two: the play operator of the play just found (a sharp step would leave the
-  // play's crossing time as a false reversal spike).
-  double play_mm[2];
-  for (int a = 0; a < 2; ++a) play_mm[a] = std::max(0.0, fits[static_cast<std::size_t>(a)].coef(backlash));
-  std::vector<AxisGram> gram2;
-  for (int a = 0; a < 2; ++a) {
-    model[a].set_pitches({best_pitch});
-    model[a].play_mm = play_mm[a];
-    gram2.emplace_back(n_pass, 1);
-  }
-  double cyc1[2];
-  walk(replay, window, [&](const Walked& w) {
-    for (int a = 0; a < 2; ++a) {
-      double c9[9], target = 0.0;
-      model[a].row(w, c9, cyc1, target);  // every sample: the play operator runs through the skipped ones too
-      if (w.skip[a]) continue;
-      double* r = gram2[a].next_row(w.pass);
-      const auto stride = static_cast<std::size_t>(AxisGram::kBlock);
-      for (std::size_t j = 0; j < 9; ++j) r[j * stride] = c9[j];
-      r[AxisGram::kTarget * stride] = target;
-      r[AxisGram::kCyc * stride] = cyc1[0], r[(AxisGram::kCyc + 1) * stride] = cyc1[1];
-      if (gram2[a].fill == AxisGram::kBlock) gram2[a].flush();
-    }
-  });
-  for (auto& g : gram2) g.flush();
-  fits[1] = solve_axis(gram2[1], 0, use, 0.0);
-  const double fixed_lag_x = both_directions ? 0.0 : fits[1].coef(lag);
-  fits[0] = both_directions ? solve_axis(gram2[0], 0, use, 0.0) : solve_axis(gram2[0], 0, use_x, fixed_lag_x);
-  if (!both_directions) fits[0].coef(lag) = fits[1].coef(lag);
-
-  if (both_directions)
-    d.servo_and_squareness_separated = true;
-  else
-    d.notes.push_back("one direction only: servo mismatch cannot be separated from squareness; equal lags assumed");
-  const Eigen::VectorXd& cx = fits[0].coef;
-  const Eigen::VectorXd& cy = fits[1].coef;
-  d.backlash_x_um = cx(backlash) * kUmPerMm;
-  d.backlash_y_um = cy(backlash) * kUmPerMm;
-  d.lateral_play_x_um = cx(lateral) * kUmPerMm;
-  d.lateral_play_y_um = cy(lateral) * kUmPerMm;
-  d.cyclic_error_x_um = std::hypot(cx(cyc_sin), cx(cyc_cos)) * kUmPerMm;
-  d.cyclic_error_y_um = std::hypot(cy(cyc_sin), cy(cyc_cos)) * kUmPerMm;
-  d.cyclic_pitch_mm = best_pitch;
-  d.lag_x_ms = cx(lag) * 1e3;
-  d.lag_y_ms = cy(lag) * 1e3;
-  d.servo_mismatch_ms = d.lag_x_ms - d.lag_y_ms;
-  d.squareness_urad = cx(square) * 1e6;
-  d.scale_mismatch_ppm = (cx(scale) - cy(scale)) * 1e6;
-  // Bow of X's travel is seen on y, and the other way round; reported as the deviation at
-  // mid-travel relative to the ends of the circle's span (the u² column is zero at mid-travel
-  // and one at the ends, hence the sign).
-  d.straightness_x_um = -cy(bow) * kUmPerMm;
-  d.straightness_y_um = -cx(bow) * kUmPerMm;
-
-  // Third replay: the residuals of the final fits. Reversal spikes (the mean signed peak
-  // of the residual in the window after each reversal of the axis, the window within the
-  // pass); what the model leaves (RMS over the samples outside the reversal windows):
-  // radially the vibration class, per axis the stick-slip class.
-  for (int a = 0; a < 2; ++a) model[a].play_mm = play_mm[a];
-  struct Spike {
-    std::size_t end;  // window end (exclusive), within the pass
-    int s;
-    double peak = 0.0;
-  };
-  std::array<std::vector<Spike>, 2> open;
-  double spike_sum[2] = {0.0, 0.0};
-  int spike_count[2] = {0, 0};
-  int last[2] = {0, 0};
-  std::size_t pass_now = SIZE_MAX;
-  double ss_rad = 0.0, ss_axis[2] = {0.0, 0.0}, ss_fit[2] = {0.0, 0.0};
-  std::size_t n = 0, n_fit[2] = {0, 0};
-  walk(replay, window, [&](const Walked& w) {
-    if (w.pass != pass_now) pass_now = w.pass, last[0] = last[1] = 0, open[0].clear(), open[1].clear();
-    double r[2];
-    for (int a = 0; a < 2; ++a) {
-      double c9[9], target = 0.0;
-      model[a].row(w, c9, cyc1, target);
-      r[a] = residual(fits[a], c9, cyc1, target, w.pass, a == 0 ? fixed_lag_x : 0.0, w.vel[a]);
-      if (!w.skip[a]) ss_fit[a] += r[a] * r[a], ++n_fit[a];
-      // A reversal opens a window when the whole window lies within the pass.
-      const int s = sgn(w.vel[a], 1e-6);
-      if (s != 0 && last[a] != 0 && s != last[a] && w.i + window <= w.n) open[a].push_back({w.i + window, s});
-      if (s != 0) last[a] = s;
-      for (auto it = open[a].begin(); it != open[a].end();) {
-        if (std::abs(r[a]) > std::abs(it->peak)) it->peak = r[a];
-        if (w.i + 1 == it->end) {
-          // Positive when the axis lags behind its new direction (friction holds it at the
-          // reversal, the usual reversal spike); an overshoot is negative.
-          spike_sum[a] -= it->peak * it->s;
-          ++spike_count[a];
-          it = open[a].erase(it);
-        } else {
-          ++it;
-        }
-      }
-    }
-    if (w.skip[0] || w.skip[1]) return;
-    const Eigen::Vector2d res(r[0], r[1]);
-    Eigen::Vector2d radial = w.cmd - opt.centre_mm;
-    if (radial.norm() <= 0.0) return;
-    radial.normalize();
-    ss_rad += std::pow(res.dot(radial), 2);
-    ss_axis[0] += res[0] * res[0], ss_axis[1] += res[1] * res[1];
-    ++n;
-  });
-  d.reversal_spike_x_um = spike_count[0] > 0 ? spike_sum[0] / spike_count[0] * kUmPerMm : 0.0;
-  d.reversal_spike_y_um = spike_count[1] > 0 ? spike_sum[1] / spike_count[1] * kUmPerMm : 0.0;
-  if (n > 0) {
-    if (opt.feed_mm_min > 0.0 && opt.feed_mm_min <= opt.creep_feed_mm_min) {
-      // Creep feed: the fast residual of each axis is its slide sticking and slipping — a
-      // sawtooth (or triangle) between 0 and the lag A, whose RMS is A/(2√3). Its mean lag
-      // A/2 against the direction of motion reads as backlash A.
-      const double ax = std::sqrt(ss_axis[0] / static_cast<double>(n)),
-                   ay = std::sqrt(ss_axis[1] / static_cast<double>(n));
-      d.stick_slip_um = 2.0 * std::sqrt(3.0) * std::max(ax, ay) * kUmPerMm;
-      d.notes.push_back(
-          "creep feed: the fast residual is reported as stick-slip (its mean lag also reads as backlash)");
-    } else {
-      d.vibration_um = std::sqrt(ss_rad / static_cast<double>(n)) * kUmPerMm;
-    }
-  }
-  const double rms_x = n_fit[0] > 0 ? std::sqrt(ss_fit[0] / static_cast<double>(n_fit[0])) : 0.0;
-  const double rms_y = n_fit[1] > 0 ? std::sqrt(ss_fit[1] / static_cast<double>(n_fit[1])) : 0.0;
-  d.residual_rms_um = std::hypot(rms_x, rms_y) * kUmPerMm;
+  report_fit(fits, pitches[best], both_directions, d);
+  // Third replay: the residuals of the final fits.
+  ResidualMeter meter(model, fits, opt.centre_mm, window);
+  walk(replay, window, [&meter](const Walked& w) { meter.add(w); });
+  report_residuals(meter.sums(), opt, d);
   return d;
 }
 

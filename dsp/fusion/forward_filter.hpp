@@ -9,6 +9,7 @@
 // (P_vv += ν², P_bb += (ν/T)², T since the last accepted velocity) and the update taken.
 // The reset is process noise at that sample: the smoother adds it there too (`resets`).
 #include "dsp/fusion/axis_filter.hpp"
+#include "dsp/fusion/support_rows.hpp"
 #include "dsp/fusion/support_schedule.hpp"
 
 #include <algorithm>
@@ -62,10 +63,10 @@ struct ForwardFilter {
     const double sz = std::max(m.zupt_sigma_um_s, zupt_sigma_um_s);
     for (int a = 0; a < 3; ++a) {
       if (flags & schedule_flag::rest) {
-        if (zupt_on) velocity_update(a, Eigen::RowVector3d(0.0, 1.0, 0.0), vel_um_s[a], sz * sz, m, 1);
+        if (zupt_on) velocity_update(a, observe::zupt_row(), vel_um_s[a], sz * sz, m, 1);
       } else if (flags & nbs_flag(a)) {
         tally[a][static_cast<int>(Support::nbs)].add(
-            axis[a].update(1, vel_um_s[a], m.nbs_sigma_um_s * m.nbs_sigma_um_s, m.gate_nis));
+            axis[a].update_row(observe::nbs_row(), vel_um_s[a], m.nbs_sigma_um_s * m.nbs_sigma_um_s, m.gate_nis));
       }
     }
   }
@@ -74,8 +75,7 @@ struct ForwardFilter {
   void velocity_mean(const VelocityMean& v, const ErrorModel& m, bool zupt_on = true) noexcept {
     if (!zupt_on) return;
     const double s = std::max(m.zupt_sigma_um_s, v.sigma_um_s);
-    for (int a = 0; a < 3; ++a)
-      velocity_update(a, Eigen::RowVector3d(0.0, 1.0, -v.lag_s), v.mean_um_s[a], s * s, m, 100);
+    for (int a = 0; a < 3; ++a) velocity_update(a, observe::velocity_mean_row(v.lag_s), v.mean_um_s[a], s * s, m, 100);
   }
 
   // CUPT: the integrated position minus the PSD's is the position error.
@@ -84,7 +84,7 @@ struct ForwardFilter {
   UpdateRecord position_fix(int a, double ins_pos_um, double fix_pos_um, double sigma_um,
                             const ErrorModel& m) noexcept {
     const double s = sigma_um * sigma_um + m.psd_floor_um * m.psd_floor_um;
-    UpdateRecord r = axis[a].update(0, ins_pos_um - fix_pos_um, s, m.gate_nis);
+    UpdateRecord r = axis[a].update_row(observe::cupt_row(), ins_pos_um - fix_pos_um, s, m.gate_nis);
     if (!r.accepted && std::isfinite(r.innovation) && std::abs(r.innovation) < 1e9) {
       if (++fix_rejections_[a] >= m.reset_after_rejections) {
         const double nu = r.innovation, t = std::max(since_position_s_[a], 0.1);
@@ -95,7 +95,7 @@ struct ForwardFilter {
         axis[a].P(2, 2) += reset.add_bb;
         if (resets && resets->size() < resets->capacity()) resets->push_back(reset);
         ++reset_count;
-        r = axis[a].update(0, ins_pos_um - fix_pos_um, s, m.gate_nis);
+        r = axis[a].update_row(observe::cupt_row(), ins_pos_um - fix_pos_um, s, m.gate_nis);
       }
     }
     if (r.accepted) fix_rejections_[a] = 0, since_position_s_[a] = 0.0;

@@ -4,6 +4,7 @@
 #include "dsp/core/error.hpp"
 #include "dsp/core/interpolate.hpp"
 #include "dsp/identify/augmented_filter.hpp"
+#include "dsp/identify/axis_observations.hpp"
 #include "dsp/identify/delay_estimate.hpp"
 
 #include <Eigen/Dense>
@@ -16,20 +17,8 @@
 namespace eical::dsp::identify {
 namespace {
 
-constexpr double kPriorError = 0.02;     // E_ij: scale and cross terms, 2 %
-constexpr double kPriorDampingMs = 0.2;  // Δ(2ζ/ω0), ms (data sheet 0.225 ms)
-constexpr double kPriorOffsetUm = 50.0;  // rest offsets, backlash, PSD mounting
-
 // Which sensor moves machine axis j: 0 table, 1 head, −1 neither.
 int owner(const RunMeta& meta, int j) { return axis_owner(meta.machine, j); }
-
-// Parameter indices of one axis' filter (−1: not fitted).
-struct Layout {
-  int e[3] = {-1, -1, -1};
-  int damping = -1, x0 = -1, backlash = -1;
-  std::vector<int> strip;  // per PSD strip of the run (−1 when it measures another axis)
-  int count = 0;
-};
 
 struct AxisFit {
   Layout layout;
@@ -55,16 +44,24 @@ double rms_about_mean(const std::vector<double>& v) {
   return std::sqrt(ss / static_cast<double>(v.size()));
 }
 
-PassResult fit_pass(const Run& run, const RunMeta& meta, const IdentifyOptions& o) {
+// The pipeline's integration with the data-sheet model as `meta` has it, the raw trace
+// kept; no PSD fixes and no smoother: the filters below fit what it leaves.
+Measurement integrate_raw(const Run& run, const RunMeta& meta, fusion::ErrorModel& model) {
   PipelineConfig cfg = pipeline_config(meta, run.frames.size());
   cfg.keep_raw = true;
   cfg.cupt = false;
   cfg.smooth = false;
+  model = cfg.fusion;
   Pipeline pipe(cfg);
   for (const auto& f : run.frames) pipe.step(f);
-  PassResult r;
-  r.m = pipe.finish();
-  const Measurement& m = r.m;
+  return pipe.finish();
+}
+
+using Standstills = std::vector<std::pair<std::size_t, std::size_t>>;  // first, last sample
+
+// The standstills of the raw trace (runs of rest samples); throws unless there is motion
+// with at least two of them.
+Standstills standstills_of(const Measurement& m) {
   const RawTrace& raw = m.raw;
   if (raw.empty())
     throw InputError("identify: the run has no motion to identify from (" +
@@ -72,140 +69,195 @@ PassResult fit_pass(const Run& run, const RunMeta& meta, const IdentifyOptions& 
   const std::size_t n = raw.pos_mm.size();
   const auto& flags = raw.schedule.flags;
   if (flags.size() != n) throw InputError("identify: the support schedule does not cover the trace");
-  namespace sf = fusion::schedule_flag;
-
-  // Standstills: runs of rest samples.
-  std::vector<std::pair<std::size_t, std::size_t>> rests;
+  Standstills rests;
   for (std::size_t k = 0; k < n; ++k) {
-    if (!(flags[k] & sf::rest)) continue;
+    if (!(flags[k] & fusion::schedule_flag::rest)) continue;
     if (rests.empty() || rests.back().second + 1 != k)
       rests.push_back({k, k});
     else
       rests.back().second = k;
   }
-  r.standstills = rests.size();
   if (rests.empty()) throw InputError("identify: no standstill in the run (the program must rest between its moves)");
   if (rests.size() < 2)
     throw InputError(
         "identify: the run rests only once in its motion: the set-point at the standstills between moves is what ties "
         "the scale "
         "down (run the identification program, eical gen-nc identify)");
+  return rests;
+}
 
+// The axes whose set-point spans more than 0.5 mm and that a sensor moves.
+void moved_axes(const Measurement& m, const RunMeta& meta, bool moved[3]) {
   for (int j = 0; j < 3; ++j) {
     double lo = 1e300, hi = -1e300;
     for (const auto& c : m.cmd_mm) lo = std::min(lo, c[j]), hi = std::max(hi, c[j]);
-    r.moved[j] = hi - lo > 0.5 && owner(meta, j) >= 0;
+    moved[j] = hi - lo > 0.5 && owner(meta, j) >= 0;
   }
-  const int n_strips = static_cast<int>(meta.psd.size());
-  const double fs = m.fs_hz;
-  const fusion::ErrorModel& model = cfg.fusion;
-  const double zupt_sigma = model.zupt_sigma_um_s;
+}
 
-  for (int i = 0; i < 3; ++i) {
-    Layout& L = r.axis[i].layout;
-    std::vector<double> prior;
+// What every axis' filter of a pass reads.
+struct PassInputs {
+  const Run& run;
+  const RunMeta& meta;
+  const IdentifyOptions& o;
+  const Measurement& m;
+  const fusion::ErrorModel& model;
+  const Standstills& rests;
+};
+
+// One axis' filter run over the trace, sample by sample: the prediction with the
+// acceleration gains of the E terms, then the observations of the sample in a fixed order
+// (the start, ZUPT, ringing standstills' velocity means, then the set-point at mid
+// standstill and the PSD fixes, or the reference).
+class AxisPass {
+ public:
+  AxisPass(const PassInputs& in, int axis, const Layout& layout, AugmentedFilter& f)
+      : in_(in),
+        i_(axis),
+        L_(layout),
+        f_(f),
+        strip_count_(in.meta.psd.size(), 0),
+        g_(Eigen::VectorXd::Zero(layout.count)),
+        h_(Eigen::RowVectorXd::Zero(3 + layout.count)) {}
+
+  void sample(std::size_t k) {
+    if (k > 0) predict(k);
+    const RawTrace& raw = in_.m.raw;
+    const double x_um = raw.pos_mm[k][i_] * 1000.0, v_um_s = raw.vel_mm_s[k][i_] * 1000.0;
+    if (k == 0 && !in_.o.against_reference) {  // the integration starts at the set-point: δx0 = −(offset there)
+      observe::start_row(L_, h_);
+      f_.update(h_, 0.0, 1e-3);
+    }
+    observe_standstill_velocity(k, v_um_s);
+    if (!in_.o.against_reference) {
+      observe_rest_setpoint(k, x_um);
+      observe_psd_fixes(k, x_um, v_um_s);
+    } else if (in_.run.channels.ref[i_] && k % static_cast<std::size_t>(std::max(1, in_.o.reference_every)) == 0) {
+      observe_reference(k, x_um, v_um_s);
+    }
+  }
+
+  std::vector<double> psd_res, rest_res;  // what the observations left, before their update
+  std::size_t psd_obs = 0, rest_obs = 0;
+
+ private:
+  // The step from k − 1 to k: E's gains the mean acceleration over it; the direction of the
+  // axis' last move (backlash).
+  void predict(std::size_t k) {
+    const RawTrace& raw = in_.m.raw;
+    const Eigen::Vector3d a_now = (raw.head_mps2[k] - raw.table_mps2[k]) * 1e6;  // µm/s²
+    const Eigen::Vector3d a_prev = (raw.head_mps2[k - 1] - raw.table_mps2[k - 1]) * 1e6;
     for (int j = 0; j < 3; ++j)
-      if (r.moved[j]) L.e[j] = static_cast<int>(prior.size()), prior.push_back(kPriorError);
-    if (r.moved[i]) L.damping = static_cast<int>(prior.size()), prior.push_back(kPriorDampingMs);
-    if (!o.against_reference) {
-      L.x0 = static_cast<int>(prior.size()), prior.push_back(kPriorOffsetUm);
-      if (r.moved[i]) L.backlash = static_cast<int>(prior.size()), prior.push_back(kPriorOffsetUm);
-      L.strip.assign(static_cast<std::size_t>(n_strips), -1);
-      for (int s = 0; s < n_strips; ++s)
-        if (axis_index(meta.psd[static_cast<std::size_t>(s)].measures) == i)
-          L.strip[static_cast<std::size_t>(s)] = static_cast<int>(prior.size()), prior.push_back(kPriorOffsetUm);
-    } else {
-      L.x0 = static_cast<int>(prior.size()), prior.push_back(kPriorOffsetUm);  // the reference's zero
-    }
-    L.count = static_cast<int>(prior.size());
-    AugmentedFilter f(model, Eigen::Vector3d(kPriorOffsetUm, 1.0, 20.0),
-                      Eigen::Map<Eigen::VectorXd>(prior.data(), L.count));
-    const int np = L.count;
-    auto row = [&] { return Eigen::RowVectorXd::Zero(3 + np).eval(); };
-
-    // Direction of the last move of axis i (backlash), and the rest-window mid samples.
-    double dir = 0.0;
-    std::size_t next_rest = 0, next_fix = 0, next_mean = 0;
-    std::vector<int> strip_count(static_cast<std::size_t>(n_strips), 0);
-    std::vector<double> psd_res, rest_res;
-    const auto& fixes = raw.schedule.fixes;
-    const auto& means = raw.schedule.velocity_means;
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(np);
-    const auto& zs = raw.schedule.zupt_sigma_um_s;
-    for (std::size_t k = 0; k < n; ++k) {
-      const Eigen::Vector3d a_now = (raw.head_mps2[k] - raw.table_mps2[k]) * 1e6;  // µm/s²
-      if (k > 0) {
-        const Eigen::Vector3d a_prev = (raw.head_mps2[k - 1] - raw.table_mps2[k - 1]) * 1e6;
-        for (int j = 0; j < 3; ++j)
-          if (L.e[j] >= 0) g[L.e[j]] = 0.5 * (a_now[j] + a_prev[j]);
-        const double h = static_cast<double>(m.sample_index[k] - m.sample_index[k - 1]) / fs;
-        f.predict(h, g, (flags[k] & sf::move_start) != 0);
-        const double dc = m.cmd_mm[k][i] - m.cmd_mm[k - 1][i];
-        if (std::abs(dc) > 1e-9) dir = dc > 0.0 ? 1.0 : -1.0;
-      }
-      const double x_um = raw.pos_mm[k][i] * 1000.0, v_um_s = raw.vel_mm_s[k][i] * 1000.0;
-      if (k == 0 && !o.against_reference) {  // the integration starts at the set-point: δx0 = −(offset there)
-        Eigen::RowVectorXd h = row();
-        h[0] = 1.0, h[3 + L.x0] = 1.0;
-        if (L.backlash >= 0) h[3 + L.backlash] = 0.0;  // direction unknown before the first move
-        f.update(h, 0.0, 1e-3);
-      }
-      if ((flags[k] & sf::rest) && !(flags[k] & sf::invalid) && (k >= zs.size() || zs[k] == 0.0F)) {
-        Eigen::RowVectorXd h = row();
-        h[1] = 1.0;
-        f.update(h, v_um_s, zupt_sigma);
-      }
-      for (; next_mean < means.size() && means[next_mean].k <= k; ++next_mean) {
-        if (means[next_mean].k != k) continue;
-        Eigen::RowVectorXd h = row();
-        h[1] = 1.0, h[2] = -means[next_mean].lag_s;
-        f.update(h, means[next_mean].mean_um_s[i], std::max(zupt_sigma, means[next_mean].sigma_um_s));
-      }
-      if (!o.against_reference) {
-        // The set-point at the middle of each standstill.
-        while (next_rest < rests.size() && (rests[next_rest].first + rests[next_rest].second) / 2 < k) ++next_rest;
-        if (next_rest < rests.size() && (rests[next_rest].first + rests[next_rest].second) / 2 == k) {
-          Eigen::RowVectorXd h = row();
-          h[0] = 1.0, h[3 + L.x0] = 1.0;
-          if (L.backlash >= 0) h[3 + L.backlash] = dir / 2.0;
-          const double z = x_um - m.cmd_mm[k][i] * 1000.0;
-          rest_res.push_back(z);
-          f.update(h, z, o.rest_sigma_um);
-          ++r.rest_obs;
-        }
-        for (; next_fix < fixes.size() && fixes[next_fix].k <= k; ++next_fix) {
-          const fusion::PositionFix& fx = fixes[next_fix];
-          if (fx.k != k || fx.axis != i || fx.strip < 0 || fx.strip >= n_strips) continue;
-          if (strip_count[static_cast<std::size_t>(fx.strip)]++ % std::max(1, o.psd_every) != 0) continue;
-          Eigen::RowVectorXd h = row();
-          h[0] = 1.0;
-          if (L.damping >= 0) h[3 + L.damping] = v_um_s * 1e-3;  // ms × µm/s
-          h[3 + L.strip[static_cast<std::size_t>(fx.strip)]] = -1.0;
-          const double z = x_um - fx.position_um;
-          psd_res.push_back(z);
-          f.update(h, z, std::hypot(fx.sigma_um, model.psd_floor_um));
-          ++r.psd_obs;
-        }
-      } else if (run.channels.ref[i] && k % static_cast<std::size_t>(std::max(1, o.reference_every)) == 0) {
-        const double pos = static_cast<double>(k) - meta.acquisition.daq_group_delay_samples;  // sensors see k − d
-        const double ref = interpolate_at(m.ref_mm, pos, i);
-        if (std::isfinite(ref) && pos >= 0.0) {
-          Eigen::RowVectorXd h = row();
-          h[0] = 1.0, h[3 + L.x0] = 1.0;
-          if (L.damping >= 0) h[3 + L.damping] = v_um_s * 1e-3;
-          f.update(h, x_um - ref * 1000.0, o.reference_sigma_um);
-          ++r.psd_obs;
-        }
-      }
-    }
-    r.axis[i].theta = f.state().tail(np);
-    r.axis[i].sigma.resize(np);
-    for (int p = 0; p < np; ++p) r.axis[i].sigma[p] = f.parameter_sigma(p);
-    r.axis[i].cov = f.covariance().bottomRightCorner(np, np);
-    // RMS of what the observations left about their offsets, before this pass's fit.
-    r.psd_rms_um = std::max(r.psd_rms_um, rms_about_mean(psd_res));
-    r.rest_rms_um = std::max(r.rest_rms_um, rms_about_mean(rest_res));
+      if (L_.e[j] >= 0) g_[L_.e[j]] = 0.5 * (a_now[j] + a_prev[j]);
+    const double h = static_cast<double>(in_.m.sample_index[k] - in_.m.sample_index[k - 1]) / in_.m.fs_hz;
+    f_.predict(h, g_, (raw.schedule.flags[k] & fusion::schedule_flag::move_start) != 0);
+    const double dc = in_.m.cmd_mm[k][i_] - in_.m.cmd_mm[k - 1][i_];
+    if (std::abs(dc) > 1e-9) dir_ = dc > 0.0 ? 1.0 : -1.0;
   }
+
+  // ZUPT at a quiet standstill; the velocity means of a ringing one.
+  void observe_standstill_velocity(std::size_t k, double v_um_s) {
+    namespace sf = fusion::schedule_flag;
+    const auto& sched = in_.m.raw.schedule;
+    const auto& zs = sched.zupt_sigma_um_s;
+    const double zupt_sigma = in_.model.zupt_sigma_um_s;
+    if ((sched.flags[k] & sf::rest) && !(sched.flags[k] & sf::invalid) && (k >= zs.size() || zs[k] == 0.0F)) {
+      observe::zupt_row(h_);
+      f_.update(h_, v_um_s, zupt_sigma);
+    }
+    const auto& means = sched.velocity_means;
+    for (; next_mean_ < means.size() && means[next_mean_].k <= k; ++next_mean_) {
+      const fusion::VelocityMean& vm = means[next_mean_];
+      if (vm.k != k) continue;
+      observe::velocity_mean_row(vm.lag_s, h_);
+      f_.update(h_, vm.mean_um_s[i_], std::max(zupt_sigma, vm.sigma_um_s));
+    }
+  }
+
+  // The set-point at the middle of each standstill.
+  void observe_rest_setpoint(std::size_t k, double x_um) {
+    const Standstills& rests = in_.rests;
+    while (next_rest_ < rests.size() && (rests[next_rest_].first + rests[next_rest_].second) / 2 < k) ++next_rest_;
+    if (next_rest_ < rests.size() && (rests[next_rest_].first + rests[next_rest_].second) / 2 == k) {
+      observe::rest_row(L_, dir_, h_);
+      const double z = x_um - in_.m.cmd_mm[k][i_] * 1000.0;
+      rest_res.push_back(z);
+      f_.update(h_, z, in_.o.rest_sigma_um);
+      ++rest_obs;
+    }
+  }
+
+  // Every psd_every-th lit sample of each strip measuring this axis.
+  void observe_psd_fixes(std::size_t k, double x_um, double v_um_s) {
+    const auto& fixes = in_.m.raw.schedule.fixes;
+    const int n_strips = static_cast<int>(in_.meta.psd.size());
+    for (; next_fix_ < fixes.size() && fixes[next_fix_].k <= k; ++next_fix_) {
+      const fusion::PositionFix& fx = fixes[next_fix_];
+      if (fx.k != k || fx.axis != i_ || fx.strip < 0 || fx.strip >= n_strips) continue;
+      if (strip_count_[static_cast<std::size_t>(fx.strip)]++ % std::max(1, in_.o.psd_every) != 0) continue;
+      observe::psd_row(L_, v_um_s, fx.strip, h_);
+      const double z = x_um - fx.position_um;
+      psd_res.push_back(z);
+      f_.update(h_, z, std::hypot(fx.sigma_um, in_.model.psd_floor_um));
+      ++psd_obs;
+    }
+  }
+
+  // The reference instrument, which the sensors see k − d samples late.
+  void observe_reference(std::size_t k, double x_um, double v_um_s) {
+    const double pos = static_cast<double>(k) - in_.meta.acquisition.daq_group_delay_samples;  // sensors see k − d
+    const double ref = interpolate_at(in_.m.ref_mm, pos, i_);
+    if (std::isfinite(ref) && pos >= 0.0) {
+      observe::reference_row(L_, v_um_s, h_);
+      f_.update(h_, x_um - ref * 1000.0, in_.o.reference_sigma_um);
+      ++psd_obs;
+    }
+  }
+
+  const PassInputs& in_;
+  const int i_;
+  const Layout& L_;
+  AugmentedFilter& f_;
+  double dir_ = 0.0;
+  std::size_t next_rest_ = 0, next_fix_ = 0, next_mean_ = 0;
+  std::vector<int> strip_count_;
+  Eigen::VectorXd g_;
+  Eigen::RowVectorXd h_;  // the observation's row
+};
+
+// One axis' augmented filter over the whole trace: its parameters and their covariance into
+// r.axis[i], its observations into r's counts and RMS.
+void fit_axis(const PassInputs& in, int i, PassResult& r) {
+  const AxisPrior prior = axis_prior(i, r.moved, in.meta.psd, in.o.against_reference);
+  const int np = prior.layout.count;
+  AugmentedFilter f(in.model, Eigen::Vector3d(kPriorOffsetUm, 1.0, 20.0),
+                    Eigen::Map<const Eigen::VectorXd>(prior.sigma.data(), np));
+  AxisPass pass(in, i, prior.layout, f);
+  const std::size_t n = in.m.raw.pos_mm.size();
+  for (std::size_t k = 0; k < n; ++k) pass.sample(k);
+  AxisFit& fit = r.axis[i];
+  fit.layout = prior.layout;
+  fit.theta = f.state().tail(np);
+  fit.sigma.resize(np);
+  for (int p = 0; p < np; ++p) fit.sigma[p] = f.parameter_sigma(p);
+  fit.cov = f.covariance().bottomRightCorner(np, np);
+  r.psd_obs += pass.psd_obs, r.rest_obs += pass.rest_obs;
+  // RMS of what the observations left about their offsets, before this pass's fit.
+  r.psd_rms_um = std::max(r.psd_rms_um, rms_about_mean(pass.psd_res));
+  r.rest_rms_um = std::max(r.rest_rms_um, rms_about_mean(pass.rest_res));
+}
+
+// One identification pass: the integration with the sensors of `meta`, then each axis'
+// filter over it.
+PassResult fit_pass(const Run& run, const RunMeta& meta, const IdentifyOptions& o) {
+  PassResult r;
+  fusion::ErrorModel model;
+  r.m = integrate_raw(run, meta, model);
+  const Standstills rests = standstills_of(r.m);
+  r.standstills = rests.size();
+  moved_axes(r.m, meta, r.moved);
+  const PassInputs in{run, meta, o, r.m, model, rests};
+  for (int i = 0; i < 3; ++i) fit_axis(in, i, r);
   return r;
 }
 
@@ -370,6 +422,132 @@ uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const I
   return c;
 }
 
+// Throws when the run cannot identify: no frames, no reference to identify against, or
+// no PSD strips.
+void check_identifiable(const Run& run, const IdentifyOptions& o) {
+  if (run.frames.empty()) throw InputError("identify: run '" + run.meta.id + "' holds no frames");
+  if (o.against_reference && !(run.channels.ref[0] || run.channels.ref[1] || run.channels.ref[2]))
+    throw InputError("identify: run '" + run.meta.id + "' has no reference instrument to identify against");
+  // Without strips the set-point at standstills alone leaves the damping term unknown and
+  // the scale barely better than the data sheet (a step without strips: E_xx ± 170 ppm
+  // against the data sheet's ± 260): refused like a run that crosses them at one speed.
+  if (!o.against_reference && run.meta.psd.empty())
+    throw InputError("identify: run '" + run.meta.id +
+                     "' has no PSD strips: the sensors are identified from strip crossings at several speeds "
+                     "(run the identification program, eical gen-nc identify, or identify against a reference, "
+                     "--compare-reference)");
+}
+
+// A pass's estimate applied to sensor s of `meta`: E from the columns it owns, Δ(2ζ/ω0)
+// weighted over its axes (where the data said something). Returns the Δ(2ζ/ω0) applied, s.
+double apply_pass(const PassResult& pr, int s, RunMeta& meta) {
+  Eigen::Matrix3d e = Eigen::Matrix3d::Zero();
+  double wsum = 0.0, dsum = 0.0;
+  for (int j = 0; j < 3; ++j) {
+    if (owner(meta, j) != s || !pr.moved[j]) continue;
+    for (int i = 0; i < 3; ++i) e(i, j) = pr.axis[i].theta[pr.axis[i].layout.e[j]];
+    const AxisFit& af = pr.axis[j];
+    if (af.layout.damping >= 0 && af.sigma[af.layout.damping] < 0.5 * kPriorDampingMs) {
+      const double sg = af.sigma[af.layout.damping];
+      wsum += 1.0 / (sg * sg), dsum += af.theta[af.layout.damping] / (sg * sg);
+    }
+  }
+  const double damping_s = wsum > 0.0 ? dsum / wsum * 1e-3 : 0.0;
+  apply_sensor(e, damping_s, meta.sensors[s]);
+  return damping_s;
+}
+
+// The passes, each fitting what the one before left: `meta` ends with every pass's estimate
+// applied, damping_total_s with each sensor's summed Δ(2ζ/ω0). Returns the last pass.
+PassResult iterate_passes(const Run& run, const IdentifyOptions& o, RunMeta& meta, double damping_total_s[2],
+                          int& iterations) {
+  PassResult last;
+  for (int it = 0; it < std::max(1, o.iterations); ++it) {
+    PassResult pr = fit_pass(run, meta, o);
+    for (int s = 0; s < 2; ++s) damping_total_s[s] += apply_pass(pr, s, meta);
+    last = std::move(pr);
+    iterations = it + 1;
+  }
+  return last;
+}
+
+// What the data sheet and the identified model leave unexplained.
+void compare_with_datasheet(const Run& run, const RunMeta& identified, Identification& id) {
+  const Agreement before = agreement(run, run.meta), after = agreement(run, identified);
+  id.psd_rms_before_um = before.psd_rms_um, id.rest_rms_before_um = before.rest_rms_um;
+  id.psd_rms_after_um = after.psd_rms_um, id.rest_rms_after_um = after.rest_rms_um;
+}
+
+// Sensor s: its total error against the data sheet (`datasheet`), with the last pass's σ;
+// its damping term where identified; its bias at the first standstill.
+void report_sensor(int s, const PassResult& last, const RunMeta& datasheet, const RunMeta& meta, double damping_total_s,
+                   Identification& id) {
+  SensorEstimate& se = id.sensor[s];
+  const Eigen::Matrix3d e_total =
+      datasheet.sensors[s].to_machine * meta.sensors[s].to_machine.inverse() - Eigen::Matrix3d::Identity();
+  double wsum = 0.0;
+  for (int j = 0; j < 3; ++j) {
+    if (owner(meta, j) != s || !last.moved[j]) continue;
+    se.moved = true;
+    for (int i = 0; i < 3; ++i) {
+      const AxisFit& af = last.axis[i];
+      se.error[i][j] = {e_total(i, j), af.sigma[af.layout.e[j]], true};
+    }
+    const AxisFit& own = last.axis[j];
+    // The damping term counts where the data said something (no PSD strip on z: nothing).
+    if (own.layout.damping >= 0 && own.sigma[own.layout.damping] < 0.5 * kPriorDampingMs)
+      wsum += 1.0 / std::pow(own.sigma[own.layout.damping] * 1e-3, 2);
+  }
+  if (wsum > 0.0)
+    se.damping_s = {damping_total_s, 1.0 / std::sqrt(wsum), true};
+  else if (se.moved)
+    id.notes.push_back(std::string(s == 0 ? "table" : "head") +
+                       " sensor: 2ζ/ω0 not identified (no PSD strip along its axes): data sheet kept");
+  // Bias at the first standstill (sensor axes, gravity removed): what the rest window took out.
+  const double g = meta.site.g_mps2;
+  const Eigen::Vector3d gravity(0.0, 0.0, g);
+  const Eigen::Vector3d b_machine = last.m.raw.rest_bias_mps2[s] - gravity;
+  se.rest_bias_g = datasheet.sensors[s].bias_g + meta.sensors[s].to_machine.inverse() * b_machine / g;
+}
+
+// The machine's parameters fitted alongside: rest offsets, backlash, the strips' mounting offsets.
+void report_machine(const PassResult& last, const RunMeta& meta, Identification& id) {
+  for (int i = 0; i < 3; ++i) {
+    const AxisFit& af = last.axis[i];
+    if (af.layout.x0 >= 0) id.rest_offset_um[i] = {af.theta[af.layout.x0], af.sigma[af.layout.x0], true};
+    if (af.layout.backlash >= 0) id.backlash_um[i] = {af.theta[af.layout.backlash], af.sigma[af.layout.backlash], true};
+  }
+  id.psd_offset_um.resize(meta.psd.size());
+  for (std::size_t s = 0; s < meta.psd.size(); ++s) {
+    const int i = axis_index(meta.psd[s].measures);
+    if (i < 0) continue;
+    const AxisFit& af = last.axis[i];
+    if (s < af.layout.strip.size() && af.layout.strip[s] >= 0)
+      id.psd_offset_um[s] = {af.theta[af.layout.strip[s]], af.sigma[af.layout.strip[s]], true};
+  }
+}
+
+// The DAQ delay: PSD readings behind the set-point (with servo lag) and the reference; the
+// data sheet's is kept unless the reference gives it or the caller accepts the set-point's.
+void identify_delay(const Measurement& m, const Run& run, const RunMeta& meta, const IdentifyOptions& o,
+                    Identification& id) {
+  id.delay_setpoint = estimate_delay(m, meta, DelayReference::setpoint);
+  if (run.channels.ref[0] || run.channels.ref[1])
+    id.delay_reference = estimate_delay(m, meta, DelayReference::reference);
+  id.daq_group_delay_samples = run.meta.acquisition.daq_group_delay_samples;
+  if (id.delay_reference.valid) {
+    id.daq_group_delay_samples = id.delay_reference.samples, id.delay_identified = true;
+  } else if (o.delay_from_setpoint && id.delay_setpoint.valid) {
+    id.daq_group_delay_samples = id.delay_setpoint.samples, id.delay_identified = true;
+    id.notes.push_back(
+        "DAQ delay taken from the PSD readings against the set-point: it includes the axes' mean servo lag");
+  } else if (id.delay_setpoint.valid) {
+    id.notes.push_back(
+        "DAQ delay kept at the data sheet's: against the set-point the PSD readings lag by the delay plus the servo "
+        "lag (no reference in the run)");
+  }
+}
+
 }  // namespace
 
 std::vector<std::string> less_certain_than_datasheet(const Identification& id,
@@ -401,112 +579,18 @@ std::vector<std::string> less_certain_than_datasheet(const Identification& id,
 }
 
 Identification identify_sensors(const Run& run, const IdentifyOptions& o) {
-  if (run.frames.empty()) throw InputError("identify: run '" + run.meta.id + "' holds no frames");
+  check_identifiable(run, o);
   Identification id;
   id.method = o.against_reference ? "ref" : "psd";
-  if (o.against_reference && !(run.channels.ref[0] || run.channels.ref[1] || run.channels.ref[2]))
-    throw InputError("identify: run '" + run.meta.id + "' has no reference instrument to identify against");
-  // Without strips the set-point at standstills alone leaves the damping term unknown and
-  // the scale barely better than the data sheet (a step without strips: E_xx ± 170 ppm
-  // against the data sheet's ± 260): refused like a run that crosses them at one speed.
-  if (!o.against_reference && run.meta.psd.empty())
-    throw InputError("identify: run '" + run.meta.id +
-                     "' has no PSD strips: the sensors are identified from strip crossings at several speeds "
-                     "(run the identification program, eical gen-nc identify, or identify against a reference, "
-                     "--compare-reference)");
   RunMeta meta = run.meta;
-  const Eigen::Matrix3d to_machine_ds[2] = {run.meta.sensors[0].to_machine, run.meta.sensors[1].to_machine};
-  PassResult last;
-  double damping_total[2] = {0.0, 0.0};
-  for (int it = 0; it < std::max(1, o.iterations); ++it) {
-    PassResult pr = fit_pass(run, meta, o);
-    // Per sensor: E from the columns it owns, Δ(2ζ/ω0) weighted over its axes.
-    for (int s = 0; s < 2; ++s) {
-      Eigen::Matrix3d e = Eigen::Matrix3d::Zero();
-      double wsum = 0.0, dsum = 0.0;
-      for (int j = 0; j < 3; ++j) {
-        if (owner(meta, j) != s || !pr.moved[j]) continue;
-        for (int i = 0; i < 3; ++i) e(i, j) = pr.axis[i].theta[pr.axis[i].layout.e[j]];
-        const AxisFit& af = pr.axis[j];
-        if (af.layout.damping >= 0 && af.sigma[af.layout.damping] < 0.5 * kPriorDampingMs) {
-          const double sg = af.sigma[af.layout.damping];
-          wsum += 1.0 / (sg * sg), dsum += af.theta[af.layout.damping] / (sg * sg);
-        }
-      }
-      const double damping_s = wsum > 0.0 ? dsum / wsum * 1e-3 : 0.0;
-      apply_sensor(e, damping_s, meta.sensors[s]);
-      damping_total[s] += damping_s;
-    }
-    last = std::move(pr);
-    id.iterations = it + 1;
-  }
+  double damping_total_s[2] = {0.0, 0.0};
+  const PassResult last = iterate_passes(run, o, meta, damping_total_s, id.iterations);
   id.psd_observations = last.psd_obs, id.rest_observations = last.rest_obs, id.standstills = last.standstills;
   if (!o.against_reference) check_crossings(last.m, meta, id);
-  {  // What the data sheet and the identified model leave unexplained.
-    const Agreement before = agreement(run, run.meta), after = agreement(run, meta);
-    id.psd_rms_before_um = before.psd_rms_um, id.rest_rms_before_um = before.rest_rms_um;
-    id.psd_rms_after_um = after.psd_rms_um, id.rest_rms_after_um = after.rest_rms_um;
-  }
-
-  // Report: the total error against the data sheet, with the last pass's σ.
-  for (int s = 0; s < 2; ++s) {
-    SensorEstimate& se = id.sensor[s];
-    const Eigen::Matrix3d e_total =
-        to_machine_ds[s] * meta.sensors[s].to_machine.inverse() - Eigen::Matrix3d::Identity();
-    double wsum = 0.0;
-    for (int j = 0; j < 3; ++j) {
-      if (owner(meta, j) != s || !last.moved[j]) continue;
-      se.moved = true;
-      for (int i = 0; i < 3; ++i) {
-        const AxisFit& af = last.axis[i];
-        se.error[i][j] = {e_total(i, j), af.sigma[af.layout.e[j]], true};
-      }
-      const AxisFit& own = last.axis[j];
-      // The damping term counts where the data said something (no PSD strip on z: nothing).
-      if (own.layout.damping >= 0 && own.sigma[own.layout.damping] < 0.5 * kPriorDampingMs)
-        wsum += 1.0 / std::pow(own.sigma[own.layout.damping] * 1e-3, 2);
-    }
-    if (wsum > 0.0)
-      se.damping_s = {damping_total[s], 1.0 / std::sqrt(wsum), true};
-    else if (se.moved)
-      id.notes.push_back(std::string(s == 0 ? "table" : "head") +
-                         " sensor: 2ζ/ω0 not identified (no PSD strip along its axes): data sheet kept");
-    // Bias at the first standstill (sensor axes, gravity removed): what the rest window took out.
-    const double g = meta.site.g_mps2;
-    const Eigen::Vector3d gravity(0.0, 0.0, g);
-    const Eigen::Vector3d b_machine = last.m.raw.rest_bias_mps2[s] - gravity;
-    se.rest_bias_g = run.meta.sensors[s].bias_g + meta.sensors[s].to_machine.inverse() * b_machine / g;
-  }
-  for (int i = 0; i < 3; ++i) {
-    const AxisFit& af = last.axis[i];
-    if (af.layout.x0 >= 0) id.rest_offset_um[i] = {af.theta[af.layout.x0], af.sigma[af.layout.x0], true};
-    if (af.layout.backlash >= 0) id.backlash_um[i] = {af.theta[af.layout.backlash], af.sigma[af.layout.backlash], true};
-  }
-  id.psd_offset_um.resize(run.meta.psd.size());
-  for (std::size_t s = 0; s < run.meta.psd.size(); ++s) {
-    const int i = axis_index(run.meta.psd[s].measures);
-    if (i < 0) continue;
-    const AxisFit& af = last.axis[i];
-    if (s < af.layout.strip.size() && af.layout.strip[s] >= 0)
-      id.psd_offset_um[s] = {af.theta[af.layout.strip[s]], af.sigma[af.layout.strip[s]], true};
-  }
-
-  // The DAQ delay: PSD readings behind the set-point (with servo lag) and the reference.
-  id.delay_setpoint = estimate_delay(last.m, meta, DelayReference::setpoint);
-  if (run.channels.ref[0] || run.channels.ref[1])
-    id.delay_reference = estimate_delay(last.m, meta, DelayReference::reference);
-  id.daq_group_delay_samples = run.meta.acquisition.daq_group_delay_samples;
-  if (id.delay_reference.valid) {
-    id.daq_group_delay_samples = id.delay_reference.samples, id.delay_identified = true;
-  } else if (o.delay_from_setpoint && id.delay_setpoint.valid) {
-    id.daq_group_delay_samples = id.delay_setpoint.samples, id.delay_identified = true;
-    id.notes.push_back(
-        "DAQ delay taken from the PSD readings against the set-point: it includes the axes' mean servo lag");
-  } else if (id.delay_setpoint.valid) {
-    id.notes.push_back(
-        "DAQ delay kept at the data sheet's: against the set-point the PSD readings lag by the delay plus the servo "
-        "lag (no reference in the run)");
-  }
+  compare_with_datasheet(run, meta, id);
+  for (int s = 0; s < 2; ++s) report_sensor(s, last, run.meta, meta, damping_total_s[s], id);
+  report_machine(last, run.meta, id);
+  identify_delay(last.m, run, meta, o, id);
   for (int s = 0; s < 2; ++s) id.sensors[s] = meta.sensors[s];
   if (!id.sensor[0].moved && !id.sensor[1].moved) throw InputError("identify: no axis moved more than 0.5 mm");
   id.covariance = covariance_of(last, id, run.meta);

@@ -7,86 +7,77 @@
 
 namespace eical::dsp::uncertainty {
 
-CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& idx,
-                       const fusion::ErrorModel& model, std::size_t q) {
-  FineSchedule f;
-  f.schedule = &fine;
-  f.samples = std::min(fine.flags.size(), idx.size());
-  f.index_at = [&idx](std::size_t k) { return idx[k]; };
-  return coarsen(f, model, q);
+namespace {
+
+// The pipeline's model on the coarse grid: σ is carried per coarse sample (zupt) and per
+// fix, so the model's floors are folded in; no gate, no reset.
+fusion::ErrorModel coarse_model(const fusion::ErrorModel& model, std::size_t q) {
+  fusion::ErrorModel m = model;
+  m.zupt_sigma_um_s = 1e-9;
+  m.psd_floor_um = 0.0;
+  m.nbs_sigma_um_s = model.nbs_sigma_um_s / std::sqrt(static_cast<double>(q));
+  m.gate_nis = 1e300;
+  m.reset_after_rejections = 1 << 30;
+  return m;
 }
 
-CoarseSchedule coarsen(const FineSchedule& in, const fusion::ErrorModel& model, std::size_t q) {
-  namespace sf = fusion::schedule_flag;
+// ZUPT σ of fine sample k (0: its own; < 0: unused).
+double zupt_sigma(const FineSchedule& in, std::size_t k) {
   const fusion::SupportSchedule& fine = *in.schedule;
-  // ZUPT σ of fine sample k (0: its own; < 0: unused).
-  auto zupt_sigma = [&](std::size_t k) {
-    if (k < fine.zupt_sigma_um_s.size()) return static_cast<double>(fine.zupt_sigma_um_s[k]);
-    if (in.zupt_unused && k < in.zupt_unused->size()) return (*in.zupt_unused)[k] ? -1.0 : 0.0;
-    return 0.0;
-  };
-  CoarseSchedule c;
-  q = std::max<std::size_t>(1, q);
-  c.block = q;
-  const std::size_t n = std::min(fine.flags.size(), in.samples);
-  const std::size_t nc = (n + q - 1) / q;
-  c.model = model;
-  // σ is carried per coarse sample (zupt) and per fix: the model's floors are folded in.
-  c.model.zupt_sigma_um_s = 1e-9;
-  c.model.psd_floor_um = 0.0;
-  c.model.nbs_sigma_um_s = model.nbs_sigma_um_s / std::sqrt(static_cast<double>(q));
-  c.model.gate_nis = 1e300;
-  c.model.reset_after_rejections = 1 << 30;
-  auto& s = c.schedule;
-  s.zupt = fine.zupt;
-  s.cupt = fine.cupt;
-  s.flags.assign(nc, 0);
-  s.zupt_sigma_um_s.assign(nc, -1.0F);
-  c.sample_index.resize(nc);
-  c.fine_end.resize(nc);
-  for (std::size_t j = 0; j < nc; ++j) {
-    const std::size_t b = j * q, e = std::min(n, b + q);
-    c.fine_end[j] = e - 1;
-    c.sample_index[j] = in.index_at(e - 1);
-    std::uint8_t any = 0;
-    std::size_t invalid = 0, rest_used = 0, nbs[3] = {0, 0, 0};
-    double info = 0.0;  // Σ 1/σ² of the block's standstill velocities
-    bool rest = false;
-    for (std::size_t k = b; k < e; ++k) {
-      const auto f = static_cast<std::uint8_t>(fine.flags[k] & in.flag_mask);
-      any |= f;
-      if (f & sf::invalid) {
-        ++invalid;
-        continue;
-      }
-      if (f & sf::rest) {
-        rest = true;
-        const double z = zupt_sigma(k);
-        if (z >= 0.0) {
-          const double sg = std::max(model.zupt_sigma_um_s, z);
-          info += 1.0 / (sg * sg), ++rest_used;
-        }
-      } else {
-        for (int a = 0; a < 3; ++a)
-          if (f & fusion::nbs_flag(a)) ++nbs[a];
-      }
+  if (k < fine.zupt_sigma_um_s.size()) return static_cast<double>(fine.zupt_sigma_um_s[k]);
+  if (in.zupt_unused && k < in.zupt_unused->size()) return (*in.zupt_unused)[k] ? -1.0 : 0.0;
+  return 0.0;
+}
+
+// The flags and ZUPT σ of the block of fine samples [b, e): a move start if any; invalid
+// if every sample is; a standstill if any sample rests, its σ that of the samples' combined
+// information (−1: none used); else NBS on an axis held for at least half the block.
+void coarsen_block(const FineSchedule& in, const fusion::ErrorModel& model, std::size_t b, std::size_t e,
+                   std::uint8_t& flags_out, float& zupt_sigma_out) {
+  namespace sf = fusion::schedule_flag;
+  std::uint8_t any = 0;
+  std::size_t invalid = 0, rest_used = 0, nbs[3] = {0, 0, 0};
+  double info = 0.0;  // Σ 1/σ² of the block's standstill velocities
+  bool rest = false;
+  for (std::size_t k = b; k < e; ++k) {
+    const auto f = static_cast<std::uint8_t>(in.schedule->flags[k] & in.flag_mask);
+    any |= f;
+    if (f & sf::invalid) {
+      ++invalid;
+      continue;
     }
-    std::uint8_t flags = static_cast<std::uint8_t>(any & sf::move_start);
-    if (invalid == e - b) flags |= sf::invalid;
-    if (rest) {
-      flags |= sf::rest;
-      s.zupt_sigma_um_s[j] = rest_used > 0 ? static_cast<float>(1.0 / std::sqrt(info)) : -1.0F;
+    if (f & sf::rest) {
+      rest = true;
+      const double z = zupt_sigma(in, k);
+      if (z >= 0.0) {
+        const double sg = std::max(model.zupt_sigma_um_s, z);
+        info += 1.0 / (sg * sg), ++rest_used;
+      }
     } else {
-      s.zupt_sigma_um_s[j] = 0.0F;
       for (int a = 0; a < 3; ++a)
-        if (2 * nbs[a] >= e - b) flags |= fusion::nbs_flag(a);
+        if (f & fusion::nbs_flag(a)) ++nbs[a];
     }
-    s.flags[j] = flags;
   }
-  // Fixes: one per (coarse sample, strip), inverse-variance combined.
+  std::uint8_t flags = static_cast<std::uint8_t>(any & sf::move_start);
+  if (invalid == e - b) flags |= sf::invalid;
+  if (rest) {
+    flags |= sf::rest;
+    zupt_sigma_out = rest_used > 0 ? static_cast<float>(1.0 / std::sqrt(info)) : -1.0F;
+  } else {
+    zupt_sigma_out = 0.0F;
+    for (int a = 0; a < 3; ++a)
+      if (2 * nbs[a] >= e - b) flags |= fusion::nbs_flag(a);
+  }
+  flags_out = flags;
+}
+
+// Fixes: one per (coarse sample, strip), inverse-variance combined, into c's schedule and
+// fix_noise_um.
+void combine_fixes(const std::vector<fusion::PositionFix>& fixes, const fusion::ErrorModel& model, std::size_t n,
+                   std::size_t q, CoarseSchedule& c) {
   // (axis, Σ w, Σ w² σ_noise²) with w = 1/var as the pipeline weighs each fix.
   std::map<std::pair<std::size_t, int>, std::tuple<int, double, double>> comb;
-  for (const auto& f : fine.fixes) {
+  for (const auto& f : fixes) {
     if (f.k >= n) continue;
     const double noise = f.sigma_um * f.sigma_um + model.psd_floor_um * model.psd_floor_um;
     const double var = noise + f.model_sigma_um * f.model_sigma_um;
@@ -99,9 +90,44 @@ CoarseSchedule coarsen(const FineSchedule& in, const fusion::ErrorModel& model, 
     fusion::PositionFix f;
     f.k = key.first, f.strip = key.second, f.axis = std::get<0>(v);
     f.sigma_um = 1.0 / std::sqrt(std::get<1>(v));
-    s.fixes.push_back(f);
+    c.schedule.fixes.push_back(f);
     c.fix_noise_um.push_back(std::sqrt(std::get<2>(v)) / std::get<1>(v));  // σ of the weighted mean's noise
   }
+}
+
+}  // namespace
+
+CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& idx,
+                       const fusion::ErrorModel& model, std::size_t q) {
+  FineSchedule f;
+  f.schedule = &fine;
+  f.samples = std::min(fine.flags.size(), idx.size());
+  f.index_at = [&idx](std::size_t k) { return idx[k]; };
+  return coarsen(f, model, q);
+}
+
+CoarseSchedule coarsen(const FineSchedule& in, const fusion::ErrorModel& model, std::size_t q) {
+  const fusion::SupportSchedule& fine = *in.schedule;
+  CoarseSchedule c;
+  q = std::max<std::size_t>(1, q);
+  c.block = q;
+  const std::size_t n = std::min(fine.flags.size(), in.samples);
+  const std::size_t nc = (n + q - 1) / q;
+  c.model = coarse_model(model, q);
+  auto& s = c.schedule;
+  s.zupt = fine.zupt;
+  s.cupt = fine.cupt;
+  s.flags.assign(nc, 0);
+  s.zupt_sigma_um_s.assign(nc, -1.0F);
+  c.sample_index.resize(nc);
+  c.fine_end.resize(nc);
+  for (std::size_t j = 0; j < nc; ++j) {
+    const std::size_t b = j * q, e = std::min(n, b + q);
+    c.fine_end[j] = e - 1;
+    c.sample_index[j] = in.index_at(e - 1);
+    coarsen_block(in, model, b, e, s.flags[j], s.zupt_sigma_um_s[j]);
+  }
+  combine_fixes(fine.fixes, model, n, q, c);
   for (auto v : fine.velocity_means) {
     if (v.k >= n) continue;
     v.k /= q;

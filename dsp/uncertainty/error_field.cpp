@@ -42,6 +42,114 @@ V at(const std::vector<V>& x, double pos) {
   return (1.0 - f) * x[i] + f * x[i + 1];
 }
 
+// The truth the noise draws simulate: the data sheet's noise (with its spread) and bias
+// walk, where they exceed the fusion model's.
+fusion::ErrorModel simulated_truth(const fusion::ErrorModel& coarse_model, const ErrorFieldInput& in) {
+  fusion::ErrorModel truth = coarse_model;
+  const double per_sensor = in.noise.bias_walk_ug_per_rts * 1e-6 * in.g_mps2 * 1e6;  // µm/s²/√s
+  truth.bias_walk_um_s2_rts = std::max(in.model.bias_walk_um_s2_rts, std::sqrt(2.0) * per_sensor);
+  truth.accel_noise_um_s2_rthz = std::max(
+      in.model.accel_noise_um_s2_rthz,
+      in.noise.noise_factor * std::hypot(in.sensor_noise_ug_per_rthz[0], in.sensor_noise_ug_per_rthz[1]) * in.g_mps2);
+  return truth;
+}
+
+void check_path(const CoarsePath& path, std::size_t nc) {
+  const bool have_temp = !path.temp_c.empty();
+  if (path.pos_mm.size() != nc || path.vel_mm_s.size() != nc || path.acc_mm_s2.size() != nc ||
+      (have_temp && path.temp_c.size() != nc))
+    throw InputError("uncertainty: the coarse path does not match its schedule");
+}
+
+// One smoother pass over pseudo-data: what is left of a unit error after the supports.
+struct Responder {
+  const CoarseSchedule& coarse;
+  const ErrorFieldInput& in;
+
+  // dx, dv: the error's position and velocity per coarse sample; strip: the one strip that
+  // reads 1 µm (−1: none); unit: the parameter's value that made them.
+  std::vector<Eigen::Vector3d> operator()(const std::vector<Eigen::Vector3d>& dx_mm,
+                                          const std::vector<Eigen::Vector3d>& dv_mm_s, int strip, double unit) const {
+    const std::size_t nc = coarse.sample_index.size();
+    fusion::SupportSchedule sched = coarse.schedule;
+    for (auto& f : sched.fixes) f.position_um = f.strip == strip ? 1.0 : 0.0;
+    for (auto& m : sched.velocity_means) {
+      const Eigen::Vector3d vm = dv_mm_s[m.k] * 1000.0;
+      for (int i = 0; i < 3; ++i) m.mean_um_s[i] = vm[i];
+    }
+    fusion::SmootherInput si;
+    si.sample_index = &coarse.sample_index;
+    si.vel_mm_s = &dv_mm_s;
+    si.pos_mm = &dx_mm;
+    si.schedule = &sched;
+    si.fs_hz = in.fs_hz;
+    si.model = coarse.model;
+    si.start_bias_sigma_um_s2 = in.start_bias_sigma_um_s2;
+    const fusion::SmootherOutput out = fusion::smooth(si);
+    std::vector<Eigen::Vector3d> r(nc);
+    for (std::size_t j = 0; j < nc; ++j) r[j] = (dx_mm[j] * 1000.0 - out.dx_um[j]) / unit;
+    return r;
+  }
+};
+
+constexpr double kUnitE = 1e-4, kUnitTau = 1e-3;
+
+// Whether the path moves along axis j (more than 1 µm).
+bool column_moves(const std::vector<Eigen::Vector3d>& p, int j) {
+  double lo = 1e300, hi = -1e300;
+  for (const auto& x : p) lo = std::min(lo, x[j]), hi = std::max(hi, x[j]);
+  return hi - lo > 1e-3;
+}
+
+// Column j of E: every axis' error from the motion along j, per unit E.
+std::vector<Eigen::Vector3d> scale_response(const Responder& respond, const CoarsePath& path, int j) {
+  const std::size_t nc = path.pos_mm.size();
+  std::vector<Eigen::Vector3d> dx(nc), dv(nc);
+  for (std::size_t k = 0; k < nc; ++k)
+    dx[k] = Eigen::Vector3d::Constant(path.pos_mm[k][j] * kUnitE),
+    dv[k] = Eigen::Vector3d::Constant(path.vel_mm_s[k][j] * kUnitE);
+  return respond(dx, dv, -1, kUnitE);
+}
+
+// The timing term (v·τ), per unit τ.
+std::vector<Eigen::Vector3d> timing_response(const Responder& respond, const CoarsePath& path) {
+  const std::size_t nc = path.pos_mm.size();
+  std::vector<Eigen::Vector3d> dx(nc), dv(nc);
+  for (std::size_t k = 0; k < nc; ++k) dx[k] = path.vel_mm_s[k] * kUnitTau, dv[k] = path.acc_mm_s2[k] * kUnitTau;
+  return respond(dx, dv, -1, kUnitTau);
+}
+
+// Sensor s' α_b of 1 µg/°C: a bias (T − T_rest)·1 µg, integrated twice (trapezoid on the coarse grid).
+std::vector<Eigen::Vector3d> temperature_response(const Responder& respond, const CoarsePath& path, int s) {
+  const std::size_t nc = path.pos_mm.size();
+  const auto& idx = respond.coarse.sample_index;
+  const double unit_mps2 = 1e-6 * respond.in.g_mps2;
+  std::vector<Eigen::Vector3d> dx(nc, Eigen::Vector3d::Zero()), dv(nc, Eigen::Vector3d::Zero());
+  for (std::size_t k = 1; k < nc; ++k) {
+    const double dt = static_cast<double>(idx[k] - idx[k - 1]) / respond.in.fs_hz;
+    const double a0 = path.temp_c[k - 1][s] * unit_mps2 * 1000.0, a1 = path.temp_c[k][s] * unit_mps2 * 1000.0;  // mm/s²
+    dv[k] = dv[k - 1] + Eigen::Vector3d::Constant(0.5 * (a0 + a1) * dt);
+    dx[k] = dx[k - 1] + 0.5 * (dv[k - 1] + dv[k]) * dt;
+  }
+  return respond(dx, dv, -1, 1.0);
+}
+
+// Per PSD strip of the fixes: the strip reads 1 µm too far, the (error-free) trace is
+// pulled towards it.
+std::vector<std::vector<Eigen::Vector3d>> strip_responses(const Responder& respond) {
+  const std::size_t nc = respond.coarse.sample_index.size();
+  const std::vector<Eigen::Vector3d> zero(nc, Eigen::Vector3d::Zero());
+  std::set<int> strips;
+  for (const auto& f : respond.coarse.schedule.fixes) strips.insert(f.strip);
+  std::vector<std::vector<Eigen::Vector3d>> response;
+  for (int s : strips) {
+    if (s < 0) continue;
+    if (response.size() <= static_cast<std::size_t>(s)) response.resize(static_cast<std::size_t>(s) + 1);
+    response[static_cast<std::size_t>(s)] = respond(zero, zero, s, 1.0);
+  }
+  return response;
+}
+
 }  // namespace
 
 double ErrorField::coarse_position(double a) const {
@@ -77,87 +185,17 @@ void ErrorField::build(const ErrorFieldInput& in, const CoarsePath& path) {
   owner_ = in.owner;
   strip_sigma_um_ = in.model_covariance.psd_offset_sigma_um;
   start_bias_sigma_ = in.start_bias_sigma_um_s2;
-  // The truth the noise draws simulate: the data sheet's noise (with its spread) and bias walk.
-  truth_ = coarse_.model;
-  const double per_sensor = in.noise.bias_walk_ug_per_rts * 1e-6 * in.g_mps2 * 1e6;  // µm/s²/√s
-  truth_.bias_walk_um_s2_rts = std::max(in.model.bias_walk_um_s2_rts, std::sqrt(2.0) * per_sensor);
-  truth_.accel_noise_um_s2_rthz = std::max(
-      in.model.accel_noise_um_s2_rthz,
-      in.noise.noise_factor * std::hypot(in.sensor_noise_ug_per_rthz[0], in.sensor_noise_ug_per_rthz[1]) * in.g_mps2);
-
-  const std::size_t nc = coarse_.sample_index.size();
-  const std::vector<Eigen::Vector3d>& p = path.pos_mm;
-  const std::vector<Eigen::Vector3d>& v = path.vel_mm_s;
-  const std::vector<Eigen::Vector3d>& acc = path.acc_mm_s2;
-  const std::vector<Eigen::Vector2d>& temp = path.temp_c;
-  const bool have_temp = !temp.empty();
-  if (p.size() != nc || v.size() != nc || acc.size() != nc || (have_temp && temp.size() != nc))
-    throw InputError("uncertainty: the coarse path does not match its schedule");
-  // One smoother pass over pseudo-data: what is left of a unit error after the supports.
-  auto respond = [&](const std::vector<Eigen::Vector3d>& dx_mm, const std::vector<Eigen::Vector3d>& dv_mm_s, int strip,
-                     double unit) {
-    fusion::SupportSchedule sched = coarse_.schedule;
-    for (auto& f : sched.fixes) f.position_um = f.strip == strip ? 1.0 : 0.0;
-    for (auto& m : sched.velocity_means) {
-      const Eigen::Vector3d vm = dv_mm_s[m.k] * 1000.0;
-      for (int i = 0; i < 3; ++i) m.mean_um_s[i] = vm[i];
-    }
-    fusion::SmootherInput si;
-    si.sample_index = &coarse_.sample_index;
-    si.vel_mm_s = &dv_mm_s;
-    si.pos_mm = &dx_mm;
-    si.schedule = &sched;
-    si.fs_hz = in.fs_hz;
-    si.model = coarse_.model;
-    si.start_bias_sigma_um_s2 = in.start_bias_sigma_um_s2;
-    const fusion::SmootherOutput out = fusion::smooth(si);
-    std::vector<Eigen::Vector3d> r(nc);
-    for (std::size_t j = 0; j < nc; ++j) r[j] = (dx_mm[j] * 1000.0 - out.dx_um[j]) / unit;
-    return r;
-  };
-  const std::vector<Eigen::Vector3d> zero(nc, Eigen::Vector3d::Zero());
-  constexpr double kUnitE = 1e-4, kUnitTau = 1e-3;
-  for (int j = 0; j < 3; ++j) {
-    double lo = 1e300, hi = -1e300;
-    for (const auto& x : p) lo = std::min(lo, x[j]), hi = std::max(hi, x[j]);
-    const auto ju = static_cast<std::size_t>(j);
-    column_moves_[ju] = hi - lo > 1e-3 && owner_[ju] >= 0;
-    if (!column_moves_[ju]) continue;
-    std::vector<Eigen::Vector3d> dx(nc), dv(nc);
-    for (std::size_t k = 0; k < nc; ++k)
-      dx[k] = Eigen::Vector3d::Constant(p[k][j] * kUnitE), dv[k] = Eigen::Vector3d::Constant(v[k][j] * kUnitE);
-    response_e_[ju] = respond(dx, dv, -1, kUnitE);
+  truth_ = simulated_truth(coarse_.model, in);
+  check_path(path, coarse_.sample_index.size());
+  const Responder respond{coarse_, in};
+  for (std::size_t j = 0; j < 3; ++j) {
+    column_moves_[j] = column_moves(path.pos_mm, static_cast<int>(j)) && owner_[j] >= 0;
+    if (column_moves_[j]) response_e_[j] = scale_response(respond, path, static_cast<int>(j));
   }
-  {
-    std::vector<Eigen::Vector3d> dx(nc), dv(nc);
-    for (std::size_t k = 0; k < nc; ++k) dx[k] = v[k] * kUnitTau, dv[k] = acc[k] * kUnitTau;
-    response_timing_ = respond(dx, dv, -1, kUnitTau);
-  }
-  if (have_temp) {
-    // α_b of 1 µg/°C: a bias (T − T_rest)·1 µg, integrated twice (trapezoid on the coarse grid).
-    const double unit_mps2 = 1e-6 * in.g_mps2;
-    for (int s = 0; s < 2; ++s) {
-      std::vector<Eigen::Vector3d> dx(nc, Eigen::Vector3d::Zero()), dv(nc, Eigen::Vector3d::Zero());
-      for (std::size_t k = 1; k < nc; ++k) {
-        const double dt = static_cast<double>(coarse_.sample_index[k] - coarse_.sample_index[k - 1]) / in.fs_hz;
-        const double a0 = temp[k - 1][s] * unit_mps2 * 1000.0, a1 = temp[k][s] * unit_mps2 * 1000.0;  // mm/s²
-        dv[k] = dv[k - 1] + Eigen::Vector3d::Constant(0.5 * (a0 + a1) * dt);
-        dx[k] = dx[k - 1] + 0.5 * (dv[k - 1] + dv[k]) * dt;
-      }
-      response_tc_[static_cast<std::size_t>(s)] = respond(dx, dv, -1, 1.0);
-    }
-  }
-  if (coarse_.schedule.cupt) {
-    std::set<int> strips;
-    for (const auto& f : coarse_.schedule.fixes) strips.insert(f.strip);
-    for (int s : strips) {
-      if (s < 0) continue;
-      if (response_strip_.size() <= static_cast<std::size_t>(s))
-        response_strip_.resize(static_cast<std::size_t>(s) + 1);
-      // The strip reads 1 µm too far: the (error-free) trace is pulled towards it.
-      response_strip_[static_cast<std::size_t>(s)] = respond(zero, zero, s, 1.0);
-    }
-  }
+  response_timing_ = timing_response(respond, path);
+  if (!path.temp_c.empty())
+    for (int s = 0; s < 2; ++s) response_tc_[static_cast<std::size_t>(s)] = temperature_response(respond, path, s);
+  if (coarse_.schedule.cupt) response_strip_ = strip_responses(respond);
   model_factor_ = draw_factor(in.model_covariance.covariance);
 }
 
