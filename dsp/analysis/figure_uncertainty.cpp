@@ -179,19 +179,23 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
   std::vector<Accumulator> acc = start(f0), acc_ideal = start(g0);
   std::mt19937_64 rng(seed_ ^ 0x9e3779b97f4a7c15ULL);
   std::vector<Eigen::Vector3d> err;
+  // Each draw perturbs a copy of the base's positions only: the rest of its measurement is
+  // copied once (the evaluation reads it, never writes it), not per draw (200 copies of
+  // every array, each mapped and faulted in afresh).
+  Measurement scratch[2] = {nominal.measurement, ideal.measurement};
   for (int d = 0; d < draws; ++d) {
     field->draw(rng, at, err);
-    for (Analysis* base : {&nominal, &ideal}) {
+    for (int b = 0; b < 2; ++b) {
+      const Analysis& base = b == 0 ? nominal : ideal;
       Analysis x;
-      x.measurement = base->measurement;
+      x.measurement = std::move(scratch[b]);
+      x.measurement.pos_mm.assign(base.measurement.pos_mm.begin(), base.measurement.pos_mm.end());
       for (std::size_t i = 0; i < err.size() && i < x.measurement.pos_mm.size(); ++i)
         x.measurement.pos_mm[i] += err[i] / 1000.0;
       x.dynamic = a.dynamic, x.nbs = a.nbs;
       evaluate_program(run, x, eo);
-      if (base == &nominal)
-        add(f0, figures_of(x), acc);
-      else
-        add(g0, figures_of(x), acc_ideal);
+      add(b == 0 ? f0 : g0, figures_of(x), b == 0 ? acc : acc_ideal);
+      scratch[b] = std::move(x.measurement);
     }
   }
   // U of element e of figure k of a set of draws (NaN when most draws could not evaluate it).
