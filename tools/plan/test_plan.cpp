@@ -287,7 +287,7 @@ void suggest_measurable_test(const dsp::Run& run, dsp::Analysis& a) {
     return;
   }
   char b[256];
-  if (const auto best = nearest_measurable(p, 10.0, 60)) {
+  if (const auto best = nearest_measurable(p, 30.0, 60)) {
     std::snprintf(b, sizeof b, "a test that would be measurable (eical plan): %s, predicted U(%s) = %.2f µm",
                   describe(best->program).c_str(), lim->limited_name, best->limited_u);
     a.verdict_reasons.push_back(b);
