@@ -2,25 +2,32 @@
 // eicald's evaluation for circular tests of 1, 10 and 30 minutes at 10 kHz (R150, both
 // directions, repeated; F1000 — the 1-minute run at F2000, since one revolution each way
 // at F1000 takes two minutes). Each analysis runs in a child process of its own, so its
-// peak resident set (getrusage ru_maxrss of the child) is its own.
+// peak resident set is its own. The acceptance: at most 150 MB for a 10-minute recording
+// and at least 50x real time.
 //
-//   eical analyze   the command as a user runs it (the run read as it streams, twice)
-//   eical analyze --no-suggest   the same without eical plan's suggestion for a test that
-//                   is not measurable (it simulates short variants, whatever the length)
-//   eicald eval     what eicald's evaluation thread runs on a recording it holds: the
-//                   frames in memory (as the recorder hands them over), then the streamed
-//                   analysis over them; "over them" is the process' peak during the
-//                   evaluation (VmHWM, reset after loading) less the frames' resident size.
-//                   Its peak RSS column is the whole process' (loading the frames included).
+//   eical analyze   the command as a user runs it (the run read as it streams), with eical
+//                   plan's suggestion of a measurable test when the test is not measurable
+//   eical analyze --no-suggest   the same without the suggestion
+//   eicald eval     eicald's own code: the recording thread (RecordingWriter) writes the
+//                   run's frames as the DSP thread hands them over (RecordingStream, fed
+//                   here as fast as it drains), then the evaluation thread (Evaluator) names
+//                   the run, renames it into place and analyses it from disk. Its time is
+//                   from the recording's end to its result.json (what follows the
+//                   measurement); its peak RSS is the process's over recording and
+//                   evaluation, "evaluation" the peak after the recording's end.
 //
 // Prints one line per run and analysis: minutes of data, samples, wall and CPU seconds,
-// × real time (wall and CPU), peak RSS in MB and the verdict (a result was written).
+// x real time (wall and CPU), peak RSS in MB and the verdict (a result was written).
 //
 //   bench_long_run [--minutes 1,10,30] [--dir DIR] [--keep] [--no-daemon]
-#include "drivers/run_io/file_spill.hpp"
 #include "drivers/run_io/run_reader.hpp"
+#include "drivers/run_io/run_stream.hpp"
 #include "dsp/core/float_limits.hpp"
-#include "dsp/stream/analyze_stream.hpp"
+#ifdef EICAL_BENCH_DAEMON
+#include "daemon/service/evaluator.hpp"
+#include "daemon/service/recording_handoff.hpp"
+#include "daemon/service/recording_stream.hpp"
+#endif
 
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -33,7 +40,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -47,7 +56,7 @@ struct Usage {
 
 double seconds(const timeval& t) { return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_usec) * 1e-6; }
 
-// Runs `child` in a forked process (stdout to /dev/null unless keep_stdout); its rusage.
+// Runs `child` in a forked process (stdout to /dev/null when quiet); its rusage.
 template <class F>
 Usage in_child(F&& child, bool quiet = true) {
   std::fflush(stdout);  // else the child's freopen() writes the parent's buffered lines again
@@ -85,26 +94,6 @@ int run_command(const std::vector<std::string>& args) {
   return 127;
 }
 
-// The process' peak resident size since the last reset_peak() (VmHWM), MB.
-double peak_mb() {
-  std::ifstream is("/proc/self/status");
-  std::string line;
-  while (std::getline(is, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
-  return eical::kNaN;
-}
-
-// Resets VmHWM to the current resident size (Linux ≥ 4.0: clear_refs 5): the peak of what
-// follows, not of what loaded the frames (their vector grows by doubling).
-void reset_peak() { std::ofstream("/proc/self/clear_refs") << "5"; }
-
-double rss_now_mb() {
-  std::ifstream is("/proc/self/statm");
-  long pages_total = 0, pages_resident = 0;
-  is >> pages_total >> pages_resident;
-  return static_cast<double>(pages_resident) * static_cast<double>(::sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
-}
-
 // eical analyze's exit status: 0, 2 and 3 come with a result (verdict ok, degraded, not
 // measurable: README "Exit status"); anything else failed.
 std::string outcome(int status) {
@@ -120,11 +109,119 @@ std::string outcome(int status) {
 void print(const char* what, double minutes, std::size_t samples, const Usage& u, const std::string& extra = "") {
   const double data_s = minutes * 60.0;
   std::printf(
-      "%-24s %6.1f min %9zu samples  wall %7.2f s (%6.1fx real time)  cpu %7.2f s (%6.1fx)  peak RSS %7.1f MB%s%s\n",
+      "%-28s %5.1f min %9zu samples  wall %7.2f s (%6.1fx real time)  cpu %7.2f s (%6.1fx)  peak RSS %6.1f MB%s%s\n",
       what, minutes, samples, u.wall_s, data_s / u.wall_s, u.user_s + u.sys_s, data_s / (u.user_s + u.sys_s), u.peak_mb,
       extra.c_str(), outcome(u.status).c_str());
   std::fflush(stdout);
 }
+
+// The simulated circle of about `minutes` (made once; kept with --keep).
+fs::path simulated_run(const fs::path& base, const std::string& eical, double minutes) {
+  // R150 both directions: F1000 turns a revolution in 56.5 s, so repeats of both cover
+  // about 113 s each; the minute-long run turns at F2000.
+  const double feed = minutes < 2.0 ? 2000.0 : 1000.0;
+  const int repeats = std::max(1, static_cast<int>(std::lround(minutes * 60.0 / (feed < 1500.0 ? 113.1 : 56.5))));
+  const fs::path run =
+      base / ("circle-r150-f" + std::to_string(static_cast<int>(feed)) + "-both-x" + std::to_string(repeats));
+  if (fs::exists(run / "run.toml")) return run;
+  const Usage s = in_child([&] {
+    return run_command({eical, "simulate", "--program", "circle", "--radius", "150", "--feed",
+                        std::to_string(static_cast<int>(feed)), "--direction", "both", "--repeats",
+                        std::to_string(repeats), "-o", run.string(), "--overwrite"});
+  });
+  if (s.status != 0) throw std::runtime_error("eical simulate failed");
+  return run;
+}
+
+std::size_t rows_of(const fs::path& run) {
+  std::ifstream is(run / "samples.csv");
+  std::string line;
+  std::size_t rows = 0;
+  while (std::getline(is, line)) ++rows;
+  return rows > 0 ? rows - 1 : 0;
+}
+
+#ifdef EICAL_BENCH_DAEMON
+// The process' peak resident size since the last reset_peak() (VmHWM), MB.
+double peak_mb() {
+  std::ifstream is("/proc/self/status");
+  std::string line;
+  while (std::getline(is, line))
+    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+  return eical::kNaN;
+}
+
+// Resets VmHWM to the current resident size (Linux >= 4.0: clear_refs 5).
+void reset_peak() { std::ofstream("/proc/self/clear_refs") << "5"; }
+
+struct Inside {
+  double eval_s = eical::kNaN, eval_cpu_s = eical::kNaN, eval_peak_mb = eical::kNaN;
+  int verdict = 1;
+};
+
+// eicald's recording thread and evaluation thread over the run's frames (read as they
+// stream, as a DAQ delivers them); the recording directory under `dir`.
+Inside daemon_evaluation(const fs::path& run, const fs::path& dir) {
+  namespace d = eical::daemon;
+  eical::drivers::RunStream frames(run);
+  d::DaemonConfig config;
+  config.recording.dir = dir;
+  d::RecordingStream stream(1 << 16);
+  d::RecordingHandoff handoff(stream);
+  d::Evaluator evaluator(config, frames.header().meta, {}, stream, handoff, {});
+  stream.begin();
+  frames.replay([&](const eical::dsp::Frame& f) {
+    while (stream.queued() > stream.capacity() / 2) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    (void)stream.frame(f);
+  });
+  reset_peak();
+  rusage a{}, b{};
+  ::getrusage(RUSAGE_SELF, &a);
+  const auto t0 = std::chrono::steady_clock::now();
+  stream.end(d::RecordingNotes{});
+  while (evaluator.status().results == 0 && evaluator.status().fault.find("recording") == std::string::npos)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  Inside in;
+  in.eval_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ::getrusage(RUSAGE_SELF, &b);
+  in.eval_cpu_s = seconds(b.ru_utime) + seconds(b.ru_stime) - seconds(a.ru_utime) - seconds(a.ru_stime);
+  in.eval_peak_mb = peak_mb();
+  evaluator.finish();
+  const d::EvaluationStatus st = evaluator.status();
+  if (st.results == 1) {
+    std::ifstream is(st.last_result);
+    const std::string text((std::istreambuf_iterator<char>(is)), std::istreambuf_iterator<char>());
+    in.verdict = text.find("\"not_measurable\"") != std::string::npos ? 3
+                 : text.find("\"degraded\"") != std::string::npos     ? 2
+                                                                      : 0;
+  }
+  return in;
+}
+
+void bench_daemon(const fs::path& run, const fs::path& base, double data_min, std::size_t rows, bool keep) {
+  const fs::path dir = base / "eicald-runs";
+  fs::remove_all(dir);
+  int fd[2];
+  if (::pipe(fd) != 0) return;
+  const Usage whole = in_child([&] {
+    ::close(fd[0]);
+    const Inside in = daemon_evaluation(run, dir);
+    const ssize_t w = ::write(fd[1], &in, sizeof in);
+    return w == sizeof in ? 0 : 1;
+  });
+  ::close(fd[1]);
+  Inside in;
+  if (::read(fd[0], &in, sizeof in) != sizeof in) in = Inside{};
+  ::close(fd[0]);
+  Usage eval = whole;  // the evaluation's own time; the peak is the process's
+  eval.wall_s = in.eval_s, eval.user_s = in.eval_cpu_s, eval.sys_s = 0.0;
+  if (whole.status == 0) eval.status = in.verdict << 8;  // the verdict, as eical analyze's exit status
+  char extra[96];
+  std::snprintf(extra, sizeof extra, "  (evaluation %.1f MB)", in.eval_peak_mb);
+  print("eicald eval", data_min, rows, eval, extra);
+  if (!keep) fs::remove_all(dir);
+}
+#endif
 
 }  // namespace
 
@@ -149,85 +246,27 @@ int main(int argc, char** argv) {
     return l.c_str();
   }());
   for (const double m : minutes) {
-    // R150 both directions: F1000 turns a revolution in 56.5 s, so repeats of both cover
-    // about 113 s each; the minute-long run turns at F2000.
-    const double feed = m < 2.0 ? 2000.0 : 1000.0;
-    const int repeats = std::max(1, static_cast<int>(std::lround(m * 60.0 / (feed < 1500.0 ? 113.1 : 56.5))));
-    const fs::path run =
-        base / ("circle-r150-f" + std::to_string(static_cast<int>(feed)) + "-both-x" + std::to_string(repeats));
-    if (!fs::exists(run / "run.toml")) {
-      const Usage s = in_child([&] {
-        return run_command({eical, "simulate", "--program", "circle", "--radius", "150", "--feed",
-                            std::to_string(static_cast<int>(feed)), "--direction", "both", "--repeats",
-                            std::to_string(repeats), "-o", run.string(), "--overwrite"});
-      });
-      if (s.status != 0) {
-        std::fprintf(stderr, "bench_long_run: eical simulate failed\n");
-        return 1;
-      }
+    fs::path run;
+    try {
+      run = simulated_run(base, eical, m);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_long_run: %s\n", e.what());
+      return 1;
     }
     const auto meta = eical::drivers::read_run_meta(run / "run.toml");
-    std::size_t rows = 0;
-    {
-      std::ifstream is(run / "samples.csv");
-      std::string line;
-      while (std::getline(is, line)) ++rows;
-      rows = rows > 0 ? rows - 1 : 0;
-    }
+    const std::size_t rows = rows_of(run);
     const double data_min = static_cast<double>(rows) / meta.acquisition.fs_hz / 60.0;
     const Usage cli = in_child([&] { return run_command({eical, "analyze", run.string(), "--json"}); });
     print("eical analyze", data_min, rows, cli);
-    // A test that is not measurable gets a measurable variant suggested (eical plan: short
-    // simulated runs analysed whole, whatever the recording's length); without it, the
-    // analysis of the recording alone.
     const Usage bare = in_child([&] {
       return run_command({eical, "analyze", run.string(), "--json", "--no-suggest"});
     });
     print("eical analyze --no-suggest", data_min, rows, bare);
-    if (!no_daemon) {
-      // The recorder's frames in memory, then eicald's evaluation over them; the pipe
-      // carries the resident size the frames took.
-      int fd[2];
-      if (::pipe(fd) != 0) return 1;
-      struct Inside {
-        double frames_mb = eical::kNaN, peak_mb = eical::kNaN, wall_s = eical::kNaN, cpu_s = eical::kNaN;
-        int status = 1;
-      };
-      const Usage ev = in_child(
-          [&] {
-            ::close(fd[0]);
-            eical::dsp::Run r = eical::drivers::read_run(run);
-            r.frames.shrink_to_fit();
-            Inside in;
-            in.frames_mb = rss_now_mb();
-            reset_peak();
-            rusage a{}, b{};
-            ::getrusage(RUSAGE_SELF, &a);
-            const auto t0 = std::chrono::steady_clock::now();
-            eical::dsp::StoredFrames frames(r.frames);
-            const eical::dsp::Analysis an = eical::dsp::analyze_stream(
-                r, frames, {}, {eical::drivers::file_spills(eical::drivers::default_spill_dir())});
-            in.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-            ::getrusage(RUSAGE_SELF, &b);
-            in.peak_mb = peak_mb();
-            in.status = an.verdict == "ok" ? 0 : an.verdict == "degraded" ? 2 : 3;
-            in.cpu_s = seconds(b.ru_utime) + seconds(b.ru_stime) - seconds(a.ru_utime) - seconds(a.ru_stime);
-            const ssize_t w = ::write(fd[1], &in, sizeof in);
-            return w == sizeof in ? 0 : 1;
-          },
-          true);
-      ::close(fd[1]);
-      Inside in;
-      if (::read(fd[0], &in, sizeof in) != sizeof in) in = Inside{};
-      ::close(fd[0]);
-      Usage eval = ev;  // the evaluation alone: its own time; the peak is the process's
-      eval.wall_s = in.wall_s, eval.user_s = in.cpu_s, eval.sys_s = 0.0;
-      if (ev.status == 0) eval.status = in.status << 8;  // the verdict, as eical analyze's exit status
-      char extra[160];
-      std::snprintf(extra, sizeof extra, "  (the frames %.1f MB; with the evaluation %.1f MB: %.1f MB over them)",
-                    in.frames_mb, in.peak_mb, in.peak_mb - in.frames_mb);
-      print("eicald eval", data_min, rows, eval, extra);
-    }
+#ifdef EICAL_BENCH_DAEMON
+    if (!no_daemon) bench_daemon(run, base, data_min, rows, keep);
+#else
+    (void)no_daemon;
+#endif
     if (!keep) fs::remove_all(run);
   }
   return 0;

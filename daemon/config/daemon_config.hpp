@@ -113,8 +113,8 @@ struct HistoryConfig {
 };
 
 struct Limits {
-  std::size_t ring_capacity_frames = 65536;  // 6.5 s at 10 kHz: rides out a stalled DSP thread
-  double max_measurement_s = 600.0;          // recorder capacity, pre-allocated at start
+  std::size_t ring_capacity_frames = 65536;  // 6.5 s at 10 kHz: rides out a stalled DSP (or recording) thread
+  double max_measurement_s = 600.0;          // longest measurement recorded (written as measured, not held)
   double temp_min_c = 5.0;
   double temp_max_c = 45.0;
   std::uint64_t max_lost_frames = 0;  // more lost frames than this → result flagged degraded

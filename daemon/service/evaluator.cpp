@@ -8,12 +8,14 @@
 #include "drivers/results/software_version.hpp"
 #include "drivers/run_io/file_spill.hpp"
 #include "drivers/run_io/run_reader.hpp"
+#include "drivers/run_io/run_stream.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/setpoint/program_catalog.hpp"
 #include "drivers/setpoint/program_setpoint.hpp"
 #include "drivers/source/servo_setpoint_source.hpp"
 #include "dsp/align/accel_lag.hpp"
 #include "dsp/analysis/verdict.hpp"
+#include "dsp/core/error.hpp"
 #include "dsp/core/float_limits.hpp"
 #include "dsp/stream/analyze_stream.hpp"
 
@@ -41,15 +43,12 @@ std::string percent(double ratio) { return std::to_string(static_cast<int>(std::
 
 // [limits] temp_min_c, temp_max_c: a present sensor's case temperature outside them
 // (its compensation is specified within them) flags the result.
-std::vector<std::string> temperature_flags(const dsp::Run& run, const Limits& limits) {
+std::vector<std::string> temperature_flags(const dsp::Run& run, const RecordingStats& stats, const Limits& limits) {
   std::vector<std::string> flags;
   const char* names[2] = {"table", "head"};
   for (int s = 0; s < 2; ++s) {
     if (!run.meta.sensor_present[s]) continue;
-    float lo = kInf, hi = -kInf;
-    for (const auto& f : run.frames)
-      if (!(f.flags & dsp::frame_flag::temp_missing) && std::isfinite(f.temp_c[s]))
-        lo = std::min(lo, f.temp_c[s]), hi = std::max(hi, f.temp_c[s]);
+    const float lo = stats.temp_lo_c[s], hi = stats.temp_hi_c[s];
     if (!(lo <= hi) || (static_cast<double>(lo) >= limits.temp_min_c && static_cast<double>(hi) <= limits.temp_max_c))
       continue;
     char b[200];
@@ -60,6 +59,37 @@ std::vector<std::string> temperature_flags(const dsp::Run& run, const Limits& li
     flags.emplace_back(b);
   }
   return flags;
+}
+
+// A run's frames as they are replayed, their temperatures seen on the way (a run of an
+// earlier start, evaluated as it streams).
+class WatchedFrames final : public dsp::FrameReplay {
+ public:
+  WatchedFrames(dsp::FrameReplay& frames, RecordingStats& stats) : frames_(frames), stats_(stats) {}
+  void replay(const std::function<void(const dsp::Frame&)>& frame) override {
+    const bool first = !seen_;
+    seen_ = true;
+    frames_.replay([&](const dsp::Frame& f) {
+      if (first) stats_.add(f);
+      frame(f);
+    });
+  }
+  [[nodiscard]] std::size_t size_hint() const override { return frames_.size_hint(); }
+
+ private:
+  dsp::FrameReplay& frames_;
+  RecordingStats& stats_;
+  bool seen_ = false;
+};
+
+// How eicald analyses a run on disk: as it streams, a long one's evaluations spilled to the
+// recording directory's disk (the samples' text reads slower than a spill reads back); one
+// short enough to be evaluated whole (StreamOptions::materialize_samples) spills nothing.
+dsp::StreamOptions stream_options(const std::filesystem::path& recording_dir, std::uint64_t frames) {
+  dsp::StreamOptions so;
+  so.spills = drivers::file_spills(recording_dir);
+  so.spill_trace = so.spill_corrections = frames > so.materialize_samples;
+  return so;
 }
 
 // The lag of the measured behind the recorded set-point and the alignment's residual.
@@ -75,18 +105,28 @@ void measure_alignment(const dsp::Run& run, dsp::SetPointOrigin& s) {
 }  // namespace
 
 Evaluator::Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis,
-                     RecordingHandoff& handoff, EvaluatorLinks links)
+                     RecordingStream& stream, RecordingHandoff& handoff, EvaluatorLinks links)
     : config_(config),
       meta_(std::move(meta)),
       analysis_(std::move(analysis)),
       handoff_(handoff),
       links_(std::move(links)),
+      writer_(
+          config.recording.dir, meta_, config.recording.gzip, stream,
+          [this](const std::string& text, bool set) {
+            if (set)
+              set_fault(text);
+            else
+              clear_fault(text);
+          },
+          kWriteRetryS),
       thread_([this] { loop(); }) {}
 
 Evaluator::~Evaluator() { finish(); }
 
 void Evaluator::finish() {
   if (!thread_.joinable()) return;
+  writer_.finish();  // the DSP thread has stopped: what it handed over is drained
   handoff_.quit();
   thread_.join();
 }
@@ -103,18 +143,18 @@ void Evaluator::set_fault(const std::string& fault) {
 
 void Evaluator::loop() {
   for (const auto& dir : links_.unevaluated) evaluate_recorded(dir);
-  RecordingJob job;
-  while (handoff_.wait_job(job)) {
+  RecordedRun job;
+  while (writer_.next(job)) {
     evaluate(job);
-    handoff_.give_back(std::move(job.frames));  // the storage goes back to the DSP thread
+    if (job.handed_over) handoff_.done();  // the DSP thread may hand the next one over
+    job = RecordedRun{};                   // its samples file closed
   }
 }
 
-dsp::Run Evaluator::make_run(RecordingJob& job) const {
+dsp::Run Evaluator::make_run(const RecordedRun& job) const {
   dsp::Run run;
   run.meta = meta_;
-  const std::string id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" +
-                         std::to_string(job.frames.empty() ? 0 : job.frames.front().sample_index);
+  const std::string id = "eicald-" + utc_now("%Y%m%dT%H%M%SZ") + "-" + std::to_string(job.stats.first_index);
   run.meta.id = id;
   // The wall clock may step back (NTP, an operator) and a restarted source counts its
   // samples from 0 again: an id an earlier run has gets a suffix, it never replaces it.
@@ -123,7 +163,6 @@ dsp::Run Evaluator::make_run(RecordingJob& job) const {
     run.meta.id = id + "-" + std::to_string(n);
   run.meta.created = utc_now("%Y-%m-%dT%H:%M:%SZ");
   run.channels.psd_count = static_cast<int>(std::min<std::size_t>(meta_.psd.size(), dsp::kMaxPsd));
-  run.frames.swap(job.frames);
   return run;
 }
 
@@ -204,52 +243,87 @@ std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingN
   return flags;
 }
 
-void Evaluator::evaluate(RecordingJob& job) {
+std::vector<std::string> Evaluator::commit(RecordedRun& job, dsp::Run& run, const std::filesystem::path& dir) {
+  std::vector<std::string> flags;
+  if (config_.setpoint.source != "none") {
+    // The set-point's alignment reads the whole recording: it comes back into memory here
+    // (only with a set-point from elsewhere; the analysis streams).
+    write_retrying("recording " + run.meta.id, [&] { job.run->finish_samples(); });
+    dsp::Run full = job.run->load();
+    full.meta = run.meta;
+    flags = add_setpoint(full, job.notes);
+    if (config_.setpoint.source == "program")
+      write_retrying("recording " + run.meta.id, [&] { job.run->rewrite(full); });
+    run.meta = std::move(full.meta);
+  }
+  // The run first: what was measured is durable before anything can fail.
+  write_retrying("recording " + run.meta.id, [&] { job.run->commit(run.meta, dir); });
+  return flags;
+}
+
+void Evaluator::add_service_flags(const RecordedRun& job, const dsp::Run& run,
+                                  const std::vector<std::string>& setpoint_flags, dsp::Analysis& a) const {
+  if (!job.cause.empty()) a.flags.push_back(job.cause), a.degraded = true;
+  if (job.notes.nonfinite_frames > 0) {
+    a.flags.push_back("not_finite: " + std::to_string(job.notes.nonfinite_frames) +
+                      " frames had NaN/Inf in a temperature or set-point channel (last finite value held)");
+    a.degraded = true;
+  }
+  for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
+  if (job.notes.source_rate_ratio != 0.0) {
+    char b[240];
+    std::snprintf(b, sizeof b,
+                  "source_rate: the source delivered %.3g times the samples per second [acquisition] fs_hz = %.0f Hz "
+                  "says during the measurement "
+                  "(a DAQ at another rate, a replay faster than real time): its times, speeds and lengths are wrong",
+                  job.notes.source_rate_ratio, run.fs_hz());
+    a.flags.push_back(b), a.degraded = true;
+  }
+  for (const auto& f : temperature_flags(run, job.stats, config_.limits)) a.flags.push_back(f), a.degraded = true;
+  if (job.stats.lost > 0) {
+    a.flags.push_back("recorder_overflow: " + std::to_string(job.stats.lost) +
+                      " frames were not recorded (the recording thread fell behind by more than its ring holds)");
+    a.degraded = true;
+  }
+}
+
+void Evaluator::evaluate(RecordedRun& job) {
   dsp::Run run = make_run(job);
   const auto dir = config_.recording.dir / run.meta.id;
   std::string error;
   try {
-    const std::vector<std::string> setpoint_flags = add_setpoint(run, job.notes);
-    // The run first: what was measured is durable before anything can fail.
-    write_retrying("recording " + run.meta.id,
-                   [&] { drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = false}); });
-    // Streamed: the recording's trace is never held twice, its long evaluations spill to
-    // the recording directory's disk (dsp/stream/analyze_stream.hpp).
-    dsp::StoredFrames frames(run.frames);
-    dsp::Analysis a = dsp::analyze_stream(run, frames, analysis_, {drivers::file_spills(config_.recording.dir)});
-    if (!job.cause.empty()) a.flags.push_back(job.cause), a.degraded = true;
-    if (job.notes.nonfinite_frames > 0) {
-      a.flags.push_back("not_finite: " + std::to_string(job.notes.nonfinite_frames) +
-                        " frames had NaN/Inf in a temperature or set-point channel (last finite value held)");
-      a.degraded = true;
-    }
-    for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
-    if (job.notes.source_rate_ratio != 0.0) {
-      char b[240];
-      std::snprintf(b, sizeof b,
-                    "source_rate: the source delivered %.3g times the samples per second [acquisition] fs_hz = %.0f Hz "
-                    "says during the measurement "
-                    "(a DAQ at another rate, a replay faster than real time): its times, speeds and lengths are wrong",
-                    job.notes.source_rate_ratio, run.fs_hz());
-      a.flags.push_back(b), a.degraded = true;
-    }
-    for (const auto& f : temperature_flags(run, config_.limits)) a.flags.push_back(f), a.degraded = true;
+    const std::vector<std::string> setpoint_flags = commit(job, run, dir);
+    // Streamed from disk as `eical analyze` reads a run: a recording of any length in
+    // bounded memory (dsp/stream/analyze_stream.hpp).
+    dsp::Analysis a;
+    write_retrying("evaluation of " + run.meta.id, [&] {  // its spills on a full disk: again
+      // The run directory removed meanwhile (an operator, a cleanup): made again from the
+      // samples still open, first.
+      if (!std::filesystem::exists(dir / "run.toml")) job.run->commit(run.meta, dir);
+      try {
+        drivers::RunStream frames(dir);
+        a = dsp::analyze_stream(run, frames, analysis_, stream_options(config_.recording.dir, job.stats.frames));
+      } catch (const dsp::InputError& e) {
+        if (std::filesystem::exists(dir / "run.toml")) throw;
+        throw std::runtime_error(e.what());  // it went while it was read: again
+      }
+    });
+    add_service_flags(job, run, setpoint_flags, a);
     dsp::judge(run.meta.program, a);  // the verdict again, with the flags the daemon added
     write_retrying("result of " + run.meta.id, [&] {
-      // The run directory removed meanwhile (an operator, a cleanup): the run again first.
-      if (!std::filesystem::exists(dir / "run.toml"))
-        drivers::write_run(run, dir, {.gzip = config_.recording.gzip, .overwrite = true});
+      // The run directory removed meanwhile (an operator, a cleanup): made again from the
+      // samples still open, first.
+      if (!std::filesystem::exists(dir / "run.toml")) job.run->commit(run.meta, dir);
       drivers::write_result(run, a, dir / "result.json");
     });
     finish_result(run, a, dir);
-    log(LogLevel::notice, "measurement %s written (%zu frames)%s", run.meta.id.c_str(), run.frames.size(),
-        a.degraded ? ", result degraded" : "");
+    log(LogLevel::notice, "measurement %s written (%llu frames)%s", run.meta.id.c_str(),
+        static_cast<unsigned long long>(job.stats.frames), a.degraded ? ", result degraded" : "");
   } catch (const std::exception& e) {
     error = e.what();
     log(LogLevel::error, "recording %s: %s", run.meta.id.c_str(), e.what());
   }
   if (!error.empty()) set_fault("recording: " + error);
-  job.frames.swap(run.frames);
 }
 
 void Evaluator::finish_result(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir) {
@@ -270,15 +344,20 @@ void Evaluator::finish_result(const dsp::Run& run, const dsp::Analysis& a, const
 // not in the run.
 void Evaluator::evaluate_recorded(const std::filesystem::path& dir) {
   try {
-    dsp::Run run = drivers::read_run(dir);
-    dsp::StoredFrames frames(run.frames);
-    dsp::Analysis a = dsp::analyze_stream(run, frames, analysis_, {drivers::file_spills(config_.recording.dir)});
+    drivers::RunStream stream(dir);
+    RecordingStats stats;
+    WatchedFrames frames(stream, stats);
+    const dsp::StreamOptions so = stream_options(config_.recording.dir, stream.size_hint());
+    dsp::Analysis a = dsp::analyze_stream(stream.header(), frames, analysis_, so);
+    if (!stream.presence_held())  // a sensor the first row did not show: again, as eical analyze does
+      a = dsp::analyze_stream(stream.header(), frames, analysis_, so);
+    const dsp::Run& run = stream.header();
     a.flags.push_back(
         "evaluated_after_restart: eicald stopped between writing this run and its result; evaluated at the next start, "
         "without the flags "
         "only the stopped service knew (cut short, non-finite channels)");
     a.degraded = true;
-    for (const auto& f : temperature_flags(run, config_.limits)) a.flags.push_back(f);
+    for (const auto& f : temperature_flags(run, stats, config_.limits)) a.flags.push_back(f);
     dsp::judge(run.meta.program, a);
     write_retrying("result of " + run.meta.id, [&] { drivers::write_result(run, a, dir / "result.json"); });
     finish_result(run, a, dir);
@@ -303,6 +382,8 @@ void Evaluator::write_retrying(const std::string& what, const std::function<void
     try {
       write();
       break;
+    } catch (const dsp::InputError&) {
+      throw;  // bad input: no retry makes it good
     } catch (const std::exception& e) {
       if (stopping()) throw;
       const std::string now = "recording: " + what + ": " + e.what() + "; retried every " +

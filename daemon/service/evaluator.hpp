@@ -1,11 +1,15 @@
 #pragma once
-// The evaluation thread: takes finished recordings from the DSP thread (RecordingHandoff)
-// and, as a flat list of stages, makes the run (metadata, id), puts the NC's set-point on
-// it when it comes from elsewhere (servo stream: the clocks' alignment; program: the
-// program M101 named, reconstructed and aligned), writes it (durable first), analyses it,
-// writes result.json and publishes Result and Trace. Not real-time: it allocates and writes.
+// The evaluation thread: takes finished recordings from the recording thread (written to
+// disk as they were measured: RecordingWriter) and, as a flat list of stages, names the run
+// (metadata, id), puts the NC's set-point on it when it comes from elsewhere (servo
+// stream: the clocks' alignment; program: the program M101 named, reconstructed and
+// aligned — these two read the recording back into memory), renames it into place
+// (durable first), analyses it as it streams from disk (bounded memory whatever its
+// length), writes result.json and publishes Result and Trace; then tells the DSP thread
+// (RecordingHandoff) that the next recording may come. Not real-time: it allocates and writes.
 #include "daemon/config/daemon_config.hpp"
 #include "daemon/service/recording_handoff.hpp"
+#include "daemon/service/recording_writer.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/core/run.hpp"
 
@@ -48,8 +52,8 @@ struct EvaluationStatus {
 
 class Evaluator {
  public:
-  Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingHandoff& handoff,
-            EvaluatorLinks links);
+  Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis, RecordingStream& stream,
+            RecordingHandoff& handoff, EvaluatorLinks links);
   ~Evaluator();  // finish()
   // Evaluates what was handed over, then stops the thread; status() stays readable.
   void finish();
@@ -66,12 +70,20 @@ class Evaluator {
 
  private:
   void loop();
-  void evaluate(RecordingJob& job);
+  void evaluate(RecordedRun& job);
   // A run of the previous eicald that has no result.json: evaluated now, flagged.
   void evaluate_recorded(const std::filesystem::path& dir);
   // result.json written: counted, into the history, published.
   void finish_result(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir);
-  dsp::Run make_run(RecordingJob& job) const;
+  // The run's metadata and name (no frames: they are on disk).
+  dsp::Run make_run(const RecordedRun& job) const;
+  // Names the recording and renames it into place; with a set-point from elsewhere, reads it
+  // back to put that on (flags for the result: empty, nothing doubtful).
+  std::vector<std::string> commit(RecordedRun& job, dsp::Run& run, const std::filesystem::path& dir);
+  // The flags only the service knows: how it ended, the guard, the set-point, the source's rate,
+  // the temperatures, frames the recorder lost.
+  void add_service_flags(const RecordedRun& job, const dsp::Run& run, const std::vector<std::string>& setpoint_flags,
+                         dsp::Analysis& a) const;
   // The program M101's P word (or [setpoint.program] default_program) names.
   std::optional<std::pair<int, dsp::Program>> named_program(const RecordingNotes& notes,
                                                             std::vector<std::string>& flags) const;
@@ -79,7 +91,8 @@ class Evaluator {
   std::vector<std::string> add_setpoint(dsp::Run& run, const RecordingNotes& notes) const;
   void publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir,
                std::uint64_t result_number);
-  // Runs `write` until it succeeds; throws its last error when the service stops first.
+  // Runs `write` until it succeeds (a fault of the storage clears); throws its last error when
+  // the service stops first, and bad input (dsp::InputError) at once.
   void write_retrying(const std::string& what, const std::function<void()>& write);
   [[nodiscard]] bool stopping() const;
 
@@ -90,6 +103,7 @@ class Evaluator {
   EvaluatorLinks links_;
   mutable std::mutex mu_;
   EvaluationStatus status_;
+  RecordingWriter writer_;  // before thread_: running while the evaluation thread runs
   std::thread thread_;
 };
 

@@ -132,6 +132,7 @@ struct Parts {
   std::vector<std::unique_ptr<TriggerChannel>> channels;  // hardware inputs
   std::vector<std::unique_ptr<TriggerListener>> listeners;
   std::unique_ptr<drivers::FrameRing> ring;
+  std::unique_ptr<RecordingStream> recording;  // the session's frames to the recording thread
   std::unique_ptr<dsp::MeasurementSession> session;
   std::unique_ptr<dsp::Pipeline> live;
   std::unique_ptr<FrameGuard> guard;
@@ -229,7 +230,10 @@ void make_measurement(Parts& p) {
   dsp::SessionConfig scfg;
   scfg.fs_hz = p.meta.acquisition.fs_hz;
   scfg.max_measurement_s = c.limits.max_measurement_s;
-  p.session = std::make_unique<dsp::MeasurementSession>(scfg);
+  // Recordings go to disk as they are measured: a ring as long as the acquisition's is all
+  // the DSP thread holds of them, whatever their length.
+  p.recording = std::make_unique<RecordingStream>(c.limits.ring_capacity_frames);
+  p.session = std::make_unique<dsp::MeasurementSession>(scfg, p.recording.get());
   dsp::PipelineConfig live_cfg = dsp::pipeline_config(p.meta, p.session->recorder_capacity());
   for (int s = 0; s < 2; ++s) live_cfg.calibration[s] = p.analysis.calibration[s];
   // The live estimate only: the evaluation runs its own pipeline over the recording, so the
@@ -238,7 +242,7 @@ void make_measurement(Parts& p) {
   p.live = std::make_unique<dsp::Pipeline>(live_cfg);
   p.guard = std::make_unique<FrameGuard>(static_cast<float>(p.meta.sensors[0].temp_ref_c),
                                          static_cast<float>(p.meta.sensors[1].temp_ref_c));
-  p.handoff = std::make_unique<RecordingHandoff>(p.session->recorder_capacity());
+  p.handoff = std::make_unique<RecordingHandoff>(*p.recording);
 }
 
 // The calibration history ([history]): results leave through an on-disk spool, never lost.
@@ -251,7 +255,7 @@ void start_evaluator(Parts& p, const std::atomic<bool>& stop) {
   links.hmi = p.hmi.get(), links.servo = p.servo, links.history = p.history.get(), links.stop = &stop;
   links.unevaluated = std::move(p.unevaluated);
   links.sensor_calibration = p.sensor_calibration;
-  p.evaluator = std::make_unique<Evaluator>(p.config, p.meta, p.analysis, *p.handoff, std::move(links));
+  p.evaluator = std::make_unique<Evaluator>(p.config, p.meta, p.analysis, *p.recording, *p.handoff, std::move(links));
   if (auto problem = recording_dir_problem(p.config.recording.dir)) p.evaluator->set_fault(*problem);
 }
 

@@ -9,7 +9,9 @@
 namespace eical::drivers {
 
 // Spills in `dir` (a disk, not tmpfs: /var/tmp, or eicald's recording directory).
-// Creating one throws InputError naming the directory when it cannot be written.
+// A spill that cannot be created, written or read throws std::runtime_error naming the
+// directory — a fault of the storage, not of the run (no InputError: nothing in dsp/
+// mistakes it for bad input and carries on with a flag).
 dsp::SpillFactory file_spills(std::filesystem::path dir);
 
 // $TMPDIR when set, else /var/tmp (which Debian keeps on disk).

@@ -6,6 +6,7 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -23,23 +24,25 @@ namespace fs = std::filesystem;
 namespace {
 
 // About how many rows a samples file holds: its size over the length of its first rows
-// (a plain file), or gzip's record of the uncompressed size (below 4 GiB). A reserve, not
-// a limit: 0 when it cannot tell.
+// (a plain file); compressed, gzip's record of the uncompressed size (below 4 GiB; of the
+// last member only when the file holds several, as eicald writes them) or the ratio of the
+// first megabyte, whichever is larger. A reserve, not a limit: 0 when it cannot tell.
 std::size_t estimate_rows(const fs::path& file) {
   std::error_code ec;
   const auto bytes = static_cast<double>(fs::file_size(file, ec));
   if (ec || bytes <= 0) return 0;
-  double plain = bytes;
-  if (file.extension() == ".gz") {
+  const bool gzip = file.extension() == ".gz";
+  double plain = gzip ? 0.0 : bytes;
+  if (gzip) {
     std::ifstream is(file, std::ios::binary);
     is.seekg(-4, std::ios::end);
     unsigned char b[4] = {};
-    if (!is.read(reinterpret_cast<char*>(b), 4)) return 0;
-    const std::uint32_t size_mod_4g =
-        b[0] | (std::uint32_t{b[1]} << 8) | (std::uint32_t{b[2]} << 16) | (std::uint32_t{b[3]} << 24);
-    const auto isize = static_cast<double>(size_mod_4g);
-    if (bytes * 40.0 > 4294967296.0 || isize < bytes) return 0;  // it may have wrapped
-    plain = isize;
+    if (is.read(reinterpret_cast<char*>(b), 4)) {
+      const std::uint32_t size_mod_4g =
+          b[0] | (std::uint32_t{b[1]} << 8) | (std::uint32_t{b[2]} << 16) | (std::uint32_t{b[3]} << 24);
+      const auto isize = static_cast<double>(size_mod_4g);
+      if (bytes * 40.0 <= 4294967296.0 && isize >= bytes) plain = isize;  // else it may have wrapped
+    }
   }
   gzFile gz = gzopen(file.c_str(), "rb");
   if (!gz) return 0;
@@ -48,8 +51,19 @@ std::size_t estimate_rows(const fs::path& file) {
   int rows = 0;
   for (int i = 0; i < 201 && gzgets(gz, line, sizeof line); ++i)
     if (i > 0) len += static_cast<double>(std::char_traits<char>::length(line)), ++rows;  // not the header
+  if (gzip) {  // the compression ratio over the first megabyte
+    std::vector<char> buf(1 << 16);
+    double text = static_cast<double>(gztell(gz));
+    for (int k = 0; k < 16; ++k) {
+      const int n = gzread(gz, buf.data(), static_cast<unsigned>(buf.size()));
+      if (n <= 0) break;
+      text += n;
+    }
+    const auto packed = static_cast<double>(gzoffset(gz));
+    if (packed > 0) plain = std::max(plain, bytes * text / packed);
+  }
   gzclose(gz);
-  if (rows == 0 || len <= 0) return 0;
+  if (rows == 0 || len <= 0 || plain <= 0) return 0;
   return static_cast<std::size_t>(plain / (len / rows) * 1.1) + 16;  // the time column grows a digit or two
 }
 

@@ -1,5 +1,7 @@
 #include "drivers/run_io/run_writer.hpp"
 
+#include "drivers/run_io/sample_rows.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -23,19 +25,9 @@ namespace {
   throw std::runtime_error(p.string() + ": " + what + ": " + std::strerror(err));
 }
 
-// Shortest text that reads back to the same double; fixed notation (as people and
-// spreadsheets expect: 0.0001, not 1e-04) unless the value is tiny or huge.
-void put_double(std::string& out, double v) {
-  char buf[64];
-  const double a = std::abs(v);
-  const auto fmt = (a == 0.0 || (a >= 1e-9 && a < 1e15)) ? std::chars_format::fixed : std::chars_format::scientific;
-  const auto r = std::to_chars(buf, buf + sizeof buf, v, fmt);
-  out.append(buf, r.ptr);
-}
-
 std::string toml_double(double v) {
   std::string s;
-  put_double(s, v);
+  append_double(s, v);
   if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
   return s;
 }
@@ -166,7 +158,20 @@ class FileOut {
   std::string buf_;
 };
 
-void write_text(const fs::path& p, const std::string& text) {
+void write_samples(const dsp::Run& run, const fs::path& file, bool gzip) {
+  FileOut out(file, gzip);
+  std::string& b = out.buffer();
+  b = samples_header(run.channels);
+  for (const auto& f : run.frames) {
+    append_sample_row(b, f, run.meta, run.channels);
+    out.flush_if_full();
+  }
+  out.close_and_sync();
+}
+
+}  // namespace
+
+void write_synced(const fs::path& p, const std::string& text) {
   FileOut f(p, false);
   f.buffer() = text;
   f.close_and_sync();
@@ -180,64 +185,6 @@ void sync_dir(const fs::path& d) {
   ::close(fd);
   if (rc != 0) sys_fail(d, "fsync of the directory failed", err);
 }
-
-void write_samples(const dsp::Run& run, const fs::path& file, bool gzip) {
-  FileOut out(file, gzip);
-  std::string& b = out.buffer();
-  const int n_psd = run.channels.psd_count;
-  b = "t,table_ax,table_ay,table_az,head_ax,head_ay,head_az,table_temp,head_temp";
-  for (int k = 0; k < n_psd; ++k) b += ",psd" + std::to_string(k) + "_i1,psd" + std::to_string(k) + "_i2";
-  b += ",cmd_x,cmd_y,cmd_z";
-  const char* ref_names[3] = {",ref_x", ",ref_y", ",ref_z"};
-  for (int a = 0; a < 3; ++a)
-    if (run.channels.ref[a]) b += ref_names[a];
-  b += ",trigger\n";
-  const double fs = run.meta.acquisition.fs_hz;
-  const double lsb = run.meta.acquisition.adc_lsb_volt;
-  const auto offset = run.meta.acquisition.adc_offset_counts;
-  char num[32];
-  auto put_int = [&](std::int64_t v) {
-    const auto r = std::to_chars(num, num + sizeof num, v);
-    b.append(num, r.ptr);
-  };
-  for (const auto& f : run.frames) {
-    put_double(b, static_cast<double>(f.sample_index) / fs);
-    for (int c = 0; c < 6; ++c) {
-      b += ',';
-      const int sensor = c < 3 ? 0 : 1;
-      // An absent triplex is written empty; a missing field of a present one too (the
-      // reader's old single flag still marks the whole frame).
-      const bool missing = !run.meta.sensor_present[sensor] || (f.flags & dsp::frame_flag::sensor_missing(sensor)) ||
-                           ((f.flags & dsp::frame_flag::accel_missing) &&
-                            !(f.flags & (dsp::frame_flag::table_missing | dsp::frame_flag::head_missing)));
-      if (!missing) put_int(f.accel_counts[c]);
-    }
-    for (int s = 0; s < 2; ++s) {
-      b += ',';
-      if (!(f.flags & dsp::frame_flag::temp_missing)) put_double(b, static_cast<double>(f.temp_c[s]));
-    }
-    for (int c = 0; c < 2 * n_psd; ++c) {
-      b += ',';
-      if (!(f.flags & dsp::frame_flag::psd_missing)) put_double(b, static_cast<double>(f.psd_counts[c] - offset) * lsb);
-    }
-    for (int a = 0; a < 3; ++a) {
-      b += ',';
-      if (!(f.flags & dsp::frame_flag::cmd_missing)) put_double(b, f.cmd_mm[a]);
-    }
-    for (int a = 0; a < 3; ++a) {
-      if (!run.channels.ref[a]) continue;
-      b += ',';
-      if (std::isfinite(f.ref_mm[a])) put_double(b, f.ref_mm[a]);
-    }
-    b += ',';
-    put_int(f.trigger);
-    b += '\n';
-    out.flush_if_full();
-  }
-  out.close_and_sync();
-}
-
-}  // namespace
 
 std::string run_toml_text(const dsp::RunMeta& m) {
   std::string o;
@@ -303,9 +250,9 @@ void write_run(const dsp::Run& run, const fs::path& dir_in, const WriteOptions& 
   const fs::path tmp = parent / ("." + dir.filename().string() + ".tmp-" + std::to_string(rd()));
   if (::mkdir(tmp.c_str(), 0755) != 0) sys_fail(tmp, "cannot create", errno);
   try {
-    write_text(tmp / "run.toml", run_toml_text(run.meta));
+    write_synced(tmp / "run.toml", run_toml_text(run.meta));
     write_samples(run, tmp / (opt.gzip ? "samples.csv.gz" : "samples.csv"), opt.gzip);
-    if (run.truth_toml) write_text(tmp / "truth.toml", *run.truth_toml);
+    if (run.truth_toml) write_synced(tmp / "truth.toml", *run.truth_toml);
     sync_dir(tmp);
     if (fs::exists(dir)) {
       // Replace atomically: old run aside, new in, old removed.

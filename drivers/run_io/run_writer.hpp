@@ -27,5 +27,10 @@ std::string sensor_section_toml(const char* name, const dsp::SensorSpec& spec);
 void write_text_atomic(const std::filesystem::path& file, const std::string& text);
 // TOML text of a number that reads back to the same double.
 std::string toml_number(double v);
+// A file written and fsynced in place (inside a temporary directory that is renamed whole);
+// throws std::runtime_error naming the path.
+void write_synced(const std::filesystem::path& file, const std::string& text);
+// fsync of a directory: its entries (a file created, a directory renamed in) are durable.
+void sync_dir(const std::filesystem::path& dir);
 
 }  // namespace eical::drivers

@@ -88,6 +88,7 @@ Pipeline::Pipeline(const PipelineConfig& c)
   SupportConfig sc;
   sc.zupt = c.zupt, sc.nbs = c.nbs, sc.cupt = c.cupt, sc.smooth = c.smooth;
   sc.record = c.trace == TraceKeeping::whole || c.trace == TraceKeeping::track;
+  sc.compact = c.trace == TraceKeeping::track;
   sc.model = c.fusion;
   sc.standstill = c.standstill;
   const double noise_mps2 = c.fusion.accel_noise_um_s2_rthz * 1e-6;

@@ -30,7 +30,10 @@ SupportStage::SupportStage(const SupportConfig& c, const Acquisition& acq, const
   // whole-trace pipelines reserve their capacity: no allocation per sample).
   reserve = std::min(reserve, capacity);
   schedule_.flags.reserve(reserve);
-  schedule_.zupt_sigma_um_s.reserve(reserve);
+  if (c.compact)
+    zupt_unused_.reserve(reserve);
+  else
+    schedule_.zupt_sigma_um_s.reserve(reserve);
   schedule_.fixes.reserve(reserve);
   schedule_.velocity_means.reserve(reserve / 100 + 16);
   gaps_.reserve(reserve);
@@ -48,6 +51,7 @@ void SupportStage::reset() noexcept {
   detector_.reset();
   schedule_.flags.clear();
   schedule_.zupt_sigma_um_s.clear();
+  zupt_unused_.clear();
   schedule_.velocity_means.clear();
   schedule_.fixes.clear();
   gaps_.clear();
@@ -231,7 +235,10 @@ void SupportStage::position_fixes(const SupportSample& s, const Eigen::Vector3d&
 void SupportStage::record(const SupportSample& s, std::uint8_t flags, const RestDecision& r) noexcept {
   if (schedule_.flags.size() >= capacity_) return;  // within the reserve: no allocation
   schedule_.flags.push_back(flags);
-  schedule_.zupt_sigma_um_s.push_back(static_cast<float>(r.zupt_sigma_um_s));
+  if (cfg_.compact)
+    zupt_unused_.push_back(r.zupt_sigma_um_s < 0.0);  // −1 or 0 (see smooth_track())
+  else
+    schedule_.zupt_sigma_um_s.push_back(static_cast<float>(r.zupt_sigma_um_s));
   if (s.k > 0 && s.gap_samples != 1) gaps_.emplace_back(s.k, s.gap_samples);
   if (fusion::reads_velocity(flags)) support_vel_mm_s_.push_back(s.vel_mm_s);
 }
@@ -262,7 +269,17 @@ SupportSummary SupportStage::refine(std::size_t n, const std::function<std::int6
   support_vel_mm_s_.resize(std::min(reads, support_vel_mm_s_.size()));
   while (!gaps_.empty() && gaps_.back().first >= n) gaps_.pop_back();
   flags.resize(n);
-  schedule_.zupt_sigma_um_s.resize(n);
+  if (cfg_.compact)
+    zupt_unused_.resize(n);
+  else
+    schedule_.zupt_sigma_um_s.resize(n);
+  auto used = [&](std::size_t k) { return cfg_.compact ? !zupt_unused_[k] : schedule_.zupt_sigma_um_s[k] == 0.0F; };
+  auto unuse = [&](std::size_t k) {
+    if (cfg_.compact)
+      zupt_unused_[k] = true;
+    else
+      schedule_.zupt_sigma_um_s[k] = -1.0F;
+  };
   // Hindsight: the velocity is trusted only from zupt_onset_skip_s into a standstill on.
   // A machine settles into its standstill (the position loop takes up its lag over a few
   // time constants, the sensors ring out); the live filter cannot wait, the offline pass
@@ -279,8 +296,8 @@ SupportSummary SupportStage::refine(std::size_t n, const std::function<std::int6
     // From its first quiet sample on (the position loop may still be taking up its lag
     // while the set-point rests: that is motion, however slow).
     std::size_t q = k;
-    while (q <= e && schedule_.zupt_sigma_um_s[q] != 0.0F) ++q;
-    for (std::size_t j = q; j <= e && j < q + skip; ++j) schedule_.zupt_sigma_um_s[j] = -1.0F;
+    while (q <= e && !used(q)) ++q;
+    for (std::size_t j = q; j <= e && j < q + skip; ++j) unuse(j);
     if (q <= e) quiet_runs.push_back({k, e});
   }
   auto& means = schedule_.velocity_means;
@@ -320,13 +337,16 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
     c->track.fix_pos_mm = std::move(fix_pos_mm_);
     // ZUPT σ per sample is 0 or −1 (step() and refine() write nothing else): as bits.
     auto& zs = c->schedule.zupt_sigma_um_s;
-    if (std::all_of(zs.begin(), zs.end(), [](float z) { return z == 0.0F || z == -1.0F; })) {
+    if (cfg_.compact) {
+      c->track.zupt_unused = std::move(zupt_unused_);
+    } else if (std::all_of(zs.begin(), zs.end(), [](float z) { return z == 0.0F || z == -1.0F; })) {
       c->track.zupt_unused.resize(zs.size());
       for (std::size_t k = 0; k < zs.size(); ++k) c->track.zupt_unused[k] = zs[k] == -1.0F;
       std::vector<float>().swap(zs);
     }
   } else {
     c->schedule = schedule_;
+    c->track.zupt_unused = zupt_unused_;
     c->track.gaps = gaps_;
     c->track.support_vel_mm_s = support_vel_mm_s_;
     c->track.fix_pos_mm = fix_pos_mm_;

@@ -36,6 +36,9 @@ struct SupportConfig {
   // Record what the offline smoother reads (the schedule and its compact track); off for
   // the live pipeline, which only needs the forward filter's estimate.
   bool record = true;
+  // Record ZUPT σ per sample as a bit (it is 0 or −1): the track of a streamed analysis,
+  // a byte and a bit per sample in its first pass instead of five bytes.
+  bool compact = false;
   fusion::ErrorModel model;
   supports::StandstillOptions standstill;
 };
@@ -181,6 +184,7 @@ class SupportStage {
   std::vector<std::pair<std::size_t, std::int64_t>> gaps_;
   std::vector<Eigen::Vector3d> support_vel_mm_s_;
   std::vector<double> fix_pos_mm_;
+  std::vector<bool> zupt_unused_;  // SupportConfig::compact: ZUPT σ −1 (true) or 0 per sample
   std::size_t capacity_ = 0;
   // Rest window before the motion: Σa, Σa² of the relative acceleration.
   Eigen::Vector3d rest_sum_ = Eigen::Vector3d::Zero(), rest_sq_ = Eigen::Vector3d::Zero();

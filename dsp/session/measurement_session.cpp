@@ -11,9 +11,9 @@ std::size_t frames_of(double seconds, double fs_hz) {
 
 }  // namespace
 
-MeasurementSession::MeasurementSession(const SessionConfig& config)
+MeasurementSession::MeasurementSession(const SessionConfig& config, RecordingSink* sink)
     : config_(config),
-      recorder_(frames_of(config.max_measurement_s, config.fs_hz), frames_of(config.pretrigger_s, config.fs_hz)),
+      recorder_(frames_of(config.max_measurement_s, config.fs_hz), frames_of(config.pretrigger_s, config.fs_hz), sink),
       posttrigger_frames_(frames_of(config.posttrigger_s, config.fs_hz)) {}
 
 bool MeasurementSession::queue_trigger(std::int64_t sample_index, int code) noexcept {

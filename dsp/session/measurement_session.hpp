@@ -34,7 +34,8 @@ struct SessionCounters {
 
 class MeasurementSession {
  public:
-  explicit MeasurementSession(const SessionConfig& config);
+  // sink: the recordings go there as they are recorded (MeasurementRecorder), none is held.
+  explicit MeasurementSession(const SessionConfig& config, RecordingSink* sink = nullptr);
 
   // Per frame, DSP thread.
   void on_frame(const Frame& frame) noexcept;
@@ -48,6 +49,8 @@ class MeasurementSession {
   [[nodiscard]] bool measurement_ready() const noexcept { return recorder_.complete(); }
   // See MeasurementRecorder::take; then evaluate and call evaluation_done().
   bool take(std::vector<Frame>& spare) noexcept { return recorder_.take(spare); }
+  // With a sink: see MeasurementRecorder::take_streamed; then evaluation_done().
+  bool take_streamed() noexcept { return recorder_.take_streamed(); }
   void evaluation_done() { (void)state_.handle(Event::evaluation_done); }
   // The data ended inside a measurement (service stopped, source failed): the frames so
   // far become a complete recording, as if M103 had come now. False when none was running.

@@ -7,6 +7,7 @@
 #include "dsp/eval/repeats.hpp"
 #include "dsp/pipeline/integration_support.hpp"
 #include "dsp/stream/circle_stream.hpp"
+#include "dsp/stream/trace_spill.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -44,11 +45,7 @@ class Scout final : public TraceSink {
     marks_.push_back(f.sample_index);
   }
   void sample(const TraceSample& s) override {
-    if (trace)
-      trace->put({{static_cast<double>(s.sample_index), static_cast<double>(s.trigger), s.pos_mm[0], s.pos_mm[1],
-                   s.pos_mm[2], s.vel_mm_s[0], s.vel_mm_s[1], s.vel_mm_s[2], s.cmd_mm[0], s.cmd_mm[1], s.cmd_mm[2],
-                   s.ref_mm[0], s.ref_mm[1], s.ref_mm[2], static_cast<double>(s.temp_c[0]),
-                   static_cast<double>(s.temp_c[1]), static_cast<double>(s.frame_flags)}});
+    if (trace) trace->put(s);
     if (circle_) {
       repeats.add(n, s.sample_index, s.cmd_mm);
       // A mark counts at the trace sample it falls on (or, between samples, at the next
@@ -64,8 +61,8 @@ class Scout final : public TraceSink {
     ++n;
   }
 
-  std::size_t n = 0;                          // trace samples
-  SpillWriter<Doubles<17>>* trace = nullptr;  // the integrated trace, for the second pass
+  std::size_t n = 0;            // trace samples
+  TraceSpill* trace = nullptr;  // the integrated trace, for the second pass
   bool circle_;
   eval::RepeatFinder repeats;
   std::optional<eval::CircleSegmentFinder> segments;
@@ -99,6 +96,11 @@ class CorrectionSpill final : public fusion::SegmentSink {
     bytes_ += buf_.size() * sizeof(Doubles<9>);
   }
   [[nodiscard]] bool has(std::size_t j) const { return j < where_.size() && where_[j].size > 0; }
+  [[nodiscard]] bool has_all(std::size_t segments) const {
+    for (std::size_t j = 0; j < segments; ++j)
+      if (!has(j)) return false;
+    return true;
+  }
   void load(std::size_t j, fusion::SmoothedSegment& out) {
     const Where& w = where_[j];
     buf_.resize(w.size);
@@ -136,6 +138,7 @@ class Emitter final : public TraceSink {
  public:
   Emitter(const Pipeline::Tracked& t, CorrectionSpill* kept, std::function<void(const Corrected&)> out)
       : n_(t.samples),
+        apply_(t.correction && t.correction->apply),
         correction_(t.correction.get()),
         kept_(kept),
         d_(t.delay_samples),
@@ -149,14 +152,13 @@ class Emitter final : public TraceSink {
     c.pos_mm = s.pos_mm, c.vel_mm_s = s.vel_mm_s, c.cmd_mm = s.cmd_mm, c.ref_mm = s.ref_mm;
     c.temp_c[0] = s.temp_c[0], c.temp_c[1] = s.temp_c[1], c.frame_flags = s.frame_flags;
     c.sigma_um = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-    if (correction_ && correction_->apply) {
-      const auto& sm = *correction_->smoother;
+    if (apply_) {
       if (c.k >= seg_.first + seg_.size() || !loaded_) {
-        const std::size_t j = c.k / sm.segment_samples();
+        const std::size_t j = c.k / segment_samples_;
         if (kept_ && kept_->has(j))
           kept_->load(j, seg_);
         else
-          sm.segment(j, seg_);
+          correction_->smoother->segment(j, seg_);
         loaded_ = true;
       }
       const std::size_t i = c.k - seg_.first;
@@ -172,6 +174,11 @@ class Emitter final : public TraceSink {
     pending_.push_back(c);
     flush();
   }
+  // Every segment's corrections are in the spill: the smoother and its track can go.
+  [[nodiscard]] bool kept_whole() const {
+    return !apply_ || (kept_ && kept_->has_all(correction_->smoother->segments()));
+  }
+  void forget_smoother() { correction_ = nullptr; }
   void finish() {
     if (seen_ != n_)
       throw InputError("the run changed between two readings (" + std::to_string(seen_) + " trace samples, then " +
@@ -205,7 +212,9 @@ class Emitter final : public TraceSink {
   }
 
   std::size_t n_;
+  bool apply_;
   const SmoothedCorrection* correction_;
+  std::size_t segment_samples_ = apply_ ? correction_->smoother->segment_samples() : 0;
   CorrectionSpill* kept_;
   double d_;
   bool align_;
@@ -256,9 +265,10 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   PipelineConfig cfg = analysis_config(header.meta, std::numeric_limits<std::size_t>::max(), options);
   cfg.reserve_samples = frames.size_hint();
   Scout scout(header, circle);
-  std::unique_ptr<Spill> trace_spill = stream.spill_trace ? stream.spills() : nullptr;
-  std::optional<SpillWriter<Doubles<17>>> trace_writer;
-  if (trace_spill) scout.trace = &trace_writer.emplace(*trace_spill);
+  std::optional<TraceSpill> trace_spill;
+  if (stream.spill_trace)
+    scout.trace = &trace_spill.emplace(stream.spills(),
+                                       header.channels.ref[0] || header.channels.ref[1] || header.channels.ref[2]);
   cfg.trace = TraceKeeping::track;
   cfg.sink = &scout;
   std::size_t n_frames = 0;
@@ -333,19 +343,15 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
     if (repeats) repeats->add(c.k, c.pos_mm, c.cmd_mm);
     if (uncertainty) uncertainty->sample(c.k, c.sample_index, c.pos_mm, c.vel_mm_s, c.cmd_mm, c.ref_mm, temp);
   });
+  // A long run's corrections all kept, its track (a byte and a bit per sample) and the
+  // smoother's checkpoints go before the second pass: the uncertainty has coarsened what it
+  // reads of the schedule, the emitter reads the spill.
+  if (!whole && emitter.kept_whole()) {
+    emitter.forget_smoother();
+    t.correction.reset();
+  }
   if (trace_spill) {  // the integrated trace as the first pass saw it
-    trace_writer->flush();
-    for_each_record<Doubles<17>>(*trace_spill, [&](const Doubles<17>& r) {
-      TraceSample ts;
-      ts.sample_index = static_cast<std::int64_t>(r.v[0]);
-      ts.trigger = static_cast<std::int32_t>(r.v[1]);
-      ts.pos_mm = {r.v[2], r.v[3], r.v[4]}, ts.vel_mm_s = {r.v[5], r.v[6], r.v[7]};
-      ts.cmd_mm = {r.v[8], r.v[9], r.v[10]}, ts.ref_mm = {r.v[11], r.v[12], r.v[13]};
-      ts.temp_c[0] = static_cast<float>(r.v[14]), ts.temp_c[1] = static_cast<float>(r.v[15]);
-      ts.frame_flags = static_cast<std::uint32_t>(r.v[16]);
-      emitter.sample(ts);
-    });
-    trace_writer.reset();
+    trace_spill->replay([&](const TraceSample& ts) { emitter.sample(ts); });
     trace_spill.reset();
   } else {  // the frames through the pipeline again (the same numbers: the same code)
     PipelineConfig cfg2 = cfg;

@@ -2,10 +2,12 @@
 // (this test's thread) through whole measurements — acquisition stamps, the guard, the
 // DAQ clock, external triggers (DDS channel: an M101 accepted with its P word, an M101
 // during the measurement refused), the session, the live pipeline, Live samples to the
-// HMI publisher and the hand-over of the recording to the evaluation thread. Other
-// threads (the HMI link's, the stand-in evaluator) may allocate: the count is per thread.
+// HMI publisher, every recorded frame into the recording ring and the hand-over of the
+// recording to the evaluation thread. Other threads (the HMI link's, the stand-in
+// recording and evaluation thread) may allocate: the count is per thread.
 #include "daemon/service/frame_loop.hpp"
 #include "daemon/service/hmi_link.hpp"
+#include "daemon/service/recording_stream.hpp"
 #include "drivers/dds/domain_claim.hpp"
 #include "drivers/source/replay_source.hpp"
 #include "sim/simulate.hpp"
@@ -62,12 +64,13 @@ TEST(FrameLoopRealTime, WholeMeasurementsAllocateNothingOnTheDspThread) {
   dsp::SessionConfig scfg;
   scfg.fs_hz = run->fs_hz();
   scfg.max_measurement_s = 30.0;
-  dsp::MeasurementSession session(scfg);
+  RecordingStream recording(1 << 16);
+  dsp::MeasurementSession session(scfg, &recording);
   dsp::PipelineConfig live_cfg = dsp::pipeline_config(run->meta, session.recorder_capacity());
   live_cfg.trace = dsp::TraceKeeping::live;  // as the service runs it
   dsp::Pipeline live(live_cfg);
   FrameGuard guard(20.0f, 20.0f);
-  RecordingHandoff handoff(session.recorder_capacity());
+  RecordingHandoff handoff(recording);
   ServiceCounters counters;
   FrameLoopOptions o;
   o.fs_hz = run->fs_hz();
@@ -77,14 +80,32 @@ TEST(FrameLoopRealTime, WholeMeasurementsAllocateNothingOnTheDspThread) {
   TriggerChannel nc("test-nc");
   loop.add_channel(nc);
 
-  // The evaluation thread's part: take each recording and give its storage back.
+  // The recording and evaluation threads' part: drain the ring, count each recording's
+  // frames, and say each one is evaluated.
   std::atomic<int> jobs{0}, returned{0};
+  std::atomic<bool> stop{false};
+  std::vector<std::size_t> recorded;  // frames of each recording, in order
   std::thread evaluator([&] {
-    RecordingJob job;
-    while (handoff.wait_job(job)) {
-      ++jobs;
-      handoff.give_back(std::move(job.frames));
-      ++returned;
+    std::vector<dsp::Frame> block(4096);
+    std::size_t frames_now = 0;
+    for (;;) {
+      const bool last = stop.load();
+      for (;;) {
+        RecordEvent e;
+        bool has_event = false;
+        const std::size_t n = recording.drain(block, e, has_event);
+        frames_now += n;
+        if (has_event && e.kind == RecordEvent::Kind::begin) frames_now = 0;
+        if (has_event && e.kind == RecordEvent::Kind::end) {
+          recorded.push_back(frames_now);
+          ++jobs;
+          handoff.done();
+          ++returned;
+        }
+        if (n == 0 && !has_event) break;
+      }
+      if (last) return;
+      recording.wait(std::chrono::milliseconds(5));
     }
   });
 
@@ -112,19 +133,23 @@ TEST(FrameLoopRealTime, WholeMeasurementsAllocateNothingOnTheDspThread) {
         sent_during = true;
       }
     }
-    // The evaluator returns the storage long before the next program ends in real time
-    // (a swap of two vectors against seconds of 10 kHz frames); free-running, wait for it.
-    for (int i = 0; i < 2000 && returned.load() < jobs.load(); ++i)
+    // Free-running, faster than a DAQ: the recording thread keeps the ring from filling
+    // and says each recording is evaluated long before the next ends in real time; wait for it.
+    for (int i = 0; i < 2000 && (recording.queued() > recording.capacity() / 2 || returned.load() < jobs.load()); ++i)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   t_counting = false;
   const std::size_t allocations = t_allocations;
-  handoff.quit();
+  stop.store(true);
+  recording.wake();
   evaluator.join();
 
   EXPECT_EQ(allocations, 0u) << "allocations on the DSP thread over " << frames << " frames";
   EXPECT_EQ(frames, run->frames.size());
   EXPECT_EQ(jobs.load(), 2) << "both measurements reached the evaluation thread";
+  ASSERT_EQ(recorded.size(), 2u);
+  for (const std::size_t n : recorded) EXPECT_GT(n, n_prog / 2) << "a recording's frames went through the ring";
+  EXPECT_EQ(recording.lost_frames(), 0u);
   TriggerVerdict v;
   ASSERT_TRUE(nc.take_verdict(v));
   EXPECT_FALSE(v.accepted);

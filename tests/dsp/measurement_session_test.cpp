@@ -94,6 +94,63 @@ TEST(MeasurementSession, OverlongMeasurementKeepsTheStartAndCountsTheOverflow) {
   EXPECT_EQ(rec.front().sample_index, 100);
 }
 
+// A sink that keeps what a streamed recording sends it (room for `room` frames).
+class KeptFrames final : public RecordingSink {
+ public:
+  explicit KeptFrames(std::size_t room = SIZE_MAX) : room_(room) {}
+  void begin() noexcept override { ++begun, frames.clear(); }
+  bool frame(const Frame& f) noexcept override {
+    if (frames.size() >= room_) return false;
+    frames.push_back(f);
+    return true;
+  }
+  void discard() noexcept override { ++discarded, frames.clear(); }
+  int begun = 0, discarded = 0;
+  std::vector<Frame> frames;
+
+ private:
+  std::size_t room_;
+};
+
+TEST(MeasurementSession, StreamedRecordingSendsTheSameFramesAndHoldsNone) {
+  KeptFrames sink;
+  MeasurementSession streamed(config(), &sink);
+  MeasurementSession held(config());
+  for (std::int64_t i = 0; i < 3000; ++i) {
+    const Frame f = frame(i, i == 1000 ? 101 : i == 1500 ? 102 : i == 2000 ? 103 : 0);
+    streamed.on_frame(f), held.on_frame(f);
+  }
+  ASSERT_TRUE(streamed.measurement_ready());
+  auto rec = spare_for(held);
+  ASSERT_TRUE(held.take(rec));
+  std::vector<Frame> none;
+  EXPECT_FALSE(streamed.take(none)) << "a streamed recording is not handed over by buffer";
+  ASSERT_TRUE(streamed.take_streamed());
+  EXPECT_FALSE(streamed.take_streamed());
+  EXPECT_EQ(sink.begun, 1);
+  ASSERT_EQ(sink.frames.size(), rec.size());
+  for (std::size_t k = 0; k < rec.size(); ++k) {
+    ASSERT_EQ(sink.frames[k].sample_index, rec[k].sample_index);
+    ASSERT_EQ(sink.frames[k].trigger, rec[k].trigger);
+  }
+  streamed.evaluation_done();
+  EXPECT_EQ(streamed.state().state(), State::done);
+}
+
+TEST(MeasurementSession, StreamedAbortDiscardsAndAFullSinkCountsTheLostFrames) {
+  KeptFrames sink(500);
+  MeasurementSession s(config(), &sink);
+  for (std::int64_t i = 0; i < 300; ++i) s.on_frame(frame(i, i == 250 ? 101 : 0));
+  EXPECT_TRUE(s.command(Event::abort).accepted);
+  EXPECT_EQ(sink.discarded, 1);
+  for (std::int64_t i = 300; i < 2000; ++i) s.on_frame(frame(i, i == 400 ? 101 : i == 1500 ? 103 : 0));
+  ASSERT_TRUE(s.take_streamed());
+  EXPECT_EQ(sink.begun, 2);
+  EXPECT_EQ(sink.frames.size(), 500u);
+  // Pre-trigger (100 frames since the abort), M101..M103, post-trigger: 500 taken, the rest lost.
+  EXPECT_EQ(s.recorder_overflow(), 100u + 1101u + 100u - 500u);
+}
+
 TEST(MeasurementSession, LostFramesAreCounted) {
   MeasurementSession s(config());
   Frame f = frame(10);
