@@ -24,6 +24,6 @@ struct ImportResult {
   ImportReport report;
 };
 
-ImportResult import_klipper(const std::filesystem::path& capture, const KlipperImport& options);
+ImportResult import_klipper(const std::filesystem::path& file, const KlipperImport& options);
 
 }  // namespace eical::drivers

@@ -6,14 +6,14 @@
 
 namespace eical::drivers {
 
-dsp::Program read_program_file(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) throw dsp::InputError(file.string() + ": no such program file");
-  const toml::table root = StrictTable::parse_file(file.string());
-  StrictTable file(root, file.string(), "");
+dsp::Program read_program_file(const std::filesystem::path& path) {
+  if (!std::filesystem::exists(path)) throw dsp::InputError(path.string() + ": no such program file");
+  const toml::table root = StrictTable::parse_file(path.string());
+  StrictTable file(root, path.string(), "");
   auto program = file.optional_table("program");
-  if (!program) throw dsp::InputError(file.string() + ": no [program] table (write it with eical gen-nc --meta)");
+  if (!program) throw dsp::InputError(path.string() + ": no [program] table (write it with eical gen-nc --meta)");
   dsp::Program p = read_program(*program);
-  if (p.gcode.empty()) throw dsp::InputError(file.string() + ": [program] has no gcode");
+  if (p.gcode.empty()) throw dsp::InputError(path.string() + ": [program] has no gcode");
   file.finish();
   return p;
 }

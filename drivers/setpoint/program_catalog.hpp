@@ -11,7 +11,7 @@
 namespace eical::drivers {
 
 // Reads the [program] table of `file` (with its gcode); InputError naming file and line.
-dsp::Program read_program_file(const std::filesystem::path& file);
+dsp::Program read_program_file(const std::filesystem::path& path);
 
 class ProgramCatalog {
  public:

@@ -294,8 +294,7 @@ std::string program_for(const std::vector<std::string>& effects) {
   return effects.empty() ? "circle" : "step";
 }
 
-Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const std::string& program,
-                                std::uint64_t seed) {
+Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const std::string& kind, std::uint64_t seed) {
   Draw d(stream_seed(seed, 7001));
   Scenario sc;
   sc.seed = seed;
@@ -305,7 +304,7 @@ Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const s
   // The program draws from its own stream: one seed is one machine (sensors, errors),
   // whichever program measures it.
   Draw dp(stream_seed(seed, 7002));
-  program(sc, program, dp, has("sensor.damping_amplitude") || has("sensor.nonlinearity"));
+  program(sc, kind, dp, has("sensor.damping_amplitude") || has("sensor.nonlinearity"));
   background(sc, d);
   // Cross coupling differs from a rotated mounting only where one sensor moves two axes.
   if (has("sensor.cross_coupling")) sc.meta.machine.table_axes = {"x", "y"}, sc.meta.machine.head_axes = {"z"};
@@ -322,9 +321,9 @@ Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const s
   std::string name = effects.empty() ? "baseline" : effects.front();
   for (std::size_t i = 1; i < effects.size(); ++i) name += "+" + effects[i];
   sc.name = name;
-  sc.meta.id = "hidden-" + name + "-" + program + "-s" + std::to_string(seed);
+  sc.meta.id = "hidden-" + name + "-" + kind + "-s" + std::to_string(seed);
   sc.description = (effects.empty() ? std::string("no effect") : name) + " hidden among tolerance-level deviations, " +
-                   program + " program";
+                   kind + " program";
   return sc;
 }
 

@@ -38,7 +38,6 @@ const std::vector<std::string>& hideable_effects();
 
 // A run of `program` with `effects` injected (empty: a baseline) over the background.
 // Throws InputError for an unknown effect or program.
-Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const std::string& program,
-                                std::uint64_t seed);
+Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const std::string& kind, std::uint64_t seed);
 
 }  // namespace eical::sim
