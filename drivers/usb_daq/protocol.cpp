@@ -54,16 +54,34 @@ void Decoder::drop(std::size_t n) noexcept {
   fill_ -= n;
 }
 
+// One packet from the buffer: its frames into `out` (n of them; none for a slow packet).
 Decoder::Step Decoder::parse_one(dsp::Frame* out, int& n) noexcept {
+  const std::size_t total = next_packet();
+  if (total == 0) return Step::need_more;
+  ++stats_.packets;
+  const std::uint8_t type = buf_[3], channels = buf_[4], samples = buf_[5];
+  const std::uint32_t seq = u32(&buf_[6]);
+  n = 0;
+  if (type == kTypeSlow)
+    read_slow(&buf_[kHeader], seq);
+  else
+    n = read_samples(&buf_[kHeader], seq, channels, samples, out);
+  drop(total);
+  return Step::consumed;
+}
+
+// The size of the whole, checked packet at the buffer's start (0: more bytes are needed).
+// What precedes a sync word, a header not understood and a packet whose CRC fails are
+// dropped and counted.
+std::size_t Decoder::next_packet() noexcept {
   for (;;) {
-    // Find the sync word.
     std::size_t i = 0;
     while (i + 1 < fill_ && !(buf_[i] == kSync0 && buf_[i + 1] == kSync1)) ++i;
     if (i > 0) {
       stats_.resync_bytes += i;
       drop(i);
     }
-    if (fill_ < kHeader) return Step::need_more;
+    if (fill_ < kHeader) return 0;
     const std::uint8_t version = buf_[2], type = buf_[3], channels = buf_[4], samples = buf_[5];
     const std::size_t payload = type == kTypeSamples
                                     ? static_cast<std::size_t>(samples) * (1 + 3 * static_cast<std::size_t>(channels))
@@ -75,65 +93,62 @@ Decoder::Step Decoder::parse_one(dsp::Frame* out, int& n) noexcept {
       continue;
     }
     const std::size_t total = kHeader + payload + kCrc;
-    if (fill_ < total) return Step::need_more;
+    if (fill_ < total) return 0;
     const std::uint16_t crc = static_cast<std::uint16_t>(buf_[total - 2] | buf_[total - 1] << 8);
-    if (crc16_ccitt(std::span<const std::uint8_t>(buf_.data() + 2, total - 4)) != crc) {
-      ++stats_.crc_errors;
-      drop(2);  // the sync was data or the packet is damaged: search on
-      continue;
-    }
-    ++stats_.packets;
-    const std::uint32_t seq = u32(&buf_[6]);
-    const std::uint8_t* p = &buf_[kHeader];
-    if (type == kTypeSlow) {
-      temp_c_[0] = static_cast<float>(static_cast<std::int16_t>(p[0] | p[1] << 8)) / 100.0f;
-      temp_c_[1] = static_cast<float>(static_cast<std::int16_t>(p[2] | p[3] << 8)) / 100.0f;
-      if (p[4] != 0) {
-        // Latched at `seq`: unwrapped against the samples seen so far.
-        pending_trigger_ = p[4];
-        pending_trigger_index_ =
-            have_seq_ ? next_index_ + static_cast<std::int32_t>(seq - next_seq_) : static_cast<std::int64_t>(seq);
-      }
-      drop(total);
-      n = 0;
-      return Step::consumed;
-    }
-    // Sequence numbers wrap at 2^32; the sample index is unwrapped from the last one.
-    bool gap = false;
-    std::int64_t first;
-    if (!have_seq_) {
-      first = seq;
-      have_seq_ = true;
-    } else {
-      const std::uint32_t missing = seq - next_seq_;  // mod 2^32: a forward jump
-      gap = missing != 0;
-      stats_.lost_samples += missing;
-      first = next_index_ + missing;
-    }
-    const int n_psd_ch = static_cast<int>(channels) - dsp::kAccelChannels;
-    for (int k = 0; k < samples; ++k) {
-      dsp::Frame& f = out[k];
-      f = dsp::Frame{};
-      const std::uint8_t status = *p++;
-      f.sample_index = first + k;
-      for (int c = 0; c < dsp::kAccelChannels && c < channels; ++c, p += 3) f.accel_counts[c] = s24(p);
-      for (int c = 0; c < n_psd_ch; ++c, p += 3) f.psd_counts[c] = s24(p);
-      if (channels < dsp::kAccelChannels) f.flags |= dsp::frame_flag::accel_missing;
-      if (n_psd_ch < 2 * psd_count_) f.flags |= dsp::frame_flag::psd_missing;
-      if (status & kStatusAccelOverload) f.flags |= dsp::frame_flag::accel_saturated;
-      if (k == 0 && gap) f.flags |= dsp::frame_flag::gap_before;
-      f.temp_c[0] = temp_c_[0], f.temp_c[1] = temp_c_[1];
-      f.flags |= dsp::frame_flag::cmd_missing;  // the NC set-point comes from another source
-      if (pending_trigger_ && f.sample_index >= pending_trigger_index_)
-        f.trigger = pending_trigger_, pending_trigger_ = 0;
-      ++stats_.frames;
-    }
-    next_seq_ = seq + samples;
-    next_index_ = first + samples;
-    drop(total);
-    n = samples;
-    return Step::consumed;
+    if (crc16_ccitt(std::span<const std::uint8_t>(buf_.data() + 2, total - 4)) == crc) return total;
+    ++stats_.crc_errors;
+    drop(2);  // the sync was data or the packet is damaged: search on
   }
+}
+
+// The slow channels: both temperatures, and a trigger latched at `seq`.
+void Decoder::read_slow(const std::uint8_t* p, std::uint32_t seq) noexcept {
+  temp_c_[0] = static_cast<float>(static_cast<std::int16_t>(p[0] | p[1] << 8)) / 100.0f;
+  temp_c_[1] = static_cast<float>(static_cast<std::int16_t>(p[2] | p[3] << 8)) / 100.0f;
+  if (p[4] != 0) {
+    // Latched at `seq`: unwrapped against the samples seen so far.
+    pending_trigger_ = p[4];
+    pending_trigger_index_ =
+        have_seq_ ? next_index_ + static_cast<std::int32_t>(seq - next_seq_) : static_cast<std::int64_t>(seq);
+  }
+}
+
+// A samples packet as frames; a jump of its sequence number is counted and flagged.
+int Decoder::read_samples(const std::uint8_t* p, std::uint32_t seq, int channels, int samples,
+                          dsp::Frame* out) noexcept {
+  // Sequence numbers wrap at 2^32; the sample index is unwrapped from the last one.
+  bool gap = false;
+  std::int64_t first;
+  if (!have_seq_) {
+    first = seq;
+    have_seq_ = true;
+  } else {
+    const std::uint32_t missing = seq - next_seq_;  // mod 2^32: a forward jump
+    gap = missing != 0;
+    stats_.lost_samples += missing;
+    first = next_index_ + missing;
+  }
+  const int n_psd_ch = channels - dsp::kAccelChannels;
+  for (int k = 0; k < samples; ++k) {
+    dsp::Frame& f = out[k];
+    f = dsp::Frame{};
+    const std::uint8_t status = *p++;
+    f.sample_index = first + k;
+    for (int c = 0; c < dsp::kAccelChannels && c < channels; ++c, p += 3) f.accel_counts[c] = s24(p);
+    for (int c = 0; c < n_psd_ch; ++c, p += 3) f.psd_counts[c] = s24(p);
+    if (channels < dsp::kAccelChannels) f.flags |= dsp::frame_flag::accel_missing;
+    if (n_psd_ch < 2 * psd_count_) f.flags |= dsp::frame_flag::psd_missing;
+    if (status & kStatusAccelOverload) f.flags |= dsp::frame_flag::accel_saturated;
+    if (k == 0 && gap) f.flags |= dsp::frame_flag::gap_before;
+    f.temp_c[0] = temp_c_[0], f.temp_c[1] = temp_c_[1];
+    f.flags |= dsp::frame_flag::cmd_missing;  // the NC set-point comes from another source
+    if (pending_trigger_ && f.sample_index >= pending_trigger_index_)
+      f.trigger = pending_trigger_, pending_trigger_ = 0;
+    ++stats_.frames;
+  }
+  next_seq_ = seq + static_cast<std::uint32_t>(samples);
+  next_index_ = first + samples;
+  return samples;
 }
 
 std::vector<std::uint8_t> encode_samples(std::uint32_t sequence,

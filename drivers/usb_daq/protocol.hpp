@@ -66,6 +66,9 @@ class Decoder {
   }
   // Decodes the next packet in the buffer into `out` (n frames for a samples packet).
   Step parse_one(dsp::Frame* out, int& n) noexcept;
+  std::size_t next_packet() noexcept;
+  void read_slow(const std::uint8_t* payload, std::uint32_t seq) noexcept;
+  int read_samples(const std::uint8_t* payload, std::uint32_t seq, int channels, int samples, dsp::Frame* out) noexcept;
   void drop(std::size_t n) noexcept;
 
   int psd_count_;

@@ -244,86 +244,104 @@ void Pipeline::integrate(std::int64_t k_samples, double dt, Eigen::Vector3d& pos
   vel_mps = integ_[1].v_out_mps - integ_[0].v_out_mps;
 }
 
+// A cycle of the pipeline (3-1): the frame's flags, the sensors' compensation, the PSD
+// strips, then the phase of the program — the rest before it (bias, ZUPT window), its
+// start, the motion integrated and fused with the supports.
 void Pipeline::step(const Frame& f) noexcept {
-  if (f.flags & frame_flag::accel_missing) quality_ |= quality_flag::accel_missing;
-  if (f.flags & frame_flag::accel_saturated) quality_ |= quality_flag::accel_saturated;
-  if (f.flags & frame_flag::not_finite) quality_ |= quality_flag::not_finite;
-  if (f.flags & frame_flag::gap_before) quality_ |= quality_flag::frames_lost;
+  note_quality(f);
   compensate(f);
   if (runs_supports()) supports_.psd_frame(f);
-  const bool accel_valid = (f.flags & kAccelBad) == 0;
-  const std::int64_t k_samples = prev_index_ >= 0 ? f.sample_index - prev_index_ : 1;
-  const double dt = static_cast<double>(k_samples) * dt_s_;
-  prev_index_ = f.sample_index;
-  if (f.trigger != 0 && m_.triggers.size() < trigger_capacity_) m_.triggers.push_back({f.sample_index, f.trigger});
-  if (f.trigger == trigger::program_start) saw_start_ = true;
-  if (f.trigger == trigger::program_end) saw_end_ = true;
-
-  const Eigen::Vector3d cmd(f.cmd_mm[0], f.cmd_mm[1], f.cmd_mm[2]);
-  const bool cmd_valid = !(f.flags & frame_flag::cmd_missing) && cmd.allFinite();
-  const bool cmd_moved = cmd_valid && prev_cmd_.allFinite() && cmd != prev_cmd_;
-  if (cmd_valid) prev_cmd_ = cmd;
-  live_.sample_index = f.sample_index;
-
+  const FrameStep fs = advance(f);
   switch (phase_) {
     case Phase::wait_start:
       if (f.trigger != trigger::program_start) return;
       phase_ = Phase::rest;
       [[fallthrough]];
     case Phase::rest:
-      if (!cmd_moved) {
-        for (int s = 0; s < 2; ++s) {
-          if (fixed_) {
-            for (int i = 0; i < 3; ++i) fbias_sum_[s][i] += aq_[s][i];
-          } else {
-            bias_sum_[s] += a_[s];
-            rest_hist_[s][2] = rest_hist_[s][1], rest_hist_[s][1] = rest_hist_[s][0], rest_hist_[s][0] = a_[s];
-          }
-        }
-        ++bias_n_;
-        const Eigen::Vector3d rel =
-            fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]);
-        if (runs_supports()) supports_.rest_sample(rel);
-        if (config_.keep_raw && m_.raw.rest_rel_mps2.size() < config_.capacity_samples)
-          m_.raw.rest_rel_mps2.push_back(rel);  // within the reserve
-        return;
-      }
-      start_motion();
-      if (runs_supports()) supports_.start();
-      // The programs dwell 0.1 s after M101; a trigger that reaches the DAQ clock a few
-      // samples late must not flag a good rest.
-      if (bias_n_ < static_cast<std::size_t>(0.05 / dt_s_)) quality_ |= quality_flag::short_rest_window;
-      m_.rest_bias_rel_mps2 = bias_[1] - bias_[0];
-      m_.rest_window_samples = bias_n_;
-      start_pos_mm_ = prev_cmd_;
-      start_index_ = motion_end_index_ = f.sample_index;
-      phase_ = Phase::moving;
-      live_.integrating = true;
-      if (runs_supports() && stored_ < config_.capacity_samples)
-        supports_.step({0, 1, accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(),
-                        cmd_valid, cmd_moved, cmd});
-      store(f, start_pos_mm_, Eigen::Vector3d::Zero());
-      return;
-    case Phase::moving: {
-      if (cmd_moved) motion_end_index_ = f.sample_index;
-      Eigen::Vector3d pos_m, vel_mps;
-      integrate(k_samples, dt, pos_m, vel_mps);
-      const Eigen::Vector3d pos_mm = start_pos_mm_ + pos_m * 1000.0;
-      const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
-      const std::size_t k = stored_;
-      if (runs_supports() && k < config_.capacity_samples)
-        supports_.step(
-            {k, k_samples, accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, cmd_valid, cmd_moved, cmd});
-      // The live filter's estimate, predicted over the DAQ delay (what finish() re-indexes).
-      const Eigen::Vector3d live_pos = pos_mm - supports_.live_dx_mm();
-      live_.vel_mm_s = vel_mm_s - supports_.live_dv_mm_s();
-      live_.pos_mm = config_.dynamic == DynamicComp::none
-                         ? live_pos
-                         : Eigen::Vector3d(live_pos + live_.vel_mm_s * (delay_samples_ * dt_s_));
-      store(f, pos_mm, vel_mm_s);  // frames after M103 belong to the rest (ZUPT) window too
-      return;
+      if (!fs.cmd_moved) return rest_sample();
+      return begin_motion(f, fs);
+    case Phase::moving: return moving_sample(f, fs);
+  }
+}
+
+void Pipeline::note_quality(const Frame& f) noexcept {
+  if (f.flags & frame_flag::accel_missing) quality_ |= quality_flag::accel_missing;
+  if (f.flags & frame_flag::accel_saturated) quality_ |= quality_flag::accel_saturated;
+  if (f.flags & frame_flag::not_finite) quality_ |= quality_flag::not_finite;
+  if (f.flags & frame_flag::gap_before) quality_ |= quality_flag::frames_lost;
+}
+
+Pipeline::FrameStep Pipeline::advance(const Frame& f) noexcept {
+  FrameStep fs;
+  fs.accel_valid = (f.flags & kAccelBad) == 0;
+  fs.k_samples = prev_index_ >= 0 ? f.sample_index - prev_index_ : 1;
+  fs.dt_s = static_cast<double>(fs.k_samples) * dt_s_;
+  prev_index_ = f.sample_index;
+  if (f.trigger != 0 && m_.triggers.size() < trigger_capacity_) m_.triggers.push_back({f.sample_index, f.trigger});
+  if (f.trigger == trigger::program_start) saw_start_ = true;
+  if (f.trigger == trigger::program_end) saw_end_ = true;
+  fs.cmd_mm = Eigen::Vector3d(f.cmd_mm[0], f.cmd_mm[1], f.cmd_mm[2]);
+  fs.cmd_valid = !(f.flags & frame_flag::cmd_missing) && fs.cmd_mm.allFinite();
+  fs.cmd_moved = fs.cmd_valid && prev_cmd_.allFinite() && fs.cmd_mm != prev_cmd_;
+  if (fs.cmd_valid) prev_cmd_ = fs.cmd_mm;
+  live_.sample_index = f.sample_index;
+  return fs;
+}
+
+// At rest before the motion: the sensors' bias sums and the ZUPT window.
+void Pipeline::rest_sample() noexcept {
+  for (int s = 0; s < 2; ++s) {
+    if (fixed_) {
+      for (int i = 0; i < 3; ++i) fbias_sum_[s][i] += aq_[s][i];
+    } else {
+      bias_sum_[s] += a_[s];
+      rest_hist_[s][2] = rest_hist_[s][1], rest_hist_[s][1] = rest_hist_[s][0], rest_hist_[s][0] = a_[s];
     }
   }
+  ++bias_n_;
+  const Eigen::Vector3d rel = fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]);
+  if (runs_supports()) supports_.rest_sample(rel);
+  if (config_.keep_raw && m_.raw.rest_rel_mps2.size() < config_.capacity_samples)
+    m_.raw.rest_rel_mps2.push_back(rel);  // within the reserve
+}
+
+// The set-point moved: the bias is fixed, the integration starts at the commanded position.
+void Pipeline::begin_motion(const Frame& f, const FrameStep& fs) noexcept {
+  start_motion();
+  if (runs_supports()) supports_.start();
+  // The programs dwell 0.1 s after M101; a trigger that reaches the DAQ clock a few
+  // samples late must not flag a good rest.
+  if (bias_n_ < static_cast<std::size_t>(0.05 / dt_s_)) quality_ |= quality_flag::short_rest_window;
+  m_.rest_bias_rel_mps2 = bias_[1] - bias_[0];
+  m_.rest_window_samples = bias_n_;
+  start_pos_mm_ = prev_cmd_;
+  start_index_ = motion_end_index_ = f.sample_index;
+  phase_ = Phase::moving;
+  live_.integrating = true;
+  if (runs_supports() && stored_ < config_.capacity_samples)
+    supports_.step({0, 1, fs.accel_valid, bias_free(0), bias_free(1), start_pos_mm_, Eigen::Vector3d::Zero(),
+                    fs.cmd_valid, fs.cmd_moved, fs.cmd_mm});
+  store(f, start_pos_mm_, Eigen::Vector3d::Zero());
+}
+
+// In motion: integrate, fuse with the supports, publish the live estimate, store.
+void Pipeline::moving_sample(const Frame& f, const FrameStep& fs) noexcept {
+  if (fs.cmd_moved) motion_end_index_ = f.sample_index;
+  Eigen::Vector3d pos_m, vel_mps;
+  integrate(fs.k_samples, fs.dt_s, pos_m, vel_mps);
+  const Eigen::Vector3d pos_mm = start_pos_mm_ + pos_m * 1000.0;
+  const Eigen::Vector3d vel_mm_s = vel_mps * 1000.0;
+  const std::size_t k = stored_;
+  if (runs_supports() && k < config_.capacity_samples)
+    supports_.step({k, fs.k_samples, fs.accel_valid, bias_free(0), bias_free(1), pos_mm, vel_mm_s, fs.cmd_valid,
+                    fs.cmd_moved, fs.cmd_mm});
+  // The live filter's estimate, predicted over the DAQ delay (what finish() re-indexes).
+  const Eigen::Vector3d live_pos = pos_mm - supports_.live_dx_mm();
+  live_.vel_mm_s = vel_mm_s - supports_.live_dv_mm_s();
+  live_.pos_mm = config_.dynamic == DynamicComp::none
+                     ? live_pos
+                     : Eigen::Vector3d(live_pos + live_.vel_mm_s * (delay_samples_ * dt_s_));
+  store(f, pos_mm, vel_mm_s);  // frames after M103 belong to the rest (ZUPT) window too
 }
 
 void Pipeline::align_delay(Measurement& m) const {

@@ -212,6 +212,19 @@ class Pipeline {
   void start_motion() noexcept;
   [[nodiscard]] Eigen::Vector3d bias_free(int sensor) const noexcept;
   void integrate(std::int64_t k_samples, double dt_s, Eigen::Vector3d& pos_m, Eigen::Vector3d& vel_mps) noexcept;
+  // One frame's step: its time step, validity and set-point, with the triggers noted.
+  struct FrameStep {
+    std::int64_t k_samples = 1;  // samples since the previous frame (lost frames: more)
+    double dt_s = 0.0;
+    bool accel_valid = false;
+    Eigen::Vector3d cmd_mm = Eigen::Vector3d::Zero();
+    bool cmd_valid = false, cmd_moved = false;
+  };
+  void note_quality(const Frame& f) noexcept;
+  FrameStep advance(const Frame& f) noexcept;
+  void rest_sample() noexcept;
+  void begin_motion(const Frame& f, const FrameStep& fs) noexcept;
+  void moving_sample(const Frame& f, const FrameStep& fs) noexcept;
 
   PipelineConfig config_;
   bool fixed_ = false;

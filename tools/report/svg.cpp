@@ -237,8 +237,8 @@ struct PlotFrame {
   double w = 0.0, h = 0.0;
   double left = 64, right = 18, top = 30, bottom = 44;
   double xmin = 0.0, xmax = 0.0, ymin = 0.0, ymax = 0.0;
-  [[nodiscard]] double X(double x) const { return left + (x - xmin) / (xmax - xmin) * (w - left - right); }
-  [[nodiscard]] double Y(double y) const { return top + (ymax - y) / (ymax - ymin) * (h - top - bottom); }
+  [[nodiscard]] double x_px(double x) const { return left + (x - xmin) / (xmax - xmin) * (w - left - right); }
+  [[nodiscard]] double y_px(double y) const { return top + (ymax - y) / (ymax - ymin) * (h - top - bottom); }
 };
 
 // The ranges of every finite point and band; a degenerate range widened, y padded by 6 %.
@@ -275,13 +275,13 @@ std::string plot_axes(const PlotFrame& f, const std::string& title, const std::s
   std::string s = text(w / 2, 17, title, "text-anchor='middle' font-size='13' font-weight='600'");
   const double xs = nice_step(f.xmax - f.xmin, 8), ys = nice_step(f.ymax - f.ymin, 6);
   for (double x : ticks(f.xmin, f.xmax, xs))
-    s += "<line x1='" + num(f.X(x)) + "' y1='" + num(top) + "' x2='" + num(f.X(x)) + "' y2='" + num(h - bottom) +
+    s += "<line x1='" + num(f.x_px(x)) + "' y1='" + num(top) + "' x2='" + num(f.x_px(x)) + "' y2='" + num(h - bottom) +
          "' stroke='#edf0f4'/>" +
-         text(f.X(x), h - bottom + 15, tick_label(x, xs), "text-anchor='middle' fill='#4a5366'");
+         text(f.x_px(x), h - bottom + 15, tick_label(x, xs), "text-anchor='middle' fill='#4a5366'");
   for (double y : ticks(f.ymin, f.ymax, ys))
-    s += "<line x1='" + num(left) + "' y1='" + num(f.Y(y)) + "' x2='" + num(w - right) + "' y2='" + num(f.Y(y)) +
+    s += "<line x1='" + num(left) + "' y1='" + num(f.y_px(y)) + "' x2='" + num(w - right) + "' y2='" + num(f.y_px(y)) +
          "' stroke='" + (std::abs(y) < ys * 1e-6 ? "#9aa3b2" : "#edf0f4") + "'/>" +
-         text(left - 5, f.Y(y) + 4, tick_label(y, ys), "text-anchor='end' fill='#4a5366'");
+         text(left - 5, f.y_px(y) + 4, tick_label(y, ys), "text-anchor='end' fill='#4a5366'");
   s += "<rect x='" + num(left) + "' y='" + num(top) + "' width='" + num(w - left - right) + "' height='" +
        num(h - top - bottom) + "' fill='none' stroke='#8a93a3'/>";
   s += text((left + w - right) / 2, h - 8, x_label, "text-anchor='middle'");
@@ -298,15 +298,15 @@ std::string plot_bands(const std::vector<LineSeries>& series, const PlotFrame& f
     if (ser.error_bars) {
       for (std::size_t i = 0; i < n; ++i)
         if (std::isfinite(ser.x[i]) && std::isfinite(ser.y_lo[i]) && std::isfinite(ser.y_hi[i]))
-          s += "<line x1='" + num(f.X(ser.x[i])) + "' y1='" + num(f.Y(ser.y_lo[i])) + "' x2='" + num(f.X(ser.x[i])) +
-               "' y2='" + num(f.Y(ser.y_hi[i])) + "' stroke='" + ser.color +
+          s += "<line x1='" + num(f.x_px(ser.x[i])) + "' y1='" + num(f.y_px(ser.y_lo[i])) + "' x2='" +
+               num(f.x_px(ser.x[i])) + "' y2='" + num(f.y_px(ser.y_hi[i])) + "' stroke='" + ser.color +
                "' stroke-opacity='0.6' stroke-width='1.2'/>";
       continue;
     }
     if (n < 2) continue;
     std::string pts;
-    for (std::size_t i = 0; i < n; ++i) pts += num(f.X(ser.x[i])) + "," + num(f.Y(ser.y_hi[i])) + " ";
-    for (std::size_t i = n; i-- > 0;) pts += num(f.X(ser.x[i])) + "," + num(f.Y(ser.y_lo[i])) + " ";
+    for (std::size_t i = 0; i < n; ++i) pts += num(f.x_px(ser.x[i])) + "," + num(f.y_px(ser.y_hi[i])) + " ";
+    for (std::size_t i = n; i-- > 0;) pts += num(f.x_px(ser.x[i])) + "," + num(f.y_px(ser.y_lo[i])) + " ";
     s += "<polygon points='" + pts + "' fill='" + ser.color + "' fill-opacity='0.13' stroke='" + ser.color +
          "' stroke-opacity='0.35' stroke-width='0.7'/>";
   }
@@ -326,13 +326,13 @@ std::string plot_lines_and_legend(const std::vector<LineSeries>& series, const P
     if (ser.markers) {
       for (std::size_t i = 0; i < n; i += stride)
         if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i]))
-          s += "<circle cx='" + num(f.X(ser.x[i])) + "' cy='" + num(f.Y(ser.y[i])) + "' r='2.2' fill='" + ser.color +
-               "' fill-opacity='0.7'/>";
+          s += "<circle cx='" + num(f.x_px(ser.x[i])) + "' cy='" + num(f.y_px(ser.y[i])) + "' r='2.2' fill='" +
+               ser.color + "' fill-opacity='0.7'/>";
     } else {
       std::string pts;
       for (std::size_t i = 0; i < n; i += stride)
         if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i]))
-          pts += num(f.X(ser.x[i])) + "," + num(f.Y(ser.y[i])) + " ";
+          pts += num(f.x_px(ser.x[i])) + "," + num(f.y_px(ser.y[i])) + " ";
       s += "<polyline fill='none' stroke='" + ser.color + "' stroke-width='" + num(ser.width) +
            "' stroke-linejoin='round'" + (ser.dashed ? " stroke-dasharray='5,3'" : "") + " points='" + pts + "'/>";
     }
