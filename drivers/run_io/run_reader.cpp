@@ -82,6 +82,120 @@ std::optional<std::int64_t> parse_int(const LineSource& src, int col, std::strin
   return v;
 }
 
+// The stages of SampleReader::next(), one row: its fields, then each group of columns into
+// the frame (in the file's column order, so the first bad field is the one reported).
+
+// Splits line into its fields; exactly n_fields (the header's) or an error naming the line.
+void split_fields(const LineSource& src, const fs::path& file, int n_fields, std::string_view line,
+                  std::vector<std::string_view>& fields) {
+  std::size_t k = 0, pos = 0;
+  for (;;) {
+    const auto comma = line.find(',', pos);
+    if (k < fields.size())
+      fields[k] = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
+    ++k;
+    if (comma == std::string_view::npos) break;
+    pos = comma + 1;
+  }
+  if (k != fields.size()) {
+    const std::string why =
+        !src.last_line_had_newline() ? "truncated file: the last line is incomplete" : "wrong number of fields";
+    throw dsp::InputError(file.string() + ":" + std::to_string(src.line_number()) + ": " + why + " (" +
+                          std::to_string(k) + " fields, header has " + std::to_string(n_fields) + ")");
+  }
+}
+
+// A row split into fields, and where each column is among them.
+struct Row {
+  const LineSource& src;
+  const std::vector<std::string_view>& fields;
+  const int* where;  // column -> field (-1: not in the file)
+  [[nodiscard]] std::string_view field(int c) const { return fields[static_cast<std::size_t>(where[c])]; }
+};
+
+// t: the sample index on the grid of fs_hz, after the previous row's (a gap flagged).
+void read_time(const Row& row, double fs, std::int64_t& prev_index, dsp::Frame& f) {
+  const auto t = parse_double(row.src, c_t, row.field(c_t));
+  if (!t) fail_at(row.src, c_t, "empty time");
+  const double idx_real = *t * fs;
+  const auto idx = static_cast<std::int64_t>(std::llround(idx_real));
+  // 1e-3 sample, plus what printing t with 10 significant digits can cost on long runs.
+  if (std::abs(idx_real - static_cast<double>(idx)) > 1e-3 + 1e-9 * std::abs(idx_real))
+    fail_at(
+        row.src, c_t,
+        "time " + std::string(row.field(c_t)) + " s is not on the sample grid of fs = " + std::to_string(fs) + " Hz");
+  if (prev_index >= 0 && idx <= prev_index) fail_at(row.src, c_t, "time does not increase");
+  if (prev_index >= 0 && idx > prev_index + 1) f.flags |= dsp::frame_flag::gap_before;
+  prev_index = idx;
+  f.sample_index = idx;
+}
+
+// The six accelerometer channels in ADC counts; full: the ADC's full scale in counts.
+void read_accel(const Row& row, double full, dsp::Frame& f) {
+  for (int c = c_tax; c <= c_haz; ++c) {
+    const auto v = parse_int(row.src, c, row.field(c), "integer ADC counts");
+    if (!v) {
+      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::sensor_missing(c - c_tax < 3 ? 0 : 1);
+      continue;
+    }
+    if (*v > INT32_MAX || *v < INT32_MIN) fail_at(row.src, c, "ADC counts out of the 32-bit range");
+    f.accel_counts[c - c_tax] = static_cast<std::int32_t>(*v);
+    if (static_cast<double>(*v) >= full - 1 || static_cast<double>(*v) <= -full)
+      f.flags |= dsp::frame_flag::accel_saturated;
+  }
+}
+
+// The case temperatures of table and head.
+void read_temperatures(const Row& row, dsp::Frame& f) {
+  for (int s = 0; s < 2; ++s) {
+    const auto v = parse_double(row.src, c_ttemp + s, row.field(c_ttemp + s));
+    // Checked before the conversion to float (beyond its range it is undefined).
+    if (v && !(std::abs(*v) <= kMaxTemp_c))
+      fail_at(row.src, c_ttemp + s, "temperature beyond +-1000 C ('" + std::string(row.field(c_ttemp + s)) + "')");
+    if (v)
+      f.temp_c[s] = static_cast<float>(*v);
+    else
+      f.flags |= dsp::frame_flag::temp_missing;
+  }
+}
+
+// The set-point and, where the file has it, the reference position, axis by axis.
+void read_positions(const Row& row, dsp::Frame& f) {
+  for (int a = 0; a < 3; ++a) {
+    const auto v = parse_double(row.src, c_cx + a, row.field(c_cx + a));
+    if (v)
+      f.cmd_mm[a] = *v;
+    else
+      f.flags |= dsp::frame_flag::cmd_missing;
+    if (row.where[c_rx + a] >= 0) {
+      const auto r = parse_double(row.src, c_rx + a, row.field(c_rx + a));
+      if (r) f.ref_mm[a] = *r;
+    }
+  }
+}
+
+// The PSD strips' electrode voltages, back to ADC counts (lsb volts a count, offset counts).
+void read_psd_counts(const Row& row, int n_psd, double lsb, double offset, dsp::Frame& f) {
+  for (int c = c_psd0; c < c_psd0 + 2 * n_psd; ++c) {
+    const auto v = parse_double(row.src, c, row.field(c));
+    if (!v) {
+      f.flags |= dsp::frame_flag::psd_missing;
+      continue;
+    }
+    const double counts = *v / lsb + offset;
+    if (!(std::abs(counts) <= INT32_MAX))
+      fail_at(row.src, c, "PSD value beyond the ADC's 32-bit range ('" + std::string(row.field(c)) + "')");
+    f.psd_counts[c - c_psd0] = static_cast<std::int32_t>(std::llround(counts));
+  }
+}
+
+// The trigger code (0: none); an empty field is an error.
+void read_trigger(const Row& row, dsp::Frame& f) {
+  const auto trig = parse_int(row.src, c_trig, row.field(c_trig), "an integer trigger code");
+  if (!trig) fail_at(row.src, c_trig, "empty trigger (0 means none)");
+  f.trigger = static_cast<std::int32_t>(*trig);
+}
+
 }  // namespace
 
 SampleReader::SampleReader(const fs::path& file, const dsp::RunMeta& meta, dsp::ChannelPresence& channels)
@@ -134,87 +248,16 @@ bool SampleReader::next(dsp::Frame& out) {
     if (rows_ == 0) throw dsp::InputError(file_.string() + ": no samples after the header");
     return false;
   }
-  const LineSource& src = *src_;
-  const double fs = meta_.acquisition.fs_hz;
-  const double lsb = meta_.acquisition.adc_lsb_volt;
-  const auto offset = static_cast<double>(meta_.acquisition.adc_offset_counts);
-  const double full = std::ldexp(1.0, meta_.acquisition.adc_bits - 1);
-  // Split into exactly n_fields fields.
-  std::size_t k = 0, pos = 0;
-  for (;;) {
-    const auto comma = line.find(',', pos);
-    if (k < fields_.size())
-      fields_[k] = line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
-    ++k;
-    if (comma == std::string_view::npos) break;
-    pos = comma + 1;
-  }
-  if (k != fields_.size()) {
-    const std::string why =
-        !src.last_line_had_newline() ? "truncated file: the last line is incomplete" : "wrong number of fields";
-    throw dsp::InputError(file_.string() + ":" + std::to_string(src.line_number()) + ": " + why + " (" +
-                          std::to_string(k) + " fields, header has " + std::to_string(n_fields_) + ")");
-  }
-  auto field = [&](int c) { return fields_[static_cast<std::size_t>(where_[c])]; };
+  const auto& acq = meta_.acquisition;
+  split_fields(*src_, file_, n_fields_, line, fields_);
+  const Row row{*src_, fields_, where_.data()};
   dsp::Frame f;
-  const auto t = parse_double(src, c_t, field(c_t));
-  if (!t) fail_at(src, c_t, "empty time");
-  const double idx_real = *t * fs;
-  const auto idx = static_cast<std::int64_t>(std::llround(idx_real));
-  // 1e-3 sample, plus what printing t with 10 significant digits can cost on long runs.
-  if (std::abs(idx_real - static_cast<double>(idx)) > 1e-3 + 1e-9 * std::abs(idx_real))
-    fail_at(src, c_t,
-            "time " + std::string(field(c_t)) + " s is not on the sample grid of fs = " + std::to_string(fs) + " Hz");
-  if (prev_index_ >= 0 && idx <= prev_index_) fail_at(src, c_t, "time does not increase");
-  if (prev_index_ >= 0 && idx > prev_index_ + 1) f.flags |= dsp::frame_flag::gap_before;
-  prev_index_ = idx;
-  f.sample_index = idx;
-  for (int c = c_tax; c <= c_haz; ++c) {
-    const auto v = parse_int(src, c, field(c), "integer ADC counts");
-    if (!v) {
-      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::sensor_missing(c - c_tax < 3 ? 0 : 1);
-      continue;
-    }
-    if (*v > INT32_MAX || *v < INT32_MIN) fail_at(src, c, "ADC counts out of the 32-bit range");
-    f.accel_counts[c - c_tax] = static_cast<std::int32_t>(*v);
-    if (static_cast<double>(*v) >= full - 1 || static_cast<double>(*v) <= -full)
-      f.flags |= dsp::frame_flag::accel_saturated;
-  }
-  for (int s = 0; s < 2; ++s) {
-    const auto v = parse_double(src, c_ttemp + s, field(c_ttemp + s));
-    // Checked before the conversion to float (beyond its range it is undefined).
-    if (v && !(std::abs(*v) <= kMaxTemp_c))
-      fail_at(src, c_ttemp + s, "temperature beyond +-1000 C ('" + std::string(field(c_ttemp + s)) + "')");
-    if (v)
-      f.temp_c[s] = static_cast<float>(*v);
-    else
-      f.flags |= dsp::frame_flag::temp_missing;
-  }
-  for (int a = 0; a < 3; ++a) {
-    const auto v = parse_double(src, c_cx + a, field(c_cx + a));
-    if (v)
-      f.cmd_mm[a] = *v;
-    else
-      f.flags |= dsp::frame_flag::cmd_missing;
-    if (where_[c_rx + a] >= 0) {
-      const auto r = parse_double(src, c_rx + a, field(c_rx + a));
-      if (r) f.ref_mm[a] = *r;
-    }
-  }
-  for (int c = c_psd0; c < c_psd0 + 2 * n_psd_; ++c) {
-    const auto v = parse_double(src, c, field(c));
-    if (!v) {
-      f.flags |= dsp::frame_flag::psd_missing;
-      continue;
-    }
-    const double counts = *v / lsb + offset;
-    if (!(std::abs(counts) <= INT32_MAX))
-      fail_at(src, c, "PSD value beyond the ADC's 32-bit range ('" + std::string(field(c)) + "')");
-    f.psd_counts[c - c_psd0] = static_cast<std::int32_t>(std::llround(counts));
-  }
-  const auto trig = parse_int(src, c_trig, field(c_trig), "an integer trigger code");
-  if (!trig) fail_at(src, c_trig, "empty trigger (0 means none)");
-  f.trigger = static_cast<std::int32_t>(*trig);
+  read_time(row, acq.fs_hz, prev_index_, f);
+  read_accel(row, std::ldexp(1.0, acq.adc_bits - 1), f);
+  read_temperatures(row, f);
+  read_positions(row, f);
+  read_psd_counts(row, n_psd_, acq.adc_lsb_volt, static_cast<double>(acq.adc_offset_counts), f);
+  read_trigger(row, f);
   for (int s = 0; s < 2; ++s)
     if (!(f.flags & dsp::frame_flag::sensor_missing(s))) seen_[s] = true;
   ++rows_;

@@ -252,40 +252,51 @@ void keep(Measurement& m, const Corrected& c, std::size_t q, std::size_t n, cons
   m.sigma_um.push_back(c.sigma_um);
 }
 
-}  // namespace
-
-Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOptions& options,
-                        const StreamOptions& stream) {
+// What a run analysed as it streams must be: fs_hz positive, and no raw trace asked for.
+void check_streamable(const Run& header, const AnalysisOptions& options) {
   if (!(header.meta.acquisition.fs_hz > 0.0)) throw InputError("run '" + header.meta.id + "': fs_hz must be positive");
   if (options.keep_raw)
     throw InputError("analysis: the raw trace (keep_raw) needs the whole run in memory (analyze_run)");
-  const bool circle = header.meta.program.kind == "circle";
+}
 
-  // First pass: the pipeline keeping what the smoother reads; what the set-point decides.
-  PipelineConfig cfg = analysis_config(header.meta, std::numeric_limits<std::size_t>::max(), options);
-  cfg.reserve_samples = frames.size_hint();
-  Scout scout(header, circle);
+// What the first pass leaves for the second: the configuration, what the set-point decided,
+// the spills, and the pipeline's track.
+struct FirstPass {
+  FirstPass(const Run& header, PipelineConfig config) : cfg(std::move(config)), scout(header, is_circle(header)) {}
+  static bool is_circle(const Run& header) { return header.meta.program.kind == "circle"; }
+
+  PipelineConfig cfg;
+  Scout scout;
   std::optional<TraceSpill> trace_spill;
-  if (stream.spill_trace)
-    scout.trace = &trace_spill.emplace(stream.spills(),
-                                       header.channels.ref[0] || header.channels.ref[1] || header.channels.ref[2]);
-  cfg.trace = TraceKeeping::track;
-  cfg.sink = &scout;
-  std::size_t n_frames = 0;
   std::optional<CorrectionSpill> kept;
-  if (stream.spill_corrections) kept.emplace(stream.spills);
   Pipeline::Tracked t;
+};
+
+// First pass: the pipeline keeping what the smoother reads; what the set-point decides.
+void run_first_pass(const Run& header, FrameReplay& frames, const StreamOptions& stream, FirstPass& p) {
+  if (stream.spill_trace)
+    p.scout.trace = &p.trace_spill.emplace(stream.spills(),
+                                           header.channels.ref[0] || header.channels.ref[1] || header.channels.ref[2]);
+  p.cfg.trace = TraceKeeping::track;
+  p.cfg.sink = &p.scout;
+  std::size_t n_frames = 0;
+  if (stream.spill_corrections) p.kept.emplace(stream.spills);
   {
-    Pipeline pipeline(cfg);
-    frames.replay([&](const Frame& f) {
+    Pipeline pipeline(p.cfg);
+    Scout& scout = p.scout;
+    frames.replay([&scout, &pipeline, &n_frames](const Frame& f) {
       scout.frame(f);
       pipeline.step(f);
       ++n_frames;
     });
     if (n_frames == 0) throw InputError("run '" + header.meta.id + "' holds no frames");
-    t = pipeline.finish_track(kept ? &*kept : nullptr);
+    p.t = pipeline.finish_track(p.kept ? &*p.kept : nullptr);
   }
-  scout.repeats.finish();
+  p.scout.repeats.finish();
+}
+
+// The analysis as the first pass's track has it: the measurement without its per-sample arrays.
+Analysis analysis_of_track(const PipelineConfig& cfg, const AnalysisOptions& options, Pipeline::Tracked& t) {
   Analysis a;
   a.dynamic = cfg.dynamic, a.nbs = cfg.nbs, a.coriolis = cfg.coriolis;
   a.sensor_model = options.sensor_model;
@@ -293,93 +304,149 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   a.measurement.trace_samples = t.samples;
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;
-  if (t.samples == 0) {  // no motion: nothing to evaluate, a verdict all the same
+  return a;
+}
+
+// What takes each corrected sample of the second pass: the measurement's arrays (every
+// q-th sample), and for a circle evaluated as it streams, its evaluations.
+struct SecondPass {
+  SecondPass(const Run& header, Measurement& measurement, std::size_t samples, bool whole_trace, std::size_t every)
+      : n(samples),
+        whole(whole_trace),
+        q(every),
+        m(measurement),
+        temp(header.meta.sensors[0].temp_ref_c, header.meta.sensors[1].temp_ref_c) {}
+  void sample(const Corrected& c);
+
+  std::size_t n;  // trace samples
+  bool whole;     // the whole trace kept, evaluated as analyze_run() does
+  std::size_t q;  // decimation of the per-sample arrays
+  Measurement& m;
+  Eigen::Vector2d temp;  // the last finite case temperatures
+  std::optional<CircleStream> circle_eval;
+  std::optional<eval::RepeatAverager> repeats;
+  std::optional<UncertaintyTrace> uncertainty;
+};
+
+void SecondPass::sample(const Corrected& c) {
+  for (int i = 0; i < 2; ++i)
+    if (!(c.frame_flags & frame_flag::temp_missing) && std::isfinite(c.temp_c[i]))
+      temp[i] = static_cast<double>(c.temp_c[i]);
+  keep(m, c, q, n, temp);
+  if (c.sigma_um.allFinite()) m.sigma_max_um = m.sigma_max_um.cwiseMax(c.sigma_um);
+  m.sigma_peak_um = std::max(m.sigma_peak_um, c.sigma_um.maxCoeff());
+  if (circle_eval) circle_eval->sample(c.sample_index, c.pos_mm, c.cmd_mm, c.ref_mm);
+  if (repeats) repeats->add(c.k, c.pos_mm, c.cmd_mm);
+  if (uncertainty) uncertainty->sample(c.k, c.sample_index, c.pos_mm, c.vel_mm_s, c.cmd_mm, c.ref_mm, temp);
+}
+
+// A run short enough keeps its whole trace and is evaluated as analyze_run() does; a
+// longer circle is evaluated as it streams.
+bool keeps_whole_trace(const Run& header, std::size_t n, const StreamOptions& stream) {
+  return !FirstPass::is_circle(header) || n <= stream.materialize_samples;
+}
+
+// The decimation of the per-sample arrays: none for a whole trace, else about
+// measurement_points of them.
+std::size_t decimation(bool whole, std::size_t n, const StreamOptions& stream) {
+  return whole ? 1
+               : std::max<std::size_t>(
+                     1, (n + stream.measurement_points - 1) / std::max<std::size_t>(1, stream.measurement_points));
+}
+
+// The evaluations of a circle evaluated as it streams, from what the first pass decided;
+// the uncertainty reads what it needs of the trace as it goes by (figure_uncertainty.hpp).
+void start_streamed_evaluation(const Run& header, const AnalysisOptions& options, const StreamOptions& stream,
+                               const FirstPass& p, const Analysis& a, SecondPass& s) {
+  if (s.whole) return;
+  const Scout& scout = p.scout;
+  s.circle_eval.emplace(header, scout.segments ? scout.segments->segments() : std::vector<eval::CircleSegment>{},
+                        scout.segment_error, scout.ref_finite, stream.spills);
+  s.repeats.emplace(scout.repeats.groups(), stream.spills(), stream.measurement_points);
+  if (options.uncertainty.enabled && p.t.correction) {
+    const SmoothedCorrection* c = p.t.correction.get();
+    const std::int64_t first = p.t.first_index;
+    s.uncertainty.emplace(
+        header, p.cfg, options, a, c->schedule, s.n, [c, first](std::size_t k) { return c->sample_index_of(first, k); },
+        &c->track.zupt_unused);
+  }
+}
+
+// Second pass: the corrected trace, each sample to s as it goes by — from the trace spill,
+// or the frames through the pipeline again (the same numbers: the same code).
+void run_second_pass(const Run& header, FrameReplay& frames, FirstPass& p, SecondPass& s) {
+  p.scout = Scout(header, false);  // what it decided is out; its set-point records can go
+  p.scout.trace = nullptr;
+  Emitter emitter(p.t, p.kept ? &*p.kept : nullptr, [&s](const Corrected& c) { s.sample(c); });
+  // A long run's corrections all kept, its track (a byte and a bit per sample) and the
+  // smoother's checkpoints go before the second pass: the uncertainty has coarsened what it
+  // reads of the schedule, the emitter reads the spill.
+  if (!s.whole && emitter.kept_whole()) {
+    emitter.forget_smoother();
+    p.t.correction.reset();
+  }
+  if (p.trace_spill) {  // the integrated trace as the first pass saw it
+    p.trace_spill->replay([&emitter](const TraceSample& ts) { emitter.sample(ts); });
+    p.trace_spill.reset();
+  } else {
+    PipelineConfig cfg2 = p.cfg;
+    cfg2.trace = TraceKeeping::replay;
+    cfg2.sink = &emitter;
+    Pipeline replay(cfg2);
+    frames.replay([&replay](const Frame& f) { replay.step(f); });
+  }
+  emitter.finish();
+  p.t.correction.reset();  // the smoother's records: done
+}
+
+// The streamed evaluations' figures into the analysis, or every positional figure null
+// when the integration is not supported (run-format.md, "No standstill"; evaluate_measurement()).
+void finish_streamed_evaluation(const Run& header, const AnalysisOptions& options, SecondPass& s, Analysis& a) {
+  if (const std::string why = unsupported_integration(s.m); !why.empty()) {
+    a.flags.push_back(std::string(kPositionNullFlag) + why);
+    a.degraded = true;
+    return;
+  }
+  s.circle_eval->finish(a);
+  s.circle_eval.reset();
+  a.repeats = s.repeats->result();
+  if (s.uncertainty)
+    s.uncertainty->finish(header, a);
+  else if (options.uncertainty.enabled)
+    a.uncertainty_note = "no support schedule: the uncertainty was not estimated";
+}
+
+}  // namespace
+
+Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOptions& options,
+                        const StreamOptions& stream) {
+  check_streamable(header, options);
+  PipelineConfig cfg = analysis_config(header.meta, std::numeric_limits<std::size_t>::max(), options);
+  cfg.reserve_samples = frames.size_hint();
+  FirstPass first(header, std::move(cfg));
+  run_first_pass(header, frames, stream, first);
+  Analysis a = analysis_of_track(first.cfg, options, first.t);
+  if (first.t.samples == 0) {  // no motion: nothing to evaluate, a verdict all the same
     judge(header.meta.program, a);
     return a;
   }
 
-  // Second pass: the corrected trace, each sample to the evaluation as it goes by. A
-  // circle is evaluated here; other programs keep the whole trace for theirs.
-  const std::size_t n = t.samples;
-  // A run short enough keeps its whole trace and is evaluated as analyze_run() does; a
-  // longer circle is evaluated as it streams.
-  const bool whole = !circle || n <= stream.materialize_samples;
-  const std::size_t q = whole ? 1
-                              : std::max<std::size_t>(1, (n + stream.measurement_points - 1) /
-                                                             std::max<std::size_t>(1, stream.measurement_points));
-  if (whole && options.uncertainty.enabled && t.correction)
-    a.measurement.raw.schedule = schedule_as_fused(*t.correction, cfg);
-  Measurement& m = a.measurement;
-  m.decimation = q;
-  std::optional<CircleStream> circle_eval;
-  std::optional<eval::RepeatAverager> repeats;
-  if (!whole) {
-    circle_eval.emplace(header, scout.segments ? scout.segments->segments() : std::vector<eval::CircleSegment>{},
-                        scout.segment_error, scout.ref_finite, stream.spills);
-    repeats.emplace(scout.repeats.groups(), stream.spills(), stream.measurement_points);
-  }
-  // A circle evaluated as it streams: the uncertainty reads what it needs of the trace as
-  // it goes by (figure_uncertainty.hpp).
-  std::optional<UncertaintyTrace> uncertainty;
-  if (!whole && options.uncertainty.enabled && t.correction) {
-    const SmoothedCorrection* c = t.correction.get();
-    const std::int64_t first = t.first_index;
-    uncertainty.emplace(
-        header, cfg, options, a, c->schedule, n, [c, first](std::size_t k) { return c->sample_index_of(first, k); },
-        &c->track.zupt_unused);
-  }
-  scout = Scout(header, false);  // what it decided is out; its set-point records can go
-  scout.trace = nullptr;
-  Eigen::Vector2d temp(header.meta.sensors[0].temp_ref_c,
-                       header.meta.sensors[1].temp_ref_c);  // the last finite case temperatures
-  Emitter emitter(t, kept ? &*kept : nullptr, [&](const Corrected& c) {
-    for (int i = 0; i < 2; ++i)
-      if (!(c.frame_flags & frame_flag::temp_missing) && std::isfinite(c.temp_c[i]))
-        temp[i] = static_cast<double>(c.temp_c[i]);
-    keep(m, c, q, n, temp);
-    if (c.sigma_um.allFinite()) m.sigma_max_um = m.sigma_max_um.cwiseMax(c.sigma_um);
-    m.sigma_peak_um = std::max(m.sigma_peak_um, c.sigma_um.maxCoeff());
-    if (circle_eval) circle_eval->sample(c.sample_index, c.pos_mm, c.cmd_mm, c.ref_mm);
-    if (repeats) repeats->add(c.k, c.pos_mm, c.cmd_mm);
-    if (uncertainty) uncertainty->sample(c.k, c.sample_index, c.pos_mm, c.vel_mm_s, c.cmd_mm, c.ref_mm, temp);
-  });
-  // A long run's corrections all kept, its track (a byte and a bit per sample) and the
-  // smoother's checkpoints go before the second pass: the uncertainty has coarsened what it
-  // reads of the schedule, the emitter reads the spill.
-  if (!whole && emitter.kept_whole()) {
-    emitter.forget_smoother();
-    t.correction.reset();
-  }
-  if (trace_spill) {  // the integrated trace as the first pass saw it
-    trace_spill->replay([&](const TraceSample& ts) { emitter.sample(ts); });
-    trace_spill.reset();
-  } else {  // the frames through the pipeline again (the same numbers: the same code)
-    PipelineConfig cfg2 = cfg;
-    cfg2.trace = TraceKeeping::replay;
-    cfg2.sink = &emitter;
-    Pipeline replay(cfg2);
-    frames.replay([&](const Frame& f) { replay.step(f); });
-  }
-  emitter.finish();
-  t.correction.reset();  // the smoother's records: done
+  // A circle is evaluated in the second pass; other programs keep the whole trace for theirs.
+  const std::size_t n = first.t.samples;
+  const bool whole = keeps_whole_trace(header, n, stream);
+  if (whole && options.uncertainty.enabled && first.t.correction)
+    a.measurement.raw.schedule = schedule_as_fused(*first.t.correction, first.cfg);
+  const std::size_t q = decimation(whole, n, stream);
+  a.measurement.decimation = q;
+  SecondPass second(header, a.measurement, n, whole, q);
+  start_streamed_evaluation(header, options, stream, first, a, second);
+  run_second_pass(header, frames, first, second);
 
   if (whole) {
-    evaluate_measurement(header, cfg, options, a);  // as analyze_run(): the whole trace is here
+    evaluate_measurement(header, first.cfg, options, a);  // as analyze_run(): the whole trace is here
     return a;
   }
-  if (const std::string why = unsupported_integration(m); !why.empty()) {
-    // run-format.md, "No standstill": every positional figure null (evaluate_measurement()).
-    a.flags.push_back(std::string(kPositionNullFlag) + why);
-    a.degraded = true;
-  } else {
-    circle_eval->finish(a);
-    circle_eval.reset();
-    a.repeats = repeats->result();
-    if (uncertainty)
-      uncertainty->finish(header, a);
-    else if (options.uncertainty.enabled)
-      a.uncertainty_note = "no support schedule: the uncertainty was not estimated";
-  }
+  finish_streamed_evaluation(header, options, second, a);
   judge(header.meta.program, a);
   return a;
 }
