@@ -386,7 +386,9 @@ void finish(Parts& p) {
 Service::Service(DaemonConfig config) : config_(std::move(config)), trigger_inputs_(&daemon::open_trigger_inputs) {}
 Service::~Service() = default;
 
-std::unique_ptr<drivers::Source> Service::make_source(const DaemonConfig& c) { return build_source(c).source; }
+std::unique_ptr<drivers::Source> Service::make_source(const DaemonConfig& config) {
+  return build_source(config).source;
+}
 
 void Service::run(const std::atomic<bool>& stop, const std::function<void(const ServiceStatus&)>& on_status) {
   Parts p(config_);

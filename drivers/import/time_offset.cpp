@@ -229,18 +229,18 @@ double jackknife_u(const FineCorrelations& fc, const LagTime& tau_of) {
 
 }  // namespace
 
-OffsetEstimate estimate_offset(const MeasuredSeries& y_in, const ReferenceSignal& ref, int F) {
-  const std::vector<int> cols = check_inputs(y_in, ref, F);
-  const double fs = y_in.fs_hz, hf = 1.0 / (fs * F);
-  const Columns rf = fine_reference(ref, cols, hf);
-  const std::size_t m_coarse = (rf.front().size() - 1) / static_cast<std::size_t>(F) + 1;
-  const Grid grid = measurement_grid(y_in);
+OffsetEstimate estimate_offset(const MeasuredSeries& measured, const ReferenceSignal& reference, int oversample) {
+  const std::vector<int> cols = check_inputs(measured, reference, oversample);
+  const double fs = measured.fs_hz, hf = 1.0 / (fs * oversample);
+  const Columns rf = fine_reference(reference, cols, hf);
+  const std::size_t m_coarse = (rf.front().size() - 1) / static_cast<std::size_t>(oversample) + 1;
+  const Grid grid = measurement_grid(measured);
   const std::size_t n = grid.valid.size();
   std::size_t L = 1;
   while (L < n + m_coarse) L <<= 1;
-  const CoarsePeak coarse = coarse_peak(coarse_scores(grid.y, rf, F, m_coarse, L), n, m_coarse);
-  const FineCorrelations fc = fine_correlations(grid, rf, F, coarse.lag);
-  const LagTime tau_of{grid.t0_s - ref.t_begin_s + static_cast<double>(coarse.lag) / fs, hf, fc.span};
+  const CoarsePeak coarse = coarse_peak(coarse_scores(grid.y, rf, oversample, m_coarse, L), n, m_coarse);
+  const FineCorrelations fc = fine_correlations(grid, rf, oversample, coarse.lag);
+  const LagTime tau_of{grid.t0_s - reference.t_begin_s + static_cast<double>(coarse.lag) / fs, hf, fc.span};
   std::vector<double> s(static_cast<std::size_t>(fc.n_lags));
   for (int j = 0; j < fc.n_lags; ++j)
     s[static_cast<std::size_t>(j)] = score(fc.total[static_cast<std::size_t>(j)], fc.g_inv);

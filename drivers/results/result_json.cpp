@@ -21,11 +21,11 @@ void write_result(const dsp::Run& run, const dsp::Analysis& analysis, const std:
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
-nlohmann::json uncertainty_json(const dsp::Analysis& a) {
+nlohmann::json uncertainty_json(const dsp::Analysis& analysis) {
   nlohmann::json u = nlohmann::json::object();
-  for (const dsp::FigureValue& f : dsp::figures_of(a)) {
-    const auto it = a.uncertainty_k2.find(f.key);
-    const bool have = it != a.uncertainty_k2.end() && it->second.size() == f.values.size();
+  for (const dsp::FigureValue& f : dsp::figures_of(analysis)) {
+    const auto it = analysis.uncertainty_k2.find(f.key);
+    const bool have = it != analysis.uncertainty_k2.end() && it->second.size() == f.values.size();
     if (!f.array) {
       u[f.key] = have ? number_or_null(it->second[0]) : nlohmann::json(nullptr);
       continue;
@@ -46,12 +46,12 @@ nlohmann::json uncertainty_json(const dsp::Analysis& a) {
   return u;
 }
 
-nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult& c) {
+nlohmann::json circle_json(const dsp::Program& program, const dsp::eval::CircleResult& c) {
   nlohmann::json j = {
-      {"plane", p.plane},
-      {"center_mm", {p.center_mm[0], p.center_mm[1]}},  // programmed, in the plane's axes
-      {"radius_nominal_mm", p.radius_mm},
-      {"feed_mm_min", p.feed_mm_min},
+      {"plane", program.plane},
+      {"center_mm", {program.center_mm[0], program.center_mm[1]}},  // programmed, in the plane's axes
+      {"radius_nominal_mm", program.radius_mm},
+      {"feed_mm_min", program.feed_mm_min},
       {"direction", c.direction},
       {"revolutions", c.revolutions},
       {"arc_deg", c.arc_deg},
@@ -83,7 +83,8 @@ nlohmann::json circle_json(const dsp::Program& p, const dsp::eval::CircleResult&
   }
   j["trace"] = {{"angle_deg", ang}, {"radius_deviation_um", dev}, {"direction", dir}};
   if (c.arc_deg < 360.0)
-    j["arc_start_deg"] = p.arc_start_deg ? nlohmann::json(*p.arc_start_deg) : nlohmann::json(90.0 - c.arc_deg / 2.0);
+    j["arc_start_deg"] =
+        program.arc_start_deg ? nlohmann::json(*program.arc_start_deg) : nlohmann::json(90.0 - c.arc_deg / 2.0);
   return j;
 }
 
@@ -242,32 +243,33 @@ nlohmann::json repeats_json(const dsp::Analysis& a) {
 
 }  // namespace
 
-nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& a) {
+nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis) {
   nlohmann::json j;
   j["format"] = "eical-result/1";
   j["run_id"] = run.meta.id;
   j["program"] = run.meta.program.kind;
   j["software"] = software_version();
-  j["quality"] = quality_json(a);
-  j["uncertainty_k2"] = uncertainty_json(a);
+  j["quality"] = quality_json(analysis);
+  j["uncertainty_k2"] = uncertainty_json(analysis);
   j["uncertainty"] = {
       {"coverage_factor", 2},
-      {"sensor_model", a.uncertainty_source},
-      {"method", a.uncertainty_note},
+      {"sensor_model", analysis.uncertainty_source},
+      {"method", analysis.uncertainty_note},
       {"resolved_rule", "a figure is resolved when |value| > U (k = 2); one that is not is never compensated"}};
-  j["sensor_model"] = {{"identified", a.sensor_model != "datasheet"}, {"source", a.sensor_model}};
-  add_circle(run.meta.program, a, j);
-  add_step_and_positioning(run.meta.program, a, j);
-  add_rectangle_and_freeform(run.meta.program.kind, a, j);
-  if (a.circle_accuracy_rms_um) {
-    j["reference_comparison"] = {{"reference", run.meta.reference ? run.meta.reference->kind : "ref"},
-                                 {"radius_deviation_error_rms_um", *a.circle_accuracy_rms_um},
-                                 {"reference_circular_deviation_G_um", a.circle_reference->circular_deviation_G_um},
-                                 {"reference_radius_mean_deviation_um", a.circle_reference->radius_mean_deviation_um}};
+  j["sensor_model"] = {{"identified", analysis.sensor_model != "datasheet"}, {"source", analysis.sensor_model}};
+  add_circle(run.meta.program, analysis, j);
+  add_step_and_positioning(run.meta.program, analysis, j);
+  add_rectangle_and_freeform(run.meta.program.kind, analysis, j);
+  if (analysis.circle_accuracy_rms_um) {
+    j["reference_comparison"] = {
+        {"reference", run.meta.reference ? run.meta.reference->kind : "ref"},
+        {"radius_deviation_error_rms_um", *analysis.circle_accuracy_rms_um},
+        {"reference_circular_deviation_G_um", analysis.circle_reference->circular_deviation_G_um},
+        {"reference_radius_mean_deviation_um", analysis.circle_reference->radius_mean_deviation_um}};
   }
-  j["pipeline"] = pipeline_json(a);
-  j["pipeline"]["supports"] = supports_json(a.measurement);
-  j["repeats"] = repeats_json(a);
+  j["pipeline"] = pipeline_json(analysis);
+  j["pipeline"]["supports"] = supports_json(analysis.measurement);
+  j["repeats"] = repeats_json(analysis);
   explain_nulls(j);
   return j;
 }
@@ -289,7 +291,7 @@ nlohmann::json path_json(const dsp::eval::PathDeviation& d) {
 }
 
 nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp::eval::PositioningResult& r,
-                                bool vdi) {
+                                bool vdi3441) {
   nlohmann::json targets = nlohmann::json::array();
   for (const auto& t : r.targets)
     targets.push_back({{"target_mm", t.target_mm},
@@ -323,7 +325,8 @@ nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp
                       {"per_target", targets},
                       {"standard", "ISO 230-2:2014"},
                       {"within_standard", r.runs >= dsp::eval::kRunsPerTargetIso230_2}};
-  if (vdi) j["vdi3441"] = {{"P_um", r.vdi.P_um}, {"Pa_um", r.vdi.Pa_um}, {"U_um", r.vdi.U_um}, {"Ps_um", r.vdi.Ps_um}};
+  if (vdi3441)
+    j["vdi3441"] = {{"P_um", r.vdi.P_um}, {"Pa_um", r.vdi.Pa_um}, {"U_um", r.vdi.U_um}, {"Ps_um", r.vdi.Ps_um}};
   return j;
 }
 

@@ -59,20 +59,20 @@ std::string strs(const std::vector<std::string>& v) {
 
 }  // namespace
 
-std::string sensor_section_toml(const char* name, const dsp::SensorSpec& s) {
-  std::string o = std::string("\n[sensors.") + name + "]\nmodel = " + toml_str(s.model) + "\nto_machine = [";
+std::string sensor_section_toml(const char* name, const dsp::SensorSpec& spec) {
+  std::string o = std::string("\n[sensors.") + name + "]\nmodel = " + toml_str(spec.model) + "\nto_machine = [";
   for (int r = 0; r < 3; ++r) {
-    const double row[3] = {s.to_machine(r, 0), s.to_machine(r, 1), s.to_machine(r, 2)};
+    const double row[3] = {spec.to_machine(r, 0), spec.to_machine(r, 1), spec.to_machine(r, 2)};
     o += (r ? ", " : "") + vec(row, 3);
   }
-  o += "]\nk1_v_per_g = " + vec(s.k1_v_per_g.data(), 3) + "\nk2_g_per_g2 = " + vec(s.k2_g_per_g2.data(), 3) +
-       "\nk3_g_per_g3 = " + vec(s.k3_g_per_g3.data(), 3) + "\nbias_g = " + vec(s.bias_g.data(), 3) +
-       "\ntc_k1_ppm_per_c = " + toml_double(s.tc_k1_ppm_per_c) +
-       "\ntc_bias_ug_per_c = " + toml_double(s.tc_bias_ug_per_c) + "\nf0_hz = " + toml_double(s.f0_hz) +
-       "\nzeta = " + toml_double(s.zeta) + "\nnoise_ug_per_rthz = " + toml_double(s.noise_ug_per_rthz) +
-       "\ntemp_ref_c = " + toml_double(s.temp_ref_c) + "\n";
-  if (s.zeta_per_g != 0.0)
-    o += "zeta_per_g = " + toml_double(s.zeta_per_g) + "\n";  // not a data-sheet key: only when found
+  o += "]\nk1_v_per_g = " + vec(spec.k1_v_per_g.data(), 3) + "\nk2_g_per_g2 = " + vec(spec.k2_g_per_g2.data(), 3) +
+       "\nk3_g_per_g3 = " + vec(spec.k3_g_per_g3.data(), 3) + "\nbias_g = " + vec(spec.bias_g.data(), 3) +
+       "\ntc_k1_ppm_per_c = " + toml_double(spec.tc_k1_ppm_per_c) +
+       "\ntc_bias_ug_per_c = " + toml_double(spec.tc_bias_ug_per_c) + "\nf0_hz = " + toml_double(spec.f0_hz) +
+       "\nzeta = " + toml_double(spec.zeta) + "\nnoise_ug_per_rthz = " + toml_double(spec.noise_ug_per_rthz) +
+       "\ntemp_ref_c = " + toml_double(spec.temp_ref_c) + "\n";
+  if (spec.zeta_per_g != 0.0)
+    o += "zeta_per_g = " + toml_double(spec.zeta_per_g) + "\n";  // not a data-sheet key: only when found
   return o;
 }
 
@@ -171,38 +171,38 @@ void write_samples(const dsp::Run& run, const fs::path& file, bool gzip) {
 
 }  // namespace
 
-void write_synced(const fs::path& p, const std::string& text) {
-  FileOut f(p, false);
+void write_synced(const fs::path& file, const std::string& text) {
+  FileOut f(file, false);
   f.buffer() = text;
   f.close_and_sync();
 }
 
-void sync_dir(const fs::path& d) {
-  const int fd = ::open(d.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) sys_fail(d, "cannot open directory to sync", errno);
+void sync_dir(const fs::path& dir) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) sys_fail(dir, "cannot open directory to sync", errno);
   const int rc = ::fsync(fd);
   const int err = errno;
   ::close(fd);
-  if (rc != 0) sys_fail(d, "fsync of the directory failed", err);
+  if (rc != 0) sys_fail(dir, "fsync of the directory failed", err);
 }
 
-std::string run_toml_text(const dsp::RunMeta& m) {
+std::string run_toml_text(const dsp::RunMeta& meta) {
   std::string o;
-  o += "format = \"eical-run/1\"\nid = " + toml_str(m.id) + "\n";
-  if (!m.created.empty()) o += "created = " + m.created + "\n";
-  const auto& a = m.acquisition;
+  o += "format = \"eical-run/1\"\nid = " + toml_str(meta.id) + "\n";
+  if (!meta.created.empty()) o += "created = " + meta.created + "\n";
+  const auto& a = meta.acquisition;
   o += "\n[acquisition]\nfs_hz = " + toml_double(a.fs_hz) + "\nadc_bits = " + std::to_string(a.adc_bits) +
        "\nadc_lsb_volt = " + toml_double(a.adc_lsb_volt) +
        "\nadc_offset_counts = " + std::to_string(a.adc_offset_counts) +
        "\ndaq_group_delay_samples = " + toml_double(a.daq_group_delay_samples) + "\n";
   if (a.daq_skew_head_samples != 0.0) o += "daq_skew_head_samples = " + toml_double(a.daq_skew_head_samples) + "\n";
-  o += "\n[site]\nlatitude_deg = " + toml_double(m.site.latitude_deg) +
-       "\nheading_deg = " + toml_double(m.site.heading_deg) + "\ng_mps2 = " + toml_double(m.site.g_mps2) + "\n";
-  o += "\n[machine]\nname = " + toml_str(m.machine.name) + "\ntable_axes = " + strs(m.machine.table_axes) +
-       "\nhead_axes = " + strs(m.machine.head_axes) + "\n";
-  o += sensor_section_toml("table", m.sensors[0]);
-  o += sensor_section_toml("head", m.sensors[1]);
-  const auto& p = m.program;
+  o += "\n[site]\nlatitude_deg = " + toml_double(meta.site.latitude_deg) +
+       "\nheading_deg = " + toml_double(meta.site.heading_deg) + "\ng_mps2 = " + toml_double(meta.site.g_mps2) + "\n";
+  o += "\n[machine]\nname = " + toml_str(meta.machine.name) + "\ntable_axes = " + strs(meta.machine.table_axes) +
+       "\nhead_axes = " + strs(meta.machine.head_axes) + "\n";
+  o += sensor_section_toml("table", meta.sensors[0]);
+  o += sensor_section_toml("head", meta.sensors[1]);
+  const auto& p = meta.program;
   o += "\n[program]\nkind = " + toml_str(p.kind) + "\nplane = " + toml_str(p.plane) +
        "\ncenter_mm = " + vec(p.center_mm, 2) + "\nradius_mm = " + toml_double(p.radius_mm) +
        "\nfeed_mm_min = " + toml_double(p.feed_mm_min) + "\ndirection = " + toml_str(p.direction) +
@@ -213,15 +213,15 @@ std::string run_toml_text(const dsp::RunMeta& m) {
   if (p.arc_deg < 360.0) o += "arc_deg = " + toml_double(p.arc_deg) + "\n";
   if (p.arc_start_deg) o += "arc_start_deg = " + toml_double(*p.arc_start_deg) + "\n";
   if (!p.gcode.empty()) o += "gcode = \"\"\"\n" + p.gcode + "\"\"\"\n";
-  for (const auto& s : m.psd) {
+  for (const auto& s : meta.psd) {
     o += "\n[[psd]]\nmeasures = " + toml_str(s.measures) + "\ncenter_mm = " + vec(s.center_mm, 2) +
          "\nlength_mm = " + toml_double(s.length_mm) + "\nwidth_mm = " + toml_double(s.width_mm) +
          "\nlockin_tau_s = " + toml_double(s.lockin_tau_s) + "\n";
   }
-  if (m.reference)
-    o += "\n[reference]\nkind = " + toml_str(m.reference->kind) + "\naxes = " + strs(m.reference->axes) + "\n";
-  if (m.setpoint) {
-    const auto& s = *m.setpoint;
+  if (meta.reference)
+    o += "\n[reference]\nkind = " + toml_str(meta.reference->kind) + "\naxes = " + strs(meta.reference->axes) + "\n";
+  if (meta.setpoint) {
+    const auto& s = *meta.setpoint;
     o += "\n[setpoint]\nsource = " + toml_str(s.source) + "\n";
     if (s.program_number >= 0) o += "program_number = " + std::to_string(s.program_number) + "\n";
     if (s.source == "servo_stream")
@@ -237,10 +237,10 @@ std::string run_toml_text(const dsp::RunMeta& m) {
   return o;
 }
 
-void write_run(const dsp::Run& run, const fs::path& dir_in, const WriteOptions& opt) {
+void write_run(const dsp::Run& run, const fs::path& dir_in, const WriteOptions& options) {
   const fs::path dir = dir_in.has_filename() ? dir_in : dir_in.parent_path();
   std::error_code ec;
-  if (fs::exists(dir, ec) && !opt.overwrite)
+  if (fs::exists(dir, ec) && !options.overwrite)
     throw std::runtime_error(dir.string() + ": a run already exists here (not overwritten)");
   const fs::path parent = dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
   if (!fs::exists(parent, ec)) fs::create_directories(parent, ec);  // like mkdir -p; errors surface below
@@ -251,7 +251,7 @@ void write_run(const dsp::Run& run, const fs::path& dir_in, const WriteOptions& 
   if (::mkdir(tmp.c_str(), 0755) != 0) sys_fail(tmp, "cannot create", errno);
   try {
     write_synced(tmp / "run.toml", run_toml_text(run.meta));
-    write_samples(run, tmp / (opt.gzip ? "samples.csv.gz" : "samples.csv"), opt.gzip);
+    write_samples(run, tmp / (options.gzip ? "samples.csv.gz" : "samples.csv"), options.gzip);
     if (run.truth_toml) write_synced(tmp / "truth.toml", *run.truth_toml);
     sync_dir(tmp);
     if (fs::exists(dir)) {

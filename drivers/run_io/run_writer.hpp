@@ -15,7 +15,7 @@ struct WriteOptions {
 };
 
 // Throws std::runtime_error naming the path and the system's reason.
-void write_run(const dsp::Run& run, const std::filesystem::path& dir, const WriteOptions& options = {});
+void write_run(const dsp::Run& run, const std::filesystem::path& dir_in, const WriteOptions& options = {});
 
 // run.toml text for `meta` (used by the writer; exposed for tests and `eical gen-nc`).
 std::string run_toml_text(const dsp::RunMeta& meta);

@@ -24,7 +24,7 @@ std::string samples_header(const dsp::ChannelPresence& channels) {
   return b;
 }
 
-void append_sample_row(std::string& b, const dsp::Frame& f, const dsp::RunMeta& meta,
+void append_sample_row(std::string& out, const dsp::Frame& f, const dsp::RunMeta& meta,
                        const dsp::ChannelPresence& channels) {
   const double fs = meta.acquisition.fs_hz;
   const double lsb = meta.acquisition.adc_lsb_volt;
@@ -32,11 +32,11 @@ void append_sample_row(std::string& b, const dsp::Frame& f, const dsp::RunMeta& 
   char num[32];
   auto put_int = [&](std::int64_t v) {
     const auto r = std::to_chars(num, num + sizeof num, v);
-    b.append(num, r.ptr);
+    out.append(num, r.ptr);
   };
-  append_double(b, static_cast<double>(f.sample_index) / fs);
+  append_double(out, static_cast<double>(f.sample_index) / fs);
   for (int c = 0; c < 6; ++c) {
-    b += ',';
+    out += ',';
     const int sensor = c < 3 ? 0 : 1;
     // An absent triplex is written empty; a missing field of a present one too (the
     // reader's old single flag still marks the whole frame).
@@ -46,26 +46,26 @@ void append_sample_row(std::string& b, const dsp::Frame& f, const dsp::RunMeta& 
     if (!missing) put_int(f.accel_counts[c]);
   }
   for (int s = 0; s < 2; ++s) {
-    b += ',';
-    if (!(f.flags & dsp::frame_flag::temp_missing)) append_double(b, static_cast<double>(f.temp_c[s]));
+    out += ',';
+    if (!(f.flags & dsp::frame_flag::temp_missing)) append_double(out, static_cast<double>(f.temp_c[s]));
   }
   for (int c = 0; c < 2 * channels.psd_count; ++c) {
-    b += ',';
+    out += ',';
     if (!(f.flags & dsp::frame_flag::psd_missing))
-      append_double(b, static_cast<double>(f.psd_counts[c] - offset) * lsb);
+      append_double(out, static_cast<double>(f.psd_counts[c] - offset) * lsb);
   }
   for (int a = 0; a < 3; ++a) {
-    b += ',';
-    if (!(f.flags & dsp::frame_flag::cmd_missing)) append_double(b, f.cmd_mm[a]);
+    out += ',';
+    if (!(f.flags & dsp::frame_flag::cmd_missing)) append_double(out, f.cmd_mm[a]);
   }
   for (int a = 0; a < 3; ++a) {
     if (!channels.ref[a]) continue;
-    b += ',';
-    if (std::isfinite(f.ref_mm[a])) append_double(b, f.ref_mm[a]);
+    out += ',';
+    if (std::isfinite(f.ref_mm[a])) append_double(out, f.ref_mm[a]);
   }
-  b += ',';
+  out += ',';
   put_int(f.trigger);
-  b += '\n';
+  out += '\n';
 }
 
 }  // namespace eical::drivers

@@ -185,24 +185,25 @@ std::string with_mcode_stops(const std::string& gcode) {
   return out;
 }
 
-ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& program, const ProgramSetPointOptions& o) {
+ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& program,
+                                        const ProgramSetPointOptions& options) {
   ProgramAlignment out;
   const double fs = run.meta.acquisition.fs_hz;
-  const std::string gcode = o.mcode_stops ? with_mcode_stops(program.gcode) : program.gcode;
-  const sim::nc::Trajectory tr = sim::nc::interpolate_gcode(gcode, "program", o.limits);
+  const std::string gcode = options.mcode_stops ? with_mcode_stops(program.gcode) : program.gcode;
+  const sim::nc::Trajectory tr = sim::nc::interpolate_gcode(gcode, "program", options.limits);
   if (run.frames.empty()) throw dsp::InputError("program set-point: the recording has no frames");
   // 1 Marks, in order; the first M101 of each is the anchor.
   const MarkPairs pairs = match_marks(tr, run, fs, out);
   // 2 Each motion block: the marks' offset, refined by cross-correlation.
   const std::vector<Eigen::Vector3d> meas = dsp::align::measured_accel_mps2(run);
-  for (const auto& [s, e] : motion_blocks(tr)) out.blocks.push_back(align_block(s, e, pairs, tr, run, meas, o));
+  for (const auto& [s, e] : motion_blocks(tr)) out.blocks.push_back(align_block(s, e, pairs, tr, run, meas, options));
   if (out.blocks.empty())
     out.flags.push_back("setpoint: the program does not move; its set-point is its start position");
   // 3 The set-point on the DAQ clock: inside a block by its offset, at rest in between.
   flag_overlaps(out);
   const std::vector<Eigen::Vector3d> cmd_mm = write_setpoint(run, tr, out.blocks, pairs);
   // 4 The residual of the whole set-point against the measured motion.
-  check_residual(cmd_mm, meas, fs, o, out);
+  check_residual(cmd_mm, meas, fs, options, out);
   run.meta.program = program;
   return out;
 }

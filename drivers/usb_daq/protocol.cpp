@@ -102,19 +102,19 @@ std::size_t Decoder::next_packet() noexcept {
 }
 
 // The slow channels: both temperatures, and a trigger latched at `seq`.
-void Decoder::read_slow(const std::uint8_t* p, std::uint32_t seq) noexcept {
-  temp_c_[0] = static_cast<float>(static_cast<std::int16_t>(p[0] | p[1] << 8)) / 100.0f;
-  temp_c_[1] = static_cast<float>(static_cast<std::int16_t>(p[2] | p[3] << 8)) / 100.0f;
-  if (p[4] != 0) {
+void Decoder::read_slow(const std::uint8_t* payload, std::uint32_t seq) noexcept {
+  temp_c_[0] = static_cast<float>(static_cast<std::int16_t>(payload[0] | payload[1] << 8)) / 100.0f;
+  temp_c_[1] = static_cast<float>(static_cast<std::int16_t>(payload[2] | payload[3] << 8)) / 100.0f;
+  if (payload[4] != 0) {
     // Latched at `seq`: unwrapped against the samples seen so far.
-    pending_trigger_ = p[4];
+    pending_trigger_ = payload[4];
     pending_trigger_index_ =
         have_seq_ ? next_index_ + static_cast<std::int32_t>(seq - next_seq_) : static_cast<std::int64_t>(seq);
   }
 }
 
 // A samples packet as frames; a jump of its sequence number is counted and flagged.
-int Decoder::read_samples(const std::uint8_t* p, std::uint32_t seq, int channels, int samples,
+int Decoder::read_samples(const std::uint8_t* payload, std::uint32_t seq, int channels, int samples,
                           dsp::Frame* out) noexcept {
   // Sequence numbers wrap at 2^32; the sample index is unwrapped from the last one.
   bool gap = false;
@@ -132,10 +132,10 @@ int Decoder::read_samples(const std::uint8_t* p, std::uint32_t seq, int channels
   for (int k = 0; k < samples; ++k) {
     dsp::Frame& f = out[k];
     f = dsp::Frame{};
-    const std::uint8_t status = *p++;
+    const std::uint8_t status = *payload++;
     f.sample_index = first + k;
-    for (int c = 0; c < dsp::kAccelChannels && c < channels; ++c, p += 3) f.accel_counts[c] = s24(p);
-    for (int c = 0; c < n_psd_ch; ++c, p += 3) f.psd_counts[c] = s24(p);
+    for (int c = 0; c < dsp::kAccelChannels && c < channels; ++c, payload += 3) f.accel_counts[c] = s24(payload);
+    for (int c = 0; c < n_psd_ch; ++c, payload += 3) f.psd_counts[c] = s24(payload);
     if (channels < dsp::kAccelChannels) f.flags |= dsp::frame_flag::accel_missing;
     if (n_psd_ch < 2 * psd_count_) f.flags |= dsp::frame_flag::psd_missing;
     if (status & kStatusAccelOverload) f.flags |= dsp::frame_flag::accel_saturated;

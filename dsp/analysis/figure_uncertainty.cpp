@@ -162,7 +162,7 @@ double expanded_uncertainty(double mean_offset, double sd, int n) {
   return 2.0 * sd + bias / (std::numbers::sqrt2 - 1.0);
 }
 
-void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const AnalysisOptions& o, Analysis& a) {
+void estimate_uncertainty(const Run& run, const PipelineConfig& config, const AnalysisOptions& options, Analysis& a) {
   const Measurement& m = a.measurement;
   const auto& fine = m.raw.schedule;
   if (fine.flags.empty() || m.sample_index.size() < 2) {
@@ -170,7 +170,7 @@ void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const Analy
     return;
   }
   const std::size_t n = std::min({m.sample_index.size(), m.pos_mm.size(), m.cmd_mm.size()});
-  UncertaintyTrace trace(run, cfg, o, a, fine, n, [&m](std::size_t k) { return m.sample_index[k]; });
+  UncertaintyTrace trace(run, config, options, a, fine, n, [&m](std::size_t k) { return m.sample_index[k]; });
   // The case temperatures along the trace (α_b's effect): a streamed run's, else from the frames.
   const bool streamed_temp = m.temp_c.size() == m.sample_index.size();
   std::size_t f = 0;
@@ -193,19 +193,19 @@ void estimate_uncertainty(const Run& run, const PipelineConfig& cfg, const Analy
   trace.finish(run, a);
 }
 
-UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& cfg, const AnalysisOptions& o,
+UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config, const AnalysisOptions& options,
                                    const Analysis& a, const fusion::SupportSchedule& schedule, std::size_t samples,
                                    std::function<std::int64_t(std::size_t)> index_at,
                                    const std::vector<bool>* zupt_unused)
-    : samples_(samples), draws_(std::max(2, o.uncertainty.draws)), seed_(o.uncertainty.seed) {
+    : samples_(samples), draws_(std::max(2, options.uncertainty.draws)), seed_(options.uncertainty.seed) {
   const Measurement& m = a.measurement;
   uncertainty::ErrorFieldInput& in = in_;
   in.fs_hz = m.fs_hz;
-  in.delay_samples = a.dynamic == DynamicComp::none ? 0.0 : cfg.acquisition.daq_group_delay_samples;
-  in.model = cfg.fusion;
+  in.delay_samples = a.dynamic == DynamicComp::none ? 0.0 : config.acquisition.daq_group_delay_samples;
+  in.model = config.fusion;
   in.start_bias_sigma_um_s2 = m.supports.start_bias_sigma_um_s2;
-  in.model_covariance =
-      o.model_covariance ? *o.model_covariance : uncertainty::datasheet_covariance(run.meta.sensors, m.fs_hz);
+  in.model_covariance = options.model_covariance ? *options.model_covariance
+                                                 : uncertainty::datasheet_covariance(run.meta.sensors, m.fs_hz);
   in.sensor_noise_ug_per_rthz[0] = run.meta.sensors[0].noise_ug_per_rthz;
   in.sensor_noise_ug_per_rthz[1] = run.meta.sensors[1].noise_ug_per_rthz;
   in.g_mps2 = run.meta.site.g_mps2;

@@ -265,26 +265,26 @@ double FourierResult::evaluate(double angle_deg) const {
   return s;
 }
 
-FourierResult fourier_calibration(const std::vector<AngleSeries>& all, const FourierOptions& opt) {
-  const Inputs in = split_series(all, opt);
+FourierResult fourier_calibration(const std::vector<AngleSeries>& series, const FourierOptions& options) {
+  const Inputs in = split_series(series, options);
   FourierResult r;
   r.series = static_cast<int>(in.series.size());
   r.points_per_series = common_grid(in.series);
   const int n = r.points_per_series;
   const Centred c = centre(in.series, r.series_offset_arcsec);
-  const int f_max = opt.max_frequency > 0 ? opt.max_frequency : std::max(1, n * r.series / 2 - 1);
+  const int f_max = options.max_frequency > 0 ? options.max_frequency : std::max(1, n * r.series / 2 - 1);
   for (int k = 1; k * n <= f_max; ++k) r.lost_frequencies.push_back(k * n);
-  std::vector<int> cand = candidate_frequencies(amplitude_spectrum(c, f_max), n, opt.candidate_sigma);
+  std::vector<int> cand = candidate_frequencies(amplitude_spectrum(c, f_max), n, options.candidate_sigma);
   std::vector<FourierTerm> rejected;
-  const Fit fit = fit_significant(c, cand, opt.alpha, rejected);
+  const Fit fit = fit_significant(c, cand, options.alpha, rejected);
   for (std::size_t l = 0; l < cand.size(); ++l)
-    r.terms.push_back(term_of(fit, cand[l], 1 + 2 * static_cast<Eigen::Index>(l), opt.alpha));
+    r.terms.push_back(term_of(fit, cand[l], 1 + 2 * static_cast<Eigen::Index>(l), options.alpha));
   r.u_x_arcsec = function_uncertainty(c, cand, fit);
   r.residual_rms_arcsec = std::sqrt(fit.residual.squaredNorm() / static_cast<int>(c.x.size()));
-  if (in.sweep) add_sweep_terms(*in.sweep, n, opt.alpha, r, rejected);
+  if (in.sweep) add_sweep_terms(*in.sweep, n, options.alpha, r, rejected);
   std::sort(r.terms.begin(), r.terms.end(), [](const auto& a, const auto& b) { return a.frequency < b.frequency; });
   r.terms.insert(r.terms.end(), rejected.begin(), rejected.end());
-  r.u_p_arcsec = opt.positioning_bound_arcsec / std::sqrt(3.0);
+  r.u_p_arcsec = options.positioning_bound_arcsec / std::sqrt(3.0);
   r.expanded_U_arcsec = 2.0 * std::hypot(r.u_x_arcsec, r.u_p_arcsec);  // (10), (11), k = 2
   return r;
 }

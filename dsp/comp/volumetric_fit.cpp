@@ -253,21 +253,21 @@ VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vec
   return f;
 }
 
-Eigen::Vector3d prediction_u_k2(const VolumetricFit& f, const Eigen::Vector3d& x_mm) {
+Eigen::Vector3d prediction_u_k2(const VolumetricFit& fit, const Eigen::Vector3d& x_mm) {
   Eigen::Vector3d u2 = Eigen::Vector3d::Zero();
   for (int a = 0; a < 3; ++a)
     for (int c = 0; c < 3; ++c) {
       const auto k = static_cast<std::size_t>(6 * a + kTx + c);
-      if (!f.component[k].observed) continue;
-      const double u = interpolate(f.model.component[k].pos_mm, f.component[k].u_k2, x_mm[a]);
+      if (!fit.component[k].observed) continue;
+      const double u = interpolate(fit.model.component[k].pos_mm, fit.component[k].u_k2, x_mm[a]);
       u2[c] += u * u;
     }
   Eigen::Vector3d r;
-  for (int a = 0; a < 3; ++a) r[a] = reference_of(f.model.range_mm[static_cast<std::size_t>(a)]);
+  for (int a = 0; a < 3; ++a) r[a] = reference_of(fit.model.range_mm[static_cast<std::size_t>(a)]);
   // Squareness terms (µrad · mm = nm): e_x −xwy·y and +xwz·z, e_y −ywz·z.
   auto add = [&](int channel, std::size_t slot, int lever_axis) {
-    if (!f.squareness[slot].observed) return;
-    const double u = f.squareness[slot].u_k2_urad * std::abs(x_mm[lever_axis] - r[lever_axis]) * 1e-3;
+    if (!fit.squareness[slot].observed) return;
+    const double u = fit.squareness[slot].u_k2_urad * std::abs(x_mm[lever_axis] - r[lever_axis]) * 1e-3;
     u2[channel] += u * u;
   };
   add(0, 0, 1);

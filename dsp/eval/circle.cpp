@@ -10,16 +10,16 @@
 
 namespace eical::dsp::eval {
 
-CircleFit fit_circle(const std::vector<Eigen::Vector2d>& pts) {
-  if (pts.size() < 3) throw InputError("circle fit: fewer than 3 points");
+CircleFit fit_circle(const std::vector<Eigen::Vector2d>& points) {
+  if (points.size() < 3) throw InputError("circle fit: fewer than 3 points");
   // Kasa: x² + y² = 2ax + 2by + c, linear in (a, b, c); centred for conditioning.
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-  for (const auto& p : pts) mean += p;
-  mean /= static_cast<double>(pts.size());
-  Eigen::MatrixXd A(static_cast<Eigen::Index>(pts.size()), 3);
-  Eigen::VectorXd y(static_cast<Eigen::Index>(pts.size()));
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    const Eigen::Vector2d q = pts[i] - mean;
+  for (const auto& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  Eigen::MatrixXd A(static_cast<Eigen::Index>(points.size()), 3);
+  Eigen::VectorXd y(static_cast<Eigen::Index>(points.size()));
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d q = points[i] - mean;
     A.row(static_cast<Eigen::Index>(i)) << 2 * q.x(), 2 * q.y(), 1.0;
     y(static_cast<Eigen::Index>(i)) = q.squaredNorm();
   }
@@ -33,7 +33,7 @@ CircleFit fit_circle(const std::vector<Eigen::Vector2d>& pts) {
   for (int it = 0; it < 10; ++it) {
     Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
     Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
-    for (const auto& p : pts) {
+    for (const auto& p : points) {
       const Eigen::Vector2d d = p - mean - c;
       const double dist = d.norm();
       if (dist <= 0.0) continue;
@@ -140,27 +140,28 @@ CircleResult CircleAccumulator::result() const {
   return r;
 }
 
-CircleResult evaluate_circle(const CircleInput& in) {
-  if (in.pos_mm.size() != in.sample_index.size())
+CircleResult evaluate_circle(const CircleInput& input) {
+  if (input.pos_mm.size() != input.sample_index.size())
     throw InputError("circle evaluation: positions and sample indices differ in length");
-  if (!(in.radius_mm > 0.0)) throw InputError("circle evaluation: nominal radius must be positive");
-  std::vector<std::pair<std::int64_t, std::int64_t>> ranges = in.segments;
+  if (!(input.radius_mm > 0.0)) throw InputError("circle evaluation: nominal radius must be positive");
+  std::vector<std::pair<std::int64_t, std::int64_t>> ranges = input.segments;
   if (ranges.empty()) {
     std::vector<std::int64_t> marks;
-    for (auto m : in.segment_marks)
-      if (!in.sample_index.empty() && m >= in.sample_index.front() && m <= in.sample_index.back()) marks.push_back(m);
+    for (auto m : input.segment_marks)
+      if (!input.sample_index.empty() && m >= input.sample_index.front() && m <= input.sample_index.back())
+        marks.push_back(m);
     std::sort(marks.begin(), marks.end());
     for (std::size_t k = 0; k + 1 < marks.size(); ++k) ranges.emplace_back(marks[k], marks[k + 1]);
   }
   if (ranges.empty())
     throw InputError(
         "circle evaluation: fewer than two M102 marks inside the measurement (a circle program marks each revolution)");
-  CircleAccumulator acc({in.center_mm, in.radius_mm, in.direction, 360.0, 1, 0});
+  CircleAccumulator acc({input.center_mm, input.radius_mm, input.direction, 360.0, 1, 0});
   for (const auto& range : ranges) {
     acc.begin();
-    for (std::size_t i = 0; i < in.sample_index.size(); ++i)
-      if (in.sample_index[i] >= range.first && in.sample_index[i] < range.second)
-        acc.add(in.sample_index[i], in.pos_mm[i]);
+    for (std::size_t i = 0; i < input.sample_index.size(); ++i)
+      if (input.sample_index[i] >= range.first && input.sample_index[i] < range.second)
+        acc.add(input.sample_index[i], input.pos_mm[i]);
     acc.end();
   }
   return acc.result();

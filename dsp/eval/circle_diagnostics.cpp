@@ -550,12 +550,12 @@ void report_residuals(const ResidualSums& s, const DiagnosticsOptions& opt, Circ
 
 }  // namespace
 
-CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& opt) {
+CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& options) {
   for (const auto& p : passes)
     if (p.cmd_mm.size() != p.meas_mm.size())
       throw InputError("circle diagnostics: commanded and measured traces differ in length");
   StoredPasses replay(passes);
-  return diagnose_circle(replay, opt);
+  return diagnose_circle(replay, options);
 }
 
 CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& opt) {

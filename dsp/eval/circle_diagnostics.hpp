@@ -90,6 +90,6 @@ class PassReplay {
 // The same fit over replayed passes; memory independent of their length. (The least
 // squares are solved from their normal equations, accumulated block by block, with the
 // columns scaled as before.)
-CircleDiagnostics diagnose_circle(PassReplay& passes, const DiagnosticsOptions& options);
+CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& opt);
 
 }  // namespace eical::dsp::eval

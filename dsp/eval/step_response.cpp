@@ -129,16 +129,16 @@ double smallest_step_resolved_um(const std::vector<StepMove>& moves) {
 
 }  // namespace
 
-StepResult evaluate_steps(const std::vector<double>& cmd, const std::vector<double>& meas, double fs_hz,
-                          const StepOptions& opt) {
-  check_inputs(cmd, meas, fs_hz);
-  const auto min_dwell = static_cast<std::size_t>(std::lround(opt.min_dwell_s * fs_hz));
-  const auto end_win = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(opt.end_window_s * fs_hz)));
-  const std::vector<Interval> rests = rests_of(cmd, min_dwell);
+StepResult evaluate_steps(const std::vector<double>& cmd_mm, const std::vector<double>& meas_mm, double fs_hz,
+                          const StepOptions& options) {
+  check_inputs(cmd_mm, meas_mm, fs_hz);
+  const auto min_dwell = static_cast<std::size_t>(std::lround(options.min_dwell_s * fs_hz));
+  const auto end_win = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(options.end_window_s * fs_hz)));
+  const std::vector<Interval> rests = rests_of(cmd_mm, min_dwell);
   StepResult r;
   std::vector<double> dwell_noise(rests.empty() ? 0 : rests.size() - 1);
   for (std::size_t k = 0; k + 1 < rests.size(); ++k)
-    r.moves.push_back(measure_move(cmd, meas, rests[k], rests[k + 1], end_win, fs_hz, opt, dwell_noise[k]));
+    r.moves.push_back(measure_move(cmd_mm, meas_mm, rests[k], rests[k + 1], end_win, fs_hz, options, dwell_noise[k]));
   if (r.moves.empty()) throw InputError("step evaluation: no complete move (rest, move, rest) in the command trace");
   std::sort(dwell_noise.begin(), dwell_noise.end());
   r.noise_um = dwell_noise[dwell_noise.size() / 2];  // median: robust to one badly settled dwell

@@ -551,7 +551,7 @@ void identify_delay(const Measurement& m, const Run& run, const RunMeta& meta, c
 }  // namespace
 
 std::vector<std::string> less_certain_than_datasheet(const Identification& id,
-                                                     const uncertainty::SensorModelCovariance& ds) {
+                                                     const uncertainty::SensorModelCovariance& datasheet) {
   // What the calibration would carry (its covariance, margins included) against the data sheet.
   std::vector<std::string> out;
   char b[200];
@@ -560,7 +560,7 @@ std::vector<std::string> less_certain_than_datasheet(const Identification& id,
       for (int j = 0; j < 3; ++j) {
         const Estimate& e = id.sensor[s].error[i][j];
         const int p = uncertainty::error_index(s, i, j);
-        const double u = id.covariance.sigma(p), lim = ds.sigma(p);
+        const double u = id.covariance.sigma(p), lim = datasheet.sigma(p);
         if (e.fitted && !(u <= lim)) {
           std::snprintf(b, sizeof b, "%s (%+.0f ± %.0f ppm, the data sheet ± %.0f ppm)",
                         uncertainty::parameter_name(p).c_str(), e.value * 1e6, u * 1e6, lim * 1e6);
@@ -568,7 +568,7 @@ std::vector<std::string> less_certain_than_datasheet(const Identification& id,
         }
       }
     const int p = uncertainty::damping_index(s);
-    const double u = id.covariance.sigma(p), lim = ds.sigma(p);
+    const double u = id.covariance.sigma(p), lim = datasheet.sigma(p);
     if (id.sensor[s].damping_s.fitted && !(u <= lim)) {
       std::snprintf(b, sizeof b, "%s (± %.2f µs, the data sheet ± %.2f µs)", uncertainty::parameter_name(p).c_str(),
                     u * 1e6, lim * 1e6);
@@ -578,19 +578,19 @@ std::vector<std::string> less_certain_than_datasheet(const Identification& id,
   return out;
 }
 
-Identification identify_sensors(const Run& run, const IdentifyOptions& o) {
-  check_identifiable(run, o);
+Identification identify_sensors(const Run& run, const IdentifyOptions& options) {
+  check_identifiable(run, options);
   Identification id;
-  id.method = o.against_reference ? "ref" : "psd";
+  id.method = options.against_reference ? "ref" : "psd";
   RunMeta meta = run.meta;
   double damping_total_s[2] = {0.0, 0.0};
-  const PassResult last = iterate_passes(run, o, meta, damping_total_s, id.iterations);
+  const PassResult last = iterate_passes(run, options, meta, damping_total_s, id.iterations);
   id.psd_observations = last.psd_obs, id.rest_observations = last.rest_obs, id.standstills = last.standstills;
-  if (!o.against_reference) check_crossings(last.m, meta, id);
+  if (!options.against_reference) check_crossings(last.m, meta, id);
   compare_with_datasheet(run, meta, id);
   for (int s = 0; s < 2; ++s) report_sensor(s, last, run.meta, meta, damping_total_s[s], id);
   report_machine(last, run.meta, id);
-  identify_delay(last.m, run, meta, o, id);
+  identify_delay(last.m, run, meta, options, id);
   for (int s = 0; s < 2; ++s) id.sensors[s] = meta.sensors[s];
   if (!id.sensor[0].moved && !id.sensor[1].moved) throw InputError("identify: no axis moved more than 0.5 mm");
   id.covariance = covariance_of(last, id, run.meta);

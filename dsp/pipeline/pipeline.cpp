@@ -53,56 +53,57 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
   return out;
 }
 
-Pipeline::Pipeline(const PipelineConfig& c)
-    : config_(c), fixed_(c.arithmetic == Arithmetic::fixed_q), dt_s_(1.0 / c.acquisition.fs_hz) {
-  if (fixed_ && c.coriolis)
+Pipeline::Pipeline(const PipelineConfig& config)
+    : config_(config), fixed_(config.arithmetic == Arithmetic::fixed_q), dt_s_(1.0 / config.acquisition.fs_hz) {
+  if (fixed_ && config.coriolis)
     throw InputError("pipeline: the fixed-point path has no Coriolis term; use double arithmetic");
-  if (fixed_ && (c.sensors[0].zeta_per_g != 0.0 || c.sensors[1].zeta_per_g != 0.0))
+  if (fixed_ && (config.sensors[0].zeta_per_g != 0.0 || config.sensors[1].zeta_per_g != 0.0))
     throw InputError(
         "pipeline: the fixed-point path does not compensate damping that grows with the acceleration (zeta_per_g); use "
         "double arithmetic");
-  if (fixed_ && c.dynamic != DynamicComp::none && c.dynamic != DynamicComp::position_level)
+  if (fixed_ && config.dynamic != DynamicComp::none && config.dynamic != DynamicComp::position_level)
     throw InputError(
         std::string("pipeline: the fixed-point path compensates the dynamics at the position level only, not ") +
-        dynamic_comp_name(c.dynamic));
+        dynamic_comp_name(config.dynamic));
   // The DAQ delay is not inverted by the series of dynamic_comp.hpp: a pure delay is exact
   // as a re-indexing of the trace (finish()), which also holds for the sharp transients of
   // backlash engagement and stick-slip, where the second-order series errs by c2·A (tens of
   // µm). The integrators compensate the sensor's PT2 only; the live estimate is predicted
   // over the delay.
-  delay_samples_ = c.acquisition.daq_group_delay_samples;
-  if (c.coriolis) coriolis_ = CoriolisComp(c.site);
+  delay_samples_ = config.acquisition.daq_group_delay_samples;
+  if (config.coriolis) coriolis_ = CoriolisComp(config.site);
   for (int s = 0; s < 2; ++s) {
-    comp_[s] = StaticComp(c.sensors[s], c.acquisition, c.site, c.calibration[s], c.static_comp);
+    comp_[s] =
+        StaticComp(config.sensors[s], config.acquisition, config.site, config.calibration[s], config.static_comp);
     fcomp_[s] = FixedStaticComp(comp_[s]);
     // A skew of the head's channels against the table's is a delay of that sensor's own:
     // the series inverts it with the PT2 (a fraction of a sample, no transient to mind).
-    const double skew_s = s == 1 ? c.acquisition.daq_skew_head_samples * dt_s_ : 0.0;
-    const DynamicCoefficients dyn = dynamic_coefficients(c.sensors[s], skew_s, c.dynamic);
-    integ_[s] = SensorIntegrator(c.dynamic, dyn, dt_s_);
-    integ_[s].c_amp_s3_per_m =
-        c.sensors[s].zeta * c.sensors[s].zeta_per_g / (2.0 * std::numbers::pi * c.sensors[s].f0_hz * c.site.g_mps2);
+    const double skew_s = s == 1 ? config.acquisition.daq_skew_head_samples * dt_s_ : 0.0;
+    const DynamicCoefficients dyn = dynamic_coefficients(config.sensors[s], skew_s, config.dynamic);
+    integ_[s] = SensorIntegrator(config.dynamic, dyn, dt_s_);
+    integ_[s].c_amp_s3_per_m = config.sensors[s].zeta * config.sensors[s].zeta_per_g /
+                               (2.0 * std::numbers::pi * config.sensors[s].f0_hz * config.site.g_mps2);
     finteg_[s] = FixedIntegrator(dt_s_, dyn);
-    temp_c_[s] = static_cast<float>(c.sensors[s].temp_ref_c);
+    temp_c_[s] = static_cast<float>(config.sensors[s].temp_ref_c);
   }
   SupportConfig sc;
-  sc.zupt = c.zupt, sc.nbs = c.nbs, sc.cupt = c.cupt, sc.smooth = c.smooth;
-  sc.record = c.trace == TraceKeeping::whole || c.trace == TraceKeeping::track;
-  sc.compact = c.trace == TraceKeeping::track;
-  sc.model = c.fusion;
-  sc.standstill = c.standstill;
-  const double noise_mps2 = c.fusion.accel_noise_um_s2_rthz * 1e-6;
-  supports_ = SupportStage(sc, c.acquisition, c.psd, noise_mps2 * noise_mps2 * c.acquisition.fs_hz, c.capacity_samples,
-                           std::min(c.capacity_samples, c.reserve_samples));
-  m_.fs_hz = c.acquisition.fs_hz;
-  if (c.trace == TraceKeeping::whole) {
-    for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->reserve(c.capacity_samples);
-    m_.sample_index.reserve(c.capacity_samples);
-  } else if (c.keep_raw) {
+  sc.zupt = config.zupt, sc.nbs = config.nbs, sc.cupt = config.cupt, sc.smooth = config.smooth;
+  sc.record = config.trace == TraceKeeping::whole || config.trace == TraceKeeping::track;
+  sc.compact = config.trace == TraceKeeping::track;
+  sc.model = config.fusion;
+  sc.standstill = config.standstill;
+  const double noise_mps2 = config.fusion.accel_noise_um_s2_rthz * 1e-6;
+  supports_ = SupportStage(sc, config.acquisition, config.psd, noise_mps2 * noise_mps2 * config.acquisition.fs_hz,
+                           config.capacity_samples, std::min(config.capacity_samples, config.reserve_samples));
+  m_.fs_hz = config.acquisition.fs_hz;
+  if (config.trace == TraceKeeping::whole) {
+    for (auto* v : {&m_.pos_mm, &m_.vel_mm_s, &m_.cmd_mm, &m_.ref_mm}) v->reserve(config.capacity_samples);
+    m_.sample_index.reserve(config.capacity_samples);
+  } else if (config.keep_raw) {
     throw InputError("pipeline: keep_raw needs the whole trace (TraceKeeping::whole)");
   }
-  if (c.keep_raw)
-    for (auto* v : {&m_.raw.table_mps2, &m_.raw.head_mps2, &m_.raw.rest_rel_mps2}) v->reserve(c.capacity_samples);
+  if (config.keep_raw)
+    for (auto* v : {&m_.raw.table_mps2, &m_.raw.head_mps2, &m_.raw.rest_rel_mps2}) v->reserve(config.capacity_samples);
   m_.triggers.reserve(trigger_capacity_);
   reset();
 }
@@ -211,14 +212,15 @@ void Pipeline::start_motion() noexcept {
 }
 
 // This frame's acceleration of one sensor less its rest-window bias, m/s², machine axes.
-Eigen::Vector3d Pipeline::bias_free(int s) const noexcept {
-  if (!fixed_) return a_[s] - bias_[s];
+Eigen::Vector3d Pipeline::bias_free(int sensor) const noexcept {
+  if (!fixed_) return a_[sensor] - bias_[sensor];
   Eigen::Vector3d a;
-  for (int i = 0; i < 3; ++i) a[i] = fx::to_double(aq_[s][i], fx::kAccelQ) - bias_[s][i];
+  for (int i = 0; i < 3; ++i) a[i] = fx::to_double(aq_[sensor][i], fx::kAccelQ) - bias_[sensor][i];
   return a;
 }
 
-void Pipeline::integrate(std::int64_t k_samples, double dt, Eigen::Vector3d& pos_m, Eigen::Vector3d& vel_mps) noexcept {
+void Pipeline::integrate(std::int64_t k_samples, double dt_s, Eigen::Vector3d& pos_m,
+                         Eigen::Vector3d& vel_mps) noexcept {
   if (fixed_) {
     std::int64_t x_q40[2][3], v_q40[2][3];
     for (int s = 0; s < 2; ++s) {
@@ -238,7 +240,7 @@ void Pipeline::integrate(std::int64_t k_samples, double dt, Eigen::Vector3d& pos
   for (int s = 0; s < 2; ++s) {
     Eigen::Vector3d as = a_[s] - bias_[s];
     if (config_.coriolis) as = coriolis_.apply(as, integ_[s].v_mps);  // (3-6), velocity fed back
-    integ_[s].step(as, dt);
+    integ_[s].step(as, dt_s);
   }
   pos_m = integ_[1].x_out_m - integ_[0].x_out_m;  // head − table (3-1)
   vel_mps = integ_[1].v_out_mps - integ_[0].v_out_mps;
@@ -247,20 +249,20 @@ void Pipeline::integrate(std::int64_t k_samples, double dt, Eigen::Vector3d& pos
 // A cycle of the pipeline (3-1): the frame's flags, the sensors' compensation, the PSD
 // strips, then the phase of the program — the rest before it (bias, ZUPT window), its
 // start, the motion integrated and fused with the supports.
-void Pipeline::step(const Frame& f) noexcept {
-  note_quality(f);
-  compensate(f);
-  if (runs_supports()) supports_.psd_frame(f);
-  const FrameStep fs = advance(f);
+void Pipeline::step(const Frame& frame) noexcept {
+  note_quality(frame);
+  compensate(frame);
+  if (runs_supports()) supports_.psd_frame(frame);
+  const FrameStep fs = advance(frame);
   switch (phase_) {
     case Phase::wait_start:
-      if (f.trigger != trigger::program_start) return;
+      if (frame.trigger != trigger::program_start) return;
       phase_ = Phase::rest;
       [[fallthrough]];
     case Phase::rest:
       if (!fs.cmd_moved) return rest_sample();
-      return begin_motion(f, fs);
-    case Phase::moving: return moving_sample(f, fs);
+      return begin_motion(frame, fs);
+    case Phase::moving: return moving_sample(frame, fs);
   }
 }
 

@@ -11,36 +11,36 @@ constexpr std::size_t kMaxRestWindows = 4096;
 
 }  // namespace
 
-SupportStage::SupportStage(const SupportConfig& c, const Acquisition& acq, const std::vector<PsdSpec>& psd,
-                           double noise_var_m2ps4, std::size_t capacity, std::size_t reserve)
-    : cfg_(c),
-      fs_hz_(acq.fs_hz),
-      step_(fusion::discretise(c.model, 1.0 / acq.fs_hz)),
-      detector_(c.standstill, acq.fs_hz, acq.daq_group_delay_samples, noise_var_m2ps4),
-      capacity_(capacity) {
+SupportStage::SupportStage(const SupportConfig& config, const Acquisition& acquisition, const std::vector<PsdSpec>& psd,
+                           double sensor_noise_var_m2ps4, std::size_t capacity_samples, std::size_t reserve_samples)
+    : cfg_(config),
+      fs_hz_(acquisition.fs_hz),
+      step_(fusion::discretise(config.model, 1.0 / acquisition.fs_hz)),
+      detector_(config.standstill, acquisition.fs_hz, acquisition.daq_group_delay_samples, sensor_noise_var_m2ps4),
+      capacity_(capacity_samples) {
   for (const auto& s : psd) {
     if (psd_.size() >= static_cast<std::size_t>(kMaxPsd)) break;
-    psd_.emplace_back(s, acq);
+    psd_.emplace_back(s, acquisition);
   }
-  schedule_.zupt = c.zupt;
-  schedule_.cupt = c.cupt;
-  if (!c.record) capacity = 0;  // live: the forward filter only, nothing per sample
-  capacity_ = capacity;
+  schedule_.zupt = config.zupt;
+  schedule_.cupt = config.cupt;
+  if (!config.record) capacity_samples = 0;  // live: the forward filter only, nothing per sample
+  capacity_ = capacity_samples;
   // Reserved, not touched: memory is taken as the measurement fills it (the live and the
   // whole-trace pipelines reserve their capacity: no allocation per sample).
-  reserve = std::min(reserve, capacity);
-  schedule_.flags.reserve(reserve);
-  if (c.compact)
-    zupt_unused_.reserve(reserve);
+  reserve_samples = std::min(reserve_samples, capacity_samples);
+  schedule_.flags.reserve(reserve_samples);
+  if (config.compact)
+    zupt_unused_.reserve(reserve_samples);
   else
-    schedule_.zupt_sigma_um_s.reserve(reserve);
-  schedule_.fixes.reserve(reserve);
-  schedule_.velocity_means.reserve(reserve / 100 + 16);
-  gaps_.reserve(reserve);
-  support_vel_mm_s_.reserve(reserve);
-  fix_pos_mm_.reserve(reserve);
+    schedule_.zupt_sigma_um_s.reserve(reserve_samples);
+  schedule_.fixes.reserve(reserve_samples);
+  schedule_.velocity_means.reserve(reserve_samples / 100 + 16);
+  gaps_.reserve(reserve_samples);
+  support_vel_mm_s_.reserve(reserve_samples);
+  fix_pos_mm_.reserve(reserve_samples);
   rests_.reserve(kMaxRestWindows);
-  block_len_ = static_cast<std::size_t>(std::max(1.0, std::round(0.02 * acq.fs_hz)));
+  block_len_ = static_cast<std::size_t>(std::max(1.0, std::round(0.02 * acquisition.fs_hz)));
   block_means_.reserve(kMaxRestWindows);
   reset();
 }
@@ -77,12 +77,12 @@ void SupportStage::psd_frame(const Frame& f) noexcept {
     psd_now_[k] = psd_[k].step(f.psd_counts[2 * k], f.psd_counts[2 * k + 1], (f.flags & frame_flag::psd_missing) != 0);
 }
 
-void SupportStage::rest_sample(const Eigen::Vector3d& a) noexcept {
-  if (!a.allFinite()) return;
-  rest_sum_ += a;
-  rest_sq_ += a.cwiseProduct(a);
+void SupportStage::rest_sample(const Eigen::Vector3d& a_rel_mps2) noexcept {
+  if (!a_rel_mps2.allFinite()) return;
+  rest_sum_ += a_rel_mps2;
+  rest_sq_ += a_rel_mps2.cwiseProduct(a_rel_mps2);
   ++rest_n_;
-  block_sum_ += a;
+  block_sum_ += a_rel_mps2;
   if (++block_n_ == block_len_) {
     if (block_means_.size() < block_means_.capacity())
       block_means_.push_back(block_sum_ / static_cast<double>(block_len_));
@@ -213,13 +213,13 @@ void SupportStage::predict_and_support_velocity(const SupportSample& s, const Re
 
 // CUPT: every lit PSD strip is a position fix along its axis (recorded always, used when
 // CUPT is on).
-void SupportStage::position_fixes(const SupportSample& s, const Eigen::Vector3d& vel_corr) noexcept {
+void SupportStage::position_fixes(const SupportSample& s, const Eigen::Vector3d& vel_corr_mm_s) noexcept {
   for (std::size_t p = 0; p < psd_.size(); ++p) {
     const supports::PsdReading& r = psd_now_[p];
     if (!r.valid) continue;
     const int ax = psd_[p].axis();
     // The lock-in output lags the spot by its time constant: add τ·v.
-    const double fix_um = (psd_[p].centre_mm() + r.u_mm + psd_[p].lockin_tau_s() * vel_corr[ax]) * 1000.0;
+    const double fix_um = (psd_[p].centre_mm() + r.u_mm + psd_[p].lockin_tau_s() * vel_corr_mm_s[ax]) * 1000.0;
     const double model_um = cfg_.model.scale_uncertainty * (s.pos_mm - start_pos_mm_).norm() * 1000.0;
     if (cfg_.cupt)
       live_.position_fix(ax, s.pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model);
@@ -383,10 +383,10 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   return c;
 }
 
-SupportSummary SupportStage::finish(const std::vector<std::int64_t>& idx, std::vector<Eigen::Vector3d>& pos_mm,
+SupportSummary SupportStage::finish(const std::vector<std::int64_t>& sample_index, std::vector<Eigen::Vector3d>& pos_mm,
                                     std::vector<Eigen::Vector3d>& vel_mm_s, std::vector<Eigen::Vector3d>& sigma_x_um) {
-  const std::size_t n = std::min({idx.size(), pos_mm.size(), schedule_.flags.size()});
-  SupportSummary sum = refine(n, [&](std::size_t k) { return idx[k]; });
+  const std::size_t n = std::min({sample_index.size(), pos_mm.size(), schedule_.flags.size()});
+  SupportSummary sum = refine(n, [&](std::size_t k) { return sample_index[k]; });
   if (n == 0) return sum;
   pos_mm.resize(n), vel_mm_s.resize(n);
   const std::unique_ptr<SmoothedCorrection> c = smooth_track(n, sum, false);

@@ -55,8 +55,8 @@ void MeasurementSession::apply_trigger(int code) noexcept {
   }
 }
 
-void MeasurementSession::on_frame(const Frame& in) noexcept {
-  Frame f = in;
+void MeasurementSession::on_frame(const Frame& frame) noexcept {
+  Frame f = frame;
   ++counters_.frames;
   if (f.flags & frame_flag::gap_before) ++counters_.frames_lost;
   if (f.flags != 0) ++counters_.frames_flagged;
@@ -78,7 +78,7 @@ void MeasurementSession::on_frame(const Frame& in) noexcept {
     apply_trigger(trigger::program_start);  // start before the push: the M101 frame is recorded
   recorder_.push(f);
   if (f.trigger != trigger::none && f.trigger != trigger::program_start) apply_trigger(f.trigger);
-  if (external != 0 && in.trigger != 0 && external != in.trigger) {
+  if (external != 0 && frame.trigger != 0 && external != frame.trigger) {
     // Two triggers on one sample: keep the DAQ's own in the frame, apply the other next
     // frame (re-queued at this index so it counts as late once).
     (void)queue_trigger(f.sample_index, external);

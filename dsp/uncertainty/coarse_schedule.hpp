@@ -39,7 +39,7 @@ struct FineSchedule {
   std::uint8_t flag_mask = 0xFF;  // the flags kept (a diverged fusion: move starts and invalid samples)
 };
 
-CoarseSchedule coarsen(const FineSchedule& fine, const fusion::ErrorModel& model, std::size_t block);
+CoarseSchedule coarsen(const FineSchedule& in, const fusion::ErrorModel& model, std::size_t q);
 
 // `fine`: the schedule the pipeline used (one flag per trace sample); `block` ≥ 1.
 CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& sample_index,

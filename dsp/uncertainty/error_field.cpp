@@ -152,42 +152,42 @@ std::vector<std::vector<Eigen::Vector3d>> strip_responses(const Responder& respo
 
 }  // namespace
 
-double ErrorField::coarse_position(double a) const {
-  const double c = (a + delay_ + 1.0) / static_cast<double>(coarse_.block) - 1.0;
+double ErrorField::coarse_position(double at) const {
+  const double c = (at + delay_ + 1.0) / static_cast<double>(coarse_.block) - 1.0;
   return std::clamp(c, 0.0, static_cast<double>(coarse_.sample_index.size()) - 1.0);
 }
 
-std::size_t ErrorField::block_for(std::size_t n, std::size_t max_coarse) noexcept {
-  return std::max<std::size_t>(1, (n + max_coarse - 1) / std::max<std::size_t>(1, max_coarse));
+std::size_t ErrorField::block_for(std::size_t samples, std::size_t max_coarse) noexcept {
+  return std::max<std::size_t>(1, (samples + max_coarse - 1) / std::max<std::size_t>(1, max_coarse));
 }
 
-ErrorField::ErrorField(const ErrorFieldInput& in) {
-  if (!in.schedule || !in.sample_index || !in.pos_mm || !in.vel_mm_s)
+ErrorField::ErrorField(const ErrorFieldInput& input) {
+  if (!input.schedule || !input.sample_index || !input.pos_mm || !input.vel_mm_s)
     throw InputError("uncertainty: input arrays missing");
-  const std::size_t n =
-      std::min({in.schedule->flags.size(), in.sample_index->size(), in.pos_mm->size(), in.vel_mm_s->size()});
+  const std::size_t n = std::min(
+      {input.schedule->flags.size(), input.sample_index->size(), input.pos_mm->size(), input.vel_mm_s->size()});
   if (n < 2) throw InputError("uncertainty: the measurement holds fewer than 2 samples");
-  coarse_ = coarsen(*in.schedule, *in.sample_index, in.model, block_for(n, in.max_coarse));
-  const bool have_temp = in.temp_c && in.temp_c->size() >= n;
-  build(in,
-        coarse_path(coarse_, in.delay_samples, in.fs_hz, *in.pos_mm, *in.vel_mm_s, have_temp ? in.temp_c : nullptr));
+  coarse_ = coarsen(*input.schedule, *input.sample_index, input.model, block_for(n, input.max_coarse));
+  const bool have_temp = input.temp_c && input.temp_c->size() >= n;
+  build(input, coarse_path(coarse_, input.delay_samples, input.fs_hz, *input.pos_mm, *input.vel_mm_s,
+                           have_temp ? input.temp_c : nullptr));
 }
 
-ErrorField::ErrorField(const ErrorFieldInput& in, CoarseSchedule coarse, const CoarsePath& path)
+ErrorField::ErrorField(const ErrorFieldInput& input, CoarseSchedule coarse, const CoarsePath& path)
     : coarse_(std::move(coarse)) {
   if (coarse_.sample_index.size() < 2) throw InputError("uncertainty: the measurement holds fewer than 2 samples");
-  build(in, path);
+  build(input, path);
 }
 
-void ErrorField::build(const ErrorFieldInput& in, const CoarsePath& path) {
-  delay_ = in.delay_samples;
-  fs_hz_ = in.fs_hz;
-  owner_ = in.owner;
-  strip_sigma_um_ = in.model_covariance.psd_offset_sigma_um;
-  start_bias_sigma_ = in.start_bias_sigma_um_s2;
-  truth_ = simulated_truth(coarse_.model, in);
+void ErrorField::build(const ErrorFieldInput& input, const CoarsePath& path) {
+  delay_ = input.delay_samples;
+  fs_hz_ = input.fs_hz;
+  owner_ = input.owner;
+  strip_sigma_um_ = input.model_covariance.psd_offset_sigma_um;
+  start_bias_sigma_ = input.start_bias_sigma_um_s2;
+  truth_ = simulated_truth(coarse_.model, input);
   check_path(path, coarse_.sample_index.size());
-  const Responder respond{coarse_, in};
+  const Responder respond{coarse_, input};
   for (std::size_t j = 0; j < 3; ++j) {
     column_moves_[j] = column_moves(path.pos_mm, static_cast<int>(j)) && owner_[j] >= 0;
     if (column_moves_[j]) response_e_[j] = scale_response(respond, path, static_cast<int>(j));
@@ -196,7 +196,7 @@ void ErrorField::build(const ErrorFieldInput& in, const CoarsePath& path) {
   if (!path.temp_c.empty())
     for (int s = 0; s < 2; ++s) response_tc_[static_cast<std::size_t>(s)] = temperature_response(respond, path, s);
   if (coarse_.schedule.cupt) response_strip_ = strip_responses(respond);
-  model_factor_ = draw_factor(in.model_covariance.covariance);
+  model_factor_ = draw_factor(input.model_covariance.covariance);
 }
 
 // One realisation of the integration's error after the pipeline's smoother (per coarse

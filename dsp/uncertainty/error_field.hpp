@@ -63,7 +63,7 @@ class ErrorField {
 
   // One draw of the path's error (µm per axis) at aligned trace positions (fractional
   // allowed).
-  void draw(std::mt19937_64& rng, const std::vector<double>& at, std::vector<Eigen::Vector3d>& error_um) const;
+  void draw(std::mt19937_64& rng, const std::vector<double>& at_pos, std::vector<Eigen::Vector3d>& error_um) const;
 
   [[nodiscard]] std::size_t coarse_samples() const noexcept { return coarse_.sample_index.size(); }
 
