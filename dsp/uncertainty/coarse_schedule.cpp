@@ -97,13 +97,13 @@ void combine_fixes(const std::vector<fusion::PositionFix>& fixes, const fusion::
 
 }  // namespace
 
-CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& idx,
-                       const fusion::ErrorModel& model, std::size_t q) {
+CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& sample_index,
+                       const fusion::ErrorModel& model, std::size_t block) {
   FineSchedule f;
   f.schedule = &fine;
-  f.samples = std::min(fine.flags.size(), idx.size());
-  f.index_at = [&idx](std::size_t k) { return idx[k]; };
-  return coarsen(f, model, q);
+  f.samples = std::min(fine.flags.size(), sample_index.size());
+  f.index_at = [&sample_index](std::size_t k) { return sample_index[k]; };
+  return coarsen(f, model, block);
 }
 
 CoarseSchedule coarsen(const FineSchedule& in, const fusion::ErrorModel& model, std::size_t q) {
