@@ -7,6 +7,7 @@
 #include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_stream.hpp"
 #include "drivers/run_io/run_writer.hpp"
+#include "tests/support/file_size_limit.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -110,27 +111,7 @@ TEST(RunAppender, WritesTheRunWriteRunWrites) {
   EXPECT_EQ(entries, 4u) << "no temporary left";
 }
 
-// "Disk full" for this process (as tests/faults: files may not grow past a size).
-class FileSizeLimit {
- public:
-  explicit FileSizeLimit(rlim_t bytes) {
-    ::getrlimit(RLIMIT_FSIZE, &old_);
-    handler_ = std::signal(SIGXFSZ, SIG_IGN);
-    rlimit small = old_;
-    small.rlim_cur = bytes;
-    ::setrlimit(RLIMIT_FSIZE, &small);
-  }
-  ~FileSizeLimit() {
-    ::setrlimit(RLIMIT_FSIZE, &old_);
-    std::signal(SIGXFSZ, handler_);
-  }
-  FileSizeLimit(const FileSizeLimit&) = delete;
-  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
-
- private:
-  rlimit old_{};
-  void (*handler_)(int) = SIG_DFL;
-};
+using eical::testing::FileSizeLimit;
 
 TEST(RunAppender, AChunkTheDiskRefusesIsHeldAndWrittenWhenItTakesItAgain) {
   TempDir tmp;

@@ -4,6 +4,7 @@
 #include "tests/faults/harness/fault_cases.hpp"
 #include "tests/faults/harness/recording_dir.hpp"
 #include "tests/faults/harness/service_thread.hpp"
+#include "tests/support/file_size_limit.hpp"
 
 #include <sys/resource.h>
 
@@ -19,32 +20,7 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// "Disk full" for this process: files may not grow past `bytes` (writes fail with EFBIG,
-// as they would with ENOSPC; SIGXFSZ ignored). Lifted by lift() or the destructor.
-class FileSizeLimit {
- public:
-  explicit FileSizeLimit(rlim_t bytes) {
-    ::getrlimit(RLIMIT_FSIZE, &old_);
-    handler_ = std::signal(SIGXFSZ, SIG_IGN);
-    rlimit small = old_;
-    small.rlim_cur = bytes;
-    ::setrlimit(RLIMIT_FSIZE, &small);
-  }
-  ~FileSizeLimit() { lift(); }
-  FileSizeLimit(const FileSizeLimit&) = delete;
-  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
-  void lift() {
-    if (lifted_) return;
-    ::setrlimit(RLIMIT_FSIZE, &old_);
-    std::signal(SIGXFSZ, handler_);
-    lifted_ = true;
-  }
-
- private:
-  rlimit old_{};
-  void (*handler_)(int) = SIG_DFL;
-  bool lifted_ = false;
-};
+using eical::testing::FileSizeLimit;
 
 // After the stop: every run readable with its result, nothing temporary left, and every
 // measurement the service completed written (the last Status comes after the evaluator
