@@ -1,5 +1,6 @@
 // eical analyze RUN [--json]: the pipeline and the program's evaluation on a recorded run.
 #include "drivers/config/sensor_calibration.hpp"
+#include "drivers/exec/thread_for.hpp"
 #include "drivers/results/result_json.hpp"
 #include "drivers/run_io/file_spill.hpp"
 #include "drivers/run_io/run_stream.hpp"
@@ -63,6 +64,7 @@ void register_analyze(CLI::App& app) {
     if (o->nbs != "auto") opt.nbs = o->nbs == "on";
     opt.coriolis = o->coriolis;
     opt.uncertainty.draws = o->draws;
+    opt.uncertainty.parallel = drivers::thread_for();
     dsp::StreamOptions so;
     so.spills = drivers::file_spills(drivers::default_spill_dir());
     so.spill_trace = so.spill_corrections = true;  // a CSV reads slower than a spill, a spill faster than the smoother

@@ -4,6 +4,7 @@
 #include "daemon/service/hmi_link.hpp"
 #include "daemon/service/trace_builder.hpp"
 #include "daemon/system/log.hpp"
+#include "drivers/exec/thread_for.hpp"
 #include "drivers/results/result_json.hpp"
 #include "drivers/results/software_version.hpp"
 #include "drivers/run_io/file_spill.hpp"
@@ -102,13 +103,20 @@ void measure_alignment(const dsp::Run& run, dsp::SetPointOrigin& s) {
   s.lag_s = lag.lag_s, s.correlation = lag.correlation, s.residual_ratio = lag.residual_ratio;
 }
 
+// The uncertainty's draws on every core: the evaluation runs beside the measurement, not
+// in its per-sample path (the acquisition and DSP threads hold their rings either way).
+dsp::AnalysisOptions with_parallel_draws(dsp::AnalysisOptions o) {
+  o.uncertainty.parallel = drivers::thread_for();
+  return o;
+}
+
 }  // namespace
 
 Evaluator::Evaluator(const DaemonConfig& config, dsp::RunMeta meta, dsp::AnalysisOptions analysis,
                      RecordingStream& stream, RecordingHandoff& handoff, EvaluatorLinks links)
     : config_(config),
       meta_(std::move(meta)),
-      analysis_(std::move(analysis)),
+      analysis_(with_parallel_draws(std::move(analysis))),
       handoff_(handoff),
       links_(std::move(links)),
       writer_(

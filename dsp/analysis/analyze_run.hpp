@@ -4,6 +4,7 @@
 // eicald (which evaluates every measurement it records), so all three agree by
 // construction. An evaluation that cannot be done leaves its result empty and says why
 // in `flags`; it does not throw.
+#include "dsp/core/parallel_for.hpp"
 #include "dsp/core/run.hpp"
 #include "dsp/eval/circle.hpp"
 #include "dsp/eval/circle_diagnostics.hpp"
@@ -43,6 +44,10 @@ struct AnalysisOptions {
     bool enabled = true;
     int draws = 100;
     std::uint64_t seed = 1;
+    // The draws are independent: this executor may evaluate them side by side (each draw's
+    // generator is seeded by its number, the sums taken in draw order: the same U whatever
+    // it is). drivers::thread_for() runs them on the machine's cores.
+    ParallelFor parallel = sequential_for();
   } uncertainty;
   std::optional<uncertainty::SensorModelCovariance> model_covariance;
 };

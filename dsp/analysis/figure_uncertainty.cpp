@@ -21,6 +21,8 @@ namespace {
 // Draws evaluate the path at about this rate (the error is smooth; the figures need no more).
 constexpr double kDrawRateHz = 1000.0;
 constexpr std::size_t kMaxDrawSamples = 30000;
+// Tasks the draws are split into (each copies the bases' measurement once).
+constexpr std::size_t kDrawBlocks = 8;
 
 struct Accumulator {
   std::vector<double> sum, sumsq;
@@ -105,18 +107,39 @@ struct DrawSums {
   std::vector<Accumulator> plug, bound;  // on the measured path, on the ideal one
 };
 
-// The seeded draws of the error field, each added to both bases and evaluated.
+// Draw d's generator: seeded by the seed and d alone (splitmix64), so that the draws may
+// run in any order and on any thread and still give the same U.
+std::uint64_t draw_seed(std::uint64_t seed, std::uint64_t d) {
+  std::uint64_t z = (seed ^ 0x9e3779b97f4a7c15ULL) + (d + 1) * 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+struct DrawnFigures {
+  std::vector<FigureValue> plug, bound;
+};
+
+// The seeded draws of the error field, each added to both bases and evaluated. Contiguous
+// blocks of draws are the executor's tasks (one copy of the bases' measurement a block);
+// the sums are taken in draw order afterwards.
 DrawSums draw_figures(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
-                      int draws, std::uint64_t seed) {
+                      int draws, std::uint64_t seed, const ParallelFor& parallel) {
+  const auto n = static_cast<std::size_t>(draws);
+  const std::size_t blocks = std::min<std::size_t>(n, kDrawBlocks);
+  std::vector<DrawnFigures> drawn(n);
+  parallel(blocks, [&](std::size_t block) {
+    std::vector<Eigen::Vector3d> err;
+    Measurement nominal_scratch = b.nominal.measurement, ideal_scratch = b.ideal.measurement;
+    for (std::size_t d = block * n / blocks; d < (block + 1) * n / blocks; ++d) {
+      std::mt19937_64 rng(draw_seed(seed, d));
+      field.draw(rng, b.at, err);
+      drawn[d].plug = perturbed_figures(run, a, b.nominal, err, b.eo, nominal_scratch);
+      drawn[d].bound = perturbed_figures(run, a, b.ideal, err, b.eo, ideal_scratch);
+    }
+  });
   DrawSums s{accumulators_for(b.f0), accumulators_for(b.g0)};
-  std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
-  std::vector<Eigen::Vector3d> err;
-  Measurement nominal_scratch = b.nominal.measurement, ideal_scratch = b.ideal.measurement;
-  for (int d = 0; d < draws; ++d) {
-    field.draw(rng, b.at, err);
-    accumulate(b.f0, perturbed_figures(run, a, b.nominal, err, b.eo, nominal_scratch), s.plug);
-    accumulate(b.g0, perturbed_figures(run, a, b.ideal, err, b.eo, ideal_scratch), s.bound);
-  }
+  for (const DrawnFigures& f : drawn) accumulate(b.f0, f.plug, s.plug), accumulate(b.g0, f.bound, s.bound);
   return s;
 }
 
@@ -197,7 +220,10 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
                                    const Analysis& a, const fusion::SupportSchedule& schedule, std::size_t samples,
                                    std::function<std::int64_t(std::size_t)> index_at,
                                    const std::vector<bool>* zupt_unused)
-    : samples_(samples), draws_(std::max(2, options.uncertainty.draws)), seed_(options.uncertainty.seed) {
+    : samples_(samples),
+      draws_(std::max(2, options.uncertainty.draws)),
+      seed_(options.uncertainty.seed),
+      parallel_(options.uncertainty.parallel ? options.uncertainty.parallel : sequential_for()) {
   const Measurement& m = a.measurement;
   uncertainty::ErrorFieldInput& in = in_;
   in.fs_hz = m.fs_hz;
@@ -258,7 +284,7 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     return;
   }
   const DrawBases bases = evaluate_bases(run, a, std::exchange(nominal_, Measurement{}), q_, samples_);
-  const DrawSums sums = draw_figures(run, a, *field, bases, draws_, seed_);
+  const DrawSums sums = draw_figures(run, a, *field, bases, draws_, seed_, parallel_);
   assign_uncertainties(bases, sums, draws_, a);
   char note[200];
   std::snprintf(note, sizeof note,

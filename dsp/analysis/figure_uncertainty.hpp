@@ -67,6 +67,7 @@ class UncertaintyTrace {
   std::size_t samples_ = 0, q_ = 1;
   int draws_ = 100;
   std::uint64_t seed_ = 0;
+  ParallelFor parallel_;
 };
 
 // U from the draws' mean offset and spread (see above); n draws.

@@ -308,6 +308,34 @@ class StoredPasses final : public PassReplay {
   std::vector<Pass> info_;
 };
 
+// Every q-th sample of each pass, from its first: what the fits read. Their columns are
+// smooth in time and the path's error is low-pass (integrated noise, bias walk), so a
+// faster sampling adds rows, not information; the uncertainty's draws fit at this rate
+// too (figure_uncertainty.cpp). The residuals' spikes are searched at the full rate.
+class DecimatedPasses final : public PassReplay {
+ public:
+  DecimatedPasses(PassReplay& full, std::size_t q) : full_(full), q_(std::max<std::size_t>(1, q)) {
+    for (const Pass& p : full.passes())
+      info_.push_back({p.direction, p.fs_hz / static_cast<double>(q_), (p.samples + q_ - 1) / q_});
+  }
+  [[nodiscard]] const std::vector<Pass>& passes() const override { return info_; }
+  void replay(const std::function<void(std::size_t, const Eigen::Vector2d&, const Eigen::Vector2d&)>& f) override {
+    std::size_t cur = SIZE_MAX, i = 0;
+    full_.replay([&](std::size_t pass, const Eigen::Vector2d& c, const Eigen::Vector2d& m) {
+      if (pass != cur) cur = pass, i = 0;
+      if (i++ % q_ == 0) f(pass, c, m);
+    });
+  }
+
+ private:
+  PassReplay& full_;
+  std::size_t q_;
+  std::vector<Pass> info_;
+};
+
+// The fits' rate (at least this; the passes' own when slower).
+constexpr double kFitRateHz = 1000.0;
+
 // Throws when the passes cannot be evaluated; whether they go round in both directions.
 bool check_passes(const std::vector<PassReplay::Pass>& passes, const DiagnosticsOptions& opt) {
   if (passes.empty()) throw InputError("circle diagnostics: no pass to evaluate");
@@ -563,11 +591,14 @@ CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& 
   const bool both_directions = check_passes(passes, opt);
   const auto window = static_cast<std::size_t>(std::lround(opt.spike_window_s * passes.front().fs_hz));
   const std::vector<double> pitches = candidate_pitches(opt);
+  DecimatedPasses fit_replay(replay,
+                             static_cast<std::size_t>(std::max(1.0, std::floor(passes.front().fs_hz / kFitRateHz))));
+  const auto fit_window = static_cast<std::size_t>(std::lround(opt.spike_window_s * fit_replay.passes().front().fs_hz));
 
   // First replay: every pitch with the backlash as a step, both axes; each axis' first
   // direction of motion per pass (the play operator starts from it).
   std::array<AxisModel, 2> model = step_models(opt, pitches, passes.size());
-  const std::vector<AxisGram> gram = accumulate_every_pitch(replay, window, model);
+  const std::vector<AxisGram> gram = accumulate_every_pitch(fit_replay, fit_window, model);
   const std::size_t best = search_pitch(gram, pitches.size());
   // Round one: the backlash as a step (what the pitch search fitted).
   const AxisFits round_one = fit_axes(gram, best, both_directions);
@@ -578,7 +609,7 @@ CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& 
     model[a].set_pitches({pitches[best]});
     model[a].play_mm = std::max(0.0, round_one.axis[a].coef(backlash));
   }
-  const AxisFits fits = fit_axes(accumulate_best_pitch(replay, window, model), 0, both_directions);
+  const AxisFits fits = fit_axes(accumulate_best_pitch(fit_replay, fit_window, model), 0, both_directions);
 
   CircleDiagnostics d;
   report_fit(fits, pitches[best], both_directions, d);

@@ -1,5 +1,6 @@
 #include "tools/plan/test_plan.hpp"
 
+#include "drivers/exec/thread_for.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/identify/sensor_identification.hpp"
@@ -170,6 +171,7 @@ Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
   const dsp::Run run = sim::simulate(scenario_of(p, seed));
   dsp::AnalysisOptions o;
   o.uncertainty.draws = draws;
+  o.uncertainty.parallel = drivers::thread_for();
   if (p.identified) {
     o.model_covariance = identified ? *identified : typical_identification(p);
     o.sensor_model = "psd";
