@@ -411,14 +411,6 @@ void psd_counts(DaqStage& d, const std::vector<std::vector<double>>& psd_v, dsp:
 
 }  // namespace
 
-std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t purpose) noexcept {
-  // splitmix64 of (seed, purpose): well-separated streams for neighbouring seeds.
-  std::uint64_t z = seed * 0x9E3779B97F4A7C15ull + purpose * 0xBF58476D1CE4E5B9ull + 0x94D049BB133111EBull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-
 std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& scenario) {
   if (scenario.sweep.on)
     return std::make_unique<nc::AccelProfileSetPoint>(nc::klipper_segments(scenario.sweep.test),

@@ -25,6 +25,7 @@
 // walk, broadband vibration, PSD noise) has its own stream, so switching one effect on
 // does not change the noise of the others.
 #include "dsp/core/run.hpp"
+#include "dsp/core/stream_seed.hpp"
 #include "sim/nc/set_point.hpp"
 #include "sim/scenario.hpp"
 
@@ -60,6 +61,6 @@ dsp::Run simulate(const Scenario& scenario, const nc::SetPoint& set_point,
 std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& scenario);
 
 // An independent random stream per purpose, derived from the scenario's seed.
-std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t purpose) noexcept;
+using dsp::stream_seed;
 
 }  // namespace eical::sim

@@ -4,6 +4,7 @@
 #include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/core/float_limits.hpp"
+#include "dsp/core/stream_seed.hpp"
 #include "dsp/uncertainty/error_field.hpp"
 
 #include <algorithm>
@@ -107,15 +108,6 @@ struct DrawSums {
   std::vector<Accumulator> plug, bound;  // on the measured path, on the ideal one
 };
 
-// Draw d's generator: seeded by the seed and d alone (splitmix64), so that the draws may
-// run in any order and on any thread and still give the same U.
-std::uint64_t draw_seed(std::uint64_t seed, std::uint64_t d) {
-  std::uint64_t z = (seed ^ 0x9e3779b97f4a7c15ULL) + (d + 1) * 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
 struct DrawnFigures {
   std::vector<FigureValue> plug, bound;
 };
@@ -132,7 +124,8 @@ DrawSums draw_figures(const Run& run, const Analysis& a, const uncertainty::Erro
     std::vector<Eigen::Vector3d> err;
     Measurement nominal_scratch = b.nominal.measurement, ideal_scratch = b.ideal.measurement;
     for (std::size_t d = block * n / blocks; d < (block + 1) * n / blocks; ++d) {
-      std::mt19937_64 rng(draw_seed(seed, d));
+      // Seeded by (seed, d) alone, so the draws may run in any order and on any thread.
+      std::mt19937_64 rng(stream_seed(seed, d));
       field.draw(rng, b.at, err);
       drawn[d].plug = perturbed_figures(run, a, b.nominal, err, b.eo, nominal_scratch);
       drawn[d].bound = perturbed_figures(run, a, b.ideal, err, b.eo, ideal_scratch);
