@@ -80,6 +80,7 @@ static RunExplanation explain_stages(const Run& run, const ExplainOptions& optio
   stage::test_standstill_bias(st);
   stage::test_stick_slip(st);
   stage::test_vibration(st);
+  stage::test_damping_band(st);
   stage::compare_accelerations(st);
   stage::apply_physical_bounds(st);
   stage::extend_and_measure(st);

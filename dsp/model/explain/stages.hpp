@@ -102,7 +102,8 @@ void separate_timing(ExplainState& st);        // the sensors' dynamics against 
 void report_earth_rate(ExplainState& st);      // site.coriolis from the site
 void test_standstill_bias(ExplainState& st);   // bias steps, drift, temperature at the standstills
 void test_stick_slip(ExplainState& st);
-void test_vibration(ExplainState& st);  // spectra and structural modes
+void test_vibration(ExplainState& st);     // spectra and structural modes
+void test_damping_band(ExplainState& st);  // damping growing with |a|, in the shared vibration
 void compare_accelerations(
     ExplainState& st);  // runs nothing holds: mounting angle, scale, lag and bias in acceleration
 // A sensor mounted otherwise than run.toml says (flip, swap, mirror): explain_run then
