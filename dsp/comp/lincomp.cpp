@@ -62,6 +62,10 @@ LinCompResult piecewise_linear(const ErrorCurve& curve, const LinCompOptions& op
                        " mm");
   }
   const double travel = curve.pos_mm.back() - curve.pos_mm.front();
+  if (travel > kMaxTravelMm)
+    throw InputError("lincomp: the curve spans " + std::to_string(travel) + " mm, more than the " +
+                     std::to_string(static_cast<int>(kMaxTravelMm / 1000.0)) +
+                     " m of any machine axis (positions in mm?)");
   if (!(options.spacing_mm > 0.0)) throw InputError("lincomp: spacing must be positive");
   if (options.spacing_mm > travel)
     throw InputError("lincomp: spacing " + std::to_string(options.spacing_mm) + " mm is larger than the travel " +
@@ -76,6 +80,10 @@ LinCompResult piecewise_linear(const ErrorCurve& curve, const LinCompOptions& op
     throw InputError("lincomp: spacing " + std::to_string(options.spacing_mm) + " mm / shift step " +
                      std::to_string(options.shift_step_mm) + " mm is more than " + std::to_string(kMaxGridShifts) +
                      " grid shifts");
+  if ((travel / options.spacing_mm + 1.0) * (options.spacing_mm / options.shift_step_mm) > kMaxTableEvaluations)
+    throw InputError("lincomp: " + std::to_string(travel / options.spacing_mm + 1.0) + " correction points times " +
+                     std::to_string(options.spacing_mm / options.shift_step_mm) + " grid shifts is more than " +
+                     std::to_string(kMaxTableEvaluations) + " table evaluations: a coarser shift step or spacing");
   if (!(options.period_error_um >= 0.0)) throw InputError("lincomp: period error u must not be negative");
 
   LinCompResult r;

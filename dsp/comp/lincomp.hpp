@@ -39,13 +39,18 @@ struct LinCompResult {
 
 // Tables and grid shifts no machine needs (a 50 m axis at 0.5 mm spacing; a 1 µm shift
 // step at 10 mm spacing): beyond these the computation runs for hours, on a curve whose
-// positions are not in millimetres, so it is refused.
+// positions are not in millimetres, so it is refused. The longest machine axes (gantry
+// mills) are a few tens of metres; each shift recomputes the whole table, so the product
+// of table points and shifts is bounded too (a second's work; fuzzing found a 3.6 km
+// curve that took minutes under the sanitizers).
 inline constexpr int kMaxCorrectionPoints = 100000;
 inline constexpr int kMaxGridShifts = 10000;
+inline constexpr double kMaxTravelMm = 100000.0;
+inline constexpr double kMaxTableEvaluations = 2e6;  // table points × grid shifts
 
-// Validates the curve (monotone, finite, no duplicates, spacing within the travel, at most
-// kMaxCorrectionPoints points and kMaxGridShifts shifts) with InputError naming the
-// offending point or figure.
+// Validates the curve (monotone, finite, no duplicates, a travel up to kMaxTravelMm,
+// spacing within it, at most kMaxCorrectionPoints points, kMaxGridShifts shifts and
+// kMaxTableEvaluations of both) with InputError naming the offending point or figure.
 LinCompResult piecewise_linear(const ErrorCurve& curve, const LinCompOptions& options);
 
 // Correction table of a grid starting at `first_mm`, spacing A, over the curve's range.

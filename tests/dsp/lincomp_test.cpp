@@ -106,5 +106,24 @@ TEST(LinComp, BadInputIsRefusedWithTheReason) {
   EXPECT_NE(msg(nan, {}).find("point 8"), std::string::npos);
 }
 
+// Found by fuzzing (fuzz/corpus/curve_csv/regression-*): a curve over 3.6 km passed every
+// bound one at a time and took minutes under the sanitizers; a curve no machine axis can
+// have is refused at once, and so is a table recomputed at more shifts than a second's work.
+TEST(LinComp, CurvesNoMachineHasAndUnboundedWorkAreRefused) {
+  auto msg = [](const ErrorCurve& cc, LinCompOptions o) -> std::string {
+    try {
+      (void)piecewise_linear(cc, o);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  const ErrorCurve km{{5.0, 100.0, 3640388.0}, {1.0, 2.0, 4.0}};
+  EXPECT_NE(msg(km, {}).find("of any machine axis"), std::string::npos) << msg(km, {});
+  const ErrorCurve long_axis{{0.0, 50000.0}, {0.0, 10.0}};  // 50 m: a gantry mill's axis
+  EXPECT_EQ(msg(long_axis, {}), "");
+  EXPECT_NE(msg(long_axis, {.spacing_mm = 10.0, .shift_step_mm = 0.001}).find("table evaluations"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace eical::dsp::comp

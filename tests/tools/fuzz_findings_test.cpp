@@ -76,7 +76,7 @@ TEST(FuzzFindings, VolumetricModelValuesCountNamesFileAndLine) {
 }
 
 // A curve whose positions reach 5.6e13 mm: at 50 mm spacing lincomp built a table of 1e12
-// points (timeout). Refused now, promptly, with the figure.
+// points (timeout). Refused now, promptly, with the figure (the travel bound comes first).
 TEST(FuzzFindings, CurveWithAnImpossibleTravelIsRefused) {
   const fs::path file = fs::path(EICAL_SOURCE_DIR) / "fuzz" / "corpus" / "curve_csv" / "finding-huge-travel";
   const auto curve = eical::tools::read_error_curve_csv(file.string());
@@ -87,7 +87,7 @@ TEST(FuzzFindings, CurveWithAnImpossibleTravelIsRefused) {
   } catch (const eical::dsp::InputError& e) {
     what = e.what();
   }
-  expect_says(what, "needs more than 100000 correction points (positions in mm?)");
+  expect_says(what, "more than the 100 m of any machine axis (positions in mm?)");
   try {
     what.clear();
     (void)eical::dsp::comp::piecewise_linear({{0.0, 100.0}, {0.0, 1.0}}, {10.0, 1e-4, 0.0});
