@@ -10,6 +10,16 @@
 namespace eical::dsp::comp {
 namespace {
 
+// Why piecewise_linear refuses a curve with these options ("" when it does not).
+std::string refusal(const ErrorCurve& curve, const LinCompOptions& options) {
+  try {
+    (void)piecewise_linear(curve, options);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 ErrorCurve sample_curve(double travel_mm = 500.0) {
   // A LIDA-like curve: a slow bow, a 37 mm wave and a little noise, every 1 mm.
   ErrorCurve c;
@@ -86,43 +96,28 @@ TEST(LinComp, TableRemovesTheErrorAtItsPointsAndALinearErrorEverywhere) {
 
 TEST(LinComp, BadInputIsRefusedWithTheReason) {
   ErrorCurve c = sample_curve(100.0);
-  auto msg = [](const ErrorCurve& cc, LinCompOptions o) -> std::string {
-    try {
-      (void)piecewise_linear(cc, o);
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "";
-  };
-  EXPECT_NE(msg(c, {.spacing_mm = 150.0}).find("larger than the travel"), std::string::npos);
+  EXPECT_NE(refusal(c, {.spacing_mm = 150.0}).find("larger than the travel"), std::string::npos);
   ErrorCurve dup = c;
   dup.pos_mm[5] = dup.pos_mm[4];
-  EXPECT_NE(msg(dup, {}).find("duplicate"), std::string::npos);
+  EXPECT_NE(refusal(dup, {}).find("duplicate"), std::string::npos);
   ErrorCurve back = c;
   back.pos_mm[5] = 2.0;
-  EXPECT_NE(msg(back, {}).find("must increase"), std::string::npos);
+  EXPECT_NE(refusal(back, {}).find("must increase"), std::string::npos);
   ErrorCurve nan = c;
   nan.error_um[7] = std::nan("");
-  EXPECT_NE(msg(nan, {}).find("point 8"), std::string::npos);
+  EXPECT_NE(refusal(nan, {}).find("point 8"), std::string::npos);
 }
 
 // Found by fuzzing (fuzz/corpus/curve_csv/regression-*): a curve over 3.6 km passed every
 // bound one at a time and took minutes under the sanitizers; a curve no machine axis can
 // have is refused at once, and so is a table recomputed at more shifts than a second's work.
 TEST(LinComp, CurvesNoMachineHasAndUnboundedWorkAreRefused) {
-  auto msg = [](const ErrorCurve& cc, LinCompOptions o) -> std::string {
-    try {
-      (void)piecewise_linear(cc, o);
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "";
-  };
   const ErrorCurve km{{5.0, 100.0, 3640388.0}, {1.0, 2.0, 4.0}};
-  EXPECT_NE(msg(km, {}).find("of any machine axis"), std::string::npos) << msg(km, {});
+  EXPECT_NE(refusal(km, {}).find("of any machine axis"), std::string::npos) << refusal(km, {});
   const ErrorCurve long_axis{{0.0, 50000.0}, {0.0, 10.0}};  // 50 m: a gantry mill's axis
-  EXPECT_EQ(msg(long_axis, {}), "");
-  EXPECT_NE(msg(long_axis, {.spacing_mm = 10.0, .shift_step_mm = 0.001}).find("table evaluations"), std::string::npos);
+  EXPECT_EQ(refusal(long_axis, {}), "");
+  EXPECT_NE(refusal(long_axis, {.spacing_mm = 10.0, .shift_step_mm = 0.001}).find("table evaluations"),
+            std::string::npos);
 }
 
 }  // namespace
