@@ -129,13 +129,15 @@ Eigen::VectorXd without_modes(const ExplainState& st, const Eigen::VectorXd& r, 
         for (auto& c : mode_columns(st, rows, fz[m].first, fz[m].second)) cols.push_back(std::move(c));
     return cols;
   };
-  double best_loop = residual_of(r, all_cols(fz.size())).squaredNorm();
+  // The modes' columns once (no loop yet); each candidate loop beside them alone.
+  const std::vector<Eigen::VectorXd> modes = all_cols(fz.size());
+  double best_loop = residual_of(r, modes).squaredNorm();
   for (double tau_ms = 0.0; tau_ms <= 100.0; tau_ms += tau_ms < 60.0 ? 2.0 : 10.0) {
     std::vector<Eigen::VectorXd> cols = loop_columns(st, rows, tau_ms * 1e-3);
-    const std::vector<Eigen::VectorXd> modes = all_cols(fz.size());
+    const std::size_t n_loop = cols.size();
     cols.insert(cols.end(), modes.begin(), modes.end());
     if (const double rss = residual_of(r, cols).squaredNorm(); rss < best_loop)
-      best_loop = rss, loop = loop_columns(st, rows, tau_ms * 1e-3);
+      best_loop = rss, loop.assign(cols.begin(), cols.begin() + static_cast<std::ptrdiff_t>(n_loop));
   }
   for (std::size_t m = 0; m < fz.size(); ++m) {
     const auto others = all_cols(m);
