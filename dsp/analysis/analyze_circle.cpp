@@ -7,6 +7,7 @@
 #include "dsp/eval/circle_arc.hpp"
 #include "dsp/eval/circle_segments.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace eical::dsp::detail {
@@ -14,22 +15,24 @@ namespace {
 
 using Ranges = std::vector<std::pair<std::int64_t, std::int64_t>>;
 
-// One evaluation of the channel `pos` (measured or reference) over the segments found.
+// One evaluation of the channel `pos` (measured or reference) over the segments found;
+// `keep_trace` false: the figures only.
 std::optional<eval::CircleResult> evaluate_channel(const Program& p, const std::vector<std::int64_t>& idx,
                                                    const std::vector<Eigen::Vector2d>& pos, const Ranges& ccw,
-                                                   const Ranges& cw) {
+                                                   const Ranges& cw, bool keep_trace) {
   std::optional<eval::CircleResult> out;
+  eval::CircleInput in;
+  in.center_mm = {p.center_mm[0], p.center_mm[1]};
+  in.radius_mm = p.radius_mm;
+  in.keep_trace = keep_trace;
+  in.sample_index = idx;
+  in.pos_mm = pos;
   for (const auto* ranges : {&ccw, &cw}) {
     if (ranges->empty()) continue;
-    eval::CircleInput in;
-    in.center_mm = {p.center_mm[0], p.center_mm[1]};
-    in.radius_mm = p.radius_mm;
     in.direction = ranges == &ccw ? "ccw" : "cw";
-    in.sample_index = idx;
-    in.pos_mm = pos;
     in.segments = *ranges;
     eval::CircleResult r = p.arc_deg < 360.0 ? eval::evaluate_arc(in, p.arc_deg) : eval::evaluate_circle(in);
-    out = out ? eval::combine(*out, r) : r;
+    out = out ? eval::combine(*out, r) : std::move(r);
   }
   return out;
 }
@@ -45,6 +48,8 @@ PlaneTrace plane_trace(const Run& run, const Measurement& m, const EvaluationOpt
   const auto [ia, ib] = plane_axes(run.meta.program.plane);
   PlaneTrace t;
   t.ref_finite = options.reference && run.channels.ref[ia] && run.channels.ref[ib];
+  t.cmd.reserve(m.sample_index.size()), t.pos.reserve(m.sample_index.size());
+  if (t.ref_finite) t.ref.reserve(m.sample_index.size());
   for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
     t.cmd.emplace_back(m.cmd_mm[i][ia], m.cmd_mm[i][ib]);
     t.pos.emplace_back(m.pos_mm[i][ia], m.pos_mm[i][ib]);
@@ -76,7 +81,7 @@ void find_segments(const Program& p, const Measurement& m, const std::vector<Eig
 void evaluate_reference(const Program& p, const Measurement& m, const std::vector<Eigen::Vector2d>& ref,
                         const Ranges& ccw, const Ranges& cw, Analysis& a) {
   try {
-    a.circle_reference = evaluate_channel(p, m.sample_index, ref, ccw, cw);
+    a.circle_reference = evaluate_channel(p, m.sample_index, ref, ccw, cw, true);
     const auto& dm = a.circle->trace.radius_deviation_um;
     const auto& dr = a.circle_reference->trace.radius_deviation_um;
     if (dm.size() == dr.size() && !dm.empty()) {
@@ -98,8 +103,11 @@ std::vector<eval::CirclePass> diagnostic_passes(const Measurement& m, const Plan
     eval::CirclePass pass;
     pass.direction = ranges == &ccw ? +1 : -1;
     pass.fs_hz = m.fs_hz;
+    const auto inside = [&](std::int64_t k) { return k >= ranges->front().first && k < ranges->back().second; };
+    const auto n = static_cast<std::size_t>(std::count_if(m.sample_index.begin(), m.sample_index.end(), inside));
+    pass.cmd_mm.reserve(n), pass.meas_mm.reserve(n);
     for (std::size_t i = 0; i < m.sample_index.size(); ++i)
-      if (m.sample_index[i] >= ranges->front().first && m.sample_index[i] < ranges->back().second) {
+      if (inside(m.sample_index[i])) {
         pass.cmd_mm.push_back(t.cmd[i]);
         pass.meas_mm.push_back(t.pos[i]);
       }
@@ -136,7 +144,7 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
   Ranges ccw, cw;
   try {
     find_segments(p, m, t.cmd, ccw, cw);
-    a.circle = evaluate_channel(p, m.sample_index, t.pos, ccw, cw);
+    a.circle = evaluate_channel(p, m.sample_index, t.pos, ccw, cw, options.traces);
   } catch (const InputError& e) {
     a.flags.push_back(std::string("circle: ") + e.what());
     a.degraded = true;

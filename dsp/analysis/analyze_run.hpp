@@ -57,6 +57,9 @@ struct AnalysisOptions {
 struct EvaluationOptions {
   bool reference = true;                  // also evaluate the reference channel
   std::optional<double> cyclic_pitch_mm;  // diagnostics: this pitch instead of the search
+  // The per-point traces (plots, CSV, the reference's RMS); the uncertainty's draws read
+  // the figures only.
+  bool traces = true;
 };
 
 struct Analysis {

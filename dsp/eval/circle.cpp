@@ -16,17 +16,18 @@ CircleFit fit_circle(const std::vector<Eigen::Vector2d>& points) {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
   for (const auto& p : points) mean += p;
   mean /= static_cast<double>(points.size());
-  Eigen::MatrixXd A(static_cast<Eigen::Index>(points.size()), 3);
-  Eigen::VectorXd y(static_cast<Eigen::Index>(points.size()));
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Eigen::Vector2d q = points[i] - mean;
-    A.row(static_cast<Eigen::Index>(i)) << 2 * q.x(), 2 * q.y(), 1.0;
-    y(static_cast<Eigen::Index>(i)) = q.squaredNorm();
+  // Its normal equations (3 x 3, no N x 3 matrix: a revolution of a long run holds half a
+  // million points): centred, their condition is about (2R)^2 / 1, far from double's limit,
+  // and the start only has to lie in Gauss-Newton's basin.
+  Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d Aty = Eigen::Vector3d::Zero();
+  for (const auto& p : points) {
+    const Eigen::Vector2d q = p - mean;
+    const Eigen::Vector3d row(2 * q.x(), 2 * q.y(), 1.0);
+    AtA.noalias() += row * row.transpose();
+    Aty.noalias() += row * q.squaredNorm();
   }
-  // Decomposed in place (the same algorithm on the same numbers): a revolution of a long
-  // run holds half a million points, and a copy of A is 13 MB more at the peak.
-  const Eigen::ColPivHouseholderQR<Eigen::Ref<Eigen::MatrixXd>> qr(A);
-  const Eigen::Vector3d k = qr.solve(y);
+  const Eigen::Vector3d k = AtA.ldlt().solve(Aty);
   Eigen::Vector2d c(k[0], k[1]);
   double r = std::sqrt(k[2] + c.squaredNorm());
   // Gauss–Newton on the geometric distances |p − c| − r.
@@ -69,7 +70,7 @@ void CircleAccumulator::begin(std::size_t expected_samples) {
 void CircleAccumulator::put(const Eigen::Vector2d& d, double dev_um) {
   double ang = std::atan2(d.y(), d.x()) * 180.0 / std::numbers::pi;
   if (ang < 0) ang += 360.0;
-  if ((o_.trace_offset + r_.points) % r_.trace.stride == 0) {
+  if (o_.keep_trace && (o_.trace_offset + r_.points) % r_.trace.stride == 0) {
     r_.trace.angle_deg.push_back(ang);
     r_.trace.radius_deviation_um.push_back(dev_um);
     r_.trace.direction.push_back(o_.direction);
@@ -156,12 +157,12 @@ CircleResult evaluate_circle(const CircleInput& input) {
   if (ranges.empty())
     throw InputError(
         "circle evaluation: fewer than two M102 marks inside the measurement (a circle program marks each revolution)");
-  CircleAccumulator acc({input.center_mm, input.radius_mm, input.direction, 360.0, 1, 0});
+  CircleAccumulator acc({input.center_mm, input.radius_mm, input.direction, 360.0, 1, 0, input.keep_trace});
   for (const auto& range : ranges) {
-    acc.begin();
+    const auto inside = [&range](std::int64_t k) { return k >= range.first && k < range.second; };
+    acc.begin(static_cast<std::size_t>(std::count_if(input.sample_index.begin(), input.sample_index.end(), inside)));
     for (std::size_t i = 0; i < input.sample_index.size(); ++i)
-      if (input.sample_index[i] >= range.first && input.sample_index[i] < range.second)
-        acc.add(input.sample_index[i], input.pos_mm[i]);
+      if (inside(input.sample_index[i])) acc.add(input.sample_index[i], input.pos_mm[i]);
     acc.end();
   }
   return acc.result();

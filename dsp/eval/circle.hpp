@@ -37,6 +37,7 @@ struct CircleInput {
   Eigen::Vector2d center_mm = Eigen::Vector2d::Zero();  // nominal
   double radius_mm = 10.0;                              // nominal
   std::string direction = "ccw";
+  bool keep_trace = true;  // false: the figures only, no per-point trace (the uncertainty's draws)
 };
 
 struct CircleTrace {
@@ -93,6 +94,7 @@ class CircleAccumulator {
     // The trace keeps the points whose index offset + i (i: this direction's own count) is
     // a multiple of trace_stride (combine() appends directions in order).
     std::size_t trace_stride = 1, trace_offset = 0;
+    bool keep_trace = true;  // false: no per-point trace at all (the figures need none)
   };
   explicit CircleAccumulator(Options o);
   // A revolution (arc) starts; expected_samples (when known) sizes its buffer at once.

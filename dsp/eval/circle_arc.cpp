@@ -16,7 +16,7 @@ CircleResult evaluate_arc(const CircleInput& in, double arc_deg) {
   if (in.segments.empty()) throw InputError("arc evaluation: no evaluated arc between two M102 marks");
   // 360 here would fit centres: an arc of the full circle is still about the programmed one.
   CircleAccumulator acc(
-      {in.center_mm, in.radius_mm, in.direction, std::min(arc_deg, std::nextafter(360.0, 0.0)), 1, 0});
+      {in.center_mm, in.radius_mm, in.direction, std::min(arc_deg, std::nextafter(360.0, 0.0)), 1, 0, in.keep_trace});
   for (const auto& seg : in.segments) {
     acc.begin();
     for (std::size_t i = 0; i < in.sample_index.size(); ++i)
