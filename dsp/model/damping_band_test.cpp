@@ -1,5 +1,6 @@
 #include "dsp/model/damping_band_test.hpp"
 
+#include "dsp/core/central_difference.hpp"
 #include "dsp/core/median.hpp"
 
 #include <Eigen/Dense>
@@ -64,12 +65,6 @@ std::vector<double> element(const std::vector<Eigen::Vector3d>& machine, const E
   const Eigen::Vector3d col = to_machine.col(e);
   for (std::size_t k = 0; k < machine.size(); ++k) out[k] = col.dot(machine[k]);  // to_machineᵀ·a (a rotation)
   return out;
-}
-
-std::vector<double> derivative(const std::vector<double>& x, double fs_hz) {
-  std::vector<double> d(x.size(), 0.0);
-  for (std::size_t k = 1; k + 1 < x.size(); ++k) d[k] = 0.5 * (x[k + 1] - x[k - 1]) * fs_hz;
-  return d;
 }
 
 // Samples near an axis' reversal of its set-point (the delay of the DAQ added) or the ends.
@@ -207,14 +202,14 @@ BandSignals band_signals(const RunResiduals& rr, std::size_t n, double lo_hz, do
     for (std::size_t k = 0; k < n; ++k)
       rel[k] = raw.head_mps2[k][static_cast<Eigen::Index>(i)] - raw.table_mps2[k][static_cast<Eigen::Index>(i)],
       t[k] = raw.table_mps2[k][static_cast<Eigen::Index>(i)];
-    b.y[i] = band(rel), b.lin[i] = band(t), b.rate[i] = band(derivative(t, fs));
+    b.y[i] = band(rel), b.lin[i] = band(t), b.rate[i] = band(central_difference(t, fs));
   }
   for (std::size_t s = 0; s < 2; ++s) {
     const auto& trace = s == 0 ? raw.table_mps2 : raw.head_mps2;
     b.to_machine[s] = rr.meta.sensors[s].to_machine;
     for (std::size_t e = 0; e < 3; ++e) {
       const std::vector<double> a = element(trace, b.to_machine[s], static_cast<int>(e));
-      const std::vector<double> ad = derivative(a, fs), a_motion = motion(a);
+      const std::vector<double> ad = central_difference(a, fs), a_motion = motion(a);
       // The amplitude the motion gives the element: the vibration's own (which the damping
       // also follows) makes products a first-order model does not hold for.
       std::vector<double> r(n);

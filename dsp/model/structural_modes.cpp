@@ -1,5 +1,6 @@
 #include "dsp/model/structural_modes.hpp"
 
+#include "dsp/core/central_difference.hpp"
 #include "dsp/core/chi2.hpp"
 #include "dsp/core/float_limits.hpp"
 #include "dsp/core/median.hpp"
@@ -203,8 +204,7 @@ std::vector<Eigen::VectorXd> nuisance_columns(const Eigen::MatrixXd& a_cmd, doub
                                               const std::vector<int>& inputs) {
   std::vector<Eigen::VectorXd> nuisance{Eigen::VectorXd::Ones(nn)};
   for (int j : inputs) {
-    Eigen::VectorXd jerk = Eigen::VectorXd::Zero(nn);
-    for (Eigen::Index k = 1; k + 1 < nn; ++k) jerk[k] = (a_cmd(k + 1, j) - a_cmd(k - 1, j)) * fs_hz / 2.0;
+    const Eigen::VectorXd jerk = central_difference(Eigen::VectorXd(a_cmd.col(j).head(nn)), fs_hz);
     // The drive's own response (a broad second-order lag, not a mode) to second order in
     // frequency: gain, lag and the curvature of its phase and magnitude.
     Eigen::VectorXd snap = Eigen::VectorXd::Zero(nn);

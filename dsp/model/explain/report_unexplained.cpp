@@ -1,6 +1,7 @@
 // Stage: a residual that the accepted effects leave beyond the noise is reported
 // (other.unexplained, run-format.md): its size against the noise and where it sits in time
 // and frequency. "Within its noise" is said only when it is true.
+#include "dsp/core/central_difference.hpp"
 #include "dsp/core/float_limits.hpp"
 #include "dsp/model/explain/stages.hpp"
 
@@ -69,9 +70,7 @@ std::vector<Eigen::VectorXd> mode_columns(const ExplainState& st, const Channel&
   for (int j = 0; j < 3; ++j) {
     if (!st.rr.moving[j]) continue;
     const Eigen::VectorXd& a_j = st.rr.a_cmd.col(j);
-    Eigen::VectorXd jerk = Eigen::VectorXd::Zero(a_j.size());
-    for (Eigen::Index k = 1; k + 1 < a_j.size(); ++k) jerk[k] = (a_j[k + 1] - a_j[k - 1]) * fs / 2.0;
-    for (const Eigen::VectorXd& drive : {a_j, jerk}) {
+    for (const Eigen::VectorXd& drive : {a_j, central_difference(a_j, fs)}) {
       const Eigen::VectorXd m_mm = mode_response(drive, fs, f_hz, zeta, true);
       for (int a = 0; a < 3; ++a) {
         Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
