@@ -594,7 +594,7 @@ Identification identify_sensors(const Run& run, const IdentifyOptions& options) 
   if (!id.sensor[0].moved && !id.sensor[1].moved) throw InputError("identify: no axis moved more than 0.5 mm");
   id.covariance = covariance_of(last, id, run.meta);
   last.m = Measurement{};  // the comparison integrates the run twice more: one trace at a time
-  compare_with_datasheet(run, meta, id);
+  if (options.compare_with_datasheet) compare_with_datasheet(run, meta, id);
   return id;
 }
 

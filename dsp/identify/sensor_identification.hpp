@@ -40,6 +40,10 @@ struct IdentifyOptions {
   bool against_reference = false;    // fit to the reference instrument instead (comparison)
   int reference_every = 50;
   double reference_sigma_um = 0.1;
+  // The RMS the data sheet and the identified model leave (psd_rms_*, rest_rms_*): two more
+  // integrations of the run, which the covariance does not read (eical plan's typical
+  // identification wants the covariance only).
+  bool compare_with_datasheet = true;
 };
 
 struct Estimate {
