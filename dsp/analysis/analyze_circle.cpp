@@ -4,11 +4,13 @@
 // full circles.
 #include "dsp/analysis/program_evaluations.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/index_span.hpp"
 #include "dsp/eval/circle_arc.hpp"
 #include "dsp/eval/circle_segments.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 namespace eical::dsp::detail {
 namespace {
@@ -103,14 +105,12 @@ std::vector<eval::CirclePass> diagnostic_passes(const Measurement& m, const Plan
     eval::CirclePass pass;
     pass.direction = ranges == &ccw ? +1 : -1;
     pass.fs_hz = m.fs_hz;
-    const auto inside = [&](std::int64_t k) { return k >= ranges->front().first && k < ranges->back().second; };
-    const auto n = static_cast<std::size_t>(std::count_if(m.sample_index.begin(), m.sample_index.end(), inside));
-    pass.cmd_mm.reserve(n), pass.meas_mm.reserve(n);
-    for (std::size_t i = 0; i < m.sample_index.size(); ++i)
-      if (inside(m.sample_index[i])) {
-        pass.cmd_mm.push_back(t.cmd[i]);
-        pass.meas_mm.push_back(t.pos[i]);
-      }
+    // The indices ascend: evaluate_circle() checked them before the diagnostics are asked for.
+    const IndexSpan in = index_span(m.sample_index, ranges->front().first, ranges->back().second);
+    pass.cmd_mm.assign(t.cmd.begin() + static_cast<std::ptrdiff_t>(in.begin),
+                       t.cmd.begin() + static_cast<std::ptrdiff_t>(in.end));
+    pass.meas_mm.assign(t.pos.begin() + static_cast<std::ptrdiff_t>(in.begin),
+                        t.pos.begin() + static_cast<std::ptrdiff_t>(in.end));
     passes.push_back(std::move(pass));
   }
   return passes;
@@ -144,7 +144,7 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
   Ranges ccw, cw;
   try {
     find_segments(p, m, t.cmd, ccw, cw);
-    a.circle = evaluate_channel(p, m.sample_index, t.pos, ccw, cw, options.traces);
+    a.circle = evaluate_channel(p, m.sample_index, t.pos, ccw, cw, options.keep_trace);
   } catch (const InputError& e) {
     a.flags.push_back(std::string("circle: ") + e.what());
     a.degraded = true;

@@ -59,7 +59,7 @@ struct EvaluationOptions {
   std::optional<double> cyclic_pitch_mm;  // diagnostics: this pitch instead of the search
   // The per-point traces (plots, CSV, the reference's RMS); the uncertainty's draws read
   // the figures only.
-  bool traces = true;
+  bool keep_trace = true;
 };
 
 struct Analysis {

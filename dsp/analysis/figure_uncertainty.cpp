@@ -46,7 +46,7 @@ DrawBases evaluate_bases(const Run& run, const Analysis& a, Measurement decimate
   const Measurement& m = a.measurement;
   DrawBases b;
   b.eo.reference = false;
-  b.eo.traces = false;
+  b.eo.keep_trace = false;
   if (a.diagnostics) b.eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
   b.nominal.measurement = std::move(decimated);
   b.nominal.measurement.fs_hz = m.fs_hz / static_cast<double>(q);

@@ -1,6 +1,7 @@
 #include "dsp/eval/circle.hpp"
 
 #include "dsp/core/error.hpp"
+#include "dsp/core/index_span.hpp"
 
 #include <Eigen/Dense>
 
@@ -164,12 +165,12 @@ CircleResult evaluate_circle(const CircleInput& input) {
   if (ranges.empty())
     throw InputError(
         "circle evaluation: fewer than two M102 marks inside the measurement (a circle program marks each revolution)");
+  require_ascending(input.sample_index, "circle evaluation");
   CircleAccumulator acc({input.center_mm, input.radius_mm, input.direction, 360.0, 1, 0, input.keep_trace});
   for (const auto& range : ranges) {
-    const auto inside = [&range](std::int64_t k) { return k >= range.first && k < range.second; };
-    acc.begin(static_cast<std::size_t>(std::count_if(input.sample_index.begin(), input.sample_index.end(), inside)));
-    for (std::size_t i = 0; i < input.sample_index.size(); ++i)
-      if (inside(input.sample_index[i])) acc.add(input.sample_index[i], input.pos_mm[i]);
+    const IndexSpan in = index_span(input.sample_index, range.first, range.second);
+    acc.begin(in.size());
+    for (std::size_t i = in.begin; i < in.end; ++i) acc.add(input.sample_index[i], input.pos_mm[i]);
     acc.end();
   }
   return acc.result();

@@ -1,6 +1,7 @@
 #include "dsp/eval/circle_arc.hpp"
 
 #include "dsp/core/error.hpp"
+#include "dsp/core/index_span.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -17,10 +18,11 @@ CircleResult evaluate_arc(const CircleInput& in, double arc_deg) {
   // 360 here would fit centres: an arc of the full circle is still about the programmed one.
   CircleAccumulator acc(
       {in.center_mm, in.radius_mm, in.direction, std::min(arc_deg, std::nextafter(360.0, 0.0)), 1, 0, in.keep_trace});
+  require_ascending(in.sample_index, "arc evaluation");
   for (const auto& seg : in.segments) {
-    acc.begin();
-    for (std::size_t i = 0; i < in.sample_index.size(); ++i)
-      if (in.sample_index[i] >= seg.first && in.sample_index[i] < seg.second) acc.add(in.sample_index[i], in.pos_mm[i]);
+    const IndexSpan span = index_span(in.sample_index, seg.first, seg.second);
+    acc.begin(span.size());
+    for (std::size_t i = span.begin; i < span.end; ++i) acc.add(in.sample_index[i], in.pos_mm[i]);
     acc.end();
   }
   CircleResult r = acc.result();

@@ -1,11 +1,15 @@
 // Full-circle evaluation (ISO 230-4) on synthetic paths: the least-squares circle far from
 // the origin, and the figures-only evaluation the uncertainty's draws use.
+#include "dsp/core/error.hpp"
+#include "dsp/core/index_span.hpp"
 #include "dsp/eval/circle.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
+#include <string>
+#include <utility>
 
 namespace eical::dsp::eval {
 namespace {
@@ -54,6 +58,27 @@ TEST(CircleEvaluationTest, FiguresOnlyEqualTheTracedEvaluationAndKeepNoTrace) {
   EXPECT_DOUBLE_EQ(bare.radius_mean_deviation_um, traced.radius_mean_deviation_um);
   EXPECT_DOUBLE_EQ(bare.radial_deviation_F_max_um, traced.radial_deviation_F_max_um);
   EXPECT_EQ(bare.deviation_sum_by_deg, traced.deviation_sum_by_deg);
+}
+
+TEST(CircleEvaluationTest, RevolutionsAreCutByIndexAndOutOfOrderIndicesAreRefused) {
+  // Each revolution holds the samples from its mark up to the next one, however the trace
+  // around it is cut.
+  CircleInput in = two_revolutions({0.0, 0.0}, 10.0, 1.0);
+  const CircleResult whole = evaluate_circle(in);
+  EXPECT_EQ(whole.points, 7200u);  // 3600 a revolution, the last sample (the end mark) in none
+  const IndexSpan second = index_span(in.sample_index, 3600, 7200);
+  EXPECT_EQ(second.begin, 3600u);
+  EXPECT_EQ(second.size(), 3600u);
+  EXPECT_EQ(index_span(in.sample_index, -50, 0).size(), 0u);       // before the trace
+  EXPECT_EQ(index_span(in.sample_index, 9000, 9500).begin, 7201u);  // after it
+  EXPECT_EQ(index_span(in.sample_index, 500, 400).size(), 0u);      // an empty stretch
+  std::swap(in.sample_index[10], in.sample_index[11]);
+  try {
+    (void)evaluate_circle(in);
+    FAIL() << "indices out of order were evaluated";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("sample indices do not ascend"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
