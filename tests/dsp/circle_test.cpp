@@ -1,8 +1,8 @@
 // Full-circle evaluation (ISO 230-4) on synthetic paths: the least-squares circle far from
 // the origin, and the figures-only evaluation the uncertainty's draws use.
+#include "dsp/eval/circle.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/core/index_span.hpp"
-#include "dsp/eval/circle.hpp"
 
 #include <gtest/gtest.h>
 
@@ -69,7 +69,7 @@ TEST(CircleEvaluationTest, RevolutionsAreCutByIndexAndOutOfOrderIndicesAreRefuse
   const IndexSpan second = index_span(in.sample_index, 3600, 7200);
   EXPECT_EQ(second.begin, 3600u);
   EXPECT_EQ(second.size(), 3600u);
-  EXPECT_EQ(index_span(in.sample_index, -50, 0).size(), 0u);       // before the trace
+  EXPECT_EQ(index_span(in.sample_index, -50, 0).size(), 0u);        // before the trace
   EXPECT_EQ(index_span(in.sample_index, 9000, 9500).begin, 7201u);  // after it
   EXPECT_EQ(index_span(in.sample_index, 500, 400).size(), 0u);      // an empty stretch
   std::swap(in.sample_index[10], in.sample_index[11]);
