@@ -48,6 +48,16 @@ struct AnalysisOptions {
     // generator is seeded by its number, the sums taken in draw order: the same U whatever
     // it is). drivers::thread_for() runs them on the machine's cores.
     ParallelFor parallel = sequential_for();
+    // A screen (eical plan's variants): after `after_draws` draws, when U of the scalar
+    // figure `key` already exceeds `above`, the draws end there. The first draws are the
+    // same whether the rest follow or not (each is seeded by its number), so a screen that
+    // does not stop gives the U of all the draws. Analysis::uncertainty_draws: how many ran.
+    struct StopAbove {
+      std::string key;
+      double above = 0.0;
+      int after_draws = 20;
+    };
+    std::optional<StopAbove> stop_above;
   } uncertainty;
   std::optional<uncertainty::SensorModelCovariance> model_covariance;
 };
@@ -86,6 +96,7 @@ struct Analysis {
   std::map<std::string, std::vector<double>> uncertainty_k2;
   std::string uncertainty_source;  // "datasheet" or the calibration's method
   std::string uncertainty_note;    // how it was estimated, or why not
+  int uncertainty_draws = 0;       // the Monte Carlo draws U comes from (0: not estimated)
   // quality.verdict of results.md: "ok", "degraded" or "not_measurable", and why.
   std::string verdict = "ok";
   std::vector<std::string> verdict_reasons;

@@ -113,18 +113,18 @@ struct DrawnFigures {
   std::vector<FigureValue> plug, bound;
 };
 
-// The seeded draws of the error field, each added to both bases and evaluated. Contiguous
-// blocks of draws are the executor's tasks (one copy of the bases' measurement a block);
-// the sums are taken in draw order afterwards.
-DrawSums draw_figures(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
-                      int draws, std::uint64_t seed, const ParallelFor& parallel) {
-  const auto n = static_cast<std::size_t>(draws);
+// The seeded draws [from, to) of the error field, each added to both bases and evaluated.
+// Contiguous blocks of draws are the executor's tasks (one copy of the bases' measurement a
+// block); the sums are taken in draw order afterwards.
+void draw_range(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
+                std::size_t from, std::size_t to, std::uint64_t seed, const ParallelFor& parallel,
+                std::vector<DrawnFigures>& drawn) {
+  const std::size_t n = to - from;
   const std::size_t blocks = std::min<std::size_t>(n, kDrawBlocks);
-  std::vector<DrawnFigures> drawn(n);
   parallel(blocks, [&](std::size_t block) {
     std::vector<Eigen::Vector3d> err;
     Measurement nominal_scratch = b.nominal.measurement, ideal_scratch = b.ideal.measurement;
-    for (std::size_t d = block * n / blocks; d < (block + 1) * n / blocks; ++d) {
+    for (std::size_t d = from + block * n / blocks; d < from + (block + 1) * n / blocks; ++d) {
       // Seeded by (seed, d) alone, so the draws may run in any order and on any thread.
       std::mt19937_64 rng(stream_seed(seed, d));
       field.draw(rng, b.at, err);
@@ -132,8 +132,12 @@ DrawSums draw_figures(const Run& run, const Analysis& a, const uncertainty::Erro
       drawn[d].bound = perturbed_figures(run, a, b.ideal, err, b.eo, ideal_scratch);
     }
   });
+}
+
+DrawSums sums_of(const DrawBases& b, const std::vector<DrawnFigures>& drawn, std::size_t n) {
   DrawSums s{accumulators_for(b.f0), accumulators_for(b.g0)};
-  for (const DrawnFigures& f : drawn) accumulate(b.f0, f.plug, s.plug), accumulate(b.g0, f.bound, s.bound);
+  for (std::size_t d = 0; d < n; ++d)
+    accumulate(b.f0, drawn[d].plug, s.plug), accumulate(b.g0, drawn[d].bound, s.bound);
   return s;
 }
 
@@ -152,22 +156,47 @@ std::size_t index_of(const std::vector<FigureValue>& f, const std::string& key) 
   return k;
 }
 
-// Figures of the full-rate analysis: U from the draws where the shapes agree, the larger
-// of the plug-in and the ideal path's bound.
+// U of a figure with `elements` values from the draws where the shapes agree, the larger
+// of the plug-in and the ideal path's bound; empty when neither base has it in that shape.
+std::vector<double> u_of_figure(const DrawBases& b, const DrawSums& s, int draws, const std::string& key,
+                                std::size_t elements) {
+  const std::size_t k = index_of(b.f0, key), j = index_of(b.g0, key);
+  const bool plug = k < b.f0.size() && b.f0[k].values.size() == elements;
+  const bool bound = j < b.g0.size() && b.g0[j].values.size() == elements;
+  if (!plug && !bound) return {};
+  std::vector<double> u(elements, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t e = 0; e < u.size(); ++e) {
+    const double up = plug ? u_of(s.plug, k, e, true, draws) : std::numeric_limits<double>::quiet_NaN();
+    const double ub = bound ? u_of(s.bound, j, e, false, draws) : std::numeric_limits<double>::quiet_NaN();
+    u[e] = std::isfinite(up) && std::isfinite(ub) ? std::max(up, ub) : std::isfinite(up) ? up : ub;
+  }
+  return u;
+}
+
+// Figures of the full-rate analysis.
 void assign_uncertainties(const DrawBases& b, const DrawSums& s, int draws, Analysis& a) {
   for (const FigureValue& full : figures_of(a)) {
-    const std::size_t k = index_of(b.f0, full.key), j = index_of(b.g0, full.key);
-    const bool plug = k < b.f0.size() && b.f0[k].values.size() == full.values.size();
-    const bool bound = j < b.g0.size() && b.g0[j].values.size() == full.values.size();
-    if (!plug && !bound) continue;
-    std::vector<double> u(full.values.size(), std::numeric_limits<double>::quiet_NaN());
-    for (std::size_t e = 0; e < u.size(); ++e) {
-      const double up = plug ? u_of(s.plug, k, e, true, draws) : std::numeric_limits<double>::quiet_NaN();
-      const double ub = bound ? u_of(s.bound, j, e, false, draws) : std::numeric_limits<double>::quiet_NaN();
-      u[e] = std::isfinite(up) && std::isfinite(ub) ? std::max(up, ub) : std::isfinite(up) ? up : ub;
-    }
-    a.uncertainty_k2[full.key] = u;
+    std::vector<double> u = u_of_figure(b, s, draws, full.key, full.values.size());
+    if (!u.empty()) a.uncertainty_k2[full.key] = std::move(u);
   }
+}
+
+// The draws: all of them, or the screen's first ones when they already put U of its figure
+// above its bound.
+int run_draws(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b, int draws,
+              std::uint64_t seed, const ParallelFor& parallel,
+              const std::optional<AnalysisOptions::Uncertainty::StopAbove>& stop, std::vector<DrawnFigures>& drawn) {
+  const auto n = static_cast<std::size_t>(draws);
+  drawn.assign(n, {});
+  const std::size_t first = stop ? static_cast<std::size_t>(std::clamp(stop->after_draws, 2, draws)) : n;
+  draw_range(run, a, field, b, 0, first, seed, parallel, drawn);
+  if (first < n) {
+    const int m = static_cast<int>(first);
+    const std::vector<double> u = u_of_figure(b, sums_of(b, drawn, first), m, stop->key, 1);
+    if (u.size() == 1 && u[0] > stop->above) return m;
+    draw_range(run, a, field, b, first, n, seed, parallel, drawn);
+  }
+  return draws;
 }
 
 }  // namespace
@@ -216,6 +245,7 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
                                    const std::vector<bool>* zupt_unused)
     : samples_(samples),
       draws_(std::max(2, options.uncertainty.draws)),
+      stop_above_(options.uncertainty.stop_above),
       seed_(options.uncertainty.seed),
       parallel_(options.uncertainty.parallel ? options.uncertainty.parallel : sequential_for()) {
   const Measurement& m = a.measurement;
@@ -278,13 +308,15 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     return;
   }
   const DrawBases bases = evaluate_bases(run, a, std::exchange(nominal_, Measurement{}), q_, samples_);
-  const DrawSums sums = draw_figures(run, a, *field, bases, draws_, seed_, parallel_);
-  assign_uncertainties(bases, sums, draws_, a);
+  std::vector<DrawnFigures> drawn;
+  const int used = run_draws(run, a, *field, bases, draws_, seed_, parallel_, stop_above_, drawn);
+  assign_uncertainties(bases, sums_of(bases, drawn, static_cast<std::size_t>(used)), used, a);
+  a.uncertainty_draws = used;
   char note[200];
   std::snprintf(note, sizeof note,
                 "GUM, k = 2: %d Monte Carlo draws of the error field (noise and bias walk between the supports, sensor "
                 "model: %s, PSD strips), path at %.0f Hz",
-                draws_, a.uncertainty_source.c_str(), a.measurement.fs_hz / static_cast<double>(q_));
+                used, a.uncertainty_source.c_str(), a.measurement.fs_hz / static_cast<double>(q_));
   a.uncertainty_note = note;
 }
 

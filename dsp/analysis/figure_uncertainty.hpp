@@ -66,6 +66,7 @@ class UncertaintyTrace {
   Measurement nominal_;                                // every q_-th trace sample
   std::size_t samples_ = 0, q_ = 1;
   int draws_ = 100;
+  std::optional<AnalysisOptions::Uncertainty::StopAbove> stop_above_;
   std::uint64_t seed_ = 0;
   ParallelFor parallel_;
 };

@@ -195,13 +195,16 @@ double duration_s(const dsp::Run& run) {
 }
 
 Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
-                   const std::optional<dsp::uncertainty::SensorModelCovariance>& identified) {
+                   const std::optional<dsp::uncertainty::SensorModelCovariance>& identified,
+                   const std::optional<Screen>& screen) {
   sim::Scenario sc = scenario_of(p, seed);
   sc.oversample = prediction_oversample(sc);
   const dsp::Run run = sim::simulate(sc);
   dsp::AnalysisOptions o;
   o.uncertainty.draws = draws;
   o.uncertainty.parallel = drivers::thread_for();
+  const dsp::ResolutionLimit* lim = dsp::resolution_limit(p.kind);
+  if (screen && lim) o.uncertainty.stop_above = {lim->limited, screen->margin * lim->limit, screen->draws};
   if (p.identified) {
     o.model_covariance = identified ? *identified : typical_identification(p);
     o.sensor_model = "psd";
@@ -210,9 +213,10 @@ Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
   Prediction r;
   r.program = p;
   r.duration_s = duration_s(run);
+  r.draws = a.uncertainty_draws;
   for (const auto& [k, u] : a.uncertainty_k2)
     if (u.size() == 1 && std::isfinite(u[0])) r.u_k2[k] = u[0];
-  if (const dsp::ResolutionLimit* lim = dsp::resolution_limit(p.kind)) {
+  if (lim) {
     r.headline = lim->headline, r.limited = lim->limited, r.limit = lim->limit;
     const auto it = r.u_k2.find(lim->limited);
     r.limited_u = it != r.u_k2.end() ? it->second : std::numeric_limits<double>::quiet_NaN();
@@ -273,17 +277,6 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
   return v;
 }
 
-namespace {
-
-// The screening of the variants. U from n draws is twice a standard deviation estimated
-// from n samples, whose relative standard error is 1/√(2(n − 1)): 16 % at 20 draws. A
-// variant whose screened U exceeds the limit twice over is 6 of those errors above it, so
-// it is left without the full prediction (which costs three times the draws).
-constexpr int kScreenDraws = 20;
-constexpr double kScreenMargin = 2.0;
-
-}  // namespace
-
 std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_duration_s, int draws) {
   std::optional<dsp::uncertainty::SensorModelCovariance> identified;  // one simulated identification for all variants
   for (const TestProgram& t : variants(p)) {
@@ -299,13 +292,11 @@ std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_du
       path_mm = 2.0 * (t.size_mm[0] + t.size_mm[1]) * std::max(1, t.repeats);
     if (path_mm / (t.feed_mm_min / 60.0) > max_duration_s) continue;
     if (t.identified && !identified) identified = typical_identification(t);
-    // A screening prediction first: the U of a variant far above the limit is told by a
-    // few draws (see kScreenDraws); only a near one is predicted with all of them.
-    if (draws > kScreenDraws) {
-      const Prediction screen = predict(t, 1, kScreenDraws, identified);
-      if (screen.limited_u > kScreenMargin * screen.limit) continue;
-    }
-    Prediction r = predict(t, 1, draws, identified);
+    // Screened: U from n draws is twice a standard deviation estimated from n samples,
+    // whose relative standard error is 1/√(2(n − 1)), 16 % at 20 draws. A variant whose
+    // U after 20 draws exceeds the limit twice over is 6 of those errors above it: its
+    // draws end there. A nearer one is predicted with all of them.
+    Prediction r = predict(t, 1, draws, identified, Screen{20, 2.0});
     if (r.measurable) return r;
   }
   return std::nullopt;

@@ -67,12 +67,20 @@ struct Prediction {
   double limited_u = 0.0, limit = 0.0;
   bool measurable = false;  // U(limited) within what the test is meant to resolve
   double duration_s = 0.0;
+  int draws = 0;  // the Monte Carlo draws U comes from
 };
 
 // Simulates and analyses the program; `draws` Monte Carlo draws. With p.identified the
 // sensor model's covariance is `identified` (or typical_identification(p) when not given).
+// `screen`: the draws stop after the screen's first ones when U of the limited figure is
+// already `screen_margin` times its limit (Prediction::draws says how many ran).
+struct Screen {
+  int draws = 20;
+  double margin = 2.0;
+};
 Prediction predict(const TestProgram& p, std::uint64_t seed = 1, int draws = 100,
-                   const std::optional<dsp::uncertainty::SensorModelCovariance>& identified = std::nullopt);
+                   const std::optional<dsp::uncertainty::SensorModelCovariance>& identified = std::nullopt,
+                   const std::optional<Screen>& screen = std::nullopt);
 
 // The nearest variants of a program, nearest first (the program itself not included): the
 // test's own changes with the sensors as they are, then the same after an identification.
