@@ -30,7 +30,7 @@ std::string g(double v) {
 // The internal grid of a prediction's simulation: ten steps per period of the sensing
 // element's resonance, at least the DAQ's rate. The prediction's machine is ideal and its
 // sensors are the data sheet's, so nothing above the DAQ's band is there to alias. No
-// predicted U moved in its fourth digit between this grid and the simulator's usual 100 kHz
+// predicted U moved by more than 0.1 % between this grid and the simulator's usual 100 kHz
 // (R50 F2000 both, 100 draws, grid at 1, 2, 4 and 10 times the DAQ's rate); the 100 kHz
 // grid took 150 MB more.
 int prediction_oversample(const sim::Scenario& sc) {
