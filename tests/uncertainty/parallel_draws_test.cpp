@@ -4,11 +4,10 @@
 #include "drivers/exec/thread_for.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/same_uncertainty.hpp"
 #include "tools/plan/test_plan.hpp"
 
 #include <gtest/gtest.h>
-
-#include <cmath>
 
 namespace eical::tools::plan {
 namespace {
@@ -23,18 +22,7 @@ TEST(ParallelDraws, ThreadsGiveTheSameUncertaintyAsOneAfterAnother) {
   const dsp::Analysis one = dsp::analyze_run(run, o);
   o.uncertainty.parallel = drivers::thread_for(3);
   const dsp::Analysis threads = dsp::analyze_run(run, o);
-  ASSERT_GE(one.uncertainty_k2.size(), 10u) << one.uncertainty_note;
-  ASSERT_EQ(one.uncertainty_k2.size(), threads.uncertainty_k2.size());
-  for (const auto& [key, u] : one.uncertainty_k2) {
-    const auto it = threads.uncertainty_k2.find(key);
-    ASSERT_NE(it, threads.uncertainty_k2.end()) << key;
-    ASSERT_EQ(it->second.size(), u.size()) << key;
-    for (std::size_t e = 0; e < u.size(); ++e)
-      if (std::isfinite(u[e]))
-        EXPECT_EQ(it->second[e], u[e]) << key << "[" << e << "]";
-      else
-        EXPECT_FALSE(std::isfinite(it->second[e])) << key << "[" << e << "]";
-  }
+  eical::testing::expect_same_uncertainty(one, threads);
 }
 
 }  // namespace

@@ -4,34 +4,18 @@
 // exactly what the unscreened draws give.
 #include "dsp/analysis/analyze_run.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/same_uncertainty.hpp"
 #include "tools/plan/test_plan.hpp"
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <map>
+#include <optional>
 #include <string>
-#include <vector>
 
 namespace eical::tools::plan {
 namespace {
 
 constexpr const char* kG = "circle.circular_deviation_G_um";
-
-void expect_same_u(const dsp::Analysis& a, const dsp::Analysis& b) {
-  ASSERT_GE(a.uncertainty_k2.size(), 10u) << a.uncertainty_note;
-  ASSERT_EQ(a.uncertainty_k2.size(), b.uncertainty_k2.size());
-  for (const auto& [key, u] : a.uncertainty_k2) {
-    const auto it = b.uncertainty_k2.find(key);
-    ASSERT_NE(it, b.uncertainty_k2.end()) << key;
-    ASSERT_EQ(it->second.size(), u.size()) << key;
-    for (std::size_t e = 0; e < u.size(); ++e)
-      if (std::isfinite(u[e]))
-        EXPECT_EQ(it->second[e], u[e]) << key << "[" << e << "]";
-      else
-        EXPECT_FALSE(std::isfinite(it->second[e])) << key << "[" << e << "]";
-  }
-}
 
 class ScreenedDraws : public ::testing::Test {
  protected:
@@ -58,7 +42,7 @@ TEST_F(ScreenedDraws, AUAboveTheBoundEndsTheDrawsAtTheScreen) {
   const dsp::Analysis screened = analyse(30, dsp::AnalysisOptions::Uncertainty::StopAbove{kG, 0.5 * u8, 8});
   EXPECT_EQ(screened.uncertainty_draws, 8);
   EXPECT_EQ(eight.uncertainty_draws, 8);
-  expect_same_u(eight, screened);
+  eical::testing::expect_same_uncertainty(eight, screened);
   EXPECT_NE(screened.uncertainty_note.find("8 Monte Carlo draws"), std::string::npos) << screened.uncertainty_note;
 }
 
@@ -68,7 +52,7 @@ TEST_F(ScreenedDraws, AUBelowTheBoundRunsEveryDrawAndChangesNothing) {
   const dsp::Analysis screened =
       analyse(30, dsp::AnalysisOptions::Uncertainty::StopAbove{kG, 100.0 * all.uncertainty_k2.at(kG)[0], 8});
   EXPECT_EQ(screened.uncertainty_draws, 30);
-  expect_same_u(all, screened);
+  eical::testing::expect_same_uncertainty(all, screened);
 }
 
 TEST_F(ScreenedDraws, AFigureTheRunDoesNotHaveNeverStopsTheDraws) {
