@@ -292,11 +292,9 @@ std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_du
       path_mm = 2.0 * (t.size_mm[0] + t.size_mm[1]) * std::max(1, t.repeats);
     if (path_mm / (t.feed_mm_min / 60.0) > max_duration_s) continue;
     if (t.identified && !identified) identified = typical_identification(t);
-    // Screened: U from n draws is twice a standard deviation estimated from n samples,
-    // whose relative standard error is 1/√(2(n − 1)), 16 % at 20 draws. A variant whose
-    // U after 20 draws exceeds the limit twice over is 6 of those errors above it: its
-    // draws end there. A nearer one is predicted with all of them.
-    Prediction r = predict(t, 1, draws, identified, Screen{20, 2.0});
+    // Screened (Screen): a variant far above the limit is told by its first draws; a
+    // nearer one is predicted with all of them.
+    Prediction r = predict(t, 1, draws, identified, Screen{});
     if (r.measurable) return r;
   }
   return std::nullopt;
