@@ -181,22 +181,28 @@ void assign_uncertainties(const DrawBases& b, const DrawSums& s, int draws, Anal
   }
 }
 
-// The draws: all of them, or the screen's first ones when they already put U of its figure
-// above its bound.
-int run_draws(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b, int draws,
-              std::uint64_t seed, const ParallelFor& parallel,
-              const std::optional<AnalysisOptions::Uncertainty::StopAbove>& stop, std::vector<DrawnFigures>& drawn) {
+// The draws' sums and how many ran: all of them, or the screen's first ones when they
+// already put U of its figure above its bound.
+struct DrawOutcome {
+  DrawSums sums;
+  int used = 0;
+};
+
+DrawOutcome run_draws(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
+                      int draws, std::uint64_t seed, const ParallelFor& parallel,
+                      const std::optional<AnalysisOptions::Uncertainty::StopAbove>& stop) {
   const auto n = static_cast<std::size_t>(draws);
-  drawn.assign(n, {});
+  std::vector<DrawnFigures> drawn(n);
   const std::size_t first = stop ? static_cast<std::size_t>(std::clamp(stop->after_draws, 2, draws)) : n;
   draw_range(run, a, field, b, 0, first, seed, parallel, drawn);
   if (first < n) {
     const int m = static_cast<int>(first);
-    const std::vector<double> u = u_of_figure(b, sums_of(b, drawn, first), m, stop->key, 1);
-    if (u.size() == 1 && u[0] > stop->above) return m;
+    DrawSums screen = sums_of(b, drawn, first);
+    const std::vector<double> u = u_of_figure(b, screen, m, stop->key, 1);
+    if (u.size() == 1 && u[0] > stop->above) return {std::move(screen), m};
     draw_range(run, a, field, b, first, n, seed, parallel, drawn);
   }
-  return draws;
+  return {sums_of(b, drawn, n), draws};
 }
 
 }  // namespace
@@ -308,15 +314,14 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     return;
   }
   const DrawBases bases = evaluate_bases(run, a, std::exchange(nominal_, Measurement{}), q_, samples_);
-  std::vector<DrawnFigures> drawn;
-  const int used = run_draws(run, a, *field, bases, draws_, seed_, parallel_, stop_above_, drawn);
-  assign_uncertainties(bases, sums_of(bases, drawn, static_cast<std::size_t>(used)), used, a);
-  a.uncertainty_draws = used;
+  const DrawOutcome drew = run_draws(run, a, *field, bases, draws_, seed_, parallel_, stop_above_);
+  assign_uncertainties(bases, drew.sums, drew.used, a);
+  a.uncertainty_draws = drew.used;
   char note[200];
   std::snprintf(note, sizeof note,
                 "GUM, k = 2: %d Monte Carlo draws of the error field (noise and bias walk between the supports, sensor "
                 "model: %s, PSD strips), path at %.0f Hz",
-                used, a.uncertainty_source.c_str(), a.measurement.fs_hz / static_cast<double>(q_));
+                drew.used, a.uncertainty_source.c_str(), a.measurement.fs_hz / static_cast<double>(q_));
   a.uncertainty_note = note;
 }
 

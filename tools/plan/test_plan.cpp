@@ -213,7 +213,6 @@ Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
   Prediction r;
   r.program = p;
   r.duration_s = duration_s(run);
-  r.draws = a.uncertainty_draws;
   for (const auto& [k, u] : a.uncertainty_k2)
     if (u.size() == 1 && std::isfinite(u[0])) r.u_k2[k] = u[0];
   if (lim) {

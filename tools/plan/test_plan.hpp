@@ -67,13 +67,12 @@ struct Prediction {
   double limited_u = 0.0, limit = 0.0;
   bool measurable = false;  // U(limited) within what the test is meant to resolve
   double duration_s = 0.0;
-  int draws = 0;  // the Monte Carlo draws U comes from
 };
 
 // Simulates and analyses the program; `draws` Monte Carlo draws. With p.identified the
 // sensor model's covariance is `identified` (or typical_identification(p) when not given).
 // `screen`: the draws stop after the screen's first ones when U of the limited figure is
-// already `margin` times its limit (Prediction::draws says how many ran). U from n draws is
+// already `margin` times its limit (a variant it stops is not measurable). U from n draws is
 // twice a standard deviation estimated from n samples, whose relative standard error is
 // 1/√(2(n − 1)), 16 % at 20 draws: a U twice the limit after 20 is six of them above it.
 struct Screen {
