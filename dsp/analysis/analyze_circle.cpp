@@ -116,16 +116,45 @@ std::vector<eval::CirclePass> diagnostic_passes(const Measurement& m, const Plan
   return passes;
 }
 
-// The ballbar-class diagnostics of full circles; a flag instead when they cannot be had.
-void diagnose(const Program& p, const std::vector<eval::CirclePass>& passes, const EvaluationOptions& options,
-              Analysis& a) {
+eval::DiagnosticsOptions diagnostics_options(const Program& p, const EvaluationOptions& options) {
   eval::DiagnosticsOptions opt;
   opt.centre_mm = {p.center_mm[0], p.center_mm[1]};
   opt.radius_mm = p.radius_mm;
   opt.feed_mm_min = p.feed_mm_min;
   if (options.cyclic_pitch_mm) opt.cyclic_pitch_mm = options.cyclic_pitch_mm;
+  return opt;
+}
+
+// The evaluated revolutions per direction: from the set-point cache when it holds them;
+// else found, and a cache not yet frozen takes them with the diagnostics' design.
+void revolutions(const Program& p, const Measurement& m, const PlaneTrace& t, const EvaluationOptions& options,
+                 Ranges& ccw, Ranges& cw) {
+  SetPointCache* cache = options.setpoint;
+  if (cache && cache->circle) {
+    ccw = cache->circle->ccw, cw = cache->circle->cw;
+    return;
+  }
+  find_segments(p, m, t.cmd, ccw, cw);
+  if (!cache || cache->frozen) return;
+  SetPointCache::Circle c{ccw, cw, nullptr};
+  if (p.arc_deg >= 360.0) {
+    try {
+      c.design = eval::circle_design(diagnostic_passes(m, t, ccw, cw), diagnostics_options(p, options));
+    } catch (const InputError&) {  // diagnose() says why, each time
+    }
+  }
+  cache->circle = std::move(c);
+}
+
+// The ballbar-class diagnostics of full circles; a flag instead when they cannot be had.
+void diagnose(const Program& p, const std::vector<eval::CirclePass>& passes, const EvaluationOptions& options,
+              Analysis& a) {
+  const eval::DiagnosticsOptions opt = diagnostics_options(p, options);
+  const SetPointCache* cache = options.setpoint;
   try {
-    a.diagnostics = eval::diagnose_circle(passes, opt);
+    a.diagnostics = cache && cache->circle && cache->circle->design
+                        ? eval::diagnose_circle(passes, opt, *cache->circle->design)
+                        : eval::diagnose_circle(passes, opt);
     if (!a.diagnostics->servo_and_squareness_separated)
       a.flags.push_back(
           "diagnostics.servo_mismatch_ms: null, one direction cannot separate servo mismatch from squareness "
@@ -143,7 +172,7 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
   const PlaneTrace t = plane_trace(run, m, options);
   Ranges ccw, cw;
   try {
-    find_segments(p, m, t.cmd, ccw, cw);
+    revolutions(p, m, t, options, ccw, cw);
     a.circle = evaluate_channel(p, m.sample_index, t.pos, ccw, cw, options.keep_trace);
   } catch (const InputError& e) {
     a.flags.push_back(std::string("circle: ") + e.what());

@@ -4,6 +4,7 @@
 // eicald (which evaluates every measurement it records), so all three agree by
 // construction. An evaluation that cannot be done leaves its result empty and says why
 // in `flags`; it does not throw.
+#include "dsp/analysis/setpoint_cache.hpp"
 #include "dsp/core/parallel_for.hpp"
 #include "dsp/core/run.hpp"
 #include "dsp/eval/circle.hpp"
@@ -70,6 +71,9 @@ struct EvaluationOptions {
   // The per-point traces (plots, CSV, the reference's RMS); the uncertainty's draws read
   // the figures only.
   bool keep_trace = true;
+  // What the set-point alone gives, shared by evaluations of paths on one set-point (the
+  // uncertainty's draws; see its header for how it is filled and read). Null: none.
+  SetPointCache* setpoint = nullptr;
 };
 
 struct Analysis {

@@ -35,6 +35,7 @@ struct Accumulator {
 // (what the error alone makes of them: for a range, an amplitude or a spread —
 // |f(t + e) − f(t)| ≤ f(e) — a bound whatever the machine).
 struct DrawBases {
+  std::unique_ptr<SetPointCache> setpoint;  // both bases' and every draw's: one set-point
   EvaluationOptions eo;
   Analysis nominal, ideal;
   std::vector<FigureValue> f0, g0;  // their figures
@@ -55,8 +56,11 @@ DrawBases evaluate_bases(const Run& run, const Analysis& a, Measurement decimate
   b.nominal.dynamic = b.ideal.dynamic = a.dynamic, b.nominal.nbs = b.ideal.nbs = a.nbs;
   b.ideal.measurement = b.nominal.measurement;
   b.ideal.measurement.pos_mm = b.ideal.measurement.cmd_mm;
-  evaluate_program(run, b.nominal, b.eo);
+  b.setpoint = std::make_unique<SetPointCache>();
+  b.eo.setpoint = b.setpoint.get();
+  evaluate_program(run, b.nominal, b.eo);  // fills the set-point cache
   evaluate_program(run, b.ideal, b.eo);
+  b.setpoint->frozen = true;  // the draws read it in parallel
   b.f0 = figures_of(b.nominal), b.g0 = figures_of(b.ideal);
   for (std::size_t i = 0; i < samples; i += q) b.at.push_back(static_cast<double>(i));
   return b;

@@ -13,14 +13,8 @@
 #include <numbers>
 
 namespace eical::dsp::eval {
-namespace {
-
-using units::kUmPerMm;
-
-int sgn(double v, double eps) { return v > eps ? 1 : (v < -eps ? -1 : 0); }
-
-// Fixed columns of the per-axis model (after the per-pass drift polynomials).
-enum Col { scale, square, lag, backlash, lateral, cyc_sin, cyc_cos, bow, n_cols };
+// Named, not anonymous: CircleDesign, declared in the header, holds records of these.
+namespace diagnostics_fit {
 
 // One sample as the fit sees it: the set-point, the measured position, the commanded
 // velocity (central differences: the set-point is noise-free) and whether it lies within
@@ -30,119 +24,9 @@ struct Walked {
   Eigen::Vector2d cmd, meas, vel;
   bool skip[2] = {false, false};
   double fs_hz = 0.0;
-};
-
-// Replays the passes and hands each sample over once its velocity is known (one sample
-// of lookahead), with the reversal masks; checks what the stored version checked.
-template <class F>
-void walk(PassReplay& replay, std::size_t window, F&& f) {
-  const auto& passes = replay.passes();
-  std::size_t cur = SIZE_MAX, i = 0, got = 0;
-  Eigen::Vector2d prev_cmd, cmd, meas;
-  int last[2] = {0, 0};
-  std::size_t until[2] = {0, 0};
-  auto emit = [&](const Eigen::Vector2d& ca, const Eigen::Vector2d& cb, std::size_t span) {
-    Walked w;
-    w.pass = cur, w.i = i, w.n = passes[cur].samples, w.cmd = cmd, w.meas = meas, w.fs_hz = passes[cur].fs_hz;
-    w.vel = span > 0 ? Eigen::Vector2d((cb - ca) * (w.fs_hz / static_cast<double>(span))) : Eigen::Vector2d::Zero();
-    for (int a = 0; a < 2; ++a) {
-      const int s = sgn(w.vel[a], 1e-6);
-      if (s != 0 && last[a] != 0 && s != last[a]) until[a] = std::max(until[a], i + window);
-      if (s != 0) last[a] = s;
-      w.skip[a] = i < until[a];
-    }
-    f(w);
-    ++i;
-  };
-  auto close_pass = [&] {
-    if (cur == SIZE_MAX || got == 0) return;
-    // The last sample: its velocity from the one before it (or none, alone).
-    if (got == 1)
-      emit(cmd, cmd, 0);
-    else
-      emit(prev_cmd, cmd, 1);
-  };
-  replay.replay([&](std::size_t pass, const Eigen::Vector2d& c, const Eigen::Vector2d& m) {
-    if (pass != cur) {
-      close_pass();
-      cur = pass, i = 0, got = 0, last[0] = last[1] = 0, until[0] = until[1] = 0;
-    }
-    if (!c.allFinite() || !m.allFinite())
-      throw InputError("circle diagnostics: non-finite position at sample " + std::to_string(got));
-    if (got >= 1) {  // the buffered sample's next one has come
-      if (got == 1)
-        emit(cmd, c, 1);
-      else
-        emit(prev_cmd, c, 2);
-      prev_cmd = cmd;
-    }
-    cmd = c, meas = m;
-    ++got;
-  });
-  close_pass();
-}
-
-// The rows of one axis' model for given settings (pitch, the play of the backlash operator).
-struct AxisModel {
-  int a = 0;  // 0 = x, 1 = y
-  DiagnosticsOptions opt;
-  std::vector<double> pitches_mm;  // the cyclic columns' pitches (one each: sin, cos)
-  double play_mm = 0.0;            // > 0: the play operator; else the step −sgn(v)/2
-  std::vector<int> d0;             // per pass: the first direction of motion of the axis
-  // Per pass state of the play operator.
-  double slide = 0.0;
-  // Fills the common features [1, t, t², scale, square, lag, backlash, lateral, bow] and
-  // the cyclic ones per pitch (sin, cos), and the target.
-  void row(const Walked& w, double* common9, double* cyc, double& target) {
-    const int b = 1 - a;
-    const double R = opt.radius_mm;
-    const Eigen::Vector2d& c = w.cmd;
-    const Eigen::Vector2d& v = w.vel;
-    const double t = static_cast<double>(w.i) / static_cast<double>(w.n) - 0.5;  // scaled time
-    common9[0] = 1.0, common9[1] = t, common9[2] = t * t;
-    common9[3] = c[a] - opt.centre_mm[a];
-    common9[4] = a == 0 ? -(c[1] - opt.centre_mm[1]) : 0.0;
-    common9[5] = -v[a];
-    // Backlash: the lost motion as the slide sees it. With a play estimate it is the play
-    // operator's output (the slide waits until the motor has crossed the play, so the step
-    // after a reversal takes time); without one, the step −sgn(v)/2.
-    if (play_mm > 0.0) {
-      const double x = c[a];
-      if (w.i == 0) slide = x - 0.5 * play_mm * d0[w.pass];  // play taken up in the first direction
-      slide = std::clamp(slide, x - 0.5 * play_mm, x + 0.5 * play_mm);
-      common9[6] = (slide - x) / play_mm;
-    } else {
-      common9[6] = -0.5 * sgn(v[a], 1e-6);
-    }
-    common9[7] = 0.5 * sgn(v[b], 1e-6);
-    const double u = (c[b] - opt.centre_mm[b]) / R;
-    common9[8] = u * u;
-    // sin, cos of 2π·x/p for every pitch; a pitch whose double is searched too takes the
-    // double angle of that one's (2 sin cos, cos² − sin²): 4 sincos for the usual 13 pitches.
-    for (std::size_t k = pitches_mm.size(); k-- > 0;) {
-      if (half_of_[k] >= 0) {
-        const double sn = cyc[2 * half_of_[k]], cs = cyc[2 * half_of_[k] + 1];
-        cyc[2 * k] = 2.0 * sn * cs;
-        cyc[2 * k + 1] = cs * cs - sn * sn;
-      } else {
-        const double arg = 2.0 * std::numbers::pi * c[a] / pitches_mm[k];
-        cyc[2 * k] = std::sin(arg);
-        cyc[2 * k + 1] = std::cos(arg);
-      }
-    }
-    target = w.meas[a] - c[a];
-  }
-  // For each pitch the index of its double among the pitches (−1: none); they ascend.
-  void set_pitches(std::vector<double> p) {
-    pitches_mm = std::move(p);
-    half_of_.assign(pitches_mm.size(), -1);
-    for (std::size_t k = 0; k < pitches_mm.size(); ++k)
-      for (std::size_t j = k + 1; j < pitches_mm.size(); ++j)
-        if (pitches_mm[j] == 2.0 * pitches_mm[k]) half_of_[k] = static_cast<int>(j);
-  }
-
- private:
-  std::vector<int> half_of_;
+  // Per axis: the set-point's columns from a CircleDesign (the 9 common ones, the backlash
+  // as a step, then sin and cos per pitch); null: the model computes them.
+  const double* cols[2] = {nullptr, nullptr};
 };
 
 // Normal equations of one axis, per pass, over the columns [common 9 | target | cyclic 2K],
@@ -198,10 +82,147 @@ struct AxisGram {
   }
 };
 
+}  // namespace diagnostics_fit
+
+namespace {
+
+using diagnostics_fit::AxisGram;
+using diagnostics_fit::Walked;
+
+using units::kUmPerMm;
+
+int sgn(double v, double eps) { return v > eps ? 1 : (v < -eps ? -1 : 0); }
+
+// Fixed columns of the per-axis model (after the per-pass drift polynomials).
+enum Col { scale, square, lag, backlash, lateral, cyc_sin, cyc_cos, bow, n_cols };
+
+// Replays the passes and hands each sample over once its velocity is known (one sample
+// of lookahead), with the reversal masks; checks what the stored version checked.
+template <class F>
+void walk(PassReplay& replay, std::size_t window, F&& f) {
+  const auto& passes = replay.passes();
+  std::size_t cur = SIZE_MAX, i = 0, got = 0;
+  Eigen::Vector2d prev_cmd, cmd, meas;
+  int last[2] = {0, 0};
+  std::size_t until[2] = {0, 0};
+  auto emit = [&](const Eigen::Vector2d& ca, const Eigen::Vector2d& cb, std::size_t span) {
+    Walked w;
+    w.pass = cur, w.i = i, w.n = passes[cur].samples, w.cmd = cmd, w.meas = meas, w.fs_hz = passes[cur].fs_hz;
+    w.vel = span > 0 ? Eigen::Vector2d((cb - ca) * (w.fs_hz / static_cast<double>(span))) : Eigen::Vector2d::Zero();
+    for (int a = 0; a < 2; ++a) {
+      const int s = sgn(w.vel[a], 1e-6);
+      if (s != 0 && last[a] != 0 && s != last[a]) until[a] = std::max(until[a], i + window);
+      if (s != 0) last[a] = s;
+      w.skip[a] = i < until[a];
+    }
+    f(w);
+    ++i;
+  };
+  auto close_pass = [&] {
+    if (cur == SIZE_MAX || got == 0) return;
+    // The last sample: its velocity from the one before it (or none, alone).
+    if (got == 1)
+      emit(cmd, cmd, 0);
+    else
+      emit(prev_cmd, cmd, 1);
+  };
+  replay.replay([&](std::size_t pass, const Eigen::Vector2d& c, const Eigen::Vector2d& m) {
+    if (pass != cur) {
+      close_pass();
+      cur = pass, i = 0, got = 0, last[0] = last[1] = 0, until[0] = until[1] = 0;
+    }
+    if (!c.allFinite() || !m.allFinite())
+      throw InputError("circle diagnostics: non-finite position at sample " + std::to_string(got));
+    if (got >= 1) {  // the buffered sample's next one has come
+      if (got == 1)
+        emit(cmd, c, 1);
+      else
+        emit(prev_cmd, c, 2);
+      prev_cmd = cmd;
+    }
+    cmd = c, meas = m;
+    ++got;
+  });
+  close_pass();
+}
+
+// The rows of one axis' model for given settings (pitch, the play of the backlash operator).
+struct AxisModel {
+  int a = 0;  // 0 = x, 1 = y
+  DiagnosticsOptions opt;
+  std::vector<double> pitches_mm;    // the cyclic columns' pitches (one each: sin, cos)
+  std::size_t cached_cyc_first = 0;  // where this model's pitches start among cached columns
+  double play_mm = 0.0;              // > 0: the play operator; else the step −sgn(v)/2
+  std::vector<int> d0;               // per pass: the first direction of motion of the axis
+  // Per pass state of the play operator.
+  double slide = 0.0;
+  // Fills the common features [1, t, t², scale, square, lag, backlash, lateral, bow] and
+  // the cyclic ones per pitch (sin, cos), and the target.
+  void row(const Walked& w, double* common9, double* cyc, double& target) {
+    if (const double* cached = w.cols[a]) {
+      std::copy_n(cached, 9, common9);
+      std::copy_n(cached + 9 + cached_cyc_first, 2 * pitches_mm.size(), cyc);
+      common9[6] = backlash_column(w);
+      target = w.meas[a] - w.cmd[a];
+      return;
+    }
+    const int b = 1 - a;
+    const double R = opt.radius_mm;
+    const Eigen::Vector2d& c = w.cmd;
+    const Eigen::Vector2d& v = w.vel;
+    const double t = static_cast<double>(w.i) / static_cast<double>(w.n) - 0.5;  // scaled time
+    common9[0] = 1.0, common9[1] = t, common9[2] = t * t;
+    common9[3] = c[a] - opt.centre_mm[a];
+    common9[4] = a == 0 ? -(c[1] - opt.centre_mm[1]) : 0.0;
+    common9[5] = -v[a];
+    common9[6] = backlash_column(w);
+    common9[7] = 0.5 * sgn(v[b], 1e-6);
+    const double u = (c[b] - opt.centre_mm[b]) / R;
+    common9[8] = u * u;
+    // sin, cos of 2π·x/p for every pitch; a pitch whose double is searched too takes the
+    // double angle of that one's (2 sin cos, cos² − sin²): 4 sincos for the usual 13 pitches.
+    for (std::size_t k = pitches_mm.size(); k-- > 0;) {
+      if (half_of_[k] >= 0) {
+        const double sn = cyc[2 * half_of_[k]], cs = cyc[2 * half_of_[k] + 1];
+        cyc[2 * k] = 2.0 * sn * cs;
+        cyc[2 * k + 1] = cs * cs - sn * sn;
+      } else {
+        const double arg = 2.0 * std::numbers::pi * c[a] / pitches_mm[k];
+        cyc[2 * k] = std::sin(arg);
+        cyc[2 * k + 1] = std::cos(arg);
+      }
+    }
+    target = w.meas[a] - c[a];
+  }
+  // Backlash: the lost motion as the slide sees it. With a play estimate it is the play
+  // operator's output (the slide waits until the motor has crossed the play, so the step
+  // after a reversal takes time); without one, the step −sgn(v)/2. Called once per sample
+  // in order (the operator's state runs through every sample of a pass).
+  double backlash_column(const Walked& w) {
+    if (!(play_mm > 0.0)) return -0.5 * sgn(w.vel[a], 1e-6);
+    const double x = w.cmd[a];
+    if (w.i == 0) slide = x - 0.5 * play_mm * d0[w.pass];  // play taken up in the first direction
+    slide = std::clamp(slide, x - 0.5 * play_mm, x + 0.5 * play_mm);
+    return (slide - x) / play_mm;
+  }
+  // For each pitch the index of its double among the pitches (−1: none); they ascend.
+  void set_pitches(std::vector<double> p) {
+    pitches_mm = std::move(p);
+    half_of_.assign(pitches_mm.size(), -1);
+    for (std::size_t k = 0; k < pitches_mm.size(); ++k)
+      for (std::size_t j = k + 1; j < pitches_mm.size(); ++j)
+        if (pitches_mm[j] == 2.0 * pitches_mm[k]) half_of_[k] = static_cast<int>(j);
+  }
+
+ private:
+  std::vector<int> half_of_;
+};
+
 struct AxisFit {
   Eigen::VectorXd coef;     // fixed columns only (n_cols)
   Eigen::VectorXd x;        // every unknown (polynomials per pass, then the used fixed columns)
   std::vector<int> col_of;  // unknown index of each fixed column, −1 when not used
+  std::size_t n_poly = 0;   // the polynomials' unknowns (x's first)
   double rms_mm = 0.0;
 };
 
@@ -268,6 +289,7 @@ AxisFit solve_axis(const AxisGram& g, std::size_t k, const std::array<bool, n_co
   const Eigen::VectorXd inv = norm.cwiseInverse();
   const Eigen::MatrixXd Gs = inv.asDiagonal() * G * inv.asDiagonal();
   fit.x = Gs.colPivHouseholderQr().solve(inv.cwiseProduct(b)).cwiseQuotient(norm);
+  fit.n_poly = static_cast<std::size_t>(n_poly);
   fit.coef = Eigen::VectorXd::Zero(n_cols);
   for (int c = 0; c < n_cols; ++c)
     if (fit.col_of[static_cast<std::size_t>(c)] >= 0)
@@ -280,8 +302,7 @@ AxisFit solve_axis(const AxisGram& g, std::size_t k, const std::array<bool, n_co
 // The fit's residual at a sample (target − model), rows as AxisModel makes them.
 double residual(const AxisFit& fit, const double* common9, const double* cyc, double target, std::size_t pass,
                 double fixed_lag_s, double v_a) {
-  const std::size_t n_poly = fit.x.size() - static_cast<Eigen::Index>(std::count_if(
-                                                fit.col_of.begin(), fit.col_of.end(), [](int c) { return c >= 0; }));
+  const std::size_t n_poly = fit.n_poly;
   double model = 0.0;
   for (std::size_t j = 0; j < 3; ++j) model += fit.x(static_cast<Eigen::Index>(3 * pass + j)) * common9[j];
   const double fixed[n_cols] = {common9[3], common9[4], common9[5], common9[6], common9[7], cyc[0], cyc[1], common9[8]};
@@ -576,6 +597,150 @@ void report_residuals(const ResidualSums& s, const DiagnosticsOptions& opt, Circ
   d.residual_rms_um = std::hypot(rms_x, rms_y) * kUmPerMm;
 }
 
+// The measured sample of a design's record (q: the record's rate divisor of the passes').
+const Eigen::Vector2d& measured(const std::vector<CirclePass>& passes, const Walked& r, std::size_t q) {
+  const Eigen::Vector2d& m = passes[r.pass].meas_mm[r.i * q];
+  if (!m.allFinite()) throw InputError("circle diagnostics: non-finite position at sample " + std::to_string(r.i * q));
+  return m;
+}
+
+}  // namespace
+
+class CircleDesign {
+ public:
+  std::vector<PassReplay::Pass> passes;
+  DiagnosticsOptions opt;
+  std::vector<double> pitches;
+  std::size_t q = 1, window = 0;
+  bool both_directions = false;
+  // The walks' records at the fits' rate and at the full rate (`full` empty when that is
+  // the fits'), their meas unset; per record and axis the columns (Walked::cols).
+  std::vector<diagnostics_fit::Walked> fit, full;
+  std::vector<double> fit_cols, full_cols;
+  std::array<std::vector<int>, 2> d0;           // per axis and pass: the first direction of motion
+  std::vector<diagnostics_fit::AxisGram> gram;  // round one's normal equations, the target zero
+
+  [[nodiscard]] std::size_t width() const noexcept { return 9 + 2 * pitches.size(); }
+  // Throws unless `p` are the passes this was made of.
+  void check(const std::vector<CirclePass>& p) const {
+    bool same = p.size() == passes.size();
+    for (std::size_t k = 0; same && k < p.size(); ++k)
+      same = p[k].direction == passes[k].direction && p[k].fs_hz == passes[k].fs_hz &&
+             p[k].cmd_mm.size() == passes[k].samples && p[k].meas_mm.size() == passes[k].samples;
+    for (std::size_t k = 0; same && k < fit.size(); k += std::max<std::size_t>(1, fit.size() / 16))
+      same = fit[k].cmd == p[fit[k].pass].cmd_mm[fit[k].i * q];
+    if (!same) throw InputError("circle diagnostics: the design was made of another set-point");
+  }
+};
+
+namespace {
+
+// The set-point's passes, each measured position the commanded one (a design reads no
+// measurement).
+class SetPointPasses final : public PassReplay {
+ public:
+  explicit SetPointPasses(const std::vector<CirclePass>& p) : p_(p) {
+    for (const auto& x : p) info_.push_back({x.direction, x.fs_hz, x.cmd_mm.size()});
+  }
+  [[nodiscard]] const std::vector<Pass>& passes() const override { return info_; }
+  void replay(const std::function<void(std::size_t, const Eigen::Vector2d&, const Eigen::Vector2d&)>& f) override {
+    for (std::size_t k = 0; k < p_.size(); ++k)
+      for (const Eigen::Vector2d& c : p_[k].cmd_mm) f(k, c, c);
+  }
+
+ private:
+  const std::vector<CirclePass>& p_;
+  std::vector<Pass> info_;
+};
+
+// The records of a walk and every record's columns (the backlash as a step, every pitch).
+void record_walk(PassReplay& replay, std::size_t window, std::array<AxisModel, 2>& model, std::vector<Walked>& out,
+                 std::vector<double>& cols) {
+  const std::size_t width = 9 + 2 * model[0].pitches_mm.size();
+  walk(replay, window, [&](const Walked& w) {
+    out.push_back(w);
+    for (int a = 0; a < 2; ++a) {
+      const std::size_t at = cols.size();
+      cols.resize(at + width);
+      double target = 0.0;
+      model[a].row(w, &cols[at], &cols[at + 9], target);
+    }
+  });
+}
+
+// Round one's normal equations: the design's, with the measured path's target products.
+std::vector<AxisGram> every_pitch_from(const CircleDesign& d, const std::vector<CirclePass>& passes) {
+  std::vector<AxisGram> gram = d.gram;
+  const std::size_t w = d.width();
+  constexpr auto kT = static_cast<Eigen::Index>(AxisGram::kTarget);
+  for (std::size_t k = 0; k < d.fit.size(); ++k) {
+    const Walked& r = d.fit[k];
+    const Eigen::Vector2d& m = measured(passes, r, d.q);
+    for (int a = 0; a < 2; ++a) {
+      if (r.skip[a]) continue;
+      const double y = m[a] - r.cmd[a];
+      const double* c = &d.fit_cols[(2 * k + static_cast<std::size_t>(a)) * w];
+      Eigen::MatrixXd& g = gram[static_cast<std::size_t>(a)].m[r.pass];
+      for (Eigen::Index j = 0; j < kT; ++j) g(kT, j) += y * c[j];
+      g(kT, kT) += y * y;
+      for (Eigen::Index j = kT; j < static_cast<Eigen::Index>(w); ++j) g(j + 1, kT) += y * c[j];
+    }
+  }
+  return gram;
+}
+
+// Round two's normal equations: round one's at the best pitch, the backlash column
+// replaced by the play operator's (model: its play, state run through every record).
+std::vector<AxisGram> best_pitch_from(const CircleDesign& d, const std::vector<CirclePass>& passes,
+                                      const std::vector<AxisGram>& every, std::size_t best,
+                                      std::array<AxisModel, 2>& model) {
+  const std::size_t w = d.width(), n_pass = d.passes.size();
+  const std::size_t from[12] = {
+      0, 1, 2, 3, 4, 5, 6, 7, 8, AxisGram::kTarget, AxisGram::kCyc + 2 * best, AxisGram::kCyc + 2 * best + 1};
+  constexpr Eigen::Index kB = 6;  // the backlash column
+  std::vector<AxisGram> gram;
+  for (std::size_t a = 0; a < 2; ++a) {
+    gram.emplace_back(n_pass, 1);
+    gram[a].rows = every[a].rows;
+    for (std::size_t p = 0; p < n_pass; ++p)
+      for (Eigen::Index r = 0; r < 12; ++r)
+        for (Eigen::Index c = 0; c <= r; ++c)
+          gram[a].m[p](r, c) =
+              r == kB || c == kB ? 0.0
+                                 : every[a].at(p, from[static_cast<std::size_t>(r)], from[static_cast<std::size_t>(c)]);
+  }
+  for (std::size_t k = 0; k < d.fit.size(); ++k) {
+    const Walked& r = d.fit[k];
+    const Eigen::Vector2d& m = passes[r.pass].meas_mm[r.i * d.q];  // every_pitch_from() checked it
+    for (int a = 0; a < 2; ++a) {
+      const double b = model[static_cast<std::size_t>(a)].backlash_column(r);
+      if (r.skip[a]) continue;
+      const double* c = &d.fit_cols[(2 * k + static_cast<std::size_t>(a)) * w];
+      Eigen::MatrixXd& g = gram[static_cast<std::size_t>(a)].m[r.pass];
+      for (Eigen::Index j = 0; j < kB; ++j) g(kB, j) += b * c[j];
+      g(kB, kB) += b * b;
+      g(7, kB) += b * c[7], g(8, kB) += b * c[8];
+      g(9, kB) += b * (m[a] - r.cmd[a]);
+      g(10, kB) += b * c[9 + 2 * best], g(11, kB) += b * c[10 + 2 * best];
+    }
+  }
+  return gram;
+}
+
+// The records at the full rate with the measured path, in order.
+template <class F>
+void replay_full(const CircleDesign& d, const std::vector<CirclePass>& passes, F&& f) {
+  const bool own = !d.full.empty();
+  const std::vector<Walked>& recs = own ? d.full : d.fit;
+  const std::vector<double>& cols = own ? d.full_cols : d.fit_cols;
+  const std::size_t w = d.width();
+  for (std::size_t k = 0; k < recs.size(); ++k) {
+    Walked r = recs[k];
+    r.meas = measured(passes, r, own ? 1 : d.q);
+    r.cols[0] = &cols[2 * k * w], r.cols[1] = &cols[(2 * k + 1) * w];
+    f(r);
+  }
+}
 }  // namespace
 
 CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& options) {
@@ -616,6 +781,66 @@ CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& 
   // Third replay: the residuals of the final fits.
   ResidualMeter meter(model, fits, opt.centre_mm, window);
   walk(replay, window, [&meter](const Walked& w) { meter.add(w); });
+  report_residuals(meter.sums(), opt, d);
+  return d;
+}
+
+std::shared_ptr<const CircleDesign> circle_design(const std::vector<CirclePass>& passes,
+                                                  const DiagnosticsOptions& options) {
+  for (const auto& p : passes)
+    if (p.cmd_mm.size() != p.meas_mm.size())
+      throw InputError("circle diagnostics: commanded and measured traces differ in length");
+  SetPointPasses replay(passes);
+  auto d = std::make_shared<CircleDesign>();
+  d->passes = replay.passes();
+  d->opt = options;
+  d->both_directions = check_passes(d->passes, options);
+  d->pitches = candidate_pitches(options);
+  const double fs_hz = d->passes.front().fs_hz;
+  d->q = static_cast<std::size_t>(std::max(1.0, std::floor(fs_hz / kFitRateHz)));
+  d->window = static_cast<std::size_t>(std::lround(options.spike_window_s * fs_hz));
+  DecimatedPasses fit_replay(replay, d->q);
+  const auto fit_window =
+      static_cast<std::size_t>(std::lround(options.spike_window_s * fit_replay.passes().front().fs_hz));
+  std::array<AxisModel, 2> model = step_models(options, d->pitches, passes.size());
+  record_walk(fit_replay, fit_window, model, d->fit, d->fit_cols);
+  if (d->q > 1) record_walk(replay, d->window, model, d->full, d->full_cols);
+  // Round one's columns as accumulate_every_pitch() sums them, the target zero.
+  for (int a = 0; a < 2; ++a) d->gram.emplace_back(passes.size(), d->pitches.size());
+  const std::size_t w = d->width();
+  for (std::size_t k = 0; k < d->fit.size(); ++k) {
+    const Walked& r = d->fit[k];
+    for (std::size_t a = 0; a < 2; ++a) {
+      if (d->d0[a].empty()) d->d0[a].assign(passes.size(), 0);
+      if (d->d0[a][r.pass] == 0) d->d0[a][r.pass] = sgn(r.vel[static_cast<Eigen::Index>(a)], 1e-6);
+      if (r.skip[a]) continue;
+      const double* c = &d->fit_cols[(2 * k + a) * w];
+      d->gram[a].add_row(r.pass, c, 0.0, c + 9, w - 9);
+    }
+  }
+  for (auto& g : d->gram) g.flush();
+  return d;
+}
+
+CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& opt,
+                                  const CircleDesign& design) {
+  design.check(passes);
+  const std::vector<double>& pitches = design.pitches;
+  std::array<AxisModel, 2> model = step_models(opt, pitches, passes.size());
+  for (std::size_t a = 0; a < 2; ++a) model[a].d0 = design.d0[a];
+  const std::vector<AxisGram> gram = every_pitch_from(design, passes);
+  const std::size_t best = search_pitch(gram, pitches.size());
+  const AxisFits round_one = fit_axes(gram, best, design.both_directions);
+  for (std::size_t a = 0; a < 2; ++a) {
+    model[a].set_pitches({pitches[best]});
+    model[a].cached_cyc_first = 2 * best;
+    model[a].play_mm = std::max(0.0, round_one.axis[a].coef(backlash));
+  }
+  const AxisFits fits = fit_axes(best_pitch_from(design, passes, gram, best, model), 0, design.both_directions);
+  CircleDiagnostics d;
+  report_fit(fits, pitches[best], design.both_directions, d);
+  ResidualMeter meter(model, fits, opt.centre_mm, design.window);
+  replay_full(design, passes, [&meter](const Walked& w) { meter.add(w); });
   report_residuals(meter.sums(), opt, d);
   return d;
 }

@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -91,5 +92,20 @@ class PassReplay {
 // squares are solved from their normal equations, accumulated block by block, with the
 // columns scaled as before.)
 CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& opt);
+
+// What the fit takes from the set-point alone: every sample's velocity, reversal windows
+// and model columns but the target and the play operator's backlash, with round one's
+// normal equations of those columns. Made once, it serves every evaluation of a path on
+// the same set-point, which then reads the measured path only: the uncertainty's draws
+// evaluate some 200 paths on one set-point (dsp/analysis/setpoint_cache.hpp). About
+// 100 B + 16 B per pitch and axis a sample, so for a path at the draws' rate (a few ten
+// thousand samples), not a long run's full rate. Throws as diagnose_circle() does.
+class CircleDesign;
+std::shared_ptr<const CircleDesign> circle_design(const std::vector<CirclePass>& passes,
+                                                  const DiagnosticsOptions& options);
+// diagnose_circle(passes, options) with the set-point's share from `design`, made of the
+// same set-point and options (InputError when its passes differ).
+CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& options,
+                                  const CircleDesign& design);
 
 }  // namespace eical::dsp::eval
