@@ -64,7 +64,7 @@ void register_analyze(CLI::App& app) {
     if (o->nbs != "auto") opt.nbs = o->nbs == "on";
     opt.coriolis = o->coriolis;
     opt.uncertainty.draws = o->draws;
-    opt.uncertainty.parallel = drivers::thread_for();
+    opt.parallel = drivers::thread_for();
     dsp::StreamOptions so;
     so.spills = drivers::file_spills(drivers::default_spill_dir());
     so.spill_trace = so.spill_corrections = true;  // a CSV reads slower than a spill, a spill faster than the smoother

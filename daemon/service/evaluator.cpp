@@ -106,7 +106,7 @@ void measure_alignment(const dsp::Run& run, dsp::SetPointOrigin& s) {
 // The uncertainty's draws on every core: the evaluation runs beside the measurement, not
 // in its per-sample path (the acquisition and DSP threads hold their rings either way).
 dsp::AnalysisOptions with_parallel_draws(dsp::AnalysisOptions o) {
-  o.uncertainty.parallel = drivers::thread_for();
+  o.parallel = drivers::thread_for();
   return o;
 }
 

@@ -135,6 +135,7 @@ PipelineConfig analysis_config(const RunMeta& meta, std::size_t capacity_samples
   cfg.cupt = options.cupt;
   cfg.keep_raw = options.keep_raw;
   cfg.keep_schedule = options.uncertainty.enabled;
+  cfg.parallel = options.parallel;
   if (options.sensor_model != "datasheet") cfg.fusion.scale_uncertainty = 3e-5;  // identified on site
   cfg.calibration[0] = options.calibration[0], cfg.calibration[1] = options.calibration[1];
   return cfg;

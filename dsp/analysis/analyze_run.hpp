@@ -27,6 +27,10 @@
 namespace eical::dsp {
 
 struct AnalysisOptions {
+  // Independent work side by side: the smoother's axes, the uncertainty's draws (each
+  // draw's generator is seeded by its number, the sums taken in draw order). The results
+  // do not depend on it; drivers::thread_for() runs it on the machine's cores.
+  ParallelFor parallel = sequential_for();
   DynamicComp dynamic = DynamicComp::two_stage;
   bool zupt = true;
   std::optional<bool> nbs;  // unset: on for rectangles (axis-parallel moves), off otherwise
@@ -45,10 +49,6 @@ struct AnalysisOptions {
     bool enabled = true;
     int draws = 100;
     std::uint64_t seed = 1;
-    // The draws are independent: this executor may evaluate them side by side (each draw's
-    // generator is seeded by its number, the sums taken in draw order: the same U whatever
-    // it is). drivers::thread_for() runs them on the machine's cores.
-    ParallelFor parallel = sequential_for();
     // A screen (eical plan's variants): after `after_draws` draws, when U of the scalar
     // figure `key` already exceeds `above`, the draws end there. The first draws are the
     // same whether the rest follow or not (each is seeded by its number), so a screen that

@@ -257,7 +257,7 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
       draws_(std::max(2, options.uncertainty.draws)),
       stop_above_(options.uncertainty.stop_above),
       seed_(options.uncertainty.seed),
-      parallel_(options.uncertainty.parallel ? options.uncertainty.parallel : sequential_for()) {
+      parallel_(options.parallel ? options.parallel : sequential_for()) {
   const Measurement& m = a.measurement;
   uncertainty::ErrorFieldInput& in = in_;
   in.fs_hz = m.fs_hz;

@@ -66,20 +66,34 @@ CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const Smo
 
   // Backward (RTS), last segment first: each segment's filtered states again from its
   // checkpoint, then the recursion down to its first sample, whose smoothed state the
-  // segment before it starts from.
+  // segment before it starts from. Two tasks a segment: axes x and y; axis z and the
+  // refilter of the segment before (the axes are independent, the refilter reads only
+  // the checkpoints).
   smoothed_e_.resize(n_seg);
   smoothed_p_.resize(n_seg);
+  const ParallelFor parallel = settings_.parallel ? settings_.parallel : sequential_for();
+  SegmentStates before;
+  refilter(n_seg - 1, states);
   for (std::size_t j = n_seg; j-- > 0;) {
     const std::size_t last = std::min(n, (j + 1) * seg_);
-    refilter(j, states);
     const bool top = j + 1 == n_seg;
-    backward(states, last, top ? nullptr : &smoothed_e_[j + 1], top ? nullptr : &smoothed_p_[j + 1], nullptr);
+    const std::array<Vec3, 3>* e_next = top ? nullptr : &smoothed_e_[j + 1];
+    const std::array<Mat3, 3>* p_next = top ? nullptr : &smoothed_p_[j + 1];
+    parallel(2, [&](std::size_t task) {
+      if (task == 0) {
+        backward(states, last, e_next, p_next, nullptr, 0, 2);
+      } else {
+        backward(states, last, e_next, p_next, nullptr, 2, 3);
+        if (j > 0) refilter(j - 1, before);
+      }
+    });
     for (int a = 0; a < 3; ++a) {
       smoothed_e_[j][a] = states.e[a][0];
       smoothed_p_[j][a] = states.p[a][0];
       for (const Vec3& e : states.e[a]) finite_ = finite_ && std::isfinite(e[0]) && std::isfinite(e[1]);
     }
     if (sink) output(states, out), sink->segment(j, out);
+    std::swap(states, before);
   }
 }
 
@@ -135,7 +149,8 @@ void CheckpointedSmoother::refilter(std::size_t j, SegmentStates& states) const 
 }
 
 void CheckpointedSmoother::backward(SegmentStates& s, std::size_t last, const std::array<Vec3, 3>* e_next,
-                                    const std::array<Mat3, 3>* p_next, std::array<std::vector<Mat3>, 3>* gains) const {
+                                    const std::array<Mat3, 3>* p_next, std::array<std::vector<Mat3>, 3>* gains,
+                                    int first_axis, int end_axis) const {
   const ErrorModel& m = settings_.model;
   const auto& flags = track_.schedule->flags;
   const std::size_t first = s.first;
@@ -145,7 +160,7 @@ void CheckpointedSmoother::backward(SegmentStates& s, std::size_t last, const st
     std::size_t g = 0;
     gap_last = gap_into(last, g);
   }
-  for (int a = 0; a < 3; ++a) {
+  for (int a = first_axis; a < end_axis; ++a) {
     auto& e = s.e[a];
     auto& p = s.p[a];
     if (gains) (*gains)[a].assign(last - first, Mat3::Zero());

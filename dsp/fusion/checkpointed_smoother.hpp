@@ -13,6 +13,7 @@
 // the compact SmootherTrack: the schedule (one flag byte and one float per sample), the
 // integrated velocity only where a velocity support reads it, the integrated position
 // only at the PSD fixes, the steps that are not one sample.
+#include "dsp/core/parallel_for.hpp"
 #include "dsp/fusion/axis_filter.hpp"
 #include "dsp/fusion/forward_filter.hpp"
 #include "dsp/fusion/support_schedule.hpp"
@@ -51,6 +52,9 @@ struct SmootherSettings {
   ErrorModel model;
   Vec3 start_bias_sigma_um_s2 = Vec3::Constant(20.0);
   bool forward_only = false;  // the live filter's causal result, no backward pass
+  // The backward pass' axes side by side with the next segment's refilter (offline; the
+  // axes are independent, so the result is the same). Empty: in order.
+  ParallelFor parallel;
 };
 
 // One segment's smoothed errors (subtract them), samples [first, first + size).
@@ -117,7 +121,8 @@ class CheckpointedSmoother {
   // smoothed state of sample `last` (the next segment's first; none for the last segment,
   // whose last sample is smoothed as filtered); the gains when asked.
   void backward(SegmentStates& s, std::size_t last, const std::array<Vec3, 3>* e_next,
-                const std::array<Mat3, 3>* p_next, std::array<std::vector<Mat3>, 3>* gains) const;
+                const std::array<Mat3, 3>* p_next, std::array<std::vector<Mat3>, 3>* gains, int first_axis = 0,
+                int end_axis = 3) const;
 
   const SmootherTrack& track_;
   SmootherSettings settings_;

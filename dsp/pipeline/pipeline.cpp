@@ -92,6 +92,7 @@ Pipeline::Pipeline(const PipelineConfig& config)
   sc.compact = config.trace == TraceKeeping::track;
   sc.model = config.fusion;
   sc.standstill = config.standstill;
+  sc.parallel = config.parallel;
   const double noise_mps2 = config.fusion.accel_noise_um_s2_rthz * 1e-6;
   supports_ = SupportStage(sc, config.acquisition, config.psd, noise_mps2 * noise_mps2 * config.acquisition.fs_hz,
                            config.capacity_samples, std::min(config.capacity_samples, config.reserve_samples));

@@ -98,6 +98,9 @@ struct PipelineConfig {
   TraceKeeping trace = TraceKeeping::whole;
   TraceSink* sink = nullptr;  // track and replay: where the stored samples go (may be none)
   supports::StandstillOptions standstill;
+  // Offline work side by side: the smoother's backward pass (fusion::SmootherSettings).
+  // Empty: in order, on the caller's thread (the live pipeline).
+  ParallelFor parallel;
 };
 
 PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples);

@@ -354,6 +354,7 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   fusion::SmootherSettings st;
   st.fs_hz = fs_hz_, st.model = cfg_.model, st.start_bias_sigma_um_s2 = start_bias_sigma_;
   st.forward_only = !cfg_.smooth;
+  st.parallel = cfg_.parallel;
   c->smoother =
       std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
   // PSD readings the integration cannot follow — its strip resets, or rejections of more

@@ -41,6 +41,7 @@ struct SupportConfig {
   bool compact = false;
   fusion::ErrorModel model;
   supports::StandstillOptions standstill;
+  ParallelFor parallel;  // the smoother's (fusion::SmootherSettings::parallel)
 };
 
 // A standstill found by the detector: where, and each sensor's mean acceleration there

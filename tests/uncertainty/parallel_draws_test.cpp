@@ -1,6 +1,7 @@
-// The uncertainty's draws on several threads (drivers::thread_for) give exactly the U the
-// same draws give one after another: each draw is seeded by its number and the sums are
-// taken in draw order, so no figure depends on the executor or the number of cores.
+// The analysis on several threads (drivers::thread_for: the smoother's axes, the
+// uncertainty's draws) gives exactly the path and the U it gives one task after another:
+// the axes are independent, each draw is seeded by its number and the sums are taken in
+// draw order, so no figure depends on the executor or the number of cores.
 #include "drivers/exec/thread_for.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "sim/simulate.hpp"
@@ -20,9 +21,13 @@ TEST(ParallelDraws, ThreadsGiveTheSameUncertaintyAsOneAfterAnother) {
   dsp::AnalysisOptions o;
   o.uncertainty.draws = 24;
   const dsp::Analysis one = dsp::analyze_run(run, o);
-  o.uncertainty.parallel = drivers::thread_for(3);
+  o.parallel = drivers::thread_for(3);
   const dsp::Analysis threads = dsp::analyze_run(run, o);
   eical::testing::expect_same_uncertainty(one, threads);
+  // The smoother's axes ran side by side too: the corrected path is the same, bit for bit.
+  ASSERT_EQ(one.measurement.pos_mm.size(), threads.measurement.pos_mm.size());
+  for (std::size_t i = 0; i < one.measurement.pos_mm.size(); ++i)
+    ASSERT_EQ(one.measurement.pos_mm[i], threads.measurement.pos_mm[i]) << "sample " << i;
 }
 
 }  // namespace

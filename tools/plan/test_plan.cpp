@@ -202,7 +202,7 @@ Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
   const dsp::Run run = sim::simulate(sc);
   dsp::AnalysisOptions o;
   o.uncertainty.draws = draws;
-  o.uncertainty.parallel = drivers::thread_for();
+  o.parallel = drivers::thread_for();
   const dsp::ResolutionLimit* lim = dsp::resolution_limit(p.kind);
   if (screen && lim) o.uncertainty.stop_above = {lim->limited, screen->margin * lim->limit, screen->draws};
   if (p.identified) {
