@@ -53,7 +53,9 @@ CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const Smo
     c.filter.resets = nullptr;
     checkpoints_.push_back(c);
     c.filter.resets = &resets;
-    forward(c, first, last, settings_.forward_only ? &states : nullptr);
+    // The last segment's filtered states are kept: the backward pass starts with them
+    // (refiltering them from the checkpoint would compute the same numbers again).
+    forward(c, first, last, settings_.forward_only || j + 1 == n_seg ? &states : nullptr);
     if (settings_.forward_only) {  // the filtered errors are the result: they must be finite
       for (int a = 0; a < 3; ++a)
         for (const Vec3& e : states.e[a]) finite_ = finite_ && std::isfinite(e[0]) && std::isfinite(e[1]);
@@ -73,7 +75,6 @@ CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const Smo
   smoothed_p_.resize(n_seg);
   const ParallelFor parallel = settings_.parallel ? settings_.parallel : sequential_for();
   SegmentStates before;
-  refilter(n_seg - 1, states);
   for (std::size_t j = n_seg; j-- > 0;) {
     const std::size_t last = std::min(n, (j + 1) * seg_);
     const bool top = j + 1 == n_seg;
