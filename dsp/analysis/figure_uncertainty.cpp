@@ -122,7 +122,7 @@ struct DrawnFigures {
 // block); the sums are taken in draw order afterwards.
 void draw_range(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
                 std::size_t from, std::size_t to, std::uint64_t seed, const ParallelFor& parallel,
-                std::vector<DrawnFigures>& drawn) {
+                std::vector<uncertainty::NoiseDraw>& noise, std::vector<DrawnFigures>& drawn) {
   const std::size_t n = to - from;
   const std::size_t blocks = std::min<std::size_t>(n, kDrawBlocks);
   parallel(blocks, [&](std::size_t block) {
@@ -130,8 +130,12 @@ void draw_range(const Run& run, const Analysis& a, const uncertainty::ErrorField
     Measurement nominal_scratch = b.nominal.measurement, ideal_scratch = b.ideal.measurement;
     for (std::size_t d = from + block * n / blocks; d < from + (block + 1) * n / blocks; ++d) {
       // Seeded by (seed, d) alone, so the draws may run in any order and on any thread.
-      std::mt19937_64 rng(stream_seed(seed, d));
-      field.draw(rng, b.at, err);
+      if (d < noise.size() && !noise[d].error_um.empty()) {  // its noise drawn already, from the same generator
+        field.draw(std::move(noise[d]), b.at, err);
+      } else {
+        std::mt19937_64 rng(stream_seed(seed, d));
+        field.draw(rng, b.at, err);
+      }
       drawn[d].plug = perturbed_figures(run, a, b.nominal, err, b.eo, nominal_scratch);
       drawn[d].bound = perturbed_figures(run, a, b.ideal, err, b.eo, ideal_scratch);
     }
@@ -194,17 +198,18 @@ struct DrawOutcome {
 
 DrawOutcome run_draws(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
                       int draws, std::uint64_t seed, const ParallelFor& parallel,
-                      const std::optional<AnalysisOptions::Uncertainty::StopAbove>& stop) {
+                      const std::optional<AnalysisOptions::Uncertainty::StopAbove>& stop,
+                      std::vector<uncertainty::NoiseDraw>& noise) {
   const auto n = static_cast<std::size_t>(draws);
   std::vector<DrawnFigures> drawn(n);
   const std::size_t first = stop ? static_cast<std::size_t>(std::clamp(stop->after_draws, 2, draws)) : n;
-  draw_range(run, a, field, b, 0, first, seed, parallel, drawn);
+  draw_range(run, a, field, b, 0, first, seed, parallel, noise, drawn);
   if (first < n) {
     const int m = static_cast<int>(first);
     DrawSums screen = sums_of(b, drawn, first);
     const std::vector<double> u = u_of_figure(b, screen, m, stop->key, 1);
     if (u.size() == 1 && u[0] > stop->above) return {std::move(screen), m};
-    draw_range(run, a, field, b, first, n, seed, parallel, drawn);
+    draw_range(run, a, field, b, first, n, seed, parallel, noise, drawn);
   }
   return {sums_of(b, drawn, n), draws};
 }
@@ -285,12 +290,20 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
   if (m.supports.diverged) c.schedule.zupt = c.schedule.cupt = false;
   probe_.emplace(c, in.delay_samples, samples, in.fs_hz);
 
+  // Slots for the noise draw_noise() may draw before finish(): the screen's first draws only
+  // when a screen may end the draws there.
+  noise_.resize(static_cast<std::size_t>(stop_above_ ? std::clamp(stop_above_->after_draws, 2, draws_) : draws_));
   // The draws evaluate the path at about kDrawRateHz, at most kMaxDrawSamples of it.
   q_ = std::max<std::size_t>(1, static_cast<std::size_t>(std::lround(m.fs_hz / kDrawRateHz)));
   q_ = std::max(q_, (samples + kMaxDrawSamples - 1) / kMaxDrawSamples);
   const std::size_t kept = (samples + q_ - 1) / q_;
   nominal_.sample_index.reserve(kept), nominal_.pos_mm.reserve(kept), nominal_.vel_mm_s.reserve(kept);
   nominal_.cmd_mm.reserve(kept), nominal_.ref_mm.reserve(kept);
+}
+
+void UncertaintyTrace::draw_noise() {
+  for (std::size_t d = next_noise_++; d < noise_.size(); d = next_noise_++)
+    noise_[d] = uncertainty::draw_noise(in_, *coarse_, std::mt19937_64(stream_seed(seed_, d)));
 }
 
 void UncertaintyTrace::sample(std::size_t k, std::int64_t sample_index, const Eigen::Vector3d& pos_mm,
@@ -318,7 +331,8 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     return;
   }
   const DrawBases bases = evaluate_bases(run, a, std::exchange(nominal_, Measurement{}), q_, samples_);
-  const DrawOutcome drew = run_draws(run, a, *field, bases, draws_, seed_, parallel_, stop_above_);
+  const DrawOutcome drew = run_draws(run, a, *field, bases, draws_, seed_, parallel_, stop_above_, noise_);
+  noise_.clear();
   assign_uncertainties(bases, drew.sums, drew.used, a);
   a.uncertainty_draws = drew.used;
   char note[200];

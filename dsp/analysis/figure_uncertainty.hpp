@@ -22,6 +22,7 @@
 #include "dsp/uncertainty/coarse_path.hpp"
 #include "dsp/uncertainty/error_field.hpp"
 
+#include <atomic>
 #include <functional>
 #include <optional>
 
@@ -53,6 +54,12 @@ class UncertaintyTrace {
   void sample(std::size_t k, std::int64_t sample_index, const Eigen::Vector3d& pos_mm, const Eigen::Vector3d& vel_mm_s,
               const Eigen::Vector3d& cmd_mm, const Eigen::Vector3d& ref_mm, const Eigen::Vector2d& temp_c);
 
+  // The draws' integration noise (uncertainty::draw_noise()), drawn before finish(): it
+  // reads only the coarse schedule, so a streamed analysis draws it beside its second pass
+  // (safe beside sample()). Several threads may call it at once: each takes the next draw
+  // not taken until none is left. Optional: finish() draws what was not drawn, the same.
+  void draw_noise();
+
   // After the last sample, `a` evaluated at full rate: the draws; fills a.uncertainty_k2,
   // its source and note.
   void finish(const Run& run, Analysis& a);
@@ -63,6 +70,8 @@ class UncertaintyTrace {
   uncertainty::ErrorFieldInput in_;
   std::optional<uncertainty::CoarseSchedule> coarse_;
   std::optional<uncertainty::CoarsePathProbe> probe_;  // reads coarse_
+  std::vector<uncertainty::NoiseDraw> noise_;          // draw_noise(): the first draws' noise
+  std::atomic<std::size_t> next_noise_{0};             // the next draw draw_noise() takes
   Measurement nominal_;                                // every q_-th trace sample
   std::size_t samples_ = 0, q_ = 1;
   int draws_ = 100;

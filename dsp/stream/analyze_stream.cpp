@@ -399,17 +399,23 @@ void run_second_pass(const Run& header, FrameReplay& frames, FirstPass& p, Secon
   p.t.correction.reset();  // the smoother's records: done
 }
 
-// The streamed evaluations' figures into the analysis, or every positional figure null
-// when the integration is not supported (run-format.md, "No standstill"; evaluate_measurement()).
-void finish_streamed_evaluation(const Run& header, const AnalysisOptions& options, SecondPass& s, Analysis& a) {
+// The streamed evaluations' figures into the analysis; false, with every positional figure
+// null, when the integration is not supported (run-format.md, "No standstill";
+// evaluate_measurement()).
+bool finish_streamed_figures(SecondPass& s, Analysis& a) {
   if (const std::string why = unsupported_integration(s.m); !why.empty()) {
     a.flags.push_back(std::string(kPositionNullFlag) + why);
     a.degraded = true;
-    return;
+    return false;
   }
   s.circle_eval->finish(a);
   s.circle_eval.reset();
   a.repeats = s.repeats->result();
+  return true;
+}
+
+// Their uncertainty, after the figures.
+void finish_streamed_uncertainty(const Run& header, const AnalysisOptions& options, SecondPass& s, Analysis& a) {
   if (s.uncertainty)
     s.uncertainty->finish(header, a);
   else if (options.uncertainty.enabled)
@@ -440,13 +446,24 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   a.measurement.decimation = q;
   SecondPass second(header, a.measurement, n, whole, q);
   start_streamed_evaluation(header, options, stream, first, a, second);
-  run_second_pass(header, frames, first, second);
+  // The second pass and the streamed figures (one core) beside the uncertainty's
+  // integration noise, which reads the coarse schedule only (figure_uncertainty.hpp); the
+  // noise's draws are taken one by one, by both tasks once the first is done.
+  bool supported = true;
+  const ParallelFor parallel = options.parallel ? options.parallel : sequential_for();
+  parallel(2, [&](std::size_t task) {
+    if (task == 0) {
+      run_second_pass(header, frames, first, second);
+      if (!whole) supported = finish_streamed_figures(second, a);
+    }
+    if (second.uncertainty) second.uncertainty->draw_noise();  // task 0 joins in when done
+  });
 
   if (whole) {
     evaluate_measurement(header, first.cfg, options, a);  // as analyze_run(): the whole trace is here
     return a;
   }
-  finish_streamed_evaluation(header, options, second, a);
+  if (supported) finish_streamed_uncertainty(header, options, second, a);
   judge(header.meta.program, a);
   return a;
 }

@@ -150,6 +150,73 @@ std::vector<std::vector<Eigen::Vector3d>> strip_responses(const Responder& respo
   return response;
 }
 
+// One realisation of the integration's error after the pipeline's smoother (per coarse
+// sample, µm): the error simulated with the truth model, the supports' observations of it
+// with their own errors, the smoother with the pipeline's model subtracting its estimate.
+std::vector<Eigen::Vector3d> noise_draw(const CoarseSchedule& coarse, const ErrorFieldInput& input,
+                                        std::mt19937_64& rng) {
+  const fusion::ErrorModel truth = simulated_truth(coarse.model, input);
+  const double fs_hz = input.fs_hz;
+  const Eigen::Vector3d& start_bias_sigma = input.start_bias_sigma_um_s2;
+  namespace sf = fusion::schedule_flag;
+  std::normal_distribution<double> g;
+  const std::size_t nc = coarse.sample_index.size();
+  const auto& flags = coarse.schedule.flags;
+  std::vector<Eigen::Vector3d> ex(nc), ev(nc), eb(nc);
+  const fusion::Mat3 p0 = fusion::initial_covariance(truth, 0.0);
+  for (int a = 0; a < 3; ++a) {
+    // Drawn one by one, the bias first (see below: a call's arguments have no order).
+    const double z_bias = g(rng), z_vel = g(rng);
+    fusion::Vec3 e(0.0, std::sqrt(p0(1, 1)) * z_vel, std::hypot(start_bias_sigma[a], truth.bias_step_um_s2) * z_bias);
+    fusion::Discrete d;
+    std::int64_t last_gap = 0;
+    Eigen::LLT<fusion::Mat3> llt;
+    for (std::size_t k = 0; k < nc; ++k) {
+      if (k > 0) {
+        const std::int64_t gap = coarse.sample_index[k] - coarse.sample_index[k - 1];
+        if (gap != last_gap) {
+          d = fusion::discretise(truth, static_cast<double>(gap) / fs_hz);
+          llt.compute(d.Q + 1e-18 * fusion::Mat3::Identity());
+          last_gap = gap;
+        }
+        // Drawn one by one (last component first, the order these runs were made with): the
+        // arguments of a call have no order, and another compiler would draw another field.
+        const double w2 = g(rng), w1 = g(rng), w0 = g(rng);
+        e = d.F * e + llt.matrixL() * fusion::Vec3(w0, w1, w2);
+        if (flags[k] & sf::move_start) e[2] += truth.bias_step_um_s2 * g(rng);
+      }
+      ex[k][a] = e[0], ev[k][a] = e[1], eb[k][a] = e[2];
+    }
+  }
+  // What the pipeline integrated (the error: the motion itself is known) and saw at the supports.
+  std::vector<Eigen::Vector3d> pos(nc), vel(nc);
+  for (std::size_t k = 0; k < nc; ++k) {
+    pos[k] = ex[k] / 1000.0;
+    Eigen::Vector3d v = ev[k];
+    // A standstill's true velocity is not exactly zero, a held axis' not either.
+    const double s = flags[k] & sf::rest ? std::max(0.0, static_cast<double>(coarse.schedule.zupt_sigma_um_s[k]))
+                                         : coarse.model.nbs_sigma_um_s;
+    for (int a = 0; a < 3; ++a) v[a] += s * g(rng);
+    vel[k] = v / 1000.0;
+  }
+  fusion::SupportSchedule sched = coarse.schedule;
+  for (std::size_t i = 0; i < sched.fixes.size(); ++i) sched.fixes[i].position_um = coarse.fix_noise_um[i] * g(rng);
+  for (auto& m : sched.velocity_means)
+    for (int a = 0; a < 3; ++a) m.mean_um_s[a] = ev[m.k][a] - m.lag_s * eb[m.k][a] + m.sigma_um_s * g(rng);
+  fusion::SmootherInput si;
+  si.sample_index = &coarse.sample_index;
+  si.vel_mm_s = &vel;
+  si.pos_mm = &pos;
+  si.schedule = &sched;
+  si.fs_hz = fs_hz;
+  si.model = coarse.model;
+  si.start_bias_sigma_um_s2 = start_bias_sigma;
+  const fusion::SmootherOutput out = fusion::smooth(si);
+  std::vector<Eigen::Vector3d> r(nc);
+  for (std::size_t k = 0; k < nc; ++k) r[k] = ex[k] - out.dx_um[k];
+  return r;
+}
+
 }  // namespace
 
 double ErrorField::coarse_position(double at) const {
@@ -180,12 +247,12 @@ ErrorField::ErrorField(const ErrorFieldInput& input, CoarseSchedule coarse, cons
 }
 
 void ErrorField::build(const ErrorFieldInput& input, const CoarsePath& path) {
+  input_ = input;
+  input_.schedule = nullptr, input_.sample_index = nullptr, input_.pos_mm = nullptr, input_.vel_mm_s = nullptr;
+  input_.temp_c = nullptr;
   delay_ = input.delay_samples;
-  fs_hz_ = input.fs_hz;
   owner_ = input.owner;
   strip_sigma_um_ = input.model_covariance.psd_offset_sigma_um;
-  start_bias_sigma_ = input.start_bias_sigma_um_s2;
-  truth_ = simulated_truth(coarse_.model, input);
   check_path(path, coarse_.sample_index.size());
   const Responder respond{coarse_, input};
   for (std::size_t j = 0; j < 3; ++j) {
@@ -199,73 +266,25 @@ void ErrorField::build(const ErrorFieldInput& input, const CoarsePath& path) {
   model_factor_ = draw_factor(input.model_covariance.covariance);
 }
 
-// One realisation of the integration's error after the pipeline's smoother (per coarse
-// sample, µm): the error simulated with the truth model, the supports' observations of it
-// with their own errors, the smoother with the pipeline's model subtracting its estimate.
-std::vector<Eigen::Vector3d> ErrorField::noise_draw(std::mt19937_64& rng) const {
-  namespace sf = fusion::schedule_flag;
-  std::normal_distribution<double> g;
-  const std::size_t nc = coarse_.sample_index.size();
-  const auto& flags = coarse_.schedule.flags;
-  std::vector<Eigen::Vector3d> ex(nc), ev(nc), eb(nc);
-  const fusion::Mat3 p0 = fusion::initial_covariance(truth_, 0.0);
-  for (int a = 0; a < 3; ++a) {
-    // Drawn one by one, the bias first (see below: a call's arguments have no order).
-    const double z_bias = g(rng), z_vel = g(rng);
-    fusion::Vec3 e(0.0, std::sqrt(p0(1, 1)) * z_vel, std::hypot(start_bias_sigma_[a], truth_.bias_step_um_s2) * z_bias);
-    fusion::Discrete d;
-    std::int64_t last_gap = 0;
-    Eigen::LLT<fusion::Mat3> llt;
-    for (std::size_t k = 0; k < nc; ++k) {
-      if (k > 0) {
-        const std::int64_t gap = coarse_.sample_index[k] - coarse_.sample_index[k - 1];
-        if (gap != last_gap) {
-          d = fusion::discretise(truth_, static_cast<double>(gap) / fs_hz_);
-          llt.compute(d.Q + 1e-18 * fusion::Mat3::Identity());
-          last_gap = gap;
-        }
-        // Drawn one by one (last component first, the order these runs were made with): the
-        // arguments of a call have no order, and another compiler would draw another field.
-        const double w2 = g(rng), w1 = g(rng), w0 = g(rng);
-        e = d.F * e + llt.matrixL() * fusion::Vec3(w0, w1, w2);
-        if (flags[k] & sf::move_start) e[2] += truth_.bias_step_um_s2 * g(rng);
-      }
-      ex[k][a] = e[0], ev[k][a] = e[1], eb[k][a] = e[2];
-    }
-  }
-  // What the pipeline integrated (the error: the motion itself is known) and saw at the supports.
-  std::vector<Eigen::Vector3d> pos(nc), vel(nc);
-  for (std::size_t k = 0; k < nc; ++k) {
-    pos[k] = ex[k] / 1000.0;
-    Eigen::Vector3d v = ev[k];
-    // A standstill's true velocity is not exactly zero, a held axis' not either.
-    const double s = flags[k] & sf::rest ? std::max(0.0, static_cast<double>(coarse_.schedule.zupt_sigma_um_s[k]))
-                                         : coarse_.model.nbs_sigma_um_s;
-    for (int a = 0; a < 3; ++a) v[a] += s * g(rng);
-    vel[k] = v / 1000.0;
-  }
-  fusion::SupportSchedule sched = coarse_.schedule;
-  for (std::size_t i = 0; i < sched.fixes.size(); ++i) sched.fixes[i].position_um = coarse_.fix_noise_um[i] * g(rng);
-  for (auto& m : sched.velocity_means)
-    for (int a = 0; a < 3; ++a) m.mean_um_s[a] = ev[m.k][a] - m.lag_s * eb[m.k][a] + m.sigma_um_s * g(rng);
-  fusion::SmootherInput si;
-  si.sample_index = &coarse_.sample_index;
-  si.vel_mm_s = &vel;
-  si.pos_mm = &pos;
-  si.schedule = &sched;
-  si.fs_hz = fs_hz_;
-  si.model = coarse_.model;
-  si.start_bias_sigma_um_s2 = start_bias_sigma_;
-  const fusion::SmootherOutput out = fusion::smooth(si);
-  std::vector<Eigen::Vector3d> r(nc);
-  for (std::size_t k = 0; k < nc; ++k) r[k] = ex[k] - out.dx_um[k];
-  return r;
+NoiseDraw draw_noise(const ErrorFieldInput& input, const CoarseSchedule& coarse, std::mt19937_64 rng) {
+  NoiseDraw d;
+  d.error_um = noise_draw(coarse, input, rng);
+  d.rng = rng;
+  return d;
 }
 
 void ErrorField::draw(std::mt19937_64& rng, const std::vector<double>& at_pos,
                       std::vector<Eigen::Vector3d>& error_um) const {
+  NoiseDraw noise{noise_draw(coarse_, input_, rng), {}};
+  noise.rng = rng;
+  draw(std::move(noise), at_pos, error_um);
+}
+
+void ErrorField::draw(NoiseDraw drawn, const std::vector<double>& at_pos,
+                      std::vector<Eigen::Vector3d>& error_um) const {
+  std::mt19937_64& rng = drawn.rng;
+  const std::vector<Eigen::Vector3d>& noise = drawn.error_um;
   std::normal_distribution<double> g;
-  const std::vector<Eigen::Vector3d> noise = noise_draw(rng);
   Eigen::VectorXd z(kModelParameters);
   for (int i = 0; i < kModelParameters; ++i) z[i] = g(rng);
   const Eigen::VectorXd theta = model_factor_ * z;

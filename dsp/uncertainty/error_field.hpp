@@ -51,6 +51,17 @@ struct ErrorFieldInput {
   std::size_t max_coarse = 4000;      // coarse samples of the smoother passes
 };
 
+// The integration noise's share of a draw, which ErrorField::draw() makes first from the
+// draw's generator: the error the pipeline's smoother leaves of simulated noise and bias walk,
+// per coarse sample. It reads the coarse schedule and the model only, not the path, so it
+// can be drawn before the path is known (a streamed analysis draws it beside its second
+// pass). rng: the generator as the noise left it, for the rest of the draw.
+struct NoiseDraw {
+  std::vector<Eigen::Vector3d> error_um;
+  std::mt19937_64 rng;
+};
+NoiseDraw draw_noise(const ErrorFieldInput& input, const CoarseSchedule& coarse, std::mt19937_64 rng);
+
 class ErrorField {
  public:
   explicit ErrorField(const ErrorFieldInput& input);
@@ -64,18 +75,19 @@ class ErrorField {
   // One draw of the path's error (µm per axis) at aligned trace positions (fractional
   // allowed).
   void draw(std::mt19937_64& rng, const std::vector<double>& at_pos, std::vector<Eigen::Vector3d>& error_um) const;
+  // The same draw with its noise drawn already (draw_noise() of this field's input and
+  // coarse schedule, from the generator draw() would have been given).
+  void draw(NoiseDraw noise, const std::vector<double>& at_pos, std::vector<Eigen::Vector3d>& error_um) const;
 
   [[nodiscard]] std::size_t coarse_samples() const noexcept { return coarse_.sample_index.size(); }
 
  private:
   void build(const ErrorFieldInput& input, const CoarsePath& path);
   [[nodiscard]] double coarse_position(double at) const;
-  [[nodiscard]] std::vector<Eigen::Vector3d> noise_draw(std::mt19937_64& rng) const;
 
   CoarseSchedule coarse_;
-  double delay_ = 0.0, fs_hz_ = 10000.0;
-  fusion::ErrorModel truth_;  // what the draws simulate
-  Eigen::Vector3d start_bias_sigma_ = Eigen::Vector3d::Zero();
+  ErrorFieldInput input_;  // what the noise draws read (its trace pointers cleared)
+  double delay_ = 0.0;
   // Model responses per coarse sample, µm per unit parameter: per column j of E (all rows
   // i at once), the timing term (v·τ), per sensor its α_b, per PSD strip its offset.
   std::array<std::vector<Eigen::Vector3d>, 3> response_e_;
