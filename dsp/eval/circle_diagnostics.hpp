@@ -103,9 +103,9 @@ CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& 
 class CircleDesign;
 std::shared_ptr<const CircleDesign> circle_design(const std::vector<CirclePass>& passes,
                                                   const DiagnosticsOptions& options);
-// diagnose_circle(passes, options) with the set-point's share from `design`, made of the
-// same set-point and options (InputError when its passes differ).
-CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& options,
+// diagnose_circle(passes, opt) with the set-point's share from `design`, made of the same
+// set-point and options (InputError when its passes differ).
+CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& opt,
                                   const CircleDesign& design);
 
 }  // namespace eical::dsp::eval

@@ -64,13 +64,17 @@ CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const Smo
   }
   tally_ = c.filter.tally, reset_count_ = c.filter.reset_count;
   for (const auto& r : resets) extra_[r.axis].push_back({r.k, Vec3(r.add_xx, r.add_vv, r.add_bb)});
-  if (settings_.forward_only) return;
+  if (!settings_.forward_only) smooth_backward(states, sink);
+}
 
-  // Backward (RTS), last segment first: each segment's filtered states again from its
-  // checkpoint, then the recursion down to its first sample, whose smoothed state the
-  // segment before it starts from. Two tasks a segment: axes x and y; axis z and the
-  // refilter of the segment before (the axes are independent, the refilter reads only
-  // the checkpoints).
+// Backward (RTS), last segment first: each segment's filtered states again from its
+// checkpoint, then the recursion down to its first sample, whose smoothed state the
+// segment before it starts from. Two tasks a segment: axes x and y; axis z and the
+// refilter of the segment before (the axes are independent, the refilter reads only the
+// checkpoints). `states`: the last segment's, filtered.
+void CheckpointedSmoother::smooth_backward(SegmentStates& states, SegmentSink* sink) {
+  const std::size_t n = track_.n, n_seg = checkpoints_.size();
+  SmoothedSegment out;
   smoothed_e_.resize(n_seg);
   smoothed_p_.resize(n_seg);
   const ParallelFor parallel = settings_.parallel ? settings_.parallel : sequential_for();

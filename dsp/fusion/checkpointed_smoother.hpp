@@ -115,6 +115,9 @@ class CheckpointedSmoother {
   // leaves at `last`; the filtered states when asked.
   void forward(Checkpoint& c, std::size_t first, std::size_t last, SegmentStates* states) const;
   void refilter(std::size_t j, SegmentStates& states) const;
+  // The backward pass over every segment (the constructor's second half); `states` holds
+  // the last segment's filtered states.
+  void smooth_backward(SegmentStates& states, SegmentSink* sink);
   // The errors of segment states into `out` (σ from P).
   static void output(const SegmentStates& s, SmoothedSegment& out);
   // The backward recursion over the segment's states (filtered in, smoothed out), from the

@@ -92,7 +92,7 @@ std::vector<bool> keep_mask(const Measurement& m, std::size_t n, double fs_hz, d
 
 // The signals a sample's rows are made of: per machine axis head − table in the band, the
 // table's a and ȧ in the band; per sensor and element its |a_motion|/g·ȧ in the band.
-struct BandSignals {
+struct DampingBandSignals {
   std::array<std::vector<double>, 3> y, lin, rate;
   std::array<std::array<std::vector<double>, 3>, 2> amp;
   std::array<Eigen::Matrix3d, 2> to_machine;
@@ -118,7 +118,7 @@ struct Normal {
   std::size_t rows = 0;
 };
 
-Normal accumulate(const BandSignals& b, const std::vector<bool>& keep) {
+Normal accumulate(const DampingBandSignals& b, const std::vector<bool>& keep) {
   Normal ne;
   Eigen::Matrix<double, 3, kCols> x;
   Eigen::Vector3d y;
@@ -169,7 +169,7 @@ std::vector<int> columns_but(int first, int count) {
 }
 
 // Windows whose residual RMS is far above the median are impulses (slips, impacts): out.
-void reject_impulses(const BandSignals& b, const Fit& f, std::size_t window, std::vector<bool>& keep) {
+void reject_impulses(const DampingBandSignals& b, const Fit& f, std::size_t window, std::vector<bool>& keep) {
   const std::size_t n = keep.size();
   Eigen::Matrix<double, 3, kCols> x;
   Eigen::Vector3d y;
@@ -192,11 +192,11 @@ void reject_impulses(const BandSignals& b, const Fit& f, std::size_t window, std
 }
 
 // Head − table and the regressors in the band, from n samples of the raw traces.
-BandSignals band_signals(const RunResiduals& rr, std::size_t n, double lo_hz, double hi_hz) {
+DampingBandSignals band_signals(const RunResiduals& rr, std::size_t n, double lo_hz, double hi_hz) {
   const RawTrace& raw = rr.measurement.raw;
   const double fs = rr.measurement.fs_hz, g = rr.meta.site.g_mps2;
   BandPass band(n, fs, lo_hz, hi_hz), motion(n, fs, 0.0, kMotionHz);
-  BandSignals b;
+  DampingBandSignals b;
   for (std::size_t i = 0; i < 3; ++i) {
     std::vector<double> rel(n), t(n);
     for (std::size_t k = 0; k < n; ++k)
@@ -221,7 +221,7 @@ BandSignals band_signals(const RunResiduals& rr, std::size_t n, double lo_hz, do
 }
 
 // The table's RMS in the band (mg): the vibration that probes.
-double probe_rms_mg(const BandSignals& b, double g) {
+double probe_rms_mg(const DampingBandSignals& b, double g) {
   double sum = 0.0;
   std::size_t count = 0;
   for (const auto& v : b.lin)
@@ -237,7 +237,7 @@ struct Fitted {
 // Rows: each kept sample on each machine axis. Columns: a 3×3 map of the table's a and of
 // its ȧ onto head − table, and per sensor and element its |a|/g·ȧ along that element's
 // machine direction. Fitted twice: the second time without the impulses the first showed.
-std::optional<Fitted> fit_without_impulses(const BandSignals& b, std::vector<bool> keep, double fs_hz) {
+std::optional<Fitted> fit_without_impulses(const DampingBandSignals& b, std::vector<bool> keep, double fs_hz) {
   std::vector<int> every(kCols);
   for (int c = 0; c < kCols; ++c) every[static_cast<std::size_t>(c)] = c;
   Fitted f;
@@ -314,7 +314,7 @@ DampingBandFinding damping_band_test(const RunResiduals& run) {
     out.why = "the record is too short or its rate too low for a band above the machine's modes";
     return out;
   }
-  const BandSignals b = band_signals(run, n, out.band_lo_hz, out.band_hi_hz);
+  const DampingBandSignals b = band_signals(run, n, out.band_lo_hz, out.band_hi_hz);
   out.probe_rms_mg = probe_rms_mg(b, run.meta.site.g_mps2);
   if (out.probe_rms_mg < kMinProbeMg) {
     out.why = "the sensors share too little vibration in the band to probe their damping";

@@ -14,9 +14,9 @@ namespace eical::dsp::model {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-const char* const kAxis[3] = {"x", "y", "z"};
+const char* const kAxisName[3] = {"x", "y", "z"};
 
-std::string ax(int a) { return kAxis[a]; }
+std::string ax(int a) { return kAxisName[a]; }
 
 double max_abs(const Eigen::VectorXd& p) { return p.size() ? p.cwiseAbs().maxCoeff() : 0.0; }
 
@@ -509,7 +509,7 @@ EffectModel cyclic_error_effect(const RunResiduals& r, const Eigen::MatrixXd& hi
     const double best_p = cyclic_pitch_mm(r, hint, a);
     if (best_p <= 0.0) continue;
     char name[64];
-    std::snprintf(name, sizeof name, "cyclic_%s_pitch_%gmm", kAxis[a], best_p);
+    std::snprintf(name, sizeof name, "cyclic_%s_pitch_%gmm", kAxisName[a], best_p);
     e.params.push_back(std::string(name) + "_sin_um");
     e.columns.push_back(on_axis((2.0 * kPi * r.cmd.col(a).array() / best_p).sin().matrix(), a));
     e.params.push_back(std::string(name) + "_cos_um");

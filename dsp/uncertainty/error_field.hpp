@@ -77,7 +77,7 @@ class ErrorField {
   void draw(std::mt19937_64& rng, const std::vector<double>& at_pos, std::vector<Eigen::Vector3d>& error_um) const;
   // The same draw with its noise drawn already (draw_noise() of this field's input and
   // coarse schedule, from the generator draw() would have been given).
-  void draw(NoiseDraw noise, const std::vector<double>& at_pos, std::vector<Eigen::Vector3d>& error_um) const;
+  void draw(NoiseDraw drawn, const std::vector<double>& at_pos, std::vector<Eigen::Vector3d>& error_um) const;
 
   [[nodiscard]] std::size_t coarse_samples() const noexcept { return coarse_.sample_index.size(); }
 
