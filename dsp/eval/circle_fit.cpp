@@ -85,19 +85,6 @@ AxisFit solve_axis(const AxisGram& g, std::size_t k, const std::array<bool, n_co
   return fit;
 }
 
-// The fit's residual at a sample (target − model), rows as AxisModel makes them.
-double residual(const AxisFit& fit, const double* common9, const double* cyc, double target, std::size_t pass,
-                double fixed_lag_s, double v_a) {
-  const std::size_t n_poly = fit.n_poly;
-  double model = 0.0;
-  for (std::size_t j = 0; j < 3; ++j) model += fit.x(static_cast<Eigen::Index>(3 * pass + j)) * common9[j];
-  const double fixed[n_cols] = {common9[3], common9[4], common9[5], common9[6], common9[7], cyc[0], cyc[1], common9[8]};
-  for (int c = 0; c < n_cols; ++c)
-    if (fit.col_of[static_cast<std::size_t>(c)] >= 0)
-      model += fit.x(static_cast<Eigen::Index>(n_poly) + fit.col_of[static_cast<std::size_t>(c)]) * fixed[c];
-  return target + fixed_lag_s * v_a - model;
-}
-
 // Throws when the passes cannot be evaluated; whether they go round in both directions.
 bool check_passes(const std::vector<PassReplay::Pass>& passes, const DiagnosticsOptions& opt) {
   if (passes.empty()) throw InputError("circle diagnostics: no pass to evaluate");
