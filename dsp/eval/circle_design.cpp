@@ -48,24 +48,6 @@ const Eigen::Vector2d& measured(const std::vector<CirclePass>& passes, const Wal
   return m;
 }
 
-// The set-point's passes, each measured position the commanded one (a design reads no
-// measurement).
-class SetPointPasses final : public PassReplay {
- public:
-  explicit SetPointPasses(const std::vector<CirclePass>& p) : p_(p) {
-    for (const auto& x : p) info_.push_back({x.direction, x.fs_hz, x.cmd_mm.size()});
-  }
-  [[nodiscard]] const std::vector<Pass>& passes() const override { return info_; }
-  void replay(const std::function<void(std::size_t, const Eigen::Vector2d&, const Eigen::Vector2d&)>& f) override {
-    for (std::size_t k = 0; k < p_.size(); ++k)
-      for (const Eigen::Vector2d& c : p_[k].cmd_mm) f(k, c, c);
-  }
-
- private:
-  const std::vector<CirclePass>& p_;
-  std::vector<Pass> info_;
-};
-
 // The records of a walk and every record's columns (the backlash as a step, every pitch).
 void record_walk(PassReplay& replay, std::size_t window, std::array<AxisModel, 2>& model, std::vector<Walked>& out,
                  std::vector<double>& cols) {
@@ -164,7 +146,7 @@ std::shared_ptr<const CircleDesign> circle_design(const std::vector<CirclePass>&
   for (const auto& p : passes)
     if (p.cmd_mm.size() != p.meas_mm.size())
       throw InputError("circle diagnostics: commanded and measured traces differ in length");
-  SetPointPasses replay(passes);
+  StoredPasses replay(passes, StoredPasses::kSetPointOnly);  // a design reads no measurement
   auto d = std::make_shared<CircleDesign>();
   d->passes = replay.passes();
   d->opt = options;

@@ -10,23 +10,6 @@ namespace eical::dsp::eval {
 namespace diagnostics_fit {
 namespace {
 
-// Stored passes, replayed from memory.
-class StoredPasses final : public PassReplay {
- public:
-  explicit StoredPasses(const std::vector<CirclePass>& p) : p_(p) {
-    for (const auto& x : p) info_.push_back({x.direction, x.fs_hz, x.cmd_mm.size()});
-  }
-  [[nodiscard]] const std::vector<Pass>& passes() const override { return info_; }
-  void replay(const std::function<void(std::size_t, const Eigen::Vector2d&, const Eigen::Vector2d&)>& f) override {
-    for (std::size_t k = 0; k < p_.size(); ++k)
-      for (std::size_t i = 0; i < p_[k].cmd_mm.size(); ++i) f(k, p_[k].cmd_mm[i], p_[k].meas_mm[i]);
-  }
-
- private:
-  const std::vector<CirclePass>& p_;
-  std::vector<Pass> info_;
-};
-
 // First replay: the normal equations of both axes over every pitch, outside the reversal
 // windows; records each axis' first direction of motion per pass into its model.
 std::vector<AxisGram> accumulate_every_pitch(PassReplay& replay, std::size_t window, std::array<AxisModel, 2>& model) {

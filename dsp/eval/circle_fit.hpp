@@ -237,6 +237,27 @@ inline double residual(const AxisFit& fit, const double* common9, const double* 
   return target + fixed_lag_s * v_a - model;
 }
 
+// Stored passes, replayed from memory; kSetPointOnly: each measured position the
+// commanded one.
+class StoredPasses final : public PassReplay {
+ public:
+  static constexpr bool kSetPointOnly = true;
+  explicit StoredPasses(const std::vector<CirclePass>& p, bool cmd_only = false) : p_(p), cmd_only_(cmd_only) {
+    for (const auto& x : p) info_.push_back({x.direction, x.fs_hz, x.cmd_mm.size()});
+  }
+  [[nodiscard]] const std::vector<Pass>& passes() const override { return info_; }
+  void replay(const std::function<void(std::size_t, const Eigen::Vector2d&, const Eigen::Vector2d&)>& f) override {
+    for (std::size_t k = 0; k < p_.size(); ++k)
+      for (std::size_t i = 0; i < p_[k].cmd_mm.size(); ++i)
+        f(k, p_[k].cmd_mm[i], (cmd_only_ ? p_[k].cmd_mm : p_[k].meas_mm)[i]);
+  }
+
+ private:
+  const std::vector<CirclePass>& p_;
+  bool cmd_only_;
+  std::vector<Pass> info_;
+};
+
 // Every q-th sample of each pass, from its first: what the fits read. Their columns are
 // smooth in time and the path's error is low-pass (integrated noise, bias walk), so a
 // faster sampling adds rows, not information; the uncertainty's draws fit at this rate

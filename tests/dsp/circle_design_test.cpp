@@ -50,29 +50,38 @@ CirclePass pass_of(int direction, const Machine& m, double fs_hz, std::uint64_t 
   return p;
 }
 
+// Every numeric figure of the diagnostics, by name.
+struct Figure {
+  const char* name;
+  double CircleDiagnostics::*value;
+};
+constexpr Figure kFigures[] = {
+    {"backlash x", &CircleDiagnostics::backlash_x_um},
+    {"backlash y", &CircleDiagnostics::backlash_y_um},
+    {"spike x", &CircleDiagnostics::reversal_spike_x_um},
+    {"spike y", &CircleDiagnostics::reversal_spike_y_um},
+    {"lateral x", &CircleDiagnostics::lateral_play_x_um},
+    {"lateral y", &CircleDiagnostics::lateral_play_y_um},
+    {"cyclic x", &CircleDiagnostics::cyclic_error_x_um},
+    {"cyclic y", &CircleDiagnostics::cyclic_error_y_um},
+    {"cyclic pitch", &CircleDiagnostics::cyclic_pitch_mm},
+    {"servo mismatch", &CircleDiagnostics::servo_mismatch_ms},
+    {"squareness", &CircleDiagnostics::squareness_urad},
+    {"scale mismatch", &CircleDiagnostics::scale_mismatch_ppm},
+    {"straightness x", &CircleDiagnostics::straightness_x_um},
+    {"straightness y", &CircleDiagnostics::straightness_y_um},
+    {"stick-slip", &CircleDiagnostics::stick_slip_um},
+    {"vibration", &CircleDiagnostics::vibration_um},
+    {"lag x", &CircleDiagnostics::lag_x_ms},
+    {"lag y", &CircleDiagnostics::lag_y_ms},
+    {"residual", &CircleDiagnostics::residual_rms_um},
+};
+
 void expect_same(const CircleDiagnostics& direct, const CircleDiagnostics& designed, const std::string& what) {
-  auto near = [&](double a, double b, const char* name) {
-    EXPECT_NEAR(a, b, 1e-9 * std::max(1.0, std::abs(a))) << name << " (" << what << ")";
-  };
-  near(direct.backlash_x_um, designed.backlash_x_um, "backlash x");
-  near(direct.backlash_y_um, designed.backlash_y_um, "backlash y");
-  near(direct.reversal_spike_x_um, designed.reversal_spike_x_um, "spike x");
-  near(direct.reversal_spike_y_um, designed.reversal_spike_y_um, "spike y");
-  near(direct.lateral_play_x_um, designed.lateral_play_x_um, "lateral x");
-  near(direct.lateral_play_y_um, designed.lateral_play_y_um, "lateral y");
-  near(direct.cyclic_error_x_um, designed.cyclic_error_x_um, "cyclic x");
-  near(direct.cyclic_error_y_um, designed.cyclic_error_y_um, "cyclic y");
-  EXPECT_EQ(direct.cyclic_pitch_mm, designed.cyclic_pitch_mm) << what;
-  near(direct.servo_mismatch_ms, designed.servo_mismatch_ms, "servo mismatch");
-  near(direct.squareness_urad, designed.squareness_urad, "squareness");
-  near(direct.scale_mismatch_ppm, designed.scale_mismatch_ppm, "scale mismatch");
-  near(direct.straightness_x_um, designed.straightness_x_um, "straightness x");
-  near(direct.straightness_y_um, designed.straightness_y_um, "straightness y");
-  near(direct.stick_slip_um, designed.stick_slip_um, "stick-slip");
-  near(direct.vibration_um, designed.vibration_um, "vibration");
-  near(direct.lag_x_ms, designed.lag_x_ms, "lag x");
-  near(direct.lag_y_ms, designed.lag_y_ms, "lag y");
-  near(direct.residual_rms_um, designed.residual_rms_um, "residual");
+  for (const Figure& f : kFigures) {
+    const double a = direct.*f.value, b = designed.*f.value;
+    EXPECT_NEAR(a, b, 1e-9 * std::max(1.0, std::abs(a))) << f.name << " (" << what << ")";
+  }
   EXPECT_EQ(direct.servo_and_squareness_separated, designed.servo_and_squareness_separated) << what;
   EXPECT_EQ(direct.notes, designed.notes) << what;
 }
