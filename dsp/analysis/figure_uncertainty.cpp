@@ -122,7 +122,7 @@ struct DrawnFigures {
 // block); the sums are taken in draw order afterwards.
 void draw_range(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
                 std::size_t from, std::size_t to, std::uint64_t seed, const ParallelFor& parallel,
-                std::vector<uncertainty::NoiseDraw>& noise, std::vector<DrawnFigures>& drawn) {
+                std::vector<std::optional<uncertainty::NoiseDraw>>& noise, std::vector<DrawnFigures>& drawn) {
   const std::size_t n = to - from;
   const std::size_t blocks = std::min<std::size_t>(n, kDrawBlocks);
   parallel(blocks, [&](std::size_t block) {
@@ -130,8 +130,8 @@ void draw_range(const Run& run, const Analysis& a, const uncertainty::ErrorField
     Measurement nominal_scratch = b.nominal.measurement, ideal_scratch = b.ideal.measurement;
     for (std::size_t d = from + block * n / blocks; d < from + (block + 1) * n / blocks; ++d) {
       // Seeded by (seed, d) alone, so the draws may run in any order and on any thread.
-      if (d < noise.size() && !noise[d].error_um.empty()) {  // its noise drawn already, from the same generator
-        field.draw(std::move(noise[d]), b.at, err);
+      if (d < noise.size() && noise[d]) {  // its noise drawn already, from the same generator
+        field.draw(std::move(*noise[d]), b.at, err);
       } else {
         std::mt19937_64 rng(stream_seed(seed, d));
         field.draw(rng, b.at, err);
@@ -199,7 +199,7 @@ struct DrawOutcome {
 DrawOutcome run_draws(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
                       int draws, std::uint64_t seed, const ParallelFor& parallel,
                       const std::optional<AnalysisOptions::Uncertainty::StopAbove>& stop,
-                      std::vector<uncertainty::NoiseDraw>& noise) {
+                      std::vector<std::optional<uncertainty::NoiseDraw>>& noise) {
   const auto n = static_cast<std::size_t>(draws);
   std::vector<DrawnFigures> drawn(n);
   const std::size_t first = stop ? static_cast<std::size_t>(std::clamp(stop->after_draws, 2, draws)) : n;

@@ -69,10 +69,10 @@ class UncertaintyTrace {
  private:
   uncertainty::ErrorFieldInput in_;
   std::optional<uncertainty::CoarseSchedule> coarse_;
-  std::optional<uncertainty::CoarsePathProbe> probe_;  // reads coarse_
-  std::vector<uncertainty::NoiseDraw> noise_;          // draw_noise(): the first draws' noise
-  std::atomic<std::size_t> next_noise_{0};             // the next draw draw_noise() takes
-  Measurement nominal_;                                // every q_-th trace sample
+  std::optional<uncertainty::CoarsePathProbe> probe_;         // reads coarse_
+  std::vector<std::optional<uncertainty::NoiseDraw>> noise_;  // draw_noise(): the first draws' noise
+  std::atomic<std::size_t> next_noise_{0};                    // the next draw draw_noise() takes
+  Measurement nominal_;                                       // every q_-th trace sample
   std::size_t samples_ = 0, q_ = 1;
   int draws_ = 100;
   std::optional<AnalysisOptions::Uncertainty::StopAbove> stop_above_;

@@ -26,15 +26,18 @@ class CircleDesign {
   std::vector<diagnostics_fit::AxisGram> gram;  // round one's normal equations, the target zero
 
   [[nodiscard]] std::size_t width() const noexcept { return 9 + 2 * pitches.size(); }
-  // Throws unless `p` are the passes this was made of.
-  void check(const std::vector<CirclePass>& p) const {
-    bool same = p.size() == passes.size();
+  // Throws unless `p` are the passes and `o` the options this was made of (the options
+  // that decide the columns, the windows and the pitches).
+  void check(const std::vector<CirclePass>& p, const DiagnosticsOptions& o) const {
+    bool same = o.radius_mm == opt.radius_mm && o.centre_mm == opt.centre_mm &&
+                o.cyclic_pitch_mm == opt.cyclic_pitch_mm && o.spike_window_s == opt.spike_window_s &&
+                p.size() == passes.size();
     for (std::size_t k = 0; same && k < p.size(); ++k)
       same = p[k].direction == passes[k].direction && p[k].fs_hz == passes[k].fs_hz &&
              p[k].cmd_mm.size() == passes[k].samples && p[k].meas_mm.size() == passes[k].samples;
     for (std::size_t k = 0; same && k < fit.size(); k += std::max<std::size_t>(1, fit.size() / 16))
       same = fit[k].cmd == p[fit[k].pass].cmd_mm[fit[k].i * q];
-    if (!same) throw InputError("circle diagnostics: the design was made of another set-point");
+    if (!same) throw InputError("circle diagnostics: the design was made of another set-point or other options");
   }
 };
 
@@ -164,10 +167,10 @@ std::shared_ptr<const CircleDesign> circle_design(const std::vector<CirclePass>&
   // Round one's columns as accumulate_every_pitch() sums them, the target zero.
   for (int a = 0; a < 2; ++a) d->gram.emplace_back(passes.size(), d->pitches.size());
   const std::size_t w = d->width();
+  for (auto& d0 : d->d0) d0.assign(passes.size(), 0);
   for (std::size_t k = 0; k < d->fit.size(); ++k) {
     const Walked& r = d->fit[k];
     for (std::size_t a = 0; a < 2; ++a) {
-      if (d->d0[a].empty()) d->d0[a].assign(passes.size(), 0);
       if (d->d0[a][r.pass] == 0) d->d0[a][r.pass] = sgn(r.vel[static_cast<Eigen::Index>(a)], 1e-6);
       if (r.skip[a]) continue;
       const double* c = &d->fit_cols[(2 * k + a) * w];
@@ -181,7 +184,7 @@ std::shared_ptr<const CircleDesign> circle_design(const std::vector<CirclePass>&
 CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& opt,
                                   const CircleDesign& design) {
   using namespace diagnostics_fit;
-  design.check(passes);
+  design.check(passes, opt);
   const std::vector<double>& pitches = design.pitches;
   std::array<AxisModel, 2> model = step_models(opt, pitches, passes.size());
   for (std::size_t a = 0; a < 2; ++a) model[a].d0 = design.d0[a];

@@ -138,6 +138,7 @@ TEST(CircleDesign, AnotherSetPointOrANonFinitePathIsRefused) {
   std::vector<CirclePass> moved = p;
   for (auto& c : moved[0].cmd_mm) c.x() += 0.5;
   EXPECT_THROW((void)diagnose_circle(moved, options(5.0), *design), InputError);
+  EXPECT_THROW((void)diagnose_circle(p, options(2.5), *design), InputError);  // another pitch
   std::vector<CirclePass> nan = p;
   nan[1].meas_mm[200].y() = std::nan("");
   try {
