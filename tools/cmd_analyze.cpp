@@ -8,6 +8,7 @@
 #include "tools/commands.hpp"
 #include "tools/exit_codes.hpp"
 #include "tools/plan/test_plan.hpp"
+#include "tools/report/tolerances.hpp"
 #include "tools/run_files.hpp"
 
 #include <malloc.h>
@@ -18,10 +19,10 @@ namespace eical::tools {
 
 void register_analyze(CLI::App& app) {
   struct Opt {
-    std::string run, dynamic = "two-stage", calibration;
+    std::string run, dynamic = "two-stage", calibration, tolerances;
     bool json = false, no_zupt = false, coriolis = false;
     int draws = 100;
-    bool no_suggest = false;
+    bool no_suggest = false, budget = false;
     std::string nbs = "auto";
   };
   auto o = std::make_shared<Opt>();
@@ -41,13 +42,22 @@ void register_analyze(CLI::App& app) {
   cmd->add_option("--calibration", o->calibration,
                   "sensor calibration (eical-sensor-cal/1, from eical identify) instead of the run's data sheet")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--tolerances", o->tolerances,
+                  "tolerance file (eical-tolerances/1, as eical report takes): each figure and the run decided by "
+                  "ISO 14253-1 with U (k = 2)")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--budget", o->budget,
+                "each source of the error alone (integration noise, sensor scale, timing, temperature, strip offsets "
+                "and nonlinearity): its U of every figure, in the text and the JSON (40 draws a source: seconds)");
   cmd->add_option("--draws", o->draws, "Monte Carlo draws of the uncertainty (seeded, deterministic)")
       ->default_val(100)
       ->check(CLI::Range(10, 100000));
   cmd->add_flag(
       "--no-suggest", o->no_suggest,
       "do not look for a measurable variant when the test is not measurable (it simulates variants: seconds)");
-  cmd->footer("Exit status: 0 verdict ok, 2 degraded, 3 not measurable, 1 an error (README \"Exit status\").");
+  cmd->footer(
+      "Exit status: 0 verdict ok, 2 degraded, 3 not measurable, 1 an error; with --tolerances and the verdict ok: 0 "
+      "conformance proven, 4 non-conformance proven, 5 undecided (README \"Exit status\").");
   cmd->callback([o] {
     // Buffers above 256 kB are mapped and go back to the system when freed: the streamed
     // analysis' passes (the first pass' records, a revolution, the repeats' sums) then do not
@@ -56,6 +66,9 @@ void register_analyze(CLI::App& app) {
     // Read as it streams: memory bounded whatever the run's length (dsp/stream).
     drivers::RunStream stream(o->run);
     dsp::Run& run = stream.header();
+    // Read before the analysis: a bad tolerance file fails in a second, not after it.
+    std::optional<report::Tolerances> tol;
+    if (!o->tolerances.empty()) tol = report::read_tolerances(o->tolerances);
     dsp::AnalysisOptions opt;
     if (!o->calibration.empty())
       drivers::apply_calibration(drivers::read_sensor_calibration(o->calibration, run.meta), run.meta, opt);
@@ -64,18 +77,22 @@ void register_analyze(CLI::App& app) {
     if (o->nbs != "auto") opt.nbs = o->nbs == "on";
     opt.coriolis = o->coriolis;
     opt.uncertainty.draws = o->draws;
+    opt.uncertainty.budget = o->budget;
     opt.parallel = drivers::thread_for();
     dsp::StreamOptions so;
     so.spills = drivers::file_spills(drivers::default_spill_dir());
     so.spill_trace = so.spill_corrections = true;  // a CSV reads slower than a spill, a spill faster than the smoother
     dsp::Analysis a = drivers::analyze_stream(stream, opt, so);
-    if (a.verdict == "not_measurable" && !o->no_suggest) plan::suggest_measurable_test(run, a);
+    if (tol) a.conformance = dsp::decide_conformance(a, report::figure_tolerances(*tol));
+    if (a.verdict == dsp::Verdict::not_measurable && !o->no_suggest) plan::suggest_measurable_test(run, a);
     if (o->json)
       std::printf("%s\n", drivers::result_json(run, a).dump(2).c_str());
     else
       std::fputs(summary_text(run, a).c_str(), stdout);
     std::fflush(stdout);
-    if (const int code = verdict_exit_code(a.verdict); code != kExitOk) throw CLI::RuntimeError(code);
+    const std::optional<dsp::Conformance> decision =
+        a.conformance ? std::optional(a.conformance->overall) : std::nullopt;
+    if (const int code = result_exit_code(a.verdict, decision); code != kExitOk) throw CLI::RuntimeError(code);
   });
 }
 

@@ -38,7 +38,9 @@ std::string prediction_text(const plan::Prediction& p) {
     o += b;
   }
   // value_with_u prints "± ?" without an uncertainty: the value here is U itself.
-  for (std::string::size_type at; (at = o.find(" ± ?")) != std::string::npos;) o.erase(at, 4);
+  // (" ± ?" is five bytes in UTF-8: erasing four left "µm?" on every line.)
+  const std::string no_u = " ± ?";
+  for (std::string::size_type at; (at = o.find(no_u)) != std::string::npos;) o.erase(at, no_u.size());
   std::snprintf(b, sizeof b, "  %s: U = %.2f µm %s the %.0f µm the test is meant to resolve\n",
                 p.measurable ? "measurable" : "NOT MEASURABLE", p.limited_u, p.measurable ? "within" : "exceeds",
                 p.limit);

@@ -7,6 +7,7 @@
 #include "tools/figure_text.hpp"
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -27,9 +28,22 @@ void write_file_atomic(const std::filesystem::path& file, const std::string& tex
   if (ec) throw std::runtime_error(file.string() + ": " + ec.message());
 }
 
-int verdict_exit_code(const std::string& verdict) {
-  if (verdict == "not_measurable") return kExitNotMeasurable;
-  if (verdict == "degraded") return kExitDegraded;
+int verdict_exit_code(dsp::Verdict verdict) {
+  switch (verdict) {
+    case dsp::Verdict::not_measurable: return kExitNotMeasurable;
+    case dsp::Verdict::degraded: return kExitDegraded;
+    case dsp::Verdict::ok: return kExitOk;
+  }
+  return kExitOk;
+}
+
+int result_exit_code(dsp::Verdict verdict, const std::optional<dsp::Conformance>& conformance) {
+  if (verdict != dsp::Verdict::ok || !conformance) return verdict_exit_code(verdict);
+  switch (*conformance) {
+    case dsp::Conformance::conforming: return kExitOk;
+    case dsp::Conformance::nonconforming: return kExitNonConforming;
+    case dsp::Conformance::undecided: return kExitUndecided;
+  }
   return kExitOk;
 }
 
@@ -46,6 +60,41 @@ const char* section_title(const std::string& section) {
 }
 
 }  // namespace
+
+std::string budget_text(const dsp::Run& run, const dsp::Analysis& analysis) {
+  const dsp::ResolutionLimit* lim = dsp::resolution_limit(run.meta.program.kind);
+  if (analysis.uncertainty_budget.empty() || !lim) return {};
+  std::vector<std::string> keys{lim->limited};
+  if (std::string(lim->headline) != lim->limited) keys.emplace_back(lim->headline);
+  std::string o = "  uncertainty budget (each source alone, U with k = 2; share of the sum of squares):\n";
+  char b[240];
+  for (const std::string& key : keys) {
+    const auto u = figure_u(analysis, key);
+    if (!u) continue;
+    std::snprintf(b, sizeof b, "    %s: U = %.2f %s\n", figure_label(key).c_str(), *u, figure_unit(key).c_str());
+    o += b;
+    double sum2 = 0.0;
+    for (const auto& [source, by_key] : analysis.uncertainty_budget)
+      if (const auto it = by_key.find(key);
+          it != by_key.end() && it->second.size() == 1 && std::isfinite(it->second[0]))
+        sum2 += it->second[0] * it->second[0];
+    for (const auto& [source, by_key] : analysis.uncertainty_budget) {
+      const auto it = by_key.find(key);
+      if (it == by_key.end() || it->second.size() != 1 || !std::isfinite(it->second[0])) continue;
+      const double us = it->second[0];
+      std::snprintf(b, sizeof b, "      %-44s %8.3f %s  %5.1f %%\n", dsp::uncertainty::error_source_words(source), us,
+                    figure_unit(key).c_str(), sum2 > 0.0 ? 100.0 * us * us / sum2 : 0.0);
+      o += b;
+    }
+    const auto nb = analysis.noise_bound_k2.find(key);
+    if (nb != analysis.noise_bound_k2.end() && nb->second.size() == 1) {
+      std::snprintf(b, sizeof b, "      %-44s %8.3f %s\n", "noise bound (white noise, optimal smoother)", nb->second[0],
+                    figure_unit(key).c_str());
+      o += b;
+    }
+  }
+  return o;
+}
 
 std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
   std::string o;
@@ -68,6 +117,11 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
     }
     const std::string unit = figure_unit(f.key);
     if (!f.array) {
+      if (const auto ne = analysis.not_evaluated.find(f.key); ne != analysis.not_evaluated.end()) {
+        std::snprintf(b, sizeof b, "    %-34s not evaluated: %s\n", figure_label(f.key).c_str(), ne->second.c_str());
+        o += b;
+        continue;
+      }
       const auto u = figure_u(analysis, f.key);
       std::snprintf(b, sizeof b, "    %-34s %s%s\n", figure_label(f.key).c_str(),
                     value_with_u(f.values[0], u, unit).c_str(),
@@ -103,12 +157,36 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
   if (!analysis.uncertainty_note.empty())
     o += "  uncertainty: " + analysis.uncertainty_note +
          (analysis.uncertainty_k2.empty() ? "" : "; * not resolved (|value| <= U)") + "\n";
+  o += budget_text(run, analysis);
+  if (const dsp::ResolutionLimit* lim = dsp::resolution_limit(run.meta.program.kind)) {
+    const auto u = figure_u(analysis, lim->limited);
+    const auto nb = analysis.noise_bound_k2.find(lim->limited);
+    if (u && nb != analysis.noise_bound_k2.end() && nb->second.size() == 1 && nb->second[0] > 0.0) {
+      std::snprintf(b, sizeof b,
+                    "  noise bound (the white noise measured at rest, the optimal smoother, these supports): U(%s) = "
+                    "%.2f µm is %.2f × its bound %.2f µm\n",
+                    lim->limited_name, *u, *u / nb->second[0], nb->second[0]);
+      o += b;
+    }
+  }
   o += "  verdict: " +
-       std::string(analysis.verdict == "not_measurable" ? "NOT MEASURABLE"
-                   : analysis.verdict == "degraded"     ? "DEGRADED"
-                                                        : "ok") +
+       std::string(analysis.verdict == dsp::Verdict::not_measurable ? "NOT MEASURABLE"
+                   : analysis.verdict == dsp::Verdict::degraded     ? "DEGRADED"
+                                                                    : "ok") +
        "\n";
   for (const auto& r : analysis.verdict_reasons) o += "    - " + r + "\n";
+  if (analysis.conformance) {
+    o += std::string("  against the tolerances (ISO 14253-1, U with k = 2): ") +
+         dsp::conformance_words(analysis.conformance->overall) + "\n";
+    for (const auto& f : analysis.conformance->figures) {
+      char u[32] = "unknown";
+      if (std::isfinite(f.u_k2)) std::snprintf(u, sizeof u, "%.2f", f.u_k2);
+      std::snprintf(b, sizeof b, "    %-40s %.2f ± %s against %.2f: %s\n", f.name.c_str(), f.magnitude, u, f.tolerance,
+                    dsp::conformance_words(f.decision));
+      o += b;
+    }
+    if (analysis.conformance->figures.empty()) o += "    (no toleranced figure in this test)\n";
+  }
   bool header = false;
   for (const auto& f : analysis.flags) {
     const auto s = dsp::flag_severity(f);

@@ -14,4 +14,7 @@ void write_file_atomic(const std::filesystem::path& file, const std::string& tex
 // One-paragraph human summary of an analysis (what `eical analyze` prints without --json).
 std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis);
 
+// The uncertainty budget of the program's headline figures (empty without one).
+std::string budget_text(const dsp::Run& run, const dsp::Analysis& analysis);
+
 }  // namespace eical::tools

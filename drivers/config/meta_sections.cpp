@@ -84,6 +84,9 @@ dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults, Unkn
   if (!(std::abs(s.zeta_per_g) <= 100.0)) t.fail("zeta_per_g", "must be within [-100, 100] per g");
   s.noise_ug_per_rthz = t.number("noise_ug_per_rthz", s.noise_ug_per_rthz);
   if (s.noise_ug_per_rthz < 0.0) t.fail("noise_ug_per_rthz", "must not be negative");
+  s.bias_walk_ug_per_rts = t.number("bias_walk_ug_per_rts", s.bias_walk_ug_per_rts);
+  if (!(s.bias_walk_ug_per_rts >= 0.0 && s.bias_walk_ug_per_rts < 1e6))
+    t.fail("bias_walk_ug_per_rts", "must be within [0, 1e6) µg/√s");
   s.temp_ref_c = t.number("temp_ref_c", s.temp_ref_c);
   if (u == Unknown::reject) t.finish();
   return s;

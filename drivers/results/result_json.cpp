@@ -21,11 +21,13 @@ void write_result(const dsp::Run& run, const dsp::Analysis& analysis, const std:
 
 nlohmann::json number_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
-nlohmann::json uncertainty_json(const dsp::Analysis& analysis) {
+// Per figure, in the figure's shape, the values `by_key` holds for it (U, or the noise bound).
+static nlohmann::json per_figure_json(const dsp::Analysis& analysis,
+                                      const std::map<std::string, std::vector<double>>& by_key) {
   nlohmann::json u = nlohmann::json::object();
   for (const dsp::FigureValue& f : dsp::figures_of(analysis)) {
-    const auto it = analysis.uncertainty_k2.find(f.key);
-    const bool have = it != analysis.uncertainty_k2.end() && it->second.size() == f.values.size();
+    const auto it = by_key.find(f.key);
+    const bool have = it != by_key.end() && it->second.size() == f.values.size();
     if (!f.array) {
       u[f.key] = have ? number_or_null(it->second[0]) : nlohmann::json(nullptr);
       continue;
@@ -44,6 +46,10 @@ nlohmann::json uncertainty_json(const dsp::Analysis& analysis) {
     u[f.key] = arr;
   }
   return u;
+}
+
+nlohmann::json uncertainty_json(const dsp::Analysis& analysis) {
+  return per_figure_json(analysis, analysis.uncertainty_k2);
 }
 
 nlohmann::json circle_json(const dsp::Program& program, const dsp::eval::CircleResult& c) {
@@ -71,6 +77,9 @@ nlohmann::json circle_json(const dsp::Program& program, const dsp::eval::CircleR
     j["circular_deviation_G_ccw_um"] = number_or_null(dsp::direction_G_um(c, "ccw"));
     j["circular_deviation_G_cw_um"] = number_or_null(dsp::direction_G_um(c, "cw"));
   }
+  // G of the averaged revolution per direction (beside ISO 230-4's G over all revolutions).
+  if (std::isfinite(c.direction_averaged_G_um[0])) j["averaged_revolution_G_ccw_um"] = c.direction_averaged_G_um[0];
+  if (std::isfinite(c.direction_averaged_G_um[1])) j["averaged_revolution_G_cw_um"] = c.direction_averaged_G_um[1];
   // The trace thinned to at most ~3600 points per revolution set: the plots need no more.
   // (A trace already thinned as it streamed keeps exactly these points: all of them go.)
   const std::size_t n = c.trace.angle_deg.size();
@@ -98,6 +107,20 @@ nlohmann::json all_null(std::initializer_list<const char*> keys) {
   return j;
 }
 
+// A figure the analysis did not evaluate (Analysis::not_evaluated) is null, with its reason.
+void null_not_evaluated(const dsp::Analysis& a, nlohmann::json& doc) {
+  for (const auto& [key, reason] : a.not_evaluated) {
+    std::string pointer = "/" + key;
+    std::replace(pointer.begin(), pointer.end(), '.', '/');
+    const nlohmann::json::json_pointer p(pointer);
+    if (!doc.contains(p)) continue;
+    doc[p] = nullptr;
+    const std::string flag = key + ": null, not evaluated: " + reason;
+    doc["quality"]["flags"].push_back(flag);
+    doc["quality"]["flag_severity"].push_back(dsp::severity_name(dsp::flag_severity(flag)));
+  }
+}
+
 // Every null figure of a program object must have a reason in quality.flags; a null the
 // evaluation did not explain gets a generic one naming it (never silently null).
 void explain_nulls(nlohmann::json& doc) {
@@ -112,7 +135,10 @@ void explain_nulls(nlohmann::json& doc) {
         const std::string text = f.get<std::string>();
         explained |= text.rfind(name, 0) == 0 || text.rfind(std::string(obj) + ": null", 0) == 0;
       }
-      if (!explained) flags.push_back(name + ": null, could not be determined from this run");
+      if (explained) continue;
+      const std::string flag = name + ": null, could not be determined from this run";
+      flags.push_back(flag);
+      doc["quality"]["flag_severity"].push_back(dsp::severity_name(dsp::flag_severity(flag)));
     }
   }
 }
@@ -121,11 +147,26 @@ constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
 // The verdict, its reasons, the flags and each flag's severity.
 nlohmann::json quality_json(const dsp::Analysis& a) {
-  nlohmann::json q = {
-      {"degraded", a.degraded}, {"verdict", a.verdict}, {"verdict_reasons", a.verdict_reasons}, {"flags", a.flags}};
+  nlohmann::json q = {{"degraded", a.degraded},
+                      {"verdict", dsp::verdict_name(a.verdict)},
+                      {"verdict_reasons", a.verdict_reasons},
+                      {"flags", a.flags}};
   nlohmann::json severity = nlohmann::json::array();
   for (const auto& f : a.flags) severity.push_back(dsp::severity_name(dsp::flag_severity(f)));
   q["flag_severity"] = severity;
+  if (a.conformance) {  // ISO 14253-1 against the tolerances the analysis was given
+    nlohmann::json figs = nlohmann::json::array();
+    for (const auto& f : a.conformance->figures)
+      figs.push_back({{"name", f.name},
+                      {"key", f.key},
+                      {"magnitude", f.magnitude},
+                      {"uncertainty_k2", std::isfinite(f.u_k2) ? nlohmann::json(f.u_k2) : nlohmann::json(nullptr)},
+                      {"tolerance", f.tolerance},
+                      {"decision", dsp::conformance_key(f.decision)}});
+    q["conformance"] = {{"rule", "ISO 14253-1, U with k = 2"},
+                        {"overall", dsp::conformance_key(a.conformance->overall)},
+                        {"figures", figs}};
+  }
   return q;
 }
 
@@ -250,9 +291,19 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis) {
   j["program"] = run.meta.program.kind;
   j["software"] = software_version();
   j["quality"] = quality_json(analysis);
-  j["uncertainty_k2"] = uncertainty_json(analysis);
+  j["uncertainty_k2"] = per_figure_json(analysis, analysis.uncertainty_k2);
+  j["noise_bound_k2"] = per_figure_json(analysis, analysis.noise_bound_k2);
+  if (!analysis.uncertainty_budget.empty()) {
+    nlohmann::json budget = nlohmann::json::object();
+    for (const auto& [source, by_key] : analysis.uncertainty_budget)
+      budget[dsp::uncertainty::error_source_key(source)] = per_figure_json(analysis, by_key);
+    j["uncertainty_budget_k2"] = budget;
+  }
   j["uncertainty"] = {
       {"coverage_factor", 2},
+      {"noise_bound",
+       "noise_bound_k2: the same evaluation of the ideal path with only the white noise measured at rest, fused by "
+       "the smoother optimal for it over this run's supports (95th percentile of the draws)"},
       {"sensor_model", analysis.uncertainty_source},
       {"method", analysis.uncertainty_note},
       {"resolved_rule", "a figure is resolved when |value| > U (k = 2); one that is not is never compensated"}};
@@ -270,6 +321,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis) {
   j["pipeline"] = pipeline_json(analysis);
   j["pipeline"]["supports"] = supports_json(analysis.measurement);
   j["repeats"] = repeats_json(analysis);
+  null_not_evaluated(analysis, j);
   explain_nulls(j);
   return j;
 }

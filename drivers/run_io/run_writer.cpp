@@ -70,6 +70,7 @@ std::string sensor_section_toml(const char* name, const dsp::SensorSpec& spec) {
        "\ntc_k1_ppm_per_c = " + toml_double(spec.tc_k1_ppm_per_c) +
        "\ntc_bias_ug_per_c = " + toml_double(spec.tc_bias_ug_per_c) + "\nf0_hz = " + toml_double(spec.f0_hz) +
        "\nzeta = " + toml_double(spec.zeta) + "\nnoise_ug_per_rthz = " + toml_double(spec.noise_ug_per_rthz) +
+       "\nbias_walk_ug_per_rts = " + toml_double(spec.bias_walk_ug_per_rts) +
        "\ntemp_ref_c = " + toml_double(spec.temp_ref_c) + "\n";
   if (spec.zeta_per_g != 0.0)
     o += "zeta_per_g = " + toml_double(spec.zeta_per_g) + "\n";  // not a data-sheet key: only when found

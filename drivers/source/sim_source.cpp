@@ -10,7 +10,7 @@ namespace eical::drivers {
 
 SimSource::SimSource(sim::Scenario scenario, SimSourceOptions options)
     : scenario_(std::move(scenario)), options_(options) {
-  run_ = std::make_shared<const dsp::Run>(sim::simulate(scenario_));
+  run_ = std::make_shared<const dsp::Run>(sim::simulate(scenario_, options_.keep_truth ? &truth_ : nullptr));
   const double fs = run_->meta.acquisition.fs_hz;
   idle_frames_ = options_.repeat ? static_cast<std::size_t>(std::llround(options_.idle_s * fs)) : 0;
   // Frames before the first trigger are at rest: the idle phase cycles through them.

@@ -16,6 +16,9 @@ struct SimSourceOptions {
   Pacing pacing = Pacing::realtime;
   bool repeat = false;
   double idle_s = 2.0;
+  // Also keep the simulator's true relative position of every frame of the program pass
+  // (true_rel_mm()): what the demo and tests compare a measurement with. Off in the daemon.
+  bool keep_truth = false;
 };
 
 class SimSource final : public Source {
@@ -32,11 +35,14 @@ class SimSource final : public Source {
   }
   // The simulated run of one program pass (with its truth.toml).
   [[nodiscard]] const std::shared_ptr<const dsp::Run>& program_run() const { return run_; }
+  // The true relative position (mm) at each frame of program_run(); empty without keep_truth.
+  [[nodiscard]] const std::vector<Eigen::Vector3d>& true_rel_mm() const { return truth_; }
 
  private:
   sim::Scenario scenario_;
   SimSourceOptions options_;
   std::shared_ptr<const dsp::Run> run_;
+  std::vector<Eigen::Vector3d> truth_;
   std::size_t pos_ = 0;          // position within program + idle cycle
   std::size_t idle_frames_ = 0;  // idle frames after each program pass
   std::size_t rest_frames_ = 0;  // rest frames at the program's start, cycled while idle

@@ -4,7 +4,9 @@
 // eicald (which evaluates every measurement it records), so all three agree by
 // construction. An evaluation that cannot be done leaves its result empty and says why
 // in `flags`; it does not throw.
+#include "dsp/analysis/conformance_kind.hpp"
 #include "dsp/analysis/setpoint_cache.hpp"
+#include "dsp/analysis/verdict_kind.hpp"
 #include "dsp/core/parallel_for.hpp"
 #include "dsp/core/run.hpp"
 #include "dsp/eval/circle.hpp"
@@ -15,9 +17,11 @@
 #include "dsp/eval/repeats.hpp"
 #include "dsp/eval/step_response.hpp"
 #include "dsp/pipeline/pipeline.hpp"
+#include "dsp/uncertainty/error_source.hpp"
 #include "dsp/uncertainty/sensor_model_covariance.hpp"
 
 #include <cstdint>
+#include <limits>
 #include <map>
 
 #include <optional>
@@ -59,6 +63,10 @@ struct AnalysisOptions {
       int after_draws = 20;
     };
     std::optional<StopAbove> stop_above;
+    // The budget (Analysis::uncertainty_budget): each source of the error alone, drawn
+    // `budget_draws` times. Costs a few seconds; eical analyze --budget.
+    bool budget = false;
+    int budget_draws = 40;
   } uncertainty;
   std::optional<uncertainty::SensorModelCovariance> model_covariance;
 };
@@ -98,12 +106,29 @@ struct Analysis {
   // Expanded uncertainty (k = 2) of each figure by result key (figures.hpp), one value per
   // element of the figure; absent when it could not be estimated (uncertainty_note says why).
   std::map<std::string, std::vector<double>> uncertainty_k2;
+  // The noise-limited U (k = 2) of the same figures: the evaluation of the ideal path with
+  // only the sensors' white noise, fused by the smoother optimal for it over the run's own
+  // supports (figure_uncertainty.hpp). What this test could reach with perfect sensor
+  // models: U / bound says how far the measurement is from its physics.
+  std::map<std::string, std::vector<double>> noise_bound_k2;
+  // With AnalysisOptions::Uncertainty::budget: per source of the error alone, U (k = 2) of
+  // every figure (the same 95th percentile of the figure's error over that source's draws).
+  std::map<uncertainty::ErrorSource, std::map<std::string, std::vector<double>>> uncertainty_budget;
+  // Scalar figures that are not results, by key, with the reason: a value no draw of the
+  // error moves (U exactly 0) is a constant of the evaluation (a detection that did not
+  // fire), not a size the measurement knows exactly. Rendered as "not evaluated".
+  std::map<std::string, std::string> not_evaluated;
   std::string uncertainty_source;  // "datasheet" or the calibration's method
   std::string uncertainty_note;    // how it was estimated, or why not
   int uncertainty_draws = 0;       // the Monte Carlo draws U comes from (0: not estimated)
-  // quality.verdict of results.md: "ok", "degraded" or "not_measurable", and why.
-  std::string verdict = "ok";
+  // λ of the truth's estimate the draws perturb (figure_uncertainty.hpp): 0 when the
+  // measured shape is all noise, 1 when the noise is negligible beside it.
+  double uncertainty_shrink = std::numeric_limits<double>::quiet_NaN();
+  // quality.verdict (verdict.hpp), and why.
+  Verdict verdict = Verdict::ok;
   std::vector<std::string> verdict_reasons;
+  // ISO 14253-1 against the user's tolerances (conformance.hpp); empty without tolerances.
+  std::optional<ConformanceResult> conformance;
 };
 
 // Throws InputError only when the run itself is unusable (no frames, fs ≤ 0). Holds the

@@ -6,6 +6,7 @@
 #include "dsp/core/float_limits.hpp"
 #include "dsp/core/stream_seed.hpp"
 #include "dsp/uncertainty/error_field.hpp"
+#include "dsp/uncertainty/rest_noise_check.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -25,69 +26,87 @@ constexpr std::size_t kMaxDrawSamples = 30000;
 // Tasks the draws are split into (each copies the bases' measurement once).
 constexpr std::size_t kDrawBlocks = 8;
 
-struct Accumulator {
-  std::vector<double> sum, sumsq;
-  std::vector<int> count;
-};
-
-// The two paths the draws perturb, evaluated at the draws' rate. The measured one (the
-// plug-in: what the error does to this machine's figures) and the ideal one, the set-point
-// (what the error alone makes of them: for a range, an amplitude or a spread —
-// |f(t + e) − f(t)| ≤ f(e) — a bound whatever the machine).
+// The paths the draws perturb, evaluated at the draws' rate, on one set-point:
+//   * the truth's estimate t̂ = s + λ (m − s): the measured path m shrunk towards the
+//     set-point s by as much of its shape as the error itself explains. m − s is the
+//     machine's shape plus the measurement's error e; their energies add, so
+//     λ² = 1 − max‖e‖² / ‖m − s‖² (the largest of 20 draws, clamped to 0..1). On a
+//     machine whose shape is all noise λ = 0 and t̂ is the set-point; on one whose shape
+//     towers over the noise λ = 1 and t̂ is the measured path. A figure's error is then
+//     drawn where the truth most likely is: a range such as G is biased by the noise by as
+//     much as the true shape leaves room for (at most f(e), on a flat path), a linear
+//     figure is the same on any path;
+//   * the set-point s with the noise bound's error (white noise only, optimal smoother).
 struct DrawBases {
-  std::unique_ptr<SetPointCache> setpoint;  // both bases' and every draw's: one set-point
+  std::unique_ptr<SetPointCache> setpoint;  // every evaluation's: one set-point
   EvaluationOptions eo;
-  Analysis nominal, ideal;
-  std::vector<FigureValue> f0, g0;  // their figures
+  Analysis truth, ideal;            // t̂ and s
+  std::vector<FigureValue> t0, g0;  // their figures
   std::vector<double> at;           // the trace positions the draws perturb
+  double shrink = 1.0;              // λ
 };
 
-// `decimated`: every q-th sample of the trace (fs/q); the triggers are kept.
-DrawBases evaluate_bases(const Run& run, const Analysis& a, Measurement decimated, std::size_t q, std::size_t samples) {
+// The decimated measurement (every q-th sample of the trace: fs/q; the triggers kept) with
+// its positions replaced.
+Analysis base_of(const Analysis& a, const Measurement& decimated, std::vector<Eigen::Vector3d> pos_mm) {
+  Analysis b;
+  b.measurement = decimated;
+  b.measurement.pos_mm = std::move(pos_mm);
+  b.dynamic = a.dynamic, b.nbs = a.nbs;
+  return b;
+}
+
+// λ of the truth's estimate from the measured path's shape and the energy of `errors`: the
+// largest of the draws', not their mean. Only the shape that no plausible error explains
+// is kept as the machine's (a run whose sensor model errs at the far end of its
+// tolerances must not lend that error to the machine, where the draws would take it as
+// shape and shrink its bias: seen as G covered in one of three data-sheet circles).
+double shrink_factor(const Measurement& m, const std::vector<std::vector<Eigen::Vector3d>>& errors) {
+  double shape_um2 = 0.0, error_um2 = 0.0;
+  for (std::size_t k = 0; k < m.pos_mm.size(); ++k) shape_um2 += ((m.pos_mm[k] - m.cmd_mm[k]) * 1000.0).squaredNorm();
+  for (const auto& e : errors) {
+    double energy_um2 = 0.0;
+    for (std::size_t k = 0; k < e.size() && k < m.pos_mm.size(); ++k) energy_um2 += e[k].squaredNorm();
+    error_um2 = std::max(error_um2, energy_um2);
+  }
+  if (errors.empty() || !(shape_um2 > 0.0)) return 0.0;
+  return std::sqrt(std::clamp(1.0 - error_um2 / shape_um2, 0.0, 1.0));
+}
+
+// Draws that measure λ, seeded apart from the draws proper: the largest energy of 20 is
+// about its 95th percentile.
+constexpr std::uint64_t kShrinkSalt = 0x736872696e6bULL;
+constexpr int kShrinkDraws = 20;
+
+DrawBases evaluate_bases(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, Measurement decimated,
+                         std::size_t q, std::size_t samples, std::uint64_t seed) {
   const Measurement& m = a.measurement;
   DrawBases b;
   b.eo.reference = false;
   b.eo.keep_trace = false;
   if (a.diagnostics) b.eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
-  b.nominal.measurement = std::move(decimated);
-  b.nominal.measurement.fs_hz = m.fs_hz / static_cast<double>(q);
-  b.nominal.measurement.triggers = m.triggers;
-  b.nominal.measurement.start_index = m.start_index, b.nominal.measurement.motion_end_index = m.motion_end_index;
-  b.nominal.dynamic = b.ideal.dynamic = a.dynamic, b.nominal.nbs = b.ideal.nbs = a.nbs;
-  b.ideal.measurement = b.nominal.measurement;
-  b.ideal.measurement.pos_mm = b.ideal.measurement.cmd_mm;
+  decimated.fs_hz = m.fs_hz / static_cast<double>(q);
+  decimated.triggers = m.triggers;
+  decimated.start_index = m.start_index, decimated.motion_end_index = m.motion_end_index;
+  for (std::size_t i = 0; i < samples; i += q) b.at.push_back(static_cast<double>(i));
+  std::vector<std::vector<Eigen::Vector3d>> errors(kShrinkDraws);
+  for (int d = 0; d < kShrinkDraws; ++d) {
+    std::mt19937_64 rng(stream_seed(seed ^ kShrinkSalt, static_cast<std::uint64_t>(d)));
+    field.draw(rng, b.at, errors[static_cast<std::size_t>(d)]);
+  }
+  b.shrink = shrink_factor(decimated, errors);
+  std::vector<Eigen::Vector3d> shrunk(decimated.pos_mm.size());
+  for (std::size_t k = 0; k < shrunk.size(); ++k)
+    shrunk[k] = decimated.cmd_mm[k] + b.shrink * (decimated.pos_mm[k] - decimated.cmd_mm[k]);
+  b.ideal = base_of(a, decimated, decimated.cmd_mm);
+  b.truth = base_of(a, decimated, std::move(shrunk));
   b.setpoint = std::make_unique<SetPointCache>();
   b.eo.setpoint = b.setpoint.get();
-  evaluate_program(run, b.nominal, b.eo);  // fills the set-point cache
+  evaluate_program(run, b.truth, b.eo);  // fills the set-point cache
   evaluate_program(run, b.ideal, b.eo);
   b.setpoint->frozen = true;  // the draws read it in parallel
-  b.f0 = figures_of(b.nominal), b.g0 = figures_of(b.ideal);
-  for (std::size_t i = 0; i < samples; i += q) b.at.push_back(static_cast<double>(i));
+  b.t0 = figures_of(b.truth), b.g0 = figures_of(b.ideal);
   return b;
-}
-
-// Per figure of a base, per element: the sums of the draws' offsets from the base.
-std::vector<Accumulator> accumulators_for(const std::vector<FigureValue>& f) {
-  std::vector<Accumulator> acc(f.size());
-  for (std::size_t k = 0; k < f.size(); ++k) {
-    const std::size_t e = f[k].values.size();
-    acc[k].sum.assign(e, 0.0), acc[k].sumsq.assign(e, 0.0), acc[k].count.assign(e, 0);
-  }
-  return acc;
-}
-
-// A draw's figures into the sums (figures whose shape differs from the base's left out).
-void accumulate(const std::vector<FigureValue>& base, const std::vector<FigureValue>& drawn,
-                std::vector<Accumulator>& acc) {
-  for (std::size_t k = 0; k < base.size(); ++k) {
-    const FigureValue* v = find_figure(drawn, base[k].key);
-    if (!v || v->values.size() != base[k].values.size()) continue;
-    for (std::size_t e = 0; e < v->values.size(); ++e) {
-      const double dv = v->values[e] - base[k].values[e];
-      if (!std::isfinite(dv)) continue;
-      acc[k].sum[e] += dv, acc[k].sumsq[e] += dv * dv, ++acc[k].count[e];
-    }
-  }
 }
 
 // The figures of a base with a draw's error (µm) added to its path. The draw perturbs the
@@ -109,17 +128,17 @@ std::vector<FigureValue> perturbed_figures(const Run& run, const Analysis& a, co
   return f;
 }
 
-struct DrawSums {
-  std::vector<Accumulator> plug, bound;  // on the measured path, on the ideal one
-};
-
 struct DrawnFigures {
-  std::vector<FigureValue> plug, bound;
+  std::vector<FigureValue> error;  // t̂ with the draw's error
+  std::vector<FigureValue> noise;  // s with the noise bound's error only
 };
 
-// The seeded draws [from, to) of the error field, each added to both bases and evaluated.
-// Contiguous blocks of draws are the executor's tasks (one copy of the bases' measurement a
-// block); the sums are taken in draw order afterwards.
+// The noise bound's draws are seeded apart from the error field's (the same draw numbers).
+constexpr std::uint64_t kNoiseBoundSalt = 0x6e6f697365626e64ULL;
+
+// The seeded draws [from, to): the error field's on t̂, the noise bound's on s, each
+// evaluated. Contiguous blocks of draws are the executor's tasks (one copy of the bases'
+// measurement a block).
 void draw_range(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
                 std::size_t from, std::size_t to, std::uint64_t seed, const ParallelFor& parallel,
                 std::vector<std::optional<uncertainty::NoiseDraw>>& noise, std::vector<DrawnFigures>& drawn) {
@@ -127,7 +146,7 @@ void draw_range(const Run& run, const Analysis& a, const uncertainty::ErrorField
   const std::size_t blocks = std::min<std::size_t>(n, kDrawBlocks);
   parallel(blocks, [&](std::size_t block) {
     std::vector<Eigen::Vector3d> err;
-    Measurement nominal_scratch = b.nominal.measurement, ideal_scratch = b.ideal.measurement;
+    Measurement truth_scratch = b.truth.measurement, ideal_scratch = b.ideal.measurement;
     for (std::size_t d = from + block * n / blocks; d < from + (block + 1) * n / blocks; ++d) {
       // Seeded by (seed, d) alone, so the draws may run in any order and on any thread.
       if (d < noise.size() && noise[d]) {  // its noise drawn already, from the same generator
@@ -136,92 +155,112 @@ void draw_range(const Run& run, const Analysis& a, const uncertainty::ErrorField
         std::mt19937_64 rng(stream_seed(seed, d));
         field.draw(rng, b.at, err);
       }
-      drawn[d].plug = perturbed_figures(run, a, b.nominal, err, b.eo, nominal_scratch);
-      drawn[d].bound = perturbed_figures(run, a, b.ideal, err, b.eo, ideal_scratch);
+      drawn[d].error = perturbed_figures(run, a, b.truth, err, b.eo, truth_scratch);
+      std::mt19937_64 bound_rng(stream_seed(seed ^ kNoiseBoundSalt, d));
+      field.draw_bound(bound_rng, b.at, err);
+      drawn[d].noise = perturbed_figures(run, a, b.ideal, err, b.eo, ideal_scratch);
     }
   });
 }
 
-DrawSums sums_of(const DrawBases& b, const std::vector<DrawnFigures>& drawn, std::size_t n) {
-  DrawSums s{accumulators_for(b.f0), accumulators_for(b.g0)};
-  for (std::size_t d = 0; d < n; ++d)
-    accumulate(b.f0, drawn[d].plug, s.plug), accumulate(b.g0, drawn[d].bound, s.bound);
-  return s;
+// The 95th percentile of |x| (linear interpolation between order statistics); NaN when
+// fewer than half the draws gave a finite value.
+double abs_quantile95(std::vector<double>& x, std::size_t draws) {
+  if (x.empty() || 2 * x.size() < draws) return std::numeric_limits<double>::quiet_NaN();
+  for (double& v : x) v = std::abs(v);
+  std::sort(x.begin(), x.end());
+  const double pos = 0.95 * static_cast<double>(x.size() - 1);
+  const auto i = static_cast<std::size_t>(pos);
+  const double f = pos - static_cast<double>(i);
+  return i + 1 < x.size() ? (1.0 - f) * x[i] + f * x[i + 1] : x[i];
 }
 
-// U of element e of figure k of a set of draws (NaN when most draws could not evaluate it).
-double u_of(const std::vector<Accumulator>& ac, std::size_t k, std::size_t e, bool plug_in, int draws) {
-  const int c = ac[k].count[e];
-  if (2 * c < draws) return std::numeric_limits<double>::quiet_NaN();
-  const double mean = ac[k].sum[e] / c;
-  const double sd = std::sqrt(std::max(0.0, (ac[k].sumsq[e] - c * mean * mean) / std::max(1, c - 1)));
-  return plug_in ? expanded_uncertainty(mean, sd, c) : std::abs(mean) + 2.0 * sd;
-}
-
-std::size_t index_of(const std::vector<FigureValue>& f, const std::string& key) {
-  std::size_t k = 0;
-  while (k < f.size() && f[k].key != key) ++k;
-  return k;
-}
-
-// U of a figure with `elements` values from the draws where the shapes agree, the larger
-// of the plug-in and the ideal path's bound; empty when neither base has it in that shape.
-std::vector<double> u_of_figure(const DrawBases& b, const DrawSums& s, int draws, const std::string& key,
-                                std::size_t elements) {
-  const std::size_t k = index_of(b.f0, key), j = index_of(b.g0, key);
-  const bool plug = k < b.f0.size() && b.f0[k].values.size() == elements;
-  const bool bound = j < b.g0.size() && b.g0[j].values.size() == elements;
-  if (!plug && !bound) return {};
-  std::vector<double> u(elements, std::numeric_limits<double>::quiet_NaN());
-  for (std::size_t e = 0; e < u.size(); ++e) {
-    const double up = plug ? u_of(s.plug, k, e, true, draws) : std::numeric_limits<double>::quiet_NaN();
-    const double ub = bound ? u_of(s.bound, j, e, false, draws) : std::numeric_limits<double>::quiet_NaN();
-    u[e] = std::isfinite(up) && std::isfinite(ub) ? std::max(up, ub) : std::isfinite(up) ? up : ub;
+// Per element of figure `key` (`elements` values), the 95th percentile of its error over
+// the first `used` draws of `which` against its base's value; empty when the base lacks it
+// in that shape.
+std::vector<double> quantile_of_figure(const std::vector<FigureValue>& base, const std::vector<DrawnFigures>& drawn,
+                                       std::size_t used, std::vector<FigureValue> DrawnFigures::*which,
+                                       const std::string& key, std::size_t elements) {
+  const FigureValue* b = find_figure(base, key);
+  if (!b || b->values.size() != elements) return {};
+  std::vector<double> out(elements);
+  std::vector<double> dev;
+  for (std::size_t e = 0; e < elements; ++e) {
+    dev.clear();
+    for (std::size_t d = 0; d < used; ++d) {
+      const FigureValue* v = find_figure(drawn[d].*which, key);
+      if (v && v->values.size() == elements && std::isfinite(v->values[e] - b->values[e]))
+        dev.push_back(v->values[e] - b->values[e]);
+    }
+    out[e] = abs_quantile95(dev, used);
   }
-  return u;
+  return out;
 }
 
-// Figures of the full-rate analysis.
-void assign_uncertainties(const DrawBases& b, const DrawSums& s, int draws, Analysis& a) {
+// U and the noise bound of every figure of the full-rate analysis, from the draws.
+void assign_uncertainties(const DrawBases& b, const std::vector<DrawnFigures>& drawn, std::size_t used, Analysis& a) {
   for (const FigureValue& full : figures_of(a)) {
-    std::vector<double> u = u_of_figure(b, s, draws, full.key, full.values.size());
-    if (!u.empty()) a.uncertainty_k2[full.key] = std::move(u);
+    std::vector<double> u = quantile_of_figure(b.t0, drawn, used, &DrawnFigures::error, full.key, full.values.size());
+    if (!u.empty()) {
+      if (u.size() == 1 && u[0] == 0.0)  // no draw moves it: not a measured size
+        a.not_evaluated[full.key] =
+            "every Monte Carlo draw of the measurement's error gives the same value: it does not follow the "
+            "measurement";
+      else
+        a.uncertainty_k2[full.key] = std::move(u);
+    }
+    std::vector<double> bound =
+        quantile_of_figure(b.g0, drawn, used, &DrawnFigures::noise, full.key, full.values.size());
+    if (!bound.empty()) a.noise_bound_k2[full.key] = std::move(bound);
   }
 }
 
-// The draws' sums and how many ran: all of them, or the screen's first ones when they
-// already put U of its figure above its bound.
-struct DrawOutcome {
-  DrawSums sums;
-  int used = 0;
-};
+// The budget: per source, `draws` draws of that source alone on t̂ (seeded apart), and the
+// 95th percentile of every figure's error over them.
+void assign_budget(const Run& run, const Analysis& a_in, const uncertainty::ErrorField& field, const DrawBases& b,
+                   int draws, std::uint64_t seed, const ParallelFor& parallel, Analysis& a) {
+  const auto n = static_cast<std::size_t>(draws);
+  const std::vector<FigureValue> figs = figures_of(a);
+  for (const uncertainty::ErrorSource source : uncertainty::kErrorSources) {
+    std::vector<DrawnFigures> drawn(n);
+    const std::uint64_t salt = 0x627564676574ULL + static_cast<std::uint64_t>(source);
+    const std::size_t blocks = std::min<std::size_t>(n, kDrawBlocks);
+    parallel(blocks, [&](std::size_t block) {
+      std::vector<Eigen::Vector3d> err;
+      Measurement scratch = b.truth.measurement;
+      for (std::size_t d = block * n / blocks; d < (block + 1) * n / blocks; ++d) {
+        std::mt19937_64 rng(stream_seed(seed ^ salt, d));
+        field.draw(rng, b.at, err, uncertainty::SourceMask::only(source));
+        drawn[d].error = perturbed_figures(run, a_in, b.truth, err, b.eo, scratch);
+      }
+    });
+    auto& by_key = a.uncertainty_budget[source];
+    for (const FigureValue& f : figs) {
+      std::vector<double> u = quantile_of_figure(b.t0, drawn, n, &DrawnFigures::error, f.key, f.values.size());
+      if (!u.empty()) by_key[f.key] = std::move(u);
+    }
+  }
+}
 
-DrawOutcome run_draws(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
+// The draws that ran: all of them, or the screen's first ones when they already put U of
+// its figure above its bound.
+std::size_t run_draws(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, const DrawBases& b,
                       int draws, std::uint64_t seed, const ParallelFor& parallel,
                       const std::optional<AnalysisOptions::Uncertainty::StopAbove>& stop,
-                      std::vector<std::optional<uncertainty::NoiseDraw>>& noise) {
+                      std::vector<std::optional<uncertainty::NoiseDraw>>& noise, std::vector<DrawnFigures>& drawn) {
   const auto n = static_cast<std::size_t>(draws);
-  std::vector<DrawnFigures> drawn(n);
+  drawn.assign(n, {});
   const std::size_t first = stop ? static_cast<std::size_t>(std::clamp(stop->after_draws, 2, draws)) : n;
   draw_range(run, a, field, b, 0, first, seed, parallel, noise, drawn);
   if (first < n) {
-    const int m = static_cast<int>(first);
-    DrawSums screen = sums_of(b, drawn, first);
-    const std::vector<double> u = u_of_figure(b, screen, m, stop->key, 1);
-    if (u.size() == 1 && u[0] > stop->above) return {std::move(screen), m};
+    const std::vector<double> u = quantile_of_figure(b.t0, drawn, first, &DrawnFigures::error, stop->key, 1);
+    if (u.size() == 1 && u[0] > stop->above) return first;
     draw_range(run, a, field, b, first, n, seed, parallel, noise, drawn);
   }
-  return {sums_of(b, drawn, n), draws};
+  return n;
 }
 
 }  // namespace
-
-double expanded_uncertainty(double mean_offset, double sd, int n) {
-  if (n < 2) return kNaN;
-  const double mc = 2.0 * sd / std::sqrt(static_cast<double>(n));
-  const double bias = std::max(0.0, std::abs(mean_offset) - mc);
-  return 2.0 * sd + bias / (std::numbers::sqrt2 - 1.0);
-}
 
 void estimate_uncertainty(const Run& run, const PipelineConfig& config, const AnalysisOptions& options, Analysis& a) {
   const Measurement& m = a.measurement;
@@ -261,6 +300,7 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
     : samples_(samples),
       draws_(std::max(2, options.uncertainty.draws)),
       stop_above_(options.uncertainty.stop_above),
+      budget_draws_(options.uncertainty.budget ? std::max(2, options.uncertainty.budget_draws) : 0),
       seed_(options.uncertainty.seed),
       parallel_(options.parallel ? options.parallel : sequential_for()) {
   const Measurement& m = a.measurement;
@@ -273,8 +313,13 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
                                                  : uncertainty::datasheet_covariance(run.meta.sensors, m.fs_hz);
   in.sensor_noise_ug_per_rthz[0] = run.meta.sensors[0].noise_ug_per_rthz;
   in.sensor_noise_ug_per_rthz[1] = run.meta.sensors[1].noise_ug_per_rthz;
+  for (int s = 0; s < 2; ++s)
+    in.bias_walk_ug_per_rts[s] = run.meta.sensor_present[s] ? run.meta.sensors[s].bias_walk_ug_per_rts : 0.0;
   in.g_mps2 = run.meta.site.g_mps2;
   for (int j = 0; j < 3; ++j) in.owner[static_cast<std::size_t>(j)] = axis_owner(run.meta.machine, j);
+  in.psd = run.meta.psd;
+  if (m.rest_noise.measured())  // the axes' rms: the fusion's model is one density for all
+    in.rel_noise_ug_per_rthz = std::sqrt(m.rest_noise.density_ug_rthz.squaredNorm() / 3.0);
 
   // The schedule as the trace was actually fused: without the strips when they disagreed,
   // without any support when the fusion diverged (the trace stayed as integrated).
@@ -330,16 +375,23 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     a.uncertainty_note = std::string("the uncertainty was not estimated: ") + e.what();
     return;
   }
-  const DrawBases bases = evaluate_bases(run, a, std::exchange(nominal_, Measurement{}), q_, samples_);
-  const DrawOutcome drew = run_draws(run, a, *field, bases, draws_, seed_, parallel_, stop_above_, noise_);
+  const DrawBases bases = evaluate_bases(run, a, *field, std::exchange(nominal_, Measurement{}), q_, samples_, seed_);
+  std::vector<DrawnFigures> drawn;
+  const std::size_t used = run_draws(run, a, *field, bases, draws_, seed_, parallel_, stop_above_, noise_, drawn);
   noise_.clear();
-  assign_uncertainties(bases, drew.sums, drew.used, a);
-  a.uncertainty_draws = drew.used;
-  char note[200];
+  assign_uncertainties(bases, drawn, used, a);
+  if (budget_draws_ > 0) assign_budget(run, a, *field, bases, budget_draws_, seed_, parallel_, a);
+  a.uncertainty_draws = static_cast<int>(used);
+  a.uncertainty_shrink = bases.shrink;
+  const double datasheet = uncertainty::datasheet_relative_noise(run.meta.sensors);
+  if (auto flag = uncertainty::noise_disagreement(a.measurement.rest_noise, datasheet)) a.flags.push_back(*flag);
+  char note[640];
   std::snprintf(note, sizeof note,
-                "GUM, k = 2: %d Monte Carlo draws of the error field (noise and bias walk between the supports, sensor "
-                "model: %s, PSD strips), path at %.0f Hz",
-                drew.used, a.uncertainty_source.c_str(), a.measurement.fs_hz / static_cast<double>(q_));
+                "GUM, k = 2: %d Monte Carlo draws of the error field (%s; bias walk %.2f and %.2f µg/√s from the "
+                "data sheet; sensor model: %s; PSD strips, their offsets and nonlinearity), path at %.0f Hz",
+                a.uncertainty_draws, uncertainty::noise_source_text(a.measurement.rest_noise, datasheet).c_str(),
+                in_.bias_walk_ug_per_rts[0], in_.bias_walk_ug_per_rts[1], a.uncertainty_source.c_str(),
+                a.measurement.fs_hz / static_cast<double>(q_));
   a.uncertainty_note = note;
 }
 

@@ -1,23 +1,24 @@
 #pragma once
 // The expanded uncertainty (GUM, k = 2) of every figure of an analysis: Monte Carlo
 // propagation (GUM supplement 1) of the measurement's error field
-// (uncertainty/error_field.hpp: integration noise and bias walk between the supports, the
-// sensor model, the reference points) through the program's own evaluation.
+// (uncertainty/error_field.hpp: integration noise and bias walk between the supports as
+// measured at rest, the sensor model, the reference points) through the program's own
+// evaluation.
 //
-// Each draw adds one realisation of the error to the measured path (decimated to about
-// 1 kHz: the error is smooth and the figures do not need more) and evaluates the program
-// again; the figure's spread over the draws is its standard uncertainty u. Figures that
-// are not linear in the path (G = max − min, F, H, amplitudes, A, R) are biased by the
-// noise: a draw adds noise to a path that already has it, so the draws' mean exceeds the
-// measured value by about (√2 − 1) times the bias of the measured value against the truth
-// (the bias of a max or an amplitude grows with σ). Hence
-//   U = 2u + b/(√2 − 1),   b = |mean of the draws − value| less its Monte Carlo error,
-// which is 2u for a linear figure and covers the bias of a range where noise dominates.
-// The same draws are also added to the ideal path, the set-point, and evaluated: what the
-// error alone makes of a figure. For a range, an amplitude or a spread the error of the
-// figure is bounded by that (|f(t + e) − f(t)| ≤ f(e), a seminorm), whatever the machine:
-// its 95 % bound |mean| + 2·sd is a floor under U — where the error is itself a shape (a
-// scale mismatch drawing an ellipse) the plug-in alone would take it for the machine's.
+// Each draw adds one realisation of the error e to the truth's estimate t̂ (decimated to
+// about 1 kHz: the error is smooth and the figures do not need more) and evaluates the
+// program again; U of a figure is the 95th percentile of |f(t̂ + e) − f(t̂)| over the draws:
+// the distribution of the figure's error itself, no rule on top. t̂ shrinks the measured
+// path m towards the set-point s by as much of its shape as the error explains,
+// t̂ = s + λ (m − s), λ² = 1 − max‖e‖²/‖m − s‖² over 20 draws: figures that are not linear in the path (G =
+// max − min, F, H, A, R) are biased by the noise, by as much as the true shape leaves room
+// for — most on a flat path (λ = 0: f(e) itself, the bound |f(t + e) − f(t)| ≤ f(e) of a
+// range), least on a path whose shape towers over the noise (λ = 1: the plug-in).
+//
+// The same draws also give each figure's noise bound: the set-point with only the white
+// noise measured at rest, fused by the smoother whose model is that noise (the optimal
+// one) over the run's own supports — what this test could reach with a perfect sensor
+// model (Analysis::noise_bound_k2).
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/uncertainty/coarse_path.hpp"
 #include "dsp/uncertainty/error_field.hpp"
@@ -76,11 +77,9 @@ class UncertaintyTrace {
   std::size_t samples_ = 0, q_ = 1;
   int draws_ = 100;
   std::optional<AnalysisOptions::Uncertainty::StopAbove> stop_above_;
+  int budget_draws_ = 0;  // 0: no budget
   std::uint64_t seed_ = 0;
   ParallelFor parallel_;
 };
-
-// U from the draws' mean offset and spread (see above); n draws.
-double expanded_uncertainty(double mean_offset, double sd, int n);
 
 }  // namespace eical::dsp

@@ -24,6 +24,8 @@ void circle_figures(const Analysis& a, Out& o) {
   if (c.circular_hysteresis_H_um) o.scalar("circle.circular_hysteresis_H_um", *c.circular_hysteresis_H_um);
   o.scalar("circle.radial_deviation_F_max_um", c.radial_deviation_F_max_um);
   o.scalar("circle.radial_deviation_F_min_um", c.radial_deviation_F_min_um);
+  o.scalar("circle.averaged_revolution_G_ccw_um", c.direction_averaged_G_um[0]);
+  o.scalar("circle.averaged_revolution_G_cw_um", c.direction_averaged_G_um[1]);
   if (c.direction == "both") {
     o.scalar("circle.circular_deviation_G_ccw_um", direction_G_um(c, "ccw"));
     o.scalar("circle.circular_deviation_G_cw_um", direction_G_um(c, "cw"));

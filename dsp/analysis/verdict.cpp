@@ -1,7 +1,6 @@
 #include "dsp/analysis/verdict.hpp"
 
 #include "dsp/analysis/figures.hpp"
-#include "dsp/uncertainty/resolved.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -76,7 +75,7 @@ void judge(const Program& program, Analysis& a) {
       a.verdict_reasons.push_back("the figures' uncertainty was not estimated" +
                                   (a.uncertainty_note.empty() ? "" : ": " + a.uncertainty_note));
     } else {
-      const double uh = u_of(lim->headline), ul = u_of(lim->limited);
+      const double ul = u_of(lim->limited);
       if (!std::isfinite(ul) || ul > lim->limit) {
         not_measurable = true;
         a.verdict_reasons.push_back("U(" + std::string(lim->limited_name) +
@@ -84,20 +83,14 @@ void judge(const Program& program, Analysis& a) {
                                     " exceeds the " + num(lim->limit, lim->unit) + " a " + program.kind +
                                     " test is meant to resolve");
       }
-      if (!uncertainty::resolved(h->values[0], uh)) {
-        not_measurable = true;
-        a.verdict_reasons.push_back(
-            std::string(lim->name) + " = " + num(h->values[0], lim->unit) +
-            " is not above its uncertainty U = " + (std::isfinite(uh) ? num(uh, lim->unit) : std::string("unknown")));
-      }
     }
   }
   if (not_measurable)
-    a.verdict = "not_measurable";
+    a.verdict = Verdict::not_measurable;
   else if (a.degraded || (lim && !a.verdict_reasons.empty()))
-    a.verdict = "degraded";
+    a.verdict = Verdict::degraded;
   else
-    a.verdict = "ok";
+    a.verdict = Verdict::ok;
   if (a.degraded)
     for (const auto& f : a.flags)
       if (flag_severity(f) == FlagSeverity::critical && !starts_with(f, kPositionNullFlag))
@@ -116,7 +109,7 @@ FlagSeverity flag_severity(const std::string& flag) {
   if (starts_with(flag, "positioning: ") && flag.find("outside the standard") == std::string::npos)
     return FlagSeverity::critical;
   // It limits the measurement.
-  for (const char* p : {"no_start_trigger", "no_end_trigger", "short_rest_window", "no_zupt_window"})
+  for (const char* p : {"no_start_trigger", "no_end_trigger", "short_rest_window", "no_zupt_window", "noise_density"})
     if (starts_with(flag, p)) return FlagSeverity::warning;
   if (flag.find("outside the standard") != std::string::npos || flag.find("runs both directions") != std::string::npos)
     return FlagSeverity::warning;

@@ -1,10 +1,13 @@
 #pragma once
-// quality.verdict of a result (shared/spec/results.md):
-//   not_measurable  the program's headline figure is not above its uncertainty, or that
-//                   uncertainty exceeds what the test is meant to resolve (the table below);
+// quality.verdict of a result (verdict_kind.hpp):
+//   not_measurable  the uncertainty of the program's limited figure exceeds what the test
+//                   is meant to resolve (the table below), or nothing holds the position;
 //   degraded        a quality flag (lost frames, saturation, the strips disagreeing, ...);
 //   ok              otherwise.
-// The figures are given in every case, with their uncertainty.
+// The figures are given in every case, with their uncertainty. A figure below its own U is
+// a result, not a failure of the measurement: |truth| <= |value| + U (k = 2) bounds it, and
+// a good machine measured well has exactly such figures. Whether a figure meets a
+// tolerance is a separate decision, ISO 14253-1's (conformance.hpp).
 //
 // What each program is meant to resolve (README "Verdict"): a circular test is a
 // ballbar-class test of G, a positioning test an interferometer-class test of A, a step

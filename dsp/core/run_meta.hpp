@@ -50,6 +50,10 @@ struct SensorSpec {
   // (ch. 8.3.1); 0 on the data sheet, found by eical explain (written when set).
   double zeta_per_g = 0.0;
   double noise_ug_per_rthz = 0.4;
+  // Bias random walk (6-5, 6-6), µg/√s: the SF3000L's units walk by 0.12–0.3, the rms of
+  // that range. The uncertainty's draws integrate it (error_field.hpp); a sensor whose data
+  // sheet or identification says otherwise sets it (run.toml [sensors.*]).
+  double bias_walk_ug_per_rts = 0.22;
   double temp_ref_c = 20.0;
 };
 

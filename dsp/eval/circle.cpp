@@ -146,6 +146,17 @@ CircleResult CircleAccumulator::result() const {
   r.circular_deviation_G_um = dmax_ - dmin_;
   const std::size_t d = r.direction == "cw" ? 1 : 0;
   r.direction_F_max_um[d] = dmax_, r.direction_F_min_um[d] = dmin_;
+  if (o_.arc_deg >= 360.0 && r.revolutions >= 2) {
+    double hi = -kInf, lo = kInf;
+    bool every_degree = true;
+    for (std::size_t k = 0; k < 360; ++k) {
+      if (!(r.points_by_deg[k] > 0.0)) every_degree = false;
+      if (!every_degree) break;
+      const double mean = r.deviation_sum_by_deg[k] / r.points_by_deg[k];
+      hi = std::max(hi, mean), lo = std::min(lo, mean);
+    }
+    if (every_degree) r.direction_averaged_G_um[d] = hi - lo;
+  }
   return r;
 }
 
@@ -186,9 +197,12 @@ CircleResult combine(const CircleResult& a, const CircleResult& b) {
   c.radial_deviation_F_max_um = std::max(a.radial_deviation_F_max_um, b.radial_deviation_F_max_um);
   c.radial_deviation_F_min_um = std::min(a.radial_deviation_F_min_um, b.radial_deviation_F_min_um);
   c.circular_deviation_G_um = c.radial_deviation_F_max_um - c.radial_deviation_F_min_um;
-  for (std::size_t d = 0; d < 2; ++d)
+  for (std::size_t d = 0; d < 2; ++d) {
     c.direction_F_max_um[d] = std::max(a.direction_F_max_um[d], b.direction_F_max_um[d]),
     c.direction_F_min_um[d] = std::min(a.direction_F_min_um[d], b.direction_F_min_um[d]);
+    c.direction_averaged_G_um[d] =
+        std::isfinite(a.direction_averaged_G_um[d]) ? a.direction_averaged_G_um[d] : b.direction_averaged_G_um[d];
+  }
   c.centers_mm.insert(c.centers_mm.end(), b.centers_mm.begin(), b.centers_mm.end());
   c.radii_mm.insert(c.radii_mm.end(), b.radii_mm.begin(), b.radii_mm.end());
   auto append = [](auto& dst, const auto& src) { dst.insert(dst.end(), src.begin(), src.end()); };

@@ -67,6 +67,12 @@ struct CircleResult {
   std::array<double, 2> direction_F_max_um{-kInf, -kInf}, direction_F_min_um{kInf, kInf};
   // Sum and count of the radius deviations per 1° of angle (H of combine()).
   std::array<double, 360> deviation_sum_by_deg{}, points_by_deg{};
+  // G of the averaged revolution of each direction (counter-clockwise, clockwise): max −
+  // min over 1° of the mean radius deviation of its revolutions. The machine's shape
+  // repeats each revolution, the noise does not: with N revolutions its share falls as
+  // 1/√N, where ISO 230-4's G over all revolutions keeps the worst of them. NaN: fewer
+  // than two full revolutions in that direction, or a degree no revolution crossed.
+  std::array<double, 2> direction_averaged_G_um{kNaN, kNaN};
 };
 
 // Geometric least-squares circle (Kasa algebraic start, Gauss–Newton on the distances).

@@ -93,4 +93,24 @@ CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& 
   return d;
 }
 
+std::vector<std::string> null_reasons(const CircleDiagnostics& d, const DiagnosticsOptions& options) {
+  std::vector<std::string> out;
+  if (!d.servo_and_squareness_separated)
+    out.emplace_back(
+        "diagnostics.servo_mismatch_ms: null, one direction cannot separate servo mismatch from squareness "
+        "(squareness assumes equal lags)");
+  const std::string creep = std::to_string(static_cast<long>(options.creep_feed_mm_min)) + " mm/min";
+  if (std::isnan(d.stick_slip_um))
+    out.push_back("diagnostics.stick_slip_um: null, not evaluated above the creep feed (" + creep +
+                  "): the fast residual there is vibration");
+  if (std::isnan(d.vibration_um))
+    out.push_back("diagnostics.vibration_um: null, not evaluated at creep feed (at most " + creep +
+                  "): the fast residual there is stick-slip");
+  if (std::isnan(d.reversal_spike_x_um))
+    out.emplace_back("diagnostics.reversal_spike_x_um: null, the first axis never reverses in this test");
+  if (std::isnan(d.reversal_spike_y_um))
+    out.emplace_back("diagnostics.reversal_spike_y_um: null, the second axis never reverses in this test");
+  return out;
+}
+
 }  // namespace eical::dsp::eval

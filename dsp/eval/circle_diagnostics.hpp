@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -51,8 +52,11 @@ struct DiagnosticsOptions {
 };
 
 struct CircleDiagnostics {
+  static constexpr double kNotEvaluated = std::numeric_limits<double>::quiet_NaN();
   double backlash_x_um = 0, backlash_y_um = 0;
-  double reversal_spike_x_um = 0, reversal_spike_y_um = 0;  // positive: the axis lags after reversing
+  // NaN: not evaluated (no reversal of that axis; the other regime's fast residual), never
+  // a 0 that reads as a measured size.
+  double reversal_spike_x_um = kNotEvaluated, reversal_spike_y_um = kNotEvaluated;  // positive: the axis lags
   double lateral_play_x_um = 0, lateral_play_y_um = 0;
   double cyclic_error_x_um = 0, cyclic_error_y_um = 0;  // amplitude
   double cyclic_pitch_mm = 0;
@@ -60,14 +64,19 @@ struct CircleDiagnostics {
   double squareness_urad = 0;
   double scale_mismatch_ppm = 0;
   double straightness_x_um = 0, straightness_y_um = 0;  // bow of the axis' path at mid-travel vs its ends
-  double stick_slip_um =
-      0;  // creep feed only: peak-to-peak lag per axis, 2√3 × the fast residual RMS (sawtooth/triangle)
-  double vibration_um = 0;            // above the creep feed: radial residual RMS above the model (fast components)
-  double lag_x_ms = 0, lag_y_ms = 0;  // each axis' lag behind the set-point (common servo lag)
-  double residual_rms_um = 0;         // what the model leaves
+  // Creep feed only: peak-to-peak lag per axis, 2√3 × the fast residual RMS (sawtooth/triangle).
+  double stick_slip_um = kNotEvaluated;
+  double vibration_um = kNotEvaluated;  // above the creep feed: radial residual RMS above the model (fast components)
+  double lag_x_ms = 0, lag_y_ms = 0;    // each axis' lag behind the set-point (common servo lag)
+  double residual_rms_um = 0;           // what the model leaves
   bool servo_and_squareness_separated = false;  // needs both directions
   std::vector<std::string> notes;
 };
+
+// Why each diagnostic the fit left out is null, as result flags ("diagnostics.<key>: null,
+// <reason>"): servo mismatch from one direction, stick-slip above the creep feed,
+// vibration at it, a reversal spike of an axis that never reversed.
+std::vector<std::string> null_reasons(const CircleDiagnostics& d, const DiagnosticsOptions& options);
 
 // Throws InputError when the passes are empty, mismatched or do not go round.
 CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& options);

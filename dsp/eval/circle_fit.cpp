@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace eical::dsp::eval::diagnostics_fit {
 
@@ -185,8 +186,10 @@ void report_fit(const AxisFits& fits, double pitch_mm, bool both_directions, Cir
 
 // Reversal spikes, the fast residual (stick-slip at creep feed, else vibration) and the fit's RMS.
 void report_residuals(const ResidualSums& s, const DiagnosticsOptions& opt, CircleDiagnostics& d) {
-  d.reversal_spike_x_um = s.spike_count[0] > 0 ? s.spike_sum[0] / s.spike_count[0] * kUmPerMm : 0.0;
-  d.reversal_spike_y_um = s.spike_count[1] > 0 ? s.spike_sum[1] / s.spike_count[1] * kUmPerMm : 0.0;
+  d.reversal_spike_x_um =
+      s.spike_count[0] > 0 ? s.spike_sum[0] / s.spike_count[0] * kUmPerMm : CircleDiagnostics::kNotEvaluated;
+  d.reversal_spike_y_um =
+      s.spike_count[1] > 0 ? s.spike_sum[1] / s.spike_count[1] * kUmPerMm : CircleDiagnostics::kNotEvaluated;
   if (s.n > 0) {
     if (opt.feed_mm_min > 0.0 && opt.feed_mm_min <= opt.creep_feed_mm_min) {
       // Creep feed: the fast residual of each axis is its slide sticking and slipping — a
@@ -196,9 +199,16 @@ void report_residuals(const ResidualSums& s, const DiagnosticsOptions& opt, Circ
                    ay = std::sqrt(s.ss_axis[1] / static_cast<double>(s.n));
       d.stick_slip_um = 2.0 * std::sqrt(3.0) * std::max(ax, ay) * kUmPerMm;
       d.notes.push_back(
-          "creep feed: the fast residual is reported as stick-slip (its mean lag also reads as backlash)");
+          "creep feed: the fast residual is reported as stick-slip (its mean lag also reads as backlash); vibration "
+          "is not evaluated at creep feed");
     } else {
       d.vibration_um = std::sqrt(s.ss_rad / static_cast<double>(s.n)) * kUmPerMm;
+      char note[160];
+      std::snprintf(note, sizeof note,
+                    "above the creep feed the fast residual is vibration: stick-slip is not evaluated (a test at "
+                    "%.0f mm/min or less shows it)",
+                    opt.creep_feed_mm_min);
+      d.notes.emplace_back(note);
     }
   }
   const double rms_x = s.n_fit[0] > 0 ? std::sqrt(s.ss_fit[0] / static_cast<double>(s.n_fit[0])) : 0.0;

@@ -54,7 +54,10 @@ std::vector<std::string> quality_flag_names(std::uint32_t bits) {
 }
 
 Pipeline::Pipeline(const PipelineConfig& config)
-    : config_(config), fixed_(config.arithmetic == Arithmetic::fixed_q), dt_s_(1.0 / config.acquisition.fs_hz) {
+    : config_(config),
+      fixed_(config.arithmetic == Arithmetic::fixed_q),
+      dt_s_(1.0 / config.acquisition.fs_hz),
+      rest_noise_(config.acquisition.fs_hz, config.site.g_mps2) {
   if (fixed_ && config.coriolis)
     throw InputError("pipeline: the fixed-point path has no Coriolis term; use double arithmetic");
   if (fixed_ && (config.sensors[0].zeta_per_g != 0.0 || config.sensors[1].zeta_per_g != 0.0))
@@ -123,6 +126,8 @@ void Pipeline::reset() noexcept {
     for (int i = 0; i < 3; ++i) aq_[s][i] = last_valid_aq_[s][i] = fbias_[s][i] = 0, fbias_sum_[s][i] = 0;
   }
   start_index_ = motion_end_index_ = -1;
+  rest_noise_.reset();
+  still_since_ = -1;
   stored_ = 0;
   first_stored_ = -1;
   live_ = LiveEstimate{};
@@ -302,7 +307,8 @@ void Pipeline::rest_sample() noexcept {
     }
   }
   ++bias_n_;
-  const Eigen::Vector3d rel = fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]);
+  const Eigen::Vector3d rel = relative_acceleration();
+  rest_noise_.sample(rel);
   if (runs_supports()) supports_.rest_sample(rel);
   if (config_.keep_raw && m_.raw.rest_rel_mps2.size() < config_.capacity_samples)
     m_.raw.rest_rel_mps2.push_back(rel);  // within the reserve
@@ -311,6 +317,8 @@ void Pipeline::rest_sample() noexcept {
 // The set-point moved: the bias is fixed, the integration starts at the commanded position.
 void Pipeline::begin_motion(const Frame& f, const FrameStep& fs) noexcept {
   start_motion();
+  rest_noise_.gap();
+  still_since_ = f.sample_index;
   if (runs_supports()) supports_.start();
   // The programs dwell 0.1 s after M101; a trigger that reaches the DAQ clock a few
   // samples late must not flag a good rest.
@@ -328,8 +336,23 @@ void Pipeline::begin_motion(const Frame& f, const FrameStep& fs) noexcept {
 }
 
 // In motion: integrate, fuse with the supports, publish the live estimate, store.
+Eigen::Vector3d Pipeline::relative_acceleration() const noexcept {
+  return fixed_ ? Eigen::Vector3d(bias_free(1) - bias_free(0)) : Eigen::Vector3d(a_[1] - a_[0]);
+}
+
+void Pipeline::note_stillness(const Frame& f, const FrameStep& fs) noexcept {
+  // A stop counts once the servo has settled and the DAQ's delay has passed: 0.25 s after
+  // the set-point's last move (a settling lag of a few µm is hundreds of µg at first).
+  constexpr double kSettleS = 0.25;
+  if (fs.cmd_moved || still_since_ < 0) still_since_ = f.sample_index;
+  const bool settled = static_cast<double>(f.sample_index - still_since_) * dt_s_ >= kSettleS;
+  if (!settled || !fs.accel_valid || fs.k_samples != 1) return rest_noise_.gap();
+  rest_noise_.sample(relative_acceleration());
+}
+
 void Pipeline::moving_sample(const Frame& f, const FrameStep& fs) noexcept {
   if (fs.cmd_moved) motion_end_index_ = f.sample_index;
+  note_stillness(f, fs);
   Eigen::Vector3d pos_m, vel_mps;
   integrate(fs.k_samples, fs.dt_s, pos_m, vel_mps);
   const Eigen::Vector3d pos_mm = start_pos_mm_ + pos_m * 1000.0;
@@ -418,6 +441,7 @@ Measurement Pipeline::finish() {
   m.start_index = start_index_;
   m.motion_end_index = motion_end_index_;
   if (phase_ != Phase::moving) quality_ |= quality_flag::no_motion;
+  m.rest_noise = rest_noise_.result();
 
   // Supports in the sensors' time base (the PSD channels are delayed like the sensors),
   // then onto the set-point's time. DynamicComp::none leaves the DAQ delay in as well
@@ -449,6 +473,7 @@ Pipeline::Tracked Pipeline::finish_track(fusion::SegmentSink* sink) {
   m.start_index = start_index_;
   m.motion_end_index = motion_end_index_;
   if (phase_ != Phase::moving) quality_ |= quality_flag::no_motion;
+  m.rest_noise = rest_noise_.result();
   t.samples = stored_;
   if (phase_ == Phase::moving && stored_ > 0) {
     const std::int64_t first = first_stored_;

@@ -23,6 +23,7 @@
 #include "dsp/pipeline/dynamic_comp.hpp"
 #include "dsp/pipeline/fixed_integrator.hpp"
 #include "dsp/pipeline/fixed_static_comp.hpp"
+#include "dsp/pipeline/rest_noise.hpp"
 #include "dsp/pipeline/sensor_integrator.hpp"
 #include "dsp/pipeline/static_comp.hpp"
 #include "dsp/pipeline/support_stage.hpp"
@@ -172,6 +173,9 @@ struct Measurement {
   // last finite ones), what the uncertainty reads from the frames otherwise.
   std::vector<Eigen::Vector2d> temp_c;
   SupportSummary supports;
+  // The relative acceleration's white noise measured where the machine stood still (the
+  // rest before the motion and every settled stop of the set-point): rest_noise.hpp.
+  RestNoise rest_noise;
   RawTrace raw;  // only with PipelineConfig::keep_raw
 };
 
@@ -228,6 +232,9 @@ class Pipeline {
   void rest_sample() noexcept;
   void begin_motion(const Frame& f, const FrameStep& fs) noexcept;
   void moving_sample(const Frame& f, const FrameStep& fs) noexcept;
+  // The quiet samples for the noise measurement (a settled stop of the set-point).
+  void note_stillness(const Frame& f, const FrameStep& fs) noexcept;
+  [[nodiscard]] Eigen::Vector3d relative_acceleration() const noexcept;
 
   PipelineConfig config_;
   bool fixed_ = false;
@@ -259,6 +266,8 @@ class Pipeline {
   std::size_t bias_n_ = 0;
   Eigen::Vector3d bias_[2];
   Eigen::Vector3d start_pos_mm_ = Eigen::Vector3d::Zero();
+  RestNoiseMeter rest_noise_;
+  std::int64_t still_since_ = -1;  // sample index of the set-point's last move
   std::int64_t start_index_ = -1, motion_end_index_ = -1;
   LiveEstimate live_;
   Measurement m_;                   // trace storage, reserved in the constructor

@@ -194,10 +194,7 @@ void CircleStream::finish(Analysis& a) {
   opt.feed_mm_min = p.feed_mm_min;
   try {
     a.diagnostics = eval::diagnose_circle(passes, opt);
-    if (!a.diagnostics->servo_and_squareness_separated)
-      a.flags.push_back(
-          "diagnostics.servo_mismatch_ms: null, one direction cannot separate servo mismatch from squareness "
-          "(squareness assumes equal lags)");
+    for (auto& reason : eval::null_reasons(*a.diagnostics, opt)) a.flags.push_back(std::move(reason));
   } catch (const InputError& e) {
     a.flags.push_back(std::string("diagnostics: null, ") + e.what());
   }

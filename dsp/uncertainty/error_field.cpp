@@ -42,15 +42,17 @@ V at(const std::vector<V>& x, double pos) {
   return (1.0 - f) * x[i] + f * x[i + 1];
 }
 
-// The truth the noise draws simulate: the data sheet's noise (with its spread) and bias
-// walk, where they exceed the fusion model's.
+// The truth the noise draws simulate: the white noise measured at rest (the data sheet's
+// where the run has no quiet stretch to measure it in) and the data sheet's bias walk,
+// whatever the fusion's model assumes (a model that assumes less is judged by what it
+// then misses, one that assumes more by what its caution costs). 1 µg = g µm/s².
 fusion::ErrorModel simulated_truth(const fusion::ErrorModel& coarse_model, const ErrorFieldInput& in) {
   fusion::ErrorModel truth = coarse_model;
-  const double per_sensor = in.noise.bias_walk_ug_per_rts * 1e-6 * in.g_mps2 * 1e6;  // µm/s²/√s
-  truth.bias_walk_um_s2_rts = std::max(in.model.bias_walk_um_s2_rts, std::sqrt(2.0) * per_sensor);
-  truth.accel_noise_um_s2_rthz = std::max(
-      in.model.accel_noise_um_s2_rthz,
-      in.noise.noise_factor * std::hypot(in.sensor_noise_ug_per_rthz[0], in.sensor_noise_ug_per_rthz[1]) * in.g_mps2);
+  truth.bias_walk_um_s2_rts = std::hypot(in.bias_walk_ug_per_rts[0], in.bias_walk_ug_per_rts[1]) * in.g_mps2;
+  const double rel_ug = std::isfinite(in.rel_noise_ug_per_rthz)
+                            ? in.rel_noise_ug_per_rthz
+                            : std::hypot(in.sensor_noise_ug_per_rthz[0], in.sensor_noise_ug_per_rthz[1]);
+  truth.accel_noise_um_s2_rthz = rel_ug * in.g_mps2;
   return truth;
 }
 
@@ -67,12 +69,16 @@ struct Responder {
   const ErrorFieldInput& in;
 
   // dx, dv: the error's position and velocity per coarse sample; strip: the one strip that
-  // reads 1 µm (−1: none); unit: the parameter's value that made them.
+  // reads 1 µm (−1: none), or what `fix_error_um` says each fix of it reads; unit: the
+  // parameter's value that made them.
   std::vector<Eigen::Vector3d> operator()(const std::vector<Eigen::Vector3d>& dx_mm,
-                                          const std::vector<Eigen::Vector3d>& dv_mm_s, int strip, double unit) const {
+                                          const std::vector<Eigen::Vector3d>& dv_mm_s, int strip, double unit,
+                                          double (*fix_error_um)(const fusion::PositionFix&, const PsdSpec&) = nullptr,
+                                          const PsdSpec* spec = nullptr) const {
     const std::size_t nc = coarse.sample_index.size();
     fusion::SupportSchedule sched = coarse.schedule;
-    for (auto& f : sched.fixes) f.position_um = f.strip == strip ? 1.0 : 0.0;
+    for (auto& f : sched.fixes)
+      f.position_um = f.strip != strip ? 0.0 : fix_error_um && spec ? fix_error_um(f, *spec) : 1.0;
     for (auto& m : sched.velocity_means) {
       const Eigen::Vector3d vm = dv_mm_s[m.k] * 1000.0;
       for (int i = 0; i < 3; ++i) m.mean_um_s[i] = vm[i];
@@ -134,6 +140,33 @@ std::vector<Eigen::Vector3d> temperature_response(const Responder& respond, cons
   return respond(dx, dv, -1, 1.0);
 }
 
+// What a strip's nonlinearity of 1 makes a fix read too far, µm: u·(2u/L)² at the spot's
+// place u on the strip (sim/psd: u_meas = u (1 + nl (2u/L)²)).
+double nonlinearity_error_um(const fusion::PositionFix& f, const PsdSpec& spec) {
+  const int axis = spec.measures == "y" ? 1 : 0;
+  const double half_mm = 0.5 * spec.length_mm;
+  const double u_mm = std::clamp(f.position_um / 1000.0 - spec.center_mm[axis], -half_mm, half_mm);
+  const double r = u_mm / half_mm;
+  return u_mm * r * r * 1000.0;
+}
+
+// Per strip of the run with fixes: its nonlinearity's response, per unit nl.
+std::vector<std::vector<Eigen::Vector3d>> strip_nonlinearity_responses(const Responder& respond,
+                                                                       const std::vector<PsdSpec>& psd) {
+  const std::size_t nc = respond.coarse.sample_index.size();
+  const std::vector<Eigen::Vector3d> zero(nc, Eigen::Vector3d::Zero());
+  std::set<int> strips;
+  for (const auto& f : respond.coarse.schedule.fixes) strips.insert(f.strip);
+  std::vector<std::vector<Eigen::Vector3d>> response;
+  for (int s : strips) {
+    if (s < 0 || static_cast<std::size_t>(s) >= psd.size()) continue;
+    if (response.size() <= static_cast<std::size_t>(s)) response.resize(static_cast<std::size_t>(s) + 1);
+    response[static_cast<std::size_t>(s)] =
+        respond(zero, zero, s, 1.0, &nonlinearity_error_um, &psd[static_cast<std::size_t>(s)]);
+  }
+  return response;
+}
+
 // Per PSD strip of the fixes: the strip reads 1 µm too far, the (error-free) trace is
 // pulled towards it.
 std::vector<std::vector<Eigen::Vector3d>> strip_responses(const Responder& respond) {
@@ -150,24 +183,39 @@ std::vector<std::vector<Eigen::Vector3d>> strip_responses(const Responder& respo
   return response;
 }
 
-// One realisation of the integration's error after the pipeline's smoother (per coarse
-// sample, µm): the error simulated with the truth model, the supports' observations of it
-// with their own errors, the smoother with the pipeline's model subtracting its estimate.
-std::vector<Eigen::Vector3d> noise_draw(const CoarseSchedule& coarse, const ErrorFieldInput& input,
-                                        std::mt19937_64& rng) {
-  const fusion::ErrorModel truth = simulated_truth(coarse.model, input);
+// Whether the schedule flags the first move's start itself (the standstill detector still
+// sees the rest for the DAQ's delay after the set-point moved): then that step is drawn
+// there, not also in the start's bias (it was counted twice).
+bool first_move_flagged(const std::vector<std::uint8_t>& flags) {
+  namespace sf = fusion::schedule_flag;
+  for (const std::uint8_t f : flags) {
+    if (f & sf::move_start) return true;
+    if (!(f & sf::rest)) return false;
+  }
+  return false;
+}
+
+// One realisation of the integration's error after a smoother (per coarse sample, µm): the
+// error simulated with the `truth` model, the supports' observations of it with their own
+// errors, the smoother with `fused` (the pipeline's model, or the truth itself for the
+// bound) subtracting its estimate. `own_fix_sigma`: the smoother weighs each strip fix by
+// the strip's own noise only (the bound; the pipeline adds the sensor model's share).
+std::vector<Eigen::Vector3d> integration_error_draw(const CoarseSchedule& coarse, const ErrorFieldInput& input,
+                                                    const fusion::ErrorModel& truth, const fusion::ErrorModel& fused,
+                                                    bool own_fix_sigma, std::mt19937_64& rng) {
   const double fs_hz = input.fs_hz;
   const Eigen::Vector3d& start_bias_sigma = input.start_bias_sigma_um_s2;
   namespace sf = fusion::schedule_flag;
   std::normal_distribution<double> g;
   const std::size_t nc = coarse.sample_index.size();
   const auto& flags = coarse.schedule.flags;
+  const double start_step_um_s2 = first_move_flagged(flags) ? 0.0 : truth.bias_step_um_s2;
   std::vector<Eigen::Vector3d> ex(nc), ev(nc), eb(nc);
   const fusion::Mat3 p0 = fusion::initial_covariance(truth, 0.0);
   for (int a = 0; a < 3; ++a) {
     // Drawn one by one, the bias first (see below: a call's arguments have no order).
     const double z_bias = g(rng), z_vel = g(rng);
-    fusion::Vec3 e(0.0, std::sqrt(p0(1, 1)) * z_vel, std::hypot(start_bias_sigma[a], truth.bias_step_um_s2) * z_bias);
+    fusion::Vec3 e(0.0, std::sqrt(p0(1, 1)) * z_vel, std::hypot(start_bias_sigma[a], start_step_um_s2) * z_bias);
     fusion::Discrete d;
     std::int64_t last_gap = 0;
     Eigen::LLT<fusion::Mat3> llt;
@@ -183,8 +231,8 @@ std::vector<Eigen::Vector3d> noise_draw(const CoarseSchedule& coarse, const Erro
         // arguments of a call have no order, and another compiler would draw another field.
         const double w2 = g(rng), w1 = g(rng), w0 = g(rng);
         e = d.F * e + llt.matrixL() * fusion::Vec3(w0, w1, w2);
-        if (flags[k] & sf::move_start) e[2] += truth.bias_step_um_s2 * g(rng);
       }
+      if ((flags[k] & sf::move_start) && truth.bias_step_um_s2 > 0.0) e[2] += truth.bias_step_um_s2 * g(rng);
       ex[k][a] = e[0], ev[k][a] = e[1], eb[k][a] = e[2];
     }
   }
@@ -200,7 +248,11 @@ std::vector<Eigen::Vector3d> noise_draw(const CoarseSchedule& coarse, const Erro
     vel[k] = v / 1000.0;
   }
   fusion::SupportSchedule sched = coarse.schedule;
-  for (std::size_t i = 0; i < sched.fixes.size(); ++i) sched.fixes[i].position_um = coarse.fix_noise_um[i] * g(rng);
+  for (std::size_t i = 0; i < sched.fixes.size(); ++i) {
+    sched.fixes[i].position_um = coarse.fix_noise_um[i] * g(rng);
+    if (own_fix_sigma)
+      sched.fixes[i].sigma_um = std::max(coarse.fix_noise_um[i], 1e-6), sched.fixes[i].model_sigma_um = 0.0;
+  }
   for (auto& m : sched.velocity_means)
     for (int a = 0; a < 3; ++a) m.mean_um_s[a] = ev[m.k][a] - m.lag_s * eb[m.k][a] + m.sigma_um_s * g(rng);
   fusion::SmootherInput si;
@@ -209,12 +261,17 @@ std::vector<Eigen::Vector3d> noise_draw(const CoarseSchedule& coarse, const Erro
   si.pos_mm = &pos;
   si.schedule = &sched;
   si.fs_hz = fs_hz;
-  si.model = coarse.model;
+  si.model = fused;
   si.start_bias_sigma_um_s2 = start_bias_sigma;
   const fusion::SmootherOutput out = fusion::smooth(si);
   std::vector<Eigen::Vector3d> r(nc);
   for (std::size_t k = 0; k < nc; ++k) r[k] = ex[k] - out.dx_um[k];
   return r;
+}
+
+std::vector<Eigen::Vector3d> noise_draw(const CoarseSchedule& coarse, const ErrorFieldInput& input,
+                                        std::mt19937_64& rng) {
+  return integration_error_draw(coarse, input, simulated_truth(coarse.model, input), coarse.model, false, rng);
 }
 
 }  // namespace
@@ -262,8 +319,25 @@ void ErrorField::build(const ErrorFieldInput& input, const CoarsePath& path) {
   response_timing_ = timing_response(respond, path);
   if (!path.temp_c.empty())
     for (int s = 0; s < 2; ++s) response_tc_[static_cast<std::size_t>(s)] = temperature_response(respond, path, s);
-  if (coarse_.schedule.cupt) response_strip_ = strip_responses(respond);
+  if (coarse_.schedule.cupt) {
+    response_strip_ = strip_responses(respond);
+    if (input.psd_nonlinearity > 0.0) response_strip_nl_ = strip_nonlinearity_responses(respond, input.psd);
+  }
   model_factor_ = draw_factor(input.model_covariance.covariance);
+}
+
+std::vector<Eigen::Vector3d> draw_noise_bound(const ErrorFieldInput& input, const CoarseSchedule& coarse,
+                                              std::mt19937_64& rng) {
+  fusion::ErrorModel truth = simulated_truth(coarse.model, input);
+  truth.bias_walk_um_s2_rts = 0.0, truth.bias_step_um_s2 = 0.0;
+  return integration_error_draw(coarse, input, truth, truth, true, rng);
+}
+
+void ErrorField::draw_bound(std::mt19937_64& rng, const std::vector<double>& at_pos,
+                            std::vector<Eigen::Vector3d>& error_um) const {
+  const std::vector<Eigen::Vector3d> e = draw_noise_bound(input_, coarse_, rng);
+  error_um.resize(at_pos.size());
+  for (std::size_t k = 0; k < at_pos.size(); ++k) error_um[k] = at(e, coarse_position(at_pos[k]));
 }
 
 NoiseDraw draw_noise(const ErrorFieldInput& input, const CoarseSchedule& coarse, std::mt19937_64 rng) {
@@ -282,38 +356,63 @@ void ErrorField::draw(std::mt19937_64& rng, const std::vector<double>& at_pos,
 
 void ErrorField::draw(NoiseDraw drawn, const std::vector<double>& at_pos,
                       std::vector<Eigen::Vector3d>& error_um) const {
-  std::mt19937_64& rng = drawn.rng;
-  const std::vector<Eigen::Vector3d>& noise = drawn.error_um;
+  error_um.resize(at_pos.size());
+  for (std::size_t e = 0; e < at_pos.size(); ++e) error_um[e] = at(drawn.error_um, coarse_position(at_pos[e]));
+  add_model(drawn.rng, at_pos, SourceMask{}, error_um);
+}
+
+void ErrorField::draw(std::mt19937_64& rng, const std::vector<double>& at_pos, std::vector<Eigen::Vector3d>& error_um,
+                      SourceMask mask) const {
+  error_um.assign(at_pos.size(), Eigen::Vector3d::Zero());
+  if (mask.has(ErrorSource::integration)) {
+    const std::vector<Eigen::Vector3d> noise = noise_draw(coarse_, input_, rng);
+    for (std::size_t e = 0; e < at_pos.size(); ++e) error_um[e] = at(noise, coarse_position(at_pos[e]));
+  }
+  add_model(rng, at_pos, mask, error_um);
+}
+
+// The sensor model's and the strips' share of a draw, added to `error_um` (the parameters
+// are drawn whatever the mask, so a source's draws are the same with or without the others).
+void ErrorField::add_model(std::mt19937_64& rng, const std::vector<double>& at_pos, SourceMask mask,
+                           std::vector<Eigen::Vector3d>& error_um) const {
   std::normal_distribution<double> g;
   Eigen::VectorXd z(kModelParameters);
   for (int i = 0; i < kModelParameters; ++i) z[i] = g(rng);
   const Eigen::VectorXd theta = model_factor_ * z;
   std::vector<double> offsets(response_strip_.size());
   for (auto& o : offsets) o = strip_sigma_um_ * g(rng);
-
-  error_um.resize(at_pos.size());
+  std::uniform_real_distribution<double> nl_of(-input_.psd_nonlinearity, input_.psd_nonlinearity);
+  std::vector<double> nl(response_strip_nl_.size());
+  for (auto& x : nl) x = nl_of(rng);
+  const bool scale = mask.has(ErrorSource::sensor_scale), timing = mask.has(ErrorSource::sensor_timing),
+             temperature = mask.has(ErrorSource::temperature), strip = mask.has(ErrorSource::strip_offset),
+             strip_nl = mask.has(ErrorSource::strip_nonlinearity);
   for (std::size_t e = 0; e < at_pos.size(); ++e) {
     const double c = coarse_position(at_pos[e]);
-    Eigen::Vector3d err = at(noise, c);
-    for (int j = 0; j < 3; ++j) {
+    Eigen::Vector3d err = Eigen::Vector3d::Zero();
+    for (int j = 0; j < 3 && scale; ++j) {
       const auto ju = static_cast<std::size_t>(j);
       if (!column_moves_[ju]) continue;
       const Eigen::Vector3d r = at(response_e_[ju], c);
       for (int i = 0; i < 3; ++i) err[i] += theta[error_index(owner_[ju], i, j)] * r[i];
     }
-    const Eigen::Vector3d rt = at(response_timing_, c);
-    for (int i = 0; i < 3; ++i) {
-      const int s = owner_[static_cast<std::size_t>(i)];
-      err[i] += ((s >= 0 ? theta[damping_index(s)] : 0.0) + theta[kDelayIndex]) * rt[i];
+    if (timing) {
+      const Eigen::Vector3d rt = at(response_timing_, c);
+      for (int i = 0; i < 3; ++i) {
+        const int s = owner_[static_cast<std::size_t>(i)];
+        err[i] += ((s >= 0 ? theta[damping_index(s)] : 0.0) + theta[kDelayIndex]) * rt[i];
+      }
     }
-    for (int s = 0; s < 2; ++s) {
+    for (int s = 0; s < 2 && temperature; ++s) {
       if (response_tc_[static_cast<std::size_t>(s)].empty()) continue;
       const Eigen::Vector3d r = at(response_tc_[static_cast<std::size_t>(s)], c);
       for (int i = 0; i < 3; ++i) err[i] += theta[tc_bias_index(s, i)] * r[i];
     }
-    for (std::size_t s = 0; s < response_strip_.size(); ++s)
+    for (std::size_t s = 0; s < response_strip_.size() && strip; ++s)
       if (!response_strip_[s].empty()) err += offsets[s] * at(response_strip_[s], c);
-    error_um[e] = err;
+    for (std::size_t s = 0; s < response_strip_nl_.size() && strip_nl; ++s)
+      if (!response_strip_nl_[s].empty()) err += nl[s] * at(response_strip_nl_[s], c);
+    error_um[e] += err;
   }
 }
 

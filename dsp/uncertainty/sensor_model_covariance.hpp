@@ -58,6 +58,9 @@ struct DatasheetTolerance {
   double f0_relative = 0.01;      // resonance
   double zeta = 0.01;             // damping
   double delay_samples = 0.0;     // the DAQ's linear-phase FIR: its delay is exact by design
+  // The noise density of a unit about the data sheet's typical value: 0.3–0.5 µg/√Hz for
+  // the SF3000L's 0.4 (what a run's rest windows are checked against).
+  double noise_density_relative = 0.25;
   double tc_bias_ug_per_c =
       210.0;  // ±100 µg/°C of unknown sign, 85–110 per unit: compensating with +100 errs by up to 210
   // A PSD strip's own nonlinearity, u_meas = u (1 + nl (2u/L)²), |nl| within this (relative
@@ -72,16 +75,6 @@ struct DatasheetTolerance {
 // the filter's own. The identification's covariance adds its variance (uniform: /3) to the
 // scale of every axis a strip measures.
 double strip_nonlinearity_scale_variance(const DatasheetTolerance& tolerance = {});
-
-// What the data sheet says of the noise the fusion's error model does not know exactly:
-// units spread about the data sheet's density (0.33–0.46 µg/√Hz for 0.4) and the DAQ adds
-// its own (200 nV/√Hz ≈ 0.16 µg/√Hz); the bias walks by 0.12–0.3 µg/√s per unit. The draws
-// use the rms over that range (GUM: the uncertainty of a unit taken from the population);
-// a fusion model that assumes less is still judged by what it then misses.
-struct DatasheetNoise {
-  double noise_factor = 1.08;          // × the data sheet's density: rms of units and DAQ noise
-  double bias_walk_ug_per_rts = 0.22;  // per sensor, rms of 0.12–0.3
-};
 
 // The covariance the data sheet gives (independent parameters).
 SensorModelCovariance datasheet_covariance(const SensorSpec sensors[2], double fs_hz,

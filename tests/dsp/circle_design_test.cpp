@@ -80,6 +80,7 @@ constexpr Figure kFigures[] = {
 void expect_same(const CircleDiagnostics& direct, const CircleDiagnostics& designed, const std::string& what) {
   for (const Figure& f : kFigures) {
     const double a = direct.*f.value, b = designed.*f.value;
+    if (std::isnan(a) && std::isnan(b)) continue;  // not evaluated by either
     EXPECT_NEAR(a, b, 1e-9 * std::max(1.0, std::abs(a))) << f.name << " (" << what << ")";
   }
   EXPECT_EQ(direct.servo_and_squareness_separated, designed.servo_and_squareness_separated) << what;

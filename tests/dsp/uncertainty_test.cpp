@@ -52,16 +52,6 @@ TEST(ResolvedRule, MagnitudeAboveTheExpandedUncertainty) {
   EXPECT_FALSE(resolved(5.0, kNaN));
 }
 
-TEST(ExpandedUncertainty, LinearFigureIsTwoSigmaAndARangeCarriesItsBias) {
-  EXPECT_NEAR(expanded_uncertainty(0.0, 1.0, 100), 2.0, 1e-12);
-  // A mean offset within the Monte Carlo error (2σ/√n) is no bias.
-  EXPECT_NEAR(expanded_uncertainty(0.15, 1.0, 100), 2.0, 1e-12);
-  // A range-like figure: the draws' mean is (√2 − 1) of the measured value's bias above it.
-  const double b_true = 3.0, b_draws = (std::sqrt(2.0) - 1.0) * b_true;
-  EXPECT_NEAR(expanded_uncertainty(b_draws + 0.2, 1.0, 100), 2.0 + b_true, 1e-9);
-  EXPECT_TRUE(std::isnan(expanded_uncertainty(0.0, 1.0, 1)));
-}
-
 // A 2 s trace at 1 kHz: standstills in the first and last 0.2 s, a PSD strip fix along x
 // in the middle (10 samples), moving elsewhere.
 struct Trace {
@@ -99,9 +89,9 @@ ErrorFieldInput input_for(const Trace& t, const fusion::ErrorModel& m) {
   in.start_bias_sigma_um_s2 = Eigen::Vector3d::Constant(5.0);
   in.g_mps2 = 9.81;
   // The truth the draws simulate is the fusion's own model.
-  in.noise.noise_factor = 1.0;
   in.sensor_noise_ug_per_rthz[0] = in.sensor_noise_ug_per_rthz[1] = m.accel_noise_um_s2_rthz / std::sqrt(2.0) / 9.81;
-  in.noise.bias_walk_ug_per_rts = m.bias_walk_um_s2_rts / std::sqrt(2.0) / 9.81;
+  in.rel_noise_ug_per_rthz = m.accel_noise_um_s2_rthz / 9.81;  // as if measured at rest
+  in.bias_walk_ug_per_rts[0] = in.bias_walk_ug_per_rts[1] = m.bias_walk_um_s2_rts / std::sqrt(2.0) / 9.81;
   in.max_coarse = 2000;  // no coarsening: compare with the fine posterior
   return in;
 }
@@ -152,7 +142,7 @@ TEST(ErrorField, AScaleErrorWithoutPositionSupportsStaysAsItIs) {
   // No strip: standstills only fix the velocity, so E·Δx is left whole.
   const Trace t = synthetic(false);
   ErrorFieldInput in = input_for(t, fusion::ErrorModel{});
-  in.noise.noise_factor = 1e-9, in.noise.bias_walk_ug_per_rts = 1e-12;
+  in.rel_noise_ug_per_rthz = 1e-12, in.bias_walk_ug_per_rts[0] = in.bias_walk_ug_per_rts[1] = 1e-12;
   in.model.accel_noise_um_s2_rthz = 1e-9, in.model.bias_walk_um_s2_rts = 1e-9;
   in.sensor_noise_ug_per_rthz[0] = in.sensor_noise_ug_per_rthz[1] = 1e-12;
   in.model_covariance.covariance.setZero();

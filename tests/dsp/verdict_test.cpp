@@ -1,8 +1,12 @@
-// quality.verdict from the headline figure, its uncertainty and the flags; the severity of
-// flags (a critical psd_disagrees never looks like the note that H needs both directions).
+// quality.verdict from the limited figure's uncertainty and the flags; the severity of flags
+// (a critical psd_disagrees never looks like the note that H needs both directions); the
+// ISO 14253-1 decision against tolerances.
 #include "dsp/analysis/verdict.hpp"
+#include "dsp/analysis/conformance.hpp"
 
 #include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace eical::dsp {
 namespace {
@@ -21,22 +25,37 @@ TEST(Verdict, OkWhenTheHeadlineIsResolvedWithinWhatTheTestResolves) {
   Program p;
   Analysis a = circle(12.0, 3.0);
   judge(p, a);
-  EXPECT_EQ(a.verdict, "ok");
+  EXPECT_EQ(a.verdict, Verdict::ok);
   EXPECT_TRUE(a.verdict_reasons.empty());
 }
 
-TEST(Verdict, NotMeasurableWhenTheUncertaintyExceedsTheLimitOrTheFigure) {
+TEST(Verdict, NotMeasurableOnlyWhenTheUncertaintyExceedsWhatTheTestResolves) {
   Program p;
   Analysis big = circle(4190.0, 28000.0);  // the ballbar-size circle without supports
   judge(p, big);
-  EXPECT_EQ(big.verdict, "not_measurable");
-  ASSERT_EQ(big.verdict_reasons.size(), 2u);
+  EXPECT_EQ(big.verdict, Verdict::not_measurable);
+  ASSERT_EQ(big.verdict_reasons.size(), 1u);
   EXPECT_NE(big.verdict_reasons[0].find("exceeds the 10.0 µm a circle test is meant to resolve"), std::string::npos)
       << big.verdict_reasons[0];
-  EXPECT_NE(big.verdict_reasons[1].find("not above its uncertainty"), std::string::npos) << big.verdict_reasons[1];
-  Analysis small = circle(1.0, 4.0);  // a machine better than the test can tell
-  judge(p, small);
-  EXPECT_EQ(small.verdict, "not_measurable");
+  Analysis at_limit = circle(30.0, 10.0);  // U exactly at the limit still resolves it
+  judge(p, at_limit);
+  EXPECT_EQ(at_limit.verdict, Verdict::ok);
+  Analysis just_over = circle(30.0, 10.01);
+  judge(p, just_over);
+  EXPECT_EQ(just_over.verdict, Verdict::not_measurable);
+}
+
+TEST(Verdict, AFigureBelowItsUncertaintyIsAResultNotAFailure) {
+  // A good machine measured well: G = 4.66 ± 5.95 µm says G <= 10.61 µm, which is what the
+  // test is for. It once was not_measurable while a worse machine got ok.
+  Program p;
+  Analysis good = circle(4.66, 5.95);
+  judge(p, good);
+  EXPECT_EQ(good.verdict, Verdict::ok);
+  EXPECT_TRUE(good.verdict_reasons.empty());
+  Analysis worse = circle(12.0, 5.95);
+  judge(p, worse);
+  EXPECT_EQ(worse.verdict, Verdict::ok);
 }
 
 TEST(Verdict, DegradedByACriticalFlagAndNotMeasurableOverridesIt) {
@@ -45,12 +64,12 @@ TEST(Verdict, DegradedByACriticalFlagAndNotMeasurableOverridesIt) {
   a.flags = {"psd_disagrees: the PSD readings contradict the integrated motion",
              "circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions"};
   judge(p, a);
-  EXPECT_EQ(a.verdict, "degraded");
+  EXPECT_EQ(a.verdict, Verdict::degraded);
   ASSERT_EQ(a.verdict_reasons.size(), 1u);
   EXPECT_EQ(a.verdict_reasons[0].rfind("psd_disagrees", 0), 0u);
   Analysis b = circle(1.0, 30.0, true);
   judge(p, b);
-  EXPECT_EQ(b.verdict, "not_measurable");
+  EXPECT_EQ(b.verdict, Verdict::not_measurable);
 }
 
 TEST(Verdict, WithoutUncertaintyTheResultIsDegraded) {
@@ -59,7 +78,7 @@ TEST(Verdict, WithoutUncertaintyTheResultIsDegraded) {
   a.uncertainty_k2.clear();
   a.uncertainty_note = "no support schedule";
   judge(p, a);
-  EXPECT_EQ(a.verdict, "degraded");
+  EXPECT_EQ(a.verdict, Verdict::degraded);
 }
 
 TEST(FlagSeverity, CriticalWarningAndNote) {
@@ -83,6 +102,41 @@ TEST(Verdict, EveryProgramHasALimit) {
     EXPECT_GT(l->limit, 0.0);
   }
   EXPECT_EQ(resolution_limit("identify"), nullptr);
+}
+
+TEST(Conformance, Iso14253DecisionRule) {
+  EXPECT_EQ(decide(4.0, 5.0, 10.0), Conformance::conforming);       // 9 <= 10
+  EXPECT_EQ(decide(5.0, 5.0, 10.0), Conformance::conforming);       // on the limit: proven
+  EXPECT_EQ(decide(6.0, 5.0, 10.0), Conformance::undecided);        // 1 .. 11 straddles 10
+  EXPECT_EQ(decide(15.0, 5.0, 10.0), Conformance::undecided);       // 10 is not beyond
+  EXPECT_EQ(decide(15.01, 5.0, 10.0), Conformance::nonconforming);  // 10.01 > 10
+  EXPECT_EQ(decide(1.0, std::nan(""), 10.0), Conformance::undecided);
+  EXPECT_STREQ(conformance_words(Conformance::conforming), "conformance proven");
+  EXPECT_STREQ(conformance_key(Conformance::nonconforming), "nonconforming");
+}
+
+TEST(Conformance, TheRunIsDecidedByItsFigures) {
+  Analysis a = circle(4.66, 5.95);
+  a.circle->radial_deviation_F_max_um = 3.0;
+  a.circle->radial_deviation_F_min_um = -7.0;
+  a.uncertainty_k2["circle.radial_deviation_F_max_um"] = {2.0};
+  a.uncertainty_k2["circle.radial_deviation_F_min_um"] = {2.5};
+  const std::vector<FigureTolerance> t{
+      {"G", {"circle.circular_deviation_G_um"}, 15.0},
+      {"F", {"circle.radial_deviation_F_max_um", "circle.radial_deviation_F_min_um"}, 10.0},
+      {"A", {"positioning.A_um"}, 5.0}};  // not in this run: left out
+  ConformanceResult r = decide_conformance(a, t);
+  ASSERT_EQ(r.figures.size(), 2u);
+  EXPECT_EQ(r.figures[0].decision, Conformance::conforming);        // 4.66 + 5.95 <= 15
+  EXPECT_EQ(r.figures[1].key, "circle.radial_deviation_F_min_um");  // the larger magnitude
+  EXPECT_DOUBLE_EQ(r.figures[1].magnitude, 7.0);
+  EXPECT_EQ(r.figures[1].decision, Conformance::conforming);  // 7 + 2.5 <= 10
+  EXPECT_EQ(r.overall, Conformance::conforming);
+  r = decide_conformance(a, {{"G", {"circle.circular_deviation_G_um"}, 8.0}});
+  EXPECT_EQ(r.overall, Conformance::undecided);
+  r = decide_conformance(circle(30.0, 5.0), {{"G", {"circle.circular_deviation_G_um"}, 15.0}, t[1]});
+  EXPECT_EQ(r.overall, Conformance::nonconforming);                          // 25 > 15, F absent
+  EXPECT_EQ(decide_conformance(a, {t[2]}).overall, Conformance::undecided);  // nothing toleranced
 }
 
 }  // namespace

@@ -32,7 +32,7 @@ TEST(NotMeasurable, BallbarSizeCircleWithoutSupportsSaysSoAndNamesAMeasurableTes
   const dsp::Run run = sim::simulate(sim::circle_scenario(150.0, 1000.0, 1, "both"));
   dsp::Analysis a = dsp::analyze_run(run);
   ASSERT_TRUE(a.circle);
-  EXPECT_EQ(a.verdict, "not_measurable");
+  EXPECT_EQ(a.verdict, dsp::Verdict::not_measurable);
   const auto u = a.uncertainty_k2.at("circle.circular_deviation_G_um").at(0);
   std::printf("R150 F1000 both: G = %.1f ± %.1f µm\n", a.circle->circular_deviation_G_um, u);
   EXPECT_GT(u, a.circle->circular_deviation_G_um);  // what it printed as G is within its own noise

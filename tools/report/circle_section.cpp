@@ -3,6 +3,8 @@
 #include "tools/report/sections.hpp"
 #include "tools/report/svg.hpp"
 
+#include <cmath>
+
 namespace eical::tools::report {
 
 namespace {
@@ -57,6 +59,11 @@ Table iso230_4_table(const dsp::eval::CircleResult& c, const dsp::Program& p, co
     iso.rows.push_back(fr.row("circle.circular_deviation_G_ccw_um", "G, counter-clockwise", "µm", 2));
     iso.rows.push_back(fr.row("circle.circular_deviation_G_cw_um", "G, clockwise", "µm", 2));
   }
+  const char* averaged[2][2] = {{"circle.averaged_revolution_G_ccw_um", "G of the averaged revolution, ccw"},
+                                {"circle.averaged_revolution_G_cw_um", "G of the averaged revolution, cw"}};
+  for (std::size_t d = 0; d < 2; ++d)
+    if (std::isfinite(c.direction_averaged_G_um[d]))
+      iso.rows.push_back(fr.row(averaged[d][0], averaged[d][1], "µm", 2, "mean per 1° over the revolutions"));
   Figure h = fr.row("circle.circular_hysteresis_H_um", "Circular hysteresis H", "µm", 2,
                     c.circular_hysteresis_H_um ? "max over 1° bins" : "needs both directions");
   iso.rows.push_back(h);

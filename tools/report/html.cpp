@@ -98,7 +98,10 @@ bool not_resolved(const Figure& f) {
 }
 
 std::string cell_class(const std::string& text) {
-  if (text == "pass" || text == "fail" || text == "undecided") return text;
+  // The ISO 14253-1 decisions (dsp::conformance_words) coloured as such.
+  if (text == "conformance proven") return "pass";
+  if (text == "non-conformance proven") return "fail";
+  if (text == "undecided") return text;
   return "c";
 }
 

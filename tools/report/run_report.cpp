@@ -4,6 +4,7 @@
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/float_limits.hpp"
 
+#include "tools/figure_text.hpp"
 #include "tools/report/html.hpp"
 #include "tools/report/sections.hpp"
 #include "tools/report/svg.hpp"
@@ -104,6 +105,44 @@ std::string title_for(const std::string& kind) {
   return "Measurement report";
 }
 
+// The headline figures' U beside their noise bound and, when the analysis has one, the
+// budget: each source of the error alone.
+void uncertainty_section(const dsp::Analysis& a, Page& page) {
+  const dsp::ResolutionLimit* lim = dsp::resolution_limit(a.program_kind);
+  if (!lim || a.uncertainty_k2.empty()) return;
+  std::vector<std::string> keys{lim->limited};
+  if (std::string(lim->headline) != lim->limited) keys.emplace_back(lim->headline);
+  Section s;
+  s.heading = "Uncertainty";
+  s.lead = "Where U comes from, and how far it is from what the physics of this test allows.";
+  std::vector<std::string> header{"source"};
+  for (const auto& k : keys) header.push_back(figure_label(k) + " (" + figure_unit(k) + ")");
+  Grid g{"U (k = 2) of each source alone, and of all together", header, {}};
+  auto row = [&](const std::string& name, const std::map<std::string, std::vector<double>>& by_key) {
+    std::vector<std::string> r{name};
+    for (const auto& k : keys) {
+      const auto it = by_key.find(k);
+      r.push_back(it != by_key.end() && it->second.size() == 1 && std::isfinite(it->second[0])
+                      ? fmt("%.3f", it->second[0])
+                      : "-");
+    }
+    g.rows.push_back(std::move(r));
+  };
+  for (const auto& [source, by_key] : a.uncertainty_budget) row(dsp::uncertainty::error_source_words(source), by_key);
+  row("all sources (U)", a.uncertainty_k2);
+  row("noise bound: white noise only, optimal smoother", a.noise_bound_k2);
+  s.grids.push_back(std::move(g));
+  if (a.uncertainty_budget.empty())
+    s.notes.push_back(
+        "eical analyze --budget adds each source's own U (integration noise, sensor scale and timing, "
+        "temperature, PSD strip offsets and nonlinearity).");
+  s.notes.push_back(
+      "The noise bound is the same evaluation of the ideal path with only the white noise measured at "
+      "rest, fused by the smoother that is optimal for it over this run's supports: what this test "
+      "could reach with a perfect sensor model.");
+  page.sections.push_back(std::move(s));
+}
+
 void measurement_section(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
   const auto& m = a.measurement;
   Section p;
@@ -126,8 +165,10 @@ void measurement_section(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
   if (!a.uncertainty_note.empty())
     p.notes.push_back(
         "Uncertainty (every ± in this report): " + a.uncertainty_note +
-        ". A figure is resolved when its magnitude exceeds U; one that is not is marked \"not resolved\".");
+        ". A figure is resolved when its magnitude exceeds U; one that is not is marked \"not resolved\": its "
+        "magnitude is then at most |value| + U.");
   page.sections.push_back(std::move(p));
+  uncertainty_section(a, page);
   std::vector<std::vector<double>> cols(7);
   for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
     cols[0].push_back(static_cast<double>(m.sample_index[i]) / m.fs_hz);
@@ -191,15 +232,19 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, co
                   {"sensors", run.meta.sensors[0].model + " (table), " + run.meta.sensors[1].model + " (head)"}};
   if (run.meta.reference) page.context.emplace_back("reference", run.meta.reference->kind);
   for (const auto& f : analysis.flags) page.flags.push_back({f, dsp::severity_name(dsp::flag_severity(f))});
-  page.verdict = analysis.verdict;
+  page.verdict = dsp::verdict_name(analysis.verdict);
   page.verdict_reasons = analysis.verdict_reasons;
   if (options.tolerances) {
-    Grid g{"Against the tolerances (ISO 14253-1 with U, k = 2)",
+    // The analysis' decision when it was made with the tolerances (analyze --tolerances),
+    // else made here from the same rule: one story in the banner, the table and the JSON.
+    const dsp::ConformanceResult c =
+        analysis.conformance ? *analysis.conformance : dsp::decide_conformance(analysis, figure_tolerances(tol));
+    Grid g{std::string("Against the tolerances (ISO 14253-1 with U, k = 2): ") + dsp::conformance_words(c.overall),
            {"figure", "measured (µm)", "U (µm)", "tolerance (µm)", "decision"},
            {}};
-    for (const auto& d : decide(analysis, tol))
-      g.rows.push_back({d.figure, fmt("%.2f", d.value), d.u ? fmt("%.2f", *d.u) : std::string("unknown"),
-                        fmt("%.2f", d.tolerance), d.decision});
+    for (const auto& d : c.figures)
+      g.rows.push_back({d.name, fmt("%.2f", d.magnitude), std::isfinite(d.u_k2) ? fmt("%.2f", d.u_k2) : "unknown",
+                        fmt("%.2f", d.tolerance), dsp::conformance_words(d.decision)});
     if (g.rows.empty()) g.rows.push_back({"(no toleranced figure in this test)", "", "", "", ""});
     page.summary.push_back(g);
   }

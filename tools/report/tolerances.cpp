@@ -1,10 +1,6 @@
 #include "tools/report/tolerances.hpp"
 
 #include "drivers/config/strict_toml.hpp"
-#include "dsp/analysis/figures.hpp"
-
-#include <cmath>
-#include <limits>
 
 namespace eical::tools::report {
 namespace {
@@ -47,42 +43,19 @@ Tolerances read_tolerances(const std::filesystem::path& file) {
   return t;
 }
 
-std::string decision(double value, std::optional<double> u, double tolerance) {
-  const double uu = u && std::isfinite(*u) ? *u : std::numeric_limits<double>::infinity();
-  if (value + uu <= tolerance) return "pass";
-  if (value - uu > tolerance) return "fail";
-  return "undecided";
-}
-
-std::vector<ToleranceDecision> decide(const dsp::Analysis& a, const Tolerances& t) {
-  const auto figs = dsp::figures_of(a);
-  std::vector<ToleranceDecision> out;
-  auto get = [&](const char* key) -> std::optional<std::pair<double, std::optional<double>>> {
-    const dsp::FigureValue* f = dsp::find_figure(figs, key);
-    if (!f || f->values.empty() || !std::isfinite(f->values[0])) return std::nullopt;
-    std::optional<double> u;
-    const auto it = a.uncertainty_k2.find(key);
-    if (it != a.uncertainty_k2.end() && !it->second.empty() && std::isfinite(it->second[0])) u = it->second[0];
-    return std::make_pair(std::abs(f->values[0]), u);
+std::vector<dsp::FigureTolerance> figure_tolerances(const Tolerances& t) {
+  std::vector<dsp::FigureTolerance> out;
+  auto add = [&](const char* name, std::vector<std::string> keys, const std::optional<double>& tol) {
+    if (tol) out.push_back({name, std::move(keys), *tol});
   };
-  auto add = [&](const char* name, const char* key, const std::optional<double>& tol) {
-    if (!tol) return;
-    if (const auto v = get(key)) out.push_back({name, v->first, v->second, *tol, decision(v->first, v->second, *tol)});
-  };
-  add("Circular deviation G (ISO 230-4)", "circle.circular_deviation_G_um", t.G_um);
-  if (t.F_um) {  // the larger of |F max| and |F min|
-    const auto fmax = get("circle.radial_deviation_F_max_um"), fmin = get("circle.radial_deviation_F_min_um");
-    if (fmax && fmin) {
-      const auto& f = fmax->first >= fmin->first ? *fmax : *fmin;
-      out.push_back(
-          {"Radial deviation F (ISO 230-4)", f.first, f.second, *t.F_um, decision(f.first, f.second, *t.F_um)});
-    }
-  }
-  add("Accuracy A (ISO 230-2)", "positioning.A_um", t.A_um);
-  add("Reversal value B (ISO 230-2)", "positioning.B_um", t.B_um);
-  add("Repeatability R (ISO 230-2)", "positioning.R_um", t.R_um);
-  add("Systematic deviation E (ISO 230-2)", "positioning.E_um", t.E_um);
-  add("Mean positional deviation M (ISO 230-2)", "positioning.M_um", t.M_um);
+  add("circular deviation G (ISO 230-4)", {"circle.circular_deviation_G_um"}, t.G_um);
+  add("radial deviation F (ISO 230-4)", {"circle.radial_deviation_F_max_um", "circle.radial_deviation_F_min_um"},
+      t.F_um);
+  add("accuracy A (ISO 230-2)", {"positioning.A_um"}, t.A_um);
+  add("reversal value B (ISO 230-2)", {"positioning.B_um"}, t.B_um);
+  add("repeatability R (ISO 230-2)", {"positioning.R_um"}, t.R_um);
+  add("systematic deviation E (ISO 230-2)", {"positioning.E_um"}, t.E_um);
+  add("mean positional deviation M (ISO 230-2)", {"positioning.M_um"}, t.M_um);
   return out;
 }
 

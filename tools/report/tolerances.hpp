@@ -17,10 +17,12 @@
 //   E_um = 8.0
 //   M_um = 6.0
 //
-// The decision follows ISO 14253-1 with the expanded uncertainty U (k = 2): "pass" when
-// the figure plus U is within the tolerance, "fail" when the figure minus U is beyond
-// it, "undecided" between (the measurement cannot tell).
-#include "dsp/analysis/analyze_run.hpp"
+// The decision follows ISO 14253-1 with the expanded uncertainty U (k = 2)
+// (dsp/analysis/conformance.hpp): conformance proven when the figure plus U is within the
+// tolerance, non-conformance proven when the figure minus U is beyond it, undecided between
+// (the measurement cannot tell). `eical analyze --tolerances` and `eical report
+// --tolerances` read the same file and decide the same way.
+#include "dsp/analysis/conformance.hpp"
 
 #include <filesystem>
 #include <optional>
@@ -38,18 +40,7 @@ struct Tolerances {
 // Throws InputError naming the file, line and key.
 Tolerances read_tolerances(const std::filesystem::path& file);
 
-struct ToleranceDecision {
-  std::string figure;       // "Circular deviation G"
-  double value = 0.0;       // the magnitude compared
-  std::optional<double> u;  // its U (k = 2)
-  double tolerance = 0.0;
-  std::string decision;  // pass | fail | undecided
-};
-
-// Every toleranced figure the analysis has.
-std::vector<ToleranceDecision> decide(const dsp::Analysis& a, const Tolerances& t);
-
-// ISO 14253-1: pass when value + U <= tolerance, fail when value − U > tolerance.
-std::string decision(double value, std::optional<double> u, double tolerance);
+// The tolerances on result keys, in the order a report lists them.
+std::vector<dsp::FigureTolerance> figure_tolerances(const Tolerances& t);
 
 }  // namespace eical::tools::report

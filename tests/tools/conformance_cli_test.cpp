@@ -1,0 +1,83 @@
+// `eical analyze --tolerances`: each toleranced figure and the run decided by ISO 14253-1
+// with U, in the text, the JSON and the exit status (README "Exit status"), from the same
+// tolerance file `eical report` takes.
+#include "drivers/run_io/run_writer.hpp"
+#include "sim/simulate.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+namespace eical {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::string run_cli(const std::string& args, int& status) {
+  FILE* p = ::popen((std::string(EICAL_CLI) + " " + args + " 2>/dev/null").c_str(), "r");
+  std::string out;
+  char buf[4096];
+  while (p && std::fgets(buf, sizeof buf, p)) out += buf;
+  const int st = p ? ::pclose(p) : -1;
+  status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return out;
+}
+
+fs::path tolerance_file(const fs::path& dir, const std::string& name, double g_um) {
+  const fs::path f = dir / name;
+  std::ofstream(f) << "format = \"eical-tolerances/1\"\n[circle]\nG_um = " << g_um << "\n";
+  return f;
+}
+
+TEST(ConformanceCli, ToleranceWideNarrowAndStraddledByU) {
+  const fs::path dir = fs::temp_directory_path() / ("conformance-" + std::to_string(std::random_device{}()));
+  drivers::write_run(sim::simulate(sim::circle_scenario(10.0, 2500.0, 1, "ccw", 3)), dir / "run", {});
+  const std::string run = (dir / "run").string() + " --no-suggest --draws 40";
+  int status = -1;
+  const json plain = json::parse(run_cli("analyze --json " + run, status));
+  EXPECT_FALSE(plain["quality"].contains("conformance"));
+  const double g = plain["circle"]["circular_deviation_G_um"],
+               u = plain["uncertainty_k2"]["circle.circular_deviation_G_um"];
+  ASSERT_GT(u, 0.0);
+  const std::string verdict = plain["quality"]["verdict"];
+  struct Case {
+    double tolerance_um;
+    const char* decision;
+    int exit_if_ok;
+  };
+  for (const Case c : {Case{g + u + 0.5, "conforming", 0}, Case{g, "undecided", 5}}) {
+    const fs::path t = tolerance_file(dir, std::string(c.decision) + ".toml", c.tolerance_um);
+    const json doc = json::parse(run_cli("analyze --json --tolerances " + t.string() + " " + run, status));
+    ASSERT_TRUE(doc["quality"].contains("conformance")) << doc["quality"].dump();
+    const json& conf = doc["quality"]["conformance"];
+    EXPECT_EQ(conf["overall"], c.decision) << "tolerance " << c.tolerance_um << ", G " << g << " ± " << u;
+    ASSERT_EQ(conf["figures"].size(), 1u);
+    EXPECT_EQ(conf["figures"][0]["key"], "circle.circular_deviation_G_um");
+    EXPECT_EQ(conf["figures"][0]["decision"], c.decision);
+    // The exit status: the verdict's unless it is ok, then the decision's.
+    EXPECT_EQ(status, verdict == "ok" ? c.exit_if_ok : verdict == "degraded" ? 2 : 3);
+    const std::string text = run_cli("analyze --tolerances " + t.string() + " " + run, status);
+    EXPECT_NE(text.find("against the tolerances (ISO 14253-1"), std::string::npos) << text;
+  }
+  if (g - u > 0.5) {  // a figure resolved above a tolerance below it: non-conformance proven
+    const fs::path t = tolerance_file(dir, "tight.toml", g - u - 0.25);
+    const json doc = json::parse(run_cli("analyze --json --tolerances " + t.string() + " " + run, status));
+    EXPECT_EQ(doc["quality"]["conformance"]["overall"], "nonconforming");
+  }
+  // A tolerance file with a typo is refused by name before anything is analysed.
+  const fs::path bad = dir / "bad.toml";
+  std::ofstream(bad) << "format = \"eical-tolerances/1\"\n[circle]\nG_mu = 3\n";
+  (void)run_cli("analyze --tolerances " + bad.string() + " " + run, status);
+  EXPECT_EQ(status, 1);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace eical
