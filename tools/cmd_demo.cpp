@@ -1,24 +1,23 @@
-// eical demo: the main job. A simulated calibration end to end through the code path of
-// the daemon: simulated machine and sensors (sim backend) → acquisition thread → SPSC
-// ring → DSP thread with the measurement session (M101 tare and start, M102 segments,
-// M103 stop) and the live pipeline → the recording written as an eical-run/1 directory →
-// the same analysis eicald runs → result.json and an HTML report.
-#include "drivers/acquisition/pump.hpp"
+// eical demo: the main job. A calibration as a machine builder runs one, on a simulated
+// machine (tools/demo/demo_stages.hpp):
+//   1. the sensors identified on site (gen-nc identify's program over the PSD strips);
+//   2. the circular test R10 F2500, both directions, through the daemon's code path;
+//   3. its analysis with that calibration: verdict, G ± U, U against the noise bound, the
+//      error against the simulator's truth, result.json and the report;
+//   4. a test beyond the instrument (R150 F4000 without strips): not measurable, and why.
+// Exit status 0 when part one's verdict is ok, else that verdict's (tools/exit_codes.hpp).
 #include "drivers/results/result_json.hpp"
 #include "drivers/run_io/run_writer.hpp"
-#include "drivers/source/sim_source.hpp"
-#include "dsp/analysis/analyze_run.hpp"
-#include "dsp/pipeline/pipeline.hpp"
-#include "dsp/session/measurement_session.hpp"
 #include "tools/commands.hpp"
+#include "tools/demo/demo_stages.hpp"
+#include "tools/exit_codes.hpp"
 #include "tools/report/run_report.hpp"
 #include "tools/run_files.hpp"
+#include "tools/uncertainty/coverage_campaign.hpp"
 
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <memory>
-#include <stdexcept>
 
 namespace eical::tools {
 
@@ -29,69 +28,62 @@ void register_demo(CLI::App& app) {
     bool realtime = false;
   };
   auto o = std::make_shared<Opt>();
-  auto* cmd = app.add_subcommand("demo", "Main job: a simulated circular test (R10, F2500, 5 repeats) end to end");
-  cmd->add_option("-o,--out", o->out, "output folder (the run, result.json, report)")->default_val("out/demo");
-  cmd->add_option("--seed", o->seed, "simulation seed")->default_val(1);
+  auto* cmd = app.add_subcommand(
+      "demo",
+      "Main job: identify the sensors on site, run a circular test R10 F2500 with PSD strips end to end, "
+      "then show a test beyond the instrument");
+  cmd->add_option("-o,--out", o->out, "output folder (the runs, the calibration, result.json, the report)")
+      ->default_val("out/demo");
+  cmd->add_option("--seed", o->seed, "simulation seed: the machine, its sensors and strips")->default_val(1);
   cmd->add_flag("--realtime", o->realtime, "pace the simulated DAQ at 10 kHz (as eicald does) instead of free-running");
+  cmd->footer("Exit status: 0 when the calibration's verdict is ok, 2 degraded, 3 not measurable, 1 an error.");
   cmd->callback([o] {
     namespace fs = std::filesystem;
     const auto t0 = std::chrono::steady_clock::now();
-    // The test case: R = 10 mm, F = 2500 mm/min, 5 repeats, noise 0.4 µg/√Hz, 10 kHz.
-    sim::Scenario sc = sim::circle_scenario(10.0, 2500.0, 5, "ccw", o->seed);
-    drivers::SimSource source(sc, {.pacing = o->realtime ? drivers::Pacing::realtime : drivers::Pacing::free_running});
-    source.open();
-    const dsp::RunMeta& meta = source.meta();
-
-    drivers::FrameRing ring(1 << 16);
-    dsp::SessionConfig scfg;
-    scfg.fs_hz = meta.acquisition.fs_hz;
-    scfg.max_measurement_s = 60.0;
-    dsp::MeasurementSession session(scfg);
-    dsp::Pipeline live(dsp::pipeline_config(meta, static_cast<std::size_t>(scfg.max_measurement_s * scfg.fs_hz)));
-    std::atomic<bool> stop{false};
-    const auto stats = drivers::pump(
-        source, ring,
-        [&](const dsp::Frame& f) {
-          session.on_frame(f);
-          if (session.state().state() == dsp::State::measuring || f.trigger == dsp::trigger::program_end) live.step(f);
-        },
-        stop);
-    if (!stats.source_error.empty()) throw std::runtime_error(stats.source_error);
-    const auto t_acq = std::chrono::steady_clock::now();
-
-    std::vector<dsp::Frame> frames;
-    frames.reserve(session.recorder_capacity());
-    if (!session.take(frames))
-      throw std::runtime_error("the simulated program did not complete a measurement (M101..M103); state " +
-                               std::string(dsp::to_string(session.state().state())));
-    dsp::Run run;
-    run.meta = meta;
-    run.meta.created = "";
-    run.channels = source.program_run()->channels;
-    run.truth_toml = source.program_run()->truth_toml;
-    run.frames = std::move(frames);
-
     const fs::path out = o->out;
     fs::create_directories(out);
-    drivers::write_run(run, out / "run", {.gzip = false, .overwrite = true});
-    const dsp::Analysis a = dsp::analyze_run(run);
-    session.evaluation_done();
-    write_file_atomic(out / "result.json", drivers::result_json(run, a).dump(2) + "\n");
-    const auto report = report::write_run_report(run, a, out / "report");
-    const auto t1 = std::chrono::steady_clock::now();
 
-    const double runtime_s = std::chrono::duration<double>(t1 - t0).count();
-    std::printf("eical demo: simulated circular test R10 F2500 x5 (ccw), both sensors, 0.4 ug/sqrt(Hz), 10 kHz\n");
-    std::printf("  frames acquired %llu, through the ring %llu, overruns %llu, lost %llu\n",
-                static_cast<unsigned long long>(stats.frames_read),
-                static_cast<unsigned long long>(stats.frames_consumed), static_cast<unsigned long long>(stats.overruns),
-                static_cast<unsigned long long>(session.counters().frames_lost));
-    std::fputs(summary_text(run, a).c_str(), stdout);
-    std::printf("  live (causal) estimate at M103, before ZUPT: x %.4f mm, y %.4f mm\n", live.live().pos_mm.x(),
-                live.live().pos_mm.y());
-    std::printf("  runtime %.2f s (acquisition and DSP %.2f s)\n", runtime_s,
-                std::chrono::duration<double>(t_acq - t0).count());
-    std::printf("  written: %s/run (recorded run), %s/result.json, %s\n", out.c_str(), out.c_str(), report.c_str());
+    const demo::DemoMachine machine = demo::demo_machine(o->seed);
+    std::printf("eical demo, part 1: a calibration, as on the machine (simulated, seed %llu)\n",
+                static_cast<unsigned long long>(o->seed));
+    std::printf("  the test: %s\n", plan::describe(machine.program).c_str());
+
+    const demo::OnSiteIdentification id = demo::identify_on_site(machine, out);
+    std::printf("  1. sensors identified on site from %s in %.1f s: %s\n", id.run_dir.c_str(), id.seconds,
+                id.file.c_str());
+
+    demo::RecordedTest test = demo::record_through_daemon_path(machine.circle, o->realtime);
+    drivers::write_run(test.run, out / "run", {.gzip = false, .overwrite = true});
+    std::printf(
+        "  2. the circular test recorded through the daemon's path in %.1f s: frames %llu, through the ring "
+        "%llu, overruns %llu, lost %llu\n",
+        test.seconds, static_cast<unsigned long long>(test.stats.frames_read),
+        static_cast<unsigned long long>(test.stats.frames_consumed),
+        static_cast<unsigned long long>(test.stats.overruns), static_cast<unsigned long long>(test.frames_lost));
+
+    const auto t_an = std::chrono::steady_clock::now();
+    const dsp::Analysis a = demo::analyze_with(test.run, id.calibration);
+    const auto truth = uncertainty::true_figures(test.run, test.truth_mm, a);
+    write_file_atomic(out / "result.json", drivers::result_json(test.run, a).dump(2) + "\n");
+    const auto report = report::write_run_report(test.run, a, out / "report");
+    std::printf("  3. analysed with the calibration in %.1f s:\n",
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t_an).count());
+    std::fputs(demo::headline_text(a, truth).c_str(), stdout);
+    std::fputs(summary_text(test.run, a).c_str(), stdout);
+    std::printf("  written: %s/run, %s, %s/result.json, %s\n", out.c_str(), id.file.c_str(), out.c_str(),
+                report.c_str());
+
+    std::printf(
+        "\neical demo, part 2: a test beyond the instrument (R150 F4000, one revolution, no PSD strips, "
+        "data-sheet sensors)\n");
+    const dsp::Analysis beyond = demo::beyond_the_instrument(o->seed);
+    std::fputs(demo::headline_text(beyond, {}).c_str(), stdout);
+    for (const auto& r : beyond.verdict_reasons) std::printf("    - %s\n", r.c_str());
+    std::printf("  (eical plan --program circle --radius 150 names the nearest test that is measurable)\n");
+
+    std::printf("\n  runtime %.1f s\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    std::fflush(stdout);
+    if (const int code = verdict_exit_code(a.verdict); code != kExitOk) throw CLI::RuntimeError(code);
   });
 }
 
