@@ -231,10 +231,11 @@ std::vector<std::string> StrictTable::keys() const {
 
 void StrictTable::finish() const {
   for (const auto& [k, v] : *table_) {
-    if (used_.count(k.str()) == 0) {
+    if (used_.count(k.str()) == 0 && !is_extension_name(k.str())) {
       std::ostringstream os;
       os << file_ << ":" << v.source().begin.line << ": " << join(section_, k.str())
-         << ": unknown key (check the spelling; every key is documented in the example file)";
+         << ": unknown key (check the spelling; every key is documented in the example file or "
+         << "docs/run-files.md; keys of other tools begin with " << kExtensionPrefix << ")";
       throw dsp::InputError(os.str());
     }
   }
