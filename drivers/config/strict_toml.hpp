@@ -28,7 +28,8 @@ class StrictTable {
   static toml::table parse_file(const std::string& path);
 
   [[nodiscard]] bool has(std::string_view key) const;
-  // The keys of this table in file order (e.g. the effect names of a scenario).
+  // The keys of this table in file order (e.g. the effect names of a scenario), other
+  // tools' ext_ keys left out.
   [[nodiscard]] std::vector<std::string> keys() const;
 
   double number(std::string_view key);  // required; integers are accepted as numbers

@@ -77,9 +77,11 @@ std::vector<Case> cases() {
     fs::copy_file(kSource / "config" / "scenarios" / "backlash-circle.toml", d / "s.toml");
   };
   const auto read_scenario = [](const fs::path& d) { (void)drivers::read_scenario_file((d / "s.toml").string()); };
-  for (const char* after : {"seed = ", "[program]", "[reference]", "[servo.x]"})
+  for (const char* after : {"seed = ", "[program]", "[reference]", "[servo.x]", "[effects.\"machine.backlash\"]"})
     c.push_back(toml_case(std::string("scenario_") + (after[0] == '[' ? "table" : "root") + std::to_string(c.size()),
                           "s.toml", scenario, read_scenario, after));
+  // [effects] itself: its keys are effect names, an unknown one is refused as such.
+  c.push_back({"scenario_effects", "s.toml", scenario, read_scenario, false, "", "[effects]"});
   const auto calibration = [](const fs::path& d) {
     drivers::SensorCalibration cal;
     cal.method = "psd";
