@@ -99,7 +99,7 @@ for p in sorted((SHARED / "external/iso230-2").glob("*.dat")):
     put("ecmc_dat", p.stem, p.read_text())
 put("ecmc_dat", "broken-index", "TGT_DATA[1]=1\nREF_DATA_FWD[1]=1\n")
 put("curve_csv", "linear", "pos_mm,error_um\n0,0\n50,1\n100,2\n150,2.5\n200,4\n")
-put("curve_csv", "comments-spaces", "# lead error\npos_mm, error_um, note\n0, 0.5, a\n100, -1, b\n300, 2, c\n")
+put("curve_csv", "comments-spaces", "# lead error\npos_mm, error_um, ext_note\n0, 0.5, a\n100, -1, b\n300, 2, c\n")
 put("curve_csv", "broken-duplicate", "pos_mm,error_um\n0,1\n10,2\n10,3\n20,4\n")
 put("series_csv", "two-series", "angle_deg,deviation_arcsec,series\n" + "".join(
     f"{s * 7.5 + k * 30},{(k % 3) - 1 + 0.1 * s},{'ABC'[s]}\n" for s in range(3) for k in range(12)))
@@ -115,7 +115,7 @@ put("klipper_capture", "legacy-stats", "##<stats>\n#time,accel_x,accel_y,accel_z
 put("klipper_capture", "broken-header", "time,x,y,z\n0,0,0,0\n")
 put("accel_csv", "by-position", b"\x00" + b"t,ax,ay,az\n" + "".join(
     f"{k * 0.0005:.9f},{k % 3},0.1,-9.8\n" for k in range(30)).encode())
-put("accel_csv", "by-name-g-ms", b"\x0b" + b"ax,t,az,ay,extra\n" + "".join(
+put("accel_csv", "by-name-g-ms", b"\x0b" + b"ax,t,az,ay,ext_extra\n" + "".join(
     f"{k % 3},{k * 0.5 + (0.3 if k == 20 else 0)},1,0,x\n" for k in range(30)).encode())
 put("accel_csv", "broken-time", b"\x00t,ax,ay,az\n0,0,0,0\n0,0,0,0\n")
 put("halsampler", "with-overrun", "".join(f"{n} {n * 0.01:f} 0.000000 1.000000 {n * 0.01:f} 0.000000 1.000000 {101 if n == 3 else 0}\n"

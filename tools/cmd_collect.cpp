@@ -6,6 +6,7 @@
 #include "tools/commands.hpp"
 
 #if EICAL_HAVE_DDS
+#include "daemon/system/notify.hpp"
 #include "drivers/dds/bus.hpp"
 #include "history/record/result_record.hpp"
 #include "history/spool/sink.hpp"
@@ -62,11 +63,20 @@ void register_collect(CLI::App& app) {
     drivers::dds::Bus bus(o->domain, drivers::dds::Role::hmi);
     std::printf("collecting results on DDS domain %d into %s\n", o->domain, history::sql::redact_uri(o->db).c_str());
     std::fflush(stdout);
+    // Type=notify (systemd/eical-collect.service): ready once the bus and the spool are up;
+    // the watchdog is fed from this loop, so a collector whose loop hangs is restarted.
+    const daemon::SystemdNotifier notifier;
+    notifier.ready("collecting on DDS domain " + std::to_string(o->domain));
+    auto fed = std::chrono::steady_clock::now();
     const auto end =
         std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                std::chrono::duration<double>(o->timeout_s > 0 ? o->timeout_s : 1e9));
     int received = 0;
     while (!g_stop && std::chrono::steady_clock::now() < end && (o->results == 0 || received < o->results)) {
+      if (const auto every = notifier.watchdog_interval(); every && std::chrono::steady_clock::now() - fed >= *every) {
+        notifier.watchdog();
+        fed = std::chrono::steady_clock::now();
+      }
       const auto m = bus.take_result(std::chrono::milliseconds(300));
       if (!m) continue;
       ++received;
@@ -85,6 +95,7 @@ void register_collect(CLI::App& app) {
       std::fflush(stdout);
     }
     // What arrived goes in before the exit (or stays spooled for the next start).
+    notifier.stopping();
     (void)sink.wait_drained(std::chrono::seconds(10));
     const auto c = sink.counts();
     std::printf("collect: %d results received, %llu stored, %llu already stored, %zu waiting in %s\n", received,

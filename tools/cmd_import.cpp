@@ -163,6 +163,7 @@ void register_csv(CLI::App* import) {
     Common c;
     std::string accel, nc, time_col, columns, unit = "mps2", time_unit = "s", nc_format = "halsampler", nc_time_col,
                                               nc_columns;
+    std::vector<std::string> ignore, nc_ignore;
     double servo_period_s = 0.001;
   };
   auto o = std::make_shared<CsvOpt>();
@@ -174,6 +175,10 @@ void register_csv(CLI::App* import) {
   cmd->add_option("--time-col", o->time_col, "its time column (default: the first)");
   cmd->add_option("--columns", o->columns,
                   "its three acceleration columns, sensor axes 1..3 (default: the three after the time)");
+  cmd->add_option("--ignore-cols", o->ignore,
+                  "its columns that are not to be read (any other unread column is refused; ext_* columns are "
+                  "always skipped)")
+      ->delimiter(',');
   cmd->add_option("--unit", o->unit, "acceleration unit: mps2, mmps2 or g")
       ->default_val("mps2")
       ->check(CLI::IsMember({"mps2", "mmps2", "g"}));
@@ -192,18 +197,22 @@ void register_csv(CLI::App* import) {
   cmd->add_option("--nc-time-col", o->nc_time_col, "csv NC trace: its time column (default: the first)");
   cmd->add_option("--nc-columns", o->nc_columns,
                   "csv NC trace: its x, y, z columns, mm (default: the three after the time)");
+  cmd->add_option("--nc-ignore-cols", o->nc_ignore, "csv NC trace: its columns that are not to be read")
+      ->delimiter(',');
   add_common(cmd, o->c);
   cmd->callback([o] {
     drivers::CsvImport k;
     const double time_scale = o->time_unit == "s" ? 1.0 : (o->time_unit == "ms" ? 1e-3 : 1e-6);
     k.accel_columns.time = o->time_col, k.accel_columns.time_scale_s = time_scale;
     if (!o->columns.empty()) k.accel_columns.values = three(o->columns, "--columns");
+    k.accel_columns.ignored = o->ignore;
     k.unit = o->unit == "mps2" ? drivers::AccelUnit::mps2
                                : (o->unit == "mmps2" ? drivers::AccelUnit::mmps2 : drivers::AccelUnit::g);
     k.nc_halsampler = o->nc_format == "halsampler";
     k.servo_period_s = o->servo_period_s;
     k.nc_columns.time = o->nc_time_col, k.nc_columns.time_scale_s = time_scale;
     if (!o->nc_columns.empty()) k.nc_columns.values = three(o->nc_columns, "--nc-columns");
+    k.nc_columns.ignored = o->nc_ignore;
     k.setup = setup_of(o->c);
     finish(o->c, drivers::import_csv(o->accel, o->nc, k));
   });

@@ -13,7 +13,7 @@ bool valid_axis(const std::string& a) { return a == "x" || a == "y" || a == "z";
 
 }  // namespace
 
-dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults, Unknown u) {
+dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults) {
   dsp::Acquisition a = defaults;
   a.fs_hz = t.number("fs_hz", a.fs_hz);
   if (a.fs_hz <= 0.0) t.fail("fs_hz", "must be positive");
@@ -27,22 +27,22 @@ dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& default
   a.daq_skew_head_samples = t.number("daq_skew_head_samples", a.daq_skew_head_samples);
   if (!(std::abs(a.daq_skew_head_samples) < 1000.0))
     t.fail("daq_skew_head_samples", "must be within (-1000, 1000) samples");
-  if (u == Unknown::reject) t.finish();
+  t.finish();
   return a;
 }
 
-dsp::Site read_site(StrictTable t, const dsp::Site& defaults, Unknown u) {
+dsp::Site read_site(StrictTable t, const dsp::Site& defaults) {
   dsp::Site s = defaults;
   s.latitude_deg = t.number("latitude_deg", s.latitude_deg);
   if (s.latitude_deg < -90.0 || s.latitude_deg > 90.0) t.fail("latitude_deg", "must be within [-90, 90]");
   s.heading_deg = t.number("heading_deg", s.heading_deg);
   s.g_mps2 = t.number("g_mps2", s.g_mps2);
   if (s.g_mps2 < 9.7 || s.g_mps2 > 9.9) t.fail("g_mps2", "local gravity must be within [9.7, 9.9] m/s^2");
-  if (u == Unknown::reject) t.finish();
+  t.finish();
   return s;
 }
 
-dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults, Unknown u) {
+dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults) {
   dsp::MachineLayout m = defaults;
   m.name = t.string("name", m.name);
   if (t.has("table_axes")) m.table_axes = t.strings("table_axes");
@@ -54,11 +54,11 @@ dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& default
   for (const auto& a : m.table_axes)
     if (std::find(m.head_axes.begin(), m.head_axes.end(), a) != m.head_axes.end())
       t.fail("head_axes", "axis '" + a + "' is moved by both table and head");
-  if (u == Unknown::reject) t.finish();
+  t.finish();
   return m;
 }
 
-dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults, Unknown u) {
+dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults) {
   dsp::SensorSpec s = defaults;
   s.model = t.string("model", s.model);
   if (t.has("to_machine")) {
@@ -88,11 +88,11 @@ dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults, Unkn
   if (!(s.bias_walk_ug_per_rts >= 0.0 && s.bias_walk_ug_per_rts < 1e6))
     t.fail("bias_walk_ug_per_rts", "must be within [0, 1e6) µg/√s");
   s.temp_ref_c = t.number("temp_ref_c", s.temp_ref_c);
-  if (u == Unknown::reject) t.finish();
+  t.finish();
   return s;
 }
 
-dsp::PsdSpec read_psd(StrictTable t, Unknown u) {
+dsp::PsdSpec read_psd(StrictTable t) {
   dsp::PsdSpec p;
   p.measures = t.choice("measures", {"x", "y", "z"}, p.measures);
   const auto c = t.numbers("center_mm", 2);
@@ -102,11 +102,11 @@ dsp::PsdSpec read_psd(StrictTable t, Unknown u) {
   if (p.length_mm <= 0.0) t.fail("length_mm", "must be positive");
   p.width_mm = t.number("width_mm", p.width_mm);
   p.lockin_tau_s = t.number("lockin_tau_s", p.lockin_tau_s);
-  if (u == Unknown::reject) t.finish();
+  t.finish();
   return p;
 }
 
-dsp::Program read_program(StrictTable t, Unknown u) {
+dsp::Program read_program(StrictTable t) {
   dsp::Program p;
   p.kind = t.string("kind");
   (void)t.choice("kind", {"step", "positioning", "rectangle", "circle", "freeform", "identify"}, p.kind);
@@ -140,11 +140,11 @@ dsp::Program read_program(StrictTable t, Unknown u) {
     p.size_mm[0] = c[0], p.size_mm[1] = c[1];
   }
   p.gcode = t.string("gcode", "");
-  if (u == Unknown::reject) t.finish();
+  t.finish();
   return p;
 }
 
-dsp::SetPointOrigin read_setpoint_origin(StrictTable t, Unknown u) {
+dsp::SetPointOrigin read_setpoint_origin(StrictTable t) {
   dsp::SetPointOrigin s;
   s.source = t.choice("source", {"servo_stream", "program"}, "servo_stream");
   s.servo_cycle_at_first_sample = t.number("servo_cycle_at_first_sample", s.servo_cycle_at_first_sample);
@@ -157,7 +157,7 @@ dsp::SetPointOrigin read_setpoint_origin(StrictTable t, Unknown u) {
   s.lag_s = t.number("lag_s", s.lag_s);
   s.correlation = t.number("correlation", s.correlation);
   s.residual_ratio = t.number("residual_ratio", s.residual_ratio);
-  if (u == Unknown::reject) t.finish();
+  t.finish();
   return s;
 }
 

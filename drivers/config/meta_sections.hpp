@@ -8,15 +8,15 @@
 namespace eical::drivers {
 
 // Each reader starts from `defaults`, overrides the keys present and checks types and
-// ranges. Configs are strict (unknown keys are errors); recorded runs may carry keys
-// added by others (spec), so run.toml is read with Unknown::accept.
-enum class Unknown { reject, accept };
-dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults = {}, Unknown u = Unknown::reject);
-dsp::Site read_site(StrictTable t, const dsp::Site& defaults = {}, Unknown u = Unknown::reject);
-dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults = {}, Unknown u = Unknown::reject);
-dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults = {}, Unknown u = Unknown::reject);
-dsp::PsdSpec read_psd(StrictTable t, Unknown u = Unknown::reject);
-dsp::Program read_program(StrictTable t, Unknown u = Unknown::reject);
-dsp::SetPointOrigin read_setpoint_origin(StrictTable t, Unknown u = Unknown::reject);
+// ranges. Every file is strict, recorded runs too: an unknown key is an error naming file,
+// line and key (a misspelt k1_v_per_g would otherwise leave the sensitivity at its default);
+// keys of other tools go in the extension namespace ext_ (docs/run-files.md).
+dsp::Acquisition read_acquisition(StrictTable t, const dsp::Acquisition& defaults = {});
+dsp::Site read_site(StrictTable t, const dsp::Site& defaults = {});
+dsp::MachineLayout read_machine(StrictTable t, const dsp::MachineLayout& defaults = {});
+dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults = {});
+dsp::PsdSpec read_psd(StrictTable t);
+dsp::Program read_program(StrictTable t);
+dsp::SetPointOrigin read_setpoint_origin(StrictTable t);
 
 }  // namespace eical::drivers

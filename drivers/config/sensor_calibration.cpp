@@ -103,7 +103,7 @@ SensorCalibration read_sensor_calibration(const std::filesystem::path& file, con
       if (!t) continue;
       if (t->has("cross_g_per_g")) cal.static_cal[s].cross_g_per_g = read_matrix(*t, "cross_g_per_g");
       // read_sensor checks the rest strictly (its copy knows cross_g_per_g was read).
-      cal.sensors[s] = read_sensor(*t, datasheet.sensors[s], Unknown::reject);
+      cal.sensors[s] = read_sensor(*t, datasheet.sensors[s]);
     }
     sensors->finish();
   }

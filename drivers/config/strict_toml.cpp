@@ -222,7 +222,8 @@ std::vector<StrictTable> StrictTable::table_or_tables(std::string_view key) {
 
 std::vector<std::string> StrictTable::keys() const {
   std::vector<std::pair<std::uint32_t, std::string>> found;
-  for (const auto& [k, v] : *table_) found.emplace_back(v.source().begin.line, std::string(k.str()));
+  for (const auto& [k, v] : *table_)
+    if (!is_extension_name(k.str())) found.emplace_back(v.source().begin.line, std::string(k.str()));
   std::stable_sort(found.begin(), found.end());
   std::vector<std::string> out;
   for (auto& [line, k] : found) out.push_back(std::move(k));
@@ -231,10 +232,11 @@ std::vector<std::string> StrictTable::keys() const {
 
 void StrictTable::finish() const {
   for (const auto& [k, v] : *table_) {
-    if (used_.count(k.str()) == 0) {
+    if (used_.count(k.str()) == 0 && !is_extension_name(k.str())) {
       std::ostringstream os;
       os << file_ << ":" << v.source().begin.line << ": " << join(section_, k.str())
-         << ": unknown key (check the spelling; every key is documented in the example file)";
+         << ": unknown key (check the spelling; every key is documented in the example file or "
+         << "docs/run-files.md; keys of other tools begin with " << kExtensionPrefix << ")";
       throw dsp::InputError(os.str());
     }
   }

@@ -2,7 +2,11 @@
 // Strict reading of TOML configuration files (daemon config, simulation scenarios):
 // every key must be known and of the right type; anything else is an error that names
 // the file, the line and the key. Unknown keys are caught by finish(), so a typo such as
-// `fs_hz` → `fs_Hz` never silently falls back to a default.
+// `fs_hz` → `fs_Hz` never silently falls back to a default. The one exception is the
+// extension namespace (docs/run-files.md): a key beginning with `ext_` (a table named so
+// included) belongs to another tool, and every eical reader passes over it.
+#include "drivers/config/extension_names.hpp"
+
 #include <toml++/toml.h>
 
 #include <array>
@@ -24,7 +28,8 @@ class StrictTable {
   static toml::table parse_file(const std::string& path);
 
   [[nodiscard]] bool has(std::string_view key) const;
-  // The keys of this table in file order (e.g. the effect names of a scenario).
+  // The keys of this table in file order (e.g. the effect names of a scenario), other
+  // tools' ext_ keys left out.
   [[nodiscard]] std::vector<std::string> keys() const;
 
   double number(std::string_view key);  // required; integers are accepted as numbers
@@ -44,6 +49,10 @@ class StrictTable {
   // An array of `rows` arrays of `cols` numbers, e.g. a 3x3 mounting matrix.
   std::vector<std::vector<double>> matrix(std::string_view key, std::size_t rows, std::size_t cols);
 
+  // The key's node as it is (nullptr when absent), marked as read: for a value of a type
+  // the readers above do not cover (run.toml's `created`, a date-time or a string).
+  const toml::node* node(std::string_view key) { return get(key, false); }
+
   // Sub-table (required or optional) and arrays of tables ([[psd]]).
   StrictTable table(std::string_view key);
   std::optional<StrictTable> optional_table(std::string_view key);
@@ -51,7 +60,7 @@ class StrictTable {
   // One table or an array of tables under `key` ([k] or [[k]]: an effect on one axis or several).
   std::vector<StrictTable> table_or_tables(std::string_view key);
 
-  // Throws InputError for the first key that was never asked for.
+  // Throws InputError for the first key that was never asked for (ext_ keys excepted).
   void finish() const;
 
   [[nodiscard]] const std::string& file() const { return file_; }

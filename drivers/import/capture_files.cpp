@@ -1,10 +1,12 @@
 #include "drivers/import/capture_files.hpp"
 
+#include "drivers/config/extension_names.hpp"
 #include "drivers/run_io/line_source.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "drivers/source/servo_stream.hpp"
 #include "dsp/core/error.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -103,6 +105,18 @@ std::array<std::size_t, 4> resolve(const LineSource& src, const std::vector<std:
     if (found == header.size()) fail(src, "no column '" + names[k] + "' (the header has: " + list + ")");
     at[k] = found;
   }
+  const auto listed = [&](std::string_view h) {
+    return std::find(cols.ignored.begin(), cols.ignored.end(), h) != cols.ignored.end();
+  };
+  for (const auto& name : cols.ignored)
+    if (std::find(header.begin(), header.end(), name) == header.end())
+      fail(src, "column '" + name + "' is to be ignored, but the header has no such column (it has: " + list + ")");
+  for (std::size_t c = 0; c < header.size(); ++c)
+    if (std::find(at.begin(), at.end(), c) == at.end() && !listed(header[c]) && !is_extension_name(header[c]))
+      fail_column(src, std::string(header[c]),
+                  "unknown column: neither read (time '" + std::string(header[at[0]]) + "', values '" +
+                      std::string(header[at[1]]) + "', '" + std::string(header[at[2]]) + "', '" +
+                      std::string(header[at[3]]) + "') nor listed as ignored");
   return at;
 }
 

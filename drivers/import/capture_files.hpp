@@ -42,10 +42,14 @@ double accel_unit_in_mps2(AccelUnit unit);  // one unit of `unit` in m/s² (g: s
 
 // Which CSV columns hold what: names from the header, or "" for "by position" (time in
 // the first column, the three values in the next three). Time in seconds × time_scale_s.
+// Every column of the header is read, listed in `ignored`, or begins with ext_ (the extension
+// namespace, docs/run-files.md); any other is refused by name, so a column the user meant to
+// read is never dropped unseen.
 struct CsvColumns {
   std::string time;
   std::array<std::string, 3> values;
   double time_scale_s = 1.0;
+  std::vector<std::string> ignored{};  // columns of the file that are deliberately not read
 };
 
 StampedAccel read_klipper_capture(const std::filesystem::path& file);

@@ -1,7 +1,5 @@
 #include "drivers/run_io/run_reader.hpp"
 
-#include <algorithm>
-
 #include "drivers/config/meta_sections.hpp"
 #include "drivers/config/strict_toml.hpp"
 #include "drivers/run_io/line_source.hpp"
@@ -19,8 +17,6 @@
 namespace eical::drivers {
 namespace fs = std::filesystem;
 namespace {
-
-using Unknown = drivers::Unknown;
 
 // No case temperature of a working sensor is beyond this; a float could not hold 1e300.
 constexpr double kMaxTemp_c = 1000.0;
@@ -210,12 +206,19 @@ SampleReader::SampleReader(const fs::path& file, const dsp::RunMeta& meta, dsp::
       const auto comma = line.find(',', pos);
       const std::string_view name =
           line.substr(pos, comma == std::string_view::npos ? std::string_view::npos : comma - pos);
+      bool known = false;
       for (int c = 0; c < c_count; ++c)
         if (column_name(c) == name) {
           if (where_[c] >= 0)
             throw dsp::InputError(file.string() + ":1: column '" + std::string(name) + "' appears twice");
           where_[c] = n_fields_;
+          known = true;
         }
+      // As run.toml's keys: a misspelt column (ref_X) is refused, never read as absent.
+      if (!known && !is_extension_name(name))
+        throw dsp::InputError(file.string() + ":1: column '" + std::string(name) +
+                              "': unknown column (check the spelling; another tool's columns begin with " +
+                              std::string(kExtensionPrefix) + ")");
       ++n_fields_;
       if (comma == std::string_view::npos) break;
       pos = comma + 1;
@@ -306,8 +309,7 @@ dsp::RunMeta read_run_meta(const fs::path& run_toml) {
   m.format = t.string("format");
   if (m.format != "eical-run/1") t.fail("format", "expected \"eical-run/1\", got \"" + m.format + "\"");
   m.id = t.string("id");
-  if (t.has("created")) {
-    const toml::node* n = root.get("created");
+  if (const toml::node* n = t.node("created")) {
     if (auto dt = n->value<toml::date_time>()) {
       std::ostringstream os;
       os << *dt;
@@ -318,21 +320,24 @@ dsp::RunMeta read_run_meta(const fs::path& run_toml) {
       t.fail("created", "expected an RFC 3339 date-time");
     }
   }
-  m.acquisition = read_acquisition(t.table("acquisition"), {}, Unknown::accept);
-  if (auto s = t.optional_table("site")) m.site = read_site(*s, {}, Unknown::accept);
-  if (auto s = t.optional_table("machine")) m.machine = read_machine(*s, {}, Unknown::accept);
+  m.acquisition = read_acquisition(t.table("acquisition"));
+  if (auto s = t.optional_table("site")) m.site = read_site(*s);
+  if (auto s = t.optional_table("machine")) m.machine = read_machine(*s);
   StrictTable sensors = t.table("sensors");
-  m.sensors[0] = read_sensor(sensors.table("table"), {}, Unknown::accept);
-  m.sensors[1] = read_sensor(sensors.table("head"), {}, Unknown::accept);
-  for (auto& p : t.tables("psd")) m.psd.push_back(read_psd(p, Unknown::accept));
-  m.program = read_program(t.table("program"), Unknown::accept);
+  m.sensors[0] = read_sensor(sensors.table("table"));
+  m.sensors[1] = read_sensor(sensors.table("head"));
+  sensors.finish();
+  for (auto& p : t.tables("psd")) m.psd.push_back(read_psd(p));
+  m.program = read_program(t.table("program"));
   if (auto r = t.optional_table("reference")) {
     dsp::Reference ref;
     ref.kind = r->string("kind");
     ref.axes = r->strings("axes");
+    r->finish();
     m.reference = ref;
   }
-  if (auto s = t.optional_table("setpoint")) m.setpoint = read_setpoint_origin(*s, Unknown::accept);
+  if (auto s = t.optional_table("setpoint")) m.setpoint = read_setpoint_origin(*s);
+  t.finish();
   return m;
 }
 

@@ -30,6 +30,36 @@ TEST(CollectUnit, RestartsAndSpoolsWhereItMayWrite) {
   EXPECT_NE(unit.find("\nEnvironmentFile=/etc/eical/collect.env\n"), std::string::npos);  // EICAL_HISTORY_DB
 }
 
+// As eicald's unit: systemd waits for READY=1 and restarts a collector whose loop stops
+// feeding the watchdog (collect_notify_test.cpp sees both from the real binary).
+TEST(CollectUnit, NotifiesSystemdAndHasAWatchdog) {
+  const std::string unit = read_file(kUnit);
+  EXPECT_NE(unit.find("\nType=notify\n"), std::string::npos);
+  EXPECT_EQ(unit.find("\nType=simple\n"), std::string::npos);
+  EXPECT_NE(unit.find("\nNotifyAccess=main\n"), std::string::npos);
+  const auto at = unit.find("\nWatchdogSec=");
+  ASSERT_NE(at, std::string::npos);
+  const double watchdog_s = std::stod(unit.substr(at + 13));
+  EXPECT_GT(watchdog_s, 0.6);  // above the loop's 300 ms receive, twice over
+  // The stop waits for the spool to drain (10 s in cmd_collect.cpp) inside TimeoutStopSec.
+  const auto stop = unit.find("\nTimeoutStopSec=");
+  ASSERT_NE(stop, std::string::npos);
+  EXPECT_GT(std::stod(unit.substr(stop + 16)), 10.0);
+}
+
+// Every long-running unit in systemd/ uses the notify protocol and a watchdog.
+TEST(CollectUnit, EveryUnitInTheTreeNotifiesAndHasAWatchdog) {
+  int units = 0;
+  for (const auto& e : fs::directory_iterator(fs::path(EICAL_SOURCE_DIR) / "systemd")) {
+    if (e.path().extension() != ".service") continue;
+    ++units;
+    const std::string unit = read_file(e.path());
+    EXPECT_NE(unit.find("\nType=notify\n"), std::string::npos) << e.path();
+    EXPECT_NE(unit.find("\nWatchdogSec="), std::string::npos) << e.path();
+  }
+  EXPECT_GE(units, 2);
+}
+
 TEST(CollectUnit, PassesSystemdAnalyzeVerify) {
   ASSERT_EQ(std::system("command -v systemd-analyze >/dev/null 2>&1"), 0)
       << "systemd-analyze not installed (scripts/deps.sh test)";

@@ -3,10 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -105,6 +107,39 @@ TEST(DaemonConfig, EveryKeyOfTheExampleIsRecognised) {
     ++checked;
   }
   EXPECT_GT(checked, 40);
+}
+
+// In every table of the example (and at its root), an unknown key is refused naming the
+// file, its line and the key; a key of the extension namespace (ext_, docs/run-files.md) is
+// passed over.
+TEST(DaemonConfig, UnknownKeyInEveryTableNamesFileLineAndKeyExtensionPassesOver) {
+  const std::string text = read_file(kExample);
+  std::vector<std::size_t> after = {0};  // offsets of the lines a key goes after: the root's first
+  for (std::size_t pos = 0; (pos = text.find("\n[", pos)) != std::string::npos; ++pos)
+    after.push_back(text.find('\n', pos + 1) + 1);
+  ASSERT_GT(after.size(), 8u);
+  for (const std::size_t at : after) {
+    const auto line =
+        static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<long>(at), '\n')) + 1;
+    for (const std::string key : {"typo_key", "ext_note"}) {
+      std::string edited = text;
+      edited.insert(at, key + " = 1\n");
+      const fs::path p = write_temp(edited);
+      std::string msg;
+      try {
+        (void)load_daemon_config(p);
+      } catch (const eical::dsp::InputError& e) {
+        msg = e.what();
+      }
+      fs::remove(p);
+      if (key == "ext_note") {
+        EXPECT_EQ(msg, "") << "line " << line;
+      } else {
+        EXPECT_NE(msg.find(p.string() + ":" + std::to_string(line) + ": "), std::string::npos) << msg;
+        EXPECT_NE(msg.find("typo_key: unknown key"), std::string::npos) << msg;
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -73,7 +73,7 @@ TEST(VolumetricFit, PredictsHeldOutPointsWithinItsUncertainty) {
   }
   run_cli({"volumetric", "--model", (dir / "model.toml").string(), "--points", (dir / "p.csv").string(), "--out",
            (dir / "e.csv").string()});
-  const eical::tools::CsvTable e(dir / "e.csv", {"ex_um", "ey_um", "ez_um", "Ux_um", "Uy_um", "Uz_um"});
+  const eical::tools::CsvTable e(dir / "e.csv", {"ex_um", "ey_um", "ez_um", "Ux_um", "Uy_um", "Uz_um"}, {"status"});
   ASSERT_EQ(e.rows(), held.size());
   const std::size_t origin = held.size() - 1;
   const Eigen::Vector3d e0(e.number(origin, "ex_um"), e.number(origin, "ey_um"), e.number(origin, "ez_um"));

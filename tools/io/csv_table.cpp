@@ -1,5 +1,6 @@
 #include "tools/io/csv_table.hpp"
 
+#include "drivers/config/extension_names.hpp"
 #include "dsp/core/error.hpp"
 
 #include <charconv>
@@ -24,9 +25,19 @@ std::vector<std::string> split(const std::string& line) {
   return out;
 }
 
+bool known(const std::string& column, const std::vector<std::string>& required,
+           const std::vector<std::string>& optional) {
+  for (const auto* list : {&required, &optional})
+    for (const auto& c : *list)
+      if (c == column) return true;
+  return false;
+}
+
 }  // namespace
 
-CsvTable::CsvTable(const std::filesystem::path& file, const std::vector<std::string>& required) : file_(file.string()) {
+CsvTable::CsvTable(const std::filesystem::path& file, const std::vector<std::string>& required,
+                   const std::vector<std::string>& optional)
+    : file_(file.string()) {
   std::ifstream is(file);
   if (!is) throw dsp::InputError(file_ + ": cannot open");
   std::string line;
@@ -36,6 +47,11 @@ CsvTable::CsvTable(const std::filesystem::path& file, const std::vector<std::str
     if (line.empty() || line[0] == '#') continue;
     if (header_.empty()) {
       header_ = split(line);
+      for (const auto& h : header_)
+        if (!known(h, required, optional) && !drivers::is_extension_name(h))
+          throw dsp::InputError(file_ + ":" + std::to_string(no) + ": column '" + h +
+                                "': unknown column (check the spelling; another tool's columns begin with " +
+                                std::string(drivers::kExtensionPrefix) + ")");
       continue;
     }
     auto f = split(line);

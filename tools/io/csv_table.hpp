@@ -10,8 +10,11 @@ namespace eical::tools {
 
 class CsvTable {
  public:
-  // Reads the file; `required` columns must be in the header (any order, others ignored).
-  CsvTable(const std::filesystem::path& file, const std::vector<std::string>& required);
+  // Reads the file; `required` columns must be in the header (any order), `optional` ones
+  // may be; any other column is refused by name (line 1) unless it begins with ext_, the
+  // extension namespace of every eical input (docs/run-files.md).
+  CsvTable(const std::filesystem::path& file, const std::vector<std::string>& required,
+           const std::vector<std::string>& optional = {});
 
   [[nodiscard]] std::size_t rows() const { return cells_.size(); }
   // A finite number, or InputError naming file, line and column.
