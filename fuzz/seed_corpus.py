@@ -90,6 +90,19 @@ for toml_path in runs:
 put("gcode", "arcs-r-and-planes.ngc", "%\nO1234 (test)\nG21 G90 G18\nG0 X0 Y0 Z0\nG2 X10 Z10 R10 F1000\nG19 G3 Y5 Z5 J2.5 K0\n"
     "G17 G91 G1 X-1 Y1 F500\nG4 P0.5\nM101 P2 Q3\n/M3 S1000\nN10 M102 ; comment\nM103\nM30\n%\n")
 put("gcode", "broken-canned-cycle.ngc", "G21 G90\nG81 X1 Y1 Z-1 R1 F100\n")
+# Each control's own syntax (sim/gcode/parser.hpp, words.hpp), and a program of another.
+put("gcode_fanuc", "dwells-units-comments.nc", "%\nO0001 (DWELLS)\nN10 G90 G21 G17 G61\nN20 G0 X0. Y0.\n"
+    "N30 G04 P250\nN40 G04 X0.5\nN50 G1 X10. F1000 ; END OF BLOCK\nN60 G3 X0. Y10. R10. \nN70 G20 G1 X1. F10.\n"
+    "M101 P1 Q2\nM30\n%\n")
+put("gcode_fanuc", "broken-seconds-in-p.nc", "G04 P0.5\nG0 X10\n")
+put("gcode_sinumerik", "dwells-units-comments.mpf", "%_N_SEED_MPF\n;$PATH=/_N_MPF_DIR\nN10 G90 G710 G17 G60\n"
+    "N20 G0 X0 Y0\nN30 S1000 M3\nN40 G4 S5\nN50 G4 F0.25\nN60 G70 G1 X1 F500\nN70 G700 G2 X0 Y1 I-1 J0 F20\n"
+    "N80 G71 G64 G18 G3 Z1 X0 K0 I1\nM5\nM30\n")
+put("gcode_sinumerik", "broken-linuxcnc-dwell.mpf", "G71\nG4 P400\nG0 X1 (comment)\n")
+put("gcode_heidenhain_iso", "centre-radius-dwell.h", "%SEED G71 *\nN10 G90 G17 *\nN20 G00 X+10 Y+0 *\n"
+    "N30 G04 F0.5 *\nN40 I+0 J+0 *\nN50 G03 X+0 Y+10 F1000 *\nN60 G02 X+10 Y+0 R+10 * ; r form\n"
+    "N70 G91 I+0 J-10 G02 X+0 Y+0 *\nN80 G90 G18 K+0 I+0 G03 Z+10 X+0 *\nN99999999 %SEED G71 *\n")
+put("gcode_heidenhain_iso", "broken-after-block-end.h", "%SEED G70 *\nN10 G00 X+1 * Y+2\n")
 
 # --- CSV tables of the command line
 put("deviation_csv", "two-runs", "target_mm,run,direction,deviation_um\n" + "".join(
@@ -221,6 +234,6 @@ if EICAL:
                     eical("gen-nc", prog, *extra, "--dialect", dialect, "-o", out)
                 except subprocess.CalledProcessError:
                     continue
-                if dialect == "linuxcnc" or prog == "circle":
-                    put("gcode", f"gen-nc-{prog}-{dialect}.ngc", pathlib.Path(out).read_text())
+                target = "gcode" if dialect == "linuxcnc" else "gcode_" + dialect.replace("-", "_")
+                put(target, f"gen-nc-{prog}-{dialect}.ngc", pathlib.Path(out).read_text())
 print("seed corpus written to", CORPUS)

@@ -416,9 +416,11 @@ std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& scenario) {
     return std::make_unique<nc::AccelProfileSetPoint>(nc::klipper_segments(scenario.sweep.test),
                                                       scenario.sweep.direction, scenario.sweep.start_mm,
                                                       scenario.sweep.lead_in_s, scenario.sweep.tail_s);
+  // eical's own text: generated, or a user's file made canonical where it was read (whose
+  // errors named that file); so no file name here, and never the run id.
   const dsp::Program& p = scenario.meta.program;
-  return std::make_unique<nc::Trajectory>(nc::interpolate_gcode(p.gcode.empty() ? gcode::program_gcode(p) : p.gcode,
-                                                                scenario.meta.id + ".ngc", scenario.limits));
+  return std::make_unique<nc::Trajectory>(
+      nc::interpolate_gcode(p.gcode.empty() ? gcode::program_gcode(p) : p.gcode, "[program] gcode", scenario.limits));
 }
 
 dsp::Run simulate(const Scenario& scenario) {

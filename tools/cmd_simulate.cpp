@@ -2,6 +2,7 @@
 #include "drivers/config/scenario_file.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
+#include "sim/gcode/dialect_id.hpp"
 #include "sim/hidden/hidden_effects.hpp"
 #include "sim/regimes/klipper_like.hpp"
 #include "sim/regimes/regimes.hpp"
@@ -28,6 +29,7 @@ struct SimulateOptions {
   bool gzip = false, overwrite = false, background = false;
   // Regimes of runs measured by other systems.
   std::string regime, sensors, mems, wrong_mounting, sweep_axis = "x";
+  std::string dialect = "linuxcnc";  // of the scenario's [program] gcode_file
   double fs_hz = 0.0;
   std::vector<std::string> resonance;
   bool klipper_legacy = false;
@@ -80,7 +82,7 @@ sim::Scenario base_scenario(const SimulateOptions& o, bool program_given) {
                                           : (o.hide.empty() ? std::vector<std::string>{"machine.resonance"} : o.hide),
                                       o.seed);
   }
-  if (!o.scenario.empty()) return drivers::read_scenario_file(o.scenario);
+  if (!o.scenario.empty()) return drivers::read_scenario_file(o.scenario, sim::gcode::dialect_from_name(o.dialect));
   if (!o.hide.empty() || o.background) {
     const bool chosen = o.program == "circle" || o.program == "step";
     const std::string kind = o.hide.empty() ? (chosen ? o.program : "circle")
@@ -152,6 +154,12 @@ void add_program_options(CLI::App& cmd, SimulateOptions& o) {
                                   "scenario file (eical-scenario/1, config/scenarios/README.md): machine errors, "
                                   "vibration, sensor truth, every effect")
                        ->check(CLI::ExistingFile);
+  cmd.add_option("--dialect", o.dialect,
+                 "the control the scenario's [program] gcode_file is written for: linuxcnc, fanuc, sinumerik or "
+                 "heidenhain-iso (dwell units, inch/metric codes, comments and block syntax; as gen-nc --dialect)")
+      ->default_val("linuxcnc")
+      ->check(CLI::IsMember({"linuxcnc", "fanuc", "sinumerik", "heidenhain-iso"}))
+      ->needs(scenario);
   cmd.add_option(
          "--program", o.program,
          "circle, step, positioning, rectangle, freeform, identify or sweep (Klipper's resonance test, no standstill)")

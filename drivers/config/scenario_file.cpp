@@ -6,6 +6,8 @@
 #include "dsp/core/error.hpp"
 #include "dsp/core/frame.hpp"
 #include "sim/effects.hpp"
+#include "sim/gcode/canonical.hpp"
+#include "sim/gcode/parser.hpp"
 #include "sim/regimes/regimes.hpp"
 #include "sim/sensor/axes_map.hpp"
 #include "sim/sensor/mems_chip.hpp"
@@ -344,19 +346,29 @@ void read_truth(StrictTable& truth, sim::Scenario& sc) {
 
 // [sweep] and [program]: with a [sweep] the program is the test; [program] may still name
 // its kind. A G-code file is read relative to the scenario's folder.
-void read_motion(StrictTable& root, const std::string& path, sim::Scenario& sc) {
+// The G-code file is in `dialect` and read here, where its name is known: its errors name
+// it, a file without motion is refused, and the program is kept in the canonical form
+// (sim/gcode/canonical.hpp). Inline `gcode` is run.toml's, canonical already.
+void read_motion(StrictTable& root, const std::string& path, sim::gcode::Dialect dialect, sim::Scenario& sc) {
   if (auto t = root.optional_table("sweep")) read_sweep(*t, sc);
+  bool gcode_file_read = false;
   if (auto program = sc.sweep.on ? root.optional_table("program") : std::optional<StrictTable>(root.table("program"))) {
     const std::string gcode_file = program->string("gcode_file", "");
     sc.meta.program = read_program(*program);  // the copy knows gcode_file is used
     if (!gcode_file.empty()) {
+      gcode_file_read = true;
       if (sc.sweep.on) program->fail("gcode_file", "a [sweep] scenario runs Klipper's test, not a G-code program");
       const std::filesystem::path p = std::filesystem::path(path).parent_path() / gcode_file;
-      sc.meta.program.gcode = read_text(p);
+      sc.meta.program.gcode = sim::gcode::canonical_gcode(read_text(p), p.string(), dialect);
+    } else if (!sc.meta.program.gcode.empty()) {
+      (void)sim::gcode::parse(sc.meta.program.gcode, path + " [program] gcode");
     }
   } else {
     sc.meta.program.kind = "freeform";
   }
+  if (dialect != sim::gcode::Dialect::linuxcnc && !gcode_file_read)
+    throw dsp::InputError(path + ": a G-code dialect (" + sim::gcode::dialect_name(dialect) +
+                          ") is for a [program] gcode_file, and this scenario has none");
 }
 
 // [[psd]]: each strip as run.toml has it, and its truth.
@@ -448,7 +460,7 @@ void read_effects(StrictTable& effects, sim::Scenario& sc) {
 
 }  // namespace
 
-sim::Scenario read_scenario_file(const std::string& path) {
+sim::Scenario read_scenario_file(const std::string& path, sim::gcode::Dialect gcode_dialect) {
   const toml::table doc = StrictTable::parse_file(path);
   StrictTable root(doc, path, "");
   sim::Scenario sc;
@@ -458,7 +470,7 @@ sim::Scenario read_scenario_file(const std::string& path) {
   if (root.has("sensors_present"))
     sim::set_sensors_present(sc, root.choice("sensors_present", {"both", "head", "table"}, "both"));
   if (auto truth = root.optional_table("truth")) read_truth(*truth, sc);
-  read_motion(root, path, sc);
+  read_motion(root, path, gcode_dialect, sc);
   read_psd_strips(root, sc);
   sc.meta.reference.reset();
   if (auto r = root.optional_table("reference")) read_reference(*r, sc);

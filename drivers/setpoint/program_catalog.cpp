@@ -3,6 +3,7 @@
 #include "drivers/config/meta_sections.hpp"
 #include "drivers/config/strict_toml.hpp"
 #include "dsp/core/error.hpp"
+#include "sim/gcode/parser.hpp"
 
 namespace eical::drivers {
 
@@ -14,6 +15,9 @@ dsp::Program read_program_file(const std::filesystem::path& path) {
   if (!program) throw dsp::InputError(path.string() + ": no [program] table (write it with eical gen-nc --meta)");
   dsp::Program p = read_program(*program);
   if (p.gcode.empty()) throw dsp::InputError(path.string() + ": [program] has no gcode");
+  // Read here, where the file is known, so that its errors name it (the set-point and the
+  // simulator read it again later, by then as eical's own text).
+  (void)sim::gcode::parse(p.gcode, path.string() + " [program] gcode");
   file.finish();
   return p;
 }

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <optional>
 #include <sstream>
+#include <string_view>
 #include <vector>
 
 namespace eical::sim::gcode {
@@ -86,6 +87,13 @@ std::string linuxcnc(const std::vector<Line>&, const std::string& canonical, con
   return "(" + id.title + ")\n" + canonical + "M2\n";
 }
 
+// FANUC counts a length without a decimal point in least input increments (X10 is
+// 0.010 mm unless parameter 3401#0 is set): every length is written with its point.
+std::string fanuc_number(const WrittenWord& w) {
+  const bool length = std::string_view("XYZIJKR").find(w.letter) != std::string_view::npos;
+  return length && w.text.find('.') == std::string::npos ? w.text + "." : w.text;
+}
+
 std::string fanuc(const std::vector<Line>& lines, const ProgramIdentity& id) {
   char head[32];
   std::snprintf(head, sizeof head, "O%04d", id.number);
@@ -96,7 +104,7 @@ std::string fanuc(const std::vector<Line>& lines, const ProgramIdentity& id) {
     if (has_g(l, 4)) {
       parts = {"G04", "P" + dwell(l, static_cast<int>(n + 1), true)};
     } else {
-      for (const auto& w : l.words) parts.push_back(std::string(1, w.letter) + w.text);
+      for (const auto& w : l.words) parts.push_back(std::string(1, w.letter) + fanuc_number(w));
     }
     if (!l.comment.empty()) parts.push_back("(" + upper(l.comment) + ")");
     if (!parts.empty()) out += join(parts) + "\n";
@@ -114,7 +122,9 @@ std::string sinumerik(const std::vector<Line>& lines, const ProgramIdentity& id)
     } else {
       for (const auto& w : l.words) {
         if (is_g(w, 21))
-          parts.push_back("G71");  // metric
+          parts.push_back("G71");  // metric lengths (the feed is in the metric base system)
+        else if (is_g(w, 20))
+          parts.push_back("G700");  // inch lengths and feed, as LinuxCNC's G20
         else if (is_g(w, 61))
           parts.push_back("G60");  // exact stop, modal
         else
@@ -162,6 +172,9 @@ std::string heidenhain(const std::vector<Line>& lines, const ProgramIdentity& id
           plane = g, parts.push_back("G" + std::to_string(g));
         else if (g == 21 || g == 61 || g == 64)
           continue;  // mm is in the begin line; no modal exact stop on the TNC
+        else if (g == 20)
+          throw dsp::InputError("dialect: line " + std::to_string(line_no) +
+                                ": inch (G20) has no HEIDENHAIN ISO form here (the begin line says G71, mm)");
         else
           throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": G" + w.text +
                                 " has no HEIDENHAIN ISO form here");
@@ -209,24 +222,6 @@ std::string heidenhain(const std::vector<Line>& lines, const ProgramIdentity& id
 }
 
 }  // namespace
-
-Dialect dialect_from_name(const std::string& name) {
-  if (name == "linuxcnc") return Dialect::linuxcnc;
-  if (name == "fanuc") return Dialect::fanuc;
-  if (name == "sinumerik") return Dialect::sinumerik;
-  if (name == "heidenhain-iso") return Dialect::heidenhain_iso;
-  throw dsp::InputError("dialect '" + name + "' is not linuxcnc, fanuc, sinumerik or heidenhain-iso");
-}
-
-const char* dialect_name(Dialect d) noexcept {
-  switch (d) {
-    case Dialect::linuxcnc: return "linuxcnc";
-    case Dialect::fanuc: return "fanuc";
-    case Dialect::sinumerik: return "sinumerik";
-    case Dialect::heidenhain_iso: return "heidenhain-iso";
-  }
-  return "?";
-}
 
 std::string write_dialect(const std::string& canonical, Dialect d, const ProgramIdentity& id) {
   std::vector<Line> lines;

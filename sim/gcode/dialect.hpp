@@ -2,7 +2,11 @@
 // The calibration programs for the control that runs them. eical's generators write one
 // canonical ISO text (LinuxCNC's RS-274, what the simulator reads); a dialect writer turns
 // it into a complete program for one control: its program start and number, its dwell
-// word and unit, its comment syntax, its arc-centre form and its program end.
+// word and unit, its comment syntax, its arc-centre form and its program end. Units: FANUC
+// lengths always carry a decimal point; SINUMERIK G21 → G71, G20 → G700 (lengths and feed,
+// as LinuxCNC's G20); HEIDENHAIN ISO is mm only (G20 is refused). eical's reader
+// (parser.hpp) reads every one of them back; tests/sim/gcode_dialect_property_test.cpp and
+// tests/tools/gcode_dialect_round_trip_test.cpp hold it to the same path and dwells.
 //
 // | dialect         | start / number               | dwell (canonical G4 P<s>) | end               |
 // |-----------------|------------------------------|---------------------------|-------------------|
@@ -29,15 +33,13 @@
 //     of the calibration programs ends in a dwell anyway).
 // The measurement M-functions M101–M103 stay as they are: on FANUC, SINUMERIK and
 // HEIDENHAIN controls the PLC decodes them (README, "How M101/M102/M103 reach eicald").
+// eical's reader takes the same dialects back (parser.hpp: the reading rules and where
+// each unit comes from).
+#include "sim/gcode/dialect_id.hpp"
+
 #include <string>
 
 namespace eical::sim::gcode {
-
-enum class Dialect { linuxcnc, fanuc, sinumerik, heidenhain_iso };
-
-// "linuxcnc", "fanuc", "sinumerik", "heidenhain-iso"; InputError otherwise.
-Dialect dialect_from_name(const std::string& name);
-const char* dialect_name(Dialect d) noexcept;
 
 struct ProgramIdentity {
   int number = 1000;           // FANUC O-number

@@ -119,7 +119,7 @@ TEST(GcodeParser, ErrorsNameLineAndColumn) {
   EXPECT_NE(error_of("G1 X=5").find("needs a number"), std::string::npos);
 }
 
-// A real part program as a CAM post-processor writes it, run as a free-form test.
+// A real part program as a CAM post-processor writes it for a FANUC, run as a free-form test.
 TEST(GcodeParser, RealPartProgramsAreRead) {
   const char* text =
       "%\n"
@@ -128,16 +128,16 @@ TEST(GcodeParser, RealPartProgramsAreRead) {
       "N20 T1 M6 (D10 END MILL)\n"
       "N30 S8000 M3\n"
       "N40 M8\n"
-      "N50 G0 X-20 Y-10\n"
+      "N50 G0 X-20. Y-10.\n"
       "/N55 M1\n"
-      "N60 G1 X20 F1200\n"
-      "N70 G3 X20 Y10 I0 J10\n"
-      "n80 g1 x-20 (lower case, as some posts write)\n"
-      "N90 G0 Z50 M9\n"
+      "N60 G1 X20. F1200\n"
+      "N70 G3 X20. Y10. I0. J10.\n"
+      "n80 g1 x-20. (lower case, as some posts write)\n"
+      "N90 G0 Z50. M9\n"
       "N100 M5\n"
       "N110 M30\n"
       "%\n";
-  const Program p = parse(text, "pocket.nc");
+  const Program p = parse(text, "pocket.nc", {.dialect = Dialect::fanuc});
   ASSERT_EQ(p.blocks.size(), 5u);  // G0, G1, G3, G1, G0: M-codes, S and T add nothing to the path
   const auto& first = std::get<Linear>(p.blocks[0]);
   EXPECT_TRUE(first.rapid);
@@ -149,8 +149,8 @@ TEST(GcodeParser, RealPartProgramsAreRead) {
 }
 
 TEST(GcodeParser, PartProgramsStillRefuseWhatTheyCannotSimulate) {
-  EXPECT_EQ(error_of("%\nO1\nN10 G81 X1 Y1 Z-2 R1 F100"), "t.ngc:3:5: unsupported G-code G81");  // canned cycle
-  EXPECT_EQ(error_of("G0 X0\nG43 H1 Z50"), "t.ngc:2:5: unsupported word 'H'");                   // tool length offset
+  EXPECT_EQ(error_of("%\nN10 G81 X1 Y1 Z-2 R1 F100"), "t.ngc:2:5: unsupported G-code G81");  // canned cycle
+  EXPECT_EQ(error_of("G0 X0\nG43 H1 Z50"), "t.ngc:2:5: unsupported word 'H'");               // tool length offset
   EXPECT_EQ(error_of("G28"), "t.ngc:1:1: unsupported G-code G28");
   EXPECT_EQ(error_of("G55"), "t.ngc:1:1: unsupported G-code G55");
   EXPECT_NE(error_of("o100 sub").find("t.ngc:1:6: O-word control flow"), std::string::npos) << error_of("o100 sub");
