@@ -321,6 +321,7 @@ dsp::RunMeta read_run_meta(const fs::path& run_toml) {
   m.acquisition = read_acquisition(t.table("acquisition"), {}, Unknown::accept);
   if (auto s = t.optional_table("site")) m.site = read_site(*s, {}, Unknown::accept);
   if (auto s = t.optional_table("machine")) m.machine = read_machine(*s, {}, Unknown::accept);
+  if (auto s = t.optional_table("envelope")) m.envelope = read_envelope(*s);
   StrictTable sensors = t.table("sensors");
   m.sensors[0] = read_sensor(sensors.table("table"), {}, Unknown::accept);
   m.sensors[1] = read_sensor(sensors.table("head"), {}, Unknown::accept);
