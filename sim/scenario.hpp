@@ -169,6 +169,10 @@ struct SweepExcitation {
   double tail_s = 0.0;
 };
 
+// The default of Scenario::max_duration_s: 40 minutes, 15 GB (the 31-minute run of the
+// long-recording bench fits).
+inline constexpr double kMaxSimulatedS = 2400.0;
+
 struct Scenario {
   std::string name = "baseline";
   std::string description;
@@ -188,8 +192,12 @@ struct Scenario {
   nc::MachineLimits limits;
   SweepExcitation sweep;  // on: runs Klipper's resonance test, not meta.program.gcode
   int oversample = 10;    // internal rate = oversample · fs (≥ 100 kHz at 10 kHz)
-  bool noise = true;      // white sensor noise (quantisation is always on: for a
-                          // near-ideal ADC use adc_bits = 32 and a tiny adc_lsb_volt)
+  // The longest run simulate() makes, at 100 kHz internal samples (a finer grid shortens it
+  // in proportion): memory grows with the run, about 0.4 GB a minute at 10 kHz, so a
+  // program longer than this is refused before anything is allocated.
+  double max_duration_s = kMaxSimulatedS;
+  bool noise = true;  // white sensor noise (quantisation is always on: for a
+                      // near-ideal ADC use adc_bits = 32 and a tiny adc_lsb_volt)
   // Effects the scenario injected on purpose (names of run-format.md) and those present
   // only at tolerance level; truth.toml lists both. Empty `present`: derived from the
   // parameters that differ from nominal.

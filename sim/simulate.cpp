@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <random>
 
@@ -59,10 +60,33 @@ struct SimGrid {
   std::size_t n_frames = 0, n_int = 0;
 };
 
+// Frames and internal samples grow with the program's duration: a program longer than the
+// scenario's budget is refused before anything is allocated.
+void check_budget(const Scenario& sc, const SimGrid& gr, double duration_s) {
+  constexpr double kBudgetInternalHz = 100000.0;  // the budget's duration is at this internal rate
+  const double frames = std::ceil(duration_s * gr.fs_hz) + 1.0;
+  const double internal = frames * gr.oversample;
+  const double max_internal = sc.max_duration_s * kBudgetInternalHz;
+  if (std::isfinite(duration_s) && internal <= max_internal) return;
+  const double channels =
+      3.0 * (sc.meta.sensor_present[0] + sc.meta.sensor_present[1]) + 2.0 * static_cast<double>(sc.meta.psd.size());
+  const double bytes_per_internal = 8.0 * channels, bytes_per_frame = static_cast<double>(sizeof(dsp::Frame));
+  char b[400];
+  std::snprintf(b, sizeof b,
+                "simulate: the program runs %.1f s (%.3g frames at %.0f Hz, %.3g internal samples, about %.3g GB), "
+                "beyond the longest simulation of %.0f s at 100 kHz (%.3g internal samples, about %.3g GB; "
+                "--max-duration)",
+                duration_s, frames, gr.fs_hz, internal,
+                (frames * bytes_per_frame + internal * bytes_per_internal) / 1e9, sc.max_duration_s, max_internal,
+                (max_internal / gr.oversample * bytes_per_frame + max_internal * bytes_per_internal) / 1e9);
+  throw dsp::InputError(b);
+}
+
 SimGrid sim_grid(const Scenario& sc, const nc::SetPoint& tr) {
   SimGrid gr;
   gr.fs_hz = sc.meta.acquisition.fs_hz;
   gr.oversample = sc.oversample;
+  check_budget(sc, gr, tr.duration_s());  // before any buffer is sized
   gr.h_s = 1.0 / (gr.fs_hz * gr.oversample);
   gr.n_frames = static_cast<std::size_t>(std::ceil(tr.duration_s() * gr.fs_hz)) + 1;
   gr.n_int = gr.n_frames * static_cast<std::size_t>(gr.oversample);
@@ -410,6 +434,11 @@ void psd_counts(DaqStage& d, const std::vector<std::vector<double>>& psd_v, dsp:
 }
 
 }  // namespace
+
+void check_budget(const Scenario& scenario, const nc::SetPoint& set_point) {
+  check(scenario);
+  (void)sim_grid(scenario, set_point);
+}
 
 std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& scenario) {
   if (scenario.sweep.on)

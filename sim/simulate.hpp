@@ -57,6 +57,11 @@ dsp::Run simulate(const Scenario& scenario, std::vector<Eigen::Vector3d>* true_r
 dsp::Run simulate(const Scenario& scenario, const nc::SetPoint& set_point,
                   std::vector<Eigen::Vector3d>* true_rel_mm = nullptr, JitteredCapture* capture = nullptr);
 
+// Throws InputError when the set-point runs longer than the scenario's budget
+// (Scenario::max_duration_s): simulate() checks it before allocating; a caller that sizes
+// buffers per frame itself checks it first.
+void check_budget(const Scenario& scenario, const nc::SetPoint& set_point);
+
 // The set-point a scenario runs: its Klipper sweep, or its program's G-code interpolated.
 std::unique_ptr<nc::SetPoint> scenario_set_point(const Scenario& scenario);
 

@@ -5,7 +5,9 @@
 // output wired to the trigger input, or a CAN frame) — see README "NC triggers".
 #include "sim/gcode/dialect.hpp"
 #include "sim/gcode/generate.hpp"
+#include "sim/nc/trajectory.hpp"
 #include "tools/commands.hpp"
+#include "tools/envelope_options.hpp"
 #include "tools/io/psd_option.hpp"
 
 #include <cctype>
@@ -30,6 +32,7 @@ struct GenOptions {
   std::string dialect = "linuxcnc";
   int program_number = 1000;
   std::string program_name;
+  EnvelopeOptions envelope;
 };
 
 std::string toml_list(const std::vector<double>& v) {
@@ -88,14 +91,19 @@ void add_output(CLI::App* cmd, GenOptions& o) {
 
 // The canonical program written for the control, and its [program] table with the
 // LinuxCNC form (what eical's reader and simulator take).
+// A program beyond the machine's work envelope is refused before anything is written: the
+// program as eical's interpolator runs it (its arcs' extremes, its feeds).
 void write_program(const std::string& canonical, dsp::Program p, const std::string& title, const std::string& out,
-                   const std::string& meta_out, const std::string& dialect, int number, std::string name) {
+                   const std::string& meta_out, const std::string& dialect, int number, std::string name,
+                   const EnvelopeOptions& envelope) {
   for (char& c : name)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_')
       throw std::runtime_error("--program-name: letters, digits and _ only");
   const sim::gcode::ProgramIdentity id{number, name.empty() ? "EICAL_" + p.kind : name, title};
-  write_text(out, sim::gcode::write_dialect(canonical, sim::gcode::dialect_from_name(dialect), id));
   p.gcode = sim::gcode::write_dialect(canonical, sim::gcode::Dialect::linuxcnc, id);
+  require_within(sim::nc::interpolate_gcode(p.gcode, "gen-nc " + p.kind, sim::nc::MachineLimits{}),
+                 envelope_of(envelope), "gen-nc " + p.kind);
+  write_text(out, sim::gcode::write_dialect(canonical, sim::gcode::dialect_from_name(dialect), id));
   if (!meta_out.empty()) write_text(meta_out, program_toml(p, p.gcode));
 }
 
@@ -120,7 +128,7 @@ void emit(GenOptions& o) {
   p.size_mm[0] = o.size.at(0), p.size_mm[1] = o.size.at(1);
   const std::string g =
       p.kind == "positioning" ? sim::gcode::positioning_program(p, o.overrun_mm) : sim::gcode::program_gcode(p);
-  write_program(g, p, title_of(p), o.out, o.meta_out, o.dialect, o.program_number, o.program_name);
+  write_program(g, p, title_of(p), o.out, o.meta_out, o.dialect, o.program_number, o.program_name, o.envelope);
 }
 
 // One option set per program kind: CLI11 writes defaults into the bound variables when
@@ -129,9 +137,9 @@ void add_circle(CLI::App* gen) {
   auto o = std::make_shared<GenOptions>();
   dsp::Program& p = o->program;
   auto* c = gen->add_subcommand("circle", "ISO 230-4 circular test");
-  c->add_option("--radius", p.radius_mm, "radius in mm")->default_val(10.0);
-  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2500.0);
-  c->add_option("--repeats", p.repeats, "full revolutions")->default_val(5);
+  c->add_option("--radius", p.radius_mm, "radius in mm")->default_val(10.0)->check(CLI::PositiveNumber);
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
+  c->add_option("--repeats", p.repeats, "full revolutions")->default_val(5)->check(CLI::Range(1, 1000));
   c->add_option("--direction", p.direction, "ccw, cw or both (ccw, then cw back)")
       ->default_val("ccw")
       ->check(CLI::IsMember({"ccw", "cw", "both"}));
@@ -142,6 +150,7 @@ void add_circle(CLI::App* gen) {
       ->check(CLI::Range(1.0, 360.0));
   c->add_option("--arc-start-deg", o->arc_start_deg, "partial arc: where it begins, deg (default 90 - arc/2)");
   add_output(c, *o);
+  add_envelope_options(*c, o->envelope);
   c->callback([o] {
     o->program.kind = "circle";
     if (o->arc_start_deg) o->program.arc_start_deg = *o->arc_start_deg;
@@ -155,11 +164,14 @@ void add_positioning(CLI::App* gen) {
   auto* c = gen->add_subcommand("positioning", "ISO 230-2 bidirectional positioning cycle");
   c->add_option("--axis", p.axis, "x, y or z")->default_val("x")->check(CLI::IsMember({"x", "y", "z"}));
   c->add_option("--targets", p.targets_mm, "targets in mm, ascending (comma separated)")->required()->delimiter(',');
-  c->add_option("--runs", p.runs, "bidirectional runs")->default_val(5);
-  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2000.0);
-  c->add_option("--dwell", p.dwell_s, "dwell at each target in s")->default_val(0.5);
-  c->add_option("--overrun", o->overrun_mm, "overrun beyond the end targets in mm")->default_val(2.0);
+  c->add_option("--runs", p.runs, "bidirectional runs")->default_val(5)->check(CLI::Range(1, 1000));
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2000.0)->check(CLI::PositiveNumber);
+  c->add_option("--dwell", p.dwell_s, "dwell at each target in s")->default_val(0.5)->check(CLI::Range(0.0, 3600.0));
+  c->add_option("--overrun", o->overrun_mm, "overrun beyond the end targets in mm")
+      ->default_val(2.0)
+      ->check(CLI::NonNegativeNumber);
   add_output(c, *o);
+  add_envelope_options(*c, o->envelope);
   c->callback([o] {
     o->program.kind = "positioning";
     emit(*o);
@@ -172,10 +184,11 @@ void add_step(CLI::App* gen) {
   auto* c = gen->add_subcommand("step", "step response: back and forth between two targets");
   c->add_option("--axis", p.axis, "x, y or z")->default_val("x")->check(CLI::IsMember({"x", "y", "z"}));
   c->add_option("--targets", p.targets_mm, "a,b in mm")->required()->expected(2)->delimiter(',');
-  c->add_option("--runs", p.runs, "there-and-back pairs")->default_val(2);
-  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(3250.0);
-  c->add_option("--dwell", p.dwell_s, "dwell at each end in s")->default_val(0.5);
+  c->add_option("--runs", p.runs, "there-and-back pairs")->default_val(2)->check(CLI::Range(1, 1000));
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(3250.0)->check(CLI::PositiveNumber);
+  c->add_option("--dwell", p.dwell_s, "dwell at each end in s")->default_val(0.5)->check(CLI::Range(0.0, 3600.0));
   add_output(c, *o);
+  add_envelope_options(*c, o->envelope);
   c->callback([o] {
     o->program.kind = "step";
     emit(*o);
@@ -188,11 +201,12 @@ void add_rectangle(CLI::App* gen) {
   auto* c = gen->add_subcommand("rectangle", "rectangle with exact stop at the corners");
   c->add_option("--corner", o->corner, "start corner in the plane, mm")->expected(2)->delimiter(',');
   c->add_option("--size", o->size, "side lengths, mm")->expected(2)->delimiter(',');
-  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(1000.0);
-  c->add_option("--dwell", p.dwell_s, "dwell at each corner in s")->default_val(0.2);
-  c->add_option("--repeats", p.repeats, "laps")->default_val(1);
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(1000.0)->check(CLI::PositiveNumber);
+  c->add_option("--dwell", p.dwell_s, "dwell at each corner in s")->default_val(0.2)->check(CLI::Range(0.0, 3600.0));
+  c->add_option("--repeats", p.repeats, "laps")->default_val(1)->check(CLI::Range(1, 1000));
   c->add_option("--plane", p.plane, "xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
   add_output(c, *o);
+  add_envelope_options(*c, o->envelope);
   c->callback([o] {
     o->program.kind = "rectangle";
     emit(*o);
@@ -205,6 +219,7 @@ void add_identify(CLI::App* gen) {
     sim::gcode::IdentifyPlan plan;
     std::string out, meta_out, dialect = "linuxcnc", name;
     int number = 1000;
+    EnvelopeOptions envelope;
   };
   auto o = std::make_shared<Id>();
   auto* c =
@@ -217,6 +232,7 @@ void add_identify(CLI::App* gen) {
       ->delimiter(',')
       ->default_str("2000,4000,6500");
   add_output(c, o->out, o->meta_out, o->dialect, o->number, o->name);
+  add_envelope_options(*c, o->envelope);
   c->callback([o] {
     for (const auto& t : o->psd) o->plan.psd.push_back(parse_psd(t));
     o->plan.axes = o->axes;
@@ -225,7 +241,7 @@ void add_identify(CLI::App* gen) {
     dsp::Program p;
     p.kind = "identify";
     write_program(g, p, "eical identify: swings across the PSD strips", o->out, o->meta_out, o->dialect, o->number,
-                  o->name);
+                  o->name, o->envelope);
   });
 }
 

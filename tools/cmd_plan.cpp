@@ -1,13 +1,18 @@
 // eical plan: the uncertainty of a test's figures before anything moves, and the nearest
 // measurable variant (tools/plan/test_plan.hpp).
 #include "dsp/analysis/verdict.hpp"
+#include "dsp/core/error.hpp"
+#include "sim/simulate.hpp"
 #include "tools/commands.hpp"
+#include "tools/envelope_options.hpp"
+#include "tools/exit_codes.hpp"
 #include "tools/figure_text.hpp"
 #include "tools/io/psd_option.hpp"
 #include "tools/plan/test_plan.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -56,6 +61,8 @@ struct PlanCommandOptions {
   bool json = false;
   int draws = 100;
   double max_s = 60.0;
+  double deadline_s = 60.0;
+  EnvelopeOptions envelope;
 };
 
 void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
@@ -97,10 +104,17 @@ void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
   cmd.add_option("--draws", o.draws, "Monte Carlo draws per prediction")
       ->default_val(100)
       ->check(CLI::Range(10, 100000));
-  cmd.add_option("--max-duration", o.max_s, "variants that run longer than this (s) are not tried")
+  cmd.add_option("--max-duration", o.max_s,
+                 "the longest program simulated, s: a longer test is refused, longer variants are not tried")
       ->default_val(60.0)
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1.0, 3600.0));
+  cmd.add_option("--deadline", o.deadline_s,
+                 "stop after this many seconds: no simulation starts later; what was not evaluated is listed "
+                 "(exit status 4)")
+      ->default_val(60.0)
+      ->check(CLI::Range(0.0, 86400.0));
   cmd.add_flag("--json", o.json, "print the prediction as JSON");
+  add_envelope_options(cmd, o.envelope);
 }
 
 // The test as asked: its rectangle size and PSD strips.
@@ -112,27 +126,110 @@ plan::TestProgram test_program(const PlanCommandOptions& o) {
   return p;
 }
 
+const char* outcome_text(plan::Outcome o) {
+  switch (o) {
+    case plan::Outcome::measurable: return "measurable";
+    case plan::Outcome::not_measurable: return "not measurable";
+    case plan::Outcome::too_long: return "not tried: runs longer than --max-duration";
+    case plan::Outcome::outside_envelope: return "not tried: beyond the work envelope";
+    case plan::Outcome::not_reached: return "NOT EVALUATED: the deadline passed";
+  }
+  return "";
+}
+
+std::string search_text(const plan::Search& s) {
+  std::string o;
+  char b[64];
+  for (const auto& t : s.tried) {
+    o += "  " + plan::describe(t.program) + ": " + outcome_text(t.outcome);
+    if (t.outcome == plan::Outcome::measurable || t.outcome == plan::Outcome::not_measurable) {
+      std::snprintf(b, sizeof b, " (U = %.2f µm)", t.limited_u);
+      o += b;
+    }
+    o += "\n";
+  }
+  return o;
+}
+
+nlohmann::json search_json(const plan::Search& s) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& t : s.tried) {
+    nlohmann::json v = {{"program", plan::describe(t.program)}, {"outcome", outcome_text(t.outcome)}};
+    if (t.outcome == plan::Outcome::measurable || t.outcome == plan::Outcome::not_measurable)
+      v["limited_u"] = t.limited_u;
+    a.push_back(v);
+  }
+  return a;
+}
+
+// The test itself must be one plan can simulate: within the machine's envelope and not
+// longer than --max-duration (its simulation's memory and time grow with its length).
+void require_simulable(const plan::TestProgram& p, const PlanCommandOptions& o, const dsp::WorkEnvelope& e) {
+  if (auto why = envelope_refusal(*sim::scenario_set_point(plan::scenario_of(p, 1)), e, "plan " + p.kind))
+    throw dsp::InputError(*why);
+  const double t_s = plan::program_duration_s(p);
+  if (t_s > o.max_s) {
+    char b[300];
+    std::snprintf(b, sizeof b,
+                  "plan %s: the test runs %.1f s, longer than the %.0f s plan simulates (--max-duration; the "
+                  "simulation's time and memory grow with it)",
+                  p.kind.c_str(), t_s, o.max_s);
+    throw dsp::InputError(b);
+  }
+}
+
 void run_plan(const PlanCommandOptions& o) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point t0 = Clock::now();
+  const auto elapsed_s = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   const plan::TestProgram p = test_program(o);
+  const dsp::WorkEnvelope envelope = envelope_of(o.envelope);
+  require_simulable(p, o, envelope);
+  std::fprintf(stderr, "plan: simulating the test: %s\n", plan::describe(p).c_str());
   const plan::Prediction r = plan::predict(p, 1, o.draws);
-  std::optional<plan::Prediction> better;
-  if (!r.measurable) better = plan::nearest_measurable(p, o.max_s, o.draws);
+  plan::Search search;
+  if (!r.measurable) {
+    plan::SearchOptions so;
+    so.max_duration_s = o.max_s, so.draws = o.draws, so.envelope = envelope;
+    so.deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.deadline_s));
+    so.progress = [&](int n, int of, const plan::TestProgram& t) {
+      if (n == 0)
+        std::fprintf(stderr, "plan: %.1f s: simulating the on-site identification the identified variants share\n",
+                     elapsed_s());
+      else
+        std::fprintf(stderr, "plan: %.1f s: variant %d of %d: %s\n", elapsed_s(), n, of, plan::describe(t).c_str());
+    };
+    search = plan::search_measurable(p, so);
+  }
+  char b[300];
+  std::snprintf(b, sizeof b,
+                "the deadline of %g s passed after %.1f s: the test was evaluated, variants marked NOT EVALUATED "
+                "were not (--deadline)",
+                o.deadline_s, elapsed_s());
+  const std::string deadline_note = b;
   if (o.json) {
     nlohmann::json j = {{"format", "eical-plan/1"}, {"prediction", prediction_json(r)}};
-    j["nearest_measurable"] = better ? prediction_json(*better) : nlohmann::json(nullptr);
+    j["nearest_measurable"] = search.found ? prediction_json(*search.found) : nlohmann::json(nullptr);
+    j["variants"] = search_json(search);
+    j["deadline_passed"] = search.deadline_passed;
     std::printf("%s\n", j.dump(2).c_str());
-    return;
-  }
-  std::string text = prediction_text(r);
-  if (!r.measurable) {
-    if (better)
-      text += "\nnearest measurable variant:\n" + prediction_text(*better);
-    else {
-      text += "\nno variant within " + std::to_string(static_cast<int>(o.max_s)) + " s is measurable; tried:\n";
-      for (const auto& v : plan::variants(p)) text += "  " + plan::describe(v) + "\n";
+  } else {
+    std::string text = prediction_text(r);
+    if (!r.measurable) {
+      if (search.found)
+        text += "\nnearest measurable variant:\n" + prediction_text(*search.found);
+      else if (!search.deadline_passed)
+        text += "\nno variant within " + std::to_string(static_cast<int>(o.max_s)) + " s is measurable; tried:\n" +
+                search_text(search);
+      else
+        text += "\nno measurable variant found before the deadline; variants:\n" + search_text(search);
     }
+    std::fputs(text.c_str(), stdout);
   }
-  std::fputs(text.c_str(), stdout);
+  if (search.deadline_passed) {
+    std::fprintf(stderr, "plan: %s\n", deadline_note.c_str());
+    throw CLI::RuntimeError(kExitIncomplete);
+  }
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "sim/simulate.hpp"
 #include "tools/cmd_simulate_export.hpp"
 #include "tools/commands.hpp"
+#include "tools/envelope_options.hpp"
 #include "tools/sim_programs.hpp"
 
 #include <cstdio>
@@ -40,6 +41,9 @@ struct SimulateOptions {
   std::string export_nc = "halsampler";
   double export_offset_s = 100.0, export_jitter_us = -1.0, export_nc_offset_s = 1234.5678;
   int export_lost_batches = 2, export_batch = 16;
+  // The machine and the simulator's budget.
+  EnvelopeOptions envelope;
+  double max_duration_s = sim::kMaxSimulatedS;
 };
 
 // "FREQ,ZETA,GAIN,AXIS" (AXIS: x, y, z or dx,dy[,dz]).
@@ -198,6 +202,11 @@ void add_output_options(CLI::App& cmd, SimulateOptions& o) {
   cmd.add_option("-o,--out", o.out, "run directory to write")->required();
   cmd.add_flag("--gzip", o.gzip, "write samples.csv.gz");
   cmd.add_flag("--overwrite", o.overwrite, "replace an existing run");
+  add_envelope_options(cmd, o.envelope);
+  cmd.add_option("--max-duration", o.max_duration_s,
+                 "the longest program simulated, s at 100 kHz internal samples (memory: about 0.4 GB a minute)")
+      ->default_val(sim::kMaxSimulatedS)
+      ->check(CLI::Range(1.0, 14400.0));
 }
 
 // Regimes of runs measured by other systems (config/scenarios/README.md has the keys).
@@ -278,6 +287,12 @@ ExportRequest export_request(const SimulateOptions& o, double fs) {
 void run_simulate(const SimulateOptions& o, bool program_given) {
   sim::Scenario sc = base_scenario(o, program_given);
   apply_regime_flags(o, sc);
+  // The machine's envelope (the scenario's, else the default, the options over it) goes
+  // into run.toml; a program beyond it is refused before anything is simulated.
+  sc.meta.envelope = envelope_of(o.envelope, sc.meta.envelope.value_or(dsp::WorkEnvelope{}));
+  sc.max_duration_s = o.max_duration_s;
+  require_within(*sim::scenario_set_point(sc), *sc.meta.envelope,
+                 "simulate " + (sc.sweep.on ? std::string("sweep") : sc.meta.program.kind));
   if (!o.export_to.empty()) {
     const double fs = sc.meta.acquisition.fs_hz;
     const std::string line = simulate_with_export(sc, export_request(o, fs), o.out, o.gzip, o.overwrite);

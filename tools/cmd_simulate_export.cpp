@@ -27,6 +27,7 @@ std::string simulate_with_export(const sim::Scenario& scenario, const ExportRequ
   if (request.kind != "klipper" && request.kind != "csv")
     throw dsp::InputError("simulate --export: '" + request.kind + "' is not klipper or csv");
   const auto set_point = sim::scenario_set_point(scenario);
+  sim::check_budget(scenario, *set_point);  // before the capture's per-frame buffers
   const double fs = scenario.meta.acquisition.fs_hz;
   const auto n_frames = static_cast<std::size_t>(std::ceil(set_point->duration_s() * fs)) + 1;
   const sim::CaptureSamples samples = sim::capture_samples(request.clock, n_frames, fs);

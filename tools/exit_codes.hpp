@@ -14,6 +14,7 @@ inline constexpr int kExitNotMeasurable = 3;  // analyze: verdict not_measurable
 // analyze --tolerances, verdict ok: ISO 14253-1's decision for the run.
 inline constexpr int kExitNonConforming = 4;  // non-conformance proven
 inline constexpr int kExitUndecided = 5;      // the uncertainty zone straddles a tolerance
+inline constexpr int kExitIncomplete = 6;     // plan: its --deadline passed; the output says what was not evaluated
 
 // The exit status of a result's verdict.
 int verdict_exit_code(dsp::Verdict verdict);

@@ -4,6 +4,8 @@
 #include "drivers/config/strict_toml.hpp"
 #include "drivers/setpoint/program_catalog.hpp"
 #include "dsp/core/error.hpp"
+#include "sim/nc/envelope_check.hpp"
+#include "sim/simulate.hpp"
 
 #include <cmath>
 
@@ -70,11 +72,12 @@ void read_source(StrictTable t, SourceConfig& s) {
   if (auto sim = t.optional_table("sim")) {
     s.sim_program = sim->choice("program", {"circle", "step"}, s.sim_program);
     s.sim_radius_mm = sim->number("radius_mm", s.sim_radius_mm);
-    if (s.sim_radius_mm <= 0.0) sim->fail("radius_mm", "must be positive");
+    if (!(s.sim_radius_mm > 0.0)) sim->fail("radius_mm", "must be positive");
     s.sim_feed_mm_min = sim->number("feed_mm_min", s.sim_feed_mm_min);
-    if (s.sim_feed_mm_min <= 0.0) sim->fail("feed_mm_min", "must be positive");
+    if (!(s.sim_feed_mm_min > 0.0)) sim->fail("feed_mm_min", "must be positive");
     s.sim_repeats = sim->int32("repeats", s.sim_repeats);
-    if (s.sim_repeats < 1) sim->fail("repeats", "must be at least 1");
+    // The program is generated (and checked against [envelope]) at load: bounded.
+    if (s.sim_repeats < 1 || s.sim_repeats > 1000) sim->fail("repeats", "must be within 1..1000");
     const auto seed = sim->integer("seed", static_cast<std::int64_t>(s.sim_seed));
     if (seed < 0) sim->fail("seed", "must not be negative");
     s.sim_seed = static_cast<std::uint64_t>(seed);
@@ -227,6 +230,19 @@ void read_realtime(StrictTable t, RealtimeConfig& r) {
   t.finish();
 }
 
+// The program the simulated NC runs ([source.sim]) must stay within [envelope]: the
+// service would otherwise simulate, record and evaluate a machine that cannot exist.
+void require_within_envelope(const DaemonConfig& c, StrictTable& t) {
+  if (c.source.kind != "sim") return;
+  const SourceConfig& s = c.source;
+  sim::Scenario sc = s.sim_program == "circle" ? sim::circle_scenario(s.sim_radius_mm, s.sim_feed_mm_min, s.sim_repeats)
+                                               : sim::step_scenario(0.0, 50.0, s.sim_feed_mm_min, s.sim_repeats);
+  if (s.sim_program_loaded) sc.meta.program = *s.sim_program_loaded;
+  if (const auto x = sim::nc::envelope_excess(*sim::scenario_set_point(sc), c.envelope))
+    t.fail("envelope", "the simulated NC's program ([source.sim]): " + sim::nc::describe(*x, c.envelope) + " (" +
+                           sim::nc::envelope_key(*x) + ")");
+}
+
 }  // namespace
 
 DaemonConfig load_daemon_config(const std::filesystem::path& file) {
@@ -245,6 +261,7 @@ DaemonConfig load_daemon_config(const std::filesystem::path& file) {
   if (auto s = t.optional_table("acquisition")) c.acquisition = drivers::read_acquisition(*s);
   if (auto s = t.optional_table("site")) c.site = drivers::read_site(*s);
   if (auto s = t.optional_table("machine")) c.machine = drivers::read_machine(*s);
+  if (auto s = t.optional_table("envelope")) c.envelope = drivers::read_envelope(*s);
   if (auto s = t.optional_table("sensors")) {
     if (auto table = s->optional_table("table")) c.sensors[0] = drivers::read_sensor(*table);
     if (auto head = s->optional_table("head")) c.sensors[1] = drivers::read_sensor(*head);
@@ -257,6 +274,7 @@ DaemonConfig load_daemon_config(const std::filesystem::path& file) {
   for (auto& p : t.tables("psd")) c.psd.push_back(drivers::read_psd(p));
   if (c.triggers.inputs.empty())
     t.fail("triggers", "no trigger input configured: the NC could not start a measurement");
+  require_within_envelope(c, t);
   if (c.history.enabled && c.machine.name.empty())
     t.fail("history", "[machine] name is required: the history keys results by machine");
   t.finish();

@@ -138,6 +138,7 @@ struct DaemonConfig {
   dsp::Acquisition acquisition;
   dsp::Site site;
   dsp::MachineLayout machine;
+  dsp::WorkEnvelope envelope;              // [envelope]: the simulated program must stay within it; runs carry it
   dsp::SensorSpec sensors[2];              // data-sheet values, table and head
   std::filesystem::path calibration_file;  // identified calibration (optional, overrides)
   std::vector<dsp::PsdSpec> psd;

@@ -17,6 +17,7 @@ std::unique_ptr<drivers::Source> make_linuxcnc_source(const DaemonConfig& config
   sc.meta.acquisition = config.acquisition;
   sc.meta.site = config.site;
   sc.meta.machine = config.machine;
+  sc.meta.envelope = config.envelope;
   sc.meta.sensors[0] = config.sensors[0];
   sc.meta.sensors[1] = config.sensors[1];
   // Without a scenario file the sensors are exactly what the configuration says.

@@ -48,6 +48,7 @@ dsp::RunMeta daq_meta(const DaemonConfig& c) {
   meta.acquisition = c.acquisition;
   meta.site = c.site;
   meta.machine = c.machine;
+  meta.envelope = c.envelope;
   meta.sensors[0] = c.sensors[0];
   meta.sensors[1] = c.sensors[1];
   meta.psd = c.psd;
@@ -67,6 +68,7 @@ std::unique_ptr<drivers::Source> make_sim_source(const DaemonConfig& c, drivers:
   sc.meta.acquisition = c.acquisition;
   sc.meta.site = c.site;
   sc.meta.machine = c.machine;
+  sc.meta.envelope = c.envelope;
   sc.meta.sensors[0] = c.sensors[0];
   sc.meta.sensors[1] = c.sensors[1];
   sc.meta.psd = c.psd;  // the strips the simulated machine carries

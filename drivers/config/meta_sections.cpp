@@ -161,4 +161,27 @@ dsp::SetPointOrigin read_setpoint_origin(StrictTable t) {
   return s;
 }
 
+dsp::WorkEnvelope read_envelope(StrictTable t, const dsp::WorkEnvelope& defaults) {
+  // Sanity bounds, not a machine: the largest gantry mills travel tens of metres.
+  constexpr double kMaxTravelMm = 100000.0, kMaxFeedMmMin = 600000.0, kMaxAccelMmS2 = 100000.0;
+  dsp::WorkEnvelope e = defaults;
+  static constexpr const char* kTravel[3] = {"travel_x_mm", "travel_y_mm", "travel_z_mm"};
+  for (int i = 0; i < 3; ++i) {
+    if (!t.has(kTravel[i])) continue;
+    const auto v = t.numbers(kTravel[i], 2);
+    if (!(v[0] < v[1])) t.fail(kTravel[i], "must be [min, max] with min below max");
+    if (!(std::abs(v[0]) <= kMaxTravelMm && std::abs(v[1]) <= kMaxTravelMm))
+      t.fail(kTravel[i], "must be within -100000..100000 mm");
+    e.travel_mm[i][0] = v[0], e.travel_mm[i][1] = v[1];
+  }
+  e.max_feed_mm_min = t.number("max_feed_mm_min", e.max_feed_mm_min);
+  if (!(e.max_feed_mm_min > 0.0 && e.max_feed_mm_min <= kMaxFeedMmMin))
+    t.fail("max_feed_mm_min", "must be within (0, 600000] mm/min");
+  e.max_accel_mm_s2 = t.number("max_accel_mm_s2", e.max_accel_mm_s2);
+  if (!(e.max_accel_mm_s2 > 0.0 && e.max_accel_mm_s2 <= kMaxAccelMmS2))
+    t.fail("max_accel_mm_s2", "must be within (0, 100000] mm/s^2");
+  t.finish();
+  return e;
+}
+
 }  // namespace eical::drivers

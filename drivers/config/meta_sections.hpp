@@ -1,6 +1,6 @@
 #pragma once
 // The metadata sections shared by run.toml, the daemon config and simulation scenarios
-// ([acquisition], [site], [machine], [sensors.*], [[psd]]), read strictly: same key names
+// ([acquisition], [site], [machine], [envelope], [sensors.*], [[psd]]), read strictly: same key names
 // and units as shared/spec/run-format.md, so a value can be copied between the files.
 #include "drivers/config/strict_toml.hpp"
 #include "dsp/core/run_meta.hpp"
@@ -18,5 +18,9 @@ dsp::SensorSpec read_sensor(StrictTable t, const dsp::SensorSpec& defaults = {})
 dsp::PsdSpec read_psd(StrictTable t);
 dsp::Program read_program(StrictTable t);
 dsp::SetPointOrigin read_setpoint_origin(StrictTable t);
+// [envelope] (dsp/core/work_envelope.hpp): travel_x_mm/travel_y_mm/travel_z_mm = [min, max],
+// max_feed_mm_min, max_accel_mm_s2. Always strict, in run.toml too: a mistyped limit must
+// not fall back to the default it was meant to change.
+dsp::WorkEnvelope read_envelope(StrictTable t, const dsp::WorkEnvelope& defaults = {});
 
 }  // namespace eical::drivers

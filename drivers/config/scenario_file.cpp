@@ -269,13 +269,14 @@ void read_sweep(StrictTable t, sim::Scenario& sc) {
   k.stop_accel_mm_s2 = t.number("stop_accel_mm_s2", k.stop_accel_mm_s2);
   if (const std::string why = k.invalid_reason(); !why.empty()) {
     // The key the reason is about (invalid_reason names it first).
-    const char* key = why.rfind("freq_start", 0) == 0     ? "freq_start_hz"
-                      : why.rfind("freq_end", 0) == 0     ? "freq_end_hz"
-                      : why.rfind("accel_per_hz", 0) == 0 ? "accel_per_hz"
-                      : why.rfind("hz_per_sec", 0) == 0   ? "hz_per_sec"
-                      : why.rfind("sweeping", 0) == 0     ? "sweeping_accel_mm_s2"
-                      : why.rfind("the stop", 0) == 0     ? "stop_accel_mm_s2"
-                                                          : "preset";
+    const char* key = why.rfind("freq_start", 0) == 0        ? "freq_start_hz"
+                      : why.rfind("freq_end", 0) == 0        ? "freq_end_hz"
+                      : why.rfind("accel_per_hz", 0) == 0    ? "accel_per_hz"
+                      : why.rfind("hz_per_sec", 0) == 0      ? "hz_per_sec"
+                      : why.rfind("sweeping_period", 0) == 0 ? "sweeping_period_s"
+                      : why.rfind("sweeping", 0) == 0        ? "sweeping_accel_mm_s2"
+                      : why.rfind("the stop", 0) == 0        ? "stop_accel_mm_s2"
+                                                             : "preset";
     t.fail(t.has(key) ? key : "preset", why);
   }
   sc.sweep.start_mm = vec3_or(t, "start_mm", Eigen::Vector3d::Zero());
@@ -313,6 +314,7 @@ void read_told(StrictTable& root, sim::Scenario& sc) {
   if (auto t = root.optional_table("acquisition")) sc.meta.acquisition = read_acquisition(*t);
   if (auto t = root.optional_table("site")) sc.meta.site = read_site(*t);
   if (auto t = root.optional_table("machine")) sc.meta.machine = read_machine(*t);
+  if (auto t = root.optional_table("envelope")) sc.meta.envelope = read_envelope(*t);
   if (auto sensors = root.optional_table("sensors")) {
     if (auto t = sensors->optional_table("table")) sc.meta.sensors[0] = read_sensor(*t);
     if (auto t = sensors->optional_table("head")) sc.meta.sensors[1] = read_sensor(*t);
@@ -352,6 +354,7 @@ void read_truth(StrictTable& truth, sim::Scenario& sc) {
 void read_motion(StrictTable& root, const std::string& path, sim::gcode::Dialect dialect, sim::Scenario& sc) {
   if (auto t = root.optional_table("sweep")) read_sweep(*t, sc);
   bool gcode_file_read = false;
+  if (sc.sweep.on && !sc.meta.envelope) sc.meta.envelope = sim::corexy_printer_envelope();  // Klipper's machine
   if (auto program = sc.sweep.on ? root.optional_table("program") : std::optional<StrictTable>(root.table("program"))) {
     const std::string gcode_file = program->string("gcode_file", "");
     sc.meta.program = read_program(*program);  // the copy knows gcode_file is used

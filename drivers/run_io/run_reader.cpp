@@ -323,6 +323,7 @@ dsp::RunMeta read_run_meta(const fs::path& run_toml) {
   m.acquisition = read_acquisition(t.table("acquisition"));
   if (auto s = t.optional_table("site")) m.site = read_site(*s);
   if (auto s = t.optional_table("machine")) m.machine = read_machine(*s);
+  if (auto s = t.optional_table("envelope")) m.envelope = read_envelope(*s);
   StrictTable sensors = t.table("sensors");
   m.sensors[0] = read_sensor(sensors.table("table"));
   m.sensors[1] = read_sensor(sensors.table("head"));

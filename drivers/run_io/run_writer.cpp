@@ -201,6 +201,12 @@ std::string run_toml_text(const dsp::RunMeta& meta) {
        "\nheading_deg = " + toml_double(meta.site.heading_deg) + "\ng_mps2 = " + toml_double(meta.site.g_mps2) + "\n";
   o += "\n[machine]\nname = " + toml_str(meta.machine.name) + "\ntable_axes = " + strs(meta.machine.table_axes) +
        "\nhead_axes = " + strs(meta.machine.head_axes) + "\n";
+  if (meta.envelope) {
+    const dsp::WorkEnvelope& e = *meta.envelope;
+    o += "\n[envelope]\ntravel_x_mm = " + vec(e.travel_mm[0], 2) + "\ntravel_y_mm = " + vec(e.travel_mm[1], 2) +
+         "\ntravel_z_mm = " + vec(e.travel_mm[2], 2) + "\nmax_feed_mm_min = " + toml_double(e.max_feed_mm_min) +
+         "\nmax_accel_mm_s2 = " + toml_double(e.max_accel_mm_s2) + "\n";
+  }
   o += sensor_section_toml("table", meta.sensors[0]);
   o += sensor_section_toml("head", meta.sensors[1]);
   const auto& p = meta.program;

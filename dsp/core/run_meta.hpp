@@ -1,6 +1,8 @@
 #pragma once
 // Metadata of a recorded run (eical-run/1, shared/spec/run-format.md) as plain data.
 // Parsing and writing live in drivers/run_io; dsp only reads these values.
+#include "dsp/core/work_envelope.hpp"
+
 #include <Eigen/Core>
 
 #include <cstdint>
@@ -132,6 +134,9 @@ struct RunMeta {
   Program program;
   std::optional<Reference> reference;
   std::optional<SetPointOrigin> setpoint;
+  // [envelope]: the machine's work envelope the run was made within (written when known:
+  // eical simulate, eicald from its config).
+  std::optional<WorkEnvelope> envelope;
 };
 
 }  // namespace eical::dsp

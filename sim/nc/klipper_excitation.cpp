@@ -109,6 +109,12 @@ std::string KlipperTest::invalid_reason() const {
   if (!(sweeping_accel_mm_s2 >= 0.0) || !(sweeping_period_s >= 0.0))
     return "sweeping_accel and sweeping_period must not be negative";
   if (!(stop_accel_mm_s2 > 0.0)) return "the stop acceleration (max_accel) must be positive";
+  // The segments are built before anything is simulated: bound their number.
+  if ((freq_end_hz - freq_start_hz) / hz_per_sec > kMaxSweepS)
+    return "hz_per_sec: the sweep from freq_start to freq_end would run " +
+           std::to_string(std::lround((freq_end_hz - freq_start_hz) / hz_per_sec)) + " s, more than " +
+           std::to_string(static_cast<int>(kMaxSweepS)) + " s";
+  if (sweeping_period_s > 0.0 && sweeping_period_s < 0.1) return "sweeping_period must be 0 or at least 0.1 s";
   if (legacy_moves && sweeping_accel_mm_s2 > 0.0 && sweeping_period_s > 0.0)
     return "the older Klipper test has no sweeping";
   return "";

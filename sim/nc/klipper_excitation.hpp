@@ -47,7 +47,9 @@ struct KlipperTest {
   static KlipperTest current();
   static KlipperTest legacy();
   // "" when the parameters are usable, else why not (Klipper's own limits: freq ≥ 1 Hz,
-  // freq_end ≥ freq_start, freq_end ≤ 300 Hz, 0 < hz_per_sec ≤ 2, accel_per_hz > 0).
+  // freq_end ≥ freq_start, freq_end ≤ 300 Hz, 0 < hz_per_sec ≤ 2, accel_per_hz > 0; and
+  // eical's: a sweep of at most kMaxSweepS, a sweeping period of 0 or at least 0.1 s).
+  static constexpr double kMaxSweepS = 3600.0;
   [[nodiscard]] std::string invalid_reason() const;
 };
 

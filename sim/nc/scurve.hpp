@@ -21,6 +21,7 @@ class SCurve {
   [[nodiscard]] double duration_s() const { return duration_; }
   [[nodiscard]] double length_mm() const { return length_; }
   [[nodiscard]] double peak_speed() const { return v_peak_; }
+  [[nodiscard]] double peak_accel() const { return a_peak_; }
   [[nodiscard]] PathState at(double t_s) const;
   // Time at which the path position reaches s (bisection on the monotone s(t)).
   [[nodiscard]] double time_at(double s_mm) const;

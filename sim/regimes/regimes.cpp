@@ -62,6 +62,14 @@ void apply_wrong_mounting(Scenario& scenario, int sensor, const std::string& axe
   t.axes_map = axes_map;
 }
 
+dsp::WorkEnvelope corexy_printer_envelope() {
+  dsp::WorkEnvelope e;
+  for (auto& t : e.travel_mm) t[0] = -175.0, t[1] = 175.0;
+  e.max_feed_mm_min = 30000.0;
+  e.max_accel_mm_s2 = 20000.0;
+  return e;
+}
+
 Scenario sweep_scenario(const nc::KlipperTest& test, const Eigen::Vector3d& direction, std::uint64_t seed) {
   Scenario sc;
   sc.name = "sweep";
@@ -86,6 +94,7 @@ Scenario sweep_scenario(const nc::KlipperTest& test, const Eigen::Vector3d& dire
   sc.sweep.on = true;
   sc.sweep.test = test;
   sc.sweep.direction = direction;
+  sc.meta.envelope = corexy_printer_envelope();
   return sc;
 }
 

@@ -33,9 +33,14 @@ void apply_mems(Scenario& scenario, const MemsChip& chip, double fs_hz = 0.0,
 // Listed as the effect sensor.misalignment.
 void apply_wrong_mounting(Scenario& scenario, int sensor, const std::string& axes_map);
 
+// The work envelope of the printer Klipper's test runs on: a 350 mm CoreXY (travel about
+// the test's start), 500 mm/s, 20 m/s² (Klipper's max_accel of such a printer; its test
+// reaches 60 mm/s² per Hz at 200 Hz, 12 m/s², beyond a machining centre's 1 g).
+dsp::WorkEnvelope corexy_printer_envelope();
+
 // Klipper's resonance test along `direction` as the whole run (no standstill from the
 // first sample to the last), program kind "freeform", an ideal reference on x, y, z; a
-// gantry's layout (the head moves x and y, the table z).
+// gantry's layout (the head moves x and y, the table z); a printer's envelope.
 Scenario sweep_scenario(const nc::KlipperTest& test, const Eigen::Vector3d& direction, std::uint64_t seed = 1);
 
 }  // namespace eical::sim

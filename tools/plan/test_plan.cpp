@@ -6,6 +6,7 @@
 #include "dsp/identify/sensor_identification.hpp"
 #include "dsp/stream/analyze_stream.hpp"
 #include "sim/hidden/hidden_effects.hpp"
+#include "sim/nc/envelope_check.hpp"
 #include "sim/simulate.hpp"
 
 #include <algorithm>
@@ -276,27 +277,78 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
   return v;
 }
 
-std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_duration_s, int draws) {
+std::optional<std::string> outside_envelope(const TestProgram& p, const dsp::WorkEnvelope& envelope) {
+  const auto x = sim::nc::envelope_excess(*sim::scenario_set_point(scenario_of(p, 1)), envelope);
+  if (!x) return std::nullopt;
+  return sim::nc::describe(*x, envelope);
+}
+
+double program_duration_s(const TestProgram& p) { return sim::scenario_set_point(scenario_of(p, 1))->duration_s(); }
+
+namespace {
+
+double rough_duration_s(const TestProgram& t) {
+  double path_mm = 0.0;
+  if (t.kind == "circle")
+    path_mm = 2.0 * 3.14159265358979 * t.radius_mm * t.arc_deg / 360.0 * t.repeats * (t.direction == "both" ? 2 : 1);
+  else if (t.kind == "step")
+    path_mm = 2.0 * std::abs(t.to_mm - t.from_mm) * t.runs;
+  else if (t.kind == "positioning")
+    path_mm = 2.0 * std::abs(t.targets_mm.back() - t.targets_mm.front()) * t.runs;
+  else
+    path_mm = 2.0 * (t.size_mm[0] + t.size_mm[1]) * std::max(1, t.repeats);
+  return path_mm / (t.feed_mm_min / 60.0);
+}
+
+}  // namespace
+
+Search search_measurable(const TestProgram& p, const SearchOptions& o) {
+  Search out;
+  const std::vector<TestProgram> all = variants(p);
+  for (const TestProgram& t : all) out.tried.push_back({t, Outcome::not_reached, 0.0});
+  const auto passed = [&] { return o.deadline && std::chrono::steady_clock::now() >= *o.deadline; };
+  const int of = static_cast<int>(all.size());
   std::optional<dsp::uncertainty::SensorModelCovariance> identified;  // one simulated identification for all variants
-  for (const TestProgram& t : variants(p)) {
-    // A rough duration first (the set-point's time), so that long variants are not simulated.
-    double path_mm = 0.0;
-    if (t.kind == "circle")
-      path_mm = 2.0 * 3.14159265358979 * t.radius_mm * t.arc_deg / 360.0 * t.repeats * (t.direction == "both" ? 2 : 1);
-    else if (t.kind == "step")
-      path_mm = 2.0 * std::abs(t.to_mm - t.from_mm) * t.runs;
-    else if (t.kind == "positioning")
-      path_mm = 2.0 * std::abs(t.targets_mm.back() - t.targets_mm.front()) * t.runs;
-    else
-      path_mm = 2.0 * (t.size_mm[0] + t.size_mm[1]) * std::max(1, t.repeats);
-    if (path_mm / (t.feed_mm_min / 60.0) > max_duration_s) continue;
-    if (t.identified && !identified) identified = typical_identification(t);
+  for (int n = 0; n < of; ++n) {
+    Tried& tried = out.tried[static_cast<std::size_t>(n)];
+    const TestProgram& t = tried.program;
+    // Nothing simulated first: the envelope, and a rough duration (the path over the feed),
+    // so that long variants are not.
+    if (outside_envelope(t, o.envelope)) {
+      tried.outcome = Outcome::outside_envelope;
+      continue;
+    }
+    if (rough_duration_s(t) > o.max_duration_s) {
+      tried.outcome = Outcome::too_long;
+      continue;
+    }
+    if (t.identified && !identified) {
+      if (passed()) break;
+      if (o.progress) o.progress(0, of, t);
+      identified = typical_identification(t);
+    }
+    if (passed()) break;
+    if (o.progress) o.progress(n + 1, of, t);
     // Screened (Screen): a variant far above the limit is told by its first draws; a
     // nearer one is predicted with all of them.
-    Prediction r = predict(t, 1, draws, identified, Screen{});
-    if (r.measurable) return r;
+    Prediction r = predict(t, 1, o.draws, identified, Screen{});
+    tried.outcome = r.measurable ? Outcome::measurable : Outcome::not_measurable;
+    tried.limited_u = r.limited_u;
+    if (r.measurable) {
+      out.found = std::move(r);
+      out.tried.resize(static_cast<std::size_t>(n) + 1);  // the rest were not needed
+      return out;
+    }
   }
-  return std::nullopt;
+  for (const Tried& t : out.tried) out.deadline_passed = out.deadline_passed || t.outcome == Outcome::not_reached;
+  return out;
+}
+
+std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_duration_s, int draws,
+                                             const dsp::WorkEnvelope& envelope) {
+  SearchOptions o;
+  o.max_duration_s = max_duration_s, o.draws = draws, o.envelope = envelope;
+  return search_measurable(p, o).found;
 }
 
 }  // namespace eical::tools::plan
@@ -325,7 +377,7 @@ void suggest_measurable_test(const dsp::Run& run, dsp::Analysis& a) {
     return;
   }
   char b[256];
-  if (const auto best = nearest_measurable(p, 30.0, 60)) {
+  if (const auto best = nearest_measurable(p, 30.0, 60, run.meta.envelope.value_or(dsp::WorkEnvelope{}))) {
     std::snprintf(b, sizeof b, "a test that would be measurable (eical plan): %s, predicted U(%s) = %.2f µm",
                   describe(best->program).c_str(), lim->limited_name, best->limited_u);
     a.verdict_reasons.push_back(b);

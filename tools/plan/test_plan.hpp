@@ -12,7 +12,9 @@
 #include "dsp/core/run_meta.hpp"
 #include "sim/scenario.hpp"
 
+#include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -87,9 +89,43 @@ Prediction predict(const TestProgram& p, std::uint64_t seed = 1, int draws = 100
 // test's own changes with the sensors as they are, then the same after an identification.
 std::vector<TestProgram> variants(const TestProgram& p);
 
+// Where the program runs beyond the machine's work envelope ("the program reaches x = ...,
+// beyond the x travel ..."), from its set-point; nullopt when it stays within.
+std::optional<std::string> outside_envelope(const TestProgram& p, const dsp::WorkEnvelope& envelope);
+// Seconds the program runs, from its set-point (nothing simulated).
+double program_duration_s(const TestProgram& p);
+
+// How the search for a measurable variant looks, and what it reports while it does.
+struct SearchOptions {
+  double max_duration_s = 60.0;  // variants that run longer are not tried
+  int draws = 60;
+  dsp::WorkEnvelope envelope;  // variants beyond it are not tried
+  // No simulation starts after it (one that has started finishes: each is at most
+  // max_duration_s of program).
+  std::optional<std::chrono::steady_clock::time_point> deadline;
+  // Before each simulation: the n-th of `of` variants (0: the on-site identification the
+  // identified variants share).
+  std::function<void(int n, int of, const TestProgram&)> progress;
+};
+
+// What became of each variant.
+enum class Outcome { measurable, not_measurable, too_long, outside_envelope, not_reached };
+struct Tried {
+  TestProgram program;
+  Outcome outcome = Outcome::not_reached;
+  double limited_u = 0.0;  // predicted U of the limited figure (measurable, not_measurable)
+};
+struct Search {
+  std::optional<Prediction> found;  // the first measurable variant, nearest first
+  std::vector<Tried> tried;         // every variant up to it, and those the deadline left
+  bool deadline_passed = false;     // variants were left (Outcome::not_reached)
+};
+Search search_measurable(const TestProgram& p, const SearchOptions& o);
+
 // The first variant (nearest first) whose predicted U is within the limit; variants that
-// run longer than `max_duration_s` are not tried. nullopt when none is.
-std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_duration_s = 60.0, int draws = 60);
+// run longer than `max_duration_s` or beyond the envelope are not tried. nullopt when none is.
+std::optional<Prediction> nearest_measurable(const TestProgram& p, double max_duration_s = 60.0, int draws = 60,
+                                             const dsp::WorkEnvelope& envelope = {});
 
 }  // namespace eical::tools::plan
 
