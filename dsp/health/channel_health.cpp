@@ -20,10 +20,14 @@ constexpr double kStuckNoiseMargin = 4.0;
 constexpr double kDeadSigmaRatio = 0.1;
 constexpr std::int64_t kDeadMinRestSamples = 100;
 
-// Two samples of noise σ (counts, after rounding) are equal with this probability.
-double equal_probability(double sigma_counts) {
-  const double sd = std::sqrt(2.0) * sigma_counts;  // σ of their difference
-  return std::min(0.9, std::erf(0.5 / (sd * std::sqrt(2.0))));
+// The shortest constant stretch of a channel with the data sheet's σ (counts) read in steps
+// of `step` counts that noise makes less likely than kStuckFalseRate: two samples are
+// equal with p = erf(0.5 / (2σ')), σ' the margined σ and the rounding, in steps.
+std::int64_t stuck_length(double sigma_counts, double step_counts) {
+  const double quiet = sigma_counts / kStuckNoiseMargin / step_counts;
+  const double sd = std::sqrt(2.0) * std::sqrt(quiet * quiet + 1.0 / 12.0);  // σ of a difference
+  const double p = std::min(0.9, std::erf(0.5 / (sd * std::sqrt(2.0))));
+  return 1 + static_cast<std::int64_t>(std::ceil(std::log(kStuckFalseRate) / std::log(p)));
 }
 
 // A simulated run whose truth.toml gives every sensor no noise at all (the simulator's noise
@@ -94,10 +98,10 @@ ChannelHealth::ChannelHealth(const Run& run)
     } else {
       ch_[c].active = c - kAccelChannels < 2 * run.channels.psd_count;
     }
-    noise_counts_[c] = std::isfinite(sigma) ? std::sqrt(sigma * sigma + quantisation) : 0.0;
-    const double quiet = sigma / kStuckNoiseMargin;
-    const double p = equal_probability(std::sqrt(quiet * quiet + quantisation));
-    stuck_samples_[c] = 1 + static_cast<std::int64_t>(std::ceil(std::log(kStuckFalseRate) / std::log(p)));
+    if (!std::isfinite(sigma)) sigma = 0.0;
+    sigma_counts_[c] = sigma;
+    noise_counts_[c] = std::sqrt(sigma * sigma + quantisation);
+    stuck_samples_[c] = stuck_length(sigma, 1.0);
   }
   if (meta.setpoint && meta.setpoint->servo_rate_hz > 0.0)
     servo_hold_samples_ = std::max<std::int64_t>(1, std::llround(std::ceil(fs_hz_ / meta.setpoint->servo_rate_hz)));
@@ -107,7 +111,10 @@ void ChannelHealth::end_same_run(Channel& ch) noexcept {
   const bool at_limit = ch.last >= clip_high_ || ch.last <= clip_low_;  // clipped, not stuck
   if (ch.same_n > 0 && !at_limit) {
     const std::int64_t c = &ch - ch_;
-    if (ch.same_n >= stuck_samples_[c] && !noise_free_) {
+    // At the channel's own resolution (an imported MEMS chip's counts come in steps of its
+    // LSB): longer than at single counts, so only a stretch that long is looked at again.
+    if (ch.same_n >= stuck_samples_[c] && !noise_free_ &&
+        ch.same_n >= stuck_length(sigma_counts_[c], static_cast<double>(std::max<std::int64_t>(1, ch.min_step)))) {
       ch.stuck.open_first = ch.same_first, ch.stuck.open_last = ch.same_last, ch.stuck.open_n = ch.same_n;
       ch.stuck.close();
       if (ch.same_n > ch.longest_stuck) ch.longest_stuck = ch.same_n, ch.stuck_value = ch.last;
@@ -133,6 +140,10 @@ void ChannelHealth::sample(int c, bool missing, std::int32_t counts, std::int64_
   if (ch.has_last && counts == ch.last) {
     ch.same_last = index, ++ch.same_n;
   } else {
+    if (ch.has_last) {
+      const std::int64_t step = std::abs(static_cast<std::int64_t>(counts) - ch.last);
+      ch.min_step = ch.min_step == 0 ? step : std::min(ch.min_step, step);
+    }
     end_same_run(ch);
     ch.same_first = ch.same_last = index, ch.same_n = 1;
   }

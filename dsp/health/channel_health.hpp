@@ -7,9 +7,10 @@
 //   stuck      the same counts for longer than the sensor's noise makes plausible: with
 //              the data sheet's noise (σ per sample n·√fs, run-format.md) two samples in a
 //              row are equal with probability p = erf(0.5 / (2σ')) (σ' = σ/4 plus the
-//              ADC's quantisation, a margin for a channel quieter than its data sheet); a
-//              run of L equal samples is taken as stuck when p^(L−1) < 1e-15 (not once in
-//              10^9 samples, a day at 10 kHz);
+//              rounding, a margin for a channel quieter than its data sheet, in the
+//              smallest step the channel was seen to take); a run of L equal samples is
+//              taken as stuck when p^(L−1) < 1e-15 (not once in 10^9 samples, a day at
+//              10 kHz);
 //   dead       at rest (M101 to the first motion of the set-point) its σ is below a tenth
 //              of the data sheet's (its variance below 1 %): a flat line that still toggles
 //              an LSB or two;
@@ -56,8 +57,9 @@ class ChannelHealth {
   // What was found (allocates; once, after the last frame).
   [[nodiscard]] std::vector<Finding> finish();
 
-  // The data sheet's σ of channel c in counts per sample (0 without a noise figure: PSD),
-  // and the shortest constant stretch taken as stuck.
+  // The data sheet's σ of channel c in counts per sample with the rounding (PSD: the
+  // rounding alone), and the shortest constant stretch taken as stuck when the channel
+  // reads in single counts (in coarser steps, as an imported MEMS chip does: longer).
   [[nodiscard]] double noise_counts(int c) const { return noise_counts_[c]; }
   [[nodiscard]] std::int64_t stuck_samples(int c) const { return stuck_samples_[c]; }
 
@@ -77,6 +79,7 @@ class ChannelHealth {
     std::int32_t last = 0;
     std::int64_t same_first = -1, same_last = -1, same_n = 0;  // the run of equal counts in progress
     std::int64_t longest_stuck = 0;
+    std::int64_t min_step = 0;  // smallest change between samples seen (0: none yet)
     std::int32_t stuck_value = 0;
     std::int64_t rest_n = 0;  // Welford over the rest window
     double rest_mean = 0.0, rest_m2 = 0.0;
@@ -89,6 +92,7 @@ class ChannelHealth {
   bool noise_free_;
   double clip_high_, clip_low_;  // counts at the ADC's limits
   double noise_counts_[kChannels] = {};
+  double sigma_counts_[kChannels] = {};  // the data sheet's σ without the rounding
   std::int64_t stuck_samples_[kChannels] = {};
   std::int64_t servo_hold_samples_ = 1;  // a set-point at servo rate holds this long between moves
   Channel ch_[kChannels];
