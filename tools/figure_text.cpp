@@ -39,6 +39,11 @@ std::string value_with_u(double value, std::optional<double> u_k2, const std::st
   return b;
 }
 
+std::string sensor_model_text(const dsp::Analysis& a) {
+  if (a.sensor_model == "datasheet") return "the data sheet's sensor model";
+  return "the sensor calibration (method " + a.sensor_model + ")";
+}
+
 std::optional<double> figure_u(const dsp::Analysis& a, const std::string& key, std::size_t i) {
   const auto it = a.uncertainty_k2.find(key);
   if (it == a.uncertainty_k2.end() || i >= it->second.size() || !std::isfinite(it->second[i])) return std::nullopt;

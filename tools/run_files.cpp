@@ -102,6 +102,7 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
   std::snprintf(b, sizeof b, "run %s (%s, %zu samples at %.0f Hz)\n", run.meta.id.c_str(),
                 run.meta.program.kind.c_str(), run.frame_count(), run.meta.acquisition.fs_hz);
   o += b;
+  o += "  sensor model: " + sensor_model_text(analysis) + "\n";
   std::string section;
   for (const dsp::FigureValue& f : dsp::figures_of(analysis)) {
     const std::string sec = f.key.substr(0, f.key.find('.'));

@@ -4,6 +4,7 @@
 #include "drivers/config/strict_toml.hpp"
 #include "drivers/run_io/line_source.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/frame_fields.hpp"
 
 #include <algorithm>
 #include <array>
@@ -131,7 +132,8 @@ void read_accel(const Row& row, double full, dsp::Frame& f) {
   for (int c = c_tax; c <= c_haz; ++c) {
     const auto v = parse_int(row.src, c, row.field(c), "integer ADC counts");
     if (!v) {
-      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::sensor_missing(c - c_tax < 3 ? 0 : 1);
+      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::sensor_missing(c - c_tax < 3 ? 0 : 1) |
+                 dsp::frame_flag::accel_field_missing(c - c_tax);
       continue;
     }
     if (*v > INT32_MAX || *v < INT32_MIN) fail_at(row.src, c, "ADC counts out of the 32-bit range");
@@ -175,7 +177,7 @@ void read_psd_counts(const Row& row, int n_psd, double lsb, double offset, dsp::
   for (int c = c_psd0; c < c_psd0 + 2 * n_psd; ++c) {
     const auto v = parse_double(row.src, c, row.field(c));
     if (!v) {
-      f.flags |= dsp::frame_flag::psd_missing;
+      f.flags |= dsp::frame_flag::psd_missing | dsp::frame_flag::psd_field_missing(c - c_psd0);
       continue;
     }
     const double counts = *v / lsb + offset;
@@ -261,8 +263,11 @@ bool SampleReader::next(dsp::Frame& out) {
   read_positions(row, f);
   read_psd_counts(row, n_psd_, acq.adc_lsb_volt, static_cast<double>(acq.adc_offset_counts), f);
   read_trigger(row, f);
+  // A sensor is there when any field of its triplex is (run-format.md, One sensor): one
+  // empty column of it is a dead channel, not an absent sensor.
   for (int s = 0; s < 2; ++s)
-    if (!(f.flags & dsp::frame_flag::sensor_missing(s))) seen_[s] = true;
+    if ((f.flags & dsp::frame_flag::sensor_fields_missing(s)) != dsp::frame_flag::sensor_fields_missing(s))
+      seen_[s] = true;
   ++rows_;
   out = f;
   return true;
@@ -271,7 +276,7 @@ bool SampleReader::next(dsp::Frame& out) {
 void absent_sensors_are_not_missing(const bool present[2], dsp::Frame& f) {
   for (int s = 0; s < 2; ++s)
     if (!present[s]) {
-      f.flags &= ~dsp::frame_flag::sensor_missing(s);
+      f.flags &= ~(dsp::frame_flag::sensor_missing(s) | dsp::frame_flag::sensor_fields_missing(s));
       if (!(f.flags & dsp::frame_flag::sensor_missing(1 - s))) f.flags &= ~dsp::frame_flag::accel_missing;
     }
 }

@@ -1,5 +1,7 @@
 #include "drivers/run_io/sample_rows.hpp"
 
+#include "dsp/core/frame_fields.hpp"
+
 #include <charconv>
 #include <cmath>
 
@@ -38,9 +40,11 @@ void append_sample_row(std::string& out, const dsp::Frame& f, const dsp::RunMeta
   for (int c = 0; c < 6; ++c) {
     out += ',';
     const int sensor = c < 3 ? 0 : 1;
-    // An absent triplex is written empty; a missing field of a present one too (the
-    // reader's old single flag still marks the whole frame).
-    const bool missing = !meta.sensor_present[sensor] || (f.flags & dsp::frame_flag::sensor_missing(sensor)) ||
+    // An absent triplex is written empty; a missing field of a present one too: the field
+    // named, or every field of a sensor (or frame) whose flag names none.
+    const bool named = (f.flags & dsp::frame_flag::sensor_fields_missing(sensor)) != 0;
+    const bool missing = !meta.sensor_present[sensor] || (f.flags & dsp::frame_flag::accel_field_missing(c)) ||
+                         (!named && (f.flags & dsp::frame_flag::sensor_missing(sensor))) ||
                          ((f.flags & dsp::frame_flag::accel_missing) &&
                           !(f.flags & (dsp::frame_flag::table_missing | dsp::frame_flag::head_missing)));
     if (!missing) put_int(f.accel_counts[c]);
@@ -51,7 +55,8 @@ void append_sample_row(std::string& out, const dsp::Frame& f, const dsp::RunMeta
   }
   for (int c = 0; c < 2 * channels.psd_count; ++c) {
     out += ',';
-    if (!(f.flags & dsp::frame_flag::psd_missing))
+    const bool psd_named = (f.flags & dsp::frame_flag::psd_fields_missing) != 0;
+    if (!(f.flags & dsp::frame_flag::psd_field_missing(c)) && (psd_named || !(f.flags & dsp::frame_flag::psd_missing)))
       append_double(out, static_cast<double>(f.psd_counts[c] - offset) * lsb);
   }
   for (int a = 0; a < 3; ++a) {

@@ -1,5 +1,6 @@
 #include "dsp/analysis/analyze_run.hpp"
 
+#include "dsp/analysis/channel_findings.hpp"
 #include "dsp/analysis/figure_uncertainty.hpp"
 #include "dsp/analysis/program_evaluations.hpp"
 #include "dsp/analysis/verdict.hpp"
@@ -144,6 +145,8 @@ PipelineConfig analysis_config(const RunMeta& meta, std::size_t capacity_samples
 Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   if (run.frames.empty()) throw InputError("run '" + run.meta.id + "' holds no frames");
   if (!(run.meta.acquisition.fs_hz > 0.0)) throw InputError("run '" + run.meta.id + "': fs_hz must be positive");
+  // Is each channel a measurement at all? Before millimetres are integrated from it.
+  std::vector<health::Finding> findings = health::check_channels(run);
   const PipelineConfig cfg = analysis_config(run.meta, run.frames.size(), options);
   Pipeline pipeline(cfg);
   for (const auto& f : run.frames) pipeline.step(f);
@@ -154,7 +157,10 @@ Analysis analyze_run(const Run& run, const AnalysisOptions& options) {
   a.measurement = pipeline.finish();
   a.flags = a.measurement.flags;
   a.degraded = a.measurement.degraded;
-  evaluate_measurement(run, cfg, options, a);
+  if (judge_channels(run.meta, std::move(findings), a))
+    evaluate_measurement(run, cfg, options, a);
+  else
+    judge(run.meta.program, a);
   return a;
 }
 

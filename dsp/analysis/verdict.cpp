@@ -1,5 +1,6 @@
 #include "dsp/analysis/verdict.hpp"
 
+#include "dsp/analysis/channel_findings.hpp"
 #include "dsp/analysis/figures.hpp"
 
 #include <algorithm>
@@ -99,9 +100,9 @@ void judge(const Program& program, Analysis& a) {
 
 FlagSeverity flag_severity(const std::string& flag) {
   // The measurement itself is wrong or incomplete.
-  for (const char* p :
-       {"accel_missing", "accel_saturated", "frames_lost", "not_finite", "capacity_exceeded", "fixed_saturated",
-        "supports_diverged", "psd_disagrees", "no_motion", "interrupted", "source_stopped", kPositionNullFlag})
+  for (const char* p : {"accel_missing", "accel_saturated", "frames_lost", "not_finite", "capacity_exceeded",
+                        "fixed_saturated", "supports_diverged", "psd_disagrees", "no_motion", "interrupted",
+                        "source_stopped", kPositionNullFlag, kChannelFlag, kTruncatedFlag})
     if (starts_with(flag, p)) return FlagSeverity::critical;
   // An evaluation that failed ("circle: …", "positioning: …" without "null").
   for (const char* p : {"circle: ", "step: ", "rectangle: null", "freeform: null"})
@@ -109,7 +110,8 @@ FlagSeverity flag_severity(const std::string& flag) {
   if (starts_with(flag, "positioning: ") && flag.find("outside the standard") == std::string::npos)
     return FlagSeverity::critical;
   // It limits the measurement.
-  for (const char* p : {"no_start_trigger", "no_end_trigger", "short_rest_window", "no_zupt_window", "noise_density"})
+  for (const char* p :
+       {"no_start_trigger", "no_end_trigger", "short_rest_window", "no_zupt_window", kUnusedChannelFlag, "noise_density"})
     if (starts_with(flag, p)) return FlagSeverity::warning;
   if (flag.find("outside the standard") != std::string::npos || flag.find("runs both directions") != std::string::npos)
     return FlagSeverity::warning;

@@ -1,5 +1,6 @@
 #include "dsp/stream/analyze_stream.hpp"
 
+#include "dsp/analysis/channel_findings.hpp"
 #include "dsp/analysis/figure_uncertainty.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/error.hpp"
@@ -262,11 +263,13 @@ void check_streamable(const Run& header, const AnalysisOptions& options) {
 // What the first pass leaves for the second: the configuration, what the set-point decided,
 // the spills, and the pipeline's track.
 struct FirstPass {
-  FirstPass(const Run& header, PipelineConfig config) : cfg(std::move(config)), scout(header, is_circle(header)) {}
+  FirstPass(const Run& header, PipelineConfig config)
+      : cfg(std::move(config)), scout(header, is_circle(header)), channel_check(header) {}
   static bool is_circle(const Run& header) { return header.meta.program.kind == "circle"; }
 
   PipelineConfig cfg;
   Scout scout;
+  health::ChannelHealth channel_check;  // each frame before the pipeline takes it
   std::optional<TraceSpill> trace_spill;
   std::optional<CorrectionSpill> kept;
   Pipeline::Tracked t;
@@ -284,7 +287,9 @@ void run_first_pass(const Run& header, FrameReplay& frames, const StreamOptions&
   {
     Pipeline pipeline(p.cfg);
     Scout& scout = p.scout;
-    frames.replay([&scout, &pipeline, &n_frames](const Frame& f) {
+    health::ChannelHealth& check = p.channel_check;
+    frames.replay([&scout, &check, &pipeline, &n_frames](const Frame& f) {
+      check.frame(f);
       scout.frame(f);
       pipeline.step(f);
       ++n_frames;
@@ -432,7 +437,9 @@ Analysis analyze_stream(const Run& header, FrameReplay& frames, const AnalysisOp
   FirstPass first(header, std::move(cfg));
   run_first_pass(header, frames, stream, first);
   Analysis a = analysis_of_track(first.cfg, options, first.t);
-  if (first.t.samples == 0) {  // no motion: nothing to evaluate, a verdict all the same
+  // No figures — a channel the program needs measures nothing, or nothing moved — and no
+  // second pass: a verdict all the same.
+  if (!judge_channels(header.meta, first.channel_check.finish(), a) || first.t.samples == 0) {
     judge(header.meta.program, a);
     return a;
   }

@@ -1,6 +1,7 @@
 #include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/frame_fields.hpp"
 
 #include <gtest/gtest.h>
 #include <zlib.h>
@@ -47,11 +48,14 @@ dsp::Run small_run() {
     f.cmd_mm[0] = 7.0710678118654755 + i * 1e-3, f.cmd_mm[1] = -1.0 / 3.0, f.cmd_mm[2] = 0.0;
     f.ref_mm[0] = f.cmd_mm[0] + 1e-6, f.ref_mm[1] = i == 10 ? std::nan("") : f.cmd_mm[1];
     f.trigger = i == 20 ? 101 : i == 280 ? 103 : 0;
+    // The reader names the empty fields too (frame_fields.hpp).
     if (i == 30)
-      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::table_missing | dsp::frame_flag::head_missing,
+      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::table_missing | dsp::frame_flag::head_missing |
+                 dsp::frame_flag::sensor_fields_missing(0) | dsp::frame_flag::sensor_fields_missing(1),
           std::fill(std::begin(f.accel_counts), std::end(f.accel_counts), 0);
     if (i == 31)
-      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::head_missing,
+      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::head_missing |
+                 dsp::frame_flag::sensor_fields_missing(1),
           std::fill(std::begin(f.accel_counts) + 3, std::end(f.accel_counts), 0);
     r.frames.push_back(f);
   }
@@ -100,7 +104,8 @@ TEST(RunIo, SingleSensorRunKeepsTheOtherSensorsData) {
   dsp::Run run = small_run();
   run.meta.sensor_present[0] = false;
   for (auto& f : run.frames)
-    f.flags &= ~(dsp::frame_flag::table_missing | dsp::frame_flag::head_missing | dsp::frame_flag::accel_missing);
+    f.flags &= ~(dsp::frame_flag::table_missing | dsp::frame_flag::head_missing | dsp::frame_flag::accel_missing |
+                 dsp::frame_flag::sensor_fields_missing(0) | dsp::frame_flag::sensor_fields_missing(1));
   write_run(run, tmp.path / "one", {});
   const dsp::Run back = read_run(tmp.path / "one");
   EXPECT_FALSE(back.meta.sensor_present[0]);

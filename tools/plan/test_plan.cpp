@@ -8,6 +8,7 @@
 #include "sim/hidden/hidden_effects.hpp"
 #include "sim/nc/envelope_check.hpp"
 #include "sim/simulate.hpp"
+#include "tools/figure_text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -358,10 +359,14 @@ namespace eical::tools::plan {
 void suggest_measurable_test(const dsp::Run& run, dsp::Analysis& a) {
   const dsp::ResolutionLimit* lim = dsp::resolution_limit(run.meta.program.kind);
   if (!lim) return;
+  // Whatever the pipeline compensated with: advice to identify the sensors only when they
+  // were not (a calibration that disagrees is to be redone or checked, not made).
   if (a.measurement.supports.psd_disagrees)
     a.verdict_reasons.push_back(
-        "the PSD readings disagree with the data sheet's sensor model: identify the sensors (eical gen-nc identify, "
-        "eical identify)");
+        "the PSD readings disagree with " + sensor_model_text(a) +
+        (a.sensor_model == "datasheet"
+             ? ": identify the sensors (eical gen-nc identify, eical identify)"
+             : ": identify the sensors again (eical gen-nc identify, eical identify) or check the calibration's run"));
   const auto it = a.uncertainty_k2.find(lim->limited);
   if (it == a.uncertainty_k2.end() || it->second.size() != 1 || !(it->second[0] > lim->limit)) {
     a.verdict_reasons.push_back(
