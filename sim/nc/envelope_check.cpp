@@ -66,10 +66,17 @@ Reach sampled_reach(const SetPoint& sp) {
   return r;
 }
 
+// To the micrometre, trailing zeros dropped: a circle's G-code rounds its start point to
+// 0.1 µm, so R400 reaches y = 399.99998867, which reads better as 400.
 std::string g(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.10g", v);
-  return b;
+  char b[512];  // %.3f of the largest double: 309 digits
+  std::snprintf(b, sizeof b, "%.3f", v);
+  std::string s = b;
+  if (s.find('.') != std::string::npos) {
+    s.erase(s.find_last_not_of('0') + 1);
+    if (s.back() == '.') s.pop_back();
+  }
+  return s == "-0" ? "0" : s;
 }
 
 }  // namespace

@@ -178,7 +178,7 @@ TEST_F(EnvelopeCli, PlanStopsAtItsDeadlineAndSaysWhatItDidNotEvaluate) {
 
 TEST_F(EnvelopeCli, PlanShowsItsProgressOnStderr) {
   // With time for them, the variants are announced one by one.
-  const Outcome o = eical("plan --radius 25 --repeats 2 --draws 10 --max-duration 10 --deadline 600");
+  const Outcome o = eical("plan --radius 25 --repeats 2 --draws 10 --max-duration 20 --deadline 600");
   EXPECT_EQ(o.exit_code, 0) << o.err;
   EXPECT_NE(o.err.find("variant 1 of"), std::string::npos) << o.err;
   EXPECT_EQ(o.err.find("deadline"), std::string::npos) << o.err;
