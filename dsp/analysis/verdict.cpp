@@ -110,8 +110,8 @@ FlagSeverity flag_severity(const std::string& flag) {
   if (starts_with(flag, "positioning: ") && flag.find("outside the standard") == std::string::npos)
     return FlagSeverity::critical;
   // It limits the measurement.
-  for (const char* p :
-       {"no_start_trigger", "no_end_trigger", "short_rest_window", "no_zupt_window", kUnusedChannelFlag, "noise_density"})
+  for (const char* p : {"no_start_trigger", "no_end_trigger", "short_rest_window", "no_zupt_window", kUnusedChannelFlag,
+                        "noise_density"})
     if (starts_with(flag, p)) return FlagSeverity::warning;
   if (flag.find("outside the standard") != std::string::npos || flag.find("runs both directions") != std::string::npos)
     return FlagSeverity::warning;

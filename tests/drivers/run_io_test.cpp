@@ -54,8 +54,8 @@ dsp::Run small_run() {
                  dsp::frame_flag::sensor_fields_missing(0) | dsp::frame_flag::sensor_fields_missing(1),
           std::fill(std::begin(f.accel_counts), std::end(f.accel_counts), 0);
     if (i == 31)
-      f.flags |= dsp::frame_flag::accel_missing | dsp::frame_flag::head_missing |
-                 dsp::frame_flag::sensor_fields_missing(1),
+      f.flags |=
+          dsp::frame_flag::accel_missing | dsp::frame_flag::head_missing | dsp::frame_flag::sensor_fields_missing(1),
           std::fill(std::begin(f.accel_counts) + 3, std::end(f.accel_counts), 0);
     r.frames.push_back(f);
   }

@@ -269,7 +269,9 @@ TEST(ChannelHealth, StuckChannelTheProgramDoesNotUseIsAWarning) {
   EXPECT_TRUE(has_flag(a, "channel_unused: table_az stuck at 1000000 counts")) << all_flags(a);
   EXPECT_TRUE(a.step.has_value());
   for (const auto& f : a.flags)
-    if (f.rfind(dsp::kUnusedChannelFlag, 0) == 0) EXPECT_EQ(dsp::flag_severity(f), dsp::FlagSeverity::warning);
+    if (f.rfind(dsp::kUnusedChannelFlag, 0) == 0) {
+      EXPECT_EQ(dsp::flag_severity(f), dsp::FlagSeverity::warning);
+    }
 }
 
 // Through the file: an empty column keeps its sensor present (run-format.md: a sensor is

@@ -105,7 +105,9 @@ TEST(GcodeDialectProperty, RandomProgramsReadBackInEveryDialect) {
       EXPECT_LE(diff.dwell_ms, 1.0);
       worst_path_um[di] = std::max(worst_path_um[di], diff.path_um);
       worst_dwell_ms[di] = std::max(worst_dwell_ms[di], diff.dwell_ms);
-      if (d != Dialect::heidenhain_iso) EXPECT_EQ(got.exact_stop, want.exact_stop);
+      if (d != Dialect::heidenhain_iso) {
+        EXPECT_EQ(got.exact_stop, want.exact_stop);
+      }
       // The canonical text the simulator keeps of it runs the same program (from where the
       // program's first rapid move puts the machine, as the simulator does).
       const std::string kept = canonical_gcode(text, "written", d);
