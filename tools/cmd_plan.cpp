@@ -60,7 +60,7 @@ struct PlanCommandOptions {
   std::vector<double> size{50.0, 50.0};
   bool json = false;
   int draws = 100;
-  double max_s = 60.0;
+  double max_s = 180.0;
   double deadline_s = 60.0;
   EnvelopeOptions envelope;
 };
@@ -106,7 +106,7 @@ void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
       ->check(CLI::Range(10, 100000));
   cmd.add_option("--max-duration", o.max_s,
                  "the longest program simulated, s: a longer test is refused, longer variants are not tried")
-      ->default_val(60.0)
+      ->default_val(180.0)
       ->check(CLI::Range(1.0, 3600.0));
   cmd.add_option("--deadline", o.deadline_s,
                  "stop after this many seconds: no simulation starts later; what was not evaluated is listed "

@@ -159,8 +159,8 @@ TEST_F(EnvelopeCli, PlanRefusesACircleBeyondTheEnvelope) {
 }
 
 TEST_F(EnvelopeCli, PlanRefusesATestLongerThanItsMaxDuration) {
-  const Outcome o = eical("plan --radius 200");
-  expect_refusal(o, {"plan circle: the test runs", "longer than the 60 s plan simulates (--max-duration"});
+  const Outcome o = eical("plan --radius 400");  // 5 revolutions at 2.5 m/min: 300 s
+  expect_refusal(o, {"plan circle: the test runs", "longer than the 180 s plan simulates (--max-duration"});
   EXPECT_LT(o.wall_s, 10.0);
 }
 
