@@ -3,6 +3,7 @@
 // against the simulator's truth lies within the expanded uncertainty U, the median U and
 // the RMS error (tools/uncertainty/coverage_campaign.hpp).
 //   bench_uncertainty [--seeds 1,2,...] [--draws 100] [--programs circle,step,...]
+#include "drivers/exec/thread_for.hpp"
 #include "tools/uncertainty/coverage_campaign.hpp"
 
 #include <CLI/CLI.hpp>
@@ -14,10 +15,13 @@ int main(int argc, char** argv) {
   eical::tools::uncertainty::CampaignOptions o;
   o.seeds = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
   app.add_option("--seeds", o.seeds, "machines to draw (each its own sensors and errors)")->delimiter(',');
-  app.add_option("--programs", o.programs, "circle, step, positioning, rectangle")->delimiter(',');
+  app.add_option("--programs", o.programs,
+                 "circle, circle-identified, circle-large, step, positioning, positioning-long, rectangle")
+      ->delimiter(',');
   app.add_option("--draws", o.draws, "Monte Carlo draws per run");
   app.add_option("--write-runs", o.write_runs, "write every simulated run into this folder");
   CLI11_PARSE(app, argc, argv);
+  o.parallel = eical::drivers::thread_for();
   std::fputs(eical::tools::uncertainty::coverage_table(eical::tools::uncertainty::run_campaign(o)).c_str(), stdout);
   return 0;
 }

@@ -13,6 +13,7 @@
 // (40 × 30 mm at 4 m/min, a strip on each of its first two sides), all on that seed's
 // machine.
 #include "dsp/analysis/figures.hpp"
+#include "dsp/core/parallel_for.hpp"
 
 #include <cstdint>
 #include <map>
@@ -25,13 +26,15 @@ struct CampaignOptions {
   std::vector<std::uint64_t> seeds{1, 2, 3};
   std::vector<std::string> programs{"circle", "step", "positioning", "rectangle"};
   int draws = 100;
-  std::string write_runs;  // a folder: every simulated run is written there (eical-run/1)
+  dsp::ParallelFor parallel = dsp::sequential_for();  // the analyses' draws and smoother
+  std::string write_runs;                             // a folder: every simulated run is written there (eical-run/1)
 };
 
 struct FigureCoverage {
   std::string key;
   std::size_t cases = 0, covered = 0;
   std::vector<double> u, abs_error;  // per case
+  std::vector<double> u_over_bound;  // per case with a noise bound
   [[nodiscard]] double coverage() const {
     return cases ? static_cast<double>(covered) / static_cast<double>(cases) : 0.0;
   }
