@@ -202,6 +202,7 @@ SampleReader::SampleReader(const fs::path& file, const dsp::RunMeta& meta, dsp::
   if (!src_->next(line)) throw dsp::InputError(file.string() + ": empty file (no header line)");
   where_.fill(-1);
   n_fields_ = 0;
+  std::string unknown;  // the first column eical does not know
   {
     std::size_t pos = 0;
     for (;;) {
@@ -217,17 +218,22 @@ SampleReader::SampleReader(const fs::path& file, const dsp::RunMeta& meta, dsp::
           known = true;
         }
       // As run.toml's keys: a misspelt column (ref_X) is refused, never read as absent.
-      if (!known && !is_extension_name(name))
-        throw dsp::InputError(file.string() + ":1: column '" + std::string(name) +
-                              "': unknown column (check the spelling; another tool's columns begin with " +
-                              std::string(kExtensionPrefix) + ")");
+      if (!known && !is_extension_name(name) && unknown.empty()) unknown = name;
       ++n_fields_;
       if (comma == std::string_view::npos) break;
       pos = comma + 1;
     }
   }
+  // A misspelt column is usually also a missing one: both are said.
+  const std::string unknown_text =
+      unknown.empty()
+          ? std::string()
+          : "column '" + unknown + "': unknown column (check the spelling; another tool's columns begin with " +
+                std::string(kExtensionPrefix) + ")";
+  const auto also_unknown = [&] { return unknown.empty() ? std::string() : "; " + unknown_text; };
   for (int c : {c_t, c_tax, c_tay, c_taz, c_hax, c_hay, c_haz, c_ttemp, c_htemp, c_cx, c_cy, c_cz, c_trig})
-    if (where_[c] < 0) throw dsp::InputError(file.string() + ":1: required column '" + column_name(c) + "' is missing");
+    if (where_[c] < 0)
+      throw dsp::InputError(file.string() + ":1: required column '" + column_name(c) + "' is missing" + also_unknown());
   n_psd_ = static_cast<int>(meta.psd.size());
   if (n_psd_ > dsp::kMaxPsd)
     throw dsp::InputError(file.string() + ": more than " + std::to_string(dsp::kMaxPsd) + " [[psd]] strips");
@@ -236,10 +242,11 @@ SampleReader::SampleReader(const fs::path& file, const dsp::RunMeta& meta, dsp::
       const int c = c_psd0 + 2 * k + e;
       if (k < n_psd_ && where_[c] < 0)
         throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' is missing (run.toml has " +
-                              std::to_string(n_psd_) + " [[psd]])");
+                              std::to_string(n_psd_) + " [[psd]])" + also_unknown());
       if (k >= n_psd_ && where_[c] >= 0)
         throw dsp::InputError(file.string() + ":1: column '" + column_name(c) + "' has no [[psd]] table in run.toml");
     }
+  if (!unknown.empty()) throw dsp::InputError(file.string() + ":1: " + unknown_text);
   for (int a = 0; a < 3; ++a) channels.ref[a] = where_[c_rx + a] >= 0;
   channels.psd_count = n_psd_;
   fields_.resize(static_cast<std::size_t>(n_fields_));
