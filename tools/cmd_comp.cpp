@@ -35,7 +35,7 @@ struct CompOptions {
   std::vector<std::string> inputs, controls = {"linuxcnc"}, travel, sinumerik_axes = {"X1", "Y1", "Z1"};
   std::string out = "comp", merge_ini;
   double spacing_mm = 0.0, fanuc_unit_um = 1.0, fanuc_reference_mm = 0.0;
-  bool force = false, allow_unresolved = false, skip_unresolved = false;
+  bool force = false, allow_unresolved = false, skip_unresolved = false, refuse_unresolved = false;
 };
 
 comp::TravelRange parse_travel(const std::string& s) {
@@ -150,20 +150,32 @@ void add_comp_options(CLI::App& cmd, CompOptions& o) {
   auto* allow = cmd.add_flag(
       "--allow-unresolved", o.allow_unresolved,
       "propose terms from figures not larger than their uncertainty (or without one), marked in comp.json");
-  auto* skip = cmd.add_flag("--skip-unresolved", o.skip_unresolved, "leave out the terms whose figure is not resolved");
+  auto* skip = cmd.add_flag("--skip-unresolved", o.skip_unresolved,
+                            "leave out the terms whose figure is not resolved, and list them (the default)");
+  auto* refuse =
+      cmd.add_flag("--refuse-unresolved", o.refuse_unresolved, "write nothing when any term's figure is not resolved");
   allow->excludes(skip);
+  allow->excludes(refuse);
+  skip->excludes(refuse);
 }
 
 // The inputs' proposal per axis; refuses to go on when no term is left.
 comp::Plan comp_plan(const std::vector<comp::CompInput>& inputs, const CompOptions& o) {
   comp::PlanOptions po;
-  po.unresolved = o.allow_unresolved  ? comp::Unresolved::allow
-                  : o.skip_unresolved ? comp::Unresolved::skip
-                                      : comp::Unresolved::refuse;
+  // Left out by default: a machine whose one axis has no backlash is the normal case, and
+  // what is resolved is still worth compensating (issue 33).
+  po.unresolved = o.allow_unresolved    ? comp::Unresolved::allow
+                  : o.refuse_unresolved ? comp::Unresolved::refuse
+                                        : comp::Unresolved::skip;
   for (const auto& t : o.travel) po.travel.push_back(parse_travel(t));
   comp::Plan plan = comp::build_plan(inputs, po);
-  if (plan.axes.empty())
-    throw dsp::InputError("comp: no term is left to propose (the unresolved ones were skipped); nothing written");
+  if (plan.axes.empty()) {
+    std::string msg = "comp: no term is resolved (|value| must exceed U, k = 2); nothing written";
+    for (const auto& u : plan.unresolved_skipped) msg += "\n  not resolved: " + u;
+    if (!plan.unresolved_skipped.empty())
+      msg += "\n  measure again (more runs or revolutions), or --allow-unresolved to propose them anyway";
+    throw dsp::InputError(msg);
+  }
   return plan;
 }
 
@@ -237,8 +249,7 @@ void print_proposal(const comp::Plan& plan, std::size_t n_files, const CompOptio
   }
   for (const auto& u : plan.unresolved_used)
     std::printf("comp: WARNING proposed from an unresolved figure (--allow-unresolved): %s\n", u.c_str());
-  for (const auto& u : plan.unresolved_skipped)
-    std::printf("comp: left out, not resolved (--skip-unresolved): %s\n", u.c_str());
+  for (const auto& u : plan.unresolved_skipped) std::printf("comp: left out, not resolved: %s\n", u.c_str());
   std::printf("comp: %zu files -> %s\n", n_files, o.out.c_str());
 }
 

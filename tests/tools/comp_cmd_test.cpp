@@ -143,14 +143,15 @@ TEST(CompCmd, NeverOverwritesWithoutForce) {
   EXPECT_FALSE(fs::exists(t.dir / "out2"));
 }
 
-TEST(CompCmd, UnresolvedFiguresAreRefusedByNameUnlessSkippedOrAllowed) {
+TEST(CompCmd, UnresolvedFiguresAreLeftOutByDefaultAndRefusedWhenAsked) {
   Tmp t;
   const auto pos = write(t.dir / "pos.json", positioning_result(0.5));
   const auto circ = write(t.dir / "circle.json", circle_result(0.5, 0.3));  // backlash y 0.3 ± 0.5 µm
   const auto bare = write(t.dir / "bare.json", positioning_result(-1.0));   // no uncertainty_k2 at all
   const std::string out = (t.dir / "out").string();
+  // --refuse-unresolved: nothing is written while one term is not resolved.
   try {
-    run_cli({"comp", pos.string(), circ.string(), "-o", out});
+    run_cli({"comp", pos.string(), circ.string(), "-o", out, "--refuse-unresolved"});
     FAIL() << "proposed from an unresolved figure";
   } catch (const eical::dsp::InputError& e) {
     const std::string m = e.what();
@@ -159,20 +160,25 @@ TEST(CompCmd, UnresolvedFiguresAreRefusedByNameUnlessSkippedOrAllowed) {
     EXPECT_EQ(m.find("positioning.M_um"), std::string::npos) << m;  // resolved ones are not named
   }
   EXPECT_FALSE(fs::exists(out));
+  // Nothing resolved at all: refused by default too, each figure named.
   try {
     run_cli({"comp", bare.string(), "-o", out});
     FAIL() << "proposed from figures without an uncertainty";
   } catch (const eical::dsp::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no term is resolved"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("positioning.M_um = 4 (no uncertainty)"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(out));
-  // --skip-unresolved: y is left out, x proposed.
-  run_cli({"comp", pos.string(), circ.string(), "-o", out, "--skip-unresolved"});
-  std::string snippet = slurp(t.dir / "out/linuxcnc/eical-comp.ini");
-  EXPECT_NE(snippet.find("[JOINT_0]"), std::string::npos);
-  EXPECT_EQ(snippet.find("[JOINT_1]"), std::string::npos) << snippet;
-  {
-    const auto left = nlohmann::json::parse(slurp(t.dir / "out/comp.json"));
+  // The default (as --skip-unresolved): y is left out and listed, x proposed.
+  for (const char* flag : {"", "--skip-unresolved"}) {
+    const std::string o = out + flag;
+    std::vector<std::string> args{"comp", pos.string(), circ.string(), "-o", o};
+    if (*flag) args.emplace_back(flag);
+    run_cli(args);
+    const std::string snippet = slurp(fs::path(o) / "linuxcnc/eical-comp.ini");
+    EXPECT_NE(snippet.find("[JOINT_0]"), std::string::npos);
+    EXPECT_EQ(snippet.find("[JOINT_1]"), std::string::npos) << snippet;
+    const auto left = nlohmann::json::parse(slurp(fs::path(o) / "comp.json"));
     ASSERT_TRUE(left.contains("left_out_unresolved_figures")) << "what was left out is said";
     ASSERT_EQ(left["left_out_unresolved_figures"].size(), 1u);
     EXPECT_NE(left["left_out_unresolved_figures"][0].get<std::string>().find("diagnostics.backlash_y_um"),

@@ -155,7 +155,7 @@ class FigureUse {
         "comp: no compensation from figures that are not resolved (|value| must exceed U, k = 2); nothing written:";
     for (const auto& r : refused_) msg += "\n  " + r;
     msg +=
-        "\n  measure again (more runs or revolutions), --skip-unresolved to leave these terms out, or "
+        "\n  measure again (more runs or revolutions), leave out --refuse-unresolved to write the resolved terms, or "
         "--allow-unresolved to propose them anyway";
     throw dsp::InputError(msg);
   }

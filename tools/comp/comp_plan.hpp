@@ -8,8 +8,8 @@
 // * an axis with circles only gets its lost motion from their backlash figure;
 // * squareness and scale mismatch are reported, not proposed (no axis table holds them).
 // A table must cover the travel every input measured on its axis (and --travel).
-// Unresolved figures: refused (InputError naming each, nothing written), left out
-// (skip), or proposed anyway (allow) — the caller's explicit choice.
+// Unresolved figures: left out and listed (skip, eical comp's default), refused
+// (InputError naming each, nothing written), or proposed anyway (allow).
 #include "tools/comp/comp_inputs.hpp"
 #include "tools/comp/proposal.hpp"
 
@@ -29,7 +29,7 @@ struct TravelRange {
 };
 
 struct PlanOptions {
-  Unresolved unresolved = Unresolved::refuse;
+  Unresolved unresolved = Unresolved::skip;
   std::vector<TravelRange> travel;  // --travel
 };
 
