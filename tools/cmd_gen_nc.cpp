@@ -9,6 +9,7 @@
 #include "tools/commands.hpp"
 #include "tools/envelope_options.hpp"
 #include "tools/io/psd_option.hpp"
+#include "tools/program_defaults.hpp"
 
 #include <cctype>
 #include <cstdio>
@@ -137,9 +138,15 @@ void add_circle(CLI::App* gen) {
   auto o = std::make_shared<GenOptions>();
   dsp::Program& p = o->program;
   auto* c = gen->add_subcommand("circle", "ISO 230-4 circular test");
-  c->add_option("--radius", p.radius_mm, "radius in mm")->default_val(10.0)->check(CLI::PositiveNumber);
-  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
-  c->add_option("--repeats", p.repeats, "full revolutions")->default_val(5)->check(CLI::Range(1, 1000));
+  c->add_option("--radius", p.radius_mm, "radius in mm")
+      ->default_val(program_defaults::kCircleRadiusMm)
+      ->check(CLI::PositiveNumber);
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")
+      ->default_val(program_defaults::kCircleFeedMmMin)
+      ->check(CLI::PositiveNumber);
+  c->add_option("--repeats", p.repeats, "full revolutions")
+      ->default_val(program_defaults::kCircleRevolutions)
+      ->check(CLI::Range(1, 1000));
   c->add_option("--direction", p.direction, "ccw, cw or both (ccw, then cw back)")
       ->default_val("ccw")
       ->check(CLI::IsMember({"ccw", "cw", "both"}));
@@ -164,8 +171,12 @@ void add_positioning(CLI::App* gen) {
   auto* c = gen->add_subcommand("positioning", "ISO 230-2 bidirectional positioning cycle");
   c->add_option("--axis", p.axis, "x, y or z")->default_val("x")->check(CLI::IsMember({"x", "y", "z"}));
   c->add_option("--targets", p.targets_mm, "targets in mm, ascending (comma separated)")->required()->delimiter(',');
-  c->add_option("--runs", p.runs, "bidirectional runs")->default_val(5)->check(CLI::Range(1, 1000));
-  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(2000.0)->check(CLI::PositiveNumber);
+  c->add_option("--runs", p.runs, "bidirectional runs")
+      ->default_val(program_defaults::kPositioningRuns)
+      ->check(CLI::Range(1, 1000));
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")
+      ->default_val(program_defaults::kPositioningFeedMmMin)
+      ->check(CLI::PositiveNumber);
   c->add_option("--dwell", p.dwell_s, "dwell at each target in s")->default_val(0.5)->check(CLI::Range(0.0, 3600.0));
   c->add_option("--overrun", o->overrun_mm, "overrun beyond the end targets in mm")
       ->default_val(2.0)
@@ -184,8 +195,12 @@ void add_step(CLI::App* gen) {
   auto* c = gen->add_subcommand("step", "step response: back and forth between two targets");
   c->add_option("--axis", p.axis, "x, y or z")->default_val("x")->check(CLI::IsMember({"x", "y", "z"}));
   c->add_option("--targets", p.targets_mm, "a,b in mm")->required()->expected(2)->delimiter(',');
-  c->add_option("--runs", p.runs, "there-and-back pairs")->default_val(2)->check(CLI::Range(1, 1000));
-  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(3250.0)->check(CLI::PositiveNumber);
+  c->add_option("--runs", p.runs, "there-and-back pairs")
+      ->default_val(program_defaults::kStepPairs)
+      ->check(CLI::Range(1, 1000));
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")
+      ->default_val(program_defaults::kStepFeedMmMin)
+      ->check(CLI::PositiveNumber);
   c->add_option("--dwell", p.dwell_s, "dwell at each end in s")->default_val(0.5)->check(CLI::Range(0.0, 3600.0));
   add_output(c, *o);
   add_envelope_options(*c, o->envelope);
@@ -201,9 +216,13 @@ void add_rectangle(CLI::App* gen) {
   auto* c = gen->add_subcommand("rectangle", "rectangle with exact stop at the corners");
   c->add_option("--corner", o->corner, "start corner in the plane, mm")->expected(2)->delimiter(',');
   c->add_option("--size", o->size, "side lengths, mm")->expected(2)->delimiter(',');
-  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")->default_val(1000.0)->check(CLI::PositiveNumber);
+  c->add_option("--feed", p.feed_mm_min, "feed in mm/min")
+      ->default_val(program_defaults::kRectangleFeedMmMin)
+      ->check(CLI::PositiveNumber);
   c->add_option("--dwell", p.dwell_s, "dwell at each corner in s")->default_val(0.2)->check(CLI::Range(0.0, 3600.0));
-  c->add_option("--repeats", p.repeats, "laps")->default_val(1)->check(CLI::Range(1, 1000));
+  c->add_option("--repeats", p.repeats, "laps")
+      ->default_val(program_defaults::kRectangleLaps)
+      ->check(CLI::Range(1, 1000));
   c->add_option("--plane", p.plane, "xy, zx or yz")->default_val("xy")->check(CLI::IsMember({"xy", "zx", "yz"}));
   add_output(c, *o);
   add_envelope_options(*c, o->envelope);

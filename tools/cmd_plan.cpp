@@ -8,7 +8,10 @@
 #include "tools/exit_codes.hpp"
 #include "tools/figure_text.hpp"
 #include "tools/io/psd_option.hpp"
+#include "tools/plan/strip_layout.hpp"
 #include "tools/plan/test_plan.hpp"
+#include "tools/program_defaults.hpp"
+#include "tools/run_files.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -16,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 
 namespace eical::tools {
 namespace {
@@ -29,7 +33,8 @@ nlohmann::json prediction_json(const plan::Prediction& p) {
           {"limited", p.limited},
           {"limited_u", std::isfinite(p.limited_u) ? nlohmann::json(p.limited_u) : nlohmann::json(nullptr)},
           {"limit", p.limit},
-          {"measurable", p.measurable}};
+          {"measurable", p.measurable},
+          {"strips", plan::layout_json(p.program)}};
 }
 
 std::string prediction_text(const plan::Prediction& p) {
@@ -49,7 +54,7 @@ std::string prediction_text(const plan::Prediction& p) {
   std::snprintf(b, sizeof b, "  %s: U = %.2f µm %s the %.0f µm the test is meant to resolve\n",
                 p.measurable ? "measurable" : "NOT MEASURABLE", p.limited_u, p.measurable ? "within" : "exceeds",
                 p.limit);
-  return o + b;
+  return o + b + plan::layout_text(p.program);
 }
 
 // What `eical plan` is told: the test program, its strips, how hard to look.
@@ -59,20 +64,26 @@ struct PlanCommandOptions {
   std::vector<std::string> strips;
   std::vector<double> size{50.0, 50.0};
   bool json = false;
+  std::string layout_svg;
   int draws = 100;
   double max_s = 180.0;
   double deadline_s = 60.0;
   EnvelopeOptions envelope;
+  // Unset: the program kind's default (tools/program_defaults.hpp), the same as gen-nc's.
+  std::optional<double> feed_mm_min;
+  std::optional<int> runs, repeats;
 };
 
 void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
   cmd.add_option("--program", o.p.kind, "circle, positioning, step or rectangle")
       ->default_val("circle")
       ->check(CLI::IsMember({"circle", "positioning", "step", "rectangle"}));
-  cmd.add_option("--radius", o.p.radius_mm, "circle radius, mm")->default_val(10.0)->check(CLI::PositiveNumber);
-  cmd.add_option("--feed", o.p.feed_mm_min, "feed, mm/min")->default_val(2500.0)->check(CLI::PositiveNumber);
-  cmd.add_option("--repeats", o.p.repeats, "circle revolutions per direction, rectangle laps")
-      ->default_val(5)
+  cmd.add_option("--radius", o.p.radius_mm, "circle radius, mm")
+      ->default_val(program_defaults::kCircleRadiusMm)
+      ->check(CLI::PositiveNumber);
+  cmd.add_option("--feed", o.feed_mm_min, "feed, mm/min (default: gen-nc's for the program)")
+      ->check(CLI::PositiveNumber);
+  cmd.add_option("--repeats", o.repeats, "circle revolutions per direction, rectangle laps (default: gen-nc's)")
       ->check(CLI::Range(1, 1000));
   cmd.add_option("--direction", o.p.direction, "circle: ccw, cw or both")
       ->default_val("ccw")
@@ -84,8 +95,7 @@ void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
       ->default_val(360.0)
       ->check(CLI::Range(1.0, 360.0));
   cmd.add_option("--targets", o.p.targets_mm, "positioning: targets on x, mm (comma separated)")->delimiter(',');
-  cmd.add_option("--runs", o.p.runs, "positioning: runs; step: there-and-back pairs")
-      ->default_val(5)
+  cmd.add_option("--runs", o.runs, "positioning: runs; step: there-and-back pairs (default: gen-nc's)")
       ->check(CLI::Range(1, 1000));
   cmd.add_option("--from", o.p.from_mm, "step: start on x, mm")->default_val(0.0);
   cmd.add_option("--to", o.p.to_mm, "step: end on x, mm")->default_val(50.0);
@@ -110,16 +120,22 @@ void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
       ->check(CLI::Range(1.0, 3600.0));
   cmd.add_option("--deadline", o.deadline_s,
                  "stop after this many seconds: no simulation starts later; what was not evaluated is listed "
-                 "(exit status 4)")
+                 "(exit status 6)")
       ->default_val(60.0)
       ->check(CLI::Range(0.0, 86400.0));
   cmd.add_flag("--json", o.json, "print the prediction as JSON");
+  cmd.add_option("--layout-svg", o.layout_svg,
+                 "draw the path and where its PSD strips go (the measurable test, else the nearest measurable "
+                 "variant) into this SVG file");
   add_envelope_options(cmd, o.envelope);
 }
 
 // The test as asked: its rectangle size and PSD strips.
 plan::TestProgram test_program(const PlanCommandOptions& o) {
   plan::TestProgram p = o.p;
+  p.feed_mm_min = o.feed_mm_min.value_or(program_defaults::feed_mm_min(p.kind));
+  p.runs = o.runs.value_or(program_defaults::runs(p.kind));
+  p.repeats = o.repeats.value_or(program_defaults::repeats(p.kind));
   p.size_mm[0] = o.size.at(0), p.size_mm[1] = o.size.at(1);
   if (o.psd == "B") p.psd = plan::strips_for(p);
   for (const auto& s : o.strips) p.psd.push_back(parse_psd(s));
@@ -225,6 +241,10 @@ void run_plan(const PlanCommandOptions& o) {
         text += "\nno measurable variant found before the deadline; variants:\n" + search_text(search);
     }
     std::fputs(text.c_str(), stdout);
+  }
+  if (!o.layout_svg.empty()) {
+    const plan::TestProgram& shown = r.measurable || !search.found ? r.program : search.found->program;
+    write_file_atomic(o.layout_svg, plan::layout_svg(shown));
   }
   if (search.deadline_passed) {
     std::fprintf(stderr, "plan: %s\n", deadline_note.c_str());
