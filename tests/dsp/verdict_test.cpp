@@ -139,5 +139,21 @@ TEST(Conformance, TheRunIsDecidedByItsFigures) {
   EXPECT_EQ(decide_conformance(a, {t[2]}).overall, Conformance::undecided);  // nothing toleranced
 }
 
+TEST(Conformance, AToleranceOverTwoFiguresIsDecidedByTheWorseDecision) {
+  // F max 5.0 ± 0.5 conforms to 10; F min -4.9 ± 6 straddles it: F is undecided, and the
+  // figure reported is F min although F max is the larger.
+  Analysis a = circle(4.0, 1.0);
+  a.circle->radial_deviation_F_max_um = 5.0;
+  a.circle->radial_deviation_F_min_um = -4.9;
+  a.uncertainty_k2["circle.radial_deviation_F_max_um"] = {0.5};
+  a.uncertainty_k2["circle.radial_deviation_F_min_um"] = {6.0};
+  const ConformanceResult r =
+      decide_conformance(a, {{"F", {"circle.radial_deviation_F_max_um", "circle.radial_deviation_F_min_um"}, 10.0}});
+  ASSERT_EQ(r.figures.size(), 1u);
+  EXPECT_EQ(r.figures[0].key, "circle.radial_deviation_F_min_um");
+  EXPECT_EQ(r.figures[0].decision, Conformance::undecided);
+  EXPECT_EQ(r.overall, Conformance::undecided);
+}
+
 }  // namespace
 }  // namespace eical::dsp
