@@ -13,7 +13,10 @@ namespace {
 
 // Top-level objects that are not program sections: the quality, the uncertainty map
 // itself, the sensor model and the pipeline's bookkeeping (counts, windows).
-constexpr std::array<const char*, 4> kNotSections = {"quality", "uncertainty_k2", "sensor_model", "pipeline"};
+// uncertainty_k2, noise_bound_k2 and uncertainty_budget_k2 describe the figures (their U,
+// the test's bound, the budget); uncertainty holds how U was computed.
+constexpr std::array<const char*, 7> kNotSections = {
+    "quality", "uncertainty_k2", "noise_bound_k2", "uncertainty_budget_k2", "uncertainty", "sensor_model", "pipeline"};
 
 // What the program was asked to do, not what was measured: not a figure of the history.
 constexpr std::array<const char*, 6> kProgramParameters = {"circle.radius_nominal_mm", "circle.feed_mm_min",
