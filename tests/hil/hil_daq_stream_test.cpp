@@ -64,8 +64,10 @@ Stream make_stream(const fs::path& program_file, std::int64_t dead_time_frames) 
   for (std::int64_t k = 0; k < lead; ++k) add(k % 2000, false);  // the run's own rest, before its M101
   for (std::int64_t j = 0; j < static_cast<std::int64_t>(s.sim.frames.size()); ++j) {
     add(j, true);
+    // The extra rest is the run's own rest again (a held frame would be a stuck channel to
+    // eicald's channel health: a real sensor at rest still shows its noise).
     if (s.sim.frames[static_cast<std::size_t>(j)].trigger == 101)
-      for (std::int64_t k = 0; k < dead_time_frames; ++k) add(j, false);
+      for (std::int64_t k = 0; k < dead_time_frames; ++k) add(k % 2000, false);
   }
   for (std::int64_t k = 0; k < tail; ++k) add(static_cast<std::int64_t>(s.sim.frames.size()) - 1, false);
   return s;
