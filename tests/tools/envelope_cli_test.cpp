@@ -159,7 +159,7 @@ TEST_F(EnvelopeCli, PlanRefusesACircleBeyondTheEnvelope) {
 }
 
 TEST_F(EnvelopeCli, PlanRefusesATestLongerThanItsMaxDuration) {
-  const Outcome o = eical("plan --radius 400");  // 5 revolutions at 2.5 m/min: 300 s
+  const Outcome o = eical("plan --radius 200 --repeats 10");  // 10 revolutions at 2.5 m/min: 302 s
   expect_refusal(o, {"plan circle: the test runs", "longer than the 180 s plan simulates (--max-duration"});
   EXPECT_LT(o.wall_s, 10.0);
 }
