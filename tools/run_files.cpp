@@ -96,13 +96,12 @@ std::string budget_text(const dsp::Run& run, const dsp::Analysis& analysis) {
   return o;
 }
 
-std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
+namespace {
+
+// Every figure with its U, section by section.
+std::string figures_text(const dsp::Analysis& analysis) {
   std::string o;
   char b[320];
-  std::snprintf(b, sizeof b, "run %s (%s, %zu samples at %.0f Hz)\n", run.meta.id.c_str(),
-                run.meta.program.kind.c_str(), run.frame_count(), run.meta.acquisition.fs_hz);
-  o += b;
-  o += "  sensor model: " + sensor_model_text(analysis) + "\n";
   std::string section;
   for (const dsp::FigureValue& f : dsp::figures_of(analysis)) {
     const std::string sec = f.key.substr(0, f.key.find('.'));
@@ -148,17 +147,13 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
     if (f.values.size() > 24) line += " …";
     o += line + "\n";
   }
-  if (analysis.circle && !analysis.circle->circular_hysteresis_H_um)
-    o += "    circular hysteresis H              n/a (needs both directions)\n";
-  if (analysis.circle_accuracy_rms_um) {
-    std::snprintf(b, sizeof b, "  against the reference: %.2f µm RMS of (measured − reference) radius deviation\n",
-                  *analysis.circle_accuracy_rms_um);
-    o += b;
-  }
-  if (!analysis.uncertainty_note.empty())
-    o += "  uncertainty: " + analysis.uncertainty_note +
-         (analysis.uncertainty_k2.empty() ? "" : "; * not resolved (|value| <= U)") + "\n";
-  o += budget_text(run, analysis);
+  return o;
+}
+
+// U of the figure the test must resolve against its noise bound.
+std::string noise_bound_text(const dsp::Run& run, const dsp::Analysis& analysis) {
+  std::string o;
+  char b[320];
   if (const dsp::ResolutionLimit* lim = dsp::resolution_limit(run.meta.program.kind)) {
     const auto u = figure_u(analysis, lim->limited);
     const auto nb = analysis.noise_bound_k2.find(lim->limited);
@@ -170,6 +165,13 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
       o += b;
     }
   }
+  return o;
+}
+
+// The verdict, its reasons and the ISO 14253-1 decisions.
+std::string verdict_text(const dsp::Analysis& analysis) {
+  std::string o;
+  char b[320];
   o += "  verdict: " +
        std::string(analysis.verdict == dsp::Verdict::not_measurable ? "NOT MEASURABLE"
                    : analysis.verdict == dsp::Verdict::degraded     ? "DEGRADED"
@@ -188,6 +190,32 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
     }
     if (analysis.conformance->figures.empty()) o += "    (no toleranced figure in this test)\n";
   }
+  return o;
+}
+
+}  // namespace
+
+std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
+  std::string o;
+  char b[320];
+  std::snprintf(b, sizeof b, "run %s (%s, %zu samples at %.0f Hz)\n", run.meta.id.c_str(),
+                run.meta.program.kind.c_str(), run.frame_count(), run.meta.acquisition.fs_hz);
+  o += b;
+  o += "  sensor model: " + sensor_model_text(analysis) + "\n";
+  o += figures_text(analysis);
+  if (analysis.circle && !analysis.circle->circular_hysteresis_H_um)
+    o += "    circular hysteresis H              n/a (needs both directions)\n";
+  if (analysis.circle_accuracy_rms_um) {
+    std::snprintf(b, sizeof b, "  against the reference: %.2f µm RMS of (measured − reference) radius deviation\n",
+                  *analysis.circle_accuracy_rms_um);
+    o += b;
+  }
+  if (!analysis.uncertainty_note.empty())
+    o += "  uncertainty: " + analysis.uncertainty_note +
+         (analysis.uncertainty_k2.empty() ? "" : "; * not resolved (|value| <= U)") + "\n";
+  o += budget_text(run, analysis);
+  o += noise_bound_text(run, analysis);
+  o += verdict_text(analysis);
   bool header = false;
   for (const auto& f : analysis.flags) {
     const auto s = dsp::flag_severity(f);

@@ -137,6 +137,35 @@ std::string sinumerik(const std::vector<Line>& lines, const ProgramIdentity& id)
   return out + "M30\n";
 }
 
+// HEIDENHAIN ISO's modal state while a program is translated.
+struct HeidenhainModal {
+  bool absolute = true;
+  int plane = 17;
+};
+
+// One G word of a canonical line in HEIDENHAIN ISO: the motion it asks for, a modal word
+// written as is, or a refusal naming the line.
+void heidenhain_g(const WrittenWord& w, int line_no, int& motion, HeidenhainModal& modal,
+                  std::vector<std::string>& parts) {
+  const int g = static_cast<int>(std::lround(w.value()));
+  if (g >= 0 && g <= 3)
+    motion = g;
+  else if (g == 90)
+    modal.absolute = true, parts.push_back("G90");
+  else if (g == 91)
+    modal.absolute = false, parts.push_back("G91");
+  else if (g == 17 || g == 18 || g == 19)
+    modal.plane = g, parts.push_back("G" + std::to_string(g));
+  else if (g == 21 || g == 61 || g == 64)
+    return;  // mm is in the begin line; no modal exact stop on the TNC
+  else if (g == 20)
+    throw dsp::InputError("dialect: line " + std::to_string(line_no) +
+                          ": inch (G20) has no HEIDENHAIN ISO form here (the begin line says G71, mm)");
+  else
+    throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": G" + w.text +
+                          " has no HEIDENHAIN ISO form here");
+}
+
 std::string heidenhain(const std::vector<Line>& lines, const ProgramIdentity& id) {
   const std::string name = upper(id.name);
   std::string out = "%" + name + " G71 *\n";
@@ -146,8 +175,7 @@ std::string heidenhain(const std::vector<Line>& lines, const ProgramIdentity& id
     out += "N" + std::to_string(block) + " " + join(parts) + " *\n";
   };
   std::array<double, 3> pos{0.0, 0.0, 0.0};
-  bool absolute = true;
-  int plane = 17;
+  HeidenhainModal modal;
   auto signed_num = [](double v) { return format_number("%+.4f", std::abs(v) < 5e-5 ? 0.0 : v); };
   for (std::size_t n = 0; n < lines.size(); ++n) {
     const Line& l = lines[n];
@@ -161,23 +189,7 @@ std::string heidenhain(const std::vector<Line>& lines, const ProgramIdentity& id
     std::array<std::optional<double>, 3> target{}, centre_offset{};
     for (const auto& w : l.words) {
       if (w.letter == 'G') {
-        const int g = static_cast<int>(std::lround(w.value()));
-        if (g >= 0 && g <= 3)
-          motion = g;
-        else if (g == 90)
-          absolute = true, parts.push_back("G90");
-        else if (g == 91)
-          absolute = false, parts.push_back("G91");
-        else if (g == 17 || g == 18 || g == 19)
-          plane = g, parts.push_back("G" + std::to_string(g));
-        else if (g == 21 || g == 61 || g == 64)
-          continue;  // mm is in the begin line; no modal exact stop on the TNC
-        else if (g == 20)
-          throw dsp::InputError("dialect: line " + std::to_string(line_no) +
-                                ": inch (G20) has no HEIDENHAIN ISO form here (the begin line says G71, mm)");
-        else
-          throw dsp::InputError("dialect: line " + std::to_string(line_no) + ": G" + w.text +
-                                " has no HEIDENHAIN ISO form here");
+        heidenhain_g(w, line_no, motion, modal, parts);
       } else if (w.letter >= 'X' && w.letter <= 'Z') {
         target[static_cast<std::size_t>(w.letter - 'X')] = w.value();
       } else if (w.letter >= 'I' && w.letter <= 'K') {
@@ -193,15 +205,20 @@ std::string heidenhain(const std::vector<Line>& lines, const ProgramIdentity& id
     for (int a = 0; a < 3; ++a)
       if (target[static_cast<std::size_t>(a)])
         end[static_cast<std::size_t>(a)] =
-            absolute ? *target[static_cast<std::size_t>(a)]
-                     : pos[static_cast<std::size_t>(a)] + *target[static_cast<std::size_t>(a)];
+            modal.absolute ? *target[static_cast<std::size_t>(a)]
+                           : pos[static_cast<std::size_t>(a)] + *target[static_cast<std::size_t>(a)];
     if (motion == 2 || motion == 3) {
-      if (!absolute)
+      if (!modal.absolute)
         throw dsp::InputError("dialect: line " + std::to_string(line_no) +
                               ": an incremental arc has no HEIDENHAIN ISO form here");
       // The circle centre in a block of its own, absolute: canonical I/J/K are offsets
       // from the arc's start (LinuxCNC's default G91.1).
-      const int u = plane == 17 ? 0 : plane == 18 ? 2 : 1, v = plane == 17 ? 1 : plane == 18 ? 0 : 2;
+      const int u = modal.plane == 17   ? 0
+                    : modal.plane == 18 ? 2
+                                        : 1,
+                v = modal.plane == 17   ? 1
+                    : modal.plane == 18 ? 0
+                                        : 2;
       std::vector<std::string> cc;
       for (int a : {u, v})
         cc.push_back(

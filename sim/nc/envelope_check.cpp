@@ -97,27 +97,27 @@ std::optional<EnvelopeExcess> envelope_excess(const SetPoint& set_point, const d
   return std::nullopt;
 }
 
-std::string describe(const EnvelopeExcess& x, const dsp::WorkEnvelope& e) {
-  switch (x.limit) {
+std::string describe(const EnvelopeExcess& excess, const dsp::WorkEnvelope& envelope) {
+  switch (excess.limit) {
     case EnvelopeLimit::travel: {
-      const std::string axis(1, static_cast<char>('x' + x.axis));
-      return "the program reaches " + axis + " = " + g(x.value) + " mm, beyond the " + axis + " travel " +
-             g(e.travel_mm[x.axis][0]) + ".." + g(e.travel_mm[x.axis][1]) + " mm";
+      const std::string axis(1, static_cast<char>('x' + excess.axis));
+      return "the program reaches " + axis + " = " + g(excess.value) + " mm, beyond the " + axis + " travel " +
+             g(envelope.travel_mm[excess.axis][0]) + ".." + g(envelope.travel_mm[excess.axis][1]) + " mm";
     }
     case EnvelopeLimit::feed:
-      return "the program moves at " + g(x.value) + " mm/min, beyond the maximum feed " + g(e.max_feed_mm_min) +
-             " mm/min";
+      return "the program moves at " + g(excess.value) + " mm/min, beyond the maximum feed " +
+             g(envelope.max_feed_mm_min) + " mm/min";
     case EnvelopeLimit::accel:
-      return "the program accelerates at " + g(x.value) + " mm/s^2, beyond the maximum acceleration " +
-             g(e.max_accel_mm_s2) + " mm/s^2";
+      return "the program accelerates at " + g(excess.value) + " mm/s^2, beyond the maximum acceleration " +
+             g(envelope.max_accel_mm_s2) + " mm/s^2";
   }
   return "";
 }
 
-const char* envelope_key(const EnvelopeExcess& x) {
+const char* envelope_key(const EnvelopeExcess& excess) {
   static constexpr const char* kTravel[3] = {"travel_x_mm", "travel_y_mm", "travel_z_mm"};
-  switch (x.limit) {
-    case EnvelopeLimit::travel: return kTravel[x.axis];
+  switch (excess.limit) {
+    case EnvelopeLimit::travel: return kTravel[excess.axis];
     case EnvelopeLimit::feed: return "max_feed_mm_min";
     case EnvelopeLimit::accel: return "max_accel_mm_s2";
   }
