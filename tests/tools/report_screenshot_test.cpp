@@ -133,6 +133,12 @@ TEST(ReportScreenshot, CircleReportRendersWithPolarPlotAndDiagnostics) {
   expect_contains(r.dom, "Radius deviation, xy plane");
   expect_contains(r.dom, "sim-circle-r10-f2500-s1");
   expect_contains(r.dom, "Circular hysteresis H");
+  // What a signer needs (issue 33): what the result rests on, and the block to sign.
+  expect_contains(r.dom, "Traceability");
+  expect_contains(r.dom, "the data sheet's, with its tolerances as U");
+  expect_contains(r.dom, "no correction to 20 °C");
+  expect_contains(r.dom, "Approval");
+  expect_contains(r.dom, "approved by");
   EXPECT_TRUE(fs::exists(r.dir / "report" / "trace_circle.csv"));
   EXPECT_TRUE(fs::exists(r.dir / "report" / "trace_measurement.csv"));
   fs::remove_all(r.dir);

@@ -62,6 +62,10 @@ td.n .nr,.nr{color:#a35a00;font-style:italic}
 td.pass{color:#1e8449;font-weight:600;text-align:right}
 td.fail{color:#c0392b;font-weight:600;text-align:right}
 td.undecided{color:#a35a00;font-weight:600;text-align:right}
+table.sign{border-collapse:collapse;width:100%;max-width:640px}
+table.sign th{text-align:left;font-weight:500;width:30%;padding:14px 8px 4px 0}
+table.sign td{border-bottom:1px solid #333;padding:14px 8px 4px}
+section.approval{break-inside:avoid;page-break-inside:avoid}
 @page{size:A4;margin:12mm 11mm}
 @media print{
  body{background:#fff;font-size:9.5pt}
@@ -187,6 +191,19 @@ std::string render_html(const Page& page) {
     for (const auto& g : s.grids) out += grid_html(g);
     for (const auto& n : s.notes) out += "<p class=\"note\">" + xml_escape(n) + "</p>\n";
     out += "</section>\n";
+  }
+  if (!page.traceability.empty()) {
+    out += "<section class=\"trace\"><h2>Traceability</h2><table class=\"grid\">";
+    for (const auto& [k, v] : page.traceability)
+      out += "<tr><th>" + xml_escape(k) + "</th><td>" + xml_escape(v) + "</td></tr>";
+    out += "</table></section>\n";
+  }
+  if (!page.approval.empty()) {
+    // Printed and signed by hand: empty fields are lines to write on.
+    out += "<section class=\"approval\"><h2>Approval</h2><table class=\"sign\">";
+    for (const auto& [k, v] : page.approval)
+      out += "<tr><th>" + xml_escape(k) + "</th><td>" + (v.empty() ? "&nbsp;" : xml_escape(v)) + "</td></tr>";
+    out += "</table></section>\n";
   }
   if (!page.files.empty()) {
     out += "<footer>Every trace behind the plots, as CSV: ";

@@ -59,8 +59,11 @@ struct Page {
   std::vector<std::string> verdict_reasons;
   std::vector<Grid> summary;  // right under the banner (e.g. against the tolerances)
   std::vector<Section> sections;
-  std::vector<std::string> files;  // CSV files next to the report (linked at the end)
-  std::string files_note;          // e.g. how the CSV traces were thinned
+  // Traceability (what the result rests on) and the approval block a signer fills in.
+  std::vector<std::pair<std::string, std::string>> traceability;
+  std::vector<std::pair<std::string, std::string>> approval;  // label → value ("" = a line to fill in)
+  std::vector<std::string> files;                             // CSV files next to the report (linked at the end)
+  std::string files_note;                                     // e.g. how the CSV traces were thinned
 };
 
 std::string render_html(const Page& page);

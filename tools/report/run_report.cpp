@@ -208,6 +208,41 @@ std::string settings(const dsp::Run& run, const dsp::Analysis& a) {
   return s;
 }
 
+// What the result rests on: the sensors, the sensor model (data sheet or the identified
+// calibration with its U), the strips, the reference, the software.
+std::vector<std::pair<std::string, std::string>> traceability(const dsp::Run& run, const dsp::Analysis& a,
+                                                              const ReportOptions& options) {
+  std::vector<std::pair<std::string, std::string>> t;
+  const char* where[2] = {"table", "head"};
+  for (int s = 0; s < 2; ++s) {
+    const auto& spec = run.meta.sensors[s];
+    t.emplace_back(std::string("sensor, ") + where[s], spec.model + fmt(", noise %.2f µg/√Hz", spec.noise_ug_per_rthz) +
+                                                           fmt(", f0 %.0f Hz", spec.f0_hz) +
+                                                           " (serial: not recorded in the run)");
+  }
+  t.emplace_back("sensor model", !options.calibration.empty()    ? options.calibration
+                                 : a.sensor_model == "datasheet" ? "the data sheet's, with its tolerances as U"
+                                                                 : "identified (" + a.sensor_model + ")");
+  std::string strips;
+  for (const auto& p : run.meta.psd)
+    strips += std::string(strips.empty() ? "" : "; ") + p.measures + fmt(" at (%.3f", p.center_mm[0]) +
+              fmt(", %.3f) mm", p.center_mm[1]) + fmt(", %.0f mm", p.length_mm);
+  t.emplace_back("PSD strips", strips.empty() ? "none"
+                                              : strips +
+                                                    " (position calibration: run.toml [[psd]]; nonlinearity within "
+                                                    "the data sheet's ±0.01 % of the strip's half length, in U)");
+  if (run.meta.reference) t.emplace_back("reference", run.meta.reference->kind);
+  // ISO 230-3: the sensors' case temperatures are all the run records; the machine's and
+  // the air's are not, and nothing is corrected to 20 °C.
+  t.emplace_back("thermal", "sensor cases " + temperatures(run) +
+                                "; machine, air and part temperatures not recorded; no correction to 20 °C (ISO "
+                                "230-3 drift not separated): the figures hold at the temperatures of the run");
+  t.emplace_back("recorded",
+                 run.meta.created.empty() ? "not recorded (a simulated run has no recording date)" : run.meta.created);
+  t.emplace_back("software", std::string(drivers::software_version()));
+  return t;
+}
+
 }  // namespace
 
 fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, const fs::path& dir,
@@ -248,6 +283,8 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, co
     if (g.rows.empty()) g.rows.push_back({"(no toleranced figure in this test)", "", "", "", ""});
     page.summary.push_back(g);
   }
+  page.traceability = traceability(run, analysis, options);
+  page.approval = {{"performed by", op}, {"approved by", ""}, {"date", ""}, {"signature", ""}, {"remarks", ""}};
   circle_sections(run, analysis, page, csv);
   positioning_sections(run, analysis, page, csv);
   step_sections(analysis, page, csv);

@@ -15,6 +15,9 @@ namespace eical::tools::report {
 struct ReportOptions {
   std::optional<Tolerances> tolerances;  // pass/fail and the header's machine, serial, operator
   std::string operator_name, serial;     // override the tolerance file's header
+  // The sensor model the analysis used, for the traceability block: "data sheet" or the
+  // calibration file, the run it was identified from and its U (cmd_report says it).
+  std::string calibration;
 };
 
 // Writes <dir>/report.html and <dir>/trace_*.csv; returns the path of the HTML file.
