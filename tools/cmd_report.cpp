@@ -3,13 +3,10 @@
 #include "drivers/results/result_json.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/analysis/analyze_run.hpp"
-#include "dsp/uncertainty/sensor_model_covariance.hpp"
 #include "tools/commands.hpp"
 #include "tools/report/run_report.hpp"
 #include "tools/run_files.hpp"
 
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -18,24 +15,16 @@ namespace eical::tools {
 
 namespace {
 
-// "calibration.toml, identified (psd) from run R; U (k = 2) of the scales up to 12 ppm, of
-// the mounting and cross terms up to 40 µrad": the traceability of the sensor model.
+// "calibration.toml, identified (psd) from run R; its covariance enters every U": the
+// traceability of the sensor model. No per-sensor U is quoted: the identification sees
+// head − table only, so one sensor's scale may trade off against the other's and its
+// marginal U says nothing about the measurement's (eical analyze --budget gives that share).
 std::string calibration_text(const std::string& file, const drivers::SensorCalibration& cal) {
-  std::string t = file + ", identified (" + cal.method + ") from run " + (cal.run_id.empty() ? "?" : cal.run_id);
+  const std::string t = file + ", identified (" + cal.method + ") from run " + (cal.run_id.empty() ? "?" : cal.run_id);
   if (!cal.covariance) return t + "; the file holds no covariance: U from the data sheet's tolerances";
-  double scale = 0.0, cross = 0.0;
-  for (int s = 0; s < 2; ++s)
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        const int k = dsp::uncertainty::error_index(s, i, j);
-        double& worst = i == j ? scale : cross;
-        worst = std::max(worst, cal.covariance->covariance(k, k));
-      }
-  char b[160];
-  std::snprintf(b, sizeof b,
-                "; U (k = 2) of the scales up to %.0f ppm, of the mounting and cross terms up to %.0f µrad",
-                2e6 * std::sqrt(scale), 2e6 * std::sqrt(cross));
-  return t + b;
+  return t +
+         "; its covariance enters every U of this report (its share: eical analyze --budget, sensor scale and "
+         "mounting)";
 }
 
 }  // namespace

@@ -137,6 +137,7 @@ TEST(ReportScreenshot, CircleReportRendersWithPolarPlotAndDiagnostics) {
   expect_contains(r.dom, "Traceability");
   expect_contains(r.dom, "the data sheet's, with its tolerances as U");
   expect_contains(r.dom, "no correction to 20 °C");
+  expect_contains(r.dom, "What makes G: each diagnostic alone on this circle, largest first");
   expect_contains(r.dom, "Approval");
   expect_contains(r.dom, "approved by");
   EXPECT_TRUE(fs::exists(r.dir / "report" / "trace_circle.csv"));

@@ -3,6 +3,7 @@
 #include "tools/report/sections.hpp"
 #include "tools/report/svg.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace eical::tools::report {
@@ -108,6 +109,53 @@ void diagnostics_table(const dsp::Analysis& a, const std::string& na, const std:
       "from zero, and eical comp never compensates it.");
 }
 
+// The diagnostics ranked by what each alone does to the circle, as a ballbar report ranks
+// them: the radial range it draws on this radius and feed (squareness and scale mismatch an
+// ellipse of range R·e, servo mismatch one of range v·Δτ, a cyclic error twice its
+// amplitude, vibration 2√2 × its RMS, the steps their size), against G.
+void contribution_grid(const dsp::Analysis& a, const dsp::Program& p, const std::string& na, const std::string& nb,
+                       Section& s) {
+  if (!a.diagnostics || !a.circle) return;
+  const auto& d = *a.diagnostics;
+  const double r_mm = p.radius_mm, v_mm_s = p.feed_mm_min / 60.0, g_um = a.circle->circular_deviation_G_um;
+  struct Part {
+    std::string name, key;
+    double range_um;
+  };
+  std::vector<Part> parts = {
+      {"Backlash " + na, "diagnostics.backlash_x_um", std::abs(d.backlash_x_um)},
+      {"Backlash " + nb, "diagnostics.backlash_y_um", std::abs(d.backlash_y_um)},
+      {"Reversal spike " + na, "diagnostics.reversal_spike_x_um", std::abs(d.reversal_spike_x_um)},
+      {"Reversal spike " + nb, "diagnostics.reversal_spike_y_um", std::abs(d.reversal_spike_y_um)},
+      {"Lateral play " + na, "diagnostics.lateral_play_x_um", std::abs(d.lateral_play_x_um)},
+      {"Lateral play " + nb, "diagnostics.lateral_play_y_um", std::abs(d.lateral_play_y_um)},
+      {"Cyclic error " + na, "diagnostics.cyclic_error_x_um", 2.0 * std::abs(d.cyclic_error_x_um)},
+      {"Cyclic error " + nb, "diagnostics.cyclic_error_y_um", 2.0 * std::abs(d.cyclic_error_y_um)},
+      {"Servo mismatch", "diagnostics.servo_mismatch_ms", v_mm_s * std::abs(d.servo_mismatch_ms)},
+      {"Squareness", "diagnostics.squareness_urad", r_mm * std::abs(d.squareness_urad) * 1e-3},
+      {"Scale mismatch", "diagnostics.scale_mismatch_ppm", r_mm * std::abs(d.scale_mismatch_ppm) * 1e-3},
+      {"Straightness " + na, "diagnostics.straightness_x_um", std::abs(d.straightness_x_um)},
+      {"Straightness " + nb, "diagnostics.straightness_y_um", std::abs(d.straightness_y_um)},
+      {"Stick-slip", "diagnostics.stick_slip_um", std::abs(d.stick_slip_um)},
+      {"Vibration", "diagnostics.vibration_um", 2.0 * std::sqrt(2.0) * std::abs(d.vibration_um)}};
+  std::erase_if(parts, [](const Part& x) { return !std::isfinite(x.range_um); });
+  std::stable_sort(parts.begin(), parts.end(), [](const Part& x, const Part& y) { return x.range_um > y.range_um; });
+  Grid g{"What makes G: each diagnostic alone on this circle, largest first",
+         {"diagnostic", "range it draws (µm)", "of G", "resolved"},
+         {}};
+  const FigureRows fr(a);
+  for (const auto& x : parts) {
+    const auto u = fr.u(x.key, 0);
+    const auto v = fr.value(x.key, 0);
+    const bool resolved = u && v && std::abs(*v) > *u;
+    g.rows.push_back({x.name, fmt("%.2f", x.range_um), g_um > 0.0 ? fmt("%.0f %%", 100.0 * x.range_um / g_um) : "",
+                      resolved ? "yes" : "no"});
+  }
+  s.grids.push_back(g);
+  s.notes.push_back(
+      "The ranges overlap in angle and do not add up to G; a diagnostic not resolved may be noise of its size.");
+}
+
 // The same evaluation of the reference channel, when the run has one.
 void reference_table(const dsp::Run& run, const dsp::Analysis& a, Section& s) {
   if (!a.circle_reference || !a.circle_accuracy_rms_um) return;
@@ -151,6 +199,7 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
                               "+" + nb, 0.0, polar_subtitle(c, fr)));
   s.tables.push_back(iso230_4_table(c, p, fr, partial));
   diagnostics_table(a, na, nb, fr, partial, s);
+  contribution_grid(a, p, na, nb, s);
   s.notes.push_back(
       partial ? "Partial arc: the radius is measured from the programmed centre (as a ballbar measures from its "
                 "pivot), because a centre fitted to a partial arc trades off against the radius. A real centre "
