@@ -19,6 +19,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInchMm = 25.4;
+// The largest number a word carries (words.cpp), for a feed after its unit conversion.
+constexpr double kMaxFeedMmMin = 1e9;
 
 // Axis index pairs (u, v) of each plane and the normal axis; ccw is positive about the normal.
 struct PlaneAxes {
@@ -77,6 +79,13 @@ class BlockReader {
     if (const auto& f = b.word('F')) {
       if (!(f->value > 0.0)) at_.fail(f->column, "feed F must be positive");
       m_.feed_mm_min = f->value * m_.feed_unit_mm;
+      // In inch a feed the word range takes can exceed it in mm/min, and the canonical text
+      // (in mm) would not read back (fuzz finding, gcode_fanuc).
+      if (m_.feed_mm_min > kMaxFeedMmMin) {
+        char msg[64];
+        std::snprintf(msg, sizeof msg, "feed F is out of range (%.0f mm/min)", m_.feed_mm_min);
+        at_.fail(f->column, msg);
+      }
     }
     if (const auto& s = b.word('S')) m_.spindle_rpm = s->value;
     add_triggers(b);

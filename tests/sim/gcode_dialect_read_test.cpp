@@ -72,6 +72,12 @@ TEST(GcodeDialectRead, InchAndMetric) {
             "as LinuxCNC (choose the control with --dialect)");
   EXPECT_NE(error_of("G21", Dialect::sinumerik).find("LinuxCNC and FANUC mean metric by it"), std::string::npos);
   EXPECT_NE(error_of("G61", Dialect::heidenhain_iso).find("mean exact stop by it"), std::string::npos);
+  // A feed within the word's range in inch/min but beyond it in mm/min is refused where
+  // it is read (fuzz finding of gcode_fanuc: its canonical text did not read back).
+  EXPECT_NE(error_of("G20 G1 X10. F100010050", Dialect::fanuc)
+                .find("user.nc:1:13: feed F is out of range (2540255270 mm/min)"),
+            std::string::npos)
+      << error_of("G20 G1 X10. F100010050", Dialect::fanuc);
 }
 
 TEST(GcodeDialectRead, BlockSyntaxOfEachControl) {
