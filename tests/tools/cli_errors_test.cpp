@@ -93,7 +93,7 @@ TEST_F(CliErrors, UsageErrorsExitOneWithOneLine) {
 
 TEST_F(CliErrors, HelpWorks) {
   std::string cmd = EICAL_CLI;
-  for (const char* args : {" help", " help analyze", " --help", " analyze --help"}) {
+  for (const char* args : {" help", " help analyze", " --help", " analyze --help", " help gen-nc identify"}) {
     FILE* p = ::popen((cmd + args + " 2>&1").c_str(), "r");
     std::string out;
     char buf[512];
@@ -102,6 +102,8 @@ TEST_F(CliErrors, HelpWorks) {
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << args << ": " << out;
     if (std::string(args).find("analyze") != std::string::npos) {
       EXPECT_NE(out.find("--calibration"), std::string::npos) << args << ": " << out;
+    } else if (std::string(args).find("identify") != std::string::npos) {  // a subcommand's subcommand
+      EXPECT_NE(out.find("--swing"), std::string::npos) << args << ": " << out;
     } else {  // the command list: every command, not the help of `help`
       for (const char* c : {"simulate", "analyze", "plan", "identify", "report", "comp", "help"})
         EXPECT_NE(out.find(std::string("  ") + c + " "), std::string::npos)
@@ -109,6 +111,7 @@ TEST_F(CliErrors, HelpWorks) {
     }
   }
   expect_one_line_error(eical("help no-such-command"), "no command 'no-such-command'");
+  expect_one_line_error(eical("help gen-nc spiral"), "no command 'spiral' under 'eical gen-nc'");
 }
 
 // eical identify on a run that cannot identify the sensors (a circle without strips): one
