@@ -130,6 +130,25 @@ std::string grid_html(const Grid& g) {
   return out + "</table>\n";
 }
 
+// What the result rests on, and the block a signer fills in by hand.
+std::string signing_html(const Page& page) {
+  std::string out;
+  if (!page.traceability.empty()) {
+    out += "<section class=\"trace\"><h2>Traceability</h2><table class=\"grid\">";
+    for (const auto& [k, v] : page.traceability)
+      out += "<tr><th>" + xml_escape(k) + "</th><td>" + xml_escape(v) + "</td></tr>";
+    out += "</table></section>\n";
+  }
+  if (!page.approval.empty()) {
+    // Printed and signed by hand: empty fields are lines to write on.
+    out += "<section class=\"approval\"><h2>Approval</h2><table class=\"sign\">";
+    for (const auto& [k, v] : page.approval)
+      out += "<tr><th>" + xml_escape(k) + "</th><td>" + (v.empty() ? "&nbsp;" : xml_escape(v)) + "</td></tr>";
+    out += "</table></section>\n";
+  }
+  return out;
+}
+
 }  // namespace
 
 std::string render_html(const Page& page) {
@@ -192,19 +211,7 @@ std::string render_html(const Page& page) {
     for (const auto& n : s.notes) out += "<p class=\"note\">" + xml_escape(n) + "</p>\n";
     out += "</section>\n";
   }
-  if (!page.traceability.empty()) {
-    out += "<section class=\"trace\"><h2>Traceability</h2><table class=\"grid\">";
-    for (const auto& [k, v] : page.traceability)
-      out += "<tr><th>" + xml_escape(k) + "</th><td>" + xml_escape(v) + "</td></tr>";
-    out += "</table></section>\n";
-  }
-  if (!page.approval.empty()) {
-    // Printed and signed by hand: empty fields are lines to write on.
-    out += "<section class=\"approval\"><h2>Approval</h2><table class=\"sign\">";
-    for (const auto& [k, v] : page.approval)
-      out += "<tr><th>" + xml_escape(k) + "</th><td>" + (v.empty() ? "&nbsp;" : xml_escape(v)) + "</td></tr>";
-    out += "</table></section>\n";
-  }
+  out += signing_html(page);
   if (!page.files.empty()) {
     out += "<footer>Every trace behind the plots, as CSV: ";
     for (std::size_t i = 0; i < page.files.size(); ++i)
