@@ -41,12 +41,7 @@ DemoMachine demo_machine(std::uint64_t seed) {
   // drawn machine's small errors.
   m.circle.machine.backlash_um[0] = 3.0;
   m.circle.machine.squareness_urad[0] = 25.0;
-  sim::Scenario& id = m.identification;
-  id = plan::identification_scenario(p, seed);
-  id.meta.site = m.circle.meta.site, id.meta.machine = m.circle.meta.machine;
-  for (int s = 0; s < 2; ++s) id.truth[s] = m.circle.truth[s];
-  id.daq = m.circle.daq, id.machine = m.circle.machine, id.coriolis = m.circle.coriolis;
-  id.psd = plan::drawn_strips(id.meta.psd, seed);  // the same strips, the same nonlinearity
+  m.identification = plan::identification_on_machine(p, m.circle, seed);
   return m;
 }
 

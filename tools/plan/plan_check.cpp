@@ -54,12 +54,7 @@ std::vector<CheckRow> check_plan(const TestProgram& p, int repeats, int draws) {
     dsp::AnalysisOptions o;
     o.coriolis = sc.coriolis;
     if (p.identified) {  // this machine's sensors identified on site first
-      sim::Scenario id = identification_scenario(p, seed);
-      const sim::Scenario machine = scenario_on_drawn_machine(p, seed);
-      id.meta.site = machine.meta.site, id.meta.machine = machine.meta.machine;
-      for (int s = 0; s < 2; ++s) id.truth[s] = machine.truth[s];
-      id.daq = machine.daq, id.machine = machine.machine, id.coriolis = machine.coriolis;
-      id.psd = drawn_strips(id.meta.psd, seed);
+      const sim::Scenario id = identification_on_machine(p, sc, seed);
       dsp::identify::apply_identification(dsp::identify::identify_sensors(sim::simulate(id)), run.meta);
       o.sensor_model = "psd";
     }

@@ -40,6 +40,11 @@ std::vector<Point> nominal_path(const TestProgram& p) {
   return path;
 }
 
+// The strip's extent along x and along y: its length lies along the axis it measures.
+Point extent_mm(const dsp::PsdSpec& s) {
+  return s.measures == "x" ? Point{s.length_mm, s.width_mm} : Point{s.width_mm, s.length_mm};
+}
+
 std::string orientation(const dsp::PsdSpec& s) {
   return "its length along " + axis_upper(s.measures) + " (it measures " + axis_upper(s.measures) + ")";
 }
@@ -83,11 +88,8 @@ std::string layout_svg(const TestProgram& p) {
   };
   for (const auto& q : path) grow(q.x_mm, q.y_mm);
   for (const auto& s : p.psd)
-    for (const double h : {-0.5, 0.5}) {
-      const bool along_x = s.measures == "x";
-      grow(s.center_mm[0] + (along_x ? h * s.length_mm : h * s.width_mm),
-           s.center_mm[1] + (along_x ? h * s.width_mm : h * s.length_mm));
-    }
+    for (const double h : {-0.5, 0.5})
+      grow(s.center_mm[0] + h * extent_mm(s).x_mm, s.center_mm[1] + h * extent_mm(s).y_mm);
   const double span = std::max({x1 - x0, y1 - y0, 1.0});
   const double margin = 0.15 * span, px = 600.0 / (span + 2.0 * margin);
   const auto sx = [&](double x) { return (x - x0 + margin) * px; };
@@ -110,10 +112,8 @@ std::string layout_svg(const TestProgram& p) {
   o += "\"/>\n";
   for (std::size_t i = 0; i < p.psd.size(); ++i) {
     const auto& s = p.psd[i];
-    const bool along_x = s.measures == "x";
-    const double lx = (along_x ? s.length_mm : s.width_mm), ly = (along_x ? s.width_mm : s.length_mm);
     // At least 3 px thick, so that a 0.5 mm strip beside a 300 mm travel is seen.
-    const double wx = std::max(lx * px, 3.0), wy = std::max(ly * px, 3.0);
+    const double wx = std::max(extent_mm(s).x_mm * px, 3.0), wy = std::max(extent_mm(s).y_mm * px, 3.0);
     // The number sits outside the path: away from the drawing's centre.
     const double cx = sx(s.center_mm[0]), cy = sy(s.center_mm[1]);
     const double dx = cx - 0.5 * w, dy = cy - 0.5 * h_draw, d = std::max(std::hypot(dx, dy), 1e-9);

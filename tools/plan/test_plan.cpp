@@ -179,6 +179,15 @@ sim::Scenario identification_scenario(const TestProgram& p, std::uint64_t seed) 
   return sc;
 }
 
+sim::Scenario identification_on_machine(const TestProgram& p, const sim::Scenario& machine, std::uint64_t seed) {
+  sim::Scenario id = identification_scenario(p, seed);
+  id.meta.site = machine.meta.site, id.meta.machine = machine.meta.machine;
+  for (int s = 0; s < 2; ++s) id.truth[s] = machine.truth[s];
+  id.daq = machine.daq, id.machine = machine.machine, id.coriolis = machine.coriolis;
+  id.psd = drawn_strips(id.meta.psd, seed);  // the machine's strips, the same nonlinearity
+  return id;
+}
+
 dsp::uncertainty::SensorModelCovariance typical_identification(const TestProgram& p) {
   sim::Scenario sc = identification_scenario(p, 1);
   // On the prediction's grid too. What one simulated identification leaves is one draw of

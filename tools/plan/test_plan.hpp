@@ -56,6 +56,9 @@ std::vector<sim::PsdTruth> drawn_strips(const std::vector<dsp::PsdSpec>& psd, st
 // The identification program (eical gen-nc identify) over PSD configuration B of a R10
 // circle, with the program's sensors and DAQ: how a machine's sensors are identified on site.
 sim::Scenario identification_scenario(const TestProgram& p, std::uint64_t seed);
+// That identification run on `machine` (a scenario_on_drawn_machine of the same seed): its
+// sensors, DAQ, machine errors, site and strips, the strips with their nonlinearity.
+sim::Scenario identification_on_machine(const TestProgram& p, const sim::Scenario& machine, std::uint64_t seed);
 // What that identification leaves the sensor model uncertain by (simulated on data-sheet
 // sensors): the covariance a calibration would carry.
 dsp::uncertainty::SensorModelCovariance typical_identification(const TestProgram& p);

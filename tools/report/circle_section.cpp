@@ -1,5 +1,6 @@
 // Circular test page: the ballbar-style polar plot (both directions) with the ISO 230-4
 // figures and the diagnostics beside it.
+#include "dsp/uncertainty/resolved.hpp"
 #include "tools/report/sections.hpp"
 #include "tools/report/svg.hpp"
 
@@ -113,8 +114,8 @@ void diagnostics_table(const dsp::Analysis& a, const std::string& na, const std:
 // them: the radial range it draws on this radius and feed (squareness and scale mismatch an
 // ellipse of range R·e, servo mismatch one of range v·Δτ, a cyclic error twice its
 // amplitude, vibration 2√2 × its RMS, the steps their size), against G.
-void contribution_grid(const dsp::Analysis& a, const dsp::Program& p, const std::string& na, const std::string& nb,
-                       Section& s) {
+void contribution_grid(const dsp::Analysis& a, const dsp::Program& p, const FigureRows& fr, const std::string& na,
+                       const std::string& nb, Section& s) {
   if (!a.diagnostics || !a.circle) return;
   const auto& d = *a.diagnostics;
   const double r_mm = p.radius_mm, v_mm_s = p.feed_mm_min / 60.0, g_um = a.circle->circular_deviation_G_um;
@@ -143,11 +144,10 @@ void contribution_grid(const dsp::Analysis& a, const dsp::Program& p, const std:
   Grid g{"What makes G: each diagnostic alone on this circle, largest first",
          {"diagnostic", "range it draws (µm)", "of G", "resolved"},
          {}};
-  const FigureRows fr(a);
   for (const auto& x : parts) {
     const auto u = fr.u(x.key, 0);
     const auto v = fr.value(x.key, 0);
-    const bool resolved = u && v && std::abs(*v) > *u;
+    const bool resolved = u && v && dsp::uncertainty::resolved(*v, *u);
     g.rows.push_back({x.name, fmt("%.2f", x.range_um), g_um > 0.0 ? fmt("%.0f %%", 100.0 * x.range_um / g_um) : "",
                       resolved ? "yes" : "no"});
   }
@@ -199,7 +199,7 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
                               "+" + nb, 0.0, polar_subtitle(c, fr)));
   s.tables.push_back(iso230_4_table(c, p, fr, partial));
   diagnostics_table(a, na, nb, fr, partial, s);
-  contribution_grid(a, p, na, nb, s);
+  contribution_grid(a, p, fr, na, nb, s);
   s.notes.push_back(
       partial ? "Partial arc: the radius is measured from the programmed centre (as a ballbar measures from its "
                 "pivot), because a centre fitted to a partial arc trades off against the radius. A real centre "

@@ -70,14 +70,10 @@ sim::Scenario scenario(const std::string& program, const CampaignProgram& c, std
   return sc;
 }
 
-// The identification of this machine's sensors (as tools/plan/plan_check.cpp makes it).
+// The identification of this machine's sensors, applied to the run.
 void identify_on_this_machine(const CampaignProgram& c, const sim::Scenario& machine, std::uint64_t seed, dsp::Run& run,
                               dsp::AnalysisOptions& ao) {
-  sim::Scenario id = plan::identification_scenario(c.program, seed);
-  id.meta.site = machine.meta.site, id.meta.machine = machine.meta.machine;
-  for (int s = 0; s < 2; ++s) id.truth[s] = machine.truth[s];
-  id.daq = machine.daq, id.machine = machine.machine, id.coriolis = machine.coriolis;
-  id.psd = plan::drawn_strips(id.meta.psd, seed);
+  const sim::Scenario id = plan::identification_on_machine(c.program, machine, seed);
   const dsp::identify::Identification ident = dsp::identify::identify_sensors(sim::simulate(id));
   dsp::identify::apply_identification(ident, run.meta);
   ao.model_covariance = ident.covariance;
