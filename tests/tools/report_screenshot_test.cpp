@@ -128,9 +128,11 @@ TEST(ReportScreenshot, CircleReportRendersWithPolarPlotAndDiagnostics) {
   expect_contains(r.dom, "Diagnostics (per axis");
   expect_contains(r.dom, "Verdict:");
   expect_contains(r.dom, "start of a revolution");
-  expect_contains(r.dom, "G ccw");
+  expect_contains(r.dom, "G, counter-clockwise");
   expect_contains(r.dom, "± ");
-  expect_contains(r.dom, "Radius deviation, xy plane");
+  // A plot per direction (issue 33).
+  expect_contains(r.dom, "Radius deviation, counter-clockwise (G3), xy plane");
+  expect_contains(r.dom, "Radius deviation, clockwise (G2), xy plane");
   expect_contains(r.dom, "sim-circle-r10-f2500-s1");
   expect_contains(r.dom, "Circular hysteresis H");
   // What a signer needs (issue 33): what the result rests on, and the block to sign.

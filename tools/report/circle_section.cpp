@@ -11,41 +11,62 @@ namespace eical::tools::report {
 
 namespace {
 
-// One trace per revolution and direction, each its own colour, closed when it is a full
-// revolution, a marker where it begins.
-std::vector<PolarTrace> revolution_traces(const dsp::eval::CircleResult& c, bool partial) {
+// One trace per revolution of one direction, each its own colour, drawn as measured (not
+// joined back to its start), a marker where it begins.
+std::vector<PolarTrace> revolution_traces(const dsp::eval::CircleResult& c, bool partial, const std::string& dir) {
   std::vector<PolarTrace> polar;
-  for (const char* dir : {"ccw", "cw"}) {
-    const bool ccw = std::string(dir) == "ccw";
-    for (int rev = 0; rev <= c.revolutions; ++rev) {
-      PolarTrace t;
-      t.color = revolution_colour(ccw, rev);
-      for (std::size_t i = 0; i < c.trace.angle_deg.size(); ++i)
-        if (c.trace.direction[i] == dir && c.trace.revolution[i] == rev)
-          t.angle_deg.push_back(c.trace.angle_deg[i]), t.deviation_um.push_back(c.trace.radius_deviation_um[i]);
-      if (t.angle_deg.empty()) continue;
-      t.label =
-          std::string(ccw ? "ccw (G3)" : "cw (G2)") + (partial ? ", arc " : ", revolution ") + std::to_string(rev + 1);
-      t.closed = !partial;
-      t.start_marker = true;
-      polar.push_back(std::move(t));
-    }
+  const bool ccw = dir == "ccw";
+  for (int rev = 0; rev <= c.revolutions; ++rev) {
+    PolarTrace t;
+    t.color = revolution_colour(ccw, rev);
+    for (std::size_t i = 0; i < c.trace.angle_deg.size(); ++i)
+      if (c.trace.direction[i] == dir && c.trace.revolution[i] == rev)
+        t.angle_deg.push_back(c.trace.angle_deg[i]), t.deviation_um.push_back(c.trace.radius_deviation_um[i]);
+    if (t.angle_deg.empty()) continue;
+    t.label =
+        std::string(ccw ? "ccw (G3)" : "cw (G2)") + (partial ? ", arc " : ", revolution ") + std::to_string(rev + 1);
+    t.start_marker = true;
+    polar.push_back(std::move(t));
   }
   return polar;
 }
 
-// G (per direction when both ran) ± U under the plot's title.
-std::string polar_subtitle(const dsp::eval::CircleResult& c, const FigureRows& fr) {
-  if (c.direction == "both") {
-    auto g = [&](const char* key) {
-      const auto v = fr.value(key), u = fr.u(key);
-      return v ? fmt("%.2f", *v) + (u ? " ± " + fmt("%.2f", *u) : "") + " µm" : std::string("n/a");
-    };
-    return "G ccw " + g("circle.circular_deviation_G_ccw_um") + ",  G cw " + g("circle.circular_deviation_G_cw_um");
+// The key of G for one direction's plot: G per direction when both ran, else G.
+std::string g_key(const dsp::eval::CircleResult& c, const std::string& dir) {
+  return c.direction == "both" ? "circle.circular_deviation_G_" + dir + "_um" : "circle.circular_deviation_G_um";
+}
+
+// One polar plot per direction. A direction whose U(G) exceeds the whole range its trace
+// spans has no shape the measurement resolves: it is drawn as the band of that U about the
+// reference circle, with a note, not as a shape the reader would take for the machine's.
+void polar_plots(const dsp::eval::CircleResult& c, const dsp::Program& p, const FigureRows& fr, bool partial,
+                 Section& s) {
+  const auto [na, nb] = plane_axis_names(p.plane);
+  for (const char* direction : {"ccw", "cw"}) {
+    const std::string dir = direction;
+    auto traces = revolution_traces(c, partial, dir);
+    if (traces.empty()) continue;
+    double max_abs_um = 0.0;
+    for (const auto& t : traces)
+      for (double d : t.deviation_um)
+        if (std::isfinite(d)) max_abs_um = std::max(max_abs_um, std::abs(d));
+    const std::string key = g_key(c, dir);
+    const auto g = fr.value(key), u = fr.u(key);
+    const std::string name = dir == "ccw" ? "counter-clockwise (G3)" : "clockwise (G2)";
+    const std::string subtitle =
+        "G " + (g ? fmt("%.2f", *g) + (u ? " ± " + fmt("%.2f", *u) : "") + " µm" : std::string("n/a"));
+    PolarBand band;
+    if (u && std::isfinite(*u) && *u > 2.0 * max_abs_um) {
+      band = {*u / 2.0, dir == "ccw" ? kBlue : kRed,
+              "± U(G)/2 = ± " + fmt("%.1f", *u / 2.0) + " µm: shape not resolved"};
+      s.notes.push_back("The " + name + " trace is drawn as the band of its uncertainty: U(G) = " + fmt("%.1f", *u) +
+                        " µm exceeds the whole range the trace spans (" + fmt("%.1f", 2.0 * max_abs_um) +
+                        " µm), so its shape is noise of the measurement, not the machine's.");
+      traces.clear();
+    }
+    s.svgs.push_back(polar_plot(traces, "Radius deviation, " + name + ", " + p.plane + " plane", "+" + na, "+" + nb,
+                                0.0, subtitle, band));
   }
-  return "G " + fmt("%.2f", c.circular_deviation_G_um) +
-         (fr.u("circle.circular_deviation_G_um") ? " ± " + fmt("%.2f", *fr.u("circle.circular_deviation_G_um")) : "") +
-         " µm, " + (c.direction == "cw" ? "clockwise" : "counter-clockwise");
 }
 
 Table iso230_4_table(const dsp::eval::CircleResult& c, const dsp::Program& p, const FigureRows& fr, bool partial) {
@@ -192,11 +213,10 @@ void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, Cs
   s.heading =
       partial ? "Circular test (ISO 230-4), " + fmt("%.0f", c.arc_deg) + "° partial arc" : "Circular test (ISO 230-4)";
   s.lead =
-      "Radius deviation along the path, both directions where measured; plot magnified about the reference circle as "
-      "on a ballbar plot.";
+      "Radius deviation along the path, one plot per direction, magnified about the reference circle as on a ballbar "
+      "plot.";
   const FigureRows fr(a);
-  s.svgs.push_back(polar_plot(revolution_traces(c, partial), "Radius deviation, " + p.plane + " plane", "+" + na,
-                              "+" + nb, 0.0, polar_subtitle(c, fr)));
+  polar_plots(c, p, fr, partial, s);
   s.tables.push_back(iso230_4_table(c, p, fr, partial));
   diagnostics_table(a, na, nb, fr, partial, s);
   contribution_grid(a, p, fr, na, nb, s);

@@ -104,6 +104,7 @@ Page trend_page(const std::string& figure, const std::vector<history::TrendPoint
   Page page;
   page.title = "Calibration history: trend";
   page.run_id = figure;
+  page.subject_label = "Figure";
   page.program = history::label_of(figure) + ", " + std::to_string(points.size()) + " results";
   page.context = {{"store", store}};
   const std::string unit = history::unit_of(figure);
@@ -140,6 +141,7 @@ Page compare_page(const history::Comparison& c, const history::Record& before, c
   Page page;
   page.title = "Calibration history: comparison";
   page.run_id = before.run_id + " → " + after.run_id;
+  page.subject_label = "Runs";
   page.program =
       before.machine == after.machine ? before.machine + ", " + before.program : before.machine + " → " + after.machine;
   page.context = {{"before", hv::when(before.measured_at) + " UTC, " + before.verdict.value_or("no verdict")},

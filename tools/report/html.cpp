@@ -74,9 +74,11 @@ section.approval{break-inside:avoid;page-break-inside:avoid}
  main{max-width:none;padding:0 2mm}
  section{border:none;border-top:1px solid #c9d0db;border-radius:0;padding:8px 0;margin:8px 0;break-inside:auto}
  .row{display:block}
- .plots{display:block}
- svg.plot{max-width:100%;height:auto;break-inside:avoid;border:none}
- table{break-inside:avoid;font-size:9pt}
+ .plots{display:flex;flex-wrap:wrap;gap:2mm;align-items:flex-start}
+ svg.plot{width:100%;max-width:100%;height:auto;break-inside:avoid;border:none}
+ svg.polar{width:49%;max-height:118mm}
+ table{break-inside:auto;font-size:9pt}
+ tr{break-inside:avoid}
  .tables{min-width:0}
  h2{break-after:avoid}
  footer a{color:#1d2330;text-decoration:none}
@@ -158,8 +160,8 @@ std::string render_html(const Page& page) {
          xml_escape(page.title + " — " + page.run_id) + "</title>\n<style>" + kStyle +
          "</style></head><body>\n<header>\n<div class=\"brand\">eical · inertial machine-tool calibration</div>\n";
   out += "<h1>" + xml_escape(page.title) + "</h1>\n";
-  out += "<div class=\"prog\">Run <span class=\"runid\">" + xml_escape(page.run_id) + "</span> &nbsp;·&nbsp; " +
-         xml_escape(page.program) + "</div>\n";
+  out += "<div class=\"prog\">" + xml_escape(page.subject_label) + " <span class=\"runid\">" + xml_escape(page.run_id) +
+         "</span> &nbsp;·&nbsp; " + xml_escape(page.program) + "</div>\n";
   if (!page.context.empty()) {
     out += "<dl class=\"ctx\">";
     for (const auto& [k, v] : page.context)

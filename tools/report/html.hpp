@@ -51,7 +51,8 @@ struct Flag {
 struct Page {
   std::string title;
   std::string run_id;
-  std::string program;  // e.g. "circle R 10 mm, F 2500 mm/min, XY, both directions"
+  std::string subject_label = "Run";  // what run_id names in the header: "Run", "Figure", "Runs"
+  std::string program;                // e.g. "circle R 10 mm, F 2500 mm/min, XY, both directions"
   std::vector<std::pair<std::string, std::string>> context;  // label → value under the header
   std::vector<std::string> warnings;                         // shown at the top, never hidden
   std::vector<Flag> flags;                                   // quality flags, critical first

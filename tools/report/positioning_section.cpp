@@ -1,5 +1,6 @@
 // ISO 230-2 page: the laser interferometer's deviation plot (mean per target and
 // direction with ±2s bands, every run's points) beside the A/E/M/R/B table.
+#include "dsp/core/float_limits.hpp"
 #include "tools/report/sections.hpp"
 #include "tools/report/svg.hpp"
 
@@ -31,10 +32,23 @@ std::string deviation_plot(const PositioningResult& r, const PositioningInput& i
                    "deviation (µm)", 680, 340);
 }
 
-std::string reversal_plot(const PositioningResult& r) {
-  LineSeries b{"reversal value B", kGreen, {}, {}};
-  for (const auto& t : r.targets) b.x.push_back(t.target_mm), b.y.push_back(t.B_um);
-  return line_plot({b}, "Reversal value per target", "target position (mm)", "B (µm)", 680, 220);
+// B per target with its U as a bar, and the mean B̄ with its U as a band: a variation of
+// B along the axis that stays inside the bars is not one the measurement shows.
+std::string reversal_plot(const PositioningResult& r, const FigureRows& fr) {
+  LineSeries b{"B per target ± U", kGreen, {}, {}, {}, {}, true, false, 1.4, true};
+  LineSeries mean{"mean B̄ ± U", kGrey, {}, {}, {}, {}, false, true, 1.2};
+  const auto bm = fr.value("positioning.B_mean_um"), bu = fr.u("positioning.B_mean_um");
+  for (std::size_t i = 0; i < r.targets.size(); ++i) {
+    const auto& t = r.targets[i];
+    const double u = fr.u("positioning.per_target.B_um", i).value_or(kNaN);
+    b.x.push_back(t.target_mm), b.y.push_back(t.B_um), b.y_lo.push_back(t.B_um - u), b.y_hi.push_back(t.B_um + u);
+    if (bm) {
+      mean.x.push_back(t.target_mm), mean.y.push_back(*bm);
+      mean.y_lo.push_back(*bm - bu.value_or(0.0)), mean.y_hi.push_back(*bm + bu.value_or(0.0));
+    }
+  }
+  return line_plot({mean, b}, "Reversal value per target (bars and band: ± U, k = 2)", "target position (mm)", "B (µm)",
+                   680, 220);
 }
 
 // The ISO 230-2 figures and VDI/DGQ 3441's, each ± U.
@@ -112,8 +126,8 @@ void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& pag
   s.lead = std::to_string(r.runs) + " bidirectional runs over " + std::to_string(r.targets.size()) +
            " targets; deviation = measured − target at each stop.";
   s.svgs.push_back(deviation_plot(r, in));
-  s.svgs.push_back(reversal_plot(r));
   const FigureRows fr(a);
+  s.svgs.push_back(reversal_plot(r, fr));
   figure_tables(fr, s);
   if (r.runs < dsp::eval::kRunsPerTargetIso230_2)
     s.notes.push_back(std::to_string(r.runs) + " runs per target and direction: ISO 230-2 asks for " +

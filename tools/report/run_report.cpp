@@ -271,9 +271,17 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, co
   page.verdict_reasons = analysis.verdict_reasons;
   if (options.tolerances) {
     // The analysis' decision when it was made with the tolerances (analyze --tolerances),
-    // else made here from the same rule: one story in the banner, the table and the JSON.
+    // else made here from the same rule, and the verdict judged again with it: one story in
+    // the banner, the table and the JSON.
     const dsp::ConformanceResult c =
         analysis.conformance ? *analysis.conformance : dsp::decide_conformance(analysis, figure_tolerances(tol));
+    if (!analysis.conformance) {
+      dsp::Analysis judged = analysis;
+      judged.conformance = c;
+      dsp::judge(p, judged);
+      page.verdict = dsp::verdict_name(judged.verdict);
+      page.verdict_reasons = judged.verdict_reasons;
+    }
     Grid g{std::string("Against the tolerances (ISO 14253-1 with U, k = 2): ") + dsp::conformance_words(c.overall),
            {"figure", "measured (µm)", "U (µm)", "tolerance (µm)", "decision"},
            {}};

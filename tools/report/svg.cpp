@@ -25,9 +25,10 @@ std::string tick_label(double v, double step) {
   return buf;
 }
 
-std::string svg_open(double w, double h) {
-  return "<svg xmlns='http://www.w3.org/2000/svg' class='plot' viewBox='0 0 " + num(w) + " " + num(h) + "' width='" +
-         num(w) + "' height='" + num(h) + "' font-family='inherit' font-size='11' fill='#1d2330'>";
+std::string svg_open(double w, double h, const char* css_class = "plot") {
+  return "<svg xmlns='http://www.w3.org/2000/svg' class='" + std::string(css_class) + "' viewBox='0 0 " + num(w) + " " +
+         num(h) + "' width='" + num(w) + "' height='" + num(h) +
+         "' font-family='inherit' font-size='11' fill='#1d2330'>";
 }
 
 std::string text(double x, double y, const std::string& s, const std::string& extra = "") {
@@ -112,9 +113,9 @@ struct PolarGeometry {
 
 // The scale: the one asked for, else a nice step for the largest deviation, raised until
 // every deviation fits inside the outer ring.
-PolarGeometry polar_geometry(const std::vector<PolarTrace>& traces, double scale_um_per_div) {
+PolarGeometry polar_geometry(const std::vector<PolarTrace>& traces, double scale_um_per_div, const PolarBand& band) {
   PolarGeometry g;
-  std::size_t labelled = 0;
+  std::size_t labelled = band.half_width_um > 0.0 ? 1 : 0;
   for (const auto& t : traces) labelled += t.label.empty() ? 0 : 1;
   const double legend_rows = static_cast<double>((labelled + 1) / 2);
   g.h = g.cy + 3 * g.ring + g.r0 + 34 + 15 * legend_rows + 34;
@@ -122,6 +123,7 @@ PolarGeometry polar_geometry(const std::vector<PolarTrace>& traces, double scale
   for (const auto& t : traces)
     for (double d : t.deviation_um)
       if (std::isfinite(d)) max_abs_um = std::max(max_abs_um, std::abs(d));
+  if (std::isfinite(band.half_width_um)) max_abs_um = std::max(max_abs_um, band.half_width_um);
   if (scale_um_per_div <= 0.0) scale_um_per_div = nice_step(std::max(max_abs_um, 0.05) * 1.05, g.divisions);
   while (scale_um_per_div * g.divisions < max_abs_um) scale_um_per_div = next_nice(scale_um_per_div);
   g.scale_um_per_div = scale_um_per_div;
@@ -148,8 +150,21 @@ std::string polar_grid(const PolarGeometry& g) {
   return s;
 }
 
-// Traces: one polyline per revolution, closed where it is a full one, a marker at its start
-// (the markers after every trace, so that none hides under the next).
+// The band: an annulus between −w and +w about the reference circle (even-odd fill).
+std::string polar_band(const PolarBand& band, const PolarGeometry& g) {
+  if (!(band.half_width_um > 0.0)) return {};
+  const double ro = g.r0 + band.half_width_um * g.px_per_um,
+               ri = std::max(0.0, g.r0 - band.half_width_um * g.px_per_um);
+  auto circle = [&](double r) {
+    return "M" + num(g.c + r) + "," + num(g.cy) + " a" + num(r) + "," + num(r) + " 0 1,0 " + num(-2 * r) + ",0 a" +
+           num(r) + "," + num(r) + " 0 1,0 " + num(2 * r) + ",0 ";
+  };
+  return "<path fill-rule='evenodd' d='" + circle(ro) + circle(ri) + "' fill='" + band.color +
+         "' fill-opacity='0.16' stroke='" + band.color + "' stroke-opacity='0.5' stroke-width='0.8'/>";
+}
+
+// Traces: one polyline per revolution as measured, a marker at its start (the markers after
+// every trace, so that none hides under the next).
 std::string polar_traces(const std::vector<PolarTrace>& traces, const PolarGeometry& g) {
   std::string s, markers;
   for (const auto& t : traces) {
@@ -169,10 +184,6 @@ std::string polar_traces(const std::vector<PolarTrace>& traces, const PolarGeome
       }
       prev_ang = t.angle_deg[i];
       g.point(t.angle_deg[i], t.deviation_um[i], x, y);
-      pts += num(x) + "," + num(y) + " ";
-    }
-    if (t.closed && n > 1) {  // back to where it began
-      g.point(t.angle_deg[0], t.deviation_um[0], x, y);
       pts += num(x) + "," + num(y) + " ";
     }
     s += "<polyline fill='none' stroke='" + t.color + "' stroke-width='1.3' stroke-linejoin='round' points='" + pts +
@@ -210,22 +221,25 @@ std::string polar_labels(const PolarGeometry& g, const std::string& axis_a, cons
 }
 
 // Legend in two columns under the plot, the scale beside.
-std::string polar_legend(const std::vector<PolarTrace>& traces, const PolarGeometry& g) {
+std::string polar_legend(const std::vector<PolarTrace>& traces, const PolarBand& band, const PolarGeometry& g) {
   const double w = g.w, h = g.h;
   std::string s;
   double ly = g.cy + g.r2 + 34;
   std::size_t k = 0;
-  for (const auto& t : traces) {
-    if (t.label.empty()) continue;
+  auto entry = [&](const std::string& label, const std::string& color, double bar_h) {
     const double lx = k % 2 == 0 ? 10.0 : 250.0;
-    s += "<rect x='" + num(lx) + "' y='" + num(ly - 5) + "' width='16' height='3' fill='" + t.color + "'/>";
-    s += text(lx + 22, ly, t.label);
+    s += "<rect x='" + num(lx) + "' y='" + num(ly - 3 - bar_h / 2) + "' width='16' height='" + num(bar_h) + "' fill='" +
+         color + "'" + (bar_h > 3 ? " fill-opacity='0.3'" : "") + "/>";
+    s += text(lx + 22, ly, label);
     if (k % 2 == 1) ly += 15;
     ++k;
-  }
+  };
+  if (band.half_width_um > 0.0) entry(band.label, band.color, 9);
+  for (const auto& t : traces)
+    if (!t.label.empty()) entry(t.label, t.color, 3);
   s += "<circle cx='" + num(14) + "' cy='" + num(h - 9) +
        "' r='3.6' fill='#ffffff' stroke='#4a5366' stroke-width='1.8'/>" +
-       text(24, h - 5, "start of a revolution", "fill='#4a5366' font-size='10'");
+       text(24, h - 5, "start of a revolution (drawn as measured, not joined)", "fill='#4a5366' font-size='10'");
   s += text(w - 10, h - 21, tick_label(g.scale_um_per_div, g.scale_um_per_div) + " µm / division",
             "text-anchor='end' fill='#4a5366'");
   s += text(w - 10, h - 5, "reference circle = 0 µm", "text-anchor='end' fill='#6b7385' font-size='10'");
@@ -313,13 +327,22 @@ std::string plot_bands(const std::vector<LineSeries>& series, const PlotFrame& f
   return s;
 }
 
-// The series as lines or markers; the legend is drawn last, on a white panel: a trace may
-// pass under it, never over it.
+// Rows of the legend under the frame: three entries to a row.
+constexpr std::size_t kLegendColumns = 3;
+constexpr double kLegendRowPx = 15.0;
+std::size_t legend_rows(const std::vector<LineSeries>& series) {
+  const auto labelled = static_cast<std::size_t>(
+      std::count_if(series.begin(), series.end(), [](const LineSeries& s) { return !s.label.empty(); }));
+  return (labelled + kLegendColumns - 1) / kLegendColumns;
+}
+
+// The series as lines or markers, then the legend under the frame's axis label, where no
+// trace can pass.
 std::string plot_lines_and_legend(const std::vector<LineSeries>& series, const PlotFrame& f) {
-  const double w = f.w, right = f.right, top = f.top;
+  const double column_px = (f.w - f.left - f.right) / static_cast<double>(kLegendColumns);
   std::string s;
-  double ly = top + 14;
   std::string legend;
+  std::size_t k = 0;
   for (const auto& ser : series) {
     const std::size_t n = std::min(ser.x.size(), ser.y.size());
     const std::size_t stride = stride_for(n, 3000);
@@ -337,38 +360,40 @@ std::string plot_lines_and_legend(const std::vector<LineSeries>& series, const P
            "' stroke-linejoin='round'" + (ser.dashed ? " stroke-dasharray='5,3'" : "") + " points='" + pts + "'/>";
     }
     if (ser.label.empty()) continue;
-    legend += ser.markers ? "<circle cx='" + num(w - right - 176) + "' cy='" + num(ly - 4) + "' r='2.5' fill='" +
-                                ser.color + "'/>"
-                          : "<rect x='" + num(w - right - 184) + "' y='" + num(ly - 5) +
-                                "' width='16' height='3' fill='" + ser.color + "'/>";
-    legend += text(w - right - 162, ly, ser.label, "fill='#1d2330'");
-    ly += 14;
+    const double lx = f.left + static_cast<double>(k % kLegendColumns) * column_px,
+                 ly = f.h + 12.0 + static_cast<double>(k / kLegendColumns) * kLegendRowPx;
+    legend += ser.markers
+                  ? "<circle cx='" + num(lx + 8) + "' cy='" + num(ly - 4) + "' r='2.5' fill='" + ser.color + "'/>"
+                  : "<rect x='" + num(lx) + "' y='" + num(ly - 5) + "' width='16' height='3' fill='" + ser.color + "'" +
+                        (ser.dashed ? " fill-opacity='0.6'" : "") + "/>";
+    legend += text(lx + 22, ly, ser.label, "fill='#1d2330'");
+    ++k;
   }
-  if (!legend.empty())
-    s += "<rect x='" + num(w - right - 190) + "' y='" + num(top + 2) + "' width='186' height='" + num(ly - top - 4) +
-         "' fill='white' fill-opacity='0.85' stroke='#d5dae3' stroke-width='0.6' rx='2'/>" + legend;
-  return s;
+  return s + legend;
 }
 
 }  // namespace
 
 std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title, const std::string& axis_a,
-                       const std::string& axis_b, double scale_um_per_div, const std::string& subtitle) {
-  const PolarGeometry g = polar_geometry(traces, scale_um_per_div);
-  std::string s = svg_open(g.w, g.h);
+                       const std::string& axis_b, double scale_um_per_div, const std::string& subtitle,
+                       const PolarBand& band) {
+  const PolarGeometry g = polar_geometry(traces, scale_um_per_div, band);
+  std::string s = svg_open(g.w, g.h, "plot polar");
   s += text(g.c, 18, title, "text-anchor='middle' font-size='14' font-weight='600'");
   if (!subtitle.empty()) s += text(g.c, 34, subtitle, "text-anchor='middle' font-size='11' fill='#4a5366'");
   s += polar_grid(g);
+  s += polar_band(band, g);
   s += polar_traces(traces, g);
   s += polar_labels(g, axis_a, axis_b);
-  s += polar_legend(traces, g);
+  s += polar_legend(traces, band, g);
   return s + "</svg>";
 }
 
 std::string line_plot(const std::vector<LineSeries>& series, const std::string& title, const std::string& x_label,
                       const std::string& y_label, double width_px, double height_px) {
   const PlotFrame f = plot_frame(series, width_px, height_px);
-  std::string s = svg_open(width_px, height_px);
+  const double legend_px = static_cast<double>(legend_rows(series)) * kLegendRowPx;
+  std::string s = svg_open(width_px, height_px + (legend_px > 0 ? legend_px + 4 : 0));
   s += plot_axes(f, title, x_label, y_label);
   s += plot_bands(series, f);
   s += plot_lines_and_legend(series, f);

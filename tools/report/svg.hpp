@@ -18,8 +18,14 @@ struct PolarTrace {
   std::string color;  // CSS colour
   std::vector<double> angle_deg;
   std::vector<double> deviation_um;
-  bool closed = false;        // a full revolution: the last point joins the first
-  bool start_marker = false;  // a marker where the trace begins (its direction shown by a tick)
+  bool start_marker = false;  // a marker where the trace begins
+};
+// What the polar plot draws instead of a shape the measurement cannot resolve: a shaded
+// ring ±half_width_um about the reference circle, with its label in the legend.
+struct PolarBand {
+  double half_width_um = 0.0;  // <= 0: no band
+  std::string color;
+  std::string label;
 };
 
 // Colours of the revolutions of one direction: ccw blues, cw reds (first = kBlue / kRed).
@@ -29,10 +35,11 @@ const char* revolution_colour(bool ccw, int revolution);
 // (zero deviation) with rings every `scale_um_per_div` (chosen when <= 0). `axis_a` and
 // `axis_b` name the plane's axes at 0° and 90° (e.g. "+X", "+Y"). Labels are drawn above
 // the traces (with a white halo) so that no trace hides them; `subtitle` (e.g. G per
-// direction) is printed under the title.
+// direction) is printed under the title. The trace is drawn as measured: a revolution is
+// not joined back to its start (the join would draw the integration's closure as shape).
 std::string polar_plot(const std::vector<PolarTrace>& traces, const std::string& title,
                        const std::string& axis_a = "0°", const std::string& axis_b = "90°",
-                       double scale_um_per_div = 0.0, const std::string& subtitle = "");
+                       double scale_um_per_div = 0.0, const std::string& subtitle = "", const PolarBand& band = {});
 
 struct LineSeries {
   std::string label = {};
@@ -46,7 +53,8 @@ struct LineSeries {
   bool error_bars = false;  // y_lo..y_hi as a bar at each point (separate measurements) instead of a band
 };
 
-// x/y plot with axes, ticks, grid and a legend; labels carry the units, e.g. "time (s)".
+// x/y plot with axes, ticks, grid and a legend under the frame (never over the data);
+// labels carry the units, e.g. "time (s)". height_px is the frame's; the legend adds its rows.
 std::string line_plot(const std::vector<LineSeries>& series, const std::string& title, const std::string& x_label,
                       const std::string& y_label, double width_px = 680, double height_px = 300);
 
