@@ -5,6 +5,7 @@
 #include "drivers/run_io/file_spill.hpp"
 #include "drivers/run_io/run_stream.hpp"
 #include "dsp/analysis/analyze_run.hpp"
+#include "dsp/analysis/verdict.hpp"
 #include "tools/commands.hpp"
 #include "tools/exit_codes.hpp"
 #include "tools/plan/test_plan.hpp"
@@ -83,7 +84,10 @@ void register_analyze(CLI::App& app) {
     so.spills = drivers::file_spills(drivers::default_spill_dir());
     so.spill_trace = so.spill_corrections = true;  // a CSV reads slower than a spill, a spill faster than the smoother
     dsp::Analysis a = drivers::analyze_stream(stream, opt, so);
-    if (tol) a.conformance = dsp::decide_conformance(a, report::figure_tolerances(*tol));
+    if (tol) {
+      a.conformance = dsp::decide_conformance(a, report::figure_tolerances(*tol));
+      dsp::judge(run.meta.program, a);  // the tolerance, not the fixed limit, says what U must resolve
+    }
     if (a.verdict == dsp::Verdict::not_measurable && !o->no_suggest) plan::suggest_measurable_test(run, a);
     if (o->json)
       std::printf("%s\n", drivers::result_json(run, a).dump(2).c_str());

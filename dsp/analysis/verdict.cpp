@@ -27,6 +27,15 @@ std::string num(double v, const char* unit) {
 
 bool starts_with(const std::string& s, const char* p) { return s.rfind(p, 0) == 0; }
 
+// The figure's ISO 14253-1 decision when the run was judged against tolerances and the
+// decision is proven, conformance or non-conformance; null otherwise.
+const FigureConformance* proven_either_way(const Analysis& a, const std::string& key) {
+  if (!a.conformance) return nullptr;
+  for (const auto& f : a.conformance->figures)
+    if (f.key == key && f.decision != Conformance::undecided) return &f;
+  return nullptr;
+}
+
 }  // namespace
 
 const std::vector<ResolutionLimit>& resolution_limits() {
@@ -53,6 +62,7 @@ const ResolutionLimit* resolution_limit(const std::string& program_kind) {
 void judge(const Program& program, Analysis& a) {
   a.verdict_reasons.clear();
   bool not_measurable = false;
+  std::string decided_note;  // said under the verdict, not a reason for a lesser one
   const ResolutionLimit* lim = resolution_limit(program.kind);
   const std::vector<FigureValue> figs = figures_of(a);
   auto u_of = [&](const char* key) -> double {
@@ -77,7 +87,17 @@ void judge(const Program& program, Analysis& a) {
                                   (a.uncertainty_note.empty() ? "" : ": " + a.uncertainty_note));
     } else {
       const double ul = u_of(lim->limited);
-      if (!std::isfinite(ul) || ul > lim->limit) {
+      // With tolerances (ISO 14253-1) the tolerance, not the program's fixed limit, says
+      // what U must resolve: a figure the decision proves either way was measured well
+      // enough for it, whatever its U against the limit.
+      const FigureConformance* decided = proven_either_way(a, lim->limited);
+      if (decided && !(ul <= lim->limit)) {
+        decided_note =
+            ("U(" + std::string(lim->limited_name) + ") = " + num(ul, lim->unit) + " exceeds the " +
+             num(lim->limit, lim->unit) + " a " + program.kind +
+             " test resolves without tolerances, but decides its tolerance of " + num(decided->tolerance, lim->unit) +
+             ": " + conformance_words(decided->decision) + " (ISO 14253-1)");
+      } else if (!std::isfinite(ul) || ul > lim->limit) {
         not_measurable = true;
         a.verdict_reasons.push_back("U(" + std::string(lim->limited_name) +
                                     ") = " + (std::isfinite(ul) ? num(ul, lim->unit) : std::string("unknown")) +
@@ -92,6 +112,7 @@ void judge(const Program& program, Analysis& a) {
     a.verdict = Verdict::degraded;
   else
     a.verdict = Verdict::ok;
+  if (!decided_note.empty()) a.verdict_reasons.push_back(decided_note);
   if (a.degraded)
     for (const auto& f : a.flags)
       if (flag_severity(f) == FlagSeverity::critical && !starts_with(f, kPositionNullFlag))

@@ -58,6 +58,26 @@ TEST(Verdict, AFigureBelowItsUncertaintyIsAResultNotAFailure) {
   EXPECT_EQ(worse.verdict, Verdict::ok);
 }
 
+TEST(Verdict, WithTolerancesTheDecisionNotTheFixedLimitSaysWhatUMustResolve) {
+  // U = 12 µm is above the 10 µm a circle resolves without tolerances, but against a
+  // 40 µm tolerance G = 3 ± 12 µm is conformance proven: the banner must not say NOT
+  // MEASURABLE over a table that says pass (issue 33).
+  Program p;
+  const std::vector<FigureTolerance> tol{{"G", {"circle.circular_deviation_G_um"}, 40.0}};
+  Analysis wide = circle(3.0, 12.0);
+  wide.conformance = decide_conformance(wide, tol);
+  judge(p, wide);
+  EXPECT_EQ(wide.verdict, Verdict::ok);
+  ASSERT_EQ(wide.verdict_reasons.size(), 1u);
+  EXPECT_NE(wide.verdict_reasons[0].find("decides its tolerance of 40.0 µm: conformance proven"), std::string::npos)
+      << wide.verdict_reasons[0];
+  // Straddled (3 + 12 > 10 >= 3 − 12): undecided, and the U is too large for the test.
+  Analysis straddled = circle(3.0, 12.0);
+  straddled.conformance = decide_conformance(straddled, {{"G", {"circle.circular_deviation_G_um"}, 10.0}});
+  judge(p, straddled);
+  EXPECT_EQ(straddled.verdict, Verdict::not_measurable);
+}
+
 TEST(Verdict, DegradedByACriticalFlagAndNotMeasurableOverridesIt) {
   Program p;
   Analysis a = circle(12.0, 3.0, true);
