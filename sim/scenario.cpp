@@ -111,9 +111,13 @@ Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vect
   gcode::IdentifyPlan plan;
   plan.psd = psd;
   plan.axes = axes;
+  return identify_scenario(plan, seed);
+}
+
+Scenario identify_scenario(const gcode::IdentifyPlan& plan, std::uint64_t seed) {
   Scenario sc = base_scenario("identify", seed, "on-site identification across the PSD strips, ideal machine");
   sc.meta.program.gcode = gcode::identify_program(plan);
-  sc.meta.psd = psd;
+  sc.meta.psd = plan.psd;
   return sc;
 }
 

@@ -5,6 +5,7 @@
 // Every effect of shared/spec/run-format.md maps onto fields here; all default to "off"
 // (an ideal machine that follows the set-point, data-sheet sensors, a nominal DAQ).
 #include "dsp/core/run_meta.hpp"
+#include "sim/gcode/generate.hpp"
 #include "sim/nc/klipper_excitation.hpp"
 #include "sim/nc/trajectory.hpp"
 
@@ -234,5 +235,7 @@ std::vector<dsp::PsdSpec> psd_config_b(double radius_mm = 10.0);
 // axes, with those strips in the run.
 Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vector<std::string>& axes = {"z"},
                            std::uint64_t seed = 1);
+// The same for a whole plan (its swing, feeds and travel).
+Scenario identify_scenario(const gcode::IdentifyPlan& plan, std::uint64_t seed);
 
 }  // namespace eical::sim

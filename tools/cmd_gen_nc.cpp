@@ -234,7 +234,7 @@ void add_rectangle(CLI::App* gen) {
 
 void add_identify(CLI::App* gen) {
   struct Id {
-    std::vector<std::string> psd, axes;
+    std::vector<std::string> psd, axes, travel;
     sim::gcode::IdentifyPlan plan;
     std::string out, meta_out, dialect = "linuxcnc", name;
     int number = 1000;
@@ -247,6 +247,8 @@ void add_identify(CLI::App* gen) {
   c->add_option("--axis", o->axes, "a further axis to swing without a strip, e.g. z (repeatable)")
       ->check(CLI::IsMember({"x", "y", "z"}));
   c->add_option("--swing", o->plan.swing_mm, "swing, peak to peak, mm")->default_val(50.0);
+  c->add_option("--travel", o->travel,
+                "AXIS:LO,HI: the swings along x or y stay inside LO…HI mm, e.g. the test's travel (repeatable)");
   c->add_option("--feeds", o->plan.feeds_mm_min, "feeds in mm/min (comma separated)")
       ->delimiter(',')
       ->default_str("2000,4000,6500");
@@ -254,6 +256,10 @@ void add_identify(CLI::App* gen) {
   add_envelope_options(*c, o->envelope);
   c->callback([o] {
     for (const auto& t : o->psd) o->plan.psd.push_back(parse_psd(t));
+    for (const auto& t : o->travel) {
+      const TravelOption tr = parse_travel(t);
+      o->plan.travel_mm[tr.axis] = sim::gcode::AxisTravel{tr.lo_mm, tr.hi_mm};
+    }
     o->plan.axes = o->axes;
     if (o->plan.feeds_mm_min.empty()) o->plan.feeds_mm_min = {2000.0, 4000.0, 6500.0};
     const std::string g = sim::gcode::identify_program(o->plan);

@@ -1,5 +1,6 @@
 // eical plan: the uncertainty of a test's figures before anything moves, and the nearest
 // measurable variant (tools/plan/test_plan.hpp).
+#include "drivers/config/sensor_calibration.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/error.hpp"
 #include "sim/simulate.hpp"
@@ -8,6 +9,7 @@
 #include "tools/exit_codes.hpp"
 #include "tools/figure_text.hpp"
 #include "tools/io/psd_option.hpp"
+#include "tools/plan/identification_plan.hpp"
 #include "tools/plan/strip_layout.hpp"
 #include "tools/plan/test_plan.hpp"
 #include "tools/program_defaults.hpp"
@@ -34,7 +36,9 @@ nlohmann::json prediction_json(const plan::Prediction& p) {
           {"limited_u", std::isfinite(p.limited_u) ? nlohmann::json(p.limited_u) : nlohmann::json(nullptr)},
           {"limit", p.limit},
           {"measurable", p.measurable},
-          {"strips", plan::layout_json(p.program)}};
+          {"strips", plan::layout_json(p.program)},
+          {"identification", p.program.identified ? plan::identification_json(plan::identification_plan(p.program))
+                                                  : nlohmann::json(nullptr)}};
 }
 
 std::string prediction_text(const plan::Prediction& p) {
@@ -54,7 +58,8 @@ std::string prediction_text(const plan::Prediction& p) {
   std::snprintf(b, sizeof b, "  %s: U = %.2f µm %s the %.0f µm the test is meant to resolve\n",
                 p.measurable ? "measurable" : "NOT MEASURABLE", p.limited_u, p.measurable ? "within" : "exceeds",
                 p.limit);
-  return o + b + plan::layout_text(p.program);
+  return o + b + plan::layout_text(p.program) +
+         (p.program.identified ? plan::identification_text(plan::identification_plan(p.program)) : std::string());
 }
 
 // What `eical plan` is told: the test program, its strips, how hard to look.
@@ -64,7 +69,7 @@ struct PlanCommandOptions {
   std::vector<std::string> strips;
   std::vector<double> size{50.0, 50.0};
   bool json = false;
-  std::string layout_svg;
+  std::string layout_svg, calibration;
   int draws = 100;
   double max_s = 180.0;
   double deadline_s = 60.0;
@@ -123,6 +128,10 @@ void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
                  "(exit status 6)")
       ->default_val(60.0)
       ->check(CLI::Range(0.0, 86400.0));
+  cmd.add_option("--calibration", o.calibration,
+                 "the machine's sensor calibration (eical-sensor-cal/1, from eical identify): the test and every "
+                 "variant are predicted with its covariance, as identified")
+      ->check(CLI::ExistingFile);
   cmd.add_flag("--json", o.json, "print the prediction as JSON");
   cmd.add_option("--layout-svg", o.layout_svg,
                  "draw the path and where its PSD strips go (the measurable test, else the nearest measurable "
@@ -194,23 +203,44 @@ void require_simulable(const plan::TestProgram& p, const PlanCommandOptions& o, 
   }
 }
 
+// The covariance of --calibration's file; a file without one is as uncertain as the data
+// sheet, which is said, and the test is then predicted as not identified.
+std::optional<dsp::uncertainty::SensorModelCovariance> calibration_covariance(const PlanCommandOptions& o,
+                                                                              plan::TestProgram& p) {
+  if (o.calibration.empty()) return std::nullopt;
+  const drivers::SensorCalibration cal = drivers::read_sensor_calibration(o.calibration, plan::scenario_of(p, 1).meta);
+  if (!cal.covariance) {
+    std::fprintf(stderr,
+                 "plan: %s has no [covariance]: the sensors are as uncertain as their data sheet, and the test is "
+                 "predicted so\n",
+                 o.calibration.c_str());
+    p.identified = false;
+    return std::nullopt;
+  }
+  std::fprintf(stderr, "plan: the sensors as calibrated by %s (run %s)\n", o.calibration.c_str(), cal.run_id.c_str());
+  return cal.covariance;
+}
+
 void run_plan(const PlanCommandOptions& o) {
   using Clock = std::chrono::steady_clock;
   const Clock::time_point t0 = Clock::now();
   const auto elapsed_s = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
-  const plan::TestProgram p = test_program(o);
+  plan::TestProgram p = test_program(o);
+  p.identified = p.identified || !o.calibration.empty();
   const dsp::WorkEnvelope envelope = envelope_of(o.envelope);
   require_simulable(p, o, envelope);
+  const auto calibration = calibration_covariance(o, p);
   std::fprintf(stderr, "plan: simulating the test: %s\n", plan::describe(p).c_str());
-  const plan::Prediction r = plan::predict(p, 1, o.draws);
+  const plan::Prediction r = plan::predict(p, 1, o.draws, calibration);
   plan::Search search;
   if (!r.measurable) {
     plan::SearchOptions so;
-    so.max_duration_s = o.max_s, so.draws = o.draws, so.envelope = envelope;
+    so.max_duration_s = o.max_s, so.draws = o.draws, so.envelope = envelope, so.calibration = calibration;
     so.deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(o.deadline_s));
     so.progress = [&](int n, int of, const plan::TestProgram& t) {
       if (n == 0)
-        std::fprintf(stderr, "plan: %.1f s: simulating the on-site identification the identified variants share\n",
+        std::fprintf(stderr,
+                     "plan: %.1f s: simulating the on-site identification over the next variant's strips and travel\n",
                      elapsed_s());
       else
         std::fprintf(stderr, "plan: %.1f s: variant %d of %d: %s\n", elapsed_s(), n, of, plan::describe(t).c_str());

@@ -190,18 +190,32 @@ std::string rectangle_program(const dsp::Program& p, const RestTimes& rest) {
   return g;
 }
 
+Swing strip_swing(const IdentifyPlan& plan, const dsp::PsdSpec& strip) {
+  const int along = strip.measures == "x" ? 0 : 1;
+  Swing w{strip.center_mm[along], plan.swing_mm / 2.0};
+  if (const auto& t = plan.travel_mm[along]) {
+    require(t->hi_mm > t->lo_mm, "identify: a travel's end lies above its start");
+    require(strip.center_mm[along] >= t->lo_mm && strip.center_mm[along] <= t->hi_mm,
+            "identify: the strip measuring " + strip.measures + " at " + num(strip.center_mm[along]) +
+                " mm lies outside the travel " + num(t->lo_mm) + " … " + num(t->hi_mm) + " mm");
+    w.half_mm = std::min(w.half_mm, (t->hi_mm - t->lo_mm) / 2.0);
+    w.centre_mm = std::clamp(w.centre_mm, t->lo_mm + w.half_mm, t->hi_mm - w.half_mm);
+  }
+  return w;
+}
+
 std::string identify_program(const IdentifyPlan& plan, const RestTimes& rest) {
   require(!plan.psd.empty() || !plan.axes.empty(), "identify needs a PSD strip or an axis to swing");
   require(plan.swing_mm > 0.0 && !plan.feeds_mm_min.empty(), "identify needs a swing and feeds");
   const double half = plan.swing_mm / 2.0;
   std::string g = header("on-site identification: swings across the PSD strips at rising feeds", "G17", true);
   const std::string dwell = "M102\nG4 P" + format_number("%.3g", plan.dwell_s) + "\n";
-  auto swings = [&](char a, double centre) {
+  auto swings = [&](char a, const Swing& w) {
     std::string s;
     for (double feed : plan.feeds_mm_min) {
       const std::string f = " F" + format_number("%.0f", feed);
-      s += std::string("G1 ") + a + num(centre + half) + f + "\n" + dwell;
-      s += std::string("G1 ") + a + num(centre - half) + f + "\n" + dwell;
+      s += std::string("G1 ") + a + num(w.centre_mm + w.half_mm) + f + "\n" + dwell;
+      s += std::string("G1 ") + a + num(w.centre_mm - w.half_mm) + f + "\n" + dwell;
     }
     return s;
   };
@@ -211,15 +225,16 @@ std::string identify_program(const IdentifyPlan& plan, const RestTimes& rest) {
             "identify: a PSD strip measures x or y, not '" + strip.measures + "'");
     const char along = axis_letter(strip.measures);
     const char cross = along == 'X' ? 'Y' : 'X';
-    const double c_along = strip.center_mm[along == 'X' ? 0 : 1], c_cross = strip.center_mm[cross == 'X' ? 0 : 1];
-    const std::string to_start = std::string(" ") + along + num(c_along - half) + " " + cross + num(c_cross);
+    const double c_cross = strip.center_mm[cross == 'X' ? 0 : 1];
+    const Swing w = strip_swing(plan, strip);
+    const std::string to_start = std::string(" ") + along + num(w.centre_mm - w.half_mm) + " " + cross + num(c_cross);
     if (!started) {
       g += "G0" + to_start + "\n" + start(rest);
       started = true;
     } else {
       g += "G1" + to_start + " F3000\n" + dwell;
     }
-    g += swings(along, c_along);
+    g += swings(along, w);
   }
   for (const auto& axis : plan.axes) {
     const char a = axis_letter(axis);

@@ -7,6 +7,7 @@
 // The text is what `eical gen-nc` prints and what the simulator runs.
 #include "dsp/core/run_meta.hpp"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,13 +53,26 @@ std::string rectangle_program(const dsp::Program& p, const RestTimes& rest = {})
 // cross-axis terms); for every further axis (e.g. z, which no strip measures) the same
 // swings from where it is, seen by the set-point at the rests only. Every move ends in a
 // dwell (ZUPT, and the set-point as a position at rest) and M102. Exact stop.
+// A travel set for x or y keeps every swing along that axis inside it: the swing shrinks
+// to the travel and its centre moves off the strip's centre as far as it must, so that the
+// identification moves the axes only where the test that follows moves them.
+struct AxisTravel {
+  double lo_mm = 0.0, hi_mm = 0.0;
+};
 struct IdentifyPlan {
   std::vector<dsp::PsdSpec> psd;
   std::vector<std::string> axes;  // swung without a strip
   double swing_mm = 50.0;         // peak to peak (the scale's lever)
   std::vector<double> feeds_mm_min = {2000.0, 4000.0, 6500.0};
-  double dwell_s = 0.5;  // the position loop settles, then ZUPT
+  double dwell_s = 0.5;                         // the position loop settles, then ZUPT
+  std::optional<AxisTravel> travel_mm[2] = {};  // x, y: where the swings must stay
 };
+// Where the swing across `strip` goes along the axis it measures: its centre and half
+// length (the travel applied).
+struct Swing {
+  double centre_mm = 0.0, half_mm = 0.0;
+};
+Swing strip_swing(const IdentifyPlan& plan, const dsp::PsdSpec& strip);
 std::string identify_program(const IdentifyPlan& plan, const RestTimes& rest = {});
 // The Program form (kind "identify"): one strip along `axis` centred at targets_mm[0],
 // swing size_mm[0] (default 50 mm).

@@ -230,3 +230,32 @@ TEST(GenNc, AnUnknownDialectIsRefused) {
 }
 
 }  // namespace
+
+namespace {
+
+// --travel keeps identify's swings where the test moves (issue 33); a travel that is not
+// AXIS:LO,HI with LO < HI is refused by name.
+TEST(GenNc, IdentifyStaysInsideTheTravelItIsGiven) {
+  const fs::path out = fs::temp_directory_path() / ("gen-nc-id-" + std::to_string(std::random_device{}()) + ".ngc");
+  const std::string g =
+      run_to_file({"gen-nc", "identify", "--psd", "x:0,0", "--travel", "x:0,100", "--axis", "z"}, out);
+  const auto prog = eical::sim::gcode::parse(g);
+  double lo = 1e300, hi = -1e300;
+  for (const auto& b : prog.blocks)
+    if (const auto* m = std::get_if<eical::sim::gcode::Linear>(&b))
+      lo = std::min(lo, m->to_mm.x()), hi = std::max(hi, m->to_mm.x());
+  EXPECT_GE(lo, 0.0) << g;
+  EXPECT_LE(hi, 100.0) << g;
+  EXPECT_NEAR(hi - lo, 50.0, 1e-6);
+  fs::remove(out);
+  for (const char* bad : {"x:100,0", "w:0,1", "x:0,ten"}) {
+    try {
+      (void)run_to_file({"gen-nc", "identify", "--psd", "x:0,0", "--travel", bad}, out);
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("--travel '") + bad + "'"), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace

@@ -4,21 +4,47 @@
 
 namespace eical::tools {
 
-dsp::PsdSpec parse_psd(const std::string& text) {
+namespace {
+
+struct AxisPair {
+  std::string axis;
+  double a = 0.0, b = 0.0;
+};
+
+// AXIS:A,B with AXIS x or y; `option` and `example` name the option in the message.
+AxisPair parse_axis_pair(const std::string& text, const std::string& option, const std::string& form) {
   const auto colon = text.find(':');
   const auto comma = text.find(',', colon == std::string::npos ? 0 : colon);
   if (colon == std::string::npos || comma == std::string::npos)
-    throw std::runtime_error("--psd '" + text + "': expected MEASURES:CX,CY (e.g. x:0,-10)");
-  dsp::PsdSpec s;
-  s.measures = text.substr(0, colon);
-  if (s.measures != "x" && s.measures != "y") throw std::runtime_error("--psd '" + text + "': a strip measures x or y");
+    throw std::runtime_error(option + " '" + text + "': expected " + form);
+  AxisPair p;
+  p.axis = text.substr(0, colon);
+  if (p.axis != "x" && p.axis != "y") throw std::runtime_error(option + " '" + text + "': the axis is x or y");
   try {
-    s.center_mm[0] = std::stod(text.substr(colon + 1, comma - colon - 1));
-    s.center_mm[1] = std::stod(text.substr(comma + 1));
+    std::size_t used_a = 0, used_b = 0;
+    const std::string a = text.substr(colon + 1, comma - colon - 1), b = text.substr(comma + 1);
+    p.a = std::stod(a, &used_a), p.b = std::stod(b, &used_b);
+    if (used_a != a.size() || used_b != b.size()) throw std::invalid_argument("trailing text");
   } catch (const std::exception&) {
-    throw std::runtime_error("--psd '" + text + "': the centre is not two numbers");
+    throw std::runtime_error(option + " '" + text + "': the two values are not numbers (" + form + ")");
   }
+  return p;
+}
+
+}  // namespace
+
+dsp::PsdSpec parse_psd(const std::string& text) {
+  const AxisPair p = parse_axis_pair(text, "--psd", "MEASURES:CX,CY, e.g. x:0,-10");
+  dsp::PsdSpec s;
+  s.measures = p.axis;
+  s.center_mm[0] = p.a, s.center_mm[1] = p.b;
   return s;
+}
+
+TravelOption parse_travel(const std::string& text) {
+  const AxisPair p = parse_axis_pair(text, "--travel", "AXIS:LO,HI, e.g. x:0,100");
+  if (!(p.b > p.a)) throw std::runtime_error("--travel '" + text + "': HI must lie above LO");
+  return {p.axis == "x" ? 0 : 1, p.a, p.b};
 }
 
 }  // namespace eical::tools

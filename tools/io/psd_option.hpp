@@ -1,6 +1,8 @@
 #pragma once
-// A PSD strip on the command line: MEASURES:CX,CY (e.g. x:0,-10: the strip measures x, its
-// centre at x = 0, y = −10, as run.toml's [[psd]]). gen-nc identify and plan take it.
+// Axis-tagged pairs on the command line, AXIS:A,B:
+//   --psd MEASURES:CX,CY   a PSD strip (e.g. x:0,-10: it measures x, its centre at x = 0,
+//                          y = −10, as run.toml's [[psd]]); gen-nc identify and plan take it;
+//   --travel AXIS:LO,HI    where gen-nc identify's swings along x or y must stay.
 #include "dsp/core/run_meta.hpp"
 
 #include <string>
@@ -9,5 +11,12 @@ namespace eical::tools {
 
 // Throws naming the option text when it is not MEASURES:CX,CY with MEASURES x or y.
 dsp::PsdSpec parse_psd(const std::string& text);
+
+struct TravelOption {
+  int axis = 0;  // 0 = x, 1 = y
+  double lo_mm = 0.0, hi_mm = 0.0;
+};
+// Throws naming the option text when it is not AXIS:LO,HI with AXIS x or y and LO < HI.
+TravelOption parse_travel(const std::string& text);
 
 }  // namespace eical::tools

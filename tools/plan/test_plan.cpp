@@ -9,6 +9,7 @@
 #include "sim/nc/envelope_check.hpp"
 #include "sim/simulate.hpp"
 #include "tools/figure_text.hpp"
+#include "tools/plan/identification_plan.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -78,6 +79,18 @@ std::string describe(const TestProgram& p) {
                      : ", " + std::to_string(p.psd.size()) + " PSD strip" + (p.psd.size() > 1 ? "s" : "");
   if (p.identified) s += ", sensors identified on site first (eical gen-nc identify, eical identify)";
   return s;
+}
+
+std::vector<dsp::PsdSpec> strips_at_both_ends(const TestProgram& p) {
+  if (p.kind != "step" && p.targets_mm.empty()) return {};
+  std::vector<dsp::PsdSpec> out(2);
+  const double lo =
+      p.kind == "step" ? std::min(p.from_mm, p.to_mm) : *std::min_element(p.targets_mm.begin(), p.targets_mm.end());
+  const double hi =
+      p.kind == "step" ? std::max(p.from_mm, p.to_mm) : *std::max_element(p.targets_mm.begin(), p.targets_mm.end());
+  out[0].measures = out[1].measures = "x";
+  out[0].center_mm[0] = lo, out[1].center_mm[0] = hi;
+  return out;
 }
 
 std::vector<dsp::PsdSpec> strips_for(const TestProgram& p) {
@@ -172,7 +185,7 @@ std::vector<sim::PsdTruth> drawn_strips(const std::vector<dsp::PsdSpec>& psd, st
 }
 
 sim::Scenario identification_scenario(const TestProgram& p, std::uint64_t seed) {
-  sim::Scenario sc = sim::identify_scenario(sim::psd_config_b(10.0), {"z"}, seed);
+  sim::Scenario sc = sim::identify_scenario(identification_plan(p), seed);
   sc.meta.acquisition.fs_hz = p.fs_hz;
   for (auto& t : sc.truth) t.spec.noise_ug_per_rthz = p.noise_ug_per_rthz;
   for (auto& s : sc.meta.sensors) s.noise_ug_per_rthz = p.noise_ug_per_rthz;
@@ -254,6 +267,13 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
     s.psd = strips_for(s);
     v.push_back(s);
   }
+  if ((p.kind == "positioning" || p.kind == "step") && s.psd.size() < 2) {
+    // A strip at each end of the travel: the position is held at both ends of every run,
+    // where a single strip at mid travel leaves the ends to the integration.
+    TestProgram ends = s;
+    ends.psd = strips_at_both_ends(s);
+    if (!ends.psd.empty()) v.push_back(ends);
+  }
   const double cap = feed_cap(s);
   for (double f : {2.0, 4.0}) {
     TestProgram t = s;
@@ -318,7 +338,9 @@ Search search_measurable(const TestProgram& p, const SearchOptions& o) {
   for (const TestProgram& t : all) out.tried.push_back({t, Outcome::not_reached, 0.0});
   const auto passed = [&] { return o.deadline && std::chrono::steady_clock::now() >= *o.deadline; };
   const int of = static_cast<int>(all.size());
-  std::optional<dsp::uncertainty::SensorModelCovariance> identified;  // one simulated identification for all variants
+  // One simulated identification per identification program (variants that share strips
+  // and travel share it).
+  std::map<std::string, dsp::uncertainty::SensorModelCovariance> identified;
   for (int n = 0; n < of; ++n) {
     Tried& tried = out.tried[static_cast<std::size_t>(n)];
     const TestProgram& t = tried.program;
@@ -332,16 +354,21 @@ Search search_measurable(const TestProgram& p, const SearchOptions& o) {
       tried.outcome = Outcome::too_long;
       continue;
     }
-    if (t.identified && !identified) {
-      if (passed()) break;
-      if (o.progress) o.progress(0, of, t);
-      identified = typical_identification(t);
+    std::optional<dsp::uncertainty::SensorModelCovariance> id = o.calibration;
+    if (t.identified && !id) {
+      const std::string key = identification_command(identification_plan(t));
+      if (!identified.contains(key)) {
+        if (passed()) break;
+        if (o.progress) o.progress(0, of, t);
+        identified.emplace(key, typical_identification(t));
+      }
+      id = identified.at(key);
     }
     if (passed()) break;
     if (o.progress) o.progress(n + 1, of, t);
     // Screened (Screen): a variant far above the limit is told by its first draws; a
     // nearer one is predicted with all of them.
-    Prediction r = predict(t, 1, o.draws, identified, Screen{});
+    Prediction r = predict(t, 1, o.draws, id, Screen{});
     tried.outcome = r.measurable ? Outcome::measurable : Outcome::not_measurable;
     tried.limited_u = r.limited_u;
     if (r.measurable) {

@@ -42,6 +42,8 @@ std::string describe(const TestProgram& p);
 // Strips for the program: configuration B about a circle, one at mid travel of a 1-D
 // test, one per side's middle of a rectangle.
 std::vector<dsp::PsdSpec> strips_for(const TestProgram& p);
+// A positioning or step test's two strips at the ends of its travel (on x).
+std::vector<dsp::PsdSpec> strips_at_both_ends(const TestProgram& p);
 // The program a recorded run ran (for analyze's suggestion).
 TestProgram program_of(const dsp::RunMeta& meta);
 // The simulated run of a program on an ideal machine with data-sheet sensors.
@@ -53,8 +55,9 @@ sim::Scenario scenario_on_drawn_machine(const TestProgram& p, std::uint64_t seed
 // sheet's bound (DatasheetTolerance::psd_nonlinearity), the same for a strip at the same
 // place (the identification's strips and a test's are the machine's).
 std::vector<sim::PsdTruth> drawn_strips(const std::vector<dsp::PsdSpec>& psd, std::uint64_t seed);
-// The identification program (eical gen-nc identify) over PSD configuration B of a R10
-// circle, with the program's sensors and DAQ: how a machine's sensors are identified on site.
+// The identification program (eical gen-nc identify) over the test's strips inside its
+// travel (identification_plan.hpp), with the program's sensors and DAQ: how a machine's
+// sensors are identified on site before this test.
 sim::Scenario identification_scenario(const TestProgram& p, std::uint64_t seed);
 // That identification run on `machine` (a scenario_on_drawn_machine of the same seed): its
 // sensors, DAQ, machine errors, site and strips, the strips with their nonlinearity.
@@ -109,6 +112,9 @@ struct SearchOptions {
   // Before each simulation: the n-th of `of` variants (0: the on-site identification the
   // identified variants share).
   std::function<void(int n, int of, const TestProgram&)> progress;
+  // The machine's own calibration (plan --calibration): every identified variant uses its
+  // covariance instead of a simulated identification.
+  std::optional<dsp::uncertainty::SensorModelCovariance> calibration;
 };
 
 // What became of each variant.

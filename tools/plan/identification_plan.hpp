@@ -1,0 +1,26 @@
+#pragma once
+// The on-site identification a planned test needs (issue 33): swings across the test's
+// own strips, inside the travel the test moves the axes over, so that the identification
+// runs where the test runs and needs no travel the test does not. z, which no strip
+// measures, is swung from where the head rests.
+#include "sim/gcode/generate.hpp"
+#include "tools/plan/test_plan.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace eical::tools::plan {
+
+// The travel of x and y the program moves over, in its coordinates (a circle about 0,0, a
+// positioning or step test on x, a rectangle from the origin); unset for an axis it holds.
+void test_travel(const TestProgram& p, std::optional<sim::gcode::AxisTravel> (&travel_mm)[2]);
+// The identification plan: the test's strips (strips_for when it names none), z, the
+// default swing shrunk to the travel.
+sim::gcode::IdentifyPlan identification_plan(const TestProgram& p);
+// The gen-nc command that writes it, and the same as text and JSON for the plan's output.
+std::string identification_command(const sim::gcode::IdentifyPlan& plan);
+std::string identification_text(const sim::gcode::IdentifyPlan& plan);
+nlohmann::json identification_json(const sim::gcode::IdentifyPlan& plan);
+
+}  // namespace eical::tools::plan
