@@ -27,6 +27,13 @@ void SimSource::open() {
 
 bool SimSource::at_end() const { return finished_; }
 
+std::int64_t SimSource::sample_time_ns(std::int64_t sample_index) const {
+  if (options_.pacing != Pacing::realtime) return 0;
+  const double fs = run_->meta.acquisition.fs_hz;
+  const auto start_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(start_.time_since_epoch()).count();
+  return start_ns + std::llround(static_cast<double>(sample_index) * 1e9 / fs);
+}
+
 std::size_t SimSource::read(std::span<dsp::Frame> out) {
   // The sample clock starts with the first read, as a DAQ streams from when it is read:
   // the time between open() and the acquisition thread's start is not caught up in a burst.

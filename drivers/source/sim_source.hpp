@@ -30,6 +30,11 @@ class SimSource final : public Source {
   std::size_t read(std::span<dsp::Frame> out) override;
   [[nodiscard]] bool at_end() const override;
   [[nodiscard]] std::string_view name() const override { return "sim"; }
+  // Paced in real time, its sample clock is ideal: sample k is taken at the first read's
+  // time + k / fs, whenever a loaded machine lets read() return it. Stamping the return
+  // time instead made late blocks look early on the DAQ clock, so an M103 sent for its
+  // sample landed before the final rest (CLOCK_MONOTONIC ns; 0 unpaced: not known).
+  [[nodiscard]] std::int64_t sample_time_ns(std::int64_t sample_index) const override;
   [[nodiscard]] Backpressure backpressure() const override {
     return options_.pacing == Pacing::realtime ? Backpressure::drop_newest : Backpressure::wait;
   }
