@@ -12,6 +12,7 @@
 #include "tools/comp/heidenhain_export.hpp"
 #include "tools/comp/linuxcnc_export.hpp"
 #include "tools/comp/sinumerik_export.hpp"
+#include "tools/io/psd_option.hpp"
 #include "tools/run_files.hpp"
 
 #include <nlohmann/json.hpp>
@@ -38,22 +39,12 @@ struct CompOptions {
   bool force = false, allow_unresolved = false, skip_unresolved = false, refuse_unresolved = false;
 };
 
-comp::TravelRange parse_travel(const std::string& s) {
-  // x:-20,20
-  const auto colon = s.find(':'), comma = s.find(',');
-  comp::TravelRange t;
-  t.axis = colon == 1 ? dsp::axis_index(s[0]) : -1;
-  if (t.axis < 0 || comma == std::string::npos || comma < colon)
-    throw dsp::InputError("--travel '" + s + "': expected AXIS:MIN,MAX in mm, e.g. x:-200,300");
-  try {
-    t.from_mm = std::stod(s.substr(colon + 1, comma - colon - 1));
-    t.to_mm = std::stod(s.substr(comma + 1));
-  } catch (const std::exception&) {
-    throw dsp::InputError("--travel '" + s + "': MIN and MAX must be numbers (mm)");
-  }
-  if (!(t.to_mm > t.from_mm)) throw dsp::InputError("--travel '" + s + "': MAX must exceed MIN");
-  t.who = "--travel asks for";
-  return t;
+comp::TravelRange travel_range(const std::string& s) {
+  const TravelOption t = parse_travel(s);
+  comp::TravelRange r;  // member by member: GCC 12 misreads the aggregate's string (-Warray-bounds)
+  r.axis = t.axis, r.from_mm = t.lo_mm, r.to_mm = t.hi_mm;
+  r.who = "--travel asks for";
+  return r;
 }
 
 std::string slurp(const std::string& file) {
@@ -167,7 +158,7 @@ comp::Plan comp_plan(const std::vector<comp::CompInput>& inputs, const CompOptio
   po.unresolved = o.allow_unresolved    ? comp::Unresolved::allow
                   : o.refuse_unresolved ? comp::Unresolved::refuse
                                         : comp::Unresolved::skip;
-  for (const auto& t : o.travel) po.travel.push_back(parse_travel(t));
+  for (const auto& t : o.travel) po.travel.push_back(travel_range(t));
   comp::Plan plan = comp::build_plan(inputs, po);
   if (plan.axes.empty()) {
     std::string msg = "comp: no term is resolved (|value| must exceed U, k = 2); nothing written";

@@ -3,6 +3,7 @@
 // On a real control the M-codes are user M-functions (LinuxCNC: executables M101..M103 in
 // the PROGRAM_PREFIX directory, which call `eical trigger`; Siemens/Heidenhain: a PLC
 // output wired to the trigger input, or a CAN frame) — see README "NC triggers".
+#include "dsp/core/error.hpp"
 #include "sim/gcode/dialect.hpp"
 #include "sim/gcode/generate.hpp"
 #include "sim/nc/trajectory.hpp"
@@ -258,6 +259,7 @@ void add_identify(CLI::App* gen) {
     for (const auto& t : o->psd) o->plan.psd.push_back(parse_psd(t));
     for (const auto& t : o->travel) {
       const TravelOption tr = parse_travel(t);
+      if (tr.axis > 1) throw dsp::InputError("--travel '" + t + "': identify swings x and y across strips, z freely");
       o->plan.travel_mm[tr.axis] = sim::gcode::AxisTravel{tr.lo_mm, tr.hi_mm};
     }
     o->plan.axes = o->axes;

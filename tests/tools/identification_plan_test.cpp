@@ -73,7 +73,10 @@ TEST(IdentificationPlan, ACirclesIdentificationUsesItsStripsAndRadius) {
   ASSERT_EQ(id.psd.size(), 2u);
   EXPECT_DOUBLE_EQ(id.psd[0].center_mm[1], -50.0) << "the test's strips, not R10's";
   const Reach r = reach(gcode::identify_program(id));
-  for (int k = 0; k < 2; ++k) EXPECT_GE(r.lo[k], -50.0), EXPECT_LE(r.hi[k], 50.0);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_GE(r.lo[k], -50.0);
+    EXPECT_LE(r.hi[k], 50.0);
+  }
   // At R10 the swing shrinks to the circle's 20 mm.
   p.radius_mm = 10.0, p.psd = plan::strips_for(p);
   const auto small = plan::identification_plan(p);

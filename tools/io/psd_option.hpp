@@ -2,7 +2,8 @@
 // Axis-tagged pairs on the command line, AXIS:A,B:
 //   --psd MEASURES:CX,CY   a PSD strip (e.g. x:0,-10: it measures x, its centre at x = 0,
 //                          y = −10, as run.toml's [[psd]]); gen-nc identify and plan take it;
-//   --travel AXIS:LO,HI    where gen-nc identify's swings along x or y must stay.
+//   --travel AXIS:LO,HI    a travel: where gen-nc identify's swings must stay, what
+//                          eical comp's table must cover.
 #include "dsp/core/run_meta.hpp"
 
 #include <string>
@@ -13,10 +14,10 @@ namespace eical::tools {
 dsp::PsdSpec parse_psd(const std::string& text);
 
 struct TravelOption {
-  int axis = 0;  // 0 = x, 1 = y
+  int axis = 0;  // 0 = x, 1 = y, 2 = z
   double lo_mm = 0.0, hi_mm = 0.0;
 };
-// Throws naming the option text when it is not AXIS:LO,HI with AXIS x or y and LO < HI.
+// Throws naming the option text when it is not AXIS:LO,HI with AXIS x, y or z and LO < HI.
 TravelOption parse_travel(const std::string& text);
 
 }  // namespace eical::tools
