@@ -1,6 +1,7 @@
 // The collector's unit file (systemd/eical-collect.service): systemd's own verifier accepts
 // it, it restarts on failure, and its spool lies in the one path it may write.
 #include <gtest/gtest.h>
+#include "tests/support/text_file.hpp"
 
 #include <cstdio>
 #include <cstdlib>
@@ -15,13 +16,10 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kUnit = fs::path(EICAL_SOURCE_DIR) / "systemd" / "eical-collect.service";
 
-std::string read_file(const fs::path& p) {
-  std::ifstream is(p);
-  return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
-}
+using test_support::slurp;
 
 TEST(CollectUnit, RestartsAndSpoolsWhereItMayWrite) {
-  const std::string unit = read_file(kUnit);
+  const std::string unit = slurp(kUnit);
   ASSERT_FALSE(unit.empty());
   EXPECT_NE(unit.find("\nRestart=on-failure\n"), std::string::npos);
   EXPECT_NE(unit.find("\nProtectSystem=strict\n"), std::string::npos);
@@ -33,7 +31,7 @@ TEST(CollectUnit, RestartsAndSpoolsWhereItMayWrite) {
 // As eicald's unit: systemd waits for READY=1 and restarts a collector whose loop stops
 // feeding the watchdog (collect_notify_test.cpp sees both from the real binary).
 TEST(CollectUnit, NotifiesSystemdAndHasAWatchdog) {
-  const std::string unit = read_file(kUnit);
+  const std::string unit = slurp(kUnit);
   EXPECT_NE(unit.find("\nType=notify\n"), std::string::npos);
   EXPECT_EQ(unit.find("\nType=simple\n"), std::string::npos);
   EXPECT_NE(unit.find("\nNotifyAccess=main\n"), std::string::npos);
@@ -53,7 +51,7 @@ TEST(CollectUnit, EveryUnitInTheTreeNotifiesAndHasAWatchdog) {
   for (const auto& e : fs::directory_iterator(fs::path(EICAL_SOURCE_DIR) / "systemd")) {
     if (e.path().extension() != ".service") continue;
     ++units;
-    const std::string unit = read_file(e.path());
+    const std::string unit = slurp(e.path());
     EXPECT_NE(unit.find("\nType=notify\n"), std::string::npos) << e.path();
     EXPECT_NE(unit.find("\nWatchdogSec="), std::string::npos) << e.path();
   }
@@ -65,7 +63,7 @@ TEST(CollectUnit, PassesSystemdAnalyzeVerify) {
       << "systemd-analyze not installed (scripts/deps.sh test)";
   const fs::path dir = fs::temp_directory_path() / ("eical-collect-unit-" + std::to_string(std::random_device{}()));
   fs::create_directories(dir);
-  std::string unit = read_file(kUnit);
+  std::string unit = slurp(kUnit);
   const std::string exec = "/usr/local/bin/eical";  // verify wants an existing binary
   unit.replace(unit.find(exec), exec.size(), "/bin/true");
   const std::string env = "/etc/eical/collect.env";

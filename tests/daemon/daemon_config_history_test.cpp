@@ -15,7 +15,7 @@ namespace {
 namespace fs = std::filesystem;
 using eical::daemon::load_daemon_config;
 
-std::string error_of(const std::string& text, eical::daemon::DaemonConfig* out = nullptr) {
+std::string history_config_error(const std::string& text, eical::daemon::DaemonConfig* out = nullptr) {
   const fs::path p = fs::temp_directory_path() / ("eicald-history-" + std::to_string(std::random_device{}()) + ".toml");
   std::ofstream(p) << text;
   std::string msg;
@@ -31,26 +31,28 @@ std::string error_of(const std::string& text, eical::daemon::DaemonConfig* out =
 
 TEST(DaemonConfigHistory, EveryKeyIsRead) {
   eical::daemon::DaemonConfig c;
-  ASSERT_EQ(error_of("[history]\nenabled = true\ndb = \"postgresql://eical@server/eical\"\nspool_dir = "
-                     "\"/tmp/s\"\nretry_s = 5.0\n",
-                     &c),
+  ASSERT_EQ(history_config_error("[history]\nenabled = true\ndb = \"postgresql://eical@server/eical\"\nspool_dir = "
+                                 "\"/tmp/s\"\nretry_s = 5.0\n",
+                                 &c),
             "");
   EXPECT_TRUE(c.history.enabled);
   EXPECT_EQ(c.history.db, "postgresql://eical@server/eical");
   EXPECT_EQ(c.history.spool_dir, "/tmp/s");
   EXPECT_EQ(c.history.retry_s, 5.0);
-  ASSERT_EQ(error_of("", &c), "");
+  ASSERT_EQ(history_config_error("", &c), "");
   EXPECT_FALSE(c.history.enabled);  // no [history]: no history kept
 }
 
 TEST(DaemonConfigHistory, BadValuesAreRefusedNamingTheKey) {
-  EXPECT_NE(error_of("[history]\nretry_s = 0.0\n").find("retry_s"), std::string::npos);
-  EXPECT_NE(error_of("[history]\ndb = \"\"\n").find("db"), std::string::npos);
-  EXPECT_NE(error_of("[history]\nspool_dir = \"\"\n").find("spool_dir"), std::string::npos);
-  EXPECT_NE(error_of("[history]\nenable = true\n").find("enable"), std::string::npos);  // a typo is not ignored
-  EXPECT_NE(error_of("[history]\nenabled = \"yes\"\n").find("enabled"), std::string::npos);
-  EXPECT_NE(error_of("[machine]\nname = \"\"\n[history]\nenabled = true\n").find("[machine] name is required"),
-            std::string::npos);
+  EXPECT_NE(history_config_error("[history]\nretry_s = 0.0\n").find("retry_s"), std::string::npos);
+  EXPECT_NE(history_config_error("[history]\ndb = \"\"\n").find("db"), std::string::npos);
+  EXPECT_NE(history_config_error("[history]\nspool_dir = \"\"\n").find("spool_dir"), std::string::npos);
+  EXPECT_NE(history_config_error("[history]\nenable = true\n").find("enable"),
+            std::string::npos);  // a typo is not ignored
+  EXPECT_NE(history_config_error("[history]\nenabled = \"yes\"\n").find("enabled"), std::string::npos);
+  EXPECT_NE(
+      history_config_error("[machine]\nname = \"\"\n[history]\nenabled = true\n").find("[machine] name is required"),
+      std::string::npos);
 }
 
 TEST(DaemonConfigHistory, TheInstalledExampleKeepsAHistoryWhereTheServiceMayWrite) {

@@ -1,5 +1,6 @@
 #include "daemon/config/daemon_config.hpp"
 #include "dsp/core/error.hpp"
+#include "tests/support/text_file.hpp"
 
 #include <gtest/gtest.h>
 
@@ -24,10 +25,7 @@ fs::path write_temp(const std::string& text) {
   return p;
 }
 
-std::string read_file(const fs::path& p) {
-  std::ifstream is(p);
-  return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
-}
+using test_support::slurp;
 
 // The error message for `text`, or "" when it loads.
 std::string error_of(const std::string& text) {
@@ -90,7 +88,7 @@ TEST(DaemonConfig, SyntaxErrorNamesLineAndColumn) {
 TEST(DaemonConfig, EveryKeyOfTheExampleIsRecognised) {
   // Misspelling any one key of the example must be refused (as unknown, or as a missing
   // required key): proves the example documents no key the loader silently ignores.
-  const std::string text = read_file(kExample);
+  const std::string text = slurp(kExample);
   std::size_t pos = 0;
   int checked = 0;
   while ((pos = text.find('\n', pos)) != std::string::npos) {
@@ -113,7 +111,7 @@ TEST(DaemonConfig, EveryKeyOfTheExampleIsRecognised) {
 // file, its line and the key; a key of the extension namespace (ext_, docs/run-files.md) is
 // passed over.
 TEST(DaemonConfig, UnknownKeyInEveryTableNamesFileLineAndKeyExtensionPassesOver) {
-  const std::string text = read_file(kExample);
+  const std::string text = slurp(kExample);
   std::vector<std::size_t> after = {0};  // offsets of the lines a key goes after: the root's first
   for (std::size_t pos = 0; (pos = text.find("\n[", pos)) != std::string::npos; ++pos)
     after.push_back(text.find('\n', pos + 1) + 1);

@@ -12,7 +12,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string error_of(const std::string& input) {
+std::string finding_error(const std::string& input) {
   const fs::path file = fs::path(EICAL_SOURCE_DIR) / "fuzz" / "corpus" / "daemon_config" / input;
   EXPECT_TRUE(fs::exists(file)) << file;
   std::string what;
@@ -28,7 +28,7 @@ std::string error_of(const std::string& input) {
 // gpio_lines = [1e10, ...]: the offset was converted to int before its range was checked,
 // undefined behaviour (UBSan: float-cast-overflow); the range is checked on the double now.
 TEST(DaemonConfigFuzz, GpioLineBeyondIntIsRefusedBeforeConversion) {
-  EXPECT_NE(error_of("review-gpio-line-beyond-int")
+  EXPECT_NE(finding_error("review-gpio-line-beyond-int")
                 .find(":2: triggers.gpio_lines: line offsets must be integers within 0..65535"),
             std::string::npos);
 }

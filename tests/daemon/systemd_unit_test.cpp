@@ -1,6 +1,7 @@
 // The unit file is part of the product: check it with systemd's own verifier and check
 // that it agrees with the daemon's defaults (recording path writable, notify protocol).
 #include "daemon/config/daemon_config.hpp"
+#include "tests/support/text_file.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,10 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 const fs::path kUnit = fs::path(EICAL_SOURCE_DIR) / "systemd" / "eicald.service";
 
-std::string read_file(const fs::path& p) {
-  std::ifstream is(p);
-  return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
-}
+using test_support::slurp;
 
 // Values of `key=` in the unit, in order (keys may repeat).
 std::vector<std::string> values_of(const std::string& unit, const std::string& key) {
@@ -40,7 +38,7 @@ std::set<std::string> words(const std::string& s) {
 }
 
 TEST(SystemdUnit, DeclaresNotifyWatchdogRestartAndHardening) {
-  const std::string unit = read_file(kUnit);
+  const std::string unit = slurp(kUnit);
   ASSERT_FALSE(unit.empty());
   EXPECT_EQ(values_of(unit, "Type"), std::vector<std::string>{"notify"});
   ASSERT_EQ(values_of(unit, "WatchdogSec").size(), 1u);
@@ -57,7 +55,7 @@ TEST(SystemdUnit, DeclaresNotifyWatchdogRestartAndHardening) {
 }
 
 TEST(SystemdUnit, RecordingDefaultIsWritableUnderTheSandbox) {
-  const std::string unit = read_file(kUnit);
+  const std::string unit = slurp(kUnit);
   const fs::path rec = eical::daemon::RecordingConfig{}.dir;  // default recording path
   const auto pos = unit.find("ReadWritePaths=");
   ASSERT_NE(pos, std::string::npos);
@@ -72,7 +70,7 @@ TEST(SystemdUnit, PassesSystemdAnalyzeVerify) {
   std::random_device rd;
   const fs::path dir = fs::temp_directory_path() / ("eicald-unit-" + std::to_string(rd()));
   fs::create_directories(dir);
-  std::string unit = read_file(kUnit);
+  std::string unit = slurp(kUnit);
   const std::string exec = "/usr/bin/eicald";
   unit.replace(unit.find(exec), exec.size(), "/bin/true");
   std::ofstream(dir / "eicald.service") << unit;

@@ -27,14 +27,14 @@ struct Injected {
   double noise_um = 0.1;
 };
 
-constexpr double kR = 10.0, kFeed = 2500.0, kFs = 1000.0;
+constexpr double kDiagRadiusMm = 10.0, kDiagFeed = 2500.0, kDiagFs = 1000.0;
 
 CirclePass make_pass(int direction, const Injected& in, std::uint64_t seed) {
   CirclePass p;
   p.direction = direction;
-  p.fs_hz = kFs;
-  const double w = kFeed / 60.0 / kR * direction;  // rad/s
-  const auto n = static_cast<std::size_t>(5 * 2 * std::numbers::pi / std::abs(w) * kFs);
+  p.fs_hz = kDiagFs;
+  const double w = kDiagFeed / 60.0 / kDiagRadiusMm * direction;  // rad/s
+  const auto n = static_cast<std::size_t>(5 * 2 * std::numbers::pi / std::abs(w) * kDiagFs);
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> noise(0.0, in.noise_um * 1e-3);
   double last_sx = 0.0, since_rev_s = 1e9;
@@ -42,10 +42,10 @@ CirclePass make_pass(int direction, const Injected& in, std::uint64_t seed) {
   // until the motor has crossed it); a negative one has no such mechanism and stays a step.
   double slide_x = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t i = 0; i < n; ++i) {
-    const double t = static_cast<double>(i) / kFs;
+    const double t = static_cast<double>(i) / kDiagFs;
     const double th = std::numbers::pi / 4 + w * t;
-    const Eigen::Vector2d c(kR * std::cos(th), kR * std::sin(th));
-    const Eigen::Vector2d v(-kR * w * std::sin(th), kR * w * std::cos(th));
+    const Eigen::Vector2d c(kDiagRadiusMm * std::cos(th), kDiagRadiusMm * std::sin(th));
+    const Eigen::Vector2d v(-kDiagRadiusMm * w * std::sin(th), kDiagRadiusMm * w * std::cos(th));
     const double sx = v.x() > 0 ? 1.0 : -1.0, sy = v.y() > 0 ? 1.0 : -1.0;
     if (last_sx != 0.0 && sx != last_sx) since_rev_s = 0.0;
     last_sx = sx;
@@ -62,20 +62,20 @@ CirclePass make_pass(int direction, const Injected& in, std::uint64_t seed) {
             in.cyclic_x_um * 1e-3 * std::sin(2 * std::numbers::pi * c.x() / in.pitch_mm + 0.3) -
             in.spike_x_um * 1e-3 * sx * std::exp(-since_rev_s / 0.008);
     e.y() = in.scale_y_ppm * 1e-6 * c.y() - in.lag_y_ms * 1e-3 * v.y() - in.backlash_y_um * 1e-3 / 2 * sy +
-            in.straightness_x_um * 1e-3 * (1.0 - (c.x() / kR) * (c.x() / kR));
+            in.straightness_x_um * 1e-3 * (1.0 - (c.x() / kDiagRadiusMm) * (c.x() / kDiagRadiusMm));
     // Integration drift: an offset and a slow quadratic per pass.
     e += Eigen::Vector2d(0.004 + 0.002 * t / 7.5, -0.003 + 0.003 * (t / 7.5) * (t / 7.5));
     e += Eigen::Vector2d(noise(rng), noise(rng));
     p.cmd_mm.push_back(c);
     p.meas_mm.push_back(c + e);
-    since_rev_s += 1.0 / kFs;
+    since_rev_s += 1.0 / kDiagFs;
   }
   return p;
 }
 
 CircleDiagnostics run(const Injected& in) {
   DiagnosticsOptions opt;
-  opt.radius_mm = kR;
+  opt.radius_mm = kDiagRadiusMm;
   opt.cyclic_pitch_mm = in.pitch_mm;
   return diagnose_circle({make_pass(+1, in, 1), make_pass(-1, in, 2)}, opt);
 }
@@ -177,7 +177,7 @@ TEST(CircleDiagnostics, OneDirectionSaysItCannotSeparateServoFromSquareness) {
   Injected in;
   in.squareness_urad = 100.0;
   DiagnosticsOptions opt;
-  opt.radius_mm = kR;
+  opt.radius_mm = kDiagRadiusMm;
   opt.cyclic_pitch_mm = 5.0;
   const auto d = diagnose_circle({make_pass(+1, in, 3)}, opt);
   EXPECT_FALSE(d.servo_and_squareness_separated);

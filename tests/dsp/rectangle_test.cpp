@@ -8,7 +8,7 @@
 namespace eical::dsp::eval {
 namespace {
 
-constexpr double kFs = 1000.0;
+constexpr double kRectangleFs = 1000.0;
 
 // A 20 × 10 mm rectangle at 10 mm/s with 0.1 s stops; the machine's Y axis is tilted by
 // `square_urad` (moving +y also moves x by −α·y), a corner error is added at (20, 10) and
@@ -21,7 +21,7 @@ void make(double square_urad, double bow_um, std::vector<Eigen::Vector2d>& cmd, 
   stop(corners[0]);
   for (std::size_t k = 0; k + 1 < corners.size(); ++k) {
     const Eigen::Vector2d d = corners[k + 1] - corners[k];
-    const int n = static_cast<int>(d.norm() / 10.0 * kFs);
+    const int n = static_cast<int>(d.norm() / 10.0 * kRectangleFs);
     for (int i = 1; i <= n; ++i) cmd.push_back(corners[k] + d * (static_cast<double>(i) / n));
     stop(corners[k + 1]);
   }
@@ -37,7 +37,7 @@ void make(double square_urad, double bow_um, std::vector<Eigen::Vector2d>& cmd, 
 TEST(Rectangle, CornerErrorsSquarenessAndStraightness) {
   std::vector<Eigen::Vector2d> cmd, meas;
   make(50.0, 2.0, cmd, meas);
-  const auto r = evaluate_rectangle(cmd, meas, kFs);
+  const auto r = evaluate_rectangle(cmd, meas, kRectangleFs);
   ASSERT_EQ(r.corners_mm.size(), 5u);
   ASSERT_EQ(r.sides.size(), 4u);
   // Corner (20, 10): the injected error plus the squareness shift −α·y = −0.5 µm in x.
@@ -56,7 +56,7 @@ TEST(Rectangle, CornerErrorsSquarenessAndStraightness) {
 TEST(Rectangle, TooFewStopsIsAnError) {
   std::vector<Eigen::Vector2d> line;
   for (int i = 0; i < 1000; ++i) line.emplace_back(i * 0.01, 0.0);
-  EXPECT_THROW((void)evaluate_rectangle(line, line, kFs), InputError);
+  EXPECT_THROW((void)evaluate_rectangle(line, line, kRectangleFs), InputError);
 }
 
 }  // namespace

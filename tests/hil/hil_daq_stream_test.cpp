@@ -32,7 +32,7 @@
 namespace eical::test {
 namespace {
 
-constexpr double kFs = 10000.0;
+constexpr double kDaqFs = 10000.0;
 constexpr std::int64_t kServoCycle0 = 734512;  // LinuxCNC's cycle count at the servo stream's start
 constexpr double kServoOffsetS = 0.0037;       // servo cycle kServoCycle0 happens 3.7 ms after DAQ sample 0
 constexpr std::int64_t kDeadTimeFrames = 370;  // (b): the NC rests 37 ms longer after M101
@@ -50,7 +50,7 @@ Stream make_stream(const fs::path& program_file, std::int64_t dead_time_frames) 
   sim::Scenario sc = sim::circle_scenario(10.0, 2500.0, 2, "ccw", 3);
   sc.meta.program = drivers::read_program_file(program_file);
   s.sim = sim::simulate(sc);
-  const auto lead = static_cast<std::int64_t>(2.5 * kFs), tail = static_cast<std::int64_t>(1.5 * kFs);
+  const auto lead = static_cast<std::int64_t>(2.5 * kDaqFs), tail = static_cast<std::int64_t>(1.5 * kDaqFs);
   auto add = [&](std::int64_t j, bool trigger) {
     dsp::Frame f = s.sim.frames[static_cast<std::size_t>(
         std::clamp<std::int64_t>(j, 0, static_cast<std::int64_t>(s.sim.frames.size()) - 1))];
@@ -114,7 +114,7 @@ class DaqDevice {
     t0_ns_ = t0;
     for (std::size_t i = 0; i < frames.size() && !stop_; i += 32) {
       const std::size_t n = std::min<std::size_t>(32, frames.size() - i);
-      sleep_until_ns(t0 + static_cast<std::int64_t>(static_cast<double>(i + n - 1) * 1e9 / kFs));
+      sleep_until_ns(t0 + static_cast<std::int64_t>(static_cast<double>(i + n - 1) * 1e9 / kDaqFs));
       bytes.clear();
       enc.encode(std::span<const dsp::Frame>(frames).subspan(i, n), bytes);
       if (::write(fd, bytes.data(), bytes.size()) < 0) break;
@@ -126,7 +126,7 @@ class DaqDevice {
     while (!stop_) {
       std::vector<dsp::Frame> block(32, rest);
       for (auto& f : block) f.sample_index = ++index, f.trigger = 0;
-      sleep_until_ns(t0 + static_cast<std::int64_t>(static_cast<double>(index) * 1e9 / kFs));
+      sleep_until_ns(t0 + static_cast<std::int64_t>(static_cast<double>(index) * 1e9 / kDaqFs));
       bytes.clear();
       enc.encode(block, bytes);
       if (::write(fd, bytes.data(), bytes.size()) < 0) break;
@@ -159,7 +159,7 @@ class ServoStreamWriter {
     const std::int64_t t0 = daq.t0_ns();
     // The commanded position at DAQ time t (s): the simulated run's set-point of that frame.
     auto cmd_at = [&](double t, int a) {
-      const double x = std::clamp(t * kFs, 0.0, static_cast<double>(s.frames.size() - 2));
+      const double x = std::clamp(t * kDaqFs, 0.0, static_cast<double>(s.frames.size() - 2));
       const auto k = static_cast<std::size_t>(x);
       const auto& f0 = s.sim.frames[static_cast<std::size_t>(s.origin[k])];
       const auto& f1 = s.sim.frames[static_cast<std::size_t>(s.origin[k + 1])];
@@ -320,7 +320,7 @@ TEST(HilDaqStream, ServoStreamSetPointBesideTheDaq) {
   EXPECT_EQ(sp.program_number, 7);
   EXPECT_EQ(run.meta.program.kind, "circle");
   const double true_cycle = static_cast<double>(kServoCycle0) +
-                            (static_cast<double>(run.frames.front().sample_index) / kFs - kServoOffsetS) * 1e3;
+                            (static_cast<double>(run.frames.front().sample_index) / kDaqFs - kServoOffsetS) * 1e3;
   const double err_um = setpoint_error_um(run, s);
   std::printf(
       "(a) servo stream: servo cycle at the first sample %.3f (true %.3f, %+.3f ms); set-point within %.2f um of the "
@@ -361,7 +361,8 @@ TEST(HilDaqStream, ProgramSetPointNamedByM101BesideTheDaq) {
     // the moment the M-code ran); M101 names program 7.
     for (const auto& f : s.frames) {
       if (f.trigger == 0) continue;
-      const std::int64_t due = daq.t0_ns() + static_cast<std::int64_t>(static_cast<double>(f.sample_index) * 1e9 / kFs);
+      const std::int64_t due =
+          daq.t0_ns() + static_cast<std::int64_t>(static_cast<double>(f.sample_index) * 1e9 / kDaqFs);
       sleep_until_ns(due - 300'000'000);
       const auto reply = nc.trigger_reply(f.trigger, due, f.trigger == 101 ? 7.0 : std::nan(""));
       ASSERT_TRUE(reply && reply->ok) << "M" << f.trigger << ": " << (reply ? reply->message : std::string("no reply"));
@@ -382,10 +383,10 @@ TEST(HilDaqStream, ProgramSetPointNamedByM101BesideTheDaq) {
       "M101: %+.3f ms "
       "expected from the marks); %d motion block(s); set-point within %.2f um of the simulated one;\n"
       "    measured lags the set-point by %+.3f ms, correlation %.4f, residual %.2f %%\n",
-      sp.marks_offset_s * 1e3, sp.offset_s * 1e3, static_cast<double>(kDeadTimeFrames) / kFs * 1e3, sp.blocks, err_um,
-      sp.lag_s * 1e3, sp.correlation, sp.residual_ratio * 100.0);
+      sp.marks_offset_s * 1e3, sp.offset_s * 1e3, static_cast<double>(kDeadTimeFrames) / kDaqFs * 1e3, sp.blocks,
+      err_um, sp.lag_s * 1e3, sp.correlation, sp.residual_ratio * 100.0);
   // The motion starts 37 ms later than the M101 mark says: the cross-correlation finds it.
-  EXPECT_NEAR((sp.offset_s - sp.marks_offset_s) * 1e3, static_cast<double>(kDeadTimeFrames) / kFs * 1e3, 8.0)
+  EXPECT_NEAR((sp.offset_s - sp.marks_offset_s) * 1e3, static_cast<double>(kDeadTimeFrames) / kDaqFs * 1e3, 8.0)
       << "the 37 ms within the DDS mark's latency";
   EXPECT_LT(err_um, 25.0);
   EXPECT_NEAR(sp.lag_s, 0.0, 5e-4);

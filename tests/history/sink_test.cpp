@@ -18,7 +18,7 @@ namespace {
 using namespace std::chrono_literals;
 using history::Sink;
 
-history::Record sample(const std::string& run) {
+history::Record sink_record(const std::string& run) {
   return history::record_from_result(circle_result(run),
                                      {"maho-1", "2026-11-12T09:11:00Z", "/runs/" + run, std::nullopt, ""});
 }
@@ -69,8 +69,8 @@ TEST_P(SinkTest, ResultsEnterTheStoreAndLeaveTheSpool) {
   Messages msg;
   {
     Sink sink(config(), msg.log());
-    sink.submit(sample("a"));
-    sink.submit(sample("b"));
+    sink.submit(sink_record("a"));
+    sink.submit(sink_record("b"));
     ASSERT_TRUE(sink.wait_drained(20s)) << msg.errors();
     EXPECT_EQ(sink.counts().stored, 2u);
     EXPECT_TRUE(sink.problem().empty());
@@ -84,7 +84,7 @@ TEST_P(SinkTest, AStoreOfANewerSchemaKeepsResultsSpooledAndSaysWhy) {
   history::Store::open(location_, {.create = true})->connection().exec("UPDATE eical_schema SET version = 99");
   Messages msg;
   Sink sink(config(), msg.log());
-  sink.submit(sample("a"));
+  sink.submit(sink_record("a"));
   // The problem is set before its message is logged: wait for both.
   ASSERT_TRUE(eventually([&] {
     return !sink.problem().empty() && msg.errors().find("results wait in") != std::string::npos;
@@ -103,11 +103,11 @@ TEST(SinkPostgresql, ADatabaseThatGoesAwayGetsTheResultsWhenItIsBack) {
   Messages msg;
   {
     Sink sink({location, dir / "spool", 0.2, true}, msg.log());
-    sink.submit(sample("before"));
+    sink.submit(sink_record("before"));
     ASSERT_TRUE(sink.wait_drained(20s)) << msg.errors();
     pg().stop();  // the database goes away
-    sink.submit(sample("while-away-1"));
-    sink.submit(sample("while-away-2"));
+    sink.submit(sink_record("while-away-1"));
+    sink.submit(sink_record("while-away-2"));
     ASSERT_TRUE(eventually([&] { return !sink.problem().empty(); }));
     EXPECT_NE(sink.problem().find("history store postgresql://"), std::string::npos) << sink.problem();
     EXPECT_EQ(history::Spool(dir / "spool").waiting().size(), 2u);
@@ -133,7 +133,7 @@ TEST(SinkSqlite, ALockedStoreGetsTheResultsWhenTheLockIsGone) {
   holder->exec("BEGIN IMMEDIATE");  // another process writing and not letting go
   Messages msg;
   Sink sink({location, dir / "spool", 0.2, true}, msg.log());
-  sink.submit(sample("a"));
+  sink.submit(sink_record("a"));
   ASSERT_TRUE(eventually([&] { return !sink.problem().empty(); }));
   EXPECT_NE(sink.problem().find("database is locked"), std::string::npos) << sink.problem();
   EXPECT_NE(sink.problem().find(location), std::string::npos) << sink.problem();
@@ -148,7 +148,7 @@ TEST(SinkSqlite, AMissingOrCorruptStoreGetsTheResultsWhenItIsThere) {
   const std::string location = (dir / "mnt" / "history.db").string();  // a mount that is not there
   Messages msg;
   Sink sink({location, dir / "spool", 0.2, true}, msg.log());
-  sink.submit(sample("a"));
+  sink.submit(sink_record("a"));
   ASSERT_TRUE(eventually([&] { return sink.problem().find("does not exist") != std::string::npos; })) << sink.problem();
   // The directory comes, but with a corrupt file in it.
   fs::create_directories(dir / "mnt");
@@ -174,8 +174,8 @@ TEST(SinkSqlite, SpooledResultsOfAnEarlierProcessEnterTheStoreAtStart) {
   {
     Messages msg;
     Sink sink({location, dir / "spool", 0.2, true}, msg.log());  // store directory missing
-    sink.submit(sample("a"));
-    sink.submit(sample("b"));
+    sink.submit(sink_record("a"));
+    sink.submit(sink_record("b"));
     ASSERT_TRUE(eventually([&] { return !sink.problem().empty(); }));
   }  // the process ends with two results spooled
   EXPECT_EQ(history::Spool(dir / "spool").waiting().size(), 2u);
@@ -197,7 +197,7 @@ TEST(SinkSqlite, AnUnreadableSpoolFileIsSetAsideAndTheOthersGoIn) {
   }
   Messages msg;
   Sink sink({(dir / "history.db").string(), dir / "spool", 0.2, true}, msg.log());
-  sink.submit(sample("good"));
+  sink.submit(sink_record("good"));
   ASSERT_TRUE(sink.wait_drained(20s)) << msg.errors();
   EXPECT_EQ(sink.counts().stored, 1u);
   EXPECT_EQ(sink.counts().set_aside, 1u);
@@ -211,7 +211,7 @@ TEST(SinkSqlite, WhenEvenTheSpoolCannotBeWrittenTheResultIsHeldInMemory) {
   { std::ofstream os(dir / "spool"); }  // a file where the spool directory should be
   Messages msg;
   Sink sink({(dir / "history.db").string(), dir / "spool", 0.2, true}, msg.log());
-  sink.submit(sample("a"));
+  sink.submit(sink_record("a"));
   ASSERT_TRUE(sink.wait_drained(20s)) << msg.errors();
   EXPECT_EQ(sink.counts().stored, 1u);
   EXPECT_NE(msg.errors().find("cannot spool result a"), std::string::npos) << msg.errors();

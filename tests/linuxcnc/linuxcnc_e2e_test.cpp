@@ -12,21 +12,21 @@
 namespace eical::test {
 namespace {
 
-constexpr double kBacklashXUm = 4.0;
+constexpr double kE2eBacklashXUm = 4.0;
 
 // A real position loop (as config/scenarios/backlash-circle.toml): with an ideal,
 // infinitely stiff one the play operator picks the slide up with a velocity step.
-std::string machine() {
+std::string e2e_machine() {
   return "[servo.x]\nkv_per_s = 33.3\nfeedforward = 0.99\n[servo.y]\nkv_per_s = 33.3\nfeedforward = 0.99\n"
          "[effects.\"machine.backlash\"]\naxis = \"x\"\nvalue_um = " +
-         std::to_string(kBacklashXUm) + "\n";
+         std::to_string(kE2eBacklashXUm) + "\n";
 }
 
 ProgramOutcome run_program(const std::string& tag, const std::vector<std::string>& gen_args) {
   LcncProgram p;
   p.tag = tag;
   p.gen_args = gen_args;
-  p.machine = machine();
+  p.machine = e2e_machine();
   return eical::test::run_program(p);
 }
 
@@ -74,14 +74,14 @@ TEST(LinuxcncE2E, CircleBothDirectionsAndIso230_2OnLinuxCncMatchTheInjectedBackl
         "circle %s on LinuxCNC: G %.2f um, mean radius deviation %.2f um, backlash x %.2f um (injected %.1f), backlash "
         "y %.2f um (injected 0), degraded %d\n",
         dir, c["circular_deviation_G_um"].get<double>(), c["radius_mean_deviation_um"].get<double>(),
-        d["backlash_x_um"].get<double>(), kBacklashXUm, d["backlash_y_um"].get<double>(),
+        d["backlash_x_um"].get<double>(), kE2eBacklashXUm, d["backlash_y_um"].get<double>(),
         o.result["quality"]["degraded"].get<bool>());
     check_and_print_timing(std::string("circle ") + dir, o);
     // The ballbar-style fit of the play on x; its residual is the model's own scatter.
     // Measured here: 2.2..3.4 um for 4 um injected, |y| <= 1.2 um (4 runs). Tolerance:
     // the fit's noise, taken as five times its residual rms (~0.45 um).
     const double tol = 5.0 * d["model_residual_rms_um"].get<double>();
-    EXPECT_NEAR(d["backlash_x_um"].get<double>(), kBacklashXUm, tol);
+    EXPECT_NEAR(d["backlash_x_um"].get<double>(), kE2eBacklashXUm, tol);
     EXPECT_NEAR(d["backlash_y_um"].get<double>(), 0.0, tol);
     EXPECT_FALSE(o.result["quality"]["degraded"].get<bool>()) << o.result["quality"].dump();
   }
@@ -92,7 +92,7 @@ TEST(LinuxcncE2E, CircleBothDirectionsAndIso230_2OnLinuxCncMatchTheInjectedBackl
   std::printf(
       "ISO 230-2 on LinuxCNC: B %.2f um, mean B %.2f um (injected backlash %.1f um), E %.2f um, M %.2f um, R %.2f um, "
       "A %.2f um\n",
-      pos["B_um"].get<double>(), pos["B_mean_um"].get<double>(), kBacklashXUm, pos["E_um"].get<double>(),
+      pos["B_um"].get<double>(), pos["B_mean_um"].get<double>(), kE2eBacklashXUm, pos["E_um"].get<double>(),
       pos["M_um"].get<double>(), pos["R_um"].get<double>(), pos["A_um"].get<double>());
   check_and_print_timing("positioning", p);
   // ISO 230-2 B = mean up - mean down; the play shifts every approach from below by -b.
@@ -101,8 +101,8 @@ TEST(LinuxcncE2E, CircleBothDirectionsAndIso230_2OnLinuxCncMatchTheInjectedBackl
   const double n = static_cast<double>(pos["targets_mm"].size() * pos["runs"].get<std::size_t>());
   const double tol_b = 3.0 * pos["R_um"].get<double>() / 4.0 * std::sqrt(2.0 / n);
   std::printf("ISO 230-2: mean B %.2f um, expected %.2f +- %.2f um (3 sigma from R)\n", pos["B_mean_um"].get<double>(),
-              -kBacklashXUm, tol_b);
-  EXPECT_NEAR(pos["B_mean_um"].get<double>(), -kBacklashXUm, tol_b);
+              -kE2eBacklashXUm, tol_b);
+  EXPECT_NEAR(pos["B_mean_um"].get<double>(), -kE2eBacklashXUm, tol_b);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "tests/support/gcode_compare.hpp"
 
 #include <gtest/gtest.h>
+#include <numbers>
 
 #include <cmath>
 #include <cstdio>
@@ -18,8 +19,6 @@
 
 namespace eical::sim::gcode {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 std::string num(double v) { return format_number("%.4f", v); }
 
@@ -55,7 +54,7 @@ std::string random_program(std::mt19937_64& rng) {
       g += std::string("G91 G1 ") + static_cast<char>('X' + a) + num(step) + feed() + "\nG90\n";
     } else if (k <= 5) {  // arc in a plane: quarter to full turn, either way, sometimes helical
       const int p = plane_pick(rng), u = plane_axes[p][0], v = plane_axes[p][1], nrm = 3 - u - v;
-      const double r = 1.0 + unit(rng) * 60.0, a0 = unit(rng) * 2.0 * kPi;
+      const double r = 1.0 + unit(rng) * 60.0, a0 = unit(rng) * 2.0 * std::numbers::pi;
       const bool full = unit(rng) < 0.25, cw = unit(rng) < 0.5;
       const double sweep = full ? 0.0 : (0.2 + unit(rng) * 5.8) * (cw ? -1.0 : 1.0);
       const double cu = pos[u] - r * std::cos(a0), cv = pos[v] - r * std::sin(a0);

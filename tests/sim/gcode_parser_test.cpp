@@ -3,14 +3,13 @@
 #include "dsp/core/error.hpp"
 
 #include <gtest/gtest.h>
+#include <numbers>
 
 #include <cmath>
 #include <string>
 
 namespace eical::sim::gcode {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The circle program of the sample runs (shared/data/baseline-0011/run.toml).
 constexpr const char* kCircle = R"(G90 G21 G17 G64 (continuous path: the arcs are one blended move)
@@ -50,13 +49,13 @@ TEST(GcodeParser, SampleCircleProgramBlocks) {
   EXPECT_TRUE(std::isnan(std::get<Trigger>(p.blocks[2]).p));
   const auto& ramp_in = std::get<Arc>(p.blocks[4]);
   EXPECT_FALSE(ramp_in.clockwise);
-  EXPECT_NEAR(ramp_in.sweep_rad, kPi / 2.0, 1e-4);
+  EXPECT_NEAR(ramp_in.sweep_rad, std::numbers::pi / 2.0, 1e-4);
   EXPECT_NEAR(ramp_in.center_mm.norm(), 0.0, 1e-4);
   EXPECT_DOUBLE_EQ(ramp_in.feed_mm_min, 2500.0);
   const auto& full = std::get<Arc>(p.blocks[6]);
-  EXPECT_NEAR(full.sweep_rad, 2.0 * kPi, 1e-12) << "same start and end point is a full turn";
+  EXPECT_NEAR(full.sweep_rad, 2.0 * std::numbers::pi, 1e-12) << "same start and end point is a full turn";
   const auto& ramp_out = std::get<Arc>(p.blocks[8]);
-  EXPECT_NEAR(ramp_out.sweep_rad, kPi / 2.0, 1e-4);
+  EXPECT_NEAR(ramp_out.sweep_rad, std::numbers::pi / 2.0, 1e-4);
   EXPECT_EQ(p.source[8].line, 10);
   EXPECT_EQ(std::get<Trigger>(p.blocks[10]).code, 103);
 }
@@ -67,19 +66,19 @@ TEST(GcodeParser, RFormArcsPickShortOrLongArc) {
   const auto& a = std::get<Arc>(shortp.blocks[0]);
   EXPECT_NEAR(a.center_mm.x(), 0.0, 1e-9);
   EXPECT_NEAR(a.center_mm.y(), 0.0, 1e-9);
-  EXPECT_NEAR(a.sweep_rad, kPi / 2.0, 1e-9);
+  EXPECT_NEAR(a.sweep_rad, std::numbers::pi / 2.0, 1e-9);
   // Negative R: the long way round (270°) about the mirrored centre.
   const Program longp = parse("G3 X0 Y10 R-10 F1000", "t", {.start_mm = {10, 0, 0}});
   const auto& b = std::get<Arc>(longp.blocks[0]);
   EXPECT_NEAR(b.center_mm.x(), 10.0, 1e-9);
   EXPECT_NEAR(b.center_mm.y(), 10.0, 1e-9);
-  EXPECT_NEAR(b.sweep_rad, 1.5 * kPi, 1e-9);
+  EXPECT_NEAR(b.sweep_rad, 1.5 * std::numbers::pi, 1e-9);
   // Clockwise short arc: centre on the other side.
   const Program cw = parse("G2 X0 Y10 R10 F1000", "t", {.start_mm = {10, 0, 0}});
   const auto& c = std::get<Arc>(cw.blocks[0]);
   EXPECT_NEAR(c.center_mm.x(), 10.0, 1e-9);
   EXPECT_NEAR(c.center_mm.y(), 10.0, 1e-9);
-  EXPECT_NEAR(c.sweep_rad, -kPi / 2.0, 1e-9);
+  EXPECT_NEAR(c.sweep_rad, -std::numbers::pi / 2.0, 1e-9);
 }
 
 TEST(GcodeParser, PlanesUnitsAndIncrementalMode) {

@@ -19,8 +19,6 @@
 namespace eical::sim {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 double decode_g(const dsp::Run& run, std::size_t n, int channel) {
   const auto& acq = run.meta.acquisition;
   const auto& s = run.meta.sensors[channel / 3];
@@ -75,7 +73,8 @@ TEST(Regimes, ModeFrequencyAndDampingFromItsFreeDecay) {
     }
   }
   ASSERT_GT(crossings.size(), 40u);
-  const double wd = kPi * static_cast<double>(crossings.size() - 1) / (crossings.back() - crossings.front());
+  const double wd =
+      std::numbers::pi * static_cast<double>(crossings.size() - 1) / (crossings.back() - crossings.front());
   double mt = 0, ml = 0;
   const auto n_peaks = static_cast<double>(peak_t.size());
   for (std::size_t k = 0; k < peak_t.size(); ++k) mt += peak_t[k] / n_peaks, ml += peak_ln[k] / n_peaks;
@@ -83,7 +82,7 @@ TEST(Regimes, ModeFrequencyAndDampingFromItsFreeDecay) {
   for (std::size_t k = 0; k < peak_t.size(); ++k)
     stt += (peak_t[k] - mt) * (peak_t[k] - mt), stl += (peak_t[k] - mt) * (peak_ln[k] - ml);
   const double sigma = -stl / stt, wn = std::hypot(wd, sigma);
-  const double f_hz = wn / (2 * kPi), zeta = sigma / wn;
+  const double f_hz = wn / (2 * std::numbers::pi), zeta = sigma / wn;
   std::printf("mode put in: 45 Hz, zeta 0.02; free decay of the simulated head: %.3f Hz, zeta %.4f\n", f_hz, zeta);
   EXPECT_NEAR(f_hz, 45.0, 0.1);
   EXPECT_NEAR(zeta, 0.02, 0.001);
@@ -96,7 +95,7 @@ std::vector<std::complex<double>> frf(const std::vector<double>& x, const std::v
   std::vector<double> sxx(seg / 2 + 1, 0.0), bx(seg), by(seg);
   for (std::size_t s = 0; s + seg <= x.size(); s += seg / 2) {
     for (std::size_t k = 0; k < seg; ++k) {
-      const double w = 0.5 - 0.5 * std::cos(2 * kPi * static_cast<double>(k) / static_cast<double>(seg));
+      const double w = 0.5 - 0.5 * std::cos(2 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(seg));
       bx[k] = w * x[s + k], by[k] = w * y[s + k];
     }
     fft.fwd(X, bx), fft.fwd(Y, by);
@@ -136,7 +135,7 @@ TEST(Regimes, ModeShowsInTheSweptResponseOfAMemsHeadSensor) {
       double den = 0.0;
       std::vector<std::complex<double>> shape(b1 - b0);
       for (std::size_t b = b0; b < b1; ++b) {
-        const double w = 2 * kPi * static_cast<double>(b) * df, wn = 2 * kPi * fn;
+        const double w = 2 * std::numbers::pi * static_cast<double>(b) * df, wn = 2 * std::numbers::pi * fn;
         shape[b - b0] = w * w / std::complex<double>(wn * wn - w * w, 2 * z * wn * w);
         num += std::conj(shape[b - b0]) * (h[b] - 1.0), den += std::norm(shape[b - b0]);
       }
@@ -202,8 +201,8 @@ double amplitude_at(const dsp::Run& run, int channel, double f_hz, double second
   const double fs = run.fs_hz();
   const auto n0 = run.frames.size() - static_cast<std::size_t>(std::llround(seconds * fs));
   for (std::size_t n = n0; n < run.frames.size(); ++n)
-    acc +=
-        decode_g(run, n, channel) * std::exp(std::complex<double>(0.0, -2 * kPi * f_hz * static_cast<double>(n) / fs));
+    acc += decode_g(run, n, channel) *
+           std::exp(std::complex<double>(0.0, -2 * std::numbers::pi * f_hz * static_cast<double>(n) / fs));
   return 2.0 * std::abs(acc) / static_cast<double>(run.frames.size() - n0);
 }
 

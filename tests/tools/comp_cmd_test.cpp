@@ -4,6 +4,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/text_file.hpp"
 #include "tests/tools/cli_runner.hpp"
 
 #include <gtest/gtest.h>
@@ -25,10 +26,7 @@ struct Tmp {
   ~Tmp() { fs::remove_all(dir); }
 };
 
-std::string slurp(const fs::path& p) {
-  std::ifstream is(p);
-  return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
-}
+using test_support::slurp;
 
 // A positioning result as eical analyze writes it: 5 targets, a lead error of 100 ppm and
 // 6 µm play; `u` = the uncertainty_k2 of M and mean B (absent when negative).

@@ -61,8 +61,16 @@ TEST(ConformanceCli, ToleranceWideNarrowAndStraddledByU) {
     ASSERT_EQ(conf["figures"].size(), 1u);
     EXPECT_EQ(conf["figures"][0]["key"], "circle.circular_deviation_G_um");
     EXPECT_EQ(conf["figures"][0]["decision"], c.decision);
-    // The exit status: the verdict's unless it is ok, then the decision's.
-    EXPECT_EQ(status, verdict == "ok" ? c.exit_if_ok : verdict == "degraded" ? 2 : 3);
+    // The exit status: the verdict's unless it is ok, then the decision's. With tolerances
+    // the verdict is judged against them: a decision proven either way is never
+    // not_measurable (the banner and the table tell one story); undecided keeps the
+    // verdict the run had without them.
+    const std::string judged = doc["quality"]["verdict"];
+    if (std::string(c.decision) == "undecided")
+      EXPECT_EQ(judged, verdict);
+    else
+      EXPECT_NE(judged, "not_measurable") << doc["quality"].dump();
+    EXPECT_EQ(status, judged == "ok" ? c.exit_if_ok : judged == "degraded" ? 2 : 3);
     const std::string text = run_cli("analyze --tolerances " + t.string() + " " + run, status);
     EXPECT_NE(text.find("against the tolerances (ISO 14253-1"), std::string::npos) << text;
   }

@@ -6,6 +6,7 @@
 #include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
+#include "tests/support/text_file.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -20,16 +21,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
+struct EnvelopeOutcome {
   int exit_code = -1;
   std::string out, err;
   double wall_s = 0.0;
 };
 
-std::string slurp(const fs::path& p) {
-  std::ifstream is(p);
-  return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
-}
+using test_support::slurp;
 
 class EnvelopeCli : public ::testing::Test {
  protected:
@@ -40,13 +38,13 @@ class EnvelopeCli : public ::testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
 
   // `eical ARGS` as a child process: its exit status, standard output and error apart.
-  Outcome eical(const std::string& args) const {
+  EnvelopeOutcome eical(const std::string& args) const {
     std::string cmd = EICAL_CLI;
     cmd.append(" ").append(args).append(" >").append((dir_ / "out.txt").string());
     cmd.append(" 2>").append((dir_ / "err.txt").string());
     const auto t0 = std::chrono::steady_clock::now();
     const int status = std::system(cmd.c_str());
-    Outcome o;
+    EnvelopeOutcome o;
     o.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     o.out = slurp(dir_ / "out.txt"), o.err = slurp(dir_ / "err.txt");
@@ -56,14 +54,14 @@ class EnvelopeCli : public ::testing::Test {
 };
 
 // One line on stderr, exit status 1, naming every part of `causes`.
-void expect_refusal(const Outcome& o, const std::vector<std::string>& causes) {
+void expect_refusal(const EnvelopeOutcome& o, const std::vector<std::string>& causes) {
   EXPECT_EQ(o.exit_code, 1) << o.err;
   EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
   for (const auto& c : causes) EXPECT_NE(o.err.find(c), std::string::npos) << "missing '" << c << "' in: " << o.err;
 }
 
 TEST_F(EnvelopeCli, GenNcRefusesACircleBeyondTheXTravel) {
-  const Outcome o = eical("gen-nc circle --radius 1e9");
+  const EnvelopeOutcome o = eical("gen-nc circle --radius 1e9");
   expect_refusal(o, {"gen-nc circle: the program reaches x = 1000000000 mm", "beyond the x travel -500..500 mm",
                      "--travel-x", "[envelope] travel_x_mm"});
   EXPECT_EQ(o.out, "");  // nothing written
@@ -72,7 +70,7 @@ TEST_F(EnvelopeCli, GenNcRefusesACircleBeyondTheXTravel) {
 TEST_F(EnvelopeCli, GenNcTakesTheTravelFromItsOptions) {
   // R400 reaches y = 400: beyond the default y travel, within the one given.
   expect_refusal(eical("gen-nc circle --radius 400"), {"y = 400 mm", "beyond the y travel -300..300 mm", "--travel-y"});
-  const Outcome o = eical("gen-nc circle --radius 400 --travel-y -450,450");
+  const EnvelopeOutcome o = eical("gen-nc circle --radius 400 --travel-y -450,450");
   EXPECT_EQ(o.exit_code, 0) << o.err;
   EXPECT_NE(o.out.find("G3"), std::string::npos);
 }
@@ -94,13 +92,13 @@ TEST_F(EnvelopeCli, GenNcRefusesAnAccelerationBeyondTheMaximum) {
 }
 
 TEST_F(EnvelopeCli, GenNcRefusesRepeatsWithoutBound) {
-  const Outcome o = eical("gen-nc circle --repeats 2000000000");
+  const EnvelopeOutcome o = eical("gen-nc circle --repeats 2000000000");
   EXPECT_EQ(o.exit_code, 1) << o.err;
   EXPECT_NE(o.err.find("--repeats"), std::string::npos) << o.err;
 }
 
 TEST_F(EnvelopeCli, SimulateRefusesACircleBeyondTheEnvelopeBeforeSimulating) {
-  const Outcome o = eical("simulate --radius 100000 -o " + (dir_ / "run").string());
+  const EnvelopeOutcome o = eical("simulate --radius 100000 -o " + (dir_ / "run").string());
   expect_refusal(o, {"simulate circle: the program reaches x = 100000 mm", "beyond the x travel", "--travel-x"});
   EXPECT_LT(o.wall_s, 10.0);
   EXPECT_FALSE(fs::exists(dir_ / "run"));
@@ -108,7 +106,7 @@ TEST_F(EnvelopeCli, SimulateRefusesACircleBeyondTheEnvelopeBeforeSimulating) {
 
 TEST_F(EnvelopeCli, SimulateRefusesAProgramLongerThanItsBudget) {
   // R100 at 1 mm/min: within the travel, but 52 hours long.
-  const Outcome o = eical("simulate --radius 100 --feed 1 -o " + (dir_ / "run").string());
+  const EnvelopeOutcome o = eical("simulate --radius 100 --feed 1 -o " + (dir_ / "run").string());
   expect_refusal(o, {"simulate: the program runs", "beyond the longest simulation of 2400 s", "--max-duration"});
   EXPECT_LT(o.wall_s, 10.0);
   // A budget below a short program's length refuses it too.
@@ -117,14 +115,14 @@ TEST_F(EnvelopeCli, SimulateRefusesAProgramLongerThanItsBudget) {
 }
 
 TEST_F(EnvelopeCli, SimulateRefusesASweepLongerThanItsBound) {
-  const Outcome o = eical("simulate --program sweep --hz-per-sec 0.0001 -o " + (dir_ / "run").string());
+  const EnvelopeOutcome o = eical("simulate --program sweep --hz-per-sec 0.0001 -o " + (dir_ / "run").string());
   EXPECT_EQ(o.exit_code, 1) << o.err;
   EXPECT_NE(o.err.find("hz_per_sec: the sweep from freq_start to freq_end would run 1950000 s"), std::string::npos)
       << o.err;
 }
 
 TEST_F(EnvelopeCli, SimulateWritesTheEnvelopeIntoRunToml) {
-  const Outcome o =
+  const EnvelopeOutcome o =
       eical("simulate --repeats 1 --radius 5 --travel-x -600,600 --max-feed 24000 -o " + (dir_ / "run").string());
   ASSERT_EQ(o.exit_code, 0) << o.err;
   const auto meta = eical::drivers::read_run_meta(dir_ / "run" / "run.toml");
@@ -153,13 +151,13 @@ TEST_F(EnvelopeCli, EnvelopeFileIsReadFromARunToml) {
 }
 
 TEST_F(EnvelopeCli, PlanRefusesACircleBeyondTheEnvelope) {
-  const Outcome o = eical("plan --radius 100000");
+  const EnvelopeOutcome o = eical("plan --radius 100000");
   expect_refusal(o, {"plan circle: the program reaches x = 100000 mm", "--travel-x"});
   EXPECT_LT(o.wall_s, 10.0);
 }
 
 TEST_F(EnvelopeCli, PlanRefusesATestLongerThanItsMaxDuration) {
-  const Outcome o = eical("plan --radius 200 --repeats 10");  // 10 revolutions at 2.5 m/min: 302 s
+  const EnvelopeOutcome o = eical("plan --radius 200 --repeats 10");  // 10 revolutions at 2.5 m/min: 302 s
   expect_refusal(o, {"plan circle: the test runs", "longer than the 180 s plan simulates (--max-duration"});
   EXPECT_LT(o.wall_s, 10.0);
 }
@@ -167,7 +165,7 @@ TEST_F(EnvelopeCli, PlanRefusesATestLongerThanItsMaxDuration) {
 TEST_F(EnvelopeCli, PlanStopsAtItsDeadlineAndSaysWhatItDidNotEvaluate) {
   // R25 twice is not measurable (tests/uncertainty): variants would follow; a deadline of
   // 0 s lets none start.
-  const Outcome o = eical("plan --radius 25 --repeats 2 --draws 20 --deadline 0");
+  const EnvelopeOutcome o = eical("plan --radius 25 --repeats 2 --draws 20 --deadline 0");
   EXPECT_EQ(o.exit_code, 6) << o.err;  // kExitIncomplete
   EXPECT_NE(o.err.find("plan: simulating the test: circle R25"), std::string::npos) << o.err;
   EXPECT_NE(o.err.find("the deadline of 0 s passed"), std::string::npos) << o.err;
@@ -178,7 +176,7 @@ TEST_F(EnvelopeCli, PlanStopsAtItsDeadlineAndSaysWhatItDidNotEvaluate) {
 
 TEST_F(EnvelopeCli, PlanShowsItsProgressOnStderr) {
   // With time for them, the variants are announced one by one.
-  const Outcome o = eical("plan --radius 25 --repeats 2 --draws 10 --max-duration 20 --deadline 600");
+  const EnvelopeOutcome o = eical("plan --radius 25 --repeats 2 --draws 10 --max-duration 20 --deadline 600");
   EXPECT_EQ(o.exit_code, 0) << o.err;
   EXPECT_NE(o.err.find("variant 1 of"), std::string::npos) << o.err;
   EXPECT_EQ(o.err.find("deadline"), std::string::npos) << o.err;

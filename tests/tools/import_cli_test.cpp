@@ -12,12 +12,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
+struct ImportOutcome {
   int exit_code;
   std::string out, err;
 };
 
-Outcome eical(const std::string& args, const fs::path& dir) {
+ImportOutcome eical(const std::string& args, const fs::path& dir) {
   const fs::path err = dir / "stderr.txt";
   std::string cmd = EICAL_CLI;
   cmd.append(" ").append(args).append(" 2>").append(err.string());
@@ -41,17 +41,17 @@ class ImportCli : public ::testing::Test {
 
 TEST_F(ImportCli, SimulatedKlipperTestExportedAndImportedBack) {
   const std::string test = " --freq-start 30 --freq-end 45 --hz-per-sec 2";
-  const Outcome sim = eical("simulate --program sweep --sensors head --mems adxl345 --fs 1600" + test +
-                                " --resonance 38,0.03,0.1,x -o " + at("sim") + " --export klipper " + at("raw.csv") +
-                                " --export-offset-s 812.5",
-                            dir_);
+  const ImportOutcome sim = eical("simulate --program sweep --sensors head --mems adxl345 --fs 1600" + test +
+                                      " --resonance 38,0.03,0.1,x -o " + at("sim") + " --export klipper " +
+                                      at("raw.csv") + " --export-offset-s 812.5",
+                                  dir_);
   ASSERT_EQ(sim.exit_code, 0) << sim.err;
   EXPECT_NE(sim.out.find("exported"), std::string::npos);
   std::ifstream truth(at("sim") + "/truth.toml");
   const std::string t{std::istreambuf_iterator<char>(truth), {}};
   EXPECT_NE(t.find("[export]"), std::string::npos);
   EXPECT_NE(t.find("[[effects.\"machine.resonance\".modes]]"), std::string::npos);
-  const Outcome imp = eical("import klipper " + at("raw.csv") + test + " -o " + at("run"), dir_);
+  const ImportOutcome imp = eical("import klipper " + at("raw.csv") + test + " -o " + at("run"), dir_);
   ASSERT_EQ(imp.exit_code, 0) << imp.err;
   std::printf("%s", imp.out.c_str());
   EXPECT_NE(imp.out.find("time offset recorder - set-point: 812.5"), std::string::npos) << imp.out;
@@ -64,7 +64,7 @@ TEST_F(ImportCli, SimulatedKlipperTestExportedAndImportedBack) {
 }
 
 TEST_F(ImportCli, BadInputIsOneLineNamingTheCause) {
-  Outcome o = eical("import klipper " + at("none.csv") + " -o " + at("run"), dir_);
+  ImportOutcome o = eical("import klipper " + at("none.csv") + " -o " + at("run"), dir_);
   EXPECT_EQ(o.exit_code, 1);
   EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
   EXPECT_NE(o.err.find("no such file"), std::string::npos) << o.err;

@@ -121,8 +121,12 @@ TEST(ReportScreenshot, CircleReportRendersWithPolarPlotAndDiagnostics) {
   const PixelStats s = stats(img);
   EXPECT_GT(s.ink_fraction, 0.01) << "the page is (nearly) blank";
   EXPECT_GT(s.colours, 64u) << "too few colours for plots and text";
-  EXPECT_GT(s.blue, 200u) << "no counter-clockwise trace visible";
-  EXPECT_GT(s.red, 200u) << "no clockwise trace visible";
+  // Data-sheet sensors at R10: U(G) (about 14 µm) exceeds the range each trace spans, so
+  // both directions are drawn as the band of their U, bordered in their colours, with the
+  // note why (issue 33); svg_test checks the traces of a resolved run.
+  EXPECT_GT(s.blue + s.red, 200u) << "neither direction's band is visible";
+  expect_contains(r.dom, "shape not resolved");
+  expect_contains(r.dom, "trace is drawn as the band of its uncertainty");
   expect_contains(r.dom, "Circular test report");
   expect_contains(r.dom, "Circular test (ISO 230-4)");
   expect_contains(r.dom, "Diagnostics (per axis");

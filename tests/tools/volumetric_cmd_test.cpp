@@ -2,6 +2,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/text_file.hpp"
 #include "tests/tools/cli_runner.hpp"
 
 #include <gtest/gtest.h>
@@ -17,10 +18,7 @@ const fs::path kModel = fs::path(EICAL_SOURCE_DIR) / "config" / "examples" / "vo
 
 using eical::tools::testing::run_cli;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream is(p);
-  return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
-}
+using test_support::slurp;
 
 TEST(VolumetricCmd, ExampleModelGivesDeviationsAndFlagsRanges) {
   const fs::path dir = fs::temp_directory_path() / ("vol-" + std::to_string(std::random_device{}()));

@@ -18,7 +18,7 @@
 namespace eical {
 namespace {
 
-std::string run_cli(const std::string& args, int& status) {
+std::string run_cli_status(const std::string& args, int& status) {
   FILE* p = ::popen((std::string(EICAL_CLI) + " " + args + " 2>/dev/null").c_str(), "r");
   std::string out;
   char buf[4096];
@@ -50,11 +50,11 @@ TEST(NotMeasurable, AnalyzeExitsThreeAndPlanPrintsTheNearestMeasurableVariant) {
   // A short circle without strips on data-sheet sensors: U(G) above 10 µm.
   drivers::write_run(sim::simulate(sim::circle_scenario(25.0, 2500.0, 2, "ccw")), dir / "run", {});
   int status = 0;
-  const std::string text = run_cli("analyze --no-suggest " + (dir / "run").string(), status);
+  const std::string text = run_cli_status("analyze --no-suggest " + (dir / "run").string(), status);
   EXPECT_EQ(status, 3) << text;
   EXPECT_NE(text.find("verdict: NOT MEASURABLE"), std::string::npos) << text;
   EXPECT_NE(text.find(" ± "), std::string::npos) << text;
-  const std::string plan = run_cli("plan --program circle --radius 25 --repeats 2 --json --draws 40", status);
+  const std::string plan = run_cli_status("plan --program circle --radius 25 --repeats 2 --json --draws 40", status);
   EXPECT_EQ(status, 0);
   const auto j = nlohmann::json::parse(plan);
   EXPECT_FALSE(j["prediction"]["measurable"].get<bool>());
