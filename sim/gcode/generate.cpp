@@ -198,8 +198,10 @@ Swing strip_swing(const IdentifyPlan& plan, const dsp::PsdSpec& strip) {
     require(strip.center_mm[along] >= t->lo_mm && strip.center_mm[along] <= t->hi_mm,
             "identify: the strip measuring " + strip.measures + " at " + num(strip.center_mm[along]) +
                 " mm lies outside the travel " + num(t->lo_mm) + " … " + num(t->hi_mm) + " mm");
-    w.half_mm = std::min(w.half_mm, (t->hi_mm - t->lo_mm) / 2.0);
-    w.centre_mm = std::clamp(w.centre_mm, t->lo_mm + w.half_mm, t->hi_mm - w.half_mm);
+    if (t->hi_mm - t->lo_mm >= plan.swing_mm)
+      w.centre_mm = std::clamp(w.centre_mm, t->lo_mm + w.half_mm, t->hi_mm - w.half_mm);
+    else  // the lever the scale needs is longer than the test: centred on its travel
+      w.centre_mm = 0.5 * (t->lo_mm + t->hi_mm);
   }
   return w;
 }

@@ -46,7 +46,7 @@ TEST(IdentificationPlan, APositioningTestsIdentificationStaysInsideItsTravel) {
   const Reach r = reach(gcode::identify_program(id));
   EXPECT_GE(r.lo[0], 0.0);
   EXPECT_LE(r.hi[0], 100.0);
-  EXPECT_NEAR(r.hi[0] - r.lo[0], 50.0, 1e-9) << "the swing keeps its lever where the travel allows it";
+  EXPECT_NEAR(r.hi[0] - r.lo[0], 50.0, 1e-9) << "the swing keeps its lever";
   EXPECT_NE(plan::identification_command(id).find("--travel x:0,100"), std::string::npos);
 }
 
@@ -77,15 +77,17 @@ TEST(IdentificationPlan, ACirclesIdentificationUsesItsStripsAndRadius) {
     EXPECT_GE(r.lo[k], -50.0);
     EXPECT_LE(r.hi[k], 50.0);
   }
-  // At R10 the swing shrinks to the circle's 20 mm.
+  // At R10 the circle spans less than the 50 mm lever: the swing keeps it, centred on the
+  // circle.
   p.radius_mm = 10.0, p.psd = plan::strips_for(p);
   const auto small = plan::identification_plan(p);
-  EXPECT_DOUBLE_EQ(gcode::strip_swing(small, small.psd[0]).half_mm, 10.0);
+  EXPECT_DOUBLE_EQ(gcode::strip_swing(small, small.psd[0]).half_mm, 25.0);
+  EXPECT_DOUBLE_EQ(gcode::strip_swing(small, small.psd[1]).centre_mm, 0.0);
   const std::string text = plan::identification_text(small);
-  EXPECT_NE(text.find("x swings -10 … 10 mm across the strip at y = -10 mm"), std::string::npos) << text;
+  EXPECT_NE(text.find("x swings -25 … 25 mm across the strip at y = -10 mm"), std::string::npos) << text;
   const auto j = plan::identification_json(small);
   EXPECT_EQ(j["swings"].size(), 3u);  // x, y and z
-  EXPECT_DOUBLE_EQ(j["swings"][1]["to_mm"].get<double>(), 10.0);
+  EXPECT_DOUBLE_EQ(j["swings"][1]["to_mm"].get<double>(), 25.0);
 }
 
 TEST(IdentificationPlan, AStripOutsideTheTravelIsRefusedByName) {

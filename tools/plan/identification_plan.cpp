@@ -66,7 +66,8 @@ std::string identification_text(const sim::gcode::IdentifyPlan& plan) {
   }
   for (const auto& a : plan.axes)
     o += "    " + a + " swings ± " + mm(plan.swing_mm / 2.0) + " mm about where it rests\n";
-  o += "    every swing stays inside the travel the test moves over\n";
+  o += "    every swing stays inside the travel the test moves over where it spans the " + mm(plan.swing_mm) +
+       " mm swing, and is centred on a shorter one\n";
   return o;
 }
 

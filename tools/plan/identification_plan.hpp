@@ -1,7 +1,7 @@
 #pragma once
 // The on-site identification a planned test needs (issue 33): swings across the test's
-// own strips, inside the travel the test moves the axes over, so that the identification
-// runs where the test runs and needs no travel the test does not. z, which no strip
+// own strips, inside the travel the test moves the axes over where it spans the swing (so
+// that the identification runs where the test runs), centred on a shorter one. z, which no strip
 // measures, is swung from where the head rests.
 #include "sim/gcode/generate.hpp"
 #include "tools/plan/test_plan.hpp"
