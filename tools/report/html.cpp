@@ -74,9 +74,9 @@ section.approval{break-inside:avoid;page-break-inside:avoid}
  main{max-width:none;padding:0 2mm}
  section{border:none;border-top:1px solid #c9d0db;border-radius:0;padding:8px 0;margin:8px 0;break-inside:auto}
  .row{display:block}
- .plots{display:flex;flex-wrap:wrap;gap:2mm;align-items:flex-start}
- svg.plot{width:100%;max-width:100%;height:auto;break-inside:avoid;border:none}
- svg.polar{width:49%;max-height:118mm}
+ .plots{display:block}
+ svg.plot{display:block;width:100%;max-width:100%;height:auto;break-inside:avoid;border:none}
+ svg.polar{display:inline-block;vertical-align:top;width:49.5%}
  table{break-inside:auto;font-size:9pt}
  tr{break-inside:avoid}
  .tables{min-width:0}

@@ -278,6 +278,11 @@ PlotFrame plot_frame(const std::vector<LineSeries>& series, double w, double h) 
   if (ymax <= ymin) ymin -= 0.5, ymax += 0.5;
   const double ypad = 0.06 * (ymax - ymin);
   ymin -= ypad, ymax += ypad;
+  // Points and bars at the ends of x would sit on the frame, half hidden: pad x for them.
+  if (std::any_of(series.begin(), series.end(), [](const LineSeries& s) { return s.markers || s.error_bars; })) {
+    const double xpad = 0.02 * (xmax - xmin);
+    xmin -= xpad, xmax += xpad;
+  }
   f.xmin = xmin, f.xmax = xmax, f.ymin = ymin, f.ymax = ymax;
   return f;
 }
