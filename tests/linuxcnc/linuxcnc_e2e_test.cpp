@@ -54,9 +54,12 @@ void check_and_print_timing(const std::string& what, const ProgramOutcome& o) {
     const double d_ms = static_cast<double>(sample - o.markers[k].second) * 0.1;
     std::printf("  M%d: marker at sample %lld, trigger at sample %lld: trigger - marker = %.1f ms\n", code,
                 static_cast<long long>(o.markers[k].second), static_cast<long long>(sample), d_ms);
-    // eical trigger reads its clock after halcmd set the marker: later, by a process start.
+    // eical trigger reads its clock after halcmd set the marker: later, by a process start
+    // and a DDS participant (48–131 ms here while CI compiles the ASan tree beside it; the
+    // figure is printed above, a latency target belongs in a benchmark). A clock off by its
+    // alignment is off by the servo stream's buffering, hundreds of ms or more, or early.
     EXPECT_GT(d_ms, -2.0) << "trigger before the script ran: clock alignment off";
-    EXPECT_LT(d_ms, 100.0) << "trigger far behind the script: clock alignment off";
+    EXPECT_LT(d_ms, 400.0) << "trigger far behind the script: clock alignment off";
     ++k;
   }
 }
