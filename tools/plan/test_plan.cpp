@@ -82,14 +82,13 @@ std::string describe(const TestProgram& p) {
 }
 
 std::vector<dsp::PsdSpec> strips_at_both_ends(const TestProgram& p) {
-  if (p.kind != "step" && p.targets_mm.empty()) return {};
+  // The ends of the x travel the test moves over: one place says where that is.
+  std::optional<sim::gcode::AxisTravel> travel_mm[2];
+  test_travel(p, travel_mm);
+  if ((p.kind != "step" && p.kind != "positioning") || !travel_mm[0]) return {};
   std::vector<dsp::PsdSpec> out(2);
-  const double lo =
-      p.kind == "step" ? std::min(p.from_mm, p.to_mm) : *std::min_element(p.targets_mm.begin(), p.targets_mm.end());
-  const double hi =
-      p.kind == "step" ? std::max(p.from_mm, p.to_mm) : *std::max_element(p.targets_mm.begin(), p.targets_mm.end());
   out[0].measures = out[1].measures = "x";
-  out[0].center_mm[0] = lo, out[1].center_mm[0] = hi;
+  out[0].center_mm[0] = travel_mm[0]->lo_mm, out[1].center_mm[0] = travel_mm[0]->hi_mm;
   return out;
 }
 
