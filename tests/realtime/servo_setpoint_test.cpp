@@ -3,11 +3,11 @@
 // set-point as servo lines into the pipe (bursts every 10 ms, as halsampler does), on a
 // servo clock 3.7 ms off the DAQ's and with its own cycle numbers. The source finds the
 // clocks' relation, puts the set-point on the frames, and read() does not allocate.
-#include "allocation_counter.hpp"
 #include "drivers/source/replay_source.hpp"
 #include "drivers/source/servo_setpoint_source.hpp"
 #include "drivers/source/stamped_source.hpp"
 #include "sim/simulate.hpp"
+#include "tests/drivers/allocation_counter.hpp"
 
 #include <gtest/gtest.h>
 
