@@ -95,7 +95,7 @@ int run_command(const std::vector<std::string>& args) {
 }
 
 // eical analyze's exit status: 0, 2 and 3 come with a result (verdict ok, degraded, not
-// measurable: README "Exit status"); anything else failed.
+// measurable: docs/command-line.md); anything else failed.
 std::string outcome(int status) {
   if (!WIFEXITED(status)) return "  FAILED (killed)";
   switch (WEXITSTATUS(status)) {

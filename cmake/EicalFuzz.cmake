@@ -1,6 +1,6 @@
 # EICAL_FUZZ=ON (clang only): every target of this build tree is compiled with libFuzzer's
 # coverage instrumentation and ASan + UBSan, and fuzz/ adds one libFuzzer executable per
-# reader (scripts/fuzz-short runs them; README "Reliability: fuzzing").
+# reader (scripts/fuzz-short runs them; fuzz/README.md).
 option(EICAL_FUZZ "Build the libFuzzer targets in fuzz/ (needs clang)" OFF)
 if(EICAL_FUZZ)
   if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")

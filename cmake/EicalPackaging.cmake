@@ -2,7 +2,7 @@
 #   cmake --build BUILD --target package   →   BUILD/eical_<version>_<arch>.deb
 # with eicald and eical in /usr/bin, the systemd unit, /etc/eical/eicald.toml and
 # /etc/eical/cyclonedds.xml as conffiles, /etc/eical/programs (the program set-point's
-# programs), the LinuxCNC kit and the documentation; postinst creates the system user
+# programs), the LinuxCNC kit, the documentation (README, docs/) and the man pages; postinst creates the system user
 # eical and /var/lib/eical/runs (packaging/debian).
 if(EICAL_BUILD_DAEMON)
   install(TARGETS eicald RUNTIME DESTINATION bin)
@@ -15,6 +15,11 @@ if(EICAL_BUILD_TOOLS)
   install(TARGETS eical RUNTIME DESTINATION bin)
 endif()
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION share/doc/eical)
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION share/doc/eical/docs FILES_MATCHING PATTERN "*.md")
+# The man pages: eical(1), eicald(8), eicald.toml(5) (docs/man).
+install(FILES ${PROJECT_SOURCE_DIR}/docs/man/eical.1 DESTINATION share/man/man1)
+install(FILES ${PROJECT_SOURCE_DIR}/docs/man/eicald.8 DESTINATION share/man/man8)
+install(FILES ${PROJECT_SOURCE_DIR}/docs/man/eicald.toml.5 DESTINATION share/man/man5)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/config/examples ${PROJECT_SOURCE_DIR}/config/scenarios DESTINATION share/doc/eical)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/integrations/linuxcnc DESTINATION share/eical/integrations USE_SOURCE_PERMISSIONS)
 

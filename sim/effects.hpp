@@ -1,5 +1,5 @@
 #pragma once
-// Which effects of shared/spec/run-format.md a scenario puts into its data, read off the
+// Which effects of docs/run-format.md a scenario puts into its data, read off the
 // scenario's parameters (anything that differs from the nominal, ideal model).
 #include "sim/scenario.hpp"
 

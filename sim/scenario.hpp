@@ -2,7 +2,7 @@
 // Everything one simulated run depends on. Nominal values (what eical is told: data sheet,
 // program) live in `meta`; the true values the data are generated with live beside them,
 // so a scenario can make reality differ from the data sheet (and truth.toml says how).
-// Every effect of shared/spec/run-format.md maps onto fields here; all default to "off"
+// Every effect of docs/run-format.md maps onto fields here; all default to "off"
 // (an ideal machine that follows the set-point, data-sheet sensors, a nominal DAQ).
 #include "dsp/core/run_meta.hpp"
 #include "sim/gcode/generate.hpp"

@@ -58,7 +58,7 @@ void register_analyze(CLI::App& app) {
       "do not look for a measurable variant when the test is not measurable (it simulates variants: seconds)");
   cmd->footer(
       "Exit status: 0 verdict ok, 2 degraded, 3 not measurable, 1 an error; with --tolerances and the verdict ok: 0 "
-      "conformance proven, 4 non-conformance proven, 5 undecided (README \"Exit status\").");
+      "conformance proven, 4 non-conformance proven, 5 undecided (docs/command-line.md, \"Exit status\").");
   cmd->callback([o] {
     // Buffers above 256 kB are mapped and go back to the system when freed: the streamed
     // analysis' passes (the first pass' records, a revolution, the repeats' sums) then do not

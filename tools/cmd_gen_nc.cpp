@@ -2,7 +2,7 @@
 // M102/M103 measurement triggers, plus the [program] metadata a recorded run carries.
 // On a real control the M-codes are user M-functions (LinuxCNC: executables M101..M103 in
 // the PROGRAM_PREFIX directory, which call `eical trigger`; Siemens/Heidenhain: a PLC
-// output wired to the trigger input, or a CAN frame) — see README "NC triggers".
+// output wired to the trigger input, or a CAN frame) — see docs/service.md.
 #include "dsp/core/error.hpp"
 #include "sim/gcode/dialect.hpp"
 #include "sim/gcode/generate.hpp"
@@ -43,7 +43,7 @@ std::string toml_list(const std::vector<double>& v) {
   return s + "]";
 }
 
-// The [program] table of run.toml (shared/spec/run-format.md) for this program.
+// The [program] table of run.toml (docs/run-format.md) for this program.
 std::string program_toml(const dsp::Program& p, const std::string& gcode) {
   std::string t = "[program]\nkind = \"" + p.kind + "\"\nplane = \"" + p.plane + "\"\n";
   t += "feed_mm_min = " + std::to_string(p.feed_mm_min) + "\n";

@@ -1,5 +1,5 @@
 // eical: the command line. Subcommands live in tools/cmd_<name>.cpp.
-// Exit status (README "Exit status", tools/exit_codes.hpp): 0 done, 1 any error — a usage
+// Exit status (docs/command-line.md, tools/exit_codes.hpp): 0 done, 1 any error — a usage
 // error of the command line as much as bad input —, and `eical analyze`'s verdict: 2
 // degraded, 3 not measurable.
 #include "tools/commands.hpp"

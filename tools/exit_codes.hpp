@@ -3,7 +3,7 @@
 #include "dsp/analysis/verdict_kind.hpp"
 
 #include <optional>
-// Exit status of `eical` (README "Exit status"): scripts and an NC's PLC can tell a good
+// Exit status of `eical` (docs/command-line.md): scripts and an NC's PLC can tell a good
 // test from one to repeat without reading its output.
 namespace eical::tools {
 

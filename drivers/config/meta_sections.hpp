@@ -1,7 +1,7 @@
 #pragma once
 // The metadata sections shared by run.toml, the daemon config and simulation scenarios
 // ([acquisition], [site], [machine], [envelope], [sensors.*], [[psd]]), read strictly: same key names
-// and units as shared/spec/run-format.md, so a value can be copied between the files.
+// and units as docs/run-format.md, so a value can be copied between the files.
 #include "drivers/config/strict_toml.hpp"
 #include "dsp/core/run_meta.hpp"
 

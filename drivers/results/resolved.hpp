@@ -1,6 +1,6 @@
 #pragma once
 // Reading a figure and its uncertainty out of an eical-result/1 document by its result
-// key (`uncertainty_k2` keys, shared/spec/results.md), and the one rule of when it says
+// key (`uncertainty_k2` keys, docs/result-format.md), and the one rule of when it says
 // something: resolved ⇔ |value| > U (k = 2) (dsp/uncertainty/resolved.hpp). For `eical
 // comp`, the reports and scripts: a figure that is not resolved is shown as such and is
 // never turned into compensation.

@@ -1,5 +1,5 @@
 #pragma once
-// eical-result/1 (shared/spec/results.md): JSON objects for each evaluation. Keys are
+// eical-result/1 (docs/result-format.md): JSON objects for each evaluation. Keys are
 // fixed by the spec; extra keys are allowed and used for figures the spec does not name.
 // A figure that could not be determined is null with a reason in quality.flags.
 #include "dsp/analysis/analyze_run.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Reads an eical-run/1 directory (shared/spec/run-format.md) strictly: any problem is a
+// Reads an eical-run/1 directory (docs/run-format.md) strictly: any problem is a
 // dsp::InputError naming the file, the line and the field. Lost frames (a time step of
 // k > 1 samples) are accepted and flagged (frame_flag::gap_before): nothing recorded is
 // dropped, and the pipeline marks the result degraded.

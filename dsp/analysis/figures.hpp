@@ -1,6 +1,6 @@
 #pragma once
 // Every numeric figure of an analysis under its result key `<section>.<key>`
-// (shared/spec/results.md): what `uncertainty_k2` gives an uncertainty for, and what the
+// (docs/result-format.md): what `uncertainty_k2` gives an uncertainty for, and what the
 // uncertainty's draws are compared on. Settings (nominal radius, feed, targets, the
 // counts of revolutions and runs) are not figures; neither is a choice among discrete
 // candidates (the cyclic error's pitch, the smallest step resolved).

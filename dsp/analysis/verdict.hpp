@@ -9,7 +9,7 @@
 // a good machine measured well has exactly such figures. Whether a figure meets a
 // tolerance is a separate decision, ISO 14253-1's (conformance.hpp).
 //
-// What each program is meant to resolve (README "Verdict"): a circular test is a
+// What each program is meant to resolve (docs/uncertainty.md, "Verdict"): a circular test is a
 // ballbar-class test of G, a positioning test an interferometer-class test of A, a step
 // test resolves end positions to a few µm, a rectangle its corners, a free form its
 // contour.

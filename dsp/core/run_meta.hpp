@@ -1,5 +1,5 @@
 #pragma once
-// Metadata of a recorded run (eical-run/1, shared/spec/run-format.md) as plain data.
+// Metadata of a recorded run (eical-run/1, docs/run-format.md) as plain data.
 // Parsing and writing live in drivers/run_io; dsp only reads these values.
 #include "dsp/core/work_envelope.hpp"
 
@@ -95,7 +95,7 @@ struct Reference {
 };
 
 // [setpoint]: where cmd_* came from when the NC is not eical's own, and how well it was
-// aligned with the DAQ clock (written by eicald; see README "The NC's set-point").
+// aligned with the DAQ clock (written by eicald; see docs/service.md, "The NC's set-point").
 struct SetPointOrigin {
   std::string source;  // "servo_stream" (another NC's servo-rate positions) | "program" (eical's interpolator)
   // servo_stream: fractional servo cycle number at the run's first sample (the two clocks'

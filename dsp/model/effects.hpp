@@ -4,7 +4,7 @@
 // tolerance band (what a data-sheet sensor or a well-kept machine shows anyway: a fit
 // inside it is background, not a finding) and its physical bound (what no sensor or
 // machine of the kind can have: a fit beyond it is not this effect but something the table
-// does not describe, reported as other.residual_like_<group>). README "What the simulation
+// does not describe, reported as other.residual_like_<group>). docs/explain.md "What the simulation
 // gets wrong" prints the table with the reason for each bound.
 #include <array>
 #include <optional>

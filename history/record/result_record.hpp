@@ -1,5 +1,5 @@
 #pragma once
-// An eical-result/1 document (shared/spec/results.md) turned into a history Record:
+// An eical-result/1 document (docs/result-format.md) turned into a history Record:
 // every numeric figure of its program sections ("<section>.<key>", one level of nested
 // objects as "<section>.<object>.<key>", and every key of uncertainty_k2) with its
 // uncertainty_k2 when the result gives one, quality.verdict when present (both are NULL

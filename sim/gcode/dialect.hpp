@@ -32,7 +32,7 @@
 //     was not found) and there is no modal exact stop (G61/G64 are dropped: every target
 //     of the calibration programs ends in a dwell anyway).
 // The measurement M-functions M101–M103 stay as they are: on FANUC, SINUMERIK and
-// HEIDENHAIN controls the PLC decodes them (README, "How M101/M102/M103 reach eicald").
+// HEIDENHAIN controls the PLC decodes them (docs/service.md, "How M101/M102/M103 reach eicald").
 // eical's reader takes the same dialects back (parser.hpp: the reading rules and where
 // each unit comes from).
 #include "sim/gcode/dialect_id.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Realistic regimes of runs measured by other systems (shared/spec/run-format.md, "Runs
+// Realistic regimes of runs measured by other systems (docs/run-format.md, "Runs
 // measured by other systems"), as changes to a scenario: one sensor, a digital MEMS chip
 // at its own rate, another DAQ rate, a wrong mounting, Klipper's sweep as the program.
 // Each writes what eical is told (scenario.meta) and the truth beside it.

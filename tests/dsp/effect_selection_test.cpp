@@ -109,10 +109,10 @@ TEST(EffectCatalogue, OneEntryPerEffectInEnumOrder) {
   EXPECT_FALSE(eical::dsp::model::effect_named("machine.nothing").has_value());
 }
 
-// The README's table of physical bounds is the catalogue's: a bound changed in one place
-// and not the other fails here.
-TEST(EffectCatalogue, TheReadmeBoundsTableIsTheCatalogue) {
-  std::ifstream in(EICAL_SOURCE_DIR "/README.md");
+// docs/explain.md's table of physical bounds is the catalogue's: a bound changed in one
+// place and not the other fails here.
+TEST(EffectCatalogue, TheDocumentedBoundsTableIsTheCatalogue) {
+  std::ifstream in(EICAL_SOURCE_DIR "/docs/explain.md");
   ASSERT_TRUE(in.good());
   const std::string readme((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   auto grouped = [](double v) {

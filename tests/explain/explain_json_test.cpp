@@ -1,4 +1,4 @@
-// eical-explain/1 (shared/spec/results.md): the keys of the document and of every effect,
+// eical-explain/1 (docs/result-format.md): the keys of the document and of every effect,
 // effect names from run-format.md's table (or other.<name>), the reference named, and two
 // runs of one machine giving the held-out-across-runs block.
 #include "dsp/model/effects.hpp"

@@ -24,7 +24,9 @@ echo "built $deb"
 # The package's contents and control data.
 contents=$(dpkg-deb -c "$deb")
 for f in ./usr/bin/eicald ./usr/bin/eical ./lib/systemd/system/eicald.service ./etc/eical/eicald.toml ./etc/eical/cyclonedds.xml \
-         ./usr/share/doc/eical/README.md ./usr/share/eical/integrations/linuxcnc/mcodes/M101; do
+         ./usr/share/doc/eical/README.md ./usr/share/doc/eical/docs/first-calibration.md \
+         ./usr/share/man/man1/eical.1 ./usr/share/man/man8/eicald.8 ./usr/share/man/man5/eicald.toml.5 \
+         ./usr/share/eical/integrations/linuxcnc/mcodes/M101; do
   grep -q " $f\$" <<<"$contents" || fail "$f is not in the package"
 done
 conffiles=$(dpkg-deb -I "$deb" conffiles)

@@ -1,5 +1,5 @@
 // `eical analyze --tolerances`: each toleranced figure and the run decided by ISO 14253-1
-// with U, in the text, the JSON and the exit status (README "Exit status"), from the same
+// with U, in the text, the JSON and the exit status (docs/command-line.md), from the same
 // tolerance file `eical report` takes.
 #include "drivers/run_io/run_writer.hpp"
 #include "sim/simulate.hpp"

@@ -1,4 +1,4 @@
-// eical-result/1 keys (shared/spec/results.md) for every program kind: simulated runs of
+// eical-result/1 keys (docs/result-format.md) for every program kind: simulated runs of
 // each kind analysed, the JSON document printed, parsed back and checked key by key —
 // names, units in the names, numbers or null, and a reason in quality.flags for each null.
 #include "drivers/results/result_json.hpp"
@@ -208,7 +208,7 @@ TEST(ResultKeys, AnalyzeCommandPrintsTheDocument) {
   const int status = pclose(p);
   const json doc = json::parse(out);
   check_document(doc, "step");
-  // The exit status is the verdict's (README "Exit status").
+  // The exit status is the verdict's (docs/command-line.md, "Exit status").
   const std::string verdict = doc["quality"]["verdict"];
   EXPECT_EQ(WEXITSTATUS(status), verdict == "ok" ? 0 : verdict == "degraded" ? 2 : 3) << verdict;
   std::filesystem::remove_all(dir);

@@ -1,5 +1,5 @@
 #pragma once
-// What `eical explain` writes: the eical-explain/1 document (../shared/spec/results.md),
+// What `eical explain` writes: the eical-explain/1 document (docs/result-format.md),
 // the summary text, and the report folder — HTML with the residuals before and after the
 // accepted extensions in time and frequency, the sensor calibration the accepted sensor
 // effects make (eical-sensor-cal/1, method "explain") and a scenario (eical-scenario/1)

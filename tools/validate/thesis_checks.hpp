@@ -1,6 +1,6 @@
 #pragma once
 // The simulator against the numbers the thesis measured and simulated (shared/seeds/000,
-// ch. 3, 6, 7, 8; shared/design/domain-digest.md). Each check simulates what the thesis
+// ch. 3, 6, 7, 8; docs/physics.md). Each check simulates what the thesis
 // describes, runs eical's own pipeline or the closed form on it, and reports the figure
 // beside the thesis' one. `eical validate-sim` prints the table; a test asserts the
 // tolerances.
