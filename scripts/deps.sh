@@ -11,9 +11,10 @@ build_pkgs=(g++ cmake ninja-build pkg-config libeigen3-dev libtomlplusplus-dev l
 # real NC (tests/linuxcnc), Depends only; postgresql: the history tests and benchmark start a
 # server of their own (initdb/postgres from /usr/lib/postgresql/<version>/bin; as root they
 # run it as user nobody, initdb refuses root). dpkg-dev (build): the .deb's library
-# dependencies (dpkg-shlibdeps, `--target package`). clang + libclang-rt-14-dev: the fuzz
-# stage (libFuzzer with ASan + UBSan, fuzz/). clang-format + clang-tidy (run-clang-tidy): the
-# style stage (scripts/check-style, .clang-format, .clang-tidy).
+# dependencies (dpkg-shlibdeps, `--target package`). clang + libclang-rt-14-dev: the
+# sanitizer stage (the ASan + UBSan tests and libFuzzer, fuzz/, in one clang tree).
+# clang-format + clang-tidy (run-clang-tidy): the style stage (scripts/check-style,
+# .clang-format, .clang-tidy).
 test_pkgs=(systemd chromium fonts-dejavu-core linuxcnc-uspace postgresql clang libclang-rt-14-dev clang-format
   clang-tidy)
 want=("${build_pkgs[@]}")

@@ -24,7 +24,7 @@ thread_local std::size_t t_allocations = 0;
 }  // namespace
 
 // Sanitizers replace operator new themselves; the count runs in the plain build only.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if defined(EICAL_SANITIZED)
 #define EICAL_COUNT_ALLOCATIONS 0
 #else
 #define EICAL_COUNT_ALLOCATIONS 1

@@ -8,7 +8,7 @@ thread_local bool t_counting = false;
 thread_local std::size_t t_allocations = 0;
 }  // namespace
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if defined(EICAL_SANITIZED)
 namespace eical::test {
 bool allocations_counted() { return false; }
 }  // namespace eical::test
