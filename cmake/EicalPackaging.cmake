@@ -2,8 +2,8 @@
 #   cmake --build BUILD --target package   →   BUILD/eical_<version>_<arch>.deb
 # with eicald and eical in /usr/bin, the systemd unit, /etc/eical/eicald.toml and
 # /etc/eical/cyclonedds.xml as conffiles, /etc/eical/programs (the program set-point's
-# programs), the LinuxCNC kit, the documentation (README, docs/) and the man pages; postinst creates the system user
-# eical and /var/lib/eical/runs (packaging/debian).
+# programs), the LinuxCNC kit, the documentation (README, docs/) and the man pages;
+# postinst creates the system user eical and /var/lib/eical/runs (packaging/debian).
 if(EICAL_BUILD_DAEMON)
   install(TARGETS eicald RUNTIME DESTINATION bin)
   install(FILES ${PROJECT_SOURCE_DIR}/systemd/eicald.service DESTINATION /lib/systemd/system)

@@ -2,10 +2,10 @@
 // sends them (FrameEncoder) come out of DaqStreamSource — the USB path's decoder — equal,
 // through a named pipe and a Unix socket, without an allocation in read(); an absent
 // writer is a clear error naming the path.
-#include "allocation_counter.hpp"
 #include "drivers/usb_daq/daq_stream_source.hpp"
 #include "drivers/usb_daq/frame_encoder.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/allocation_counter.hpp"
 
 #include <gtest/gtest.h>
 

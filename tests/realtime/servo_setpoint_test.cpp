@@ -7,7 +7,7 @@
 #include "drivers/source/servo_setpoint_source.hpp"
 #include "drivers/source/stamped_source.hpp"
 #include "sim/simulate.hpp"
-#include "tests/drivers/allocation_counter.hpp"
+#include "tests/support/allocation_counter.hpp"
 
 #include <gtest/gtest.h>
 
