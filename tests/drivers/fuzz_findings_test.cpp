@@ -5,6 +5,7 @@
 #include "drivers/import/uniform_clock.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/core/error.hpp"
+#include "tests/support/temp_dir.hpp"
 
 #include <gtest/gtest.h>
 
@@ -25,11 +26,7 @@ std::string corpus(const std::string& target, const std::string& input) {
   return {std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
 }
 
-struct TempDir {
-  fs::path path = fs::temp_directory_path() / ("eical-finding-" + std::to_string(std::random_device{}()));
-  TempDir() { fs::create_directories(path); }
-  ~TempDir() { fs::remove_all(path); }
-};
+using test_support::TempDir;
 
 // A run_dir input as fuzz/run_dir.cpp lays it out: run.toml, "\n%%samples\n", samples.csv.
 fs::path run_dir_of(const std::string& input, const TempDir& tmp) {

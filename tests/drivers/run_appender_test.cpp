@@ -8,6 +8,7 @@
 #include "drivers/run_io/run_stream.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "tests/support/file_size_limit.hpp"
+#include "tests/support/temp_dir.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
@@ -26,18 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::random_device rd;
-    path = fs::temp_directory_path() / ("eical-appender-" + std::to_string(rd()));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
+using test_support::TempDir;
 
 // Longer than one chunk of text (about 1 MB): several gzip members.
 dsp::Run long_run(std::size_t frames = 12000) {

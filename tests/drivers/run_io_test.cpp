@@ -2,6 +2,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/core/frame_fields.hpp"
+#include "tests/support/temp_dir.hpp"
 
 #include <gtest/gtest.h>
 #include <zlib.h>
@@ -17,13 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-  fs::path path;
-  TempDir() : path(fs::temp_directory_path() / ("eical-runio-" + std::to_string(std::random_device{}()))) {
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
+using test_support::TempDir;
 
 dsp::Run small_run() {
   dsp::Run r;

@@ -10,6 +10,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "sim/regimes/regimes.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/temp_dir.hpp"
 #include "tools/sim_programs.hpp"
 
 #include <gtest/gtest.h>
@@ -24,11 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct TempDir {
-  fs::path path = fs::temp_directory_path() / ("eical-import-" + std::to_string(std::random_device{}()));
-  TempDir() { fs::create_directories(path); }
-  ~TempDir() { fs::remove_all(path); }
-};
+using test_support::TempDir;
 
 double decode_g(const dsp::Run& run, std::size_t n, int channel) {
   const auto& acq = run.meta.acquisition;
