@@ -21,6 +21,7 @@
 #include "dsp/uncertainty/sensor_model_covariance.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <map>
 
@@ -29,6 +30,14 @@
 #include <vector>
 
 namespace eical::dsp {
+
+struct Analysis;
+struct FigureValue;  // figures.hpp
+// Figures a caller derives from an analysis beyond its program's own (keys of its own, e.g.
+// `eical volumetric`'s standstills): the uncertainty's draws evaluate them on every
+// perturbed path too, and their U lands in Analysis::uncertainty_k2 under their keys. The
+// draws call it from several threads at once: it must not write shared state.
+using MoreFigures = std::function<std::vector<FigureValue>(const Analysis&)>;
 
 struct AnalysisOptions {
   // Independent work side by side: the smoother's axes, the uncertainty's draws (each
@@ -69,6 +78,8 @@ struct AnalysisOptions {
     int budget_draws = 40;
   } uncertainty;
   std::optional<uncertainty::SensorModelCovariance> model_covariance;
+  // The caller's figures beside the program's (MoreFigures), each with U from the same draws.
+  MoreFigures more_figures;  // empty: the program's figures only
 };
 
 // What the program's evaluation may leave out or fix (the uncertainty's draws re-evaluate

@@ -44,7 +44,16 @@ struct DrawBases {
   std::vector<FigureValue> t0, g0;  // their figures
   std::vector<double> at;           // the trace positions the draws perturb
   double shrink = 1.0;              // λ
+  MoreFigures more;                 // the caller's figures beside the program's
 };
+
+// The program's figures and the caller's (AnalysisOptions::more_figures).
+std::vector<FigureValue> all_figures(const Analysis& a, const MoreFigures& more) {
+  std::vector<FigureValue> f = figures_of(a);
+  if (more)
+    for (FigureValue& v : more(a)) f.push_back(std::move(v));
+  return f;
+}
 
 // The decimated measurement (every q-th sample of the trace: fs/q; the triggers kept) with
 // its positions replaced.
@@ -79,9 +88,10 @@ constexpr std::uint64_t kShrinkSalt = 0x736872696e6bULL;
 constexpr int kShrinkDraws = 20;
 
 DrawBases evaluate_bases(const Run& run, const Analysis& a, const uncertainty::ErrorField& field, Measurement decimated,
-                         std::size_t q, std::size_t samples, std::uint64_t seed) {
+                         std::size_t q, std::size_t samples, std::uint64_t seed, MoreFigures more) {
   const Measurement& m = a.measurement;
   DrawBases b;
+  b.more = std::move(more);
   b.eo.reference = false;
   b.eo.keep_trace = false;
   if (a.diagnostics) b.eo.cyclic_pitch_mm = a.diagnostics->cyclic_pitch_mm;
@@ -105,7 +115,7 @@ DrawBases evaluate_bases(const Run& run, const Analysis& a, const uncertainty::E
   evaluate_program(run, b.truth, b.eo);  // fills the set-point cache
   evaluate_program(run, b.ideal, b.eo);
   b.setpoint->frozen = true;  // the draws read it in parallel
-  b.t0 = figures_of(b.truth), b.g0 = figures_of(b.ideal);
+  b.t0 = all_figures(b.truth, b.more), b.g0 = all_figures(b.ideal, b.more);
   return b;
 }
 
@@ -114,7 +124,7 @@ DrawBases evaluate_bases(const Run& run, const Analysis& a, const uncertainty::E
 // (the evaluation reads it, never writes it), not per draw (200 copies of every array, each
 // mapped and faulted in afresh).
 std::vector<FigureValue> perturbed_figures(const Run& run, const Analysis& a, const Analysis& base,
-                                           const std::vector<Eigen::Vector3d>& err, const EvaluationOptions& eo,
+                                           const std::vector<Eigen::Vector3d>& err, const DrawBases& b,
                                            Measurement& scratch) {
   Analysis x;
   x.measurement = std::move(scratch);
@@ -122,8 +132,8 @@ std::vector<FigureValue> perturbed_figures(const Run& run, const Analysis& a, co
   for (std::size_t i = 0; i < err.size() && i < x.measurement.pos_mm.size(); ++i)
     x.measurement.pos_mm[i] += err[i] / 1000.0;
   x.dynamic = a.dynamic, x.nbs = a.nbs;
-  evaluate_program(run, x, eo);
-  std::vector<FigureValue> f = figures_of(x);
+  evaluate_program(run, x, b.eo);
+  std::vector<FigureValue> f = all_figures(x, b.more);
   scratch = std::move(x.measurement);
   return f;
 }
@@ -155,10 +165,10 @@ void draw_range(const Run& run, const Analysis& a, const uncertainty::ErrorField
         std::mt19937_64 rng(stream_seed(seed, d));
         field.draw(rng, b.at, err);
       }
-      drawn[d].error = perturbed_figures(run, a, b.truth, err, b.eo, truth_scratch);
+      drawn[d].error = perturbed_figures(run, a, b.truth, err, b, truth_scratch);
       std::mt19937_64 bound_rng(stream_seed(seed ^ kNoiseBoundSalt, d));
       field.draw_bound(bound_rng, b.at, err);
-      drawn[d].noise = perturbed_figures(run, a, b.ideal, err, b.eo, ideal_scratch);
+      drawn[d].noise = perturbed_figures(run, a, b.ideal, err, b, ideal_scratch);
     }
   });
 }
@@ -199,7 +209,7 @@ std::vector<double> quantile_of_figure(const std::vector<FigureValue>& base, con
 
 // U and the noise bound of every figure of the full-rate analysis, from the draws.
 void assign_uncertainties(const DrawBases& b, const std::vector<DrawnFigures>& drawn, std::size_t used, Analysis& a) {
-  for (const FigureValue& full : figures_of(a)) {
+  for (const FigureValue& full : all_figures(a, b.more)) {
     std::vector<double> u = quantile_of_figure(b.t0, drawn, used, &DrawnFigures::error, full.key, full.values.size());
     if (!u.empty()) {
       if (u.size() == 1 && u[0] == 0.0)  // no draw moves it: not a measured size
@@ -220,7 +230,7 @@ void assign_uncertainties(const DrawBases& b, const std::vector<DrawnFigures>& d
 void assign_budget(const Run& run, const Analysis& a_in, const uncertainty::ErrorField& field, const DrawBases& b,
                    int draws, std::uint64_t seed, const ParallelFor& parallel, Analysis& a) {
   const auto n = static_cast<std::size_t>(draws);
-  const std::vector<FigureValue> figs = figures_of(a);
+  const std::vector<FigureValue> figs = all_figures(a, b.more);
   for (const uncertainty::ErrorSource source : uncertainty::kErrorSources) {
     std::vector<DrawnFigures> drawn(n);
     const std::uint64_t salt = 0x627564676574ULL + static_cast<std::uint64_t>(source);
@@ -231,7 +241,7 @@ void assign_budget(const Run& run, const Analysis& a_in, const uncertainty::Erro
       for (std::size_t d = block * n / blocks; d < (block + 1) * n / blocks; ++d) {
         std::mt19937_64 rng(stream_seed(seed ^ salt, d));
         field.draw(rng, b.at, err, uncertainty::SourceMask::only(source));
-        drawn[d].error = perturbed_figures(run, a_in, b.truth, err, b.eo, scratch);
+        drawn[d].error = perturbed_figures(run, a_in, b.truth, err, b, scratch);
       }
     });
     auto& by_key = a.uncertainty_budget[source];
@@ -302,6 +312,7 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
       stop_above_(options.uncertainty.stop_above),
       budget_draws_(options.uncertainty.budget ? std::max(2, options.uncertainty.budget_draws) : 0),
       seed_(options.uncertainty.seed),
+      more_(options.more_figures),
       parallel_(options.parallel ? options.parallel : sequential_for()) {
   const Measurement& m = a.measurement;
   uncertainty::ErrorFieldInput& in = in_;
@@ -375,7 +386,8 @@ void UncertaintyTrace::finish(const Run& run, Analysis& a) {
     a.uncertainty_note = std::string("the uncertainty was not estimated: ") + e.what();
     return;
   }
-  const DrawBases bases = evaluate_bases(run, a, *field, std::exchange(nominal_, Measurement{}), q_, samples_, seed_);
+  const DrawBases bases =
+      evaluate_bases(run, a, *field, std::exchange(nominal_, Measurement{}), q_, samples_, seed_, more_);
   std::vector<DrawnFigures> drawn;
   const std::size_t used = run_draws(run, a, *field, bases, draws_, seed_, parallel_, stop_above_, noise_, drawn);
   noise_.clear();

@@ -79,6 +79,7 @@ class UncertaintyTrace {
   std::optional<AnalysisOptions::Uncertainty::StopAbove> stop_above_;
   int budget_draws_ = 0;  // 0: no budget
   std::uint64_t seed_ = 0;
+  MoreFigures more_;  // AnalysisOptions::more_figures
   ParallelFor parallel_;
 };
 
