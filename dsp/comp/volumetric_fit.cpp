@@ -27,150 +27,118 @@ struct Pair {
 };
 constexpr Pair kPairs[3] = {{0, 1, -1.0}, {1, 2, -1.0}, {0, 2, +1.0}};  // xwy, ywz, xwz
 
-struct Channel {
-  std::vector<double> pos_mm, value_um, u_um;  // standard uncertainty
-};
+double reference_of(const std::array<double, 2>& range) { return range[0] <= 0.0 && 0.0 <= range[1] ? 0.0 : range[0]; }
 
-// Per target of the moving axis: bidirectional mean of the channel over all stops. Its
-// uncertainty: the pooled scatter of single stops about their target-and-direction mean
-// (type A, over the runs) and the smoother's σ there, which repeating the run does not
-// average away (type B).
-Channel channel_of(const AxisPass& p, int c) {
-  std::map<long long, std::array<std::vector<double>, 2>> by_target;  // 1 µm keys; [up, down]
-  std::map<long long, std::pair<double, int>> sigma;                  // Σσ², count
-  for (const auto& s : p.stops) {
-    if (s.approach[p.axis] == 0) continue;
-    const long long key = std::llround(s.cmd_mm[p.axis] * 1000.0);
-    by_target[key][s.approach[p.axis] > 0 ? 0 : 1].push_back(s.dev_um[c]);
-    sigma[key].first += s.sigma_um[c] * s.sigma_um[c], sigma[key].second += 1;
+// Per target of the moving axis (1 µm keys), the bidirectional mean of channel c: the mean
+// of the two directions' means (a backlash then adds half of itself everywhere, which the
+// reference takes out). Targets reached from one side only are left out: their mean would
+// carry half a reversal the others do not.
+RunChannel bidirectional_means(int axis, const std::vector<Standstill>& stops, int c) {
+  std::map<long long, std::array<std::pair<double, int>, 2>> by_target;  // [up, down]: Σ, n
+  for (const auto& s : stops) {
+    if (s.approach[axis] == 0) continue;
+    auto& d = by_target[std::llround(s.cmd_mm[axis] * 1000.0)][s.approach[axis] > 0 ? 0 : 1];
+    d.first += s.dev_um[c], d.second += 1;
   }
-  double ss = 0.0;
-  int dof = 0;
-  for (const auto& [k, dirs] : by_target)
-    for (const auto& v : dirs) {
-      if (v.size() < 2) continue;
-      double m = 0.0;
-      for (double x : v) m += x;
-      m /= static_cast<double>(v.size());
-      for (double x : v) ss += (x - m) * (x - m);
-      dof += static_cast<int>(v.size()) - 1;
-    }
-  if (dof < 1)
-    throw InputError("volumetric: the " + letter(p.axis) + " run " + p.source +
-                     " has no target reached twice from one side: no scatter, no uncertainty");
-  const double s = std::sqrt(ss / dof);
-  Channel ch;
-  for (const auto& [k, dirs] : by_target) {
-    double sum = 0.0, var = 0.0;
-    int n_dir = 0;
-    for (const auto& v : dirs) {
-      if (v.empty()) continue;
-      double m = 0.0;
-      for (double x : v) m += x;
-      sum += m / static_cast<double>(v.size());
-      var += s * s / static_cast<double>(v.size());
-      ++n_dir;
-    }
-    ch.pos_mm.push_back(static_cast<double>(k) / 1000.0);
-    ch.value_um.push_back(sum / n_dir);
-    const double type_b2 = sigma[k].second > 0 ? sigma[k].first / sigma[k].second : 0.0;
-    ch.u_um.push_back(std::sqrt(var / (n_dir * n_dir) + type_b2));
+  RunChannel ch;
+  for (const auto& [key, dirs] : by_target) {
+    if (dirs[0].second == 0 || dirs[1].second == 0) continue;
+    ch.pos_mm.push_back(static_cast<double>(key) / 1000.0);
+    ch.value_um.push_back(0.5 * (dirs[0].first / dirs[0].second + dirs[1].first / dirs[1].second));
   }
   return ch;
 }
 
-struct Line {
-  double slope = 0.0, intercept = 0.0, u_slope = 0.0;  // µm/mm, standard uncertainty
-};
-Line weighted_line(const Channel& ch) {
-  double sw = 0, sx = 0, sy = 0;
-  for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) {
-    const double w = 1.0 / std::max(ch.u_um[i] * ch.u_um[i], 1e-12);
-    sw += w, sx += w * ch.pos_mm[i], sy += w * ch.value_um[i];
-  }
-  const double xm = sx / sw, ym = sy / sw;
-  double sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) {
-    const double w = 1.0 / std::max(ch.u_um[i] * ch.u_um[i], 1e-12);
-    sxx += w * (ch.pos_mm[i] - xm) * (ch.pos_mm[i] - xm), sxy += w * (ch.pos_mm[i] - xm) * (ch.value_um[i] - ym);
-  }
-  Line l;
-  l.slope = sxx > 0 ? sxy / sxx : 0.0;
-  l.intercept = ym - l.slope * xm;
-  l.u_slope = sxx > 0 ? std::sqrt(1.0 / sxx) : 0.0;
-  return l;
+// The least-squares slope (µm/mm) and intercept; unweighted: every target's mean is as good
+// as another's (the same stops, the same supports), and the draws re-fit the same line.
+std::pair<double, double> least_squares_line(const RunChannel& ch) {
+  const auto n = static_cast<double>(ch.pos_mm.size());
+  double xm = 0.0, ym = 0.0;
+  for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) xm += ch.pos_mm[i] / n, ym += ch.value_um[i] / n;
+  double sxx = 0.0, sxy = 0.0;
+  for (std::size_t i = 0; i < ch.pos_mm.size(); ++i)
+    sxx += (ch.pos_mm[i] - xm) * (ch.pos_mm[i] - xm), sxy += (ch.pos_mm[i] - xm) * (ch.value_um[i] - ym);
+  const double slope = sxx > 0.0 ? sxy / sxx : 0.0;
+  return {slope, ym - slope * xm};
 }
 
-double reference_of(const std::array<double, 2>& range) { return range[0] <= 0.0 && 0.0 <= range[1] ? 0.0 : range[0]; }
+using MergedRuns = std::array<std::optional<AxisPass>, 3>;  // per axis: its runs as one
 
-using MergedRuns = std::array<std::optional<AxisPass>, 3>;  // per axis: all its positioning runs as one
+// The runs of one axis as one: per target the mean of their values, and of their U — the
+// runs share the sensor model and the strips, whose error averaging does not shrink (full
+// correlation: the mean's U is at most the runs' mean U).
+AxisPass merge_axis(const std::vector<const AxisPass*>& runs) {
+  AxisPass m = *runs.front();
+  const auto n = static_cast<double>(runs.size());
+  for (std::size_t r = 1; r < runs.size(); ++r) {
+    const AxisPass& p = *runs[r];
+    m.source += " + " + p.source;
+    for (std::size_t c = 0; c < 3; ++c)
+      if (p.fit.channel[c].pos_mm != m.fit.channel[c].pos_mm)
+        throw InputError("volumetric: the " + letter(m.axis) + " runs " + m.source +
+                         " reached different targets: fit them apart or repeat the same cycle");
+  }
+  for (std::size_t c = 0; c < 3; ++c) {
+    auto& ch = m.fit.channel[c];
+    std::fill(ch.value_um.begin(), ch.value_um.end(), 0.0);
+    std::fill(m.u_k2_um[c].begin(), m.u_k2_um[c].end(), 0.0);
+    ch.slope_um_per_mm = m.slope_u_k2_um_per_mm[c] = 0.0;
+    for (const AxisPass* p : runs) {
+      for (std::size_t i = 0; i < ch.value_um.size(); ++i)
+        ch.value_um[i] += p->fit.channel[c].value_um[i] / n, m.u_k2_um[c][i] += p->u_k2_um[c][i] / n;
+      ch.slope_um_per_mm += p->fit.channel[c].slope_um_per_mm / n;
+      m.slope_u_k2_um_per_mm[c] += p->slope_u_k2_um_per_mm[c] / n;
+    }
+  }
+  return m;
+}
 
 // Every axis' runs merged into one; the range of each axis no run moved (where it stood,
 // on average) into range_mm. Throws when no axis moved.
 MergedRuns merge_runs(const std::vector<AxisPass>& passes, std::array<std::array<double, 2>, 3>& range_mm) {
   std::array<std::vector<const AxisPass*>, 3> by_axis;
-  for (const auto& p : passes) by_axis[static_cast<std::size_t>(p.axis)].push_back(&p);
-  // Ranges: a moved axis over its targets; a standing one where it stood.
-  std::array<double, 3> still_sum{}, still_n{};
-  for (const auto& p : passes)
-    for (const auto& s : p.stops)
-      for (int a = 0; a < 3; ++a)
-        if (a != p.axis)
-          still_sum[static_cast<std::size_t>(a)] += s.cmd_mm[a], still_n[static_cast<std::size_t>(a)] += 1.0;
+  for (const auto& p : passes) {
+    for (std::size_t c = 0; c < 3; ++c)
+      if (p.u_k2_um[c].size() != p.fit.channel[c].pos_mm.size())
+        throw InputError("volumetric: the run " + p.source + " has no uncertainty for its " + letter(int(c)) +
+                         " channel");
+    by_axis[static_cast<std::size_t>(p.axis)].push_back(&p);
+  }
   MergedRuns merged;
   for (int a = 0; a < 3; ++a) {
     const auto ai = static_cast<std::size_t>(a);
-    if (by_axis[ai].empty()) {
-      const double at = still_n[ai] > 0 ? still_sum[ai] / still_n[ai] : 0.0;
+    if (by_axis[ai].empty()) {  // an axis no run moved: where the runs stood
+      double sum = 0.0;
+      for (const auto& p : passes) sum += p.fit.standing_mm[ai];
+      const double at = passes.empty() ? 0.0 : sum / static_cast<double>(passes.size());
       range_mm[ai] = {at, at};
       continue;
     }
-    AxisPass m;
-    m.axis = a;
-    for (const auto* p : by_axis[ai]) {
-      m.source += (m.source.empty() ? "" : " + ") + p->source;
-      m.stops.insert(m.stops.end(), p->stops.begin(), p->stops.end());
-    }
-    merged[ai] = m;
+    merged[ai] = merge_axis(by_axis[ai]);
   }
   if (!merged[0] && !merged[1] && !merged[2]) throw InputError("volumetric: no positioning run to fit the model from");
   return merged;
 }
 
-using Slopes = std::array<std::array<std::optional<Line>, 3>, 3>;  // [moving axis][channel]
+using Slopes = std::array<std::array<std::optional<std::pair<double, double>>, 3>, 3>;  // [axis][channel]: µm/mm, U
 
 // The translation component of the run's axis a in direction c (positioning for c = a,
-// straightness less its slope, which goes to `slope`, otherwise), relative to the machine at
-// the axis' reference point, with its U; the axis' range from the run's targets.
+// straightness less its slope otherwise), its U per support, the axis' range.
 void fit_translation(const AxisPass& run, int c, VolumetricFit& f, Slopes& slope) {
   const int a = run.axis;
-  const auto ai = static_cast<std::size_t>(a);
-  const int k = 6 * a + kTx + c;
-  auto& comp = f.component[static_cast<std::size_t>(k)];
-  Channel ch = channel_of(run, c);
-  if (ch.pos_mm.size() < 2)
-    throw InputError("volumetric: the " + letter(a) + " run " + run.source + " reached fewer than 2 targets");
+  const auto ai = static_cast<std::size_t>(a), ci = static_cast<std::size_t>(c);
+  auto& comp = f.component[static_cast<std::size_t>(6 * a + kTx + c)];
+  const RunChannel& ch = run.fit.channel[ci];
   f.model.range_mm[ai] = {ch.pos_mm.front(), ch.pos_mm.back()};
   std::string note = "positioning run " + run.source + ", channel " + letter(c);
   if (c != a) {
-    // A straightness has no slope: that is the frame and the squareness (kPairs).
-    const Line l = weighted_line(ch);
-    slope[ai][static_cast<std::size_t>(c)] = l;
-    for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) ch.value_um[i] -= l.slope * ch.pos_mm[i] + l.intercept;
+    slope[ai][ci] = std::pair(ch.slope_um_per_mm, run.slope_u_k2_um_per_mm[ci]);
     note += " less its slope (frame and squareness)";
   }
-  // Relative to the machine at the reference point of the axis.
-  const double r = reference_of(f.model.range_mm[ai]);
-  const double v_r = interpolate(ch.pos_mm, ch.value_um, r), u_r = interpolate(ch.pos_mm, ch.u_um, r);
-  comp.u_k2.clear();
-  for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) {
-    ch.value_um[i] -= v_r;
-    const bool at_ref = std::abs(ch.pos_mm[i] - r) < 1e-9;
-    comp.u_k2.push_back(at_ref ? 0.0 : 2.0 * std::hypot(ch.u_um[i], u_r));
-  }
-  f.model.component[static_cast<std::size_t>(k)] = {ch.pos_mm, ch.value_um};
+  f.model.component[static_cast<std::size_t>(6 * a + kTx + c)] = {ch.pos_mm, ch.value_um};
+  comp.u_k2 = run.u_k2_um[ci];
   comp.observed = true;
-  comp.note = note;
+  comp.note = note + "; U from the run's draws";
 }
 
 using SquarenessEstimates = std::array<std::vector<std::pair<double, double>>, 3>;  // (µrad, U) per slot
@@ -184,8 +152,8 @@ SquarenessEstimates squareness_estimates(const Slopes& slope, const std::vector<
     const auto& ba = slope[b][a];  // b's run seen in a's channel
     const auto& ab = slope[a][b];
     if (ba && ab)
-      square_est[sl].emplace_back(kPairs[sl].sign * (ba->slope + ab->slope) * 1e3,
-                                  2.0 * std::hypot(ba->u_slope, ab->u_slope) * 1e3);
+      square_est[sl].emplace_back(kPairs[sl].sign * (ba->first + ab->first) * 1e3,
+                                  std::hypot(ba->second, ab->second) * 1e3);
   }
   for (const auto& c : circles) {
     const auto slot = static_cast<std::size_t>(c.pair);
@@ -240,6 +208,30 @@ void mark_unobserved(VolumetricFit& f) {
 }
 
 }  // namespace
+
+RunComponents run_components(int axis, const std::vector<Standstill>& stops) {
+  RunComponents r;
+  r.axis = axis;
+  for (const auto& s : stops)
+    for (int a = 0; a < 3; ++a)
+      r.standing_mm[static_cast<std::size_t>(a)] += s.cmd_mm[a] / static_cast<double>(stops.size());
+  for (int c = 0; c < 3; ++c) {
+    RunChannel ch = bidirectional_means(axis, stops, c);
+    if (ch.pos_mm.size() < 2)
+      throw InputError("volumetric: the " + letter(axis) + " run reached fewer than 2 targets from both sides");
+    if (c != axis) {
+      // A straightness has no slope: that is the frame and the squareness (kPairs).
+      const auto [slope, intercept] = least_squares_line(ch);
+      ch.slope_um_per_mm = slope;
+      for (std::size_t i = 0; i < ch.pos_mm.size(); ++i) ch.value_um[i] -= slope * ch.pos_mm[i] + intercept;
+    }
+    // Relative to the machine at the reference point of the axis.
+    const double v_r = interpolate(ch.pos_mm, ch.value_um, reference_of({ch.pos_mm.front(), ch.pos_mm.back()}));
+    for (double& v : ch.value_um) v -= v_r;
+    r.channel[static_cast<std::size_t>(c)] = std::move(ch);
+  }
+  return r;
+}
 
 VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vector<SquarenessFigure>& circles) {
   VolumetricFit f;

@@ -14,9 +14,13 @@
 //   translation at one point, where a carriage's rotation is indistinguishable from a
 //   translation; it needs a second measuring point at a known lever or an angle
 //   reference — and everything of an axis no run moved.
-// Every value is relative to the machine at the origin of the measured range (a common
-// offset is a zero point no relative measurement sees), with its expanded uncertainty
-// (k = 2): the scatter over the runs and the smoother's posterior σ at the standstills.
+// Every value is relative to the machine at the reference point of the measured range (the
+// origin when the range holds it: a common offset is a zero point no relative measurement
+// sees), with its expanded uncertainty (k = 2) from the runs' own Monte Carlo draws
+// (dsp/analysis/figure_uncertainty: integration noise, bias walk, the sensor model of the
+// data sheet or of the calibration, the strips): each run's share of the model is a pure
+// function of its standstills (run_components), which the draws evaluate on every perturbed
+// path, so U holds everything the analysis knows the run's error by — not only the scatter.
 #include "dsp/comp/standstills.hpp"
 #include "dsp/comp/volumetric.hpp"
 
@@ -29,11 +33,30 @@
 
 namespace eical::dsp::comp {
 
-// One positioning run: the axis it moves and its standstills.
+// One positioning run's share of the model, per channel c: the bidirectional mean deviation
+// at each target (the mean of the two directions' means), relative to the axis' reference
+// point; a straightness channel (c ≠ axis) less its least-squares line, whose slope is the
+// frame and the squareness (kept in slope_um_per_mm).
+struct RunChannel {
+  std::vector<double> pos_mm, value_um;
+  double slope_um_per_mm = 0.0;
+};
+struct RunComponents {
+  int axis = 0;
+  std::array<RunChannel, 3> channel;
+  std::array<double, 3> standing_mm{};  // where each axis stood, on average over the stops
+};
+
+// InputError when fewer than 2 targets were reached from both sides.
+RunComponents run_components(int axis, const std::vector<Standstill>& stops);
+
+// One positioning run: its components and their U (k = 2) from the run's draws.
 struct AxisPass {
   int axis = 0;
   std::string source;
-  std::vector<Standstill> stops;
+  RunComponents fit;
+  std::array<std::vector<double>, 3> u_k2_um;    // per channel, per target
+  std::array<double, 3> slope_u_k2_um_per_mm{};  // per channel (the run's own channel: 0)
 };
 
 // A squareness figure from elsewhere (a circle), pair 0 xy, 1 yz (ywz), 2 zx (xwz).
@@ -62,7 +85,7 @@ struct VolumetricFit {
   std::array<SquarenessFit, 3> squareness;  // xwy, ywz, xwz (the pairs' order)
 };
 
-// InputError when no pass has two targets with two stops each.
+// InputError when there is no pass, or the runs of one axis reached different targets.
 VolumetricFit fit_volumetric(const std::vector<AxisPass>& passes, const std::vector<SquarenessFigure>& circles);
 
 // Expanded uncertainty (k = 2) of the predicted e(x) − e(origin) of the observed model
