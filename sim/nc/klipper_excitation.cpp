@@ -73,14 +73,32 @@ std::vector<AccelSegment> current_segments(const KlipperTest& k) {
   return seg;
 }
 
+// The older executor's moves as the lookahead plans them. v = accel·t_seg = accel_per_hz/4
+// is every move's speed limit, and L = ½·accel·t_seg² is exactly the distance over which
+// accel brings 0 to v: so each move out from the centre decelerates from v to rest at the
+// reversal (±accel for t_seg), and each move back accelerates to v at the centre, where the
+// next move continues in the same direction (a collinear junction: no slowdown). The head
+// passes the centre at v; only the first move (from rest) and the last (to rest) are
+// triangles, ±accel for t_seg/√2 each way.
 std::vector<AccelSegment> legacy_segments(const KlipperTest& k) {
   std::vector<AccelSegment> seg;
   double freq = k.freq_start_hz, sign = 1.0;
+  bool first = true;
   while (freq <= k.freq_end_hz + 1e-6) {
     const double t_seg = 0.25 / freq, accel = k.accel_per_hz * freq;
     const double half = t_seg / std::sqrt(2.0);  // a triangle over L = ½·a·t_seg²
-    for (double s : {sign, -sign, -sign, sign}) seg.push_back({half, s * accel});
-    freq += 2.0 * t_seg * k.hz_per_sec;
+    const double next_freq = freq + 2.0 * t_seg * k.hz_per_sec;
+    const bool last = !(next_freq <= k.freq_end_hz + 1e-6);
+    if (first)
+      seg.push_back({half, sign * accel}), seg.push_back({half, -sign * accel});
+    else
+      seg.push_back({t_seg, -sign * accel});  // out: from v at the centre to rest
+    if (last)
+      seg.push_back({half, -sign * accel}), seg.push_back({half, sign * accel});
+    else
+      seg.push_back({t_seg, -sign * accel});  // back: from rest to v at the centre
+    first = false;
+    freq = next_freq;
     sign = -sign;
   }
   return seg;

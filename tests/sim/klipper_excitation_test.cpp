@@ -56,24 +56,38 @@ TEST(KlipperExcitation, PulsesAloneReturnToRestEveryPeriodAndSweepTheFrequency) 
   EXPECT_NEAR(t, 195.0, 0.5);
 }
 
-TEST(KlipperExcitation, OlderExecutorRunsTrianglesOutAndBack) {
+TEST(KlipperExcitation, OlderExecutorPassesTheCentreAtFullSpeed) {
   const KlipperTest k = KlipperTest::legacy();
   EXPECT_NEAR(k.freq_end_hz, 133.3333333, 1e-6);
   EXPECT_EQ(k.accel_per_hz, 75.0);
   const auto seg = klipper_segments(k);
-  ASSERT_EQ(seg.size() % 4, 0u);
   const AccelProfileSetPoint sp(seg, Eigen::Vector3d::UnitX(), Eigen::Vector3d::Zero());
-  // First step at 5 Hz: out by L = ½·375·0.05² = 0.46875 mm and back, at rest at each end.
+  // First step at 5 Hz, from rest: a triangle out to L = ½·375·0.05² = 0.46875 mm, at rest.
   const double half = 0.05 / std::sqrt(2.0);
   EXPECT_NEAR(sp.at(2.0 * half).pos_mm.x(), 0.46875, 1e-12);
   EXPECT_NEAR(sp.at(2.0 * half).vel_mm_s.x(), 0.0, 1e-12);
-  EXPECT_NEAR(sp.at(4.0 * half).pos_mm.x(), 0.0, 1e-12);
-  // Every step returns to the start.
-  double t = 0.0;
-  for (std::size_t i = 0; i < seg.size(); i += 4) {
-    t += seg[i].duration_s + seg[i + 1].duration_s + seg[i + 2].duration_s + seg[i + 3].duration_s;
-    ASSERT_NEAR(sp.at(t).pos_mm.x(), 0.0, 1e-9) << "step " << i / 4;
+  // Back through the centre at max_v = accel·t_seg = accel_per_hz/4 (no stop there) ...
+  const double v_mm_s = 75.0 / 4.0;
+  EXPECT_NEAR(sp.at(2.0 * half + 0.05).pos_mm.x(), 0.0, 1e-12);
+  EXPECT_NEAR(sp.at(2.0 * half + 0.05).vel_mm_s.x(), -v_mm_s, 1e-9);
+  // ... and at every later pass: each reversal at rest, each centre passed at max_v.
+  double t = 2.0 * half, freq = 5.0;
+  int centres = 0;
+  for (std::size_t i = 2; i + 2 < seg.size(); i += 2) {
+    t += seg[i].duration_s;
+    ASSERT_NEAR(std::abs(sp.at(t).vel_mm_s.x()), v_mm_s, 1e-6) << "segment " << i;
+    ASSERT_NEAR(sp.at(t).pos_mm.x(), 0.0, 1e-6) << "segment " << i;
+    ++centres;
+    t += seg[i + 1].duration_s;
+    ASSERT_NEAR(sp.at(t).vel_mm_s.x(), 0.0, 1e-6) << "segment " << i + 1;
+    freq += 0.5 / freq;
   }
+  EXPECT_GT(centres, 1000);
+  // It ends at rest at the start, after about 128 s for 5 → 133 Hz at 1 Hz/s (real captures
+  // of this test last 128.3 s; a stop at every centre would take √2 as long, 181 s).
+  EXPECT_NEAR(sp.at(sp.motion_s()).pos_mm.x(), 0.0, 1e-9);
+  EXPECT_NEAR(sp.at(sp.motion_s()).vel_mm_s.x(), 0.0, 1e-9);
+  EXPECT_NEAR(sp.motion_s(), 128.3, 0.5);
 }
 
 TEST(KlipperExcitation, SetPointIsConsistentAndAtRestOutsideTheTest) {
