@@ -18,7 +18,7 @@ namespace {
 // What both importers take: where the sensor sits, its chip and mounting, the layout.
 struct Common {
   std::string out, id, sensor = "head", chip = "adxl345", mounting = "x,y,z", head_axes = "xy", table_axes = "z";
-  double bandwidth_hz = 0.0, noise_ug = -1.0, g_mps2 = drivers::kStandardGravity_mps2;
+  double bandwidth_hz = 0.0, noise_ug = -1.0, g_mps2 = drivers::kStandardGravity_mps2, accel_scale = 1.0;
   bool gzip = false, overwrite = false;
 };
 
@@ -50,6 +50,10 @@ void add_common(CLI::App* cmd, Common& c) {
                   "gravity at the site, m/s2: converts the recorded acceleration to g (run.toml [site]; default "
                   "standard gravity)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--accel-scale", c.accel_scale,
+                  "multiply the recorded acceleration by this (a recorder that converted one chip's counts with "
+                  "another's constants; import klipper names the factor gravity shows)")
+      ->check(CLI::PositiveNumber);
   cmd->add_flag("--gzip", c.gzip, "write samples.csv.gz");
   cmd->add_flag("--overwrite", c.overwrite, "replace an existing run");
 }
@@ -66,6 +70,7 @@ drivers::ImportSetup setup_of(const Common& c) {
   s.machine.head_axes = drivers::axis_list(c.head_axes, "--head-axes");
   s.machine.table_axes = drivers::axis_list(c.table_axes, "--table-axes");
   s.site.g_mps2 = c.g_mps2;
+  s.accel_scale = c.accel_scale;
   return s;
 }
 
@@ -94,6 +99,12 @@ void finish(const Common& c, const drivers::ImportResult& r) {
       "per mm/s2\n",
       static_cast<char>('x' + axis), seen.x() / seen.norm(), seen.y() / seen.norm(), seen.z() / seen.norm(),
       seen.norm());
+  if (r.report.mounting) {
+    std::printf("gravity at rest: %.3f g; the stated mounting %s %s\n", r.report.mounting->gravity_g,
+                r.report.mounting->stated_map.c_str(),
+                r.report.mounting->consistent ? "fits it and the motion" : "does not fit");
+    for (const auto& f : r.report.mounting->findings) std::printf("  %s\n", f.c_str());
+  }
   if (r.report.nc_clock)
     std::printf("NC trace: %.6g Hz, jitter %.2f us rms, %zu lost samples bridged\n", r.report.nc_clock->fs_hz,
                 r.report.nc_clock->jitter_rms_s * 1e6, r.report.nc_clock->lost_frames);

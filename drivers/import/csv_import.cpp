@@ -15,7 +15,8 @@ ImportResult import_csv(const std::filesystem::path& accel_file, const std::file
                                            : read_nc_csv(nc_file, options.nc_columns);
   const UniformClock clock = fit_uniform_clock(capture.t_s, capture.source);
   UniformSeries accel = resample(capture.t_s, capture.accel_mps2, clock);
-  for (auto& v : accel.values) v /= options.setup.site.g_mps2;  // in g of the site, as run.toml's [site] says
+  // In g of the site, as run.toml's [site] says, times what the recorder's constants were off by.
+  for (auto& v : accel.values) v *= options.setup.accel_scale / options.setup.site.g_mps2;
   const UniformClock nc_clock = fit_uniform_clock(nc.t_s, nc.source);
   const std::vector<Eigen::Vector3d> nc_uniform = bridge_gaps(nc.t_s, nc.pos_mm, nc_clock);
   const std::size_t n_nc = nc_uniform.size();
@@ -53,6 +54,7 @@ ImportResult import_csv(const std::filesystem::path& accel_file, const std::file
   r.nc_clock = nc_clock;
   r.samples = capture.t_s.size();
   r.offset = offset;
+  r.accel_scale = options.setup.accel_scale;
   return out;
 }
 

@@ -82,6 +82,8 @@ std::string import_report_toml(const ImportReport& report) {
   o += "format = \"eical-import/1\"\nkind = " + str(report.kind) + "\nsource = " + str(report.source) + "\n";
   if (!report.nc_source.empty()) o += "nc_source = " + str(report.nc_source) + "\n";
   o += "excitation = " + str(report.excitation) + "\nsamples = " + std::to_string(report.samples) + "\n";
+  o += "# what the recorded acceleration was multiplied by (--accel-scale)\naccel_scale = " +
+       toml_number(report.accel_scale) + "\n";
   o += clock("accel_clock", report.accel_clock);
   if (report.nc_clock) o += clock("nc_clock", *report.nc_clock);
   o += "\n[time_offset]\noffset_s = " + toml_number(report.offset.offset_s) +
@@ -95,7 +97,17 @@ std::string import_report_toml(const ImportReport& report) {
     for (int j = 0; j < 3; ++j) o += (j ? ", " : "") + toml_number(report.offset.gain(i, j));
     o += "]";
   }
-  return o + "]\n";
+  o += "]\n";
+  if (report.mounting) {
+    o += "\n# gravity (the capture's mean) and the commanded motion against the stated mounting\n[mounting]\n";
+    o += "gravity_g = " + toml_number(report.mounting->gravity_g) +
+         "\nstated_map = " + str(report.mounting->stated_map) +
+         "\nconsistent = " + (report.mounting->consistent ? "true" : "false") + "\nfindings = [";
+    for (std::size_t i = 0; i < report.mounting->findings.size(); ++i)
+      o += (i ? ", " : "") + str(report.mounting->findings[i]);
+    o += "]\n";
+  }
+  return o;
 }
 
 void write_import_report(const std::filesystem::path& run_dir, const ImportReport& report) {

@@ -7,6 +7,7 @@
 // low-pass output). No temperature is recorded: the temperature fields are empty.
 // import.toml beside run.toml says how it was imported (clock, jitter, lost frames, the
 // time offset with its uncertainty).
+#include "drivers/import/mounting_check.hpp"
 #include "drivers/import/time_offset.hpp"
 #include "drivers/import/uniform_clock.hpp"
 #include "dsp/core/run.hpp"
@@ -30,6 +31,7 @@ struct ImportSetup {
   dsp::MachineLayout machine;
   dsp::Site site;
   double feed_mm_min = 1.0;  // the motion's peak speed
+  double accel_scale = 1.0;  // multiplies the recorded acceleration (a recorder's wrong constants)
 };
 
 // The sensor's data sheet for run.toml at the capture's rate.
@@ -56,6 +58,8 @@ struct ImportReport {
   std::optional<UniformClock> nc_clock;
   std::size_t samples = 0;
   OffsetEstimate offset;
+  double accel_scale = 1.0;               // applied to the recording (ImportSetup::accel_scale)
+  std::optional<MountingCheck> mounting;  // gravity and motion against the stated scale and axes
 };
 std::string import_report_toml(const ImportReport& report);
 void write_import_report(const std::filesystem::path& run_dir, const ImportReport& report);

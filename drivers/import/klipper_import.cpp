@@ -8,12 +8,53 @@
 #include <cstdio>
 
 namespace eical::drivers {
+namespace {
+
+// The test ends where it starts, so the capture's mean is the sensor's reading at rest:
+// gravity. A capture whose scale or axes map contradicts it (or the motion) is refused with
+// the fix, before explain would read a wrong scale as the machine's or a turned axis as a
+// misalignment.
+MountingCheck check_capture_mounting(const UniformSeries& accel_g, const OffsetEstimate& offset,
+                                     const KlipperImport& options) {
+  Eigen::Vector3d mean_g = Eigen::Vector3d::Zero();
+  for (const auto& v : accel_g.values) mean_g += v;
+  if (!accel_g.values.empty()) mean_g /= static_cast<double>(accel_g.values.size());
+  MountingCheck c = check_mounting(mean_g, offset.gain, options.setup.to_machine, options.direction.normalized());
+  if (c.consistent) return c;
+  std::string why;
+  for (const auto& f : c.findings) why += "; " + f;
+  throw dsp::InputError("import klipper: the capture contradicts its stated scale or mounting" + why);
+}
+
+// Klipper records the whole test: the capture starts before it and ends after it. A test
+// that the alignment puts mostly outside the capture (a short capture matched to a stretch
+// of a long sweep) is not this capture's test, however well the stretch correlates.
+constexpr double kMinTestInsideCapture = 0.95;
+
+void require_test_inside_capture(const UniformClock& clock, const OffsetEstimate& offset, double test_s,
+                                 const std::string& source) {
+  const double capture_begin_s = clock.time_at(0), capture_end_s = clock.time_at(clock.index.back());
+  const double test_begin_s = offset.offset_s, test_end_s = offset.offset_s + test_s;
+  const double inside_s = std::max(0.0, std::min(capture_end_s, test_end_s) - std::max(capture_begin_s, test_begin_s));
+  if (test_s > 0.0 && inside_s >= kMinTestInsideCapture * test_s) return;
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                ": the capture spans %.2f s, the resonance test %.2f s; aligned at its best offset (%.3f s, the "
+                "command explaining %.1f %% of the measured), %.1f %% of the test lies inside the capture, %.0f %% "
+                "needed: not this capture's test (other test parameters, or a capture of something else)",
+                capture_end_s - capture_begin_s, test_s, offset.offset_s, 100.0 * offset.explained,
+                100.0 * inside_s / test_s, 100.0 * kMinTestInsideCapture);
+  throw dsp::InputError(source + buf);
+}
+
+}  // namespace
 
 ImportResult import_klipper(const std::filesystem::path& file, const KlipperImport& options) {
   const StampedAccel capture = read_klipper_capture(file);
   const UniformClock clock = fit_uniform_clock(capture.t_s, capture.source);
   UniformSeries accel = resample(capture.t_s, capture.accel_mps2, clock);
-  for (auto& v : accel.values) v /= options.setup.site.g_mps2;  // in g of the site, as run.toml's [site] says
+  // In g of the site, as run.toml's [site] says, times what the recorder's constants were off by.
+  for (auto& v : accel.values) v *= options.setup.accel_scale / options.setup.site.g_mps2;
   const sim::nc::AccelProfileSetPoint sp(sim::nc::klipper_segments(options.test), options.direction, options.start_mm);
 
   MeasuredSeries measured{clock.fs_hz, clock.t0_s, accel.grid_index, accel.values};
@@ -25,6 +66,8 @@ ImportResult import_klipper(const std::filesystem::path& file, const KlipperImpo
   ref.sensor_f0_hz = spec.f0_hz, ref.sensor_zeta = spec.zeta;
   const OffsetEstimate offset = estimate_offset(measured, ref);
   require_alignment(offset, capture.source);
+  require_test_inside_capture(clock, offset, sp.duration_s(), capture.source);
+  const MountingCheck mounting = check_capture_mounting(accel, offset, options);
 
   ImportSetup setup = options.setup;
   double v_max = 0.0;
@@ -47,6 +90,8 @@ ImportResult import_klipper(const std::filesystem::path& file, const KlipperImpo
   r.accel_clock = clock;
   r.samples = capture.t_s.size();
   r.offset = offset;
+  r.accel_scale = options.setup.accel_scale;
+  r.mounting = mounting;
   return out;
 }
 

@@ -3,7 +3,7 @@
 #include "dsp/core/error.hpp"
 #include "sim/sensor/pt2.hpp"
 
-#include <Eigen/LU>
+#include <Eigen/Eigenvalues>
 #include <unsupported/Eigen/FFT>
 
 #include <algorithm>
@@ -27,6 +27,22 @@ double peak(const std::vector<double>& s) {
   const double a = s[best - 1], b = s[best], c = s[best + 1];
   const double den = a - 2.0 * b + c;
   return static_cast<double>(best) + (den < 0.0 ? 0.5 * (a - c) / den : 0.0);
+}
+
+// The Moore–Penrose inverse of a reference Gram matrix, or an empty matrix when the
+// reference is zero. A pseudo-inverse, not an inverse: a test along a diagonal (a CoreXY's
+// belt test) moves x and y together, so their columns are collinear and the Gram matrix
+// singular; the score then is that of the one direction the motion spans, and the gain the
+// minimum-norm split of it over the axes.
+Eigen::MatrixXd gram_pseudo_inverse(const Eigen::MatrixXd& g) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(g);
+  const Eigen::VectorXd& ev = es.eigenvalues();
+  const double largest = ev.size() > 0 ? ev.maxCoeff() : 0.0;
+  if (!(largest > 0.0) || !std::isfinite(largest)) return {};
+  Eigen::VectorXd inv = Eigen::VectorXd::Zero(ev.size());
+  for (Eigen::Index i = 0; i < ev.size(); ++i)
+    if (ev[i] > 1e-9 * largest) inv[i] = 1.0 / ev[i];
+  return es.eigenvectors() * inv.asDiagonal() * es.eigenvectors().transpose();
 }
 
 using Columns = std::vector<std::vector<double>>;  // per reference column (or axis), its samples
@@ -119,9 +135,9 @@ std::vector<double> coarse_scores(const Columns& y, const Columns& rf, int F, st
         g_coarse(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(d)) +=
             rf[c][m * static_cast<std::size_t>(F)] * rf[d][m * static_cast<std::size_t>(F)];
   }
-  if (!(g_coarse.determinant() > 0.0))
+  const Eigen::MatrixXd g_inv = gram_pseudo_inverse(g_coarse);
+  if (g_inv.size() == 0)
     throw dsp::InputError("time offset: the commanded acceleration is zero (nothing to correlate with)");
-  const Eigen::MatrixXd g_inv = g_coarse.inverse();
   // corr[a][c][lag mod L] = Σ_n y_a[n] r_c[n − lag]
   std::vector<std::vector<std::vector<double>>> corr(3, std::vector<std::vector<double>>(rf.size()));
   std::vector<std::complex<double>> prod(L);
@@ -193,9 +209,8 @@ FineCorrelations fine_correlations(const Grid& grid, const Columns& rf, int F, l
       if (j == 0) g += r * r.transpose();
     }
   }
-  if (!(g.determinant() > 0.0))
-    throw dsp::InputError("time offset: the measurement does not overlap the commanded motion");
-  fc.g_inv = g.inverse();
+  fc.g_inv = gram_pseudo_inverse(g);
+  if (fc.g_inv.size() == 0) throw dsp::InputError("time offset: the measurement does not overlap the commanded motion");
   fc.total.assign(static_cast<std::size_t>(n_lags), Eigen::MatrixXd::Zero(3, nc));
   for (int b = 0; b < kBlocks; ++b)
     for (int j = 0; j < n_lags; ++j)
