@@ -306,7 +306,16 @@ void read_header(StrictTable& root, sim::Scenario& sc) {
   sc.oversample = root.int32("oversample", 10);
   if (sc.oversample < 1 || sc.oversample > 100) root.fail("oversample", "must be 1..100");
   sc.noise = root.boolean("noise", true);
-  sc.meta.id = root.string("id", "sim-" + sc.name + "-s" + std::to_string(sc.seed));
+  sc.meta.id = root.string("id", "");
+}
+
+// Without an `id`, the run's id names the scenario, its program and seed: one machine's
+// scenario runs several programs (identification, circle, positioning), and the history
+// keeps runs by id, so an id without the program would take the second for the first.
+void default_run_id(sim::Scenario& sc) {
+  if (!sc.meta.id.empty()) return;
+  const std::string& kind = sc.meta.program.kind;
+  sc.meta.id = "sim-" + sc.name + (kind.empty() || kind == sc.name ? "" : "-" + kind) + "-s" + std::to_string(sc.seed);
 }
 
 // What eical is told (run.toml's sections); the truth starts from it.
@@ -474,6 +483,7 @@ sim::Scenario read_scenario_file(const std::string& path, sim::gcode::Dialect gc
     sim::set_sensors_present(sc, root.choice("sensors_present", {"both", "head", "table"}, "both"));
   if (auto truth = root.optional_table("truth")) read_truth(*truth, sc);
   read_motion(root, path, gcode_dialect, sc);
+  default_run_id(sc);
   read_psd_strips(root, sc);
   sc.meta.reference.reset();
   if (auto r = root.optional_table("reference")) read_reference(*r, sc);

@@ -57,6 +57,24 @@ TEST(ScenarioFile, AnEffectOnSeveralAxesIsAnArrayOfTables) {
   EXPECT_EQ(sim::effect_lists(sc).present, (std::vector<std::string>{"machine.backlash"}));
 }
 
+// One machine's scenario runs several programs; the history keeps runs by id, so the
+// default id names the program too (a stated id is kept as it is).
+TEST(ScenarioFile, TheDefaultRunIdNamesTheProgram) {
+  const std::string head = "format = \"eical-scenario/1\"\nname = \"dmu50\"\nseed = 7\n";
+  const sim::Scenario circle = drivers::read_scenario_file(
+      write_tmp("eical-scenario-id-circle.toml", head + "[program]\nkind = \"circle\"\nradius_mm = 10.0\n"));
+  const sim::Scenario positioning = drivers::read_scenario_file(
+      write_tmp("eical-scenario-id-positioning.toml", head + "[program]\nkind = \"positioning\"\naxis = \"x\"\n"
+                                                             "targets_mm = [0.0, 10.0]\n"));
+  EXPECT_EQ(circle.meta.id, "sim-dmu50-circle-s7");
+  EXPECT_EQ(positioning.meta.id, "sim-dmu50-positioning-s7");
+  const sim::Scenario stated =
+      drivers::read_scenario_file(write_tmp("eical-scenario-id-stated.toml",
+                                            "format = \"eical-scenario/1\"\nid = \"acceptance-7\"\n[program]\n"
+                                            "kind = \"circle\"\nradius_mm = 10.0\n"));
+  EXPECT_EQ(stated.meta.id, "acceptance-7");
+}
+
 TEST(ScenarioFile, UnknownEffectKeyAndTypeAreNamedWithTheLine) {
   const std::string head = "format = \"eical-scenario/1\"\n[program]\nkind = \"circle\"\nradius_mm = 10.0\n";
   auto error_of = [&](const std::string& body) {
