@@ -3,11 +3,13 @@
 #include "drivers/results/result_json.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/analysis/analyze_run.hpp"
+#include "dsp/core/error.hpp"
 #include "tools/commands.hpp"
 #include "tools/report/run_report.hpp"
 #include "tools/run_files.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -32,6 +34,7 @@ std::string calibration_text(const std::string& file, const drivers::SensorCalib
 void register_report(CLI::App& app) {
   struct Opt {
     std::string run, out, calibration, tolerances, operator_name, serial;
+    bool force = false;
   };
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand("report", "Render the HTML report of a recorded run");
@@ -46,7 +49,13 @@ void register_report(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--operator", o->operator_name, "operator's name for the header");
   cmd->add_option("--serial", o->serial, "the machine's serial number for the header");
+  cmd->add_flag("--force", o->force, "replace a report already in the folder");
   cmd->callback([o] {
+    const std::filesystem::path dir =
+        o->out.empty() ? std::filesystem::path(o->run) / "report" : std::filesystem::path(o->out);
+    // A report may be signed already: replacing it takes a word, not a default.
+    if (std::filesystem::exists(dir / "report.html") && !o->force)
+      throw dsp::InputError("report: " + dir.string() + " holds a report already (--force to replace it)");
     dsp::Run run = drivers::read_run(o->run);
     dsp::AnalysisOptions opt;
     report::ReportOptions ro;
@@ -58,8 +67,6 @@ void register_report(CLI::App& app) {
     if (!o->tolerances.empty()) ro.tolerances = report::read_tolerances(o->tolerances);
     ro.operator_name = o->operator_name, ro.serial = o->serial;
     const dsp::Analysis a = dsp::analyze_run(run, opt);
-    const std::filesystem::path dir =
-        o->out.empty() ? std::filesystem::path(o->run) / "report" : std::filesystem::path(o->out);
     const auto file = report::write_run_report(run, a, dir, ro);
     write_file_atomic(dir / "result.json", drivers::result_json(run, a).dump(2) + "\n");
     std::printf("report: %s\n", file.c_str());

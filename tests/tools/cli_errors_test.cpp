@@ -147,4 +147,14 @@ TEST_F(CliErrors, WrongTypeInRunToml) {
   expect_one_line_error(eical("analyze " + run()), "acquisition.adc_bits: expected an integer, got string");
 }
 
+// A report may be signed already: writing over it takes --force.
+TEST_F(CliErrors, ReportOverAnExistingReportNeedsForce) {
+  const std::string out = (dir_ / "rep").string();
+  ASSERT_EQ(eical("report " + run() + " -o " + out).exit_code, 0);
+  const auto written = fs::last_write_time(dir_ / "rep" / "report.html");
+  expect_one_line_error(eical("report " + run() + " -o " + out), "holds a report already (--force to replace it)");
+  EXPECT_EQ(fs::last_write_time(dir_ / "rep" / "report.html"), written);
+  EXPECT_EQ(eical("report " + run() + " -o " + out + " --force").exit_code, 0);
+}
+
 }  // namespace
