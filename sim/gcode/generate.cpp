@@ -202,6 +202,16 @@ Swing strip_swing(const IdentifyPlan& plan, const dsp::PsdSpec& strip) {
       w.centre_mm = std::clamp(w.centre_mm, t->lo_mm + w.half_mm, t->hi_mm - w.half_mm);
     else  // the lever the scale needs is longer than the test: centred on its travel
       w.centre_mm = 0.5 * (t->lo_mm + t->hi_mm);
+    // Each swing must carry the light spot over the whole strip at every feed: a swing that
+    // turns on the strip gives no crossing, and identify then refuses the run.
+    const double reach_mm = std::abs(strip.center_mm[along] - w.centre_mm) + 0.5 * strip.length_mm;
+    require(reach_mm <= w.half_mm + 1e-9,
+            "identify: the strip measuring " + strip.measures + " at " + format_number("%g", strip.center_mm[along]) +
+                " mm lies " +
+                format_number("%g", std::min(strip.center_mm[along] - t->lo_mm, t->hi_mm - strip.center_mm[along])) +
+                " mm inside the travel " + format_number("%g", t->lo_mm) + " … " + format_number("%g", t->hi_mm) +
+                " mm: a swing inside the travel cannot cross its " + format_number("%g", strip.length_mm) +
+                " mm; mount it at least " + format_number("%g", 0.5 * strip.length_mm) + " mm inside");
   }
   return w;
 }

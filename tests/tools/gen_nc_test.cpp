@@ -238,7 +238,7 @@ namespace {
 TEST(GenNc, IdentifyStaysInsideTheTravelItIsGiven) {
   const fs::path out = fs::temp_directory_path() / ("gen-nc-id-" + std::to_string(std::random_device{}()) + ".ngc");
   const std::string g =
-      run_to_file({"gen-nc", "identify", "--psd", "x:0,0", "--travel", "x:0,100", "--axis", "z"}, out);
+      run_to_file({"gen-nc", "identify", "--psd", "x:10,0", "--travel", "x:0,100", "--axis", "z"}, out);
   const auto prog = eical::sim::gcode::parse(g);
   double lo = 1e300, hi = -1e300;
   for (const auto& b : prog.blocks)

@@ -53,16 +53,35 @@ TEST(IdentificationPlan, APositioningTestsIdentificationStaysInsideItsTravel) {
 TEST(IdentificationPlan, StripsAtBothEndsOfATravelAreSwungFromInside) {
   plan::TestProgram p;
   p.kind = "positioning", p.targets_mm = {0.0, 150.0, 300.0};
-  p.psd.resize(2);
-  p.psd[0].measures = p.psd[1].measures = "x";
-  p.psd[0].center_mm[0] = 0.0, p.psd[1].center_mm[0] = 300.0;
+  p.psd = plan::strips_at_both_ends(p);
+  ASSERT_EQ(p.psd.size(), 2u);
+  EXPECT_DOUBLE_EQ(p.psd[0].center_mm[0], 10.0);  // one strip length inside each end
+  EXPECT_DOUBLE_EQ(p.psd[1].center_mm[0], 290.0);
   const auto id = plan::identification_plan(p);
   const auto a = gcode::strip_swing(id, id.psd[0]), b = gcode::strip_swing(id, id.psd[1]);
   EXPECT_DOUBLE_EQ(a.centre_mm - a.half_mm, 0.0);
   EXPECT_DOUBLE_EQ(b.centre_mm + b.half_mm, 300.0);
+  // Each swing carries the spot over its whole strip.
+  EXPECT_LE(std::abs(p.psd[0].center_mm[0] - a.centre_mm) + 0.5 * p.psd[0].length_mm, a.half_mm);
+  EXPECT_LE(std::abs(p.psd[1].center_mm[0] - b.centre_mm) + 0.5 * p.psd[1].length_mm, b.half_mm);
   const Reach r = reach(gcode::identify_program(id));
   EXPECT_GE(r.lo[0], 0.0);
   EXPECT_LE(r.hi[0], 300.0);
+}
+
+// A strip at the very end of the travel cannot be crossed by a swing that stays inside it:
+// refused with where it must go, not written as a program whose run identify refuses.
+TEST(IdentificationPlan, AStripAtTheEndOfTheTravelIsRefusedWithWhereItMustGo) {
+  gcode::IdentifyPlan id;
+  id.psd.resize(1);
+  id.psd[0].measures = "x", id.psd[0].center_mm[0] = 0.0;
+  id.travel_mm[0] = gcode::AxisTravel{0.0, 300.0};
+  try {
+    (void)gcode::identify_program(id);
+    FAIL() << "accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("mount it at least 5 mm inside"), std::string::npos) << e.what();
+  }
 }
 
 TEST(IdentificationPlan, ACirclesIdentificationUsesItsStripsAndRadius) {

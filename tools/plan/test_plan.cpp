@@ -88,7 +88,11 @@ std::vector<dsp::PsdSpec> strips_at_both_ends(const TestProgram& p) {
   if ((p.kind != "step" && p.kind != "positioning") || !travel_mm[0]) return {};
   std::vector<dsp::PsdSpec> out(2);
   out[0].measures = out[1].measures = "x";
-  out[0].center_mm[0] = travel_mm[0]->lo_mm, out[1].center_mm[0] = travel_mm[0]->hi_mm;
+  // One strip length inside each end: every run crosses each strip as it leaves and nears
+  // the end, and the identification's swings, which stay inside the travel, cross it whole.
+  const double inset_mm = out[0].length_mm;
+  if (travel_mm[0]->hi_mm - travel_mm[0]->lo_mm < 4.0 * inset_mm) return {};
+  out[0].center_mm[0] = travel_mm[0]->lo_mm + inset_mm, out[1].center_mm[0] = travel_mm[0]->hi_mm - inset_mm;
   return out;
 }
 
