@@ -73,6 +73,21 @@ TEST(ConformanceCli, ToleranceWideNarrowAndStraddledByU) {
     EXPECT_EQ(status, judged == "ok" ? c.exit_if_ok : judged == "degraded" ? 2 : 3);
     const std::string text = run_cli("analyze --tolerances " + t.string() + " " + run, status);
     EXPECT_NE(text.find("against the tolerances (ISO 14253-1"), std::string::npos) << text;
+    // The report's banner says the verdict and the decision together.
+    const fs::path rep = dir / (std::string("report-") + c.decision);
+    (void)run_cli("report " + (dir / "run").string() + " --tolerances " + t.string() + " -o " + rep.string(), status);
+    ASSERT_EQ(status, 0);
+    std::ifstream html(rep / "report.html");
+    const std::string page{std::istreambuf_iterator<char>(html), std::istreambuf_iterator<char>()};
+    // (The report draws 100 times where this analysis drew 40: its U, and so its decision,
+    // may differ; what must hold is that the banner says the table's decision.)
+    const std::string banner = "against the tolerances: <b>", table = "(ISO 14253-1 with U, k = 2): ";
+    const auto at_banner = page.find(banner), at_table = page.find(table);
+    ASSERT_NE(at_banner, std::string::npos);
+    ASSERT_NE(at_table, std::string::npos);
+    const std::string said =
+        page.substr(at_banner + banner.size(), page.find('<', at_banner + banner.size()) - at_banner - banner.size());
+    EXPECT_EQ(page.compare(at_table + table.size(), said.size(), said), 0) << said;
   }
   if (g - u > 0.5) {  // a figure resolved above a tolerance below it: non-conformance proven
     const fs::path t = tolerance_file(dir, "tight.toml", g - u - 0.25);

@@ -171,6 +171,10 @@ std::string render_html(const Page& page) {
   out += "</header>\n<main>\n";
   if (!page.verdict.empty()) {
     out += "<div class=\"verdict " + xml_escape(page.verdict) + "\">Verdict: <b>" + verdict_word(page.verdict) + "</b>";
+    // The verdict judges the measurement; the tolerances are a decision of their own, and
+    // a reader must not take an OK measurement for a machine in tolerance.
+    if (!page.conformance.empty())
+      out += " (the measurement) &nbsp;·&nbsp; against the tolerances: <b>" + xml_escape(page.conformance) + "</b>";
     if (!page.verdict_reasons.empty()) {
       out += "<ul>";
       for (const auto& r : page.verdict_reasons) out += "<li>" + xml_escape(r) + "</li>";

@@ -58,6 +58,9 @@ struct Page {
   std::vector<Flag> flags;                                   // quality flags, critical first
   std::string verdict;                                       // "ok", "degraded", "not_measurable" (a banner when set)
   std::vector<std::string> verdict_reasons;
+  // With tolerances: ISO 14253-1's decision for the whole run (conformance_words), said in
+  // the banner beside the verdict so that the two are read as one story.
+  std::string conformance;
   std::vector<Grid> summary;  // right under the banner (e.g. against the tolerances)
   std::vector<Section> sections;
   // Traceability (what the result rests on) and the approval block a signer fills in.

@@ -282,6 +282,7 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, co
       page.verdict = dsp::verdict_name(judged.verdict);
       page.verdict_reasons = judged.verdict_reasons;
     }
+    page.conformance = dsp::conformance_words(c.overall);
     Grid g{std::string("Against the tolerances (ISO 14253-1 with U, k = 2): ") + dsp::conformance_words(c.overall),
            {"figure", "measured (µm)", "U (µm)", "tolerance (µm)", "decision"},
            {}};
