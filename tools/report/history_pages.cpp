@@ -48,6 +48,13 @@ std::vector<PolarTrace> polar_traces(const history::Record& r, const std::string
 }
 
 std::string short_date(const std::string& t) { return t.substr(0, 10); }
+// "2026-12-02T14:08:48Z" → "2026-12-02 14:08 UTC": the origin of an axis in minutes or hours.
+std::string short_time(const std::string& t) {
+  if (t.size() < 16) return t;
+  std::string o = t.substr(0, 16);
+  o[10] = ' ';
+  return o + " UTC";
+}
 
 std::string judgement_text(history::Judgement j) {
   switch (j) {
@@ -59,15 +66,31 @@ std::string judgement_text(history::Judgement j) {
   return "";
 }
 
+// The time axis' unit for the span the results cover: a re-measurement minutes after the
+// first reads as minutes, not as 0.00035 days.
+struct TimeUnit {
+  double seconds;
+  const char* name;
+};
+TimeUnit time_unit_for(double span_s) {
+  if (span_s < 2.0 * 3600.0) return {60.0, "minutes"};
+  if (span_s < 2.0 * 86400.0) return {3600.0, "hours"};
+  return {86400.0, "days"};
+}
+
 }  // namespace
 
 std::string trend_plot(const std::string& figure, const std::vector<history::TrendPoint>& points,
                        const std::vector<std::string>& marked) {
-  std::optional<double> t0;
-  std::string first_day;
+  std::optional<double> t0, t1;
+  std::string first_at;
   for (const auto& p : points)
-    if (const auto s = history::epoch_s(p.measured_at); s && (!t0 || *s < *t0))
-      t0 = *s, first_day = short_date(p.measured_at);
+    if (const auto s = history::epoch_s(p.measured_at)) {
+      if (!t0 || *s < *t0) t0 = *s, first_at = p.measured_at;
+      if (!t1 || *s > *t1) t1 = *s;
+    }
+  const TimeUnit unit_t = time_unit_for(t0 ? *t1 - *t0 : 0.0);
+  const std::string origin = unit_t.seconds < 86400.0 ? short_time(first_at) : short_date(first_at);
   std::map<std::string, std::size_t> machine_index;
   for (const auto& p : points) machine_index.emplace(p.machine, machine_index.size());
   std::vector<LineSeries> series;
@@ -83,7 +106,7 @@ std::string trend_plot(const std::string& figure, const std::vector<history::Tre
   for (const auto& p : points) {
     const auto s = history::epoch_s(p.measured_at);
     if (!p.value || !s) continue;
-    const double x = (*s - *t0) / 86400.0;
+    const double x = (*s - *t0) / unit_t.seconds;
     series[line_of[p.machine]].x.push_back(x), series[line_of[p.machine]].y.push_back(*p.value);
     auto& d = series[dots_of[p.machine]];
     d.x.push_back(x), d.y.push_back(*p.value);
@@ -95,7 +118,7 @@ std::string trend_plot(const std::string& figure, const std::vector<history::Tre
   if (!ring.x.empty()) series.push_back(ring);
   const std::string unit = history::unit_of(figure);
   return line_plot(series, history::label_of(figure) + " over time (bars: ± U, k = 2)",
-                   "days since " + (first_day.empty() ? "the first result" : first_day),
+                   std::string(unit_t.name) + " since " + (origin.empty() ? "the first result" : origin),
                    history::label_of(figure) + (unit.empty() ? "" : " (" + unit + ")"), 760, 320);
 }
 
