@@ -3,6 +3,7 @@
 #include "drivers/config/sensor_calibration.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/sample_rate.hpp"
 #include "sim/simulate.hpp"
 #include "tools/commands.hpp"
 #include "tools/envelope_options.hpp"
@@ -115,7 +116,9 @@ void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
   cmd.add_option("--noise", o.p.noise_ug_per_rthz, "each sensor's noise density, ug/sqrt(Hz) (two-sided)")
       ->default_val(0.4)
       ->check(CLI::PositiveNumber);
-  cmd.add_option("--fs", o.p.fs_hz, "DAQ sampling rate, Hz")->default_val(10000.0)->check(CLI::Range(1000.0, 100000.0));
+  cmd.add_option("--fs", o.p.fs_hz, "DAQ sampling rate, Hz")
+      ->default_val(dsp::kDefaultFs_hz)
+      ->check(CLI::Range(1000.0, 100000.0));
   cmd.add_option("--draws", o.draws, "Monte Carlo draws per prediction")
       ->default_val(100)
       ->check(CLI::Range(10, 100000));

@@ -13,6 +13,7 @@
 #include "daemon/triggers/trigger_gate.hpp"
 #include "drivers/source/sample_clock.hpp"
 #include "drivers/source/stamped_source.hpp"
+#include "dsp/core/sample_rate.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 #include "dsp/session/measurement_session.hpp"
 
@@ -24,7 +25,7 @@ namespace eical::daemon {
 class HmiLink;
 
 struct FrameLoopOptions {
-  double fs_hz = 10000.0;
+  double fs_hz = dsp::kDefaultFs_hz;
   bool frame_triggers = true;      // the DAQ's own trigger channel is an input
   std::uint64_t live_every = 100;  // every n-th frame goes to the Live topic
 };

@@ -1,6 +1,7 @@
 #pragma once
 // Metadata of a recorded run (eical-run/1, docs/run-format.md) as plain data.
 // Parsing and writing live in drivers/run_io; dsp only reads these values.
+#include "dsp/core/sample_rate.hpp"
 #include "dsp/core/work_envelope.hpp"
 
 #include <Eigen/Core>
@@ -13,7 +14,7 @@
 namespace eical::dsp {
 
 struct Acquisition {
-  double fs_hz = 10000.0;
+  double fs_hz = kDefaultFs_hz;
   int adc_bits = 24;
   double adc_lsb_volt = 1.1920929e-6;  // 20 V span / 2^24
   std::int64_t adc_offset_counts = 0;

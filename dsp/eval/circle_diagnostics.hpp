@@ -1,4 +1,5 @@
 #pragma once
+#include "dsp/core/sample_rate.hpp"
 // Ballbar-class diagnostics of a circular test (ISO 230-4 context), from the 2-D relative
 // path that eical measures. A ballbar sees only the radius; eical sees both axes, so the
 // machine errors are fitted per axis against the commanded path:
@@ -33,7 +34,7 @@ namespace eical::dsp::eval {
 // One direction of the circular test: steady revolutions only (no ramp-in/out).
 struct CirclePass {
   int direction = +1;  // +1 counter-clockwise, −1 clockwise (seen from +normal)
-  double fs_hz = 10000.0;
+  double fs_hz = kDefaultFs_hz;
   std::vector<Eigen::Vector2d> cmd_mm;   // commanded relative position, plane axes (u, v)
   std::vector<Eigen::Vector2d> meas_mm;  // measured relative position, same samples
 };
@@ -87,7 +88,7 @@ class PassReplay {
  public:
   struct Pass {
     int direction = +1;
-    double fs_hz = 10000.0;
+    double fs_hz = kDefaultFs_hz;
     std::size_t samples = 0;
   };
   virtual ~PassReplay() = default;

@@ -7,6 +7,7 @@
 // repeats of one segment. The deviation measured − commanded is averaged sample by sample
 // across them: the noise falls as 1/√N while the machine's systematic deviation stays,
 // and the spread across them is the repeatability (what the thesis quotes as scatter).
+#include "dsp/core/sample_rate.hpp"
 #include "dsp/core/spill.hpp"
 
 #include <Eigen/Core>
@@ -36,7 +37,7 @@ struct RepeatInput {
   const std::vector<Eigen::Vector3d>* pos_mm = nullptr;  // measured
   const std::vector<Eigen::Vector3d>* cmd_mm = nullptr;  // commanded
   std::vector<std::int64_t> marks;                       // M102 sample indices
-  double fs_hz = 10000.0;
+  double fs_hz = kDefaultFs_hz;
 };
 
 // Groups of at least two repeats, largest first. Segments that are not contiguous in the

@@ -14,6 +14,7 @@
 // integrated velocity only where a velocity support reads it, the integrated position
 // only at the PSD fixes, the steps that are not one sample.
 #include "dsp/core/parallel_for.hpp"
+#include "dsp/core/sample_rate.hpp"
 #include "dsp/fusion/axis_filter.hpp"
 #include "dsp/fusion/forward_filter.hpp"
 #include "dsp/fusion/support_schedule.hpp"
@@ -48,7 +49,7 @@ struct SmootherTrack {
 };
 
 struct SmootherSettings {
-  double fs_hz = 10000.0;
+  double fs_hz = kDefaultFs_hz;
   ErrorModel model;
   Vec3 start_bias_sigma_um_s2 = Vec3::Constant(20.0);
   bool forward_only = false;  // the live filter's causal result, no backward pass

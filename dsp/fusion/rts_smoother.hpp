@@ -11,6 +11,7 @@
 // The posterior covariance of the linear-Gaussian model is the smallest error any
 // unbiased estimator reaches with these supports (Cramér–Rao): it is the noise-limited
 // bound the accuracy benchmark quotes (`cross_covariance_chain` gives it between samples).
+#include "dsp/core/sample_rate.hpp"
 #include "dsp/fusion/axis_filter.hpp"
 #include "dsp/fusion/support_schedule.hpp"
 
@@ -27,7 +28,7 @@ struct SmootherInput {
   const std::vector<Eigen::Vector3d>* vel_mm_s = nullptr;   // integrated relative velocity
   const std::vector<Eigen::Vector3d>* pos_mm = nullptr;     // integrated relative position
   const SupportSchedule* schedule = nullptr;
-  double fs_hz = 10000.0;
+  double fs_hz = kDefaultFs_hz;
   ErrorModel model;
   Vec3 start_bias_sigma_um_s2 = Vec3::Constant(20.0);  // σ of the rest-window bias per axis
   bool keep_gains = false;                             // keep C_k (for cross-time covariances: the accuracy bound)

@@ -12,6 +12,7 @@
 // The sensor side is fitted through the integration's noise model (kf_selection.hpp): the
 // tracks hold the integrated motion as it was integrated, against each axis' reference.
 #include "dsp/core/run.hpp"
+#include "dsp/core/sample_rate.hpp"
 #include "dsp/model/kf_selection.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 
@@ -33,7 +34,7 @@ struct Channel {
 
 struct RunResiduals {
   std::string run_id, reference;  // "ref" | "psd" | "cmd"
-  double fs_hz = 10000.0, dt_s = 1e-3;
+  double fs_hz = kDefaultFs_hz, dt_s = 1e-3;
   int n = 0;                       // decimated samples
   std::vector<std::size_t> trace;  // decimated → aligned trace position
   std::array<bool, 3> moving{}, has_ref{}, has_psd{};

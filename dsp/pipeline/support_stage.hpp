@@ -11,6 +11,7 @@
 // the corrected trace onto the set-point's time afterwards.
 #include "dsp/core/frame.hpp"
 #include "dsp/core/run_meta.hpp"
+#include "dsp/core/sample_rate.hpp"
 #include "dsp/fusion/checkpointed_smoother.hpp"
 #include "dsp/fusion/forward_filter.hpp"
 #include "dsp/fusion/rts_smoother.hpp"
@@ -172,7 +173,7 @@ class SupportStage {
                                                    fusion::SegmentSink* sink = nullptr);
 
   SupportConfig cfg_;
-  double fs_hz_ = 10000.0;
+  double fs_hz_ = kDefaultFs_hz;
   fusion::Discrete step_;
   supports::StandstillDetector detector_;
   std::vector<supports::PsdDecoder> psd_;

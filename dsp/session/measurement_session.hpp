@@ -5,6 +5,7 @@
 // object runs in eicald and in `eical demo`, so the offline tools exercise the service's
 // code path. Per-frame work does not allocate or throw.
 #include "dsp/core/frame.hpp"
+#include "dsp/core/sample_rate.hpp"
 #include "dsp/session/measurement_recorder.hpp"
 #include "dsp/session/measurement_state.hpp"
 
@@ -15,7 +16,7 @@
 namespace eical::dsp {
 
 struct SessionConfig {
-  double fs_hz = 10000.0;
+  double fs_hz = kDefaultFs_hz;
   double max_measurement_s = 600.0;
   double pretrigger_s = 0.4;   // rest kept before M101 (bias window if M101 comes late)
   double posttrigger_s = 0.1;  // frames kept after M103

@@ -1,4 +1,5 @@
 #pragma once
+#include "dsp/core/sample_rate.hpp"
 // Automatic standstill detection for ZUPT (ch. 3.4.2, 8.3.1): no hand-set windows. A
 // sample is at rest when, over the last W samples,
 //   1 the relative acceleration carries no more energy than the sensors' noise: the
@@ -74,7 +75,7 @@ class StandstillDetector {
   std::size_t vhead_ = 0, vfilled_ = 0;
   Eigen::Vector3d vsum_ = Eigen::Vector3d::Zero(), vsq_ = Eigen::Vector3d::Zero();
   std::size_t head_ = 0, filled_ = 0, since_recompute_ = 0, bad_ = 0;
-  double sum_ = 0.0, var_ = 1.0, datasheet_var_ = 1.0, fs_hz_ = 10000.0, gamma_ = 1.0, t_ = 0.0;
+  double sum_ = 0.0, var_ = 1.0, datasheet_var_ = 1.0, fs_hz_ = kDefaultFs_hz, gamma_ = 1.0, t_ = 0.0;
   std::int64_t cmd_still_samples_ = 0, cmd_needed_ = 0;
 };
 

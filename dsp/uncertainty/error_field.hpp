@@ -21,6 +21,7 @@
 // Everything runs on a coarse grid (coarse_schedule.hpp) in the sensors' time base and is
 // interpolated onto the set-point's (the pipeline's delay alignment) where it is asked for.
 // Draws are seeded and deterministic.
+#include "dsp/core/sample_rate.hpp"
 #include "dsp/fusion/error_model.hpp"
 #include "dsp/fusion/support_schedule.hpp"
 #include "dsp/uncertainty/coarse_path.hpp"
@@ -45,7 +46,7 @@ struct ErrorFieldInput {
   const std::vector<Eigen::Vector3d>* pos_mm = nullptr;  // the measured path, aligned to the set-point
   const std::vector<Eigen::Vector3d>* vel_mm_s = nullptr;
   const std::vector<Eigen::Vector2d>* temp_c = nullptr;  // case temperature of table, head per trace sample (optional)
-  double fs_hz = 10000.0;
+  double fs_hz = kDefaultFs_hz;
   double delay_samples = 0.0;  // aligned position = sensor position − delay
   fusion::ErrorModel model;    // the pipeline's fusion model
   Eigen::Vector3d start_bias_sigma_um_s2 = Eigen::Vector3d::Constant(20.0);

@@ -10,6 +10,7 @@
 // radius or travel, down to the thesis' test.
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/core/run_meta.hpp"
+#include "dsp/core/sample_rate.hpp"
 #include "sim/scenario.hpp"
 
 #include <chrono>
@@ -33,7 +34,7 @@ struct TestProgram {
   double size_mm[2] = {50.0, 50.0};                             // rectangle
   std::vector<dsp::PsdSpec> psd;                                // the strips on the machine
   double noise_ug_per_rthz = 0.4;                               // each sensor, two-sided
-  double fs_hz = 10000.0;                                       // the DAQ's rate
+  double fs_hz = dsp::kDefaultFs_hz;                            // the DAQ's rate
   bool identified = false;                                      // sensors identified on site first (eical identify)
 };
 
