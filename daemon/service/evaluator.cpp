@@ -19,6 +19,7 @@
 #include "dsp/core/error.hpp"
 #include "dsp/core/float_limits.hpp"
 #include "dsp/stream/analyze_stream.hpp"
+#include "history/record/utc_time.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -30,15 +31,7 @@
 namespace eical::daemon {
 namespace {
 
-// UTC now in a strftime format: "%Y%m%dT%H%M%SZ" for run ids, RFC 3339 for run.toml.
-std::string utc_now(const char* format) {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, format, &tm);
-  return b;
-}
+using history::utc_now;  // "%Y%m%dT%H%M%SZ" for run ids, RFC 3339 for run.toml
 
 std::string percent(double ratio) { return std::to_string(static_cast<int>(std::lround(ratio * 100.0))) + " %"; }
 
@@ -169,7 +162,7 @@ dsp::Run Evaluator::make_run(const RecordedRun& job) const {
   std::error_code ec;
   for (int n = 2; std::filesystem::exists(config_.recording.dir / run.meta.id, ec); ++n)
     run.meta.id = id + "-" + std::to_string(n);
-  run.meta.created = utc_now("%Y-%m-%dT%H:%M:%SZ");
+  run.meta.created = utc_now();
   run.channels.psd_count = static_cast<int>(std::min<std::size_t>(meta_.psd.size(), dsp::kMaxPsd));
   return run;
 }

@@ -2,6 +2,7 @@
 
 #include "daemon/system/log.hpp"
 #include "drivers/run_io/run_writer.hpp"
+#include "history/record/utc_time.hpp"
 
 #include <unistd.h>
 
@@ -12,14 +13,7 @@ namespace eical::daemon {
 
 namespace {
 
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return b;
-}
+using history::utc_now;
 
 }  // namespace
 

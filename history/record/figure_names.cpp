@@ -1,5 +1,7 @@
 #include "history/record/figure_names.hpp"
 
+#include "history/record/utc_time.hpp"
+
 #include <array>
 #include <cctype>
 #include <cstdio>
@@ -77,12 +79,7 @@ std::string utc_rfc3339(const std::string& text) {
   if (mo < 1 || mo > 12 || d < 1 || d > 31 || h > 23 || mi > 59 || s > 60) return "";
   std::tm tm{};
   tm.tm_year = y - 1900, tm.tm_mon = mo - 1, tm.tm_mday = d, tm.tm_hour = h, tm.tm_min = mi, tm.tm_sec = s;
-  const std::time_t t = timegm(&tm) - offset_s;
-  std::tm out{};
-  gmtime_r(&t, &out);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &out);
-  return b;
+  return utc_text(timegm(&tm) - offset_s);
 }
 
 }  // namespace eical::history

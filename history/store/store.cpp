@@ -1,5 +1,6 @@
 #include "history/store/store.hpp"
 
+#include "history/record/utc_time.hpp"
 #include "history/sql/pg_connection.hpp"
 #include "history/sql/sqlite_connection.hpp"
 #include "history/store/schema.hpp"
@@ -11,15 +12,6 @@ namespace eical::history {
 namespace {
 
 using sql::Value;
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return b;
-}
 
 Value text_or_null(const std::optional<std::string>& s) { return s ? Value(*s) : Value(); }
 Value number_or_null(const std::optional<double>& d) { return d ? Value(*d) : Value(); }

@@ -6,6 +6,7 @@
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "history/record/result_record.hpp"
+#include "history/record/utc_time.hpp"
 
 #include <sys/stat.h>
 
@@ -21,12 +22,7 @@ namespace {
 // run.toml without `created`: its modification time stands in.
 std::string file_time_utc(const fs::path& p) {
   struct stat st {};
-  const std::time_t t = ::stat(p.c_str(), &st) == 0 ? st.st_mtime : std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return b;
+  return history::utc_text(::stat(p.c_str(), &st) == 0 ? st.st_mtime : std::time(nullptr));
 }
 
 }  // namespace
