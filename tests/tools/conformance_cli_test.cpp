@@ -73,7 +73,9 @@ TEST(ConformanceCli, ToleranceWideNarrowAndStraddledByU) {
     EXPECT_EQ(status, judged == "ok" ? c.exit_if_ok : judged == "degraded" ? 2 : 3);
     const std::string text = run_cli("analyze --tolerances " + t.string() + " " + run, status);
     EXPECT_NE(text.find("against the tolerances (ISO 14253-1"), std::string::npos) << text;
-    // The report's banner says the verdict and the decision together.
+    // The report's banner says the verdict and the decision together (one report: each
+    // renders its 100 draws).
+    if (std::string(c.decision) != "undecided") continue;
     const fs::path rep = dir / (std::string("report-") + c.decision);
     (void)run_cli("report " + (dir / "run").string() + " --tolerances " + t.string() + " -o " + rep.string(), status);
     ASSERT_EQ(status, 0);
