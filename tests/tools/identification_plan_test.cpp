@@ -55,7 +55,11 @@ TEST(IdentificationPlan, StripsAtBothEndsOfATravelAreSwungFromInside) {
   p.kind = "positioning", p.targets_mm = {0.0, 150.0, 300.0};
   p.psd = plan::strips_at_both_ends(p);
   ASSERT_EQ(p.psd.size(), 2u);
-  EXPECT_DOUBLE_EQ(p.psd[0].center_mm[0], 10.0);  // one strip length inside each end
+  EXPECT_DOUBLE_EQ(p.psd[0].center_mm[0], 0.0);  // on the ends: the test stands on them
+  EXPECT_DOUBLE_EQ(p.psd[1].center_mm[0], 300.0);
+  // Identified, one strip length inside each end, where a swing inside the travel crosses.
+  p.psd = plan::strips_identification_can_cross(p);
+  EXPECT_DOUBLE_EQ(p.psd[0].center_mm[0], 10.0);
   EXPECT_DOUBLE_EQ(p.psd[1].center_mm[0], 290.0);
   const auto id = plan::identification_plan(p);
   const auto a = gcode::strip_swing(id, id.psd[0]), b = gcode::strip_swing(id, id.psd[1]);

@@ -88,11 +88,26 @@ std::vector<dsp::PsdSpec> strips_at_both_ends(const TestProgram& p) {
   if ((p.kind != "step" && p.kind != "positioning") || !travel_mm[0]) return {};
   std::vector<dsp::PsdSpec> out(2);
   out[0].measures = out[1].measures = "x";
-  // One strip length inside each end: every run crosses each strip as it leaves and nears
-  // the end, and the identification's swings, which stay inside the travel, cross it whole.
-  const double inset_mm = out[0].length_mm;
-  if (travel_mm[0]->hi_mm - travel_mm[0]->lo_mm < 4.0 * inset_mm) return {};
-  out[0].center_mm[0] = travel_mm[0]->lo_mm + inset_mm, out[1].center_mm[0] = travel_mm[0]->hi_mm - inset_mm;
+  out[0].center_mm[0] = travel_mm[0]->lo_mm, out[1].center_mm[0] = travel_mm[0]->hi_mm;
+  return out;
+}
+
+std::vector<dsp::PsdSpec> strips_identification_can_cross(const TestProgram& p) {
+  std::optional<sim::gcode::AxisTravel> travel_mm[2];
+  test_travel(p, travel_mm);
+  std::vector<dsp::PsdSpec> out = p.psd;
+  for (auto& s : out) {
+    const int along = s.measures == "x" ? 0 : s.measures == "y" ? 1 : -1;
+    if (along < 0 || !travel_mm[along]) continue;
+    const auto& t = *travel_mm[along];
+    // One strip length inside each end: a swing that stays inside the travel crosses it
+    // whole (gen-nc identify refuses one it cannot cross); on a travel too short for that,
+    // the middle.
+    const double inset_mm = s.length_mm;
+    s.center_mm[along] = t.hi_mm - t.lo_mm >= 2.0 * inset_mm
+                             ? std::clamp(s.center_mm[along], t.lo_mm + inset_mm, t.hi_mm - inset_mm)
+                             : 0.5 * (t.lo_mm + t.hi_mm);
+  }
   return out;
 }
 
@@ -253,13 +268,20 @@ Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
 
 std::vector<TestProgram> variants(const TestProgram& p) {
   std::vector<TestProgram> v = geometric_variants(p);
-  if (!p.identified) {
-    TestProgram same = p;
-    same.identified = true;
-    std::vector<TestProgram> with_id{same};
-    for (TestProgram t : v) t.identified = true, with_id.push_back(t);
-    v.insert(v.end(), with_id.begin(), with_id.end());
+  // Identified: the identification crosses the test's strips, so a strip on a travel's end
+  // moves one strip length inside it (the plan prints where each goes).
+  auto identified = [](TestProgram t) {
+    t.identified = true;
+    t.psd = strips_identification_can_cross(t);
+    return t;
+  };
+  if (p.identified) {
+    for (auto& t : v) t = identified(t);
+    return v;
   }
+  std::vector<TestProgram> with_id{identified(p)};
+  for (const TestProgram& t : v) with_id.push_back(identified(t));
+  v.insert(v.end(), with_id.begin(), with_id.end());
   return v;
 }
 

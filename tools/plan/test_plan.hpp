@@ -45,6 +45,9 @@ std::string describe(const TestProgram& p);
 std::vector<dsp::PsdSpec> strips_for(const TestProgram& p);
 // A positioning or step test's two strips at the ends of its travel (on x).
 std::vector<dsp::PsdSpec> strips_at_both_ends(const TestProgram& p);
+// The program's strips where an identification that stays inside the test's travel can
+// cross them: a strip on (or near) a travel's end moved one strip length inside it.
+std::vector<dsp::PsdSpec> strips_identification_can_cross(const TestProgram& p);
 // The program a recorded run ran (for analyze's suggestion).
 TestProgram program_of(const dsp::RunMeta& meta);
 // The simulated run of a program on an ideal machine with data-sheet sensors.
