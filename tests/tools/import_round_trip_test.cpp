@@ -1,8 +1,7 @@
-// eical import on recordings it wrote itself from a known truth: the
-// simulator's run exported as another system records it (jittered stamps, lost
-// batches, an unknown clock offset), imported back, and compared with the run:
-// the offset within its uncertainty, the resampled acceleration against the
-// truth, the set-point against the motion.
+// eical import on recordings it wrote itself from a known truth: the simulator's run
+// exported as another system records it (jittered stamps, lost batches, an unknown clock
+// offset), imported back, and compared with the run: the offset within its uncertainty,
+// the resampled acceleration against the truth, the set-point against the motion.
 #include "drivers/config/strict_toml.hpp"
 #include "drivers/import/capture_export.hpp"
 #include "drivers/import/csv_import.hpp"
@@ -22,6 +21,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 
@@ -55,8 +55,7 @@ Simulated simulate_capture(const sim::Scenario& sc, const sim::CaptureClock& clo
   return s;
 }
 
-// What taking the jittered samples as if they were on the grid would cost (no
-// resampling).
+// What taking the jittered samples as if they were on the grid would cost (no resampling).
 double unresampled_rms_g(const Simulated& s, int part) {
   double ss = 0.0;
   std::size_t n_kept = 0;
@@ -121,6 +120,31 @@ sim::Scenario klipper_sweep(bool legacy, double f0, double f1, const char* chip,
   return sc;
 }
 
+// The simulated capture written as Klipper writes it, each data line passed through
+// `edit` (a rewrite, or "" to drop it) into `file`.
+void write_capture_as(const Simulated& truth, const sim::CaptureClock& clock, const fs::path& file,
+                      const std::function<std::string(const std::string&)>& edit) {
+  const fs::path raw = file.parent_path() / "as-recorded.csv";
+  drivers::write_klipper_capture(
+      raw, drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 1, raw.string()));
+  std::ifstream in(raw);
+  std::ofstream out(file);
+  for (std::string line; std::getline(in, line);) {
+    const std::string kept = line.empty() || line[0] == '#' ? line : edit(line);
+    if (!kept.empty()) out << kept << "\n";
+  }
+}
+
+// What import_klipper refuses the capture with ("" when it imports it).
+std::string refusal_of(const fs::path& file, const drivers::KlipperImport& k) {
+  try {
+    (void)drivers::import_klipper(file, k);
+  } catch (const dsp::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(ImportRoundTrip, KlipperCaptureWithJitterGapsAndAnUnknownStart) {
   const TempDir dir;
   const sim::Scenario sc = klipper_sweep(false, 20.0, 50.0, "adxl345", 3200.0, 21);
@@ -141,13 +165,10 @@ TEST(ImportRoundTrip, KlipperCaptureWithJitterGapsAndAnUnknownStart) {
   const Comparison c = compare(r.run, 1, truth, clock.offset_s, ck.t0_s);
   const double unresampled = unresampled_rms_g(truth, 1);
   std::printf(
-      "klipper round trip (adxl345, 3200 Hz, 20-50 Hz): offset %.7f s "
-      "(truth %.7f, error %+.2f us, u %.2f us k=1); "
-      "fs %.4f Hz; jitter %.2f us (truth %.2f); %zu lost frames in %zu "
-      "gaps (truth %zu); acceleration %.3f mg rms from "
+      "klipper round trip (adxl345, 3200 Hz, 20-50 Hz): offset %.7f s (truth %.7f, error %+.2f us, u %.2f us k=1); "
+      "fs %.4f Hz; jitter %.2f us (truth %.2f); %zu lost frames in %zu gaps (truth %zu); acceleration %.3f mg rms from "
       "the truth "
-      "(%.3f mg without resampling; noise %.2f mg, signal %.1f mg "
-      "rms); set-point within %.4f um (peak speed %.0f "
+      "(%.3f mg without resampling; noise %.2f mg, signal %.1f mg rms); set-point within %.4f um (peak speed %.0f "
       "mm/s)\n",
       off.offset_s, clock.offset_s, (off.offset_s - clock.offset_s) * 1e6, off.u_s * 1e6, ck.fs_hz,
       ck.jitter_rms_s * 1e6, truth.samples.jitter_rms_s * 1e6, ck.lost_frames, ck.gaps, truth.samples.lost,
@@ -160,10 +181,8 @@ TEST(ImportRoundTrip, KlipperCaptureWithJitterGapsAndAnUnknownStart) {
   EXPECT_NEAR(ck.jitter_rms_s, truth.samples.jitter_rms_s, 0.1 * truth.samples.jitter_rms_s);
   EXPECT_EQ(c.matched, r.run.frames.size());
   EXPECT_LT(c.accel_rms_g, 0.2 * c.noise_g);
-  EXPECT_LT(c.accel_rms_g, unresampled);  // (the noise of neighbouring samples
-                                          // enters the interpolation too)
-  // The set-point is the motion itself, shifted by what the offset is off (3 u
-  // at the peak speed).
+  EXPECT_LT(c.accel_rms_g, unresampled);  // (the noise of neighbouring samples enters the interpolation too)
+  // The set-point is the motion itself, shifted by what the offset is off (3 u at the peak speed).
   EXPECT_LT(c.cmd_max_um, 1e3 * c.v_max_mm_s * 3.0 * off.u_s + 0.01);
 
   // Written and read back: one sensor, the gaps flagged, the report beside it.
@@ -206,35 +225,31 @@ TEST(ImportRoundTrip, OlderKlipperTestThroughTwoModes) {
   const Comparison c = compare(r.run, 1, truth, clock.offset_s, r.report.accel_clock.t0_s);
   const double unresampled = unresampled_rms_g(truth, 1);
   std::printf(
-      "older Klipper test through modes at 38 and 61 Hz (lis2dw, 1600 "
-      "Hz): offset error %+.2f us, u %.2f us (k=1), the "
+      "older Klipper test through modes at 38 and 61 Hz (lis2dw, 1600 Hz): offset error %+.2f us, u %.2f us (k=1), the "
       "command explains %.1f %%; "
-      "acceleration %.3f mg rms from the truth (%.3f mg without "
-      "resampling; noise %.2f mg, signal %.1f mg rms); "
+      "acceleration %.3f mg rms from the truth (%.3f mg without resampling; noise %.2f mg, signal %.1f mg rms); "
       "set-point within %.4f um "
       "(peak speed %.0f mm/s)\n",
       (off.offset_s - clock.offset_s) * 1e6, off.u_s * 1e6, 100.0 * off.explained, c.accel_rms_g * 1e3,
       unresampled * 1e3, c.noise_g * 1e3, c.signal_rms_g * 1e3, c.cmd_max_um, c.v_max_mm_s);
-  // The modes' phase moves the correlation peak. The older test passes the
-  // centre at full speed: its acceleration is a square wave whose fundamental
-  // sweeps through both modes, so what the command does not explain (half the
-  // signal here) is phase-shifted response, and it differs from block to block
-  // as the sweep crosses the modes; the jackknife sees that. Without the modes
-  // the same capture aligns to 0.73 µs (u 2.97 µs); with them +242 µs, u 90.6
-  // µs (measured).
+  // The modes' phase moves the correlation peak. The older test passes the centre at full
+  // speed: its acceleration is a square wave whose fundamental sweeps through both modes,
+  // so what the command does not explain (half the signal here) is phase-shifted response,
+  // and it differs from block to block as the sweep crosses the modes; the jackknife sees
+  // that. Without the modes the same capture aligns to 0.73 µs (u 2.97 µs); with them
+  // +242 µs, u 90.6 µs (measured).
   EXPECT_LE(std::abs(off.offset_s - clock.offset_s), 3.0 * off.u_s);
-  // Square-wave edges through an 800 Hz corner sampled at 1600 Hz put content
-  // up to Nyquist; sampled 8 % of a sample early or late, cubic interpolation
-  // recovers it to a few percent of the signal (with no jitter the round trip
-  // is exact), better than taking the samples as if they were on the grid.
+  // Square-wave edges through an 800 Hz corner sampled at 1600 Hz put content up to
+  // Nyquist; sampled 8 % of a sample early or late, cubic interpolation recovers it to a
+  // few percent of the signal (with no jitter the round trip is exact), better than taking
+  // the samples as if they were on the grid.
   EXPECT_LT(c.accel_rms_g, 0.05 * c.signal_rms_g);
   EXPECT_LT(c.accel_rms_g, unresampled);
   EXPECT_LT(c.cmd_max_um, 1e3 * c.v_max_mm_s * (std::abs(off.offset_s - clock.offset_s) + 3.0 * off.u_s) + 0.01);
 }
 
-// A CoreXY's belt test (TEST_RESONANCES AXIS=1,-1) moves x and y together:
-// their commanded accelerations are collinear, and the offset is found along
-// the one direction they span.
+// A CoreXY's belt test (TEST_RESONANCES AXIS=1,-1) moves x and y together: their commanded
+// accelerations are collinear, and the offset is found along the one direction they span.
 TEST(ImportRoundTrip, BeltTestAlongADiagonal) {
   const TempDir dir;
   const Eigen::Vector3d direction = sim::nc::test_direction("1,-1", "--axis");
@@ -252,57 +267,38 @@ TEST(ImportRoundTrip, BeltTestAlongADiagonal) {
   k.setup.site.g_mps2 = sc.meta.site.g_mps2;
   const drivers::ImportResult r = drivers::import_klipper(file, k);
   const auto& off = r.report.offset;
-  std::printf(
-      "belt test along (1,-1) (lis2dw, 400 Hz): offset error %+.2f us, "
-      "u %.2f us (k=1), explains %.1f %%\n",
-      (off.offset_s - clock.offset_s) * 1e6, off.u_s * 1e6, 100.0 * off.explained);
+  std::printf("belt test along (1,-1) (lis2dw, 400 Hz): offset error %+.2f us, u %.2f us (k=1), explains %.1f %%\n",
+              (off.offset_s - clock.offset_s) * 1e6, off.u_s * 1e6, 100.0 * off.explained);
   EXPECT_LE(std::abs(off.offset_s - clock.offset_s), 3.0 * off.u_s + 0.05 / 400.0);
   EXPECT_GT(off.explained, 0.8);
-  // The gain splits the one direction over x and y by the minimum norm: equal
-  // and opposite.
+  // The gain splits the one direction over x and y by the minimum norm: equal and opposite.
   EXPECT_NEAR(off.gain(0, 0), -off.gain(0, 1), 0.05 * std::abs(off.gain(0, 0)) + 1e-6);
 }
 
-// A capture as a misconfigured Klipper writes it: its values ×8 (one chip's
-// counts with another's constants) and its axes turned by 90° about z. The
-// import refuses it, naming both fixes from gravity and the motion; with the
-// fixes it imports.
+// A capture as a misconfigured Klipper writes it: its values ×8 (one chip's counts with
+// another's constants) and its axes turned by 90° about z. The import refuses it, naming
+// both fixes from gravity and the motion; with the fixes it imports.
 TEST(ImportRoundTrip, KlipperCaptureWithAWrongScaleAndTurnedAxesIsRefusedWithTheFix) {
   const TempDir dir;
   const sim::Scenario sc = klipper_sweep(false, 30.0, 60.0, "lis2dw", 400.0, 24);
   sim::CaptureClock clock;
   clock.offset_s = 3.0, clock.batch = 8, clock.seed = 8;
-  const Simulated truth = simulate_capture(sc, clock);
-  const fs::path right = dir.path / "right.csv", wrong = dir.path / "raw_data_x.csv";
-  drivers::write_klipper_capture(
-      right, drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 1, right.string()));
+  const fs::path wrong = dir.path / "raw_data_x.csv";
   // The file's columns: (−y, x, z) of the sensor's, times 8.
-  std::ifstream in(right);
-  std::ofstream out(wrong);
-  for (std::string line; std::getline(in, line);) {
-    if (line.empty() || line[0] == '#') {
-      out << line << "\n";
-      continue;
-    }
+  write_capture_as(simulate_capture(sc, clock), clock, wrong, [](const std::string& line) {
     std::stringstream ss(line);
     double t = 0, ax = 0, ay = 0, az = 0;
     char c = 0;
     ss >> t >> c >> ax >> c >> ay >> c >> az;
     char buf[160];
     std::snprintf(buf, sizeof buf, "%.6f,%.6f,%.6f,%.6f", t, -8.0 * ay, 8.0 * ax, 8.0 * az);
-    out << buf << "\n";
-  }
-  out.close();
+    return std::string(buf);
+  });
   drivers::KlipperImport k;
   k.test = sc.sweep.test;
   k.setup.chip = "lis2dw";
   k.setup.site.g_mps2 = sc.meta.site.g_mps2;
-  std::string message;
-  try {
-    (void)drivers::import_klipper(wrong, k);
-  } catch (const dsp::InputError& e) {
-    message = e.what();
-  }
+  const std::string message = refusal_of(wrong, k);
   std::printf("refused: %s\n", message.c_str());
   EXPECT_NE(message.find("--accel-scale 0.12"), std::string::npos) << message;
   EXPECT_NE(message.find("--mounting y,-x,z"), std::string::npos) << message;
@@ -314,39 +310,25 @@ TEST(ImportRoundTrip, KlipperCaptureWithAWrongScaleAndTurnedAxesIsRefusedWithThe
   EXPECT_NEAR(r.report.mounting->gravity_g, 1.0, 0.01);
 }
 
-// A short capture that matches a stretch of a long test is not that test's
-// capture: Klipper records the whole test, so the import refuses a test that
-// lies mostly outside the file.
+// A short capture that matches a stretch of a long test is not that test's capture: Klipper
+// records the whole test, so the import refuses a test that lies mostly outside the file.
 TEST(ImportRoundTrip, AShortCaptureMatchedToAStretchOfALongTestIsRefused) {
   const TempDir dir;
   const sim::Scenario sc = klipper_sweep(false, 20.0, 50.0, "adxl345", 3200.0, 25);
   sim::CaptureClock clock;
   clock.offset_s = 40.0, clock.batch = 16, clock.seed = 9;
   const Simulated truth = simulate_capture(sc, clock);
-  const fs::path whole = dir.path / "whole.csv", piece = dir.path / "raw_data_x.csv";
-  drivers::write_klipper_capture(
-      whole, drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 1, whole.string()));
+  const fs::path piece = dir.path / "raw_data_x.csv";
   // Two seconds from the middle of the sweep.
-  std::ifstream in(whole);
-  std::ofstream out(piece);
   const double mid_s = clock.offset_s + 0.5 * static_cast<double>(truth.run.frames.size()) / truth.run.fs_hz();
-  for (std::string line; std::getline(in, line);) {
-    if (!line.empty() && line[0] != '#') {
-      const double t = std::stod(line.substr(0, line.find(',')));
-      if (t < mid_s - 1.0 || t > mid_s + 1.0) continue;
-    }
-    out << line << "\n";
-  }
-  out.close();
+  write_capture_as(truth, clock, piece, [mid_s](const std::string& line) {
+    const double t = std::stod(line.substr(0, line.find(',')));
+    return t < mid_s - 1.0 || t > mid_s + 1.0 ? std::string() : line;
+  });
   drivers::KlipperImport k;
   k.test = sc.sweep.test;
   k.setup.site.g_mps2 = sc.meta.site.g_mps2;
-  std::string message;
-  try {
-    (void)drivers::import_klipper(piece, k);
-  } catch (const dsp::InputError& e) {
-    message = e.what();
-  }
+  const std::string message = refusal_of(piece, k);
   std::printf("refused: %s\n", message.c_str());
   EXPECT_NE(message.find("of the test lies inside the capture"), std::string::npos) << message;
 }
@@ -376,16 +358,13 @@ TEST(ImportRoundTrip, AccelerometerCsvWithAHalsamplerTrace) {
   const double true_offset = clock.offset_s - nc_offset;
   const Comparison c = compare(r.run, 0, truth, clock.offset_s, r.report.accel_clock.t0_s);
   std::printf(
-      "accel CSV + halsampler (mpu6050, 1000 Hz, free-form contour): "
-      "offset %.7f s (truth %.7f, error %+.2f us, u %.2f "
+      "accel CSV + halsampler (mpu6050, 1000 Hz, free-form contour): offset %.7f s (truth %.7f, error %+.2f us, u %.2f "
       "us k=1); "
-      "acceleration %.3f mg rms from the truth (noise %.2f mg, signal "
-      "%.1f mg rms); set-point within %.4f um (peak "
+      "acceleration %.3f mg rms from the truth (noise %.2f mg, signal %.1f mg rms); set-point within %.4f um (peak "
       "speed %.0f mm/s)\n",
       off.offset_s, true_offset, (off.offset_s - true_offset) * 1e6, off.u_s * 1e6, c.accel_rms_g * 1e3,
       c.noise_g * 1e3, c.signal_rms_g * 1e3, c.cmd_max_um, c.v_max_mm_s);
-  // A jerk-limited contour has no sharp edges: its offset is known to a
-  // fraction of a sample.
+  // A jerk-limited contour has no sharp edges: its offset is known to a fraction of a sample.
   EXPECT_LE(std::abs(off.offset_s - true_offset), 3.0 * off.u_s + 1e-7);
   EXPECT_LT(off.u_s, 1.0 / 1000.0);
   EXPECT_LT(c.accel_rms_g, 0.2 * c.noise_g);
@@ -401,8 +380,7 @@ TEST(ImportRoundTrip, NcCsvWithJitteredStampsAndNamedColumns) {
   sim::CaptureClock clock;
   clock.offset_s = 3.5, clock.jitter_rms_s = 0.03 / 1600.0, clock.seed = 8;
   const Simulated truth = simulate_capture(sc, clock);
-  // The accelerometer CSV in mm/s² with the time in ms and its columns in
-  // another order.
+  // The accelerometer CSV in mm/s² with the time in ms and its columns in another order.
   const drivers::StampedAccel cap =
       drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 0, "accel");
   std::string text = "az_mmps2,time_ms,ax_mmps2,ay_mmps2\n";
@@ -413,8 +391,7 @@ TEST(ImportRoundTrip, NcCsvWithJitteredStampsAndNamedColumns) {
     text += buf;
   }
   drivers::write_text_atomic(dir.path / "accel.csv", text);
-  // A servo trace with its own jittered stamps (ms too), positions at those
-  // times.
+  // A servo trace with its own jittered stamps (ms too), positions at those times.
   std::mt19937_64 rng(3);
   std::normal_distribution<double> jitter(0.0, 40e-6);
   text = "t_ms,x_mm,y_mm,z_mm\n";
@@ -438,19 +415,16 @@ TEST(ImportRoundTrip, NcCsvWithJitteredStampsAndNamedColumns) {
   const double true_offset = clock.offset_s - nc_offset;
   const Comparison c = compare(r.run, 0, truth, clock.offset_s, r.report.accel_clock.t0_s);
   std::printf(
-      "accel CSV (mm/s2, ms) + jittered NC CSV (500 Hz, 40 us): offset "
-      "error %+.2f us, u %.2f us (k=1); NC clock %.4f "
+      "accel CSV (mm/s2, ms) + jittered NC CSV (500 Hz, 40 us): offset error %+.2f us, u %.2f us (k=1); NC clock %.4f "
       "Hz, jitter %.1f us; "
-      "acceleration %.3f mg rms from the truth (noise %.2f mg); "
-      "set-point within %.3f um\n",
+      "acceleration %.3f mg rms from the truth (noise %.2f mg); set-point within %.3f um\n",
       (off.offset_s - true_offset) * 1e6, off.u_s * 1e6, r.report.nc_clock->fs_hz,
       r.report.nc_clock->jitter_rms_s * 1e6, c.accel_rms_g * 1e3, c.noise_g * 1e3, c.cmd_max_um);
   EXPECT_LE(std::abs(off.offset_s - true_offset), 3.0 * off.u_s + 1e-7);
   EXPECT_NEAR(r.report.nc_clock->fs_hz, 500.0, 0.01);
   EXPECT_LT(c.accel_rms_g, 0.2 * c.noise_g);
   EXPECT_LT(off.u_s, 1.0 / 1600.0);
-  // The offset's error at the peak speed, and a spline through 500 Hz positions
-  // whose stamps jitter by 40 us.
+  // The offset's error at the peak speed, and a spline through 500 Hz positions whose stamps jitter by 40 us.
   EXPECT_LT(c.cmd_max_um, 1e3 * c.v_max_mm_s * (3.0 * off.u_s + 3.0 * 40e-6));
 }
 
