@@ -2,6 +2,7 @@
 
 #include "dsp/core/float_limits.hpp"
 #include "history/record/figure_names.hpp"
+#include "history/record/utc_time.hpp"
 #include "tools/history/history_format.hpp"
 #include "tools/report/svg.hpp"
 
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <ctime>
 #include <map>
 
 namespace eical::tools::report {
@@ -48,14 +50,6 @@ std::vector<PolarTrace> polar_traces(const history::Record& r, const std::string
 }
 
 std::string short_date(const std::string& t) { return t.substr(0, 10); }
-// "2026-12-02T14:08:48Z" → "2026-12-02 14:08 UTC": the origin of an axis in minutes or hours.
-std::string short_time(const std::string& t) {
-  if (t.size() < 16) return t;
-  std::string o = t.substr(0, 16);
-  o[10] = ' ';
-  return o + " UTC";
-}
-
 std::string judgement_text(history::Judgement j) {
   switch (j) {
     case history::Judgement::significant: return "significant";
@@ -83,14 +77,16 @@ TimeUnit time_unit_for(double span_s) {
 std::string trend_plot(const std::string& figure, const std::vector<history::TrendPoint>& points,
                        const std::vector<std::string>& marked) {
   std::optional<double> t0, t1;
-  std::string first_at;
   for (const auto& p : points)
     if (const auto s = history::epoch_s(p.measured_at)) {
-      if (!t0 || *s < *t0) t0 = *s, first_at = p.measured_at;
+      if (!t0 || *s < *t0) t0 = *s;
       if (!t1 || *s > *t1) t1 = *s;
     }
   const TimeUnit unit_t = time_unit_for(t0 ? *t1 - *t0 : 0.0);
-  const std::string origin = unit_t.seconds < 86400.0 ? short_time(first_at) : short_date(first_at);
+  // The first result's time below days (minutes from 14:08, not from midnight), else its date.
+  const std::string origin = t0 ? history::utc_text(static_cast<std::time_t>(*t0),
+                                                    unit_t.seconds < 86400.0 ? "%Y-%m-%d %H:%M UTC" : "%Y-%m-%d")
+                                : std::string();
   std::map<std::string, std::size_t> machine_index;
   for (const auto& p : points) machine_index.emplace(p.machine, machine_index.size());
   std::vector<LineSeries> series;
