@@ -60,6 +60,15 @@ Eigen::Matrix3d best_map(const Eigen::Vector3d& up_sensor, const Eigen::Vector3d
   return best;
 }
 
+// The machine axis a direction lies along within kMountingToleranceDeg ("x", "y", "z"; "",
+// when none, or along one against the axis' sense).
+std::string axis_along(const Eigen::Vector3d& v) {
+  for (int a = 0; a < 3; ++a)
+    if (angle_deg(v, Eigen::Vector3d::Unit(a)) <= kMountingToleranceDeg)
+      return std::string(1, static_cast<char>('x' + a));
+  return "";
+}
+
 }  // namespace
 
 MountingCheck check_mounting(const Eigen::Vector3d& mean_sensor_g, const Eigen::Matrix3d& gain,
@@ -71,7 +80,6 @@ MountingCheck check_mounting(const Eigen::Vector3d& mean_sensor_g, const Eigen::
   const bool has_gravity = c.gravity_g >= kNoGravityBelow_g;
   const Eigen::Vector3d motion_sensor = gain * direction;
   const bool has_motion = motion_sensor.norm() > 0.0 && std::isfinite(motion_sensor.norm());
-  if (has_gravity) c.up_in_machine = (to_machine * mean_sensor_g).normalized();
   char b[400];
   if (!has_gravity) {
     std::snprintf(b, sizeof b,
@@ -103,10 +111,17 @@ MountingCheck check_mounting(const Eigen::Vector3d& mean_sensor_g, const Eigen::
     why += " the commanded motion " + vec_text(direction) + " shows along " +
            vec_text((to_machine * motion_sensor).normalized());
   c.consistent = false;
+  // Gravity fits and only the motion does not: the test more likely ran along another axis
+  // than the sensor turned about the vertical. Both are named, the axis first.
+  const std::string other_axis = up_fits ? axis_along((to_machine * motion_sensor).normalized()) : "";
   if (fit_fits) {
     c.fitting_map = sim::axes_map_text(fit);
-    c.findings.push_back(why + "; the axes map " + c.fitting_map +
-                         " fits both gravity (up) and the motion; fix: --mounting " + c.fitting_map);
+    c.findings.push_back(why + "; " +
+                         (other_axis.empty() ? ""
+                                             : "the test ran along " + other_axis + " (fix: --axis " + other_axis +
+                                                   "), or the sensor is turned about the vertical: ") +
+                         "the axes map " + c.fitting_map + " fits both gravity (up) and the motion; fix: --mounting " +
+                         c.fitting_map);
   } else {
     c.findings.push_back(why + "; no axes map (a signed permutation) fits both within " +
                          std::to_string(static_cast<int>(kMountingToleranceDeg)) +

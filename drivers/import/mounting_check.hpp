@@ -23,13 +23,12 @@ inline constexpr double kGravityScaleTolerance = 0.25;
 inline constexpr double kMountingToleranceDeg = 30.0;
 
 struct MountingCheck {
-  double gravity_g = 0.0;                                   // |mean| of the capture, in g of the site
-  Eigen::Vector3d up_in_machine = Eigen::Vector3d::Zero();  // the mean through the stated mounting, unit
-  std::optional<double> scale_fix;                          // multiply the recording by this (gravity → 1 g)
-  std::string stated_map;                                   // --mounting as stated
-  std::string fitting_map;                                  // the signed permutation that fits; "" when none does
-  std::vector<std::string> findings;                        // each names the cause and, where known, the fix
-  bool consistent = true;  // false: the scale or the axes map contradicts gravity or the motion
+  double gravity_g = 0.0;             // |mean| of the capture, in g of the site
+  std::optional<double> scale_fix;    // multiply the recording by this (gravity → 1 g)
+  std::string stated_map;             // --mounting as stated
+  std::string fitting_map;            // the signed permutation that fits; "" when none does
+  std::vector<std::string> findings;  // each names the cause and, where known, the fix
+  bool consistent = true;             // false: the scale or the axes map contradicts gravity or the motion
 };
 
 // mean_sensor_g: the capture's mean (sensor axes, g); gain: measured (sensor axes, g) per

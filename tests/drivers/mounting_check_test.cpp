@@ -59,6 +59,18 @@ TEST(MountingCheck, AxesTurnedBy90DegreesAreNamedWithTheMapThatFits) {
   EXPECT_NE(m.findings[0].find("--mounting -y,x,z"), std::string::npos) << m.findings[0];
 }
 
+// Gravity fits and the motion shows along machine y: the likelier cause, the test run
+// along y, is named before a sensor turned about the vertical.
+TEST(MountingCheck, AMotionAlongAnotherAxisNamesThatAxisFirst) {
+  const Capture c = capture("x,y,z", 1.0, Eigen::Vector3d::UnitY());
+  Eigen::Matrix3d gain = Eigen::Matrix3d::Zero();
+  gain.col(0) = c.gain.col(1);  // imported as a test along x
+  const MountingCheck m = check_mounting(c.mean_g, gain, Eigen::Matrix3d::Identity(), Eigen::Vector3d::UnitX());
+  EXPECT_FALSE(m.consistent);
+  ASSERT_EQ(m.findings.size(), 1u);
+  EXPECT_NE(m.findings[0].find("the test ran along y (fix: --axis y)"), std::string::npos) << m.findings[0];
+}
+
 TEST(MountingCheck, AFlippedVerticalAxisIsNamed) {
   // The sensor turned over about x (its y and z reversed): gravity shows z, and a
   // right-handed map then fixes y.
