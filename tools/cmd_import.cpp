@@ -85,9 +85,9 @@ void finish(const Common& c, const drivers::ImportResult& r) {
       c.out.c_str(), r.run.frames.size(), k.fs_hz, k.median_dt_s * 1e6, k.jitter_rms_s * 1e6, k.lost_frames, k.gaps,
       c.sensor.c_str());
   std::printf(
-      "time offset recorder - set-point: %.6f s +- %.1f us (k=1, block jackknife of %d), commanded acceleration "
-      "explains %.1f %% of the measured\n",
-      off.offset_s, off.u_s * 1e6, off.blocks, 100.0 * off.explained);
+      "time offset recorder - set-point: %.6f s +- %.1f us (k=1: block jackknife of %d, and %.1f us for the response "
+      "beyond the excited band), commanded acceleration explains %.1f %% of the measured\n",
+      off.offset_s, off.u_s * 1e6, off.blocks, off.u_extension_s * 1e6, 100.0 * off.explained);
   // Where the commanded motion shows, through the stated mounting: a wrong --mounting or
   // --axis shows here (eical explain names it as sensor.misalignment).
   const Eigen::Vector3d moved =

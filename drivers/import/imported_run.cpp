@@ -77,8 +77,9 @@ std::string import_report_toml(const ImportReport& report) {
   std::string o =
       "# How this run was imported (eical import): the recorder's clock, the resampling\n"
       "# (cubic Lagrange onto the uniform clock, drivers/import/uniform_clock.hpp) and the\n"
-      "# time offset recorder - set-point by cross-correlation (u: standard uncertainty, k = 1,\n"
-      "# block jackknife).\n";
+      "# time offset recorder - set-point by cross-correlation with the structure's response\n"
+      "# taken out (u: standard uncertainty, k = 1: block jackknife and the response beyond the\n"
+      "# excited band, u_extension_s).\n";
   o += "format = \"eical-import/1\"\nkind = " + str(report.kind) + "\nsource = " + str(report.source) + "\n";
   if (!report.nc_source.empty()) o += "nc_source = " + str(report.nc_source) + "\n";
   o += "excitation = " + str(report.excitation) + "\nsamples = " + std::to_string(report.samples) + "\n";
@@ -87,7 +88,9 @@ std::string import_report_toml(const ImportReport& report) {
   o += clock("accel_clock", report.accel_clock);
   if (report.nc_clock) o += clock("nc_clock", *report.nc_clock);
   o += "\n[time_offset]\noffset_s = " + toml_number(report.offset.offset_s) +
-       "\nu_s = " + toml_number(report.offset.u_s) + "\nexplained = " + toml_number(report.offset.explained) +
+       "\nu_s = " + toml_number(report.offset.u_s) + "\nu_extension_s = " + toml_number(report.offset.u_extension_s) +
+       "\nstructure_peak = " + toml_number(report.offset.structure_peak) +
+       "\nexplained = " + toml_number(report.offset.explained) +
        "\npeak_to_median = " + toml_number(report.offset.peak_to_median) +
        "\nblocks = " + std::to_string(report.offset.blocks) +
        "\nfine_step_s = " + toml_number(report.offset.fine_step_s) +

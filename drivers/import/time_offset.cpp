@@ -1,5 +1,6 @@
 #include "drivers/import/time_offset.hpp"
 
+#include "drivers/import/structure_phase.hpp"
 #include "dsp/core/error.hpp"
 #include "sim/sensor/pt2.hpp"
 
@@ -84,6 +85,14 @@ Columns fine_reference(const ReferenceSignal& ref, const std::vector<int>& cols,
     for (double& v : r) v -= mean;
   }
   return rf;
+}
+
+// The reference at the measurement's rate: every F-th fine sample, m_coarse of them.
+Columns coarse_columns(const Columns& rf, int F, std::size_t m_coarse) {
+  Columns out(rf.size(), std::vector<double>(m_coarse));
+  for (std::size_t c = 0; c < rf.size(); ++c)
+    for (std::size_t m = 0; m < m_coarse; ++m) out[c][m] = rf[c][m * static_cast<std::size_t>(F)];
+  return out;
 }
 
 // The measurement on its grid, mean removed, lost frames zero.
@@ -242,6 +251,33 @@ double jackknife_u(const FineCorrelations& fc, const LagTime& tau_of) {
   return std::sqrt((kBlocks - 1.0) / kBlocks * ss);
 }
 
+// The offset from the measurement with the structure's response taken out, the response
+// extended beyond the excited band as `beyond` says (structure_phase.hpp).
+struct RigidOffset {
+  CoarsePeak coarse;
+  double offset_s = 0.0, u_s = 0.0, j_hat = 0.0, structure_peak = 0.0;
+};
+
+RigidOffset rigid_offset(const Grid& grid, const Columns& rf, int F, std::size_t m_coarse, std::size_t L, double fs,
+                         double t_begin_s, Beyond beyond) {
+  const StructureResponse structure = structure_response(grid.y, coarse_columns(rf, F, m_coarse), fs, L, beyond);
+  Grid rigid = grid;
+  if (!structure.inverse.empty())
+    for (auto& y : rigid.y) apply_response(y, 1.0 / fs, structure.inverse, structure.bin_hz);
+  RigidOffset r;
+  r.structure_peak = structure.peak_over_level;
+  r.coarse = coarse_peak(coarse_scores(rigid.y, rf, F, m_coarse, L), grid.valid.size(), m_coarse);
+  const FineCorrelations fc = fine_correlations(rigid, rf, F, r.coarse.lag);
+  const LagTime tau_of{grid.t0_s - t_begin_s + static_cast<double>(r.coarse.lag) / fs, 1.0 / (fs * F), fc.span};
+  std::vector<double> s(static_cast<std::size_t>(fc.n_lags));
+  for (int j = 0; j < fc.n_lags; ++j)
+    s[static_cast<std::size_t>(j)] = score(fc.total[static_cast<std::size_t>(j)], fc.g_inv);
+  r.j_hat = peak(s);
+  r.offset_s = tau_of(r.j_hat);
+  r.u_s = jackknife_u(fc, tau_of);
+  return r;
+}
+
 }  // namespace
 
 OffsetEstimate estimate_offset(const MeasuredSeries& measured, const ReferenceSignal& reference, int oversample) {
@@ -250,26 +286,29 @@ OffsetEstimate estimate_offset(const MeasuredSeries& measured, const ReferenceSi
   const Columns rf = fine_reference(reference, cols, hf);
   const std::size_t m_coarse = (rf.front().size() - 1) / static_cast<std::size_t>(oversample) + 1;
   const Grid grid = measurement_grid(measured);
-  const std::size_t n = grid.valid.size();
   std::size_t L = 1;
-  while (L < n + m_coarse) L <<= 1;
-  const CoarsePeak coarse = coarse_peak(coarse_scores(grid.y, rf, oversample, m_coarse, L), n, m_coarse);
-  const FineCorrelations fc = fine_correlations(grid, rf, oversample, coarse.lag);
-  const LagTime tau_of{grid.t0_s - reference.t_begin_s + static_cast<double>(coarse.lag) / fs, hf, fc.span};
-  std::vector<double> s(static_cast<std::size_t>(fc.n_lags));
-  for (int j = 0; j < fc.n_lags; ++j)
-    s[static_cast<std::size_t>(j)] = score(fc.total[static_cast<std::size_t>(j)], fc.g_inv);
-  const double j_hat = peak(s);
+  while (L < grid.valid.size() + m_coarse) L <<= 1;
+  // The response beyond the band is not measured: the estimate holds its edges, and the
+  // other guess (the median level) bounds what that choice moves the offset by, a
+  // rectangular distribution of that half-width (GUM 4.3.7) beside the jackknife's.
+  const RigidOffset held = rigid_offset(grid, rf, oversample, m_coarse, L, fs, reference.t_begin_s, Beyond::hold_edges);
+  const RigidOffset level = rigid_offset(grid, rf, oversample, m_coarse, L, fs, reference.t_begin_s, Beyond::level);
+  const double extension_s = held.offset_s - level.offset_s;
   OffsetEstimate out;
-  out.peak_to_median = coarse.median > 0.0 ? coarse.best / coarse.median : std::numeric_limits<double>::infinity();
-  out.offset_s = tau_of(j_hat);
+  out.peak_to_median =
+      held.coarse.median > 0.0 ? held.coarse.best / held.coarse.median : std::numeric_limits<double>::infinity();
+  out.offset_s = held.offset_s;
+  out.u_s = std::sqrt(held.u_s * held.u_s + extension_s * extension_s / 3.0);
+  out.u_extension_s = std::abs(extension_s) / std::sqrt(3.0);
   out.fine_step_s = hf;
   out.blocks = kBlocks;
-  const auto j_best = static_cast<std::size_t>(std::lround(j_hat));
-  out.explained = grid.energy > 0.0 ? s[j_best] / grid.energy : 0.0;
-  const Eigen::MatrixXd gain = fc.total[j_best] * fc.g_inv;
+  out.structure_peak = held.structure_peak;
+  // The gain and the explained fraction from the measurement as it is, at the offset.
+  const FineCorrelations whole = fine_correlations(grid, rf, oversample, held.coarse.lag);
+  const auto j_best = static_cast<std::size_t>(std::lround(held.j_hat));
+  out.explained = grid.energy > 0.0 ? score(whole.total[j_best], whole.g_inv) / grid.energy : 0.0;
+  const Eigen::MatrixXd gain = whole.total[j_best] * whole.g_inv;
   for (std::size_t c = 0; c < cols.size(); ++c) out.gain.col(cols[c]) = gain.col(static_cast<Eigen::Index>(c));
-  out.u_s = jackknife_u(fc, tau_of);
   return out;
 }
 

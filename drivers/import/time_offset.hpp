@@ -44,10 +44,12 @@ struct ReferenceSignal {
 
 struct OffsetEstimate {
   double offset_s = 0.0;
-  double u_s = 0.0;             // standard uncertainty (k = 1), block jackknife
+  double u_s = 0.0;             // standard uncertainty (k = 1): block jackknife and the response's extension
+  double u_extension_s = 0.0;   // of which: the response beyond the excited band (structure_phase.hpp)
   double explained = 0.0;       // fraction of the measured variance the reference explains at the peak
   double peak_to_median = 0.0;  // coarse peak score / median score over all lags
   Eigen::Matrix3d gain = Eigen::Matrix3d::Zero();  // regression: measured (sensor axes) ≈ gain · reference
+  double structure_peak = 0.0;  // the response's peak over its median magnitude (structure_phase.hpp)
   int blocks = 0;
   double fine_step_s = 0.0;
 };
