@@ -1,9 +1,12 @@
 #include "drivers/import/structure_phase.hpp"
 
+#include "dsp/core/median.hpp"
+
 #include <unsupported/Eigen/FFT>
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace eical::drivers {
 namespace {
@@ -39,57 +42,55 @@ double noise_power(const std::vector<double>& pm, const std::vector<double>& pr,
   std::vector<double> quiet;
   for (std::size_t k = 1; k < pr.size(); ++k)
     if (!(pr[k] > kExcitedFraction * pr_max)) quiet.push_back(pm[k]);
-  if (quiet.size() < 16) return 0.0;
-  std::nth_element(quiet.begin(), quiet.begin() + static_cast<std::ptrdiff_t>(quiet.size() / 2), quiet.end());
-  return quiet[quiet.size() / 2];
+  return quiet.size() < 16 ? 0.0 : dsp::median(std::move(quiet), 0.0);
 }
 
-// ln|H| at bins 0 .. L/2 where the reference excites the structure above the measurement's
-// noise; elsewhere as `beyond` says (`level`: filled in by the caller). Empty when no bin is
-// excited.
-std::vector<double> log_magnitude(const std::vector<double>& pm, const std::vector<double>& pr, Beyond beyond,
-                                  std::vector<bool>& excited) {
-  const double pr_max = *std::max_element(pr.begin(), pr.end());
-  const double noise = noise_power(pm, pr, pr_max);
-  std::vector<double> out(pr.size(), 0.0);
-  excited.assign(pr.size(), false);
-  bool any = false;
-  for (std::size_t k = 1; k < pr.size(); ++k)  // not DC: both means are removed
-    if (pr_max > 0.0 && pr[k] > kExcitedFraction * pr_max && pm[k] > kMinSignalToNoise * noise && pm[k] > 0.0)
-      out[k] = 0.5 * std::log((pm[k] - noise) / pr[k]), excited[k] = any = true;
-  if (!any) return {};
-  if (beyond == Beyond::level) return out;
-  // Forward: each unexcited bin takes the last excited value; the ones before the first take it.
+// ln|H| extended beyond the excited bins as `beyond` says.
+std::vector<double> extended(const ResponseMagnitude& m, Beyond beyond) {
+  std::vector<double> out = m.log_h;
+  if (beyond == Beyond::level) {
+    for (std::size_t k = 0; k < out.size(); ++k)
+      if (!m.excited[k]) out[k] = std::log(m.level);
+    return out;
+  }
+  // Each unexcited bin takes the last excited value; the ones before the first take it.
   std::size_t first = 0;
-  while (!excited[first]) ++first;
+  while (!m.excited[first]) ++first;
   for (std::size_t k = 0; k < first; ++k) out[k] = out[first];
   for (std::size_t k = first + 1; k < out.size(); ++k)
-    if (!excited[k]) out[k] = out[k - 1];
+    if (!m.excited[k]) out[k] = out[k - 1];
   return out;
 }
 
 }  // namespace
 
-StructureResponse structure_response(const std::vector<std::vector<double>>& y,
-                                     const std::vector<std::vector<double>>& r, double fs_hz, std::size_t L,
-                                     Beyond beyond) {
-  StructureResponse s;
-  s.bin_hz = fs_hz / static_cast<double>(L);
-  const auto half = static_cast<std::size_t>(std::ceil(kSmoothingHalfWidth_hz / s.bin_hz));
+ResponseMagnitude response_magnitude(const std::vector<std::vector<double>>& y,
+                                     const std::vector<std::vector<double>>& r, double fs_hz, std::size_t L) {
+  ResponseMagnitude m;
+  m.bin_hz = fs_hz / static_cast<double>(L);
+  const auto half = static_cast<std::size_t>(std::ceil(kSmoothingHalfWidth_hz / m.bin_hz));
   const std::vector<double> pm = smoothed(power(y, L), half), pr = smoothed(power(r, L), half);
-  std::vector<bool> excited;
-  std::vector<double> log_h = log_magnitude(pm, pr, beyond, excited);
-  if (log_h.empty()) return s;
-  std::vector<double> sorted;
-  for (std::size_t k = 0; k < log_h.size(); ++k)
-    if (excited[k]) sorted.push_back(log_h[k]);
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-  const double log_level = sorted[sorted.size() / 2];
-  s.level = std::exp(log_level);
-  if (beyond == Beyond::level)
-    for (std::size_t k = 0; k < log_h.size(); ++k)
-      if (!excited[k]) log_h[k] = log_level;
-  s.peak_over_level = std::exp(*std::max_element(log_h.begin(), log_h.end())) / s.level;
+  const double pr_max = *std::max_element(pr.begin(), pr.end());
+  const double noise = noise_power(pm, pr, pr_max);
+  m.log_h.assign(pr.size(), 0.0);
+  m.excited.assign(pr.size(), false);
+  std::vector<double> excited_log_h;
+  for (std::size_t k = 1; k < pr.size(); ++k)  // not DC: both means are removed
+    if (pr_max > 0.0 && pr[k] > kExcitedFraction * pr_max && pm[k] > kMinSignalToNoise * noise && pm[k] > 0.0) {
+      m.log_h[k] = 0.5 * std::log((pm[k] - noise) / pr[k]), m.excited[k] = true;
+      excited_log_h.push_back(m.log_h[k]);
+    }
+  m.level = excited_log_h.empty() ? 0.0 : std::exp(dsp::median(std::move(excited_log_h), 0.0));
+  return m;
+}
+
+StructureResponse minimum_phase_inverse(const ResponseMagnitude& m, Beyond beyond) {
+  StructureResponse s;
+  s.bin_hz = m.bin_hz;
+  if (!(m.level > 0.0)) return s;  // nothing excited: no response to take out
+  const std::vector<double> log_h = extended(m, beyond);
+  const std::size_t L = 2 * (log_h.size() - 1);
+  s.peak_over_level = std::exp(*std::max_element(log_h.begin(), log_h.end())) / m.level;
   // The folded real cepstrum: ln|H| even in f → its cepstrum c; the causal part (c[0],
   // 2c[n], c[L/2]) is ln H_min.
   Eigen::FFT<double> fft;
@@ -102,7 +103,7 @@ StructureResponse structure_response(const std::vector<std::vector<double>>& y,
   std::fill(cep.begin() + static_cast<std::ptrdiff_t>(L / 2 + 1), cep.end(), 0.0);
   fft.fwd(spectrum, cep);
   s.inverse.resize(L / 2 + 1);
-  for (std::size_t k = 0; k <= L / 2; ++k) s.inverse[k] = s.level / std::exp(spectrum[k]);
+  for (std::size_t k = 0; k <= L / 2; ++k) s.inverse[k] = m.level / std::exp(spectrum[k]);
   return s;
 }
 

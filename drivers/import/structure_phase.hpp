@@ -22,10 +22,18 @@
 
 namespace eical::drivers {
 
+// |H| as measured: ln|H| on the excited bins 0 .. L/2 (0 elsewhere), computed once and
+// extended beyond them by each guess of `Beyond`.
+struct ResponseMagnitude {
+  double bin_hz = 0.0;
+  std::vector<double> log_h;
+  std::vector<bool> excited;
+  double level = 0.0;  // median |H| over the excited bins; 0 when none is excited
+};
+
 struct StructureResponse {
   double bin_hz = 0.0;
-  std::vector<std::complex<double>> inverse;  // per bin 0 .. L/2: level / H_min(f)
-  double level = 0.0;                         // median |H| over the excited bins
+  std::vector<std::complex<double>> inverse;  // per bin 0 .. L/2: level / H_min(f); empty: none
   double peak_over_level = 0.0;               // max |H| / level: 1 for a rigid structure
 };
 
@@ -49,9 +57,11 @@ enum class Beyond { hold_edges, level };
 
 // y: the measured axes and r: the reference columns, both on the same grid (fs_hz), zero
 // padded to L (a power of two) inside.
-StructureResponse structure_response(const std::vector<std::vector<double>>& y,
-                                     const std::vector<std::vector<double>>& r, double fs_hz, std::size_t L,
-                                     Beyond beyond);
+ResponseMagnitude response_magnitude(const std::vector<std::vector<double>>& y,
+                                     const std::vector<std::vector<double>>& r, double fs_hz, std::size_t L);
+
+// The inverse of the minimum-phase response with that magnitude, extended as `beyond` says.
+StructureResponse minimum_phase_inverse(const ResponseMagnitude& magnitude, Beyond beyond);
 
 // x filtered by w (w[k] at k · bin_hz for k ≥ 0, conjugate at −f; 0 beyond), x's samples
 // dt_s apart.

@@ -259,8 +259,8 @@ struct RigidOffset {
 };
 
 RigidOffset rigid_offset(const Grid& grid, const Columns& rf, int F, std::size_t m_coarse, std::size_t L, double fs,
-                         double t_begin_s, Beyond beyond) {
-  const StructureResponse structure = structure_response(grid.y, coarse_columns(rf, F, m_coarse), fs, L, beyond);
+                         double t_begin_s, const ResponseMagnitude& magnitude, Beyond beyond) {
+  const StructureResponse structure = minimum_phase_inverse(magnitude, beyond);
   Grid rigid = grid;
   if (!structure.inverse.empty())
     for (auto& y : rigid.y) apply_response(y, 1.0 / fs, structure.inverse, structure.bin_hz);
@@ -291,8 +291,11 @@ OffsetEstimate estimate_offset(const MeasuredSeries& measured, const ReferenceSi
   // The response beyond the band is not measured: the estimate holds its edges, and the
   // other guess (the median level) bounds what that choice moves the offset by, a
   // rectangular distribution of that half-width (GUM 4.3.7) beside the jackknife's.
-  const RigidOffset held = rigid_offset(grid, rf, oversample, m_coarse, L, fs, reference.t_begin_s, Beyond::hold_edges);
-  const RigidOffset level = rigid_offset(grid, rf, oversample, m_coarse, L, fs, reference.t_begin_s, Beyond::level);
+  const ResponseMagnitude magnitude = response_magnitude(grid.y, coarse_columns(rf, oversample, m_coarse), fs, L);
+  const RigidOffset held =
+      rigid_offset(grid, rf, oversample, m_coarse, L, fs, reference.t_begin_s, magnitude, Beyond::hold_edges);
+  const RigidOffset level =
+      rigid_offset(grid, rf, oversample, m_coarse, L, fs, reference.t_begin_s, magnitude, Beyond::level);
   const double extension_s = held.offset_s - level.offset_s;
   OffsetEstimate out;
   out.peak_to_median =
