@@ -61,7 +61,7 @@ ResponseMagnitude response_magnitude(const std::vector<std::vector<double>>& y,
                                      const std::vector<std::vector<double>>& r, double fs_hz, std::size_t L);
 
 // The inverse of the minimum-phase response with that magnitude, extended as `beyond` says.
-StructureResponse minimum_phase_inverse(const ResponseMagnitude& magnitude, Beyond beyond);
+StructureResponse minimum_phase_inverse(const ResponseMagnitude& m, Beyond beyond);
 
 // x filtered by w (w[k] at k · bin_hz for k ≥ 0, conjugate at −f; 0 beyond), x's samples
 // dt_s apart.
