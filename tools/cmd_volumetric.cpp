@@ -81,8 +81,9 @@ dsp::comp::AxisPass pass_of(const std::string& path, int axis, const dsp::Analys
 // incomplete in a way its U does not hold, so it must not feed the model.
 std::string critical_reason(const dsp::Analysis& a) {
   std::string r;
-  for (const auto& f : a.flags)
-    if (dsp::flag_severity(f) == dsp::FlagSeverity::critical) r += (r.empty() ? "critical flag: " : "; ") + f;
+  for (const dsp::Flag& f : a.flags)
+    if (dsp::severity(f) == dsp::FlagSeverity::critical)
+      r += (r.empty() ? "critical flag: " : "; ") + dsp::flag_text(f);
   return r;
 }
 

@@ -217,10 +217,9 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
   o += noise_bound_text(run, analysis);
   o += verdict_text(analysis);
   bool header = false;
-  for (const auto& f : analysis.flags) {
-    const auto s = dsp::flag_severity(f);
+  for (const dsp::Flag& f : analysis.flags) {
     if (!header) o += "  flags:\n", header = true;
-    o += std::string("    [") + dsp::severity_name(s) + "] " + f + "\n";
+    o += std::string("    [") + dsp::severity_name(dsp::severity(f)) + "] " + dsp::flag_text(f) + "\n";
   }
   return o;
 }

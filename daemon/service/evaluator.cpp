@@ -37,8 +37,8 @@ std::string percent(double ratio) { return std::to_string(static_cast<int>(std::
 
 // [limits] temp_min_c, temp_max_c: a present sensor's case temperature outside them
 // (its compensation is specified within them) flags the result.
-std::vector<std::string> temperature_flags(const dsp::Run& run, const RecordingStats& stats, const Limits& limits) {
-  std::vector<std::string> flags;
+std::vector<dsp::Flag> temperature_flags(const dsp::Run& run, const RecordingStats& stats, const Limits& limits) {
+  std::vector<dsp::Flag> flags;
   const char* names[2] = {"table", "head"};
   for (int s = 0; s < 2; ++s) {
     if (!run.meta.sensor_present[s]) continue;
@@ -46,11 +46,10 @@ std::vector<std::string> temperature_flags(const dsp::Run& run, const RecordingS
     if (!(lo <= hi) || (static_cast<double>(lo) >= limits.temp_min_c && static_cast<double>(hi) <= limits.temp_max_c))
       continue;
     char b[200];
-    std::snprintf(
-        b, sizeof b,
-        "temperature: the %s sensor was at %.1f..%.1f degC, outside [limits] temp_min_c..temp_max_c = %.1f..%.1f degC",
-        names[s], static_cast<double>(lo), static_cast<double>(hi), limits.temp_min_c, limits.temp_max_c);
-    flags.emplace_back(b);
+    std::snprintf(b, sizeof b,
+                  "the %s sensor was at %.1f..%.1f degC, outside [limits] temp_min_c..temp_max_c = %.1f..%.1f degC",
+                  names[s], static_cast<double>(lo), static_cast<double>(hi), limits.temp_min_c, limits.temp_max_c);
+    flags.push_back({dsp::FlagCode::temperature, {}, b});
   }
   return flags;
 }
@@ -168,25 +167,27 @@ dsp::Run Evaluator::make_run(const RecordedRun& job) const {
 }
 
 std::optional<std::pair<int, dsp::Program>> Evaluator::named_program(const RecordingNotes& notes,
-                                                                     std::vector<std::string>& flags) const {
+                                                                     std::vector<dsp::Flag>& flags) const {
   const auto& sp = config_.setpoint;
   const int number =
       std::isfinite(notes.program_p) ? static_cast<int>(std::lround(notes.program_p)) : sp.default_program;
   if (number < 0) {
-    flags.push_back("setpoint: M101 named no program (P word) and [setpoint.program] default_program is not set");
+    flags.push_back({dsp::FlagCode::setpoint,
+                     {},
+                     "M101 named no program (P word) and [setpoint.program] default_program is not set"});
     return std::nullopt;
   }
   try {
     return std::pair{number, drivers::ProgramCatalog(sp.program_dir).program(number)};
   } catch (const std::exception& e) {
-    flags.push_back(std::string("setpoint: program ") + std::to_string(number) + ": " + e.what());
+    flags.push_back({dsp::FlagCode::setpoint, {}, "program " + std::to_string(number) + ": " + e.what()});
     return std::nullopt;
   }
 }
 
-std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingNotes& notes) const {
+std::vector<dsp::Flag> Evaluator::add_setpoint(dsp::Run& run, const RecordingNotes& notes) const {
   const auto& sp = config_.setpoint;
-  std::vector<std::string> flags;
+  std::vector<dsp::Flag> flags;
   if (sp.source == "none") return flags;
   const auto program = named_program(notes, flags);
   if (sp.source == "servo_stream") {
@@ -205,8 +206,10 @@ std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingN
     std::size_t missing = 0;
     for (const auto& f : run.frames) missing += (f.flags & dsp::frame_flag::cmd_missing) != 0;
     if (missing > 0)
-      flags.push_back("setpoint: " + std::to_string(missing) +
-                      " frames had no servo cycle of the set-point (LinuxCNC's stream absent or late)");
+      flags.push_back(
+          {dsp::FlagCode::setpoint,
+           {},
+           std::to_string(missing) + " frames had no servo cycle of the set-point (LinuxCNC's stream absent or late)"});
     run.meta.setpoint = s;
     log(LogLevel::info,
         "setpoint: servo stream, cycle %.3f at the first sample; measured lags it by %+.2f ms, residual %s",
@@ -239,13 +242,13 @@ std::vector<std::string> Evaluator::add_setpoint(dsp::Run& run, const RecordingN
         s.program_number, s.marks_offset_s * 1e3, (s.offset_s - s.marks_offset_s) * 1e3, s.blocks,
         percent(s.residual_ratio).c_str());
   } catch (const std::exception& e) {
-    flags.push_back(std::string("setpoint: program ") + std::to_string(program->first) + ": " + e.what());
+    flags.push_back({dsp::FlagCode::setpoint, {}, "program " + std::to_string(program->first) + ": " + e.what()});
   }
   return flags;
 }
 
-std::vector<std::string> Evaluator::commit(RecordedRun& job, dsp::Run& run, const std::filesystem::path& dir) {
-  std::vector<std::string> flags;
+std::vector<dsp::Flag> Evaluator::commit(RecordedRun& job, dsp::Run& run, const std::filesystem::path& dir) {
+  std::vector<dsp::Flag> flags;
   if (config_.setpoint.source != "none") {
     // The set-point's alignment reads the whole recording: it comes back into memory here
     // (only with a set-point from elsewhere; the analysis streams).
@@ -263,27 +266,31 @@ std::vector<std::string> Evaluator::commit(RecordedRun& job, dsp::Run& run, cons
 }
 
 void Evaluator::add_service_flags(const RecordedRun& job, const dsp::Run& run,
-                                  const std::vector<std::string>& setpoint_flags, dsp::Analysis& a) const {
-  if (!job.cause.empty()) a.flags.push_back(job.cause), a.degraded = true;
+                                  const std::vector<dsp::Flag>& setpoint_flags, dsp::Analysis& a) const {
+  if (job.cause) a.flags.push_back(*job.cause), a.degraded = true;
   if (job.notes.nonfinite_frames > 0) {
-    a.flags.push_back("not_finite: " + std::to_string(job.notes.nonfinite_frames) +
-                      " frames had NaN/Inf in a temperature or set-point channel (last finite value held)");
+    a.flags.push_back({dsp::FlagCode::not_finite,
+                       {},
+                       std::to_string(job.notes.nonfinite_frames) +
+                           " frames had NaN/Inf in a temperature or set-point channel (last finite value held)"});
     a.degraded = true;
   }
   for (const auto& f : setpoint_flags) a.flags.push_back(f), a.degraded = true;
   if (job.notes.source_rate_ratio != 0.0) {
     char b[240];
     std::snprintf(b, sizeof b,
-                  "source_rate: the source delivered %.3g times the samples per second [acquisition] fs_hz = %.0f Hz "
+                  "the source delivered %.3g times the samples per second [acquisition] fs_hz = %.0f Hz "
                   "says during the measurement "
                   "(a DAQ at another rate, a replay faster than real time): its times, speeds and lengths are wrong",
                   job.notes.source_rate_ratio, run.fs_hz());
-    a.flags.push_back(b), a.degraded = true;
+    a.flags.push_back({dsp::FlagCode::source_rate, {}, b}), a.degraded = true;
   }
   for (const auto& f : temperature_flags(run, job.stats, config_.limits)) a.flags.push_back(f), a.degraded = true;
   if (job.stats.lost > 0) {
-    a.flags.push_back("recorder_overflow: " + std::to_string(job.stats.lost) +
-                      " frames were not recorded (the recording thread fell behind by more than its ring holds)");
+    a.flags.push_back({dsp::FlagCode::recorder_overflow,
+                       {},
+                       std::to_string(job.stats.lost) +
+                           " frames were not recorded (the recording thread fell behind by more than its ring holds)"});
     a.degraded = true;
   }
 }
@@ -293,7 +300,7 @@ void Evaluator::evaluate(RecordedRun& job) {
   const auto dir = config_.recording.dir / run.meta.id;
   std::string error;
   try {
-    const std::vector<std::string> setpoint_flags = commit(job, run, dir);
+    const std::vector<dsp::Flag> setpoint_flags = commit(job, run, dir);
     // Streamed from disk as `eical analyze` reads a run: a recording of any length in
     // bounded memory (dsp/stream/analyze_stream.hpp).
     dsp::Analysis a;
@@ -353,10 +360,7 @@ void Evaluator::evaluate_recorded(const std::filesystem::path& dir) {
     if (!stream.presence_held())  // a sensor the first row did not show: again, as eical analyze does
       a = dsp::analyze_stream(stream.header(), frames, analysis_, so);
     const dsp::Run& run = stream.header();
-    a.flags.push_back(
-        "evaluated_after_restart: eicald stopped between writing this run and its result; evaluated at the next start, "
-        "without the flags "
-        "only the stopped service knew (cut short, non-finite channels)");
+    a.flags.push_back({dsp::FlagCode::evaluated_after_restart, {}, {}});
     a.degraded = true;
     for (const auto& f : temperature_flags(run, stats, config_.limits)) a.flags.push_back(f);
     dsp::judge(run.meta.program, a);

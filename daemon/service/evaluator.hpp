@@ -79,16 +79,16 @@ class Evaluator {
   dsp::Run make_run(const RecordedRun& job) const;
   // Names the recording and renames it into place; with a set-point from elsewhere, reads it
   // back to put that on (flags for the result: empty, nothing doubtful).
-  std::vector<std::string> commit(RecordedRun& job, dsp::Run& run, const std::filesystem::path& dir);
+  std::vector<dsp::Flag> commit(RecordedRun& job, dsp::Run& run, const std::filesystem::path& dir);
   // The flags only the service knows: how it ended, the guard, the set-point, the source's rate,
   // the temperatures, frames the recorder lost.
-  void add_service_flags(const RecordedRun& job, const dsp::Run& run, const std::vector<std::string>& setpoint_flags,
+  void add_service_flags(const RecordedRun& job, const dsp::Run& run, const std::vector<dsp::Flag>& setpoint_flags,
                          dsp::Analysis& a) const;
   // The program M101's P word (or [setpoint.program] default_program) names.
   std::optional<std::pair<int, dsp::Program>> named_program(const RecordingNotes& notes,
-                                                            std::vector<std::string>& flags) const;
+                                                            std::vector<dsp::Flag>& flags) const;
   // Fills cmd_*, [program] and [setpoint]; returns flags for the result (empty: nothing doubtful).
-  std::vector<std::string> add_setpoint(dsp::Run& run, const RecordingNotes& notes) const;
+  std::vector<dsp::Flag> add_setpoint(dsp::Run& run, const RecordingNotes& notes) const;
   void publish(const dsp::Run& run, const dsp::Analysis& a, const std::filesystem::path& dir,
                std::uint64_t result_number);
   // Runs `write` until it succeeds (a fault of the storage clears); throws its last error when

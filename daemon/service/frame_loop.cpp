@@ -157,7 +157,7 @@ void FrameLoop::continue_after_reopen() noexcept {
   live_.reset();
 }
 
-void FrameLoop::close_measurement(const std::string& cause) {
+void FrameLoop::close_measurement(const dsp::Flag& cause) {
   if (session_.close_now() || session_.measurement_ready()) {
     if (handoff_.offer_waiting(session_, notes_, cause)) session_.evaluation_done(), live_.reset();
   }

@@ -45,7 +45,7 @@ class FrameLoop {
   // After the source was reopened: its sample clock restarts, the DAQ clock continues.
   void continue_after_reopen() noexcept;
   // At the end of the data: a measurement the data ended inside is recorded with `cause`.
-  void close_measurement(const std::string& cause);
+  void close_measurement(const dsp::Flag& cause);
 
   // The DAQ clock (sample index ↔ CLOCK_MONOTONIC) as the acquisition stamps say; any thread.
   [[nodiscard]] const drivers::SampleClock& daq_clock() const noexcept { return daq_clock_; }

@@ -3,7 +3,7 @@
 namespace eical::daemon {
 
 bool RecordingHandoff::hand(dsp::MeasurementSession& session, const RecordingNotes& notes,
-                            const std::string* cause) noexcept {
+                            const dsp::Flag* cause) noexcept {
   if (!have_token_ && returned_.try_acquire()) have_token_ = true;
   if (!have_token_ || !session.take_streamed()) return false;
   if (!cause) {
@@ -24,7 +24,7 @@ bool RecordingHandoff::offer(dsp::MeasurementSession& session, const RecordingNo
 }
 
 bool RecordingHandoff::offer_waiting(dsp::MeasurementSession& session, const RecordingNotes& notes,
-                                     const std::string& cause) {
+                                     const dsp::Flag& cause) {
   if (!have_token_) returned_.acquire(), have_token_ = true;
   return hand(session, notes, &cause);
 }

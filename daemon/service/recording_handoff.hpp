@@ -25,7 +25,7 @@ class RecordingHandoff {
   // of the previous one is done; false (nothing waits) otherwise.
   bool offer(dsp::MeasurementSession& session, const RecordingNotes& notes) noexcept;
   // DSP thread at the end of the data (not real-time): waits for the previous evaluation.
-  bool offer_waiting(dsp::MeasurementSession& session, const RecordingNotes& notes, const std::string& cause);
+  bool offer_waiting(dsp::MeasurementSession& session, const RecordingNotes& notes, const dsp::Flag& cause);
 
   // Evaluation thread: the recording handed over last is evaluated.
   void done() { returned_.release(); }
@@ -34,7 +34,7 @@ class RecordingHandoff {
   [[nodiscard]] bool quitting() const noexcept { return quit_.load(); }
 
  private:
-  bool hand(dsp::MeasurementSession& session, const RecordingNotes& notes, const std::string* cause) noexcept;
+  bool hand(dsp::MeasurementSession& session, const RecordingNotes& notes, const dsp::Flag* cause) noexcept;
 
   RecordingStream& stream_;
   bool have_token_ = true;  // DSP thread

@@ -45,7 +45,7 @@ void RecordingStream::end(const RecordingNotes& notes) noexcept {
   (void)push_event(e);
 }
 
-void RecordingStream::end(const RecordingNotes& notes, const std::string& cause) {
+void RecordingStream::end(const RecordingNotes& notes, const dsp::Flag& cause) {
   {
     std::lock_guard lk(cause_mu_);
     cause_ = cause;
@@ -82,7 +82,7 @@ std::size_t RecordingStream::drain(std::span<dsp::Frame> out, RecordEvent& event
   return n;
 }
 
-std::string RecordingStream::take_cause() {
+dsp::Flag RecordingStream::take_cause() {
   std::lock_guard lk(cause_mu_);
   return std::move(cause_);
 }

@@ -9,6 +9,7 @@
 // ring's length) is lost, counted and flagged in its recording's result.
 #include "daemon/service/recording_notes.hpp"
 #include "drivers/ring/spsc_ring.hpp"
+#include "dsp/core/flag.hpp"
 #include "dsp/session/recording_sink.hpp"
 
 #include <atomic>
@@ -44,7 +45,7 @@ class RecordingStream final : public dsp::RecordingSink {
   // DSP thread: the recording begun last is complete.
   void end(const RecordingNotes& notes) noexcept;
   // DSP thread at the end of the data (not real-time): complete, with why it ended.
-  void end(const RecordingNotes& notes, const std::string& cause);
+  void end(const RecordingNotes& notes, const dsp::Flag& cause);
 
   // Recording thread: waits until woken or `timeout` passed.
   void wait(std::chrono::milliseconds timeout);
@@ -52,7 +53,7 @@ class RecordingStream final : public dsp::RecordingSink {
   // (`event` filled, popped): the frames first, then the event.
   std::size_t drain(std::span<dsp::Frame> out, RecordEvent& event, bool& has_event) noexcept;
   // Recording thread: the cause of the end event just drained (has_cause).
-  std::string take_cause();
+  dsp::Flag take_cause();
   // Recording thread: wakes wait() (to stop).
   void wake() noexcept { wake_.release(); }
 
@@ -72,7 +73,7 @@ class RecordingStream final : public dsp::RecordingSink {
   std::uint64_t drained_ = 0;              // recording thread: frames out of the ring
   std::optional<RecordEvent> next_event_;  // recording thread: popped, its frames not yet all out
   std::mutex cause_mu_;
-  std::string cause_;
+  dsp::Flag cause_{dsp::FlagCode::source_stopped, {}, {}};
 };
 
 }  // namespace eical::daemon

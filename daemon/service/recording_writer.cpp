@@ -69,7 +69,8 @@ void RecordingWriter::loop() {
   if (open_) {  // begun, never ended nor dropped (the DSP thread stopped inside it): kept all the same
     log(LogLevel::warning, "recording: a measurement without its end at the stop (%llu frames): evaluated as cut short",
         static_cast<unsigned long long>(open_->stats.frames));
-    open_->cause = "interrupted: the service stopped before the measurement's end was handed over";
+    open_->cause =
+        dsp::Flag{dsp::FlagCode::interrupted, {}, "the service stopped before the measurement's end was handed over"};
     open_->handed_over = false;
     deliver(std::move(*open_));
     open_.reset();

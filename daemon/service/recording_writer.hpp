@@ -21,6 +21,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
@@ -41,7 +42,7 @@ struct RecordingStats {
 struct RecordedRun {
   std::unique_ptr<drivers::RunAppender> run;  // its samples written (or held), not yet named
   RecordingNotes notes;
-  std::string cause;  // empty, or why it ended without M103 (a quality flag)
+  std::optional<dsp::Flag> cause;  // why it ended without M103, when it did
   RecordingStats stats;
   bool handed_over = true;  // ended by the DSP thread's hand-over (false: cut off at the stop)
 };

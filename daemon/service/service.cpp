@@ -309,11 +309,12 @@ void enter_realtime(const Parts& p) {
 }
 
 // A measurement the data ended inside is kept: recorded, evaluated and flagged.
-std::string end_cause(const drivers::PumpStats& stats) {
+dsp::Flag end_cause(const drivers::PumpStats& stats) {
   if (stats.stopped)
-    return "interrupted: the service was stopped during the measurement; frames up to the stop are kept";
-  if (!stats.source_error.empty()) return "source_stopped: " + stats.source_error;
-  return "source_stopped: the source ended during the measurement";
+    return {dsp::FlagCode::interrupted,
+            {},
+            "the service was stopped during the measurement; frames up to the stop are kept"};
+  return {dsp::FlagCode::source_stopped, {}, stats.source_error};  // empty: the code's default
 }
 
 // The source failed: FAULT with the reason (Status, journal), reopened every retry_s.

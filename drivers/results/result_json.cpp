@@ -108,51 +108,54 @@ nlohmann::json all_null(std::initializer_list<const char*> keys) {
 }
 
 // A figure the analysis did not evaluate (Analysis::not_evaluated) is null, with its reason.
-void null_not_evaluated(const dsp::Analysis& a, nlohmann::json& doc) {
+void null_not_evaluated(const dsp::Analysis& a, nlohmann::json& doc, std::vector<dsp::Flag>& flags) {
   for (const auto& [key, reason] : a.not_evaluated) {
     std::string pointer = "/" + key;
     std::replace(pointer.begin(), pointer.end(), '.', '/');
     const nlohmann::json::json_pointer p(pointer);
     if (!doc.contains(p)) continue;
     doc[p] = nullptr;
-    const std::string flag = key + ": null, not evaluated: " + reason;
-    doc["quality"]["flags"].push_back(flag);
-    doc["quality"]["flag_severity"].push_back(dsp::severity_name(dsp::flag_severity(flag)));
+    flags.push_back({dsp::FlagCode::figure_null, key, "not evaluated: " + reason});
   }
+}
+
+// A flag that says why `key` of program object `obj` is null: one on the figure itself, or
+// one that left the whole object null.
+bool explains(const dsp::Flag& f, const std::string& obj, const std::string& key) {
+  if (f.figure == key) return true;
+  return f.figure == obj && (f.code == dsp::FlagCode::figure_null || f.code == dsp::FlagCode::evaluation_failed);
 }
 
 // Every null figure of a program object must have a reason in quality.flags; a null the
 // evaluation did not explain gets a generic one naming it (never silently null).
-void explain_nulls(nlohmann::json& doc) {
-  auto& flags = doc["quality"]["flags"];
+void explain_nulls(const nlohmann::json& doc, std::vector<dsp::Flag>& flags) {
   for (const char* obj : {"circle", "diagnostics", "positioning", "step", "rectangle", "freeform"}) {
     if (!doc.contains(obj) || !doc[obj].is_object()) continue;
     for (const auto& [key, value] : doc[obj].items()) {
       if (!value.is_null()) continue;
       const std::string name = std::string(obj) + "." + key;
-      bool explained = false;
-      for (const auto& f : flags) {
-        const std::string text = f.get<std::string>();
-        explained |= text.rfind(name, 0) == 0 || text.rfind(std::string(obj) + ": null", 0) == 0;
-      }
-      if (explained) continue;
-      const std::string flag = name + ": null, could not be determined from this run";
-      flags.push_back(flag);
-      doc["quality"]["flag_severity"].push_back(dsp::severity_name(dsp::flag_severity(flag)));
+      if (std::none_of(flags.begin(), flags.end(), [&](const dsp::Flag& f) { return explains(f, obj, name); }))
+        flags.push_back({dsp::FlagCode::figure_null, name, {}});
     }
   }
 }
 
 constexpr const char* kAxisNames[3] = {"x", "y", "z"};
 
-// The verdict, its reasons, the flags and each flag's severity.
-nlohmann::json quality_json(const dsp::Analysis& a) {
+// The verdict, its reasons, the flags with each flag's code and severity.
+nlohmann::json quality_json(const dsp::Analysis& a, const std::vector<dsp::Flag>& flags) {
   nlohmann::json q = {{"degraded", a.degraded},
                       {"verdict", dsp::verdict_name(a.verdict)},
                       {"verdict_reasons", a.verdict_reasons},
-                      {"flags", a.flags}};
-  nlohmann::json severity = nlohmann::json::array();
-  for (const auto& f : a.flags) severity.push_back(dsp::severity_name(dsp::flag_severity(f)));
+                      {"flags", dsp::flag_texts(flags)}};
+  nlohmann::json codes = nlohmann::json::array(), figures = nlohmann::json::array(), severity = nlohmann::json::array();
+  for (const dsp::Flag& f : flags) {
+    codes.push_back(dsp::code_name(f.code));
+    figures.push_back(f.figure);
+    severity.push_back(dsp::severity_name(dsp::severity(f)));
+  }
+  q["flag_codes"] = codes;
+  q["flag_figures"] = figures;
   q["flag_severity"] = severity;
   if (a.conformance) {  // ISO 14253-1 against the tolerances the analysis was given
     nlohmann::json figs = nlohmann::json::array();
@@ -290,7 +293,6 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis) {
   j["run_id"] = run.meta.id;
   j["program"] = run.meta.program.kind;
   j["software"] = software_version();
-  j["quality"] = quality_json(analysis);
   j["uncertainty_k2"] = per_figure_json(analysis, analysis.uncertainty_k2);
   j["noise_bound_k2"] = per_figure_json(analysis, analysis.noise_bound_k2);
   if (!analysis.uncertainty_budget.empty()) {
@@ -321,8 +323,10 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis) {
   j["pipeline"] = pipeline_json(analysis);
   j["pipeline"]["supports"] = supports_json(analysis.measurement);
   j["repeats"] = repeats_json(analysis);
-  null_not_evaluated(analysis, j);
-  explain_nulls(j);
+  std::vector<dsp::Flag> flags = analysis.flags;
+  null_not_evaluated(analysis, j, flags);
+  explain_nulls(j, flags);
+  j["quality"] = quality_json(analysis, flags);
   return j;
 }
 

@@ -52,10 +52,12 @@ MarkPairs match_marks(const sim::nc::Trajectory& tr, const dsp::Run& run, double
   out.marks_recorded = static_cast<int>(rec.end() - r101);
   out.marks_matched = static_cast<int>(pairs.size());
   if (out.marks_matched != out.marks_program || out.marks_matched != out.marks_recorded)
-    out.flags.push_back("setpoint: the recording's marks (" + std::to_string(out.marks_recorded) +
-                        " from M101) and the program's (" + std::to_string(out.marks_program) +
-                        ") agree for the first " + std::to_string(out.marks_matched) +
-                        " only; the rest is aligned by the motion alone");
+    out.flags.push_back({dsp::FlagCode::setpoint,
+                         {},
+                         "the recording's marks (" + std::to_string(out.marks_recorded) +
+                             " from M101) and the program's (" + std::to_string(out.marks_program) +
+                             ") agree for the first " + std::to_string(out.marks_matched) +
+                             " only; the rest is aligned by the motion alone"});
   return pairs;
 }
 
@@ -107,9 +109,11 @@ void flag_overlaps(ProgramAlignment& out) {
     const auto& a = out.blocks[k - 1];
     const auto& b = out.blocks[k];
     if (b.program_start_s + b.offset_s < a.program_end_s + a.offset_s - 1e-4)
-      out.flags.push_back("setpoint: motion blocks " + std::to_string(k) + " and " + std::to_string(k + 1) +
-                          " overlap on the DAQ clock after the alignment (offsets " + std::to_string(a.offset_s) +
-                          " s, " + std::to_string(b.offset_s) + " s)");
+      out.flags.push_back({dsp::FlagCode::setpoint,
+                           {},
+                           "motion blocks " + std::to_string(k) + " and " + std::to_string(k + 1) +
+                               " overlap on the DAQ clock after the alignment (offsets " + std::to_string(a.offset_s) +
+                               " s, " + std::to_string(b.offset_s) + " s)"});
   }
 }
 
@@ -145,10 +149,12 @@ void check_residual(const std::vector<Eigen::Vector3d>& cmd_mm, const std::vecto
   const auto lag = dsp::align::estimate_lag(dsp::align::setpoint_accel_mps2(cmd_mm, fs), meas, fs);
   out.lag_s = lag.lag_s, out.correlation = lag.correlation, out.residual_ratio = lag.residual_ratio;
   if (!lag.valid || lag.residual_ratio > o.poor_residual_ratio)
-    out.flags.push_back("setpoint: the program's set-point does not match the measured motion (residual " +
-                        std::to_string(static_cast<int>(std::lround(lag.residual_ratio * 100.0))) +
-                        " % of the commanded acceleration, correlation " + std::to_string(lag.correlation) +
-                        "): another program, a feed override or other machine limits?");
+    out.flags.push_back({dsp::FlagCode::setpoint,
+                         {},
+                         "the program's set-point does not match the measured motion (residual " +
+                             std::to_string(static_cast<int>(std::lround(lag.residual_ratio * 100.0))) +
+                             " % of the commanded acceleration, correlation " + std::to_string(lag.correlation) +
+                             "): another program, a feed override or other machine limits?"});
 }
 
 }  // namespace
@@ -198,7 +204,8 @@ ProgramAlignment apply_program_setpoint(dsp::Run& run, const dsp::Program& progr
   const std::vector<Eigen::Vector3d> meas = dsp::align::measured_accel_mps2(run);
   for (const auto& [s, e] : motion_blocks(tr)) out.blocks.push_back(align_block(s, e, pairs, tr, run, meas, options));
   if (out.blocks.empty())
-    out.flags.push_back("setpoint: the program does not move; its set-point is its start position");
+    out.flags.push_back(
+        {dsp::FlagCode::setpoint, {}, "the program does not move; its set-point is its start position"});
   // 3 The set-point on the DAQ clock: inside a block by its offset, at rest in between.
   flag_overlaps(out);
   const std::vector<Eigen::Vector3d> cmd_mm = write_setpoint(run, tr, out.blocks, pairs);

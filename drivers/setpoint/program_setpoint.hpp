@@ -15,6 +15,7 @@
 // The lag found includes the machine's servo lag (the set-point is then aligned with the
 // actual motion). The alignment's residual, RMS(measured − commanded acceleration) relative
 // to RMS(commanded), says how well the reconstructed program matches what the NC did.
+#include "dsp/core/flag.hpp"
 #include "dsp/core/run.hpp"
 #include "sim/nc/trajectory.hpp"
 
@@ -44,7 +45,7 @@ struct ProgramAlignment {
   std::vector<BlockAlignment> blocks;
   int marks_program = 0, marks_recorded = 0, marks_matched = 0;
   double lag_s = 0.0, correlation = 0.0, residual_ratio = 1.0;  // of the final set-point
-  std::vector<std::string> flags;                               // why the alignment is doubtful (empty: fine)
+  std::vector<dsp::Flag> flags;  // why the alignment is doubtful (FlagCode::setpoint; empty: fine)
 };
 
 // Fills every frame's cmd_mm from `program` (clearing cmd_missing) and sets

@@ -92,7 +92,7 @@ void evaluate_reference(const Program& p, const Measurement& m, const std::vecto
       a.circle_accuracy_rms_um = std::sqrt(ss / static_cast<double>(dm.size()));
     }
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("circle reference: ") + e.what());
+    a.flags.push_back({FlagCode::circle_reference, "circle", e.what()});
   }
 }
 
@@ -157,7 +157,7 @@ void diagnose(const Program& p, const std::vector<eval::CirclePass>& passes, con
                         : eval::diagnose_circle(passes, opt);
     for (auto& reason : eval::null_reasons(*a.diagnostics, opt)) a.flags.push_back(std::move(reason));
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("diagnostics: null, ") + e.what());
+    a.flags.push_back({FlagCode::figure_null, "diagnostics", e.what()});
   }
 }
 
@@ -172,20 +172,22 @@ void evaluate_circle_program(const Run& run, Analysis& a, const EvaluationOption
     revolutions(p, m, t, options, ccw, cw);
     a.circle = evaluate_channel(p, m.sample_index, t.pos, ccw, cw, options.keep_trace);
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("circle: ") + e.what());
+    a.flags.push_back({FlagCode::evaluation_failed, "circle", e.what()});
     a.degraded = true;
     return;
   }
   if (p.direction == "both" && (ccw.empty() || cw.empty()))
-    a.flags.push_back(std::string("circle: the program runs both directions but only ") + (ccw.empty() ? "cw" : "ccw") +
-                      " was found");
+    a.flags.push_back(
+        {FlagCode::one_direction, "circle",
+         std::string("the program runs both directions but only ") + (ccw.empty() ? "cw" : "ccw") + " was found"});
   if (!a.circle->circular_hysteresis_H_um)
-    a.flags.push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions (this run has " +
-                      a.circle->direction + " only)");
+    a.flags.push_back({FlagCode::figure_null, "circle.circular_hysteresis_H_um",
+                       "ISO 230-4 H needs both directions (this run has " + a.circle->direction + " only)"});
   if (t.ref_finite && !t.ref.empty()) evaluate_reference(p, m, t.ref, ccw, cw, a);
   if (p.arc_deg < 360.0) {
-    a.flags.push_back("diagnostics: null, the ballbar-class diagnostics need full revolutions (this run is a " +
-                      std::to_string(static_cast<int>(std::lround(p.arc_deg))) + " deg partial arc)");
+    a.flags.push_back({FlagCode::figure_null, "diagnostics",
+                       "the ballbar-class diagnostics need full revolutions (this run is a " +
+                           std::to_string(static_cast<int>(std::lround(p.arc_deg))) + " deg partial arc)"});
     return;
   }
   diagnose(p, diagnostic_passes(m, t, ccw, cw), options, a);

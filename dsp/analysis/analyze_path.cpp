@@ -17,14 +17,14 @@ void evaluate_rectangle_program(const Run& run, Analysis& a) {
   try {
     a.rectangle = eval::evaluate_rectangle(cmd, meas, m.fs_hz);
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("rectangle: null, ") + e.what());
+    a.flags.push_back({FlagCode::evaluation_failed, "rectangle", std::string("null, ") + e.what()});
     a.degraded = true;
   }
   // The contour between the corners as well: the rectangle is a free form too.
   try {
     a.path = eval::path_deviation(m.cmd_mm, m.pos_mm, m.fs_hz);
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("path deviation: ") + e.what());
+    a.flags.push_back({FlagCode::path_deviation, "rectangle", e.what()});
   }
 }
 
@@ -34,7 +34,7 @@ void evaluate_freeform_program(const Run& run, Analysis& a) {
   try {
     a.path = eval::path_deviation(m.cmd_mm, m.pos_mm, m.fs_hz);
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("freeform: null, ") + e.what());
+    a.flags.push_back({FlagCode::evaluation_failed, "freeform", std::string("null, ") + e.what()});
     a.degraded = true;
   }
 }

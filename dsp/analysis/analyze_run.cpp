@@ -39,17 +39,21 @@ void evaluate_step_program(const Run& run, Analysis& a) {
     // Figures the moves cannot give are null in the result; say why here.
     const auto& mv = a.step->moves;
     if (std::none_of(mv.begin(), mv.end(), [](const eval::StepMove& s) { return s.settled; }))
-      a.flags.push_back("step.settling_s: null, no move settled into the band before its dwell ended");
+      a.flags.push_back(
+          {FlagCode::figure_null, "step.settling_s", "no move settled into the band before its dwell ended"});
     if (a.step->smallest_step_resolved_um <= 0.0)
-      a.flags.push_back("step.smallest_step_resolved_um: null, not even the largest step was resolved");
+      a.flags.push_back(
+          {FlagCode::figure_null, "step.smallest_step_resolved_um", "not even the largest step was resolved"});
     bool repeat = false;
     for (std::size_t i = 0; i < mv.size(); ++i)
       for (std::size_t k = i + 1; k < mv.size(); ++k)
         repeat |= std::abs(mv[i].to_mm - mv[k].to_mm) < 1e-6 &&
                   (mv[i].to_mm > mv[i].from_mm) == (mv[k].to_mm > mv[k].from_mm);
-    if (!repeat) a.flags.push_back("step.scatter_um: null, no target was approached twice from the same side");
+    if (!repeat)
+      a.flags.push_back(
+          {FlagCode::figure_null, "step.scatter_um", "no target was approached twice from the same side"});
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("step: ") + e.what());
+    a.flags.push_back({FlagCode::evaluation_failed, "step", e.what()});
     a.degraded = true;
   }
 }
@@ -61,12 +65,12 @@ void evaluate_positioning_program(const Run& run, Analysis& a) {
     // ISO 230-2:2014 clause 4.3.2: five runs per target and direction; fewer are evaluated
     // by the same formulas, but the figures are outside the standard (s from < 5 runs).
     if (a.positioning->runs < eval::kRunsPerTargetIso230_2)
-      a.flags.push_back("positioning: " + std::to_string(a.positioning->runs) +
-                        " runs per target and direction, ISO 230-2 asks for " +
-                        std::to_string(eval::kRunsPerTargetIso230_2) +
-                        ": evaluated by its formulas, outside the standard");
+      a.flags.push_back({FlagCode::outside_standard, "positioning",
+                         std::to_string(a.positioning->runs) + " runs per target and direction, ISO 230-2 asks for " +
+                             std::to_string(eval::kRunsPerTargetIso230_2) +
+                             ": evaluated by its formulas, outside the standard"});
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("positioning: ") + e.what());
+    a.flags.push_back({FlagCode::evaluation_failed, "positioning", e.what()});
     a.degraded = true;
   }
 }
@@ -171,7 +175,7 @@ void evaluate_measurement(const Run& run, const PipelineConfig& config, const An
   const std::string unsupported =
       a.measurement.sample_index.empty() ? std::string() : unsupported_integration(a.measurement);
   if (!unsupported.empty()) {
-    a.flags.push_back(std::string(kPositionNullFlag) + unsupported);
+    a.flags.push_back({FlagCode::position_unsupported, {}, unsupported});
     a.degraded = true;
   } else if (!a.measurement.sample_index.empty()) {  // no motion: nothing to evaluate
     eval::RepeatInput ri;
@@ -200,7 +204,7 @@ void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& opti
   else if (kind == "freeform")
     detail::evaluate_freeform_program(run, a);
   else
-    a.flags.push_back("program kind '" + kind + "': no evaluation in this version");
+    a.flags.push_back({FlagCode::unknown_program, kind, {}});
 }
 
 }  // namespace eical::dsp

@@ -7,6 +7,7 @@
 #include "dsp/analysis/conformance_kind.hpp"
 #include "dsp/analysis/setpoint_cache.hpp"
 #include "dsp/analysis/verdict_kind.hpp"
+#include "dsp/core/flag.hpp"
 #include "dsp/core/parallel_for.hpp"
 #include "dsp/core/run.hpp"
 #include "dsp/eval/circle.hpp"
@@ -113,7 +114,7 @@ struct Analysis {
   std::vector<eval::RepeatGroup> repeats;   // segments between M102 marks run more than once, averaged
   std::string program_kind;
   bool degraded = false;
-  std::vector<std::string> flags;  // pipeline quality flags and evaluation failures
+  std::vector<Flag> flags;  // pipeline quality flags and evaluation failures
   // Expanded uncertainty (k = 2) of each figure by result key (figures.hpp), one value per
   // element of the figure; absent when it could not be estimated (uncertainty_note says why).
   std::map<std::string, std::vector<double>> uncertainty_k2;
@@ -162,10 +163,6 @@ void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& opti
 // mean of measured − set-point over the second half of the dwell, grouped by target and
 // approach direction; a run is one pass up and one pass down (ISO 230-2 linear cycle).
 eval::PositioningInput positioning_deviations(const Measurement& m, const Program& program);
-
-// The flag of a run whose integrated motion is no position (pipeline/integration_support.hpp),
-// followed by the reason.
-inline constexpr const char* kPositionNullFlag = "position: null, ";
 
 // Plane axes of a program ("xy" → 0, 1; "zx" → 2, 0; "yz" → 1, 2).
 std::pair<int, int> plane_axes(const std::string& plane);

@@ -93,13 +93,13 @@ bool judge_channels(const RunMeta& meta, const std::vector<health::Finding>& fin
                     "the recording ends at %.3f s before its program does: M101 (101) started it, no M103 (103) "
                     "ended it%s; the figures cover what was recorded",
                     f.to_s, f.set_point_moving ? ", the set-point still moving at the last sample" : "");
-      a.flags.push_back(std::string(kTruncatedFlag) + b);
+      a.flags.push_back({FlagCode::truncated, {}, b});
       a.degraded = true;
       continue;
     }
     const std::string what = finding_text(f);
     if (!health::is_accel(f.channel)) {  // a PSD electrode: its strip's fixes
-      a.flags.push_back(std::string(kChannelFlag) + what + ": the fixes of its PSD strip are not to be trusted");
+      a.flags.push_back({FlagCode::channel_untrusted, {}, what + ": the fixes of its PSD strip are not to be trusted"});
       a.degraded = true;
       continue;
     }
@@ -118,8 +118,8 @@ bool judge_channels(const RunMeta& meta, const std::vector<health::Finding>& fin
     }
     whom += " (machine " + axes_text(axes) + ")";
     if (!(axes & needed)) {
-      a.flags.push_back(std::string(kUnusedChannelFlag) + what + ": " + whom + ", which " + program_text(p) +
-                        " does not use");
+      a.flags.push_back(
+          {FlagCode::channel_unused, {}, what + ": " + whom + ", which " + program_text(p) + " does not use"});
       continue;
     }
     a.degraded = true;
@@ -127,16 +127,19 @@ bool judge_channels(const RunMeta& meta, const std::vector<health::Finding>& fin
       unmeasured |= axes & needed;
       unmeasured_why +=
           (unmeasured_why.empty() ? "" : ", ") + health::channel_name(f.channel) + " " + health::fault_code(f.fault);
-      a.flags.push_back(std::string(kChannelFlag) + what + ": " + whom + ", which " + program_text(p) +
-                        " needs, is not measured");
+      a.flags.push_back({FlagCode::channel_untrusted,
+                         {},
+                         what + ": " + whom + ", which " + program_text(p) + " needs, is not measured"});
     } else {
-      a.flags.push_back(std::string(kChannelFlag) + what + ": " + whom + ", which " + program_text(p) +
-                        " needs, at its last value there");
+      a.flags.push_back({FlagCode::channel_untrusted,
+                         {},
+                         what + ": " + whom + ", which " + program_text(p) + " needs, at its last value there"});
     }
   }
   if (!unmeasured) return true;
-  a.flags.push_back(p.kind + ": null, not evaluated: machine " + axes_text(unmeasured) + " not measured (" +
-                    unmeasured_why + ")");
+  a.flags.push_back(
+      {FlagCode::evaluation_failed, p.kind,
+       "null, not evaluated: machine " + axes_text(unmeasured) + " not measured (" + unmeasured_why + ")"});
   return false;
 }
 

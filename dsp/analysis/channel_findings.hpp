@@ -15,20 +15,14 @@
 
 namespace eical::dsp {
 
-// Flag prefixes (verdict.cpp's severity): a finding that limits the result, one on a
-// channel the program does not use, a recording shorter than its program.
-inline constexpr const char* kChannelFlag = "channel: ";
-inline constexpr const char* kUnusedChannelFlag = "channel_unused: ";
-inline constexpr const char* kTruncatedFlag = "truncated: ";
-
 // Machine axes (bit i: X, Y, Z) the program's figures are made of.
 unsigned program_axes(const Program& program);
 // Machine axes accel channel c (0..5) contributes to (to_machine; none for other channels).
 unsigned channel_axes(const RunMeta& meta, int c);
 
-// Flags each finding; a.degraded when one limits the result. False when the program's
-// figures must not be evaluated (a needed channel does not measure): a flag
-// "<kind>: null, ..." then says why.
+// Flags each finding (channel_untrusted, channel_unused, truncated); a.degraded when one
+// limits the result. False when the program's figures must not be evaluated (a needed
+// channel does not measure): an evaluation_failed flag on the program then says why.
 bool judge_channels(const RunMeta& meta, const std::vector<health::Finding>& findings, Analysis& a);
 
 }  // namespace eical::dsp

@@ -1,6 +1,5 @@
 #include "dsp/analysis/verdict.hpp"
 
-#include "dsp/analysis/channel_findings.hpp"
 #include "dsp/analysis/figures.hpp"
 
 #include <algorithm>
@@ -24,8 +23,6 @@ std::string num(double v, const char* unit) {
                   v, std::string(unit) == "um" ? "µm" : unit);
   return b;
 }
-
-bool starts_with(const std::string& s, const char* p) { return s.rfind(p, 0) == 0; }
 
 // The figure's ISO 14253-1 decision when the run was judged against tolerances and the
 // decision is proven, conformance or non-conformance; null otherwise.
@@ -73,13 +70,11 @@ void judge(const Program& program, Analysis& a) {
   if (lim) {
     const FigureValue* h = find_figure(figs, lim->headline);
     const FigureValue* l = find_figure(figs, lim->limited);
-    const auto unsupported = std::find_if(a.flags.begin(), a.flags.end(),
-                                          [](const std::string& f) { return starts_with(f, kPositionNullFlag); });
-    if (!h && unsupported != a.flags.end()) {
+    const Flag* unsupported = find_flag(a.flags, FlagCode::position_unsupported);
+    if (!h && unsupported) {
       // Nothing holds the double integral: no position figure at all, whatever its size.
       not_measurable = true;
-      a.verdict_reasons.push_back(std::string(lim->name) +
-                                  " is not measurable: " + unsupported->substr(std::string(kPositionNullFlag).size()));
+      a.verdict_reasons.push_back(std::string(lim->name) + " is not measurable: " + unsupported->detail);
     } else if (!h || !l) {
       a.verdict_reasons.push_back(std::string(lim->name) + " could not be determined (see the flags)");
     } else if (a.uncertainty_k2.empty()) {
@@ -114,38 +109,9 @@ void judge(const Program& program, Analysis& a) {
     a.verdict = Verdict::ok;
   if (!decided_note.empty()) a.verdict_reasons.push_back(decided_note);
   if (a.degraded)
-    for (const auto& f : a.flags)
-      if (flag_severity(f) == FlagSeverity::critical && !starts_with(f, kPositionNullFlag))
-        a.verdict_reasons.push_back(f);
-}
-
-FlagSeverity flag_severity(const std::string& flag) {
-  // The measurement itself is wrong or incomplete.
-  for (const char* p : {"accel_missing", "accel_saturated", "frames_lost", "not_finite", "capacity_exceeded",
-                        "fixed_saturated", "supports_diverged", "psd_disagrees", "no_motion", "interrupted",
-                        "source_stopped", kPositionNullFlag, kChannelFlag, kTruncatedFlag})
-    if (starts_with(flag, p)) return FlagSeverity::critical;
-  // An evaluation that failed ("circle: …", "positioning: …" without "null").
-  for (const char* p : {"circle: ", "step: ", "rectangle: null", "freeform: null"})
-    if (starts_with(flag, p) && flag.find("runs both directions") == std::string::npos) return FlagSeverity::critical;
-  if (starts_with(flag, "positioning: ") && flag.find("outside the standard") == std::string::npos)
-    return FlagSeverity::critical;
-  // It limits the measurement.
-  for (const char* p : {"no_start_trigger", "no_end_trigger", "short_rest_window", "no_zupt_window", kUnusedChannelFlag,
-                        "noise_density"})
-    if (starts_with(flag, p)) return FlagSeverity::warning;
-  if (flag.find("outside the standard") != std::string::npos || flag.find("runs both directions") != std::string::npos)
-    return FlagSeverity::warning;
-  return FlagSeverity::note;
-}
-
-const char* severity_name(FlagSeverity s) {
-  switch (s) {
-    case FlagSeverity::critical: return "critical";
-    case FlagSeverity::warning: return "warning";
-    case FlagSeverity::note: return "note";
-  }
-  return "note";
+    for (const Flag& f : a.flags)
+      if (severity(f) == FlagSeverity::critical && f.code != FlagCode::position_unsupported)
+        a.verdict_reasons.push_back(flag_text(f));
 }
 
 }  // namespace eical::dsp

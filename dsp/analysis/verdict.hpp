@@ -36,10 +36,4 @@ const ResolutionLimit* resolution_limit(const std::string& program_kind);
 // Sets a.verdict and a.verdict_reasons from the figures, their uncertainty and the flags.
 void judge(const Program& program, Analysis& a);
 
-// Severity of a quality flag: what a reader must not miss (the measurement is wrong or
-// incomplete), what limits it, and what only explains a figure that is absent.
-enum class FlagSeverity { critical, warning, note };
-FlagSeverity flag_severity(const std::string& flag);
-const char* severity_name(FlagSeverity s);
-
 }  // namespace eical::dsp

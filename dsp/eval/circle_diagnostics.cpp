@@ -93,23 +93,23 @@ CircleDiagnostics diagnose_circle(PassReplay& replay, const DiagnosticsOptions& 
   return d;
 }
 
-std::vector<std::string> null_reasons(const CircleDiagnostics& d, const DiagnosticsOptions& options) {
-  std::vector<std::string> out;
+std::vector<Flag> null_reasons(const CircleDiagnostics& d, const DiagnosticsOptions& options) {
+  std::vector<Flag> out;
+  auto null = [&out](const char* key, std::string why) { out.push_back({FlagCode::figure_null, key, std::move(why)}); };
   if (!d.servo_and_squareness_separated)
-    out.emplace_back(
-        "diagnostics.servo_mismatch_ms: null, one direction cannot separate servo mismatch from squareness "
-        "(squareness assumes equal lags)");
+    null("diagnostics.servo_mismatch_ms",
+         "one direction cannot separate servo mismatch from squareness (squareness assumes equal lags)");
   const std::string creep = std::to_string(static_cast<long>(options.creep_feed_mm_min)) + " mm/min";
   if (std::isnan(d.stick_slip_um))
-    out.push_back("diagnostics.stick_slip_um: null, not evaluated above the creep feed (" + creep +
-                  "): the fast residual there is vibration");
+    null("diagnostics.stick_slip_um",
+         "not evaluated above the creep feed (" + creep + "): the fast residual there is vibration");
   if (std::isnan(d.vibration_um))
-    out.push_back("diagnostics.vibration_um: null, not evaluated at creep feed (at most " + creep +
-                  "): the fast residual there is stick-slip");
+    null("diagnostics.vibration_um",
+         "not evaluated at creep feed (at most " + creep + "): the fast residual there is stick-slip");
   if (std::isnan(d.reversal_spike_x_um))
-    out.emplace_back("diagnostics.reversal_spike_x_um: null, the first axis never reverses in this test");
+    null("diagnostics.reversal_spike_x_um", "the first axis never reverses in this test");
   if (std::isnan(d.reversal_spike_y_um))
-    out.emplace_back("diagnostics.reversal_spike_y_um: null, the second axis never reverses in this test");
+    null("diagnostics.reversal_spike_y_um", "the second axis never reverses in this test");
   return out;
 }
 

@@ -1,4 +1,5 @@
 #pragma once
+#include "dsp/core/flag.hpp"
 #include "dsp/core/sample_rate.hpp"
 // Ballbar-class diagnostics of a circular test (ISO 230-4 context), from the 2-D relative
 // path that eical measures. A ballbar sees only the radius; eical sees both axes, so the
@@ -74,10 +75,10 @@ struct CircleDiagnostics {
   std::vector<std::string> notes;
 };
 
-// Why each diagnostic the fit left out is null, as result flags ("diagnostics.<key>: null,
-// <reason>"): servo mismatch from one direction, stick-slip above the creep feed,
+// Why each diagnostic the fit left out is null, as result flags (figure_null on
+// "diagnostics.<key>"): servo mismatch from one direction, stick-slip above the creep feed,
 // vibration at it, a reversal spike of an axis that never reversed.
-std::vector<std::string> null_reasons(const CircleDiagnostics& d, const DiagnosticsOptions& options);
+std::vector<Flag> null_reasons(const CircleDiagnostics& d, const DiagnosticsOptions& options);
 
 // Throws InputError when the passes are empty, mismatched or do not go round.
 CircleDiagnostics diagnose_circle(const std::vector<CirclePass>& passes, const DiagnosticsOptions& options);

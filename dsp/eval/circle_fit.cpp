@@ -162,7 +162,7 @@ void report_fit(const AxisFits& fits, double pitch_mm, bool both_directions, Cir
   if (both_directions)
     d.servo_and_squareness_separated = true;
   else
-    d.notes.push_back("one direction only: servo mismatch cannot be separated from squareness; equal lags assumed");
+    d.notes.emplace_back("one direction only: servo mismatch cannot be separated from squareness; equal lags assumed");
   const Eigen::VectorXd& cx = fits.axis[0].coef;
   const Eigen::VectorXd& cy = fits.axis[1].coef;
   d.backlash_x_um = cx(backlash) * kUmPerMm;
@@ -198,7 +198,7 @@ void report_residuals(const ResidualSums& s, const DiagnosticsOptions& opt, Circ
       const double ax = std::sqrt(s.ss_axis[0] / static_cast<double>(s.n)),
                    ay = std::sqrt(s.ss_axis[1] / static_cast<double>(s.n));
       d.stick_slip_um = 2.0 * std::sqrt(3.0) * std::max(ax, ay) * kUmPerMm;
-      d.notes.push_back(
+      d.notes.emplace_back(
           "creep feed: the fast residual is reported as stick-slip (its mean lag also reads as backlash); vibration "
           "is not evaluated at creep feed");
     } else {

@@ -65,7 +65,7 @@ Standstills standstills_of(const Measurement& m) {
   const RawTrace& raw = m.raw;
   if (raw.empty())
     throw InputError("identify: the run has no motion to identify from (" +
-                     std::string(m.flags.empty() ? "" : m.flags.front()) + ")");
+                     std::string(m.flags.empty() ? "" : flag_text(m.flags.front())) + ")");
   const std::size_t n = raw.pos_mm.size();
   const auto& flags = raw.schedule.flags;
   if (flags.size() != n) throw InputError("identify: the support schedule does not cover the trace");

@@ -30,26 +30,16 @@ PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples
   return c;
 }
 
-std::vector<std::string> quality_flag_names(std::uint32_t bits) {
-  static const char* const names[] = {
-      "accel_missing: acceleration samples missing (last value held)",
-      "accel_saturated: ADC at full scale (last valid value held)",
-      "frames_lost: the DAQ or driver lost frames (gap integrated with the last value)",
-      "not_finite: NaN or Inf in a sample (last valid value held)",
-      "no_start_trigger: no M101 (101) trigger; rest window taken from the start of the data",
-      "no_motion: the set-point never moved",
-      "short_rest_window: fewer than 0.05 s at rest before the motion (bias uncertain)",
-      "no_zupt_window: no rest after the motion (velocity drift not removed)",
-      "capacity_exceeded: the measurement is longer than the trace capacity (end cut off)",
-      "no_end_trigger: no M103 (103) trigger; the measurement ends with the data",
-      "fixed_saturated: the fixed-point path clamped a value outside its Q-format range",
-      "supports_diverged: the support fusion met values it cannot take (trace left as integrated, no ZUPT/NBS/CUPT)",
-      ("psd_disagrees: the PSD readings contradict the integrated motion beyond their noise (sensor model off? run "
-       "eical identify); fused without them"),
-  };
-  std::vector<std::string> out;
-  for (std::uint32_t b = 0; b < std::size(names); ++b)
-    if (bits & (1u << b)) out.emplace_back(names[b]);
+// The bit of each quality flag is its code's number.
+static_assert(quality_flag::accel_missing == 1u << static_cast<unsigned>(FlagCode::accel_missing));
+static_assert(quality_flag::not_finite == 1u << static_cast<unsigned>(FlagCode::not_finite));
+static_assert(quality_flag::capacity_exceeded == 1u << static_cast<unsigned>(FlagCode::capacity_exceeded));
+static_assert(quality_flag::psd_disagrees == 1u << static_cast<unsigned>(FlagCode::psd_disagrees));
+
+std::vector<Flag> quality_flags(std::uint32_t bits) {
+  std::vector<Flag> out;
+  for (std::uint32_t b = 0; b <= static_cast<std::uint32_t>(FlagCode::psd_disagrees); ++b)
+    if (bits & (1u << b)) out.push_back({static_cast<FlagCode>(b), {}, {}});
   return out;
 }
 
@@ -450,7 +440,7 @@ Measurement Pipeline::finish() {
   if (config_.dynamic != DynamicComp::none && phase_ == Phase::moving && !m.sample_index.empty()) align_delay(m);
   m.trace_samples = m.sample_index.size();
   note_sigma(m, m.sigma_um);
-  m.flags = quality_flag_names(quality_);
+  m.flags = quality_flags(quality_);
   m.degraded = quality_ != 0;
   return m;
 }
@@ -494,7 +484,7 @@ Pipeline::Tracked Pipeline::finish_track(fusion::SegmentSink* sink) {
     rest_windows_done(m, v_rest);
     if (config_.dynamic != DynamicComp::none) t.delay_samples = delay_samples_;
   }
-  m.flags = quality_flag_names(quality_);
+  m.flags = quality_flags(quality_);
   m.degraded = quality_ != 0;
   return t;
 }

@@ -17,6 +17,7 @@
 //     the same filter again plus the RTS smoother in finish()
 //   6 finish(): the DAQ delay removed by re-indexing the trace (exact for any signal; the
 //     live estimate is predicted over it instead)
+#include "dsp/core/flag.hpp"
 #include "dsp/core/frame.hpp"
 #include "dsp/core/run_meta.hpp"
 #include "dsp/pipeline/coriolis.hpp"
@@ -106,7 +107,8 @@ struct PipelineConfig {
 
 PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples);
 
-// Why a result is degraded (bit set) — named in Measurement::flags.
+// Why a result is degraded (bit set) — in Measurement::flags as the FlagCode of the same
+// number (dsp/core/flag.hpp).
 namespace quality_flag {
 inline constexpr std::uint32_t accel_missing = 1u << 0;
 inline constexpr std::uint32_t accel_saturated = 1u << 1;
@@ -123,7 +125,7 @@ inline constexpr std::uint32_t supports_diverged = 1u << 11;
 inline constexpr std::uint32_t psd_disagrees = 1u << 12;
 }  // namespace quality_flag
 
-std::vector<std::string> quality_flag_names(std::uint32_t bits);
+std::vector<Flag> quality_flags(std::uint32_t bits);
 
 struct LiveEstimate {
   std::int64_t sample_index = -1;
@@ -156,7 +158,7 @@ struct Measurement {
   std::int64_t start_index = -1;       // first sample of the motion (integration start)
   std::int64_t motion_end_index = -1;  // last sample where the set-point moved
   bool degraded = false;
-  std::vector<std::string> flags;
+  std::vector<Flag> flags;
   Eigen::Vector3d rest_bias_rel_mps2 = Eigen::Vector3d::Zero();        // head − table, incl. gravity
   Eigen::Vector3d zupt_velocity_error_mm_s = Eigen::Vector3d::Zero();  // integrated velocity at the last standstill
   std::size_t rest_window_samples = 0, zupt_window_samples = 0;

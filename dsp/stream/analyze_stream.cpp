@@ -409,7 +409,7 @@ void run_second_pass(const Run& header, FrameReplay& frames, FirstPass& p, Secon
 // evaluate_measurement()).
 bool finish_streamed_figures(SecondPass& s, Analysis& a) {
   if (const std::string why = unsupported_integration(s.m); !why.empty()) {
-    a.flags.push_back(std::string(kPositionNullFlag) + why);
+    a.flags.push_back({FlagCode::position_unsupported, {}, why});
     a.degraded = true;
     return false;
   }

@@ -136,7 +136,7 @@ void CircleStream::finish(Analysis& a) {
   }
   const Program& p = run_.meta.program;
   if (segment_error_) {
-    a.flags.push_back("circle: " + *segment_error_);
+    a.flags.push_back({FlagCode::evaluation_failed, "circle", *segment_error_});
     a.degraded = true;
     return;
   }
@@ -154,16 +154,17 @@ void CircleStream::finish(Analysis& a) {
   try {
     a.circle = combined(meas_);
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("circle: ") + e.what());
+    a.flags.push_back({FlagCode::evaluation_failed, "circle", e.what()});
     a.degraded = true;
     return;
   }
   if (p.direction == "both" && (by_dir_[0].empty() || by_dir_[1].empty()))
-    a.flags.push_back(std::string("circle: the program runs both directions but only ") +
-                      (by_dir_[0].empty() ? "cw" : "ccw") + " was found");
+    a.flags.push_back({FlagCode::one_direction, "circle",
+                       std::string("the program runs both directions but only ") + (by_dir_[0].empty() ? "cw" : "ccw") +
+                           " was found"});
   if (!a.circle->circular_hysteresis_H_um)
-    a.flags.push_back("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions (this run has " +
-                      a.circle->direction + " only)");
+    a.flags.push_back({FlagCode::figure_null, "circle.circular_hysteresis_H_um",
+                       "ISO 230-4 H needs both directions (this run has " + a.circle->direction + " only)"});
 
   // The reference instrument (or the simulator's truth) through the same evaluation.
   if (reference_) {
@@ -172,14 +173,15 @@ void CircleStream::finish(Analysis& a) {
       if (a.circle->points == a.circle_reference->points && a.circle->points > 0 && accuracy_n_ == a.circle->points)
         a.circle_accuracy_rms_um = std::sqrt(accuracy_ss_ / static_cast<double>(accuracy_n_));
     } catch (const InputError& e) {
-      a.flags.push_back(std::string("circle reference: ") + e.what());
+      a.flags.push_back({FlagCode::circle_reference, "circle", e.what()});
     }
   }
 
   // Diagnostics: one pass per direction over its steady revolutions.
   if (p.arc_deg < 360.0) {
-    a.flags.push_back("diagnostics: null, the ballbar-class diagnostics need full revolutions (this run is a " +
-                      std::to_string(static_cast<int>(std::lround(p.arc_deg))) + " deg partial arc)");
+    a.flags.push_back({FlagCode::figure_null, "diagnostics",
+                       "the ballbar-class diagnostics need full revolutions (this run is a " +
+                           std::to_string(static_cast<int>(std::lround(p.arc_deg))) + " deg partial arc)"});
     return;
   }
   SpilledPasses passes;
@@ -196,7 +198,7 @@ void CircleStream::finish(Analysis& a) {
     a.diagnostics = eval::diagnose_circle(passes, opt);
     for (auto& reason : eval::null_reasons(*a.diagnostics, opt)) a.flags.push_back(std::move(reason));
   } catch (const InputError& e) {
-    a.flags.push_back(std::string("diagnostics: null, ") + e.what());
+    a.flags.push_back({FlagCode::figure_null, "diagnostics", e.what()});
   }
 }
 

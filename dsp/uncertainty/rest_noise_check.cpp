@@ -15,8 +15,8 @@ double rms(const Eigen::Vector3d& v) { return std::sqrt(v.squaredNorm() / 3.0); 
 
 }  // namespace
 
-std::optional<std::string> noise_disagreement(const RestNoise& measured, double datasheet_ug_rthz,
-                                              const DatasheetTolerance& tolerance) {
+std::optional<Flag> noise_disagreement(const RestNoise& measured, double datasheet_ug_rthz,
+                                       const DatasheetTolerance& tolerance) {
   if (!measured.measured() || !(datasheet_ug_rthz > 0.0)) return std::nullopt;
   const double n = rms(measured.density_ug_rthz), ratio = n / datasheet_ug_rthz;
   // Outside the data sheet's spread by more than twice the estimate's own uncertainty.
@@ -26,14 +26,14 @@ std::optional<std::string> noise_disagreement(const RestNoise& measured, double 
   if (ratio >= lo && ratio <= hi) return std::nullopt;
   char b[320];
   std::snprintf(b, sizeof b,
-                "noise_density: head − table's white noise measured at rest is %.3f µg/√Hz (x %.3f, y %.3f, z %.3f; "
+                "head − table's white noise measured at rest is %.3f µg/√Hz (x %.3f, y %.3f, z %.3f; "
                 "%zu Allan clusters of %.0f ms), %s the data sheet's %.3f (%.3f–%.3f): the uncertainty uses the "
                 "measured one",
                 n, measured.density_ug_rthz.x(), measured.density_ug_rthz.y(), measured.density_ug_rthz.z(),
                 measured.differences, measured.tau_s * 1000.0, ratio > 1.0 ? "above" : "below", datasheet_ug_rthz,
                 datasheet_ug_rthz * (1.0 - tolerance.noise_density_relative),
                 datasheet_ug_rthz * (1.0 + tolerance.noise_density_relative));
-  return std::string(b);
+  return Flag{FlagCode::noise_density, {}, b};
 }
 
 std::string noise_source_text(const RestNoise& measured, double datasheet_ug_rthz) {

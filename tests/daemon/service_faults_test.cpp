@@ -82,9 +82,10 @@ nlohmann::json result_of(const fs::path& run) {
   return nlohmann::json::parse(is);
 }
 
-bool has_flag(const nlohmann::json& j, const std::string& prefix) {
-  for (const auto& f : j["quality"]["flags"])
-    if (f.get<std::string>().rfind(prefix, 0) == 0) return true;
+// By the flag's code (result-format.md, "Quality flags").
+bool has_flag(const nlohmann::json& j, const std::string& code) {
+  for (const auto& c : j["quality"]["flag_codes"])
+    if (c == code) return true;
   return false;
 }
 

@@ -92,7 +92,7 @@ TEST(ProgramSetPoint, ReconstructsTheSetPointFromMovedMarks) {
   }
   ProgramSetPointOptions o;
   const auto a = apply_program_setpoint(p.daq, p.truth.meta.program, o);
-  EXPECT_TRUE(a.flags.empty()) << a.flags.front();
+  EXPECT_TRUE(a.flags.empty()) << (a.flags.empty() ? "" : flag_text(a.flags.front()));
   ASSERT_EQ(a.blocks.size(), 1u) << "a blended circle program is one motion block";
   EXPECT_NEAR(a.blocks[0].marks_offset_s, 0.0123, 1e-9);
   EXPECT_TRUE(a.blocks[0].correlated);
@@ -113,7 +113,9 @@ TEST(ProgramSetPoint, AnotherProgramIsFlaggedByItsResidual) {
   const auto a = apply_program_setpoint(p.daq, other, ProgramSetPointOptions{});
   EXPECT_GT(a.residual_ratio, 0.5);
   ASSERT_FALSE(a.flags.empty());
-  EXPECT_NE(a.flags.back().find("does not match the measured motion"), std::string::npos) << a.flags.back();
+  EXPECT_EQ(a.flags.back().code, dsp::FlagCode::setpoint);
+  EXPECT_NE(a.flags.back().detail.find("does not match the measured motion"), std::string::npos)
+      << a.flags.back().detail;
 }
 
 TEST(ProgramSetPoint, McodeStopsAddAZeroDwellAfterTheTriggersOnly) {

@@ -3,10 +3,13 @@
 // ISO 14253-1 decision against tolerances.
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/analysis/conformance.hpp"
+#include "dsp/core/flag.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <string>
 
 namespace eical::dsp {
 namespace {
@@ -81,12 +84,12 @@ TEST(Verdict, WithTolerancesTheDecisionNotTheFixedLimitSaysWhatUMustResolve) {
 TEST(Verdict, DegradedByACriticalFlagAndNotMeasurableOverridesIt) {
   Program p;
   Analysis a = circle(12.0, 3.0, true);
-  a.flags = {"psd_disagrees: the PSD readings contradict the integrated motion",
-             "circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions"};
+  a.flags = {{FlagCode::psd_disagrees, {}, {}},
+             {FlagCode::figure_null, "circle.circular_hysteresis_H_um", "ISO 230-4 H needs both directions"}};
   judge(p, a);
   EXPECT_EQ(a.verdict, Verdict::degraded);
   ASSERT_EQ(a.verdict_reasons.size(), 1u);
-  EXPECT_EQ(a.verdict_reasons[0].rfind("psd_disagrees", 0), 0u);
+  EXPECT_EQ(a.verdict_reasons[0], flag_text(a.flags[0]));
   Analysis b = circle(1.0, 30.0, true);
   judge(p, b);
   EXPECT_EQ(b.verdict, Verdict::not_measurable);
@@ -102,17 +105,66 @@ TEST(Verdict, WithoutUncertaintyTheResultIsDegraded) {
 }
 
 TEST(FlagSeverity, CriticalWarningAndNote) {
-  EXPECT_EQ(flag_severity("psd_disagrees: the PSD readings contradict"), FlagSeverity::critical);
-  EXPECT_EQ(flag_severity("frames_lost: the DAQ lost frames"), FlagSeverity::critical);
-  EXPECT_EQ(flag_severity("circle: no stretch between two M102 marks sweeps the programmed arc"),
-            FlagSeverity::critical);
-  EXPECT_EQ(flag_severity("no_zupt_window: no rest after the motion"), FlagSeverity::warning);
-  EXPECT_EQ(flag_severity("positioning: 3 runs per target and direction, ISO 230-2 asks for 5: evaluated by its "
-                          "formulas, outside the standard"),
-            FlagSeverity::warning);
-  EXPECT_EQ(flag_severity("circle.circular_hysteresis_H_um: null, ISO 230-4 H needs both directions"),
-            FlagSeverity::note);
+  EXPECT_EQ(severity(FlagCode::psd_disagrees), FlagSeverity::critical);
+  EXPECT_EQ(severity(FlagCode::frames_lost), FlagSeverity::critical);
+  EXPECT_EQ(severity(FlagCode::evaluation_failed), FlagSeverity::critical);
+  EXPECT_EQ(severity(FlagCode::source_rate), FlagSeverity::critical);
+  EXPECT_EQ(severity(FlagCode::no_zupt_window), FlagSeverity::warning);
+  EXPECT_EQ(severity(FlagCode::outside_standard), FlagSeverity::warning);
+  EXPECT_EQ(severity(FlagCode::one_direction), FlagSeverity::warning);
+  EXPECT_EQ(severity(FlagCode::figure_null), FlagSeverity::note);
   EXPECT_STREQ(severity_name(FlagSeverity::critical), "critical");
+}
+
+// The verdict reads codes: the same flags with other words decide the same.
+TEST(FlagSeverity, TheVerdictDoesNotReadTheText) {
+  Program p;
+  Analysis a = circle(12.0, 3.0, true);
+  a.flags = {{FlagCode::evaluation_failed, "circle", "runs both directions, outside the standard"}};
+  judge(p, a);
+  EXPECT_EQ(a.verdict, Verdict::degraded);
+  ASSERT_EQ(a.verdict_reasons.size(), 1u);  // critical, whatever it says
+  Analysis b = circle(12.0, 3.0);
+  b.flags = {{FlagCode::one_direction, "circle", "frames_lost: psd_disagrees"}};
+  judge(p, b);
+  EXPECT_EQ(b.verdict, Verdict::ok);  // a warning, whatever it says
+  EXPECT_TRUE(b.verdict_reasons.empty());
+}
+
+TEST(FlagSeverity, NothingHoldsThePositionIsNotMeasurable) {
+  Program p;
+  Analysis a;
+  a.degraded = true;
+  a.flags = {{FlagCode::position_unsupported, {}, "no standstill and no strip"}};
+  judge(p, a);
+  EXPECT_EQ(a.verdict, Verdict::not_measurable);
+  ASSERT_EQ(a.verdict_reasons.size(), 1u);
+  EXPECT_EQ(a.verdict_reasons[0], "circular deviation G is not measurable: no standstill and no strip");
+}
+
+// Text is rendered once, from the code, the figure and the detail.
+TEST(FlagSeverity, TextIsRenderedFromTheCode) {
+  EXPECT_EQ(flag_text({FlagCode::figure_null, "step.scatter_um", "no target was approached twice"}),
+            "step.scatter_um: null, no target was approached twice");
+  EXPECT_EQ(flag_text({FlagCode::evaluation_failed, "circle", "no stretch sweeps the arc"}),
+            "circle: no stretch sweeps the arc");
+  EXPECT_EQ(flag_text({FlagCode::position_unsupported, {}, "no standstill"}), "position: null, no standstill");
+  EXPECT_EQ(flag_text({FlagCode::unknown_program, "spiral", {}}),
+            "program kind 'spiral': no evaluation in this version");
+  EXPECT_EQ(flag_text({FlagCode::frames_lost, {}, {}}),
+            "frames_lost: the DAQ or driver lost frames (gap integrated with the last value)");
+  EXPECT_EQ(flag_text({FlagCode::frames_lost, {}, "12 frames"}), "frames_lost: 12 frames");
+  EXPECT_STREQ(code_name(FlagCode::channel_untrusted), "channel");
+  EXPECT_STREQ(code_name(FlagCode::unknown_program), "unknown_program");
+}
+
+TEST(FlagSeverity, EveryCodeHasItsOwnNameAndAText) {
+  std::set<std::string> names;
+  for (int c = 0; c <= static_cast<int>(FlagCode::unknown_program); ++c) {
+    const auto code = static_cast<FlagCode>(c);
+    EXPECT_TRUE(names.insert(code_name(code)).second) << code_name(code) << " twice";
+    EXPECT_FALSE(flag_text({code, "circle", {}}).empty()) << code_name(code);
+  }
 }
 
 TEST(Verdict, EveryProgramHasALimit) {

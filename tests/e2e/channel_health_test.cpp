@@ -63,12 +63,24 @@ const Finding* find(const std::vector<Finding>& f, Fault fault, int channel) {
 
 std::string all_flags(const dsp::Analysis& a) {
   std::string s;
-  for (const auto& f : a.flags) s += f + "\n";
+  for (const auto& f : a.flags) s += flag_text(f) + "\n";
   return s;
 }
 
-bool has_flag(const dsp::Analysis& a, const std::string& prefix) {
-  return std::any_of(a.flags.begin(), a.flags.end(), [&](const std::string& f) { return f.rfind(prefix, 0) == 0; });
+using dsp::FlagCode;
+
+// A flag of that code whose detail begins with `detail` (the counts and times the finding
+// carries).
+bool has_flag(const dsp::Analysis& a, FlagCode code, const std::string& detail = {}) {
+  return std::any_of(a.flags.begin(), a.flags.end(),
+                     [&](const dsp::Flag& f) { return f.code == code && f.detail.rfind(detail, 0) == 0; });
+}
+
+// The program's figures left unevaluated, with the reason.
+bool has_program_null(const dsp::Analysis& a, const std::string& program, const std::string& why) {
+  return std::any_of(a.flags.begin(), a.flags.end(), [&](const dsp::Flag& f) {
+    return f.code == FlagCode::evaluation_failed && f.figure == program && f.detail == why;
+  });
 }
 
 // Degraded because of the finding: the result says so, and the verdict names it among its
@@ -115,9 +127,9 @@ TEST(ChannelHealth, HealthyRunsOfSeveralSeedsHaveNoFinding) {
   }
   const dsp::Analysis a = dsp::analyze_run(circle_run(), fast());
   EXPECT_TRUE(a.circle.has_value());
-  EXPECT_FALSE(has_flag(a, dsp::kChannelFlag)) << all_flags(a);
-  EXPECT_FALSE(has_flag(a, dsp::kUnusedChannelFlag)) << all_flags(a);
-  EXPECT_FALSE(has_flag(a, dsp::kTruncatedFlag)) << all_flags(a);
+  EXPECT_FALSE(has_flag(a, FlagCode::channel_untrusted)) << all_flags(a);
+  EXPECT_FALSE(has_flag(a, FlagCode::channel_unused)) << all_flags(a);
+  EXPECT_FALSE(has_flag(a, FlagCode::truncated)) << all_flags(a);
 }
 
 // The limits come from the data sheet: σ of an SF3000L axis at 10 kHz is about 41 counts
@@ -152,8 +164,9 @@ TEST(ChannelHealth, StuckAtZeroGivesNoMillimetres) {
   const dsp::Analysis a = dsp::analyze_run(run, fast());
   EXPECT_FALSE(a.circle.has_value());
   EXPECT_FALSE(a.diagnostics.has_value());
-  EXPECT_TRUE(has_flag(a, "circle: null, not evaluated: machine Y not measured (table_ay stuck)")) << all_flags(a);
-  EXPECT_TRUE(has_flag(a, "channel: table_ay stuck at 0 counts from 0.000 s")) << all_flags(a);
+  EXPECT_TRUE(has_program_null(a, "circle", "null, not evaluated: machine Y not measured (table_ay stuck)"))
+      << all_flags(a);
+  EXPECT_TRUE(has_flag(a, FlagCode::channel_untrusted, "table_ay stuck at 0 counts from 0.000 s")) << all_flags(a);
   expect_degraded_naming(a, "table_ay stuck");
   expect_same_in_stream(run, a);
 }
@@ -194,7 +207,8 @@ TEST(ChannelHealth, FlatAtRestIsDead) {
   EXPECT_DOUBLE_EQ(d->to_s, t_of(run, motion - 1));
   const dsp::Analysis a = dsp::analyze_run(run, fast());
   EXPECT_FALSE(a.circle.has_value());
-  EXPECT_TRUE(has_flag(a, "circle: null, not evaluated: machine Y not measured (table_ay dead)")) << all_flags(a);
+  EXPECT_TRUE(has_program_null(a, "circle", "null, not evaluated: machine Y not measured (table_ay dead)"))
+      << all_flags(a);
 }
 
 TEST(ChannelHealth, ClippedSpanIsNamedAndDegrades) {
@@ -214,7 +228,9 @@ TEST(ChannelHealth, ClippedSpanIsNamedAndDegrades) {
   EXPECT_EQ(c->samples, static_cast<std::int64_t>(to - from + 1));
   const dsp::Analysis a = dsp::analyze_run(run, fast());
   expect_degraded_naming(a, "channel: table_ax clipped");
-  EXPECT_TRUE(has_flag(a, "channel: table_ax clipped at the ADC's full scale from 2.000 s to 2.100 s")) << all_flags(a);
+  EXPECT_TRUE(
+      has_flag(a, FlagCode::channel_untrusted, "table_ax clipped at the ADC's full scale from 2.000 s to 2.100 s"))
+      << all_flags(a);
 }
 
 TEST(ChannelHealth, MissingSpanIsNamedAndDegrades) {
@@ -233,7 +249,7 @@ TEST(ChannelHealth, MissingSpanIsNamedAndDegrades) {
   const dsp::Analysis a = dsp::analyze_run(run, fast());
   expect_degraded_naming(a, "channel: table_ax missing");
   EXPECT_TRUE(a.circle.has_value());  // the sensor held over the gap: degraded, not refused
-  EXPECT_TRUE(has_flag(a, "channel: table_ax missing from 1.000 s to 1.200 s")) << all_flags(a);
+  EXPECT_TRUE(has_flag(a, FlagCode::channel_untrusted, "table_ax missing from 1.000 s to 1.200 s")) << all_flags(a);
   expect_same_in_stream(run, a);
 }
 
@@ -254,9 +270,11 @@ TEST(ChannelHealth, EmptyColumnSpoilsItsSensor) {
   EXPECT_EQ(e->samples, static_cast<std::int64_t>(run.frames.size()));
   const dsp::Analysis a = dsp::analyze_run(run, fast());
   expect_degraded_naming(a, "channel: head_az empty");
-  EXPECT_TRUE(has_flag(a, "channel: head_az empty: not one sample in the run: the head sensor, held without it"))
+  EXPECT_TRUE(has_flag(a, FlagCode::channel_untrusted,
+                       "head_az empty: not one sample in the run: the head sensor, held without it"))
       << all_flags(a);
-  EXPECT_TRUE(has_flag(a, "circle: null, not evaluated: machine X, Y not measured (head_az empty)")) << all_flags(a);
+  EXPECT_TRUE(has_program_null(a, "circle", "null, not evaluated: machine X, Y not measured (head_az empty)"))
+      << all_flags(a);
   EXPECT_FALSE(a.circle.has_value());
   expect_same_in_stream(run, a);
 }
@@ -266,12 +284,10 @@ TEST(ChannelHealth, StuckChannelTheProgramDoesNotUseIsAWarning) {
   dsp::Run run = sim::simulate(sim::step_scenario(0.0, 20.0, 3250.0, 1));
   for (auto& f : run.frames) f.accel_counts[2] = 1000000;
   const dsp::Analysis a = dsp::analyze_run(run, fast());
-  EXPECT_TRUE(has_flag(a, "channel_unused: table_az stuck at 1000000 counts")) << all_flags(a);
+  EXPECT_TRUE(has_flag(a, FlagCode::channel_unused, "table_az stuck at 1000000 counts")) << all_flags(a);
   EXPECT_TRUE(a.step.has_value());
-  for (const auto& f : a.flags)
-    if (f.rfind(dsp::kUnusedChannelFlag, 0) == 0) {
-      EXPECT_EQ(dsp::flag_severity(f), dsp::FlagSeverity::warning);
-    }
+  EXPECT_EQ(dsp::severity(FlagCode::channel_unused), dsp::FlagSeverity::warning);
+  EXPECT_FALSE(dsp::any_critical(a.flags)) << all_flags(a);
 }
 
 // Through the file: an empty column keeps its sensor present (run-format.md: a sensor is
@@ -331,7 +347,7 @@ TEST(ChannelHealth, StuckPsdElectrodeDegrades) {
   ASSERT_NE(find(findings, Fault::stuck, kPsd0I1), nullptr);
   const dsp::Analysis a = dsp::analyze_run(run, fast());
   expect_degraded_naming(a, "channel: psd0_i1 stuck");
-  EXPECT_TRUE(has_flag(a, "channel: psd0_i1 stuck at 1234 counts")) << all_flags(a);
+  EXPECT_TRUE(has_flag(a, FlagCode::channel_untrusted, "psd0_i1 stuck at 1234 counts")) << all_flags(a);
 }
 
 TEST(ChannelHealth, RecordingCutAtHalfIsTruncated) {
@@ -345,7 +361,7 @@ TEST(ChannelHealth, RecordingCutAtHalfIsTruncated) {
   EXPECT_DOUBLE_EQ(t->to_s, t_of(run, run.frames.size() - 1));
   const dsp::Analysis a = dsp::analyze_run(run, fast());
   expect_degraded_naming(a, "truncated: the recording ends at");
-  EXPECT_TRUE(has_flag(a, dsp::kTruncatedFlag)) << all_flags(a);
+  EXPECT_TRUE(has_flag(a, FlagCode::truncated)) << all_flags(a);
   expect_same_in_stream(run, a);
   // The whole run's end trigger is there: not truncated.
   EXPECT_EQ(find(dsp::health::check_channels(circle_run()), Fault::truncated, -1), nullptr);

@@ -105,7 +105,7 @@ TEST(AnalyzeStream, CircleBothDirectionsEqualsTheWholeTraceAnalysis) {
   const dsp::Run run = sim::simulate(circle(10.0, 2500.0, 3, "both"));
   const dsp::Analysis whole = whole_trace(run);
   ASSERT_TRUE(whole.circle && whole.diagnostics && whole.circle_accuracy_rms_um)
-      << (whole.flags.empty() ? "" : whole.flags.front());
+      << (whole.flags.empty() ? "" : flag_text(whole.flags.front()));
   ASSERT_EQ(whole.repeats.size(), 2u);  // three revolutions each way
   const dsp::Analysis s = streamed(run);
   expect_same_result(run, whole, s);
@@ -137,7 +137,7 @@ TEST(AnalyzeStream, PartialArcsPsdStripsAndOneDirection) {
   for (const auto& sc : {arc, psd}) {
     const dsp::Run run = sim::simulate(sc);
     const dsp::Analysis whole = whole_trace(run);
-    ASSERT_TRUE(whole.circle) << (whole.flags.empty() ? "" : whole.flags.front());
+    ASSERT_TRUE(whole.circle) << (whole.flags.empty() ? "" : flag_text(whole.flags.front()));
     expect_same_result(run, whole, streamed(run));
   }
 }

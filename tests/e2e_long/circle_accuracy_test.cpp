@@ -42,7 +42,7 @@ TEST(CircleAccuracy, NoiseFreeTwoStageCompensationIsExact) {
   dsp::AnalysisOptions compensation_only;
   compensation_only.zupt = false;
   const auto a = dsp::analyze_run(run, compensation_only);
-  ASSERT_TRUE(a.circle && a.circle_accuracy_rms_um) << (a.flags.empty() ? "" : a.flags.front());
+  ASSERT_TRUE(a.circle && a.circle_accuracy_rms_um) << (a.flags.empty() ? "" : flag_text(a.flags.front()));
   EXPECT_LT(*a.circle_accuracy_rms_um, 0.01);
   EXPECT_LT(position_rms_um(a.measurement, true), 0.01);
   // Over the whole move the (6-38) expansion's neglected third-order term shows at the
@@ -50,7 +50,7 @@ TEST(CircleAccuracy, NoiseFreeTwoStageCompensationIsExact) {
   EXPECT_LT(position_rms_um(a.measurement), 0.1);
   EXPECT_LT(a.circle->circular_deviation_G_um, 0.01);
   EXPECT_EQ(a.circle->revolutions, 5);
-  EXPECT_FALSE(a.degraded) << a.flags.front();
+  EXPECT_FALSE(a.degraded) << (a.flags.empty() ? "" : flag_text(a.flags.front()));
 
   dsp::AnalysisOptions none = compensation_only;
   none.dynamic = dsp::DynamicComp::none;
@@ -110,7 +110,7 @@ TEST(CircleAccuracy, BadFramesDegradeTheResultWithNamedReasons) {
   const auto a = dsp::analyze_run(run);
   EXPECT_TRUE(a.degraded);
   std::string all;
-  for (const auto& f : a.flags) all += f + "\n";
+  for (const auto& f : a.flags) all += flag_text(f) + "\n";
   EXPECT_NE(all.find("accel_saturated"), std::string::npos) << all;
   EXPECT_NE(all.find("accel_missing"), std::string::npos) << all;
   EXPECT_NE(all.find("frames_lost"), std::string::npos) << all;
@@ -125,6 +125,7 @@ TEST(CircleAccuracy, RunWithoutTriggersIsFlaggedNotCrashed) {
   EXPECT_TRUE(a.degraded);
   EXPECT_FALSE(a.circle.has_value());
   ASSERT_FALSE(a.flags.empty());
+  EXPECT_TRUE(dsp::any_critical(a.flags)) << flag_text(a.flags.front());
 }
 
 }  // namespace

@@ -56,7 +56,7 @@ std::map<std::string, std::pair<double, double>> table(const Diagnostics& d, dou
 void expect_diagnostics(const sim::Scenario& sc, const std::map<std::string, double>& truth) {
   const dsp::Run run = sim::simulate(sc);
   const dsp::Analysis a = dsp::analyze_run(run);
-  ASSERT_TRUE(a.diagnostics.has_value()) << (a.flags.empty() ? "" : a.flags.front());
+  ASSERT_TRUE(a.diagnostics.has_value()) << (a.flags.empty() ? "" : flag_text(a.flags.front()));
   ASSERT_TRUE(a.diagnostics->servo_and_squareness_separated);
   for (const auto& [name, value_tol] : table(*a.diagnostics, sc.meta.program.radius_mm, sc.meta.program.feed_mm_min)) {
     const auto it = truth.find(name);

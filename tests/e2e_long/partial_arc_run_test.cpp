@@ -30,7 +30,7 @@ dsp::Analysis partial_arc(const std::string& plane) {
 }
 
 void expect_arc_structure(const dsp::Analysis& a) {
-  ASSERT_TRUE(a.circle) << (a.flags.empty() ? "" : a.flags.front());
+  ASSERT_TRUE(a.circle) << (a.flags.empty() ? "" : flag_text(a.flags.front()));
   EXPECT_EQ(a.circle->direction, "both");
   EXPECT_EQ(a.circle->revolutions, 2);  // one arc each way; the reversal between them is no arc
   EXPECT_DOUBLE_EQ(a.circle->arc_deg, 220.0);
@@ -44,8 +44,9 @@ void expect_arc_structure(const dsp::Analysis& a) {
   EXPECT_LT(a.circle_reference->circular_deviation_G_um, 0.2);
   // Partial arcs carry no diagnostics, and say so.
   EXPECT_FALSE(a.diagnostics);
-  EXPECT_TRUE(std::any_of(a.flags.begin(), a.flags.end(),
-                          [](const std::string& f) { return f.rfind("diagnostics: null", 0) == 0; }));
+  EXPECT_TRUE(std::any_of(a.flags.begin(), a.flags.end(), [](const dsp::Flag& f) {
+    return f.code == dsp::FlagCode::figure_null && f.figure == "diagnostics";
+  }));
 }
 
 TEST(PartialArcRun, GeneratedXyArcBothDirectionsAgreesWithTheTruth) {
@@ -70,7 +71,7 @@ TEST(PartialArcRun, GeneratedYzArcBothDirectionsIsFoundAndEvaluatedOverTheArc) {
 TEST(PartialArcRun, FullCircleBothDirectionsGivesHysteresisAndSeparatesServoMismatch) {
   const dsp::Run run = sim::simulate(noise_free(sim::circle_scenario(10.0, 2500.0, 1, "both")));
   const auto a = dsp::analyze_run(run);
-  ASSERT_TRUE(a.circle) << (a.flags.empty() ? "" : a.flags.front());
+  ASSERT_TRUE(a.circle) << (a.flags.empty() ? "" : flag_text(a.flags.front()));
   EXPECT_EQ(a.circle->direction, "both");
   EXPECT_EQ(a.circle->revolutions, 2);
   ASSERT_TRUE(a.circle->circular_hysteresis_H_um);

@@ -13,7 +13,7 @@ namespace {
 TEST(PositioningRun, SimulatedCycleEvaluatesAllRunsAndTargets) {
   const dsp::Run run = sim::simulate(sim::positioning_scenario({0.0, 10.0, 20.0, 30.0}, 3));
   const auto a = dsp::analyze_run(run);
-  ASSERT_TRUE(a.positioning) << (a.flags.empty() ? "" : a.flags.front());
+  ASSERT_TRUE(a.positioning) << (a.flags.empty() ? "" : flag_text(a.flags.front()));
   EXPECT_EQ(a.positioning->runs, 3);
   EXPECT_EQ(a.positioning->targets.size(), 4u);
   std::printf("ideal machine, 0.4 ug/sqrt(Hz): A %.2f um, R %.2f um, B %.2f um\n", a.positioning->A_um,

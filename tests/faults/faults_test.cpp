@@ -119,7 +119,7 @@ TEST(Faults, ARunLeftWithoutResultIsEvaluatedAtTheNextStart) {
   ASSERT_TRUE(fs::exists(result));
   const auto j = nlohmann::json::parse(slurp(result));
   EXPECT_TRUE(j["quality"]["degraded"].get<bool>());
-  EXPECT_NE(j["quality"]["flags"].dump().find("evaluated_after_restart"), std::string::npos)
+  EXPECT_NE(j["quality"]["flag_codes"].dump().find("\"evaluated_after_restart\""), std::string::npos)
       << j["quality"]["flags"].dump();
   EXPECT_TRUE(j["circle"].is_object()) << "the circle was not evaluated";
 }

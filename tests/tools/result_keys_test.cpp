@@ -52,10 +52,13 @@ bool has_unit(const std::string& key) {
   return key == "runs" || key == "revolutions";
 }
 
+// By code and figure, as a program reading the result decides (result-format.md).
 bool flag_explains(const json& doc, const std::string& object, const std::string& key) {
-  for (const auto& f : doc["quality"]["flags"]) {
-    const std::string t = f.get<std::string>();
-    if (t.rfind(object + "." + key, 0) == 0 || t.rfind(object + ": null", 0) == 0) return true;
+  const json& q = doc["quality"];
+  for (std::size_t i = 0; i < q["flag_codes"].size(); ++i) {
+    const std::string code = q["flag_codes"][i].get<std::string>(), figure = q["flag_figures"][i].get<std::string>();
+    if (figure == object + "." + key) return true;
+    if (figure == object && (code == "figure_null" || code == "evaluation_failed")) return true;
   }
   return false;
 }
@@ -89,6 +92,8 @@ void check_document(const json& doc, const std::string& kind) {
   EXPECT_TRUE(verdict == "ok" || verdict == "degraded" || verdict == "not_measurable") << verdict;
   EXPECT_TRUE(doc.at("quality").at("verdict_reasons").is_array());
   EXPECT_EQ(doc.at("quality").at("flag_severity").size(), doc.at("quality").at("flags").size());
+  EXPECT_EQ(doc.at("quality").at("flag_codes").size(), doc.at("quality").at("flags").size());
+  EXPECT_EQ(doc.at("quality").at("flag_figures").size(), doc.at("quality").at("flags").size());
   ASSERT_TRUE(doc.at("uncertainty_k2").is_object());
   EXPECT_EQ(doc.at("uncertainty").at("coverage_factor"), 2);
   EXPECT_EQ(doc.at("format"), "eical-result/1");
@@ -162,8 +167,9 @@ TEST(ResultKeys, Positioning) {
   // Fewer than 5 runs: evaluated, and said to be outside ISO 230-2.
   EXPECT_FALSE(doc["positioning"]["within_standard"].get<bool>());
   bool flagged = false;
-  for (const auto& f : doc["quality"]["flags"])
-    flagged |= f.get<std::string>().find("outside the standard") != std::string::npos;
+  for (std::size_t i = 0; i < doc["quality"]["flag_codes"].size(); ++i)
+    flagged |=
+        doc["quality"]["flag_codes"][i] == "outside_standard" && doc["quality"]["flag_figures"][i] == "positioning";
   EXPECT_TRUE(flagged);
   EXPECT_EQ(doc["uncertainty_k2"]["positioning.per_target.mean_um"].size(), 3u);
   EXPECT_EQ(doc["positioning"]["deviation_um"]["up"][0].size(), 3u);

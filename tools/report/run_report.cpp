@@ -266,7 +266,8 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, co
                   {"test settings", settings(run, analysis)},
                   {"sensors", run.meta.sensors[0].model + " (table), " + run.meta.sensors[1].model + " (head)"}};
   if (run.meta.reference) page.context.emplace_back("reference", run.meta.reference->kind);
-  for (const auto& f : analysis.flags) page.flags.push_back({f, dsp::severity_name(dsp::flag_severity(f))});
+  for (const dsp::Flag& f : analysis.flags)
+    page.flags.push_back({dsp::flag_text(f), dsp::severity_name(dsp::severity(f))});
   page.verdict = dsp::verdict_name(analysis.verdict);
   page.verdict_reasons = analysis.verdict_reasons;
   if (options.tolerances) {

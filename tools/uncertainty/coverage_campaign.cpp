@@ -159,8 +159,8 @@ CampaignResult run_campaign(const CampaignOptions& options) {
       // The same evaluation of the true relative path.
       const auto measured = dsp::figures_of(a), true_figs = true_figures(run, truth, a);
       if (measured.empty()) {
-        r.failures.push_back(sc.meta.id + ": no figures (" + (a.flags.empty() ? std::string("?") : a.flags.front()) +
-                             ")");
+        r.failures.push_back(sc.meta.id + ": no figures (" +
+                             (a.flags.empty() ? std::string("?") : dsp::flag_text(a.flags.front())) + ")");
         continue;
       }
       for (const auto& f : measured) {

@@ -25,9 +25,10 @@ daemon::DaemonConfig daq_config(const fs::path& scratch) {
   return c;
 }
 
-bool has_flag(const nlohmann::json& result, const std::string& prefix) {
-  for (const auto& f : result["quality"]["flags"])
-    if (f.get<std::string>().rfind(prefix, 0) == 0) return true;
+// By the flag's code (result-format.md, "Quality flags").
+bool has_flag(const nlohmann::json& result, const std::string& code) {
+  for (const auto& c : result["quality"]["flag_codes"])
+    if (c == code) return true;
   return false;
 }
 
