@@ -29,12 +29,12 @@ enum class FlagCode : std::uint8_t {
   supports_diverged,
   psd_disagrees,
   // The acquisition as the service saw it.
-  interrupted,        // the service stopped during the measurement
-  source_stopped,     // the source ended or failed during it
-  source_rate,        // the source delivered another rate than configured
-  recorder_overflow,  // frames analysed but not recorded
-  temperature,        // a sensor outside its compensated temperature range
-  setpoint,           // the set-point could not be reconstructed as configured
+  interrupted,              // the service stopped during the measurement
+  source_stopped,           // the source ended or failed during it
+  source_rate,              // the source delivered another rate than configured
+  recorder_overflow,        // frames analysed but not recorded
+  temperature,              // a sensor outside its compensated temperature range
+  setpoint,                 // the set-point could not be reconstructed as configured
   evaluated_after_restart,  // evaluated at the next start, without the service's own flags
   // What holds the position, and which channels can be trusted.
   position_unsupported,  // nothing holds the double integral: no position figure
