@@ -3,6 +3,7 @@
 #include "drivers/config/sensor_calibration.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/key_unit.hpp"
 #include "dsp/core/sample_rate.hpp"
 #include "sim/simulate.hpp"
 #include "tools/commands.hpp"
@@ -48,7 +49,8 @@ std::string prediction_text(const plan::Prediction& p) {
   std::snprintf(b, sizeof b, "  runs %.1f s; predicted expanded uncertainty (k = 2) of its figures:\n", p.duration_s);
   o += b;
   for (const auto& [k, v] : p.u_k2) {
-    std::snprintf(b, sizeof b, "    %-40s U = %s%s\n", k.c_str(), value_with_u(v, std::nullopt, figure_unit(k)).c_str(),
+    std::snprintf(b, sizeof b, "    %-40s U = %s%s\n", k.c_str(),
+                  value_with_u(v, std::nullopt, dsp::unit_of_key(k)).c_str(),
                   k == p.limited ? "   <- what the test must resolve" : "");
     o += b;
   }

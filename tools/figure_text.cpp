@@ -1,28 +1,14 @@
 #include "tools/figure_text.hpp"
 
+#include "dsp/core/key_unit.hpp"
+
 #include <cmath>
 #include <cstdio>
 
 namespace eical::tools {
 
-std::string figure_unit(const std::string& key) {
-  for (const auto& [suffix, unit] : std::initializer_list<std::pair<const char*, const char*>>{
-           {"_um", "µm"}, {"_ms", "ms"}, {"_urad", "µrad"}, {"_ppm", "ppm"}, {"_s", "s"}, {"_mm", "mm"}}) {
-    const std::string s = suffix;
-    if (key.size() > s.size() && key.compare(key.size() - s.size(), s.size(), s) == 0) return unit;
-  }
-  return "";
-}
-
 std::string figure_label(const std::string& key) {
-  std::string k = key.substr(key.find('.') + 1);
-  for (const char* suffix : {"_um", "_ms", "_urad", "_ppm", "_s", "_mm"}) {
-    const std::string s = suffix;
-    if (k.size() > s.size() && k.compare(k.size() - s.size(), s.size(), s) == 0) {
-      k.resize(k.size() - s.size());
-      break;
-    }
-  }
+  std::string k = dsp::key_without_unit(key.substr(key.find('.') + 1));
   for (auto& c : k)
     if (c == '_' || c == '.') c = ' ';
   return k;

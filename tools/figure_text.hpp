@@ -9,9 +9,9 @@
 
 namespace eical::tools {
 
-// "circle.circular_deviation_G_um" → "circular deviation G"; its unit ("µm", "ms", …).
+// "circle.circular_deviation_G_um" → "circular deviation G"; its unit is
+// dsp::unit_of_key (dsp/core/key_unit.hpp).
 std::string figure_label(const std::string& key);
-std::string figure_unit(const std::string& key);
 
 // "2.80 ± 1.10 µm", or "2.80 µm ± ?" without an uncertainty; decimals by the unit.
 std::string value_with_u(double value, std::optional<double> u_k2, const std::string& unit);

@@ -2,6 +2,7 @@
 
 #include "dsp/analysis/figures.hpp"
 #include "dsp/analysis/verdict.hpp"
+#include "dsp/core/key_unit.hpp"
 #include "dsp/uncertainty/resolved.hpp"
 #include "tools/exit_codes.hpp"
 #include "tools/figure_text.hpp"
@@ -71,7 +72,7 @@ std::string budget_text(const dsp::Run& run, const dsp::Analysis& analysis) {
   for (const std::string& key : keys) {
     const auto u = figure_u(analysis, key);
     if (!u) continue;
-    std::snprintf(b, sizeof b, "    %s: U = %.2f %s\n", figure_label(key).c_str(), *u, figure_unit(key).c_str());
+    std::snprintf(b, sizeof b, "    %s: U = %.2f %s\n", figure_label(key).c_str(), *u, dsp::unit_of_key(key).c_str());
     o += b;
     double sum2 = 0.0;
     for (const auto& [source, by_key] : analysis.uncertainty_budget)
@@ -83,13 +84,13 @@ std::string budget_text(const dsp::Run& run, const dsp::Analysis& analysis) {
       if (it == by_key.end() || it->second.size() != 1 || !std::isfinite(it->second[0])) continue;
       const double us = it->second[0];
       std::snprintf(b, sizeof b, "      %-44s %8.3f %s  %5.1f %%\n", dsp::uncertainty::error_source_words(source), us,
-                    figure_unit(key).c_str(), sum2 > 0.0 ? 100.0 * us * us / sum2 : 0.0);
+                    dsp::unit_of_key(key).c_str(), sum2 > 0.0 ? 100.0 * us * us / sum2 : 0.0);
       o += b;
     }
     const auto nb = analysis.noise_bound_k2.find(key);
     if (nb != analysis.noise_bound_k2.end() && nb->second.size() == 1) {
       std::snprintf(b, sizeof b, "      %-44s %8.3f %s\n", "noise bound (white noise, optimal smoother)", nb->second[0],
-                    figure_unit(key).c_str());
+                    dsp::unit_of_key(key).c_str());
       o += b;
     }
   }
@@ -115,7 +116,7 @@ std::string figures_text(const dsp::Analysis& analysis) {
         o += ", axis " + analysis.positioning->axis + ", " + std::to_string(analysis.positioning->runs) + " runs";
       o += "\n";
     }
-    const std::string unit = figure_unit(f.key);
+    const std::string unit = dsp::unit_of_key(f.key);
     if (!f.array) {
       if (const auto ne = analysis.not_evaluated.find(f.key); ne != analysis.not_evaluated.end()) {
         std::snprintf(b, sizeof b, "    %-34s not evaluated: %s\n", figure_label(f.key).c_str(), ne->second.c_str());

@@ -1,6 +1,7 @@
 #include "dsp/analysis/verdict.hpp"
 
 #include "dsp/analysis/figures.hpp"
+#include "dsp/core/key_unit.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -10,17 +11,15 @@
 namespace eical::dsp {
 namespace {
 
-std::string num(double v, const char* unit) {
+// `v` in the unit `key` names, as a person reads it.
+std::string num(double v, const char* key) {
+  const std::string unit = unit_of_key(key);
   char b[64];
   const double a = std::abs(v);
-  if (std::string(unit) == "um" && a >= 1000.0)
+  if (unit == "µm" && a >= 1000.0)
     std::snprintf(b, sizeof b, "%.2f mm", v / 1000.0);
   else
-    std::snprintf(b, sizeof b,
-                  a >= 100.0  ? "%.0f %s"
-                  : a >= 10.0 ? "%.1f %s"
-                              : "%.2f %s",
-                  v, std::string(unit) == "um" ? "µm" : unit);
+    std::snprintf(b, sizeof b, a >= 100.0 ? "%.0f %s" : a >= 10.0 ? "%.1f %s" : "%.2f %s", v, unit.c_str());
   return b;
 }
 
@@ -37,15 +36,14 @@ const FigureConformance* proven_either_way(const Analysis& a, const std::string&
 
 const std::vector<ResolutionLimit>& resolution_limits() {
   static const std::vector<ResolutionLimit> limits = {
-      {"circle", "circle.circular_deviation_G_um", "circular deviation G", "circle.circular_deviation_G_um", "G", 10.0,
-       "um"},
-      {"positioning", "positioning.A_um", "positioning accuracy A", "positioning.E_um", "E", 5.0, "um"},
+      {"circle", "circle.circular_deviation_G_um", "circular deviation G", "circle.circular_deviation_G_um", "G", 10.0},
+      {"positioning", "positioning.A_um", "positioning accuracy A", "positioning.E_um", "E", 5.0},
       {"step", "step.largest_step_measured_um", "the measured step", "step.end_position_error_um",
-       "the end-position error", 2.0, "um"},
+       "the end-position error", 2.0},
       {"rectangle", "rectangle.corner_error_max_um", "the largest corner error", "rectangle.corner_error_max_um",
-       "the corner error", 10.0, "um"},
+       "the corner error", 10.0},
       {"freeform", "freeform.contour_error_max_um", "the largest contour error", "freeform.contour_error_max_um",
-       "the contour error", 10.0, "um"},
+       "the contour error", 10.0},
   };
   return limits;
 }
@@ -88,15 +86,15 @@ void judge(const Program& program, Analysis& a) {
       const FigureConformance* decided = proven_either_way(a, lim->limited);
       if (decided && !(ul <= lim->limit)) {
         decided_note =
-            ("U(" + std::string(lim->limited_name) + ") = " + num(ul, lim->unit) + " exceeds the " +
-             num(lim->limit, lim->unit) + " a " + program.kind +
-             " test resolves without tolerances, but decides its tolerance of " + num(decided->tolerance, lim->unit) +
-             ": " + conformance_words(decided->decision) + " (ISO 14253-1)");
+            ("U(" + std::string(lim->limited_name) + ") = " + num(ul, lim->limited) + " exceeds the " +
+             num(lim->limit, lim->limited) + " a " + program.kind +
+             " test resolves without tolerances, but decides its tolerance of " +
+             num(decided->tolerance, lim->limited) + ": " + conformance_words(decided->decision) + " (ISO 14253-1)");
       } else if (!std::isfinite(ul) || ul > lim->limit) {
         not_measurable = true;
         a.verdict_reasons.push_back("U(" + std::string(lim->limited_name) +
-                                    ") = " + (std::isfinite(ul) ? num(ul, lim->unit) : std::string("unknown")) +
-                                    " exceeds the " + num(lim->limit, lim->unit) + " a " + program.kind +
+                                    ") = " + (std::isfinite(ul) ? num(ul, lim->limited) : std::string("unknown")) +
+                                    " exceeds the " + num(lim->limit, lim->limited) + " a " + program.kind +
                                     " test is meant to resolve");
       }
     }

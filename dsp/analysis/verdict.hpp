@@ -26,8 +26,7 @@ struct ResolutionLimit {
   const char* name;      // as a user reads it
   const char* limited;   // result key whose U must stay within `limit_um`
   const char* limited_name;
-  double limit;  // in the limited figure's unit
-  const char* unit;
+  double limit;  // in the limited figure's unit (its key's suffix, dsp::unit_of_key)
 };
 
 const std::vector<ResolutionLimit>& resolution_limits();

@@ -1,5 +1,6 @@
 #include "history/record/figure_names.hpp"
 
+#include "dsp/core/key_unit.hpp"
 #include "history/record/utc_time.hpp"
 
 #include <array>
@@ -9,38 +10,10 @@
 #include <utility>
 
 namespace eical::history {
-namespace {
-
-// Longest suffix first ("_mm_min" before "_min"-less "_mm").
-constexpr std::array<std::pair<const char*, const char*>, 9> kUnits = {{{"_mm_min", "mm/min"},
-                                                                        {"_urad", "µrad"},
-                                                                        {"_ppm", "ppm"},
-                                                                        {"_deg", "°"},
-                                                                        {"_um", "µm"},
-                                                                        {"_mm", "mm"},
-                                                                        {"_ms", "ms"},
-                                                                        {"_hz", "Hz"},
-                                                                        {"_s", "s"}}};
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-}  // namespace
-
-std::string unit_of(const std::string& figure) {
-  for (const auto& [suffix, unit] : kUnits)
-    if (ends_with(figure, suffix)) return unit;
-  return "";
-}
 
 std::string label_of(const std::string& figure) {
-  std::string key = figure.substr(figure.rfind('.') == std::string::npos ? 0 : figure.rfind('.') + 1);
-  for (const auto& [suffix, unit] : kUnits)
-    if (ends_with(key, suffix)) {
-      key.resize(key.size() - std::char_traits<char>::length(suffix));
-      break;
-    }
+  const std::string key =
+      dsp::key_without_unit(figure.substr(figure.rfind('.') == std::string::npos ? 0 : figure.rfind('.') + 1));
   std::string out;
   std::size_t start = 0;
   while (start <= key.size()) {

@@ -1,12 +1,9 @@
 #pragma once
-// What a figure's key says about it: its unit (from the key's suffix, results.md: "units
-// are in the key names") and a label for people ("diagnostics.backlash_x_um" → "backlash X").
+// What a figure's key says to people: a label ("diagnostics.backlash_x_um" → "backlash X");
+// its unit is dsp::unit_of_key (dsp/core/key_unit.hpp).
 #include <string>
 
 namespace eical::history {
-
-// "µm", "ms", "µrad", "ppm", "s", "mm", "°", "Hz", "mm/min"; "" when the key names none.
-std::string unit_of(const std::string& figure);
 
 // The key without section and unit, words separated, axis letters upper case.
 std::string label_of(const std::string& figure);

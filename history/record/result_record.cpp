@@ -1,5 +1,6 @@
 #include "history/record/result_record.hpp"
 
+#include "dsp/core/key_unit.hpp"
 #include "history/record/figure_names.hpp"
 
 #include <algorithm>
@@ -35,7 +36,7 @@ void collect(const nlohmann::json& obj, const std::string& prefix, std::map<std:
     if (v.is_number()) {
       const double x = v.get<double>();
       out[name] = {name, std::isfinite(x) ? std::optional<double>(x) : std::nullopt, std::nullopt};
-    } else if (v.is_null() && !unit_of(name).empty()) {
+    } else if (v.is_null() && !dsp::unit_of_key(name).empty()) {
       out[name] = {name, std::nullopt, std::nullopt};
     } else if (v.is_object() && depth == 0 && key != "trace") {
       collect(v, name + ".", out, depth + 1);

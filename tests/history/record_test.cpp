@@ -1,6 +1,7 @@
 // An eical-result/1 document becomes a history record: every numeric figure with its
 // uncertainty (NULL where the result gives none), the verdict when there is one, program
 // parameters and pipeline bookkeeping left out, traces thinned, provenance checked.
+#include "dsp/core/key_unit.hpp"
 #include "history/record/figure_names.hpp"
 #include "history/record/record_json.hpp"
 #include "history/record/result_record.hpp"
@@ -93,10 +94,15 @@ TEST(HistoryRecord, JsonRoundTripIsExact) {
 }
 
 TEST(HistoryRecord, NamesSayUnitAndLabel) {
-  EXPECT_EQ(history::unit_of("diagnostics.backlash_x_um"), "µm");
-  EXPECT_EQ(history::unit_of("diagnostics.squareness_urad"), "µrad");
-  EXPECT_EQ(history::unit_of("step.settling_s"), "s");
-  EXPECT_EQ(history::unit_of("circle.feed_mm_min"), "mm/min");
+  EXPECT_EQ(dsp::unit_of_key("diagnostics.backlash_x_um"), "µm");
+  EXPECT_EQ(dsp::unit_of_key("diagnostics.squareness_urad"), "µrad");
+  EXPECT_EQ(dsp::unit_of_key("step.settling_s"), "s");
+  EXPECT_EQ(dsp::unit_of_key("circle.feed_mm_min"), "mm/min");
+  EXPECT_EQ(dsp::unit_of_key("modes.frequency_hz"), "Hz");
+  EXPECT_EQ(dsp::unit_of_key("circle.revolutions"), "");
+  EXPECT_EQ(dsp::key_without_unit("circle.feed_mm_min"), "circle.feed");
+  EXPECT_EQ(dsp::key_without_unit("step.settling_ms"), "step.settling");
+  EXPECT_EQ(dsp::key_without_unit("_um"), "_um");  // a suffix alone names nothing
   EXPECT_EQ(history::label_of("diagnostics.backlash_x_um"), "backlash X");
   EXPECT_EQ(history::label_of("circle.circular_deviation_G_um"), "circular deviation G");
   EXPECT_EQ(history::utc_rfc3339("2026-11-12 23:30:00-02:00"), "2026-11-13T01:30:00Z");

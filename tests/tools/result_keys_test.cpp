@@ -4,6 +4,7 @@
 #include "drivers/results/result_json.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/analysis/analyze_run.hpp"
+#include "dsp/core/key_unit.hpp"
 #include "sim/simulate.hpp"
 #include "tools/sim_programs.hpp"
 
@@ -43,13 +44,9 @@ const std::map<std::string, std::vector<std::string>> kObjectsOfKind = {
     {"rectangle", {"rectangle"}},          {"freeform", {"freeform"}},
 };
 
-// A number-valued key must say its unit: one of these suffixes, or be a count.
+// A number-valued key must say its unit (a suffix of dsp/core/key_unit.hpp's table), or be a count.
 bool has_unit(const std::string& key) {
-  for (const char* u : {"_um", "_mm", "_ms", "_urad", "_ppm", "_s", "_mm_min", "_deg", "_hz"})
-    if (key.size() > std::string(u).size() &&
-        key.compare(key.size() - std::string(u).size(), std::string::npos, u) == 0)
-      return true;
-  return key == "runs" || key == "revolutions";
+  return !dsp::unit_of_key(key).empty() || key == "runs" || key == "revolutions";
 }
 
 // By code and figure, as a program reading the result decides (result-format.md).

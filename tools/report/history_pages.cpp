@@ -1,6 +1,7 @@
 #include "tools/report/history_pages.hpp"
 
 #include "dsp/core/float_limits.hpp"
+#include "dsp/core/key_unit.hpp"
 #include "history/record/figure_names.hpp"
 #include "history/record/utc_time.hpp"
 #include "tools/history/history_format.hpp"
@@ -112,7 +113,7 @@ std::string trend_plot(const std::string& figure, const std::vector<history::Tre
       ring.x.push_back(x), ring.y.push_back(*p.value);
   }
   if (!ring.x.empty()) series.push_back(ring);
-  const std::string unit = history::unit_of(figure);
+  const std::string unit = dsp::unit_of_key(figure);
   return line_plot(series, history::label_of(figure) + " over time (bars: ± U, k = 2)",
                    std::string(unit_t.name) + " since " + (origin.empty() ? "the first result" : origin),
                    history::label_of(figure) + (unit.empty() ? "" : " (" + unit + ")"), 760, 320);
@@ -126,7 +127,7 @@ Page trend_page(const std::string& figure, const std::vector<history::TrendPoint
   page.subject_label = "Figure";
   page.program = history::label_of(figure) + ", " + std::to_string(points.size()) + " results";
   page.context = {{"store", store}};
-  const std::string unit = history::unit_of(figure);
+  const std::string unit = dsp::unit_of_key(figure);
   Section s;
   s.heading = history::label_of(figure) + " over time";
   s.lead = "Each result with its expanded uncertainty (k = 2); one colour per machine.";
@@ -192,7 +193,7 @@ Page compare_page(const history::Comparison& c, const history::Record& before, c
   Grid sig{"Significant changes", {"figure", "before", "after", "difference"}, {}};
   for (const auto& f : c.figures)
     if (f.judgement == history::Judgement::significant) {
-      const std::string unit = history::unit_of(f.name);
+      const std::string unit = dsp::unit_of_key(f.name);
       sig.rows.push_back({history::label_of(f.name), hv::measure(f.before, f.u_before, unit),
                           hv::measure(f.after, f.u_after, unit), hv::measure(f.difference, f.uncertainty_k2, unit)});
     }
@@ -208,7 +209,7 @@ Page compare_page(const history::Comparison& c, const history::Record& before, c
   f.lead = "Difference after − before with U = √(U_before² + U_after²) (k = 2); significant when |difference| > U.";
   Grid g{"", {"figure", "before", "after", "difference", "judgement"}, {}};
   for (const auto& fc : c.figures) {
-    const std::string unit = history::unit_of(fc.name);
+    const std::string unit = dsp::unit_of_key(fc.name);
     g.rows.push_back({history::label_of(fc.name) + " (" + fc.name + ")", hv::measure(fc.before, fc.u_before, unit),
                       hv::measure(fc.after, fc.u_after, unit),
                       fc.difference ? hv::measure(fc.difference, fc.uncertainty_k2, unit) : "-",
