@@ -52,21 +52,10 @@ void save_trace(const std::filesystem::path& dir, const drivers::dds::TraceMsg& 
 
 // ", 2 triggers refused, 1 decode errors": the counters of a Status that are not zero.
 std::string nonzero_counters(const drivers::dds::StatusMsg& s) {
-  const std::pair<const char*, std::uint64_t> all[] = {{"bad frames", s.bad_frames},
-                                                       {"Live overruns", s.live_overruns},
-                                                       {"stamp overruns", s.stamp_overruns},
-                                                       {"DDS write errors", s.dds_write_errors},
-                                                       {"triggers refused", s.triggers_refused},
-                                                       {"triggers late", s.triggers_late},
-                                                       {"trigger events ignored", s.trigger_events_ignored},
-                                                       {"recorder overflow", s.recorder_overflow},
-                                                       {"decode errors", s.source_decode_errors},
-                                                       {"samples lost by the source", s.source_lost_samples},
-                                                       {"frames dropped by the source", s.source_dropped_frames},
-                                                       {"frames without set-point", s.setpoint_missing}};
   std::string out;
-  for (const auto& [name, value] : all)
-    if (value != 0) out += ", " + std::to_string(value) + " " + name;
+  drivers::dds::for_each_counter(s.counters, [&](const drivers::dds::StatusCounterView& c) {
+    if (c.trouble && c.value != 0) out += ", " + std::to_string(c.value) + " " + c.label;
+  });
   return out;
 }
 

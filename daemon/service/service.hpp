@@ -5,6 +5,7 @@
 // it by buffer swap and are written by the evaluation thread.
 #include "daemon/config/daemon_config.hpp"
 #include "daemon/triggers/trigger_input.hpp"
+#include "drivers/dds/status_counters.hpp"
 
 #include <atomic>
 #include <cstdint>
@@ -19,15 +20,8 @@ class Source;
 
 namespace eical::daemon {
 
-// Every other counter of the service, named as in the Status topic (drivers/dds/eical.idl).
-struct StatusCounters {
-  std::uint64_t bad_frames = 0, live_overruns = 0, stamp_overruns = 0, dds_write_errors = 0;
-  std::uint64_t triggers_accepted = 0, triggers_refused = 0, triggers_late = 0, trigger_events_ignored = 0;
-  std::uint64_t recorder_overflow = 0, handoffs_deferred = 0;
-  std::uint64_t source_decode_errors = 0, source_lost_samples = 0, source_dropped_frames = 0;
-  std::uint64_t setpoint_samples = 0, setpoint_missing = 0;
-  std::uint64_t frames_flagged = 0, commands = 0;
-};
+// Every other counter of the service, as the Status topic publishes them.
+using StatusCounters = drivers::dds::StatusCounters;
 
 struct ServiceStatus {
   std::string state;  // IDLE, ARMED, MEASURING, EVALUATING, DONE, FAULT

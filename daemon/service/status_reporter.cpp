@@ -154,16 +154,7 @@ void StatusReporter::publish_to_hmi(const ServiceStatus& st) {
   m.measurements = st.measurements, m.results = st.results_written;
   m.sample_index = st.sample_index, m.sample_time_ns = st.sample_time_ns;
   m.temp_table_c = st.temp_table_c, m.temp_head_c = st.temp_head_c;
-  const StatusCounters& c = st.counters;
-  m.bad_frames = c.bad_frames, m.live_overruns = c.live_overruns, m.stamp_overruns = c.stamp_overruns,
-  m.dds_write_errors = c.dds_write_errors;
-  m.triggers_accepted = c.triggers_accepted, m.triggers_refused = c.triggers_refused, m.triggers_late = c.triggers_late;
-  m.trigger_events_ignored = c.trigger_events_ignored, m.recorder_overflow = c.recorder_overflow,
-  m.handoffs_deferred = c.handoffs_deferred;
-  m.source_decode_errors = c.source_decode_errors, m.source_lost_samples = c.source_lost_samples;
-  m.source_dropped_frames = c.source_dropped_frames, m.setpoint_samples = c.setpoint_samples,
-  m.setpoint_missing = c.setpoint_missing;
-  m.frames_flagged = c.frames_flagged, m.commands = c.commands;
+  m.counters = st.counters;
   const dsp::State state = s_.counters->faulted.load() ? dsp::State::fault : s_.counters->measurement_state();
   s_.hmi->set_status(m, state);
 }

@@ -105,15 +105,7 @@ bool Bus::publish(const StatusMsg& m) {
   s.results = m.results;
   s.temp_table_c = m.temp_table_c, s.temp_head_c = m.temp_head_c, s.time_ns = m.time_ns;
   s.sample_index = m.sample_index, s.sample_time_ns = m.sample_time_ns;
-  s.bad_frames = m.bad_frames, s.live_overruns = m.live_overruns, s.stamp_overruns = m.stamp_overruns,
-  s.dds_write_errors = m.dds_write_errors;
-  s.triggers_accepted = m.triggers_accepted, s.triggers_refused = m.triggers_refused, s.triggers_late = m.triggers_late;
-  s.trigger_events_ignored = m.trigger_events_ignored, s.recorder_overflow = m.recorder_overflow,
-  s.handoffs_deferred = m.handoffs_deferred;
-  s.source_decode_errors = m.source_decode_errors, s.source_lost_samples = m.source_lost_samples;
-  s.source_dropped_frames = m.source_dropped_frames, s.setpoint_samples = m.setpoint_samples,
-  s.setpoint_missing = m.setpoint_missing;
-  s.frames_flagged = m.frames_flagged, s.commands = m.commands;
+  copy_counters(s, m.counters);
   const bool ok = impl_->status.writer > 0 && dds_write(impl_->status.writer, &s) >= 0;
   if (!ok) write_errors_.fetch_add(1, std::memory_order_relaxed);
   return ok;
@@ -185,17 +177,9 @@ std::optional<StatusMsg> Bus::take_status(std::chrono::milliseconds timeout) {
   if (impl_->status.reader <= 0) return std::nullopt;
   StatusMsg out;
   const bool ok = impl_->take_one<eical_msg_Status>(impl_->status, timeout, [&](const eical_msg_Status& s) {
-    out = {str(s.daemon), str(s.state),   str(s.fault),  s.frames,  s.overruns,     s.frames_lost,   s.measurements,
-           s.results,     s.temp_table_c, s.temp_head_c, s.time_ns, s.sample_index, s.sample_time_ns};
-    out.bad_frames = s.bad_frames, out.live_overruns = s.live_overruns, out.stamp_overruns = s.stamp_overruns;
-    out.dds_write_errors = s.dds_write_errors, out.triggers_accepted = s.triggers_accepted,
-    out.triggers_refused = s.triggers_refused;
-    out.triggers_late = s.triggers_late, out.trigger_events_ignored = s.trigger_events_ignored;
-    out.recorder_overflow = s.recorder_overflow, out.handoffs_deferred = s.handoffs_deferred;
-    out.source_decode_errors = s.source_decode_errors, out.source_lost_samples = s.source_lost_samples;
-    out.source_dropped_frames = s.source_dropped_frames, out.setpoint_samples = s.setpoint_samples,
-    out.setpoint_missing = s.setpoint_missing;
-    out.frames_flagged = s.frames_flagged, out.commands = s.commands;
+    out = {str(s.daemon), str(s.state),   str(s.fault),  s.frames,  s.overruns,     s.frames_lost,    s.measurements,
+           s.results,     s.temp_table_c, s.temp_head_c, s.time_ns, s.sample_index, s.sample_time_ns, {}};
+    copy_counters(out.counters, s);
   });
   return ok ? std::optional(out) : std::nullopt;
 }

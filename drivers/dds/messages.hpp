@@ -1,6 +1,7 @@
 #pragma once
 // Plain C++ forms of the DDS topics (drivers/dds/eical.idl): the rest of eical never
 // touches generated C types or dds_* calls.
+#include "drivers/dds/status_counters.hpp"
 #include "dsp/core/float_limits.hpp"
 
 #include <array>
@@ -17,13 +18,7 @@ struct StatusMsg {
   float temp_table_c = kNaN, temp_head_c = kNaN;
   std::int64_t time_ns = 0;
   std::int64_t sample_index = 0, sample_time_ns = 0;  // DAQ clock ↔ CLOCK_MONOTONIC
-  // Every counter of the service (eical.idl says what each one counts).
-  std::uint64_t bad_frames = 0, live_overruns = 0, stamp_overruns = 0, dds_write_errors = 0;
-  std::uint64_t triggers_accepted = 0, triggers_refused = 0, triggers_late = 0, trigger_events_ignored = 0;
-  std::uint64_t recorder_overflow = 0, handoffs_deferred = 0;
-  std::uint64_t source_decode_errors = 0, source_lost_samples = 0, source_dropped_frames = 0;
-  std::uint64_t setpoint_samples = 0, setpoint_missing = 0;
-  std::uint64_t frames_flagged = 0, commands = 0;
+  StatusCounters counters;                            // every counter of the service (status_counters.hpp)
 };
 
 struct LiveMsg {

@@ -45,25 +45,8 @@ TEST(DdsBus, StatusAndLiveRoundTrip) {
   s.temp_table_c = 21.5f;
   s.time_ns = 42;
   // Every counter travels (each a different value: a swapped field shows).
-  std::uint64_t StatusMsg::*const counters[] = {&StatusMsg::bad_frames,
-                                                &StatusMsg::live_overruns,
-                                                &StatusMsg::stamp_overruns,
-                                                &StatusMsg::dds_write_errors,
-                                                &StatusMsg::triggers_accepted,
-                                                &StatusMsg::triggers_refused,
-                                                &StatusMsg::triggers_late,
-                                                &StatusMsg::trigger_events_ignored,
-                                                &StatusMsg::recorder_overflow,
-                                                &StatusMsg::handoffs_deferred,
-                                                &StatusMsg::source_decode_errors,
-                                                &StatusMsg::source_lost_samples,
-                                                &StatusMsg::source_dropped_frames,
-                                                &StatusMsg::setpoint_samples,
-                                                &StatusMsg::setpoint_missing,
-                                                &StatusMsg::frames_flagged,
-                                                &StatusMsg::commands};
   std::uint64_t value = 1000;
-  for (auto c : counters) s.*c = ++value;
+  for (auto c : kStatusCounterFields) s.counters.*c = ++value;
   // Reliable + volatile: publish until the reader has matched and taken one.
   const auto got = wait_for([&] {
     daemon.publish(s);
@@ -77,7 +60,7 @@ TEST(DdsBus, StatusAndLiveRoundTrip) {
   EXPECT_EQ(got->frames_lost, 2u);
   EXPECT_FLOAT_EQ(got->temp_table_c, 21.5f);
   EXPECT_EQ(got->time_ns, 42);
-  for (auto c : counters) EXPECT_EQ((*got).*c, s.*c);
+  for (auto c : kStatusCounterFields) EXPECT_EQ(got->counters.*c, s.counters.*c);
 
   LiveMsg l;
   l.daemon = "eicald@test";
