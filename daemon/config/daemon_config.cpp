@@ -4,8 +4,6 @@
 #include "drivers/config/strict_toml.hpp"
 #include "drivers/setpoint/program_catalog.hpp"
 #include "dsp/core/error.hpp"
-#include "sim/nc/envelope_check.hpp"
-#include "sim/simulate.hpp"
 
 #include <cmath>
 
@@ -234,13 +232,8 @@ void read_realtime(StrictTable t, RealtimeConfig& r) {
 // service would otherwise simulate, record and evaluate a machine that cannot exist.
 void require_within_envelope(const DaemonConfig& c, StrictTable& t) {
   if (c.source.kind != "sim") return;
-  const SourceConfig& s = c.source;
-  sim::Scenario sc = s.sim_program == "circle" ? sim::circle_scenario(s.sim_radius_mm, s.sim_feed_mm_min, s.sim_repeats)
-                                               : sim::step_scenario(0.0, 50.0, s.sim_feed_mm_min, s.sim_repeats);
-  if (s.sim_program_loaded) sc.meta.program = *s.sim_program_loaded;
-  if (const auto x = sim::nc::envelope_excess(*sim::scenario_set_point(sc), c.envelope))
-    t.fail("envelope", "the simulated NC's program ([source.sim]): " + sim::nc::describe(*x, c.envelope) + " (" +
-                           sim::nc::envelope_key(*x) + ")");
+  if (const auto x = drivers::sim_program_outside_envelope(sim_machine(c)))
+    t.fail("envelope", "the simulated NC's program ([source.sim]): " + x->text + " (" + x->key + ")");
 }
 
 }  // namespace
@@ -279,6 +272,31 @@ DaemonConfig load_daemon_config(const std::filesystem::path& file) {
     t.fail("history", "[machine] name is required: the history keys results by machine");
   t.finish();
   return c;
+}
+
+dsp::RunMeta hardware_meta(const DaemonConfig& c) {
+  dsp::RunMeta meta;
+  meta.acquisition = c.acquisition;
+  meta.site = c.site;
+  meta.machine = c.machine;
+  meta.envelope = c.envelope;
+  meta.sensors[0] = c.sensors[0];
+  meta.sensors[1] = c.sensors[1];
+  meta.psd = c.psd;
+  meta.program.kind = "freeform";
+  return meta;
+}
+
+drivers::SimMachine sim_machine(const DaemonConfig& c) {
+  const SourceConfig& s = c.source;
+  drivers::SimMachine m;
+  m.program = s.sim_program_loaded;
+  m.builtin = s.sim_program;
+  m.radius_mm = s.sim_radius_mm, m.feed_mm_min = s.sim_feed_mm_min;
+  m.repeats = s.sim_repeats;
+  m.seed = s.sim_seed;
+  m.meta = hardware_meta(c);
+  return m;
 }
 
 }  // namespace eical::daemon

@@ -3,6 +3,7 @@
 // or mistyped keys are errors naming file, line and key, so a typo never silently falls
 // back to a default on a machine tool.
 #include "drivers/source/fault_source.hpp"
+#include "drivers/source/sim_factory.hpp"
 #include "dsp/core/run_meta.hpp"
 
 #include <cstdint>
@@ -146,5 +147,13 @@ struct DaemonConfig {
 
 // Throws dsp::InputError "file:line: section.key: reason" on any problem.
 DaemonConfig load_daemon_config(const std::filesystem::path& file);
+
+// What the service believes about its hardware, as a run's metadata: DAQ, site, machine,
+// envelope, sensors and strips; the program is unknown until a set-point source names one
+// (freeform).
+dsp::RunMeta hardware_meta(const DaemonConfig& c);
+
+// The simulated machine of [source.sim] (the backend when no hardware is present).
+drivers::SimMachine sim_machine(const DaemonConfig& c);
 
 }  // namespace eical::daemon

@@ -21,13 +21,12 @@
 #include "drivers/source/fault_source.hpp"
 #include "drivers/source/replay_source.hpp"
 #include "drivers/source/servo_setpoint_source.hpp"
-#include "drivers/source/sim_source.hpp"
+#include "drivers/source/sim_factory.hpp"
 #include "drivers/source/stamped_source.hpp"
 #include "drivers/usb_daq/daq_stream_source.hpp"
 #include "drivers/usb_daq/usb_daq_source.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 #include "dsp/session/measurement_session.hpp"
-#include "sim/scenario.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -41,40 +40,8 @@ bool has_input(const TriggerConfig& t, const char* input) {
   return std::find(t.inputs.begin(), t.inputs.end(), input) != t.inputs.end();
 }
 
-// What the service believes about a DAQ's hardware: the configuration. The program is
-// unknown until a set-point source names one.
-dsp::RunMeta daq_meta(const DaemonConfig& c) {
-  dsp::RunMeta meta;
-  meta.acquisition = c.acquisition;
-  meta.site = c.site;
-  meta.machine = c.machine;
-  meta.envelope = c.envelope;
-  meta.sensors[0] = c.sensors[0];
-  meta.sensors[1] = c.sensors[1];
-  meta.psd = c.psd;
-  meta.program.kind = "freeform";
-  return meta;
-}
-
 std::unique_ptr<drivers::Source> make_sim_source(const DaemonConfig& c, drivers::Pacing pacing) {
-  sim::Scenario sc =
-      c.source.sim_program == "circle"
-          ? sim::circle_scenario(c.source.sim_radius_mm, c.source.sim_feed_mm_min, c.source.sim_repeats, "ccw",
-                                 c.source.sim_seed)
-          : sim::step_scenario(0.0, 50.0, c.source.sim_feed_mm_min, c.source.sim_repeats, c.source.sim_seed);
-  // A program file (eical gen-nc --meta): the simulated NC runs its G-code.
-  if (c.source.sim_program_loaded) sc.meta.program = *c.source.sim_program_loaded;
-  // The daemon's configuration is what the service believes about its hardware.
-  sc.meta.acquisition = c.acquisition;
-  sc.meta.site = c.site;
-  sc.meta.machine = c.machine;
-  sc.meta.envelope = c.envelope;
-  sc.meta.sensors[0] = c.sensors[0];
-  sc.meta.sensors[1] = c.sensors[1];
-  sc.meta.psd = c.psd;  // the strips the simulated machine carries
-  for (int s = 0; s < 2; ++s) sc.truth[s].spec = c.sensors[s];
-  return std::make_unique<drivers::SimSource>(
-      sc, drivers::SimSourceOptions{pacing, c.source.sim_repeat_program, c.source.sim_idle_s});
+  return drivers::make_sim_source(sim_machine(c), {pacing, c.source.sim_repeat_program, c.source.sim_idle_s});
 }
 
 // The frames' origin: a DAQ, a simulator, a recording, or LinuxCNC driving the simulator.
@@ -87,11 +54,11 @@ std::unique_ptr<drivers::Source> make_sensor_source(const DaemonConfig& c) {
   }
   if (c.source.kind == "linuxcnc") return make_linuxcnc_source(c);
   if (c.source.kind == "usb_daq")
-    return std::make_unique<drivers::UsbDaqSource>(daq_meta(c), drivers::parse_usb_id(c.source.usb_id));
+    return std::make_unique<drivers::UsbDaqSource>(hardware_meta(c), drivers::parse_usb_id(c.source.usb_id));
   if (c.source.kind == "daq_stream") {
     const auto& d = c.source.daq_stream;
     return std::make_unique<drivers::DaqStreamSource>(
-        daq_meta(c), drivers::DaqStreamOptions{d.path, d.connect_timeout_s, d.stall_timeout_s});
+        hardware_meta(c), drivers::DaqStreamOptions{d.path, d.connect_timeout_s, d.stall_timeout_s});
   }
   return make_sim_source(c, pacing);
 }

@@ -21,6 +21,7 @@
 // the right frame whatever that latency.
 #include "drivers/ring/fixed_queue.hpp"
 #include "drivers/ring/spsc_ring.hpp"
+#include "drivers/source/linuxcnc_options.hpp"
 #include "drivers/source/sample_clock.hpp"
 #include "drivers/source/servo_stream_reader.hpp"
 #include "drivers/source/source.hpp"
@@ -36,17 +37,6 @@
 #include <thread>
 
 namespace eical::drivers {
-
-struct LinuxcncSourceOptions {
-  std::filesystem::path fifo = "/run/eical/linuxcnc-servo.fifo";
-  WindowedSimOptions window;
-  bool drive_from_feedback = false;    // feedback (LinuxCNC's plant) instead of the command drives the machine
-  double connect_timeout_s = 10.0;     // open(): first servo line within this time, else "LinuxCNC absent"
-  double stall_timeout_s = 2.0;        // no line for this long while streaming: the source fails
-  double hold_s = 1.0;                 // frames are released this long after their servo cycle (DDS trigger latency)
-  std::size_t max_fill_cycles = 1000;  // lost cycles up to this many are interpolated; more fail the source
-  std::size_t ring_frames = 1u << 16;
-};
 
 // What the worker learned about the stream (for the log and tests).
 struct LinuxcncStreamStats {

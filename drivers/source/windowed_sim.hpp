@@ -13,6 +13,7 @@
 // number). Effects whose state or clock outlives the history — bias random walk, bias
 // steps and drift, warming case temperature, stick-slip, vibration modes and tones — are
 // refused with a message naming them.
+#include "drivers/source/linuxcnc_options.hpp"
 #include "dsp/core/frame.hpp"
 #include "sim/scenario.hpp"
 
@@ -23,14 +24,6 @@
 #include <vector>
 
 namespace eical::drivers {
-
-struct WindowedSimOptions {
-  double servo_rate_hz = 1000.0;
-  std::size_t block_cycles = 200;
-  std::size_t history_cycles = 300;
-  std::size_t lookahead_cycles = 5;
-  std::size_t prefix_cycles = 60;  // 10 hold, 20 approach, 30 settle (DAQ filter, PT2)
-};
 
 class WindowedSim {
  public:
