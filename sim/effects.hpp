@@ -8,7 +8,8 @@
 
 namespace eical::sim {
 
-// Every effect name of run-format.md's table, in its order.
+// Every effect name of run-format.md's table, in its order: dsp::model::effect_catalogue's
+// names (the one catalogue explain and the simulator share).
 const std::vector<std::string>& effect_names();
 
 // The effects whose parameters differ from nominal in this scenario.
