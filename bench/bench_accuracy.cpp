@@ -1,9 +1,9 @@
 // Accuracy benchmark (issue 4): sensors off their data sheet, identified on site from the
 // PSD strips and the set-point only, then the thesis' circle, 1-D move and rectangle
 // against the simulator's truth; every figure beside its noise-limited bound
-// (tools/accuracy/accuracy_campaign.hpp says how the bound is derived).
+// (tests/support/accuracy_campaign.hpp says how the bound is derived).
 //   bench_accuracy [--seeds 1,2,3] [--datasheet]
-#include "tools/accuracy/accuracy_campaign.hpp"
+#include "tests/support/accuracy_campaign.hpp"
 
 #include <CLI/CLI.hpp>
 

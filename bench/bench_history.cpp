@@ -11,8 +11,8 @@
 // Each result: a circle with 27 figures, each with its uncertainty, and a stored document of
 // the size eical stores (720-point trace), drawn from 50 distinct documents.
 //   bench_history [--results 100000] [--machines 30] [--batch 1000] [--single 1000] [--store sqlite|postgresql|both]
-#include "history/pg_scratch/scratch_server.hpp"
 #include "history/store/store.hpp"
+#include "tests/support/pg_scratch/scratch_server.hpp"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>

@@ -8,7 +8,7 @@
 #include "dsp/analysis/verdict.hpp"
 #include "tools/commands.hpp"
 #include "tools/exit_codes.hpp"
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 #include "tools/report/tolerances.hpp"
 #include "tools/run_files.hpp"
 

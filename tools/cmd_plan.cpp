@@ -1,5 +1,5 @@
 // eical plan: the uncertainty of a test's figures before anything moves, and the nearest
-// measurable variant (tools/plan/test_plan.hpp).
+// measurable variant (tools/plan/predicted_uncertainty.hpp).
 #include "drivers/config/sensor_calibration.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/error.hpp"
@@ -12,8 +12,8 @@
 #include "tools/figure_text.hpp"
 #include "tools/io/psd_option.hpp"
 #include "tools/plan/identification_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 #include "tools/plan/strip_layout.hpp"
-#include "tools/plan/test_plan.hpp"
 #include "tools/program_defaults.hpp"
 #include "tools/run_files.hpp"
 

@@ -1,7 +1,7 @@
 // The accuracy campaign on one drawn machine: identified on site, every figure within
 // twice the target (the benchmark prints the figures themselves), and the data
 // sheet far worse (what the identification buys).
-#include "tools/accuracy/accuracy_campaign.hpp"
+#include "tests/support/accuracy_campaign.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // started at the first use, stopped by the environment's TearDown, also when tests fail;
 // it dies with the process if the process crashes), a fresh store location per test for
 // each backend, and eical-result/1 documents that carry uncertainty_k2 and quality.verdict.
-#include "history/pg_scratch/scratch_server.hpp"
+#include "tests/support/pg_scratch/scratch_server.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

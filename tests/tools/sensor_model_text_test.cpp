@@ -2,7 +2,7 @@
 // --calibration the calibration, not the data sheet's — and advises identifying the
 // sensors only when they were not.
 #include "tools/figure_text.hpp"
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 #include "tools/run_files.hpp"
 
 #include <gtest/gtest.h>

@@ -10,7 +10,7 @@
 #include "tests/tools/cli_runner.hpp"
 #include "tools/io/csv_table.hpp"
 #include "tools/io/volumetric_model_file.hpp"
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include <gtest/gtest.h>
 

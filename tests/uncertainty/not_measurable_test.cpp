@@ -5,7 +5,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "sim/simulate.hpp"
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>

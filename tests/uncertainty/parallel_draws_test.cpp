@@ -6,7 +6,7 @@
 #include "dsp/analysis/analyze_run.hpp"
 #include "sim/simulate.hpp"
 #include "tests/support/same_uncertainty.hpp"
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include <gtest/gtest.h>
 

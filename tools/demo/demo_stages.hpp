@@ -8,7 +8,7 @@
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/analysis/figures.hpp"
 #include "sim/scenario.hpp"
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include <cstdint>
 #include <filesystem>

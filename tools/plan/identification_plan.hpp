@@ -4,7 +4,7 @@
 // that the identification runs where the test runs), centred on a shorter one. z, which no strip
 // measures, is swung from where the head rests.
 #include "sim/gcode/generate.hpp"
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include <nlohmann/json.hpp>
 

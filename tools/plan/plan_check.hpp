@@ -5,7 +5,7 @@
 // tolerances, each against the simulator's truth. The empirical U of a figure is
 // |mean error| + 2·(sd of the error) over the repeats — the 95 % bound that U claims, bias
 // included (a range such as G is biased by the noise).
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include <string>
 #include <vector>
@@ -23,7 +23,7 @@ struct CheckRow {
 // The programs of the check (at least four): a circle with strips, a 1-D step, an ISO
 // 230-2 cycle and a rectangle; `repeats` seeds each.
 // With p.identified every repeat's machine is first identified by the identification
-// program (tools/plan/test_plan.hpp), as a user of a measurable test would.
+// program (tools/plan/predicted_uncertainty.hpp), as a user of a measurable test would.
 // `identified`: each program after an on-site identification of the sensors (the plan's
 // measurable variants), else on the data sheet's sensor model.
 std::vector<TestProgram> check_programs(bool identified = true);

@@ -6,7 +6,7 @@
 // SVG drawing of the test's path with the strips on it. A strip sits on the table where
 // the head's light spot passes over it when the program is at that point; the spot crosses
 // it moving along the axis it measures.
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include <nlohmann/json.hpp>
 

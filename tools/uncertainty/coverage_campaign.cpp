@@ -8,7 +8,7 @@
 #include "dsp/identify/sensor_identification.hpp"
 #include "sim/hidden/hidden_effects.hpp"
 #include "sim/simulate.hpp"
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include <algorithm>
 #include <chrono>

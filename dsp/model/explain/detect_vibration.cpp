@@ -1,8 +1,8 @@
 // Stage: vibration in the spectra and modes the motion drives.
 #include "dsp/core/float_limits.hpp"
 #include "dsp/model/explain/stages.hpp"
-#include "dsp/model/spectral_tests.hpp"
 #include "dsp/model/structural_modes.hpp"
+#include "dsp/model/vibration_spectra.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "dsp/model/spectral_tests.hpp"
+#include "dsp/model/vibration_spectra.hpp"
 
 #include "dsp/core/chi2.hpp"
 #include "dsp/core/median.hpp"

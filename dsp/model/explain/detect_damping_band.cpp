@@ -1,5 +1,5 @@
 // Stage: damping that grows with the acceleration, where the shared vibration shows it.
-#include "dsp/model/damping_band_test.hpp"
+#include "dsp/model/damping_band_regression.hpp"
 #include "dsp/model/explain/stages.hpp"
 
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "dsp/model/stick_slip_test.hpp"
+#include "dsp/model/stick_slip_bursts.hpp"
 
 #include "dsp/core/median.hpp"
 

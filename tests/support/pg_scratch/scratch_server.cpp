@@ -1,4 +1,4 @@
-#include "history/pg_scratch/scratch_server.hpp"
+#include "tests/support/pg_scratch/scratch_server.hpp"
 
 #include <libpq-fe.h>
 

@@ -1,6 +1,6 @@
 // Stage: stick-slip while an axis creeps.
 #include "dsp/model/explain/stages.hpp"
-#include "dsp/model/stick_slip_test.hpp"
+#include "dsp/model/stick_slip_bursts.hpp"
 
 #include <algorithm>
 #include <cmath>

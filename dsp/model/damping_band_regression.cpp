@@ -1,4 +1,4 @@
-#include "dsp/model/damping_band_test.hpp"
+#include "dsp/model/damping_band_regression.hpp"
 
 #include "dsp/core/central_difference.hpp"
 #include "dsp/core/median.hpp"

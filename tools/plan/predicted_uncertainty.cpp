@@ -1,4 +1,4 @@
-#include "tools/plan/test_plan.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include "drivers/exec/thread_for.hpp"
 #include "dsp/analysis/verdict.hpp"

@@ -1,4 +1,4 @@
-#include "tools/accuracy/accuracy_campaign.hpp"
+#include "tests/support/accuracy_campaign.hpp"
 
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/eval/circle_segments.hpp"
