@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Writes the committed seed corpus of every fuzz target into fuzz/corpus/<target>/.
 
-Seeds are small valid inputs taken from config/, ../shared/data and what eical itself
+Seeds are small valid inputs taken from config/, tests/data and what eical itself
 writes (when EICAL is given: gen-nc programs, simulate --export captures, a sensor
 calibration), plus a few broken ones. Run from the repository:
     fuzz/seed_corpus.py [EICAL_BINARY]
@@ -17,7 +17,7 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-SHARED = ROOT.parent / "shared" / "data"
+SHARED = ROOT / "tests" / "data"
 CORPUS = ROOT / "fuzz" / "corpus"
 EICAL = sys.argv[1] if len(sys.argv) > 1 else None
 
@@ -40,7 +40,7 @@ def eical(*args, cwd=None):
 
 # --- run directory: run.toml, "\n%%samples\n", samples (plain or gzip), "\n%%truth\n", truth.toml
 runs = sorted(SHARED.glob("*/run.toml"))[:6] + [SHARED / "independent" / r / "run.toml" for r in
-                                                  ("baseline.positioning-0012", "baseline.rectangle-0012")]
+                                                  ("baseline.rectangle-0012", "sensor.bias_drift-0012")]
 for i, toml_path in enumerate(runs):
     run = toml_path.parent
     toml = toml_path.read_text()

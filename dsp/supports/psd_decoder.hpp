@@ -3,7 +3,7 @@
 // by the spot's position u along the strip; normalising by their sum makes u independent
 // of the light's intensity and of how much of the spot falls on the strip:
 //   u = (L/2) · (i1 − i2) / (i1 + i2)        (i1 is the electrode at the +u end)
-// (that electrode order is what the sample runs in ../shared/data show: checked against
+// (that electrode order is what the sample runs in tests/data show: checked against
 // their reference instrument). A sample is a fix when the strip is lit — the sum above
 // both 30 σ of its noise and 30 % of the brightest sum seen — and the spot is clear of
 // the strip's ends. Its σ follows from the electrodes' noise by propagation:

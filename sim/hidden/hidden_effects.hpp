@@ -2,7 +2,7 @@
 // Runs with effects hidden among realistic tolerances: what `eical explain` must see
 // through (issue 7), and what `eical simulate --hide` writes.
 //
-// Every run carries the background the sample runs carry (shared/data truth.toml): sensors
+// Every run carries the background the sample runs carry (tests/data/*/truth.toml): sensors
 // within their data sheet (k1 ±400 ppm, k2/k3 ±5 %, f0 ±1 %, ζ ±0.01, cross terms and
 // mounting ±0.2 mrad, bias walk, a slowly warming case), Earth rate, position loops with
 // 99 % feed-forward, a well-kept machine (backlash, spikes, cyclic and straightness below

@@ -3,7 +3,7 @@
 // (the embedded calibrator's support points, ch. 9.7). The spot (Gaussian, 1/e² diameter
 // spot_mm) lights the strip with the fraction of its power that falls on the active area;
 // the two electrodes share the photocurrent by the spot's position u along the strip,
-// electrode 1 at the +u end (as in the sample runs of ../shared/data):
+// electrode 1 at the +u end (as in the sample runs of tests/data):
 //   i1 = I·FS·(1/2 + u'/L),  i2 = I·FS·(1/2 − u'/L),  u' = u (1 + nl (2u/L)²).
 // The lock-in amplifier's output follows with its first-order time constant.
 #include "dsp/core/run_meta.hpp"

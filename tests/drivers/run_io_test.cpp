@@ -2,6 +2,7 @@
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/core/frame_fields.hpp"
+#include "tests/support/sample_data.hpp"
 #include "tests/support/temp_dir.hpp"
 
 #include <gtest/gtest.h>
@@ -124,18 +125,15 @@ TEST(RunIo, SingleSensorRunKeepsTheOtherSensorsData) {
 }
 
 TEST(RunIo, ReadsEverySharedRun) {
-  const fs::path data = EICAL_SHARED_DATA;
-  if (!fs::exists(data)) GTEST_SKIP() << "no shared data at " << data << ": nothing to read";
   int runs = 0;
-  for (const auto& e : fs::directory_iterator(data)) {
-    if (!fs::exists(e.path() / "run.toml")) continue;
-    const dsp::Run r = read_run(e.path());
+  for (const fs::path& dir : test::all_runs()) {
+    const dsp::Run r = read_run(dir);
     ++runs;
-    EXPECT_GT(r.frames.size(), 1000u) << e.path();
+    EXPECT_GT(r.frames.size(), 1000u) << dir;
     EXPECT_EQ(r.channels.psd_count, static_cast<int>(r.meta.psd.size()));
-    EXPECT_TRUE(r.truth_toml.has_value()) << e.path();
+    EXPECT_TRUE(r.truth_toml.has_value()) << dir;
     for (std::size_t i = 0; i < r.frames.size(); ++i) {
-      ASSERT_EQ(r.frames[i].sample_index, static_cast<std::int64_t>(i)) << e.path();
+      ASSERT_EQ(r.frames[i].sample_index, static_cast<std::int64_t>(i)) << dir;
       ASSERT_TRUE(std::isfinite(r.frames[i].cmd_mm[0]));
     }
   }

@@ -15,6 +15,7 @@
 #include "dsp/stream/analyze_stream.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulate.hpp"
+#include "tests/support/sample_data.hpp"
 
 #include <gtest/gtest.h>
 
@@ -379,30 +380,26 @@ TEST(ChannelHealth, ProgramAxesFollowTheMounting) {
   EXPECT_EQ(dsp::program_axes(meta.program), 4u);
 }
 
-// The sample runs (an independent simulator's, ../shared/data): no false finding.
+// The sample runs (an independent simulator's, tests/data/README.md): no false finding.
 TEST(ChannelHealth, SampleRunsHaveNoFinding) {
-  const fs::path root = EICAL_SHARED_DATA;
-  if (!fs::exists(root)) GTEST_SKIP() << root << " not found";
   int runs = 0;
-  for (const auto& e : fs::recursive_directory_iterator(root)) {
-    if (e.path().filename() != "run.toml") continue;
-    SCOPED_TRACE(e.path().parent_path().string());
-    const dsp::Run run = drivers::read_run(e.path().parent_path());
+  for (const fs::path& dir : test::all_runs()) {
+    SCOPED_TRACE(dir.string());
+    const dsp::Run run = drivers::read_run(dir);
     for (const auto& x : dsp::health::check_channels(run))
       ADD_FAILURE() << dsp::health::fault_code(x.fault) << " " << dsp::health::channel_name(x.channel) << " "
                     << x.from_s << ".." << x.to_s << " s";
     ++runs;
   }
-  EXPECT_GE(runs, 18);
+  EXPECT_GE(runs, static_cast<int>(test::committed_runs().size()));
 }
 
-// Real ADXL345 captures (../shared/data/real: 3200 Hz, 4 mg steps, moving), as
+// Real ADXL345 captures (tests/data/real: 3200 Hz, 4 mg steps, moving), as
 // `eical import` would set them up (1 µg a count, the chip's data sheet), without the
 // importer's resampling (its exact values repeat the most): no finding. Their counts come in
 // steps of the chip's LSB, where a few equal samples in a row are common (up to 9 here).
 TEST(ChannelHealth, RealMemsCapturesHaveNoFinding) {
-  const fs::path dir = fs::path(EICAL_SHARED_DATA) / "real" / "3dp-accelerometer_host-api";
-  if (!fs::exists(dir)) GTEST_SKIP() << dir << " not found";
+  const fs::path dir = test::committed_data() / "real" / "3dp-accelerometer_host-api";
   int captures = 0;
   for (const auto& e : fs::directory_iterator(dir)) {
     if (e.path().extension() != ".tsv") continue;

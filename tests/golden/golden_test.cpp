@@ -1,8 +1,9 @@
 // Golden outputs (issue 20, item 4): `eical analyze --json` and `eical explain --json` of every
-// run in ../shared/data diffed against tests/golden/expected with the per-key tolerances of
-// tests/golden/tolerances.toml. A failure lists every changed key, old → new.
-// EICAL_GOLDEN_UPDATE=1 rewrites the expected documents instead (read the diff, commit both).
+// sample run (tests/data, and EICAL_EXTRA_DATA when present) diffed against tests/golden/expected with the per-key
+// tolerances of tests/golden/tolerances.toml. A failure lists every changed key, old → new. EICAL_GOLDEN_UPDATE=1
+// rewrites the expected documents instead (read the diff, commit both).
 #include "dsp/core/float_limits.hpp"
+#include "tests/support/sample_data.hpp"
 
 #include <gtest/gtest.h>
 #include <toml++/toml.h>
@@ -40,14 +41,11 @@ void PrintTo(const Case& c, std::ostream* os) { *os << c.command << " " << c.nam
 
 std::vector<Case> cases() {
   std::vector<Case> out;
-  const fs::path data(EICAL_SHARED_DATA);
-  std::vector<fs::path> runs;
-  for (const fs::path& dir : {data, data / "independent"}) {
-    std::error_code ec;
-    for (const auto& e : fs::directory_iterator(dir, ec))
-      if (fs::exists(e.path() / "run.toml")) runs.push_back(e.path());
-  }
-  std::sort(runs.begin(), runs.end());
+  // None when tests/data is missing: GoogleTest then fails the uninstantiated suite, and
+  // GoldenData.CommittedRunsPresent says why.
+  std::vector<fs::path> runs = eical::test::runs_in(eical::test::committed_data(), true);
+  const auto more = eical::test::extra_runs();
+  runs.insert(runs.end(), more.begin(), more.end());
   for (const char* cmd : {"analyze", "explain"})
     for (const auto& r : runs) out.push_back({cmd, r, r.filename().string()});
   return out;
@@ -278,7 +276,29 @@ std::string case_name(const ::testing::TestParamInfo<Case>& info) {
   return s;
 }
 
-INSTANTIATE_TEST_SUITE_P(SharedData, Golden, ::testing::ValuesIn(cases()), case_name);
-GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(Golden);
+INSTANTIATE_TEST_SUITE_P(SampleRuns, Golden, ::testing::ValuesIn(cases()), case_name);
+
+TEST(GoldenData, CommittedRunsPresent) {
+  try {
+    EXPECT_GE(eical::test::committed_runs().size(), 6u);
+  } catch (const std::exception& e) {
+    FAIL() << e.what();
+  }
+}
+
+// Every expected document has its run, committed or extra; without the extra folder the
+// documents of its runs wait unread, and this says so.
+TEST(GoldenData, ExtraRunsPresent) {
+  std::set<std::string> have;
+  for (const auto& c : cases()) have.insert(c.command + "/" + c.name + ".json");
+  std::vector<std::string> unread;
+  for (const auto& e : fs::recursive_directory_iterator(kExpected))
+    if (e.is_regular_file() && !have.count(fs::relative(e.path(), kExpected).string()))
+      unread.push_back(fs::relative(e.path(), kExpected).string());
+  if (!unread.empty() && eical::test::extra_runs().empty())
+    GTEST_SKIP() << unread.size() << " expected documents are of runs in EICAL_EXTRA_DATA = " << EICAL_EXTRA_DATA
+                 << ", which has none: not compared";
+  EXPECT_TRUE(unread.empty()) << "expected documents without a run, e.g. " << (unread.empty() ? "" : unread.front());
+}
 
 }  // namespace

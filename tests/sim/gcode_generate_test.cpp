@@ -1,6 +1,7 @@
 #include "dsp/core/error.hpp"
 #include "sim/gcode/generate.hpp"
 #include "sim/gcode/parser.hpp"
+#include "tests/support/sample_data.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,7 +22,7 @@ int count_triggers(const Program& prog, int code) {
 
 // The G-code stored in a recorded run's run.toml (between gcode = """ and """).
 std::string recorded_gcode(const std::string& run) {
-  const auto path = std::filesystem::path(EICAL_SHARED_DATA) / run / "run.toml";
+  const auto path = test::committed_data() / run / "run.toml";
   std::ifstream is(path);
   const std::string text{std::istreambuf_iterator<char>(is), std::istreambuf_iterator<char>()};
   const auto a = text.find("gcode = \"\"\"\n");
@@ -41,13 +42,13 @@ dsp::Program circle() {
 
 TEST(GcodeGenerate, CircleMatchesTheRecordedRunsProgram) {
   const std::string recorded = recorded_gcode("baseline-0011");
-  if (recorded.empty()) GTEST_SKIP() << "shared data not found at " << EICAL_SHARED_DATA;
+  ASSERT_FALSE(recorded.empty()) << "no G-code in " << test::committed_data() / "baseline-0011/run.toml";
   EXPECT_EQ(circle_program(circle()), recorded);
 }
 
 TEST(GcodeGenerate, StepMatchesTheRecordedRunsProgram) {
   const std::string recorded = recorded_gcode("baseline.step-0011");
-  if (recorded.empty()) GTEST_SKIP() << "shared data not found at " << EICAL_SHARED_DATA;
+  ASSERT_FALSE(recorded.empty()) << "no G-code in " << test::committed_data() / "baseline.step-0011/run.toml";
   dsp::Program p;
   p.kind = "step";
   p.axis = "x";

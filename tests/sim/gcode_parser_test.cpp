@@ -11,7 +11,7 @@
 namespace eical::sim::gcode {
 namespace {
 
-// The circle program of the sample runs (shared/data/baseline-0011/run.toml).
+// The circle program of the sample runs (tests/data/baseline-0011/run.toml).
 constexpr const char* kCircle = R"(G90 G21 G17 G64 (continuous path: the arcs are one blended move)
 G0 X7.0711 Y7.0711
 G4 P0.4

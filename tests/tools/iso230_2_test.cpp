@@ -2,6 +2,7 @@
 // inequalities, bad tables are refused with the line.
 #include "dsp/core/error.hpp"
 #include "dsp/eval/positioning.hpp"
+#include "tests/support/sample_data.hpp"
 #include "tools/io/positioning_readers.hpp"
 
 #include <gtest/gtest.h>
@@ -18,12 +19,14 @@ namespace {
 namespace fs = std::filesystem;
 using eical::dsp::eval::evaluate_positioning;
 
-const fs::path kDir = fs::path(EICAL_SHARED_DATA) / "external" / "iso230-2";
+const fs::path kDir = eical::test::committed_data() / "external" / "iso230-2";
 
 TEST(Iso2302Inputs, EcmcAndDeviationCsvGiveTheSameFigures) {
-  if (!fs::exists(kDir)) GTEST_SKIP() << "no external ISO 230-2 data at " << kDir;
+  ASSERT_TRUE(fs::is_directory(kDir)) << "no ISO 230-2 runs at " << kDir << " (tests/data is part of the repo)";
+  int files = 0;
   for (const auto& e : fs::directory_iterator(kDir)) {
     if (e.path().extension() != ".dat") continue;
+    ++files;
     const auto a = eical::tools::read_ecmc_dat(e.path().string());
     // The same data as a deviation table, rows shuffled.
     std::vector<std::string> rows;
@@ -59,6 +62,7 @@ TEST(Iso2302Inputs, EcmcAndDeviationCsvGiveTheSameFigures) {
     std::printf("%s: A %.3f E %.3f M %.3f R %.3f B %.3f um\n", e.path().filename().c_str(), ra.A_um, ra.E_um, ra.M_um,
                 ra.R_um, ra.B_um);
   }
+  EXPECT_EQ(files, 4) << kDir;
 }
 
 TEST(Iso2302Inputs, BadTablesAreRefusedWithTheLine) {
