@@ -1,0 +1,123 @@
+// The chart of U(G) over radius × feed × strips that README.md shows: eical plan's
+// prediction (tools/plan/predicted_uncertainty.hpp) of a circular test, both directions,
+// with the sensors identified on site first, on a grid of designs. Prints a Markdown table
+// and writes the chart as SVG; a design that runs longer than --max-duration is left out.
+//   bench_u_chart [--draws 60] [--repeats 2] [--svg docs/u-of-g.svg] [--max-duration 120]
+#include "tools/plan/predicted_uncertainty.hpp"
+#include "tools/report/svg.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using eical::tools::plan::TestProgram;
+
+constexpr double kClip_um = 50.0;
+
+// Configuration B (strips at (0, −R) measuring x and (R, 0) measuring y), and with 4 the
+// opposite pair as well: each strip where the path runs along the axis it measures.
+std::vector<eical::dsp::PsdSpec> strips(double radius_mm, int count) {
+  std::vector<eical::dsp::PsdSpec> out;
+  const double at[4][3] = {{0.0, -1.0, 0.0}, {1.0, 0.0, 1.0}, {0.0, 1.0, 0.0}, {-1.0, 0.0, 1.0}};
+  for (int i = 0; i < count && i < 4; ++i) {
+    eical::dsp::PsdSpec s;
+    s.measures = at[i][2] == 0.0 ? "x" : "y";
+    s.center_mm[0] = at[i][0] * radius_mm, s.center_mm[1] = at[i][1] * radius_mm;
+    out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("U(G) over radius x feed x strips, as eical plan predicts it");
+  int draws = 60, repeats = 2;
+  double max_duration_s = 120.0;
+  std::string svg_path;
+  std::vector<double> radii{10.0, 25.0, 50.0, 100.0, 150.0}, feeds{1000.0, 2500.0, 4000.0, 10000.0};
+  std::vector<int> counts{0, 2, 4};
+  app.add_option("--draws", draws, "Monte Carlo draws per prediction");
+  app.add_option("--repeats", repeats, "revolutions per direction");
+  app.add_option("--max-duration", max_duration_s, "designs that run longer (s) are left out");
+  app.add_option("--svg", svg_path, "write the chart here");
+  app.add_option("--radii", radii, "radii, mm")->delimiter(',');
+  app.add_option("--feeds", feeds, "feeds, mm/min")->delimiter(',');
+  app.add_option("--strips", counts, "strip counts (0, 2 or 4)")->delimiter(',');
+  CLI11_PARSE(app, argc, argv);
+
+  // u[count][feed] = U(G) per radius (NaN: left out).
+  std::map<int, std::map<double, std::vector<double>>> u;
+  std::printf("| strips | feed (mm/min) |");
+  for (double r : radii) std::printf(" R%g |", r);
+  std::printf("\n|---|---|");
+  for (std::size_t i = 0; i < radii.size(); ++i) std::printf("---|");
+  std::printf("\n");
+  for (int n : counts)
+    for (double f : feeds) {
+      std::printf("| %d | %g |", n, f);
+      for (double r : radii) {
+        TestProgram p;
+        p.kind = "circle", p.direction = "both", p.radius_mm = r, p.feed_mm_min = f, p.repeats = repeats;
+        p.psd = strips(r, n);
+        p.identified = true;
+        double g = NAN;
+        if (eical::tools::plan::program_duration_s(p) <= max_duration_s) {
+          const auto pred = eical::tools::plan::predict(p, 1, draws);
+          const auto it = pred.u_k2.find("circle.circular_deviation_G_um");
+          if (it != pred.u_k2.end()) g = it->second;
+        }
+        u[n][f].push_back(g);
+        if (std::isfinite(g))
+          std::printf(" %.1f |", g);
+        else
+          std::printf(" — |");
+        std::fflush(stdout);
+      }
+      std::printf("\n");
+    }
+  if (svg_path.empty()) return 0;
+  const char* colours[] = {eical::tools::report::kBlue, eical::tools::report::kGreen, eical::tools::report::kRed,
+                           "#8e44ad"};
+  std::ofstream os(svg_path);
+  os << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"700\" height=\"" << 420 * counts.size() << "\">\n";
+  double y0 = 0.0;
+  for (int n : counts) {
+    std::vector<eical::tools::report::LineSeries> series;
+    int c = 0;
+    for (double f : feeds) {
+      eical::tools::report::LineSeries s;
+      s.label = "F" + std::to_string(static_cast<int>(f)) + " mm/min";
+      s.color = colours[c++ % 4];
+      // Clipped at kClip_um: the region that decides a verdict stays readable (the table
+      // printed above has every value).
+      for (std::size_t i = 0; i < radii.size(); ++i)
+        if (std::isfinite(u[n][f][i])) s.x.push_back(radii[i]), s.y.push_back(std::min(u[n][f][i], kClip_um));
+      series.push_back(s);
+    }
+    for (const auto& [level, label] :
+         {std::pair{10.0, "10 µm: what a circle must resolve"}, std::pair{2.0, "2 µm: ballbar class"}}) {
+      eical::tools::report::LineSeries s;
+      s.label = label, s.color = eical::tools::report::kGrey, s.dashed = true;
+      s.x = {radii.front(), radii.back()}, s.y = {level, level};
+      series.push_back(s);
+    }
+    os << "<g transform=\"translate(0," << y0 << ")\">"
+       << eical::tools::report::line_plot(
+              series, "U(G), k = 2, circle both directions, sensors identified, " + std::to_string(n) + " PSD strips",
+              "radius (mm)", "U(G) (µm, clipped at 50)")
+       << "</g>\n";
+    y0 += 420.0;
+  }
+  os << "</svg>\n";
+  return os ? 0 : 1;
+}
