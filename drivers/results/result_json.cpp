@@ -210,8 +210,8 @@ void add_step_and_positioning(const dsp::Program& p, const dsp::Analysis& a, nlo
   if (a.positioning && a.positioning_input) {
     j["positioning"] = positioning_json(*a.positioning_input, *a.positioning, true);
   } else if (p.kind == "positioning") {
-    j["positioning"] = all_null({"A_um", "A_up_um", "A_down_um", "E_um", "M_um", "R_um", "R_up_um", "R_down_um", "B_um",
-                                 "B_mean_um", "deviation_um"});
+    j["positioning"] = all_null({"deviation_um"});
+    for (const auto& f : dsp::eval::iso230_2_figures({})) j["positioning"][f.key] = nullptr;
     j["positioning"]["axis"] = p.axis;
     j["positioning"]["targets_mm"] = p.targets_mm;
     j["positioning"]["runs"] = p.runs;
@@ -365,24 +365,13 @@ nlohmann::json positioning_json(const dsp::eval::PositioningInput& in, const dsp
   nlohmann::json j = {{"axis", r.axis},
                       {"targets_mm", in.targets_mm},
                       {"runs", r.runs},
-                      {"A_um", r.A_um},
-                      {"A_up_um", r.A_up_um},
-                      {"A_down_um", r.A_down_um},
-                      {"E_um", r.E_um},
-                      {"E_up_um", r.E_up_um},
-                      {"E_down_um", r.E_down_um},
-                      {"M_um", r.M_um},
-                      {"R_um", r.R_um},
-                      {"R_up_um", r.R_up_um},
-                      {"R_down_um", r.R_down_um},
-                      {"B_um", r.B_um},
-                      {"B_mean_um", r.B_mean_um},
                       {"deviation_um", {{"up", in.up_um}, {"down", in.down_um}}},
                       {"per_target", targets},
                       {"standard", "ISO 230-2:2014"},
                       {"within_standard", r.runs >= dsp::eval::kRunsPerTargetIso230_2}};
+  for (const auto& f : dsp::eval::iso230_2_figures(r)) j[f.key] = f.value;
   if (vdi3441)
-    j["vdi3441"] = {{"P_um", r.vdi.P_um}, {"Pa_um", r.vdi.Pa_um}, {"U_um", r.vdi.U_um}, {"Ps_um", r.vdi.Ps_um}};
+    for (const auto& f : dsp::eval::vdi3441_figures(r.vdi)) j["vdi3441"][f.key] = f.value;
   return j;
 }
 

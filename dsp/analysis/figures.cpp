@@ -57,23 +57,8 @@ void diagnostics_figures(const Analysis& a, Out& o) {
 
 void positioning_figures(const Analysis& a, Out& o) {
   const auto& r = *a.positioning;
-  const std::pair<const char*, double> f[] = {{"A_um", r.A_um},
-                                              {"A_up_um", r.A_up_um},
-                                              {"A_down_um", r.A_down_um},
-                                              {"E_um", r.E_um},
-                                              {"E_up_um", r.E_up_um},
-                                              {"E_down_um", r.E_down_um},
-                                              {"M_um", r.M_um},
-                                              {"R_um", r.R_um},
-                                              {"R_up_um", r.R_up_um},
-                                              {"R_down_um", r.R_down_um},
-                                              {"B_um", r.B_um},
-                                              {"B_mean_um", r.B_mean_um},
-                                              {"vdi3441.P_um", r.vdi.P_um},
-                                              {"vdi3441.Pa_um", r.vdi.Pa_um},
-                                              {"vdi3441.U_um", r.vdi.U_um},
-                                              {"vdi3441.Ps_um", r.vdi.Ps_um}};
-  for (const auto& [k, v] : f) o.scalar(std::string("positioning.") + k, v);
+  for (const auto& [k, v] : eval::iso230_2_figures(r)) o.scalar(std::string("positioning.") + k, v);
+  for (const auto& [k, v] : eval::vdi3441_figures(r.vdi)) o.scalar(std::string("positioning.vdi3441.") + k, v);
   std::vector<double> mu, md, m, b, rr;
   for (const auto& t : r.targets)
     mu.push_back(t.mean_up_um), md.push_back(t.mean_down_um), m.push_back(t.mean_um), b.push_back(t.B_um),

@@ -83,4 +83,23 @@ PositioningResult evaluate_positioning(const PositioningInput& input) {
   return r;
 }
 
+std::array<NamedFigure, 12> iso230_2_figures(const PositioningResult& r) {
+  return {{{"A_um", r.A_um},
+           {"A_up_um", r.A_up_um},
+           {"A_down_um", r.A_down_um},
+           {"E_um", r.E_um},
+           {"E_up_um", r.E_up_um},
+           {"E_down_um", r.E_down_um},
+           {"M_um", r.M_um},
+           {"R_um", r.R_um},
+           {"R_up_um", r.R_up_um},
+           {"R_down_um", r.R_down_um},
+           {"B_um", r.B_um},
+           {"B_mean_um", r.B_mean_um}}};
+}
+
+std::array<NamedFigure, 4> vdi3441_figures(const Vdi3441& v) {
+  return {{{"P_um", v.P_um}, {"Pa_um", v.Pa_um}, {"U_um", v.U_um}, {"Ps_um", v.Ps_um}}};
+}
+
 }  // namespace eical::dsp::eval

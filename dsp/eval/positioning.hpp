@@ -8,6 +8,7 @@
 // B̄ = mean B_i, R = max R_i, E↑/↓ = max − min of x̄i↑/↓, E = max(x̄↑, x̄↓) − min(x̄↑, x̄↓),
 // M = max x̄i − min x̄i (x̄i = (x̄i↑ + x̄i↓)/2), A↑/↓ = max(x̄ + 2s) − min(x̄ − 2s) per
 // direction, A = the same over both directions.
+#include <array>
 #include <string>
 #include <vector>
 
@@ -51,5 +52,14 @@ struct PositioningResult {
 
 // Throws InputError for fewer than 2 runs or 2 targets, ragged tables or NaN.
 PositioningResult evaluate_positioning(const PositioningInput& input);
+
+// The axis figures by the keys a result's "positioning" object names them ("A_um", …):
+// the one list the result document, the figures of an analysis and their nulls read.
+struct NamedFigure {
+  const char* key;
+  double value;
+};
+std::array<NamedFigure, 12> iso230_2_figures(const PositioningResult& r);
+std::array<NamedFigure, 4> vdi3441_figures(const Vdi3441& v);  // keys of its own "vdi3441" object
 
 }  // namespace eical::dsp::eval
