@@ -23,17 +23,17 @@ using eical::tools::plan::TestProgram;
 
 constexpr double kClip_um = 50.0;
 
-// Configuration B (strips at (0, −R) measuring x and (R, 0) measuring y), and with 4 the
-// opposite pair as well: each strip where the path runs along the axis it measures.
-std::vector<eical::dsp::PsdSpec> strips(double radius_mm, int count) {
-  std::vector<eical::dsp::PsdSpec> out;
-  const double at[4][3] = {{0.0, -1.0, 0.0}, {1.0, 0.0, 1.0}, {0.0, 1.0, 0.0}, {-1.0, 0.0, 1.0}};
-  for (int i = 0; i < count && i < 4; ++i) {
-    eical::dsp::PsdSpec s;
-    s.measures = at[i][2] == 0.0 ? "x" : "y";
-    s.center_mm[0] = at[i][0] * radius_mm, s.center_mm[1] = at[i][1] * radius_mm;
-    out.push_back(s);
-  }
+// Configuration B (eical plan's strips for a circle), and with 4 its mirror about the
+// centre as well: each strip where the path runs along the axis it measures.
+std::vector<eical::dsp::PsdSpec> strips(const TestProgram& p, int count) {
+  if (count == 0) return {};
+  std::vector<eical::dsp::PsdSpec> out = eical::tools::plan::strips_for(p);
+  if (count == 4)
+    for (std::size_t i = 0, n = out.size(); i < n; ++i) {
+      eical::dsp::PsdSpec mirrored = out[i];
+      mirrored.center_mm[0] = -mirrored.center_mm[0], mirrored.center_mm[1] = -mirrored.center_mm[1];
+      out.push_back(mirrored);
+    }
   return out;
 }
 
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
   app.add_option("--svg", svg_path, "write the chart here");
   app.add_option("--radii", radii, "radii, mm")->delimiter(',');
   app.add_option("--feeds", feeds, "feeds, mm/min")->delimiter(',');
-  app.add_option("--strips", counts, "strip counts (0, 2 or 4)")->delimiter(',');
+  app.add_option("--strips", counts, "strip counts (0, 2 or 4)")->delimiter(',')->check(CLI::IsMember({0, 2, 4}));
   CLI11_PARSE(app, argc, argv);
 
   // u[count][feed] = U(G) per radius (NaN: left out).
@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
       for (double r : radii) {
         TestProgram p;
         p.kind = "circle", p.direction = "both", p.radius_mm = r, p.feed_mm_min = f, p.repeats = repeats;
-        p.psd = strips(r, n);
+        p.psd = strips(p, n);
         p.identified = true;
         double g = NAN;
         if (eical::tools::plan::program_duration_s(p) <= max_duration_s) {
