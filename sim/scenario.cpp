@@ -1,8 +1,13 @@
 #include "sim/scenario.hpp"
 
+#include "dsp/core/error.hpp"
+#include "dsp/core/frame.hpp"
 #include "sim/gcode/generate.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <string>
 
 namespace eical::sim {
 
@@ -99,11 +104,26 @@ Scenario gcode_scenario(const std::string& gcode, const std::string& kind, std::
   return sc;
 }
 
-std::vector<dsp::PsdSpec> psd_config_b(double radius_mm) {
-  dsp::PsdSpec x, y;
-  x.measures = "x", x.center_mm[0] = 0.0, x.center_mm[1] = -radius_mm;
-  y.measures = "y", y.center_mm[0] = radius_mm, y.center_mm[1] = 0.0;
-  return {x, y};
+std::vector<dsp::PsdSpec> psd_config_b(double radius_mm) { return psd_ring(radius_mm, 2); }
+
+std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count) {
+  if (count < 1 || count > dsp::kMaxPsd)
+    throw dsp::InputError("psd: " + std::to_string(count) + " strips about a circle, 1 to " +
+                          std::to_string(dsp::kMaxPsd) + " possible");
+  auto nm = [](double mm) { return std::round(mm * 1e6) / 1e6; };  // cos(90°) is 6e-17, not 0
+  std::vector<dsp::PsdSpec> out;
+  for (int k = 0; k < count; ++k) {
+    const int slots = std::max(count, 4);  // 2 is B: a quarter apart, not opposite
+    const double theta = (-0.5 + 2.0 * k / slots) * std::numbers::pi;
+    const double x = nm(radius_mm * std::cos(theta)), y = nm(radius_mm * std::sin(theta));
+    dsp::PsdSpec strip;
+    // The path's direction is (−y, x): it runs along x where |y| > |x|.
+    const bool along_x = std::abs(y) != std::abs(x) ? std::abs(y) > std::abs(x) : x * y < 0.0;
+    strip.measures = along_x ? "x" : "y";
+    strip.center_mm[0] = x, strip.center_mm[1] = y;
+    out.push_back(strip);
+  }
+  return out;
 }
 
 Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vector<std::string>& axes,

@@ -230,6 +230,11 @@ Scenario gcode_scenario(const std::string& gcode, const std::string& kind = "fre
 // measuring x where the circle crosses −y, one measuring y where it crosses +x (each 10 mm
 // long, tangent to the circle: the spot runs along it for millimetres).
 std::vector<dsp::PsdSpec> psd_config_b(double radius_mm = 10.0);
+// Configuration B widened to `count` strips (1..dsp::kMaxPsd) around the circle, from where
+// it crosses −y counter-clockwise, 360°/count apart (90° for fewer than 4): each measures
+// the axis the path runs along more (at 45° x and y alternate). 2 is configuration B, 4 B
+// and its mirror.
+std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count);
 
 // On-site identification (sim/gcode identify_program) over the given strips and further
 // axes, with those strips in the run.

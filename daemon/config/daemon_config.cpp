@@ -4,6 +4,7 @@
 #include "drivers/config/strict_toml.hpp"
 #include "drivers/setpoint/program_catalog.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/frame.hpp"
 
 #include <cmath>
 
@@ -265,6 +266,8 @@ DaemonConfig load_daemon_config(const std::filesystem::path& file) {
     s->finish();
   }
   for (auto& p : t.tables("psd")) c.psd.push_back(drivers::read_psd(p));
+  if (c.psd.size() > static_cast<std::size_t>(dsp::kMaxPsd))  // a frame carries that many
+    t.fail("psd", std::to_string(c.psd.size()) + " strips, at most " + std::to_string(dsp::kMaxPsd));
   if (c.triggers.inputs.empty())
     t.fail("triggers", "no trigger input configured: the NC could not start a measurement");
   require_within_envelope(c, t);

@@ -177,7 +177,7 @@ void read_psd_counts(const Row& row, int n_psd, double lsb, double offset, dsp::
   for (int c = c_psd0; c < c_psd0 + 2 * n_psd; ++c) {
     const auto v = parse_double(row.src, c, row.field(c));
     if (!v) {
-      f.flags |= dsp::frame_flag::psd_missing | dsp::frame_flag::psd_field_missing(c - c_psd0);
+      dsp::frame_flag::mark_psd_field_missing(f, c - c_psd0);
       continue;
     }
     const double counts = *v / lsb + offset;

@@ -151,9 +151,9 @@ int Decoder::read_samples(const std::uint8_t* payload, std::uint32_t seq, int ch
   return samples;
 }
 
-std::vector<std::uint8_t> encode_samples(std::uint32_t sequence,
-                                         const std::vector<std::array<std::int32_t, 14>>& samples, int channels,
-                                         std::uint8_t status) {
+std::vector<std::uint8_t> encode_samples(std::uint32_t sequence, const std::vector<SampleChannels>& samples,
+                                         int channels, std::uint8_t status) {
+  channels = std::clamp(channels, 0, kMaxChannels);
   std::vector<std::uint8_t> p = {kSync0,
                                  kSync1,
                                  kVersion,

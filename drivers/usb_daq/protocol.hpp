@@ -20,6 +20,7 @@ inline constexpr std::uint8_t kTypeSamples = 1, kTypeSlow = 2;
 inline constexpr std::size_t kHeader = 10, kCrc = 2;
 inline constexpr int kMaxSamplesPerPacket = 64;
 inline constexpr int kMaxChannels = dsp::kAccelChannels + 2 * dsp::kMaxPsd;
+using SampleChannels = std::array<std::int32_t, kMaxChannels>;  // one sample's counts, accel then PSD
 inline constexpr std::size_t kSlowPayload = 5;
 inline constexpr std::uint8_t kStatusAccelOverload = 1u << 0, kStatusPsdOverload = 1u << 1;
 
@@ -84,9 +85,8 @@ class Decoder {
 };
 
 // The firmware side, for tests and the device simulator: one samples packet.
-std::vector<std::uint8_t> encode_samples(std::uint32_t sequence,
-                                         const std::vector<std::array<std::int32_t, 14>>& samples, int channels,
-                                         std::uint8_t status = 0);
+std::vector<std::uint8_t> encode_samples(std::uint32_t sequence, const std::vector<SampleChannels>& samples,
+                                         int channels, std::uint8_t status = 0);
 std::vector<std::uint8_t> encode_slow(std::uint32_t sequence, float temp_table_c, float temp_head_c, int trigger);
 
 }  // namespace eical::drivers::usb_daq

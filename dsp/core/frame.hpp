@@ -8,7 +8,7 @@
 
 namespace eical::dsp {
 
-inline constexpr int kMaxPsd = 4;         // PSD strips per machine (i1, i2 each)
+inline constexpr int kMaxPsd = 16;        // PSD strips per machine (i1, i2 each)
 inline constexpr int kAccelChannels = 6;  // table ax, ay, az, head ax, ay, az
 
 enum class Sensor : int { table = 0, head = 1 };
@@ -50,9 +50,12 @@ struct Frame {
                       std::numeric_limits<double>::quiet_NaN()};  // reference; NaN = none
   std::int32_t trigger = 0;                                       // NC trigger code, 0 = none
   std::uint32_t flags = 0;                                        // frame_flag bits
+  std::uint32_t psd_missing_electrodes = 0;                       // bit e: psd_counts[e] was empty (frame_fields.hpp)
 };
 
 static_assert(std::is_trivially_copyable_v<Frame>);
-static_assert(sizeof(Frame) <= 128, "Frame should stay within two cache lines");
+static_assert(2 * kMaxPsd <= 32, "one bit per PSD electrode in psd_missing_electrodes");
+// 16 strips' 32 electrodes take four cache lines; at 10 kHz that is 2.4 MB/s through the ring.
+static_assert(sizeof(Frame) <= 256, "Frame should stay within four cache lines");
 
 }  // namespace eical::dsp

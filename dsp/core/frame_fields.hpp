@@ -14,9 +14,14 @@ constexpr std::uint32_t accel_field_missing(int c) { return 1u << (9 + c); }
 constexpr std::uint32_t sensor_fields_missing(int s) {
   return accel_field_missing(3 * s) | accel_field_missing(3 * s + 1) | accel_field_missing(3 * s + 2);
 }
-// PSD electrode c (0..7: psd k i1 = 2k, i2 = 2k + 1).
-constexpr std::uint32_t psd_field_missing(int c) { return 1u << (15 + c); }
-inline constexpr std::uint32_t psd_fields_missing = 0xFFu << 15;  // any of them
+// PSD electrode e (psd k i1 = 2k, i2 = 2k + 1) has its own bit in
+// Frame::psd_missing_electrodes: 16 strips' 32 electrodes do not fit beside the flags.
+constexpr bool psd_field_missing(const Frame& f, int e) { return (f.psd_missing_electrodes >> e) & 1u; }
+constexpr bool psd_fields_named(const Frame& f) { return f.psd_missing_electrodes != 0; }
+constexpr void mark_psd_field_missing(Frame& f, int e) {
+  f.flags |= psd_missing;
+  f.psd_missing_electrodes |= 1u << e;
+}
 
 static_assert(accel_field_missing(0) > head_missing, "the field bits follow frame.hpp's");
 

@@ -1,5 +1,6 @@
 #include "dsp/pipeline/support_stage.hpp"
 #include "dsp/core/float_limits.hpp"
+#include "dsp/core/frame_fields.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -73,8 +74,16 @@ void SupportStage::reset() noexcept {
 }
 
 void SupportStage::psd_frame(const Frame& f) noexcept {
-  for (std::size_t k = 0; k < psd_.size(); ++k)
-    psd_now_[k] = psd_[k].step(f.psd_counts[2 * k], f.psd_counts[2 * k + 1], (f.flags & frame_flag::psd_missing) != 0);
+  // A source that names the empty electrodes loses only those strips; one that cannot
+  // (psd_missing alone) loses them all for this sample.
+  const bool named = frame_flag::psd_fields_named(f);
+  const bool all_missing = (f.flags & frame_flag::psd_missing) != 0;
+  for (std::size_t k = 0; k < psd_.size(); ++k) {
+    const int e = 2 * static_cast<int>(k);
+    const bool missing =
+        named ? frame_flag::psd_field_missing(f, e) || frame_flag::psd_field_missing(f, e + 1) : all_missing;
+    psd_now_[k] = psd_[k].step(f.psd_counts[e], f.psd_counts[e + 1], missing);
+  }
 }
 
 void SupportStage::rest_sample(const Eigen::Vector3d& a_rel_mps2) noexcept {

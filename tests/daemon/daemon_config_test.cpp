@@ -78,6 +78,10 @@ TEST(DaemonConfig, OutOfRangeAndInvalidValuesAreRefused) {
   // Accepted, it would do nothing: every lost frame degrades the result.
   EXPECT_NE(error_of("[limits]\nmax_lost_frames = 3\n").find("only 0"), std::string::npos);
   EXPECT_NE(error_of("[limits]\ntemp_min_c = 40.0\ntemp_max_c = 30.0\n").find("temp_max_c"), std::string::npos);
+  // Accepted, the strips beyond a frame's 16 would be left out of every recording.
+  std::string seventeen = "[triggers]\ninputs = [\"frame\"]\n";
+  for (int k = 0; k < 17; ++k) seventeen += "[[psd]]\nmeasures = \"x\"\ncenter_mm = [0.0, 0.0]\n";
+  EXPECT_NE(error_of(seventeen).find("17 strips, at most 16"), std::string::npos) << error_of(seventeen);
 }
 
 TEST(DaemonConfig, SyntaxErrorNamesLineAndColumn) {

@@ -71,6 +71,7 @@ void expect_same(const dsp::Run& a, const dsp::Run& b) {
     const auto &x = a.frames[i], &y = b.frames[i];
     ASSERT_EQ(x.sample_index, y.sample_index) << i;
     ASSERT_EQ(x.flags, y.flags) << i;
+    ASSERT_EQ(x.psd_missing_electrodes, y.psd_missing_electrodes) << i;
     for (int c = 0; c < 6; ++c) ASSERT_EQ(x.accel_counts[c], y.accel_counts[c]) << i;
     for (int c = 0; c < 2 * a.channels.psd_count; ++c) ASSERT_EQ(x.psd_counts[c], y.psd_counts[c]) << i;
     for (int k = 0; k < 3; ++k) {
@@ -91,6 +92,26 @@ TEST(RunIo, RoundTripPlainAndGzip) {
     EXPECT_TRUE(fs::exists(dir / (gz ? "samples.csv.gz" : "samples.csv")));
     expect_same(run, read_run(dir));
   }
+}
+
+// 16 strips, the most a frame holds: every electrode's column written and read back, and
+// an empty electrode named as that one (the others of that sample kept).
+TEST(RunIo, SixteenStripsRoundTripWithOneEmptyElectrode) {
+  TempDir tmp;
+  dsp::Run run = small_run();
+  run.meta.psd.assign(dsp::kMaxPsd, dsp::PsdSpec{});
+  for (int k = 0; k < dsp::kMaxPsd; ++k) run.meta.psd[static_cast<std::size_t>(k)].center_mm[0] = 5.0 * k;
+  run.channels.psd_count = dsp::kMaxPsd;
+  for (auto& f : run.frames)
+    for (int c = 0; c < 2 * dsp::kMaxPsd; ++c) f.psd_counts[c] = static_cast<std::int32_t>(100 * c - f.sample_index);
+  dsp::frame_flag::mark_psd_field_missing(run.frames[40], 27);  // strip 13's i2
+  run.frames[40].psd_counts[27] = 0;
+  write_run(run, tmp.path / "r");
+  const dsp::Run back = read_run(tmp.path / "r");
+  ASSERT_EQ(back.channels.psd_count, dsp::kMaxPsd);
+  expect_same(run, back);
+  EXPECT_EQ(back.frames[40].psd_missing_electrodes, 1u << 27);
+  EXPECT_EQ(back.frames[40].psd_counts[26], 100 * 26 - back.frames[40].sample_index);
 }
 
 // run-format.md, "One sensor": a triplex empty in every row is absent, not missing — the

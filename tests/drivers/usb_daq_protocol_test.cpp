@@ -11,8 +11,8 @@
 namespace eical::drivers::usb_daq {
 namespace {
 
-std::vector<std::array<std::int32_t, 14>> samples(int n, int base) {
-  std::vector<std::array<std::int32_t, 14>> v(static_cast<std::size_t>(n));
+std::vector<SampleChannels> samples(int n, int base) {
+  std::vector<SampleChannels> v(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k)
     for (int c = 0; c < 10; ++c)
       v[static_cast<std::size_t>(k)][static_cast<std::size_t>(c)] = (base + k) * (c % 2 ? -1 : 1) * 1000 + c;
@@ -92,6 +92,22 @@ TEST(UsbDaqProtocol, FuzzSeedFullTransferDecodesEveryFrame) {
   std::size_t frames = 0;
   d.feed(std::span<const std::uint8_t>(bytes).subspan(1), [&](const dsp::Frame&) { ++frames; });
   EXPECT_EQ(frames, 640u);
+  EXPECT_EQ(d.stats().crc_errors, 0u);
+}
+
+// 16 strips: 6 + 32 channels a sample, each electrode where the frame keeps it.
+TEST(UsbDaqProtocol, SixteenStripsDecodeEveryElectrode) {
+  constexpr int kChannels = kMaxChannels;
+  std::vector<SampleChannels> v(8);
+  for (std::size_t k = 0; k < v.size(); ++k)
+    for (int c = 0; c < kChannels; ++c) v[k][static_cast<std::size_t>(c)] = 1000 * c - static_cast<int>(k);
+  const auto pk = encode_samples(0, v, kChannels);
+  Decoder d(dsp::kMaxPsd);
+  std::vector<dsp::Frame> out;
+  d.feed(pk, [&](const dsp::Frame& f) { out.push_back(f); });
+  ASSERT_EQ(out.size(), v.size());
+  EXPECT_EQ(out[3].psd_counts[0], 1000 * dsp::kAccelChannels - 3);
+  EXPECT_EQ(out[3].psd_counts[31], 1000 * (kChannels - 1) - 3);
   EXPECT_EQ(d.stats().crc_errors, 0u);
 }
 

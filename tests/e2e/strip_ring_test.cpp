@@ -1,0 +1,132 @@
+// Up to 16 PSD strips about a circle (sim::psd_ring, eical plan --psd B16): where they go,
+// that the simulated spot lights every one, that the pipeline fixes the position at each
+// and that one strip's empty electrode costs only that strip.
+#include "pipeline_test_util.hpp"
+
+#include "dsp/core/error.hpp"
+#include "dsp/core/frame_fields.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+namespace eical {
+namespace {
+
+using testutil::config_for;
+using testutil::run_pipeline;
+using testutil::simulate_with_truth;
+
+TEST(StripRing, TwoIsConfigurationBAndFourAddsItsMirror) {
+  const auto b = sim::psd_ring(10.0, 2), four = sim::psd_ring(10.0, 4);
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(b[0].measures, "x");
+  EXPECT_EQ(b[0].center_mm[0], 0.0);
+  EXPECT_EQ(b[0].center_mm[1], -10.0);
+  EXPECT_EQ(b[1].measures, "y");
+  EXPECT_EQ(b[1].center_mm[0], 10.0);
+  EXPECT_EQ(b[1].center_mm[1], 0.0);
+  ASSERT_EQ(four.size(), 4u);
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(four[k + 2].measures, b[k].measures);
+    EXPECT_EQ(four[k + 2].center_mm[0], -b[k].center_mm[0]);
+    EXPECT_EQ(four[k + 2].center_mm[1], -b[k].center_mm[1]);
+  }
+}
+
+TEST(StripRing, SixteenEvenlyAboutTheCircleEachAlongThePath) {
+  const double r_mm = 50.0;
+  const auto ring = sim::psd_ring(r_mm, 16);
+  ASSERT_EQ(ring.size(), 16u);
+  int along_x = 0;
+  for (int k = 0; k < 16; ++k) {
+    const auto& s = ring[static_cast<std::size_t>(k)];
+    const double x = s.center_mm[0], y = s.center_mm[1];
+    EXPECT_NEAR(std::hypot(x, y), r_mm, 1e-5) << k;
+    const double expected_rad = -0.5 * std::numbers::pi + k * std::numbers::pi / 8.0;
+    EXPECT_NEAR(std::remainder(std::atan2(y, x) - expected_rad, 2.0 * std::numbers::pi), 0.0, 1e-6) << k;
+    // The path's direction at (x, y) is (−y, x): the strip measures its larger component
+    // (the ties at 45° alternate).
+    if (std::abs(std::abs(x) - std::abs(y)) > 1e-3) {
+      EXPECT_EQ(s.measures, std::abs(y) > std::abs(x) ? "x" : "y") << k;
+    }
+    along_x += s.measures == "x";
+  }
+  EXPECT_EQ(along_x, 8);
+}
+
+TEST(StripRing, MoreStripsThanAFrameHoldsAreRefused) {
+  EXPECT_THROW(sim::psd_ring(50.0, dsp::kMaxPsd + 1), dsp::InputError);
+  EXPECT_THROW(sim::psd_ring(50.0, 0), dsp::InputError);
+  sim::Scenario sc = sim::circle_scenario(50.0, 4000.0, 1, "ccw", 1);
+  sc.meta.psd = sim::psd_ring(50.0, dsp::kMaxPsd);
+  sc.meta.psd.push_back(sc.meta.psd.front());
+  EXPECT_THROW(sim::simulate(sc), dsp::InputError);
+}
+
+struct RingRun {
+  testutil::SimRun sim;
+  std::vector<int> fixes_per_strip;
+  double rms_error_um = 0.0;
+};
+
+// RMS of the error's radial part on the circle (what G is made of; along the path the
+// trace also carries the DAQ delay's alignment, which no strip changes), µm.
+double rms_radial_error_um(const dsp::Measurement& m, const std::vector<Eigen::Vector3d>& true_mm, double r_mm) {
+  double ss = 0.0;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < m.pos_mm.size(); ++i) {
+    const Eigen::Vector3d& t = true_mm[static_cast<std::size_t>(m.sample_index[i])];
+    const Eigen::Vector2d radial = t.head<2>();
+    if (radial.norm() < 0.9 * r_mm) continue;
+    const double e = (m.pos_mm[i] - t).head<2>().dot(radial.normalized());
+    ss += e * e, ++n;
+  }
+  return n == 0 ? 0.0 : std::sqrt(ss / static_cast<double>(n)) * 1000.0;
+}
+
+RingRun ring_run(int strips, int empty_strip = -1) {
+  sim::Scenario sc = sim::circle_scenario(50.0, 4000.0, 1, "ccw", 7);
+  sc.meta.psd = sim::psd_ring(50.0, strips);
+  // The data sheet's sensors, as if identified: what is left between the strips is noise.
+  for (int k = 0; k < 2; ++k) {
+    sc.truth[k] = sim::SensorTruth{};
+    sc.truth[k].spec = sc.meta.sensors[k];
+  }
+  RingRun r;
+  r.sim = simulate_with_truth(sc);
+  if (empty_strip >= 0)
+    for (auto& f : r.sim.run.frames) dsp::frame_flag::mark_psd_field_missing(f, 2 * empty_strip + 1);
+  dsp::PipelineConfig cfg = config_for(r.sim.run);
+  cfg.keep_schedule = true;  // the fixes, each with its strip
+  const dsp::Measurement m = run_pipeline(r.sim.run, cfg);
+  r.fixes_per_strip.assign(static_cast<std::size_t>(strips), 0);
+  for (const auto& fix : m.raw.schedule.fixes) ++r.fixes_per_strip.at(static_cast<std::size_t>(fix.strip));
+  r.rms_error_um = rms_radial_error_um(m, r.sim.true_mm, 50.0);
+  return r;
+}
+
+TEST(StripRing, EveryStripOfSixteenFixesThePositionAndTheErrorFalls) {
+  const RingRun two = ring_run(2), sixteen = ring_run(16);
+  std::printf("R50 F4000, one revolution: RMS radial error %.2f um with 2 strips, %.2f um with 16; fixes per strip:",
+              two.rms_error_um, sixteen.rms_error_um);
+  for (int n : sixteen.fixes_per_strip) std::printf(" %d", n);
+  std::printf("\n");
+  for (std::size_t k = 0; k < sixteen.fixes_per_strip.size(); ++k)
+    EXPECT_GE(sixteen.fixes_per_strip[k], 10) << "strip " << k << " was never a fix";
+  EXPECT_LT(sixteen.rms_error_um, 0.5 * two.rms_error_um);
+}
+
+TEST(StripRing, AnEmptyElectrodeCostsOnlyItsStrip) {
+  const RingRun r = ring_run(16, 5);
+  EXPECT_EQ(r.fixes_per_strip[5], 0);
+  for (std::size_t k = 0; k < r.fixes_per_strip.size(); ++k)
+    if (k != 5) {
+      EXPECT_GE(r.fixes_per_strip[k], 10) << "strip " << k;
+    }
+}
+
+}  // namespace
+}  // namespace eical
