@@ -2,7 +2,9 @@
 // figures beside the spread of the figures over repeats on machines drawn within the data
 // sheet's tolerances (tools/plan/plan_check.hpp).
 //   bench_plan [--repeats 20] [--draws 100] [--programs circle,...] [--datasheet]
+//              [--circle R,F,STRIPS ...]   a circle of its own, both directions x2 (e.g. 50,4000,16)
 #include "tools/plan/plan_check.hpp"
+#include "tools/plan/predicted_uncertainty.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -13,14 +15,28 @@ int main(int argc, char** argv) {
   CLI::App app("eical plan-vs-simulation benchmark");
   int repeats = 20, draws = 100;
   std::vector<std::string> only;
+  std::vector<std::vector<double>> circles;
   bool datasheet = false;
   app.add_option("--repeats", repeats, "simulated repeats per program");
   app.add_option("--draws", draws, "Monte Carlo draws of the prediction");
   app.add_option("--programs", only, "circle, step, positioning, rectangle (default: all)")->delimiter(',');
   app.add_flag("--datasheet", datasheet, "the data sheet's sensor model instead of an identification before each test");
+  app.add_option("--circle", circles, "instead of the programs: a circle RADIUS,FEED,STRIPS (repeatable)")
+      ->delimiter(',')
+      ->expected(3)
+      ->allow_extra_args(false);
   CLI11_PARSE(app, argc, argv);
+  std::vector<eical::tools::plan::TestProgram> programs = eical::tools::plan::check_programs(!datasheet);
+  if (!circles.empty()) programs.clear();
+  for (const auto& c : circles) {
+    eical::tools::plan::TestProgram p;
+    p.kind = "circle", p.direction = "both", p.repeats = 2, p.identified = !datasheet;
+    p.radius_mm = c.at(0), p.feed_mm_min = c.at(1);
+    p.psd = eical::tools::plan::strips_for(p, static_cast<int>(c.at(2)));
+    programs.push_back(p);
+  }
   std::vector<eical::tools::plan::CheckRow> rows;
-  for (const auto& p : eical::tools::plan::check_programs(!datasheet)) {
+  for (const auto& p : programs) {
     if (!only.empty() && std::find(only.begin(), only.end(), p.kind) == only.end()) continue;
     const auto r = eical::tools::plan::check_plan(p, repeats, draws);
     rows.insert(rows.end(), r.begin(), r.end());

@@ -1,7 +1,8 @@
 // eical demo: the main job. A calibration as a machine builder runs one, on a simulated
 // machine (tools/demo/demo_stages.hpp):
 //   1. the sensors identified on site (gen-nc identify's program over the PSD strips);
-//   2. the circular test R10 F2500, both directions, through the daemon's code path;
+//   2. the circular test R10 F2500, both directions (or --radius --feed --repeats --psd),
+//      through the daemon's code path;
 //   3. its analysis with that calibration: verdict, G ± U, U against the noise bound, the
 //      error against the simulator's truth, result.json and the report;
 //   4. a test beyond the instrument (R150 F4000 without strips): not measurable, and why.
@@ -11,6 +12,7 @@
 #include "tools/commands.hpp"
 #include "tools/demo/demo_stages.hpp"
 #include "tools/exit_codes.hpp"
+#include "tools/io/psd_option.hpp"
 #include "tools/report/run_report.hpp"
 #include "tools/run_files.hpp"
 #include "tools/uncertainty/coverage_campaign.hpp"
@@ -26,16 +28,30 @@ void register_demo(CLI::App& app) {
     std::string out = "out/demo";
     std::uint64_t seed = 1;
     bool realtime = false;
+    demo::DemoTest test;
+    std::string psd = "B";
   };
   auto o = std::make_shared<Opt>();
   auto* cmd = app.add_subcommand(
       "demo",
-      "Main job: identify the sensors on site, run a circular test R10 F2500 with PSD strips end to end, "
+      "Main job: identify the sensors on site, run a circular test (R10 F2500 unless told) with PSD strips end to end, "
       "then show a test beyond the instrument");
   cmd->add_option("-o,--out", o->out, "output folder (the runs, the calibration, result.json, the report)")
       ->default_val("out/demo");
   cmd->add_option("--seed", o->seed, "simulation seed: the machine, its sensors and strips")->default_val(1);
   cmd->add_flag("--realtime", o->realtime, "pace the simulated DAQ at 10 kHz (as eicald does) instead of free-running");
+  cmd->add_option("--radius", o->test.radius_mm, "part 1's circle: radius, mm")
+      ->default_val(10.0)
+      ->check(CLI::Range(1.0, 500.0));
+  cmd->add_option("--feed", o->test.feed_mm_min, "part 1's circle: feed, mm/min")
+      ->default_val(2500.0)
+      ->check(CLI::Range(100.0, 20000.0));
+  cmd->add_option("--repeats", o->test.repeats, "part 1's circle: revolutions per direction")
+      ->default_val(5)
+      ->check(CLI::Range(1, 20));
+  cmd->add_option("--psd", o->psd, "part 1's PSD strips about the circle: B (2), B4, B8, B16")
+      ->default_val("B")
+      ->check(CLI::IsMember({"B", "B4", "B8", "B16"}));
   cmd->footer("Exit status: 0 when the calibration's verdict is ok, 2 degraded, 3 not measurable, 1 an error.");
   cmd->callback([o] {
     namespace fs = std::filesystem;
@@ -43,7 +59,8 @@ void register_demo(CLI::App& app) {
     const fs::path out = o->out;
     fs::create_directories(out);
 
-    const demo::DemoMachine machine = demo::demo_machine(o->seed);
+    o->test.strips = psd_layout_strips(o->psd);
+    const demo::DemoMachine machine = demo::demo_machine(o->seed, o->test);
     std::printf("eical demo, part 1: a calibration, as on the machine (simulated, seed %llu)\n",
                 static_cast<unsigned long long>(o->seed));
     std::printf("  the test: %s\n", plan::describe(machine.program).c_str());

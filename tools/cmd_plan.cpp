@@ -111,9 +111,10 @@ void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
       ->expected(2)
       ->delimiter(',');
   cmd.add_option("--psd", o.psd,
-                 "PSD strips: none, B (configuration B about the circle, one at mid travel, mid sides of a rectangle)")
+                 "PSD strips: none, B (configuration B about the circle, one at mid travel, mid sides of a "
+                 "rectangle), B4, B8, B16 (that many strips evenly about the circle)")
       ->default_val("none")
-      ->check(CLI::IsMember({"none", "B"}));
+      ->check(CLI::IsMember(psd_layout_names()));
   cmd.add_option("--strip", o.strips, "a strip on the machine as MEASURES:CX,CY, e.g. x:0,-10 (repeat for each)");
   cmd.add_option("--noise", o.p.noise_ug_per_rthz, "each sensor's noise density, ug/sqrt(Hz) (two-sided)")
       ->default_val(0.4)
@@ -151,7 +152,7 @@ plan::TestProgram test_program(const PlanCommandOptions& o) {
   p.runs = o.runs.value_or(program_defaults::runs(p.kind));
   p.repeats = o.repeats.value_or(program_defaults::repeats(p.kind));
   p.size_mm[0] = o.size.at(0), p.size_mm[1] = o.size.at(1);
-  if (o.psd == "B") p.psd = plan::strips_for(p);
+  p.psd = plan::strips_for(p, psd_layout_strips(o.psd));
   for (const auto& s : o.strips) p.psd.push_back(parse_psd(s));
   return p;
 }

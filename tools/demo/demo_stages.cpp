@@ -30,11 +30,12 @@ double scalar(const std::map<std::string, std::vector<double>>& m, const char* k
 
 }  // namespace
 
-DemoMachine demo_machine(std::uint64_t seed) {
+DemoMachine demo_machine(std::uint64_t seed, const DemoTest& test) {
   DemoMachine m;
   plan::TestProgram& p = m.program;
-  p.kind = "circle", p.radius_mm = 10.0, p.feed_mm_min = 2500.0, p.direction = "both", p.repeats = 5;
-  p.psd = plan::strips_for(p);  // configuration B: a strip across each axis' crossing
+  p.kind = "circle", p.direction = "both";
+  p.radius_mm = test.radius_mm, p.feed_mm_min = test.feed_mm_min, p.repeats = test.repeats;
+  p.psd = plan::strips_for(p, test.strips);  // 2: configuration B, a strip across each axis' crossing
   p.identified = true;
   m.circle = plan::scenario_on_drawn_machine(p, seed);
   // What a circular test is for: a backlash on x and an out-of-square xy, on top of the

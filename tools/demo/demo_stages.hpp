@@ -16,6 +16,14 @@
 
 namespace eical::tools::demo {
 
+// The circular test the demo runs, both directions: the thesis' R10 F2500 ×5 over
+// configuration B unless told otherwise (eical demo --radius --feed --repeats --psd).
+struct DemoTest {
+  double radius_mm = 10.0, feed_mm_min = 2500.0;
+  int repeats = 5;
+  int strips = 2;  // sim::psd_ring: 2 is configuration B
+};
+
 // The machine the demo calibrates: sensors and strips drawn within the data sheet's
 // tolerances for `seed`, small machine errors, plus a backlash and a squareness error a
 // circular test is meant to find. `program`: the circular test it runs.
@@ -24,7 +32,7 @@ struct DemoMachine {
   sim::Scenario circle;          // the test on this machine
   sim::Scenario identification;  // eical gen-nc identify on this machine: same sensors, strips
 };
-DemoMachine demo_machine(std::uint64_t seed);
+DemoMachine demo_machine(std::uint64_t seed, const DemoTest& test = {});
 
 // Stage 1: the identification run and `eical identify` of it; writes the run and the
 // calibration (eical-sensor-cal/1) under `out`.

@@ -37,6 +37,18 @@ AxisPair parse_axis_pair(const std::string& text, const std::string& option, con
 
 }  // namespace
 
+const std::vector<std::string>& psd_layout_names() {
+  static const std::vector<std::string> names{"none", "B", "B4", "B8", "B16"};
+  return names;
+}
+
+int psd_layout_strips(const std::string& layout) {
+  if (layout == "none") return 0;
+  if (layout == "B") return 2;
+  if (layout == "B4" || layout == "B8" || layout == "B16") return std::stoi(layout.substr(1));
+  throw dsp::InputError("--psd '" + layout + "': one of none, B, B4, B8, B16");
+}
+
 dsp::PsdSpec parse_psd(const std::string& text) {
   const AxisPair p = parse_axis_pair(text, "--psd", "MEASURES:CX,CY, e.g. x:0,-10");
   dsp::PsdSpec s;

@@ -3,6 +3,7 @@
 #include "drivers/exec/thread_for.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/error.hpp"
+#include "dsp/core/frame.hpp"
 #include "dsp/identify/sensor_identification.hpp"
 #include "dsp/stream/analyze_stream.hpp"
 #include "sim/hidden/hidden_effects.hpp"
@@ -128,6 +129,14 @@ std::vector<dsp::PsdSpec> strips_for(const TestProgram& p) {
   x.center_mm[0] = 0.5 * p.size_mm[0], x.center_mm[1] = 0.0;
   y.center_mm[0] = p.size_mm[0], y.center_mm[1] = 0.5 * p.size_mm[1];
   return {x, y};
+}
+
+std::vector<dsp::PsdSpec> strips_for(const TestProgram& p, int count) {
+  if (count == 0) return {};
+  if (p.kind == "circle") return sim::psd_ring(p.radius_mm, count);
+  if (count == 2) return strips_for(p);
+  throw dsp::InputError("plan: " + std::to_string(count) + " strips are a circle's layout; a " + p.kind +
+                        " test takes B (" + std::to_string(strips_for(p).size()) + ") or strips given one by one");
 }
 
 TestProgram program_of(const dsp::RunMeta& meta) {
@@ -304,6 +313,16 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
     TestProgram t = s;
     t.feed_mm_min = std::min(cap, s.feed_mm_min * f);
     if (t.feed_mm_min > s.feed_mm_min * 1.2) v.push_back(t);
+  }
+  if (p.kind == "circle") {
+    // More strips about the same circle: each crossing fixes the position once more a
+    // revolution, so the integration's error grows over a shorter arc.
+    for (int n : {4, dsp::kMaxPsd}) {
+      if (static_cast<int>(s.psd.size()) >= n) continue;
+      TestProgram t = s;
+      t.psd = strips_for(t, n);
+      v.push_back(t);
+    }
   }
   if (p.kind == "circle") {
     for (double r : {p.radius_mm / 3.0, 10.0}) {

@@ -43,6 +43,9 @@ std::string describe(const TestProgram& p);
 // Strips for the program: configuration B about a circle, one at mid travel of a 1-D
 // test, one per side's middle of a rectangle.
 std::vector<dsp::PsdSpec> strips_for(const TestProgram& p);
+// A circle's `count` strips (1..16, sim::psd_ring: 2 is configuration B); another program's
+// strips_for for 2 and none for 0, and refused for more.
+std::vector<dsp::PsdSpec> strips_for(const TestProgram& p, int count);
 // A positioning or step test's two strips at the ends of its travel (on x).
 std::vector<dsp::PsdSpec> strips_at_both_ends(const TestProgram& p);
 // The program's strips where an identification that stays inside the test's travel can
