@@ -23,20 +23,6 @@ using eical::tools::plan::TestProgram;
 
 constexpr double kClip_um = 50.0;
 
-// Configuration B (eical plan's strips for a circle), and with 4 its mirror about the
-// centre as well: each strip where the path runs along the axis it measures.
-std::vector<eical::dsp::PsdSpec> strips(const TestProgram& p, int count) {
-  if (count == 0) return {};
-  std::vector<eical::dsp::PsdSpec> out = eical::tools::plan::strips_for(p);
-  if (count == 4)
-    for (std::size_t i = 0, n = out.size(); i < n; ++i) {
-      eical::dsp::PsdSpec mirrored = out[i];
-      mirrored.center_mm[0] = -mirrored.center_mm[0], mirrored.center_mm[1] = -mirrored.center_mm[1];
-      out.push_back(mirrored);
-    }
-  return out;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -45,14 +31,16 @@ int main(int argc, char** argv) {
   double max_duration_s = 120.0;
   std::string svg_path;
   std::vector<double> radii{10.0, 25.0, 50.0, 100.0, 150.0}, feeds{1000.0, 2500.0, 4000.0, 10000.0};
-  std::vector<int> counts{0, 2, 4};
+  std::vector<int> counts{0, 2, 4, 8, 16};
   app.add_option("--draws", draws, "Monte Carlo draws per prediction");
   app.add_option("--repeats", repeats, "revolutions per direction");
   app.add_option("--max-duration", max_duration_s, "designs that run longer (s) are left out");
   app.add_option("--svg", svg_path, "write the chart here");
   app.add_option("--radii", radii, "radii, mm")->delimiter(',');
   app.add_option("--feeds", feeds, "feeds, mm/min")->delimiter(',');
-  app.add_option("--strips", counts, "strip counts (0, 2 or 4)")->delimiter(',')->check(CLI::IsMember({0, 2, 4}));
+  app.add_option("--strips", counts, "strip counts (0, 2, 4, 8 or 16: eical plan --psd none, B, B4, B8, B16)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({0, 2, 4, 8, 16}));
   CLI11_PARSE(app, argc, argv);
 
   // u[count][feed] = U(G) per radius (NaN: left out).
@@ -68,7 +56,7 @@ int main(int argc, char** argv) {
       for (double r : radii) {
         TestProgram p;
         p.kind = "circle", p.direction = "both", p.radius_mm = r, p.feed_mm_min = f, p.repeats = repeats;
-        p.psd = strips(p, n);
+        p.psd = eical::tools::plan::strips_for(p, n);
         p.identified = true;
         double g = NAN;
         if (eical::tools::plan::program_duration_s(p) <= max_duration_s) {
