@@ -7,13 +7,6 @@
 
 namespace eical::tools {
 
-std::string figure_label(const std::string& key) {
-  std::string k = dsp::key_without_unit(key.substr(key.find('.') + 1));
-  for (auto& c : k)
-    if (c == '_' || c == '.') c = ' ';
-  return k;
-}
-
 std::string value_with_u(double value, std::optional<double> u_k2, const std::string& unit) {
   const double scale = std::max(std::abs(value), u_k2 ? *u_k2 : 0.0);
   const int d = scale >= 1000.0 ? 0 : scale >= 100.0 ? 1 : scale >= 0.1 ? 2 : 3;

@@ -1,6 +1,7 @@
 #pragma once
 // Figures as a person reads them: "circular deviation G   2.80 ± 1.10 µm", "not resolved"
-// when a figure is not above its uncertainty (dsp/uncertainty/resolved.hpp).
+// when a figure is not above its uncertainty (dsp/uncertainty/resolved.hpp). The label and
+// unit of a key: dsp::label_of_key, dsp::unit_of_key (dsp/core/key_unit.hpp).
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/analysis/figures.hpp"
 
@@ -8,10 +9,6 @@
 #include <string>
 
 namespace eical::tools {
-
-// "circle.circular_deviation_G_um" → "circular deviation G"; its unit is
-// dsp::unit_of_key (dsp/core/key_unit.hpp).
-std::string figure_label(const std::string& key);
 
 // "2.80 ± 1.10 µm", or "2.80 µm ± ?" without an uncertainty; decimals by the unit.
 std::string value_with_u(double value, std::optional<double> u_k2, const std::string& unit);

@@ -72,7 +72,8 @@ std::string budget_text(const dsp::Run& run, const dsp::Analysis& analysis) {
   for (const std::string& key : keys) {
     const auto u = figure_u(analysis, key);
     if (!u) continue;
-    std::snprintf(b, sizeof b, "    %s: U = %.2f %s\n", figure_label(key).c_str(), *u, dsp::unit_of_key(key).c_str());
+    std::snprintf(b, sizeof b, "    %s: U = %.2f %s\n", dsp::label_of_key(key).c_str(), *u,
+                  dsp::unit_of_key(key).c_str());
     o += b;
     double sum2 = 0.0;
     for (const auto& [source, by_key] : analysis.uncertainty_budget)
@@ -119,18 +120,19 @@ std::string figures_text(const dsp::Analysis& analysis) {
     const std::string unit = dsp::unit_of_key(f.key);
     if (!f.array) {
       if (const auto ne = analysis.not_evaluated.find(f.key); ne != analysis.not_evaluated.end()) {
-        std::snprintf(b, sizeof b, "    %-34s not evaluated: %s\n", figure_label(f.key).c_str(), ne->second.c_str());
+        std::snprintf(b, sizeof b, "    %-34s not evaluated: %s\n", dsp::label_of_key(f.key).c_str(),
+                      ne->second.c_str());
         o += b;
         continue;
       }
       const auto u = figure_u(analysis, f.key);
-      std::snprintf(b, sizeof b, "    %-34s %s%s\n", figure_label(f.key).c_str(),
+      std::snprintf(b, sizeof b, "    %-34s %s%s\n", dsp::label_of_key(f.key).c_str(),
                     value_with_u(f.values[0], u, unit).c_str(),
                     u && !dsp::uncertainty::resolved(f.values[0], *u) ? "   not resolved" : "");
       o += b;
       continue;
     }
-    std::string line = "    " + figure_label(f.key) + " (" + unit + "):";
+    std::string line = "    " + dsp::label_of_key(f.key) + " (" + unit + "):";
     for (std::size_t i = 0; i < f.values.size() && i < 24; ++i) {
       const auto u = figure_u(analysis, f.key, i);
       char e[80];

@@ -41,4 +41,23 @@ inline std::string key_without_unit(std::string_view key) {
   return std::string(e != nullptr ? key.substr(0, key.size() - e->first.size()) : key);
 }
 
+// A figure as a person reads it: the key without its program and unit, words apart, an
+// axis in capitals ("diagnostics.backlash_x_um" → "backlash X", "circle.circular_deviation_G_um"
+// → "circular deviation G"). The report, analyze's text and the history all say it so.
+inline std::string label_of_key(std::string_view key) {
+  const std::size_t dot = key.find('.');
+  const std::string bare = key_without_unit(dot == std::string_view::npos ? key : key.substr(dot + 1));
+  std::string out;
+  std::size_t start = 0;
+  while (start <= bare.size()) {
+    std::size_t end = bare.find_first_of("_.", start);
+    if (end == std::string::npos) end = bare.size();
+    std::string word = bare.substr(start, end - start);
+    if (word == "x" || word == "y" || word == "z") word[0] = static_cast<char>(word[0] - 'a' + 'A');
+    if (!word.empty()) out += (out.empty() ? "" : " ") + word;
+    start = end + 1;
+  }
+  return out;
+}
+
 }  // namespace eical::dsp

@@ -1,6 +1,5 @@
 #include "history/record/figure_names.hpp"
 
-#include "dsp/core/key_unit.hpp"
 #include "history/record/utc_time.hpp"
 
 #include <array>
@@ -10,22 +9,6 @@
 #include <utility>
 
 namespace eical::history {
-
-std::string label_of(const std::string& figure) {
-  const std::string key =
-      dsp::key_without_unit(figure.substr(figure.rfind('.') == std::string::npos ? 0 : figure.rfind('.') + 1));
-  std::string out;
-  std::size_t start = 0;
-  while (start <= key.size()) {
-    const std::size_t end = std::min(key.find('_', start), key.size());
-    std::string word = key.substr(start, end - start);
-    if (word == "x" || word == "y" || word == "z")
-      word[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(word[0])));
-    if (!word.empty()) out += (out.empty() ? "" : " ") + word;
-    start = end + 1;
-  }
-  return out;
-}
 
 std::string utc_rfc3339(const std::string& text) {
   int y = 0, mo = 0, d = 0, h = 0, mi = 0, s = 0, n = 0;

@@ -103,8 +103,8 @@ TEST(HistoryRecord, NamesSayUnitAndLabel) {
   EXPECT_EQ(dsp::key_without_unit("circle.feed_mm_min"), "circle.feed");
   EXPECT_EQ(dsp::key_without_unit("step.settling_ms"), "step.settling");
   EXPECT_EQ(dsp::key_without_unit("_um"), "_um");  // a suffix alone names nothing
-  EXPECT_EQ(history::label_of("diagnostics.backlash_x_um"), "backlash X");
-  EXPECT_EQ(history::label_of("circle.circular_deviation_G_um"), "circular deviation G");
+  EXPECT_EQ(dsp::label_of_key("diagnostics.backlash_x_um"), "backlash X");
+  EXPECT_EQ(dsp::label_of_key("circle.circular_deviation_G_um"), "circular deviation G");
   EXPECT_EQ(history::utc_rfc3339("2026-11-12 23:30:00-02:00"), "2026-11-13T01:30:00Z");
   EXPECT_EQ(history::utc_rfc3339("2026-11-12T09:11:00.123Z"), "2026-11-12T09:11:00Z");
   EXPECT_EQ(history::utc_rfc3339("2026-13-12T09:11:00Z"), "");

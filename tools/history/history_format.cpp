@@ -107,14 +107,14 @@ std::string record_text(const history::Record& r) {
   out += "  " + pad("figure", w + 2) + "value ± U (k = 2)\n";
   for (const auto& f : r.figures)
     out += "  " + pad(f.name, w + 2) + pad(measure(f.value, f.uncertainty_k2, dsp::unit_of_key(f.name)), 24) +
-           history::label_of(f.name) + (f.value ? "" : " (not determined)") + "\n";
+           dsp::label_of_key(f.name) + (f.value ? "" : " (not determined)") + "\n";
   return out;
 }
 
 std::string trend_text(const std::string& figure, const std::vector<history::TrendPoint>& points,
                        const std::vector<history::TrendSummary>& summaries) {
   const std::string unit = dsp::unit_of_key(figure);
-  std::string out = figure + " (" + history::label_of(figure) + (unit.empty() ? "" : ", " + unit) +
+  std::string out = figure + " (" + dsp::label_of_key(figure) + (unit.empty() ? "" : ", " + unit) +
                     "): " + std::to_string(points.size()) + " result" + (points.size() == 1 ? "" : "s") + "\n";
   if (points.empty()) return out;
   std::size_t wm = 7, wr = 3;
@@ -146,7 +146,7 @@ std::string trend_text(const std::string& figure, const std::vector<history::Tre
 }
 
 std::string change_sentence(const FigureChange& c) {
-  const std::string unit = dsp::unit_of_key(c.name), label = history::label_of(c.name);
+  const std::string unit = dsp::unit_of_key(c.name), label = dsp::label_of_key(c.name);
   const std::string tail = unit.empty() ? "" : " " + unit;
   switch (c.judgement) {
     case Judgement::missing:
@@ -215,7 +215,7 @@ nlohmann::json trend_json(const std::string& figure, const std::vector<history::
                     {"drift_per_30d", opt(s.slope_per_30d)},
                     {"drift_uncertainty_k2", opt(s.slope_u_k2)},
                     {"drift_significant", s.drift_significant}});
-  return {{"format", "eical-history-trend/1"}, {"figure", figure}, {"label", history::label_of(figure)},
+  return {{"format", "eical-history-trend/1"}, {"figure", figure}, {"label", dsp::label_of_key(figure)},
           {"unit", dsp::unit_of_key(figure)},  {"points", pts},    {"machines", sums}};
 }
 
@@ -223,7 +223,7 @@ nlohmann::json compare_json(const history::Comparison& c) {
   nlohmann::json figs = nlohmann::json::array();
   for (const auto& f : c.figures)
     figs.push_back({{"name", f.name},
-                    {"label", history::label_of(f.name)},
+                    {"label", dsp::label_of_key(f.name)},
                     {"unit", dsp::unit_of_key(f.name)},
                     {"before", opt(f.before)},
                     {"before_uncertainty_k2", opt(f.u_before)},

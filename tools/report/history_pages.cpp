@@ -114,9 +114,9 @@ std::string trend_plot(const std::string& figure, const std::vector<history::Tre
   }
   if (!ring.x.empty()) series.push_back(ring);
   const std::string unit = dsp::unit_of_key(figure);
-  return line_plot(series, history::label_of(figure) + " over time (bars: ± U, k = 2)",
+  return line_plot(series, dsp::label_of_key(figure) + " over time (bars: ± U, k = 2)",
                    std::string(unit_t.name) + " since " + (origin.empty() ? "the first result" : origin),
-                   history::label_of(figure) + (unit.empty() ? "" : " (" + unit + ")"), 760, 320);
+                   dsp::label_of_key(figure) + (unit.empty() ? "" : " (" + unit + ")"), 760, 320);
 }
 
 Page trend_page(const std::string& figure, const std::vector<history::TrendPoint>& points,
@@ -125,11 +125,11 @@ Page trend_page(const std::string& figure, const std::vector<history::TrendPoint
   page.title = "Calibration history: trend";
   page.run_id = figure;
   page.subject_label = "Figure";
-  page.program = history::label_of(figure) + ", " + std::to_string(points.size()) + " results";
+  page.program = dsp::label_of_key(figure) + ", " + std::to_string(points.size()) + " results";
   page.context = {{"store", store}};
   const std::string unit = dsp::unit_of_key(figure);
   Section s;
-  s.heading = history::label_of(figure) + " over time";
+  s.heading = dsp::label_of_key(figure) + " over time";
   s.lead = "Each result with its expanded uncertainty (k = 2); one colour per machine.";
   s.svgs.push_back(trend_plot(figure, points));
   Grid drift{"Per machine", {"machine", "first", "last", "drift per 30 days", ""}, {}};
@@ -194,7 +194,7 @@ Page compare_page(const history::Comparison& c, const history::Record& before, c
   for (const auto& f : c.figures)
     if (f.judgement == history::Judgement::significant) {
       const std::string unit = dsp::unit_of_key(f.name);
-      sig.rows.push_back({history::label_of(f.name), hv::measure(f.before, f.u_before, unit),
+      sig.rows.push_back({dsp::label_of_key(f.name), hv::measure(f.before, f.u_before, unit),
                           hv::measure(f.after, f.u_after, unit), hv::measure(f.difference, f.uncertainty_k2, unit)});
     }
   if (sig.rows.empty())
@@ -210,7 +210,7 @@ Page compare_page(const history::Comparison& c, const history::Record& before, c
   Grid g{"", {"figure", "before", "after", "difference", "judgement"}, {}};
   for (const auto& fc : c.figures) {
     const std::string unit = dsp::unit_of_key(fc.name);
-    g.rows.push_back({history::label_of(fc.name) + " (" + fc.name + ")", hv::measure(fc.before, fc.u_before, unit),
+    g.rows.push_back({dsp::label_of_key(fc.name) + " (" + fc.name + ")", hv::measure(fc.before, fc.u_before, unit),
                       hv::measure(fc.after, fc.u_after, unit),
                       fc.difference ? hv::measure(fc.difference, fc.uncertainty_k2, unit) : "-",
                       judgement_text(fc.judgement)});

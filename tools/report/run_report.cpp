@@ -117,7 +117,7 @@ void uncertainty_section(const dsp::Analysis& a, Page& page) {
   s.heading = "Uncertainty";
   s.lead = "Where U comes from, and how far it is from what the physics of this test allows.";
   std::vector<std::string> header{"source"};
-  for (const auto& k : keys) header.push_back(figure_label(k) + " (" + dsp::unit_of_key(k) + ")");
+  for (const auto& k : keys) header.push_back(dsp::label_of_key(k) + " (" + dsp::unit_of_key(k) + ")");
   Grid g{"U (k = 2) of each source alone, and of all together", header, {}};
   auto row = [&](const std::string& name, const std::map<std::string, std::vector<double>>& by_key) {
     std::vector<std::string> r{name};
