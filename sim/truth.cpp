@@ -1,5 +1,6 @@
 #include "sim/truth.hpp"
 
+#include "dsp/model/effects.hpp"
 #include "sim/effects.hpp"
 #include "sim/sensor/earth_rate.hpp"
 
@@ -7,10 +8,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <vector>
 
 namespace eical::sim {
 namespace {
+
+using dsp::model::Effect;
 
 std::string num(double v) {
   char buf[40];
@@ -65,81 +69,85 @@ std::string sensors_with(const Scenario& sc, bool (*pred)(const Scenario&, int))
 // Which sensors an effect of the sensor.* family shows in: its test on one sensor.
 using SensorTest = bool (*)(const Scenario&, int);
 
-SensorTest sensor_test(const std::string& name) {
-  if (name == "sensor.scale")
-    return [](const Scenario& s, int i) {
-      return (s.truth[i].spec.k1_v_per_g - s.meta.sensors[i].k1_v_per_g).norm() > 1e-12;
-    };
-  if (name == "sensor.bias_drift")
-    return [](const Scenario& s, int i) {
-      return s.truth[i].bias_rw_ug_per_rts != 0.0 || s.truth[i].bias_step_ug != 0.0 ||
-             s.truth[i].bias_drift_ug_per_s != 0.0;
-    };
-  if (name == "sensor.nonlinearity")
-    return [](const Scenario& s, int i) {
-      return (s.truth[i].spec.k2_g_per_g2 - s.meta.sensors[i].k2_g_per_g2).norm() +
-                 (s.truth[i].spec.k3_g_per_g3 - s.meta.sensors[i].k3_g_per_g3).norm() >
-             1e-12;
-    };
-  if (name == "sensor.cross_coupling")
-    return [](const Scenario& s, int i) {
-      return s.truth[i].k_cross_g_per_g.squaredNorm() + s.truth[i].k_cross2_g_per_g2.squaredNorm() > 0.0;
-    };
-  if (name == "sensor.misalignment")
-    return [](const Scenario& s, int i) {
-      return (s.truth[i].spec.to_machine - s.meta.sensors[i].to_machine).norm() > 1e-12;
-    };
-  if (name == "sensor.dynamics")
-    return [](const Scenario& s, int i) {
-      return std::abs(s.truth[i].spec.f0_hz - s.meta.sensors[i].f0_hz) +
-                 std::abs(s.truth[i].spec.zeta - s.meta.sensors[i].zeta) >
-             1e-12;
-    };
-  if (name == "sensor.damping_amplitude")
-    return [](const Scenario& s, int i) { return s.truth[i].zeta_per_g != s.meta.sensors[i].zeta_per_g; };
-  if (name == "sensor.scale_temperature")
-    return [](const Scenario& s, int i) { return s.truth[i].temperature.rise_c != 0.0; };
-  return nullptr;
+SensorTest sensor_test(Effect e) {
+  switch (e) {
+    case Effect::sensor_scale:
+      return [](const Scenario& s, int i) {
+        return (s.truth[i].spec.k1_v_per_g - s.meta.sensors[i].k1_v_per_g).norm() > 1e-12;
+      };
+    case Effect::sensor_bias_drift:
+      return [](const Scenario& s, int i) {
+        return s.truth[i].bias_rw_ug_per_rts != 0.0 || s.truth[i].bias_step_ug != 0.0 ||
+               s.truth[i].bias_drift_ug_per_s != 0.0;
+      };
+    case Effect::sensor_nonlinearity:
+      return [](const Scenario& s, int i) {
+        return (s.truth[i].spec.k2_g_per_g2 - s.meta.sensors[i].k2_g_per_g2).norm() +
+                   (s.truth[i].spec.k3_g_per_g3 - s.meta.sensors[i].k3_g_per_g3).norm() >
+               1e-12;
+      };
+    case Effect::sensor_cross_coupling:
+      return [](const Scenario& s, int i) {
+        return s.truth[i].k_cross_g_per_g.squaredNorm() + s.truth[i].k_cross2_g_per_g2.squaredNorm() > 0.0;
+      };
+    case Effect::sensor_misalignment:
+      return [](const Scenario& s, int i) {
+        return (s.truth[i].spec.to_machine - s.meta.sensors[i].to_machine).norm() > 1e-12;
+      };
+    case Effect::sensor_dynamics:
+      return [](const Scenario& s, int i) {
+        return std::abs(s.truth[i].spec.f0_hz - s.meta.sensors[i].f0_hz) +
+                   std::abs(s.truth[i].spec.zeta - s.meta.sensors[i].zeta) >
+               1e-12;
+      };
+    case Effect::sensor_damping_amplitude:
+      return [](const Scenario& s, int i) { return s.truth[i].zeta_per_g != s.meta.sensors[i].zeta_per_g; };
+    case Effect::sensor_scale_temperature:
+      return [](const Scenario& s, int i) { return s.truth[i].temperature.rise_c != 0.0; };
+    default: return nullptr;
+  }
 }
 
 // The parameters of a sensor effect in sensor s.
-std::string sensor_effect_params(const Scenario& sc, const std::string& name, int s) {
-  const SensorTruth& st = sc.truth[s];
-  const SensorTruth& t = st;
-  std::string o;
-  if (name == "sensor.scale") o += "k1_v_per_g = " + vec3(t.spec.k1_v_per_g) + "\n";
-  if (name == "sensor.bias_drift")
-    o += "rw_ug_per_rts = " + num(t.bias_rw_ug_per_rts) + "\nstep_ug = " + num(t.bias_step_ug) +
-         "\ndrift_ug_per_s = " + num(t.bias_drift_ug_per_s) + "\n";
-  if (name == "sensor.nonlinearity")
-    o += "k2_g_per_g2 = " + vec3(t.spec.k2_g_per_g2) + "\nk3_g_per_g3 = " + vec3(t.spec.k3_g_per_g3) + "\n";
-  if (name == "sensor.cross_coupling")
-    o += "k_cross_g_per_g = " + mat3(t.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(t.k_cross2_g_per_g2) + "\n";
-  if (name == "sensor.misalignment") {
-    // A sign flip, swap or mirror is no small rotation: the true matrix says what it is.
-    if (!st.axes_map.empty())
-      o += "axes_map = " + str(st.axes_map) +
-           "\nmounting = " + str(mounting_kind(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
-    else
-      o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
-    o += "to_machine = " + mat3(t.spec.to_machine) + "\n";
+std::string sensor_effect_params(const Scenario& sc, Effect e, int s) {
+  const SensorTruth& t = sc.truth[s];
+  switch (e) {
+    case Effect::sensor_scale: return "k1_v_per_g = " + vec3(t.spec.k1_v_per_g) + "\n";
+    case Effect::sensor_bias_drift:
+      return "rw_ug_per_rts = " + num(t.bias_rw_ug_per_rts) + "\nstep_ug = " + num(t.bias_step_ug) +
+             "\ndrift_ug_per_s = " + num(t.bias_drift_ug_per_s) + "\n";
+    case Effect::sensor_nonlinearity:
+      return "k2_g_per_g2 = " + vec3(t.spec.k2_g_per_g2) + "\nk3_g_per_g3 = " + vec3(t.spec.k3_g_per_g3) + "\n";
+    case Effect::sensor_cross_coupling:
+      return "k_cross_g_per_g = " + mat3(t.k_cross_g_per_g) + "\nk_cross2_g_per_g2 = " + mat3(t.k_cross2_g_per_g2) +
+             "\n";
+    case Effect::sensor_misalignment: {
+      std::string o;
+      // A sign flip, swap or mirror is no small rotation: the true matrix says what it is.
+      if (!t.axes_map.empty())
+        o += "axes_map = " + str(t.axes_map) +
+             "\nmounting = " + str(mounting_kind(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
+      else
+        o += "misalignment_mrad = " + vec3(misalignment_mrad(sc.meta.sensors[s].to_machine, t.spec.to_machine)) + "\n";
+      return o + "to_machine = " + mat3(t.spec.to_machine) + "\n";
+    }
+    case Effect::sensor_dynamics: return "f0_hz = " + num(t.spec.f0_hz) + "\nzeta = " + num(t.spec.zeta) + "\n";
+    case Effect::sensor_damping_amplitude:
+      return "zeta0 = " + num(t.spec.zeta) + "\nzeta_per_g = " + num(t.zeta_per_g) + "\n";
+    case Effect::sensor_scale_temperature:
+      return "rise_c = " + num(t.temperature.rise_c) + "\ntau_s = " + num(t.temperature.tau_s) +
+             "\ntc_k1_ppm_per_c = " + num(t.spec.tc_k1_ppm_per_c) +
+             "\ntc_bias_ug_per_c = " + num(t.spec.tc_bias_ug_per_c) + "\n";
+    default: return "";
   }
-  if (name == "sensor.dynamics") o += "f0_hz = " + num(t.spec.f0_hz) + "\nzeta = " + num(t.spec.zeta) + "\n";
-  if (name == "sensor.damping_amplitude")
-    o += "zeta0 = " + num(t.spec.zeta) + "\nzeta_per_g = " + num(t.zeta_per_g) + "\n";
-  if (name == "sensor.scale_temperature")
-    o += "rise_c = " + num(t.temperature.rise_c) + "\ntau_s = " + num(t.temperature.tau_s) +
-         "\ntc_k1_ppm_per_c = " + num(t.spec.tc_k1_ppm_per_c) + "\ntc_bias_ug_per_c = " + num(t.spec.tc_bias_ug_per_c) +
-         "\n";
-  return o;
 }
 
 // A sensor effect: the sensors it shows in, and its parameters in the head when only the
 // head has it, else in the table.
-std::string sensor_effect_table(const Scenario& sc, const std::string& name) {
-  const SensorTest pred = sensor_test(name);
+std::string sensor_effect_table(const Scenario& sc, Effect e) {
+  const SensorTest pred = sensor_test(e);
   const std::string which = pred ? sensors_with(sc, pred) : "none";
-  return "sensor = " + str(which) + "\n" + sensor_effect_params(sc, name, which == "head" ? 1 : 0);
+  return "sensor = " + str(which) + "\n" + sensor_effect_params(sc, e, which == "head" ? 1 : 0);
 }
 
 std::string tones_table(const std::string& name, const std::vector<Tone>& tones) {
@@ -150,9 +158,9 @@ std::string tones_table(const std::string& name, const std::vector<Tone>& tones)
   return o;
 }
 
-std::string vibration_effect_table(const Scenario& sc, const std::string& name) {
+std::string vibration_effect_table(const Scenario& sc, Effect e, const std::string& name) {
   std::string o;
-  if (name == "machine.common_vibration") {
+  if (e == Effect::machine_common_vibration) {
     const CommonVibration& v = sc.common_vibration;
     o += "broadband_rms_mg = " + vec3(v.broadband_rms_mg) + "\nband_hz = " + arr(v.band_hz, 2) + "\n";
     o += tones_table(name, v.tones);
@@ -177,47 +185,47 @@ std::string largest_axis(Size size, Body body) {
 }
 
 // The errors of the axes and between them (machine.*, vibration aside).
-std::string machine_effect_table(const Scenario& sc, const std::string& name) {
+std::string machine_effect_table(const Scenario& sc, Effect e, const std::string& name) {
   const MachineErrors& m = sc.machine;
   std::string o;
-  if (name == "machine.backlash") {
+  if (e == Effect::machine_backlash) {
     o += largest_axis([&](int i) { return m.backlash_um[i]; },
                       [&](int i) { return "value_um = " + num(m.backlash_um[i]) + "\n"; });
-  } else if (name == "machine.reversal_spike") {
+  } else if (e == Effect::machine_reversal_spike) {
     o += largest_axis(
         [&](int i) { return m.spike[i].amp_um; },
         [&](int i) { return "amp_um = " + num(m.spike[i].amp_um) + "\ntau_ms = " + num(m.spike[i].tau_ms) + "\n"; });
-  } else if (name == "machine.servo_mismatch") {
+  } else if (e == Effect::machine_servo_mismatch) {
     for (int i = 0; i < 3; ++i)
       o += std::string("lag_") + kAxis[i] +
            "_ms = " + num(m.servo[i].kv_per_s > 0 ? 1e3 * (1.0 - m.servo[i].feedforward) / m.servo[i].kv_per_s : 0.0) +
            "\n";
-  } else if (name == "machine.squareness") {
+  } else if (e == Effect::machine_squareness) {
     for (int i = 0; i < 3; ++i)
       if (m.squareness_urad[i] != 0.0)
         o += std::string("plane = ") + str(kPair[i]) + "\nvalue_urad = " + num(m.squareness_urad[i]) + "\n";
-  } else if (name == "machine.scale_mismatch") {
+  } else if (e == Effect::machine_scale_mismatch) {
     for (int i = 0; i < 3; ++i) o += std::string(kAxis[i]) + "_ppm = " + num(m.scale_ppm[i]) + "\n";
-  } else if (name == "machine.cyclic_error") {
+  } else if (e == Effect::machine_cyclic_error) {
     o += largest_axis([&](int i) { return m.cyclic[i].amp_um; },
                       [&](int i) {
                         return "amp_um = " + num(m.cyclic[i].amp_um) + "\npitch_mm = " + num(m.cyclic[i].pitch_mm) +
                                "\nphase_deg = " + num(m.cyclic[i].phase_deg) + "\n";
                       });
-  } else if (name == "machine.straightness") {
+  } else if (e == Effect::machine_straightness) {
     o += largest_axis([&](int i) { return m.straightness[i].direction >= 0 ? m.straightness[i].bow_um : 0.0; },
                       [&](int i) {
                         return "direction = " + str(kAxis[m.straightness[i].direction]) +
                                "\nbow_um = " + num(m.straightness[i].bow_um) +
                                "\nspan_mm = " + arr(m.straightness[i].span_mm, 2) + "\n";
                       });
-  } else if (name == "machine.resonance") {
+  } else if (e == Effect::machine_resonance) {
     o += "part = " + str(kSensor[sc.resonance.part]) + "\n";
     for (const StructuralMode& md : sc.resonance.modes)
       o += "\n[[effects.\"" + name + "\".modes]]\nfrequency_hz = " + num(md.frequency_hz) +
            "\ndamping_ratio = " + num(md.damping_ratio) + "\ngain = " + num(md.gain) +
            "\ndirection = " + vec3(md.direction.normalized()) + "\n";
-  } else if (name == "machine.stick_slip") {
+  } else if (e == Effect::machine_stick_slip) {
     o += largest_axis([&](int i) { return m.stick_slip[i].amp_um; },
                       [&](int i) {
                         return "amp_um = " + num(m.stick_slip[i].amp_um) +
@@ -231,18 +239,21 @@ std::string machine_effect_table(const Scenario& sc, const std::string& name) {
 // [effects."NAME"]: where an effect present is, with its true parameters.
 std::string effect_table(const Scenario& sc, const std::string& name) {
   std::string o = "\n[effects.\"" + name + "\"]\n";
-  if (name.rfind("sensor.", 0) == 0)
-    o += sensor_effect_table(sc, name);
-  else if (name == "daq.group_delay")
-    o += "group_delay_samples = " + num(sc.daq.group_delay_samples) +
-         "\nskew_head_samples = " + num(sc.daq.skew_head_samples) + "\n";
-  else if (name == "site.coriolis")
-    o += "latitude_deg = " + num(sc.meta.site.latitude_deg) + "\nheading_deg = " + num(sc.meta.site.heading_deg) + "\n";
-  else if (name == "machine.common_vibration" || name == "machine.differential_vibration")
-    o += vibration_effect_table(sc, name);
-  else
-    o += machine_effect_table(sc, name);
-  return o;
+  const std::optional<Effect> e = dsp::model::effect_named(name);
+  if (!e) return o;
+  switch (dsp::model::info(*e).side) {
+    case dsp::model::EffectSide::sensor: return o + sensor_effect_table(sc, *e);
+    case dsp::model::EffectSide::daq:
+      return o + "group_delay_samples = " + num(sc.daq.group_delay_samples) +
+             "\nskew_head_samples = " + num(sc.daq.skew_head_samples) + "\n";
+    case dsp::model::EffectSide::site:
+      return o + "latitude_deg = " + num(sc.meta.site.latitude_deg) +
+             "\nheading_deg = " + num(sc.meta.site.heading_deg) + "\n";
+    case dsp::model::EffectSide::machine: break;
+  }
+  if (*e == Effect::machine_common_vibration || *e == Effect::machine_differential_vibration)
+    return o + vibration_effect_table(sc, *e, name);
+  return o + machine_effect_table(sc, *e, name);
 }
 
 // The comments, the scenario, the effects present and in the background, and where each

@@ -5,6 +5,7 @@
 #include "drivers/config/strict_toml.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/core/frame.hpp"
+#include "dsp/model/effects.hpp"
 #include "sim/effects.hpp"
 #include "sim/gcode/canonical.hpp"
 #include "sim/gcode/parser.hpp"
@@ -18,10 +19,13 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 namespace eical::drivers {
 namespace {
+
+using dsp::model::Effect;
 
 int axis_of(StrictTable& t, std::string_view key) {
   const std::string a = t.choice(key, {"x", "y", "z"}, "");
@@ -52,11 +56,11 @@ std::vector<int> sensors_of(StrictTable& t) {
   return {0, 1};
 }
 
-void read_sensor_effect(const std::string& name, StrictTable& t, sim::Scenario& sc) {
+void read_sensor_effect(Effect e, StrictTable& t, sim::Scenario& sc) {
   for (int s : sensors_of(t)) {
     sim::SensorTruth& st = sc.truth[s];
     const dsp::SensorSpec& nominal = sc.meta.sensors[s];
-    if (name == "sensor.scale") {
+    if (e == Effect::sensor_scale) {
       if (t.has("scale_ppm")) {
         const Eigen::Vector3d ppm = vec3_or(t, "scale_ppm", Eigen::Vector3d::Zero());
         st.spec.k1_v_per_g = nominal.k1_v_per_g.cwiseProduct(Eigen::Vector3d::Ones() + ppm * 1e-6);
@@ -64,17 +68,17 @@ void read_sensor_effect(const std::string& name, StrictTable& t, sim::Scenario& 
       } else {
         st.spec.k1_v_per_g = vec3_or(t, "k1_v_per_g", nominal.k1_v_per_g);
       }
-    } else if (name == "sensor.bias_drift") {
+    } else if (e == Effect::sensor_bias_drift) {
       st.bias_rw_ug_per_rts = t.number("rw_ug_per_rts", 0.0);
       st.bias_step_ug = t.number("step_ug", 0.0);
       st.bias_drift_ug_per_s = t.number("drift_ug_per_s", 0.0);
-    } else if (name == "sensor.nonlinearity") {
+    } else if (e == Effect::sensor_nonlinearity) {
       st.spec.k2_g_per_g2 = vec3_or(t, "k2_g_per_g2", nominal.k2_g_per_g2);
       st.spec.k3_g_per_g3 = vec3_or(t, "k3_g_per_g3", nominal.k3_g_per_g3);
-    } else if (name == "sensor.cross_coupling") {
+    } else if (e == Effect::sensor_cross_coupling) {
       st.k_cross_g_per_g = mat3(t, "k_cross_g_per_g");
       st.k_cross2_g_per_g2 = mat3(t, "k_cross2_g_per_g2");
-    } else if (name == "sensor.misalignment") {
+    } else if (e == Effect::sensor_misalignment) {
       const Eigen::Vector3d r = vec3_or(t, "misalignment_mrad", Eigen::Vector3d::Zero()) * 1e-3;
       // Rotation about the sensor axes, applied after the nominal mounting.
       const Eigen::Matrix3d rot =
@@ -87,18 +91,18 @@ void read_sensor_effect(const std::string& name, StrictTable& t, sim::Scenario& 
         const std::string map = t.string("axes_map");
         try {
           st.spec.to_machine = sim::axes_map_matrix(map, "") * st.spec.to_machine;
-        } catch (const dsp::InputError& e) {
-          t.fail("axes_map", e.what());
+        } catch (const dsp::InputError& bad) {
+          t.fail("axes_map", bad.what());
         }
         st.axes_map = map;
       }
-    } else if (name == "sensor.dynamics") {
+    } else if (e == Effect::sensor_dynamics) {
       st.spec.f0_hz = positive(t, "f0_hz", nominal.f0_hz);
       st.spec.zeta = positive(t, "zeta", nominal.zeta);
-    } else if (name == "sensor.damping_amplitude") {
+    } else if (e == Effect::sensor_damping_amplitude) {
       st.spec.zeta = positive(t, "zeta0", st.spec.zeta);
       st.zeta_per_g = t.number("zeta_per_g");
-    } else if (name == "sensor.scale_temperature") {
+    } else if (e == Effect::sensor_scale_temperature) {
       st.temperature.t0_c = t.number("t0_c", st.temperature.t0_c);
       st.temperature.rise_c = t.number("rise_c");
       st.temperature.tau_s = positive(t, "tau_s", st.temperature.tau_s);
@@ -131,9 +135,9 @@ sim::DriveMode read_mode(StrictTable t, const std::string& gain_key = "gain") {
   return m;
 }
 
-void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario& sc) {
+void read_machine_effect(Effect e, StrictTable& t, sim::Scenario& sc) {
   sim::MachineErrors& m = sc.machine;
-  if (name == "machine.common_vibration") {
+  if (e == Effect::machine_common_vibration) {
     sim::CommonVibration& v = sc.common_vibration;
     v.broadband_rms_mg = vec3_or(t, "broadband_rms_mg", Eigen::Vector3d::Zero());
     if (t.has("band_hz")) {
@@ -144,14 +148,14 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
     v.tones = read_tones(t);
     if (auto mode = t.optional_table("mode")) v.mode = read_mode(*mode);
     if (!v.on()) t.fail("broadband_rms_mg", "common vibration needs tones, broadband_rms_mg or a mode with gain");
-  } else if (name == "machine.differential_vibration") {
+  } else if (e == Effect::machine_differential_vibration) {
     sc.differential_vibration.freq_hz = positive(t, "freq_hz", 9.0);
     sc.differential_vibration.zeta = positive(t, "zeta", 0.03);
     sc.differential_vibration.gain = vec3_or(t, "gain", Eigen::Vector3d::Zero());
     sc.differential_tones = read_tones(t);
     if (sc.differential_vibration.gain.squaredNorm() == 0.0 && sc.differential_tones.empty())
       t.fail("gain", "differential vibration needs a mode gain or tones");
-  } else if (name == "machine.resonance") {
+  } else if (e == Effect::machine_resonance) {
     sc.resonance.part = t.choice("part", {"table", "head"}, "head") == "head" ? 1 : 0;
     sc.resonance.modes.clear();
     for (StrictTable mt : t.tables("modes")) {
@@ -167,13 +171,13 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
     }
     if (!sc.resonance.on())
       t.fail("modes", "machine.resonance needs at least one [[…modes]] table with a non-zero gain");
-  } else if (name == "machine.backlash") {
+  } else if (e == Effect::machine_backlash) {
     m.backlash_um[axis_of(t, "axis")] = t.number("value_um");
-  } else if (name == "machine.reversal_spike") {
+  } else if (e == Effect::machine_reversal_spike) {
     const int a = axis_of(t, "axis");
     m.spike[a].amp_um = t.number("amp_um");
     m.spike[a].tau_ms = positive(t, "tau_ms", m.spike[a].tau_ms);
-  } else if (name == "machine.servo_mismatch") {
+  } else if (e == Effect::machine_servo_mismatch) {
     // Needs a position loop on every axis: without [servo.*] the axes get Kv 30/s and
     // 90 % velocity feed-forward, then the named axis its own Kv.
     for (auto& s : m.servo)
@@ -181,17 +185,17 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
     const int a = axis_of(t, "axis");
     m.servo[a].kv_per_s = positive(t, "kv_per_s", m.servo[a].kv_per_s);
     m.servo[a].feedforward = t.number("feedforward", m.servo[a].feedforward);
-  } else if (name == "machine.squareness") {
+  } else if (e == Effect::machine_squareness) {
     const std::string plane = t.choice("plane", {"xy", "yz", "zx"}, "xy");
     m.squareness_urad[plane == "xy" ? 0 : (plane == "yz" ? 1 : 2)] = t.number("value_urad");
-  } else if (name == "machine.scale_mismatch") {
+  } else if (e == Effect::machine_scale_mismatch) {
     m.scale_ppm[axis_of(t, "axis")] = t.number("value_ppm");
-  } else if (name == "machine.cyclic_error") {
+  } else if (e == Effect::machine_cyclic_error) {
     const int a = axis_of(t, "axis");
     m.cyclic[a].amp_um = t.number("amp_um");
     m.cyclic[a].pitch_mm = positive(t, "pitch_mm", m.cyclic[a].pitch_mm);
     m.cyclic[a].phase_deg = t.number("phase_deg", 0.0);
-  } else if (name == "machine.straightness") {
+  } else if (e == Effect::machine_straightness) {
     const int a = axis_of(t, "axis");
     const int d = axis_of(t, "direction");
     if (d == a) t.fail("direction", "must differ from the axis");
@@ -202,7 +206,7 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
       if (!(s[1] > s[0])) t.fail("span_mm", "must be [from, to] with from < to");
       m.straightness[a].span_mm[0] = s[0], m.straightness[a].span_mm[1] = s[1];
     }
-  } else if (name == "machine.stick_slip") {
+  } else if (e == Effect::machine_stick_slip) {
     const int a = axis_of(t, "axis");
     m.stick_slip[a].amp_um = t.number("amp_um");
     m.stick_slip[a].below_mm_min = positive(t, "below_mm_min", m.stick_slip[a].below_mm_min);
@@ -210,17 +214,16 @@ void read_machine_effect(const std::string& name, StrictTable& t, sim::Scenario&
   }
 }
 
-void read_effect(const std::string& name, StrictTable t, sim::Scenario& sc) {
-  if (name.rfind("sensor.", 0) == 0) {
-    read_sensor_effect(name, t, sc);
-  } else if (name == "daq.group_delay") {
-    sc.daq.group_delay_samples = t.number("group_delay_samples", sc.meta.acquisition.daq_group_delay_samples);
-    sc.daq.skew_head_samples = t.number("skew_head_samples", sc.meta.acquisition.daq_skew_head_samples);
-    if (sc.daq.group_delay_samples < 0.0) t.fail("group_delay_samples", "must not be negative");
-  } else if (name == "site.coriolis") {
-    sc.coriolis = t.boolean("on", true);
-  } else {
-    read_machine_effect(name, t, sc);
+void read_effect(Effect e, StrictTable t, sim::Scenario& sc) {
+  switch (dsp::model::info(e).side) {
+    case dsp::model::EffectSide::sensor: read_sensor_effect(e, t, sc); break;
+    case dsp::model::EffectSide::daq:
+      sc.daq.group_delay_samples = t.number("group_delay_samples", sc.meta.acquisition.daq_group_delay_samples);
+      sc.daq.skew_head_samples = t.number("skew_head_samples", sc.meta.acquisition.daq_skew_head_samples);
+      if (sc.daq.group_delay_samples < 0.0) t.fail("group_delay_samples", "must not be negative");
+      break;
+    case dsp::model::EffectSide::site: sc.coriolis = t.boolean("on", true); break;
+    case dsp::model::EffectSide::machine: read_machine_effect(e, t, sc); break;
   }
   t.finish();
 }
@@ -457,14 +460,14 @@ void read_servo(StrictTable& servo, sim::Scenario& sc) {
 
 // [effects.*]: every effect the simulator knows, each table (or array of tables) of it.
 void read_effects(StrictTable& effects, sim::Scenario& sc) {
-  const auto& known = sim::effect_names();
   for (const std::string& name : effects.keys()) {
-    if (std::find(known.begin(), known.end(), name) == known.end()) {
+    const std::optional<Effect> e = dsp::model::effect_named(name);
+    if (!e) {
       std::string list;
-      for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+      for (const auto& k : sim::effect_names()) list += (list.empty() ? "" : ", ") + k;
       effects.fail(name, "unknown effect (known: " + list + ")");
     }
-    for (StrictTable& t : effects.table_or_tables(name)) read_effect(name, std::move(t), sc);
+    for (StrictTable& t : effects.table_or_tables(name)) read_effect(*e, std::move(t), sc);
     sc.effects_present.push_back(name);
   }
   effects.finish();

@@ -1,6 +1,7 @@
 #include "dsp/model/extension.hpp"
 
 #include "dsp/core/axes.hpp"
+#include "dsp/model/effects.hpp"
 
 #include <Eigen/Dense>
 
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <string>
 
 namespace eical::dsp::model {
@@ -126,24 +128,20 @@ void add_scale_temperature(const RunMeta& meta, const Params& p, Extension& x) {
 // pipeline does not take from a calibration into the notes.
 void apply_effect(const RunMeta& meta, const ExplainedEffect& ef, CrossAxisTerms& e, Extension& x) {
   const Params& p = ef.params;
-  if (ef.name == "sensor.scale") {
-    add_scale(meta, p, e);
-  } else if (ef.name == "sensor.misalignment") {
-    add_misalignment(meta, p, e);
-  } else if (ef.name == "sensor.cross_coupling") {
-    add_cross_coupling(meta, p, e);
-  } else if (ef.name == "sensor.nonlinearity") {
-    add_nonlinearity(meta, p, x);
-  } else if (ef.name == "sensor.dynamics") {
-    add_dynamics(p, x);
-  } else if (ef.name == "daq.group_delay") {
-    add_group_delay(p, x);
-  } else if (ef.name == "sensor.damping_amplitude") {
-    add_damping_amplitude(meta, ef, x);
-  } else if (ef.name == "sensor.scale_temperature") {
-    add_scale_temperature(meta, p, x);
-  } else if (ef.name.rfind("sensor.", 0) == 0 || ef.name == "site.coriolis") {
-    x.notes.push_back(ef.name + ": found; the pipeline does not compensate it from a calibration (yet)");
+  const std::optional<Effect> id = effect_named(ef.name);
+  if (!id) return;  // other.*: nothing of the sensors to extend
+  switch (*id) {
+    case Effect::sensor_scale: return add_scale(meta, p, e);
+    case Effect::sensor_misalignment: return add_misalignment(meta, p, e);
+    case Effect::sensor_cross_coupling: return add_cross_coupling(meta, p, e);
+    case Effect::sensor_nonlinearity: return add_nonlinearity(meta, p, x);
+    case Effect::sensor_dynamics: return add_dynamics(p, x);
+    case Effect::daq_group_delay: return add_group_delay(p, x);
+    case Effect::sensor_damping_amplitude: return add_damping_amplitude(meta, ef, x);
+    case Effect::sensor_scale_temperature: return add_scale_temperature(meta, p, x);
+    default:
+      if (info(*id).side == EffectSide::sensor || info(*id).side == EffectSide::site)
+        x.notes.push_back(ef.name + ": found; the pipeline does not compensate it from a calibration (yet)");
   }
 }
 

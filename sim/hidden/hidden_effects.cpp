@@ -1,6 +1,7 @@
 #include "sim/hidden/hidden_effects.hpp"
 
 #include "dsp/core/error.hpp"
+#include "dsp/model/effects.hpp"
 #include "sim/effects.hpp"
 #include "sim/regimes/regimes.hpp"
 #include "sim/simulate.hpp"
@@ -9,10 +10,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
 namespace eical::sim {
 namespace {
+
+using dsp::model::Effect;
 
 struct Draw {
   std::mt19937_64 rng;
@@ -128,21 +132,21 @@ int moving_axis(const Scenario& sc, Draw& d) {
 }
 
 // sensor.*: into the sensor that moves an axis of the program (both sensors' cases warm).
-void inject_sensor(Scenario& sc, const std::string& e, Draw& d) {
-  if (e == "sensor.scale") {
+void inject_sensor(Scenario& sc, Effect e, Draw& d) {
+  if (e == Effect::sensor_scale) {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
     for (int i = 0; i < 3; ++i)
       t.spec.k1_v_per_g[i] = sc.meta.sensors[&t - sc.truth].k1_v_per_g[i] * (1.0 + d.mag(2000e-6, 5000e-6));
-  } else if (e == "sensor.bias_drift") {
+  } else if (e == Effect::sensor_bias_drift) {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
     if (sc.meta.program.kind == "step")
       t.bias_step_ug = d.u(6.0, 15.0);
     else
       t.bias_drift_ug_per_s = d.mag(0.3, 1.0);
-  } else if (e == "sensor.nonlinearity") {
+  } else if (e == Effect::sensor_nonlinearity) {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
     for (int i = 0; i < 3; ++i) t.spec.k2_g_per_g2[i] += d.mag(2e-3, 4e-3), t.spec.k3_g_per_g3[i] += d.mag(2e-3, 4e-3);
-  } else if (e == "sensor.cross_coupling") {
+  } else if (e == Effect::sensor_cross_coupling) {
     // Sensing axes not square to each other: each pair responds to the other alike (the
     // antisymmetric part of a cross-axis matrix is a rotation: sensor.misalignment).
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
@@ -151,19 +155,19 @@ void inject_sensor(Scenario& sc, const std::string& e, Draw& d) {
         const double k = d.mag(0.8e-3, 2e-3);
         t.k_cross_g_per_g(i, j) += k, t.k_cross_g_per_g(j, i) += k;
       }
-  } else if (e == "sensor.misalignment") {
+  } else if (e == Effect::sensor_misalignment) {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
     Eigen::Vector3d r(d.pm(3e-4), d.pm(3e-4), d.pm(3e-4));
     r[d.pick(3)] = d.mag(1.5e-3, 4e-3);
     t.spec.to_machine = sc.meta.sensors[&t - sc.truth].to_machine * rotation(r);
-  } else if (e == "sensor.dynamics") {
+  } else if (e == Effect::sensor_dynamics) {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
     t.spec.zeta = sc.meta.sensors[&t - sc.truth].zeta + d.mag(0.08, 0.15);
     t.spec.f0_hz = sc.meta.sensors[&t - sc.truth].f0_hz * (1.0 + d.pm(0.06));
-  } else if (e == "sensor.damping_amplitude") {
+  } else if (e == Effect::sensor_damping_amplitude) {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
     t.zeta_per_g = d.u(0.5, 1.5);
-  } else if (e == "sensor.scale_temperature") {
+  } else if (e == Effect::sensor_scale_temperature) {
     // The cases warm by a degree or more, and their coefficients are off the data sheet's
     // (which the pipeline compensates with) by about the data sheet's own size.
     for (int s = 0; s < 2; ++s) {
@@ -173,13 +177,13 @@ void inject_sensor(Scenario& sc, const std::string& e, Draw& d) {
       t.spec.tc_k1_ppm_per_c = sc.meta.sensors[s].tc_k1_ppm_per_c + d.mag(50.0, 150.0);
     }
   } else {
-    unknown_effect(e);
+    unknown_effect(std::string(dsp::model::name(e)));
   }
 }
 
 // The vibration common to table and head, and the head's against the table.
-void inject_vibration(Scenario& sc, const std::string& e, Draw& d) {
-  if (e == "machine.common_vibration") {
+void inject_vibration(Scenario& sc, Effect e, Draw& d) {
+  if (e == Effect::machine_common_vibration) {
     auto& v = sc.common_vibration;
     Tone drive;
     drive.freq_hz = 100.0, drive.amp_mg = Eigen::Vector3d(d.u(1.0, 4.0), d.u(1.0, 3.0), d.u(0.5, 1.5)),
@@ -191,7 +195,7 @@ void inject_vibration(Scenario& sc, const std::string& e, Draw& d) {
     v.broadband_rms_mg = Eigen::Vector3d(d.u(0.4, 1.5), d.u(0.4, 1.5), d.u(0.4, 1.5));
     v.mode.freq_hz = d.u(8.0, 11.0), v.mode.zeta = d.u(0.03, 0.05),
     v.mode.gain = Eigen::Vector3d::Constant(d.u(0.005, 0.015));
-  } else if (e == "machine.differential_vibration") {
+  } else if (e == Effect::machine_differential_vibration) {
     sc.differential_vibration.freq_hz = d.u(12.0, 25.0), sc.differential_vibration.zeta = d.u(0.03, 0.06);
     sc.differential_vibration.gain = Eigen::Vector3d::Constant(d.u(0.01, 0.03));
     Tone t;
@@ -199,35 +203,35 @@ void inject_vibration(Scenario& sc, const std::string& e, Draw& d) {
     t.phase_deg = d.u(0, 360);
     sc.differential_tones = {t};
   } else {
-    unknown_effect(e);
+    unknown_effect(std::string(dsp::model::name(e)));
   }
 }
 
 // The errors of an axis the program moves (squareness: of the xy pair).
-void inject_machine(Scenario& sc, const std::string& e, Draw& d) {
+void inject_machine(Scenario& sc, Effect e, Draw& d) {
   auto& m = sc.machine;
-  if (e == "machine.backlash") {
+  if (e == Effect::machine_backlash) {
     m.backlash_um[moving_axis(sc, d)] = d.u(3.0, 10.0);
-  } else if (e == "machine.reversal_spike") {
+  } else if (e == Effect::machine_reversal_spike) {
     m.spike[moving_axis(sc, d)] = ReversalSpike{d.u(2.0, 6.0), d.u(10.0, 25.0)};
-  } else if (e == "machine.servo_mismatch") {
+  } else if (e == Effect::machine_servo_mismatch) {
     AxisServo& a = m.servo[moving_axis(sc, d)];
     a.kv_per_s *= d.u(0.6, 0.85), a.feedforward = d.u(0.95, 0.98);
-  } else if (e == "machine.squareness") {
+  } else if (e == Effect::machine_squareness) {
     m.squareness_urad[0] = d.mag(15.0, 50.0);
-  } else if (e == "machine.scale_mismatch") {
+  } else if (e == Effect::machine_scale_mismatch) {
     m.scale_ppm[moving_axis(sc, d)] = d.mag(20.0, 60.0);
-  } else if (e == "machine.cyclic_error") {
+  } else if (e == Effect::machine_cyclic_error) {
     m.cyclic[moving_axis(sc, d)] = CyclicError{d.u(1.0, 3.0), d.pick(2) ? 5.0 : 10.0, d.u(0.0, 360.0)};
-  } else if (e == "machine.straightness") {
+  } else if (e == Effect::machine_straightness) {
     const int a = moving_axis(sc, d);
     const double span =
         sc.meta.program.kind == "circle" ? sc.meta.program.radius_mm : sc.meta.program.targets_mm.back();
     m.straightness[a] =
         Straightness{a == 0 ? 1 : 0, d.mag(2.0, 5.0), {sc.meta.program.kind == "circle" ? -span : 0.0, span}};
-  } else if (e == "machine.stick_slip") {
+  } else if (e == Effect::machine_stick_slip) {
     m.stick_slip[moving_axis(sc, d)] = StickSlip{d.u(1.0, 3.0), d.u(100.0, 200.0), 2.0};
-  } else if (e == "machine.resonance") {
+  } else if (e == Effect::machine_resonance) {
     // A lightly damped mode between the moving axis' drive and its part's measured point,
     // rung by every acceleration ramp of the program.
     const int a = moving_axis(sc, d);
@@ -243,24 +247,26 @@ void inject_machine(Scenario& sc, const std::string& e, Draw& d) {
     // explain names machine.differential_vibration (run-format.md).
     set_sensors_present(sc, sc.resonance.part == 1 ? "head" : "table");
   } else {
-    unknown_effect(e);
+    unknown_effect(std::string(dsp::model::name(e)));
   }
 }
 
 // The effect e on top of the background, its sizes drawn from d.
-void inject(Scenario& sc, const std::string& e, Draw& d) {
-  if (e.rfind("sensor.", 0) == 0) {
-    inject_sensor(sc, e, d);
-  } else if (e == "daq.group_delay") {
-    sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples + d.mag(0.8, 2.0);
-    if (d.pick(2) == 1) sc.daq.skew_head_samples = d.mag(0.3, 1.0);
-  } else if (e == "site.coriolis") {
-    sc.coriolis = true;
-  } else if (e == "machine.common_vibration" || e == "machine.differential_vibration") {
-    inject_vibration(sc, e, d);
-  } else {
-    inject_machine(sc, e, d);
+void inject(Scenario& sc, const std::string& name, Draw& d) {
+  const std::optional<Effect> e = dsp::model::effect_named(name);
+  if (!e) unknown_effect(name);
+  switch (dsp::model::info(*e).side) {
+    case dsp::model::EffectSide::sensor: return inject_sensor(sc, *e, d);
+    case dsp::model::EffectSide::daq:
+      sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples + d.mag(0.8, 2.0);
+      if (d.pick(2) == 1) sc.daq.skew_head_samples = d.mag(0.3, 1.0);
+      return;
+    case dsp::model::EffectSide::site: sc.coriolis = true; return;
+    case dsp::model::EffectSide::machine: break;
   }
+  if (*e == Effect::machine_common_vibration || *e == Effect::machine_differential_vibration)
+    return inject_vibration(sc, *e, d);
+  inject_machine(sc, *e, d);
 }
 
 }  // namespace
@@ -274,18 +280,20 @@ const std::vector<std::string>& hidden_programs() {
 const std::vector<std::string>& hideable_effects() { return effect_names(); }
 
 std::string program_for(const std::string& effect) {
-  static const std::vector<std::string> step = {"sensor.scale",
-                                                "sensor.bias_drift",
-                                                "sensor.nonlinearity",
-                                                "sensor.dynamics",
-                                                "sensor.damping_amplitude",
-                                                "sensor.scale_temperature",
-                                                "machine.common_vibration",
-                                                "machine.differential_vibration",
-                                                "machine.scale_mismatch",
-                                                "site.coriolis",
-                                                "machine.resonance"};
-  return std::find(step.begin(), step.end(), effect) != step.end() ? "step" : "circle";
+  // What a long straight move shows best: the sensors' own errors, vibration, a scale.
+  static constexpr Effect kStep[] = {Effect::sensor_scale,
+                                     Effect::sensor_bias_drift,
+                                     Effect::sensor_nonlinearity,
+                                     Effect::sensor_dynamics,
+                                     Effect::sensor_damping_amplitude,
+                                     Effect::sensor_scale_temperature,
+                                     Effect::machine_common_vibration,
+                                     Effect::machine_differential_vibration,
+                                     Effect::machine_scale_mismatch,
+                                     Effect::site_coriolis,
+                                     Effect::machine_resonance};
+  const std::optional<Effect> e = dsp::model::effect_named(effect);
+  return e && std::find(std::begin(kStep), std::end(kStep), *e) != std::end(kStep) ? "step" : "circle";
 }
 
 std::string program_for(const std::vector<std::string>& effects) {
@@ -300,14 +308,17 @@ Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const s
   sc.seed = seed;
   // Damping that grows with |a| and nonlinearity show with the acceleration of a fast move
   // (the sample run of sensor.damping_amplitude: 6.5 m/min).
-  auto has = [&](const char* e) { return std::find(effects.begin(), effects.end(), e) != effects.end(); };
+  auto has = [&](Effect x) {
+    return std::any_of(effects.begin(), effects.end(),
+                       [&](const std::string& e) { return dsp::model::effect_named(e) == x; });
+  };
   // The program draws from its own stream: one seed is one machine (sensors, errors),
   // whichever program measures it.
   Draw dp(stream_seed(seed, 7002));
-  program(sc, kind, dp, has("sensor.damping_amplitude") || has("sensor.nonlinearity"));
+  program(sc, kind, dp, has(Effect::sensor_damping_amplitude) || has(Effect::sensor_nonlinearity));
   background(sc, d);
   // Cross coupling differs from a rotated mounting only where one sensor moves two axes.
-  if (has("sensor.cross_coupling")) sc.meta.machine.table_axes = {"x", "y"}, sc.meta.machine.head_axes = {"z"};
+  if (has(Effect::sensor_cross_coupling)) sc.meta.machine.table_axes = {"x", "y"}, sc.meta.machine.head_axes = {"z"};
   for (const auto& e : effects) {
     // Each effect from its own stream: its size does not depend on what else is hidden.
     const auto& names = hideable_effects();

@@ -2,6 +2,7 @@
 
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/axes.hpp"
+#include "dsp/model/effects.hpp"
 #include "dsp/model/extension.hpp"
 
 #include <Eigen/Dense>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -17,6 +19,7 @@ namespace eical::tools::explain {
 namespace {
 
 using Params = std::map<std::string, double>;
+using dsp::model::Effect;
 
 // The sensor side: what explain took into the model (it made the pipeline follow the
 // reference better) as a sensor calibration; the rest stays a finding.
@@ -128,27 +131,32 @@ std::string machine_effects_toml(const dsp::Run& run, const dsp::model::RunExpla
   for (const auto& x : ex.effects) {
     if (!x.significant) continue;
     const auto& p = x.params;
-    if (x.name.rfind("sensor.", 0) == 0 || x.name == "daq.group_delay" || x.name == "site.coriolis") {
-      continue;
-    } else if (x.name == "machine.backlash") {
-      effects_toml += backlash_toml(p);
-    } else if (x.name == "machine.reversal_spike") {
-      effects_toml += reversal_spike_toml(p);
-    } else if (x.name == "machine.squareness") {
-      effects_toml += squareness_toml(p);
-    } else if (x.name == "machine.scale_mismatch") {
-      effects_toml += scale_mismatch_toml(p);
-    } else if (x.name == "machine.cyclic_error") {
-      effects_toml += cyclic_error_toml(p);
-    } else if (x.name == "machine.resonance" ||
-               (x.name == "machine.differential_vibration" && p.count("mode0_frequency_hz"))) {
-      // A driven mode of the head against the table is the simulator's resonance of the
-      // moving part: the same equation of motion.
-      effects_toml += resonance_toml(run, p, notes);
-    } else {
+    const std::optional<Effect> id = dsp::model::effect_named(x.name);
+    if (!id) {  // other.*: no table in the simulator
       notes.push_back(x.name + ": found; not taken into the scenario (its shape is not one of the simulator's tables)");
+      continue;
     }
-    if (x.name.rfind("machine.", 0) == 0) notes.push_back(x.name + ": into the scenario");
+    if (dsp::model::info(*id).side != dsp::model::EffectSide::machine) continue;  // into the calibration
+    switch (*id) {
+      case Effect::machine_backlash: effects_toml += backlash_toml(p); break;
+      case Effect::machine_reversal_spike: effects_toml += reversal_spike_toml(p); break;
+      case Effect::machine_squareness: effects_toml += squareness_toml(p); break;
+      case Effect::machine_scale_mismatch: effects_toml += scale_mismatch_toml(p); break;
+      case Effect::machine_cyclic_error: effects_toml += cyclic_error_toml(p); break;
+      case Effect::machine_differential_vibration:
+      case Effect::machine_resonance:
+        // A driven mode of the head against the table is the simulator's resonance of the
+        // moving part: the same equation of motion.
+        if (*id == Effect::machine_resonance || p.count("mode0_frequency_hz")) {
+          effects_toml += resonance_toml(run, p, notes);
+          break;
+        }
+        [[fallthrough]];
+      default:
+        notes.push_back(x.name +
+                        ": found; not taken into the scenario (its shape is not one of the simulator's tables)");
+    }
+    notes.push_back(x.name + ": into the scenario");
   }
   return effects_toml;
 }
@@ -157,7 +165,7 @@ std::string machine_effects_toml(const dsp::Run& run, const dsp::model::RunExpla
 std::string servo_toml(const dsp::model::RunExplanation& ex) {
   std::string o;
   for (const auto& x : ex.effects)
-    if (x.name == "machine.servo_mismatch")
+    if (dsp::model::effect_named(x.name) == Effect::machine_servo_mismatch)
       for (const auto& [k, v] : x.params)
         if (k.rfind("lag_", 0) == 0 && v > 1e-4)
           o += "\n[servo." + std::string(1, k[4]) + "]\nkv_per_s = " + drivers::toml_number(0.01 / (v * 1e-3)) +
