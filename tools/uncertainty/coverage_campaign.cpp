@@ -26,6 +26,7 @@ namespace {
 struct CampaignProgram {
   plan::TestProgram program;
   bool background = false;  // the background circle or step of that seed (sim/hidden)
+  int strips = 2;           // about a circle (plan::strips_for; 2: configuration B)
 };
 
 CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
@@ -41,6 +42,10 @@ CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
   } else if (program == "circle-identified") {  // ballbar class: R10–R50, both directions
     p.kind = "circle", p.direction = "both", p.repeats = 3, p.identified = true;
     p.radius_mm = pick({10.0, 25.0, 50.0}), p.feed_mm_min = pick({1000.0, 2500.0, 4000.0});
+  } else if (program == "circle-strips") {  // 4–16 strips about R25–R100, identified
+    p.kind = "circle", p.direction = "both", p.repeats = 2, p.identified = true;
+    p.radius_mm = pick({25.0, 50.0, 100.0}), p.feed_mm_min = pick({2500.0, 4000.0, 10000.0});
+    c.strips = static_cast<int>(pick({4.0, 8.0, 16.0}));
   } else if (program == "circle-large") {  // beyond the instrument without more strips
     p.kind = "circle", p.repeats = 1, p.radius_mm = pick({50.0, 100.0, 150.0});
     p.feed_mm_min = pick({4000.0, 10000.0});
@@ -57,9 +62,9 @@ CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
   } else {
     throw dsp::InputError(
         "coverage campaign: unknown program '" + program +
-        "' (circle, circle-identified, circle-large, step, positioning, positioning-long, rectangle)");
+        "' (circle, circle-identified, circle-strips, circle-large, step, positioning, positioning-long, rectangle)");
   }
-  p.psd = plan::strips_for(p);
+  p.psd = p.kind == "circle" ? plan::strips_for(p, c.strips) : plan::strips_for(p);
   return c;
 }
 
