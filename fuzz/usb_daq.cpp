@@ -1,5 +1,5 @@
 // Fuzz target: the USB DAQ wire protocol (drivers/usb_daq/PROTOCOL.md) through
-// usb_daq::Decoder. Byte 0 chooses the PSD strips expected (0..4) and the chunking; the
+// usb_daq::Decoder. Byte 0 chooses the PSD strips expected (0..16) and the chunking; the
 // rest is the byte stream. Differential check: the stream fed as the source reads it
 // (bulk transfers of up to 16 KiB) and fed in small uneven chunks must decode to the same
 // frames and statistics — how the bytes are split into transfers must not change what is
@@ -34,9 +34,18 @@ Decoded decode(int psd_count, std::span<const std::uint8_t> bytes, NextChunk&& n
   return out;
 }
 
-bool same(const dsp::Frame& a, const dsp::Frame& b) {
-  // cmd_mm is NaN in both: compare the bytes.
+// Field by field, each field's bytes (cmd_mm and ref_mm may be NaN in both): the frame's
+// padding is no part of what is recorded, and nothing guarantees it the same.
+template <class T>
+bool same_bytes(const T& a, const T& b) {
   return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+bool same(const dsp::Frame& a, const dsp::Frame& b) {
+  return same_bytes(a.sample_index, b.sample_index) && same_bytes(a.accel_counts, b.accel_counts) &&
+         same_bytes(a.psd_counts, b.psd_counts) && same_bytes(a.temp_c, b.temp_c) && same_bytes(a.cmd_mm, b.cmd_mm) &&
+         same_bytes(a.ref_mm, b.ref_mm) && a.trigger == b.trigger && a.flags == b.flags &&
+         a.psd_missing_electrodes == b.psd_missing_electrodes;
 }
 
 }  // namespace
