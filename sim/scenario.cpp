@@ -111,9 +111,9 @@ std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count) {
     throw dsp::InputError("psd: " + std::to_string(count) + " strips about a circle, 1 to " +
                           std::to_string(dsp::kMaxPsd) + " possible");
   auto nm = [](double mm) { return std::round(mm * 1e6) / 1e6; };  // cos(90°) is 6e-17, not 0
+  const int slots = std::max(count, 4);                            // 2 is B: a quarter apart, not opposite
   std::vector<dsp::PsdSpec> out;
   for (int k = 0; k < count; ++k) {
-    const int slots = std::max(count, 4);  // 2 is B: a quarter apart, not opposite
     const double theta = (-0.5 + 2.0 * k / slots) * std::numbers::pi;
     const double x = nm(radius_mm * std::cos(theta)), y = nm(radius_mm * std::sin(theta));
     dsp::PsdSpec strip;

@@ -158,7 +158,8 @@ std::string tones_table(const std::string& name, const std::vector<Tone>& tones)
   return o;
 }
 
-std::string vibration_effect_table(const Scenario& sc, Effect e, const std::string& name) {
+std::string vibration_effect_table(const Scenario& sc, Effect e) {
+  const std::string name(dsp::model::name(e));
   std::string o;
   if (e == Effect::machine_common_vibration) {
     const CommonVibration& v = sc.common_vibration;
@@ -185,7 +186,8 @@ std::string largest_axis(Size size, Body body) {
 }
 
 // The errors of the axes and between them (machine.*, vibration aside).
-std::string machine_effect_table(const Scenario& sc, Effect e, const std::string& name) {
+std::string machine_effect_table(const Scenario& sc, Effect e) {
+  const std::string name(dsp::model::name(e));
   const MachineErrors& m = sc.machine;
   std::string o;
   if (e == Effect::machine_backlash) {
@@ -252,8 +254,8 @@ std::string effect_table(const Scenario& sc, const std::string& name) {
     case dsp::model::EffectSide::machine: break;
   }
   if (*e == Effect::machine_common_vibration || *e == Effect::machine_differential_vibration)
-    return o + vibration_effect_table(sc, *e, name);
-  return o + machine_effect_table(sc, *e, name);
+    return o + vibration_effect_table(sc, *e);
+  return o + machine_effect_table(sc, *e);
 }
 
 // The comments, the scenario, the effects present and in the background, and where each

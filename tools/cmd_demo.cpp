@@ -22,6 +22,25 @@
 #include <memory>
 
 namespace eical::tools {
+namespace {
+
+// Part one's circle: its radius, feed, revolutions and strips (demo::DemoTest).
+void add_design_options(CLI::App* cmd, demo::DemoTest& test, std::string& psd) {
+  cmd->add_option("--radius", test.radius_mm, "part 1's circle: radius, mm")
+      ->default_val(10.0)
+      ->check(CLI::Range(1.0, 500.0));
+  cmd->add_option("--feed", test.feed_mm_min, "part 1's circle: feed, mm/min")
+      ->default_val(2500.0)
+      ->check(CLI::Range(100.0, 20000.0));
+  cmd->add_option("--repeats", test.repeats, "part 1's circle: revolutions per direction")
+      ->default_val(5)
+      ->check(CLI::Range(1, 20));
+  cmd->add_option("--psd", psd, "part 1's PSD strips about the circle: B (2), B4, B8, B16")
+      ->default_val("B")
+      ->check(CLI::IsMember(psd_layout_names()));
+}
+
+}  // namespace
 
 void register_demo(CLI::App& app) {
   struct Opt {
@@ -40,18 +59,7 @@ void register_demo(CLI::App& app) {
       ->default_val("out/demo");
   cmd->add_option("--seed", o->seed, "simulation seed: the machine, its sensors and strips")->default_val(1);
   cmd->add_flag("--realtime", o->realtime, "pace the simulated DAQ at 10 kHz (as eicald does) instead of free-running");
-  cmd->add_option("--radius", o->test.radius_mm, "part 1's circle: radius, mm")
-      ->default_val(10.0)
-      ->check(CLI::Range(1.0, 500.0));
-  cmd->add_option("--feed", o->test.feed_mm_min, "part 1's circle: feed, mm/min")
-      ->default_val(2500.0)
-      ->check(CLI::Range(100.0, 20000.0));
-  cmd->add_option("--repeats", o->test.repeats, "part 1's circle: revolutions per direction")
-      ->default_val(5)
-      ->check(CLI::Range(1, 20));
-  cmd->add_option("--psd", o->psd, "part 1's PSD strips about the circle: B (2), B4, B8, B16")
-      ->default_val("B")
-      ->check(CLI::IsMember({"B", "B4", "B8", "B16"}));
+  add_design_options(cmd, o->test, o->psd);
   cmd->footer("Exit status: 0 when the calibration's verdict is ok, 2 degraded, 3 not measurable, 1 an error.");
   cmd->callback([o] {
     namespace fs = std::filesystem;
@@ -60,6 +68,8 @@ void register_demo(CLI::App& app) {
     fs::create_directories(out);
 
     o->test.strips = psd_layout_strips(o->psd);
+    if (o->test.strips == 0)
+      throw CLI::ValidationError("--psd", "the demo's circle runs over strips: B, B4, B8 or B16");
     const demo::DemoMachine machine = demo::demo_machine(o->seed, o->test);
     std::printf("eical demo, part 1: a calibration, as on the machine (simulated, seed %llu)\n",
                 static_cast<unsigned long long>(o->seed));

@@ -55,8 +55,7 @@ void append_sample_row(std::string& out, const dsp::Frame& f, const dsp::RunMeta
   }
   for (int c = 0; c < 2 * channels.psd_count; ++c) {
     out += ',';
-    const bool psd_named = dsp::frame_flag::psd_fields_named(f);
-    if (!dsp::frame_flag::psd_field_missing(f, c) && (psd_named || !(f.flags & dsp::frame_flag::psd_missing)))
+    if (!dsp::frame_flag::psd_electrode_empty(f, c))
       append_double(out, static_cast<double>(f.psd_counts[c] - offset) * lsb);
   }
   for (int a = 0; a < 3; ++a) {

@@ -18,6 +18,11 @@ constexpr std::uint32_t sensor_fields_missing(int s) {
 // Frame::psd_missing_electrodes: 16 strips' 32 electrodes do not fit beside the flags.
 constexpr bool psd_field_missing(const Frame& f, int e) { return (f.psd_missing_electrodes >> e) & 1u; }
 constexpr bool psd_fields_named(const Frame& f) { return f.psd_missing_electrodes != 0; }
+// Whether electrode e's count is absent: by its own bit where the source names the empty
+// electrodes, else by psd_missing (every electrode of that sample).
+constexpr bool psd_electrode_empty(const Frame& f, int e) {
+  return psd_fields_named(f) ? psd_field_missing(f, e) : (f.flags & psd_missing) != 0;
+}
 constexpr void mark_psd_field_missing(Frame& f, int e) {
   f.flags |= psd_missing;
   f.psd_missing_electrodes |= 1u << e;

@@ -194,12 +194,10 @@ void ChannelHealth::frame(const Frame& f) noexcept {
                                      ((f.flags & frame_flag::accel_missing) && !any_sensor);
     sample(c, missing, f.accel_counts[c], f.sample_index, rest_);
   }
-  const bool psd_named = frame_flag::psd_fields_named(f);
   for (int c = kAccelChannels; c < kChannels; ++c) {
     if (!ch_[c].active) continue;
     const int e = c - kAccelChannels;
-    const bool missing = psd_named ? frame_flag::psd_field_missing(f, e) : (f.flags & frame_flag::psd_missing) != 0;
-    sample(c, missing, f.psd_counts[e], f.sample_index, false);
+    sample(c, frame_flag::psd_electrode_empty(f, e), f.psd_counts[e], f.sample_index, false);
   }
 }
 

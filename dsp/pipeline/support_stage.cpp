@@ -76,12 +76,9 @@ void SupportStage::reset() noexcept {
 void SupportStage::psd_frame(const Frame& f) noexcept {
   // A source that names the empty electrodes loses only those strips; one that cannot
   // (psd_missing alone) loses them all for this sample.
-  const bool named = frame_flag::psd_fields_named(f);
-  const bool all_missing = (f.flags & frame_flag::psd_missing) != 0;
   for (std::size_t k = 0; k < psd_.size(); ++k) {
     const int e = 2 * static_cast<int>(k);
-    const bool missing =
-        named ? frame_flag::psd_field_missing(f, e) || frame_flag::psd_field_missing(f, e + 1) : all_missing;
+    const bool missing = frame_flag::psd_electrode_empty(f, e) || frame_flag::psd_electrode_empty(f, e + 1);
     psd_now_[k] = psd_[k].step(f.psd_counts[e], f.psd_counts[e + 1], missing);
   }
 }

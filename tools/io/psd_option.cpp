@@ -37,16 +37,31 @@ AxisPair parse_axis_pair(const std::string& text, const std::string& option, con
 
 }  // namespace
 
+namespace {
+
+struct PsdLayout {
+  const char* name;
+  int strips;
+};
+constexpr PsdLayout kPsdLayouts[] = {{"none", 0}, {"B", 2}, {"B4", 4}, {"B8", 8}, {"B16", 16}};
+
+}  // namespace
+
 const std::vector<std::string>& psd_layout_names() {
-  static const std::vector<std::string> names{"none", "B", "B4", "B8", "B16"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> v;
+    for (const PsdLayout& l : kPsdLayouts) v.emplace_back(l.name);
+    return v;
+  }();
   return names;
 }
 
 int psd_layout_strips(const std::string& layout) {
-  if (layout == "none") return 0;
-  if (layout == "B") return 2;
-  if (layout == "B4" || layout == "B8" || layout == "B16") return std::stoi(layout.substr(1));
-  throw dsp::InputError("--psd '" + layout + "': one of none, B, B4, B8, B16");
+  for (const PsdLayout& l : kPsdLayouts)
+    if (layout == l.name) return l.strips;
+  std::string names;
+  for (const std::string& n : psd_layout_names()) names += (names.empty() ? "" : ", ") + n;
+  throw dsp::InputError("--psd '" + layout + "': one of " + names);
 }
 
 dsp::PsdSpec parse_psd(const std::string& text) {

@@ -64,7 +64,7 @@ CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
         "coverage campaign: unknown program '" + program +
         "' (circle, circle-identified, circle-strips, circle-large, step, positioning, positioning-long, rectangle)");
   }
-  p.psd = p.kind == "circle" ? plan::strips_for(p, c.strips) : plan::strips_for(p);
+  p.psd = plan::strips_for(p, c.strips);
   return c;
 }
 
