@@ -12,6 +12,10 @@ constexpr double kNoiseAlpha = 1.0 / 2000.0;  // 0.2 s memory at 10 kHz
 constexpr double kLitSigmas = 30.0;
 constexpr double kLitOfPeak = 0.3;
 constexpr double kD2PerSigma = 1.954;  // E|i[k] − 2i[k−1] + i[k−2]| = √6·√(2/π) σ for white noise
+// Second differences averaged plainly before any is clipped: a clip at 4× a mean of one or
+// two values can hold the estimate near zero for seconds (it grows only as n³), and every
+// noise sample is then "lit" (a strip read 73 false fixes 45 mm off at a run's start).
+constexpr long kUnclippedD2 = 64;
 
 }  // namespace
 
@@ -40,19 +44,20 @@ void PsdDecoder::reset() noexcept {
 PsdReading PsdDecoder::step(std::int32_t i1_counts, std::int32_t i2_counts, bool missing) noexcept {
   PsdReading r;
   if (missing) return r;
-  const double i[2] = {(static_cast<double>(i1_counts) - offset_counts_) * lsb_v_,
-                       (static_cast<double>(i2_counts) - offset_counts_) * lsb_v_};
-  // Electrode noise from second differences (robust: each clipped at 4× the running mean).
+  const double c[2] = {static_cast<double>(i1_counts), static_cast<double>(i2_counts)};
+  const double i[2] = {(c[0] - offset_counts_) * lsb_v_, (c[1] - offset_counts_) * lsb_v_};
+  // Electrode noise from second differences (robust: each clipped at 4× the running mean
+  // once the mean stands on kUnclippedD2 of them). In counts, exact: a zero is a zero.
   if (seen_ >= 2) {
     for (int e = 0; e < 2; ++e) {
-      double d2 = std::abs(i[e] - 2.0 * hist_[e][0] + hist_[e][1]);
-      if (mean_abs_d2_ > 0.0) d2 = std::min(d2, 4.0 * mean_abs_d2_);
+      double d2 = std::abs(c[e] - 2.0 * hist_[e][0] + hist_[e][1]) * lsb_v_;
+      if (d2_count_ >= kUnclippedD2) d2 = std::min(d2, 4.0 * mean_abs_d2_);
       ++d2_count_;  // a plain mean at first, then exponential forgetting
       mean_abs_d2_ += std::max(kNoiseAlpha, 1.0 / static_cast<double>(d2_count_)) * (d2 - mean_abs_d2_);
     }
     sigma_i_v_ = mean_abs_d2_ / kD2PerSigma;
   }
-  for (int e = 0; e < 2; ++e) hist_[e][1] = hist_[e][0], hist_[e][0] = i[e];
+  for (int e = 0; e < 2; ++e) hist_[e][1] = hist_[e][0], hist_[e][0] = c[e];
   if (seen_ < 1000000) ++seen_;
 
   const double sum = i[0] + i[1];

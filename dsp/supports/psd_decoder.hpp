@@ -46,7 +46,7 @@ class PsdDecoder {
   double sigma_i_v_ = 0.0;  // tracked electrode noise
   double mean_abs_d2_ = 0.0;
   double peak_v_ = 0.0;
-  double hist_[2][2] = {{0, 0}, {0, 0}};  // last two values per electrode
+  double hist_[2][2] = {{0, 0}, {0, 0}};  // last two values per electrode, counts
   int seen_ = 0;
   long d2_count_ = 0;
 };

@@ -62,6 +62,27 @@ TEST(PsdDecoder, RecoversPositionAndNoiseAndIgnoresDarkAndEnds) {
   EXPECT_FALSE(d.step(0, 0, true).valid);  // missing channel
 }
 
+// A dark strip whose first second difference is exactly zero in counts (−21, −33, −45: the
+// recording of the seed that found it). In volts it was 3.4e-21 V, not zero, and a clip at 4×
+// that mean held the noise estimate near zero for seconds: every noise sample was "lit",
+// 73 false fixes up to 45 mm off, and the run's PSD readings were dropped as disagreeing.
+TEST(PsdDecoder, ADarkStripWhoseFirstDifferenceIsZeroStaysDark) {
+  Strip s;
+  s.acq.adc_lsb_volt = 1.1920929e-6;  // the default: 20 V / 2^24, rounded (not a power of two)
+  PsdDecoder d(s.spec, s.acq);
+  const std::int32_t start[3][2] = {{-21, 36}, {-33, 3}, {-45, 6}};
+  for (const auto& c : start) EXPECT_FALSE(d.step(c[0], c[1], false).valid);
+  std::mt19937_64 rng(1002);
+  const double noise_v = 6e-5;
+  int lit = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const auto [c1, c2] = s.counts(0.0, 0.0, noise_v, rng);
+    lit += d.step(c1, c2, false).valid;
+  }
+  EXPECT_EQ(lit, 0) << "noise read as light";
+  EXPECT_NEAR(d.noise_v(), noise_v, 0.15 * noise_v);
+}
+
 TEST(PsdDecoder, RejectsAStripMeasuringZ) {
   Strip s;
   s.spec.measures = "z";
