@@ -2,9 +2,11 @@
 // figures beside the spread of the figures over repeats on machines drawn within the data
 // sheet's tolerances (tools/plan/plan_check.hpp).
 //   bench_plan [--repeats 20] [--draws 100] [--programs circle,...] [--datasheet]
-//              [--circle R,F,STRIPS ...]   a circle of its own, both directions x2 (e.g. 50,4000,16)
+//              [--circle R,F,PSD ...]   a circle of its own, both directions x2 (e.g. 50,4000,R16;
+//                                       PSD as eical plan --psd takes it)
 #include "tools/plan/plan_check.hpp"
 #include "tools/plan/predicted_uncertainty.hpp"
+#include "tools/plan/psd_layouts.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -15,13 +17,14 @@ int main(int argc, char** argv) {
   CLI::App app("eical plan-vs-simulation benchmark");
   int repeats = 20, draws = 100;
   std::vector<std::string> only;
-  std::vector<std::vector<double>> circles;
+  std::vector<std::vector<std::string>> circles;
   bool datasheet = false;
   app.add_option("--repeats", repeats, "simulated repeats per program");
   app.add_option("--draws", draws, "Monte Carlo draws of the prediction");
   app.add_option("--programs", only, "circle, step, positioning, rectangle (default: all)")->delimiter(',');
   app.add_flag("--datasheet", datasheet, "the data sheet's sensor model instead of an identification before each test");
-  app.add_option("--circle", circles, "instead of the programs: a circle RADIUS,FEED,STRIPS (repeatable)")
+  app.add_option("--circle", circles,
+                 "instead of the programs: a circle RADIUS,FEED,PSD (repeatable; PSD e.g. B16, R16)")
       ->delimiter(',')
       ->expected(3)
       ->allow_extra_args(false);
@@ -31,8 +34,15 @@ int main(int argc, char** argv) {
   for (const auto& c : circles) {
     eical::tools::plan::TestProgram p;
     p.kind = "circle", p.direction = "both", p.repeats = 2, p.identified = !datasheet;
-    p.radius_mm = c.at(0), p.feed_mm_min = c.at(1);
-    p.psd = eical::tools::plan::strips_for(p, static_cast<int>(c.at(2)));
+    try {
+      p.radius_mm = std::stod(c.at(0)), p.feed_mm_min = std::stod(c.at(1));
+      const auto layout = eical::tools::plan::psd_layout(c.at(2));
+      p.psd = eical::tools::plan::strips_for(p, layout.strips, layout.facing);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_plan --circle %s,%s,%s: %s\n", c.at(0).c_str(), c.at(1).c_str(), c.at(2).c_str(),
+                   e.what());
+      return 1;
+    }
     programs.push_back(p);
   }
   std::vector<eical::tools::plan::CheckRow> rows;

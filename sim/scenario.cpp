@@ -106,7 +106,7 @@ Scenario gcode_scenario(const std::string& gcode, const std::string& kind, std::
 
 std::vector<dsp::PsdSpec> psd_config_b(double radius_mm) { return psd_ring(radius_mm, 2); }
 
-std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count) {
+std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count, StripFacing facing) {
   if (count < 1 || count > dsp::kMaxPsd)
     throw dsp::InputError("psd: " + std::to_string(count) + " strips about a circle, 1 to " +
                           std::to_string(dsp::kMaxPsd) + " possible");
@@ -118,8 +118,8 @@ std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count) {
     const double x = nm(radius_mm * std::cos(theta)), y = nm(radius_mm * std::sin(theta));
     dsp::PsdSpec strip;
     // The path's direction is (−y, x): it runs along x where |y| > |x|.
-    const bool along_x = std::abs(y) != std::abs(x) ? std::abs(y) > std::abs(x) : x * y < 0.0;
-    strip.measures = along_x ? "x" : "y";
+    const bool path_along_x = std::abs(y) != std::abs(x) ? std::abs(y) > std::abs(x) : x * y < 0.0;
+    strip.measures = path_along_x == (facing == StripFacing::along_path) ? "x" : "y";
     strip.center_mm[0] = x, strip.center_mm[1] = y;
     out.push_back(strip);
   }

@@ -230,11 +230,18 @@ Scenario gcode_scenario(const std::string& gcode, const std::string& kind = "fre
 // measuring x where the circle crosses −y, one measuring y where it crosses +x (each 10 mm
 // long, tangent to the circle: the spot runs along it for millimetres).
 std::vector<dsp::PsdSpec> psd_config_b(double radius_mm = 10.0);
+// How a ring's strips face the circle. Along the path (configuration B): the spot runs
+// along each strip for millimetres and it reads the position along the path. Across the
+// path (radial): each strip turned a quarter, the spot crosses its width in milliseconds
+// and it reads the radius there, as a ballbar does; the radius is what G is made of, so at
+// R50 F4000 with 16 strips the noise bound of G falls from 3.25 to 1.77 µm (eical demo,
+// seed 1).
+enum class StripFacing { along_path, across_path };
 // Configuration B widened to `count` strips (1..dsp::kMaxPsd) around the circle, from where
-// it crosses −y counter-clockwise, 360°/count apart (90° for fewer than 4): each measures
-// the axis the path runs along more (at 45° x and y alternate). 2 is configuration B, 4 B
-// and its mirror.
-std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count);
+// it crosses −y counter-clockwise, 360°/count apart (90° for fewer than 4): along the path
+// each measures the axis the path runs along more, across it the other (at 45° x and y
+// alternate). Along, 2 is configuration B, 4 B and its mirror.
+std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count, StripFacing facing = StripFacing::along_path);
 
 // On-site identification (sim/gcode identify_program) over the given strips and further
 // axes, with those strips in the run.

@@ -12,7 +12,7 @@
 #include "tools/commands.hpp"
 #include "tools/demo/demo_stages.hpp"
 #include "tools/exit_codes.hpp"
-#include "tools/io/psd_option.hpp"
+#include "tools/plan/psd_layouts.hpp"
 #include "tools/report/run_report.hpp"
 #include "tools/run_files.hpp"
 #include "tools/uncertainty/coverage_campaign.hpp"
@@ -35,9 +35,11 @@ void add_design_options(CLI::App* cmd, demo::DemoTest& test, std::string& psd) {
   cmd->add_option("--repeats", test.repeats, "part 1's circle: revolutions per direction")
       ->default_val(5)
       ->check(CLI::Range(1, 20));
-  cmd->add_option("--psd", psd, "part 1's PSD strips about the circle: B (2), B4, B8, B16")
+  cmd->add_option("--psd", psd,
+                  "part 1's PSD strips about the circle: B (2), B4, B8, B16 along its path, R4, R8, R16 turned "
+                  "radial")
       ->default_val("B")
-      ->check(CLI::IsMember(psd_layout_names()));
+      ->check(CLI::IsMember(plan::psd_layout_names()));
 }
 
 }  // namespace
@@ -67,9 +69,9 @@ void register_demo(CLI::App& app) {
     const fs::path out = o->out;
     fs::create_directories(out);
 
-    o->test.strips = psd_layout_strips(o->psd);
-    if (o->test.strips == 0)
-      throw CLI::ValidationError("--psd", "the demo's circle runs over strips: B, B4, B8 or B16");
+    const plan::PsdLayout layout = plan::psd_layout(o->psd);
+    if (layout.strips == 0) throw CLI::ValidationError("--psd", "the demo's circle runs over strips, not none");
+    o->test.strips = layout.strips, o->test.facing = layout.facing;
     const demo::DemoMachine machine = demo::demo_machine(o->seed, o->test);
     std::printf("eical demo, part 1: a calibration, as on the machine (simulated, seed %llu)\n",
                 static_cast<unsigned long long>(o->seed));

@@ -13,6 +13,7 @@
 #include "tools/io/psd_option.hpp"
 #include "tools/plan/identification_plan.hpp"
 #include "tools/plan/predicted_uncertainty.hpp"
+#include "tools/plan/psd_layouts.hpp"
 #include "tools/plan/strip_layout.hpp"
 #include "tools/program_defaults.hpp"
 #include "tools/run_files.hpp"
@@ -58,9 +59,9 @@ std::string prediction_text(const plan::Prediction& p) {
   // (" ± ?" is five bytes in UTF-8: erasing four left "µm?" on every line.)
   const std::string no_u = " ± ?";
   for (std::string::size_type at; (at = o.find(no_u)) != std::string::npos;) o.erase(at, no_u.size());
-  std::snprintf(b, sizeof b, "  %s: U = %.2f µm %s the %.0f µm the test is meant to resolve\n",
+  std::snprintf(b, sizeof b, "  %s: U = %.2f µm %s the %g µm the test is meant to resolve%s\n",
                 p.measurable ? "measurable" : "NOT MEASURABLE", p.limited_u, p.measurable ? "within" : "exceeds",
-                p.limit);
+                p.limit, p.program.resolve_um ? " (--resolve)" : "");
   return o + b + plan::layout_text(p.program) +
          (p.program.identified ? plan::identification_text(plan::identification_plan(p.program)) : std::string());
 }
@@ -112,9 +113,10 @@ void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
       ->delimiter(',');
   cmd.add_option("--psd", o.psd,
                  "PSD strips: none, B (configuration B about the circle, one at mid travel, mid sides of a "
-                 "rectangle), B4, B8, B16 (that many strips evenly about the circle)")
+                 "rectangle), B4, B8, B16 (that many strips evenly about the circle, along its path), R4, R8, R16 "
+                 "(the same, turned radial)")
       ->default_val("none")
-      ->check(CLI::IsMember(psd_layout_names()));
+      ->check(CLI::IsMember(plan::psd_layout_names()));
   cmd.add_option("--strip", o.strips, "a strip on the machine as MEASURES:CX,CY, e.g. x:0,-10 (repeat for each)");
   cmd.add_option("--noise", o.p.noise_ug_per_rthz, "each sensor's noise density, ug/sqrt(Hz) (two-sided)")
       ->default_val(0.4)
@@ -138,6 +140,13 @@ void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
                  "the machine's sensor calibration (eical-sensor-cal/1, from eical identify): the test and every "
                  "variant are predicted with its covariance, as identified")
       ->check(CLI::ExistingFile);
+  cmd.add_flag("--identified", o.p.identified,
+               "the sensors identified on site first (eical gen-nc identify, eical identify): the test and every "
+               "variant predicted so, with a simulated identification");
+  cmd.add_option("--resolve", o.p.resolve_um,
+                 "the U (k = 2, µm) the test's limited figure must reach, e.g. 3 for a circle's G; default what the "
+                 "program must resolve (a circle's G: 10 µm)")
+      ->check(CLI::Range(0.01, 1000.0));
   cmd.add_flag("--json", o.json, "print the prediction as JSON");
   cmd.add_option("--layout-svg", o.layout_svg,
                  "draw the path and where its PSD strips go (the measurable test, else the nearest measurable "
@@ -152,7 +161,8 @@ plan::TestProgram test_program(const PlanCommandOptions& o) {
   p.runs = o.runs.value_or(program_defaults::runs(p.kind));
   p.repeats = o.repeats.value_or(program_defaults::repeats(p.kind));
   p.size_mm[0] = o.size.at(0), p.size_mm[1] = o.size.at(1);
-  p.psd = plan::strips_for(p, psd_layout_strips(o.psd));
+  const plan::PsdLayout layout = plan::psd_layout(o.psd);
+  p.psd = plan::strips_for(p, layout.strips, layout.facing);
   for (const auto& s : o.strips) p.psd.push_back(parse_psd(s));
   return p;
 }

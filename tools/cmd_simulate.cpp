@@ -10,7 +10,7 @@
 #include "tools/cmd_simulate_export.hpp"
 #include "tools/commands.hpp"
 #include "tools/envelope_options.hpp"
-#include "tools/io/psd_option.hpp"
+#include "tools/plan/psd_layouts.hpp"
 #include "tools/sim_programs.hpp"
 
 #include <algorithm>
@@ -79,6 +79,12 @@ sim::nc::KlipperTest sweep_test(const SimulateOptions& o) {
   return k;
 }
 
+// The identification's strips: --psd's about the circle, configuration B for none.
+std::vector<dsp::PsdSpec> identify_strips(const SimulateOptions& o) {
+  const plan::PsdLayout layout = plan::psd_layout(o.psd);
+  return layout.strips == 0 ? sim::psd_config_b(o.radius_mm) : sim::psd_ring(o.radius_mm, layout.strips, layout.facing);
+}
+
 sim::Scenario base_scenario(const SimulateOptions& o, bool program_given) {
   if (!o.regime.empty()) {
     if (!o.scenario.empty() || program_given)
@@ -102,12 +108,12 @@ sim::Scenario base_scenario(const SimulateOptions& o, bool program_given) {
       : o.program == "step"      ? sim::step_scenario(o.from_mm, o.to_mm, o.feed_mm_min, o.runs, o.seed)
       : o.program == "rectangle" ? sim::rectangle_scenario(20.0, 10.0, o.feed_mm_min, o.plane, 1, o.seed)
       : o.program == "freeform"  ? freeform_scenario(o.feed_mm_min, o.seed)
-      : o.program == "identify"
-          ? sim::identify_scenario(sim::psd_ring(o.radius_mm, std::max(2, psd_layout_strips(o.psd))), {"z"}, o.seed)
+      : o.program == "identify"  ? sim::identify_scenario(identify_strips(o), {"z"}, o.seed)
       : o.program == "sweep"
           ? sim::sweep_scenario(sweep_test(o), sim::nc::test_direction(o.sweep_axis, "--sweep-axis"), o.seed)
           : sim::positioning_scenario(o.targets, o.runs, o.feed_mm_min, o.seed);
-  if (const int strips = psd_layout_strips(o.psd); strips > 0) sc.meta.psd = sim::psd_ring(o.radius_mm, strips);
+  if (const auto layout = plan::psd_layout(o.psd); layout.strips > 0)
+    sc.meta.psd = sim::psd_ring(o.radius_mm, layout.strips, layout.facing);
   if (o.program == "circle") {
     sc.meta.program.plane = o.plane;
     sc.meta.program.arc_deg = o.arc_deg;
@@ -175,9 +181,10 @@ void add_program_options(CLI::App& cmd, SimulateOptions& o) {
       ->excludes(scenario);
   cmd.add_option("--psd", o.psd,
                  "PSD strips about a circle of --radius: B (configuration B of the sample runs: 2 strips), B4, B8, B16 "
-                 "(that many, evenly around it), none; identify: B by default")
+                 "(that many, evenly around it, along its path), R4, R8, R16 (the same, turned radial), none; "
+                 "identify: B by default")
       ->default_val("none")
-      ->check(CLI::IsMember(psd_layout_names()));
+      ->check(CLI::IsMember(plan::psd_layout_names()));
   cmd.add_option("--plane", o.plane, "circle, rectangle: xy, zx or yz")
       ->default_val("xy")
       ->check(CLI::IsMember({"xy", "zx", "yz"}));

@@ -50,6 +50,28 @@ TEST(IdentificationPlan, APositioningTestsIdentificationStaysInsideItsTravel) {
   EXPECT_NE(plan::identification_command(id).find("--travel x:0,100"), std::string::npos);
 }
 
+// Turned radial, a ring's strips sit on the circle's ends (x = ±R measuring x): they stay
+// where the circle crosses them, and the swings run on beyond the circle just far enough to
+// cross each whole.
+TEST(IdentificationPlan, ARadialRingIsReachedBeyondTheCircle) {
+  plan::TestProgram p;
+  p.kind = "circle", p.radius_mm = 50.0, p.identified = true;
+  p.psd = plan::strips_for(p, 16, eical::sim::StripFacing::across_path);
+  EXPECT_EQ(plan::strips_identification_can_cross(p).at(4).center_mm[0], 50.0) << "the strip stays on the circle";
+  const auto id = plan::identification_plan(p);
+  ASSERT_TRUE(id.travel_mm[0] && id.travel_mm[1]);
+  EXPECT_DOUBLE_EQ(id.travel_mm[0]->hi_mm, 56.0);
+  EXPECT_DOUBLE_EQ(id.travel_mm[1]->lo_mm, -56.0);
+  const Reach r = reach(gcode::identify_program(id));  // accepted: every strip crossed whole
+  EXPECT_LE(r.hi[0], 56.0);
+  EXPECT_GE(r.hi[0], 55.0);
+  // Along the path the circle's own travel suffices: no swing leaves it.
+  p.psd = plan::strips_for(p, 16);
+  const Reach along = reach(gcode::identify_program(plan::identification_plan(p)));
+  EXPECT_LE(along.hi[0], 50.0);
+  EXPECT_GE(along.lo[1], -50.0);
+}
+
 TEST(IdentificationPlan, StripsAtBothEndsOfATravelAreSwungFromInside) {
   plan::TestProgram p;
   p.kind = "positioning", p.targets_mm = {0.0, 150.0, 300.0};

@@ -64,5 +64,21 @@ TEST(NotMeasurable, AnalyzeExitsThreeAndPlanPrintsTheNearestMeasurableVariant) {
   std::filesystem::remove_all(dir);
 }
 
+// eical plan --resolve: the U the engineer needs replaces what the program must resolve, in
+// the verdict of the prediction and in the search for a design that reaches it.
+TEST(NotMeasurable, PlanResolveIsTheLimitTheDesignMustReach) {
+  tools::plan::TestProgram p;
+  p.kind = "circle", p.radius_mm = 10.0, p.feed_mm_min = 2500.0, p.repeats = 1;
+  p.psd = tools::plan::strips_for(p);
+  const auto ten = tools::plan::predict(p, 1, 20);
+  EXPECT_DOUBLE_EQ(ten.limit, 10.0) << "a circle's G: what it must resolve";
+  p.resolve_um = 0.5 * ten.limited_u;
+  const auto tight = tools::plan::predict(p, 1, 20);
+  EXPECT_DOUBLE_EQ(tight.limit, 0.5 * ten.limited_u);
+  EXPECT_FALSE(tight.measurable) << "U " << tight.limited_u << " against " << tight.limit;
+  p.resolve_um = 2.0 * ten.limited_u;
+  EXPECT_TRUE(tools::plan::predict(p, 1, 20).measurable);
+}
+
 }  // namespace
 }  // namespace eical

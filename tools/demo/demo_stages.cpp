@@ -35,7 +35,7 @@ DemoMachine demo_machine(std::uint64_t seed, const DemoTest& test) {
   plan::TestProgram& p = m.program;
   p.kind = "circle", p.direction = "both";
   p.radius_mm = test.radius_mm, p.feed_mm_min = test.feed_mm_min, p.repeats = test.repeats;
-  p.psd = plan::strips_for(p, test.strips);  // 2: configuration B, a strip across each axis' crossing
+  p.psd = plan::strips_for(p, test.strips, test.facing);  // 2 along: configuration B
   p.identified = true;
   m.circle = plan::scenario_on_drawn_machine(p, seed);
   // What a circular test is for: a backlash on x and an out-of-square xy, on top of the

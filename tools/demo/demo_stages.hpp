@@ -21,7 +21,8 @@ namespace eical::tools::demo {
 struct DemoTest {
   double radius_mm = 10.0, feed_mm_min = 2500.0;
   int repeats = 5;
-  int strips = 2;  // sim::psd_ring: 2 is configuration B
+  int strips = 2;  // sim::psd_ring: 2 along the path is configuration B
+  sim::StripFacing facing = sim::StripFacing::along_path;
 };
 
 // The machine the demo calibrates: sensors and strips drawn within the data sheet's

@@ -37,33 +37,6 @@ AxisPair parse_axis_pair(const std::string& text, const std::string& option, con
 
 }  // namespace
 
-namespace {
-
-struct PsdLayout {
-  const char* name;
-  int strips;
-};
-constexpr PsdLayout kPsdLayouts[] = {{"none", 0}, {"B", 2}, {"B4", 4}, {"B8", 8}, {"B16", 16}};
-
-}  // namespace
-
-const std::vector<std::string>& psd_layout_names() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> v;
-    for (const PsdLayout& l : kPsdLayouts) v.emplace_back(l.name);
-    return v;
-  }();
-  return names;
-}
-
-int psd_layout_strips(const std::string& layout) {
-  for (const PsdLayout& l : kPsdLayouts)
-    if (layout == l.name) return l.strips;
-  std::string names;
-  for (const std::string& n : psd_layout_names()) names += (names.empty() ? "" : ", ") + n;
-  throw dsp::InputError("--psd '" + layout + "': one of " + names);
-}
-
 dsp::PsdSpec parse_psd(const std::string& text) {
   const AxisPair p = parse_axis_pair(text, "--psd", "MEASURES:CX,CY, e.g. x:0,-10");
   dsp::PsdSpec s;

@@ -14,12 +14,6 @@ namespace eical::tools {
 // Throws naming the option text when it is not MEASURES:CX,CY with MEASURES x or y.
 dsp::PsdSpec parse_psd(const std::string& text);
 
-// The named layouts --psd takes: none, B (configuration B) and B4, B8, B16 (that many
-// strips about a circle, sim::psd_ring).
-const std::vector<std::string>& psd_layout_names();
-// Strips a named layout puts about a circle (B: 2, none: 0); throws on another name.
-int psd_layout_strips(const std::string& layout);
-
 struct TravelOption {
   int axis = 0;  // 0 = x, 1 = y, 2 = z
   double lo_mm = 0.0, hi_mm = 0.0;

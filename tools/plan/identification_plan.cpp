@@ -40,6 +40,19 @@ sim::gcode::IdentifyPlan identification_plan(const TestProgram& p) {
   plan.psd = p.psd.empty() ? strips_for(p) : p.psd;
   plan.axes = {"z"};
   test_travel(p, plan.travel_mm);
+  if (p.kind == "circle") {
+    // A circle crosses each strip where it is mounted, and a strip turned radial sits on the
+    // circle's ends: the swing runs on beyond the circle just far enough to cross it whole
+    // (a tenth of its length clear of each end).
+    for (const auto& s : plan.psd) {
+      const int along = s.measures == "x" ? 0 : s.measures == "y" ? 1 : -1;
+      if (along < 0 || !plan.travel_mm[along]) continue;
+      auto& t = *plan.travel_mm[along];
+      const double reach_mm = 0.6 * s.length_mm;
+      t.lo_mm = std::min(t.lo_mm, s.center_mm[along] - reach_mm);
+      t.hi_mm = std::max(t.hi_mm, s.center_mm[along] + reach_mm);
+    }
+  }
   return plan;
 }
 
@@ -66,8 +79,9 @@ std::string identification_text(const sim::gcode::IdentifyPlan& plan) {
   }
   for (const auto& a : plan.axes)
     o += "    " + a + " swings ± " + mm(plan.swing_mm / 2.0) + " mm about where it rests\n";
-  o += "    every swing stays inside the travel the test moves over where it spans the " + mm(plan.swing_mm) +
-       " mm swing, and is centred on a shorter one\n";
+  o += "    every swing stays inside --travel (the test's own; about a circle as far beyond it as a strip on its "
+       "end needs to be crossed whole) where it spans the " +
+       mm(plan.swing_mm) + " mm swing, and is centred on a shorter one\n";
   return o;
 }
 

@@ -59,6 +59,21 @@ double feed_cap(const TestProgram& p) {
   return f;
 }
 
+// Strips about a circle that all measure the axis their centre lies further along: each
+// turned radial, across the path (sim::StripFacing::across_path); those at 45° say nothing.
+bool turned_radial(const TestProgram& p) {
+  if (p.kind != "circle") return false;
+  int radial = 0;
+  for (const auto& s : p.psd) {
+    const double along = std::abs(s.center_mm[s.measures == "y" ? 1 : 0]);
+    const double other = std::abs(s.center_mm[s.measures == "y" ? 0 : 1]);
+    if (std::abs(along - other) < 1e-6) continue;
+    if (along < other) return false;
+    ++radial;
+  }
+  return radial > 0;
+}
+
 }  // namespace
 
 std::string describe(const TestProgram& p) {
@@ -78,6 +93,7 @@ std::string describe(const TestProgram& p) {
   }
   s += p.psd.empty() ? ", no PSD strips"
                      : ", " + std::to_string(p.psd.size()) + " PSD strip" + (p.psd.size() > 1 ? "s" : "");
+  if (turned_radial(p)) s += " turned radial";
   if (p.identified) s += ", sensors identified on site first (eical gen-nc identify, eical identify)";
   return s;
 }
@@ -97,6 +113,9 @@ std::vector<dsp::PsdSpec> strips_identification_can_cross(const TestProgram& p) 
   std::optional<sim::gcode::AxisTravel> travel_mm[2];
   test_travel(p, travel_mm);
   std::vector<dsp::PsdSpec> out = p.psd;
+  // A circle crosses each strip where it is: the identification reaches it there
+  // (identification_plan runs the swing on beyond the circle where it must).
+  if (p.kind == "circle") return out;
   for (auto& s : out) {
     const int along = s.measures == "x" ? 0 : s.measures == "y" ? 1 : -1;
     if (along < 0 || !travel_mm[along]) continue;
@@ -131,10 +150,10 @@ std::vector<dsp::PsdSpec> strips_for(const TestProgram& p) {
   return {x, y};
 }
 
-std::vector<dsp::PsdSpec> strips_for(const TestProgram& p, int count) {
+std::vector<dsp::PsdSpec> strips_for(const TestProgram& p, int count, sim::StripFacing facing) {
   if (count == 0) return {};
-  if (p.kind == "circle") return sim::psd_ring(p.radius_mm, count);
-  if (count == 2) return strips_for(p);
+  if (p.kind == "circle") return sim::psd_ring(p.radius_mm, count, facing);
+  if (count == 2 && facing == sim::StripFacing::along_path) return strips_for(p);
   throw dsp::InputError("plan: " + std::to_string(count) + " strips are a circle's layout; a " + p.kind +
                         " test takes B (" + std::to_string(strips_for(p).size()) + ") or strips given one by one");
 }
@@ -255,7 +274,8 @@ Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
   o.uncertainty.draws = draws;
   o.parallel = drivers::thread_for();
   const dsp::ResolutionLimit* lim = dsp::resolution_limit(p.kind);
-  if (screen && lim) o.uncertainty.stop_above = {lim->limited, screen->margin * lim->limit, screen->draws};
+  const double limit = lim ? p.resolve_um.value_or(lim->limit) : 0.0;
+  if (screen && lim) o.uncertainty.stop_above = {lim->limited, screen->margin * limit, screen->draws};
   if (p.identified) {
     o.model_covariance = identified ? *identified : typical_identification(p);
     o.sensor_model = "psd";
@@ -267,10 +287,10 @@ Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
   for (const auto& [k, u] : a.uncertainty_k2)
     if (u.size() == 1 && std::isfinite(u[0])) r.u_k2[k] = u[0];
   if (lim) {
-    r.headline = lim->headline, r.limited = lim->limited, r.limit = lim->limit;
+    r.headline = lim->headline, r.limited = lim->limited, r.limit = limit;
     const auto it = r.u_k2.find(lim->limited);
     r.limited_u = it != r.u_k2.end() ? it->second : std::numeric_limits<double>::quiet_NaN();
-    r.measurable = it != r.u_k2.end() && it->second <= lim->limit;
+    r.measurable = it != r.u_k2.end() && it->second <= limit;
   }
   return r;
 }
@@ -316,11 +336,14 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
   }
   if (p.kind == "circle") {
     // More strips about the same circle: each crossing fixes the position once more a
-    // revolution, so the integration's error grows over a shorter arc.
-    for (int n : {4, dsp::kMaxPsd}) {
+    // revolution, so the integration's error grows over a shorter arc. Four stay along the
+    // path (the spot runs along each for millimetres); sixteen are turned radial, each a
+    // reading of the radius (bench_u_chart: R50 F4000 U(G) 1.8 µm against 3.3 along).
+    for (const auto& [n, facing] :
+         {std::pair{4, sim::StripFacing::along_path}, std::pair{dsp::kMaxPsd, sim::StripFacing::across_path}}) {
       if (static_cast<int>(s.psd.size()) >= n) continue;
       TestProgram t = s;
-      t.psd = strips_for(t, n);
+      t.psd = strips_for(t, n, facing);
       v.push_back(t);
     }
   }

@@ -36,6 +36,9 @@ struct TestProgram {
   double noise_ug_per_rthz = 0.4;                               // each sensor, two-sided
   double fs_hz = dsp::kDefaultFs_hz;                            // the DAQ's rate
   bool identified = false;                                      // sensors identified on site first (eical identify)
+  // What the limited figure's U must reach (eical plan --resolve); unset: what the program
+  // must resolve (dsp::resolution_limit, a circle's G 10 µm).
+  std::optional<double> resolve_um;
 };
 
 // "circle R10 F2500 ccw ×5 in xy, 2 PSD strips".
@@ -43,13 +46,16 @@ std::string describe(const TestProgram& p);
 // Strips for the program: configuration B about a circle, one at mid travel of a 1-D
 // test, one per side's middle of a rectangle.
 std::vector<dsp::PsdSpec> strips_for(const TestProgram& p);
-// A circle's `count` strips (1..16, sim::psd_ring: 2 is configuration B); another program's
-// strips_for for 2 and none for 0, and refused for more.
-std::vector<dsp::PsdSpec> strips_for(const TestProgram& p, int count);
+// A circle's `count` strips facing so (1..16, sim::psd_ring: 2 along the path is
+// configuration B); another program's strips_for for 2 and none for 0, and refused for more.
+std::vector<dsp::PsdSpec> strips_for(const TestProgram& p, int count,
+                                     sim::StripFacing facing = sim::StripFacing::along_path);
 // A positioning or step test's two strips at the ends of its travel (on x).
 std::vector<dsp::PsdSpec> strips_at_both_ends(const TestProgram& p);
 // The program's strips where an identification that stays inside the test's travel can
-// cross them: a strip on (or near) a travel's end moved one strip length inside it.
+// cross them: a strip on (or near) a travel's end moved one strip length inside it. A
+// circle's strips stay: the circle crosses them where they are, and its identification runs
+// on beyond the circle to reach them (identification_plan).
 std::vector<dsp::PsdSpec> strips_identification_can_cross(const TestProgram& p);
 // The program a recorded run ran (for analyze's suggestion).
 TestProgram program_of(const dsp::RunMeta& meta);

@@ -9,6 +9,7 @@
 #include "sim/hidden/hidden_effects.hpp"
 #include "sim/simulate.hpp"
 #include "tools/plan/predicted_uncertainty.hpp"
+#include "tools/plan/psd_layouts.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -27,6 +28,7 @@ struct CampaignProgram {
   plan::TestProgram program;
   bool background = false;  // the background circle or step of that seed (sim/hidden)
   int strips = 2;           // about a circle (plan::strips_for; 2: configuration B)
+  sim::StripFacing facing = sim::StripFacing::along_path;
 };
 
 CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
@@ -36,16 +38,20 @@ CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
   auto pick = [&](std::initializer_list<double> v) {
     return *(v.begin() + std::uniform_int_distribution<std::size_t>(0, v.size() - 1)(rng));
   };
+  auto pick_name = [&](std::initializer_list<const char*> v) {
+    return std::string(*(v.begin() + std::uniform_int_distribution<std::size_t>(0, v.size() - 1)(rng)));
+  };
   if (program == "circle" || program == "step") {
     c.background = true;
     p.kind = program;
   } else if (program == "circle-identified") {  // ballbar class: R10–R50, both directions
     p.kind = "circle", p.direction = "both", p.repeats = 3, p.identified = true;
     p.radius_mm = pick({10.0, 25.0, 50.0}), p.feed_mm_min = pick({1000.0, 2500.0, 4000.0});
-  } else if (program == "circle-strips") {  // 4–16 strips about R25–R100, identified
+  } else if (program == "circle-strips") {  // 4–16 strips along the path or radial, R25–R100, identified
     p.kind = "circle", p.direction = "both", p.repeats = 2, p.identified = true;
     p.radius_mm = pick({25.0, 50.0, 100.0}), p.feed_mm_min = pick({2500.0, 4000.0, 10000.0});
-    c.strips = static_cast<int>(pick({4.0, 8.0, 16.0}));
+    const plan::PsdLayout layout = plan::psd_layout(pick_name({"B4", "B8", "B16", "R8", "R16"}));
+    c.strips = layout.strips, c.facing = layout.facing;
   } else if (program == "circle-large") {  // beyond the instrument without more strips
     p.kind = "circle", p.repeats = 1, p.radius_mm = pick({50.0, 100.0, 150.0});
     p.feed_mm_min = pick({4000.0, 10000.0});
@@ -64,7 +70,7 @@ CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
         "coverage campaign: unknown program '" + program +
         "' (circle, circle-identified, circle-strips, circle-large, step, positioning, positioning-long, rectangle)");
   }
-  p.psd = plan::strips_for(p, c.strips);
+  p.psd = plan::strips_for(p, c.strips, c.facing);
   return c;
 }
 
