@@ -106,6 +106,27 @@ Scenario gcode_scenario(const std::string& gcode, const std::string& kind, std::
 
 std::vector<dsp::PsdSpec> psd_config_b(double radius_mm) { return psd_ring(radius_mm, 2); }
 
+namespace {
+
+// The circle's path at (x, y) is (−y, x): it runs along x where |y| > |x| (at 45°, the ties
+// alternate by quadrant).
+bool path_along_x(double x, double y) { return std::abs(y) != std::abs(x) ? std::abs(y) > std::abs(x) : x * y < 0.0; }
+
+}  // namespace
+
+std::optional<StripFacing> ring_facing(const std::vector<dsp::PsdSpec>& psd) {
+  std::optional<StripFacing> facing;
+  for (const auto& s : psd) {
+    const double x = s.center_mm[0], y = s.center_mm[1];
+    if (std::abs(std::abs(x) - std::abs(y)) < 1e-6) continue;  // at 45°: either
+    const StripFacing f =
+        path_along_x(x, y) == (s.measures == "x") ? StripFacing::along_path : StripFacing::across_path;
+    if (facing && *facing != f) return std::nullopt;
+    facing = f;
+  }
+  return facing;
+}
+
 std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count, StripFacing facing) {
   if (count < 1 || count > dsp::kMaxPsd)
     throw dsp::InputError("psd: " + std::to_string(count) + " strips about a circle, 1 to " +
@@ -117,9 +138,7 @@ std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count, StripFacing faci
     const double theta = (-0.5 + 2.0 * k / slots) * std::numbers::pi;
     const double x = nm(radius_mm * std::cos(theta)), y = nm(radius_mm * std::sin(theta));
     dsp::PsdSpec strip;
-    // The path's direction is (−y, x): it runs along x where |y| > |x|.
-    const bool path_along_x = std::abs(y) != std::abs(x) ? std::abs(y) > std::abs(x) : x * y < 0.0;
-    strip.measures = path_along_x == (facing == StripFacing::along_path) ? "x" : "y";
+    strip.measures = path_along_x(x, y) == (facing == StripFacing::along_path) ? "x" : "y";
     strip.center_mm[0] = x, strip.center_mm[1] = y;
     out.push_back(strip);
   }

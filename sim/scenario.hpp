@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -242,6 +243,9 @@ enum class StripFacing { along_path, across_path };
 // each measures the axis the path runs along more, across it the other (at 45° x and y
 // alternate). Along, 2 is configuration B, 4 B and its mirror.
 std::vector<dsp::PsdSpec> psd_ring(double radius_mm, int count, StripFacing facing = StripFacing::along_path);
+// How strips about a circle centred at the origin face it, by the rule psd_ring places
+// them with; nullopt when they are mixed or every one sits at 45° (where both apply).
+std::optional<StripFacing> ring_facing(const std::vector<dsp::PsdSpec>& psd);
 
 // On-site identification (sim/gcode identify_program) over the given strips and further
 // axes, with those strips in the run.

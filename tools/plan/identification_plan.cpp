@@ -1,5 +1,7 @@
 #include "tools/plan/identification_plan.hpp"
 
+#include "dsp/core/axes.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -45,8 +47,8 @@ sim::gcode::IdentifyPlan identification_plan(const TestProgram& p) {
     // circle's ends: the swing runs on beyond the circle just far enough to cross it whole
     // (a tenth of its length clear of each end).
     for (const auto& s : plan.psd) {
-      const int along = s.measures == "x" ? 0 : s.measures == "y" ? 1 : -1;
-      if (along < 0 || !plan.travel_mm[along]) continue;
+      const int along = dsp::axis_index(s.measures);
+      if (along < 0 || along > 1 || !plan.travel_mm[along]) continue;
       auto& t = *plan.travel_mm[along];
       const double reach_mm = 0.6 * s.length_mm;
       t.lo_mm = std::min(t.lo_mm, s.center_mm[along] - reach_mm);

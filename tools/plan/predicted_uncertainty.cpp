@@ -2,6 +2,7 @@
 
 #include "drivers/exec/thread_for.hpp"
 #include "dsp/analysis/verdict.hpp"
+#include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/core/frame.hpp"
 #include "dsp/identify/sensor_identification.hpp"
@@ -59,21 +60,6 @@ double feed_cap(const TestProgram& p) {
   return f;
 }
 
-// Strips about a circle that all measure the axis their centre lies further along: each
-// turned radial, across the path (sim::StripFacing::across_path); those at 45° say nothing.
-bool turned_radial(const TestProgram& p) {
-  if (p.kind != "circle") return false;
-  int radial = 0;
-  for (const auto& s : p.psd) {
-    const double along = std::abs(s.center_mm[s.measures == "y" ? 1 : 0]);
-    const double other = std::abs(s.center_mm[s.measures == "y" ? 0 : 1]);
-    if (std::abs(along - other) < 1e-6) continue;
-    if (along < other) return false;
-    ++radial;
-  }
-  return radial > 0;
-}
-
 }  // namespace
 
 std::string describe(const TestProgram& p) {
@@ -93,7 +79,7 @@ std::string describe(const TestProgram& p) {
   }
   s += p.psd.empty() ? ", no PSD strips"
                      : ", " + std::to_string(p.psd.size()) + " PSD strip" + (p.psd.size() > 1 ? "s" : "");
-  if (turned_radial(p)) s += " turned radial";
+  if (p.kind == "circle" && sim::ring_facing(p.psd) == sim::StripFacing::across_path) s += " turned radial";
   if (p.identified) s += ", sensors identified on site first (eical gen-nc identify, eical identify)";
   return s;
 }
@@ -117,8 +103,8 @@ std::vector<dsp::PsdSpec> strips_identification_can_cross(const TestProgram& p) 
   // (identification_plan runs the swing on beyond the circle where it must).
   if (p.kind == "circle") return out;
   for (auto& s : out) {
-    const int along = s.measures == "x" ? 0 : s.measures == "y" ? 1 : -1;
-    if (along < 0 || !travel_mm[along]) continue;
+    const int along = dsp::axis_index(s.measures);
+    if (along < 0 || along > 1 || !travel_mm[along]) continue;
     const auto& t = *travel_mm[along];
     // One strip length inside each end: a swing that stays inside the travel crosses it
     // whole (gen-nc identify refuses one it cannot cross); on a travel too short for that,

@@ -30,10 +30,4 @@ PsdLayout psd_layout(const std::string& name) {
   throw dsp::InputError("--psd '" + name + "': one of " + names);
 }
 
-std::string psd_layout_name(int strips, sim::StripFacing facing) {
-  for (const PsdLayout& l : kPsdLayouts)
-    if (l.strips == strips && (l.facing == facing || strips == 0)) return l.name;
-  return "";
-}
-
 }  // namespace eical::tools::plan

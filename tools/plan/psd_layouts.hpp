@@ -19,7 +19,5 @@ struct PsdLayout {
 const std::vector<std::string>& psd_layout_names();
 // Throws InputError naming the choices on another name.
 PsdLayout psd_layout(const std::string& name);
-// The name of `strips` facing so, or "" where no named layout has them.
-std::string psd_layout_name(int strips, sim::StripFacing facing);
 
 }  // namespace eical::tools::plan
