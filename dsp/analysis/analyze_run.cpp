@@ -116,6 +116,7 @@ eval::PositioningInput positioning_deviations(const Measurement& m, const Progra
     double dev = 0.0;
     for (std::size_t i = from; i <= end; ++i) dev += m.pos_mm[i][ax] - m.cmd_mm[i][ax];
     dev = dev / static_cast<double>(end - from + 1) * 1000.0;
+    in.read_sample_index.emplace_back(m.sample_index[from], m.sample_index[end]);
     // Approach direction: where the set-point came from.
     std::size_t before = ku;
     while (before > 0 && std::abs(m.cmd_mm[before][ax] - target_here) < 1e-6) --before;

@@ -4,6 +4,7 @@
 #include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/core/float_limits.hpp"
+#include "dsp/core/index_span.hpp"
 #include "dsp/core/stream_seed.hpp"
 #include "dsp/uncertainty/error_field.hpp"
 #include "dsp/uncertainty/rest_noise_check.hpp"
@@ -65,17 +66,35 @@ Analysis base_of(const Analysis& a, const Measurement& decimated, std::vector<Ei
   return b;
 }
 
-// λ of the truth's estimate from the measured path's shape and the energy of `errors`: the
-// largest of the draws', not their mean. Only the shape that no plausible error explains
-// is kept as the machine's (a run whose sensor model errs at the far end of its
-// tolerances must not lend that error to the machine, where the draws would take it as
-// shape and shrink its bias: seen as G covered in one of three data-sheet circles).
-double shrink_factor(const Measurement& m, const std::vector<std::vector<Eigen::Vector3d>>& errors) {
+// The positions of `m` the figures read, or empty: all of them. A positioning test reads
+// the dwells only; the servo's lag while it moves is shape no figure sees, and taken as
+// shape it made λ ≈ 0.5 on flat machines (4 of 40 data-sheet runs then had U(M) below
+// their error).
+std::vector<IndexSpan> read_spans(const Analysis& a, const Measurement& m) {
+  std::vector<IndexSpan> spans;
+  if (a.positioning_input)
+    for (const auto& [first, last] : a.positioning_input->read_sample_index)
+      spans.push_back(index_span(m.sample_index, first, last + 1));
+  return spans;
+}
+
+// λ of the truth's estimate from the measured path's shape and the energy of `errors` over
+// the positions the figures read: the largest of the draws', not their mean. Only the
+// shape that no plausible error explains is kept as the machine's (a run whose sensor model
+// errs at the far end of its tolerances must not lend that error to the machine, where the
+// draws would take it as shape and shrink its bias: seen as G covered in one of three
+// data-sheet circles).
+double shrink_factor(const Measurement& m, const std::vector<std::vector<Eigen::Vector3d>>& errors,
+                     std::vector<IndexSpan> spans) {
+  if (spans.empty()) spans.push_back({0, m.pos_mm.size()});
   double shape_um2 = 0.0, error_um2 = 0.0;
-  for (std::size_t k = 0; k < m.pos_mm.size(); ++k) shape_um2 += ((m.pos_mm[k] - m.cmd_mm[k]) * 1000.0).squaredNorm();
+  for (const IndexSpan& s : spans)
+    for (std::size_t k = s.begin; k < s.end && k < m.pos_mm.size(); ++k)
+      shape_um2 += ((m.pos_mm[k] - m.cmd_mm[k]) * 1000.0).squaredNorm();
   for (const auto& e : errors) {
     double energy_um2 = 0.0;
-    for (std::size_t k = 0; k < e.size() && k < m.pos_mm.size(); ++k) energy_um2 += e[k].squaredNorm();
+    for (const IndexSpan& s : spans)
+      for (std::size_t k = s.begin; k < s.end && k < e.size(); ++k) energy_um2 += e[k].squaredNorm();
     error_um2 = std::max(error_um2, energy_um2);
   }
   if (errors.empty() || !(shape_um2 > 0.0)) return 0.0;
@@ -104,7 +123,7 @@ DrawBases evaluate_bases(const Run& run, const Analysis& a, const uncertainty::E
     std::mt19937_64 rng(stream_seed(seed ^ kShrinkSalt, static_cast<std::uint64_t>(d)));
     field.draw(rng, b.at, errors[static_cast<std::size_t>(d)]);
   }
-  b.shrink = shrink_factor(decimated, errors);
+  b.shrink = shrink_factor(decimated, errors, read_spans(a, decimated));
   std::vector<Eigen::Vector3d> shrunk(decimated.pos_mm.size());
   for (std::size_t k = 0; k < shrunk.size(); ++k)
     shrunk[k] = decimated.cmd_mm[k] + b.shrink * (decimated.pos_mm[k] - decimated.cmd_mm[k]);

@@ -9,7 +9,9 @@
 // M = max x̄i − min x̄i (x̄i = (x̄i↑ + x̄i↓)/2), A↑/↓ = max(x̄ + 2s) − min(x̄ − 2s) per
 // direction, A = the same over both directions.
 #include <array>
+#include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace eical::dsp::eval {
@@ -22,6 +24,9 @@ struct PositioningInput {
   std::vector<double> targets_mm;
   std::vector<std::vector<double>> up_um;    // [run][target]
   std::vector<std::vector<double>> down_um;  // [run][target]
+  // The sample indices [first, last] each deviation averages (the dwells' second halves):
+  // the only part of the path the figures read. Empty: not known (deviations imported).
+  std::vector<std::pair<std::int64_t, std::int64_t>> read_sample_index;
 };
 
 struct PositioningTarget {
