@@ -262,6 +262,7 @@ nlohmann::json supports_json(const dsp::Measurement& m) {
   sup["standstills"] = m.supports.rest_windows.size();
   sup["psd_readings"] = m.supports.psd_fixes;
   sup["psd_disagrees"] = m.supports.psd_disagrees;
+  sup["psd_crossings_merged"] = m.supports.psd_crossings_merged;
   sup["resets"] = m.supports.resets;
   sup["smoothed"] = m.supports.smoothed;
   const Eigen::Vector3d& worst = m.sigma_max_um;  // over the whole trace

@@ -1,6 +1,7 @@
 #include "dsp/pipeline/support_stage.hpp"
 #include "dsp/core/float_limits.hpp"
 #include "dsp/core/frame_fields.hpp"
+#include "dsp/fusion/crossing_fixes.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -366,18 +367,47 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   // PSD readings the integration cannot follow — its strip resets, or rejections of more
   // than 5 % — mean the sensor model is off (uncalibrated scale or mounting: the error is
   // then no slowly wandering bias, and pulling the trace to the strips would bend it far
-  // between them). The measurement is then fused without them, and says so.
-  std::size_t cupt_ok = 0, cupt_bad = 0;
-  for (int a = 0; a < 3; ++a) {
-    const auto& cupt = c->smoother->tally()[a][static_cast<int>(fusion::Support::cupt)];
-    cupt_ok += cupt.accepted, cupt_bad += cupt.rejected;
-  }
-  if (c->schedule.cupt && cupt_ok + cupt_bad > 0 && (c->smoother->resets() > 0 || 20 * cupt_bad > cupt_ok + cupt_bad)) {
-    sum.psd_disagrees = true;
-    sum.psd_rejected = cupt_bad;
-    c->schedule.cupt = false;  // for good: segments are recomputed from this schedule
+  // between them). First their slope goes: a crossing's readings imply the velocity, which
+  // the scale errs by scale × v, and a standstill right after contradicts it
+  // (fusion/crossing_fixes.hpp); each crossing then gives one position. When even those
+  // disagree, the measurement is fused without them, and says so.
+  const auto disagrees = [&c](std::size_t& rejected) {
+    std::size_t ok = 0;
+    rejected = 0;
+    for (int a = 0; a < 3; ++a) {
+      const auto& cupt = c->smoother->tally()[a][static_cast<int>(fusion::Support::cupt)];
+      ok += cupt.accepted, rejected += cupt.rejected;
+    }
+    return c->schedule.cupt && ok + rejected > 0 && (c->smoother->resets() > 0 || 20 * rejected > ok + rejected);
+  };
+  const auto resmooth = [&] {
     c->smoother =
         std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
+  };
+  std::size_t rejected = 0, merged_rejected = 0;
+  bool disagree = disagrees(rejected);
+  if (disagree) {
+    std::vector<fusion::PositionFix> fixes = c->schedule.fixes;
+    std::vector<double> fix_pos_mm = c->track.fix_pos_mm;
+    fusion::merge_crossings(fixes, fix_pos_mm, cfg_.model.scale_uncertainty,
+                            static_cast<std::size_t>(std::ceil(fusion::kCrossingGapS * fs_hz_)));
+    if (fixes.size() < c->schedule.fixes.size()) {
+      std::swap(fixes, c->schedule.fixes), std::swap(fix_pos_mm, c->track.fix_pos_mm);
+      resmooth();
+      disagree = disagrees(merged_rejected);
+      if (disagree) {  // as they were: the run's record of what the strips read
+        std::swap(fixes, c->schedule.fixes), std::swap(fix_pos_mm, c->track.fix_pos_mm);
+      } else {
+        sum.psd_crossings_merged = true;
+        if (!hand_over) schedule_.fixes = c->schedule.fixes, fix_pos_mm_ = c->track.fix_pos_mm;  // what the draws model
+      }
+    }
+  }
+  if (disagree) {
+    sum.psd_disagrees = true;
+    sum.psd_rejected = rejected;
+    c->schedule.cupt = false;  // for good: segments are recomputed from this schedule
+    resmooth();
   }
   c->apply = c->smoother->finite();
   if (!c->apply) {  // an input the model cannot take (a saturated channel): leave the trace as integrated

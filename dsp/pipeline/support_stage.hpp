@@ -61,6 +61,8 @@ struct SupportSummary {
   std::size_t psd_fixes = 0, psd_fixes_dropped = 0;
   std::size_t resets = 0;      // covariance resets (a standstill the model could not explain)
   bool psd_disagrees = false;  // the PSD readings contradicted the integration: not used
+  // Their slopes contradicted the standstills: one position per crossing was fused instead.
+  bool psd_crossings_merged = false;
   std::size_t psd_rejected = 0;
   bool smoothed = false;
   bool diverged = false;  // the fusion met values it cannot take: trace left as integrated
