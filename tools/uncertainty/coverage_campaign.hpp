@@ -45,6 +45,7 @@ struct FigureCoverage {
 struct CampaignResult {
   std::size_t runs = 0;
   std::vector<std::string> failures;  // runs that could not be analysed, why
+  std::vector<std::string> misses;    // headline cases outside their U: run, figure, measured, true, U
   std::map<std::string, FigureCoverage> figures;
   FigureCoverage headline;  // all headline figures pooled
   double seconds = 0.0;
