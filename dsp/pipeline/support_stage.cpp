@@ -332,6 +332,57 @@ SupportSummary SupportStage::refine(std::size_t n, const std::function<std::int6
   return sum;
 }
 
+// PSD readings the integration cannot follow — its strip resets, or rejections of more
+// than 5 % — mean the sensor model is off (uncalibrated scale or mounting: the error is
+// then no slowly wandering bias, and pulling the trace to the strips would bend it far
+// between them). First their slope goes: a crossing's readings imply the velocity, which
+// the scale errs by scale × v, and a standstill right after contradicts it
+// (fusion/crossing_fixes.hpp); each crossing then gives one position. When even those
+// disagree, the measurement is fused without them, and says so.
+void SupportStage::fuse_psd(SmoothedCorrection& c, SupportSummary& sum, bool hand_over,
+                            const fusion::SmootherSettings& st, fusion::SegmentSink* sink) {
+  c.smoother =
+      std::make_unique<fusion::CheckpointedSmoother>(c.track, st, fusion::CheckpointedSmoother::kSegment, sink);
+  const auto disagrees = [&c](std::size_t& rejected) {
+    std::size_t ok = 0;
+    rejected = 0;
+    for (int a = 0; a < 3; ++a) {
+      const auto& cupt = c.smoother->tally()[a][static_cast<int>(fusion::Support::cupt)];
+      ok += cupt.accepted, rejected += cupt.rejected;
+    }
+    return c.schedule.cupt && ok + rejected > 0 && (c.smoother->resets() > 0 || 20 * rejected > ok + rejected);
+  };
+  const auto resmooth = [&] {
+    c.smoother =
+        std::make_unique<fusion::CheckpointedSmoother>(c.track, st, fusion::CheckpointedSmoother::kSegment, sink);
+  };
+  std::size_t rejected = 0, merged_rejected = 0;
+  bool disagree = disagrees(rejected);
+  if (disagree) {
+    std::vector<fusion::PositionFix> fixes = c.schedule.fixes;
+    std::vector<double> fix_pos_mm = c.track.fix_pos_mm;
+    fusion::merge_crossings(fixes, fix_pos_mm, cfg_.model.scale_uncertainty,
+                            static_cast<std::size_t>(std::ceil(fusion::kCrossingGapS * fs_hz_)));
+    if (fixes.size() < c.schedule.fixes.size()) {
+      std::swap(fixes, c.schedule.fixes), std::swap(fix_pos_mm, c.track.fix_pos_mm);
+      resmooth();
+      disagree = disagrees(merged_rejected);
+      if (disagree) {  // as they were: the run's record of what the strips read
+        std::swap(fixes, c.schedule.fixes), std::swap(fix_pos_mm, c.track.fix_pos_mm);
+      } else {
+        sum.psd_crossings_merged = true;
+        if (!hand_over) schedule_.fixes = c.schedule.fixes, fix_pos_mm_ = c.track.fix_pos_mm;  // what the draws model
+      }
+    }
+  }
+  if (disagree) {
+    sum.psd_disagrees = true;
+    sum.psd_rejected = rejected;
+    c.schedule.cupt = false;  // for good: segments are recomputed from this schedule
+    resmooth();
+  }
+}
+
 std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, SupportSummary& sum, bool hand_over,
                                                                fusion::SegmentSink* sink) {
   auto c = std::make_unique<SmoothedCorrection>();
@@ -362,53 +413,7 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   st.fs_hz = fs_hz_, st.model = cfg_.model, st.start_bias_sigma_um_s2 = start_bias_sigma_;
   st.forward_only = !cfg_.smooth;
   st.parallel = cfg_.parallel;
-  c->smoother =
-      std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
-  // PSD readings the integration cannot follow — its strip resets, or rejections of more
-  // than 5 % — mean the sensor model is off (uncalibrated scale or mounting: the error is
-  // then no slowly wandering bias, and pulling the trace to the strips would bend it far
-  // between them). First their slope goes: a crossing's readings imply the velocity, which
-  // the scale errs by scale × v, and a standstill right after contradicts it
-  // (fusion/crossing_fixes.hpp); each crossing then gives one position. When even those
-  // disagree, the measurement is fused without them, and says so.
-  const auto disagrees = [&c](std::size_t& rejected) {
-    std::size_t ok = 0;
-    rejected = 0;
-    for (int a = 0; a < 3; ++a) {
-      const auto& cupt = c->smoother->tally()[a][static_cast<int>(fusion::Support::cupt)];
-      ok += cupt.accepted, rejected += cupt.rejected;
-    }
-    return c->schedule.cupt && ok + rejected > 0 && (c->smoother->resets() > 0 || 20 * rejected > ok + rejected);
-  };
-  const auto resmooth = [&] {
-    c->smoother =
-        std::make_unique<fusion::CheckpointedSmoother>(c->track, st, fusion::CheckpointedSmoother::kSegment, sink);
-  };
-  std::size_t rejected = 0, merged_rejected = 0;
-  bool disagree = disagrees(rejected);
-  if (disagree) {
-    std::vector<fusion::PositionFix> fixes = c->schedule.fixes;
-    std::vector<double> fix_pos_mm = c->track.fix_pos_mm;
-    fusion::merge_crossings(fixes, fix_pos_mm, cfg_.model.scale_uncertainty,
-                            static_cast<std::size_t>(std::ceil(fusion::kCrossingGapS * fs_hz_)));
-    if (fixes.size() < c->schedule.fixes.size()) {
-      std::swap(fixes, c->schedule.fixes), std::swap(fix_pos_mm, c->track.fix_pos_mm);
-      resmooth();
-      disagree = disagrees(merged_rejected);
-      if (disagree) {  // as they were: the run's record of what the strips read
-        std::swap(fixes, c->schedule.fixes), std::swap(fix_pos_mm, c->track.fix_pos_mm);
-      } else {
-        sum.psd_crossings_merged = true;
-        if (!hand_over) schedule_.fixes = c->schedule.fixes, fix_pos_mm_ = c->track.fix_pos_mm;  // what the draws model
-      }
-    }
-  }
-  if (disagree) {
-    sum.psd_disagrees = true;
-    sum.psd_rejected = rejected;
-    c->schedule.cupt = false;  // for good: segments are recomputed from this schedule
-    resmooth();
-  }
+  fuse_psd(*c, sum, hand_over, st, sink);
   c->apply = c->smoother->finite();
   if (!c->apply) {  // an input the model cannot take (a saturated channel): leave the trace as integrated
     sum.diverged = true;

@@ -173,6 +173,10 @@ class SupportStage {
   // disagree. hand_over: the recorded schedule and track move into the result.
   std::unique_ptr<SmoothedCorrection> smooth_track(std::size_t n, SupportSummary& sum, bool hand_over,
                                                    fusion::SegmentSink* sink = nullptr);
+  // The smoother over the PSD fixes, over one per crossing when they disagree, or without
+  // them when those disagree too (sum says which).
+  void fuse_psd(SmoothedCorrection& c, SupportSummary& sum, bool hand_over, const fusion::SmootherSettings& st,
+                fusion::SegmentSink* sink);
 
   SupportConfig cfg_;
   double fs_hz_ = kDefaultFs_hz;
