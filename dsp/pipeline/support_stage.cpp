@@ -343,21 +343,21 @@ void SupportStage::fuse_psd(SmoothedCorrection& c, SupportSummary& sum, bool han
                             const fusion::SmootherSettings& st, fusion::SegmentSink* sink) {
   c.smoother =
       std::make_unique<fusion::CheckpointedSmoother>(c.track, st, fusion::CheckpointedSmoother::kSegment, sink);
-  const auto disagrees = [&c](std::size_t& rejected) {
-    std::size_t ok = 0;
-    rejected = 0;
+  std::size_t rejected = 0;  // by the smoother over every reading: what the summary reports
+  const auto disagrees = [&c](std::size_t* rejected_out) {
+    std::size_t ok = 0, bad = 0;
     for (int a = 0; a < 3; ++a) {
       const auto& cupt = c.smoother->tally()[a][static_cast<int>(fusion::Support::cupt)];
-      ok += cupt.accepted, rejected += cupt.rejected;
+      ok += cupt.accepted, bad += cupt.rejected;
     }
-    return c.schedule.cupt && ok + rejected > 0 && (c.smoother->resets() > 0 || 20 * rejected > ok + rejected);
+    if (rejected_out) *rejected_out = bad;
+    return c.schedule.cupt && ok + bad > 0 && (c.smoother->resets() > 0 || 20 * bad > ok + bad);
   };
   const auto resmooth = [&] {
     c.smoother =
         std::make_unique<fusion::CheckpointedSmoother>(c.track, st, fusion::CheckpointedSmoother::kSegment, sink);
   };
-  std::size_t rejected = 0, merged_rejected = 0;
-  bool disagree = disagrees(rejected);
+  bool disagree = disagrees(&rejected);
   if (disagree) {
     std::vector<fusion::PositionFix> fixes = c.schedule.fixes;
     std::vector<double> fix_pos_mm = c.track.fix_pos_mm;
@@ -366,7 +366,7 @@ void SupportStage::fuse_psd(SmoothedCorrection& c, SupportSummary& sum, bool han
     if (fixes.size() < c.schedule.fixes.size()) {
       std::swap(fixes, c.schedule.fixes), std::swap(fix_pos_mm, c.track.fix_pos_mm);
       resmooth();
-      disagree = disagrees(merged_rejected);
+      disagree = disagrees(nullptr);
       if (disagree) {  // as they were: the run's record of what the strips read
         std::swap(fixes, c.schedule.fixes), std::swap(fix_pos_mm, c.track.fix_pos_mm);
       } else {
