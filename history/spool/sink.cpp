@@ -39,16 +39,17 @@ Sink::~Sink() {
 }
 
 void Sink::submit(const Record& r) {
-  std::filesystem::path file;
   std::string error;
-  try {
-    file = spool_.put(r);
-  } catch (const std::exception& e) {
-    error = e.what();
-  }
   {
+    // The file and its count appear together: a writer that finds the file on disk and
+    // fails to store it then reports it among those waiting, not "0 results wait".
     std::lock_guard lk(mu_);
-    if (!error.empty()) memory_.emplace_back(std::filesystem::path(), r);
+    try {
+      spool_.put(r);
+    } catch (const std::exception& e) {
+      error = e.what();
+      memory_.emplace_back(std::filesystem::path(), r);
+    }
     ++waiting_;
     wake_ = true;
   }
