@@ -265,6 +265,18 @@ nlohmann::json supports_json(const dsp::Measurement& m) {
   sup["psd_crossings_merged"] = m.supports.psd_crossings_merged;
   sup["resets"] = m.supports.resets;
   sup["smoothed"] = m.supports.smoothed;
+  // The bias jump per move start the smoother assumed and where it came from, beside what
+  // the standstills showed (µg of standard gravity, as data sheets state it).
+  constexpr double um_s2_per_ug = 9.80665;
+  const auto& bs = m.supports.bias_step;
+  const auto or_null = [&](double um_s2) {
+    return bs.measured ? nlohmann::json(um_s2 / um_s2_per_ug) : nlohmann::json();
+  };
+  sup["bias_step"] = {{"ug", m.supports.bias_step_um_s2 / um_s2_per_ug},
+                      {"source", m.supports.bias_step_from_standstills ? "standstills" : "model"},
+                      {"standstills_ug", or_null(bs.step_um_s2)},
+                      {"standstill_pairs", bs.pairs},
+                      {"noise_ug_per_rthz", or_null(bs.noise_um_s2_rthz)}};
   const Eigen::Vector3d& worst = m.sigma_max_um;  // over the whole trace
   sup["position_sigma_max_um"] = {worst.x(), worst.y(), worst.z()};
   return sup;

@@ -17,9 +17,10 @@ Discrete discretise(const ErrorModel& model, double h_s) {
   return d;
 }
 
-Mat3 initial_covariance(const ErrorModel& model, double start_bias_sigma_um_s2) {
+Mat3 initial_covariance(const ErrorModel& model, int axis, double start_bias_sigma_um_s2) {
   Mat3 p = Mat3::Zero();
-  p(0, 0) = model.start_position_um * model.start_position_um;
+  const double frame_um = model.start_frame_um[static_cast<std::size_t>(axis)];
+  p(0, 0) = model.start_position_um * model.start_position_um + frame_um * frame_um;
   p(1, 1) = model.start_velocity_um_s * model.start_velocity_um_s;
   p(2, 2) = start_bias_sigma_um_s2 * start_bias_sigma_um_s2 + model.bias_step_um_s2 * model.bias_step_um_s2;
   return p;

@@ -15,6 +15,8 @@
 // Units are µm and seconds so that the covariances stay near 1 (well conditioned).
 #include <Eigen/Core>
 
+#include <array>
+
 namespace eical::dsp::fusion {
 
 using Vec3 = Eigen::Vector3d;
@@ -38,6 +40,12 @@ struct ErrorModel {
   // identified on site: a few 1e-5): a PSD fix d mm from where the integration started
   // cannot be trusted closer than this times d — the error there is no wandering bias.
   double scale_uncertainty = 3e-4;
+  // The start position is given in the set-point's frame, a strip's readings in the strip's;
+  // integrated from one to the other they differ by the scale error over the way between
+  // (on one run only the first pass sees both, so anchoring it to both invents repeatability).
+  // Per axis: the σ of that difference, scale_uncertainty × the distance from the start to
+  // the nearest strip on the axis (SupportStage sets it; zero without strips).
+  std::array<double, 3> start_frame_um{};
   double gate_nis = 25.0;  // innovation test: reject beyond 5 σ
   // A standstill whose velocity the filter keeps rejecting means the model was too sure
   // (a bias jump it did not expect): after this many rejections in a row (per-sample
@@ -54,8 +62,8 @@ struct Discrete {
 Discrete discretise(const ErrorModel& model, double h_s);
 
 // Covariance of one axis' error at the start of the motion: the start position against
-// the set-point, the velocity at rest, the rest-window bias (σ given) and its jump into
-// the first move.
-Mat3 initial_covariance(const ErrorModel& model, double start_bias_sigma_um_s2);
+// the set-point (and the strips' frame), the velocity at rest, the rest-window bias (σ
+// given) and its jump into the first move.
+Mat3 initial_covariance(const ErrorModel& model, int axis, double start_bias_sigma_um_s2);
 
 }  // namespace eical::dsp::fusion

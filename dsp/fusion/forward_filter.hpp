@@ -36,7 +36,7 @@ struct ForwardFilter {
   void start(const ErrorModel& m, const Vec3& start_bias_sigma_um_s2) noexcept {
     for (int a = 0; a < 3; ++a) {
       axis[a].e.setZero();
-      axis[a].P = initial_covariance(m, start_bias_sigma_um_s2[a]);
+      axis[a].P = initial_covariance(m, a, start_bias_sigma_um_s2[a]);
     }
     tally = {};
     rejections_ = {}, fix_rejections_ = {};

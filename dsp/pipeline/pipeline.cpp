@@ -27,6 +27,7 @@ PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples
   c.fusion.accel_noise_um_s2_rthz = std::hypot(meta.sensor_present[0] ? meta.sensors[0].noise_ug_per_rthz : 0.0,
                                                meta.sensor_present[1] ? meta.sensors[1].noise_ug_per_rthz : 0.0) *
                                     meta.site.g_mps2;
+  c.strips_set_the_frame = meta.program.kind == "positioning";
   return c;
 }
 
@@ -81,6 +82,7 @@ Pipeline::Pipeline(const PipelineConfig& config)
   }
   SupportConfig sc;
   sc.zupt = config.zupt, sc.nbs = config.nbs, sc.cupt = config.cupt, sc.smooth = config.smooth;
+  sc.strips_set_the_frame = config.strips_set_the_frame;
   sc.record = config.trace == TraceKeeping::whole || config.trace == TraceKeeping::track;
   sc.compact = config.trace == TraceKeeping::track;
   sc.model = config.fusion;

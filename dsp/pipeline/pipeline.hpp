@@ -92,7 +92,13 @@ struct PipelineConfig {
   // its integrated drift there is removed (and so is any real motion of it: straightness of
   // the moving axis is no longer seen). For rectangles and other axis-parallel programs.
   bool nbs = false;
-  bool cupt = true;            // PSD strips as position fixes (when the run has [[psd]])
+  bool cupt = true;  // PSD strips as position fixes (when the run has [[psd]])
+  // The strips set the frame: the start is anchored to the set-point only within the
+  // scale's share of the way to the nearest strip (fusion::ErrorModel::start_frame_um). For
+  // tests whose figures are differences (ISO 230-2): there the set-point at the start is
+  // no reference, and the first run must meet the strip like the others. pipeline_config()
+  // sets it from the program.
+  bool strips_set_the_frame = false;
   bool smooth = true;          // RTS pass in finish() (off: the forward filter's causal result)
   fusion::ErrorModel fusion;   // pipeline_config() sets the noise from the sensors' data sheet
   bool keep_raw = false;       // Measurement::raw (identification, explain; offline only)

@@ -12,6 +12,7 @@
 #include "dsp/core/frame.hpp"
 #include "dsp/core/run_meta.hpp"
 #include "dsp/core/sample_rate.hpp"
+#include "dsp/fusion/bias_steps.hpp"
 #include "dsp/fusion/checkpointed_smoother.hpp"
 #include "dsp/fusion/forward_filter.hpp"
 #include "dsp/fusion/rts_smoother.hpp"
@@ -32,8 +33,9 @@ namespace eical::dsp {
 struct SupportConfig {
   bool zupt = true;
   bool nbs = false;
-  bool cupt = true;    // PSD strips as position fixes, when the run has any
-  bool smooth = true;  // offline RTS pass (off: the forward filter's result, as live)
+  bool cupt = true;                   // PSD strips as position fixes, when the run has any
+  bool strips_set_the_frame = false;  // PipelineConfig::strips_set_the_frame
+  bool smooth = true;                 // offline RTS pass (off: the forward filter's result, as live)
   // Record what the offline smoother reads (the schedule and its compact track); off for
   // the live pipeline, which only needs the forward filter's estimate.
   bool record = true;
@@ -52,6 +54,9 @@ struct RestWindow {
   Eigen::Vector3d table_mps2 = Eigen::Vector3d::Zero(), head_mps2 = Eigen::Vector3d::Zero();
   std::size_t samples = 0;
   bool quiet = true;  // the acceleration confirmed it (false: found by the set-point, machine ringing)
+  // Its late part (settled; quiet standstills only): mean relative reading head − table, length.
+  Eigen::Vector3d late_rel_mps2 = Eigen::Vector3d::Zero();
+  double late_s = 0.0;
 };
 
 // What the supports did in one measurement (published with the result).
@@ -67,6 +72,12 @@ struct SupportSummary {
   bool smoothed = false;
   bool diverged = false;  // the fusion met values it cannot take: trace left as integrated
   Eigen::Vector3d start_bias_sigma_um_s2 = Eigen::Vector3d::Zero();  // how well the first rest fixed the bias
+  std::array<double, 3> start_frame_um{};  // the strips' frame against the start (fusion::ErrorModel)
+  // The bias jump at a move start as the standstills show it, and what the smoother assumed
+  // (the measured one, or the model's when there was nothing to measure it on).
+  fusion::BiasStepMeasurement bias_step;
+  double bias_step_um_s2 = 0.0;
+  bool bias_step_from_standstills = false;  // else the model's
 };
 
 // One sample of the motion as the supports see it (sensor time base).
@@ -167,6 +178,9 @@ class SupportStage {
   void record(const SupportSample& s, std::uint8_t flags, const RestDecision& r) noexcept;
   void track_rest_window(const SupportSample& s, const RestDecision& r) noexcept;
   void close_rest_window() noexcept;
+  void late_part_sample(const Eigen::Vector3d& a_rel_mps2) noexcept;
+  void measure_bias_step(SupportSummary& sum) const;
+  void anchor_start(const Eigen::Vector3d& pos_mm) noexcept;
   // The schedule with hindsight and the rest windows in sample indices (finish's first half).
   SupportSummary refine(std::size_t n, const std::function<std::int64_t(std::size_t)>& index_at);
   // The smoother over the recorded track (its second half); CUPT is dropped when the strips
@@ -206,9 +220,18 @@ class SupportStage {
   // Detected rests.
   bool at_rest_ = false, started_ = false;
   Eigen::Vector3d start_pos_mm_ = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Vector3d frame_ref_mm_ = Eigen::Vector3d::Constant(
+      std::numeric_limits<double>::quiet_NaN());  // per axis: where the strips' frame is referred (anchor_start)
   Eigen::Vector3d cmd_at_rest_ = Eigen::Vector3d::Zero();
   RestWindow open_{};
   std::vector<RestWindow> rests_;
+  // The open standstill's late part in batches (fusion/bias_steps.hpp): the running batch,
+  // the sum and square sum of its batch means; their scatter pooled over the closed ones.
+  Eigen::Vector3d late_batch_sum_ = Eigen::Vector3d::Zero(), late_sum_ = Eigen::Vector3d::Zero(),
+                  late_sq_ = Eigen::Vector3d::Zero(), batch_ss_ = Eigen::Vector3d::Zero();
+  std::size_t late_batch_n_ = 0, late_batches_ = 0, batch_dof_ = 0;
+  bool late_quiet_ = true;                                 // the acceleration confirmed every sample of the late part
+  std::size_t late_settle_ = 2000, late_batch_len_ = 500;  // samples (set from fs)
   std::size_t rests_dropped_ = 0, fixes_dropped_ = 0, ringing_count_ = 0;
 };
 

@@ -211,7 +211,7 @@ std::vector<Eigen::Vector3d> integration_error_draw(const CoarseSchedule& coarse
   const auto& flags = coarse.schedule.flags;
   const double start_step_um_s2 = first_move_flagged(flags) ? 0.0 : truth.bias_step_um_s2;
   std::vector<Eigen::Vector3d> ex(nc), ev(nc), eb(nc);
-  const fusion::Mat3 p0 = fusion::initial_covariance(truth, 0.0);
+  const fusion::Mat3 p0 = fusion::initial_covariance(truth, 0, 0.0);  // its velocity term
   for (int a = 0; a < 3; ++a) {
     // Drawn one by one, the bias first (see below: a call's arguments have no order).
     const double z_bias = g(rng), z_vel = g(rng);

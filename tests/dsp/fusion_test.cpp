@@ -77,7 +77,7 @@ Batch batch_posterior(const ErrorModel& m, double h, const Vec3& bias0, const Su
   const auto n = static_cast<Eigen::Index>(sch.flags.size());
   const Discrete d = discretise(m, h);
   std::vector<Mat3> p(static_cast<std::size_t>(n));
-  p[0] = initial_covariance(m, bias0[axis]);
+  p[0] = initial_covariance(m, axis, bias0[axis]);
   for (Eigen::Index k = 1; k < n; ++k) {
     p[static_cast<std::size_t>(k)] = d.F * p[static_cast<std::size_t>(k - 1)] * d.F.transpose() + d.Q;
     if (sch.flags[static_cast<std::size_t>(k)] & schedule_flag::move_start)

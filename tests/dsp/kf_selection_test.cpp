@@ -16,11 +16,11 @@ namespace eical::dsp::model {
 namespace {
 
 constexpr double kFs = 1000.0;
-constexpr int kN = 20000;  // 20 s
+constexpr int kSamples = 20000;  // 20 s
 
 Eigen::VectorXd wave(double f_hz, bool cosine) {
-  Eigen::VectorXd u(kN);
-  for (int s = 0; s < kN; ++s) {
+  Eigen::VectorXd u(kSamples);
+  for (int s = 0; s < kSamples; ++s) {
     const double ph = 2.0 * std::numbers::pi * f_hz * s / kFs;
     u[s] = 1000.0 * (cosine ? std::cos(ph) : std::sin(ph));  // µm/s² per unit
   }
@@ -33,14 +33,14 @@ std::array<AxisTrack, 3> track(const Eigen::VectorXd& u, double value, std::uint
   std::array<AxisTrack, 3> t;
   AxisTrack& x = t[0];
   x.present = true;
-  x.h_s = Eigen::VectorXd::Constant(kN, 1.0 / kFs);
-  x.bias_step.assign(kN, 0), x.zupt.assign(kN, 0);
-  x.v_um_s = Eigen::VectorXd::Zero(kN);
+  x.h_s = Eigen::VectorXd::Constant(kSamples, 1.0 / kFs);
+  x.bias_step.assign(kSamples, 0), x.zupt.assign(kSamples, 0);
+  x.v_um_s = Eigen::VectorXd::Zero(kSamples);
   std::mt19937 rng(seed);
   std::normal_distribution<double> noise(0.0, 0.05);
   double v = 0.0, p = 0.0;
   int k = 0;
-  for (int s = 1; s < kN; ++s) {
+  for (int s = 1; s < kSamples; ++s) {
     const double a = value * 0.5 * (u[s - 1] + u[s]);
     p += v / kFs + 0.5 * a / (kFs * kFs), v += a / kFs;
     if (s % 100 == 0) x.obs.push_back({s, p + noise(rng), 0.05, (k++ % 5) == 4, -1});
