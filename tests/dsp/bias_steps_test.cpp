@@ -28,22 +28,31 @@ std::vector<StandstillMean> standstills(int n, double step_um_s2, double period_
   return out;
 }
 
+// Standstills whose batches show the model's noise (30 batches or more of 50 ms).
+BiasStepMeasurement measured_with_model_noise(const std::vector<StandstillMean>& s) {
+  return measure_bias_step(s, Eigen::Vector3d::Zero(), kNoise * kNoise / 0.05, 60, 0.05, kNoise, kWalk);
+}
+
 TEST(BiasSteps, NoStandstillLeavesTheModelsStep) {
   const BiasStepMeasurement m = measure_bias_step({}, Eigen::Vector3d::Zero(), 1.0, 10, 0.05, kNoise, kWalk);
   EXPECT_FALSE(m.measured);
   EXPECT_EQ(m.pairs, 0u);
 }
 
+// `runs` runs of `n` standstills a second apart, each measured.
+std::vector<BiasStepMeasurement> runs_of(int runs, int n, double step_um_s2, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<BiasStepMeasurement> out;
+  for (int run = 0; run < runs; ++run) out.push_back(measured_with_model_noise(standstills(n, step_um_s2, 1.0, rng)));
+  return out;
+}
+
 // A sensor without jumps: the estimate is near zero, its bound well below the thesis' 2 µg
 // (20 µm/s²) that the model assumed before, and it covers zero in most runs.
 TEST(BiasSteps, ASensorWithoutJumpsIsBoundWellBelowTheThesisValue) {
-  std::mt19937_64 rng(7);
   int above = 0;
   double largest = 0.0;
-  for (int run = 0; run < 200; ++run) {
-    const auto s = standstills(30, 0.0, 1.0, rng);
-    const BiasStepMeasurement m =
-        measure_bias_step(s, Eigen::Vector3d::Zero(), kNoise * kNoise / 0.05, 30, 0.05, kNoise, kWalk);
+  for (const BiasStepMeasurement& m : runs_of(200, 30, 0.0, 7)) {
     ASSERT_TRUE(m.measured);
     EXPECT_EQ(m.pairs, 30u);
     largest = std::max(largest, m.step_um_s2);
@@ -58,13 +67,9 @@ TEST(BiasSteps, ASensorWithoutJumpsIsBoundWellBelowTheThesisValue) {
 // Jumps of 2 µg: the point estimate finds them within 25 % over 60 standstills, and the
 // bound lies above the truth in most runs.
 TEST(BiasSteps, JumpsOfTwoMicroGAreMeasured) {
-  std::mt19937_64 rng(11);
   int covered = 0;
   double sum = 0.0;
-  for (int run = 0; run < 100; ++run) {
-    const auto s = standstills(60, 20.0, 1.0, rng);
-    const BiasStepMeasurement m =
-        measure_bias_step(s, Eigen::Vector3d::Zero(), kNoise * kNoise / 0.05, 60, 0.05, kNoise, kWalk);
+  for (const BiasStepMeasurement& m : runs_of(100, 60, 20.0, 11)) {
     sum += std::sqrt(std::max(0.0, m.excess_um2_s4));
     covered += m.step_um_s2 >= 20.0 ? 1 : 0;
   }
@@ -78,8 +83,7 @@ TEST(BiasSteps, ADriftBetweenFarStandstillsIsNoJump) {
   std::vector<StandstillMean> s(2);
   s[0].t_s = 60.0, s[0].length_s = 2.0, s[0].mean_um_s2 = Eigen::Vector3d::Constant(200.0);
   s[1].t_s = 62.0, s[1].length_s = 2.0, s[1].mean_um_s2 = Eigen::Vector3d::Constant(200.0);
-  const BiasStepMeasurement m =
-      measure_bias_step(s, Eigen::Vector3d::Zero(), kNoise * kNoise / 0.05, 80, 0.05, kNoise, kWalk);
+  const BiasStepMeasurement m = measured_with_model_noise(s);
   EXPECT_FALSE(m.measured);
   EXPECT_EQ(m.pairs, 1u);  // the two ends of the circle, 2 s apart; the minute of drift is left out
 }

@@ -19,29 +19,41 @@
 namespace eical {
 namespace {
 
-TEST(PositioningStrip, AScaleAtTheEndOfItsToleranceKeepsTheStripAndInventsNoRepeatability) {
-  tools::plan::TestProgram p;
-  p.kind = "positioning", p.runs = 3, p.feed_mm_min = 3000.0, p.targets_mm = {0.0, 10.0, 20.0, 30.0};
-  p.psd = tools::plan::strips_for(p, 2);
-  const sim::Scenario sc = tools::plan::scenario_on_drawn_machine(p, 7);
+// The program on drawn machine `machine`, analysed with `draws` draws; each figure of `keys`
+// within its U of the truth. Returns the measured figures.
+std::vector<dsp::FigureValue> expect_within_u(const tools::plan::TestProgram& p, int machine, int draws,
+                                              std::initializer_list<const char*> keys, dsp::Analysis& a) {
+  const sim::Scenario sc = tools::plan::scenario_on_drawn_machine(p, machine);
   std::vector<Eigen::Vector3d> truth;
   const dsp::Run run = sim::simulate(sc, &truth);
   dsp::AnalysisOptions ao;
   ao.coriolis = sc.coriolis;
-  ao.uncertainty.draws = 60;
-  const dsp::Analysis a = dsp::analyze_run(run, ao);
-  EXPECT_FALSE(a.measurement.supports.psd_disagrees);
-  EXPECT_TRUE(a.measurement.supports.psd_crossings_merged);
-  const auto measured = dsp::figures_of(a), true_figs = tools::uncertainty::true_figures(run, truth, a);
-  for (const char* key : {"positioning.R_um", "positioning.B_um", "positioning.E_um"}) {
+  ao.uncertainty.draws = draws;
+  a = dsp::analyze_run(run, ao);
+  auto measured = dsp::figures_of(a);
+  const auto true_figs = tools::uncertainty::true_figures(run, truth, a);
+  for (const char* key : keys) {
     const dsp::FigureValue* m = dsp::find_figure(measured, key);
     const dsp::FigureValue* t = dsp::find_figure(true_figs, key);
-    ASSERT_TRUE(m && t) << key;
+    EXPECT_TRUE(m && t) << key;
+    if (!m || !t) continue;
     const double u = a.uncertainty_k2.at(key).front();
     std::printf("%s: measured %.2f, true %.2f, U %.2f um\n", key, m->values[0], t->values[0], u);
     EXPECT_LE(std::abs(m->values[0] - t->values[0]), u) << key;
   }
+  return measured;
+}
+
+TEST(PositioningStrip, AScaleAtTheEndOfItsToleranceKeepsTheStripAndInventsNoRepeatability) {
+  tools::plan::TestProgram p;
+  p.kind = "positioning", p.runs = 3, p.feed_mm_min = 3000.0, p.targets_mm = {0.0, 10.0, 20.0, 30.0};
+  p.psd = tools::plan::strips_for(p, 2);
+  dsp::Analysis a;
+  const auto measured = expect_within_u(p, 7, 60, {"positioning.R_um", "positioning.B_um", "positioning.E_um"}, a);
+  EXPECT_FALSE(a.measurement.supports.psd_disagrees);
+  EXPECT_TRUE(a.measurement.supports.psd_crossings_merged);
   // Repeatability the machine does not have: below 3 µm (it was 7.75 µm without the strip).
+  ASSERT_NE(dsp::find_figure(measured, "positioning.R_um"), nullptr);
   EXPECT_LT(dsp::find_figure(measured, "positioning.R_um")->values[0], 3.0);
 }
 
@@ -54,24 +66,11 @@ TEST(PositioningStrip, TheFirstRunMeetsTheStripsFrameLikeTheOthers) {
   tools::plan::TestProgram p;
   p.kind = "positioning", p.runs = 5, p.feed_mm_min = 4000.0, p.targets_mm = {0.0, 40.0, 80.0, 120.0, 160.0, 200.0};
   p.psd = tools::plan::strips_for(p, 2);
-  const sim::Scenario sc = tools::plan::scenario_on_drawn_machine(p, 3);
-  std::vector<Eigen::Vector3d> truth;
-  const dsp::Run run = sim::simulate(sc, &truth);
-  dsp::AnalysisOptions ao;
-  ao.coriolis = sc.coriolis;
-  ao.uncertainty.draws = 40;
-  const dsp::Analysis a = dsp::analyze_run(run, ao);
+  dsp::Analysis a;
+  const auto measured = expect_within_u(p, 3, 40, {"positioning.R_um", "positioning.B_um"}, a);
   EXPECT_FALSE(a.measurement.supports.psd_disagrees);
-  const auto measured = dsp::figures_of(a), true_figs = tools::uncertainty::true_figures(run, truth, a);
-  for (const char* key : {"positioning.R_um", "positioning.B_um"}) {
-    const dsp::FigureValue* m = dsp::find_figure(measured, key);
-    const dsp::FigureValue* t = dsp::find_figure(true_figs, key);
-    ASSERT_TRUE(m && t) << key;
-    const double u = a.uncertainty_k2.at(key).front();
-    std::printf("%s: measured %.2f, true %.2f, U %.2f um\n", key, m->values[0], t->values[0], u);
-    EXPECT_LE(std::abs(m->values[0] - t->values[0]), u) << key;
-  }
   // What is left of R is the noise between the strip and the far targets (s ≈ 2 µm).
+  ASSERT_NE(dsp::find_figure(measured, "positioning.R_um"), nullptr);
   EXPECT_LT(dsp::find_figure(measured, "positioning.R_um")->values[0], 15.0);
 }
 
