@@ -249,7 +249,7 @@ nlohmann::json pipeline_json(const dsp::Analysis& a) {
 
 // What the supports did: accepted and rejected updates per kind and axis, the
 // standstills found, the strips' readings, and the measurement's own noise-limited σ.
-nlohmann::json supports_json(const dsp::Measurement& m) {
+nlohmann::json supports_json(const dsp::Measurement& m, double g_mps2) {
   nlohmann::json sup;
   for (int k = 0; k < dsp::fusion::kSupportKinds; ++k) {
     nlohmann::json kind_j;
@@ -266,8 +266,9 @@ nlohmann::json supports_json(const dsp::Measurement& m) {
   sup["resets"] = m.supports.resets;
   sup["smoothed"] = m.supports.smoothed;
   // The bias jump per move start the smoother assumed and where it came from, beside what
-  // the standstills showed (µg of standard gravity, as data sheets state it).
-  constexpr double um_s2_per_ug = 9.80665;
+  // the standstills showed; µg with the site's g, as pipeline_config() turned the data
+  // sheet's µg into the model's µm/s².
+  const double um_s2_per_ug = g_mps2;
   const auto& bs = m.supports.bias_step;
   const auto or_null = [&](double um_s2) {
     return bs.measured ? nlohmann::json(um_s2 / um_s2_per_ug) : nlohmann::json();
@@ -334,7 +335,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis) {
         {"reference_radius_mean_deviation_um", analysis.circle_reference->radius_mean_deviation_um}};
   }
   j["pipeline"] = pipeline_json(analysis);
-  j["pipeline"]["supports"] = supports_json(analysis.measurement);
+  j["pipeline"]["supports"] = supports_json(analysis.measurement, run.meta.site.g_mps2);
   j["repeats"] = repeats_json(analysis);
   std::vector<dsp::Flag> flags = analysis.flags;
   null_not_evaluated(analysis, j, flags);

@@ -440,9 +440,9 @@ void SupportStage::fuse_psd(SmoothedCorrection& c, SupportSummary& sum, bool han
     if (rejected_out) *rejected_out = bad;
     return c.schedule.cupt && ok + bad > 0 && (c.smoother->resets() > 0 || 20 * bad > ok + bad);
   };
-  const auto resmooth = [&] {
+  const auto resmooth = [&](const fusion::SmootherSettings& settings) {
     c.smoother =
-        std::make_unique<fusion::CheckpointedSmoother>(c.track, st, fusion::CheckpointedSmoother::kSegment, sink);
+        std::make_unique<fusion::CheckpointedSmoother>(c.track, settings, fusion::CheckpointedSmoother::kSegment, sink);
   };
   bool disagree = disagrees(&rejected);
   if (disagree) {
@@ -452,7 +452,7 @@ void SupportStage::fuse_psd(SmoothedCorrection& c, SupportSummary& sum, bool han
                             static_cast<std::size_t>(std::ceil(fusion::kCrossingGapS * fs_hz_)));
     if (fixes.size() < c.schedule.fixes.size()) {
       std::swap(fixes, c.schedule.fixes), std::swap(fix_pos_mm, c.track.fix_pos_mm);
-      resmooth();
+      resmooth(st);
       disagree = disagrees(nullptr);
       if (disagree) {  // as they were: the run's record of what the strips read
         std::swap(fixes, c.schedule.fixes), std::swap(fix_pos_mm, c.track.fix_pos_mm);
@@ -469,8 +469,7 @@ void SupportStage::fuse_psd(SmoothedCorrection& c, SupportSummary& sum, bool han
     c.schedule.cupt = false;  // for good: segments are recomputed from this schedule
     fusion::SmootherSettings without = st;
     without.model.start_frame_um = {};
-    c.smoother =
-        std::make_unique<fusion::CheckpointedSmoother>(c.track, without, fusion::CheckpointedSmoother::kSegment, sink);
+    resmooth(without);
   }
 }
 
