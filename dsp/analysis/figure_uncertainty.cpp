@@ -338,7 +338,8 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
   in.fs_hz = m.fs_hz;
   in.delay_samples = a.dynamic == DynamicComp::none ? 0.0 : config.acquisition.daq_group_delay_samples;
   in.model = config.fusion;
-  in.model.start_frame_um = m.supports.start_frame_um;  // as the pipeline anchored the start
+  in.model.start_frame_um = m.supports.start_frame_um;    // as the pipeline anchored the start
+  in.model.scale_state_ppm = m.supports.scale_state_ppm;  // and kept the scale
   if (m.supports.bias_step_um_s2 > 0.0) in.model.bias_step_um_s2 = m.supports.bias_step_um_s2;  // as it measured
   in.start_bias_sigma_um_s2 = m.supports.start_bias_sigma_um_s2;
   in.model_covariance = options.model_covariance ? *options.model_covariance

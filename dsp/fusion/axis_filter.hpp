@@ -35,8 +35,8 @@ struct SupportTally {
 };
 
 struct AxisFilter {
-  Vec3 e = Vec3::Zero();
-  Mat3 P = Mat3::Zero();
+  State e = State::Zero();
+  StateCov P = StateCov::Zero();
 
   void predict(const Discrete& d) noexcept {
     e = d.F * e;
@@ -44,14 +44,14 @@ struct AxisFilter {
   }
 
   // z = h·e + noise of variance r; the symmetric form keeps P symmetric.
-  UpdateRecord update_row(const Eigen::RowVector3d& h, double z, double r, double gate_nis) noexcept {
+  UpdateRecord update_row(const StateRow& h, double z, double r, double gate_nis) noexcept {
     UpdateRecord rec;
-    const Vec3 ph = P * h.transpose();
+    const State ph = P * h.transpose();
     const double s = h.dot(ph) + r;
     rec.innovation = z - h.dot(e);
     rec.nis = rec.innovation * rec.innovation / s;
     if (!(rec.nis <= gate_nis) || !(s > 0.0) || !std::isfinite(s)) return rec;  // also rejects NaN
-    const Vec3 k = ph / s;
+    const State k = ph / s;
     e += k * rec.innovation;
     P -= k * ph.transpose();
     P = 0.5 * (P + P.transpose());
@@ -60,7 +60,7 @@ struct AxisFilter {
   }
   // An observation of a single state (h = unit row).
   UpdateRecord update(int state, double z, double r, double gate_nis) noexcept {
-    return update_row(Eigen::RowVector3d::Unit(state), z, r, gate_nis);
+    return update_row(StateRow::Unit(state), z, r, gate_nis);
   }
 };
 

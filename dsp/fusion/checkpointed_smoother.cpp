@@ -58,11 +58,15 @@ CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const Smo
     forward(c, first, last, settings_.forward_only || j + 1 == n_seg ? &states : nullptr);
     if (settings_.forward_only) {  // the filtered errors are the result: they must be finite
       for (int a = 0; a < 3; ++a)
-        for (const Vec3& e : states.e[a]) finite_ = finite_ && std::isfinite(e[0]) && std::isfinite(e[1]);
+        for (const State& e : states.e[a]) finite_ = finite_ && std::isfinite(e[0]) && std::isfinite(e[1]);
       if (sink) output(states, out), sink->segment(j, out);
     }
   }
   tally_ = c.filter.tally, reset_count_ = c.filter.reset_count;
+  for (std::size_t a = 0; a < 3; ++a) {
+    end_scale_ppm_[a] = c.filter.axis[a].e[kScaleState];
+    end_scale_sigma_ppm_[a] = std::sqrt(std::max(c.filter.axis[a].P(kScaleState, kScaleState), 0.0));
+  }
   for (const auto& r : resets) extra_[r.axis].push_back({r.k, Vec3(r.add_xx, r.add_vv, r.add_bb)});
   if (!settings_.forward_only) smooth_backward(states, sink);
 }
@@ -82,8 +86,8 @@ void CheckpointedSmoother::smooth_backward(SegmentStates& states, SegmentSink* s
   for (std::size_t j = n_seg; j-- > 0;) {
     const std::size_t last = std::min(n, (j + 1) * seg_);
     const bool top = j + 1 == n_seg;
-    const std::array<Vec3, 3>* e_next = top ? nullptr : &smoothed_e_[j + 1];
-    const std::array<Mat3, 3>* p_next = top ? nullptr : &smoothed_p_[j + 1];
+    const std::array<State, 3>* e_next = top ? nullptr : &smoothed_e_[j + 1];
+    const std::array<StateCov, 3>* p_next = top ? nullptr : &smoothed_p_[j + 1];
     parallel(2, [&](std::size_t task) {
       if (task == 0) {
         backward(states, last, e_next, p_next, nullptr, 0, 2);
@@ -95,7 +99,7 @@ void CheckpointedSmoother::smooth_backward(SegmentStates& states, SegmentSink* s
     for (int a = 0; a < 3; ++a) {
       smoothed_e_[j][a] = states.e[a][0];
       smoothed_p_[j][a] = states.p[a][0];
-      for (const Vec3& e : states.e[a]) finite_ = finite_ && std::isfinite(e[0]) && std::isfinite(e[1]);
+      for (const State& e : states.e[a]) finite_ = finite_ && std::isfinite(e[0]) && std::isfinite(e[1]);
     }
     if (sink) output(states, out), sink->segment(j, out);
     std::swap(states, before);
@@ -138,7 +142,7 @@ void CheckpointedSmoother::forward(Checkpoint& c, std::size_t first, std::size_t
       const PositionFix& f = fixes_[c.next_fix];
       if (sch.cupt)
         fwd.position_fix(f.axis, fix_pos_mm_[c.next_fix] * 1000.0, f.position_um,
-                         std::hypot(f.sigma_um, f.model_sigma_um), m);
+                         std::hypot(f.sigma_um, f.model_sigma_um), m, f.way_mm);
     }
     if (states) {
       states->gap[k - first] = gap;
@@ -153,8 +157,8 @@ void CheckpointedSmoother::refilter(std::size_t j, SegmentStates& states) const 
   forward(c, j * seg_, std::min(track_.n, (j + 1) * seg_), &states);
 }
 
-void CheckpointedSmoother::backward(SegmentStates& s, std::size_t last, const std::array<Vec3, 3>* e_next,
-                                    const std::array<Mat3, 3>* p_next, std::array<std::vector<Mat3>, 3>* gains,
+void CheckpointedSmoother::backward(SegmentStates& s, std::size_t last, const std::array<State, 3>* e_next,
+                                    const std::array<StateCov, 3>* p_next, std::array<std::vector<StateCov>, 3>* gains,
                                     int first_axis, int end_axis) const {
   const ErrorModel& m = settings_.model;
   const auto& flags = track_.schedule->flags;
@@ -168,7 +172,7 @@ void CheckpointedSmoother::backward(SegmentStates& s, std::size_t last, const st
   for (int a = first_axis; a < end_axis; ++a) {
     auto& e = s.e[a];
     auto& p = s.p[a];
-    if (gains) (*gains)[a].assign(last - first, Mat3::Zero());
+    if (gains) (*gains)[a].assign(last - first, StateCov::Zero());
     const auto& extra = extra_[a];
     // Entries at or below `last`: the recursion at k reads those at k + 1 ≤ last.
     std::size_t next_extra = static_cast<std::size_t>(
@@ -180,14 +184,15 @@ void CheckpointedSmoother::backward(SegmentStates& s, std::size_t last, const st
       const bool at_top = k + 1 == last;
       const std::int64_t gap = at_top ? gap_last : s.gap[i + 1];
       const Discrete d = gap == 1 ? nominal_ : discretise(m, static_cast<double>(gap) / settings_.fs_hz);
-      Mat3 pp = d.F * p[i] * d.F.transpose() + d.Q;
+      StateCov pp = d.F * p[i] * d.F.transpose() + d.Q;
       if (flags[k + 1] & schedule_flag::move_start) pp(2, 2) += m.bias_step_um_s2 * m.bias_step_um_s2;
       while (next_extra > 0 && extra[next_extra - 1].first > k + 1) --next_extra;
-      for (std::size_t r = next_extra; r > 0 && extra[r - 1].first == k + 1; --r) pp.diagonal() += extra[r - 1].second;
-      const Vec3 ep = d.F * e[i];
-      const Mat3 c = pp.ldlt().solve(d.F * p[i].transpose()).transpose();  // P_k Fᵀ P⁻¹ (P⁻ symmetric)
-      const Vec3& e1 = at_top ? (*e_next)[a] : e[i + 1];
-      const Mat3& p1 = at_top ? (*p_next)[a] : p[i + 1];
+      for (std::size_t r = next_extra; r > 0 && extra[r - 1].first == k + 1; --r)
+        pp.diagonal().head<3>() += extra[r - 1].second;
+      const State ep = d.F * e[i];
+      const StateCov c = pp.ldlt().solve(d.F * p[i].transpose()).transpose();  // P_k Fᵀ P⁻¹ (P⁻ symmetric)
+      const State& e1 = at_top ? (*e_next)[a] : e[i + 1];
+      const StateCov& p1 = at_top ? (*p_next)[a] : p[i + 1];
       e[i] += c * (e1 - ep);
       p[i] += c * (p1 - pp) * c.transpose();
       p[i] = 0.5 * (p[i] + p[i].transpose());
@@ -205,24 +210,40 @@ void CheckpointedSmoother::segment(std::size_t j, SmoothedSegment& out, bool kee
     backward(s, last, top ? nullptr : &smoothed_e_[j + 1], top ? nullptr : &smoothed_p_[j + 1],
              keep_gains ? &out.gain : nullptr);
   } else if (keep_gains) {
-    for (int a = 0; a < 3; ++a) out.gain[a].assign(last - first, Mat3::Zero());
+    for (int a = 0; a < 3; ++a) out.gain[a].assign(last - first, StateCov::Zero());
   }
   if (keep_gains)
     for (int a = 0; a < 3; ++a) out.p_smoothed[a] = s.p[a];
   output(s, out);
 }
 
-void CheckpointedSmoother::output(const SegmentStates& s, SmoothedSegment& out) {
+void CheckpointedSmoother::output(const SegmentStates& s, SmoothedSegment& out) const {
   const std::size_t len = s.gap.size();
   out.first = s.first;
   out.dx_um.resize(len), out.dv_um_s.resize(len), out.bias_um_s2.resize(len), out.sigma_x_um.resize(len);
-  for (int a = 0; a < 3; ++a)
+  const auto& way = track_.schedule->way_mm;
+  for (int a = 0; a < 3; ++a) {
+    const bool scaled = way.size() == track_.n && settings_.model.scale_state_ppm[static_cast<std::size_t>(a)] > 0.0;
     for (std::size_t i = 0; i < len; ++i) {
-      out.dx_um[i][a] = s.e[a][i][0];
-      out.dv_um_s[i][a] = s.e[a][i][1];
-      out.bias_um_s2[i][a] = s.e[a][i][2];
-      out.sigma_x_um[i][a] = std::sqrt(std::max(s.p[a][i](0, 0), 0.0));
+      const State& e = s.e[a][i];
+      const StateCov& p = s.p[a][i];
+      out.dx_um[i][a] = e[0];
+      out.dv_um_s[i][a] = e[1];
+      out.bias_um_s2[i][a] = e[2];
+      double var_x = p(0, 0);
+      if (scaled) {  // the scale's share: δs·way, and δs·v (v from the way around the sample)
+        const std::size_t k = s.first + i, lo = k > 0 ? k - 1 : k, hi = std::min(k + 1, way.size() - 1);
+        const double w = 1e-3 * static_cast<double>(way[k][a]);
+        const double v_mm_s =
+            hi > lo ? static_cast<double>(way[hi][a] - way[lo][a]) * settings_.fs_hz / static_cast<double>(hi - lo)
+                    : 0.0;
+        out.dx_um[i][a] += w * e[kScaleState];
+        out.dv_um_s[i][a] += 1e-3 * v_mm_s * e[kScaleState];
+        var_x += 2.0 * w * p(0, kScaleState) + w * w * p(kScaleState, kScaleState);
+      }
+      out.sigma_x_um[i][a] = std::sqrt(std::max(var_x, 0.0));
     }
+  }
 }
 
 }  // namespace eical::dsp::fusion

@@ -63,7 +63,7 @@ struct SmoothedSegment {
   std::size_t first = 0;
   std::vector<Vec3> dx_um, dv_um_s, bias_um_s2, sigma_x_um;
   // Only when asked (segment(j, out, true)): per axis and sample the gain C_k and P_k|N.
-  std::array<std::vector<Mat3>, 3> gain, p_smoothed;
+  std::array<std::vector<StateCov>, 3> gain, p_smoothed;
   [[nodiscard]] std::size_t size() const noexcept { return dx_um.size(); }
 };
 
@@ -95,6 +95,12 @@ class CheckpointedSmoother {
 
   [[nodiscard]] const std::array<std::array<SupportTally, kSupportKinds>, 3>& tally() const noexcept { return tally_; }
   [[nodiscard]] std::size_t resets() const noexcept { return reset_count_; }
+  // Axis a's scale error (ppm) and its σ as the whole measurement shows them: a constant
+  // state (no process noise), so the filter's at the end is the smoothed one at every sample.
+  [[nodiscard]] std::pair<double, double> scale_ppm(int a) const noexcept {
+    const auto i = static_cast<std::size_t>(a);
+    return {end_scale_ppm_[i], end_scale_sigma_ppm_[i]};
+  }
   // False when a smoothed (or, forward only, filtered) position or velocity error is not
   // finite: the model met values it cannot take.
   [[nodiscard]] bool finite() const noexcept { return finite_; }
@@ -107,8 +113,8 @@ class CheckpointedSmoother {
   };
   struct SegmentStates {
     std::size_t first = 0;
-    std::array<std::vector<Vec3>, 3> e;
-    std::array<std::vector<Mat3>, 3> p;
+    std::array<std::vector<State>, 3> e;
+    std::array<std::vector<StateCov>, 3> p;
     std::vector<std::int64_t> gap;  // the step into each sample
   };
   [[nodiscard]] std::int64_t gap_into(std::size_t k, std::size_t& next_gap) const noexcept;
@@ -119,13 +125,13 @@ class CheckpointedSmoother {
   // The backward pass over every segment (the constructor's second half); `states` holds
   // the last segment's filtered states.
   void smooth_backward(SegmentStates& states, SegmentSink* sink);
-  // The errors of segment states into `out` (σ from P).
-  static void output(const SegmentStates& s, SmoothedSegment& out);
+  // The errors of segment states into `out` (σ from P), the scale's share added.
+  void output(const SegmentStates& s, SmoothedSegment& out) const;
   // The backward recursion over the segment's states (filtered in, smoothed out), from the
   // smoothed state of sample `last` (the next segment's first; none for the last segment,
   // whose last sample is smoothed as filtered); the gains when asked.
-  void backward(SegmentStates& s, std::size_t last, const std::array<Vec3, 3>* e_next,
-                const std::array<Mat3, 3>* p_next, std::array<std::vector<Mat3>, 3>* gains, int first_axis = 0,
+  void backward(SegmentStates& s, std::size_t last, const std::array<State, 3>* e_next,
+                const std::array<StateCov, 3>* p_next, std::array<std::vector<StateCov>, 3>* gains, int first_axis = 0,
                 int end_axis = 3) const;
 
   const SmootherTrack& track_;
@@ -134,14 +140,15 @@ class CheckpointedSmoother {
   Discrete nominal_;
   std::vector<PositionFix> fixes_;  // sorted by k (stable), with their integrated position
   std::vector<double> fix_pos_mm_;
-  std::vector<VelocityMean> means_;              // sorted by k (stable)
-  std::vector<Checkpoint> checkpoints_;          // one per segment
-  std::vector<std::array<Vec3, 3>> smoothed_e_;  // smoothed state at each segment's first sample
-  std::vector<std::array<Mat3, 3>> smoothed_p_;
+  std::vector<VelocityMean> means_;               // sorted by k (stable)
+  std::vector<Checkpoint> checkpoints_;           // one per segment
+  std::vector<std::array<State, 3>> smoothed_e_;  // smoothed state at each segment's first sample
+  std::vector<std::array<StateCov, 3>> smoothed_p_;
   // Per axis: (sample, added process noise) of each covariance reset, ascending sample.
   std::array<std::vector<std::pair<std::size_t, Vec3>>, 3> extra_;
   std::array<std::array<SupportTally, kSupportKinds>, 3> tally_{};
   std::size_t reset_count_ = 0;
+  std::array<double, 3> end_scale_ppm_{}, end_scale_sigma_ppm_{};
   bool finite_ = true;
 };
 

@@ -12,6 +12,7 @@ ErrorCovariance::ErrorCovariance(const SupportSchedule& schedule, const std::vec
   model.gate_nis = 1e300;         // the covariance of the supports as scheduled
   model.start_position_um = 0.0;  // measured from where it starts
   model.reset_after_rejections = 1 << 30;
+  model.scale_state_ppm = {};  // the sensors' noise alone: the scale is no noise
   const std::size_t n = sample_index.size();
   SupportSchedule noise_only = schedule;  // the strips' own noise: the bound is the sensors'
   for (auto& f : noise_only.fixes) f.model_sigma_um = 0.0;
@@ -40,13 +41,13 @@ Eigen::MatrixXd ErrorCovariance::position(const std::vector<std::size_t>& at, in
   const auto& g = gain_[axis];
   const auto& p = p_[axis];
   // Chain of gains from each grid point to the next: T_i = C_{at_i} … C_{at_{i+1}−1}.
-  std::vector<Mat3> t(at.size(), Mat3::Identity());
+  std::vector<StateCov> t(at.size(), StateCov::Identity());
   for (std::size_t i = 0; i + 1 < at.size(); ++i) {
     if (at[i + 1] < at[i]) throw InputError("error covariance: positions must ascend");
     for (std::size_t k = at[i]; k < at[i + 1]; ++k) t[i] = t[i] * g[k];
   }
   for (Eigen::Index a = 0; a < m; ++a) {
-    Mat3 chain = Mat3::Identity();
+    StateCov chain = StateCov::Identity();
     for (Eigen::Index b = a; b < m; ++b) {
       if (b > a) chain = chain * t[static_cast<std::size_t>(b - 1)];
       const double v = (chain * p[at[static_cast<std::size_t>(b)]])(0, 0);

@@ -33,7 +33,7 @@ class ErrorCovariance {
   [[nodiscard]] double sigma_um(std::size_t k, int axis) const;
 
  private:
-  std::array<std::vector<Mat3>, 3> gain_, p_;
+  std::array<std::vector<StateCov>, 3> gain_, p_;
 };
 
 }  // namespace eical::dsp::fusion

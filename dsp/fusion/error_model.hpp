@@ -1,17 +1,24 @@
 #pragma once
 // The error of the integrated relative motion along one machine axis (ch. 5.5: the
 // forward, or feed-forward, configuration of Bild 2-6: the integration runs on, the filter
-// estimates what it is off by). State e = [δx µm, δv µm/s, δb µm/s²]: position, velocity
-// and acceleration-bias error of head − table after the rest-window bias was removed.
+// estimates what it is off by). State e = [δx µm, δv µm/s, δb µm/s², δs ppm]: position,
+// velocity and acceleration-bias error of head − table after the rest-window bias was
+// removed, and the scale error of the integrated way along the axis.
 //
-//   δx' = δv,   δv' = δb + w_a,   δb' = w_b
+//   δx' = δv,   δv' = δb + w_a,   δb' = w_b,   δs' = 0
+//
+// The scale's share of the integrated position is δs · (way from the start): it enters
+// where a position is observed (support_rows.hpp), never the dynamics, so F stays constant.
+// At rest the true velocity is zero and so is the scale's share of the integrated one.
+// Only axes whose strips span a distance observe δs (ErrorModel::scale_state_ppm); on the
+// others it is a decoupled unit state that nothing reads.
 //
 // w_a: the two sensors' white noise, two-sided density n per sensor (run-format.md), so
 // q_a = n_table² + n_head²; w_b: the bias random walk (6-5, 6-6), q_b = walk² (both
 // sensors). Exact discretisation over a step h (Van Loan for this chain):
-//   F = [1 h h²/2; 0 1 h; 0 0 1]
+//   F = [1 h h²/2; 0 1 h; 0 0 1] (and 1 for δs)
 //   Q = q_a [h³/3 h²/2 0; h²/2 h 0; 0 0 0]
-//     + q_b [h⁵/20 h⁴/8 h³/6; h⁴/8 h³/3 h²/2; h³/6 h²/2 h]
+//     + q_b [h⁵/20 h⁴/8 h³/6; h⁴/8 h³/3 h²/2; h³/6 h²/2 h]   (0 for δs)
 // Units are µm and seconds so that the covariances stay near 1 (well conditioned).
 #include <Eigen/Core>
 
@@ -19,8 +26,14 @@
 
 namespace eical::dsp::fusion {
 
-using Vec3 = Eigen::Vector3d;
+using Vec3 = Eigen::Vector3d;  // one value per machine axis
 using Mat3 = Eigen::Matrix3d;
+// One axis' error state [δx, δv, δb, δs] and its covariance.
+inline constexpr int kStates = 4;
+inline constexpr int kScaleState = 3;
+using State = Eigen::Matrix<double, kStates, 1>;
+using StateCov = Eigen::Matrix<double, kStates, kStates>;
+using StateRow = Eigen::Matrix<double, 1, kStates>;
 
 // What the filter assumes about the sensors and the supports; defaults are the data
 // sheet's (SF3000L, ch. 6.2) and what the thesis measured (ch. 8.3.2).
@@ -46,6 +59,10 @@ struct ErrorModel {
   // Per axis: the σ of that difference, scale_uncertainty × the distance from the start to
   // the nearest strip on the axis (SupportStage sets it; zero without strips).
   std::array<double, 3> start_frame_um{};
+  // Per axis: σ (ppm) of the scale error as a state of the filter, which strips at different
+  // places along the axis observe (two readings d mm apart differ by δs·d); 0: no such
+  // strips, the scale stays in each reading's model σ. SupportStage sets it from the strips.
+  std::array<double, 3> scale_state_ppm{};
   double gate_nis = 25.0;  // innovation test: reject beyond 5 σ
   // A standstill whose velocity the filter keeps rejecting means the model was too sure
   // (a bias jump it did not expect): after this many rejections in a row (per-sample
@@ -53,9 +70,16 @@ struct ErrorModel {
   int reset_after_rejections = 100;
 };
 
+// True when the model keeps the scale of some axis as a state (the schedule carries the way).
+inline bool scale_is_a_state(const ErrorModel& model) noexcept {
+  for (const double s : model.scale_state_ppm)
+    if (s > 0.0) return true;
+  return false;
+}
+
 struct Discrete {
-  Mat3 F = Mat3::Identity();
-  Mat3 Q = Mat3::Zero();
+  StateCov F = StateCov::Identity();
+  StateCov Q = StateCov::Zero();
   double h_s = 0.0;
 };
 
@@ -63,7 +87,7 @@ Discrete discretise(const ErrorModel& model, double h_s);
 
 // Covariance of one axis' error at the start of the motion: the start position against
 // the set-point (and the strips' frame), the velocity at rest, the rest-window bias (σ
-// given) and its jump into the first move.
-Mat3 initial_covariance(const ErrorModel& model, int axis, double start_bias_sigma_um_s2);
+// given) and its jump into the first move, the scale (1 where it is no state).
+StateCov initial_covariance(const ErrorModel& model, int axis, double start_bias_sigma_um_s2);
 
 }  // namespace eical::dsp::fusion

@@ -78,13 +78,15 @@ struct ForwardFilter {
     for (int a = 0; a < 3; ++a) velocity_update(a, observe::velocity_mean_row(v.lag_s), v.mean_um_s[a], s * s, m, 100);
   }
 
-  // CUPT: the integrated position minus the PSD's is the position error.
+  // CUPT: the integrated position minus the PSD's is the position error (and the scale's
+  // share over way_mm, the way from the start along the axis, where the scale is a state).
   // A strip the filter keeps rejecting is reset to like a standstill (the position error is
   // ν; the bias that would have made it since the last position support, 2ν/T²).
-  UpdateRecord position_fix(int a, double ins_pos_um, double fix_pos_um, double sigma_um,
-                            const ErrorModel& m) noexcept {
+  UpdateRecord position_fix(int a, double ins_pos_um, double fix_pos_um, double sigma_um, const ErrorModel& m,
+                            double way_mm = 0.0) noexcept {
     const double s = sigma_um * sigma_um + m.psd_floor_um * m.psd_floor_um;
-    UpdateRecord r = axis[a].update_row(observe::cupt_row(), ins_pos_um - fix_pos_um, s, m.gate_nis);
+    const StateRow h = observe::cupt_row(m.scale_state_ppm[static_cast<std::size_t>(a)] > 0.0 ? way_mm : 0.0);
+    UpdateRecord r = axis[a].update_row(h, ins_pos_um - fix_pos_um, s, m.gate_nis);
     if (!r.accepted && std::isfinite(r.innovation) && std::abs(r.innovation) < 1e9) {
       if (++fix_rejections_[a] >= m.reset_after_rejections) {
         const double nu = r.innovation, t = std::max(since_position_s_[a], 0.1);
@@ -95,7 +97,7 @@ struct ForwardFilter {
         axis[a].P(2, 2) += reset.add_bb;
         if (resets && resets->size() < resets->capacity()) resets->push_back(reset);
         ++reset_count;
-        r = axis[a].update_row(observe::cupt_row(), ins_pos_um - fix_pos_um, s, m.gate_nis);
+        r = axis[a].update_row(h, ins_pos_um - fix_pos_um, s, m.gate_nis);
       }
     }
     if (r.accepted) fix_rejections_[a] = 0, since_position_s_[a] = 0.0;
@@ -104,8 +106,7 @@ struct ForwardFilter {
   }
 
  private:
-  void velocity_update(int a, const Eigen::RowVector3d& h, double z, double r, const ErrorModel& m,
-                       int weight) noexcept {
+  void velocity_update(int a, const StateRow& h, double z, double r, const ErrorModel& m, int weight) noexcept {
     UpdateRecord rec = axis[a].update_row(h, z, r, m.gate_nis);
     if (!rec.accepted && std::isfinite(rec.innovation) && std::abs(rec.innovation) < 1e9) {  // 1 km/s: never a bias
       rejections_[a] += weight;

@@ -42,7 +42,7 @@ struct SmootherOutput {
   std::array<std::array<SupportTally, kSupportKinds>, 3> tally{};  // [axis][support]
   std::size_t resets = 0;  // covariance resets of the forward pass (forward_filter.hpp)
   // keep_gains: per axis and sample, C_k and the smoothed covariance P_k|N.
-  std::array<std::vector<Mat3>, 3> gain, p_smoothed;
+  std::array<std::vector<StateCov>, 3> gain, p_smoothed;
 };
 
 // Throws InputError when the arrays disagree in length. Runs the checkpointed smoother

@@ -3,6 +3,8 @@
 // smoother, built from the same decisions the live filter makes (standstill detector, NBS
 // from the set-point, PSD fixes), refined with hindsight (a standstill is known from its
 // first quiet sample, not from the end of the detector's window).
+#include <Eigen/Core>
+
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -26,6 +28,7 @@ struct PositionFix {
   double sigma_um = 0.0;        // the strip's own noise
   int strip = 0;                // which PSD strip
   double model_sigma_um = 0.0;  // what the sensor model's uncertainty adds there (scale × distance)
+  double way_mm = 0.0;          // the integrated way along `axis` from the start (the scale state's share)
 };
 
 // The mean integrated velocity over a window ending at sample k of a standstill where the
@@ -45,8 +48,12 @@ struct SupportSchedule {
   // (their swings are correlated) but through velocity_means.
   std::vector<float> zupt_sigma_um_s;
   std::vector<VelocityMean> velocity_means;  // ascending k
-  bool zupt = true;                          // off: standstills are found and reported, not used
-  bool cupt = true;                          // off: PSD fixes are recorded, not used
+  // Where an axis' scale is a state (ErrorModel::scale_state_ppm): the integrated way from
+  // the start per sample (mm; float: 0.1 µm in 1 m, times a scale error of 1e-3), the
+  // scale's share of the position there. Empty without such an axis.
+  std::vector<Eigen::Vector3f> way_mm;
+  bool zupt = true;  // off: standstills are found and reported, not used
+  bool cupt = true;  // off: PSD fixes are recorded, not used
 };
 
 }  // namespace eical::dsp::fusion

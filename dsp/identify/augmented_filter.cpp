@@ -35,7 +35,7 @@ void AugmentedFilter::predict(double h_s, const Eigen::VectorXd& accel_gain, boo
   p_.col(0) = c0;
   p_.col(1) = c1;
   if (h_s != step_.h_s) step_ = fusion::discretise(model_, h_s);
-  p_.topLeftCorner<3, 3>() += step_.Q;
+  p_.topLeftCorner<3, 3>() += step_.Q.topLeftCorner<3, 3>();
   if (bias_step) p_(2, 2) += model_.bias_step_um_s2 * model_.bias_step_um_s2;
   p_ = 0.5 * (p_ + p_.transpose()).eval();
 }

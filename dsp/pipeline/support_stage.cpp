@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 namespace eical::dsp {
 namespace {
@@ -14,6 +15,26 @@ constexpr double kLateSettleS = 0.2;
 constexpr double kLateBatchS = 0.05;
 
 constexpr std::size_t kMaxRestWindows = 4096;
+
+// Strips this far apart along their axis observe its scale: two readings differ by δs·d.
+// One strip length: closer, a strip's own reach over its length sees as much.
+constexpr double kScaleSpanMm = 10.0;
+
+// Per axis, the σ (ppm) of the scale as a state: the model's scale uncertainty where the
+// strips measuring the axis span kScaleSpanMm along it, else 0 (fusion::ErrorModel).
+std::array<double, 3> scale_state_ppm(const std::vector<supports::PsdDecoder>& psd, double scale_uncertainty) {
+  std::array<double, 3> lo{}, hi{}, out{};
+  std::array<bool, 3> seen{};
+  for (const auto& strip : psd) {
+    const auto a = static_cast<std::size_t>(strip.axis());
+    lo[a] = seen[a] ? std::min(lo[a], strip.centre_mm()) : strip.centre_mm();
+    hi[a] = seen[a] ? std::max(hi[a], strip.centre_mm()) : strip.centre_mm();
+    seen[a] = true;
+  }
+  for (std::size_t a = 0; a < 3; ++a)
+    if (seen[a] && hi[a] - lo[a] >= kScaleSpanMm) out[a] = scale_uncertainty * 1e6;
+  return out;
+}
 
 }  // namespace
 
@@ -30,6 +51,8 @@ SupportStage::SupportStage(const SupportConfig& config, const Acquisition& acqui
   }
   schedule_.zupt = config.zupt;
   schedule_.cupt = config.cupt;
+  if (config.cupt) cfg_.model.scale_state_ppm = scale_state_ppm(psd_, config.model.scale_uncertainty);
+  record_way_ = fusion::scale_is_a_state(cfg_.model);
   if (!config.record) capacity_samples = 0;  // live: the forward filter only, nothing per sample
   capacity_ = capacity_samples;
   // Reserved, not touched: memory is taken as the measurement fills it (the live and the
@@ -45,6 +68,7 @@ SupportStage::SupportStage(const SupportConfig& config, const Acquisition& acqui
   gaps_.reserve(reserve_samples);
   support_vel_mm_s_.reserve(reserve_samples);
   fix_pos_mm_.reserve(reserve_samples);
+  if (record_way_) schedule_.way_mm.reserve(reserve_samples);
   rests_.reserve(kMaxRestWindows);
   block_len_ = static_cast<std::size_t>(std::max(1.0, std::round(0.02 * acquisition.fs_hz)));
   late_settle_ = static_cast<std::size_t>(std::round(kLateSettleS * acquisition.fs_hz));
@@ -65,6 +89,7 @@ void SupportStage::reset() noexcept {
   gaps_.clear();
   support_vel_mm_s_.clear();
   fix_pos_mm_.clear();
+  schedule_.way_mm.clear();
   rest_sum_.setZero(), rest_sq_.setZero();
   rest_n_ = 0;
   block_means_.clear();
@@ -270,14 +295,18 @@ void SupportStage::position_fixes(const SupportSample& s, const Eigen::Vector3d&
     // The lock-in output lags the spot by its time constant: add τ·v.
     const double fix_um = (psd_[p].centre_mm() + r.u_mm + psd_[p].lockin_tau_s() * vel_corr_mm_s[ax]) * 1000.0;
     // The scale's share: along the strip's axis from the frame's reference (anchor_start),
-    // across it (the mounting) from the start.
+    // or none where the filter keeps the scale as a state; across it (the mounting) from
+    // the start.
     Eigen::Vector3d way_mm = s.pos_mm - start_pos_mm_;
-    way_mm[ax] = s.pos_mm[ax] - frame_ref_mm_[ax];
+    const double along_mm = way_mm[ax];
+    const bool scale_state = cfg_.model.scale_state_ppm[static_cast<std::size_t>(ax)] > 0.0;
+    way_mm[ax] = scale_state ? 0.0 : s.pos_mm[ax] - frame_ref_mm_[ax];
     const double model_um = cfg_.model.scale_uncertainty * way_mm.norm() * 1000.0;
     if (cfg_.cupt)
-      live_.position_fix(ax, s.pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model);
+      live_.position_fix(ax, s.pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model,
+                         along_mm);
     if (schedule_.fixes.size() < capacity_) {
-      schedule_.fixes.push_back({s.k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(p), model_um});
+      schedule_.fixes.push_back({s.k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(p), model_um, along_mm});
       fix_pos_mm_.push_back(s.pos_mm[ax]);
     } else if (cfg_.record) {
       ++fixes_dropped_;
@@ -294,6 +323,7 @@ void SupportStage::record(const SupportSample& s, std::uint8_t flags, const Rest
     schedule_.zupt_sigma_um_s.push_back(static_cast<float>(r.zupt_sigma_um_s));
   if (s.k > 0 && s.gap_samples != 1) gaps_.emplace_back(s.k, s.gap_samples);
   if (fusion::reads_velocity(flags)) support_vel_mm_s_.push_back(s.vel_mm_s);
+  if (record_way_) schedule_.way_mm.push_back((s.pos_mm - start_pos_mm_).cast<float>());
 }
 
 // The sensors' mean at a standstill: their bias there (the drift between rests).
@@ -361,6 +391,7 @@ SupportSummary SupportStage::refine(std::size_t n, const std::function<std::int6
   support_vel_mm_s_.resize(std::min(reads, support_vel_mm_s_.size()));
   while (!gaps_.empty() && gaps_.back().first >= n) gaps_.pop_back();
   flags.resize(n);
+  if (schedule_.way_mm.size() > n) schedule_.way_mm.resize(n);
   if (cfg_.compact)
     zupt_unused_.resize(n);
   else
@@ -414,6 +445,7 @@ SupportSummary SupportStage::refine(std::size_t n, const std::function<std::int6
   sum.psd_fixes = schedule_.fixes.size();
   sum.start_bias_sigma_um_s2 = start_bias_sigma_;
   sum.start_frame_um = cfg_.model.start_frame_um;
+  sum.scale_state_ppm = cfg_.model.scale_state_ppm;
   sum.psd_fixes_dropped = fixes_dropped_;
   measure_bias_step(sum);
   return sum;
@@ -512,6 +544,10 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   }
   sum.tally = c->smoother->tally();
   sum.resets = c->smoother->resets();
+  for (int a = 0; a < 3; ++a)
+    if (sum.scale_state_ppm[static_cast<std::size_t>(a)] > 0.0)
+      std::tie(sum.scale_ppm[static_cast<std::size_t>(a)], sum.scale_sigma_ppm[static_cast<std::size_t>(a)]) =
+          c->smoother->scale_ppm(a);
   sum.smoothed = cfg_.smooth;
   return c;
 }

@@ -72,7 +72,10 @@ struct SupportSummary {
   bool smoothed = false;
   bool diverged = false;  // the fusion met values it cannot take: trace left as integrated
   Eigen::Vector3d start_bias_sigma_um_s2 = Eigen::Vector3d::Zero();  // how well the first rest fixed the bias
-  std::array<double, 3> start_frame_um{};  // the strips' frame against the start (fusion::ErrorModel)
+  std::array<double, 3> start_frame_um{};   // the strips' frame against the start (fusion::ErrorModel)
+  std::array<double, 3> scale_state_ppm{};  // the axes whose strips observe the scale (fusion::ErrorModel)
+  // Their scale error as the strips showed it, ppm, and its σ (0, 0 on the other axes).
+  std::array<double, 3> scale_ppm{}, scale_sigma_ppm{};
   // The bias jump at a move start as the standstills show it, and what the smoother assumed
   // (the measured one, or the model's when there was nothing to measure it on).
   fusion::BiasStepMeasurement bias_step;
@@ -207,6 +210,7 @@ class SupportStage {
   std::vector<Eigen::Vector3d> support_vel_mm_s_;
   std::vector<double> fix_pos_mm_;
   std::vector<bool> zupt_unused_;  // SupportConfig::compact: ZUPT σ −1 (true) or 0 per sample
+  bool record_way_ = false;        // the schedule's way per sample (a scale state on some axis)
   std::size_t capacity_ = 0;
   // Rest window before the motion: Σa, Σa² of the relative acceleration.
   Eigen::Vector3d rest_sum_ = Eigen::Vector3d::Zero(), rest_sq_ = Eigen::Vector3d::Zero();

@@ -75,22 +75,23 @@ void coarsen_block(const FineSchedule& in, const fusion::ErrorModel& model, std:
 // fix_noise_um.
 void combine_fixes(const std::vector<fusion::PositionFix>& fixes, const fusion::ErrorModel& model, std::size_t n,
                    std::size_t q, CoarseSchedule& c) {
-  // (axis, Σ w, Σ w² σ_noise², Σ w·position) with w = 1/var as the pipeline weighs each fix.
-  std::map<std::pair<std::size_t, int>, std::tuple<int, double, double, double>> comb;
+  // (axis, Σ w, Σ w² σ_noise², Σ w·position, Σ w·way) with w = 1/var as the pipeline weighs each fix.
+  std::map<std::pair<std::size_t, int>, std::tuple<int, double, double, double, double>> comb;
   for (const auto& f : fixes) {
     if (f.k >= n) continue;
     const double noise = f.sigma_um * f.sigma_um + model.psd_floor_um * model.psd_floor_um;
     const double var = noise + f.model_sigma_um * f.model_sigma_um;
     if (!(var > 0.0) || !std::isfinite(var)) continue;
-    auto& [axis, w, wn, wp] = comb[{f.k / q, f.strip}];
+    auto& [axis, w, wn, wp, ww] = comb[{f.k / q, f.strip}];
     axis = f.axis;
-    w += 1.0 / var, wn += noise / (var * var), wp += f.position_um / var;
+    w += 1.0 / var, wn += noise / (var * var), wp += f.position_um / var, ww += f.way_mm / var;
   }
   for (const auto& [key, v] : comb) {
     fusion::PositionFix f;
     f.k = key.first, f.strip = key.second, f.axis = std::get<0>(v);
     f.sigma_um = 1.0 / std::sqrt(std::get<1>(v));
     f.position_um = std::get<3>(v) / std::get<1>(v);  // where on its strip (the nonlinearity's response)
+    f.way_mm = std::get<4>(v) / std::get<1>(v);
     c.schedule.fixes.push_back(f);
     c.fix_noise_um.push_back(std::sqrt(std::get<2>(v)) / std::get<1>(v));  // σ of the weighted mean's noise
   }
@@ -127,7 +128,9 @@ CoarseSchedule coarsen(const FineSchedule& in, const fusion::ErrorModel& model, 
     c.fine_end[j] = e - 1;
     c.sample_index[j] = in.index_at(e - 1);
     coarsen_block(in, model, b, e, s.flags[j], s.zupt_sigma_um_s[j]);
+    if (fine.way_mm.size() >= n) s.way_mm.push_back(fine.way_mm[e - 1]);
   }
+  if (s.way_mm.size() != nc) s.way_mm.clear();
   combine_fixes(fine.fixes, model, n, q, c);
   for (auto v : fine.velocity_means) {
     if (v.k >= n) continue;

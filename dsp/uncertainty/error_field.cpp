@@ -211,7 +211,7 @@ std::vector<Eigen::Vector3d> integration_error_draw(const CoarseSchedule& coarse
   const auto& flags = coarse.schedule.flags;
   const double start_step_um_s2 = first_move_flagged(flags) ? 0.0 : truth.bias_step_um_s2;
   std::vector<Eigen::Vector3d> ex(nc), ev(nc), eb(nc);
-  const fusion::Mat3 p0 = fusion::initial_covariance(truth, 0, 0.0);  // its velocity term
+  const fusion::StateCov p0 = fusion::initial_covariance(truth, 0, 0.0);  // its velocity term
   for (int a = 0; a < 3; ++a) {
     // Drawn one by one, the bias first (see below: a call's arguments have no order).
     const double z_bias = g(rng), z_vel = g(rng);
@@ -224,13 +224,13 @@ std::vector<Eigen::Vector3d> integration_error_draw(const CoarseSchedule& coarse
         const std::int64_t gap = coarse.sample_index[k] - coarse.sample_index[k - 1];
         if (gap != last_gap) {
           d = fusion::discretise(truth, static_cast<double>(gap) / fs_hz);
-          llt.compute(d.Q + 1e-18 * fusion::Mat3::Identity());
+          llt.compute(d.Q.topLeftCorner<3, 3>() + 1e-18 * fusion::Mat3::Identity());
           last_gap = gap;
         }
         // Drawn one by one (last component first, the order these runs were made with): the
         // arguments of a call have no order, and another compiler would draw another field.
         const double w2 = g(rng), w1 = g(rng), w0 = g(rng);
-        e = d.F * e + llt.matrixL() * fusion::Vec3(w0, w1, w2);
+        e = d.F.topLeftCorner<3, 3>() * e + llt.matrixL() * fusion::Vec3(w0, w1, w2);
       }
       if ((flags[k] & sf::move_start) && truth.bias_step_um_s2 > 0.0) e[2] += truth.bias_step_um_s2 * g(rng);
       ex[k][a] = e[0], ev[k][a] = e[1], eb[k][a] = e[2];

@@ -21,33 +21,35 @@ namespace eical::dsp::fusion {
 namespace {
 
 template <class F>
-Eigen::RowVector3d numeric_row(const F& f, const Vec3& e, double step = 1e-3) {
-  Eigen::RowVector3d h;
-  for (int i = 0; i < 3; ++i) {
-    Vec3 ep = e, em = e;
+StateRow numeric_row(const F& f, const State& e, double step = 1e-3) {
+  StateRow h;
+  for (int i = 0; i < kStates; ++i) {
+    State ep = e, em = e;
     ep[i] += step, em[i] -= step;
     h[i] = (f(ep) - f(em)) / (2.0 * step);
   }
   return h;
 }
 
-void expect_row(const Eigen::RowVector3d& analytic, const Eigen::RowVector3d& numeric, const std::string& what) {
-  for (int i = 0; i < 3; ++i)
+void expect_row(const StateRow& analytic, const StateRow& numeric, const std::string& what) {
+  for (int i = 0; i < kStates; ++i)
     EXPECT_NEAR(analytic[i], numeric[i], 1e-9 * (1.0 + std::abs(numeric[i]))) << what << ", state " << i;
 }
 
 TEST(FusionJacobian, EverySupportRowIsTheGradientOfItsMeasurementFunction) {
-  for (const Vec3& e : {Vec3(1.5, -2.0, 30.0), Vec3(-40.0, 0.3, -7.0)}) {
-    expect_row(observe::zupt_row(), numeric_row([](const Vec3& s) { return observe::zupt(s); }, e), "zupt");
-    expect_row(observe::nbs_row(), numeric_row([](const Vec3& s) { return observe::nbs(s); }, e), "nbs");
-    expect_row(observe::cupt_row(), numeric_row([](const Vec3& s) { return observe::cupt(s); }, e), "cupt");
+  for (const State& e : {State(1.5, -2.0, 30.0, 120.0), State(-40.0, 0.3, -7.0, -35.0)}) {
+    expect_row(observe::zupt_row(), numeric_row([](const State& s) { return observe::zupt(s); }, e), "zupt");
+    expect_row(observe::nbs_row(), numeric_row([](const State& s) { return observe::nbs(s); }, e), "nbs");
+    for (const double way_mm : {0.0, 87.5, -240.0})
+      expect_row(observe::cupt_row(way_mm), numeric_row([&](const State& s) { return observe::cupt(s, way_mm); }, e),
+                 "cupt at " + std::to_string(way_mm) + " mm");
     // A ringing standstill's window: 0.1 s at 1 kHz ending at sample k, and an uneven one.
     std::vector<double> even(100);
     for (std::size_t i = 0; i < even.size(); ++i) even[i] = static_cast<double>(i) * 1e-3;
     for (const std::vector<double>& ago_s : {even, std::vector<double>{0.0, 0.002, 0.011, 0.05}}) {
       const double lag_s = std::accumulate(ago_s.begin(), ago_s.end(), 0.0) / static_cast<double>(ago_s.size());
       expect_row(observe::velocity_mean_row(lag_s),
-                 numeric_row([&](const Vec3& s) { return observe::window_mean_velocity(s, ago_s); }, e),
+                 numeric_row([&](const State& s) { return observe::window_mean_velocity(s, ago_s); }, e),
                  "velocity mean over " + std::to_string(ago_s.size()) + " samples");
     }
   }
@@ -56,16 +58,17 @@ TEST(FusionJacobian, EverySupportRowIsTheGradientOfItsMeasurementFunction) {
 TEST(FusionJacobian, TheFilterUpdatesWithTheseRows) {
   // Each support moves the state along its row's gain: with P = I the update of z = h·e
   // changes e by h/(h·h + r) times the innovation.
-  const ErrorModel m;
-  const Vec3 e0(1.0, 2.0, 3.0);
-  const auto check = [&](const Eigen::RowVector3d& h, double z, double r, auto&& apply, const std::string& what) {
+  ErrorModel m;
+  m.scale_state_ppm = {300.0, 0.0, 0.0};
+  const State e0(1.0, 2.0, 3.0, 4.0);
+  const auto check = [&](const StateRow& h, double z, double r, auto&& apply, const std::string& what) {
     ForwardFilter f;
     f.start(m, Vec3::Constant(1.0));
-    f.axis[0].e = e0, f.axis[0].P = Mat3::Identity();
+    f.axis[0].e = e0, f.axis[0].P = StateCov::Identity();
     apply(f);
     const double nu = z - h.dot(e0);
-    const Vec3 expected = e0 + h.transpose() / (h.dot(h) + r) * nu;
-    for (int i = 0; i < 3; ++i) EXPECT_NEAR(f.axis[0].e[i], expected[i], 1e-12) << what << ", state " << i;
+    const State expected = e0 + h.transpose() / (h.dot(h) + r) * nu;
+    for (int i = 0; i < kStates; ++i) EXPECT_NEAR(f.axis[0].e[i], expected[i], 1e-12) << what << ", state " << i;
   };
   const double zs = m.zupt_sigma_um_s, ns = m.nbs_sigma_um_s;
   check(
@@ -81,8 +84,12 @@ TEST(FusionJacobian, TheFilterUpdatesWithTheseRows) {
       "velocity mean");
   const double fs = m.psd_floor_um;
   check(
-      observe::cupt_row(), 0.5, 0.04 + fs * fs,
-      [](ForwardFilter& f) { (void)f.position_fix(0, 10.5, 10.0, 0.2, ErrorModel{}); }, "cupt");
+      observe::cupt_row(0.0), 0.5, 0.04 + fs * fs,
+      [](ForwardFilter& f) { (void)f.position_fix(0, 10.5, 10.0, 0.2, ErrorModel{}, 120.0); },
+      "cupt, the scale no state");
+  check(
+      observe::cupt_row(120.0), 0.5, 0.04 + fs * fs,
+      [&](ForwardFilter& f) { (void)f.position_fix(0, 10.5, 10.0, 0.2, m, 120.0); }, "cupt, the scale a state");
 }
 
 // The continuous error model of error_model.hpp: ė = A e + w, w into δv and δb.
@@ -116,7 +123,7 @@ TEST(FusionJacobian, TheTransitionIsTheJacobianOfTheContinuousFlow) {
       ep[j] += 1e-3, em[j] -= 1e-3;
       numeric.col(j) = (flow(ep, h_s) - flow(em, h_s)) / 2e-3;
     }
-    EXPECT_LT((d.F - numeric).cwiseAbs().maxCoeff(), 1e-9) << "h = " << h_s;
+    EXPECT_LT((d.F.topLeftCorner<3, 3>() - numeric).cwiseAbs().maxCoeff(), 1e-9) << "h = " << h_s;
   }
 }
 
@@ -136,8 +143,8 @@ TEST(FusionJacobian, TransitionAndNoiseEqualVanLoansExponentialOfTheContinuousMo
     const Mat3 f = ex.bottomRightCorner<3, 3>().transpose();
     const Mat3 q = f * ex.topRightCorner<3, 3>();
     const Discrete d = discretise(m, h_s);
-    EXPECT_LT((d.F - f).cwiseAbs().maxCoeff(), 1e-12) << "h = " << h_s;
-    EXPECT_LT((d.Q - q).cwiseAbs().maxCoeff(), 1e-9 * q.cwiseAbs().maxCoeff()) << "h = " << h_s;
+    EXPECT_LT((d.F.topLeftCorner<3, 3>() - f).cwiseAbs().maxCoeff(), 1e-12) << "h = " << h_s;
+    EXPECT_LT((d.Q.topLeftCorner<3, 3>() - q).cwiseAbs().maxCoeff(), 1e-9 * q.cwiseAbs().maxCoeff()) << "h = " << h_s;
   }
 }
 

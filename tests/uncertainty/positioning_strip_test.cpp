@@ -74,5 +74,39 @@ TEST(PositioningStrip, TheFirstRunMeetsTheStripsFrameLikeTheOthers) {
   EXPECT_LT(dsp::find_figure(measured, "positioning.R_um")->values[0], 15.0);
 }
 
+// The plan's design for a long travel: a strip at each end. Drawn machine 7 again (x scale
+// +486 ppm: k1 +319 ppm, the x–z cross term with gravity +167 ppm). Two strips 100 mm apart
+// observe the scale (a state of the fusion on x, fusion/error_model.hpp): the run measures
+// it, and E and A are what the noise leaves, where one strip left them to the data sheet's
+// scale tolerance (E 48 µm, U 46 µm; positioning-long in bench_uncertainty).
+TEST(PositioningStrip, StripsAtBothEndsMeasureTheScaleAndLeaveTheTravelToTheNoise) {
+  tools::plan::TestProgram p;
+  p.kind = "positioning", p.runs = 5, p.feed_mm_min = 4000.0;
+  p.targets_mm = {0.0, 20.0, 40.0, 60.0, 80.0, 100.0};
+  p.psd = tools::plan::strips_at_both_ends(p);
+  ASSERT_EQ(p.psd.size(), 2u);
+  dsp::Analysis a;
+  expect_within_u(p, 7, 40, {"positioning.A_um", "positioning.E_um", "positioning.M_um", "positioning.B_um"}, a);
+  EXPECT_FALSE(a.measurement.supports.psd_disagrees);
+  EXPECT_LT(a.uncertainty_k2.at("positioning.E_um").front(), 5.0);
+  // The scale the strips showed against the sensor's truth: the table's k1 and its x–z
+  // cross term with gravity (z reads +1 g), and what the test leaves out — the temperature
+  // coefficient's and k2's deviations from the data sheet the pipeline compensates with.
+  const sim::Scenario sc = tools::plan::scenario_on_drawn_machine(p, 7);
+  const sim::SensorTruth& t = sc.truth[0];
+  const dsp::SensorSpec& sheet = sc.meta.sensors[0];
+  const double expected_ppm =
+      (t.spec.k1_v_per_g[0] / sheet.k1_v_per_g[0] - 1.0) * 1e6 + t.k_cross2_g_per_g2(0, 2) * 1e6;
+  const double left_out_ppm =
+      std::abs(t.spec.tc_k1_ppm_per_c - sheet.tc_k1_ppm_per_c) * std::abs(t.temperature.t0_c - sheet.temp_ref_c) +
+      2.0 * std::abs(t.spec.k2_g_per_g2[0] - sheet.k2_g_per_g2[0]) * std::abs(t.spec.bias_g[0]) * 1e6;
+  const auto& sup = a.measurement.supports;
+  std::printf("x scale: measured %.1f +- %.1f ppm, expected %.1f ppm (+- %.1f left out)\n", sup.scale_ppm[0],
+              sup.scale_sigma_ppm[0], expected_ppm, left_out_ppm);
+  EXPECT_GT(sup.scale_state_ppm[0], 0.0);
+  EXPECT_LT(sup.scale_sigma_ppm[0], 20.0);
+  EXPECT_LE(std::abs(sup.scale_ppm[0] - expected_ppm), 3.0 * sup.scale_sigma_ppm[0] + left_out_ppm);
+}
+
 }  // namespace
 }  // namespace eical
