@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", o.seeds, "machines to draw (each its own sensors and errors)")->delimiter(',');
   app.add_option("--programs", o.programs,
                  "circle, circle-identified, circle-strips (4-16 strips, along the path or radial), circle-large, "
-                 "step, positioning, positioning-long, rectangle")
+                 "step, positioning, positioning-long, positioning-ends, rectangle")
       ->delimiter(',');
   app.add_option("--draws", o.draws, "Monte Carlo draws per run");
   app.add_option("--write-runs", o.write_runs, "write every simulated run into this folder");

@@ -29,6 +29,7 @@ struct CampaignProgram {
   bool background = false;  // the background circle or step of that seed (sim/hidden)
   int strips = 2;           // about a circle (plan::strips_for; 2: configuration B)
   sim::StripFacing facing = sim::StripFacing::along_path;
+  bool at_both_ends = false;  // a positioning test's strips at the ends of its travel (plan::strips_at_both_ends)
 };
 
 CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
@@ -58,19 +59,20 @@ CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
   } else if (program == "positioning") {
     p.kind = program, p.runs = 3, p.feed_mm_min = 3000.0;
     p.targets_mm = {0.0, 10.0, 20.0, 30.0};
-  } else if (program == "positioning-long") {  // 100–300 mm of travel, 5 runs (ISO 230-2)
+  } else if (program == "positioning-long" || program == "positioning-ends") {  // 100–300 mm, 5 runs (ISO 230-2)
     p.kind = "positioning", p.runs = 5, p.feed_mm_min = 4000.0;
+    c.at_both_ends = program == "positioning-ends";
     const double travel = pick({100.0, 200.0, 300.0});
     p.targets_mm.clear();
     for (int k = 0; k <= 5; ++k) p.targets_mm.push_back(travel * k / 5.0);
   } else if (program == "rectangle") {
     p.kind = "rectangle", p.size_mm[0] = 40.0, p.size_mm[1] = 30.0, p.feed_mm_min = 4000.0;
   } else {
-    throw dsp::InputError(
-        "coverage campaign: unknown program '" + program +
-        "' (circle, circle-identified, circle-strips, circle-large, step, positioning, positioning-long, rectangle)");
+    throw dsp::InputError("coverage campaign: unknown program '" + program +
+                          "' (circle, circle-identified, circle-strips, circle-large, step, positioning, "
+                          "positioning-long, positioning-ends, rectangle)");
   }
-  p.psd = plan::strips_for(p, c.strips, c.facing);
+  p.psd = c.at_both_ends ? plan::strips_at_both_ends(p) : plan::strips_for(p, c.strips, c.facing);
   return c;
 }
 
