@@ -279,11 +279,12 @@ nlohmann::json supports_json(const dsp::Measurement& m, double g_mps2) {
                       {"standstill_pairs", bs.pairs},
                       {"noise_ug_per_rthz", or_null(bs.noise_um_s2_rthz)}};
   // The scale of each axis whose strips span a distance, as they showed it (a state of the
-  // fusion there: fusion/error_model.hpp); absent where no axis has one.
+  // fusion there: fusion/error_model.hpp); absent where no axis has one, or the strips were
+  // dropped (psd_disagrees: nothing showed it).
   nlohmann::json scale;
   for (int ax = 0; ax < 3; ++ax) {
     const auto i = static_cast<std::size_t>(ax);
-    if (m.supports.scale_state_ppm[i] > 0.0)
+    if (m.supports.scale_state_ppm[i] > 0.0 && !m.supports.psd_disagrees)
       scale[kAxisNames[ax]] = {{"ppm", m.supports.scale_ppm[i]},
                                {"sigma_ppm", m.supports.scale_sigma_ppm[i]},
                                {"prior_sigma_ppm", m.supports.scale_state_ppm[i]}};

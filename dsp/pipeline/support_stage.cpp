@@ -16,6 +16,10 @@ constexpr double kLateBatchS = 0.05;
 
 constexpr std::size_t kMaxRestWindows = 4096;
 
+// The start's σ on an axis whose strips set its frame: no constraint (a machine is never a
+// millimetre off its set-point) that still keeps the filter's numbers near 1.
+constexpr double kFreeStartUm = 1000.0;
+
 // Strips this far apart along their axis observe its scale: two readings differ by δs·d.
 // One strip length: closer, a strip's own reach over its length sees as much.
 constexpr double kScaleSpanMm = 10.0;
@@ -190,7 +194,11 @@ void SupportStage::close_rest_window() noexcept {
 // Where the integration is anchored, and how far the strips' frame may sit from that
 // anchor on each axis (ErrorModel::start_frame_um): the filter starts with both. The
 // strip nearest the start is the frame's reference on its axis: a reading's scale share
-// counts from there.
+// counts from there. Where the strips span an axis (its scale a state) they set its frame
+// whatever the program: the set-point at the start is then no reference at all, for the
+// machine's error there is what the test measures (a drawn machine's straightness put a
+// R150 circle's start 20 µm off its set-point; anchored there within 2 µm, the strip under
+// the start contradicted it 100 times, the filter reset and the run lost all its strips).
 void SupportStage::anchor_start(const Eigen::Vector3d& pos_mm) noexcept {
   start_pos_mm_ = pos_mm;
   frame_ref_mm_ = pos_mm;
@@ -205,7 +213,9 @@ void SupportStage::anchor_start(const Eigen::Vector3d& pos_mm) noexcept {
   for (int a = 0; a < 3; ++a) {
     const auto i = static_cast<std::size_t>(a);
     cfg_.model.start_frame_um[i] =
-        std::isfinite(nearest_mm[i]) ? cfg_.model.scale_uncertainty * nearest_mm[i] * 1000.0 : 0.0;
+        cfg_.model.scale_state_ppm[i] > 0.0
+            ? kFreeStartUm
+            : (std::isfinite(nearest_mm[i]) ? cfg_.model.scale_uncertainty * nearest_mm[i] * 1000.0 : 0.0);
     live_.axis[a].P(0, 0) = fusion::initial_covariance(cfg_.model, a, 0.0)(0, 0);
   }
 }
@@ -544,8 +554,8 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   }
   sum.tally = c->smoother->tally();
   sum.resets = c->smoother->resets();
-  for (int a = 0; a < 3; ++a)
-    if (sum.scale_state_ppm[static_cast<std::size_t>(a)] > 0.0)
+  for (int a = 0; a < 3; ++a)  // what the strips showed (none when they were dropped)
+    if (sum.scale_state_ppm[static_cast<std::size_t>(a)] > 0.0 && c->schedule.cupt)
       std::tie(sum.scale_ppm[static_cast<std::size_t>(a)], sum.scale_sigma_ppm[static_cast<std::size_t>(a)]) =
           c->smoother->scale_ppm(a);
   sum.smoothed = cfg_.smooth;
