@@ -10,6 +10,7 @@
 // the readings' mean innovation at its middle sample.
 #include "dsp/fusion/support_schedule.hpp"
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -20,8 +21,10 @@ inline constexpr double kCrossingGapS = 0.002;
 
 // `fixes` in ascending k, `fix_pos_mm` the integrated position at each (same order);
 // readings of one strip more than `max_gap_samples` apart are separate crossings. Both
-// vectors are rewritten, still in ascending k.
+// vectors are rewritten, still in ascending k. `scale_is_a_state`: per axis, the filter
+// keeps the scale as a state (ErrorModel::scale_state_ppm), so a merged fix adds no scale
+// share between crossings to its σ (the state carries it).
 void merge_crossings(std::vector<PositionFix>& fixes, std::vector<double>& fix_pos_mm, double scale_uncertainty,
-                     std::size_t max_gap_samples);
+                     std::size_t max_gap_samples, const std::array<bool, 3>& scale_is_a_state = {});
 
 }  // namespace eical::dsp::fusion

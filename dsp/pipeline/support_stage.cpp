@@ -490,8 +490,10 @@ void SupportStage::fuse_psd(SmoothedCorrection& c, SupportSummary& sum, bool han
   if (disagree) {
     std::vector<fusion::PositionFix> fixes = c.schedule.fixes;
     std::vector<double> fix_pos_mm = c.track.fix_pos_mm;
+    std::array<bool, 3> scale_is_a_state{};
+    for (std::size_t a = 0; a < 3; ++a) scale_is_a_state[a] = cfg_.model.scale_state_ppm[a] > 0.0;
     fusion::merge_crossings(fixes, fix_pos_mm, cfg_.model.scale_uncertainty,
-                            static_cast<std::size_t>(std::ceil(fusion::kCrossingGapS * fs_hz_)));
+                            static_cast<std::size_t>(std::ceil(fusion::kCrossingGapS * fs_hz_)), scale_is_a_state);
     if (fixes.size() < c.schedule.fixes.size()) {
       std::swap(fixes, c.schedule.fixes), std::swap(fix_pos_mm, c.track.fix_pos_mm);
       resmooth(st);

@@ -65,6 +65,25 @@ TEST(CrossingFixes, StripsReadAtOnceAreCrossingsOfTheirOwnAndTheSamePlaceAddsNoS
   EXPECT_NEAR(fixes[2].model_sigma_um, 9.0, 1e-6);
 }
 
+// Where the filter keeps x's scale as a state, a merged fix's σ gains no scale share
+// between crossings: the state carries it (counted twice, the strips would weigh less).
+TEST(CrossingFixes, WhereTheScaleIsAStateTheMergedFixesAddNoScaleShare) {
+  std::vector<PositionFix> fixes;
+  std::vector<double> pos_mm;
+  cross(fixes, pos_mm, 0, 0, 500, 10.0, 20.0, 5e-4, 0.0);
+  cross(fixes, pos_mm, 1, 2000, 500, 40.0, 50.0, 5e-4, 0.0);
+  for (auto& f : fixes) f.model_sigma_um = 2.0;  // the mounting's share across the axis
+  std::vector<PositionFix> as_noise = fixes;
+  std::vector<double> as_noise_pos = pos_mm;
+  merge_crossings(as_noise, as_noise_pos, 3e-4, 20);
+  merge_crossings(fixes, pos_mm, 3e-4, 20, {true, false, false});
+  ASSERT_EQ(fixes.size(), 2u);
+  ASSERT_EQ(as_noise.size(), 2u);
+  EXPECT_NEAR(as_noise[1].model_sigma_um, 9.0, 1e-6);  // 30 mm at 3e-4 between the crossings
+  EXPECT_DOUBLE_EQ(fixes[0].model_sigma_um, 2.0);
+  EXPECT_DOUBLE_EQ(fixes[1].model_sigma_um, 2.0);
+}
+
 TEST(CrossingFixes, ASecondPassOverTheSameStripIsPinnedToItsReadings) {
   std::vector<PositionFix> fixes;
   std::vector<double> pos_mm;
