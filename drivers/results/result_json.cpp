@@ -284,7 +284,7 @@ nlohmann::json supports_json(const dsp::Measurement& m, double g_mps2) {
   nlohmann::json scale;
   for (int ax = 0; ax < 3; ++ax) {
     const auto i = static_cast<std::size_t>(ax);
-    if (m.supports.scale_state_ppm[i] > 0.0 && !m.supports.psd_disagrees)
+    if (dsp::fusion::scale_is_a_state(m.supports.scale_state_ppm, ax) && !m.supports.psd_disagrees)
       scale[kAxisNames[ax]] = {{"ppm", m.supports.scale_ppm[i]},
                                {"sigma_ppm", m.supports.scale_sigma_ppm[i]},
                                {"prior_sigma_ppm", m.supports.scale_state_ppm[i]}};

@@ -223,7 +223,7 @@ void CheckpointedSmoother::output(const SegmentStates& s, SmoothedSegment& out) 
   out.dx_um.resize(len), out.dv_um_s.resize(len), out.bias_um_s2.resize(len), out.sigma_x_um.resize(len);
   const auto& way = track_.schedule->way_mm;
   for (int a = 0; a < 3; ++a) {
-    const bool scaled = way.size() == track_.n && settings_.model.scale_state_ppm[static_cast<std::size_t>(a)] > 0.0;
+    const bool scaled = way.size() == track_.n && scale_is_a_state(settings_.model, a);
     for (std::size_t i = 0; i < len; ++i) {
       const State& e = s.e[a][i];
       const StateCov& p = s.p[a][i];

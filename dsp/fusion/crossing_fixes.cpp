@@ -17,7 +17,7 @@ struct Merged {
 // The readings of one crossing (indices into fixes): one fix, or each as it was.
 // `previous_mm`: the mean position the strip read on the last crossing on this axis (NaN: none).
 void close_crossing(const std::vector<PositionFix>& fixes, const std::vector<double>& fix_pos_mm,
-                    const std::vector<std::size_t>& crossing, double scale_uncertainty, bool scale_is_a_state,
+                    const std::vector<std::size_t>& crossing, double scale_uncertainty, bool scale_state,
                     double& previous_mm, std::vector<Merged>& out) {
   const auto n = static_cast<double>(crossing.size());
   double var_um2 = 0.0, mean_mm = 0.0, innovation_um = 0.0;
@@ -45,7 +45,7 @@ void close_crossing(const std::vector<PositionFix>& fixes, const std::vector<dou
   // The scale's share of the mean innovation is the same at every pass over the same place:
   // against the last crossing it is what the scale does between the two (the first keeps its
   // distance from the start).
-  if (std::isfinite(previous) && !scale_is_a_state)
+  if (std::isfinite(previous) && !scale_state)
     m.fix.model_sigma_um = scale_uncertainty * std::abs(mean_mm - previous) * 1000.0;
   out.push_back(m);
 }
@@ -53,7 +53,7 @@ void close_crossing(const std::vector<PositionFix>& fixes, const std::vector<dou
 }  // namespace
 
 void merge_crossings(std::vector<PositionFix>& fixes, std::vector<double>& fix_pos_mm, double scale_uncertainty,
-                     std::size_t max_gap_samples, const std::array<bool, 3>& scale_is_a_state) {
+                     std::size_t max_gap_samples, const std::array<double, 3>& scale_state_ppm) {
   if (fixes.size() != fix_pos_mm.size() || fixes.size() < 3 || !(scale_uncertainty > 0.0)) return;
   // The crossings, each the readings of one strip without a gap, in the order they begin.
   std::vector<std::vector<std::size_t>> crossings;
@@ -75,8 +75,9 @@ void merge_crossings(std::vector<PositionFix>& fixes, std::vector<double>& fix_p
   std::array<double, 3> previous_mm;
   previous_mm.fill(std::numeric_limits<double>::quiet_NaN());
   for (const auto& c : crossings) {
-    const auto axis = static_cast<std::size_t>(std::clamp(fixes[c.front()].axis, 0, 2));
-    close_crossing(fixes, fix_pos_mm, c, scale_uncertainty, scale_is_a_state[axis], previous_mm[axis], out);
+    const int axis = std::clamp(fixes[c.front()].axis, 0, 2);
+    close_crossing(fixes, fix_pos_mm, c, scale_uncertainty, scale_is_a_state(scale_state_ppm, axis),
+                   previous_mm[static_cast<std::size_t>(axis)], out);
   }
   std::stable_sort(out.begin(), out.end(), [](const Merged& a, const Merged& b) { return a.fix.k < b.fix.k; });
   fixes.clear(), fix_pos_mm.clear();

@@ -8,6 +8,7 @@
 // rejected it: resets, and a data-sheet positioning run lost its strip (psd_disagrees) and
 // integrated its targets apart by a random walk instead. Such a crossing becomes one fix:
 // the readings' mean innovation at its middle sample.
+#include "dsp/fusion/error_model.hpp"
 #include "dsp/fusion/support_schedule.hpp"
 
 #include <array>
@@ -21,10 +22,10 @@ inline constexpr double kCrossingGapS = 0.002;
 
 // `fixes` in ascending k, `fix_pos_mm` the integrated position at each (same order);
 // readings of one strip more than `max_gap_samples` apart are separate crossings. Both
-// vectors are rewritten, still in ascending k. `scale_is_a_state`: per axis, the filter
-// keeps the scale as a state (ErrorModel::scale_state_ppm), so a merged fix adds no scale
-// share between crossings to its σ (the state carries it).
+// vectors are rewritten, still in ascending k. `scale_state_ppm` (ErrorModel's): on an axis
+// where the filter keeps the scale as a state, a merged fix adds no scale share between
+// crossings to its σ (the state carries it).
 void merge_crossings(std::vector<PositionFix>& fixes, std::vector<double>& fix_pos_mm, double scale_uncertainty,
-                     std::size_t max_gap_samples, const std::array<bool, 3>& scale_is_a_state = {});
+                     std::size_t max_gap_samples, const std::array<double, 3>& scale_state_ppm = {});
 
 }  // namespace eical::dsp::fusion

@@ -70,11 +70,16 @@ struct ErrorModel {
   int reset_after_rejections = 100;
 };
 
-// True when the model keeps the scale of some axis as a state (the schedule carries the way).
+// True when the model keeps axis a's scale as a state (ErrorModel::scale_state_ppm).
+inline bool scale_is_a_state(const std::array<double, 3>& scale_state_ppm, int a) noexcept {
+  return scale_state_ppm[static_cast<std::size_t>(a)] > 0.0;
+}
+inline bool scale_is_a_state(const ErrorModel& model, int a) noexcept {
+  return scale_is_a_state(model.scale_state_ppm, a);
+}
+// True when it does on some axis (the schedule then carries the way).
 inline bool scale_is_a_state(const ErrorModel& model) noexcept {
-  for (const double s : model.scale_state_ppm)
-    if (s > 0.0) return true;
-  return false;
+  return scale_is_a_state(model, 0) || scale_is_a_state(model, 1) || scale_is_a_state(model, 2);
 }
 
 struct Discrete {

@@ -85,7 +85,7 @@ struct ForwardFilter {
   UpdateRecord position_fix(int a, double ins_pos_um, double fix_pos_um, double sigma_um, const ErrorModel& m,
                             double way_mm = 0.0) noexcept {
     const double s = sigma_um * sigma_um + m.psd_floor_um * m.psd_floor_um;
-    const StateRow h = observe::cupt_row(m.scale_state_ppm[static_cast<std::size_t>(a)] > 0.0 ? way_mm : 0.0);
+    const StateRow h = observe::cupt_row(scale_is_a_state(m, a) ? way_mm : 0.0);
     UpdateRecord r = axis[a].update_row(h, ins_pos_um - fix_pos_um, s, m.gate_nis);
     if (!r.accepted && std::isfinite(r.innovation) && std::abs(r.innovation) < 1e9) {
       if (++fix_rejections_[a] >= m.reset_after_rejections) {

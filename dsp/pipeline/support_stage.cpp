@@ -213,7 +213,7 @@ void SupportStage::anchor_start(const Eigen::Vector3d& pos_mm) noexcept {
   for (int a = 0; a < 3; ++a) {
     const auto i = static_cast<std::size_t>(a);
     cfg_.model.start_frame_um[i] =
-        cfg_.model.scale_state_ppm[i] > 0.0
+        fusion::scale_is_a_state(cfg_.model, a)
             ? kFreeStartUm
             : (std::isfinite(nearest_mm[i]) ? cfg_.model.scale_uncertainty * nearest_mm[i] * 1000.0 : 0.0);
     live_.axis[a].P(0, 0) = fusion::initial_covariance(cfg_.model, a, 0.0)(0, 0);
@@ -309,7 +309,7 @@ void SupportStage::position_fixes(const SupportSample& s, const Eigen::Vector3d&
     // the start.
     Eigen::Vector3d way_mm = s.pos_mm - start_pos_mm_;
     const double along_mm = way_mm[ax];
-    const bool scale_state = cfg_.model.scale_state_ppm[static_cast<std::size_t>(ax)] > 0.0;
+    const bool scale_state = fusion::scale_is_a_state(cfg_.model, ax);
     way_mm[ax] = scale_state ? 0.0 : s.pos_mm[ax] - frame_ref_mm_[ax];
     const double model_um = cfg_.model.scale_uncertainty * way_mm.norm() * 1000.0;
     if (cfg_.cupt)
@@ -490,10 +490,9 @@ void SupportStage::fuse_psd(SmoothedCorrection& c, SupportSummary& sum, bool han
   if (disagree) {
     std::vector<fusion::PositionFix> fixes = c.schedule.fixes;
     std::vector<double> fix_pos_mm = c.track.fix_pos_mm;
-    std::array<bool, 3> scale_is_a_state{};
-    for (std::size_t a = 0; a < 3; ++a) scale_is_a_state[a] = cfg_.model.scale_state_ppm[a] > 0.0;
     fusion::merge_crossings(fixes, fix_pos_mm, cfg_.model.scale_uncertainty,
-                            static_cast<std::size_t>(std::ceil(fusion::kCrossingGapS * fs_hz_)), scale_is_a_state);
+                            static_cast<std::size_t>(std::ceil(fusion::kCrossingGapS * fs_hz_)),
+                            cfg_.model.scale_state_ppm);
     if (fixes.size() < c.schedule.fixes.size()) {
       std::swap(fixes, c.schedule.fixes), std::swap(fix_pos_mm, c.track.fix_pos_mm);
       resmooth(st);
@@ -557,7 +556,7 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   sum.tally = c->smoother->tally();
   sum.resets = c->smoother->resets();
   for (int a = 0; a < 3; ++a)  // what the strips showed (none when they were dropped)
-    if (sum.scale_state_ppm[static_cast<std::size_t>(a)] > 0.0 && c->schedule.cupt)
+    if (fusion::scale_is_a_state(sum.scale_state_ppm, a) && c->schedule.cupt)
       std::tie(sum.scale_ppm[static_cast<std::size_t>(a)], sum.scale_sigma_ppm[static_cast<std::size_t>(a)]) =
           c->smoother->scale_ppm(a);
   sum.smoothed = cfg_.smooth;

@@ -76,7 +76,7 @@ TEST(CrossingFixes, WhereTheScaleIsAStateTheMergedFixesAddNoScaleShare) {
   std::vector<PositionFix> as_noise = fixes;
   std::vector<double> as_noise_pos = pos_mm;
   merge_crossings(as_noise, as_noise_pos, 3e-4, 20);
-  merge_crossings(fixes, pos_mm, 3e-4, 20, {true, false, false});
+  merge_crossings(fixes, pos_mm, 3e-4, 20, {300.0, 0.0, 0.0});
   ASSERT_EQ(fixes.size(), 2u);
   ASSERT_EQ(as_noise.size(), 2u);
   EXPECT_NEAR(as_noise[1].model_sigma_um, 9.0, 1e-6);  // 30 mm at 3e-4 between the crossings
