@@ -8,6 +8,9 @@
 namespace eical::sim::gcode {
 namespace {
 
+// Coordinates at kWrittenResolutionMm (9 decimals), which the reader's checks allow for.
+static_assert(kWrittenResolutionMm == 1e-9, "append_xyz and the arc offsets write 9 decimals");
+
 // " X.. Y.. Z..", appended (GCC 12 warns falsely on `"literal" + std::string&&`).
 void append_xyz(std::string& out, const Eigen::Vector3d& p_mm) {
   for (int a = 0; a < 3; ++a) {

@@ -375,7 +375,7 @@ class BlockReader {
     } else {
       c = centre_of(b, ax, s);
       const double r_start = (s - c).norm(), r_end = (e - c).norm();
-      if (std::abs(r_start - r_end) > o_.arc_radius_tolerance_mm)
+      if (std::abs(r_start - r_end) > o_.arc_radius_tolerance_mm + 4.0 * kWrittenResolutionMm)
         at_.fail(b.words.front().column, "arc end point is not on the circle (radius " + std::to_string(r_start) +
                                              " vs " + std::to_string(r_end) + " mm)");
       if (r_start < 1e-9) at_.fail(b.words.front().column, "arc radius is zero");

@@ -45,6 +45,11 @@
 
 namespace eical::sim::gcode {
 
+// The resolution eical writes a coordinate at (linuxcnc_text: 9 decimals of a mm). A check
+// that compares lengths allows a few of these, so that a program read once is read again
+// after writing: rounding the start, end and centre moves the two radii by ≤ 3 nm.
+inline constexpr double kWrittenResolutionMm = 1e-9;
+
 struct ParseOptions {
   Eigen::Vector3d start_mm = Eigen::Vector3d::Zero();  // machine position before the program
   // M-codes passed through as triggers; other M-codes are accepted only if listed in

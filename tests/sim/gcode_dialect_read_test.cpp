@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 
 namespace eical::sim::gcode {
@@ -147,6 +148,32 @@ TEST(GcodeDialectRead, CanonicalTextRunsLikeTheUsersProgram) {
   EXPECT_NEAR(arc.center_mm.norm(), 0.0, 1e-9);
   EXPECT_DOUBLE_EQ(arc.feed_mm_min, 1200.0);
   EXPECT_EQ(std::get<Trigger>(b.blocks[5]).code, 103);
+}
+
+// An arc whose end lies just inside the radius tolerance stays readable once written: the
+// canonical text rounds every coordinate to its resolution, and the reader allows for that
+// (a fuzz finding: 7.070600 vs 7.071600 mm, read once, refused after writing).
+TEST(GcodeDialectRead, AnArcAtTheRadiusToleranceStaysReadableOnceWritten) {
+  int near_the_edge = 0;
+  for (int k = 0; k < 2000; ++k) {
+    // Start radius r, end radius r + 1e-3 - eps with eps across the rounding quantum.
+    const double r = 1.0 + 0.0137 * k, eps = (k % 40 - 20) * 1e-10;
+    char text[256];
+    std::snprintf(
+        text, sizeof text,
+        "N10 G00 X+%.10f Y+0.3333333333 *\nN20 I+0 J+0.3333333333 *\nN30 G02 X-%.10f Y+0.3333333333 F1000 *\n", r,
+        r + 1e-3 - eps);
+    Program original;
+    try {
+      original = read(text, Dialect::heidenhain_iso);
+    } catch (const dsp::InputError&) {
+      continue;  // outside the tolerance as written: not this test's case
+    }
+    ++near_the_edge;
+    const std::string kept = canonical_gcode(text, "user.nc", Dialect::heidenhain_iso);
+    EXPECT_NO_THROW((void)parse(kept, "canonical")) << text << "\n" << kept;
+  }
+  EXPECT_GT(near_the_edge, 500) << "the sweep must cross the edge of the tolerance";
 }
 
 }  // namespace eical::sim::gcode
