@@ -91,7 +91,11 @@ void combine_fixes(const std::vector<fusion::PositionFix>& fixes, const fusion::
     f.k = key.first, f.strip = key.second, f.axis = std::get<0>(v);
     f.sigma_um = 1.0 / std::sqrt(std::get<1>(v));
     f.position_um = std::get<3>(v) / std::get<1>(v);  // where on its strip (the nonlinearity's response)
-    f.way_mm = std::get<4>(v) / std::get<1>(v);
+    // The scale row reads the way where the coarse sample's state is (its block's last
+    // fine sample), not the block's mean: a strip crossed at speed would otherwise read the
+    // scale at a way v·block/2 from where the error is compared.
+    f.way_mm = f.k < c.schedule.way_mm.size() ? static_cast<double>(c.schedule.way_mm[f.k][f.axis])
+                                              : std::get<4>(v) / std::get<1>(v);
     c.schedule.fixes.push_back(f);
     c.fix_noise_um.push_back(std::sqrt(std::get<2>(v)) / std::get<1>(v));  // σ of the weighted mean's noise
   }

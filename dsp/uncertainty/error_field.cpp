@@ -107,6 +107,17 @@ bool column_moves(const std::vector<Eigen::Vector3d>& p, int j) {
   return hi - lo > 1e-3;
 }
 
+// An error that follows the motion (E·v, τ·a) has no velocity where the machine rests, and
+// that is what a standstill reads. A coarse block counts as a standstill when any of its
+// samples rests, while the path is read at its last sample, which may already move: there
+// the standstill must read zero, not the motion's share (the smoother would take it for a
+// velocity error and carry it into the rest of the travel).
+void standstills_read_no_motion(const CoarseSchedule& coarse, std::vector<Eigen::Vector3d>& dv_mm_s) {
+  const auto& flags = coarse.schedule.flags;
+  for (std::size_t k = 0; k < dv_mm_s.size() && k < flags.size(); ++k)
+    if (flags[k] & fusion::schedule_flag::rest) dv_mm_s[k].setZero();
+}
+
 // Column j of E: every axis' error from the motion along j, per unit E.
 std::vector<Eigen::Vector3d> scale_response(const Responder& respond, const CoarsePath& path, int j) {
   const std::size_t nc = path.pos_mm.size();
@@ -114,6 +125,7 @@ std::vector<Eigen::Vector3d> scale_response(const Responder& respond, const Coar
   for (std::size_t k = 0; k < nc; ++k)
     dx[k] = Eigen::Vector3d::Constant(path.pos_mm[k][j] * kUnitE),
     dv[k] = Eigen::Vector3d::Constant(path.vel_mm_s[k][j] * kUnitE);
+  standstills_read_no_motion(respond.coarse, dv);
   return respond(dx, dv, -1, kUnitE);
 }
 
@@ -122,6 +134,7 @@ std::vector<Eigen::Vector3d> timing_response(const Responder& respond, const Coa
   const std::size_t nc = path.pos_mm.size();
   std::vector<Eigen::Vector3d> dx(nc), dv(nc);
   for (std::size_t k = 0; k < nc; ++k) dx[k] = path.vel_mm_s[k] * kUnitTau, dv[k] = path.acc_mm_s2[k] * kUnitTau;
+  standstills_read_no_motion(respond.coarse, dv);
   return respond(dx, dv, -1, kUnitTau);
 }
 

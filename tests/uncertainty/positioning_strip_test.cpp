@@ -108,5 +108,35 @@ TEST(PositioningStrip, StripsAtBothEndsMeasureTheScaleAndLeaveTheTravelToTheNois
   EXPECT_LE(std::abs(sup.scale_ppm[0] - expected_ppm), 3.0 * sup.scale_sigma_ppm[0] + left_out_ppm);
 }
 
+// With the scale a state, a scale error is one number the strips measure: the smoother
+// takes out all of it (what the strips' noise leaves is the integration's share of U). The
+// uncertainty once left 0.9 µm of it in E and B here, 3 µm over 300 mm: its coarse grid
+// read a strip crossed at speed at the block's mean way while comparing the error at the
+// block's end, and let a standstill block whose last sample already moved read the motion's
+// share as a velocity error.
+TEST(PositioningStrip, WhereTheStripsMeasureTheScaleItsShareOfUIsTheScalesSigmaOverTheTravel) {
+  tools::plan::TestProgram p;
+  p.kind = "positioning", p.runs = 5, p.feed_mm_min = 4000.0;
+  p.targets_mm = {0.0, 20.0, 40.0, 60.0, 80.0, 100.0};
+  p.psd = tools::plan::strips_at_both_ends(p);
+  const sim::Scenario sc = tools::plan::scenario_on_drawn_machine(p, 7);
+  const dsp::Run run = sim::simulate(sc);
+  dsp::AnalysisOptions ao;
+  ao.coriolis = sc.coriolis;
+  ao.uncertainty.draws = 20;
+  ao.uncertainty.budget = true;
+  const dsp::Analysis a = dsp::analyze_run(run, ao);
+  const auto& sup = a.measurement.supports;
+  ASSERT_GT(sup.scale_state_ppm[0], 0.0);
+  const auto& scale = a.uncertainty_budget.at(dsp::uncertainty::ErrorSource::sensor_scale);
+  // Half a percent of what the scale's prior (2σ) would make of the 100 mm travel: 0.3 µm.
+  const double allowed_um = 0.005 * 2.0 * sup.scale_state_ppm[0] * 1e-6 * 100.0 * 1000.0;
+  for (const char* key : {"positioning.E_um", "positioning.B_um", "positioning.M_um"}) {
+    const double u_um = scale.at(key).front();
+    std::printf("%s: U of the sensor scale and mounting alone %.3f um (allowed %.3f)\n", key, u_um, allowed_um);
+    EXPECT_LT(u_um, allowed_um) << key;
+  }
+}
+
 }  // namespace
 }  // namespace eical
