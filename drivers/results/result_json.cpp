@@ -290,6 +290,17 @@ nlohmann::json supports_json(const dsp::Measurement& m, double g_mps2) {
                                {"prior_sigma_ppm", m.supports.scale_state_ppm[i]}};
   }
   if (!scale.is_null()) sup["scale"] = scale;
+  // Likewise the timing of each axis a strip measures: the error of the sensor model's
+  // damping term and the DAQ's delay, as the strips crossed at speed showed it.
+  nlohmann::json timing;
+  for (int ax = 0; ax < 3; ++ax) {
+    const auto i = static_cast<std::size_t>(ax);
+    if (m.supports.timing_state_us[i] > 0.0 && !m.supports.psd_disagrees)
+      timing[kAxisNames[ax]] = {{"us", m.supports.timing_us[i]},
+                                {"sigma_us", m.supports.timing_sigma_us[i]},
+                                {"prior_sigma_us", m.supports.timing_state_us[i]}};
+  }
+  if (!timing.is_null()) sup["timing"] = timing;
   const Eigen::Vector3d& worst = m.sigma_max_um;  // over the whole trace
   sup["position_sigma_max_um"] = {worst.x(), worst.y(), worst.z()};
   return sup;

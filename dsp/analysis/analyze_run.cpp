@@ -7,6 +7,7 @@
 #include "dsp/core/float_limits.hpp"
 #include "dsp/pipeline/integration_support.hpp"
 
+#include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
 
 #include <algorithm>
@@ -143,6 +144,8 @@ PipelineConfig analysis_config(const RunMeta& meta, std::size_t capacity_samples
   cfg.keep_schedule = options.uncertainty.enabled;
   cfg.parallel = options.parallel;
   if (options.sensor_model != "datasheet") cfg.fusion.scale_uncertainty = 3e-5;  // identified on site
+  if (options.model_covariance)  // the timing as the identification knows it
+    cfg.fusion.timing_uncertainty_s = uncertainty::timing_sigma_s(*options.model_covariance, axis_owners(meta.machine));
   cfg.calibration[0] = options.calibration[0], cfg.calibration[1] = options.calibration[1];
   return cfg;
 }

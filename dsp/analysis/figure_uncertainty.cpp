@@ -340,6 +340,7 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
   in.model = config.fusion;
   in.model.start_frame_um = m.supports.start_frame_um;    // as the pipeline anchored the start
   in.model.scale_state_ppm = m.supports.scale_state_ppm;  // and kept the scale
+  in.model.timing_state_us = m.supports.timing_state_us;  // and the timing
   if (m.supports.bias_step_um_s2 > 0.0) in.model.bias_step_um_s2 = m.supports.bias_step_um_s2;  // as it measured
   in.start_bias_sigma_um_s2 = m.supports.start_bias_sigma_um_s2;
   in.model_covariance = options.model_covariance ? *options.model_covariance
@@ -361,6 +362,7 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
   fine.samples = std::min(samples, schedule.flags.size());
   fine.index_at = std::move(index_at);
   fine.zupt_unused = zupt_unused;
+  fine.fs_hz = m.fs_hz;
   if (m.supports.diverged) fine.flag_mask = fusion::schedule_flag::move_start | fusion::schedule_flag::invalid;
   uncertainty::CoarseSchedule& c = coarse_.emplace(
       uncertainty::coarsen(fine, in.model, uncertainty::ErrorField::block_for(fine.samples, in.max_coarse)));

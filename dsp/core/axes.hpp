@@ -2,6 +2,7 @@
 // Machine axis names ("x", "y", "z" → 0, 1, 2) and which sensor moves an axis.
 #include "dsp/core/run_meta.hpp"
 
+#include <array>
 #include <string_view>
 
 namespace eical::dsp {
@@ -17,6 +18,11 @@ inline int axis_owner(const MachineLayout& m, int j) noexcept {
   for (const auto& a : m.head_axes)
     if (axis_index(a) == j) return 1;
   return -1;
+}
+
+// Which sensor moves each machine axis (axis_owner of x, y, z).
+inline std::array<int, 3> axis_owners(const MachineLayout& m) noexcept {
+  return {axis_owner(m, 0), axis_owner(m, 1), axis_owner(m, 2)};
 }
 
 // The two axis letters right after `prefix` in a parameter name: "rotation_xy_mrad" → 0, 1.

@@ -66,6 +66,8 @@ CheckpointedSmoother::CheckpointedSmoother(const SmootherTrack& track, const Smo
   for (std::size_t a = 0; a < 3; ++a) {
     end_scale_ppm_[a] = c.filter.axis[a].e[kScaleState];
     end_scale_sigma_ppm_[a] = std::sqrt(std::max(c.filter.axis[a].P(kScaleState, kScaleState), 0.0));
+    end_timing_us_[a] = c.filter.axis[a].e[kTimingState];
+    end_timing_sigma_us_[a] = std::sqrt(std::max(c.filter.axis[a].P(kTimingState, kTimingState), 0.0));
   }
   for (const auto& r : resets) extra_[r.axis].push_back({r.k, Vec3(r.add_xx, r.add_vv, r.add_bb)});
   if (!settings_.forward_only) smooth_backward(states, sink);
@@ -142,7 +144,7 @@ void CheckpointedSmoother::forward(Checkpoint& c, std::size_t first, std::size_t
       const PositionFix& f = fixes_[c.next_fix];
       if (sch.cupt)
         fwd.position_fix(f.axis, fix_pos_mm_[c.next_fix] * 1000.0, f.position_um,
-                         std::hypot(f.sigma_um, f.model_sigma_um), m, f.way_mm);
+                         std::hypot(f.sigma_um, f.model_sigma_um), m, f.way_mm, f.vel_mm_s);
     }
     if (states) {
       states->gap[k - first] = gap;
@@ -223,25 +225,32 @@ void CheckpointedSmoother::output(const SegmentStates& s, SmoothedSegment& out) 
   out.dx_um.resize(len), out.dv_um_s.resize(len), out.bias_um_s2.resize(len), out.sigma_x_um.resize(len);
   const auto& way = track_.schedule->way_mm;
   for (int a = 0; a < 3; ++a) {
-    const bool scaled = way.size() == track_.n && scale_is_a_state(settings_.model, a);
+    const bool has_way = way.size() == track_.n;
+    const bool scaled = has_way && scale_is_a_state(settings_.model, a);
+    const bool timed = has_way && timing_is_a_state(settings_.model, a);
+    std::size_t next_gap = 0;  // gap_into's cursor: the samples come in order
     for (std::size_t i = 0; i < len; ++i) {
       const State& e = s.e[a][i];
       const StateCov& p = s.p[a][i];
       out.dx_um[i][a] = e[0];
       out.dv_um_s[i][a] = e[1];
       out.bias_um_s2[i][a] = e[2];
-      double var_x = p(0, 0);
-      if (scaled) {  // the scale's share: δs·way, and δs·v (v from the way around the sample)
-        const std::size_t k = s.first + i, lo = k > 0 ? k - 1 : k, hi = std::min(k + 1, way.size() - 1);
-        const double w = 1e-3 * static_cast<double>(way[k][a]);
-        const double v_mm_s =
-            hi > lo ? static_cast<double>(way[hi][a] - way[lo][a]) * settings_.fs_hz / static_cast<double>(hi - lo)
-                    : 0.0;
-        out.dx_um[i][a] += w * e[kScaleState];
-        out.dv_um_s[i][a] += 1e-3 * v_mm_s * e[kScaleState];
-        var_x += 2.0 * w * p(0, kScaleState) + w * w * p(kScaleState, kScaleState);
+      if (!scaled && !timed) {
+        out.sigma_x_um[i][a] = std::sqrt(std::max(p(0, 0), 0.0));
+        continue;
       }
-      out.sigma_x_um[i][a] = std::sqrt(std::max(var_x, 0.0));
+      // The position reads h·e with h = [1, 0, 0, way, v] (support_rows.hpp: cupt_row), the
+      // velocity δv + δs·v (v from the way around the sample over the samples' true spacing —
+      // lost frames, a coarse grid — the same whatever the segments; δτ·a is left out).
+      const std::size_t k = s.first + i, lo = k > 0 ? k - 1 : k, hi = std::min(k + 1, way.size() - 1);
+      std::int64_t steps = 0;
+      for (std::size_t j = lo + 1; j <= hi; ++j) steps += gap_into(j, next_gap);
+      const double v_mm_s =
+          steps > 0 ? static_cast<double>(way[hi][a] - way[lo][a]) * settings_.fs_hz / static_cast<double>(steps) : 0.0;
+      const StateRow h = observe::cupt_row(scaled ? static_cast<double>(way[k][a]) : 0.0, timed ? v_mm_s : 0.0);
+      out.dx_um[i][a] = h.dot(e);
+      if (scaled) out.dv_um_s[i][a] += 1e-3 * v_mm_s * e[kScaleState];
+      out.sigma_x_um[i][a] = std::sqrt(std::max(h.dot(p * h.transpose()), 0.0));
     }
   }
 }

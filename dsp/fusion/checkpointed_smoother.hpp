@@ -101,6 +101,11 @@ class CheckpointedSmoother {
     const auto i = static_cast<std::size_t>(a);
     return {end_scale_ppm_[i], end_scale_sigma_ppm_[i]};
   }
+  // Axis a's timing error (µs) and its σ, the same way.
+  [[nodiscard]] std::pair<double, double> timing_us(int a) const noexcept {
+    const auto i = static_cast<std::size_t>(a);
+    return {end_timing_us_[i], end_timing_sigma_us_[i]};
+  }
   // False when a smoothed (or, forward only, filtered) position or velocity error is not
   // finite: the model met values it cannot take.
   [[nodiscard]] bool finite() const noexcept { return finite_; }
@@ -149,6 +154,7 @@ class CheckpointedSmoother {
   std::array<std::array<SupportTally, kSupportKinds>, 3> tally_{};
   std::size_t reset_count_ = 0;
   std::array<double, 3> end_scale_ppm_{}, end_scale_sigma_ppm_{};
+  std::array<double, 3> end_timing_us_{}, end_timing_sigma_us_{};
   bool finite_ = true;
 };
 

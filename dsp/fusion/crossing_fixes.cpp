@@ -20,9 +20,10 @@ void close_crossing(const std::vector<PositionFix>& fixes, const std::vector<dou
                     const std::vector<std::size_t>& crossing, double scale_uncertainty, bool scale_state,
                     double& previous_mm, std::vector<Merged>& out) {
   const auto n = static_cast<double>(crossing.size());
-  double var_um2 = 0.0, mean_mm = 0.0, innovation_um = 0.0;
+  double var_um2 = 0.0, mean_mm = 0.0, innovation_um = 0.0, vel_mm_s = 0.0;
   for (std::size_t i : crossing) {
     var_um2 += fixes[i].sigma_um * fixes[i].sigma_um;
+    vel_mm_s += fixes[i].vel_mm_s;
     mean_mm += fixes[i].position_um / 1000.0;
     innovation_um += fixes[i].position_um - fix_pos_mm[i] * 1000.0;
   }
@@ -42,6 +43,7 @@ void close_crossing(const std::vector<PositionFix>& fixes, const std::vector<dou
   Merged m{fixes[mid], fix_pos_mm[mid]};
   m.fix.position_um = fix_pos_mm[mid] * 1000.0 + innovation_um;
   m.fix.sigma_um = sigma_um / std::sqrt(n);
+  m.fix.vel_mm_s = vel_mm_s / n;  // the timing's share of the mean innovation
   // The scale's share of the mean innovation is the same at every pass over the same place:
   // against the last crossing it is what the scale does between the two (the first keeps its
   // distance from the start).

@@ -12,7 +12,8 @@ ErrorCovariance::ErrorCovariance(const SupportSchedule& schedule, const std::vec
   model.gate_nis = 1e300;         // the covariance of the supports as scheduled
   model.start_position_um = 0.0;  // measured from where it starts
   model.reset_after_rejections = 1 << 30;
-  model.scale_state_ppm = {};  // the sensors' noise alone: the scale is no noise
+  model.scale_state_ppm = {};  // the sensors' noise alone: the scale is no noise,
+  model.timing_state_us = {};  // nor is the timing
   const std::size_t n = sample_index.size();
   SupportSchedule noise_only = schedule;  // the strips' own noise: the bound is the sensors'
   for (auto& f : noise_only.fixes) f.model_sigma_um = 0.0;

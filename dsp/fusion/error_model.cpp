@@ -25,6 +25,8 @@ StateCov initial_covariance(const ErrorModel& model, int axis, double start_bias
   p(2, 2) = start_bias_sigma_um_s2 * start_bias_sigma_um_s2 + model.bias_step_um_s2 * model.bias_step_um_s2;
   const double scale_ppm = model.scale_state_ppm[static_cast<std::size_t>(axis)];
   p(kScaleState, kScaleState) = scale_ppm > 0.0 ? scale_ppm * scale_ppm : 1.0;
+  const double timing_us = model.timing_state_us[static_cast<std::size_t>(axis)];
+  p(kTimingState, kTimingState) = timing_us > 0.0 ? timing_us * timing_us : 1.0;
   return p;
 }
 

@@ -1,17 +1,21 @@
 #pragma once
 // The error of the integrated relative motion along one machine axis (ch. 5.5: the
 // forward, or feed-forward, configuration of Bild 2-6: the integration runs on, the filter
-// estimates what it is off by). State e = [δx µm, δv µm/s, δb µm/s², δs ppm]: position,
-// velocity and acceleration-bias error of head − table after the rest-window bias was
-// removed, and the scale error of the integrated way along the axis.
+// estimates what it is off by). State e = [δx µm, δv µm/s, δb µm/s², δs ppm, δτ µs]:
+// position, velocity and acceleration-bias error of head − table after the rest-window
+// bias was removed, the scale error of the integrated way along the axis, and the timing
+// error of the integrated path against the strips.
 //
-//   δx' = δv,   δv' = δb + w_a,   δb' = w_b,   δs' = 0
+//   δx' = δv,   δv' = δb + w_a,   δb' = w_b,   δs' = 0,   δτ' = 0
 //
-// The scale's share of the integrated position is δs · (way from the start): it enters
-// where a position is observed (support_rows.hpp), never the dynamics, so F stays constant.
-// At rest the true velocity is zero and so is the scale's share of the integrated one.
-// Only axes whose strips span a distance observe δs (ErrorModel::scale_state_ppm); on the
-// others it is a decoupled unit state that nothing reads.
+// The scale's share of the integrated position is δs · (way from the start), the timing's
+// δτ · v: the damping term 2ζ/ω0 the dynamic compensation (6-38) takes from the sensor
+// model shifts the integrated path in time by its error, so a strip crossed at v reads it
+// off by v·δτ, the same δτ at every crossing. Both enter where a position is observed
+// (support_rows.hpp), never the dynamics, so F stays constant; at rest the true velocity
+// is zero and so are both shares of the integrated one. Only axes whose strips span a
+// distance observe δs (ErrorModel::scale_state_ppm), only axes with strips δτ
+// (ErrorModel::timing_state_us); elsewhere each is a decoupled unit state nothing reads.
 //
 // w_a: the two sensors' white noise, two-sided density n per sensor (run-format.md), so
 // q_a = n_table² + n_head²; w_b: the bias random walk (6-5, 6-6), q_b = walk² (both
@@ -28,9 +32,10 @@ namespace eical::dsp::fusion {
 
 using Vec3 = Eigen::Vector3d;  // one value per machine axis
 using Mat3 = Eigen::Matrix3d;
-// One axis' error state [δx, δv, δb, δs] and its covariance.
-inline constexpr int kStates = 4;
+// One axis' error state [δx, δv, δb, δs, δτ] and its covariance.
+inline constexpr int kStates = 5;
 inline constexpr int kScaleState = 3;
+inline constexpr int kTimingState = 4;
 using State = Eigen::Matrix<double, kStates, 1>;
 using StateCov = Eigen::Matrix<double, kStates, kStates>;
 using StateRow = Eigen::Matrix<double, 1, kStates>;
@@ -63,6 +68,14 @@ struct ErrorModel {
   // places along the axis observe (two readings d mm apart differ by δs·d); 0: no such
   // strips, the scale stays in each reading's model σ. SupportStage sets it from the strips.
   std::array<double, 3> scale_state_ppm{};
+  // Per axis: σ (s) of the sensor model's timing, the damping term of the sensor that
+  // carries the axis and the DAQ's delay (data sheet or identification;
+  // uncertainty::timing_sigma_s). pipeline_config() sets it.
+  std::array<double, 3> timing_uncertainty_s{};
+  // Per axis: σ (µs) of the timing error as a state of the filter, which the strips on the
+  // axis observe where they are crossed at speed; 0: no strips, no state. SupportStage
+  // sets it from the strips and timing_uncertainty_s.
+  std::array<double, 3> timing_state_us{};
   double gate_nis = 25.0;  // innovation test: reject beyond 5 σ
   // A standstill whose velocity the filter keeps rejecting means the model was too sure
   // (a bias jump it did not expect): after this many rejections in a row (per-sample
@@ -77,9 +90,16 @@ inline bool scale_is_a_state(const std::array<double, 3>& scale_state_ppm, int a
 inline bool scale_is_a_state(const ErrorModel& model, int a) noexcept {
   return scale_is_a_state(model.scale_state_ppm, a);
 }
-// True when it does on some axis (the schedule then carries the way).
-inline bool scale_is_a_state(const ErrorModel& model) noexcept {
-  return scale_is_a_state(model, 0) || scale_is_a_state(model, 1) || scale_is_a_state(model, 2);
+// True when the model keeps axis a's timing as a state (ErrorModel::timing_state_us).
+inline bool timing_is_a_state(const ErrorModel& model, int a) noexcept {
+  return model.timing_state_us[static_cast<std::size_t>(a)] > 0.0;
+}
+// True when a position reading depends on where and how fast the axis moved (the scale or
+// the timing is a state on some axis): the schedule then carries the way.
+inline bool reads_the_way(const ErrorModel& model) noexcept {
+  for (int a = 0; a < 3; ++a)
+    if (scale_is_a_state(model, a) || timing_is_a_state(model, a)) return true;
+  return false;
 }
 
 struct Discrete {
@@ -92,7 +112,7 @@ Discrete discretise(const ErrorModel& model, double h_s);
 
 // Covariance of one axis' error at the start of the motion: the start position against
 // the set-point (and the strips' frame), the velocity at rest, the rest-window bias (σ
-// given) and its jump into the first move, the scale (1 where it is no state).
+// given) and its jump into the first move, the scale and the timing (1 where no state).
 StateCov initial_covariance(const ErrorModel& model, int axis, double start_bias_sigma_um_s2);
 
 }  // namespace eical::dsp::fusion

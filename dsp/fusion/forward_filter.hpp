@@ -79,13 +79,15 @@ struct ForwardFilter {
   }
 
   // CUPT: the integrated position minus the PSD's is the position error (and the scale's
-  // share over way_mm, the way from the start along the axis, where the scale is a state).
+  // share over way_mm, the way from the start along the axis, where the scale is a state;
+  // the timing's at the integrated velocity vel_mm_s, where the timing is one).
   // A strip the filter keeps rejecting is reset to like a standstill (the position error is
   // ν; the bias that would have made it since the last position support, 2ν/T²).
   UpdateRecord position_fix(int a, double ins_pos_um, double fix_pos_um, double sigma_um, const ErrorModel& m,
-                            double way_mm = 0.0) noexcept {
+                            double way_mm = 0.0, double vel_mm_s = 0.0) noexcept {
     const double s = sigma_um * sigma_um + m.psd_floor_um * m.psd_floor_um;
-    const StateRow h = observe::cupt_row(scale_is_a_state(m, a) ? way_mm : 0.0);
+    const StateRow h =
+        observe::cupt_row(scale_is_a_state(m, a) ? way_mm : 0.0, timing_is_a_state(m, a) ? vel_mm_s : 0.0);
     UpdateRecord r = axis[a].update_row(h, ins_pos_um - fix_pos_um, s, m.gate_nis);
     if (!r.accepted && std::isfinite(r.innovation) && std::abs(r.innovation) < 1e9) {
       if (++fix_rejections_[a] >= m.reset_after_rejections) {

@@ -1,7 +1,7 @@
 #pragma once
 // The fusion's support observations (forward_filter.hpp), each as its measurement function
 // — what the observation z predicts from one axis' error state e = [δx µm, δv µm/s,
-// δb µm/s², δs ppm] (error_model.hpp) — and the row h that linearises it (z = h·e + noise). The
+// δb µm/s², δs ppm, δτ µs] (error_model.hpp) — and the row h that linearises it (z = h·e + noise). The
 // filter updates with the rows; tests/dsp/fusion_jacobian_test.cpp checks each against
 // central differences of its function.
 #include "dsp/fusion/error_model.hpp"
@@ -20,12 +20,16 @@ inline double nbs(const State& e) { return e[1]; }
 inline StateRow nbs_row() { return StateRow::Unit(1); }
 
 // CUPT: the integrated position minus a PSD strip's reading, at way_mm from the start
-// along the axis: the scale error has made δs·way of it (1 ppm of 1 mm is 1e-3 µm).
-// way_mm = 0 where the scale is no state.
-inline double cupt(const State& e, double way_mm) { return e[0] + 1e-3 * way_mm * e[kScaleState]; }
-inline StateRow cupt_row(double way_mm) {
+// along the axis and at the integrated velocity vel_mm_s along it: the scale error has
+// made δs·way of it (1 ppm of 1 mm is 1e-3 µm), the timing error δτ·v (1 µs at 1 mm/s is
+// 1e-3 µm). way_mm, vel_mm_s = 0 where the scale, the timing is no state.
+inline double cupt(const State& e, double way_mm, double vel_mm_s = 0.0) {
+  return e[0] + 1e-3 * way_mm * e[kScaleState] + 1e-3 * vel_mm_s * e[kTimingState];
+}
+inline StateRow cupt_row(double way_mm, double vel_mm_s = 0.0) {
   StateRow h = StateRow::Unit(0);
   h[kScaleState] = 1e-3 * way_mm;
+  h[kTimingState] = 1e-3 * vel_mm_s;
   return h;
 }
 
@@ -38,6 +42,10 @@ inline double window_mean_velocity(const State& e, const std::vector<double>& ag
   return sum / static_cast<double>(ago_s.size());
 }
 // Its row; lag_s: from the window's mean time to sample k (the mean of ago_s).
-inline StateRow velocity_mean_row(double lag_s) { return {0.0, 1.0, -lag_s, 0.0}; }
+inline StateRow velocity_mean_row(double lag_s) {
+  StateRow h = StateRow::Zero();
+  h[1] = 1.0, h[2] = -lag_s;
+  return h;
+}
 
 }  // namespace eical::dsp::fusion::observe

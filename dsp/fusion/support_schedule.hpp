@@ -29,6 +29,7 @@ struct PositionFix {
   int strip = 0;                // which PSD strip
   double model_sigma_um = 0.0;  // what the sensor model's uncertainty adds there (scale × distance)
   double way_mm = 0.0;          // the integrated way along `axis` from the start (the scale state's share)
+  double vel_mm_s = 0.0;        // the integrated velocity along `axis` (the timing state's share)
 };
 
 // The mean integrated velocity over a window ending at sample k of a standstill where the
@@ -48,9 +49,10 @@ struct SupportSchedule {
   // (their swings are correlated) but through velocity_means.
   std::vector<float> zupt_sigma_um_s;
   std::vector<VelocityMean> velocity_means;  // ascending k
-  // Where an axis' scale is a state (ErrorModel::scale_state_ppm): the integrated way from
-  // the start per sample (mm; float: 0.1 µm in 1 m, times a scale error of 1e-3), the
-  // scale's share of the position there. Empty without such an axis.
+  // Where an axis' scale or timing is a state (reads_the_way): the integrated way from the
+  // start per sample (mm; float: 0.1 µm in 1 m, times a scale error of 1e-3), the scale's
+  // share of the position there, and by its differences the velocity, the timing's share.
+  // Empty without such an axis.
   std::vector<Eigen::Vector3f> way_mm;
   bool zupt = true;  // off: standstills are found and reported, not used
   bool cupt = true;  // off: PSD fixes are recorded, not used

@@ -40,6 +40,18 @@ std::array<double, 3> scale_state_ppm(const std::vector<supports::PsdDecoder>& p
   return out;
 }
 
+// Per axis, the σ (µs) of the timing as a state: the model's timing uncertainty where a strip
+// measures the axis, else 0 (fusion::ErrorModel).
+std::array<double, 3> timing_state_us(const std::vector<supports::PsdDecoder>& psd,
+                                      const std::array<double, 3>& timing_uncertainty_s) {
+  std::array<double, 3> out{};
+  for (const auto& strip : psd) {
+    const auto a = static_cast<std::size_t>(strip.axis());
+    out[a] = timing_uncertainty_s[a] * 1e6;
+  }
+  return out;
+}
+
 }  // namespace
 
 SupportStage::SupportStage(const SupportConfig& config, const Acquisition& acquisition, const std::vector<PsdSpec>& psd,
@@ -55,8 +67,11 @@ SupportStage::SupportStage(const SupportConfig& config, const Acquisition& acqui
   }
   schedule_.zupt = config.zupt;
   schedule_.cupt = config.cupt;
-  if (config.cupt) cfg_.model.scale_state_ppm = scale_state_ppm(psd_, config.model.scale_uncertainty);
-  record_way_ = fusion::scale_is_a_state(cfg_.model);
+  if (config.cupt) {
+    cfg_.model.scale_state_ppm = scale_state_ppm(psd_, config.model.scale_uncertainty);
+    cfg_.model.timing_state_us = timing_state_us(psd_, config.model.timing_uncertainty_s);
+  }
+  record_way_ = fusion::reads_the_way(cfg_.model);
   if (!config.record) capacity_samples = 0;  // live: the forward filter only, nothing per sample
   capacity_ = capacity_samples;
   // Reserved, not touched: memory is taken as the measurement fills it (the live and the
@@ -314,9 +329,10 @@ void SupportStage::position_fixes(const SupportSample& s, const Eigen::Vector3d&
     const double model_um = cfg_.model.scale_uncertainty * way_mm.norm() * 1000.0;
     if (cfg_.cupt)
       live_.position_fix(ax, s.pos_mm[ax] * 1000.0, fix_um, std::hypot(r.sigma_mm * 1000.0, model_um), cfg_.model,
-                         along_mm);
+                         along_mm, s.vel_mm_s[ax]);
     if (schedule_.fixes.size() < capacity_) {
-      schedule_.fixes.push_back({s.k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(p), model_um, along_mm});
+      schedule_.fixes.push_back(
+          {s.k, ax, fix_um, r.sigma_mm * 1000.0, static_cast<int>(p), model_um, along_mm, s.vel_mm_s[ax]});
       fix_pos_mm_.push_back(s.pos_mm[ax]);
     } else if (cfg_.record) {
       ++fixes_dropped_;
@@ -456,6 +472,7 @@ SupportSummary SupportStage::refine(std::size_t n, const std::function<std::int6
   sum.start_bias_sigma_um_s2 = start_bias_sigma_;
   sum.start_frame_um = cfg_.model.start_frame_um;
   sum.scale_state_ppm = cfg_.model.scale_state_ppm;
+  sum.timing_state_us = cfg_.model.timing_state_us;
   sum.psd_fixes_dropped = fixes_dropped_;
   measure_bias_step(sum);
   return sum;
@@ -555,10 +572,14 @@ std::unique_ptr<SmoothedCorrection> SupportStage::smooth_track(std::size_t n, Su
   }
   sum.tally = c->smoother->tally();
   sum.resets = c->smoother->resets();
-  for (int a = 0; a < 3; ++a)  // what the strips showed (none when they were dropped)
-    if (fusion::scale_is_a_state(sum.scale_state_ppm, a) && c->schedule.cupt)
-      std::tie(sum.scale_ppm[static_cast<std::size_t>(a)], sum.scale_sigma_ppm[static_cast<std::size_t>(a)]) =
-          c->smoother->scale_ppm(a);
+  for (int a = 0; a < 3; ++a) {  // what the strips showed (none when they were dropped)
+    const auto i = static_cast<std::size_t>(a);
+    if (!c->schedule.cupt) continue;
+    if (fusion::scale_is_a_state(sum.scale_state_ppm, a))
+      std::tie(sum.scale_ppm[i], sum.scale_sigma_ppm[i]) = c->smoother->scale_ppm(a);
+    if (fusion::timing_is_a_state(cfg_.model, a))
+      std::tie(sum.timing_us[i], sum.timing_sigma_us[i]) = c->smoother->timing_us(a);
+  }
   sum.smoothed = cfg_.smooth;
   return c;
 }

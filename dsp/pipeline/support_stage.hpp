@@ -76,6 +76,9 @@ struct SupportSummary {
   std::array<double, 3> scale_state_ppm{};  // the axes whose strips observe the scale (fusion::ErrorModel)
   // Their scale error as the strips showed it, ppm, and its σ (0, 0 on the other axes).
   std::array<double, 3> scale_ppm{}, scale_sigma_ppm{};
+  std::array<double, 3> timing_state_us{};  // the axes whose strips observe the timing (fusion::ErrorModel)
+  // Their timing error as the strips showed it, µs, and its σ (0, 0 on the other axes).
+  std::array<double, 3> timing_us{}, timing_sigma_us{};
   // The bias jump at a move start as the standstills show it, and what the smoother assumed
   // (the measured one, or the model's when there was nothing to measure it on).
   fusion::BiasStepMeasurement bias_step;

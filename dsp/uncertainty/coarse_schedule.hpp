@@ -37,12 +37,13 @@ struct FineSchedule {
   // (fusion::SmootherTrack::zupt_unused); absent: 0, each standstill sample used.
   const std::vector<bool>* zupt_unused = nullptr;
   std::uint8_t flag_mask = 0xFF;  // the flags kept (a diverged fusion: move starts and invalid samples)
+  double fs_hz = 0.0;             // the trace's sample rate: the way's differences give the fixes' velocity
 };
 
 CoarseSchedule coarsen(const FineSchedule& in, const fusion::ErrorModel& model, std::size_t q);
 
 // `fine`: the schedule the pipeline used (one flag per trace sample); `block` ≥ 1.
 CoarseSchedule coarsen(const fusion::SupportSchedule& fine, const std::vector<std::int64_t>& sample_index,
-                       const fusion::ErrorModel& model, std::size_t block);
+                       const fusion::ErrorModel& model, std::size_t block, double fs_hz);
 
 }  // namespace eical::dsp::uncertainty

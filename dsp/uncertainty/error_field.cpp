@@ -304,7 +304,7 @@ ErrorField::ErrorField(const ErrorFieldInput& input) {
   const std::size_t n = std::min(
       {input.schedule->flags.size(), input.sample_index->size(), input.pos_mm->size(), input.vel_mm_s->size()});
   if (n < 2) throw InputError("uncertainty: the measurement holds fewer than 2 samples");
-  coarse_ = coarsen(*input.schedule, *input.sample_index, input.model, block_for(n, input.max_coarse));
+  coarse_ = coarsen(*input.schedule, *input.sample_index, input.model, block_for(n, input.max_coarse), input.fs_hz);
   const bool have_temp = input.temp_c && input.temp_c->size() >= n;
   build(input, coarse_path(coarse_, input.delay_samples, input.fs_hz, *input.pos_mm, *input.vel_mm_s,
                            have_temp ? input.temp_c : nullptr));
@@ -343,6 +343,8 @@ std::vector<Eigen::Vector3d> draw_noise_bound(const ErrorFieldInput& input, cons
                                               std::mt19937_64& rng) {
   fusion::ErrorModel truth = simulated_truth(coarse.model, input);
   truth.bias_walk_um_s2_rts = 0.0, truth.bias_step_um_s2 = 0.0;
+  // A perfect sensor model: no scale or timing left to estimate (as fusion::ErrorCovariance).
+  truth.scale_state_ppm = {}, truth.timing_state_us = {};
   return integration_error_draw(coarse, input, truth, truth, true, rng);
 }
 

@@ -62,6 +62,15 @@ SensorModelCovariance datasheet_covariance(const SensorSpec sensors[2], double f
   return c;
 }
 
+std::array<double, 3> timing_sigma_s(const SensorModelCovariance& c, const std::array<int, 3>& owner) {
+  std::array<double, 3> out{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    const double damping_var = owner[i] >= 0 ? c.covariance(damping_index(owner[i]), damping_index(owner[i])) : 0.0;
+    out[i] = std::sqrt(std::max(0.0, damping_var + c.covariance(kDelayIndex, kDelayIndex)));
+  }
+  return out;
+}
+
 double strip_nonlinearity_scale_variance(const DatasheetTolerance& tolerance) {
   const double a = 0.6 * tolerance.psd_nonlinearity;
   return a * a / 3.0;

@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <string>
 
 namespace eical::dsp::uncertainty {
@@ -75,6 +76,11 @@ struct DatasheetTolerance {
 // the filter's own. The identification's covariance adds its variance (uniform: /3) to the
 // scale of every axis a strip measures.
 double strip_nonlinearity_scale_variance(const DatasheetTolerance& tolerance = {});
+
+// Per machine axis, σ (s) of the sensor model's timing: the damping term of the sensor that
+// carries the axis (owner: 0 table, 1 head, −1 none) and the DAQ's delay
+// (fusion::ErrorModel::timing_uncertainty_s).
+std::array<double, 3> timing_sigma_s(const SensorModelCovariance& c, const std::array<int, 3>& owner);
 
 // The covariance the data sheet gives (independent parameters).
 SensorModelCovariance datasheet_covariance(const SensorSpec sensors[2], double fs_hz,

@@ -37,12 +37,14 @@ void expect_row(const StateRow& analytic, const StateRow& numeric, const std::st
 }
 
 TEST(FusionJacobian, EverySupportRowIsTheGradientOfItsMeasurementFunction) {
-  for (const State& e : {State(1.5, -2.0, 30.0, 120.0), State(-40.0, 0.3, -7.0, -35.0)}) {
+  for (const State& e : {State{1.5, -2.0, 30.0, 120.0, 2.5}, State{-40.0, 0.3, -7.0, -35.0, -1.2}}) {
     expect_row(observe::zupt_row(), numeric_row([](const State& s) { return observe::zupt(s); }, e), "zupt");
     expect_row(observe::nbs_row(), numeric_row([](const State& s) { return observe::nbs(s); }, e), "nbs");
     for (const double way_mm : {0.0, 87.5, -240.0})
-      expect_row(observe::cupt_row(way_mm), numeric_row([&](const State& s) { return observe::cupt(s, way_mm); }, e),
-                 "cupt at " + std::to_string(way_mm) + " mm");
+      for (const double vel_mm_s : {0.0, 66.7, -150.0})
+        expect_row(observe::cupt_row(way_mm, vel_mm_s),
+                   numeric_row([&](const State& s) { return observe::cupt(s, way_mm, vel_mm_s); }, e),
+                   "cupt at " + std::to_string(way_mm) + " mm, " + std::to_string(vel_mm_s) + " mm/s");
     // A ringing standstill's window: 0.1 s at 1 kHz ending at sample k, and an uneven one.
     std::vector<double> even(100);
     for (std::size_t i = 0; i < even.size(); ++i) even[i] = static_cast<double>(i) * 1e-3;
@@ -60,7 +62,7 @@ TEST(FusionJacobian, TheFilterUpdatesWithTheseRows) {
   // changes e by h/(h·h + r) times the innovation.
   ErrorModel m;
   m.scale_state_ppm = {300.0, 0.0, 0.0};
-  const State e0(1.0, 2.0, 3.0, 4.0);
+  const State e0{1.0, 2.0, 3.0, 4.0, 5.0};
   const auto check = [&](const StateRow& h, double z, double r, auto&& apply, const std::string& what) {
     ForwardFilter f;
     f.start(m, Vec3::Constant(1.0));
@@ -89,7 +91,13 @@ TEST(FusionJacobian, TheFilterUpdatesWithTheseRows) {
       "cupt, the scale no state");
   check(
       observe::cupt_row(120.0), 0.5, 0.04 + fs * fs,
-      [&](ForwardFilter& f) { (void)f.position_fix(0, 10.5, 10.0, 0.2, m, 120.0); }, "cupt, the scale a state");
+      [&](ForwardFilter& f) { (void)f.position_fix(0, 10.5, 10.0, 0.2, m, 120.0, 50.0); }, "cupt, the scale a state");
+  ErrorModel timed = m;
+  timed.timing_state_us = {2.0, 0.0, 0.0};
+  check(
+      observe::cupt_row(120.0, 50.0), 0.5, 0.04 + fs * fs,
+      [&](ForwardFilter& f) { (void)f.position_fix(0, 10.5, 10.0, 0.2, timed, 120.0, 50.0); },
+      "cupt, the scale and the timing states");
 }
 
 // The continuous error model of error_model.hpp: ė = A e + w, w into δv and δb.

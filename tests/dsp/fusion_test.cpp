@@ -43,14 +43,14 @@ TEST(ErrorModel, DiscreteNoiseEqualsTheIntegralOfTheContinuousModel) {
 
 TEST(AxisFilter, ScalarUpdateEqualsTheGeneralKalmanUpdate) {
   AxisFilter f;
-  f.e << 1.0, -2.0, 0.5, 40.0;
+  f.e << 1.0, -2.0, 0.5, 40.0, 1.5;
   StateCov a = StateCov::Random();
   f.P = a * a.transpose() + StateCov::Identity();
   const State e0 = f.e;
   const StateCov p0 = f.P;
   const double z = 0.3, r = 0.7;
   const UpdateRecord rec = f.update(1, z, r, 1e9);
-  StateRow h(0, 1, 0, 0);
+  const StateRow h = StateRow::Unit(1);
   const double s = (h * p0 * h.transpose())(0) + r;
   const State k = p0 * h.transpose() / s;
   EXPECT_LT((f.e - (e0 + k * (z - h * e0))).norm(), 1e-12);

@@ -164,7 +164,7 @@ TEST(ErrorField, AScaleErrorWithoutPositionSupportsStaysAsItIs) {
 TEST(CoarseSchedule, BlocksCombineStandstillsAndFixesByTheirInformation) {
   Trace t = synthetic(true);
   fusion::ErrorModel m;
-  const CoarseSchedule c = coarsen(t.schedule, t.idx, m, 10);
+  const CoarseSchedule c = coarsen(t.schedule, t.idx, m, 10, kDefaultFs_hz);
   ASSERT_EQ(c.sample_index.size(), 200u);
   EXPECT_EQ(c.sample_index[0], 9);
   EXPECT_TRUE(c.schedule.flags[0] & sf::rest);
