@@ -64,8 +64,7 @@ nlohmann::json identification_json(const dsp::identify::Identification& id) {
   j["strip_crossings"] = id.strip_crossings;
   j["crossing_speeds_mm_s"] = id.crossing_speeds_mm_s;
   nlohmann::json sig = nlohmann::json::object();
-  for (int p = 0; p < dsp::uncertainty::kModelParameters; ++p)
-    sig[dsp::uncertainty::parameter_name(p)] = id.covariance.sigma(p);
+  for (int p = 0; p < dsp::kModelParameters; ++p) sig[dsp::parameter_name(p)] = id.covariance.sigma(p);
   j["standard_uncertainty"] = sig;  // σ of every model parameter (the data sheet's where not identified)
   j["notes"] = id.notes;
   return j;
@@ -151,7 +150,7 @@ void register_identify(CLI::App& app) {
     const dsp::identify::Identification id = dsp::identify::identify_sensors(run, opt);
     // A calibration less certain than the data sheet would make every figure worse.
     const auto worse = dsp::identify::less_certain_than_datasheet(
-        id, dsp::uncertainty::datasheet_covariance(run.meta.sensors, run.meta.acquisition.fs_hz));
+        id, dsp::datasheet_covariance(run.meta.sensors, run.meta.acquisition.fs_hz));
     if (!worse.empty()) {
       std::string list;
       for (std::size_t i = 0; i < worse.size() && i < 4; ++i) list += (i ? "; " : "") + worse[i];

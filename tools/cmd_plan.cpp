@@ -221,8 +221,7 @@ void require_simulable(const plan::TestProgram& p, const PlanCommandOptions& o, 
 
 // The covariance of --calibration's file; a file without one is as uncertain as the data
 // sheet, which is said, and the test is then predicted as not identified.
-std::optional<dsp::uncertainty::SensorModelCovariance> calibration_covariance(const PlanCommandOptions& o,
-                                                                              plan::TestProgram& p) {
+std::optional<dsp::SensorModelCovariance> calibration_covariance(const PlanCommandOptions& o, plan::TestProgram& p) {
   if (o.calibration.empty()) return std::nullopt;
   const drivers::SensorCalibration cal = drivers::read_sensor_calibration(o.calibration, plan::scenario_of(p, 1).meta);
   if (!cal.covariance) {

@@ -38,8 +38,8 @@ std::string matrix_toml(const Eigen::Matrix3d& m) {
 }
 
 // [covariance]: named parameters, a symmetric positive semi-definite matrix over them.
-dsp::uncertainty::SensorModelCovariance read_covariance(StrictTable& t, const dsp::RunMeta& datasheet) {
-  namespace u = dsp::uncertainty;
+dsp::SensorModelCovariance read_covariance(StrictTable& t, const dsp::RunMeta& datasheet) {
+  namespace u = dsp;
   u::SensorModelCovariance c = u::datasheet_covariance(datasheet.sensors, datasheet.acquisition.fs_hz);
   const std::vector<std::string> names = t.strings("parameters");
   std::vector<int> index;
@@ -135,7 +135,7 @@ void write_sensor_calibration(const SensorCalibration& cal, const std::filesyste
   }
   if (cal.covariance) {
     // The parameters with a variance (every other keeps the data sheet's, by definition).
-    namespace u = dsp::uncertainty;
+    namespace u = dsp;
     std::vector<int> used;
     for (int p = 0; p < u::kModelParameters; ++p)
       if (cal.covariance->covariance(p, p) > 0.0) used.push_back(p);
@@ -175,7 +175,7 @@ void apply_calibration(const SensorCalibration& cal, dsp::RunMeta& meta, dsp::An
   options.sensor_model = cal.method;
   // Without its own covariance a calibration is as uncertain as the data sheet.
   options.model_covariance =
-      cal.covariance ? *cal.covariance : dsp::uncertainty::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
+      cal.covariance ? *cal.covariance : dsp::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
   if (!cal.covariance)
     options.model_covariance->source = cal.method + " (no covariance in the file: the data sheet's tolerance)";
 }

@@ -38,9 +38,9 @@ struct SensorCalibration {
   std::string run_id;
   std::optional<double> daq_group_delay_samples;
   std::optional<double> daq_skew_head_samples;
-  dsp::SensorSpec sensors[2];            // complete (data sheet where the file is silent)
-  dsp::StaticCalibration static_cal[2];  // cross terms (mounting is in sensors[].to_machine)
-  std::optional<dsp::uncertainty::SensorModelCovariance> covariance;  // [covariance]
+  dsp::SensorSpec sensors[2];                            // complete (data sheet where the file is silent)
+  dsp::StaticCalibration static_cal[2];                  // cross terms (mounting is in sensors[].to_machine)
+  std::optional<dsp::SensorModelCovariance> covariance;  // [covariance]
 };
 
 // Reads `file`; keys it does not set keep the values of `datasheet` (a run's or the daemon

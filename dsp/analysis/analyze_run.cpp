@@ -145,7 +145,7 @@ PipelineConfig analysis_config(const RunMeta& meta, std::size_t capacity_samples
   cfg.parallel = options.parallel;
   if (options.sensor_model != "datasheet") cfg.fusion.scale_uncertainty = 3e-5;  // identified on site
   if (options.model_covariance)  // the timing as the identification knows it
-    cfg.fusion.timing_uncertainty_s = uncertainty::timing_sigma_s(*options.model_covariance, axis_owners(meta.machine));
+    cfg.fusion.timing_uncertainty_s = dsp::timing_sigma_s(*options.model_covariance, axis_owners(meta.machine));
   cfg.calibration[0] = options.calibration[0], cfg.calibration[1] = options.calibration[1];
   return cfg;
 }

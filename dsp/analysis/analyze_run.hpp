@@ -10,6 +10,7 @@
 #include "dsp/core/flag.hpp"
 #include "dsp/core/parallel_for.hpp"
 #include "dsp/core/run.hpp"
+#include "dsp/core/sensor_model_covariance.hpp"
 #include "dsp/eval/circle.hpp"
 #include "dsp/eval/circle_diagnostics.hpp"
 #include "dsp/eval/path_deviation.hpp"
@@ -19,7 +20,6 @@
 #include "dsp/eval/step_response.hpp"
 #include "dsp/pipeline/pipeline.hpp"
 #include "dsp/uncertainty/error_source.hpp"
-#include "dsp/uncertainty/sensor_model_covariance.hpp"
 
 #include <cstdint>
 #include <functional>
@@ -78,7 +78,7 @@ struct AnalysisOptions {
     bool budget = false;
     int budget_draws = 40;
   } uncertainty;
-  std::optional<uncertainty::SensorModelCovariance> model_covariance;
+  std::optional<dsp::SensorModelCovariance> model_covariance;
   // The caller's figures beside the program's (MoreFigures), each with U from the same draws.
   MoreFigures more_figures;  // empty: the program's figures only
 };

@@ -343,8 +343,8 @@ UncertaintyTrace::UncertaintyTrace(const Run& run, const PipelineConfig& config,
   in.model.timing_state_us = m.supports.timing_state_us;  // and the timing
   if (m.supports.bias_step_um_s2 > 0.0) in.model.bias_step_um_s2 = m.supports.bias_step_um_s2;  // as it measured
   in.start_bias_sigma_um_s2 = m.supports.start_bias_sigma_um_s2;
-  in.model_covariance = options.model_covariance ? *options.model_covariance
-                                                 : uncertainty::datasheet_covariance(run.meta.sensors, m.fs_hz);
+  in.model_covariance =
+      options.model_covariance ? *options.model_covariance : dsp::datasheet_covariance(run.meta.sensors, m.fs_hz);
   in.sensor_noise_ug_per_rthz[0] = run.meta.sensors[0].noise_ug_per_rthz;
   in.sensor_noise_ug_per_rthz[1] = run.meta.sensors[1].noise_ug_per_rthz;
   for (int s = 0; s < 2; ++s)

@@ -70,7 +70,7 @@ struct ErrorModel {
   std::array<double, 3> scale_state_ppm{};
   // Per axis: σ (s) of the sensor model's timing, the damping term of the sensor that
   // carries the axis and the DAQ's delay (data sheet or identification;
-  // uncertainty::timing_sigma_s). pipeline_config() sets it.
+  // dsp::timing_sigma_s). pipeline_config() sets it.
   std::array<double, 3> timing_uncertainty_s{};
   // Per axis: σ (µs) of the timing error as a state of the filter, which the strips on the
   // axis observe where they are crossed at speed; 0: no strips, no state. SupportStage

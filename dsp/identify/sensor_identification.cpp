@@ -381,9 +381,8 @@ void check_crossings(const Measurement& m, const RunMeta& meta, Identification& 
 // 1.46 σ rms, the cross terms by 0.9 σ (tests/accuracy); the calibration carries
 // σ × kSigmaMargin.
 constexpr double kSigmaMargin = 1.5;
-uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const Identification& id,
-                                                 const RunMeta& meta) {
-  uncertainty::SensorModelCovariance c = uncertainty::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
+dsp::SensorModelCovariance covariance_of(const PassResult& last, const Identification& id, const RunMeta& meta) {
+  dsp::SensorModelCovariance c = dsp::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
   c.source = id.method;
   for (int i = 0; i < 3; ++i) {
     const AxisFit& af = last.axis[i];
@@ -395,7 +394,7 @@ uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const I
         const int pk = af.layout.e[k];
         const int sk = owner(meta, k);
         if (pk < 0 || sk < 0) continue;
-        c.covariance(uncertainty::error_index(sj, i, j), uncertainty::error_index(sk, i, k)) =
+        c.covariance(dsp::error_index(sj, i, j), dsp::error_index(sk, i, k)) =
             kSigmaMargin * kSigmaMargin * af.cov(pj, pk);
       }
     }
@@ -407,17 +406,16 @@ uncertainty::SensorModelCovariance covariance_of(const PassResult& last, const I
                                       [&](const PsdSpec& strip) { return axis_index(strip.measures) == i; });
     const int s = owner(meta, i);
     if (!measured || s < 0 || last.axis[i].layout.e[i] < 0) continue;
-    c.covariance(uncertainty::error_index(s, i, i), uncertainty::error_index(s, i, i)) +=
-        uncertainty::strip_nonlinearity_scale_variance();
+    c.covariance(dsp::error_index(s, i, i), dsp::error_index(s, i, i)) += dsp::strip_nonlinearity_scale_variance();
   }
   for (int s = 0; s < 2; ++s)
     if (id.sensor[s].damping_s.fitted)
-      c.covariance(uncertainty::damping_index(s), uncertainty::damping_index(s)) =
+      c.covariance(dsp::damping_index(s), dsp::damping_index(s)) =
           std::pow(kSigmaMargin * id.sensor[s].damping_s.sigma, 2);
   const auto& dl = id.delay_reference.valid ? id.delay_reference : id.delay_setpoint;
   if (id.delay_identified && dl.valid) {
     const double u = kSigmaMargin * dl.sigma / meta.acquisition.fs_hz;
-    c.covariance(uncertainty::kDelayIndex, uncertainty::kDelayIndex) = u * u;
+    c.covariance(dsp::kDelayIndex, dsp::kDelayIndex) = u * u;
   }
   return c;
 }
@@ -551,7 +549,7 @@ void identify_delay(const Measurement& m, const Run& run, const RunMeta& meta, c
 }  // namespace
 
 std::vector<std::string> less_certain_than_datasheet(const Identification& id,
-                                                     const uncertainty::SensorModelCovariance& datasheet) {
+                                                     const dsp::SensorModelCovariance& datasheet) {
   // What the calibration would carry (its covariance, margins included) against the data sheet.
   std::vector<std::string> out;
   char b[200];
@@ -559,19 +557,19 @@ std::vector<std::string> less_certain_than_datasheet(const Identification& id,
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
         const Estimate& e = id.sensor[s].error[i][j];
-        const int p = uncertainty::error_index(s, i, j);
+        const int p = dsp::error_index(s, i, j);
         const double u = id.covariance.sigma(p), lim = datasheet.sigma(p);
         if (e.fitted && !(u <= lim)) {
-          std::snprintf(b, sizeof b, "%s (%+.0f ± %.0f ppm, the data sheet ± %.0f ppm)",
-                        uncertainty::parameter_name(p).c_str(), e.value * 1e6, u * 1e6, lim * 1e6);
+          std::snprintf(b, sizeof b, "%s (%+.0f ± %.0f ppm, the data sheet ± %.0f ppm)", dsp::parameter_name(p).c_str(),
+                        e.value * 1e6, u * 1e6, lim * 1e6);
           out.emplace_back(b);
         }
       }
-    const int p = uncertainty::damping_index(s);
+    const int p = dsp::damping_index(s);
     const double u = id.covariance.sigma(p), lim = datasheet.sigma(p);
     if (id.sensor[s].damping_s.fitted && !(u <= lim)) {
-      std::snprintf(b, sizeof b, "%s (± %.2f µs, the data sheet ± %.2f µs)", uncertainty::parameter_name(p).c_str(),
-                    u * 1e6, lim * 1e6);
+      std::snprintf(b, sizeof b, "%s (± %.2f µs, the data sheet ± %.2f µs)", dsp::parameter_name(p).c_str(), u * 1e6,
+                    lim * 1e6);
       out.emplace_back(b);
     }
   }

@@ -22,8 +22,8 @@
 // has a reference instrument, behind that (the delay itself). The data sheet's delay is
 // kept unless the reference is there or the caller accepts the set-point's figure.
 #include "dsp/core/run.hpp"
+#include "dsp/core/sensor_model_covariance.hpp"
 #include "dsp/pipeline/pipeline.hpp"
-#include "dsp/uncertainty/sensor_model_covariance.hpp"
 
 #include <Eigen/Core>
 
@@ -86,7 +86,7 @@ struct Identification {
   // The calibration's covariance (sensor_model_covariance.hpp layout): each axis' filter
   // block for the E terms it fitted, the damping terms and the delay; the data sheet's
   // tolerance where nothing was identified (the data sheet is kept there).
-  uncertainty::SensorModelCovariance covariance;
+  dsp::SensorModelCovariance covariance;
   // Strip crossings and their distinct speeds (mm/s), standstills in the motion.
   std::size_t strip_crossings = 0;
   std::vector<double> crossing_speeds_mm_s;
@@ -102,7 +102,7 @@ Identification identify_sensors(const Run& run, const IdentifyOptions& options =
 // (the σ its covariance carries above the data sheet's u): a calibration with them would
 // be worse than none.
 std::vector<std::string> less_certain_than_datasheet(const Identification& id,
-                                                     const uncertainty::SensorModelCovariance& datasheet);
+                                                     const dsp::SensorModelCovariance& datasheet);
 
 // The run's metadata with an identification applied (what the pipeline then uses).
 void apply_identification(const Identification& id, RunMeta& meta, PipelineConfig* config = nullptr);

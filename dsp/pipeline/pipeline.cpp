@@ -2,7 +2,7 @@
 
 #include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
-#include "dsp/uncertainty/sensor_model_covariance.hpp"
+#include "dsp/core/sensor_model_covariance.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -30,8 +30,8 @@ PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples
                                                meta.sensor_present[1] ? meta.sensors[1].noise_ug_per_rthz : 0.0) *
                                     meta.site.g_mps2;
   c.strips_set_the_frame = meta.program.kind == "positioning";
-  c.fusion.timing_uncertainty_s = uncertainty::timing_sigma_s(
-      uncertainty::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz), axis_owners(meta.machine));
+  c.fusion.timing_uncertainty_s =
+      dsp::timing_sigma_s(dsp::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz), axis_owners(meta.machine));
   return c;
 }
 

@@ -22,12 +22,12 @@
 // interpolated onto the set-point's (the pipeline's delay alignment) where it is asked for.
 // Draws are seeded and deterministic.
 #include "dsp/core/sample_rate.hpp"
+#include "dsp/core/sensor_model_covariance.hpp"
 #include "dsp/fusion/error_model.hpp"
 #include "dsp/fusion/support_schedule.hpp"
 #include "dsp/uncertainty/coarse_path.hpp"
 #include "dsp/uncertainty/coarse_schedule.hpp"
 #include "dsp/uncertainty/error_source.hpp"
-#include "dsp/uncertainty/sensor_model_covariance.hpp"
 
 #include <Eigen/Core>
 

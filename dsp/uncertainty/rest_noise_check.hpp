@@ -6,8 +6,8 @@
 // does not cancel between head and table.
 #include "dsp/core/flag.hpp"
 #include "dsp/core/run_meta.hpp"
+#include "dsp/core/sensor_model_covariance.hpp"
 #include "dsp/pipeline/rest_noise.hpp"
-#include "dsp/uncertainty/sensor_model_covariance.hpp"
 
 #include <optional>
 #include <string>

@@ -117,24 +117,22 @@ TEST(Identification, ARunWithoutStripsIsRefused) {
 TEST(Identification, TheCalibrationCarriesACovarianceWithinTheDataSheetsTolerance) {
   const dsp::Run run = sim::simulate(sim::identify_scenario(sim::psd_config_b(10.0), {"z"}, 2));
   const dsp::identify::Identification id = dsp::identify::identify_sensors(run);
-  const auto ds = dsp::uncertainty::datasheet_covariance(run.meta.sensors, run.meta.acquisition.fs_hz);
+  const auto ds = dsp::datasheet_covariance(run.meta.sensors, run.meta.acquisition.fs_hz);
   EXPECT_TRUE(dsp::identify::less_certain_than_datasheet(id, ds).empty());
   EXPECT_GE(id.crossing_speeds_mm_s.size(), 3u);  // 2, 4 and 6.5 m/min
   // The fitted terms: the identification's own σ with its margin (and, for a scale a strip
   // measures, the strips' nonlinearity), well below the data sheet's.
-  const int xx = dsp::uncertainty::error_index(0, 0, 0), xy = dsp::uncertainty::error_index(0, 0, 1);
+  const int xx = dsp::error_index(0, 0, 0), xy = dsp::error_index(0, 0, 1);
   EXPECT_NEAR(id.covariance.sigma(xy), 1.5 * id.sensor[0].error[0][1].sigma, 1e-12);
   EXPECT_NEAR(id.covariance.covariance(xx, xx),
-              std::pow(1.5 * id.sensor[0].error[0][0].sigma, 2) + dsp::uncertainty::strip_nonlinearity_scale_variance(),
-              1e-18);
+              std::pow(1.5 * id.sensor[0].error[0][0].sigma, 2) + dsp::strip_nonlinearity_scale_variance(), 1e-18);
   EXPECT_LT(id.covariance.sigma(xx), 0.2 * ds.sigma(xx));
   // Terms it did not fit keep the data sheet's.
-  EXPECT_DOUBLE_EQ(id.covariance.sigma(dsp::uncertainty::error_index(1, 0, 0)),
-                   ds.sigma(dsp::uncertainty::error_index(1, 0, 0)));
+  EXPECT_DOUBLE_EQ(id.covariance.sigma(dsp::error_index(1, 0, 0)), ds.sigma(dsp::error_index(1, 0, 0)));
   // A fitted term as uncertain as the circle's E_zx is reported as worse than the data sheet.
   dsp::identify::Identification bad = id;
   bad.sensor[0].error[2][0] = {-3778e-6, 14106e-6, true};
-  const int zx = dsp::uncertainty::error_index(0, 2, 0);
+  const int zx = dsp::error_index(0, 2, 0);
   bad.covariance.covariance(zx, zx) = 14106e-6 * 14106e-6;
   const auto worse = dsp::identify::less_certain_than_datasheet(bad, ds);
   ASSERT_EQ(worse.size(), 1u);

@@ -130,7 +130,7 @@ namespace {
 // The calibration's covariance: written, read back exactly, applied to the analysis; a
 // file without one is as uncertain as the data sheet.
 TEST(SensorCalibration, CovarianceRoundTripsAndIsApplied) {
-  namespace u = eical::dsp::uncertainty;
+  namespace u = eical::dsp;
   eical::dsp::RunMeta meta;
   SensorCalibration cal;
   for (int s = 0; s < 2; ++s) cal.sensors[s] = meta.sensors[s];

@@ -5,11 +5,11 @@
 // of when a figure is resolved.
 #include "dsp/analysis/figure_uncertainty.hpp"
 #include "dsp/core/float_limits.hpp"
+#include "dsp/core/sensor_model_covariance.hpp"
 #include "dsp/fusion/error_covariance.hpp"
 #include "dsp/uncertainty/coarse_schedule.hpp"
 #include "dsp/uncertainty/error_field.hpp"
 #include "dsp/uncertainty/resolved.hpp"
-#include "dsp/uncertainty/sensor_model_covariance.hpp"
 
 #include <gtest/gtest.h>
 

@@ -203,7 +203,7 @@ sim::Scenario scenario_on_drawn_machine(const TestProgram& p, std::uint64_t seed
 
 std::vector<sim::PsdTruth> drawn_strips(const std::vector<dsp::PsdSpec>& psd, std::uint64_t seed) {
   std::vector<sim::PsdTruth> out;
-  const double bound = dsp::uncertainty::DatasheetTolerance{}.psd_nonlinearity;
+  const double bound = dsp::DatasheetTolerance{}.psd_nonlinearity;
   for (const dsp::PsdSpec& s : psd) {
     // Keyed by the strip's place: the identification and the test cross the same strip.
     const std::string key = s.measures + ":" + std::to_string(std::llround(s.center_mm[0] * 1000.0)) + "," +
@@ -233,7 +233,7 @@ sim::Scenario identification_on_machine(const TestProgram& p, const sim::Scenari
   return id;
 }
 
-dsp::uncertainty::SensorModelCovariance typical_identification(const TestProgram& p) {
+dsp::SensorModelCovariance typical_identification(const TestProgram& p) {
   sim::Scenario sc = identification_scenario(p, 1);
   // On the prediction's grid too. What one simulated identification leaves is one draw of
   // it: the R10 variant's predicted U(G) after it was 6.31, 6.36, 6.59, 7.47 and 6.06 µm
@@ -251,8 +251,7 @@ double duration_s(const dsp::Run& run) {
 }
 
 Prediction predict(const TestProgram& p, std::uint64_t seed, int draws,
-                   const std::optional<dsp::uncertainty::SensorModelCovariance>& identified,
-                   const std::optional<Screen>& screen) {
+                   const std::optional<dsp::SensorModelCovariance>& identified, const std::optional<Screen>& screen) {
   sim::Scenario sc = scenario_of(p, seed);
   sc.oversample = prediction_oversample(sc);
   const dsp::Run run = sim::simulate(sc);
@@ -393,7 +392,7 @@ Search search_measurable(const TestProgram& p, const SearchOptions& o) {
   const int of = static_cast<int>(all.size());
   // One simulated identification per identification program (variants that share strips
   // and travel share it).
-  std::map<std::string, dsp::uncertainty::SensorModelCovariance> identified;
+  std::map<std::string, dsp::SensorModelCovariance> identified;
   for (int n = 0; n < of; ++n) {
     Tried& tried = out.tried[static_cast<std::size_t>(n)];
     const TestProgram& t = tried.program;
@@ -407,7 +406,7 @@ Search search_measurable(const TestProgram& p, const SearchOptions& o) {
       tried.outcome = Outcome::too_long;
       continue;
     }
-    std::optional<dsp::uncertainty::SensorModelCovariance> id = o.calibration;
+    std::optional<dsp::SensorModelCovariance> id = o.calibration;
     if (t.identified && !id) {
       const std::string key = identification_command(identification_plan(t));
       if (!identified.contains(key)) {

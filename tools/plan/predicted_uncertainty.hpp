@@ -77,7 +77,7 @@ sim::Scenario identification_scenario(const TestProgram& p, std::uint64_t seed);
 sim::Scenario identification_on_machine(const TestProgram& p, const sim::Scenario& machine, std::uint64_t seed);
 // What that identification leaves the sensor model uncertain by (simulated on data-sheet
 // sensors): the covariance a calibration would carry.
-dsp::uncertainty::SensorModelCovariance typical_identification(const TestProgram& p);
+dsp::SensorModelCovariance typical_identification(const TestProgram& p);
 // Seconds the program runs (from the simulation's set-point).
 double duration_s(const dsp::Run& run);
 
@@ -101,7 +101,7 @@ struct Screen {
   double margin = 2.0;
 };
 Prediction predict(const TestProgram& p, std::uint64_t seed = 1, int draws = 100,
-                   const std::optional<dsp::uncertainty::SensorModelCovariance>& identified = std::nullopt,
+                   const std::optional<dsp::SensorModelCovariance>& identified = std::nullopt,
                    const std::optional<Screen>& screen = std::nullopt);
 
 // The nearest variants of a program, nearest first (the program itself not included): the
@@ -127,7 +127,7 @@ struct SearchOptions {
   std::function<void(int n, int of, const TestProgram&)> progress;
   // The machine's own calibration (plan --calibration): every identified variant uses its
   // covariance instead of a simulated identification.
-  std::optional<dsp::uncertainty::SensorModelCovariance> calibration;
+  std::optional<dsp::SensorModelCovariance> calibration;
 };
 
 // What became of each variant.

@@ -1,9 +1,9 @@
-#include "dsp/uncertainty/sensor_model_covariance.hpp"
+#include "dsp/core/sensor_model_covariance.hpp"
 
 #include <cmath>
 #include <numbers>
 
-namespace eical::dsp::uncertainty {
+namespace eical::dsp {
 namespace {
 
 constexpr const char* kSensor[2] = {"table", "head"};
@@ -76,4 +76,4 @@ double strip_nonlinearity_scale_variance(const DatasheetTolerance& tolerance) {
   return a * a / 3.0;
 }
 
-}  // namespace eical::dsp::uncertainty
+}  // namespace eical::dsp

@@ -23,7 +23,7 @@
 #include <array>
 #include <string>
 
-namespace eical::dsp::uncertainty {
+namespace eical::dsp {
 
 inline constexpr int kModelParameters = 27;
 inline constexpr int kDelayIndex = 20;
@@ -86,4 +86,4 @@ std::array<double, 3> timing_sigma_s(const SensorModelCovariance& c, const std::
 SensorModelCovariance datasheet_covariance(const SensorSpec sensors[2], double fs_hz,
                                            const DatasheetTolerance& tolerance = {});
 
-}  // namespace eical::dsp::uncertainty
+}  // namespace eical::dsp
