@@ -245,8 +245,7 @@ void CheckpointedSmoother::output(const SegmentStates& s, SmoothedSegment& out) 
       const std::size_t k = s.first + i, lo = k > 0 ? k - 1 : k, hi = std::min(k + 1, way.size() - 1);
       std::int64_t steps = 0;
       for (std::size_t j = lo + 1; j <= hi; ++j) steps += gap_into(j, next_gap);
-      const double v_mm_s =
-          steps > 0 ? static_cast<double>(way[hi][a] - way[lo][a]) * settings_.fs_hz / static_cast<double>(steps) : 0.0;
+      const double v_mm_s = track_.schedule->way_velocity_mm_s(lo, hi, steps, settings_.fs_hz)[a];
       const StateRow h = observe::cupt_row(scaled ? static_cast<double>(way[k][a]) : 0.0, timed ? v_mm_s : 0.0);
       out.dx_um[i][a] = h.dot(e);
       if (scaled) out.dv_um_s[i][a] += 1e-3 * v_mm_s * e[kScaleState];

@@ -56,6 +56,14 @@ struct SupportSchedule {
   std::vector<Eigen::Vector3f> way_mm;
   bool zupt = true;  // off: standstills are found and reported, not used
   bool cupt = true;  // off: PSD fixes are recorded, not used
+
+  // The velocity (mm/s) of the way between trace samples lo < hi that lie `steps` sample
+  // periods apart (their true spacing: lost frames, a coarse grid); 0 without a span.
+  [[nodiscard]] Eigen::Vector3d way_velocity_mm_s(std::size_t lo, std::size_t hi, std::int64_t steps,
+                                                  double fs_hz) const {
+    if (steps <= 0 || hi >= way_mm.size()) return Eigen::Vector3d::Zero();
+    return (way_mm[hi] - way_mm[lo]).cast<double>() * (fs_hz / static_cast<double>(steps));
+  }
 };
 
 }  // namespace eical::dsp::fusion

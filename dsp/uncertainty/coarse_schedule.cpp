@@ -72,51 +72,46 @@ void coarsen_block(const FineSchedule& in, const fusion::ErrorModel& model, std:
 }
 
 // Fixes: one per (coarse sample, strip), inverse-variance combined, into c's schedule and
-// fix_noise_um.
+// fix_noise_um. The way and the velocity (the scale's and the timing's rows) are read where
+// the coarse sample's state is, its block's last fine sample, not at the readings' mean: a
+// strip crossed at speed would otherwise read them v·block/2 from where the error is
+// compared. Without the way in the schedule neither state exists and the rows ignore both.
 void combine_fixes(const std::vector<fusion::PositionFix>& fixes, const fusion::ErrorModel& model, std::size_t n,
                    std::size_t q, const std::vector<Eigen::Vector3d>& vel_at_end, CoarseSchedule& c) {
-  // (axis, Σ w, Σ w² σ_noise², Σ w·position, Σ w·way, Σ w·velocity) with w = 1/var as the
-  // pipeline weighs each fix.
-  std::map<std::pair<std::size_t, int>, std::tuple<int, double, double, double, double, double>> comb;
+  // (axis, Σ w, Σ w² σ_noise², Σ w·position) with w = 1/var as the pipeline weighs each fix.
+  std::map<std::pair<std::size_t, int>, std::tuple<int, double, double, double>> comb;
   for (const auto& f : fixes) {
     if (f.k >= n) continue;
     const double noise = f.sigma_um * f.sigma_um + model.psd_floor_um * model.psd_floor_um;
     const double var = noise + f.model_sigma_um * f.model_sigma_um;
     if (!(var > 0.0) || !std::isfinite(var)) continue;
-    auto& [axis, w, wn, wp, ww, wv] = comb[{f.k / q, f.strip}];
+    auto& [axis, w, wn, wp] = comb[{f.k / q, f.strip}];
     axis = f.axis;
-    w += 1.0 / var, wn += noise / (var * var), wp += f.position_um / var, ww += f.way_mm / var;
-    wv += f.vel_mm_s / var;
+    w += 1.0 / var, wn += noise / (var * var), wp += f.position_um / var;
   }
   for (const auto& [key, v] : comb) {
     fusion::PositionFix f;
     f.k = key.first, f.strip = key.second, f.axis = std::get<0>(v);
     f.sigma_um = 1.0 / std::sqrt(std::get<1>(v));
     f.position_um = std::get<3>(v) / std::get<1>(v);  // where on its strip (the nonlinearity's response)
-    // The scale row reads the way where the coarse sample's state is (its block's last
-    // fine sample), not the block's mean: a strip crossed at speed would otherwise read the
-    // scale at a way v·block/2 from where the error is compared.
-    f.way_mm = f.k < c.schedule.way_mm.size() ? static_cast<double>(c.schedule.way_mm[f.k][f.axis])
-                                              : std::get<4>(v) / std::get<1>(v);
-    // The velocity likewise belongs at the block's end (the timing row); the readings' mean
-    // where the schedule carries no way.
-    f.vel_mm_s = f.k < vel_at_end.size() ? vel_at_end[f.k][f.axis] : std::get<5>(v) / std::get<1>(v);
+    if (f.k < c.schedule.way_mm.size()) f.way_mm = static_cast<double>(c.schedule.way_mm[f.k][f.axis]);
+    if (f.k < vel_at_end.size()) f.vel_mm_s = vel_at_end[f.k][f.axis];
     c.schedule.fixes.push_back(f);
     c.fix_noise_um.push_back(std::sqrt(std::get<2>(v)) / std::get<1>(v));  // σ of the weighted mean's noise
   }
 }
 
-// The velocity (mm/s) at each block's last sample from the way around it (±4 samples, one
-// sample apart: a lost frame there errs by its share), where the schedule carries the way.
-std::vector<Eigen::Vector3d> way_velocity_at_block_ends(const fusion::SupportSchedule& fine, std::size_t n,
-                                                        std::size_t q, double fs_hz) {
+// The velocity (mm/s) at each block's last sample from the way ±4 samples around it, over
+// their true spacing (lost frames), where the schedule carries the way.
+std::vector<Eigen::Vector3d> way_velocity_at_block_ends(const FineSchedule& in, std::size_t n, std::size_t q) {
+  const fusion::SupportSchedule& fine = *in.schedule;
   std::vector<Eigen::Vector3d> v;
-  if (fine.way_mm.size() < n || !(fs_hz > 0.0) || n < 2) return v;
+  if (fine.way_mm.size() < n || !(in.fs_hz > 0.0) || n < 2) return v;
   const std::size_t nc = (n + q - 1) / q;
   v.resize(nc);
   for (std::size_t j = 0; j < nc; ++j) {
     const std::size_t k = std::min(n, j * q + q) - 1, lo = k >= 4 ? k - 4 : 0, hi = std::min(n - 1, k + 4);
-    v[j] = (fine.way_mm[hi] - fine.way_mm[lo]).cast<double>() * fs_hz / static_cast<double>(hi - lo);
+    v[j] = fine.way_velocity_mm_s(lo, hi, in.index_at(hi) - in.index_at(lo), in.fs_hz);
   }
   return v;
 }
@@ -156,7 +151,7 @@ CoarseSchedule coarsen(const FineSchedule& in, const fusion::ErrorModel& model, 
     if (fine.way_mm.size() >= n) s.way_mm.push_back(fine.way_mm[e - 1]);
   }
   if (s.way_mm.size() != nc) s.way_mm.clear();
-  combine_fixes(fine.fixes, model, n, q, way_velocity_at_block_ends(fine, n, q, in.fs_hz), c);
+  combine_fixes(fine.fixes, model, n, q, way_velocity_at_block_ends(in, n, q), c);
   for (auto v : fine.velocity_means) {
     if (v.k >= n) continue;
     v.k /= q;

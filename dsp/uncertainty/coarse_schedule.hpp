@@ -32,7 +32,7 @@ struct CoarseSchedule {
 struct FineSchedule {
   const fusion::SupportSchedule* schedule = nullptr;  // one flag per trace sample, the fixes, the window means
   std::size_t samples = 0;                            // trace samples coarsened (at most schedule->flags.size())
-  std::function<std::int64_t(std::size_t)> index_at;  // sample index of trace sample k (read at block ends only)
+  std::function<std::int64_t(std::size_t)> index_at;  // sample index of trace sample k (read about block ends only)
   // ZUPT σ per sample as bits (true: −1, unused) when schedule->zupt_sigma_um_s is empty
   // (fusion::SmootherTrack::zupt_unused); absent: 0, each standstill sample used.
   const std::vector<bool>* zupt_unused = nullptr;
