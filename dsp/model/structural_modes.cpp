@@ -13,7 +13,6 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
-#include <optional>
 
 namespace eical::dsp::model {
 namespace {
@@ -56,6 +55,8 @@ class TimeModel {
     base_rss_ = e_.squaredNorm();
   }
   [[nodiscard]] double base_rss() const { return base_rss_; }
+  // What the nuisance (and the modes in it) leave of the measured − commanded acceleration.
+  [[nodiscard]] const Eigen::MatrixXd& projected() const { return e_; }
   [[nodiscard]] Eigen::MatrixXd project(const Eigen::MatrixXd& m) const { return m - q_ * (q_.transpose() * m); }
   [[nodiscard]] Fit fit(const std::vector<Eigen::VectorXd>& mode) const {
     Fit out;
@@ -159,6 +160,7 @@ struct ModeProblem {
   Eigen::Index n = 0;
   const Responses& fr;
   double df_hz = 0.0, f_min_hz = 0.0, f_max_hz = 0.0;
+  std::size_t seg = 0;      // the frequency responses' segment (samples)
   std::vector<int> inputs;  // the commanded axes with a response
   Eigen::MatrixXd e;        // measured − commanded acceleration, n × 3
   std::vector<Eigen::VectorXd> nuisance;
@@ -239,19 +241,28 @@ void grid_search(const ModeProblem& p, const TimeModel& model, double f_lo, doub
     }
 }
 
+// The frequency step of the coarse grid about a candidate at f (and of the finer grids'
+// reach).
+double coarse_step_hz(const ModeProblem& p, double f_hz) { return 2.0 * std::max(2.0 * p.df_hz, 0.1 * f_hz) / 20.0; }
+
+// Two finer grids about (f, ζ), the fit on `model` recomputed.
+BestMode refine_mode(const ModeProblem& p, const TimeModel& model, BestMode best, double fstep) {
+  best.fit = Fit{};
+  const double f = best.f_hz, z = best.zeta;
+  grid_search(p, model, f - fstep, f + fstep, 9, std::max(kZetaMin, z / 1.6), std::min(kZetaMax, z * 1.6), 9, best);
+  // A last, finer pass: the previous grid's 12 % steps in ζ would bias it by up to 6 %.
+  grid_search(p, model, best.f_hz - fstep / 4.0, best.f_hz + fstep / 4.0, 7, std::max(kZetaMin, best.zeta / 1.13),
+              std::min(kZetaMax, best.zeta * 1.13), 9, best);
+  return best;
+}
+
 // Coarse about the candidate, then two finer grids about the best.
 BestMode search_mode(const ModeProblem& p, const TimeModel& model, const PeakCandidate& c) {
   BestMode best;
   best.f_hz = c.f_hz;
   const double span = std::max(2.0 * p.df_hz, 0.1 * c.f_hz);
   grid_search(p, model, c.f_hz - span, c.f_hz + span, 21, kZetaMin, kZetaMax, 14, best);
-  const double fstep = 2.0 * span / 20.0;
-  grid_search(p, model, best.f_hz - fstep, best.f_hz + fstep, 9, std::max(kZetaMin, best.zeta / 1.6),
-              std::min(kZetaMax, best.zeta * 1.6), 9, best);
-  // A last, finer pass: the previous grid's 12 % steps in ζ would bias it by up to 6 %.
-  grid_search(p, model, best.f_hz - fstep / 4.0, best.f_hz + fstep / 4.0, 7, std::max(kZetaMin, best.zeta / 1.13),
-              std::min(kZetaMax, best.zeta * 1.13), 9, best);
-  return best;
+  return refine_mode(p, model, best, coarse_step_hz(p, c.f_hz));
 }
 
 // Profile uncertainty of the frequency (`freq`) or the damping, one side (`dir`): χ² in
@@ -296,10 +307,14 @@ void mode_footprint(const ModeProblem& p, const BestMode& best, Eigen::Index bj,
   md.displacement_rms_um = md.response_rms_mg * kMmS2PerMg / (om * om) * 1000.0;
 }
 
-// One mode's fit on a model whose nuisance holds the base columns (and, in the second
-// pass, the other modes found).
-StructuralMode fit_mode(const ModeProblem& p, const PeakCandidate& c, const TimeModel& model) {
-  const BestMode best = search_mode(p, model, c);
+// A fitted mode's figures on `model` (the nuisance and the other modes): its χ² drop
+// against the model without it, the profile bounds of frequency and damping, its path and
+// footprint. `explains`: the fit is better by χ² at z = 5, the input drives the response
+// where the fit puts the mode (a broad shape fitted into a band the motion leaves
+// unexcited is none), inside the band searched. `significant` adds what makes it a
+// structural mode of this run: amplification, size over the noise, light damping.
+StructuralMode assess_mode(const ModeProblem& p, const TimeModel& model, const BestMode& best, bool& explains,
+                           bool bounds) {
   StructuralMode md;
   md.frequency_hz = best.f_hz, md.damping_ratio = best.zeta;
   // The residual's effective count (it is no white noise: vibration, the servo's error).
@@ -311,66 +326,153 @@ StructuralMode fit_mode(const ModeProblem& p, const PeakCandidate& c, const Time
   md.chi2_threshold = chi2_quantile(dof, kZ);
   Eigen::Index bj = 0, bi = 0;
   strongest_path(p, best, md, bj, bi);
-  md.sigma_frequency_hz =
-      0.5 * (profile_bound(p, model, best, n_eff, true, -1.0) + profile_bound(p, model, best, n_eff, true, 1.0));
-  md.sigma_damping_ratio =
-      0.5 * (profile_bound(p, model, best, n_eff, false, -1.0) + profile_bound(p, model, best, n_eff, false, 1.0));
+  if (bounds) {
+    md.sigma_frequency_hz =
+        0.5 * (profile_bound(p, model, best, n_eff, true, -1.0) + profile_bound(p, model, best, n_eff, true, 1.0));
+    md.sigma_damping_ratio =
+        0.5 * (profile_bound(p, model, best, n_eff, false, -1.0) + profile_bound(p, model, best, n_eff, false, 1.0));
+  }
   mode_footprint(p, best, bj, bi, md);
-  // The input must drive the response where the fit puts the mode, not only where the
-  // candidate was: a broad shape fitted into a band the motion leaves unexcited is none.
-  md.significant =
-      md.chi2_drop > md.chi2_threshold && md.peak_amplification >= kMinAmplification && md.coherence >= kMinCoherence &&
-      (md.displacement_rms_um >= kMaterialUm || md.response_rms_mg >= kMaterialMg) && best.zeta > kZetaMin * 1.1 &&
-      best.zeta <= kZetaStructuralMax && best.f_hz >= p.f_min_hz && best.f_hz <= p.f_max_hz;
+  // A damping at either end of the grid is no resonance found but a trend or a spike.
+  explains = md.chi2_drop > md.chi2_threshold && md.coherence >= kMinCoherence && best.zeta > kZetaMin * 1.1 &&
+             best.zeta < kZetaMax / 1.1 && best.f_hz >= p.f_min_hz && best.f_hz <= p.f_max_hz;
+  md.significant = explains && md.peak_amplification >= kMinAmplification &&
+                   (md.displacement_rms_um >= kMaterialUm || md.response_rms_mg >= kMaterialMg) &&
+                   best.zeta <= kZetaStructuralMax;
   return md;
 }
 
-// Candidates by prominence, each on a model that holds the modes already found: a strong
-// mode's response left in the residual would drag a weaker one's fit onto its own.
-std::vector<StructuralMode> fit_candidates(const ModeProblem& p, const std::vector<PeakCandidate>& cands,
-                                           const TimeModel& tm) {
-  std::vector<StructuralMode> modes;
-  std::vector<Eigen::VectorXd> found_cols = p.nuisance;
-  std::optional<TimeModel> with_found;
-  for (const PeakCandidate& c : cands) {
-    const StructuralMode md = fit_mode(p, c, with_found ? *with_found : tm);
-    if (md.significant) {
-      for (auto& col : mode_columns(p, md.frequency_hz, md.damping_ratio)) found_cols.push_back(std::move(col));
-      with_found.emplace(p.e, found_cols);
-    }
-    // One mode seen from several inputs: keep its best fit.
-    bool merged = false;
-    for (auto& o : modes)
-      if (std::abs(o.frequency_hz - md.frequency_hz) <=
-          2.0 * p.df_hz + 2.0 * std::max(o.sigma_frequency_hz, md.sigma_frequency_hz)) {
-        if (md.chi2_drop > o.chi2_drop) o = md;
-        merged = true;
-      }
-    if (!merged) modes.push_back(md);
-  }
-  return modes;
+// The time-domain model with the nuisance and every mode of `modes` but `skip`.
+TimeModel model_without(const ModeProblem& p, const std::vector<BestMode>& modes, std::size_t skip) {
+  std::vector<Eigen::VectorXd> cols = p.nuisance;
+  for (std::size_t o = 0; o < modes.size(); ++o)
+    if (o != skip)
+      for (auto& col : mode_columns(p, modes[o].f_hz, modes[o].zeta)) cols.push_back(std::move(col));
+  return {p.e, cols};
 }
 
-// Modes close together bias each other's damping when fitted one at a time: each
-// significant mode once more with the others' responses as nuisance (one backfitting pass).
-void backfit_modes(const ModeProblem& p, std::vector<StructuralMode>& modes) {
-  std::vector<std::size_t> sig;
-  for (std::size_t k = 0; k < modes.size(); ++k)
-    if (modes[k].significant) sig.push_back(k);
-  if (sig.size() < 2) return;
-  std::vector<StructuralMode> refit = modes;
-  for (std::size_t k : sig) {
-    std::vector<Eigen::VectorXd> with_others = p.nuisance;
-    for (std::size_t o : sig)
-      if (o != k)
-        for (auto& col : mode_columns(p, modes[o].frequency_hz, modes[o].damping_ratio))
-          with_others.push_back(std::move(col));
-    PeakCandidate c;
-    c.input = modes[k].input_axis, c.f_hz = modes[k].frequency_hz;
-    const StructuralMode md = fit_mode(p, c, TimeModel(p.e, with_others));
-    if (md.significant) refit[k] = md;
+// Modes close together bias each other when fitted one at a time: a strong mode left in
+// the residual drags a weaker one's fit onto it, and two strong modes fitted as one become
+// a single broad shape. Each mode is searched again with the others as nuisance
+// (backfitting).
+void backfit(const ModeProblem& p, std::vector<BestMode>& modes) {
+  if (modes.size() < 2) return;
+  // A full search first (a broad shape fitted over two modes narrows onto one of them once
+  // the other is in the model), then a finer pass about where each went.
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::size_t k = 0; k < modes.size(); ++k) {
+      const TimeModel model = model_without(p, modes, k);
+      if (pass == 0) {
+        PeakCandidate c;
+        c.f_hz = modes[k].f_hz;
+        modes[k] = search_mode(p, model, c);
+      } else {
+        modes[k] = refine_mode(p, model, modes[k], coarse_step_hz(p, modes[k].f_hz));
+      }
+    }
+}
+
+// Two modes whose half-power bands overlap (|f1 − f2| < ζ1·f1 + ζ2·f2, or closer than two
+// bins) are one peak to this response: the data cannot tell them apart, so the model keeps
+// one. The index of the weaker of the first such pair, or npos.
+std::size_t unresolved(const ModeProblem& p, const std::vector<BestMode>& modes, const std::vector<double>& chi2) {
+  for (std::size_t a = 0; a < modes.size(); ++a)
+    for (std::size_t b = a + 1; b < modes.size(); ++b) {
+      const double sep = std::abs(modes[a].f_hz - modes[b].f_hz);
+      const double bands = modes[a].zeta * modes[a].f_hz + modes[b].zeta * modes[b].f_hz;
+      if (sep < std::max(bands, 2.0 * p.df_hz)) return chi2[a] < chi2[b] ? a : b;
+    }
+  return std::string::npos;
+}
+
+// Every mode assessed with the others as nuisance (`explains` per mode); the profile bounds
+// when `bounds` (they cost a fit per step: only for the modes chosen).
+std::vector<StructuralMode> assess_all(const ModeProblem& p, const std::vector<BestMode>& modes,
+                                       std::vector<bool>& explains, bool bounds) {
+  std::vector<StructuralMode> out;
+  explains.assign(modes.size(), false);
+  for (std::size_t k = 0; k < modes.size(); ++k) {
+    bool ex = false;
+    out.push_back(assess_mode(p, model_without(p, modes, k), modes[k], ex, bounds));
+    explains[k] = ex;
   }
-  modes = std::move(refit);
+  return out;
+}
+
+// Peaks of the response the modes kept leave unexplained: the frequency response of the
+// residual over the commanded acceleration. A shoulder beside a stronger peak (a broad mode
+// beside a sharp one) is no local maximum of the whole response, but stands out once the
+// stronger one is modelled.
+std::vector<PeakCandidate> residual_candidates(const ModeProblem& p, const std::vector<BestMode>& kept) {
+  const TimeModel model = model_without(p, kept, kept.size());
+  const Eigen::MatrixXd& r = model.projected();
+  Responses fr;
+  for (int j : p.inputs)
+    for (int i = 0; i < 3; ++i)
+      fr[static_cast<std::size_t>(j)][static_cast<std::size_t>(i)] =
+          frequency_response(p.a_cmd.col(j).head(p.n), r.col(i), p.fs_hz, p.seg);
+  int averages = 0;
+  return peak_candidates(fr, p.f_min_hz, p.f_max_hz, averages);
+}
+
+// Forward selection, in rounds: first the response's own peaks by prominence, then the
+// peaks of what the modes kept leave, while a round adds a mode. Each candidate is fitted on
+// a model that holds the modes kept so far and kept while it explains the response (any
+// damping: a broad fit over two strong modes is kept until the second one is fitted and the
+// joint refit separates them); after each round, all are refitted jointly. Then backward: a mode
+// that no longer explains the response with the others present, or that the data cannot
+// resolve from a stronger one (one physical peak, one mode), leaves, and the rest are
+// refitted.
+std::vector<StructuralMode> select_modes(const ModeProblem& p, const std::vector<PeakCandidate>& cands,
+                                         const TimeModel& tm) {
+  std::vector<BestMode> kept;
+  std::vector<PeakCandidate> round = cands;
+  for (bool first_round = true; !round.empty() && kept.size() < kMaxCandidates; first_round = false) {
+    bool added = false;
+    for (const PeakCandidate& c : round) {
+      if (kept.size() >= kMaxCandidates) break;
+      // A peak of the response within the half-power band of a mode kept is that mode's (a
+      // broad shape kept for now may still hold two); a peak of what the modes leave there is
+      // a second mode the first one covered, which the backward pass keeps if the data
+      // resolve the two.
+      bool inside = false;
+      for (const auto& m : kept)
+        inside = inside || (first_round && m.zeta <= kZetaStructuralMax &&
+                            std::abs(c.f_hz - m.f_hz) < std::max(m.zeta * m.f_hz, 2.0 * p.df_hz));
+      if (inside) continue;
+      const TimeModel model = kept.empty() ? tm : model_without(p, kept, kept.size());
+      const BestMode best = search_mode(p, model, c);
+      bool explains = false;
+      (void)assess_mode(p, model, best, explains, false);
+      if (!explains) continue;
+      kept.push_back(best);
+      added = true;
+    }
+    if (!added) break;
+    backfit(p, kept);
+    round = residual_candidates(p, kept);
+  }
+  // Backward: first every mode that no longer explains the response beside the others, then
+  // the weaker of each pair the data cannot resolve, one at a time, refitting in between.
+  std::vector<bool> explains;
+  std::vector<StructuralMode> modes = assess_all(p, kept, explains, false);
+  while (!kept.empty()) {
+    std::vector<BestMode> explaining;
+    for (std::size_t k = 0; k < kept.size(); ++k)
+      if (explains[k]) explaining.push_back(kept[k]);
+    if (explaining.size() == kept.size()) {
+      std::vector<double> chi2;
+      for (const auto& md : modes) chi2.push_back(md.chi2_drop);
+      const std::size_t drop = unresolved(p, kept, chi2);
+      if (drop == std::string::npos) break;
+      explaining.erase(explaining.begin() + static_cast<std::ptrdiff_t>(drop));
+    }
+    kept = std::move(explaining);
+    backfit(p, kept);
+    modes = assess_all(p, kept, explains, false);
+  }
+  modes = assess_all(p, kept, explains, true);
+  return modes;
 }
 
 // The gain of the modes found: the residual RMS without and with them.
@@ -432,12 +534,12 @@ ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::Mat
                       .df_hz = out.df_hz,
                       .f_min_hz = out.f_min_hz,
                       .f_max_hz = out.f_max_hz,
+                      .seg = seg,
                       .inputs = inputs,
                       .e = a_meas.topRows(nn) - a_cmd.topRows(nn),
                       .nuisance = nuisance_columns(a_cmd, fs_hz, nn, inputs)};
   const TimeModel tm(p.e, p.nuisance);
-  out.modes = fit_candidates(p, cands, tm);
-  backfit_modes(p, out.modes);
+  out.modes = select_modes(p, cands, tm);
   residual_gain(p, tm, out);
   sort_modes(out.modes);
   out.evidence = describe_search(out);

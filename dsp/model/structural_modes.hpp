@@ -10,6 +10,9 @@
 // and it amplifies the commanded acceleration by at least 10 % at its peak, and what it adds
 // to this run stands out of the sensors' noise: 0.1 µm RMS of relative position or 0.1 mg of
 // acceleration. A structural mode is lightly damped (ζ ≤ 0.1); broader shapes are none.
+// The modes are chosen as a model: forward from the response's peaks and then from what
+// the modes kept leave, refitted jointly; backward until every mode explains the response
+// beside the others and no two overlap in their half-power bands (one peak, one mode).
 #include <Eigen/Core>
 
 #include <array>
@@ -48,7 +51,7 @@ Eigen::VectorXd mode_response(const Eigen::VectorXd& u, double fs_hz, double f_h
 
 // `a_meas`, `a_cmd`: n × 3 (mm/s², same time base, sample rate fs_hz); `driven`: the axes the
 // set-point moves (the inputs); `max_hz`: the highest frequency a mode may have here (the
-// sensors' own dynamics and the DAQ filter shape the response above it).
+// search stops at 0.4·fs in any case).
 ModeSearch find_structural_modes(const Eigen::MatrixXd& a_meas, const Eigen::MatrixXd& a_cmd, double fs_hz,
                                  const std::array<bool, 3>& driven, double max_hz);
 

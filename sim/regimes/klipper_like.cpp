@@ -63,11 +63,17 @@ Scenario klipper_like_scenario(const std::vector<std::string>& effects, std::uin
   // Each hideable effect from its own stream: its draw does not depend on the other.
   auto has = [&](const char* e) { return std::find(effects.begin(), effects.end(), e) != effects.end(); };
   Draw dm(stream_seed(seed, 8002));
-  const double f1 = dm.u(30.0, 65.0), f2 = dm.u(f1 + 8.0, 80.0);
-  for (double f : {f1, f2}) {
+  // Printers' modes: ζ 0.02–0.1 (log-uniform), peaks of ×1.5–40 (gain/2ζ). One seed in
+  // three holds a close pair, apart by 1.5–2.5 times the sum of their half-power
+  // half-widths: two modes the data resolve.
+  const double z1 = 0.02 * std::pow(5.0, dm.u(0.0, 1.0)), z2 = 0.02 * std::pow(5.0, dm.u(0.0, 1.0));
+  const double f1 = dm.u(30.0, 65.0);
+  const bool close = dm.u(0.0, 1.0) < 1.0 / 3.0;
+  const double f2 = close ? f1 + std::max(3.0, dm.u(1.5, 2.5) * (z1 + z2) * f1) : dm.u(f1 + 8.0, 80.0);
+  for (const auto& [f, z] : {std::pair{f1, z1}, std::pair{f2, z2}}) {
     const double tilt = dm.u(-15.0, 15.0) * std::numbers::pi / 180.0, base = axis == 0 ? 0.0 : std::numbers::pi / 2.0;
     StructuralMode m;
-    m.frequency_hz = f, m.damping_ratio = dm.u(0.01, 0.05), m.gain = dm.u(0.05, 0.25);
+    m.frequency_hz = f, m.damping_ratio = z, m.gain = dm.u(0.1, 0.8);
     m.direction = Eigen::Vector3d(std::cos(base + tilt), std::sin(base + tilt), 0.0);
     if (has("machine.resonance")) sc.resonance.modes.push_back(m);
   }

@@ -1,8 +1,9 @@
 // Issue 15 item 7: explain on the regimes of runs measured by other systems, made by eical's
 // simulator with a known truth — a CoreXY head under Klipper's resonance test (one MEMS
-// sensor at 400 Hz–3.2 kHz, no standstill, two modes 30–80 Hz), a wrong mounting. Each
-// true mode within ±2 Hz and its damping within ±30 %; the mounting named with the map
-// that fits; no significant figure outside its physical bound.
+// sensor at 400 Hz–3.2 kHz, no standstill, two modes 30–100 Hz, ζ 0.02–0.1), a wrong
+// mounting. Each true mode found once within ±2 Hz and its damping within a factor of 1.5;
+// the mounting named with the map that fits; no significant figure outside its physical
+// bound.
 #include "dsp/core/float_limits.hpp"
 #include "dsp/model/effects.hpp"
 #include "dsp/model/explain.hpp"
@@ -11,9 +12,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace eical {
 namespace {
@@ -38,7 +41,9 @@ void expect_within_bounds(const dsp::model::RunExplanation& ex, const std::strin
 
 class KlipperLikeModes : public ::testing::TestWithParam<int> {};
 
-TEST_P(KlipperLikeModes, EachTrueModeFoundWithinTwoHertzAndThirtyPercentDamping) {
+// Issue 34: one physical peak is one mode, and its damping within a factor of 1.5 — on
+// printers' modes (ζ 0.02–0.1, peaks of up to ×40, in some seeds a close pair).
+TEST_P(KlipperLikeModes, EachTrueModeFoundOnceWithinTwoHertzAndItsDampingWithinAFactorOfOnePointFive) {
   const auto seed = static_cast<std::uint64_t>(GetParam());
   const sim::Scenario sc = sim::klipper_like_scenario({"machine.resonance"}, seed);
   const dsp::Run run = sim::simulate(sc);
@@ -48,18 +53,30 @@ TEST_P(KlipperLikeModes, EachTrueModeFoundWithinTwoHertzAndThirtyPercentDamping)
   ASSERT_NE(res, nullptr);
   EXPECT_TRUE(res->significant);
   ASSERT_GE(sc.resonance.modes.size(), 1u);
+  std::vector<double> found_hz;
+  for (int k = 0;; ++k) {
+    const auto f = res->params.find("mode" + std::to_string(k) + "_frequency_hz");
+    if (f == res->params.end()) break;
+    found_hz.push_back(f->second);
+  }
   for (const auto& truth : sc.resonance.modes) {
     double best_df = kInf, zeta = kNaN;
-    for (int k = 0; k < 6; ++k) {
-      const auto f = res->params.find("mode" + std::to_string(k) + "_frequency_hz");
-      if (f == res->params.end()) break;
-      if (std::abs(f->second - truth.frequency_hz) < std::abs(best_df))
-        best_df = f->second - truth.frequency_hz, zeta = res->params.at("mode" + std::to_string(k) + "_damping_ratio");
-    }
+    for (std::size_t k = 0; k < found_hz.size(); ++k)
+      if (std::abs(found_hz[k] - truth.frequency_hz) < std::abs(best_df))
+        best_df = found_hz[k] - truth.frequency_hz,
+        zeta = res->params.at("mode" + std::to_string(k) + "_damping_ratio");
     std::printf("seed %d: true mode %.2f Hz zeta %.4f; found %+.2f Hz, zeta %.4f (%+.0f %%)\n", GetParam(),
                 truth.frequency_hz, truth.damping_ratio, best_df, zeta, 100.0 * (zeta / truth.damping_ratio - 1.0));
     EXPECT_LE(std::abs(best_df), 2.0) << "mode at " << truth.frequency_hz << " Hz";
-    EXPECT_NEAR(zeta, truth.damping_ratio, 0.3 * truth.damping_ratio) << "mode at " << truth.frequency_hz << " Hz";
+    EXPECT_GE(zeta, truth.damping_ratio / 1.5) << "mode at " << truth.frequency_hz << " Hz";
+    EXPECT_LE(zeta, truth.damping_ratio * 1.5) << "mode at " << truth.frequency_hz << " Hz";
+  }
+  // No mode beside them: every mode named lies within 4 Hz of a true one, one each.
+  EXPECT_EQ(found_hz.size(), sc.resonance.modes.size());
+  for (double f : found_hz) {
+    double nearest = kInf;
+    for (const auto& truth : sc.resonance.modes) nearest = std::min(nearest, std::abs(f - truth.frequency_hz));
+    EXPECT_LE(nearest, 4.0) << "a mode at " << f << " Hz that is none";
   }
   expect_within_bounds(ex, "seed " + std::to_string(seed));
 }
