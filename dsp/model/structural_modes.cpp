@@ -241,9 +241,10 @@ void grid_search(const ModeProblem& p, const TimeModel& model, double f_lo, doub
     }
 }
 
-// The frequency step of the coarse grid about a candidate at f (and of the finer grids'
-// reach).
-double coarse_step_hz(const ModeProblem& p, double f_hz) { return 2.0 * std::max(2.0 * p.df_hz, 0.1 * f_hz) / 20.0; }
+// How far the coarse grid reaches either side of a candidate at f; its 21 points are a
+// tenth of that apart, which is the finer grids' reach.
+double search_span_hz(const ModeProblem& p, double f_hz) { return std::max(2.0 * p.df_hz, 0.1 * f_hz); }
+double coarse_step_hz(const ModeProblem& p, double f_hz) { return search_span_hz(p, f_hz) / 10.0; }
 
 // Two finer grids about (f, ζ), the fit on `model` recomputed.
 BestMode refine_mode(const ModeProblem& p, const TimeModel& model, BestMode best, double fstep) {
@@ -260,7 +261,7 @@ BestMode refine_mode(const ModeProblem& p, const TimeModel& model, BestMode best
 BestMode search_mode(const ModeProblem& p, const TimeModel& model, const PeakCandidate& c) {
   BestMode best;
   best.f_hz = c.f_hz;
-  const double span = std::max(2.0 * p.df_hz, 0.1 * c.f_hz);
+  const double span = search_span_hz(p, c.f_hz);
   grid_search(p, model, c.f_hz - span, c.f_hz + span, 21, kZetaMin, kZetaMax, 14, best);
   return refine_mode(p, model, best, coarse_step_hz(p, c.f_hz));
 }
