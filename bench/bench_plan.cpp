@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
   if (!circles.empty()) programs.clear();
   for (const auto& c : circles) {
     eical::tools::plan::TestProgram p;
-    p.kind = "circle", p.direction = "both", p.repeats = 2, p.identified = !datasheet;
+    p.kind = eical::dsp::ProgramKind::circle, p.direction = "both", p.repeats = 2, p.identified = !datasheet;
     try {
       p.radius_mm = std::stod(c.at(0)), p.feed_mm_min = std::stod(c.at(1));
       const auto layout = eical::tools::plan::psd_layout(c.at(2));
@@ -47,7 +47,8 @@ int main(int argc, char** argv) {
   }
   std::vector<eical::tools::plan::CheckRow> rows;
   for (const auto& p : programs) {
-    if (!only.empty() && std::find(only.begin(), only.end(), p.kind) == only.end()) continue;
+    if (!only.empty() && std::find(only.begin(), only.end(), eical::dsp::program_kind_name(p.kind)) == only.end())
+      continue;
     const auto r = eical::tools::plan::check_plan(p, repeats, draws);
     rows.insert(rows.end(), r.begin(), r.end());
     std::fputs(eical::tools::plan::check_table(r).c_str(), stdout);

@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
       const auto layout = eical::tools::plan::psd_layout(n);
       for (double r : radii) {
         TestProgram p;
-        p.kind = "circle", p.direction = "both", p.radius_mm = r, p.feed_mm_min = f, p.repeats = repeats;
+        p.kind = eical::dsp::ProgramKind::circle, p.direction = "both", p.radius_mm = r, p.feed_mm_min = f,
+        p.repeats = repeats;
         p.psd = eical::tools::plan::strips_for(p, layout.strips, layout.facing);
         p.identified = true;
         double g = NAN;

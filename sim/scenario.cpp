@@ -29,20 +29,20 @@ namespace {
 
 // The common part of the built-in scenarios: data-sheet sensors that are also the truth,
 // an ideal reference instrument on all axes.
-Scenario base_scenario(const std::string& kind, std::uint64_t seed, std::string description) {
+Scenario base_scenario(dsp::ProgramKind kind, std::uint64_t seed, std::string description) {
   Scenario sc;
-  sc.name = kind;
+  sc.name = dsp::program_kind_name(kind);
   sc.seed = seed;
   sc.description = std::move(description);
   sc.meta.program.kind = kind;
-  sc.meta.id = "sim-" + kind + "-s" + std::to_string(seed);
+  sc.meta.id = "sim-" + sc.name + "-s" + std::to_string(seed);
   sc.meta.reference = dsp::Reference{"ideal", {"x", "y", "z"}};
   for (int s = 0; s < 2; ++s) sc.truth[s].spec = sc.meta.sensors[s];
   return sc;
 }
 
 // Single-axis programs on x with a 0.5 s dwell (step and positioning).
-Scenario axis_scenario(const std::string& kind, std::vector<double> targets_mm, double feed_mm_min, int runs,
+Scenario axis_scenario(dsp::ProgramKind kind, std::vector<double> targets_mm, double feed_mm_min, int runs,
                        std::uint64_t seed, std::string description) {
   Scenario sc = base_scenario(kind, seed, std::move(description));
   auto& p = sc.meta.program;
@@ -58,7 +58,7 @@ Scenario axis_scenario(const std::string& kind, std::vector<double> targets_mm, 
 
 Scenario circle_scenario(double radius_mm, double feed_mm_min, int repeats, const std::string& direction,
                          std::uint64_t seed) {
-  Scenario sc = base_scenario("circle", seed,
+  Scenario sc = base_scenario(dsp::ProgramKind::circle, seed,
                               "R" + std::to_string(radius_mm) + " circle F" + std::to_string(feed_mm_min) + " x" +
                                   std::to_string(repeats) + " " + direction + ", ideal machine, data-sheet sensors");
   auto& p = sc.meta.program;
@@ -74,19 +74,19 @@ Scenario circle_scenario(double radius_mm, double feed_mm_min, int repeats, cons
 }
 
 Scenario step_scenario(double from_mm, double to_mm, double feed_mm_min, int runs, std::uint64_t seed) {
-  return axis_scenario("step", {from_mm, to_mm}, feed_mm_min, runs, seed,
+  return axis_scenario(dsp::ProgramKind::step, {from_mm, to_mm}, feed_mm_min, runs, seed,
                        "x step " + std::to_string(from_mm) + " -> " + std::to_string(to_mm) + " mm, ideal machine");
 }
 
 Scenario positioning_scenario(const std::vector<double>& targets_mm, int runs, double feed_mm_min, std::uint64_t seed) {
-  return axis_scenario("positioning", targets_mm, feed_mm_min, runs, seed,
+  return axis_scenario(dsp::ProgramKind::positioning, targets_mm, feed_mm_min, runs, seed,
                        "ISO 230-2 linear cycle on x, ideal machine");
 }
 
 Scenario rectangle_scenario(double size_a_mm, double size_b_mm, double feed_mm_min, const std::string& plane,
                             int repeats, std::uint64_t seed) {
   Scenario sc = base_scenario(
-      "rectangle", seed,
+      dsp::ProgramKind::rectangle, seed,
       "rectangle " + std::to_string(size_a_mm) + " x " + std::to_string(size_b_mm) + " mm, ideal machine");
   auto& p = sc.meta.program;
   p.plane = plane;
@@ -98,7 +98,7 @@ Scenario rectangle_scenario(double size_a_mm, double size_b_mm, double feed_mm_m
   return sc;
 }
 
-Scenario gcode_scenario(const std::string& gcode, const std::string& kind, std::uint64_t seed) {
+Scenario gcode_scenario(const std::string& gcode, dsp::ProgramKind kind, std::uint64_t seed) {
   Scenario sc = base_scenario(kind, seed, "G-code program, ideal machine");
   sc.meta.program.gcode = gcode;
   return sc;
@@ -154,7 +154,8 @@ Scenario identify_scenario(const std::vector<dsp::PsdSpec>& psd, const std::vect
 }
 
 Scenario identify_scenario(const gcode::IdentifyPlan& plan, std::uint64_t seed) {
-  Scenario sc = base_scenario("identify", seed, "on-site identification across the PSD strips, ideal machine");
+  Scenario sc =
+      base_scenario(dsp::ProgramKind::identify, seed, "on-site identification across the PSD strips, ideal machine");
   sc.meta.program.gcode = gcode::identify_program(plan);
   sc.meta.psd = plan.psd;
   return sc;

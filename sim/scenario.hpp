@@ -225,7 +225,8 @@ Scenario rectangle_scenario(double size_a_mm = 50.0, double size_b_mm = 50.0, do
                             const std::string& plane = "xy", int repeats = 1, std::uint64_t seed = 1);
 
 // A scenario running the given G-code (a free-form program or any generated one).
-Scenario gcode_scenario(const std::string& gcode, const std::string& kind = "freeform", std::uint64_t seed = 1);
+Scenario gcode_scenario(const std::string& gcode, dsp::ProgramKind kind = dsp::ProgramKind::freeform,
+                        std::uint64_t seed = 1);
 
 // PSD configuration B of the sample runs for a circle of radius R about the origin: a strip
 // measuring x where the circle crosses −y, one measuring y where it crosses +x (each 10 mm

@@ -45,14 +45,15 @@ std::string toml_list(const std::vector<double>& v) {
 
 // The [program] table of run.toml (docs/run-format.md) for this program.
 std::string program_toml(const dsp::Program& p, const std::string& gcode) {
-  std::string t = "[program]\nkind = \"" + p.kind + "\"\nplane = \"" + p.plane + "\"\n";
+  std::string t =
+      "[program]\nkind = \"" + std::string(dsp::program_kind_name(p.kind)) + "\"\nplane = \"" + p.plane + "\"\n";
   t += "feed_mm_min = " + std::to_string(p.feed_mm_min) + "\n";
-  if (p.kind == "circle") {
+  if (p.kind == dsp::ProgramKind::circle) {
     t += "center_mm = " + toml_list({p.center_mm[0], p.center_mm[1]}) + "\nradius_mm = " + std::to_string(p.radius_mm) +
          "\ndirection = \"" + p.direction + "\"\nrepeats = " + std::to_string(p.repeats) +
          "\narc_deg = " + std::to_string(p.arc_deg) + "\n";
     if (p.arc_deg < 360.0) t += "arc_start_deg = " + std::to_string(sim::gcode::partial_arc_start_deg(p)) + "\n";
-  } else if (p.kind == "rectangle") {
+  } else if (p.kind == dsp::ProgramKind::rectangle) {
     t += "corner_mm = " + toml_list({p.corner_mm[0], p.corner_mm[1]}) +
          "\nsize_mm = " + toml_list({p.size_mm[0], p.size_mm[1]}) + "\ndwell_s = " + std::to_string(p.dwell_s) +
          "\nrepeats = " + std::to_string(p.repeats) + "\n";
@@ -101,24 +102,25 @@ void write_program(const std::string& canonical, dsp::Program p, const std::stri
   for (char& c : name)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_')
       throw std::runtime_error("--program-name: letters, digits and _ only");
-  const sim::gcode::ProgramIdentity id{number, name.empty() ? "EICAL_" + p.kind : name, title};
+  const sim::gcode::ProgramIdentity id{
+      number, name.empty() ? "EICAL_" + std::string(dsp::program_kind_name(p.kind)) : name, title};
   p.gcode = sim::gcode::write_dialect(canonical, sim::gcode::Dialect::linuxcnc, id);
-  require_within(sim::nc::interpolate_gcode(p.gcode, "gen-nc " + p.kind, sim::nc::MachineLimits{}),
-                 envelope_of(envelope), "gen-nc " + p.kind);
+  const std::string what = "gen-nc " + std::string(dsp::program_kind_name(p.kind));
+  require_within(sim::nc::interpolate_gcode(p.gcode, what, sim::nc::MachineLimits{}), envelope_of(envelope), what);
   write_text(out, sim::gcode::write_dialect(canonical, sim::gcode::dialect_from_name(dialect), id));
   if (!meta_out.empty()) write_text(meta_out, program_toml(p, p.gcode));
 }
 
 std::string title_of(const dsp::Program& p) {
   char b[160];
-  if (p.kind == "circle")
+  if (p.kind == dsp::ProgramKind::circle)
     std::snprintf(b, sizeof b, "eical circle R%g F%g %s, %d revolutions, plane %s", p.radius_mm, p.feed_mm_min,
                   p.direction.c_str(), p.repeats, p.plane.c_str());
-  else if (p.kind == "rectangle")
+  else if (p.kind == dsp::ProgramKind::rectangle)
     std::snprintf(b, sizeof b, "eical rectangle %gx%g mm F%g, plane %s", p.size_mm[0], p.size_mm[1], p.feed_mm_min,
                   p.plane.c_str());
   else
-    std::snprintf(b, sizeof b, "eical %s %s, %zu targets, %d runs, F%g", p.kind.c_str(), p.axis.c_str(),
+    std::snprintf(b, sizeof b, "eical %s %s, %zu targets, %d runs, F%g", dsp::program_kind_name(p.kind), p.axis.c_str(),
                   p.targets_mm.size(), p.runs, p.feed_mm_min);
   return b;
 }
@@ -128,8 +130,8 @@ void emit(GenOptions& o) {
   p.center_mm[0] = o.center.at(0), p.center_mm[1] = o.center.at(1);
   p.corner_mm[0] = o.corner.at(0), p.corner_mm[1] = o.corner.at(1);
   p.size_mm[0] = o.size.at(0), p.size_mm[1] = o.size.at(1);
-  const std::string g =
-      p.kind == "positioning" ? sim::gcode::positioning_program(p, o.overrun_mm) : sim::gcode::program_gcode(p);
+  const std::string g = p.kind == dsp::ProgramKind::positioning ? sim::gcode::positioning_program(p, o.overrun_mm)
+                                                                : sim::gcode::program_gcode(p);
   write_program(g, p, title_of(p), o.out, o.meta_out, o.dialect, o.program_number, o.program_name, o.envelope);
 }
 
@@ -160,7 +162,7 @@ void add_circle(CLI::App* gen) {
   add_output(c, *o);
   add_envelope_options(*c, o->envelope);
   c->callback([o] {
-    o->program.kind = "circle";
+    o->program.kind = dsp::ProgramKind::circle;
     if (o->arc_start_deg) o->program.arc_start_deg = *o->arc_start_deg;
     emit(*o);
   });
@@ -185,7 +187,7 @@ void add_positioning(CLI::App* gen) {
   add_output(c, *o);
   add_envelope_options(*c, o->envelope);
   c->callback([o] {
-    o->program.kind = "positioning";
+    o->program.kind = dsp::ProgramKind::positioning;
     emit(*o);
   });
 }
@@ -206,7 +208,7 @@ void add_step(CLI::App* gen) {
   add_output(c, *o);
   add_envelope_options(*c, o->envelope);
   c->callback([o] {
-    o->program.kind = "step";
+    o->program.kind = dsp::ProgramKind::step;
     emit(*o);
   });
 }
@@ -228,7 +230,7 @@ void add_rectangle(CLI::App* gen) {
   add_output(c, *o);
   add_envelope_options(*c, o->envelope);
   c->callback([o] {
-    o->program.kind = "rectangle";
+    o->program.kind = dsp::ProgramKind::rectangle;
     emit(*o);
   });
 }
@@ -266,7 +268,7 @@ void add_identify(CLI::App* gen) {
     if (o->plan.feeds_mm_min.empty()) o->plan.feeds_mm_min = {2000.0, 4000.0, 6500.0};
     const std::string g = sim::gcode::identify_program(o->plan);
     dsp::Program p;
-    p.kind = "identify";
+    p.kind = dsp::ProgramKind::identify;
     write_program(g, p, "eical identify: swings across the PSD strips", o->out, o->meta_out, o->dialect, o->number,
                   o->name, o->envelope);
   });

@@ -16,6 +16,7 @@
 #include "tools/plan/psd_layouts.hpp"
 #include "tools/plan/strip_layout.hpp"
 #include "tools/program_defaults.hpp"
+#include "tools/program_kind_option.hpp"
 #include "tools/run_files.hpp"
 
 #include <nlohmann/json.hpp>
@@ -84,9 +85,10 @@ struct PlanCommandOptions {
 };
 
 void add_plan_options(CLI::App& cmd, PlanCommandOptions& o) {
-  cmd.add_option("--program", o.p.kind, "circle, positioning, step or rectangle")
-      ->default_val("circle")
-      ->check(CLI::IsMember({"circle", "positioning", "step", "rectangle"}));
+  add_program_kind_option(
+      cmd, "--program", o.p.kind,
+      {dsp::ProgramKind::circle, dsp::ProgramKind::positioning, dsp::ProgramKind::step, dsp::ProgramKind::rectangle},
+      "circle, positioning, step or rectangle");
   cmd.add_option("--radius", o.p.radius_mm, "circle radius, mm")
       ->default_val(program_defaults::kCircleRadiusMm)
       ->check(CLI::PositiveNumber);
@@ -206,7 +208,8 @@ nlohmann::json search_json(const plan::Search& s) {
 // The test itself must be one plan can simulate: within the machine's envelope and not
 // longer than --max-duration (its simulation's memory and time grow with its length).
 void require_simulable(const plan::TestProgram& p, const PlanCommandOptions& o, const dsp::WorkEnvelope& e) {
-  if (auto why = envelope_refusal(*sim::scenario_set_point(plan::scenario_of(p, 1)), e, "plan " + p.kind))
+  if (auto why = envelope_refusal(*sim::scenario_set_point(plan::scenario_of(p, 1)), e,
+                                  "plan " + std::string(dsp::program_kind_name(p.kind))))
     throw dsp::InputError(*why);
   const double t_s = plan::program_duration_s(p);
   if (t_s > o.max_s) {
@@ -214,7 +217,7 @@ void require_simulable(const plan::TestProgram& p, const PlanCommandOptions& o, 
     std::snprintf(b, sizeof b,
                   "plan %s: the test runs %.1f s, longer than the %.0f s plan simulates (--max-duration; the "
                   "simulation's time and memory grow with it)",
-                  p.kind.c_str(), t_s, o.max_s);
+                  dsp::program_kind_name(p.kind), t_s, o.max_s);
     throw dsp::InputError(b);
   }
 }

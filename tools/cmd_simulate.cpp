@@ -96,9 +96,10 @@ sim::Scenario base_scenario(const SimulateOptions& o, bool program_given) {
   }
   if (!o.scenario.empty()) return drivers::read_scenario_file(o.scenario, sim::gcode::dialect_from_name(o.dialect));
   if (!o.hide.empty() || o.background) {
-    const bool chosen = o.program == "circle" || o.program == "step";
-    const std::string kind = o.hide.empty() ? (chosen ? o.program : "circle")
-                                            : (program_given && chosen ? o.program : sim::program_for(o.hide));
+    const std::optional<dsp::ProgramKind> asked = dsp::parse_program_kind(o.program);
+    const bool chosen = asked == dsp::ProgramKind::circle || asked == dsp::ProgramKind::step;
+    const dsp::ProgramKind kind = o.hide.empty() ? (chosen ? *asked : dsp::ProgramKind::circle)
+                                                 : (program_given && chosen ? *asked : sim::program_for(o.hide));
     if (program_given && !chosen)
       throw dsp::InputError("simulate --hide/--background: --program must be circle or step");
     return sim::hidden_effect_scenario(o.hide, kind, o.seed);
@@ -302,17 +303,19 @@ void run_simulate(const SimulateOptions& o, bool program_given) {
   sc.meta.envelope = envelope_of(o.envelope, sc.meta.envelope.value_or(dsp::WorkEnvelope{}));
   sc.max_duration_s = o.max_duration_s;
   require_within(*sim::scenario_set_point(sc), *sc.meta.envelope,
-                 "simulate " + (sc.sweep.on ? std::string("sweep") : sc.meta.program.kind));
+                 "simulate " + std::string(sc.sweep.on ? "sweep" : dsp::program_kind_name(sc.meta.program.kind)));
   if (!o.export_to.empty()) {
     const double fs = sc.meta.acquisition.fs_hz;
     const std::string line = simulate_with_export(sc, export_request(o, fs), o.out, o.gzip, o.overwrite);
-    std::printf("wrote %s (program %s, %.0f Hz)\n%s\n", o.out.c_str(), sc.meta.program.kind.c_str(), fs, line.c_str());
+    std::printf("wrote %s (program %s, %.0f Hz)\n%s\n", o.out.c_str(), dsp::program_kind_name(sc.meta.program.kind), fs,
+                line.c_str());
     return;
   }
   const dsp::Run run = sim::simulate(sc);
   drivers::write_run(run, o.out, {.gzip = o.gzip, .overwrite = o.overwrite});
   std::printf("wrote %s: %zu samples, %.2f s, program %s\n", o.out.c_str(), run.frames.size(),
-              static_cast<double>(run.frames.size()) / run.meta.acquisition.fs_hz, run.meta.program.kind.c_str());
+              static_cast<double>(run.frames.size()) / run.meta.acquisition.fs_hz,
+              dsp::program_kind_name(run.meta.program.kind));
 }
 
 }  // namespace

@@ -101,10 +101,11 @@ void take_run(const std::string& path, const std::optional<std::string>& calibra
   dsp::AnalysisOptions opt;
   if (calibration) drivers::apply_calibration(drivers::read_sensor_calibration(*calibration, run.meta), run.meta, opt);
   const auto& kind = run.meta.program.kind;
-  const int axis = kind == "positioning" ? dsp::axis_index(run.meta.program.axis) : -1;
+  const int axis = kind == dsp::ProgramKind::positioning ? dsp::axis_index(run.meta.program.axis) : -1;
   if (axis >= 0) opt.more_figures = [axis](const dsp::Analysis& a) { return run_figures(axis, a); };
   const dsp::Analysis a = dsp::analyze_run(run, opt);
-  if (const std::string why = critical_reason(a); !why.empty() && (kind == "positioning" || kind == "circle")) {
+  if (const std::string why = critical_reason(a);
+      !why.empty() && (kind == dsp::ProgramKind::positioning || kind == dsp::ProgramKind::circle)) {
     in.left_out.push_back(path + ": left out, " + why);
     return;
   }
@@ -117,7 +118,7 @@ void take_run(const std::string& path, const std::optional<std::string>& calibra
     }
     in.used.push_back(path + ": positioning along " + run.meta.program.axis + " (translations of " +
                       run.meta.program.axis + " in x, y, z)");
-  } else if (kind == "circle" && a.diagnostics) {
+  } else if (kind == dsp::ProgramKind::circle && a.diagnostics) {
     const auto [u, v] = dsp::plane_axes(run.meta.program.plane);
     const int pair = (u == 0 && v == 1) ? 0 : (u == 1 && v == 2) ? 1 : 2;
     const auto it = a.uncertainty_k2.find("diagnostics.squareness_urad");
@@ -126,13 +127,13 @@ void take_run(const std::string& path, const std::optional<std::string>& calibra
     in.circles.push_back({pair, a.diagnostics->squareness_urad, uk2, path});
     in.used.push_back(path + ": circle " + run.meta.program.plane +
                       (uk2 ? " (squareness)" : " (squareness without uncertainty: not used)"));
-  } else if (kind == "rectangle") {
+  } else if (kind == dsp::ProgramKind::rectangle) {
     in.used.push_back(
         path +
         ": rectangle not used: NBS holds the standing axis of each side at zero, which takes the squareness out with "
         "the drift; without NBS the drift over a side buries it");
   } else {
-    in.used.push_back(path + ": " + kind + " not used");
+    in.used.push_back(path + ": " + dsp::program_kind_name(kind) + " not used");
   }
 }
 

@@ -18,18 +18,20 @@ inline constexpr double kRectangleFeedMmMin = 1000.0;
 inline constexpr int kRectangleLaps = 1;
 
 // The feed of a program kind (circle, positioning, step, rectangle); 0 for another kind.
-constexpr double feed_mm_min(std::string_view kind) {
-  if (kind == "circle") return kCircleFeedMmMin;
-  if (kind == "positioning") return kPositioningFeedMmMin;
-  if (kind == "step") return kStepFeedMmMin;
-  if (kind == "rectangle") return kRectangleFeedMmMin;
+constexpr double feed_mm_min(dsp::ProgramKind kind) {
+  if (kind == dsp::ProgramKind::circle) return kCircleFeedMmMin;
+  if (kind == dsp::ProgramKind::positioning) return kPositioningFeedMmMin;
+  if (kind == dsp::ProgramKind::step) return kStepFeedMmMin;
+  if (kind == dsp::ProgramKind::rectangle) return kRectangleFeedMmMin;
   return 0.0;
 }
 
 // Positioning runs or step pairs (what --runs counts for that kind).
-constexpr int runs(std::string_view kind) { return kind == "step" ? kStepPairs : kPositioningRuns; }
+constexpr int runs(dsp::ProgramKind kind) { return kind == dsp::ProgramKind::step ? kStepPairs : kPositioningRuns; }
 
 // Circle revolutions or rectangle laps (what --repeats counts for that kind).
-constexpr int repeats(std::string_view kind) { return kind == "rectangle" ? kRectangleLaps : kCircleRevolutions; }
+constexpr int repeats(dsp::ProgramKind kind) {
+  return kind == dsp::ProgramKind::rectangle ? kRectangleLaps : kCircleRevolutions;
+}
 
 }  // namespace eical::tools::program_defaults

@@ -202,7 +202,7 @@ std::string summary_text(const dsp::Run& run, const dsp::Analysis& analysis) {
   std::string o;
   char b[320];
   std::snprintf(b, sizeof b, "run %s (%s, %zu samples at %.0f Hz)\n", run.meta.id.c_str(),
-                run.meta.program.kind.c_str(), run.frame_count(), run.meta.acquisition.fs_hz);
+                dsp::program_kind_name(run.meta.program.kind), run.frame_count(), run.meta.acquisition.fs_hz);
   o += b;
   o += "  sensor model: " + sensor_model_text(analysis) + "\n";
   o += figures_text(analysis);

@@ -15,7 +15,7 @@ std::string freeform_gcode(double feed_mm_min) {
 }
 
 sim::Scenario freeform_scenario(double feed_mm_min, std::uint64_t seed) {
-  sim::Scenario sc = sim::gcode_scenario(freeform_gcode(feed_mm_min), "freeform", seed);
+  sim::Scenario sc = sim::gcode_scenario(freeform_gcode(feed_mm_min), dsp::ProgramKind::freeform, seed);
   sc.meta.program.plane = "xy";
   sc.meta.program.feed_mm_min = feed_mm_min;
   sc.meta.id = "sim-freeform-s" + std::to_string(seed);

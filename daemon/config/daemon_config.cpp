@@ -286,7 +286,7 @@ dsp::RunMeta hardware_meta(const DaemonConfig& c) {
   meta.sensors[0] = c.sensors[0];
   meta.sensors[1] = c.sensors[1];
   meta.psd = c.psd;
-  meta.program.kind = "freeform";
+  meta.program.kind = dsp::ProgramKind::freeform;
   return meta;
 }
 

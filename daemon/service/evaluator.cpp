@@ -419,7 +419,7 @@ void Evaluator::publish(const dsp::Run& run, const dsp::Analysis& a, const std::
   r.program_id = run.meta.id;
   r.measured_at = run.meta.created, r.run_path = dir.string(), r.software_version = drivers::software_version();
   r.sensor_calibration = links_.sensor_calibration;
-  r.program = run.meta.program.kind;
+  r.program = dsp::program_kind_name(run.meta.program.kind);
   r.degraded = a.degraded;
   r.results = result_number;
   if (a.circle)

@@ -18,7 +18,7 @@ std::optional<drivers::dds::TraceMsg> make_trace(const dsp::Run& run, const dsp:
                                                  std::size_t max_points) {
   drivers::dds::TraceMsg t;
   t.program_id = run.meta.id;
-  t.program = run.meta.program.kind;
+  t.program = dsp::program_kind_name(run.meta.program.kind);
   if (analysis.circle) {
     const auto& c = analysis.circle->trace;
     const std::size_t n = std::min(c.angle_deg.size(), c.radius_deviation_um.size());

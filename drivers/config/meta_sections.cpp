@@ -108,8 +108,10 @@ dsp::PsdSpec read_psd(StrictTable t) {
 
 dsp::Program read_program(StrictTable t) {
   dsp::Program p;
-  p.kind = t.string("kind");
-  (void)t.choice("kind", {"step", "positioning", "rectangle", "circle", "freeform", "identify"}, p.kind);
+  std::vector<std::string> kinds;
+  for (const auto& [kind, name] : dsp::kProgramKindNames) kinds.emplace_back(name);
+  (void)t.string("kind");  // required: a run says which program it carries
+  p.kind = dsp::parse_program_kind(t.choice("kind", kinds, "circle")).value_or(p.kind);
   p.plane = t.choice("plane", {"xy", "zx", "yz"}, p.plane);
   if (t.has("center_mm")) {
     const auto c = t.numbers("center_mm", 2);

@@ -317,8 +317,8 @@ void read_header(StrictTable& root, sim::Scenario& sc) {
 // keeps runs by id, so an id without the program would take the second for the first.
 void default_run_id(sim::Scenario& sc) {
   if (!sc.meta.id.empty()) return;
-  const std::string& kind = sc.meta.program.kind;
-  sc.meta.id = "sim-" + sc.name + (kind.empty() || kind == sc.name ? "" : "-" + kind) + "-s" + std::to_string(sc.seed);
+  const std::string kind = dsp::program_kind_name(sc.meta.program.kind);
+  sc.meta.id = "sim-" + sc.name + (kind == sc.name ? "" : "-" + kind) + "-s" + std::to_string(sc.seed);
 }
 
 // What eical is told (run.toml's sections); the truth starts from it.
@@ -379,7 +379,7 @@ void read_motion(StrictTable& root, const std::string& path, sim::gcode::Dialect
       (void)sim::gcode::parse(sc.meta.program.gcode, path + " [program] gcode");
     }
   } else {
-    sc.meta.program.kind = "freeform";
+    sc.meta.program.kind = dsp::ProgramKind::freeform;
   }
   if (dialect != sim::gcode::Dialect::linuxcnc && !gcode_file_read)
     throw dsp::InputError(path + ": a G-code dialect (" + sim::gcode::dialect_name(dialect) +

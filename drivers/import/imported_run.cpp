@@ -36,7 +36,7 @@ dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel_g, c
   m.sensors[0] = m.sensors[1] = spec;
   m.sensor_present[setup.part] = true;
   m.sensor_present[1 - setup.part] = false;
-  m.program.kind = "freeform";
+  m.program.kind = dsp::ProgramKind::freeform;
   m.program.feed_mm_min = std::max(1.0, setup.feed_mm_min);
   m.program.repeats = 1;
   run.frames.resize(accel_g.values.size());

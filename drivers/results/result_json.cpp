@@ -178,7 +178,7 @@ nlohmann::json quality_json(const dsp::Analysis& a, const std::vector<dsp::Flag>
 void add_circle(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
   if (a.circle) {
     j["circle"] = circle_json(p, *a.circle);
-  } else if (p.kind == "circle") {
+  } else if (p.kind == dsp::ProgramKind::circle) {
     j["circle"] = all_null({"radius_mean_deviation_um", "circular_deviation_G_um", "circular_hysteresis_H_um",
                             "radial_deviation_F_max_um", "radial_deviation_F_min_um"});
     j["circle"]["plane"] = p.plane;
@@ -191,7 +191,7 @@ void add_circle(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j
   }
   if (a.diagnostics) {
     j["diagnostics"] = diagnostics_json(*a.diagnostics);
-  } else if (p.kind == "circle") {
+  } else if (p.kind == dsp::ProgramKind::circle) {
     j["diagnostics"] =
         all_null({"backlash_x_um", "backlash_y_um", "reversal_spike_x_um", "reversal_spike_y_um", "lateral_play_x_um",
                   "lateral_play_y_um", "cyclic_error_x_um", "cyclic_error_y_um", "servo_mismatch_ms", "squareness_urad",
@@ -203,13 +203,13 @@ void add_circle(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j
 void add_step_and_positioning(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
   if (a.step) {
     j["step"] = step_json(a.step_axis, *a.step);
-  } else if (p.kind == "step") {
+  } else if (p.kind == dsp::ProgramKind::step) {
     j["step"] = all_null({"end_position_error_um", "scatter_um", "overshoot_um", "settling_s"});
     j["step"]["axis"] = p.axis;
   }
   if (a.positioning && a.positioning_input) {
     j["positioning"] = positioning_json(*a.positioning_input, *a.positioning, true);
-  } else if (p.kind == "positioning") {
+  } else if (p.kind == dsp::ProgramKind::positioning) {
     j["positioning"] = all_null({"deviation_um"});
     for (const auto& f : dsp::eval::iso230_2_figures({})) j["positioning"][f.key] = nullptr;
     j["positioning"]["axis"] = p.axis;
@@ -219,15 +219,15 @@ void add_step_and_positioning(const dsp::Program& p, const dsp::Analysis& a, nlo
 }
 
 // rectangle (with its path deviation) and free form, likewise.
-void add_rectangle_and_freeform(const std::string& kind, const dsp::Analysis& a, nlohmann::json& j) {
+void add_rectangle_and_freeform(dsp::ProgramKind kind, const dsp::Analysis& a, nlohmann::json& j) {
   if (a.rectangle) {
     j["rectangle"] = rectangle_json(*a.rectangle);
-  } else if (kind == "rectangle") {
+  } else if (kind == dsp::ProgramKind::rectangle) {
     j["rectangle"] = all_null({"corners_mm", "corner_errors_um"});
   }
-  if (kind == "rectangle" && j["rectangle"].is_object())
+  if (kind == dsp::ProgramKind::rectangle && j["rectangle"].is_object())
     j["rectangle"]["path_deviation"] = a.path ? path_json(*a.path) : nlohmann::json(nullptr);
-  if (kind == "freeform")
+  if (kind == dsp::ProgramKind::freeform)
     j["freeform"] =
         a.path ? path_json(*a.path) : all_null({"contour_error_max_um", "contour_error_rms_um", "tangential_rms_um"});
 }
@@ -328,7 +328,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis) {
   nlohmann::json j;
   j["format"] = "eical-result/1";
   j["run_id"] = run.meta.id;
-  j["program"] = run.meta.program.kind;
+  j["program"] = dsp::program_kind_name(run.meta.program.kind);
   j["software"] = software_version();
   j["uncertainty_k2"] = per_figure_json(analysis, analysis.uncertainty_k2);
   j["noise_bound_k2"] = per_figure_json(analysis, analysis.noise_bound_k2);

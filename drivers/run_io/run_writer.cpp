@@ -210,7 +210,7 @@ std::string run_toml_text(const dsp::RunMeta& meta) {
   o += sensor_section_toml("table", meta.sensors[0]);
   o += sensor_section_toml("head", meta.sensors[1]);
   const auto& p = meta.program;
-  o += "\n[program]\nkind = " + toml_str(p.kind) + "\nplane = " + toml_str(p.plane) +
+  o += "\n[program]\nkind = " + toml_str(dsp::program_kind_name(p.kind)) + "\nplane = " + toml_str(p.plane) +
        "\ncenter_mm = " + vec(p.center_mm, 2) + "\nradius_mm = " + toml_double(p.radius_mm) +
        "\nfeed_mm_min = " + toml_double(p.feed_mm_min) + "\ndirection = " + toml_str(p.direction) +
        "\nrepeats = " + std::to_string(p.repeats) + "\naxis = " + toml_str(p.axis) +

@@ -13,7 +13,7 @@ namespace {
 sim::Scenario builtin_scenario(const SimMachine& m) {
   if (m.builtin == "circle") return sim::circle_scenario(m.radius_mm, m.feed_mm_min, m.repeats, "ccw", m.seed);
   if (m.builtin == "step") return sim::step_scenario(0.0, 50.0, m.feed_mm_min, m.repeats, m.seed);
-  return sim::gcode_scenario("", "freeform", m.seed);
+  return sim::gcode_scenario("", dsp::ProgramKind::freeform, m.seed);
 }
 
 sim::Scenario scenario_of(const SimMachine& m) {

@@ -137,7 +137,7 @@ PipelineConfig analysis_config(const RunMeta& meta, std::size_t capacity_samples
   PipelineConfig cfg = pipeline_config(meta, capacity_samples);
   cfg.dynamic = options.dynamic;
   cfg.zupt = options.zupt;
-  cfg.nbs = options.nbs.value_or(meta.program.kind == "rectangle");
+  cfg.nbs = options.nbs.value_or(meta.program.kind == ProgramKind::rectangle);
   cfg.coriolis = options.coriolis;
   cfg.cupt = options.cupt;
   cfg.keep_raw = options.keep_raw;
@@ -196,19 +196,15 @@ void evaluate_measurement(const Run& run, const PipelineConfig& config, const An
 
 void evaluate_program(const Run& run, Analysis& a, const EvaluationOptions& options) {
   a.program_kind = run.meta.program.kind;
-  const std::string& kind = run.meta.program.kind;
-  if (kind == "circle")
-    detail::evaluate_circle_program(run, a, options);
-  else if (kind == "step")
-    evaluate_step_program(run, a);
-  else if (kind == "positioning")
-    evaluate_positioning_program(run, a);
-  else if (kind == "rectangle")
-    detail::evaluate_rectangle_program(run, a);
-  else if (kind == "freeform")
-    detail::evaluate_freeform_program(run, a);
-  else
-    a.flags.push_back({FlagCode::unknown_program, kind, {}});
+  switch (run.meta.program.kind) {
+    case ProgramKind::circle: return detail::evaluate_circle_program(run, a, options);
+    case ProgramKind::step: return evaluate_step_program(run, a);
+    case ProgramKind::positioning: return evaluate_positioning_program(run, a);
+    case ProgramKind::rectangle: return detail::evaluate_rectangle_program(run, a);
+    case ProgramKind::freeform: return detail::evaluate_freeform_program(run, a);
+    case ProgramKind::identify: break;  // swings across the strips: `eical identify` reads it
+  }
+  a.flags.push_back({FlagCode::unknown_program, program_kind_name(run.meta.program.kind), {}});
 }
 
 }  // namespace eical::dsp

@@ -112,7 +112,7 @@ struct Analysis {
   std::optional<eval::RectangleResult> rectangle;
   std::optional<eval::PathDeviation> path;  // free form (and the rectangle's contour)
   std::vector<eval::RepeatGroup> repeats;   // segments between M102 marks run more than once, averaged
-  std::string program_kind;
+  ProgramKind program_kind = ProgramKind::circle;
   bool degraded = false;
   std::vector<Flag> flags;  // pipeline quality flags and evaluation failures
   // Expanded uncertainty (k = 2) of each figure by result key (figures.hpp), one value per

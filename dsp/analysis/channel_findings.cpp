@@ -56,20 +56,22 @@ bool measures_nothing(health::Fault f) {
 }
 
 std::string program_text(const Program& p) {
-  if (p.kind == "step" || p.kind == "positioning") return "the " + p.kind + " along " + p.axis;
-  if (p.kind == "circle" || p.kind == "rectangle" || p.kind == "freeform") return "the " + p.kind + " in " + p.plane;
-  return "the " + p.kind;
+  const std::string kind(program_kind_name(p.kind));
+  if (p.kind == ProgramKind::step || p.kind == ProgramKind::positioning) return "the " + kind + " along " + p.axis;
+  if (p.kind == ProgramKind::circle || p.kind == ProgramKind::rectangle || p.kind == ProgramKind::freeform)
+    return "the " + kind + " in " + p.plane;
+  return "the " + kind;
 }
 
 }  // namespace
 
 unsigned program_axes(const Program& program) {
-  const std::string& k = program.kind;
-  if (k == "circle" || k == "rectangle" || k == "freeform") {
+  const ProgramKind k = program.kind;
+  if (k == ProgramKind::circle || k == ProgramKind::rectangle || k == ProgramKind::freeform) {
     const auto [a, b] = plane_axes(program.plane);
     return (1u << a) | (1u << b);
   }
-  if (k == "step" || k == "positioning") return 1u << axis_of(program.axis);
+  if (k == ProgramKind::step || k == ProgramKind::positioning) return 1u << axis_of(program.axis);
   return 7u;
 }
 
@@ -138,7 +140,7 @@ bool judge_channels(const RunMeta& meta, const std::vector<health::Finding>& fin
   }
   if (!unmeasured) return true;
   a.flags.push_back(
-      {FlagCode::evaluation_failed, p.kind,
+      {FlagCode::evaluation_failed, program_kind_name(p.kind),
        "null, not evaluated: machine " + axes_text(unmeasured) + " not measured (" + unmeasured_why + ")"});
   return false;
 }

@@ -133,8 +133,9 @@ std::vector<FigureValue> figures_of(const Analysis& analysis) {
   if (analysis.step) step_figures(analysis, o);
   if (analysis.rectangle) rectangle_figures(analysis, o);
   if (analysis.path)
-    path_figures(analysis.rectangle || analysis.program_kind == "rectangle" ? "rectangle.path_deviation" : "freeform",
-                 *analysis.path, o);
+    path_figures(
+        analysis.rectangle || analysis.program_kind == ProgramKind::rectangle ? "rectangle.path_deviation" : "freeform",
+        *analysis.path, o);
   return f;
 }
 

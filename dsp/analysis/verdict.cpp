@@ -36,21 +36,22 @@ const FigureConformance* proven_either_way(const Analysis& a, const std::string&
 
 const std::vector<ResolutionLimit>& resolution_limits() {
   static const std::vector<ResolutionLimit> limits = {
-      {"circle", "circle.circular_deviation_G_um", "circular deviation G", "circle.circular_deviation_G_um", "G", 10.0},
-      {"positioning", "positioning.A_um", "positioning accuracy A", "positioning.E_um", "E", 5.0},
-      {"step", "step.largest_step_measured_um", "the measured step", "step.end_position_error_um",
+      {ProgramKind::circle, "circle.circular_deviation_G_um", "circular deviation G", "circle.circular_deviation_G_um",
+       "G", 10.0},
+      {ProgramKind::positioning, "positioning.A_um", "positioning accuracy A", "positioning.E_um", "E", 5.0},
+      {ProgramKind::step, "step.largest_step_measured_um", "the measured step", "step.end_position_error_um",
        "the end-position error", 2.0},
-      {"rectangle", "rectangle.corner_error_max_um", "the largest corner error", "rectangle.corner_error_max_um",
-       "the corner error", 10.0},
-      {"freeform", "freeform.contour_error_max_um", "the largest contour error", "freeform.contour_error_max_um",
-       "the contour error", 10.0},
+      {ProgramKind::rectangle, "rectangle.corner_error_max_um", "the largest corner error",
+       "rectangle.corner_error_max_um", "the corner error", 10.0},
+      {ProgramKind::freeform, "freeform.contour_error_max_um", "the largest contour error",
+       "freeform.contour_error_max_um", "the contour error", 10.0},
   };
   return limits;
 }
 
-const ResolutionLimit* resolution_limit(const std::string& program_kind) {
+const ResolutionLimit* resolution_limit(ProgramKind program) {
   for (const auto& l : resolution_limits())
-    if (program_kind == l.program) return &l;
+    if (program == l.program) return &l;
   return nullptr;
 }
 
@@ -87,15 +88,15 @@ void judge(const Program& program, Analysis& a) {
       if (decided && !(ul <= lim->limit)) {
         decided_note =
             ("U(" + std::string(lim->limited_name) + ") = " + num(ul, lim->limited) + " exceeds the " +
-             num(lim->limit, lim->limited) + " a " + program.kind +
+             num(lim->limit, lim->limited) + " a " + program_kind_name(program.kind) +
              " test resolves without tolerances, but decides its tolerance of " +
              num(decided->tolerance, lim->limited) + ": " + conformance_words(decided->decision) + " (ISO 14253-1)");
       } else if (!std::isfinite(ul) || ul > lim->limit) {
         not_measurable = true;
         a.verdict_reasons.push_back("U(" + std::string(lim->limited_name) +
                                     ") = " + (std::isfinite(ul) ? num(ul, lim->limited) : std::string("unknown")) +
-                                    " exceeds the " + num(lim->limit, lim->limited) + " a " + program.kind +
-                                    " test is meant to resolve");
+                                    " exceeds the " + num(lim->limit, lim->limited) + " a " +
+                                    program_kind_name(program.kind) + " test is meant to resolve");
       }
     }
   }

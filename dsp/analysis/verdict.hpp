@@ -21,7 +21,7 @@
 namespace eical::dsp {
 
 struct ResolutionLimit {
-  const char* program;   // kind
+  ProgramKind program;
   const char* headline;  // result key of the headline figure (must exceed its U)
   const char* name;      // as a user reads it
   const char* limited;   // result key whose U must stay within `limit_um`
@@ -30,7 +30,7 @@ struct ResolutionLimit {
 };
 
 const std::vector<ResolutionLimit>& resolution_limits();
-const ResolutionLimit* resolution_limit(const std::string& program_kind);
+const ResolutionLimit* resolution_limit(ProgramKind program);
 
 // Sets a.verdict and a.verdict_reasons from the figures, their uncertainty and the flags.
 void judge(const Program& program, Analysis& a);

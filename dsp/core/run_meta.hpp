@@ -1,6 +1,7 @@
 #pragma once
 // Metadata of a recorded run (eical-run/1, docs/run-format.md) as plain data.
 // Parsing and writing live in drivers/run_io; dsp only reads these values.
+#include "dsp/core/program_kind.hpp"
 #include "dsp/core/sample_rate.hpp"
 #include "dsp/core/work_envelope.hpp"
 
@@ -70,7 +71,7 @@ struct PsdSpec {
 
 // [program]: which keys are meaningful depends on kind (see run-format.md).
 struct Program {
-  std::string kind = "circle";  // step | positioning | rectangle | circle | freeform
+  ProgramKind kind = ProgramKind::circle;
   std::string plane = "xy";
   double center_mm[2] = {0.0, 0.0};
   double radius_mm = 10.0;

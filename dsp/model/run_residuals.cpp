@@ -36,7 +36,7 @@ Measurement nominal_measurement(const Run& run) {
   PipelineConfig cfg = pipeline_config(run.meta, run.frames.size());
   cfg.keep_raw = true;
   cfg.cupt = false;  // the strips are a reference here
-  cfg.nbs = run.meta.program.kind == "rectangle";
+  cfg.nbs = run.meta.program.kind == ProgramKind::rectangle;
   Pipeline pipe(cfg);
   for (const auto& f : run.frames) pipe.step(f);
   return pipe.finish();

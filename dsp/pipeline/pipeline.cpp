@@ -29,7 +29,7 @@ PipelineConfig pipeline_config(const RunMeta& meta, std::size_t capacity_samples
   c.fusion.accel_noise_um_s2_rthz = std::hypot(meta.sensor_present[0] ? meta.sensors[0].noise_ug_per_rthz : 0.0,
                                                meta.sensor_present[1] ? meta.sensors[1].noise_ug_per_rthz : 0.0) *
                                     meta.site.g_mps2;
-  c.strips_set_the_frame = meta.program.kind == "positioning";
+  c.strips_set_the_frame = meta.program.kind == ProgramKind::positioning;
   c.fusion.timing_uncertainty_s =
       dsp::timing_sigma_s(dsp::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz), axis_owners(meta.machine));
   return c;

@@ -265,7 +265,7 @@ void check_streamable(const Run& header, const AnalysisOptions& options) {
 struct FirstPass {
   FirstPass(const Run& header, PipelineConfig config)
       : cfg(std::move(config)), scout(header, is_circle(header)), channel_check(header) {}
-  static bool is_circle(const Run& header) { return header.meta.program.kind == "circle"; }
+  static bool is_circle(const Run& header) { return header.meta.program.kind == ProgramKind::circle; }
 
   PipelineConfig cfg;
   Scout scout;

@@ -277,12 +277,15 @@ std::string identify_program(const dsp::Program& p, const RestTimes& rest) {
 }
 
 std::string program_gcode(const dsp::Program& p) {
-  if (p.kind == "circle") return circle_program(p);
-  if (p.kind == "positioning") return positioning_program(p);
-  if (p.kind == "step") return step_program(p);
-  if (p.kind == "rectangle") return rectangle_program(p);
-  if (p.kind == "identify") return identify_program(p);
-  throw dsp::InputError("program kind '" + p.kind +
+  switch (p.kind) {
+    case dsp::ProgramKind::circle: return circle_program(p);
+    case dsp::ProgramKind::positioning: return positioning_program(p);
+    case dsp::ProgramKind::step: return step_program(p);
+    case dsp::ProgramKind::rectangle: return rectangle_program(p);
+    case dsp::ProgramKind::identify: return identify_program(p);
+    case dsp::ProgramKind::freeform: break;  // a contour is the user's own NC
+  }
+  throw dsp::InputError(std::string("program kind '") + dsp::program_kind_name(p.kind) +
                         "' has no generator (circle, positioning, step, rectangle, identify)");
 }
 

@@ -57,12 +57,12 @@ void background_sensor(SensorTruth& t, const dsp::SensorSpec& sheet, Draw& d) {
   t.temperature.tau_s = d.u(240.0, 540.0);
 }
 
-void program(Scenario& sc, const std::string& kind, Draw& d, bool fast) {
-  if (kind == "circle") {
+void program(Scenario& sc, dsp::ProgramKind kind, Draw& d, bool fast) {
+  if (kind == dsp::ProgramKind::circle) {
     const double r = std::round(d.u(8.0, 15.0));
     sc = circle_scenario(r, std::round(d.u(2000.0, 3000.0) / 50.0) * 50.0, 5, "ccw", sc.seed);
     sc.meta.psd = psd_config_b(r);
-  } else if (kind == "step") {
+  } else if (kind == dsp::ProgramKind::step) {
     const double to = std::round(d.u(40.0, 60.0));
     const double feed = d.u(0.0, 1.0) < 0.5 ? 3250.0 : 6500.0;
     sc = step_scenario(0.0, to, fast ? 6500.0 : feed, 3, sc.seed);
@@ -72,7 +72,8 @@ void program(Scenario& sc, const std::string& kind, Draw& d, bool fast) {
     s.measures = "x", s.center_mm[0] = to / 2.0, s.center_mm[1] = 0.0;
     sc.meta.psd = {s};
   } else {
-    throw dsp::InputError("hidden effects: unknown program '" + kind + "' (circle or step)");
+    throw dsp::InputError(std::string("hidden effects: unknown program '") + dsp::program_kind_name(kind) +
+                          "' (circle or step)");
   }
 }
 
@@ -92,7 +93,7 @@ void background(Scenario& sc, Draw& d) {
     m.cyclic[a] = CyclicError{d.u(0.0, 0.1), 10.0, d.u(0.0, 360.0)};
   }
   m.squareness_urad[0] = d.pm(2.5);
-  const double span = sc.meta.program.kind == "circle" ? sc.meta.program.radius_mm : 50.0;
+  const double span = sc.meta.program.kind == dsp::ProgramKind::circle ? sc.meta.program.radius_mm : 50.0;
   m.straightness[0] = Straightness{1, d.pm(0.26), {-span, span}};
   m.straightness[1] = Straightness{0, d.pm(0.26), {-span, span}};
   sc.daq.group_delay_samples = sc.meta.acquisition.daq_group_delay_samples;
@@ -117,14 +118,14 @@ void background(Scenario& sc, Draw& d) {
 int moving_sensor(const Scenario& sc, Draw& d) {
   const bool head_moves = std::find(sc.meta.machine.head_axes.begin(), sc.meta.machine.head_axes.end(), "y") !=
                           sc.meta.machine.head_axes.end();
-  const bool circle = sc.meta.program.kind == "circle";
+  const bool circle = sc.meta.program.kind == dsp::ProgramKind::circle;
   const int pick = d.pick(2);              // drawn always: the sizes after it do not depend on the program
   return circle && head_moves ? pick : 0;  // x (and y) are the table's otherwise
 }
 
 int moving_axis(const Scenario& sc, Draw& d) {
   const int pick = d.pick(2);
-  return sc.meta.program.kind == "circle" ? pick : 0;
+  return sc.meta.program.kind == dsp::ProgramKind::circle ? pick : 0;
 }
 
 [[noreturn]] void unknown_effect(const std::string& e) {
@@ -139,7 +140,7 @@ void inject_sensor(Scenario& sc, Effect e, Draw& d) {
       t.spec.k1_v_per_g[i] = sc.meta.sensors[&t - sc.truth].k1_v_per_g[i] * (1.0 + d.mag(2000e-6, 5000e-6));
   } else if (e == Effect::sensor_bias_drift) {
     SensorTruth& t = sc.truth[moving_sensor(sc, d)];
-    if (sc.meta.program.kind == "step")
+    if (sc.meta.program.kind == dsp::ProgramKind::step)
       t.bias_step_ug = d.u(6.0, 15.0);
     else
       t.bias_drift_ug_per_s = d.mag(0.3, 1.0);
@@ -225,10 +226,10 @@ void inject_machine(Scenario& sc, Effect e, Draw& d) {
     m.cyclic[moving_axis(sc, d)] = CyclicError{d.u(1.0, 3.0), d.pick(2) ? 5.0 : 10.0, d.u(0.0, 360.0)};
   } else if (e == Effect::machine_straightness) {
     const int a = moving_axis(sc, d);
-    const double span =
-        sc.meta.program.kind == "circle" ? sc.meta.program.radius_mm : sc.meta.program.targets_mm.back();
-    m.straightness[a] =
-        Straightness{a == 0 ? 1 : 0, d.mag(2.0, 5.0), {sc.meta.program.kind == "circle" ? -span : 0.0, span}};
+    const double span = sc.meta.program.kind == dsp::ProgramKind::circle ? sc.meta.program.radius_mm
+                                                                         : sc.meta.program.targets_mm.back();
+    m.straightness[a] = Straightness{
+        a == 0 ? 1 : 0, d.mag(2.0, 5.0), {sc.meta.program.kind == dsp::ProgramKind::circle ? -span : 0.0, span}};
   } else if (e == Effect::machine_stick_slip) {
     m.stick_slip[moving_axis(sc, d)] = StickSlip{d.u(1.0, 3.0), d.u(100.0, 200.0), 2.0};
   } else if (e == Effect::machine_resonance) {
@@ -279,7 +280,7 @@ const std::vector<std::string>& hidden_programs() {
 // Every effect of the table can be hidden (the simulator's own list of them).
 const std::vector<std::string>& hideable_effects() { return effect_names(); }
 
-std::string program_for(const std::string& effect) {
+dsp::ProgramKind program_for(const std::string& effect) {
   // What a long straight move shows best: the sensors' own errors, vibration, a scale.
   static constexpr Effect kStep[] = {Effect::sensor_scale,
                                      Effect::sensor_bias_drift,
@@ -293,16 +294,17 @@ std::string program_for(const std::string& effect) {
                                      Effect::site_coriolis,
                                      Effect::machine_resonance};
   const std::optional<Effect> e = dsp::model::effect_named(effect);
-  return e && std::find(std::begin(kStep), std::end(kStep), *e) != std::end(kStep) ? "step" : "circle";
+  return e && std::find(std::begin(kStep), std::end(kStep), *e) != std::end(kStep) ? dsp::ProgramKind::step
+                                                                                   : dsp::ProgramKind::circle;
 }
 
-std::string program_for(const std::vector<std::string>& effects) {
+dsp::ProgramKind program_for(const std::vector<std::string>& effects) {
   for (const auto& e : effects)
-    if (program_for(e) == "circle") return "circle";
-  return effects.empty() ? "circle" : "step";
+    if (program_for(e) == dsp::ProgramKind::circle) return dsp::ProgramKind::circle;
+  return effects.empty() ? dsp::ProgramKind::circle : dsp::ProgramKind::step;
 }
 
-Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const std::string& kind, std::uint64_t seed) {
+Scenario hidden_effect_scenario(const std::vector<std::string>& effects, dsp::ProgramKind kind, std::uint64_t seed) {
   Draw d(stream_seed(seed, 7001));
   Scenario sc;
   sc.seed = seed;
@@ -332,9 +334,9 @@ Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const s
   std::string name = effects.empty() ? "baseline" : effects.front();
   for (std::size_t i = 1; i < effects.size(); ++i) name += "+" + effects[i];
   sc.name = name;
-  sc.meta.id = "hidden-" + name + "-" + kind + "-s" + std::to_string(seed);
+  sc.meta.id = "hidden-" + name + "-" + dsp::program_kind_name(kind) + "-s" + std::to_string(seed);
   sc.description = (effects.empty() ? std::string("no effect") : name) + " hidden among tolerance-level deviations, " +
-                   kind + " program";
+                   dsp::program_kind_name(kind) + " program";
   return sc;
 }
 

@@ -28,16 +28,16 @@ const std::vector<std::string>& hidden_programs();
 
 // The program an effect shows itself in best (circle for the geometry and the loops, step
 // for what needs acceleration or standstills: the resonance rings after every ramp).
-std::string program_for(const std::string& effect);
+dsp::ProgramKind program_for(const std::string& effect);
 // Several effects: a circle when any of them needs two moving axes (geometry, loops),
 // else the step.
-std::string program_for(const std::vector<std::string>& effects);
+dsp::ProgramKind program_for(const std::vector<std::string>& effects);
 
 // Every effect name of run-format.md's table that can be hidden.
 const std::vector<std::string>& hideable_effects();
 
 // A run of `program` with `effects` injected (empty: a baseline) over the background.
 // Throws InputError for an unknown effect or program.
-Scenario hidden_effect_scenario(const std::vector<std::string>& effects, const std::string& kind, std::uint64_t seed);
+Scenario hidden_effect_scenario(const std::vector<std::string>& effects, dsp::ProgramKind kind, std::uint64_t seed);
 
 }  // namespace eical::sim

@@ -77,7 +77,7 @@ Scenario sweep_scenario(const nc::KlipperTest& test, const Eigen::Vector3d& dire
   sc.description = "Klipper resonance test " + std::to_string(test.freq_start_hz) + " .. " +
                    std::to_string(test.freq_end_hz) + " Hz, no standstill, ideal machine";
   sc.meta.id = "sim-sweep-s" + std::to_string(seed);
-  sc.meta.program.kind = "freeform";
+  sc.meta.program.kind = dsp::ProgramKind::freeform;
   // The test's peak speed as the program's feed (run.toml needs a positive one).
   double v = 0.0, v_max = 0.0;
   for (const auto& seg : nc::klipper_segments(test)) {

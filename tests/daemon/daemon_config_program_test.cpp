@@ -37,7 +37,7 @@ TEST(DaemonConfigProgram, ReadsTheGenNcProgramTableWithItsGcode) {
                                       "\"\n[source.fault]\ngap_at_s = 2.5\ngap_frames = 10\n");
   const auto c = eical::daemon::load_daemon_config(cfg);
   ASSERT_TRUE(c.source.sim_program_loaded);
-  EXPECT_EQ(c.source.sim_program_loaded->kind, "circle");
+  EXPECT_EQ(c.source.sim_program_loaded->kind, eical::dsp::ProgramKind::circle);
   EXPECT_DOUBLE_EQ(c.source.sim_program_loaded->radius_mm, 7.5);
   EXPECT_EQ(c.source.sim_program_loaded->direction, "cw");
   EXPECT_NE(c.source.sim_program_loaded->gcode.find("M101"), std::string::npos);

@@ -36,22 +36,25 @@ std::vector<Case> every_program() {
     for (const char* dir : {"ccw", "cw", "both"})
       for (double arc : {360.0, 220.0}) {
         eical::dsp::Program p;
-        p.kind = "circle", p.plane = plane, p.direction = dir, p.arc_deg = arc, p.repeats = 2;
+        p.kind = eical::dsp::ProgramKind::circle, p.plane = plane, p.direction = dir, p.arc_deg = arc, p.repeats = 2;
         p.radius_mm = 25.0, p.center_mm[0] = 5.0, p.center_mm[1] = -5.0, p.feed_mm_min = 2500.0;
         cases.push_back({std::string("circle ") + plane + " " + dir + " " + std::to_string(static_cast<int>(arc)),
                          [p] { return g::circle_program(p); }});
       }
   eical::dsp::Program pos;
-  pos.kind = "positioning", pos.axis = "x", pos.targets_mm = {0.0, 12.5, 25.0, 50.0}, pos.runs = 2;
+  pos.kind = eical::dsp::ProgramKind::positioning, pos.axis = "x", pos.targets_mm = {0.0, 12.5, 25.0, 50.0},
+  pos.runs = 2;
   pos.feed_mm_min = 2000.0, pos.dwell_s = 0.25;
   cases.push_back({"positioning", [pos] { return g::positioning_program(pos, 2.0); }});
   eical::dsp::Program step;
-  step.kind = "step", step.axis = "y", step.targets_mm = {0.0, 50.0}, step.runs = 2, step.feed_mm_min = 3250.0;
+  step.kind = eical::dsp::ProgramKind::step, step.axis = "y", step.targets_mm = {0.0, 50.0}, step.runs = 2,
+  step.feed_mm_min = 3250.0;
   step.dwell_s = 0.5;
   cases.push_back({"step", [step] { return g::step_program(step); }});
   for (const char* plane : {"xy", "zx", "yz"}) {
     eical::dsp::Program r;
-    r.kind = "rectangle", r.plane = plane, r.size_mm[0] = 40.0, r.size_mm[1] = 20.0, r.feed_mm_min = 1000.0;
+    r.kind = eical::dsp::ProgramKind::rectangle, r.plane = plane, r.size_mm[0] = 40.0, r.size_mm[1] = 20.0,
+    r.feed_mm_min = 1000.0;
     r.dwell_s = 0.2, r.repeats = 1;
     cases.push_back({std::string("rectangle ") + plane, [r] { return g::rectangle_program(r); }});
   }

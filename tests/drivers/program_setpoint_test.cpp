@@ -131,7 +131,7 @@ TEST(ProgramCatalog, NamesTheMissingProgramFile) {
   std::ofstream(dir / "7.toml")
       << "[program]\nkind = \"circle\"\nradius_mm = 10.0\ngcode = \"\"\"\nG0 X10\nM101\nG1 X0 F100\nM103\n\"\"\"\n";
   const ProgramCatalog catalog(dir);
-  EXPECT_EQ(catalog.program(7).kind, "circle");
+  EXPECT_EQ(catalog.program(7).kind, eical::dsp::ProgramKind::circle);
   try {
     (void)catalog.program(8);
     FAIL() << "program 8 does not exist";

@@ -34,7 +34,7 @@ dsp::Run long_run(std::size_t frames = 12000) {
   dsp::Run r;
   r.meta.id = "appended-0001";
   r.meta.created = "2026-11-27T10:00:00Z";
-  r.meta.program.kind = "circle";
+  r.meta.program.kind = eical::dsp::ProgramKind::circle;
   r.meta.psd = {dsp::PsdSpec{}};
   r.channels.psd_count = 1;
   for (std::size_t i = 0; i < frames; ++i) {

@@ -25,7 +25,7 @@ dsp::Run small_run() {
   dsp::Run r;
   r.meta.id = "unit-0001";
   r.meta.created = "2026-11-22T10:00:00Z";
-  r.meta.program.kind = "circle";
+  r.meta.program.kind = eical::dsp::ProgramKind::circle;
   r.meta.program.gcode = "G90\nM101\n";
   r.meta.psd = {dsp::PsdSpec{}, dsp::PsdSpec{}};
   r.meta.psd[1].measures = "y";

@@ -24,7 +24,7 @@ void write_small_run(const fs::path& dir) {
   dsp::Run r;
   r.meta.id = "strict-0001";
   r.meta.created = "2026-11-28T10:00:00Z";
-  r.meta.program.kind = "circle";
+  r.meta.program.kind = eical::dsp::ProgramKind::circle;
   r.meta.program.gcode = "G90\nM101\n";
   r.meta.psd = {dsp::PsdSpec{}};
   r.meta.reference = dsp::Reference{"KGM182", {"x", "y"}};

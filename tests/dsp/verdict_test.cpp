@@ -168,12 +168,13 @@ TEST(FlagSeverity, EveryCodeHasItsOwnNameAndAText) {
 }
 
 TEST(Verdict, EveryProgramHasALimit) {
-  for (const char* kind : {"circle", "positioning", "step", "rectangle", "freeform"}) {
+  for (const ProgramKind kind : {ProgramKind::circle, ProgramKind::positioning, ProgramKind::step,
+                                 ProgramKind::rectangle, ProgramKind::freeform}) {
     const ResolutionLimit* l = resolution_limit(kind);
-    ASSERT_NE(l, nullptr) << kind;
+    ASSERT_NE(l, nullptr) << program_kind_name(kind);
     EXPECT_GT(l->limit, 0.0);
   }
-  EXPECT_EQ(resolution_limit("identify"), nullptr);
+  EXPECT_EQ(resolution_limit(ProgramKind::identify), nullptr);
 }
 
 TEST(Conformance, Iso14253DecisionRule) {

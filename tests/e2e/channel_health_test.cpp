@@ -376,7 +376,7 @@ TEST(ChannelHealth, ProgramAxesFollowTheMounting) {
   EXPECT_EQ(dsp::channel_axes(meta, kHeadAz), 4u);
   meta.sensors[1].to_machine << 0, 1, 0, -1, 0, 0, 0, 0, 1;  // head turned 90° about Z
   EXPECT_EQ(dsp::channel_axes(meta, 3), 2u);                 // its axis 1 measures machine Y
-  meta.program.kind = "step", meta.program.axis = "z";
+  meta.program.kind = eical::dsp::ProgramKind::step, meta.program.axis = "z";
   EXPECT_EQ(dsp::program_axes(meta.program), 4u);
 }
 

@@ -16,8 +16,9 @@ namespace eical {
 namespace {
 
 TEST(ExplainJson, KeysOfResultsMdAndNamesOfTheEffectTable) {
-  std::vector<dsp::Run> runs = {sim::simulate(sim::hidden_effect_scenario({"sensor.scale"}, "step", 102)),
-                                sim::simulate(sim::hidden_effect_scenario({"sensor.scale"}, "circle", 102))};
+  std::vector<dsp::Run> runs = {
+      sim::simulate(sim::hidden_effect_scenario({"sensor.scale"}, eical::dsp::ProgramKind::step, 102)),
+      sim::simulate(sim::hidden_effect_scenario({"sensor.scale"}, eical::dsp::ProgramKind::circle, 102))};
   std::vector<dsp::model::RunExplanation> ex;
   for (const auto& r : runs) ex.push_back(dsp::model::explain_run(r));
   std::vector<dsp::model::TransferGain> transfers = {dsp::model::transfer_gain(runs[1], ex[0])};

@@ -35,7 +35,7 @@ double pipeline_rms_um(const dsp::Run& run) {
 }
 
 TEST(ExtendedModel, ScenarioReproducesTheRunAndTheCalibrationRemovesTheEffect) {
-  const dsp::Run run = sim::simulate(sim::hidden_effect_scenario({"sensor.scale"}, "step", 101));
+  const dsp::Run run = sim::simulate(sim::hidden_effect_scenario({"sensor.scale"}, eical::dsp::ProgramKind::step, 101));
   const auto ex = dsp::model::explain_run(run);
   const auto model = tools::explain::extended_model(run, ex);
   const fs::path dir = fs::temp_directory_path() / ("eical_ext_" + std::to_string(::getpid()));
@@ -63,7 +63,7 @@ TEST(ExtendedModel, ScenarioReproducesTheRunAndTheCalibrationRemovesTheEffect) {
 // A machine effect on two axes (backlash on x and y of a circle) is written as an array of
 // tables the scenario reader takes back, with each axis' value.
 TEST(ExtendedModel, AnEffectOnTwoAxesRoundTripsThroughTheScenario) {
-  sim::Scenario sc = sim::hidden_effect_scenario({"machine.backlash"}, "circle", 101);
+  sim::Scenario sc = sim::hidden_effect_scenario({"machine.backlash"}, eical::dsp::ProgramKind::circle, 101);
   sc.machine.backlash_um[0] = 6.0, sc.machine.backlash_um[1] = 4.0;
   const dsp::Run run = sim::simulate(sc);
   const auto ex = dsp::model::explain_run(run);
@@ -96,7 +96,7 @@ double mode_near(const dsp::model::RunExplanation& ex, double f_hz, double& zeta
 }
 
 TEST(ExtendedModel, TheModesFoundAreSimulatedAgainAndFoundAgain) {
-  sim::Scenario sc = sim::hidden_effect_scenario({}, "step", 101);
+  sim::Scenario sc = sim::hidden_effect_scenario({}, eical::dsp::ProgramKind::step, 101);
   sim::set_sensors_present(sc, "head");
   sim::StructuralMode md;
   md.frequency_hz = 45.0, md.damping_ratio = 0.03, md.gain = 0.15, md.direction = Eigen::Vector3d::UnitX();

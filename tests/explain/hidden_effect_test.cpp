@@ -32,7 +32,7 @@ std::string joined(const std::vector<std::string>& v) {
   return s.empty() ? "none" : s;
 }
 
-dsp::model::RunExplanation explain_hidden(const std::vector<std::string>& effects, const std::string& program,
+dsp::model::RunExplanation explain_hidden(const std::vector<std::string>& effects, dsp::ProgramKind program,
                                           std::uint64_t seed) {
   const dsp::Run run = sim::simulate(sim::hidden_effect_scenario(effects, program, seed));
   const auto t0 = std::chrono::steady_clock::now();
@@ -84,7 +84,7 @@ class Baseline : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(Baseline, ShowsNoSignificantEffect) {
   for (std::uint64_t seed : kSeeds) {
-    const auto sig = significant(explain_hidden({}, GetParam(), seed));
+    const auto sig = significant(explain_hidden({}, *dsp::parse_program_kind(GetParam()), seed));
     std::printf("baseline %s seed %llu: %s\n", GetParam().c_str(), static_cast<unsigned long long>(seed),
                 joined(sig).c_str());
     EXPECT_TRUE(sig.empty()) << GetParam() << " seed " << seed << ": " << joined(sig);

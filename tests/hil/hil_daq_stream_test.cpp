@@ -318,7 +318,7 @@ TEST(HilDaqStream, ServoStreamSetPointBesideTheDaq) {
   const auto& sp = *run.meta.setpoint;
   EXPECT_EQ(sp.source, "servo_stream");
   EXPECT_EQ(sp.program_number, 7);
-  EXPECT_EQ(run.meta.program.kind, "circle");
+  EXPECT_EQ(run.meta.program.kind, eical::dsp::ProgramKind::circle);
   const double true_cycle = static_cast<double>(kServoCycle0) +
                             (static_cast<double>(run.frames.front().sample_index) / kDaqFs - kServoOffsetS) * 1e3;
   const double err_um = setpoint_error_um(run, s);
@@ -375,7 +375,7 @@ TEST(HilDaqStream, ProgramSetPointNamedByM101BesideTheDaq) {
   const auto& sp = *run.meta.setpoint;
   EXPECT_EQ(sp.source, "program");
   EXPECT_EQ(sp.program_number, 7);
-  EXPECT_EQ(run.meta.program.kind, "circle");
+  EXPECT_EQ(run.meta.program.kind, eical::dsp::ProgramKind::circle);
   EXPECT_FALSE(run.meta.program.gcode.empty()) << "the program travels with the run";
   const double err_um = setpoint_error_um(run, s);
   std::printf(

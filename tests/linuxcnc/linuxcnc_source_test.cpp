@@ -62,7 +62,7 @@ TEST(SampleClock, TheFreshestLineOfABurstSetsTheOffset) {
 
 TEST(LinuxcncSource, WithoutLinuxCncOpenFailsNamingThePipeAndTheKit) {
   const fs::path fifo = scratch_fifo();
-  LinuxcncSource src(sim::gcode_scenario("", "freeform", 1), options(fifo));
+  LinuxcncSource src(sim::gcode_scenario("", eical::dsp::ProgramKind::freeform, 1), options(fifo));
   const auto t0 = std::chrono::steady_clock::now();
   try {
     src.open();
@@ -81,7 +81,7 @@ TEST(LinuxcncSource, RefusesAPathThatIsNotAPipe) {
   std::FILE* f = std::fopen(fifo.c_str(), "w");
   ASSERT_NE(f, nullptr);
   std::fclose(f);
-  LinuxcncSource src(sim::gcode_scenario("", "freeform", 1), options(fifo));
+  LinuxcncSource src(sim::gcode_scenario("", eical::dsp::ProgramKind::freeform, 1), options(fifo));
   EXPECT_THROW(src.open(), SourceError);
 }
 
@@ -100,7 +100,7 @@ TEST(LinuxcncSource, StreamedCyclesBecomeFramesAndAMalformedLineFailsTheSource) 
   lines += "1400 0.5 0 0 0.5 0 0 zzz\n";
   ASSERT_EQ(::write(w, lines.data(), lines.size()), static_cast<ssize_t>(lines.size()));
 
-  LinuxcncSource src(sim::gcode_scenario("", "freeform", 1), options(fifo));
+  LinuxcncSource src(sim::gcode_scenario("", eical::dsp::ProgramKind::freeform, 1), options(fifo));
   src.open();
   std::vector<dsp::Frame> out(4096);
   std::size_t frames = 0;

@@ -52,7 +52,7 @@ std::vector<Eigen::Vector3d> servo_trajectory() {
 }
 
 sim::Scenario scenario() {
-  sim::Scenario sc = sim::gcode_scenario("", "freeform", 5);
+  sim::Scenario sc = sim::gcode_scenario("", eical::dsp::ProgramKind::freeform, 5);
   sc.noise = false;  // compare the deterministic signal; noise is drawn per window anyway
   sc.machine.backlash_um[0] = 4.0;
   sc.machine.scale_ppm[0] = 50.0;

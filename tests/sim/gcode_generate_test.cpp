@@ -33,7 +33,7 @@ std::string recorded_gcode(const std::string& run) {
 
 dsp::Program circle() {
   dsp::Program p;
-  p.kind = "circle";
+  p.kind = eical::dsp::ProgramKind::circle;
   p.radius_mm = 10.0;
   p.feed_mm_min = 2500.0;
   p.repeats = 5;
@@ -50,7 +50,7 @@ TEST(GcodeGenerate, StepMatchesTheRecordedRunsProgram) {
   const std::string recorded = recorded_gcode("baseline.step-0011");
   ASSERT_FALSE(recorded.empty()) << "no G-code in " << test::committed_data() / "baseline.step-0011/run.toml";
   dsp::Program p;
-  p.kind = "step";
+  p.kind = eical::dsp::ProgramKind::step;
   p.axis = "x";
   p.targets_mm = {0.0, 50.0};
   p.feed_mm_min = 3250.0;
@@ -91,7 +91,7 @@ TEST(GcodeGenerate, CircleInEveryPlaneAndDirectionParsesToTheRightSweep) {
 
 TEST(GcodeGenerate, PositioningVisitsEveryTargetInBothDirectionsEachRun) {
   dsp::Program p;
-  p.kind = "positioning";
+  p.kind = eical::dsp::ProgramKind::positioning;
   p.axis = "y";
   p.targets_mm = {0.0, 10.0, 25.0, 40.0};
   p.runs = 5;
@@ -117,13 +117,13 @@ TEST(GcodeGenerate, PositioningVisitsEveryTargetInBothDirectionsEachRun) {
 
 TEST(GcodeGenerate, RectangleAndIdentifyParse) {
   dsp::Program r;
-  r.kind = "rectangle";
+  r.kind = eical::dsp::ProgramKind::rectangle;
   r.size_mm[0] = 20;
   r.size_mm[1] = 10;
   r.repeats = 2;
   EXPECT_EQ(count_triggers(parse(program_gcode(r)), 102), 8);
   dsp::Program id;
-  id.kind = "identify";
+  id.kind = eical::dsp::ProgramKind::identify;
   id.targets_mm = {25.0};
   EXPECT_EQ(count_triggers(parse(program_gcode(id)), 102), 6);  // three feeds, both ways
   // Two strips and z: 6 swings each, a transfer to the second strip, z out, 6, back.
@@ -147,10 +147,10 @@ TEST(GcodeGenerate, IncompleteProgramsAreRefused) {
   p.plane = "xz";
   EXPECT_THROW((void)circle_program(p), dsp::InputError);
   dsp::Program pos;
-  pos.kind = "positioning";
+  pos.kind = eical::dsp::ProgramKind::positioning;
   pos.targets_mm = {10, 0};
   EXPECT_THROW((void)program_gcode(pos), dsp::InputError);
-  pos.kind = "spiral";
+  pos.kind = eical::dsp::ProgramKind::freeform;  // a contour is the user's own NC
   EXPECT_THROW((void)program_gcode(pos), dsp::InputError);
 }
 

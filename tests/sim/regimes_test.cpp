@@ -29,7 +29,7 @@ double decode_g(const dsp::Run& run, std::size_t n, int channel) {
 // A machine whose head moves every axis, with ideal sensors: no noise, a 32-bit ADC, no
 // DAQ delay, f0 far above the signal, no k2/k3 and no bias.
 Scenario ideal_head_scenario(const std::string& gcode) {
-  Scenario sc = gcode_scenario(gcode, "freeform", 3);
+  Scenario sc = gcode_scenario(gcode, eical::dsp::ProgramKind::freeform, 3);
   sc.meta.machine.table_axes = {};
   sc.meta.machine.head_axes = {"x", "y", "z"};
   sc.noise = false;
@@ -156,7 +156,7 @@ TEST(Regimes, ModeShowsInTheSweptResponseOfAMemsHeadSensor) {
 Scenario rest_scenario(double seconds) {
   char g[128];
   std::snprintf(g, sizeof g, "G90 G21\nG0 X0 Y0 Z0\nG4 P0.1\nM101\nG4 P%.3f\nM103\n", seconds);
-  return gcode_scenario(g, "freeform", 9);
+  return gcode_scenario(g, eical::dsp::ProgramKind::freeform, 9);
 }
 
 TEST(Regimes, MemsChipHasItsNoiseDensityAndQuantisationStep) {

@@ -15,7 +15,7 @@ namespace {
 
 Trajectory circle_trajectory(int repeats = 5) {
   dsp::Program p;
-  p.kind = "circle";
+  p.kind = eical::dsp::ProgramKind::circle;
   p.repeats = repeats;
   return interpolate_gcode(gcode::circle_program(p), "circle", MachineLimits{});
 }
@@ -69,7 +69,7 @@ TEST(Trajectory, CircleRunsOnTheRadiusAtFeedWithinTheLimits) {
 
 TEST(Trajectory, ExactStopStepsReachTheirTargetsAndRest) {
   dsp::Program p;
-  p.kind = "step";
+  p.kind = eical::dsp::ProgramKind::step;
   p.targets_mm = {0.0, 50.0};
   p.feed_mm_min = 3250.0;
   p.runs = 2;

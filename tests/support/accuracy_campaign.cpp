@@ -279,7 +279,7 @@ void circle_figures(const Machine& mach, Report& rep) {
 }
 
 void step_figures(const Machine& mach, Report& rep) {
-  sim::Scenario sc = sim::gcode_scenario(step_gcode(), "step", rep.seed);
+  sim::Scenario sc = sim::gcode_scenario(step_gcode(), eical::dsp::ProgramKind::step, rep.seed);
   auto& p = sc.meta.program;
   p.axis = "x", p.targets_mm = {-25.0, 25.0}, p.feed_mm_min = 6500.0, p.runs = 5, p.dwell_s = 0.5;
   mach.apply(sc, true);
@@ -333,7 +333,7 @@ void step_figures(const Machine& mach, Report& rep) {
 }
 
 void rectangle_figures(const Machine& mach, Report& rep) {
-  sim::Scenario sc = sim::gcode_scenario(rectangle_gcode(), "rectangle", rep.seed);
+  sim::Scenario sc = sim::gcode_scenario(rectangle_gcode(), eical::dsp::ProgramKind::rectangle, rep.seed);
   auto& p = sc.meta.program;
   p.corner_mm[0] = -40.0, p.corner_mm[1] = -10.0, p.size_mm[0] = 50.0, p.size_mm[1] = 50.0, p.feed_mm_min = 6500.0,
   p.dwell_s = 0.5;

@@ -44,7 +44,8 @@ std::size_t count(const std::string& s, const std::string& what) {
 
 Page page_of(const dsp::Analysis& a) {
   dsp::Run run;
-  run.meta.program.kind = "circle", run.meta.program.radius_mm = 100.0, run.meta.program.feed_mm_min = 4000.0;
+  run.meta.program.kind = eical::dsp::ProgramKind::circle, run.meta.program.radius_mm = 100.0,
+  run.meta.program.feed_mm_min = 4000.0;
   const fs::path dir = fs::temp_directory_path() / ("eical-circle-section-" + std::to_string(std::random_device{}()));
   fs::create_directories(dir);
   CsvFiles csv(dir);

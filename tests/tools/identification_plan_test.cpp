@@ -40,7 +40,7 @@ Reach reach(const std::string& program) {
 TEST(IdentificationPlan, APositioningTestsIdentificationStaysInsideItsTravel) {
   // The case of issue 33: 0–100 mm swung x from −25 to 125 mm.
   plan::TestProgram p;
-  p.kind = "positioning", p.targets_mm = {0.0, 25.0, 50.0, 75.0, 100.0};
+  p.kind = eical::dsp::ProgramKind::positioning, p.targets_mm = {0.0, 25.0, 50.0, 75.0, 100.0};
   p.psd = plan::strips_for(p);
   const auto id = plan::identification_plan(p);
   const Reach r = reach(gcode::identify_program(id));
@@ -55,7 +55,7 @@ TEST(IdentificationPlan, APositioningTestsIdentificationStaysInsideItsTravel) {
 // cross each whole.
 TEST(IdentificationPlan, ARadialRingIsReachedBeyondTheCircle) {
   plan::TestProgram p;
-  p.kind = "circle", p.radius_mm = 50.0, p.identified = true;
+  p.kind = eical::dsp::ProgramKind::circle, p.radius_mm = 50.0, p.identified = true;
   p.psd = plan::strips_for(p, 16, eical::sim::StripFacing::across_path);
   EXPECT_EQ(plan::strips_identification_can_cross(p).at(4).center_mm[0], 50.0) << "the strip stays on the circle";
   const auto id = plan::identification_plan(p);
@@ -74,7 +74,7 @@ TEST(IdentificationPlan, ARadialRingIsReachedBeyondTheCircle) {
 
 TEST(IdentificationPlan, StripsAtBothEndsOfATravelAreSwungFromInside) {
   plan::TestProgram p;
-  p.kind = "positioning", p.targets_mm = {0.0, 150.0, 300.0};
+  p.kind = eical::dsp::ProgramKind::positioning, p.targets_mm = {0.0, 150.0, 300.0};
   p.psd = plan::strips_at_both_ends(p);
   ASSERT_EQ(p.psd.size(), 2u);
   EXPECT_DOUBLE_EQ(p.psd[0].center_mm[0], 0.0);  // on the ends: the test stands on them
@@ -112,7 +112,7 @@ TEST(IdentificationPlan, AStripAtTheEndOfTheTravelIsRefusedWithWhereItMustGo) {
 
 TEST(IdentificationPlan, ACirclesIdentificationUsesItsStripsAndRadius) {
   plan::TestProgram p;
-  p.kind = "circle", p.radius_mm = 50.0;
+  p.kind = eical::dsp::ProgramKind::circle, p.radius_mm = 50.0;
   p.psd = plan::strips_for(p);
   const auto id = plan::identification_plan(p);
   ASSERT_EQ(id.psd.size(), 2u);

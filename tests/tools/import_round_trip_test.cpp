@@ -197,7 +197,7 @@ TEST(ImportRoundTrip, KlipperCaptureWithJitterGapsAndAnUnknownStart) {
   EXPECT_EQ(gaps, ck.gaps);
   EXPECT_EQ(back.frames.front().trigger, 101);
   EXPECT_EQ(back.frames.back().trigger, 103);
-  EXPECT_EQ(back.meta.program.kind, "freeform");
+  EXPECT_EQ(back.meta.program.kind, eical::dsp::ProgramKind::freeform);
   EXPECT_EQ(back.meta.sensors[1].model, "adxl345");
   const toml::table report = drivers::StrictTable::parse_file((dir.path / "run" / "import.toml").string());
   EXPECT_NEAR(report["time_offset"]["offset_s"].value_or(0.0), off.offset_s, 1e-9);

@@ -25,7 +25,7 @@ TEST(RegimeScenarios, KlipperLikeExampleIsWhatItSays) {
   EXPECT_NEAR(sc.truth[1].spec.bias_g.y(), -3.4e-3, 1e-12);
   EXPECT_TRUE(sc.sweep.on);
   EXPECT_TRUE(sc.sweep.test.legacy_moves);
-  EXPECT_EQ(sc.meta.program.kind, "freeform");
+  EXPECT_EQ(sc.meta.program.kind, eical::dsp::ProgramKind::freeform);
   ASSERT_EQ(sc.resonance.modes.size(), 2u);
   EXPECT_DOUBLE_EQ(sc.resonance.modes[1].frequency_hz, 67.0);
   EXPECT_EQ(sim::effect_lists(sc).present, std::vector<std::string>{"machine.resonance"});

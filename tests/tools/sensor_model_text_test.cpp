@@ -12,7 +12,7 @@ namespace {
 
 dsp::Analysis psd_disagreeing(const std::string& sensor_model) {
   dsp::Analysis a;
-  a.program_kind = "circle";
+  a.program_kind = eical::dsp::ProgramKind::circle;
   a.sensor_model = sensor_model;
   a.measurement.supports.psd_disagrees = true;
   return a;
@@ -20,7 +20,7 @@ dsp::Analysis psd_disagreeing(const std::string& sensor_model) {
 
 TEST(SensorModelText, NamesTheCalibrationWhenOneWasApplied) {
   dsp::Run run;
-  run.meta.program.kind = "circle";
+  run.meta.program.kind = eical::dsp::ProgramKind::circle;
   dsp::Analysis cal = psd_disagreeing("psd");
   EXPECT_EQ(sensor_model_text(cal), "the sensor calibration (method psd)");
   plan::suggest_measurable_test(run, cal);

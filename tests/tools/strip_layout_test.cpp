@@ -19,7 +19,7 @@ std::size_t count(const std::string& s, const std::string& what) {
 
 TEST(StripLayout, ConfigurationBOfACircleIsPlacedOnItsPath) {
   plan::TestProgram p;
-  p.kind = "circle", p.radius_mm = 50.0;
+  p.kind = eical::dsp::ProgramKind::circle, p.radius_mm = 50.0;
   p.psd = plan::strips_for(p);
   const auto j = plan::layout_json(p);
   ASSERT_EQ(j.size(), 2u);
@@ -39,7 +39,7 @@ TEST(StripLayout, ConfigurationBOfACircleIsPlacedOnItsPath) {
 
 TEST(StripLayout, APositioningTestGetsItsStripAtMidTravel) {
   plan::TestProgram p;
-  p.kind = "positioning", p.targets_mm = {0.0, 100.0, 200.0, 300.0};
+  p.kind = eical::dsp::ProgramKind::positioning, p.targets_mm = {0.0, 100.0, 200.0, 300.0};
   p.psd = plan::strips_for(p);
   const auto j = plan::layout_json(p);
   ASSERT_EQ(j.size(), 1u);

@@ -136,7 +136,7 @@ eical::sim::MachineErrors campaign_machine(std::uint64_t seed) {
 // The positioning run of `axis` on the drawn machine of `seed`.
 eical::sim::Scenario campaign_run(int axis, std::uint64_t seed, const eical::sim::MachineErrors& errors) {
   eical::tools::plan::TestProgram p;
-  p.kind = "positioning", p.targets_mm = kCampaignTargetsMm, p.runs = 2, p.feed_mm_min = 2000.0;
+  p.kind = eical::dsp::ProgramKind::positioning, p.targets_mm = kCampaignTargetsMm, p.runs = 2, p.feed_mm_min = 2000.0;
   eical::dsp::PsdSpec sx, sy;
   sx.measures = "x", sy.measures = "y";
   p.psd = {sx, sy};

@@ -68,7 +68,7 @@ TEST(NotMeasurable, AnalyzeExitsThreeAndPlanPrintsTheNearestMeasurableVariant) {
 // the verdict of the prediction and in the search for a design that reaches it.
 TEST(NotMeasurable, PlanResolveIsTheLimitTheDesignMustReach) {
   tools::plan::TestProgram p;
-  p.kind = "circle", p.radius_mm = 10.0, p.feed_mm_min = 2500.0, p.repeats = 1;
+  p.kind = eical::dsp::ProgramKind::circle, p.radius_mm = 10.0, p.feed_mm_min = 2500.0, p.repeats = 1;
   p.psd = tools::plan::strips_for(p);
   const auto ten = tools::plan::predict(p, 1, 20);
   EXPECT_DOUBLE_EQ(ten.limit, 10.0) << "a circle's G: what it must resolve";

@@ -47,7 +47,8 @@ std::vector<dsp::FigureValue> expect_within_u(const tools::plan::TestProgram& p,
 
 TEST(PositioningStrip, AScaleAtTheEndOfItsToleranceKeepsTheStripAndInventsNoRepeatability) {
   tools::plan::TestProgram p;
-  p.kind = "positioning", p.runs = 3, p.feed_mm_min = 3000.0, p.targets_mm = {0.0, 10.0, 20.0, 30.0};
+  p.kind = eical::dsp::ProgramKind::positioning, p.runs = 3, p.feed_mm_min = 3000.0,
+  p.targets_mm = {0.0, 10.0, 20.0, 30.0};
   p.psd = tools::plan::strips_for(p, 2);
   dsp::Analysis a;
   const auto measured = expect_within_u(p, 7, 60, {"positioning.R_um", "positioning.B_um", "positioning.E_um"}, a);
@@ -65,7 +66,8 @@ TEST(PositioningStrip, AScaleAtTheEndOfItsToleranceKeepsTheStripAndInventsNoRepe
 // targets sat 15–20 µm from the other runs', and R was 35.7 µm on a machine without any.
 TEST(PositioningStrip, TheFirstRunMeetsTheStripsFrameLikeTheOthers) {
   tools::plan::TestProgram p;
-  p.kind = "positioning", p.runs = 5, p.feed_mm_min = 4000.0, p.targets_mm = {0.0, 40.0, 80.0, 120.0, 160.0, 200.0};
+  p.kind = eical::dsp::ProgramKind::positioning, p.runs = 5, p.feed_mm_min = 4000.0,
+  p.targets_mm = {0.0, 40.0, 80.0, 120.0, 160.0, 200.0};
   p.psd = tools::plan::strips_for(p, 2);
   dsp::Analysis a;
   const auto measured = expect_within_u(p, 3, 40, {"positioning.R_um", "positioning.B_um"}, a);
@@ -82,7 +84,7 @@ TEST(PositioningStrip, TheFirstRunMeetsTheStripsFrameLikeTheOthers) {
 // scale tolerance (E 48 µm, U 46 µm; positioning-long in bench_uncertainty).
 TEST(PositioningStrip, StripsAtBothEndsMeasureTheScaleAndLeaveTheTravelToTheNoise) {
   tools::plan::TestProgram p;
-  p.kind = "positioning", p.runs = 5, p.feed_mm_min = 4000.0;
+  p.kind = eical::dsp::ProgramKind::positioning, p.runs = 5, p.feed_mm_min = 4000.0;
   p.targets_mm = {0.0, 20.0, 40.0, 60.0, 80.0, 100.0};
   p.psd = tools::plan::strips_at_both_ends(p);
   ASSERT_EQ(p.psd.size(), 2u);
@@ -117,7 +119,7 @@ TEST(PositioningStrip, StripsAtBothEndsMeasureTheScaleAndLeaveTheTravelToTheNois
 // share as a velocity error.
 TEST(PositioningStrip, WhereTheStripsMeasureTheScaleItsShareOfUIsTheScalesSigmaOverTheTravel) {
   tools::plan::TestProgram p;
-  p.kind = "positioning", p.runs = 5, p.feed_mm_min = 4000.0;
+  p.kind = eical::dsp::ProgramKind::positioning, p.runs = 5, p.feed_mm_min = 4000.0;
   p.targets_mm = {0.0, 20.0, 40.0, 60.0, 80.0, 100.0};
   p.psd = tools::plan::strips_at_both_ends(p);
   const sim::Scenario sc = tools::plan::scenario_on_drawn_machine(p, 7);
@@ -147,7 +149,7 @@ TEST(PositioningStrip, WhereTheStripsMeasureTheScaleItsShareOfUIsTheScalesSigmaO
 // it, and the targets stay where they were.
 TEST(PositioningStrip, ADampingTermOffItsTrueValueIsMeasuredByTheStripsNotPutIntoTheTargets) {
   tools::plan::TestProgram p;
-  p.kind = "positioning", p.runs = 3, p.feed_mm_min = 4000.0;
+  p.kind = eical::dsp::ProgramKind::positioning, p.runs = 3, p.feed_mm_min = 4000.0;
   p.targets_mm = {0.0, 50.0, 100.0, 150.0};
   p.psd = tools::plan::strips_at_both_ends(p);
   const sim::Scenario sc = tools::plan::scenario_on_drawn_machine(p, 1);

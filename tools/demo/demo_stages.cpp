@@ -33,7 +33,7 @@ double scalar(const std::map<std::string, std::vector<double>>& m, const char* k
 DemoMachine demo_machine(std::uint64_t seed, const DemoTest& test) {
   DemoMachine m;
   plan::TestProgram& p = m.program;
-  p.kind = "circle", p.direction = "both";
+  p.kind = dsp::ProgramKind::circle, p.direction = "both";
   p.radius_mm = test.radius_mm, p.feed_mm_min = test.feed_mm_min, p.repeats = test.repeats;
   p.psd = plan::strips_for(p, test.strips, test.facing);  // 2 along: configuration B
   p.identified = true;

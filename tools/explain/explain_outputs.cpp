@@ -248,7 +248,7 @@ void write_run_report(const dsp::Run& run, const Explanation& r, const std::file
   report::Page page;
   page.title = "What the simulation gets wrong";
   page.run_id = r.run_id;
-  page.program = run.meta.program.kind;
+  page.program = dsp::program_kind_name(run.meta.program.kind);
   page.context = {{"compared with", r.reference},
                   {"pipeline residual RMS, extended model",
                    report_fmt(r.nominal_residual_rms_um) + " -> " + report_fmt(r.final_residual_rms_um) + " um"},

@@ -114,7 +114,7 @@ std::string resonance_toml(const dsp::Run& run, const Params& p, std::vector<std
              drivers::toml_number(d.x()) + ", " + drivers::toml_number(d.y()) + ", " + drivers::toml_number(d.z()) +
              "]\n";
   }
-  if (run.meta.program.kind == "freeform" && run.meta.program.gcode.empty())
+  if (run.meta.program.kind == dsp::ProgramKind::freeform && run.meta.program.gcode.empty())
     notes.push_back(
         "machine.resonance: into the scenario; the run's program (a recorded set-point, no G-code) has no "
         "generator: add a [sweep] or a gcode_file to simulate it");

@@ -20,16 +20,16 @@ std::string mm(double v) {
 
 void test_travel(const TestProgram& p, std::optional<sim::gcode::AxisTravel> (&travel_mm)[2]) {
   travel_mm[0].reset(), travel_mm[1].reset();
-  if (p.kind == "circle") {
+  if (p.kind == dsp::ProgramKind::circle) {
     const sim::gcode::AxisTravel t{-p.radius_mm, p.radius_mm};
     if (p.plane == "xy" || p.plane == "zx") travel_mm[0] = t;
     if (p.plane == "xy" || p.plane == "yz") travel_mm[1] = t;
-  } else if (p.kind == "positioning" && !p.targets_mm.empty()) {
+  } else if (p.kind == dsp::ProgramKind::positioning && !p.targets_mm.empty()) {
     const auto [lo, hi] = std::minmax_element(p.targets_mm.begin(), p.targets_mm.end());
     travel_mm[0] = sim::gcode::AxisTravel{*lo, *hi};
-  } else if (p.kind == "step") {
+  } else if (p.kind == dsp::ProgramKind::step) {
     travel_mm[0] = sim::gcode::AxisTravel{std::min(p.from_mm, p.to_mm), std::max(p.from_mm, p.to_mm)};
-  } else if (p.kind == "rectangle") {
+  } else if (p.kind == dsp::ProgramKind::rectangle) {
     travel_mm[0] = sim::gcode::AxisTravel{0.0, p.size_mm[0]};
     travel_mm[1] = sim::gcode::AxisTravel{0.0, p.size_mm[1]};
   }
@@ -42,7 +42,7 @@ sim::gcode::IdentifyPlan identification_plan(const TestProgram& p) {
   plan.psd = p.psd.empty() ? strips_for(p) : p.psd;
   plan.axes = {"z"};
   test_travel(p, plan.travel_mm);
-  if (p.kind == "circle") {
+  if (p.kind == dsp::ProgramKind::circle) {
     // A circle crosses each strip where it is mounted, and a strip turned radial sits on the
     // circle's ends: the swing runs on beyond the circle just far enough to cross it whole
     // (a tenth of its length clear of each end).

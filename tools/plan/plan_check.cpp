@@ -19,19 +19,19 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 std::vector<TestProgram> check_programs(bool identified) {
   std::vector<TestProgram> out;
   TestProgram c;
-  c.kind = "circle", c.radius_mm = 10.0, c.feed_mm_min = 2500.0, c.repeats = 5;
+  c.kind = dsp::ProgramKind::circle, c.radius_mm = 10.0, c.feed_mm_min = 2500.0, c.repeats = 5;
   c.psd = strips_for(c);
   out.push_back(c);
   TestProgram s;
-  s.kind = "step", s.from_mm = 0.0, s.to_mm = 50.0, s.feed_mm_min = 6500.0, s.runs = 3;
+  s.kind = dsp::ProgramKind::step, s.from_mm = 0.0, s.to_mm = 50.0, s.feed_mm_min = 6500.0, s.runs = 3;
   s.psd = strips_for(s);
   out.push_back(s);
   TestProgram p;
-  p.kind = "positioning", p.targets_mm = {0.0, 10.0, 20.0, 30.0}, p.runs = 3, p.feed_mm_min = 3000.0;
+  p.kind = dsp::ProgramKind::positioning, p.targets_mm = {0.0, 10.0, 20.0, 30.0}, p.runs = 3, p.feed_mm_min = 3000.0;
   p.psd = strips_for(p);
   out.push_back(p);
   TestProgram r;
-  r.kind = "rectangle", r.size_mm[0] = 40.0, r.size_mm[1] = 30.0, r.feed_mm_min = 4000.0, r.repeats = 1;
+  r.kind = dsp::ProgramKind::rectangle, r.size_mm[0] = 40.0, r.size_mm[1] = 30.0, r.feed_mm_min = 4000.0, r.repeats = 1;
   r.psd = strips_for(r);
   out.push_back(r);
   for (auto& t : out) t.identified = identified;
@@ -42,8 +42,8 @@ std::vector<CheckRow> check_plan(const TestProgram& p, int repeats, int draws) {
   const Prediction pred = predict(p, 1, draws);
   const dsp::ResolutionLimit* lim = dsp::resolution_limit(p.kind);
   std::vector<std::string> keys{lim->limited};
-  if (p.kind == "circle") keys.emplace_back("circle.radius_mean_deviation_um");
-  if (p.kind == "positioning") keys.emplace_back("positioning.M_um");
+  if (p.kind == dsp::ProgramKind::circle) keys.emplace_back("circle.radius_mean_deviation_um");
+  if (p.kind == dsp::ProgramKind::positioning) keys.emplace_back("positioning.M_um");
   std::vector<std::vector<double>> errors(keys.size());
   int degraded = 0;
   for (int r = 0; r < repeats; ++r) {

@@ -56,7 +56,7 @@ dsp::Analysis analyze_prediction(const dsp::Run& run, const dsp::AnalysisOptions
 // The largest feed a variant may ask for: 20 m/min and 2 m/s² of centripetal acceleration.
 double feed_cap(const TestProgram& p) {
   double f = 20000.0;
-  if (p.kind == "circle") f = std::min(f, std::sqrt(2000.0 * p.radius_mm) * 60.0);
+  if (p.kind == dsp::ProgramKind::circle) f = std::min(f, std::sqrt(2000.0 * p.radius_mm) * 60.0);
   return f;
 }
 
@@ -64,14 +64,14 @@ double feed_cap(const TestProgram& p) {
 
 std::string describe(const TestProgram& p) {
   std::string s;
-  if (p.kind == "circle") {
+  if (p.kind == dsp::ProgramKind::circle) {
     s = "circle R" + g(p.radius_mm) + " F" + g(p.feed_mm_min) + " " + p.direction + " x" + std::to_string(p.repeats) +
         " in " + p.plane;
     if (p.arc_deg < 360.0) s += ", " + g(p.arc_deg) + " deg arc";
-  } else if (p.kind == "positioning") {
+  } else if (p.kind == dsp::ProgramKind::positioning) {
     s = "positioning x " + g(p.targets_mm.front()) + ".." + g(p.targets_mm.back()) + " mm, " +
         std::to_string(p.targets_mm.size()) + " targets, " + std::to_string(p.runs) + " runs, F" + g(p.feed_mm_min);
-  } else if (p.kind == "step") {
+  } else if (p.kind == dsp::ProgramKind::step) {
     s = "step x " + g(p.from_mm) + " -> " + g(p.to_mm) + " mm, " + std::to_string(p.runs) + " pairs, F" +
         g(p.feed_mm_min);
   } else {
@@ -79,7 +79,8 @@ std::string describe(const TestProgram& p) {
   }
   s += p.psd.empty() ? ", no PSD strips"
                      : ", " + std::to_string(p.psd.size()) + " PSD strip" + (p.psd.size() > 1 ? "s" : "");
-  if (p.kind == "circle" && sim::ring_facing(p.psd) == sim::StripFacing::across_path) s += " turned radial";
+  if (p.kind == dsp::ProgramKind::circle && sim::ring_facing(p.psd) == sim::StripFacing::across_path)
+    s += " turned radial";
   if (p.identified) s += ", sensors identified on site first (eical gen-nc identify, eical identify)";
   return s;
 }
@@ -88,7 +89,7 @@ std::vector<dsp::PsdSpec> strips_at_both_ends(const TestProgram& p) {
   // The ends of the x travel the test moves over: one place says where that is.
   std::optional<sim::gcode::AxisTravel> travel_mm[2];
   test_travel(p, travel_mm);
-  if ((p.kind != "step" && p.kind != "positioning") || !travel_mm[0]) return {};
+  if ((p.kind != dsp::ProgramKind::step && p.kind != dsp::ProgramKind::positioning) || !travel_mm[0]) return {};
   std::vector<dsp::PsdSpec> out(2);
   out[0].measures = out[1].measures = "x";
   out[0].center_mm[0] = travel_mm[0]->lo_mm, out[1].center_mm[0] = travel_mm[0]->hi_mm;
@@ -101,7 +102,7 @@ std::vector<dsp::PsdSpec> strips_identification_can_cross(const TestProgram& p) 
   std::vector<dsp::PsdSpec> out = p.psd;
   // A circle crosses each strip where it is: the identification reaches it there
   // (identification_plan runs the swing on beyond the circle where it must).
-  if (p.kind == "circle") return out;
+  if (p.kind == dsp::ProgramKind::circle) return out;
   for (auto& s : out) {
     const int along = dsp::axis_index(s.measures);
     if (along < 0 || along > 1 || !travel_mm[along]) continue;
@@ -118,14 +119,14 @@ std::vector<dsp::PsdSpec> strips_identification_can_cross(const TestProgram& p) 
 }
 
 std::vector<dsp::PsdSpec> strips_for(const TestProgram& p) {
-  if (p.kind == "circle") return sim::psd_config_b(p.radius_mm);
+  if (p.kind == dsp::ProgramKind::circle) return sim::psd_config_b(p.radius_mm);
   dsp::PsdSpec x;
   x.measures = "x";
-  if (p.kind == "step") {
+  if (p.kind == dsp::ProgramKind::step) {
     x.center_mm[0] = 0.5 * (p.from_mm + p.to_mm);
     return {x};
   }
-  if (p.kind == "positioning") {
+  if (p.kind == dsp::ProgramKind::positioning) {
     x.center_mm[0] = 0.5 * (p.targets_mm.front() + p.targets_mm.back());
     return {x};
   }
@@ -138,10 +139,11 @@ std::vector<dsp::PsdSpec> strips_for(const TestProgram& p) {
 
 std::vector<dsp::PsdSpec> strips_for(const TestProgram& p, int count, sim::StripFacing facing) {
   if (count == 0) return {};
-  if (p.kind == "circle") return sim::psd_ring(p.radius_mm, count, facing);
+  if (p.kind == dsp::ProgramKind::circle) return sim::psd_ring(p.radius_mm, count, facing);
   if (count == 2 && facing == sim::StripFacing::along_path) return strips_for(p);
-  throw dsp::InputError("plan: " + std::to_string(count) + " strips are a circle's layout; a " + p.kind +
-                        " test takes B (" + std::to_string(strips_for(p).size()) + ") or strips given one by one");
+  throw dsp::InputError("plan: " + std::to_string(count) + " strips are a circle's layout; a " +
+                        std::string(dsp::program_kind_name(p.kind)) + " test takes B (" +
+                        std::to_string(strips_for(p).size()) + ") or strips given one by one");
 }
 
 TestProgram program_of(const dsp::RunMeta& meta) {
@@ -153,7 +155,8 @@ TestProgram program_of(const dsp::RunMeta& meta) {
   p.repeats = std::max(1, q.repeats);
   if (!q.targets_mm.empty()) p.targets_mm = q.targets_mm;
   p.runs = std::max(1, q.runs);
-  if (q.kind == "step" && q.targets_mm.size() >= 2) p.from_mm = q.targets_mm[0], p.to_mm = q.targets_mm[1];
+  if (q.kind == dsp::ProgramKind::step && q.targets_mm.size() >= 2)
+    p.from_mm = q.targets_mm[0], p.to_mm = q.targets_mm[1];
   p.size_mm[0] = q.size_mm[0] > 0.0 ? q.size_mm[0] : 50.0, p.size_mm[1] = q.size_mm[1] > 0.0 ? q.size_mm[1] : 50.0;
   p.psd = meta.psd;
   p.noise_ug_per_rthz =
@@ -164,18 +167,19 @@ TestProgram program_of(const dsp::RunMeta& meta) {
 
 sim::Scenario scenario_of(const TestProgram& p, std::uint64_t seed) {
   sim::Scenario sc;
-  if (p.kind == "circle") {
+  if (p.kind == dsp::ProgramKind::circle) {
     sc = sim::circle_scenario(p.radius_mm, p.feed_mm_min, p.repeats, p.direction, seed);
     sc.meta.program.plane = p.plane;
     sc.meta.program.arc_deg = p.arc_deg;
-  } else if (p.kind == "step") {
+  } else if (p.kind == dsp::ProgramKind::step) {
     sc = sim::step_scenario(p.from_mm, p.to_mm, p.feed_mm_min, p.runs, seed);
-  } else if (p.kind == "positioning") {
+  } else if (p.kind == dsp::ProgramKind::positioning) {
     sc = sim::positioning_scenario(p.targets_mm, p.runs, p.feed_mm_min, seed);
-  } else if (p.kind == "rectangle") {
+  } else if (p.kind == dsp::ProgramKind::rectangle) {
     sc = sim::rectangle_scenario(p.size_mm[0], p.size_mm[1], p.feed_mm_min, p.plane, std::max(1, p.repeats), seed);
   } else {
-    throw dsp::InputError("plan: program kind '" + p.kind + "' (circle, positioning, step or rectangle)");
+    throw dsp::InputError("plan: program kind '" + std::string(dsp::program_kind_name(p.kind)) +
+                          "' (circle, positioning, step or rectangle)");
   }
   sc.meta.psd = p.psd;
   sc.meta.acquisition.fs_hz = p.fs_hz;
@@ -186,7 +190,8 @@ sim::Scenario scenario_of(const TestProgram& p, std::uint64_t seed) {
 
 sim::Scenario scenario_on_drawn_machine(const TestProgram& p, std::uint64_t seed) {
   sim::Scenario sc = scenario_of(p, seed);
-  const sim::Scenario bg = sim::hidden_effect_scenario({}, p.kind == "circle" ? "circle" : "step", seed);
+  const sim::Scenario bg = sim::hidden_effect_scenario(
+      {}, p.kind == dsp::ProgramKind::circle ? dsp::ProgramKind::circle : dsp::ProgramKind::step, seed);
   sc.meta.site = bg.meta.site;
   sc.meta.machine = bg.meta.machine;
   for (int s = 0; s < 2; ++s) {
@@ -306,7 +311,7 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
     s.psd = strips_for(s);
     v.push_back(s);
   }
-  if ((p.kind == "positioning" || p.kind == "step") && s.psd.size() < 2) {
+  if ((p.kind == dsp::ProgramKind::positioning || p.kind == dsp::ProgramKind::step) && s.psd.size() < 2) {
     // A strip at each end of the travel: the position is held at both ends of every run,
     // where a single strip at mid travel leaves the ends to the integration.
     TestProgram ends = s;
@@ -319,7 +324,7 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
     t.feed_mm_min = std::min(cap, s.feed_mm_min * f);
     if (t.feed_mm_min > s.feed_mm_min * 1.2) v.push_back(t);
   }
-  if (p.kind == "circle") {
+  if (p.kind == dsp::ProgramKind::circle) {
     // More strips about the same circle: each crossing fixes the position once more a
     // revolution, so the integration's error grows over a shorter arc. Four stay along the
     // path (the spot runs along each for millimetres); sixteen are turned radial, each a
@@ -332,7 +337,7 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
       v.push_back(t);
     }
   }
-  if (p.kind == "circle") {
+  if (p.kind == dsp::ProgramKind::circle) {
     for (double r : {p.radius_mm / 3.0, 10.0}) {
       TestProgram t = s;
       t.radius_mm = std::max(10.0, std::round(r));
@@ -342,15 +347,15 @@ std::vector<TestProgram> geometric_variants(const TestProgram& p) {
       t.psd = strips_for(t);
       v.push_back(t);
     }
-  } else if (p.kind == "step" || p.kind == "positioning") {
+  } else if (p.kind == dsp::ProgramKind::step || p.kind == dsp::ProgramKind::positioning) {
     TestProgram t = s;
-    if (p.kind == "step")
+    if (p.kind == dsp::ProgramKind::step)
       t.to_mm = t.from_mm + 0.5 * (t.to_mm - t.from_mm);
     else
       for (auto& x : t.targets_mm) x = t.targets_mm.front() + 0.5 * (x - t.targets_mm.front());
     t.psd = strips_for(t);
     v.push_back(t);
-  } else if (p.kind == "rectangle") {
+  } else if (p.kind == dsp::ProgramKind::rectangle) {
     TestProgram t = s;
     t.size_mm[0] *= 0.5, t.size_mm[1] *= 0.5;
     t.psd = strips_for(t);
@@ -371,11 +376,11 @@ namespace {
 
 double rough_duration_s(const TestProgram& t) {
   double path_mm = 0.0;
-  if (t.kind == "circle")
+  if (t.kind == dsp::ProgramKind::circle)
     path_mm = 2.0 * 3.14159265358979 * t.radius_mm * t.arc_deg / 360.0 * t.repeats * (t.direction == "both" ? 2 : 1);
-  else if (t.kind == "step")
+  else if (t.kind == dsp::ProgramKind::step)
     path_mm = 2.0 * std::abs(t.to_mm - t.from_mm) * t.runs;
-  else if (t.kind == "positioning")
+  else if (t.kind == dsp::ProgramKind::positioning)
     path_mm = 2.0 * std::abs(t.targets_mm.back() - t.targets_mm.front()) * t.runs;
   else
     path_mm = 2.0 * (t.size_mm[0] + t.size_mm[1]) * std::max(1, t.repeats);

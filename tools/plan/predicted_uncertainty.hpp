@@ -24,7 +24,7 @@
 namespace eical::tools::plan {
 
 struct TestProgram {
-  std::string kind = "circle";  // circle | positioning | step | rectangle
+  dsp::ProgramKind kind = dsp::ProgramKind::circle;
   std::string plane = "xy", direction = "ccw";
   double radius_mm = 10.0, feed_mm_min = 2500.0, arc_deg = 360.0;
   int repeats = 5;                                              // circle revolutions, rectangle laps

@@ -24,15 +24,15 @@ std::string axis_upper(const std::string& a) {
 // The nominal path the program's head follows relative to the table, in its plane.
 std::vector<Point> nominal_path(const TestProgram& p) {
   std::vector<Point> path;
-  if (p.kind == "circle") {
+  if (p.kind == dsp::ProgramKind::circle) {
     const int n = 180;
     for (int i = 0; i <= n; ++i) {
       const double a = 2.0 * std::numbers::pi * i / n;
       path.push_back({p.radius_mm * std::cos(a), p.radius_mm * std::sin(a)});
     }
-  } else if (p.kind == "rectangle") {
+  } else if (p.kind == dsp::ProgramKind::rectangle) {
     path = {{0, 0}, {p.size_mm[0], 0}, {p.size_mm[0], p.size_mm[1]}, {0, p.size_mm[1]}, {0, 0}};
-  } else if (p.kind == "step") {
+  } else if (p.kind == dsp::ProgramKind::step) {
     path = {{p.from_mm, 0}, {p.to_mm, 0}};
   } else if (!p.targets_mm.empty()) {
     path = {{p.targets_mm.front(), 0}, {p.targets_mm.back(), 0}};
@@ -131,7 +131,7 @@ std::string layout_svg(const TestProgram& p) {
   std::snprintf(b, sizeof b,
                 "<text x=\"8\" y=\"%.0f\">%s: the path (grey) and the PSD strips (red), program coordinates, "
                 "plane %s</text>\n</svg>\n",
-                h - 12.0, p.kind.c_str(), p.plane.c_str());
+                h - 12.0, dsp::program_kind_name(p.kind), p.plane.c_str());
   return o + b;
 }
 

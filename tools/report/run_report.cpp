@@ -77,32 +77,34 @@ namespace {
 // One line naming the program the way a calibration engineer would.
 std::string program_line(const dsp::Program& p) {
   const auto [na, nb] = plane_axis_names(p.plane);
-  if (p.kind == "circle") {
+  if (p.kind == dsp::ProgramKind::circle) {
     std::string s = "circular test R " + fmt("%g", p.radius_mm) + " mm, F " + fmt("%g", p.feed_mm_min) + " mm/min, " +
                     na + nb + " plane, ";
     s += p.direction == "both" ? "both directions" : p.direction == "cw" ? "clockwise" : "counter-clockwise";
     if (p.arc_deg < 360.0) s += ", " + fmt("%g", p.arc_deg) + "° partial arc";
     return s;
   }
-  if (p.kind == "positioning" || p.kind == "step") {
-    std::string s = (p.kind == "step" ? "step response, axis " : "ISO 230-2 positioning, axis ") + p.axis + ", targets";
+  if (p.kind == dsp::ProgramKind::positioning || p.kind == dsp::ProgramKind::step) {
+    std::string s = (p.kind == dsp::ProgramKind::step ? "step response, axis " : "ISO 230-2 positioning, axis ") +
+                    p.axis + ", targets";
     for (std::size_t i = 0; i < p.targets_mm.size() && i < 12; ++i) s += (i ? ", " : " ") + fmt("%g", p.targets_mm[i]);
     if (p.targets_mm.size() > 12) s += ", …";
     return s + " mm, " + std::to_string(p.runs) + " runs, F " + fmt("%g", p.feed_mm_min) + " mm/min";
   }
-  if (p.kind == "rectangle")
+  if (p.kind == dsp::ProgramKind::rectangle)
     return "rectangle " + fmt("%g", p.size_mm[0]) + " × " + fmt("%g", p.size_mm[1]) + " mm in " + na + nb + ", F " +
            fmt("%g", p.feed_mm_min) + " mm/min";
-  if (p.kind == "freeform") return "free-form path (G-code of the run), F " + fmt("%g", p.feed_mm_min) + " mm/min";
-  return p.kind + " program";
+  if (p.kind == dsp::ProgramKind::freeform)
+    return "free-form path (G-code of the run), F " + fmt("%g", p.feed_mm_min) + " mm/min";
+  return dsp::program_kind_name(p.kind) + std::string(" program");
 }
 
-std::string title_for(const std::string& kind) {
-  if (kind == "circle") return "Circular test report";
-  if (kind == "positioning") return "Positioning test report";
-  if (kind == "step") return "Step response report";
-  if (kind == "rectangle") return "Rectangle test report";
-  if (kind == "freeform") return "Free-form contour report";
+std::string title_for(dsp::ProgramKind kind) {
+  if (kind == dsp::ProgramKind::circle) return "Circular test report";
+  if (kind == dsp::ProgramKind::positioning) return "Positioning test report";
+  if (kind == dsp::ProgramKind::step) return "Step response report";
+  if (kind == dsp::ProgramKind::rectangle) return "Rectangle test report";
+  if (kind == dsp::ProgramKind::freeform) return "Free-form contour report";
   return "Measurement report";
 }
 
@@ -299,8 +301,8 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, co
   circle_sections(run, analysis, page, csv);
   positioning_sections(run, analysis, page, csv);
   step_sections(analysis, page, csv);
-  if (p.kind == "rectangle") rectangle_sections(run, analysis, page, csv);
-  if (p.kind == "freeform") freeform_sections(run, analysis, page, csv);
+  if (p.kind == dsp::ProgramKind::rectangle) rectangle_sections(run, analysis, page, csv);
+  if (p.kind == dsp::ProgramKind::freeform) freeform_sections(run, analysis, page, csv);
   measurement_section(analysis, page, csv);
   page.files = csv.names();
   if (csv.thinned())

@@ -44,29 +44,29 @@ CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
   };
   if (program == "circle" || program == "step") {
     c.background = true;
-    p.kind = program;
+    p.kind = program == "circle" ? dsp::ProgramKind::circle : dsp::ProgramKind::step;
   } else if (program == "circle-identified") {  // ballbar class: R10–R50, both directions
-    p.kind = "circle", p.direction = "both", p.repeats = 3, p.identified = true;
+    p.kind = dsp::ProgramKind::circle, p.direction = "both", p.repeats = 3, p.identified = true;
     p.radius_mm = pick({10.0, 25.0, 50.0}), p.feed_mm_min = pick({1000.0, 2500.0, 4000.0});
   } else if (program == "circle-strips") {  // 4–16 strips along the path or radial, R25–R100, identified
-    p.kind = "circle", p.direction = "both", p.repeats = 2, p.identified = true;
+    p.kind = dsp::ProgramKind::circle, p.direction = "both", p.repeats = 2, p.identified = true;
     p.radius_mm = pick({25.0, 50.0, 100.0}), p.feed_mm_min = pick({2500.0, 4000.0, 10000.0});
     const plan::PsdLayout layout = plan::psd_layout(pick_name({"B4", "B8", "B16", "R8", "R16"}));
     c.strips = layout.strips, c.facing = layout.facing;
   } else if (program == "circle-large") {  // beyond the instrument without more strips
-    p.kind = "circle", p.repeats = 1, p.radius_mm = pick({50.0, 100.0, 150.0});
+    p.kind = dsp::ProgramKind::circle, p.repeats = 1, p.radius_mm = pick({50.0, 100.0, 150.0});
     p.feed_mm_min = pick({4000.0, 10000.0});
   } else if (program == "positioning") {
-    p.kind = program, p.runs = 3, p.feed_mm_min = 3000.0;
+    p.kind = dsp::ProgramKind::positioning, p.runs = 3, p.feed_mm_min = 3000.0;
     p.targets_mm = {0.0, 10.0, 20.0, 30.0};
   } else if (program == "positioning-long" || program == "positioning-ends") {  // 100–300 mm, 5 runs (ISO 230-2)
-    p.kind = "positioning", p.runs = 5, p.feed_mm_min = 4000.0;
+    p.kind = dsp::ProgramKind::positioning, p.runs = 5, p.feed_mm_min = 4000.0;
     c.at_both_ends = program == "positioning-ends";
     const double travel = pick({100.0, 200.0, 300.0});
     p.targets_mm.clear();
     for (int k = 0; k <= 5; ++k) p.targets_mm.push_back(travel * k / 5.0);
   } else if (program == "rectangle") {
-    p.kind = "rectangle", p.size_mm[0] = 40.0, p.size_mm[1] = 30.0, p.feed_mm_min = 4000.0;
+    p.kind = dsp::ProgramKind::rectangle, p.size_mm[0] = 40.0, p.size_mm[1] = 30.0, p.feed_mm_min = 4000.0;
   } else {
     throw dsp::InputError("coverage campaign: unknown program '" + program +
                           "' (circle, circle-identified, circle-strips, circle-large, step, positioning, "

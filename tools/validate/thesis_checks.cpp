@@ -43,7 +43,8 @@ double peak_dynamic_error_um(const Scenario& sc, std::initializer_list<int> axes
 
 // A machine at rest for `duration_s` (G4 only), no reference.
 Scenario rest_scenario(double duration_s, std::uint64_t seed) {
-  Scenario sc = gcode_scenario("G90 G21 G17\nG4 P" + std::to_string(duration_s) + "\n", "freeform", seed);
+  Scenario sc =
+      gcode_scenario("G90 G21 G17\nG4 P" + std::to_string(duration_s) + "\n", dsp::ProgramKind::freeform, seed);
   sc.meta.reference.reset();
   sc.oversample = 1;  // at rest the DAQ filter sees constants; the noise is added at fs
   return sc;
@@ -157,7 +158,8 @@ ThesisCheck quantisation(const ValidationOptions& o) {
 
 ThesisCheck coriolis_acceleration(double& position_um) {
   // 10 m/min due north (+X at heading 0) at 50° latitude: a_c = 2 Ω v sin φ on Y.
-  Scenario sc = gcode_scenario("G90 G21 G17 G61\nG0 X0 Y0\nG4 P0.5\nG1 X250 F10000\nG4 P0.5\n", "freeform", 1);
+  Scenario sc =
+      gcode_scenario("G90 G21 G17 G61\nG0 X0 Y0\nG4 P0.5\nG1 X250 F10000\nG4 P0.5\n", dsp::ProgramKind::freeform, 1);
   sc.meta.site.latitude_deg = 50.0;
   sc.meta.site.heading_deg = 0.0;
   sc.meta.reference.reset();
