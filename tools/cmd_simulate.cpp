@@ -85,6 +85,15 @@ std::vector<dsp::PsdSpec> identify_strips(const SimulateOptions& o) {
   return layout.strips == 0 ? sim::psd_config_b(o.radius_mm) : sim::psd_ring(o.radius_mm, layout.strips, layout.facing);
 }
 
+// What --program takes: every program kind, and Klipper's resonance sweep (a scenario, not a
+// program a run carries).
+std::vector<std::string> simulate_programs() {
+  std::vector<std::string> names;
+  for (const auto& [kind, name] : dsp::kProgramKindNames) names.emplace_back(name);
+  names.emplace_back("sweep");
+  return names;
+}
+
 sim::Scenario base_scenario(const SimulateOptions& o, bool program_given) {
   if (!o.regime.empty()) {
     if (!o.scenario.empty() || program_given)
@@ -178,7 +187,7 @@ void add_program_options(CLI::App& cmd, SimulateOptions& o) {
          "--program", o.program,
          "circle, step, positioning, rectangle, freeform, identify or sweep (Klipper's resonance test, no standstill)")
       ->default_val("circle")
-      ->check(CLI::IsMember({"circle", "step", "positioning", "rectangle", "freeform", "identify", "sweep"}))
+      ->check(CLI::IsMember(simulate_programs()))
       ->excludes(scenario);
   cmd.add_option("--psd", o.psd,
                  "PSD strips about a circle of --radius: B (configuration B of the sample runs: 2 strips), B4, B8, B16 "

@@ -206,8 +206,9 @@ CampaignResult run_campaign(const CampaignOptions& options) {
           add(c, err, u->second[e], bound);
           if (!headline) continue;
           add(r.headline, err, u->second[e], bound);
-          FigureCoverage& d = r.headline_by_design[program + " " + f.key];
-          d.key = program + " " + f.key;
+          const std::string design_key = program + " " + f.key;
+          FigureCoverage& d = r.headline_by_design[design_key];
+          d.key = design_key;
           add(d, err, u->second[e], bound);
           if (std::abs(err) > u->second[e])
             r.misses.push_back(miss_line(sc.meta.id, f, e, tf->values[e], u->second[e], a));
