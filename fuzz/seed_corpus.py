@@ -126,6 +126,25 @@ put("klipper_capture", "current", "#time,accel_x,accel_y,accel_z\n" + "".join(
 put("klipper_capture", "legacy-stats", "##<stats>\n#time,accel_x,accel_y,accel_z\n" + "".join(
     f"{5.0 + k / 1600:.6f},{k:.6f},0.000000,{-k:.6f}\n" for k in range(10)))
 put("klipper_capture", "broken-header", "time,x,y,z\n0,0,0,0\n")
+
+
+def zstd_raw_frames(data, block=200):
+    """zstd frames holding `data` as raw (stored) blocks, RFC 8878 3.1.1: no zstd module needed."""
+    out = b""
+    for i in range(0, max(len(data), 1), 255):
+        part = data[i:i + 255]
+        out += b"\x28\xb5\x2f\xfd\x20" + bytes([len(part)])
+        out += struct.pack("<I", 1 | (len(part) << 3))[:3] + part
+    return out
+
+
+put("shaketune_stdata", "one-measurement", zstd_raw_frames(
+    b'{"name": "axis_x_20261207", "samples": [' +
+    b", ".join(b"[%.6f, %.3f, %.3f, %.3f]" % (100 + i / 400, 10 * i, -5.0, 9806.65) for i in range(12)) + b"]}\n"))
+put("shaketune_stdata", "two-belts", zstd_raw_frames(
+    b'{"name": "belt_a", "samples": [[1.0, 1, 2, 9806], [1.0025, 3, 4, 9807]]}\n'
+    b'{"name": "belt_b", "samples": [[9.0, 1, 2, 9806], [9.0025, 3, 4, 9807], [9.005, 0, 0, 9806]]}\n'))
+put("shaketune_stdata", "pickled", zstd_raw_frames(b"\x80\x04\x95\x10\x00\x00\x00]\x94}\x94."))
 put("accel_csv", "by-position", b"\x00" + b"t,ax,ay,az\n" + "".join(
     f"{k * 0.0005:.9f},{k % 3},0.1,-9.8\n" for k in range(30)).encode())
 put("accel_csv", "by-name-g-ms", b"\x0b" + b"ax,t,az,ay,ext_extra\n" + "".join(

@@ -4,7 +4,7 @@
 set -euo pipefail
 # libsqlite3-dev, libpq-dev: the calibration history (SQLite on the control PC, PostgreSQL client).
 build_pkgs=(g++ cmake ninja-build pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev
-  nlohmann-json3-dev zlib1g-dev libsystemd-dev libusb-1.0-0-dev libgpiod-dev
+  nlohmann-json3-dev zlib1g-dev libzstd-dev libsystemd-dev libusb-1.0-0-dev libgpiod-dev
   cyclonedds-dev cyclonedds-tools libgtest-dev libbenchmark-dev libboost-dev dpkg-dev
   libsqlite3-dev libpq-dev)
 # chromium + fonts: the report screenshot test; linuxcnc-uspace: the end-to-end test with a

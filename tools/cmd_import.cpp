@@ -1,4 +1,4 @@
-// eical import klipper|csv: recordings made by other systems into eical-run/1
+// eical import klipper|shaketune|csv: recordings made by other systems into eical-run/1
 // (drivers/import; run-format.md "Runs measured by other systems").
 #include "drivers/import/csv_import.hpp"
 #include "drivers/import/klipper_import.hpp"
@@ -111,50 +111,77 @@ void finish(const Common& c, const drivers::ImportResult& r) {
   std::printf("import.toml records the clock, the resampling and the offset\n");
 }
 
+// Klipper's resonance test as it ran: what both Klipper's capture and Shake&Tune's file need.
+struct KlipperOpt {
+  Common c;
+  std::string axis = "x";
+  bool legacy = false;
+  double freq_start = 0.0, freq_end = 0.0, accel_per_hz = 0.0, hz_per_sec = 0.0, sweeping_accel = -1.0,
+         sweeping_period = -1.0, max_accel = 0.0;
+  std::vector<double> start{0.0, 0.0, 0.0};
+};
+
+void add_klipper_test_options(CLI::App* cmd, KlipperOpt& o) {
+  cmd->add_option("--axis", o.axis, "the test's AXIS: x, y or dx,dy (as TEST_RESONANCES)")->default_val("x");
+  cmd->add_flag("--klipper-legacy", o.legacy,
+                "older Klipper: max_freq 133.33 Hz, accel_per_hz 75, no sweeping, moves out and back");
+  cmd->add_option("--freq-start", o.freq_start, "FREQ_START, Hz (default 5)");
+  cmd->add_option("--freq-end", o.freq_end, "FREQ_END, Hz (default 200; legacy 133.33)");
+  cmd->add_option("--accel-per-hz", o.accel_per_hz, "accel_per_hz, mm/s2 per Hz (default 60; legacy 75)");
+  cmd->add_option("--hz-per-sec", o.hz_per_sec, "hz_per_sec (default 1)");
+  cmd->add_option("--sweeping-accel", o.sweeping_accel, "sweeping_accel, mm/s2 (default 400; legacy none)");
+  cmd->add_option("--sweeping-period", o.sweeping_period, "sweeping_period, s (default 1.2; 0: no sweeping)");
+  cmd->add_option("--max-accel", o.max_accel, "the printer's max_accel, mm/s2: the stop after a sweep (default 5000)");
+  cmd->add_option("--start", o.start, "where the test starts, mm (Klipper's probe point)")->expected(3)->delimiter(',');
+  add_common(cmd, o.c);
+}
+
+drivers::KlipperImport klipper_import_of(const KlipperOpt& o) {
+  drivers::KlipperImport k;
+  k.test = o.legacy ? sim::nc::KlipperTest::legacy() : sim::nc::KlipperTest::current();
+  if (o.freq_start > 0.0) k.test.freq_start_hz = o.freq_start;
+  if (o.freq_end > 0.0) k.test.freq_end_hz = o.freq_end;
+  if (o.accel_per_hz > 0.0) k.test.accel_per_hz = o.accel_per_hz;
+  if (o.hz_per_sec > 0.0) k.test.hz_per_sec = o.hz_per_sec;
+  if (o.sweeping_accel >= 0.0) k.test.sweeping_accel_mm_s2 = o.sweeping_accel;
+  if (o.sweeping_period >= 0.0) k.test.sweeping_period_s = o.sweeping_period;
+  if (o.max_accel > 0.0) k.test.stop_accel_mm_s2 = o.max_accel;
+  k.direction = sim::nc::test_direction(o.axis, "--axis");
+  k.start_mm = Eigen::Vector3d(o.start[0], o.start[1], o.start[2]);
+  k.setup = setup_of(o.c);
+  return k;
+}
+
 void register_klipper(CLI::App* import) {
-  struct KlipperOpt {
-    Common c;
-    std::string capture, axis = "x";
-    bool legacy = false;
-    double freq_start = 0.0, freq_end = 0.0, accel_per_hz = 0.0, hz_per_sec = 0.0, sweeping_accel = -1.0,
-           sweeping_period = -1.0, max_accel = 0.0;
-    std::vector<double> start{0.0, 0.0, 0.0};
+  struct CaptureOpt {
+    KlipperOpt k;
+    std::string capture;
   };
-  auto o = std::make_shared<KlipperOpt>();
+  auto o = std::make_shared<CaptureOpt>();
   auto* cmd = import->add_subcommand(
       "klipper",
       "A Klipper raw accelerometer capture (#time,accel_x,accel_y,accel_z; print time, mm/s2) of TEST_RESONANCES; "
       "the set-point from Klipper's resonance_tester.py, its start found by cross-correlation");
   cmd->add_option("capture", o->capture, "the capture (raw_data_*.csv)")->required();
-  cmd->add_option("--axis", o->axis, "the test's AXIS: x, y or dx,dy (as TEST_RESONANCES)")->default_val("x");
-  cmd->add_flag("--klipper-legacy", o->legacy,
-                "older Klipper: max_freq 133.33 Hz, accel_per_hz 75, no sweeping, moves out and back");
-  cmd->add_option("--freq-start", o->freq_start, "FREQ_START, Hz (default 5)");
-  cmd->add_option("--freq-end", o->freq_end, "FREQ_END, Hz (default 200; legacy 133.33)");
-  cmd->add_option("--accel-per-hz", o->accel_per_hz, "accel_per_hz, mm/s2 per Hz (default 60; legacy 75)");
-  cmd->add_option("--hz-per-sec", o->hz_per_sec, "hz_per_sec (default 1)");
-  cmd->add_option("--sweeping-accel", o->sweeping_accel, "sweeping_accel, mm/s2 (default 400; legacy none)");
-  cmd->add_option("--sweeping-period", o->sweeping_period, "sweeping_period, s (default 1.2; 0: no sweeping)");
-  cmd->add_option("--max-accel", o->max_accel, "the printer's max_accel, mm/s2: the stop after a sweep (default 5000)");
-  cmd->add_option("--start", o->start, "where the test starts, mm (Klipper's probe point)")
-      ->expected(3)
-      ->delimiter(',');
-  add_common(cmd, o->c);
-  cmd->callback([o] {
-    drivers::KlipperImport k;
-    k.test = o->legacy ? sim::nc::KlipperTest::legacy() : sim::nc::KlipperTest::current();
-    if (o->freq_start > 0.0) k.test.freq_start_hz = o->freq_start;
-    if (o->freq_end > 0.0) k.test.freq_end_hz = o->freq_end;
-    if (o->accel_per_hz > 0.0) k.test.accel_per_hz = o->accel_per_hz;
-    if (o->hz_per_sec > 0.0) k.test.hz_per_sec = o->hz_per_sec;
-    if (o->sweeping_accel >= 0.0) k.test.sweeping_accel_mm_s2 = o->sweeping_accel;
-    if (o->sweeping_period >= 0.0) k.test.sweeping_period_s = o->sweeping_period;
-    if (o->max_accel > 0.0) k.test.stop_accel_mm_s2 = o->max_accel;
-    k.direction = sim::nc::test_direction(o->axis, "--axis");
-    k.start_mm = Eigen::Vector3d(o->start[0], o->start[1], o->start[2]);
-    k.setup = setup_of(o->c);
-    finish(o->c, drivers::import_klipper(o->capture, k));
-  });
+  add_klipper_test_options(cmd, o->k);
+  cmd->callback([o] { finish(o->k.c, drivers::import_klipper(o->capture, klipper_import_of(o->k))); });
+}
+
+void register_shaketune(CLI::App* import) {
+  struct StdataOpt {
+    KlipperOpt k;
+    std::string file, measurement;
+  };
+  auto o = std::make_shared<StdataOpt>();
+  auto* cmd = import->add_subcommand(
+      "shaketune",
+      "A measurement of Shake&Tune's .stdata file (K-ShakeTune: zstd JSON lines of Klipper's samples); the "
+      "set-point from Klipper's generator the plugin drives, as for import klipper (its raw CSVs: import klipper)");
+  cmd->add_option("file", o->file, "the .stdata file")->required();
+  cmd->add_option("--measurement", o->measurement,
+                  "the measurement's name (the file's only one when left out; a belt or axes test holds two)");
+  add_klipper_test_options(cmd, o->k);
+  cmd->callback([o] { finish(o->k.c, drivers::import_shaketune(o->file, o->measurement, klipper_import_of(o->k))); });
 }
 
 // "a,b,c" → three names.
@@ -237,6 +264,7 @@ void register_import(CLI::App& app) {
       "Recordings made by other systems into eical-run/1 (one sensor, set-point reconstructed, time offset estimated)");
   cmd->require_subcommand(1);
   register_klipper(cmd);
+  register_shaketune(cmd);
   register_csv(cmd);
 }
 

@@ -273,7 +273,8 @@ void add_sweep_options(CLI::App& cmd, SimulateOptions& o) {
 void add_export_options(CLI::App& cmd, SimulateOptions& o) {
   cmd.add_option("--export", o.export_to,
                  "also write the run as another system records it, with jittered stamps: 'klipper FILE' (a raw "
-                 "accelerometer capture) or 'csv PREFIX' (PREFIX-accel.csv and an NC trace); truth.toml [export]")
+                 "accelerometer capture), 'shaketune FILE' (Shake&Tune's .stdata) or 'csv PREFIX' (PREFIX-accel.csv "
+                 "and an NC trace); truth.toml [export]")
       ->expected(2);
   cmd.add_option("--export-nc", o.export_nc,
                  "csv export: NC trace as halsampler (PREFIX-nc.txt) or csv (PREFIX-nc.csv)")

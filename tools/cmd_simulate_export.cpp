@@ -1,6 +1,7 @@
 #include "tools/cmd_simulate_export.hpp"
 
 #include "drivers/import/capture_export.hpp"
+#include "drivers/import/shaketune_file.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
 #include "sim/simulate.hpp"
@@ -24,8 +25,8 @@ std::size_t gaps_of(const sim::CaptureSamples& s) {
 
 std::string simulate_with_export(const sim::Scenario& scenario, const ExportRequest& request, const std::string& out,
                                  bool gzip, bool overwrite) {
-  if (request.kind != "klipper" && request.kind != "csv")
-    throw dsp::InputError("simulate --export: '" + request.kind + "' is not klipper or csv");
+  if (request.kind != "klipper" && request.kind != "shaketune" && request.kind != "csv")
+    throw dsp::InputError("simulate --export: '" + request.kind + "' is not klipper, shaketune or csv");
   const auto set_point = sim::scenario_set_point(scenario);
   sim::check_budget(scenario, *set_point);  // before the capture's per-frame buffers
   const double fs = scenario.meta.acquisition.fs_hz;
@@ -43,8 +44,12 @@ std::string simulate_with_export(const sim::Scenario& scenario, const ExportRequ
   truth += "format = \"" + request.kind + "\"\nsensor = \"" + std::string(part ? "head" : "table") + "\"\n";
   const drivers::StampedAccel capture =
       drivers::exported_capture(run, jittered, samples, request.clock, part, request.target);
-  if (request.kind == "klipper") {
-    drivers::write_klipper_capture(request.target, capture);
+  const bool klipper_samples = request.kind == "klipper" || request.kind == "shaketune";
+  if (klipper_samples) {
+    if (request.kind == "klipper")
+      drivers::write_klipper_capture(request.target, capture);
+    else  // one measurement, named as Shake&Tune names its axis tests
+      drivers::write_shaketune_stdata(request.target, {{"axis_" + run.meta.id, capture}});
     files = request.target;
     truth += "file = \"" + request.target + "\"\noffset_s = " + num(request.clock.offset_s) + "\n";
   } else {
@@ -70,7 +75,7 @@ std::string simulate_with_export(const sim::Scenario& scenario, const ExportRequ
   char line[512];
   std::snprintf(line, sizeof line, "exported %s: %zu samples (%zu lost in %zu gaps), jitter %.1f us rms, offset %.6f s",
                 files.c_str(), capture.t_s.size(), samples.lost, gaps_of(samples), samples.jitter_rms_s * 1e6,
-                request.kind == "klipper" ? request.clock.offset_s : request.clock.offset_s - request.nc_offset_s);
+                klipper_samples ? request.clock.offset_s : request.clock.offset_s - request.nc_offset_s);
   return line;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// `eical simulate --export klipper FILE | csv PREFIX`: the simulated run as another system
+// `eical simulate --export klipper FILE | shaketune FILE | csv PREFIX`: the simulated run as another system
 // would have recorded it, with jittered stamps and lost batches (drivers/import
 // capture_export), and the export's truth appended to the run's truth.toml ([export]).
 #include "sim/regimes/capture_clock.hpp"
@@ -11,8 +11,8 @@
 namespace eical::tools {
 
 struct ExportRequest {
-  std::string kind;                      // "klipper" | "csv"
-  std::string target;                    // klipper: the capture file; csv: PREFIX-accel.csv, PREFIX-nc.{ngc.txt|csv}
+  std::string kind;                      // "klipper" | "shaketune" | "csv"
+  std::string target;                    // klipper, shaketune: the file; csv: PREFIX-accel.csv, PREFIX-nc.{ngc.txt|csv}
   std::string nc_format = "halsampler";  // csv: "halsampler" | "csv"
   double servo_period_s = 0.001;
   double nc_offset_s = 1234.5678;  // NC clock at the run's t = 0

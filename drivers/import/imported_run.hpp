@@ -51,7 +51,7 @@ dsp::Run imported_run(const UniformClock& clock, const UniformSeries& accel_g, c
 
 // What import.toml records.
 struct ImportReport {
-  std::string kind;  // "klipper" | "csv"
+  std::string kind;  // "klipper" | "shaketune" | "csv"
   std::string source, nc_source;
   std::string excitation;  // how the set-point was made
   UniformClock accel_clock;

@@ -1,6 +1,7 @@
 #include "drivers/import/klipper_import.hpp"
 
 #include "drivers/import/capture_files.hpp"
+#include "drivers/import/shaketune_file.hpp"
 #include "dsp/core/error.hpp"
 
 #include <algorithm>
@@ -50,7 +51,18 @@ void require_test_inside_capture(const UniformClock& clock, const OffsetEstimate
 }  // namespace
 
 ImportResult import_klipper(const std::filesystem::path& file, const KlipperImport& options) {
-  const StampedAccel capture = read_klipper_capture(file);
+  return import_klipper_capture(read_klipper_capture(file), options);
+}
+
+ImportResult import_shaketune(const std::filesystem::path& file, const std::string& measurement,
+                              const KlipperImport& options) {
+  const auto measurements = read_shaketune_stdata(file);
+  ImportResult r = import_klipper_capture(pick_measurement(measurements, measurement, file.string()).capture, options);
+  r.report.kind = "shaketune";
+  return r;
+}
+
+ImportResult import_klipper_capture(const StampedAccel& capture, const KlipperImport& options) {
   const UniformClock clock = fit_uniform_clock(capture.t_s, capture.source);
   UniformSeries accel = resample(capture.t_s, capture.accel_mps2, clock);
   // In g of the site, as run.toml's [site] says, times what the recorder's constants were off by.

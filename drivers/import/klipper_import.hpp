@@ -5,10 +5,12 @@
 // acceleration with the measured one (drivers/import/time_offset) and reported. Before the
 // test and after it the head rests where the test starts and ends (Klipper dwells before
 // the test and stops the capture once the moves are done).
+#include "drivers/import/capture_files.hpp"
 #include "drivers/import/imported_run.hpp"
 #include "sim/nc/klipper_excitation.hpp"
 
 #include <filesystem>
+#include <string>
 
 namespace eical::drivers {
 
@@ -25,5 +27,14 @@ struct ImportResult {
 };
 
 ImportResult import_klipper(const std::filesystem::path& file, const KlipperImport& options);
+
+// A measurement of Shake&Tune's .stdata (drivers/import/shaketune_file): the same samples a
+// raw_data CSV holds, from the same excitation (the plugin drives Klipper's own generator).
+// `measurement` empty: the file's only one.
+ImportResult import_shaketune(const std::filesystem::path& file, const std::string& measurement,
+                              const KlipperImport& options);
+
+// What both do once the samples are read.
+ImportResult import_klipper_capture(const StampedAccel& capture, const KlipperImport& options);
 
 }  // namespace eical::drivers

@@ -6,6 +6,7 @@
 #include "drivers/import/capture_export.hpp"
 #include "drivers/import/csv_import.hpp"
 #include "drivers/import/klipper_import.hpp"
+#include "drivers/import/shaketune_file.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/core/error.hpp"
@@ -273,6 +274,56 @@ TEST(ImportRoundTrip, BeltTestAlongADiagonal) {
   EXPECT_GT(off.explained, 0.8);
   // The gain splits the one direction over x and y by the minimum norm: equal and opposite.
   EXPECT_NEAR(off.gain(0, 0), -off.gain(0, 1), 0.05 * std::abs(off.gain(0, 0)) + 1e-6);
+}
+
+// Shake&Tune's compare-belts test as its .stdata keeps it: both belts' measurements in one
+// file (the plugin drives Klipper's own generator). Each imported by name lands on its own
+// offset; the same samples as Klipper's CSV import to the same offset.
+TEST(ImportRoundTrip, ShakeTuneBeltsFileImportsEachMeasurementByName) {
+  const TempDir dir;
+  std::vector<drivers::ShakeTuneMeasurement> file_content;
+  std::vector<Eigen::Vector3d> directions;
+  const double offsets_s[2] = {31.25, 104.5};
+  for (int belt = 0; belt < 2; ++belt) {
+    directions.push_back(sim::nc::test_direction(belt == 0 ? "1,-1" : "1,1", "--axis"));
+    const sim::Scenario sc = klipper_sweep(false, 30.0, 60.0, "adxl345", 3200.0, 41 + belt, directions.back());
+    sim::CaptureClock clock;
+    clock.offset_s = offsets_s[belt], clock.jitter_rms_s = 0.05 / 3200.0, clock.batch = 16, clock.seed = 9 + belt;
+    const Simulated truth = simulate_capture(sc, clock);
+    drivers::ShakeTuneMeasurement m;
+    m.name = belt == 0 ? "belt_a_20261207_101500" : "belt_b_20261207_101500";
+    m.capture = drivers::exported_capture(truth.run, truth.jittered, truth.samples, clock, 1, m.name);
+    if (belt == 0) drivers::write_klipper_capture(dir.path / "belt_a.csv", m.capture);
+    file_content.push_back(std::move(m));
+  }
+  const fs::path file = dir.path / "compare_belts.stdata";
+  drivers::write_shaketune_stdata(file, file_content);
+  for (int belt = 0; belt < 2; ++belt) {
+    drivers::KlipperImport k;
+    k.direction = directions[belt];
+    k.test.freq_start_hz = 30.0, k.test.freq_end_hz = 60.0, k.test.hz_per_sec = 2.0;
+    const drivers::ImportResult r = drivers::import_shaketune(file, file_content[belt].name, k);
+    const auto& off = r.report.offset;
+    std::printf("shake&tune %s: offset error %+.2f us, u %.2f us (k=1), explains %.1f %%\n",
+                file_content[belt].name.c_str(), (off.offset_s - offsets_s[belt]) * 1e6, off.u_s * 1e6,
+                100.0 * off.explained);
+    EXPECT_EQ(r.report.kind, "shaketune");
+    EXPECT_EQ(r.report.source, file.string() + "#" + file_content[belt].name);
+    EXPECT_LE(std::abs(off.offset_s - offsets_s[belt]), 3.0 * off.u_s + 0.05 / 3200.0);
+    EXPECT_GT(off.explained, 0.8);
+    if (belt == 0) {
+      const drivers::ImportResult csv = drivers::import_klipper(dir.path / "belt_a.csv", k);
+      EXPECT_NEAR(csv.report.offset.offset_s, off.offset_s, 0.1 * off.u_s);  // the CSV keeps 6 decimals
+    }
+  }
+  // Both belts in the file and none named: refused, naming them.
+  drivers::KlipperImport k;
+  try {
+    (void)drivers::import_shaketune(file, "", k);
+    ADD_FAILURE() << "a file of two measurements imported without --measurement";
+  } catch (const dsp::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("belt_b_20261207_101500"), std::string::npos) << e.what();
+  }
 }
 
 // A capture as a misconfigured Klipper writes it: its values ×8 (one chip's counts with
