@@ -132,6 +132,10 @@ std::string figures_text(const dsp::Analysis& analysis) {
       o += b;
       continue;
     }
+    if (const auto ne = analysis.not_evaluated.find(f.key); ne != analysis.not_evaluated.end()) {
+      o += "    " + dsp::label_of_key(f.key) + ": not evaluated: " + ne->second + "\n";
+      continue;
+    }
     std::string line = "    " + dsp::label_of_key(f.key) + " (" + unit + "):";
     for (std::size_t i = 0; i < f.values.size() && i < 24; ++i) {
       const auto u = figure_u(analysis, f.key, i);

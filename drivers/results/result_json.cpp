@@ -107,15 +107,31 @@ nlohmann::json all_null(std::initializer_list<const char*> keys) {
   return j;
 }
 
+// `path` (a key's parts) nulled below `node`; through an array (the rectangle's sides),
+// in each element. Whether anything was.
+bool null_path(nlohmann::json& node, const std::vector<std::string>& path, std::size_t at) {
+  if (node.is_array()) {
+    bool any = false;
+    for (auto& element : node) any = null_path(element, path, at) || any;
+    return any;
+  }
+  if (at >= path.size() || !node.is_object() || !node.contains(path[at])) return false;
+  if (at + 1 == path.size()) {
+    node[path[at]] = nullptr;
+    return true;
+  }
+  return null_path(node[path[at]], path, at + 1);
+}
+
 // A figure the analysis did not evaluate (Analysis::not_evaluated) is null, with its reason.
 void null_not_evaluated(const dsp::Analysis& a, nlohmann::json& doc, std::vector<dsp::Flag>& flags) {
   for (const auto& [key, reason] : a.not_evaluated) {
-    std::string pointer = "/" + key;
-    std::replace(pointer.begin(), pointer.end(), '.', '/');
-    const nlohmann::json::json_pointer p(pointer);
-    if (!doc.contains(p)) continue;
-    doc[p] = nullptr;
-    flags.push_back({dsp::FlagCode::figure_null, key, "not evaluated: " + reason});
+    std::vector<std::string> path;
+    for (std::size_t b = 0, e; b <= key.size(); b = e + 1) {
+      e = std::min(key.find('.', b), key.size());
+      path.push_back(key.substr(b, e - b));
+    }
+    if (null_path(doc, path, 0)) flags.push_back({dsp::FlagCode::figure_null, key, "not evaluated: " + reason});
   }
 }
 

@@ -229,6 +229,7 @@ std::vector<double> quantile_of_figure(const std::vector<FigureValue>& base, con
 // U and the noise bound of every figure of the full-rate analysis, from the draws.
 void assign_uncertainties(const DrawBases& b, const std::vector<DrawnFigures>& drawn, std::size_t used, Analysis& a) {
   for (const FigureValue& full : all_figures(a, b.more)) {
+    if (a.not_evaluated.count(full.key)) continue;  // the evaluation's own reason stands
     std::vector<double> u = quantile_of_figure(b.t0, drawn, used, &DrawnFigures::error, full.key, full.values.size());
     if (!u.empty()) {
       if (u.size() == 1 && u[0] == 0.0)  // no draw moves it: not a measured size

@@ -98,14 +98,26 @@ void rectangle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page,
     Grid sides{"Sides",
                {"side", "from → to (mm)", "straightness (µm)", "direction error (µrad)", "angle to next side (µrad)"},
                {}};
+    const auto assumed = [&](const char* key) { return a.not_evaluated.count(key) > 0; };
+    const bool direction_assumed = assumed("rectangle.sides.direction_error_urad");
+    const bool angle_assumed = assumed("rectangle.corner_angle_error_urad");
+    const bool straightness_assumed = assumed("rectangle.sides.straightness_um");
     for (std::size_t k = 0; k < r.sides.size(); ++k) {
       const auto& sd = r.sides[k];
-      sides.rows.push_back({std::to_string(k + 1),
-                            "(" + fmt("%.2f", sd.from_mm.x()) + ", " + fmt("%.2f", sd.from_mm.y()) + ") → (" +
-                                fmt("%.2f", sd.to_mm.x()) + ", " + fmt("%.2f", sd.to_mm.y()) + ")",
-                            fmt("%.2f", sd.straightness_um), fmt("%.1f", sd.direction_error_urad),
-                            k < r.corner_angle_error_urad.size() ? fmt("%.1f", r.corner_angle_error_urad[k]) : "—"});
+      sides.rows.push_back(
+          {std::to_string(k + 1),
+           "(" + fmt("%.2f", sd.from_mm.x()) + ", " + fmt("%.2f", sd.from_mm.y()) + ") → (" +
+               fmt("%.2f", sd.to_mm.x()) + ", " + fmt("%.2f", sd.to_mm.y()) + ")",
+           straightness_assumed ? "—" : fmt("%.2f", sd.straightness_um),
+           direction_assumed ? "—" : fmt("%.1f", sd.direction_error_urad),
+           !angle_assumed && k < r.corner_angle_error_urad.size() ? fmt("%.1f", r.corner_angle_error_urad[k]) : "—"});
     }
+    if (direction_assumed || angle_assumed || straightness_assumed)
+      s.notes.push_back("Not evaluated: " +
+                        a.not_evaluated.at(direction_assumed ? "rectangle.sides.direction_error_urad"
+                                           : angle_assumed   ? "rectangle.corner_angle_error_urad"
+                                                             : "rectangle.sides.straightness_um") +
+                        ".");
     s.grids.push_back(sides);
     csv.write("trace_rectangle_corners.csv", {"corner_a_mm", "corner_b_mm", "error_a_um", "error_b_um"},
               {ca, cb, ea, eb});
