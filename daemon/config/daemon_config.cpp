@@ -69,7 +69,8 @@ void read_source(StrictTable t, SourceConfig& s) {
   if (s.kind == "replay" && s.replay_run.empty()) t.fail("replay_run", "required when kind = \"replay\"");
   s.usb_id = t.string("usb_id", s.usb_id);
   if (auto sim = t.optional_table("sim")) {
-    s.sim_program = sim->choice("program", {"circle", "step"}, s.sim_program);
+    s.sim_program =
+        *dsp::parse_program_kind(sim->choice("program", {"circle", "step"}, dsp::program_kind_name(s.sim_program)));
     s.sim_radius_mm = sim->number("radius_mm", s.sim_radius_mm);
     if (!(s.sim_radius_mm > 0.0)) sim->fail("radius_mm", "must be positive");
     s.sim_feed_mm_min = sim->number("feed_mm_min", s.sim_feed_mm_min);

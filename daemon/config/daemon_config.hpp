@@ -43,7 +43,7 @@ struct SourceConfig {
   std::filesystem::path replay_run;  // replay: an eical-run/1 directory
   // sim: the calibration program the simulated NC runs; its M101/102/103 reach the
   // daemon on the DAQ trigger channel, as a PLC wired to the DAQ's trigger input would.
-  std::string sim_program = "circle";  // circle | step
+  dsp::ProgramKind sim_program = dsp::ProgramKind::circle;  // circle | step
   double sim_radius_mm = 10.0;
   double sim_feed_mm_min = 2500.0;
   int sim_repeats = 5;

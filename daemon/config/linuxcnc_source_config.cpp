@@ -9,7 +9,7 @@ namespace eical::daemon {
 std::unique_ptr<drivers::Source> make_linuxcnc_source(const DaemonConfig& config) {
   const LinuxcncConfig& l = config.source.linuxcnc;
   drivers::SimMachine m;
-  m.builtin = "freeform";
+  m.builtin = dsp::ProgramKind::freeform;
   m.program = *l.program_loaded;
   m.seed = l.seed;
   m.meta = hardware_meta(config);

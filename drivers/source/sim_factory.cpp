@@ -11,8 +11,15 @@ namespace eical::drivers {
 namespace {
 
 sim::Scenario builtin_scenario(const SimMachine& m) {
-  if (m.builtin == "circle") return sim::circle_scenario(m.radius_mm, m.feed_mm_min, m.repeats, "ccw", m.seed);
-  if (m.builtin == "step") return sim::step_scenario(0.0, 50.0, m.feed_mm_min, m.repeats, m.seed);
+  switch (m.builtin) {
+    case dsp::ProgramKind::circle: return sim::circle_scenario(m.radius_mm, m.feed_mm_min, m.repeats, "ccw", m.seed);
+    case dsp::ProgramKind::step: return sim::step_scenario(0.0, 50.0, m.feed_mm_min, m.repeats, m.seed);
+    case dsp::ProgramKind::positioning:
+    case dsp::ProgramKind::rectangle:
+    case dsp::ProgramKind::freeform:
+    case dsp::ProgramKind::identify:
+      break;  // none built in: a program file's, or LinuxCNC's servo stream moves the machine
+  }
   return sim::gcode_scenario("", dsp::ProgramKind::freeform, m.seed);
 }
 

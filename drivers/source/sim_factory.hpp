@@ -19,7 +19,7 @@ struct SimMachine {
   // `builtin` ("circle": R radius_mm at feed, repeats revolutions, ccw; "step": 0 → 50 mm
   // along x, repeats runs; "freeform": none, LinuxCNC's servo stream moves the machine).
   std::optional<dsp::Program> program;
-  std::string builtin = "circle";
+  dsp::ProgramKind builtin = dsp::ProgramKind::circle;
   double radius_mm = 10.0, feed_mm_min = 2500.0;
   int repeats = 5;
   std::uint64_t seed = 1;
