@@ -293,7 +293,7 @@ void add_export_options(CLI::App& cmd, SimulateOptions& o) {
 // The capture clock and files of --export: drawn for a regime, else from the flags.
 ExportRequest export_request(const SimulateOptions& o, double fs) {
   ExportRequest req;
-  req.kind = o.export_to[0], req.target = o.export_to[1], req.nc_format = o.export_nc,
+  req.format = parse_export_format(o.export_to[0]), req.target = o.export_to[1], req.nc_format = o.export_nc,
   req.nc_offset_s = o.export_nc_offset_s;
   if (!o.regime.empty()) {
     req.clock = sim::klipper_like_capture_clock(o.seed, fs);

@@ -21,12 +21,30 @@ std::size_t gaps_of(const sim::CaptureSamples& s) {
   return gaps;
 }
 
+constexpr ExportFormat kFormats[] = {ExportFormat::klipper, ExportFormat::shaketune, ExportFormat::csv};
+
 }  // namespace
+
+const char* export_format_name(ExportFormat format) {
+  switch (format) {
+    case ExportFormat::klipper: return "klipper";
+    case ExportFormat::shaketune: return "shaketune";
+    case ExportFormat::csv: return "csv";
+  }
+  return "?";
+}
+
+ExportFormat parse_export_format(const std::string& name) {
+  std::string names;
+  for (const ExportFormat f : kFormats) {
+    if (name == export_format_name(f)) return f;
+    names += std::string(names.empty() ? "" : ", ") + export_format_name(f);
+  }
+  throw dsp::InputError("simulate --export: '" + name + "' is not one of " + names);
+}
 
 std::string simulate_with_export(const sim::Scenario& scenario, const ExportRequest& request, const std::string& out,
                                  bool gzip, bool overwrite) {
-  if (request.kind != "klipper" && request.kind != "shaketune" && request.kind != "csv")
-    throw dsp::InputError("simulate --export: '" + request.kind + "' is not klipper, shaketune or csv");
   const auto set_point = sim::scenario_set_point(scenario);
   sim::check_budget(scenario, *set_point);  // before the capture's per-frame buffers
   const double fs = scenario.meta.acquisition.fs_hz;
@@ -41,12 +59,13 @@ std::string simulate_with_export(const sim::Scenario& scenario, const ExportRequ
           "\n[export]\n# The run as another system recorded it (eical simulate --export): frame n taken at\n"
           "# n/fs + jitter, stamped offset_s + that time; lost batches left out. offset_s is what\n"
           "# eical import must find: recorder time - set-point time.\n";
-  truth += "format = \"" + request.kind + "\"\nsensor = \"" + std::string(part ? "head" : "table") + "\"\n";
+  truth += "format = \"" + std::string(export_format_name(request.format)) + "\"\nsensor = \"" +
+           std::string(part ? "head" : "table") + "\"\n";
   const drivers::StampedAccel capture =
       drivers::exported_capture(run, jittered, samples, request.clock, part, request.target);
-  const bool klipper_samples = request.kind == "klipper" || request.kind == "shaketune";
+  const bool klipper_samples = request.format != ExportFormat::csv;
   if (klipper_samples) {
-    if (request.kind == "klipper")
+    if (request.format == ExportFormat::klipper)
       drivers::write_klipper_capture(request.target, capture);
     else  // one measurement, named as Shake&Tune names its axis tests
       drivers::write_shaketune_stdata(request.target, {{"axis_" + run.meta.id, capture}});

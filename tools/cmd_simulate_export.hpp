@@ -10,8 +10,14 @@
 
 namespace eical::tools {
 
+// The systems whose recordings --export writes: Klipper's raw capture, Shake&Tune's .stdata,
+// an accelerometer CSV with an NC trace.
+enum class ExportFormat { klipper, shaketune, csv };
+const char* export_format_name(ExportFormat format);        // as --export takes it and truth.toml records it
+ExportFormat parse_export_format(const std::string& name);  // InputError naming the three
+
 struct ExportRequest {
-  std::string kind;                      // "klipper" | "shaketune" | "csv"
+  ExportFormat format = ExportFormat::klipper;
   std::string target;                    // klipper, shaketune: the file; csv: PREFIX-accel.csv, PREFIX-nc.{ngc.txt|csv}
   std::string nc_format = "halsampler";  // csv: "halsampler" | "csv"
   double servo_period_s = 0.001;
