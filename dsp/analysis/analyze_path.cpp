@@ -1,6 +1,7 @@
 // Rectangle and free-form programs of a run: both compare the measured path with the
 // set-point; the rectangle in its plane at the corner stops, the free form along the
 // whole path in 3-D.
+#include "dsp/analysis/figures.hpp"
 #include "dsp/analysis/program_evaluations.hpp"
 #include "dsp/core/error.hpp"
 
@@ -27,8 +28,7 @@ void evaluate_rectangle_program(const Run& run, Analysis& a) {
   // 3.6 µm bow the straightness came out 9.2 ± 0.05 µm. Without the support U is about
   // 380 µrad and 0.4–3 µm on 40–100 mm sides (the integration noise) and covered.
   if (a.rectangle && a.nbs)
-    for (const char* key : {"rectangle.sides.direction_error_urad", "rectangle.corner_angle_error_urad",
-                            "rectangle.sides.straightness_um"})
+    for (const char* key : kRectangleAcrossSideKeys)
       a.not_evaluated[key] =
           "the other axis is held along each side (NBS), so its motion across a side is assumed, not measured; "
           "analyze --nbs off measures the sides' straightness and direction, to the integration noise (about a "

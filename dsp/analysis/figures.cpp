@@ -109,9 +109,9 @@ void rectangle_figures(const Analysis& a, Out& o) {
   o.scalar("rectangle.corner_error_max_um", worst);
   o.array("rectangle.corner_errors_um", corners, 2);
   for (const auto& s : r.sides) straight.push_back(s.straightness_um), direction.push_back(s.direction_error_urad);
-  o.array("rectangle.sides.straightness_um", straight);
-  o.array("rectangle.sides.direction_error_urad", direction);
-  o.array("rectangle.corner_angle_error_urad", r.corner_angle_error_urad);
+  o.array(kRectangleStraightnessKey, straight);
+  o.array(kRectangleDirectionKey, direction);
+  o.array(kRectangleCornerAngleKey, r.corner_angle_error_urad);
 }
 
 }  // namespace

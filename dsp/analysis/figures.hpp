@@ -21,6 +21,14 @@ struct FigureValue {
   int columns = 1;
 };
 
+// A rectangle's figures of the motion across its sides: what NBS, holding the other axis,
+// assumes rather than measures (analyze_path.cpp), written and read under these keys.
+inline constexpr const char* kRectangleStraightnessKey = "rectangle.sides.straightness_um";
+inline constexpr const char* kRectangleDirectionKey = "rectangle.sides.direction_error_urad";
+inline constexpr const char* kRectangleCornerAngleKey = "rectangle.corner_angle_error_urad";
+inline constexpr const char* kRectangleAcrossSideKeys[] = {kRectangleStraightnessKey, kRectangleDirectionKey,
+                                                           kRectangleCornerAngleKey};
+
 std::vector<FigureValue> figures_of(const Analysis& analysis);
 
 // The figure under `key`, or null.

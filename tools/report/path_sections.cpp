@@ -1,6 +1,8 @@
 // Rectangle and free-form pages: the path in its plane with the deviation magnified, the
 // contour deviation along the path, and the corner / contour figures.
 #include "tools/report/sections.hpp"
+
+#include "dsp/analysis/figures.hpp"
 #include "tools/report/svg.hpp"
 
 namespace eical::tools::report {
@@ -99,9 +101,9 @@ void rectangle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page,
                {"side", "from → to (mm)", "straightness (µm)", "direction error (µrad)", "angle to next side (µrad)"},
                {}};
     const auto assumed = [&](const char* key) { return a.not_evaluated.count(key) > 0; };
-    const bool direction_assumed = assumed("rectangle.sides.direction_error_urad");
-    const bool angle_assumed = assumed("rectangle.corner_angle_error_urad");
-    const bool straightness_assumed = assumed("rectangle.sides.straightness_um");
+    const bool direction_assumed = assumed(dsp::kRectangleDirectionKey);
+    const bool angle_assumed = assumed(dsp::kRectangleCornerAngleKey);
+    const bool straightness_assumed = assumed(dsp::kRectangleStraightnessKey);
     for (std::size_t k = 0; k < r.sides.size(); ++k) {
       const auto& sd = r.sides[k];
       sides.rows.push_back(
@@ -112,12 +114,11 @@ void rectangle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page,
            direction_assumed ? "—" : fmt("%.1f", sd.direction_error_urad),
            !angle_assumed && k < r.corner_angle_error_urad.size() ? fmt("%.1f", r.corner_angle_error_urad[k]) : "—"});
     }
-    if (direction_assumed || angle_assumed || straightness_assumed)
-      s.notes.push_back("Not evaluated: " +
-                        a.not_evaluated.at(direction_assumed ? "rectangle.sides.direction_error_urad"
-                                           : angle_assumed   ? "rectangle.corner_angle_error_urad"
-                                                             : "rectangle.sides.straightness_um") +
-                        ".");
+    for (const char* key : dsp::kRectangleAcrossSideKeys)  // one reason for the three: said once
+      if (assumed(key)) {
+        s.notes.push_back("Not evaluated: " + a.not_evaluated.at(key) + ".");
+        break;
+      }
     s.grids.push_back(sides);
     csv.write("trace_rectangle_corners.csv", {"corner_a_mm", "corner_b_mm", "error_a_um", "error_b_um"},
               {ca, cb, ea, eb});
