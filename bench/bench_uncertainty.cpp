@@ -1,10 +1,10 @@
 // Uncertainty benchmark (issue 16): a seeded campaign of simulated runs across programs on
 // machines within the data sheet's tolerances; prints per figure how often the error
 // against the simulator's truth lies within the expanded uncertainty U, the median U and
-// the RMS error (tools/uncertainty/coverage_campaign.hpp).
+// the RMS error (tests/support/coverage_campaign.hpp).
 //   bench_uncertainty [--seeds 1,2,...] [--draws 100] [--programs circle,step,...]
 #include "drivers/exec/thread_for.hpp"
-#include "tools/uncertainty/coverage_campaign.hpp"
+#include "tests/support/coverage_campaign.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -12,7 +12,7 @@
 
 int main(int argc, char** argv) {
   CLI::App app("eical uncertainty coverage benchmark");
-  eical::tools::uncertainty::CampaignOptions o;
+  eical::coverage::CampaignOptions o;
   o.seeds = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
   app.add_option("--seeds", o.seeds, "machines to draw (each its own sensors and errors)")->delimiter(',');
   app.add_option("--programs", o.programs,
@@ -23,6 +23,6 @@ int main(int argc, char** argv) {
   app.add_option("--write-runs", o.write_runs, "write every simulated run into this folder");
   CLI11_PARSE(app, argc, argv);
   o.parallel = eical::drivers::thread_for();
-  std::fputs(eical::tools::uncertainty::coverage_table(eical::tools::uncertainty::run_campaign(o)).c_str(), stdout);
+  std::fputs(eical::coverage::coverage_table(eical::coverage::run_campaign(o)).c_str(), stdout);
   return 0;
 }

@@ -9,13 +9,13 @@
 // Exit status 0 when part one's verdict is ok, else that verdict's (tools/exit_codes.hpp).
 #include "drivers/results/result_json.hpp"
 #include "drivers/run_io/run_writer.hpp"
+#include "dsp/analysis/figures_on_path.hpp"
 #include "tools/commands.hpp"
 #include "tools/demo/demo_stages.hpp"
 #include "tools/exit_codes.hpp"
 #include "tools/plan/psd_layouts.hpp"
 #include "tools/report/run_report.hpp"
 #include "tools/run_files.hpp"
-#include "tools/uncertainty/coverage_campaign.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -92,7 +92,7 @@ void register_demo(CLI::App& app) {
 
     const auto t_an = std::chrono::steady_clock::now();
     const dsp::Analysis a = demo::analyze_with(test.run, id.calibration);
-    const auto truth = uncertainty::true_figures(test.run, test.truth_mm, a);
+    const auto truth = dsp::figures_on_path(test.run, test.truth_mm, a);
     write_file_atomic(out / "result.json", drivers::result_json(test.run, a).dump(2) + "\n");
     const auto report = report::write_run_report(test.run, a, out / "report");
     std::printf("  3. analysed with the calibration in %.1f s:\n",

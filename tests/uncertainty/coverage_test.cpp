@@ -5,13 +5,13 @@
 // default, so that two hard machines do not decide the test; positioning, step and
 // rectangle on three. bench_uncertainty runs the full campaign and prints the table per
 // figure.
-#include "tools/uncertainty/coverage_campaign.hpp"
+#include "tests/support/coverage_campaign.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
 
-namespace eical::tools::uncertainty {
+namespace eical::coverage {
 namespace {
 
 CampaignResult campaign(std::vector<std::uint64_t> seeds, std::vector<std::string> programs) {
@@ -42,4 +42,4 @@ TEST(UncertaintyCoverage, HeadlineFiguresAreCoveredAndUIsNotInflated) {
 }
 
 }  // namespace
-}  // namespace eical::tools::uncertainty
+}  // namespace eical::coverage

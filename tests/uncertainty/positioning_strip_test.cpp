@@ -7,9 +7,9 @@
 // targets, within its U.
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/analysis/figures.hpp"
+#include "dsp/analysis/figures_on_path.hpp"
 #include "sim/simulate.hpp"
 #include "tools/plan/predicted_uncertainty.hpp"
-#include "tools/uncertainty/coverage_campaign.hpp"
 
 #include <gtest/gtest.h>
 
@@ -32,7 +32,7 @@ std::vector<dsp::FigureValue> expect_within_u(const tools::plan::TestProgram& p,
   ao.uncertainty.draws = draws;
   a = dsp::analyze_run(run, ao);
   auto measured = dsp::figures_of(a);
-  const auto true_figs = tools::uncertainty::true_figures(run, truth, a);
+  const auto true_figs = dsp::figures_on_path(run, truth, a);
   for (const char* key : keys) {
     const dsp::FigureValue* m = dsp::find_figure(measured, key);
     const dsp::FigureValue* t = dsp::find_figure(true_figs, key);

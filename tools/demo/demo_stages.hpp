@@ -60,7 +60,7 @@ dsp::Analysis analyze_with(const dsp::Run& run, const drivers::SensorCalibration
 
 // The block the demo prints for one test: verdict, G ± U, U against the noise bound, the
 // error against the simulator's truth (its ideal reference instrument).
-// `truth`: the same evaluation of the true path (tools/uncertainty true_figures), or empty.
+// `truth`: the same evaluation of the true path (dsp::figures_on_path), or empty.
 std::string headline_text(const dsp::Analysis& a, const std::vector<dsp::FigureValue>& truth);
 
 // Part two: a test the inertial physics cannot resolve (R150 F4000, one revolution, no

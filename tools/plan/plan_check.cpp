@@ -1,10 +1,10 @@
 #include "tools/plan/plan_check.hpp"
 
 #include "dsp/analysis/figures.hpp"
+#include "dsp/analysis/figures_on_path.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/identify/sensor_identification.hpp"
 #include "sim/simulate.hpp"
-#include "tools/uncertainty/coverage_campaign.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -66,7 +66,7 @@ std::vector<CheckRow> check_plan(const TestProgram& p, int repeats, int draws) {
       ++degraded;
       continue;
     }
-    const auto measured = dsp::figures_of(a), true_figs = uncertainty::true_figures(run, truth, a);
+    const auto measured = dsp::figures_of(a), true_figs = dsp::figures_on_path(run, truth, a);
     for (std::size_t k = 0; k < keys.size(); ++k) {
       const auto* m = dsp::find_figure(measured, keys[k]);
       const auto* t = dsp::find_figure(true_figs, keys[k]);

@@ -9,7 +9,7 @@
 // The table has each figure pooled over the designs and each headline figure per design
 // (pooled, the designs with the largest errors set the RMS).
 //
-// Designs (program_for in the .cpp): the background circle (R 8–15 mm, PSD configuration B)
+// Designs (kDesigns in the .cpp): the background circle (R 8–15 mm, PSD configuration B)
 // and step; circles identified on site (R10–R50, both directions), with 4–16 strips
 // (R25–R100, up to F10000) and beyond the instrument (R50–R150, two strips); ISO 230-2
 // positioning over 30 mm and over 100–300 mm, with strips at mid travel or at both ends;
@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-namespace eical::tools::uncertainty {
+namespace eical::coverage {
 
 struct CampaignOptions {
   std::vector<std::uint64_t> seeds{1, 2, 3};
@@ -57,10 +57,6 @@ struct CampaignResult {
   double seconds = 0.0;
 };
 
-// The figures of the same evaluation of the simulator's true relative path (per frame).
-std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vector<Eigen::Vector3d>& truth,
-                                           const dsp::Analysis& measured);
-
 // The headline figures of each program (the ones the campaign must cover).
 const std::vector<std::string>& headline_keys();
 
@@ -69,4 +65,4 @@ CampaignResult run_campaign(const CampaignOptions& options);
 // The coverage table as bench_uncertainty prints it.
 std::string coverage_table(const CampaignResult& result);
 
-}  // namespace eical::tools::uncertainty
+}  // namespace eical::coverage

@@ -1,8 +1,9 @@
-#include "tools/uncertainty/coverage_campaign.hpp"
+#include "tests/support/coverage_campaign.hpp"
 
 #include "drivers/run_io/run_writer.hpp"
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/analysis/figures.hpp"
+#include "dsp/analysis/figures_on_path.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/core/float_limits.hpp"
 #include "dsp/core/stream_seed.hpp"
@@ -21,24 +22,9 @@
 #include <limits>
 #include <random>
 
-namespace eical::tools::uncertainty {
+namespace eical::coverage {
+namespace plan = tools::plan;
 namespace {
-
-// The campaign's test designs. A design's place here keys the noise of its runs.
-constexpr std::array<const char*, 9> kDesigns = {
-    "circle",      "circle-identified", "circle-strips",    "circle-large", "step",
-    "positioning", "positioning-long",  "positioning-ends", "rectangle"};
-
-// One seed is one machine, whichever design measures it; the noise of a run (the sensors',
-// their bias walk, the DAQ's, the strips') is the design's own. With the machine's seed for
-// both, the three positioning designs on one machine integrated the same noise and missed
-// R together: one unlucky draw counted three times (three of R's five misses in 27 runs
-// were one machine; over 24 noise draws of that machine's strips-at-both-ends run, R was
-// covered 23 times).
-std::uint64_t noise_seed(const std::string& program, std::uint64_t seed) {
-  const auto d = std::find_if(kDesigns.begin(), kDesigns.end(), [&](const char* n) { return program == n; });
-  return dsp::stream_seed(seed, 9100 + static_cast<std::uint64_t>(d - kDesigns.begin()));
-}
 
 // The program of a campaign entry on the machine of `seed`; `identified`: the sensors are
 // identified on site first (the plan's identification program on the same machine).
@@ -50,46 +36,105 @@ struct CampaignProgram {
   bool at_both_ends = false;  // a positioning test's strips at the ends of its travel (plan::strips_at_both_ends)
 };
 
+// A design's random choices (radius, feed, layout), drawn from its own generator.
+class Pick {
+ public:
+  explicit Pick(std::uint64_t seed) : rng_(seed) {}
+  template <class T>
+  T one_of(std::initializer_list<T> v) {
+    return *(v.begin() + std::uniform_int_distribution<std::size_t>(0, v.size() - 1)(rng_));
+  }
+
+ private:
+  std::mt19937_64 rng_;
+};
+
+void background_circle(CampaignProgram& c, Pick&) { c.background = true, c.program.kind = dsp::ProgramKind::circle; }
+
+void background_step(CampaignProgram& c, Pick&) { c.background = true, c.program.kind = dsp::ProgramKind::step; }
+
+void circle_identified(CampaignProgram& c, Pick& pick) {  // ballbar class: R10–R50, both directions
+  plan::TestProgram& p = c.program;
+  p.kind = dsp::ProgramKind::circle, p.direction = "both", p.repeats = 3, p.identified = true;
+  p.radius_mm = pick.one_of({10.0, 25.0, 50.0}), p.feed_mm_min = pick.one_of({1000.0, 2500.0, 4000.0});
+}
+
+void circle_strips(CampaignProgram& c, Pick& pick) {  // 4–16 strips along the path or radial, R25–R100, identified
+  plan::TestProgram& p = c.program;
+  p.kind = dsp::ProgramKind::circle, p.direction = "both", p.repeats = 2, p.identified = true;
+  p.radius_mm = pick.one_of({25.0, 50.0, 100.0}), p.feed_mm_min = pick.one_of({2500.0, 4000.0, 10000.0});
+  const plan::PsdLayout layout = plan::psd_layout(pick.one_of<const char*>({"B4", "B8", "B16", "R8", "R16"}));
+  c.strips = layout.strips, c.facing = layout.facing;
+}
+
+void circle_large(CampaignProgram& c, Pick& pick) {  // beyond the instrument without more strips
+  plan::TestProgram& p = c.program;
+  p.kind = dsp::ProgramKind::circle, p.repeats = 1, p.radius_mm = pick.one_of({50.0, 100.0, 150.0});
+  p.feed_mm_min = pick.one_of({4000.0, 10000.0});
+}
+
+void positioning_short(CampaignProgram& c, Pick&) {
+  plan::TestProgram& p = c.program;
+  p.kind = dsp::ProgramKind::positioning, p.runs = 3, p.feed_mm_min = 3000.0;
+  p.targets_mm = {0.0, 10.0, 20.0, 30.0};
+}
+
+void positioning_long(CampaignProgram& c, Pick& pick) {  // 100–300 mm, 5 runs (ISO 230-2)
+  plan::TestProgram& p = c.program;
+  p.kind = dsp::ProgramKind::positioning, p.runs = 5, p.feed_mm_min = 4000.0;
+  const double travel = pick.one_of({100.0, 200.0, 300.0});
+  p.targets_mm.clear();
+  for (int k = 0; k <= 5; ++k) p.targets_mm.push_back(travel * k / 5.0);
+}
+
+void positioning_ends(CampaignProgram& c, Pick& pick) {
+  positioning_long(c, pick);
+  c.at_both_ends = true;
+}
+
+void rectangle(CampaignProgram& c, Pick&) {
+  plan::TestProgram& p = c.program;
+  p.kind = dsp::ProgramKind::rectangle, p.size_mm[0] = 40.0, p.size_mm[1] = 30.0, p.feed_mm_min = 4000.0;
+}
+
+// The campaign's test designs, by name. A design's place here keys the noise of its runs.
+struct Design {
+  const char* name;
+  void (*build)(CampaignProgram&, Pick&);
+};
+constexpr std::array<Design, 9> kDesigns = {{{"circle", background_circle},
+                                             {"circle-identified", circle_identified},
+                                             {"circle-strips", circle_strips},
+                                             {"circle-large", circle_large},
+                                             {"step", background_step},
+                                             {"positioning", positioning_short},
+                                             {"positioning-long", positioning_long},
+                                             {"positioning-ends", positioning_ends},
+                                             {"rectangle", rectangle}}};
+
+std::size_t design_index(const std::string& program) {
+  const auto d = std::find_if(kDesigns.begin(), kDesigns.end(), [&](const Design& x) { return program == x.name; });
+  if (d != kDesigns.end()) return static_cast<std::size_t>(d - kDesigns.begin());
+  std::string names;
+  for (const Design& x : kDesigns) names += std::string(names.empty() ? "" : ", ") + x.name;
+  throw dsp::InputError("coverage campaign: unknown program '" + program + "' (" + names + ")");
+}
+
+// One seed is one machine, whichever design measures it; the noise of a run (the sensors',
+// their bias walk, the DAQ's, the strips') is the design's own. With the machine's seed for
+// both, the three positioning designs on one machine integrated the same noise and missed
+// R together: one unlucky draw counted three times (three of R's five misses in 27 runs
+// were one machine; over 24 noise draws of that machine's strips-at-both-ends run, R was
+// covered 23 times).
+std::uint64_t noise_seed(const std::string& program, std::uint64_t seed) {
+  return dsp::stream_seed(seed, 9100 + static_cast<std::uint64_t>(design_index(program)));
+}
+
 CampaignProgram program_for(const std::string& program, std::uint64_t seed) {
   CampaignProgram c;
+  Pick pick(seed * 7919 + std::hash<std::string>{}(program));
+  kDesigns[design_index(program)].build(c, pick);
   plan::TestProgram& p = c.program;
-  std::mt19937_64 rng(seed * 7919 + std::hash<std::string>{}(program));
-  auto pick = [&](std::initializer_list<double> v) {
-    return *(v.begin() + std::uniform_int_distribution<std::size_t>(0, v.size() - 1)(rng));
-  };
-  auto pick_name = [&](std::initializer_list<const char*> v) {
-    return std::string(*(v.begin() + std::uniform_int_distribution<std::size_t>(0, v.size() - 1)(rng)));
-  };
-  if (program == "circle" || program == "step") {
-    c.background = true;
-    p.kind = program == "circle" ? dsp::ProgramKind::circle : dsp::ProgramKind::step;
-  } else if (program == "circle-identified") {  // ballbar class: R10–R50, both directions
-    p.kind = dsp::ProgramKind::circle, p.direction = "both", p.repeats = 3, p.identified = true;
-    p.radius_mm = pick({10.0, 25.0, 50.0}), p.feed_mm_min = pick({1000.0, 2500.0, 4000.0});
-  } else if (program == "circle-strips") {  // 4–16 strips along the path or radial, R25–R100, identified
-    p.kind = dsp::ProgramKind::circle, p.direction = "both", p.repeats = 2, p.identified = true;
-    p.radius_mm = pick({25.0, 50.0, 100.0}), p.feed_mm_min = pick({2500.0, 4000.0, 10000.0});
-    const plan::PsdLayout layout = plan::psd_layout(pick_name({"B4", "B8", "B16", "R8", "R16"}));
-    c.strips = layout.strips, c.facing = layout.facing;
-  } else if (program == "circle-large") {  // beyond the instrument without more strips
-    p.kind = dsp::ProgramKind::circle, p.repeats = 1, p.radius_mm = pick({50.0, 100.0, 150.0});
-    p.feed_mm_min = pick({4000.0, 10000.0});
-  } else if (program == "positioning") {
-    p.kind = dsp::ProgramKind::positioning, p.runs = 3, p.feed_mm_min = 3000.0;
-    p.targets_mm = {0.0, 10.0, 20.0, 30.0};
-  } else if (program == "positioning-long" || program == "positioning-ends") {  // 100–300 mm, 5 runs (ISO 230-2)
-    p.kind = dsp::ProgramKind::positioning, p.runs = 5, p.feed_mm_min = 4000.0;
-    c.at_both_ends = program == "positioning-ends";
-    const double travel = pick({100.0, 200.0, 300.0});
-    p.targets_mm.clear();
-    for (int k = 0; k <= 5; ++k) p.targets_mm.push_back(travel * k / 5.0);
-  } else if (program == "rectangle") {
-    p.kind = dsp::ProgramKind::rectangle, p.size_mm[0] = 40.0, p.size_mm[1] = 30.0, p.feed_mm_min = 4000.0;
-  } else {
-    std::string names;
-    for (const char* d : kDesigns) names += std::string(names.empty() ? "" : ", ") + d;
-    throw dsp::InputError("coverage campaign: unknown program '" + program + "' (" + names + ")");
-  }
   p.psd = c.at_both_ends ? plan::strips_at_both_ends(p) : plan::strips_for(p, c.strips, c.facing);
   return c;
 }
@@ -140,22 +185,6 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-std::vector<dsp::FigureValue> true_figures(const dsp::Run& run, const std::vector<Eigen::Vector3d>& truth,
-                                           const dsp::Analysis& measured) {
-  dsp::Analysis t;
-  t.measurement = measured.measurement;
-  const std::int64_t first = run.frames.front().sample_index;
-  for (std::size_t k = 0; k < t.measurement.pos_mm.size(); ++k) {
-    const auto i = static_cast<std::size_t>(t.measurement.sample_index[k] - first);
-    if (i < truth.size()) t.measurement.pos_mm[k] = truth[i];
-  }
-  dsp::EvaluationOptions eo;
-  eo.reference = false;
-  if (measured.diagnostics) eo.cyclic_pitch_mm = measured.diagnostics->cyclic_pitch_mm;
-  dsp::evaluate_program(run, t, eo);
-  return dsp::figures_of(t);
-}
-
 double FigureCoverage::median_u() const { return median(u); }
 
 double FigureCoverage::rms_error() const {
@@ -202,7 +231,7 @@ CampaignResult run_campaign(const CampaignOptions& options) {
       const dsp::Analysis a = dsp::analyze_run(run, ao);
       ++r.runs;
       // The same evaluation of the true relative path.
-      const auto measured = dsp::figures_of(a), true_figs = true_figures(run, truth, a);
+      const auto measured = dsp::figures_of(a), true_figs = dsp::figures_on_path(run, truth, a);
       if (measured.empty()) {
         r.failures.push_back(sc.meta.id + ": no figures (" +
                              (a.flags.empty() ? std::string("?") : dsp::flag_text(a.flags.front())) + ")");
@@ -265,4 +294,4 @@ std::string coverage_table(const CampaignResult& result) {
   return o;
 }
 
-}  // namespace eical::tools::uncertainty
+}  // namespace eical::coverage
