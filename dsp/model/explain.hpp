@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -35,8 +36,15 @@ struct ExplainedEffect {
   double heldout_rms_before_um = 0.0, heldout_rms_after_um = 0.0;
   double importance_um = 0.0;     // the residual RMS it explains (ranking)
   bool taken_into_model = false;  // a sensor-side extension the pipeline now compensates with
-  std::string group;              // the model group it was fitted as (other.residual_like_<group>)
-  std::string resembles;          // what its regressor is, in words
+  // σ of `magnitude` where the fit gives one (NaN: none). With it the physical bounds
+  // decide whether the data can size the effect at all (`identifiable`).
+  double sigma = std::numeric_limits<double>::quiet_NaN();
+  // False: the data cannot support a size — the fitted size, or its 2σ interval, reaches
+  // beyond what any sensor or machine of the kind can have (apply_physical_bounds). The
+  // effect is then reported without a size; `magnitude` is kept for the evidence only.
+  bool identifiable = true;
+  std::string group;      // the model group it was fitted as (other.residual_like_<group>)
+  std::string resembles;  // what its regressor is, in words
 };
 
 struct RunExplanation {

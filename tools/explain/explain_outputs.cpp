@@ -30,7 +30,8 @@ nlohmann::json effect_json(const dsp::model::ExplainedEffect& e) {
           {"evidence", e.evidence},
           {"params", p},
           {"channel", e.channel},
-          {"size", e.magnitude},
+          {"identifiable", e.identifiable},
+          {"size", e.identifiable ? nlohmann::json(e.magnitude) : nlohmann::json(nullptr)},
           {"tolerance", e.tolerance},
           {"unit", e.unit},
           {"bic_drop", e.bic_drop},
@@ -136,6 +137,10 @@ std::string explain_text(const std::vector<dsp::model::RunExplanation>& ex,
     }
     if (sig == 0)
       o += "  no significant effect: the nominal model explains the run within its noise and the tolerance bands\n";
+    std::string unsized;
+    for (const auto& e : r.effects)
+      if (!e.identifiable) unsized += (unsized.empty() ? "" : ", ") + e.name;
+    if (!unsized.empty()) o += "  not identifiable (the run cannot size them; no size is given): " + unsized + "\n";
   }
   for (const auto& t : transfers) {
     std::snprintf(b, sizeof b, "held out: %s with the model extended on %s: pipeline residual %.3f -> %.3f um RMS\n",
@@ -159,7 +164,8 @@ report::Section effects_section(const Explanation& r) {
   report::Grid g;
   g.header = {"", "effect", "size", "tolerance", "residual RMS before -> after (um)", "evidence"};
   for (const auto& e : r.effects)
-    g.rows.push_back({e.significant ? "significant" : "", e.name, report_fmt(e.magnitude) + " " + e.unit,
+    g.rows.push_back({e.significant ? "significant" : "", e.name,
+                      e.identifiable ? report_fmt(e.magnitude) + " " + e.unit : "not identifiable",
                       report_fmt(e.tolerance),
                       report_fmt(e.residual_rms_before_um) + " -> " + report_fmt(e.residual_rms_after_um), e.evidence});
   table.grids.push_back(g);

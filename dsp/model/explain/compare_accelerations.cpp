@@ -79,7 +79,7 @@ void compare_accelerations(ExplainState& st) {
     const double s_ppm = (g - 1.0) * 1e6, ss_ppm = sg * 1e6;
     scale.params["scale_" + axis_letter(i) + "_ppm"] = s_ppm,
                                              scale.params["sigma_scale_" + axis_letter(i) + "_ppm"] = ss_ppm;
-    if (std::abs(s_ppm) > std::abs(scale.magnitude)) scale.magnitude = s_ppm;
+    if (std::abs(s_ppm) > std::abs(scale.magnitude)) scale.magnitude = s_ppm, scale.sigma = ss_ppm;
     scale_sure = std::max(scale_sure, std::abs(s_ppm) - 2.0 * ss_ppm);
     // The commanded axis seen on the other measured axes: the mounting's angle (with one
     // moving axis per sensor, mounting and cross coupling are one effect here).
@@ -90,7 +90,7 @@ void compare_accelerations(ExplainState& st) {
                  sa_mrad = std::sqrt(off_var) / std::max(std::abs(g), 1e-9) * 1e3;
     angle.params["angle_" + axis_letter(i) + "_mrad"] = a_mrad,
                                              angle.params["sigma_angle_" + axis_letter(i) + "_mrad"] = sa_mrad;
-    angle.magnitude = std::max(angle.magnitude, a_mrad);
+    if (a_mrad > angle.magnitude) angle.magnitude = a_mrad, angle.sigma = sa_mrad;
     angle_sure = std::max(angle_sure, a_mrad - 2.0 * sa_mrad);
   }
   scale.significant = scale_sure > scale.tolerance;

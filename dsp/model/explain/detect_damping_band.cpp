@@ -11,7 +11,7 @@ void test_damping_band(ExplainState& st) {
   if (!f.valid || !f.found) return;  // the reference channel's candidate stands
   ExplainedEffect x = effect_of(Effect::sensor_damping_amplitude);
   x.channel = "acceleration band";
-  x.magnitude = f.zeta_per_g;
+  x.magnitude = f.zeta_per_g, x.sigma = f.sigma_zeta_per_g;
   x.significant = std::abs(f.zeta_per_g) - 2.0 * f.sigma_zeta_per_g > x.tolerance;
   x.bic_drop = f.bic_drop[static_cast<std::size_t>(f.sensor)];
   x.evidence = f.evidence;

@@ -50,13 +50,16 @@ Attribution machine_attribution(const EffectModel& m, const std::map<std::string
   return a;
 }
 
-// The effects one group's verdict stands for, at its fitted values and 2σ towards zero.
+// The effects one group's verdict stands for, at its fitted values and 2σ towards and away
+// from zero.
 bool attributions(const ExplainState& st, const GroupVerdict& v, bool is_sensor, std::vector<Attribution>& atts,
-                  std::vector<Attribution>& sure) {
-  const std::map<std::string, double> sure_value = toward_zero(v.value, v.sigma);
+                  std::vector<Attribution>& sure, std::vector<Attribution>& far) {
+  const std::map<std::string, double> sure_value = toward_zero(v.value, v.sigma),
+                                      far_value = away_from_zero(v.value, v.sigma);
   if (is_sensor) {
     atts = attribute_sensor_group(st.rr, v.name, v.value);
     sure = attribute_sensor_group(st.rr, v.name, sure_value);
+    far = attribute_sensor_group(st.rr, v.name, far_value);
     return true;
   }
   const auto it =
@@ -64,14 +67,23 @@ bool attributions(const ExplainState& st, const GroupVerdict& v, bool is_sensor,
   if (it == st.machine.end()) return false;
   atts = {machine_attribution(*it, v.value)};
   sure = {machine_attribution(*it, sure_value)};
+  far = {machine_attribution(*it, far_value)};
   return true;
+}
+
+// The magnitude of the attribution named `name` (0: none).
+double magnitude_named(const std::vector<Attribution>& atts, const std::string& name) {
+  for (const auto& a : atts)
+    if (a.name == name) return a.magnitude;
+  return 0.0;
 }
 
 // One attributed effect of a group's verdict.
 ExplainedEffect explained(const ExplainState& st, const GroupVerdict& v, bool is_sensor, const Attribution& at,
-                          double sure_magnitude, double share) {
+                          double sure_magnitude, double far_magnitude, double share) {
   ExplainedEffect x;
   x.name = at.name, x.params = at.params, x.magnitude = at.magnitude, x.tolerance = at.tolerance, x.unit = at.unit;
+  x.sigma = magnitude_sigma(at.magnitude, sure_magnitude, far_magnitude);
   x.group = v.name, x.resembles = at.regressor;
   if (v.accepted) x.params["model_group_accepted"] = 1.0;  // its values are part of the fitted model
   x.channel = is_sensor ? st.rr.reference : "total";
@@ -123,18 +135,16 @@ void fit_integrated_motion(ExplainState& st) {
   for (const auto& v : ks.groups) {
     const bool is_sensor = std::any_of(groups.begin(), groups.begin() + static_cast<std::ptrdiff_t>(n_sensor_groups),
                                        [&](const ParamGroup& g) { return g.name == v.name; });
-    std::vector<Attribution> atts, sure_atts;
-    if (!attributions(st, v, is_sensor, atts, sure_atts)) continue;
+    std::vector<Attribution> atts, sure_atts, far_atts;
+    if (!attributions(st, v, is_sensor, atts, sure_atts, far_atts)) continue;
     // One group's gain shared by the effects it stands for, by how far each is outside its band.
     double excess_sum = 0.0;
     for (const auto& at : atts) excess_sum += at.tolerance > 0.0 ? at.magnitude / at.tolerance : 0.0;
     for (const auto& at : atts) {
-      double sure_magnitude = 0.0;
-      for (const auto& sa : sure_atts)
-        if (sa.name == at.name) sure_magnitude = sa.magnitude;
       const double share =
           atts.size() > 1 && excess_sum > 0.0 && at.tolerance > 0.0 ? at.magnitude / at.tolerance / excess_sum : 1.0;
-      st.merge(explained(st, v, is_sensor, at, sure_magnitude, share));
+      st.merge(explained(st, v, is_sensor, at, magnitude_named(sure_atts, at.name), magnitude_named(far_atts, at.name),
+                         share));
     }
   }
   st.ex.heldout_nominal_rms_um = ks.held_rms_nominal_um, st.ex.heldout_final_rms_um = ks.held_rms_final_um;

@@ -143,19 +143,22 @@ double split_rms(const Eigen::VectorXd& v, const std::vector<bool>& heldout, boo
 }
 
 // The selected parameters on the effect's full parameter list (the others zero), and the
-// same moved 2σ towards zero: the size outside the tolerance with confidence.
-void full_parameters(const EffectVerdict& v, const EffectModel& e, Eigen::VectorXd& full, Eigen::VectorXd& sure) {
+// same moved 2σ towards zero (the size outside the tolerance with confidence) and away from
+// it (with `sure`, the size's own σ).
+void full_parameters(const EffectVerdict& v, const EffectModel& e, Eigen::VectorXd& full, Eigen::VectorXd& sure,
+                     Eigen::VectorXd& far) {
   full = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(e.params.size()));
   for (std::size_t p = 0; p < v.param_names.size(); ++p)
     for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
       if (e.params[q2] == v.param_names[p])
         full[static_cast<Eigen::Index>(q2)] = v.params[static_cast<Eigen::Index>(p)];
-  sure = full;
+  sure = full, far = full;
   for (std::size_t p = 0; p < v.param_names.size() && static_cast<Eigen::Index>(p) < v.param_sigma.size(); ++p)
     for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
       if (e.params[q2] == v.param_names[p]) {
         const double a = full[static_cast<Eigen::Index>(q2)], s2 = 2.0 * v.param_sigma[static_cast<Eigen::Index>(p)];
         sure[static_cast<Eigen::Index>(q2)] = std::abs(a) > s2 ? a - std::copysign(s2, a) : 0.0;
+        far[static_cast<Eigen::Index>(q2)] = a + std::copysign(s2, a);
       }
 }
 
@@ -168,10 +171,11 @@ ExplainedEffect explained_effect(const EffectVerdict& v, const EffectModel& e, c
   x.name = v.name, x.channel = ch.name, x.bic_drop = v.bic_drop, x.correlation = v.correlation;
   for (std::size_t p = 0; p < v.param_names.size(); ++p)
     x.params[v.param_names[p]] = v.params[static_cast<Eigen::Index>(p)];
-  Eigen::VectorXd full, sure;
-  full_parameters(v, e, full, sure);
+  Eigen::VectorXd full, sure, far;
+  full_parameters(v, e, full, sure, far);
   x.magnitude = e.magnitude(full), x.tolerance = e.tolerance, x.unit = e.unit;
   const double sure_magnitude = e.magnitude(sure);
+  x.sigma = magnitude_sigma(x.magnitude, sure_magnitude, e.magnitude(far));
   // Its own prediction in µm, against the nominal residual (offsets out).
   pred = project(w.asDiagonal() * (columns_on(e, ch) * full)).cwiseProduct(ch.sigma_um);
   const Eigen::VectorXd after = res.before_um - pred;

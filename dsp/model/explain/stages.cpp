@@ -43,6 +43,19 @@ std::map<std::string, double> toward_zero(const std::map<std::string, double>& v
   return out;
 }
 
+std::map<std::string, double> away_from_zero(const std::map<std::string, double>& value,
+                                             const std::map<std::string, double>& sigma, double k) {
+  std::map<std::string, double> out = value;
+  for (auto& [name, x] : out)
+    if (const auto sg = sigma.find(name); sg != sigma.end()) x += std::copysign(k * sg->second, x);
+  return out;
+}
+
+double magnitude_sigma(double magnitude, double toward, double away) {
+  const double m = std::abs(magnitude);
+  return 0.5 * std::max(std::abs(away) - m, m - std::abs(toward));
+}
+
 std::optional<double> axes_mean(const std::map<std::string, double>& value, const std::string& name) {
   double sum = 0.0;
   int cnt = 0;

@@ -81,6 +81,15 @@ std::string fmt(const char* f, Num... v) {
 std::map<std::string, double> toward_zero(const std::map<std::string, double>& value,
                                           const std::map<std::string, double>& sigma, double k = 2.0);
 
+// The same moved k standard errors away from zero: with toward_zero, the interval whose
+// magnitudes give the size's own σ (magnitude_sigma).
+std::map<std::string, double> away_from_zero(const std::map<std::string, double>& value,
+                                             const std::map<std::string, double>& sigma, double k = 2.0);
+
+// σ of a size from its magnitude at the fitted values and at the values moved 2σ towards
+// and away from zero: the wider half-interval, halved.
+double magnitude_sigma(double magnitude, double toward, double away);
+
 // A parameter fitted per axis ("name@x", "name@y") as one value: their mean (nullopt: none).
 std::optional<double> axes_mean(const std::map<std::string, double>& value, const std::string& name);
 
