@@ -97,7 +97,7 @@ std::vector<ShakeTuneMeasurement> read_shaketune_stdata(const std::filesystem::p
     nlohmann::json j;
     try {
       j = nlohmann::json::parse(line);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {  // parse_error, and out_of_range for a number like 1e2500
       throw dsp::InputError(where + ": not JSON (" + e.what() + ")");
     }
     out.push_back(measurement_of(j, where, source));

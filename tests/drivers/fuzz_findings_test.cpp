@@ -2,6 +2,7 @@
 // review-* by reading the reader while writing its target), through the normal readers:
 // the clean one-line error naming the file, nothing else.
 #include "drivers/import/capture_files.hpp"
+#include "drivers/import/shaketune_file.hpp"
 #include "drivers/import/uniform_clock.hpp"
 #include "drivers/run_io/run_reader.hpp"
 #include "dsp/core/error.hpp"
@@ -106,6 +107,16 @@ TEST(DriversFuzz, GapsWhoseIndicesWouldOverflowAreRefused) {
   const std::string what = nc_trace_error("review-gaps-overflow-index", tmp);
   EXPECT_NE(what.find("loses more samples than the 7 recorded (time stamps in another unit?)"), std::string::npos)
       << what;
+}
+
+// A Shake&Tune line with 100.0e2500: nlohmann's parser throws out_of_range for a number no
+// double holds, not parse_error, and the reader caught only the latter: std::terminate.
+TEST(DriversFuzz, ShakeTuneNumberBeyondADoubleIsRefusedNamingTheLine) {
+  TempDir tmp;
+  const fs::path file = tmp.path / "capture.stdata";
+  std::ofstream(file, std::ios::binary) << corpus("shaketune_stdata", "finding-number-out-of-range");
+  const std::string what = error_of([&] { (void)eical::drivers::read_shaketune_stdata(file); });
+  EXPECT_NE(what.find(file.string() + ":1: not JSON"), std::string::npos) << what;
 }
 
 }  // namespace

@@ -109,6 +109,10 @@ TEST(ShakeTuneFile, EachBadFileIsRefusedByItsCause) {
   write_bytes(f, zstd_raw_frame("{\"name\": \"a\", \"samples\": [[1.0, 0, 0, 1]]}\n{\"name\": \"b\", \"samp"));
   EXPECT_NE(refusal(f).find("bad.stdata:2: not JSON"), std::string::npos) << refusal(f);
 
+  // A number no double holds is nlohmann's out_of_range, not a parse_error (found by the fuzzer).
+  write_bytes(f, zstd_raw_frame("{\"name\": \"a\", \"samples\": [[100.0e2500, 0, 0, 1]]}\n"));
+  EXPECT_NE(refusal(f).find("bad.stdata:1: not JSON"), std::string::npos) << refusal(f);
+
   write_bytes(f, zstd_raw_frame("{\"name\": \"a\", \"samples\": [[1.0, 0, 0, 1], [0.5, 0, 0, 1]]}\n"));
   EXPECT_NE(refusal(f).find("measurement 'a', sample 1: time"), std::string::npos) << refusal(f);
 
