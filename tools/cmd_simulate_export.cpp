@@ -7,6 +7,7 @@
 #include "sim/simulate.hpp"
 
 #include <cstdio>
+#include <utility>
 
 namespace eical::tools {
 namespace {
@@ -21,24 +22,23 @@ std::size_t gaps_of(const sim::CaptureSamples& s) {
   return gaps;
 }
 
-constexpr ExportFormat kFormats[] = {ExportFormat::klipper, ExportFormat::shaketune, ExportFormat::csv};
+// Each format and the name --export takes and truth.toml records (as ProgramKind's names).
+constexpr std::pair<ExportFormat, const char*> kFormatNames[] = {
+    {ExportFormat::klipper, "klipper"}, {ExportFormat::shaketune, "shaketune"}, {ExportFormat::csv, "csv"}};
 
 }  // namespace
 
 const char* export_format_name(ExportFormat format) {
-  switch (format) {
-    case ExportFormat::klipper: return "klipper";
-    case ExportFormat::shaketune: return "shaketune";
-    case ExportFormat::csv: return "csv";
-  }
+  for (const auto& [f, name] : kFormatNames)
+    if (f == format) return name;
   return "?";
 }
 
 ExportFormat parse_export_format(const std::string& name) {
   std::string names;
-  for (const ExportFormat f : kFormats) {
-    if (name == export_format_name(f)) return f;
-    names += std::string(names.empty() ? "" : ", ") + export_format_name(f);
+  for (const auto& [f, text] : kFormatNames) {
+    if (name == text) return f;
+    names += std::string(names.empty() ? "" : ", ") + text;
   }
   throw dsp::InputError("simulate --export: '" + name + "' is not one of " + names);
 }

@@ -164,10 +164,8 @@ Eigen::VectorXd without_modes(const ExplainState& st, const Eigen::VectorXd& r, 
 Eigen::VectorXd without_differential_mode(const ExplainState& st, const Eigen::VectorXd& r, const Channel& rows,
                                           double& found_hz) {
   found_hz = 0.0;
-  const auto d = std::find_if(st.effects.begin(), st.effects.end(), [](const ExplainedEffect& e) {
-    return e.name == name(Effect::machine_differential_vibration);
-  });
-  if (d == st.effects.end() || !d->significant || r.size() < 64) return r;
+  const ExplainedEffect* d = st.find(name(Effect::machine_differential_vibration));
+  if (!d || !d->significant || r.size() < 64) return r;
   const double n = static_cast<double>(r.size()), rss0 = r.squaredNorm();
   if (!(rss0 > 0.0)) return r;
   const double f_max = std::min(100.0, 0.4 / st.rr.dt_s);

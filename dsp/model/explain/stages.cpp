@@ -13,6 +13,12 @@ ExplainedEffect* ExplainState::find(std::string_view name) {
   return nullptr;
 }
 
+const ExplainedEffect* ExplainState::find(std::string_view name) const {
+  for (const auto& e : effects)
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
 void ExplainState::merge(ExplainedEffect e) { stage::merge(effects, std::move(e)); }
 
 void merge(std::vector<ExplainedEffect>& all, ExplainedEffect e) {

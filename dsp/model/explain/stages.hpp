@@ -55,6 +55,7 @@ struct ExplainState {
   } leftover;
 
   ExplainedEffect* find(std::string_view name);
+  [[nodiscard]] const ExplainedEffect* find(std::string_view name) const;
   // An effect found twice (two channels, two tests) is kept once: the significant or more
   // important finding, with the other's parameters added.
   void merge(ExplainedEffect e);
