@@ -157,8 +157,8 @@ void full_parameters(const EffectVerdict& v, const EffectModel& e, Eigen::Vector
     for (std::size_t q2 = 0; q2 < e.params.size(); ++q2)
       if (e.params[q2] == v.param_names[p]) {
         const double a = full[static_cast<Eigen::Index>(q2)], s2 = 2.0 * v.param_sigma[static_cast<Eigen::Index>(p)];
-        sure[static_cast<Eigen::Index>(q2)] = std::abs(a) > s2 ? a - std::copysign(s2, a) : 0.0;
-        far[static_cast<Eigen::Index>(q2)] = a + std::copysign(s2, a);
+        sure[static_cast<Eigen::Index>(q2)] = toward_zero(a, s2);
+        far[static_cast<Eigen::Index>(q2)] = away_from_zero(a, s2);
       }
 }
 

@@ -44,8 +44,7 @@ std::map<std::string, double> toward_zero(const std::map<std::string, double>& v
                                           const std::map<std::string, double>& sigma, double k) {
   std::map<std::string, double> out = value;
   for (auto& [name, x] : out)
-    if (const auto sg = sigma.find(name); sg != sigma.end())
-      x = std::abs(x) > k * sg->second ? x - std::copysign(k * sg->second, x) : 0.0;
+    if (const auto sg = sigma.find(name); sg != sigma.end()) x = toward_zero(x, k * sg->second);
   return out;
 }
 
@@ -53,7 +52,7 @@ std::map<std::string, double> away_from_zero(const std::map<std::string, double>
                                              const std::map<std::string, double>& sigma, double k) {
   std::map<std::string, double> out = value;
   for (auto& [name, x] : out)
-    if (const auto sg = sigma.find(name); sg != sigma.end()) x += std::copysign(k * sg->second, x);
+    if (const auto sg = sigma.find(name); sg != sigma.end()) x = away_from_zero(x, k * sg->second);
   return out;
 }
 

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <optional>
@@ -77,8 +78,15 @@ std::string fmt(const char* f, Num... v) {
   return buf;
 }
 
-// Each value moved k standard errors towards zero (to zero when within them): the size that
-// lies outside a band with confidence.
+// A value moved by `shift` (k standard errors) towards zero, to zero when within it: the
+// size that lies outside a band with confidence; and moved as far away from zero. Every
+// σ-shifted size (the maps below, a channel's parameter vectors) is made by these two.
+inline double toward_zero(double value, double shift) {
+  return std::abs(value) > shift ? value - std::copysign(shift, value) : 0.0;
+}
+inline double away_from_zero(double value, double shift) { return value + std::copysign(shift, value); }
+
+// Each value moved k standard errors towards zero (to zero when within them).
 std::map<std::string, double> toward_zero(const std::map<std::string, double>& value,
                                           const std::map<std::string, double>& sigma, double k = 2.0);
 
