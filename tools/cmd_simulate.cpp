@@ -94,6 +94,23 @@ std::vector<std::string> simulate_programs() {
   return names;
 }
 
+// The scenario of --program with its options; "sweep" is Klipper's resonance test, not a
+// calibration program (no ProgramKind of its own).
+sim::Scenario program_scenario(const SimulateOptions& o) {
+  const std::optional<dsp::ProgramKind> kind = dsp::parse_program_kind(o.program);
+  if (!kind) return sim::sweep_scenario(sweep_test(o), sim::nc::test_direction(o.sweep_axis, "--sweep-axis"), o.seed);
+  switch (*kind) {
+    case dsp::ProgramKind::circle:
+      return sim::circle_scenario(o.radius_mm, o.feed_mm_min, o.repeats, o.direction, o.seed);
+    case dsp::ProgramKind::step: return sim::step_scenario(o.from_mm, o.to_mm, o.feed_mm_min, o.runs, o.seed);
+    case dsp::ProgramKind::rectangle: return sim::rectangle_scenario(20.0, 10.0, o.feed_mm_min, o.plane, 1, o.seed);
+    case dsp::ProgramKind::freeform: return freeform_scenario(o.feed_mm_min, o.seed);
+    case dsp::ProgramKind::identify: return sim::identify_scenario(identify_strips(o), {"z"}, o.seed);
+    case dsp::ProgramKind::positioning: break;
+  }
+  return sim::positioning_scenario(o.targets, o.runs, o.feed_mm_min, o.seed);
+}
+
 sim::Scenario base_scenario(const SimulateOptions& o, bool program_given) {
   if (!o.regime.empty()) {
     if (!o.scenario.empty() || program_given)
@@ -113,18 +130,10 @@ sim::Scenario base_scenario(const SimulateOptions& o, bool program_given) {
       throw dsp::InputError("simulate --hide/--background: --program must be circle or step");
     return sim::hidden_effect_scenario(o.hide, kind, o.seed);
   }
-  sim::Scenario sc =
-      o.program == "circle"      ? sim::circle_scenario(o.radius_mm, o.feed_mm_min, o.repeats, o.direction, o.seed)
-      : o.program == "step"      ? sim::step_scenario(o.from_mm, o.to_mm, o.feed_mm_min, o.runs, o.seed)
-      : o.program == "rectangle" ? sim::rectangle_scenario(20.0, 10.0, o.feed_mm_min, o.plane, 1, o.seed)
-      : o.program == "freeform"  ? freeform_scenario(o.feed_mm_min, o.seed)
-      : o.program == "identify"  ? sim::identify_scenario(identify_strips(o), {"z"}, o.seed)
-      : o.program == "sweep"
-          ? sim::sweep_scenario(sweep_test(o), sim::nc::test_direction(o.sweep_axis, "--sweep-axis"), o.seed)
-          : sim::positioning_scenario(o.targets, o.runs, o.feed_mm_min, o.seed);
+  sim::Scenario sc = program_scenario(o);
   if (const auto layout = plan::psd_layout(o.psd); layout.strips > 0)
     sc.meta.psd = sim::psd_ring(o.radius_mm, layout.strips, layout.facing);
-  if (o.program == "circle") {
+  if (sc.meta.program.kind == dsp::ProgramKind::circle && !sc.sweep.on) {
     sc.meta.program.plane = o.plane;
     sc.meta.program.arc_deg = o.arc_deg;
   }

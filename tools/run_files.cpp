@@ -1,6 +1,7 @@
 #include "tools/run_files.hpp"
 
 #include "dsp/analysis/figures.hpp"
+#include "dsp/analysis/program_descriptor.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/key_unit.hpp"
 #include "dsp/uncertainty/resolved.hpp"
@@ -50,14 +51,10 @@ int result_exit_code(dsp::Verdict verdict, const std::optional<dsp::Conformance>
 
 namespace {
 
+// A result section's heading: a program's own title, or the circle's diagnostics.
 const char* section_title(const std::string& section) {
-  if (section == "circle") return "circular test (ISO 230-4)";
-  if (section == "diagnostics") return "diagnostics";
-  if (section == "positioning") return "positioning (ISO 230-2)";
-  if (section == "step") return "step response";
-  if (section == "rectangle") return "rectangle";
-  if (section == "freeform") return "free form";
-  return "";
+  if (const auto kind = dsp::parse_program_kind(section)) return dsp::program_descriptor(*kind).title;
+  return section == "diagnostics" ? "diagnostics" : "";
 }
 
 }  // namespace

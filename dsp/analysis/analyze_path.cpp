@@ -7,7 +7,7 @@
 
 namespace eical::dsp::detail {
 
-void evaluate_rectangle_program(const Run& run, Analysis& a) {
+void evaluate_rectangle_program(const Run& run, Analysis& a, const EvaluationOptions&) {
   const Measurement& m = a.measurement;
   const auto [ia, ib] = plane_axes(run.meta.program.plane);
   std::vector<Eigen::Vector2d> cmd, meas;
@@ -41,7 +41,7 @@ void evaluate_rectangle_program(const Run& run, Analysis& a) {
   }
 }
 
-void evaluate_freeform_program(const Run& run, Analysis& a) {
+void evaluate_freeform_program(const Run& run, Analysis& a, const EvaluationOptions&) {
   (void)run;
   const Measurement& m = a.measurement;
   try {

@@ -1,5 +1,7 @@
 #include "dsp/analysis/channel_findings.hpp"
 
+#include "dsp/analysis/program_descriptor.hpp"
+
 #include <cmath>
 #include <cstdio>
 
@@ -57,21 +59,25 @@ bool measures_nothing(health::Fault f) {
 
 std::string program_text(const Program& p) {
   const std::string kind(program_kind_name(p.kind));
-  if (p.kind == ProgramKind::step || p.kind == ProgramKind::positioning) return "the " + kind + " along " + p.axis;
-  if (p.kind == ProgramKind::circle || p.kind == ProgramKind::rectangle || p.kind == ProgramKind::freeform)
-    return "the " + kind + " in " + p.plane;
+  switch (program_descriptor(p.kind).motion) {
+    case ProgramMotion::along_axis: return "the " + kind + " along " + p.axis;
+    case ProgramMotion::in_plane: return "the " + kind + " in " + p.plane;
+    case ProgramMotion::swings: break;
+  }
   return "the " + kind;
 }
 
 }  // namespace
 
 unsigned program_axes(const Program& program) {
-  const ProgramKind k = program.kind;
-  if (k == ProgramKind::circle || k == ProgramKind::rectangle || k == ProgramKind::freeform) {
-    const auto [a, b] = plane_axes(program.plane);
-    return (1u << a) | (1u << b);
+  switch (program_descriptor(program.kind).motion) {
+    case ProgramMotion::in_plane: {
+      const auto [a, b] = plane_axes(program.plane);
+      return (1u << a) | (1u << b);
+    }
+    case ProgramMotion::along_axis: return 1u << axis_of(program.axis);
+    case ProgramMotion::swings: break;
   }
-  if (k == ProgramKind::step || k == ProgramKind::positioning) return 1u << axis_of(program.axis);
   return 7u;
 }
 

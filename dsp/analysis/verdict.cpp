@@ -34,25 +34,9 @@ const FigureConformance* proven_either_way(const Analysis& a, const std::string&
 
 }  // namespace
 
-const std::vector<ResolutionLimit>& resolution_limits() {
-  static const std::vector<ResolutionLimit> limits = {
-      {ProgramKind::circle, "circle.circular_deviation_G_um", "circular deviation G", "circle.circular_deviation_G_um",
-       "G", 10.0},
-      {ProgramKind::positioning, "positioning.A_um", "positioning accuracy A", "positioning.E_um", "E", 5.0},
-      {ProgramKind::step, "step.largest_step_measured_um", "the measured step", "step.end_position_error_um",
-       "the end-position error", 2.0},
-      {ProgramKind::rectangle, "rectangle.corner_error_max_um", "the largest corner error",
-       "rectangle.corner_error_max_um", "the corner error", 10.0},
-      {ProgramKind::freeform, "freeform.contour_error_max_um", "the largest contour error",
-       "freeform.contour_error_max_um", "the contour error", 10.0},
-  };
-  return limits;
-}
-
 const ResolutionLimit* resolution_limit(ProgramKind program) {
-  for (const auto& l : resolution_limits())
-    if (program == l.program) return &l;
-  return nullptr;
+  const auto& r = program_descriptor(program).resolution;
+  return r ? &*r : nullptr;
 }
 
 void judge(const Program& program, Analysis& a) {

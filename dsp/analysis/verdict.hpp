@@ -1,7 +1,7 @@
 #pragma once
 // quality.verdict of a result (verdict_kind.hpp):
 //   not_measurable  the uncertainty of the program's limited figure exceeds what the test
-//                   is meant to resolve (the table below), or nothing holds the position;
+//                   is meant to resolve (program_descriptor.hpp), or nothing holds the position;
 //   degraded        a quality flag (lost frames, saturation, the strips disagreeing, ...);
 //   ok              otherwise.
 // The figures are given in every case, with their uncertainty. A figure below its own U is
@@ -14,22 +14,14 @@
 // test resolves end positions to a few µm, a rectangle its corners, a free form its
 // contour.
 #include "dsp/analysis/analyze_run.hpp"
+#include "dsp/analysis/program_descriptor.hpp"
 
 #include <string>
 #include <vector>
 
 namespace eical::dsp {
 
-struct ResolutionLimit {
-  ProgramKind program;
-  const char* headline;  // result key of the headline figure (must exceed its U)
-  const char* name;      // as a user reads it
-  const char* limited;   // result key whose U must stay within `limit_um`
-  const char* limited_name;
-  double limit;  // in the limited figure's unit (its key's suffix, dsp::unit_of_key)
-};
-
-const std::vector<ResolutionLimit>& resolution_limits();
+// What the program must resolve (its row of program_descriptor.cpp); null: nothing.
 const ResolutionLimit* resolution_limit(ProgramKind program);
 
 // Sets a.verdict and a.verdict_reasons from the figures, their uncertainty and the flags.

@@ -2,7 +2,9 @@
 // (a critical psd_disagrees never looks like the note that H needs both directions); the
 // ISO 14253-1 decision against tolerances.
 #include "dsp/analysis/verdict.hpp"
+#include "dsp/analysis/channel_findings.hpp"
 #include "dsp/analysis/conformance.hpp"
+#include "dsp/analysis/program_descriptor.hpp"
 #include "dsp/core/flag.hpp"
 
 #include <gtest/gtest.h>
@@ -167,14 +169,35 @@ TEST(FlagSeverity, EveryCodeHasItsOwnNameAndAText) {
   }
 }
 
-TEST(Verdict, EveryProgramHasALimit) {
-  for (const ProgramKind kind : {ProgramKind::circle, ProgramKind::positioning, ProgramKind::step,
-                                 ProgramKind::rectangle, ProgramKind::freeform}) {
-    const ResolutionLimit* l = resolution_limit(kind);
-    ASSERT_NE(l, nullptr) << program_kind_name(kind);
-    EXPECT_GT(l->limit, 0.0);
+TEST(ProgramDescriptor, EveryKindHasItsRowAndEveryEvaluatedProgramALimit) {
+  std::set<ProgramKind> kinds;
+  for (const ProgramDescriptor& d : program_descriptors()) {
+    EXPECT_TRUE(kinds.insert(d.kind).second) << program_kind_name(d.kind) << " twice";
+    EXPECT_EQ(&program_descriptor(d.kind), &d) << program_kind_name(d.kind);
+    EXPECT_NE(std::string(d.title), "") << program_kind_name(d.kind);
+    EXPECT_NE(std::string(d.report_title), "") << program_kind_name(d.kind);
+    // A program analyze evaluates has a verdict on its U, and the reverse.
+    EXPECT_EQ(d.evaluate != nullptr, d.resolution.has_value()) << program_kind_name(d.kind);
+    if (d.resolution) {
+      EXPECT_GT(d.resolution->limit, 0.0) << program_kind_name(d.kind);
+    }
   }
+  EXPECT_EQ(kinds.size(), kProgramKindNames.size());
   EXPECT_EQ(resolution_limit(ProgramKind::identify), nullptr);
+  EXPECT_TRUE(program_descriptor(ProgramKind::rectangle).nbs_by_default);
+  EXPECT_FALSE(program_descriptor(ProgramKind::circle).nbs_by_default);
+}
+
+// The motion's geometry decides which channels a program needs: a positioning test along
+// y needs y alone, a circle in zx both z and x.
+TEST(ProgramDescriptor, MotionNamesTheAxesAProgramMoves) {
+  Program p;
+  p.kind = ProgramKind::positioning, p.axis = "y";
+  EXPECT_EQ(program_axes(p), 2u);
+  p.kind = ProgramKind::circle, p.plane = "zx";
+  EXPECT_EQ(program_axes(p), 5u);
+  p.kind = ProgramKind::identify;
+  EXPECT_EQ(program_axes(p), 7u);
 }
 
 TEST(Conformance, Iso14253DecisionRule) {

@@ -1,6 +1,7 @@
 #include "tools/report/run_report.hpp"
 
 #include "drivers/results/software_version.hpp"
+#include "dsp/analysis/program_descriptor.hpp"
 #include "dsp/analysis/verdict.hpp"
 #include "dsp/core/float_limits.hpp"
 
@@ -97,15 +98,6 @@ std::string program_line(const dsp::Program& p) {
   if (p.kind == dsp::ProgramKind::freeform)
     return "free-form path (G-code of the run), F " + fmt("%g", p.feed_mm_min) + " mm/min";
   return dsp::program_kind_name(p.kind) + std::string(" program");
-}
-
-std::string title_for(dsp::ProgramKind kind) {
-  if (kind == dsp::ProgramKind::circle) return "Circular test report";
-  if (kind == dsp::ProgramKind::positioning) return "Positioning test report";
-  if (kind == dsp::ProgramKind::step) return "Step response report";
-  if (kind == dsp::ProgramKind::rectangle) return "Rectangle test report";
-  if (kind == dsp::ProgramKind::freeform) return "Free-form contour report";
-  return "Measurement report";
 }
 
 // The headline figures' U beside their noise bound and, when the analysis has one, the
@@ -254,7 +246,7 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, co
   CsvFiles csv(dir);
   Page page;
   const auto& p = run.meta.program;
-  page.title = title_for(p.kind);
+  page.title = dsp::program_descriptor(p.kind).report_title;
   page.run_id = run.meta.id;
   page.program = program_line(p);
   const Tolerances tol = options.tolerances.value_or(Tolerances{});
