@@ -6,11 +6,13 @@
 #include "dsp/analysis/verdict.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <initializer_list>
 #include <map>
 #include <stdexcept>
+#include <utility>
 
 namespace eical::drivers {
 
@@ -189,12 +191,12 @@ nlohmann::json quality_json(const dsp::Analysis& a, const std::vector<dsp::Flag>
   return q;
 }
 
-// circle and diagnostics: the evaluation's, or for a circle program whose evaluation failed
-// every key null.
-void add_circle(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
+// Each program's section of the result: the evaluation's, or, when it failed, every key
+// null (a reader finds the section of the run's program either way).
+void circle_section(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
   if (a.circle) {
     j["circle"] = circle_json(p, *a.circle);
-  } else if (p.kind == dsp::ProgramKind::circle) {
+  } else {
     j["circle"] = all_null({"radius_mean_deviation_um", "circular_deviation_G_um", "circular_hysteresis_H_um",
                             "radial_deviation_F_max_um", "radial_deviation_F_min_um"});
     j["circle"]["plane"] = p.plane;
@@ -205,27 +207,27 @@ void add_circle(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j
                             {"radius_deviation_um", nlohmann::json::array()},
                             {"direction", nlohmann::json::array()}};
   }
-  if (a.diagnostics) {
-    j["diagnostics"] = diagnostics_json(*a.diagnostics);
-  } else if (p.kind == dsp::ProgramKind::circle) {
-    j["diagnostics"] =
-        all_null({"backlash_x_um", "backlash_y_um", "reversal_spike_x_um", "reversal_spike_y_um", "lateral_play_x_um",
-                  "lateral_play_y_um", "cyclic_error_x_um", "cyclic_error_y_um", "servo_mismatch_ms", "squareness_urad",
-                  "scale_mismatch_ppm", "straightness_x_um", "straightness_y_um", "stick_slip_um", "vibration_um"});
-  }
+  j["diagnostics"] = a.diagnostics
+                         ? diagnostics_json(*a.diagnostics)
+                         : all_null({"backlash_x_um", "backlash_y_um", "reversal_spike_x_um", "reversal_spike_y_um",
+                                     "lateral_play_x_um", "lateral_play_y_um", "cyclic_error_x_um", "cyclic_error_y_um",
+                                     "servo_mismatch_ms", "squareness_urad", "scale_mismatch_ppm", "straightness_x_um",
+                                     "straightness_y_um", "stick_slip_um", "vibration_um"});
 }
 
-// step and positioning, likewise.
-void add_step_and_positioning(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
+void step_section(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
   if (a.step) {
     j["step"] = step_json(a.step_axis, *a.step);
-  } else if (p.kind == dsp::ProgramKind::step) {
+  } else {
     j["step"] = all_null({"end_position_error_um", "scatter_um", "overshoot_um", "settling_s"});
     j["step"]["axis"] = p.axis;
   }
+}
+
+void positioning_section(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
   if (a.positioning && a.positioning_input) {
     j["positioning"] = positioning_json(*a.positioning_input, *a.positioning, true);
-  } else if (p.kind == dsp::ProgramKind::positioning) {
+  } else {
     j["positioning"] = all_null({"deviation_um"});
     for (const auto& f : dsp::eval::iso230_2_figures({})) j["positioning"][f.key] = nullptr;
     j["positioning"]["axis"] = p.axis;
@@ -234,18 +236,31 @@ void add_step_and_positioning(const dsp::Program& p, const dsp::Analysis& a, nlo
   }
 }
 
-// rectangle (with its path deviation) and free form, likewise.
-void add_rectangle_and_freeform(dsp::ProgramKind kind, const dsp::Analysis& a, nlohmann::json& j) {
-  if (a.rectangle) {
-    j["rectangle"] = rectangle_json(*a.rectangle);
-  } else if (kind == dsp::ProgramKind::rectangle) {
-    j["rectangle"] = all_null({"corners_mm", "corner_errors_um"});
-  }
-  if (kind == dsp::ProgramKind::rectangle && j["rectangle"].is_object())
-    j["rectangle"]["path_deviation"] = a.path ? path_json(*a.path) : nlohmann::json(nullptr);
-  if (kind == dsp::ProgramKind::freeform)
-    j["freeform"] =
-        a.path ? path_json(*a.path) : all_null({"contour_error_max_um", "contour_error_rms_um", "tangential_rms_um"});
+void rectangle_section(const dsp::Program&, const dsp::Analysis& a, nlohmann::json& j) {
+  j["rectangle"] = a.rectangle ? rectangle_json(*a.rectangle) : all_null({"corners_mm", "corner_errors_um"});
+  j["rectangle"]["path_deviation"] = a.path ? path_json(*a.path) : nlohmann::json(nullptr);
+}
+
+void freeform_section(const dsp::Program&, const dsp::Analysis& a, nlohmann::json& j) {
+  j["freeform"] =
+      a.path ? path_json(*a.path) : all_null({"contour_error_max_um", "contour_error_rms_um", "tangential_rms_um"});
+}
+
+// Per ProgramKind, in the enum's order (the identification has no section: `eical
+// identify` writes the calibration).
+using SectionWriter = void (*)(const dsp::Program&, const dsp::Analysis&, nlohmann::json&);
+constexpr std::array<std::pair<dsp::ProgramKind, SectionWriter>, 6> kSections = {{
+    {dsp::ProgramKind::step, step_section},
+    {dsp::ProgramKind::positioning, positioning_section},
+    {dsp::ProgramKind::rectangle, rectangle_section},
+    {dsp::ProgramKind::circle, circle_section},
+    {dsp::ProgramKind::freeform, freeform_section},
+    {dsp::ProgramKind::identify, nullptr},
+}};
+
+void add_program_section(const dsp::Program& p, const dsp::Analysis& a, nlohmann::json& j) {
+  for (const auto& [kind, write] : kSections)
+    if (kind == p.kind && write) write(p, a, j);
 }
 
 // How the pipeline ran: its windows, the dynamic compensation, NBS, Coriolis.
@@ -363,9 +378,7 @@ nlohmann::json result_json(const dsp::Run& run, const dsp::Analysis& analysis) {
       {"method", analysis.uncertainty_note},
       {"resolved_rule", "a figure is resolved when |value| > U (k = 2); one that is not is never compensated"}};
   j["sensor_model"] = {{"identified", analysis.sensor_model != "datasheet"}, {"source", analysis.sensor_model}};
-  add_circle(run.meta.program, analysis, j);
-  add_step_and_positioning(run.meta.program, analysis, j);
-  add_rectangle_and_freeform(run.meta.program.kind, analysis, j);
+  add_program_section(run.meta.program, analysis, j);
   if (analysis.circle_accuracy_rms_um) {
     j["reference_comparison"] = {
         {"reference", run.meta.reference ? run.meta.reference->kind : "ref"},
