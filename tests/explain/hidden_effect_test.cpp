@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
@@ -92,6 +93,22 @@ TEST_P(Baseline, ShowsNoSignificantEffect) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Programs, Baseline, ::testing::Values("circle", "step"));
+
+// The head vibrating against the table is named from the spectra; the reference then
+// sees its ringing, which the mode fitted there must account for, not leave to a foreign
+// other.unexplained. On seeds 21–32 of the step program that finding came with it on 3 of
+// 12 while the mode was fitted beside the table's effects instead of with them (issue 34);
+// 21 and 26 were two of them.
+TEST(DifferentialVibration, TheReferencesRingingIsTheModeNotAnUnexplainedFinding) {
+  for (std::uint64_t seed : {21, 22, 26}) {
+    const auto sig = significant(explain_hidden({"machine.differential_vibration"}, dsp::ProgramKind::step, seed));
+    std::printf("machine.differential_vibration seed %llu: %s\n", static_cast<unsigned long long>(seed),
+                joined(sig).c_str());
+    ASSERT_FALSE(sig.empty()) << "seed " << seed;
+    EXPECT_EQ(sig.front(), "machine.differential_vibration") << "seed " << seed;
+    EXPECT_EQ(std::count(sig.begin(), sig.end(), "other.unexplained"), 0) << "seed " << seed << ": " << joined(sig);
+  }
+}
 
 class TwoEffects : public ::testing::TestWithParam<std::vector<std::string>> {};
 

@@ -16,7 +16,8 @@ namespace {
 struct ChannelResult {
   std::vector<ExplainedEffect> effects;
   Eigen::VectorXd before_um, after_um;
-  Eigen::VectorXd unexplained_um;  // after every candidate of the table, fitted freely together
+  Eigen::VectorXd unexplained_um;     // after every candidate of the table, fitted freely together
+  Eigen::MatrixXd unexplained_basis;  // orthonormal: the weighted columns unexplained_um is without
   std::vector<bool> heldout;
 };
 
@@ -65,16 +66,23 @@ Eigen::MatrixXd base_columns(const RunResiduals& rr, const Channel& ch, const La
   return m;
 }
 
-// What no effect of the table accounts for: the residual after all candidates at once. An
-// effect below its tolerance is background, not unexplained (run-format.md).
-Eigen::VectorXd without_all(const Eigen::VectorXd& y, const std::vector<Candidate>& cands) {
+// What no effect of the table accounts for: the residual after all candidates at once (an
+// effect below its tolerance is background, not unexplained: run-format.md), and an
+// orthonormal basis of everything it is without — the base model's columns `base` and
+// the candidates' — for a model sought in it later (ExplainState::machine_projected).
+Eigen::VectorXd without_all(const Eigen::VectorXd& y, const std::vector<Candidate>& cands, const Eigen::MatrixXd& base,
+                            Eigen::MatrixXd& basis) {
   Eigen::Index cols = 0;
   for (const auto& c : cands) cols += c.regressors.cols();
-  if (cols == 0 || cols >= y.size() / 2) return y;
-  Eigen::MatrixXd x(y.size(), cols);
-  Eigen::Index at = 0;
-  for (const auto& c : cands) x.middleCols(at, c.regressors.cols()) = c.regressors, at += c.regressors.cols();
-  return y - x * x.colPivHouseholderQr().solve(y);
+  if (cols >= y.size() / 2) cols = 0;  // as many columns as rows would fit anything
+  Eigen::MatrixXd x(y.size(), base.cols() + cols);
+  x.leftCols(base.cols()) = base;
+  Eigen::Index at = base.cols();
+  if (cols > 0)
+    for (const auto& c : cands) x.middleCols(at, c.regressors.cols()) = c.regressors, at += c.regressors.cols();
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(x);
+  basis = qr.householderQ() * Eigen::MatrixXd::Identity(y.size(), qr.rank());
+  return y - basis * (basis.transpose() * y);
 }
 
 // The base model's columns projected out (an orthonormal basis of them).
@@ -211,7 +219,7 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
   out.after_um = out.before_um;
   if (cands.empty() || rows < 50) return out;
   const SelectionResult sel = select_effects(y, cands, out.heldout, channel_selection_options(rr, ch, o));
-  out.unexplained_um = without_all(y, cands).cwiseProduct(ch.sigma_um);
+  out.unexplained_um = without_all(y, cands, project.q, out.unexplained_basis).cwiseProduct(ch.sigma_um);
   for (const auto& v : sel.effects) {
     std::size_t k = 0;
     while (k < cands.size() && cands[k].name != v.name) ++k;
@@ -240,6 +248,8 @@ void fit_reference_channel(ExplainState& st) {
   st.leftover.machine_noise_um = 1.4826 * median(d, 0.0) / std::sqrt(2.0);
   st.leftover.machine_residual = r;
   st.leftover.machine_rows = &st.rr.machine;
+  if (fit.unexplained_um.size() == r.size())
+    st.leftover.machine_basis = fit.unexplained_basis, st.leftover.machine_sigma_um = st.rr.machine.sigma_um;
 }
 
 }  // namespace eical::dsp::model::stage

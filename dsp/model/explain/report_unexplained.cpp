@@ -85,10 +85,13 @@ std::vector<Eigen::VectorXd> mode_columns(const ExplainState& st, const Channel&
   return cols;
 }
 
-Eigen::VectorXd residual_of(const Eigen::VectorXd& r, const std::vector<Eigen::VectorXd>& cols) {
+// The machine residual r less its fit by `cols`, each column first left without what r is
+// without (the base model and the table: ExplainState::machine_projected).
+Eigen::VectorXd residual_of(const ExplainState& st, const Eigen::VectorXd& r,
+                            const std::vector<Eigen::VectorXd>& cols) {
   if (cols.empty()) return r;
   Eigen::MatrixXd x(r.size(), static_cast<Eigen::Index>(cols.size()));
-  for (std::size_t c = 0; c < cols.size(); ++c) x.col(static_cast<Eigen::Index>(c)) = cols[c];
+  for (std::size_t c = 0; c < cols.size(); ++c) x.col(static_cast<Eigen::Index>(c)) = st.machine_projected(cols[c]);
   return r - x * x.colPivHouseholderQr().solve(r);
 }
 
@@ -131,12 +134,12 @@ Eigen::VectorXd without_modes(const ExplainState& st, const Eigen::VectorXd& r, 
   };
   // The modes' columns once (no loop yet); each candidate loop beside them alone.
   const std::vector<Eigen::VectorXd> modes = all_cols(fz.size());
-  double best_loop = residual_of(r, modes).squaredNorm();
+  double best_loop = residual_of(st, r, modes).squaredNorm();
   for (double tau_ms = 0.0; tau_ms <= 100.0; tau_ms += tau_ms < 60.0 ? 2.0 : 10.0) {
     std::vector<Eigen::VectorXd> cols = loop_columns(st, rows, tau_ms * 1e-3);
     const std::size_t n_loop = cols.size();
     cols.insert(cols.end(), modes.begin(), modes.end());
-    if (const double rss = residual_of(r, cols).squaredNorm(); rss < best_loop)
+    if (const double rss = residual_of(st, r, cols).squaredNorm(); rss < best_loop)
       best_loop = rss, loop.assign(cols.begin(), cols.begin() + static_cast<std::ptrdiff_t>(n_loop));
   }
   for (std::size_t m = 0; m < fz.size(); ++m) {
@@ -148,11 +151,11 @@ Eigen::VectorXd without_modes(const ExplainState& st, const Eigen::VectorXd& r, 
         const double f = f0 * (1.0 + 0.005 * fi), z = z0 * std::pow(1.12, zi);
         auto cols = others;
         for (auto& c : mode_columns(st, rows, f, z)) cols.push_back(std::move(c));
-        const double rss = residual_of(r, cols).squaredNorm();
+        const double rss = residual_of(st, r, cols).squaredNorm();
         if (rss < best) best = rss, fz[m] = {f, z};
       }
   }
-  return residual_of(r, all_cols(fz.size()));
+  return residual_of(st, r, all_cols(fz.size()));
 }
 
 // The head vibrating against the table at a mode the motion drives too weakly for the
@@ -174,7 +177,7 @@ Eigen::VectorXd without_differential_mode(const ExplainState& st, const Eigen::V
   auto consider = [&](double f, double z) {
     const auto cols = mode_columns(st, rows, f, z);
     if (cols.empty()) return;
-    Eigen::VectorXd left = residual_of(r, cols);
+    Eigen::VectorXd left = residual_of(st, r, cols);
     const double bic = n * std::log(left.squaredNorm() / rss0) + static_cast<double>(cols.size() + 2) * std::log(n);
     if (bic < best_bic) best_bic = bic, best = std::move(left), best_f = f, best_z = z;
   };

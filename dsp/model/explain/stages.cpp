@@ -40,6 +40,14 @@ ExplainedEffect effect_of(Effect e) {
   return x;
 }
 
+Eigen::VectorXd ExplainState::machine_projected(const Eigen::VectorXd& column_um) const {
+  const Eigen::MatrixXd& q = leftover.machine_basis;
+  const Eigen::VectorXd& sigma = leftover.machine_sigma_um;
+  if (q.rows() != column_um.size() || sigma.size() != column_um.size()) return column_um;
+  const Eigen::VectorXd w = column_um.cwiseQuotient(sigma);
+  return (w - q * (q.transpose() * w)).cwiseProduct(sigma);
+}
+
 std::map<std::string, double> toward_zero(const std::map<std::string, double>& value,
                                           const std::map<std::string, double>& sigma, double k) {
   std::map<std::string, double> out = value;

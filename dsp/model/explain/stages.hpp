@@ -53,7 +53,17 @@ struct ExplainState {
     double machine_rms_um = 0.0, machine_noise_um = 0.0;   // reference − set-point
     Eigen::VectorXd machine_residual;
     const Channel* machine_rows = nullptr;
+    // The residual is what the base model and the whole table leave: an orthonormal basis
+    // of their weighted columns, and the rows' σ. A model sought in it afterwards (a mode)
+    // must leave the same columns out of its own (machine_projected), or the table's fit
+    // keeps part of its signal and the search chases the rest (Frisch–Waugh–Lovell).
+    Eigen::MatrixXd machine_basis;
+    Eigen::VectorXd machine_sigma_um;
   } leftover;
+
+  // A column on the machine rows (µm) as the residual sees it: weighted, the base model and
+  // the table left out, back in µm. Unchanged when no basis was kept.
+  [[nodiscard]] Eigen::VectorXd machine_projected(const Eigen::VectorXd& column_um) const;
 
   ExplainedEffect* find(std::string_view name);
   [[nodiscard]] const ExplainedEffect* find(std::string_view name) const;
