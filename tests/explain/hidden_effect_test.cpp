@@ -110,6 +110,20 @@ TEST(DifferentialVibration, TheReferencesRingingIsTheModeNotAnUnexplainedFinding
   }
 }
 
+// Static friction that makes an axis stick-slip also holds it at each reversal: the lag
+// there, within the slips' sawtooth, is the stick-slip's. On seeds 41–45 a reversal spike
+// was named beside it on 4 of 5 (the simulated machine had none); 41, 42 and 45 were three.
+TEST(StickSlip, TheBreakawayAtAReversalIsNotASecondEffect) {
+  for (std::uint64_t seed : {41, 42, 45}) {
+    const auto sig = significant(explain_hidden({"machine.stick_slip"}, sim::program_for("machine.stick_slip"), seed));
+    std::printf("machine.stick_slip seed %llu: %s\n", static_cast<unsigned long long>(seed), joined(sig).c_str());
+    ASSERT_FALSE(sig.empty()) << "seed " << seed;
+    EXPECT_EQ(sig.front(), "machine.stick_slip") << "seed " << seed;
+    EXPECT_EQ(std::count(sig.begin(), sig.end(), "machine.reversal_spike"), 0)
+        << "seed " << seed << ": " << joined(sig);
+  }
+}
+
 class TwoEffects : public ::testing::TestWithParam<std::vector<std::string>> {};
 
 TEST_P(TwoEffects, BothNamed) {
