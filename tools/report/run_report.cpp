@@ -290,11 +290,7 @@ fs::path write_run_report(const dsp::Run& run, const dsp::Analysis& analysis, co
   }
   page.traceability = traceability(run, analysis, options);
   page.approval = {{"performed by", op}, {"approved by", ""}, {"date", ""}, {"signature", ""}, {"remarks", ""}};
-  circle_sections(run, analysis, page, csv);
-  positioning_sections(run, analysis, page, csv);
-  step_sections(analysis, page, csv);
-  if (p.kind == dsp::ProgramKind::rectangle) rectangle_sections(run, analysis, page, csv);
-  if (p.kind == dsp::ProgramKind::freeform) freeform_sections(run, analysis, page, csv);
+  program_sections(run, analysis, page, csv);
   measurement_section(analysis, page, csv);
   page.files = csv.names();
   if (csv.thinned())

@@ -53,10 +53,13 @@ std::string fmt(const char* format, double v);
 // "+X", "+Y", "+Z" for the plane's two axes (xy → X, Y; zx → Z, X; yz → Y, Z).
 std::pair<std::string, std::string> plane_axis_names(const std::string& plane);
 
+// Each program's sections of the report (one file each), nothing when its evaluation is
+// missing; program_sections() calls the one of the run's kind.
 void circle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv);
 void positioning_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv);
-void step_sections(const dsp::Analysis& a, Page& page, CsvFiles& csv);
+void step_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv);
 void rectangle_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv);
 void freeform_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv);
+void program_sections(const dsp::Run& run, const dsp::Analysis& a, Page& page, CsvFiles& csv);
 
 }  // namespace eical::tools::report

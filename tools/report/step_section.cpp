@@ -9,7 +9,7 @@
 
 namespace eical::tools::report {
 
-void step_sections(const dsp::Analysis& a, Page& page, CsvFiles& csv) {
+void step_sections(const dsp::Run&, const dsp::Analysis& a, Page& page, CsvFiles& csv) {
   if (!a.step) return;
   const auto& st = *a.step;
   const auto& m = a.measurement;
