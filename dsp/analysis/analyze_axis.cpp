@@ -1,6 +1,7 @@
 // The programs along one axis: the step response and ISO 230-2 positioning.
 #include "dsp/analysis/analyze_run.hpp"
 #include "dsp/analysis/program_evaluations.hpp"
+#include "dsp/core/axes.hpp"
 #include "dsp/core/error.hpp"
 #include "dsp/core/float_limits.hpp"
 
@@ -12,7 +13,8 @@
 namespace eical::dsp {
 namespace {
 
-int axis_index(const std::string& axis) { return axis == "y" ? 1 : axis == "z" ? 2 : 0; }
+// The program's axis (run.toml names one of x, y, z; x for anything else, as before).
+int program_axis(const std::string& axis) { return std::max(0, axis_index(axis)); }
 
 }  // namespace
 
@@ -20,7 +22,7 @@ namespace detail {
 
 void evaluate_step_program(const Run& run, Analysis& a, const EvaluationOptions&) {
   const Measurement& m = a.measurement;
-  const int ax = axis_index(run.meta.program.axis);
+  const int ax = program_axis(run.meta.program.axis);
   a.step_axis = run.meta.program.axis;
   std::vector<double> cmd, meas;
   for (std::size_t i = 0; i < m.sample_index.size(); ++i) {
@@ -71,7 +73,7 @@ void evaluate_positioning_program(const Run& run, Analysis& a, const EvaluationO
 }  // namespace detail
 
 eval::PositioningInput positioning_deviations(const Measurement& m, const Program& program) {
-  const int ax = axis_index(program.axis);
+  const int ax = program_axis(program.axis);
   eval::PositioningInput in;
   in.axis = program.axis;
   in.targets_mm = program.targets_mm;

@@ -1,7 +1,9 @@
 #include "dsp/analysis/channel_findings.hpp"
 
 #include "dsp/analysis/program_descriptor.hpp"
+#include "dsp/core/axes.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -14,7 +16,7 @@ constexpr double kAxisCoupling = 0.05;
 
 const char* const kAxisName[3] = {"X", "Y", "Z"};
 
-int axis_of(const std::string& a) { return a == "y" ? 1 : a == "z" ? 2 : 0; }
+int axis_of(const std::string& a) { return std::max(0, axis_index(a)); }
 
 std::string axes_text(unsigned axes) {
   std::string s;

@@ -1,6 +1,7 @@
 // Step response page (cross-grid encoder practice): position and set-point over time,
 // each move's arrival overlaid (measured − target against time since arrival), the
 // figures beside, one row per move below.
+#include "dsp/core/axes.hpp"
 #include "tools/report/sections.hpp"
 #include "tools/report/svg.hpp"
 
@@ -13,7 +14,7 @@ void step_sections(const dsp::Run&, const dsp::Analysis& a, Page& page, CsvFiles
   if (!a.step) return;
   const auto& st = *a.step;
   const auto& m = a.measurement;
-  const int ax = a.step_axis == "y" ? 1 : a.step_axis == "z" ? 2 : 0;
+  const int ax = std::max(0, dsp::axis_index(a.step_axis));
   Section s;
   s.heading = "Step response (axis " + a.step_axis + ")";
   s.lead =
