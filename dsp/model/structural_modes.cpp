@@ -19,8 +19,22 @@ namespace {
 
 constexpr double kTargetDfHz = 0.25;  // resolves ζ ≈ 0.01 at 15 Hz (half-power band 2ζf)
 constexpr int kMinAverages = 4;
-constexpr double kMinCoherence = 0.5;      // at a candidate peak: the input drives it
-constexpr double kProminence = 1.08;       // |H| over its neighbourhood's median
+constexpr double kMinCoherence = 0.5;  // at a candidate peak: the input drives it
+constexpr double kProminence = 1.08;   // |H| over its neighbourhood's median
+// A peak of |H| = |S_yu| / S_uu where the input's power is below this fraction of its
+// neighbourhood's median is a hole in the input's spectrum, not a peak of the response: a
+// step program's spectrum has nulls, where |H| stands 10–200 times over its neighbours
+// from a trace of what the reconstructed set-point misses. Ranked by prominence they took
+// every place of the search from a real mode (issue 34: 39 and 35 Hz table modes, seeds 41
+// and 42, never fitted).
+constexpr double kInputHole = 0.1;
+// A machine follows its set-point (|H| ≈ 1) but at its modes, each a peak over that level.
+// Where the neighbourhood's median |H| stands above this, the measured acceleration holds
+// far more than the commanded one drives linearly (on the simulator's step runs with both
+// sensors, 9–16 times the command from 150 Hz up, coherent with the moves' comb): no mode
+// of the set-point's response can be told there, and a broad fit into it (250 Hz, ζ 0.094)
+// was named a mode. Real modes stood on a level of 0.7–1.2 (15 seeds).
+constexpr double kMaxLevel = 2.0;
 constexpr double kMinAmplification = 0.1;  // the mode adds 10 % at its peak
 constexpr double kZ = 5.0;                 // χ² threshold
 constexpr double kZetaMin = 0.002, kZetaMax = 0.4;
@@ -82,7 +96,7 @@ class TimeModel {
 struct PeakCandidate {
   int input = 0;
   double f_hz = 0.0;
-  double prominence = 0.0;
+  double prominence = 0.0;  // |H| over its neighbourhood's median
 };
 constexpr std::size_t kMaxCandidates = 6;  // the most prominent peaks (a fit each costs a grid)
 
@@ -105,11 +119,14 @@ std::vector<PeakCandidate> peaks(const FrequencyResponse& fr, int input, double 
     bool top = true;
     for (std::size_t j = k - 2; j <= k + 2; ++j) top = top && (j == k || std::abs(fr.h[j]) <= mag);
     if (!top) continue;
-    std::vector<double> around;
+    std::vector<double> around, input_around;
     for (std::size_t j = 0; j < nb; ++j)
-      if (fr.f_hz[j] >= f / 1.5 && fr.f_hz[j] <= f * 1.5 && fr.coherence[j] > 0.3) around.push_back(std::abs(fr.h[j]));
-    if (around.size() < 5 || mag < kProminence * median(around, mag)) continue;
-    out.push_back({input, f, mag / median(around, mag)});
+      if (fr.f_hz[j] >= f / 1.5 && fr.f_hz[j] <= f * 1.5 && fr.coherence[j] > 0.3)
+        around.push_back(std::abs(fr.h[j])), input_around.push_back(fr.s_uu[j]);
+    const double base = median(around, mag);
+    if (around.size() < 5 || mag < kProminence * base || base > kMaxLevel) continue;
+    if (fr.s_uu[k] < kInputHole * median(input_around, fr.s_uu[k])) continue;
+    out.push_back({input, f, mag / base});
   }
   return out;
 }

@@ -27,8 +27,11 @@ struct ChannelResult {
 // on a circle at one feed this is the same column as a scale mismatch, which that program
 // then cannot show), and the rotation of a reference instrument that measures two axes
 // against the machine axes ((−θ·y, θ·x): squareness is the symmetric shear of the pair,
-// whatever the split in the data).
-Eigen::MatrixXd base_columns(const RunResiduals& rr, const Channel& ch, const LagColumns& lag) {
+// whatever the split in the data). The structural modes the frequency response found ring
+// after every change of acceleration (test_vibration): their displacement is the machine's
+// too, and left out of the base it is what a reversal's spike or backlash column fits.
+Eigen::MatrixXd base_columns(const RunResiduals& rr, const Channel& ch, const LagColumns& lag,
+                             const std::vector<StructuralMode>& modes) {
   const Eigen::Index rows = ch.rows();
   std::vector<Eigen::VectorXd> cols;
   auto add = [&](const Eigen::VectorXd& c) {
@@ -61,6 +64,9 @@ Eigen::MatrixXd base_columns(const RunResiduals& rr, const Channel& ch, const La
       }
       add(c);
     }
+  for (const StructuralMode& md : modes)
+    for (const Eigen::VectorXd& c : mode_displacement_columns(rr, ch, md.frequency_hz, md.damping_ratio))
+      add(c.cwiseQuotient(ch.sigma_um));
   Eigen::MatrixXd m(rows, static_cast<Eigen::Index>(cols.size()));
   for (std::size_t c = 0; c < cols.size(); ++c) m.col(static_cast<Eigen::Index>(c)) = cols[c];
   return m;
@@ -94,8 +100,9 @@ struct BaseProjection {
   }
 };
 
-BaseProjection base_projection(const RunResiduals& rr, const Channel& ch, const LagColumns& lag) {
-  const Eigen::MatrixXd nu = base_columns(rr, ch, lag);
+BaseProjection base_projection(const RunResiduals& rr, const Channel& ch, const LagColumns& lag,
+                               const std::vector<StructuralMode>& modes) {
+  const Eigen::MatrixXd nu = base_columns(rr, ch, lag, modes);
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(nu);
   return {qr.householderQ() * Eigen::MatrixXd::Identity(ch.rows(), nu.cols())};
 }
@@ -203,10 +210,11 @@ ExplainedEffect explained_effect(const EffectVerdict& v, const EffectModel& e, c
 }
 
 ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const std::vector<EffectModel>& catalog,
-                              const LagColumns& lag, const ExplainOptions& o) {
+                              const LagColumns& lag, const std::vector<StructuralMode>& modes,
+                              const ExplainOptions& o) {
   ChannelResult out;
   const Eigen::Index rows = ch.rows();
-  const BaseProjection project = base_projection(rr, ch, lag);
+  const BaseProjection project = base_projection(rr, ch, lag, modes);
   const Eigen::VectorXd w = ch.sigma_um.cwiseInverse();
   const Eigen::VectorXd y = project(ch.residual_um.cwiseProduct(w));
   std::vector<const EffectModel*> models;
@@ -236,7 +244,7 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
 
 void fit_reference_channel(ExplainState& st) {
   if (st.rr.machine.rows() < 50) return;
-  const ChannelResult fit = analyse_channel(st.rr, st.rr.machine, st.machine, st.lag, st.options);
+  const ChannelResult fit = analyse_channel(st.rr, st.rr.machine, st.machine, st.lag, st.modes, st.options);
   for (const auto& e : fit.effects) st.merge(e);
   // What is left of reference − set-point after the base model and every effect of the
   // table, against its white part (the reference's own noise: successive differences / √2).

@@ -1,7 +1,6 @@
 // Stage: a residual that the accepted effects leave beyond the noise is reported
 // (other.unexplained, run-format.md): its size against the noise and where it sits in time
 // and frequency. "Within its noise" is said only when it is true.
-#include "dsp/core/central_difference.hpp"
 #include "dsp/core/float_limits.hpp"
 #include "dsp/model/explain/stages.hpp"
 
@@ -61,30 +60,6 @@ ExplainedEffect unexplained(const std::string& channel, double rms_um, double no
   return x;
 }
 
-// One mode's columns on a channel's rows: its displacement response to each driven axis'
-// acceleration and jerk (the mode is driven by the axis' actual acceleration, the
-// set-point's through its position loop: to first order a_cmd − τ·ȧ_cmd), per measured axis.
-std::vector<Eigen::VectorXd> mode_columns(const ExplainState& st, const Channel& rows, double f_hz, double zeta) {
-  std::vector<Eigen::VectorXd> cols;
-  const double fs = 1.0 / st.rr.dt_s;
-  const Eigen::Index n = rows.rows();
-  for (int j = 0; j < 3; ++j) {
-    if (!st.rr.moving[j]) continue;
-    const Eigen::VectorXd& a_j = st.rr.a_cmd.col(j);
-    for (const Eigen::VectorXd& drive : {a_j, central_difference(a_j, fs)}) {
-      const Eigen::VectorXd m_mm = mode_response(drive, fs, f_hz, zeta, true);
-      for (int a = 0; a < 3; ++a) {
-        Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
-        for (Eigen::Index i = 0; i < n; ++i)
-          if (rows.axis[static_cast<std::size_t>(i)] == a)
-            c[i] = m_mm[rows.sample[static_cast<std::size_t>(i)]] * 1000.0;
-        if (c.norm() > 0.0) cols.push_back(c);
-      }
-    }
-  }
-  return cols;
-}
-
 // The machine residual r less its fit by `cols`, each column first left without what r is
 // without (the base model and the table: ExplainState::machine_projected).
 Eigen::VectorXd residual_of(const ExplainState& st, const Eigen::VectorXd& r,
@@ -129,7 +104,7 @@ Eigen::VectorXd without_modes(const ExplainState& st, const Eigen::VectorXd& r, 
     std::vector<Eigen::VectorXd> cols = loop;
     for (std::size_t m = 0; m < fz.size(); ++m)
       if (m != skip)
-        for (auto& c : mode_columns(st, rows, fz[m].first, fz[m].second)) cols.push_back(std::move(c));
+        for (auto& c : mode_displacement_columns(st.rr, rows, fz[m].first, fz[m].second)) cols.push_back(std::move(c));
     return cols;
   };
   // The modes' columns once (no loop yet); each candidate loop beside them alone.
@@ -150,7 +125,7 @@ Eigen::VectorXd without_modes(const ExplainState& st, const Eigen::VectorXd& r, 
       for (int zi = -3; zi <= 3; ++zi) {
         const double f = f0 * (1.0 + 0.005 * fi), z = z0 * std::pow(1.12, zi);
         auto cols = others;
-        for (auto& c : mode_columns(st, rows, f, z)) cols.push_back(std::move(c));
+        for (auto& c : mode_displacement_columns(st.rr, rows, f, z)) cols.push_back(std::move(c));
         const double rss = residual_of(st, r, cols).squaredNorm();
         if (rss < best) best = rss, fz[m] = {f, z};
       }
@@ -175,7 +150,7 @@ Eigen::VectorXd without_differential_mode(const ExplainState& st, const Eigen::V
   Eigen::VectorXd best = r;
   double best_bic = 0.0, best_f = 0.0, best_z = 0.0;
   auto consider = [&](double f, double z) {
-    const auto cols = mode_columns(st, rows, f, z);
+    const auto cols = mode_displacement_columns(st.rr, rows, f, z);
     if (cols.empty()) return;
     Eigen::VectorXd left = residual_of(st, r, cols);
     const double bic = n * std::log(left.squaredNorm() / rss0) + static_cast<double>(cols.size() + 2) * std::log(n);

@@ -1,5 +1,6 @@
 #include "dsp/model/explain/stages.hpp"
 
+#include "dsp/core/central_difference.hpp"
 #include "dsp/model/extension.hpp"
 
 #include <algorithm>
@@ -86,6 +87,30 @@ Eigen::MatrixXd columns_on(const EffectModel& e, const Channel& ch) {
       m(i, static_cast<Eigen::Index>(p)) =
           e.columns[p](ch.sample[static_cast<std::size_t>(i)], ch.axis[static_cast<std::size_t>(i)]);
   return m;
+}
+
+// The mode is driven by the axis' actual acceleration, the set-point's through its position
+// loop: to first order a_cmd − τ·ȧ_cmd, so each drive has two columns.
+std::vector<Eigen::VectorXd> mode_displacement_columns(const RunResiduals& rr, const Channel& rows, double f_hz,
+                                                       double zeta) {
+  std::vector<Eigen::VectorXd> cols;
+  const double fs = 1.0 / rr.dt_s;
+  const Eigen::Index n = rows.rows();
+  for (int j = 0; j < 3; ++j) {
+    if (!rr.moving[j]) continue;
+    const Eigen::VectorXd& a_j = rr.a_cmd.col(j);
+    for (const Eigen::VectorXd& drive : {a_j, central_difference(a_j, fs)}) {
+      const Eigen::VectorXd m_mm = mode_response(drive, fs, f_hz, zeta, true);
+      for (int a = 0; a < 3; ++a) {
+        Eigen::VectorXd c = Eigen::VectorXd::Zero(n);
+        for (Eigen::Index i = 0; i < n; ++i)
+          if (rows.axis[static_cast<std::size_t>(i)] == a)
+            c[i] = m_mm[rows.sample[static_cast<std::size_t>(i)]] * 1000.0;
+        if (c.norm() > 0.0) cols.push_back(c);
+      }
+    }
+  }
+  return cols;
 }
 
 // A channel's residual with each axis' offset taken out (the reference's zero is arbitrary).

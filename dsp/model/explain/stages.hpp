@@ -114,6 +114,10 @@ std::optional<double> axes_mean(const std::map<std::string, double>& value, cons
 
 // An effect's columns on a channel's rows (µm per unit).
 Eigen::MatrixXd columns_on(const EffectModel& e, const Channel& ch);
+// One mode's columns on a channel's rows (µm per unit gain): its displacement response to
+// each moving axis' commanded acceleration and jerk, per measured axis.
+std::vector<Eigen::VectorXd> mode_displacement_columns(const RunResiduals& rr, const Channel& rows, double f_hz,
+                                                       double zeta);
 // A channel's residual with each axis' offset taken out (the reference's zero is arbitrary).
 Eigen::VectorXd offsets_out(const Channel& ch);
 // RMS over the rows of the axes the program moves.
@@ -125,13 +129,13 @@ Run extended_run(const Run& run, const std::vector<ExplainedEffect>& taken);
 ExplainState prepare(const Run& run, const ExplainOptions& options);
 void fit_integrated_motion(
     ExplainState& st);  // sensor effects (and set-point-only machine ones) through the integration's filter
-void fit_reference_channel(ExplainState& st);  // machine effects on reference − set-point
+void test_vibration(ExplainState& st);         // spectra and structural modes
+void fit_reference_channel(ExplainState& st);  // machine effects on reference − set-point, beside the modes
 void separate_timing(ExplainState& st);        // the sensors' dynamics against the DAQ delay
 void report_earth_rate(ExplainState& st);      // site.coriolis from the site
 void test_standstill_bias(ExplainState& st);   // bias steps, drift, temperature at the standstills
-void test_stick_slip(ExplainState& st);
-void test_vibration(ExplainState& st);     // spectra and structural modes
-void test_damping_band(ExplainState& st);  // damping growing with |a|, in the shared vibration
+void test_stick_slip(ExplainState& st);        // trains of slips while an axis creeps
+void test_damping_band(ExplainState& st);      // damping growing with |a|, in the shared vibration
 void compare_accelerations(
     ExplainState& st);  // runs nothing holds: mounting angle, scale, lag and bias in acceleration
 // A sensor mounted otherwise than run.toml says (flip, swap, mirror): explain_run then
