@@ -74,12 +74,13 @@ static RunExplanation explain_stages(const Run& run, const ExplainOptions& optio
       return ex;
     }
   stage::fit_integrated_motion(st);
-  stage::test_vibration(st);  // before the reference: the modes found are in its base model
+  stage::test_vibration(st);   // before the reference: the modes found are in its base model,
+  stage::test_stick_slip(st);  // and the stick-slip axis' creep lag
   stage::fit_reference_channel(st);
+  stage::breakaway_at_reversals(st);
   stage::separate_timing(st);
   stage::report_earth_rate(st);
   stage::test_standstill_bias(st);
-  stage::test_stick_slip(st);
   stage::test_damping_band(st);
   stage::compare_accelerations(st);
   stage::apply_physical_bounds(st);

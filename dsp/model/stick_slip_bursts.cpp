@@ -185,4 +185,14 @@ StickSlipFinding stick_slip_test(const RunResiduals& run) {
   return out;
 }
 
+Eigen::VectorXd creep_direction(const RunResiduals& run, int axis) {
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(run.v_cmd.rows());
+  if (axis < 0 || axis > 2) return d;
+  for (Eigen::Index k = 0; k < d.size(); ++k) {
+    const double v = run.v_cmd(k, axis);
+    if (std::abs(v) > kStillMmS && std::abs(v) < kCreepMmS) d[k] = v > 0.0 ? 1.0 : -1.0;
+  }
+  return d;
+}
+
 }  // namespace eical::dsp::model

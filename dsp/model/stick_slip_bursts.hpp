@@ -24,4 +24,10 @@ struct StickSlipFinding {
 
 StickSlipFinding stick_slip_test(const RunResiduals& run);
 
+// Where axis `axis` creeps (its set-point slower than stick-slip's creep speed, but moving),
+// the set-point's direction there (+1, −1), per decimated sample of `run`; 0 elsewhere.
+// The slide sticks behind its set-point and slips forward, so reference − set-point lags
+// by about half the sawtooth against this direction (the reference's creep-lag column).
+Eigen::VectorXd creep_direction(const RunResiduals& run, int axis);
+
 }  // namespace eical::dsp::model

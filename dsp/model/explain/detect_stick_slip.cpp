@@ -17,7 +17,7 @@ namespace {
 // seeds, 1.2–1.5 µm against a sawtooth of 2.3–3.0 µm, where the simulated machine had no
 // spike). Such a lag is the stick-slip's, not a second effect; one larger than the
 // sawtooth, or one on another axis, stays a reversal spike.
-void breakaway_at_reversals(ExplainState& st, const StickSlipFinding& ss) {
+void breakaway_within_sawtooth(ExplainState& st, const StickSlipFinding& ss) {
   ExplainedEffect* spike = st.find(name(Effect::machine_reversal_spike));
   if (!spike || !spike->significant || ss.axis < 0 || !(ss.slip_um > 0.0)) return;
   const std::string on_axis = "spike_" + axis_letter(ss.axis) + "_";
@@ -53,8 +53,12 @@ void test_stick_slip(ExplainState& st) {
     x.bic_drop = ss.bursts_in_creep;
     x.evidence = ss.evidence;
     all.push_back(x);
-    if (ss.found) breakaway_at_reversals(st, ss);
+    st.stick_slip = ss;
   }
+}
+
+void breakaway_at_reversals(ExplainState& st) {
+  if (st.stick_slip.found) breakaway_within_sawtooth(st, st.stick_slip);
 }
 
 }  // namespace eical::dsp::model::stage

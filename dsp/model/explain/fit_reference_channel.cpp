@@ -29,9 +29,13 @@ struct ChannelResult {
 // against the machine axes ((−θ·y, θ·x): squareness is the symmetric shear of the pair,
 // whatever the split in the data). The structural modes the frequency response found ring
 // after every change of acceleration (test_vibration): their displacement is the machine's
-// too, and left out of the base it is what a reversal's spike or backlash column fits.
+// too, and left out of the base it is what a reversal's spike or backlash column fits. So is
+// an axis' stick-slip (test_stick_slip): the slide lags its set-point by about half the
+// sawtooth while it creeps, which on a circle is where the other axis stands at ±R with the
+// creep's direction — the squareness column's shape (issue 34: 73–180 µrad named beside
+// stick-slip on 3 of 11 seeds, the machine's was ~2 µrad).
 Eigen::MatrixXd base_columns(const RunResiduals& rr, const Channel& ch, const LagColumns& lag,
-                             const std::vector<StructuralMode>& modes) {
+                             const std::vector<StructuralMode>& modes, const StickSlipFinding& stick_slip) {
   const Eigen::Index rows = ch.rows();
   std::vector<Eigen::VectorXd> cols;
   auto add = [&](const Eigen::VectorXd& c) {
@@ -67,6 +71,14 @@ Eigen::MatrixXd base_columns(const RunResiduals& rr, const Channel& ch, const La
   for (const StructuralMode& md : modes)
     for (const Eigen::VectorXd& c : mode_displacement_columns(rr, ch, md.frequency_hz, md.damping_ratio))
       add(c.cwiseQuotient(ch.sigma_um));
+  if (stick_slip.found) {
+    const Eigen::VectorXd dir = creep_direction(rr, stick_slip.axis);
+    Eigen::VectorXd c = Eigen::VectorXd::Zero(rows);
+    for (Eigen::Index i = 0; i < rows; ++i)
+      if (ch.axis[static_cast<std::size_t>(i)] == stick_slip.axis)
+        c[i] = dir[ch.sample[static_cast<std::size_t>(i)]] / ch.sigma_um[i];
+    add(c);
+  }
   Eigen::MatrixXd m(rows, static_cast<Eigen::Index>(cols.size()));
   for (std::size_t c = 0; c < cols.size(); ++c) m.col(static_cast<Eigen::Index>(c)) = cols[c];
   return m;
@@ -101,8 +113,8 @@ struct BaseProjection {
 };
 
 BaseProjection base_projection(const RunResiduals& rr, const Channel& ch, const LagColumns& lag,
-                               const std::vector<StructuralMode>& modes) {
-  const Eigen::MatrixXd nu = base_columns(rr, ch, lag, modes);
+                               const std::vector<StructuralMode>& modes, const StickSlipFinding& stick_slip) {
+  const Eigen::MatrixXd nu = base_columns(rr, ch, lag, modes, stick_slip);
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(nu);
   return {qr.householderQ() * Eigen::MatrixXd::Identity(ch.rows(), nu.cols())};
 }
@@ -211,10 +223,10 @@ ExplainedEffect explained_effect(const EffectVerdict& v, const EffectModel& e, c
 
 ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const std::vector<EffectModel>& catalog,
                               const LagColumns& lag, const std::vector<StructuralMode>& modes,
-                              const ExplainOptions& o) {
+                              const StickSlipFinding& stick_slip, const ExplainOptions& o) {
   ChannelResult out;
   const Eigen::Index rows = ch.rows();
-  const BaseProjection project = base_projection(rr, ch, lag, modes);
+  const BaseProjection project = base_projection(rr, ch, lag, modes, stick_slip);
   const Eigen::VectorXd w = ch.sigma_um.cwiseInverse();
   const Eigen::VectorXd y = project(ch.residual_um.cwiseProduct(w));
   std::vector<const EffectModel*> models;
@@ -244,7 +256,8 @@ ChannelResult analyse_channel(const RunResiduals& rr, const Channel& ch, const s
 
 void fit_reference_channel(ExplainState& st) {
   if (st.rr.machine.rows() < 50) return;
-  const ChannelResult fit = analyse_channel(st.rr, st.rr.machine, st.machine, st.lag, st.modes, st.options);
+  const ChannelResult fit =
+      analyse_channel(st.rr, st.rr.machine, st.machine, st.lag, st.modes, st.stick_slip, st.options);
   for (const auto& e : fit.effects) st.merge(e);
   // What is left of reference − set-point after the base model and every effect of the
   // table, against its white part (the reference's own noise: successive differences / √2).

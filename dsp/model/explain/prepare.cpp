@@ -10,7 +10,7 @@
 namespace eical::dsp::model::stage {
 
 ExplainState prepare(const Run& run, const ExplainOptions& options) {
-  ExplainState st{run, options, build_residuals(run), {}, {}, {}, {}, {}, {}, true, {}};
+  ExplainState st{run, options, build_residuals(run), {}, {}, {}, {}, {}, {}, {}, true, {}};
   const RunResiduals& rr = st.rr;
   st.ex.run_id = rr.run_id, st.ex.reference = rr.reference;
   // A reference instrument holds the integration as a standstill does.

@@ -7,6 +7,7 @@
 #include "dsp/model/effects.hpp"
 #include "dsp/model/explain.hpp"
 #include "dsp/model/run_residuals.hpp"
+#include "dsp/model/stick_slip_bursts.hpp"
 #include "dsp/model/structural_modes.hpp"
 
 #include <Eigen/Core>
@@ -46,6 +47,7 @@ struct ExplainState {
   std::vector<ExplainedEffect> effects;
   RunExplanation ex;
   std::vector<StructuralMode> modes;  // significant modes the motion drives (test_vibration)
+  StickSlipFinding stick_slip;        // test_stick_slip
   bool integration_supported = true;  // a rest or a position support holds the double integral
   // What the accepted effects leave, for the unexplained-residual test.
   struct Leftover {
@@ -129,13 +131,14 @@ Run extended_run(const Run& run, const std::vector<ExplainedEffect>& taken);
 ExplainState prepare(const Run& run, const ExplainOptions& options);
 void fit_integrated_motion(
     ExplainState& st);  // sensor effects (and set-point-only machine ones) through the integration's filter
-void test_vibration(ExplainState& st);         // spectra and structural modes
-void fit_reference_channel(ExplainState& st);  // machine effects on reference − set-point, beside the modes
-void separate_timing(ExplainState& st);        // the sensors' dynamics against the DAQ delay
-void report_earth_rate(ExplainState& st);      // site.coriolis from the site
-void test_standstill_bias(ExplainState& st);   // bias steps, drift, temperature at the standstills
-void test_stick_slip(ExplainState& st);        // trains of slips while an axis creeps
-void test_damping_band(ExplainState& st);      // damping growing with |a|, in the shared vibration
+void test_vibration(ExplainState& st);          // spectra and structural modes
+void test_stick_slip(ExplainState& st);         // trains of slips while an axis creeps
+void fit_reference_channel(ExplainState& st);   // machine effects on reference − set-point, beside both
+void breakaway_at_reversals(ExplainState& st);  // a reversal's lag within the stick-slip's sawtooth
+void separate_timing(ExplainState& st);         // the sensors' dynamics against the DAQ delay
+void report_earth_rate(ExplainState& st);       // site.coriolis from the site
+void test_standstill_bias(ExplainState& st);    // bias steps, drift, temperature at the standstills
+void test_damping_band(ExplainState& st);       // damping growing with |a|, in the shared vibration
 void compare_accelerations(
     ExplainState& st);  // runs nothing holds: mounting angle, scale, lag and bias in acceleration
 // A sensor mounted otherwise than run.toml says (flip, swap, mirror): explain_run then
