@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,18 @@ dsp::model::RunExplanation explain_hidden(const std::vector<std::string>& effect
   auto ex = dsp::model::explain_run(run);
   ex.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return ex;
+}
+
+// `effect` hidden alone at each seed of `program`: named first, `foreign` not named beside it.
+void expect_first_without(const std::string& effect, dsp::ProgramKind program,
+                          std::initializer_list<std::uint64_t> seeds, const std::string& foreign) {
+  for (std::uint64_t seed : seeds) {
+    const auto sig = significant(explain_hidden({effect}, program, seed));
+    std::printf("%s seed %llu: %s\n", effect.c_str(), static_cast<unsigned long long>(seed), joined(sig).c_str());
+    ASSERT_FALSE(sig.empty()) << effect << " seed " << seed;
+    EXPECT_EQ(sig.front(), effect) << "seed " << seed;
+    EXPECT_EQ(std::count(sig.begin(), sig.end(), foreign), 0) << "seed " << seed << ": " << joined(sig);
+  }
 }
 
 class HiddenEffect : public ::testing::TestWithParam<std::string> {};
@@ -100,28 +113,15 @@ INSTANTIATE_TEST_SUITE_P(Programs, Baseline, ::testing::Values("circle", "step")
 // 12 while the mode was fitted beside the table's effects instead of with them (issue 34);
 // 21 and 26 were two of them.
 TEST(DifferentialVibration, TheReferencesRingingIsTheModeNotAnUnexplainedFinding) {
-  for (std::uint64_t seed : {21, 22, 26}) {
-    const auto sig = significant(explain_hidden({"machine.differential_vibration"}, dsp::ProgramKind::step, seed));
-    std::printf("machine.differential_vibration seed %llu: %s\n", static_cast<unsigned long long>(seed),
-                joined(sig).c_str());
-    ASSERT_FALSE(sig.empty()) << "seed " << seed;
-    EXPECT_EQ(sig.front(), "machine.differential_vibration") << "seed " << seed;
-    EXPECT_EQ(std::count(sig.begin(), sig.end(), "other.unexplained"), 0) << "seed " << seed << ": " << joined(sig);
-  }
+  expect_first_without("machine.differential_vibration", dsp::ProgramKind::step, {21, 22, 26}, "other.unexplained");
 }
 
 // Static friction that makes an axis stick-slip also holds it at each reversal: the lag
 // there, within the slips' sawtooth, is the stick-slip's. On seeds 41–45 a reversal spike
 // was named beside it on 4 of 5 (the simulated machine had none); 41, 42 and 45 were three.
 TEST(StickSlip, TheBreakawayAtAReversalIsNotASecondEffect) {
-  for (std::uint64_t seed : {41, 42, 45}) {
-    const auto sig = significant(explain_hidden({"machine.stick_slip"}, sim::program_for("machine.stick_slip"), seed));
-    std::printf("machine.stick_slip seed %llu: %s\n", static_cast<unsigned long long>(seed), joined(sig).c_str());
-    ASSERT_FALSE(sig.empty()) << "seed " << seed;
-    EXPECT_EQ(sig.front(), "machine.stick_slip") << "seed " << seed;
-    EXPECT_EQ(std::count(sig.begin(), sig.end(), "machine.reversal_spike"), 0)
-        << "seed " << seed << ": " << joined(sig);
-  }
+  expect_first_without("machine.stick_slip", sim::program_for("machine.stick_slip"), {41, 42, 45},
+                       "machine.reversal_spike");
 }
 
 // On a circle an axis creeps at its reversals, where the other axis stands at ±R with the
@@ -131,13 +131,7 @@ TEST(StickSlip, TheBreakawayAtAReversalIsNotASecondEffect) {
 // only, where squareness paired with a servo mismatch, each making the held-out points
 // worse alone (no finding of its own: fit_reference_channel.cpp).
 TEST(StickSlip, TheCreepLagAtTheReversalsIsNoSquareness) {
-  for (std::uint64_t seed : {43, 44}) {
-    const auto sig = significant(explain_hidden({"machine.stick_slip"}, sim::program_for("machine.stick_slip"), seed));
-    std::printf("machine.stick_slip seed %llu: %s\n", static_cast<unsigned long long>(seed), joined(sig).c_str());
-    ASSERT_FALSE(sig.empty()) << "seed " << seed;
-    EXPECT_EQ(sig.front(), "machine.stick_slip") << "seed " << seed;
-    EXPECT_EQ(std::count(sig.begin(), sig.end(), "machine.squareness"), 0) << "seed " << seed << ": " << joined(sig);
-  }
+  expect_first_without("machine.stick_slip", sim::program_for("machine.stick_slip"), {43, 44}, "machine.squareness");
 }
 
 // A mode is sought where the motion drives it: the step program's spectrum has nulls, where
@@ -146,14 +140,7 @@ TEST(StickSlip, TheCreepLagAtTheReversalsIsNoSquareness) {
 // Its ringing after every move then made a reversal spike of 2.5 µm on the reference (true:
 // 0.1 µm); the modes found are in the reference's base model now.
 TEST(Resonance, AModeTheMotionDrivesIsFoundAndItsRingingIsNoReversalSpike) {
-  for (std::uint64_t seed : {41, 42}) {
-    const auto sig = significant(explain_hidden({"machine.resonance"}, sim::program_for("machine.resonance"), seed));
-    std::printf("machine.resonance seed %llu: %s\n", static_cast<unsigned long long>(seed), joined(sig).c_str());
-    ASSERT_FALSE(sig.empty()) << "seed " << seed;
-    EXPECT_EQ(sig.front(), "machine.resonance") << "seed " << seed;
-    EXPECT_EQ(std::count(sig.begin(), sig.end(), "machine.reversal_spike"), 0)
-        << "seed " << seed << ": " << joined(sig);
-  }
+  expect_first_without("machine.resonance", sim::program_for("machine.resonance"), {41, 42}, "machine.reversal_spike");
 }
 
 class TwoEffects : public ::testing::TestWithParam<std::vector<std::string>> {};
