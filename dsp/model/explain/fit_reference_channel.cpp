@@ -218,13 +218,14 @@ ExplainedEffect explained_effect(const EffectVerdict& v, const EffectModel& e, c
   // coefficients: issue 34, 123–185 µrad named beside stick-slip, each making the held-out
   // RMS worse alone, 0.287 -> 0.526 µm).
   const bool predicts_worse = x.heldout_rms_after_um > x.heldout_rms_before_um;
-  x.significant = v.significant && sure_magnitude > x.tolerance && !predicts_worse;
+  const bool outside_tolerance = v.significant && sure_magnitude > x.tolerance;
+  x.significant = outside_tolerance && !predicts_worse;
   x.evidence = "residual correlates with " + e.regressor +
                fmt(" (r = %.2f); BIC drop %.0f; held-out RMS %.3f -> %.3f um; ", v.correlation, v.bic_drop,
                    x.heldout_rms_before_um, x.heldout_rms_after_um) +
                fmt("size %.3g (%.3g at 2 sigma) ", x.magnitude, sure_magnitude) + x.unit +
                fmt(" against a tolerance of %.3g ", x.tolerance) + x.unit;
-  if (v.significant && sure_magnitude > x.tolerance && predicts_worse)
+  if (outside_tolerance && predicts_worse)
     x.evidence += " (alone it predicts the held-out points worse: a split with the effects fitted beside it)";
   else if (v.significant && !x.significant)
     x.evidence += " (not clearly outside the tolerance: background)";
