@@ -55,6 +55,9 @@ nlohmann::json identification_json(const dsp::identify::Identification& id) {
   }
   j["psd_offset_um"] = nlohmann::json::array();
   for (const auto& o : id.psd_offset_um) j["psd_offset_um"].push_back(estimate_json(o));
+  j["psd_nonlinearity"] = nlohmann::json::array();
+  for (const auto& n : id.psd_nonlinearity) j["psd_nonlinearity"].push_back(estimate_json(n));
+  j["position_nis"] = {{"x", id.position_nis[0]}, {"y", id.position_nis[1]}, {"z", id.position_nis[2]}};
   j["agreement"] = {{"psd_rms_before_um", id.psd_rms_before_um},
                     {"psd_rms_after_um", id.psd_rms_after_um},
                     {"rest_rms_before_um", id.rest_rms_before_um},
@@ -114,6 +117,17 @@ std::string summary(const dsp::identify::Identification& id) {
                 "agreement with the PSD readings (not used by the pipeline): %.2f → %.2f µm RMS; set-point at "
                 "standstills: %.2f → %.2f µm RMS\n",
                 id.psd_rms_before_um, id.psd_rms_after_um, id.rest_rms_before_um, id.rest_rms_after_um);
+  o += b;
+  for (std::size_t s = 0; s < id.psd_nonlinearity.size(); ++s)
+    if (id.psd_nonlinearity[s].fitted) {
+      std::snprintf(b, sizeof b, "PSD strip %zu: nonlinearity %+.1e ± %.1e (of u (1 + nl (2u/L)²))\n", s + 1,
+                    id.psd_nonlinearity[s].value, id.psd_nonlinearity[s].sigma);
+      o += b;
+    }
+  std::snprintf(b, sizeof b,
+                "normalised innovations² of the strips and standstills (1 where the model holds): x %.2f, y %.2f, "
+                "z %.2f\n",
+                id.position_nis[0], id.position_nis[1], id.position_nis[2]);
   o += b;
   for (const auto& n : id.notes) o += "note: " + n + "\n";
   return o;

@@ -71,9 +71,4 @@ std::array<double, 3> timing_sigma_s(const SensorModelCovariance& c, const std::
   return out;
 }
 
-double strip_nonlinearity_scale_variance(const DatasheetTolerance& tolerance) {
-  const double a = 0.6 * tolerance.psd_nonlinearity;
-  return a * a / 3.0;
-}
-
 }  // namespace eical::dsp

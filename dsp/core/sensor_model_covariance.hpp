@@ -69,14 +69,6 @@ struct DatasheetTolerance {
   double psd_nonlinearity = 1e-4;
 };
 
-// What the strips' nonlinearity does to a scale identified from them: the least-squares
-// slope of nl·u·(2u/L)² against u over a swing across the whole strip is nl·(4/L²)·⟨u⁴⟩/⟨u²⟩
-// = 0.6·nl (u uniform on ±L/2), the same for every strip length. Seen on simulated machines
-// as shifts of the identified E_xx by up to 54 ppm (rms 26 ppm) against ideal strips, 4σ of
-// the filter's own. The identification's covariance adds its variance (uniform: /3) to the
-// scale of every axis a strip measures.
-double strip_nonlinearity_scale_variance(const DatasheetTolerance& tolerance = {});
-
 // Per machine axis, σ (s) of the sensor model's timing: the damping term of the sensor that
 // carries the axis (owner: 0 table, 1 head, −1 none) and the DAQ's delay
 // (fusion::ErrorModel::timing_uncertainty_s).

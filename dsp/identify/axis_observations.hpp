@@ -7,9 +7,11 @@
 // checks each row against central differences of its model.
 #include "dsp/core/axes.hpp"
 #include "dsp/core/run_meta.hpp"
+#include "dsp/core/sensor_model_covariance.hpp"
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <vector>
 
 namespace eical::dsp::identify {
@@ -17,19 +19,22 @@ namespace eical::dsp::identify {
 inline constexpr double kPriorError = 0.02;     // E_ij: scale and cross terms, 2 %
 inline constexpr double kPriorDampingMs = 0.2;  // Δ(2ζ/ω0), ms (data sheet 0.225 ms)
 inline constexpr double kPriorOffsetUm = 50.0;  // rest offsets, backlash, PSD mounting
+// A strip's nonlinearity: uniform within the data sheet's bound.
+inline double prior_strip_nonlinearity() { return DatasheetTolerance{}.psd_nonlinearity / std::sqrt(3.0); }
 
 // Parameter indices of one axis' filter (−1: not fitted).
 struct Layout {
   int e[3] = {-1, -1, -1};  // E_ij, j = the axis whose acceleration it scales
   int damping = -1, x0 = -1, backlash = -1;
-  std::vector<int> strip;  // per PSD strip of the run (−1 when it measures another axis)
+  std::vector<int> strip;     // per PSD strip of the run (−1 when it measures another axis)
+  std::vector<int> strip_nl;  // its nonlinearity (−1: not fitted)
   int count = 0;
 };
 
 // The parameters of axis i and their prior σ (in the order of their indices): E_ij for
 // every moved axis j, Δ(2ζ/ω0) when i moved; against the set-point the rest offset, the
-// backlash (when i moved) and the mounting offset of each strip measuring i; against a
-// reference its zero only.
+// backlash (when i moved) and the mounting offset of each strip measuring i and, where i
+// moved, its nonlinearity; against a reference its zero only.
 struct AxisPrior {
   Layout layout;
   std::vector<double> sigma;
@@ -49,8 +54,16 @@ inline AxisPrior axis_prior(int i, const bool moved[3], const std::vector<PsdSpe
     L.x0 = add(kPriorOffsetUm);
     if (moved[i]) L.backlash = add(kPriorOffsetUm);
     L.strip.assign(psd.size(), -1);
+    L.strip_nl.assign(psd.size(), -1);
     for (std::size_t s = 0; s < psd.size(); ++s)
-      if (axis_index(psd[s].measures) == i) L.strip[s] = add(kPriorOffsetUm);
+      if (axis_index(psd[s].measures) == i) {
+        L.strip[s] = add(kPriorOffsetUm);
+        // A strip's nonlinearity: the least-squares slope of nl·u·(2u/L)² against u over a
+        // swing across the strip is 0.6·nl, a scale error of the axis (up to 60 ppm at the
+        // data sheet's bound, 35 ppm rms). Fitted beside the scale, the rest of its shape
+        // (u³ − 0.6·(L/2)²·u) tells the two apart.
+        if (moved[i]) L.strip_nl[s] = add(prior_strip_nonlinearity());
+      }
   } else {
     L.x0 = add(kPriorOffsetUm);  // the reference's zero
   }
@@ -100,16 +113,27 @@ inline void velocity_mean_row(double lag_s, Eigen::RowVectorXd& h) {
   h[1] = 1.0, h[2] = -lag_s;
 }
 
-// A lit PSD sample of `strip`: integrated − reading = δx + Δ(2ζ/ω0)·v − o_strip
-// (Δ(2ζ/ω0) in ms, v in µm/s).
-inline double psd(const Layout& L, const Eigen::VectorXd& state, double v_um_s, int strip) {
-  return state[0] + param(state, L.damping) * v_um_s * 1e-3 - param(state, L.strip[static_cast<std::size_t>(strip)]);
+// The shape a strip's nonlinearity gives its reading u (µm from its centre) on a strip of
+// length_um: u_meas = u (1 + nl (2u/L)²), so u_meas − u = nl · cubic.
+inline double strip_cubic_um(double u_um, double length_um) {
+  const double r = 2.0 * u_um / length_um;
+  return u_um * r * r;
 }
-inline void psd_row(const Layout& L, double v_um_s, int strip, Eigen::RowVectorXd& h) {
+
+// A lit PSD sample of `strip`, `cubic_um` its strip_cubic_um: integrated − reading =
+// δx + Δ(2ζ/ω0)·v − o_strip − nl_strip·cubic (Δ(2ζ/ω0) in ms, v in µm/s).
+inline double psd(const Layout& L, const Eigen::VectorXd& state, double v_um_s, int strip, double cubic_um) {
+  const auto s = static_cast<std::size_t>(strip);
+  const double nl = s < L.strip_nl.size() ? param(state, L.strip_nl[s]) : 0.0;
+  return state[0] + param(state, L.damping) * v_um_s * 1e-3 - param(state, L.strip[s]) - nl * cubic_um;
+}
+inline void psd_row(const Layout& L, double v_um_s, int strip, double cubic_um, Eigen::RowVectorXd& h) {
+  const auto s = static_cast<std::size_t>(strip);
   h.setZero();
   h[0] = 1.0;
   if (L.damping >= 0) h[3 + L.damping] = v_um_s * 1e-3;  // ms × µm/s
-  h[3 + L.strip[static_cast<std::size_t>(strip)]] = -1.0;
+  h[3 + L.strip[s]] = -1.0;
+  if (s < L.strip_nl.size() && L.strip_nl[s] >= 0) h[3 + L.strip_nl[s]] = -cubic_um;
 }
 
 // A reference instrument's reading: integrated − reference = δx + x0 + Δ(2ζ/ω0)·v (x0: the

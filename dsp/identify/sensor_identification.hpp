@@ -69,7 +69,8 @@ struct DelayEstimate {
 struct Identification {
   SensorEstimate sensor[2];  // table, head
   Estimate rest_offset_um[3], backlash_um[3];
-  std::vector<Estimate> psd_offset_um;  // per strip
+  std::vector<Estimate> psd_offset_um;     // per strip
+  std::vector<Estimate> psd_nonlinearity;  // per strip: nl of u (1 + nl (2u/L)²), where its axis moved
   DelayEstimate delay_setpoint, delay_reference;
   // The calibration to use from now on: the run's sensors with the estimate applied.
   SensorSpec sensors[2];
@@ -80,6 +81,9 @@ struct Identification {
   double psd_rms_before_um = 0.0, psd_rms_after_um = 0.0;
   double rest_rms_before_um = 0.0, rest_rms_after_um = 0.0;
   std::size_t psd_observations = 0, rest_observations = 0, standstills = 0;
+  // Per machine axis, the mean normalised innovation² of its position observations (PSD or
+  // reference, set-point at rest): 1 where the filter's noise and sensor model hold.
+  double position_nis[3] = {0.0, 0.0, 0.0};
   int iterations = 0;
   std::string method;  // "psd" (PSD fixes + set-point at rest) | "ref"
   std::vector<std::string> notes;
