@@ -4,6 +4,7 @@
 // --calibration and eicald's [calibration] file compensate with.
 #include "drivers/config/sensor_calibration.hpp"
 #include "drivers/run_io/run_reader.hpp"
+#include "dsp/identify/axis_observations.hpp"
 #include "dsp/identify/sensor_identification.hpp"
 #include "tools/commands.hpp"
 
@@ -118,12 +119,18 @@ std::string summary(const dsp::identify::Identification& id) {
                 "standstills: %.2f → %.2f µm RMS\n",
                 id.psd_rms_before_um, id.psd_rms_after_um, id.rest_rms_before_um, id.rest_rms_after_um);
   o += b;
-  for (std::size_t s = 0; s < id.psd_nonlinearity.size(); ++s)
-    if (id.psd_nonlinearity[s].fitted) {
-      std::snprintf(b, sizeof b, "PSD strip %zu: nonlinearity %+.1e ± %.1e (of u (1 + nl (2u/L)²))\n", s + 1,
-                    id.psd_nonlinearity[s].value, id.psd_nonlinearity[s].sigma);
-      o += b;
-    }
+  for (std::size_t s = 0; s < id.psd_nonlinearity.size(); ++s) {
+    const auto& nl = id.psd_nonlinearity[s];
+    if (!nl.fitted) continue;
+    // Where the run did not cross the strip along its length the prior is all there is.
+    if (nl.sigma >= 0.9 * dsp::identify::prior_strip_nonlinearity())
+      std::snprintf(b, sizeof b, "PSD strip %zu: nonlinearity not resolved by the run (the data sheet's ± %.0e)\n",
+                    s + 1, dsp::DatasheetTolerance{}.psd_nonlinearity);
+    else
+      std::snprintf(b, sizeof b, "PSD strip %zu: nonlinearity %+.1e ± %.1e (of u (1 + nl (2u/L)²))\n", s + 1, nl.value,
+                    nl.sigma);
+    o += b;
+  }
   std::snprintf(b, sizeof b,
                 "normalised innovations² of the strips and standstills (1 where the model holds): x %.2f, y %.2f, "
                 "z %.2f\n",
