@@ -423,6 +423,44 @@ dsp::SensorModelCovariance covariance_of(const PassResult& last, const Identific
   return c;
 }
 
+// A damping term the run resolves less well than the data sheet promises (a small circle's
+// strips are crossed at low speeds, where 2ζ/ω0·v is a fraction of a µm) is weighed with the
+// data sheet instead of replacing it: where the two agree (within twice their combined σ)
+// the calibration carries their inverse-variance mean and its σ, never worse than the data
+// sheet's; where they do not, the sensor is off its data sheet and the run's value stands.
+void weigh_damping_with_datasheet(const RunMeta& datasheet, Identification& id) {
+  const dsp::SensorModelCovariance ds = dsp::datasheet_covariance(datasheet.sensors, datasheet.acquisition.fs_hz);
+  for (int s = 0; s < 2; ++s) {
+    const Estimate& d = id.sensor[s].damping_s;
+    const int p = dsp::damping_index(s);
+    const double u_run = id.covariance.sigma(p), u_sheet = ds.sigma(p);
+    if (!d.fitted || !(u_run > u_sheet) || !(u_sheet > 0.0)) continue;
+    const double u_both = std::hypot(u_run, u_sheet);
+    const char* who = s == 0 ? "table" : "head";
+    char b[320];
+    if (std::abs(d.value) > 2.0 * u_both) {
+      std::snprintf(b, sizeof b,
+                    "%s sensor: 2ζ/ω0 %+.2f ± %.2f µs from the data sheet's, more than twice their combined σ: off its "
+                    "data sheet, the run's value kept",
+                    who, d.value * 1e6, u_run * 1e6);
+      id.notes.emplace_back(b);
+      continue;
+    }
+    const double w = u_sheet * u_sheet / (u_both * u_both);  // the run's weight
+    const double value = w * d.value, u = u_run * u_sheet / u_both;
+    SensorSpec& spec = id.sensors[s];
+    const double w0 = 2.0 * std::numbers::pi * spec.f0_hz;
+    const double c1 = 2.0 * datasheet.sensors[s].zeta / w0 - value;  // value: data sheet − identified
+    spec.zeta = std::max(0.0, c1 * w0 / 2.0);
+    id.covariance.covariance(p, p) = u * u;
+    std::snprintf(b, sizeof b,
+                  "%s sensor: 2ζ/ω0 %+.2f ± %.2f µs from the data sheet's, less certain than its ± %.2f µs: weighed "
+                  "with it, %+.2f ± %.2f µs (ζ = %.4f)",
+                  who, d.value * 1e6, u_run * 1e6, u_sheet * 1e6, value * 1e6, u * 1e6, spec.zeta);
+    id.notes.emplace_back(b);
+  }
+}
+
 // Throws when the run cannot identify: no frames, no reference to identify against, or
 // no PSD strips.
 void check_identifiable(const Run& run, const IdentifyOptions& o) {
@@ -598,6 +636,8 @@ Identification identify_sensors(const Run& run, const IdentifyOptions& options) 
   if (!id.sensor[0].moved && !id.sensor[1].moved) throw InputError("identify: no axis moved more than 0.5 mm");
   for (int i = 0; i < 3; ++i) id.position_nis[i] = last.axis[i].position_nis;
   id.covariance = covariance_of(last, id, run.meta);
+  weigh_damping_with_datasheet(run.meta, id);
+  for (int s = 0; s < 2; ++s) meta.sensors[s].zeta = id.sensors[s].zeta;  // the comparison's model too
   last.m = Measurement{};  // the comparison integrates the run twice more: one trace at a time
   if (options.compare_with_datasheet) compare_with_datasheet(run, meta, id);
   return id;
