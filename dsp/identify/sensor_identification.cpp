@@ -390,8 +390,9 @@ void check_crossings(const Measurement& m, const RunMeta& meta, Identification& 
 // share of the scale in the E block's covariance): against the
 // simulator's truth on 12 machines drawn within the data sheet the scale terms erred by
 // 1.46 σ rms, the cross terms by 0.9 σ (tests/accuracy); with the strips' nonlinearity
-// fitted, 1.25 σ over 16 machines against a truth without the temperature coefficient's
-// deviation (docs/accuracy.md). The calibration carries σ × kSigmaMargin.
+// fitted, 1.06 σ over 16 machines at the identification's own temperature. The margin
+// stands in for the scale's temperature coefficient between identification and test, not
+// yet a source of its own (docs/accuracy.md). The calibration carries σ × kSigmaMargin.
 constexpr double kSigmaMargin = 1.5;
 dsp::SensorModelCovariance covariance_of(const PassResult& last, const Identification& id, const RunMeta& meta) {
   dsp::SensorModelCovariance c = dsp::datasheet_covariance(meta.sensors, meta.acquisition.fs_hz);
