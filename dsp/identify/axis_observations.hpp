@@ -113,14 +113,7 @@ inline void velocity_mean_row(double lag_s, Eigen::RowVectorXd& h) {
   h[1] = 1.0, h[2] = -lag_s;
 }
 
-// The shape a strip's nonlinearity gives its reading u (µm from its centre) on a strip of
-// length_um: u_meas = u (1 + nl (2u/L)²), so u_meas − u = nl · cubic.
-inline double strip_cubic_um(double u_um, double length_um) {
-  const double r = 2.0 * u_um / length_um;
-  return u_um * r * r;
-}
-
-// A lit PSD sample of `strip`, `cubic_um` its strip_cubic_um: integrated − reading =
+// A lit PSD sample of `strip`, `cubic_um` its supports::psd_nonlinearity_shape_um: integrated − reading =
 // δx + Δ(2ζ/ω0)·v − o_strip − nl_strip·cubic (Δ(2ζ/ω0) in ms, v in µm/s).
 inline double psd(const Layout& L, const Eigen::VectorXd& state, double v_um_s, int strip, double cubic_um) {
   const auto s = static_cast<std::size_t>(strip);

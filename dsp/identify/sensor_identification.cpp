@@ -6,6 +6,7 @@
 #include "dsp/identify/augmented_filter.hpp"
 #include "dsp/identify/axis_observations.hpp"
 #include "dsp/identify/delay_estimate.hpp"
+#include "dsp/supports/psd_nonlinearity.hpp"
 
 #include <Eigen/Dense>
 
@@ -25,9 +26,8 @@ struct AxisFit {
   Eigen::VectorXd theta, sigma;
   Eigen::MatrixXd cov;  // of the parameters
   // The position observations' mean normalised innovation² (1 when the filter's model of
-  // the noise and the sensors holds) and how many there were.
+  // the noise and the sensors holds).
   double position_nis = 0.0;
-  std::size_t position_obs = 0;
 };
 
 struct PassResult {
@@ -200,10 +200,9 @@ class AxisPass {
       const fusion::PositionFix& fx = fixes[next_fix_];
       if (fx.k != k || fx.axis != i_ || fx.strip < 0 || fx.strip >= n_strips) continue;
       if (strip_count_[static_cast<std::size_t>(fx.strip)]++ % std::max(1, in_.o.psd_every) != 0) continue;
-      const PsdSpec& strip = in_.meta.psd[static_cast<std::size_t>(fx.strip)];
-      const double half_um = 500.0 * strip.length_mm;  // a reading beyond the strip's end is its end
-      const double u_um = std::clamp(fx.position_um - strip.center_mm[i_] * 1000.0, -half_um, half_um);
-      observe::psd_row(L_, v_um_s, fx.strip, observe::strip_cubic_um(u_um, 2.0 * half_um), h_);
+      const double shape_um =
+          supports::psd_nonlinearity_shape_um(in_.meta.psd[static_cast<std::size_t>(fx.strip)], fx.position_um);
+      observe::psd_row(L_, v_um_s, fx.strip, shape_um, h_);
       const double z = x_um - fx.position_um;
       psd_res.push_back(z);
       nis_sum += f_.update(h_, z, std::hypot(fx.sigma_um, in_.model.psd_floor_um));
@@ -249,8 +248,8 @@ void fit_axis(const PassInputs& in, int i, PassResult& r) {
   fit.sigma.resize(np);
   for (int p = 0; p < np; ++p) fit.sigma[p] = f.parameter_sigma(p);
   fit.cov = f.covariance().bottomRightCorner(np, np);
-  fit.position_obs = pass.psd_obs + pass.rest_obs;
-  fit.position_nis = fit.position_obs > 0 ? pass.nis_sum / static_cast<double>(fit.position_obs) : 0.0;
+  const std::size_t position_obs = pass.psd_obs + pass.rest_obs;
+  fit.position_nis = position_obs > 0 ? pass.nis_sum / static_cast<double>(position_obs) : 0.0;
   r.psd_obs += pass.psd_obs, r.rest_obs += pass.rest_obs;
   // RMS of what the observations left about their offsets, before this pass's fit.
   r.psd_rms_um = std::max(r.psd_rms_um, rms_about_mean(pass.psd_res));
@@ -327,12 +326,16 @@ Agreement agreement(const Run& run, const RunMeta& meta) {
   return a;
 }
 
+// ζ of a sensor at f0_hz whose damping term 2ζ/ω0 is `damping_s` below that of ζ.
+double zeta_less_damping(double zeta, double f0_hz, double damping_s) {
+  const double w0 = 2.0 * std::numbers::pi * f0_hz;
+  return std::max(0.0, (2.0 * zeta / w0 - damping_s) * w0 / 2.0);
+}
+
 // (I + E)⁻¹ applied to the data-sheet mounting of one sensor: its corrected to_machine.
 void apply_sensor(const Eigen::Matrix3d& e, double damping_s, SensorSpec& spec) {
   spec.to_machine = (Eigen::Matrix3d::Identity() + e).inverse() * spec.to_machine;
-  const double w0 = 2.0 * std::numbers::pi * spec.f0_hz;
-  const double c1 = 2.0 * spec.zeta / w0 - damping_s;
-  spec.zeta = std::max(0.0, c1 * w0 / 2.0);
+  spec.zeta = zeta_less_damping(spec.zeta, spec.f0_hz, damping_s);
 }
 
 // Strip crossings (runs of lit samples of one strip) and the set-point's speed along the
@@ -450,9 +453,7 @@ void weigh_damping_with_datasheet(const RunMeta& datasheet, Identification& id) 
     const double w = u_sheet * u_sheet / (u_both * u_both);  // the run's weight
     const double value = w * d.value, u = u_run * u_sheet / u_both;
     SensorSpec& spec = id.sensors[s];
-    const double w0 = 2.0 * std::numbers::pi * spec.f0_hz;
-    const double c1 = 2.0 * datasheet.sensors[s].zeta / w0 - value;  // value: data sheet − identified
-    spec.zeta = std::max(0.0, c1 * w0 / 2.0);
+    spec.zeta = zeta_less_damping(datasheet.sensors[s].zeta, spec.f0_hz, value);  // value: data sheet − identified
     id.covariance.covariance(p, p) = u * u;
     std::snprintf(b, sizeof b,
                   "%s sensor: 2ζ/ω0 %+.2f ± %.2f µs from the data sheet's, less certain than its ± %.2f µs: weighed "

@@ -2,6 +2,7 @@
 
 #include "dsp/core/error.hpp"
 #include "dsp/fusion/rts_smoother.hpp"
+#include "dsp/supports/psd_nonlinearity.hpp"
 
 #include <Eigen/Cholesky>
 
@@ -153,14 +154,9 @@ std::vector<Eigen::Vector3d> temperature_response(const Responder& respond, cons
   return respond(dx, dv, -1, 1.0);
 }
 
-// What a strip's nonlinearity of 1 makes a fix read too far, µm: u·(2u/L)² at the spot's
-// place u on the strip (sim/psd: u_meas = u (1 + nl (2u/L)²)).
+// What a strip's nonlinearity of 1 makes a fix read too far, µm.
 double nonlinearity_error_um(const fusion::PositionFix& f, const PsdSpec& spec) {
-  const int axis = spec.measures == "y" ? 1 : 0;
-  const double half_mm = 0.5 * spec.length_mm;
-  const double u_mm = std::clamp(f.position_um / 1000.0 - spec.center_mm[axis], -half_mm, half_mm);
-  const double r = u_mm / half_mm;
-  return u_mm * r * r * 1000.0;
+  return supports::psd_nonlinearity_shape_um(spec, f.position_um);
 }
 
 // Per strip of the run with fixes: its nonlinearity's response, per unit nl.

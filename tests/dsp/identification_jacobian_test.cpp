@@ -92,15 +92,14 @@ TEST(IdentificationJacobian, EveryObservationRowIsTheGradientOfItsModel) {
       for (int strip = 0; strip < static_cast<int>(L.strip.size()); ++strip) {
         if (L.strip[static_cast<std::size_t>(strip)] < 0) continue;  // a strip of another axis: not this filter's
         for (double v_um_s : {0.0, 2000.0, -6500.0})
-          for (double u_um : {0.0, 3100.0, -4900.0}) {  // on a 10 mm strip
-            const double cubic_um = observe::strip_cubic_um(u_um, 10000.0);
+          for (double cubic_um : {0.0, 1191.6, -4706.0}) {  // u·(2u/L)² at u 0, 3.1, −4.9 mm on 10 mm
             observe::psd_row(L, v_um_s, strip, cubic_um, h);
             expect_row(
                 h,
                 numeric_row([&](const Eigen::VectorXd& s) { return observe::psd(L, s, v_um_s, strip, cubic_um); }, x,
                             step),
-                c.name + ": strip " + std::to_string(strip) + " at " + std::to_string(v_um_s) + " um/s, u " +
-                    std::to_string(u_um) + " um");
+                c.name + ": strip " + std::to_string(strip) + " at " + std::to_string(v_um_s) + " um/s, shape " +
+                    std::to_string(cubic_um) + " um");
           }
       }
     }

@@ -4,6 +4,7 @@
 // raises a false alarm on noise.
 #include "dsp/core/float_limits.hpp"
 #include "dsp/supports/psd_decoder.hpp"
+#include "dsp/supports/psd_nonlinearity.hpp"
 #include "dsp/supports/standstill_detector.hpp"
 
 #include <gtest/gtest.h>
@@ -81,6 +82,18 @@ TEST(PsdDecoder, ADarkStripWhoseFirstDifferenceIsZeroStaysDark) {
   }
   EXPECT_EQ(lit, 0) << "noise read as light";
   EXPECT_NEAR(d.noise_v(), noise_v, 0.15 * noise_v);
+}
+
+// u·(2u/L)², u from the strip's centre along the axis it measures, clamped at its ends:
+// what the identification fits and the uncertainty draws, per unit nl.
+TEST(PsdNonlinearity, TheShapeIsCubicAboutTheCentreAndHeldAtTheEnds) {
+  PsdSpec y;
+  y.measures = "y", y.center_mm[0] = 40.0, y.center_mm[1] = -10.0, y.length_mm = 10.0;
+  EXPECT_DOUBLE_EQ(psd_nonlinearity_shape_um(y, -10000.0), 0.0);
+  EXPECT_NEAR(psd_nonlinearity_shape_um(y, -10000.0 + 3100.0), 3100.0 * 0.62 * 0.62, 1e-9);
+  EXPECT_NEAR(psd_nonlinearity_shape_um(y, -10000.0 - 4900.0), -4900.0 * 0.98 * 0.98, 1e-9);
+  EXPECT_DOUBLE_EQ(psd_nonlinearity_shape_um(y, -10000.0 + 5000.0), 5000.0);  // its end: u = L/2
+  EXPECT_DOUBLE_EQ(psd_nonlinearity_shape_um(y, -10000.0 + 9000.0), 5000.0);  // beyond it
 }
 
 TEST(PsdDecoder, RejectsAStripMeasuringZ) {
